@@ -1,0 +1,50 @@
+"""The coefficient table: regressors and measured aerodynamic coefficients over time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["COEFFICIENTS", "FORCE_COEFFICIENTS", "MOMENT_COEFFICIENTS", "REGRESSORS", "CoefficientTable"]
+
+COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
+FORCE_COEFFICIENTS = ("CX", "CY", "CZ")
+MOMENT_COEFFICIENTS = ("Cl", "Cm", "Cn")
+#: Regressor order used everywhere (columns of ``CoefficientTable.X``).
+REGRESSORS = ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "delta_a", "delta_r", "delta_t", "V")
+
+
+@dataclass
+class CoefficientTable:
+    """Regressors and measured body-axis coefficients.
+
+    Attributes:
+        t: vehicle time, s, shape (T,).
+        X: regressors, shape (T, 10), columns :data:`REGRESSORS` (rad, -, -, -, -,
+            rad, rad, rad, 0..1, m/s).
+        Y: measured coefficients, shape (T, 6), columns :data:`COEFFICIENTS`.
+        valid: (T,) bool, rows usable for learning (airborne, all inputs present).
+        qbar: dynamic pressure, Pa, shape (T,).
+        notes: one-line remarks (e.g. "CX includes thrust: airframe has no thrust model").
+    """
+
+    t: np.ndarray
+    X: np.ndarray
+    Y: np.ndarray
+    valid: np.ndarray
+    qbar: np.ndarray
+    notes: list[str] = field(default_factory=list)
+
+    def x(self, name: str) -> np.ndarray:
+        """Regressor column by name, shape (T,)."""
+        return self.X[:, REGRESSORS.index(name)]
+
+    def y(self, name: str) -> np.ndarray:
+        """Coefficient column by name, shape (T,)."""
+        return self.Y[:, COEFFICIENTS.index(name)]
+
+    def select(self, mask: np.ndarray) -> "CoefficientTable":
+        """Rows where ``mask`` (T,) is True."""
+        return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
+                                list(self.notes))

@@ -1,0 +1,421 @@
+"""Airframe description: mass properties, reference geometry, servo maps and mixing.
+
+The airframe file is TOML (format in ``docs/airframe.md``). Everything inside is
+SI (kg, m, kg m^2, rad); the file gives servo deflections in degrees and servo
+commands in PWM microseconds because that is how servos are set up on the bench.
+
+Servo -> control mixing is linear: each servo's deflection (rad, positive by the
+surface's own sign convention, trailing edge down for ailerons, elevators,
+elevons and ruddervators, trailing edge left for a rudder) contributes
+``mix[control] * deflection`` to the effective controls delta_e, delta_a,
+delta_r. Examples (``docs/airframe.md``): two ailerons ``delta_a = 0.5*right -
+0.5*left``; elevons ``delta_e = 0.5*(left+right)``, ``delta_a = 0.5*(right-left)``.
+Sign conventions follow DEVELOPERS.md: delta_e trailing edge down, delta_a right
+aileron trailing edge down, delta_r trailing edge left are positive.
+
+The optional thrust model is a static-thrust form (e.g. Beard and McLain, *Small
+Unmanned Aircraft*, 2012, sec. 4.3, simplified)::
+
+    T(delta_t, V) = T_static * delta_t**exponent * max(0, 1 - V / V_zero)   [N]
+
+acting along body x through the CG.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = [
+    "CONTROLS",
+    "Servo",
+    "Throttle",
+    "ThrustModel",
+    "Airframe",
+    "load_airframe",
+    "airframe_from_dict",
+    "airframe_to_dict",
+]
+
+CONTROLS = ("delta_e", "delta_a", "delta_r")
+
+
+@dataclass(frozen=True)
+class Servo:
+    """One servo output and its PWM -> deflection map.
+
+    The map is piecewise linear through three points: ``pwm_min -> deflection
+    at pwm_min``, ``pwm_trim -> 0`` and ``pwm_max -> deflection at pwm_max``;
+    the result is clipped to ``[limit_min, limit_max]``. A reversed servo is
+    expressed by the signs of the two end deflections.
+
+    Attributes:
+        name: surface name, e.g. ``"elevator"`` or ``"aileron_left"``.
+        channel: 1-based servo output channel (SERVO_OUTPUT_RAW servoN_raw, RCOU CN).
+        pwm_min, pwm_trim, pwm_max: PWM in microseconds, ``pwm_min < pwm_trim < pwm_max``.
+        deflection_at_min, deflection_at_max: deflection in rad at the PWM ends.
+        limit_min, limit_max: deflection limits in rad.
+        mix: contribution of this servo's deflection to each control in CONTROLS.
+    """
+
+    name: str
+    channel: int
+    pwm_min: float
+    pwm_trim: float
+    pwm_max: float
+    deflection_at_min: float
+    deflection_at_max: float
+    limit_min: float
+    limit_max: float
+    mix: Mapping[str, float]
+
+    def deflection(self, pwm: np.ndarray) -> np.ndarray:
+        """Deflection (rad) for PWM commands (us), any shape; NaN where pwm <= 0."""
+        pwm = np.asarray(pwm, dtype=float)
+        up = (pwm - self.pwm_trim) / (self.pwm_max - self.pwm_trim) * self.deflection_at_max
+        down = (self.pwm_trim - pwm) / (self.pwm_trim - self.pwm_min) * self.deflection_at_min
+        d = np.where(pwm >= self.pwm_trim, up, down)
+        d = np.clip(d, self.limit_min, self.limit_max)
+        return np.where(pwm > 0, d, np.nan)
+
+    def pwm(self, deflection: np.ndarray) -> np.ndarray:
+        """Inverse map: PWM (us) for a deflection (rad), any shape; clipped to the ends."""
+        d = np.clip(np.asarray(deflection, dtype=float), self.limit_min, self.limit_max)
+        same_sign_max = np.sign(d) == np.sign(self.deflection_at_max)
+        up = self.pwm_trim + d / self.deflection_at_max * (self.pwm_max - self.pwm_trim)
+        down = self.pwm_trim - d / self.deflection_at_min * (self.pwm_trim - self.pwm_min)
+        p = np.where(same_sign_max | (d == 0), up, down)
+        return np.clip(p, self.pwm_min, self.pwm_max)
+
+
+@dataclass(frozen=True)
+class Throttle:
+    """Throttle channel: ``delta_t = (pwm - pwm_min) / (pwm_max - pwm_min)`` clipped to [0, 1]."""
+
+    channel: int
+    pwm_min: float = 1000.0
+    pwm_max: float = 2000.0
+
+    def delta_t(self, pwm: np.ndarray) -> np.ndarray:
+        """Throttle fraction in [0, 1] for PWM (us); NaN where pwm <= 0."""
+        pwm = np.asarray(pwm, dtype=float)
+        x = np.clip((pwm - self.pwm_min) / (self.pwm_max - self.pwm_min), 0.0, 1.0)
+        return np.where(pwm > 0, x, np.nan)
+
+    def pwm(self, delta_t: np.ndarray) -> np.ndarray:
+        """PWM (us) for a throttle fraction."""
+        return self.pwm_min + np.clip(np.asarray(delta_t, float), 0, 1) * (self.pwm_max - self.pwm_min)
+
+
+@dataclass(frozen=True)
+class ThrustModel:
+    """Static-thrust model ``T = T_static * delta_t**exponent * max(0, 1 - V/V_zero)`` (N)."""
+
+    T_static: float
+    V_zero: float
+    exponent: float = 2.0
+
+    def thrust(self, delta_t, V):
+        """Thrust in N along body x for throttle fraction ``delta_t`` and true airspeed ``V`` (m/s).
+
+        Works on numpy and JAX arrays (broadcasting)."""
+        xp = _array_module(delta_t, V)
+        dt = xp.clip(delta_t, 0.0, 1.0)
+        return self.T_static * dt**self.exponent * xp.maximum(0.0, 1.0 - V / self.V_zero)
+
+
+def _array_module(*xs):
+    for x in xs:
+        if type(x).__module__.startswith("jax"):
+            import jax.numpy as jnp
+
+            return jnp
+    return np
+
+
+@dataclass(frozen=True)
+class Airframe:
+    """Mass properties, reference geometry, servos and thrust of one aircraft.
+
+    Attributes:
+        name: airframe name.
+        mass: kg.
+        Ixx, Iyy, Izz, Ixz: body-axis inertia in kg m^2 (Ixz = integral of x z dm;
+            the tensor is ``[[Ixx, 0, -Ixz], [0, Iyy, 0], [-Ixz, 0, Izz]]``).
+        S: wing reference area, m^2. b: span, m. c: mean aerodynamic chord, m.
+        servos: the control-surface servos.
+        throttle: the throttle channel, or None (glider).
+        thrust: optional thrust model; without one CX includes thrust.
+        imu_lever_arm: IMU position relative to the CG in body axes, m, shape (3,).
+        source: path of the file it was read from ("" if built in code).
+        notes: free-text provenance of the values.
+    """
+
+    name: str
+    mass: float
+    Ixx: float
+    Iyy: float
+    Izz: float
+    Ixz: float
+    S: float
+    b: float
+    c: float
+    servos: tuple[Servo, ...]
+    throttle: Throttle | None = None
+    thrust: ThrustModel | None = None
+    imu_lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    source: str = ""
+    notes: str = ""
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """Inertia tensor (3, 3) in kg m^2, body axes."""
+        return np.array([[self.Ixx, 0.0, -self.Ixz], [0.0, self.Iyy, 0.0], [-self.Ixz, 0.0, self.Izz]])
+
+    @property
+    def mixing(self) -> np.ndarray:
+        """Mixing matrix (3, n_servos): controls (delta_e, delta_a, delta_r) = M @ servo deflections."""
+        return np.array([[s.mix.get(cn, 0.0) for s in self.servos] for cn in CONTROLS])
+
+    @property
+    def channels(self) -> list[int]:
+        """All servo and throttle channels used (1-based)."""
+        ch = [s.channel for s in self.servos]
+        return ch + ([self.throttle.channel] if self.throttle else [])
+
+    def controls_from_pwm(self, pwm: Mapping[int, np.ndarray]) -> dict[str, np.ndarray]:
+        """Effective controls from servo PWM.
+
+        Args:
+            pwm: channel (1-based) -> PWM array in us, all of shape (T,).
+
+        Returns:
+            dict with ``delta_e``, ``delta_a``, ``delta_r`` (rad) and ``delta_t``
+            (0..1), each of shape (T,). A control whose servos are all missing is
+            absent from the dict; a missing throttle channel omits ``delta_t``.
+        """
+        out: dict[str, np.ndarray] = {}
+        defl = {s.name: s.deflection(pwm[s.channel]) for s in self.servos if s.channel in pwm}
+        for cn in CONTROLS:
+            used = [s for s in self.servos if s.mix.get(cn, 0.0) != 0.0]
+            if used and all(s.name in defl for s in used):
+                out[cn] = sum(s.mix[cn] * defl[s.name] for s in used)
+        if self.throttle and self.throttle.channel in pwm:
+            out["delta_t"] = self.throttle.delta_t(pwm[self.throttle.channel])
+        return out
+
+    def pwm_from_controls(self, controls: Mapping[str, np.ndarray]) -> dict[int, np.ndarray]:
+        """Servo PWM (us) that produce the given controls (least-squares inverse of the mixing).
+
+        Args:
+            controls: ``delta_e``, ``delta_a``, ``delta_r`` (rad) and optionally
+                ``delta_t`` (0..1), arrays of one shape (T,); missing controls are 0.
+
+        Returns:
+            channel -> PWM array of shape (T,).
+        """
+        shape = np.shape(next(iter(controls.values())))
+        u = np.stack([np.broadcast_to(np.asarray(controls.get(cn, 0.0), float), shape) for cn in CONTROLS])
+        defl = np.linalg.pinv(self.mixing) @ u.reshape(3, -1)
+        out = {s.channel: s.pwm(defl[i].reshape(shape)) for i, s in enumerate(self.servos)}
+        if self.throttle is not None:
+            out[self.throttle.channel] = self.throttle.pwm(controls.get("delta_t", np.zeros(shape)))
+        return out
+
+
+# ----------------------------------------------------------------------------- loading
+
+
+def _req(d: Mapping[str, Any], key: str, where: str, src: str, positive: bool = False) -> float:
+    if key not in d:
+        raise InputError(f"{src}: {where} is missing required field '{key}'")
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise InputError(f"{src}: {where} field '{key}' must be a finite number, got {v!r}")
+    if positive and v <= 0:
+        raise InputError(f"{src}: {where} field '{key}' must be > 0, got {v!r}")
+    return float(v)
+
+
+def _opt(d: Mapping[str, Any], key: str, default: float, where: str, src: str) -> float:
+    return _req(d, key, where, src) if key in d else default
+
+
+def _channel(d: Mapping[str, Any], where: str, src: str) -> int:
+    ch = d.get("channel")
+    if isinstance(ch, bool) or not isinstance(ch, int) or not 1 <= ch <= 32:
+        raise InputError(f"{src}: {where} field 'channel' must be an integer servo channel 1..32, got {ch!r}")
+    return ch
+
+
+def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Airframe:
+    """Build and validate an :class:`Airframe` from a parsed TOML document.
+
+    Args:
+        doc: the parsed file (format in ``docs/airframe.md``).
+        source: file name used in error messages.
+
+    Raises:
+        InputError: a field is missing, has the wrong type or an impossible value;
+            the message names the file and the field.
+    """
+    src = source
+    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes"}
+    for k in doc:
+        if k not in known:
+            raise InputError(f"{src}: unknown top-level field '{k}' (expected one of {sorted(known)})")
+    name = doc.get("name")
+    if not isinstance(name, str) or not name:
+        raise InputError(f"{src}: field 'name' must be a non-empty string")
+    mass = _req(doc, "mass", "top level", src, positive=True)
+    inertia = doc.get("inertia")
+    if not isinstance(inertia, Mapping):
+        raise InputError(f"{src}: missing table [inertia] with Ixx, Iyy, Izz (kg m^2) and optional Ixz")
+    Ixx = _req(inertia, "Ixx", "[inertia]", src, positive=True)
+    Iyy = _req(inertia, "Iyy", "[inertia]", src, positive=True)
+    Izz = _req(inertia, "Izz", "[inertia]", src, positive=True)
+    Ixz = _opt(inertia, "Ixz", 0.0, "[inertia]", src)
+    if Ixx * Izz - Ixz**2 <= 0:
+        raise InputError(f"{src}: [inertia] tensor is not positive definite (Ixx*Izz must exceed Ixz^2)")
+    if Ixx + Iyy < Izz or Iyy + Izz < Ixx or Ixx + Izz < Iyy:
+        raise InputError(f"{src}: [inertia] violates the triangle inequality (e.g. Ixx + Iyy >= Izz)")
+    geom = doc.get("geometry")
+    if not isinstance(geom, Mapping):
+        raise InputError(f"{src}: missing table [geometry] with S (m^2), b (m), c (m)")
+    S = _req(geom, "S", "[geometry]", src, positive=True)
+    b = _req(geom, "b", "[geometry]", src, positive=True)
+    c = _req(geom, "c", "[geometry]", src, positive=True)
+
+    servos_doc = doc.get("servo")
+    if not isinstance(servos_doc, list) or not servos_doc:
+        raise InputError(f"{src}: needs at least one [[servo]] table (control-surface servo)")
+    servos = []
+    used_channels: dict[int, str] = {}
+    for i, sd in enumerate(servos_doc):
+        if not isinstance(sd, Mapping):
+            raise InputError(f"{src}: [[servo]] #{i + 1} must be a table")
+        sname = sd.get("name")
+        if not isinstance(sname, str) or not sname:
+            raise InputError(f"{src}: [[servo]] #{i + 1} needs a string 'name'")
+        where = f"[[servo]] '{sname}'"
+        ch = _channel(sd, where, src)
+        if ch in used_channels:
+            raise InputError(f"{src}: {where} channel {ch} is already used by '{used_channels[ch]}'")
+        used_channels[ch] = sname
+        pmin = _opt(sd, "pwm_min", 1100.0, where, src)
+        ptrim = _opt(sd, "pwm_trim", 1500.0, where, src)
+        pmax = _opt(sd, "pwm_max", 1900.0, where, src)
+        if not pmin < ptrim < pmax:
+            raise InputError(
+                f"{src}: {where} needs pwm_min < pwm_trim < pwm_max, got {pmin:g}, {ptrim:g}, {pmax:g}"
+            )
+        dmin = math.radians(_req(sd, "deflection_at_pwm_min_deg", where, src))
+        dmax = math.radians(_req(sd, "deflection_at_pwm_max_deg", where, src))
+        if dmin == 0 or dmax == 0 or np.sign(dmin) == np.sign(dmax):
+            raise InputError(
+                f"{src}: {where} deflection_at_pwm_min_deg and deflection_at_pwm_max_deg must be non-zero "
+                f"and of opposite sign, got {math.degrees(dmin):g} and {math.degrees(dmax):g}"
+            )
+        lim = sd.get("limit_deg", [min(dmin, dmax) * 180 / math.pi, max(dmin, dmax) * 180 / math.pi])
+        if not (isinstance(lim, list) and len(lim) == 2 and all(isinstance(x, (int, float)) for x in lim)) or not lim[0] < 0 < lim[1]:
+            raise InputError(f"{src}: {where} limit_deg must be [negative, positive] degrees, got {lim!r}")
+        mix = sd.get("mix")
+        if not isinstance(mix, Mapping) or not mix:
+            raise InputError(f"{src}: {where} needs a 'mix' table, e.g. mix = {{ delta_e = 1.0 }}")
+        for k, v in mix.items():
+            if k not in CONTROLS:
+                raise InputError(f"{src}: {where} mix key '{k}' is not one of {', '.join(CONTROLS)}")
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise InputError(f"{src}: {where} mix.{k} must be a number, got {v!r}")
+        servos.append(
+            Servo(sname, ch, pmin, ptrim, pmax, dmin, dmax, math.radians(lim[0]), math.radians(lim[1]),
+                  {k: float(v) for k, v in mix.items()})
+        )
+    throttle = None
+    if "throttle" in doc:
+        td = doc["throttle"]
+        if not isinstance(td, Mapping):
+            raise InputError(f"{src}: [throttle] must be a table with 'channel'")
+        tch = _channel(td, "[throttle]", src)
+        if tch in used_channels:
+            raise InputError(f"{src}: [throttle] channel {tch} is already used by servo '{used_channels[tch]}'")
+        tmin = _opt(td, "pwm_min", 1000.0, "[throttle]", src)
+        tmax = _opt(td, "pwm_max", 2000.0, "[throttle]", src)
+        if not tmin < tmax:
+            raise InputError(f"{src}: [throttle] needs pwm_min < pwm_max, got {tmin:g}, {tmax:g}")
+        throttle = Throttle(tch, tmin, tmax)
+    thrust = None
+    if "thrust" in doc:
+        th = doc["thrust"]
+        if not isinstance(th, Mapping):
+            raise InputError(f"{src}: [thrust] must be a table with T_static (N) and V_zero (m/s)")
+        thrust = ThrustModel(
+            _req(th, "T_static", "[thrust]", src, positive=True),
+            _req(th, "V_zero", "[thrust]", src, positive=True),
+            _opt(th, "exponent", 2.0, "[thrust]", src),
+        )
+        if throttle is None:
+            raise InputError(f"{src}: [thrust] is given but there is no [throttle] channel to drive it")
+    arm = doc.get("imu_lever_arm", [0.0, 0.0, 0.0])
+    if not (isinstance(arm, list) and len(arm) == 3 and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in arm)):
+        raise InputError(f"{src}: imu_lever_arm must be [x, y, z] in metres, got {arm!r}")
+    notes = doc.get("notes", "")
+    if not isinstance(notes, str):
+        raise InputError(f"{src}: notes must be a string")
+    return Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
+                    tuple(float(x) for x in arm), source, notes)
+
+
+def load_airframe(path: str | Path) -> Airframe:
+    """Read and validate an airframe TOML file.
+
+    Raises:
+        InputError: the file is missing, not TOML, or a field is invalid (the
+            message names the file and the field).
+    """
+    p = Path(path)
+    try:
+        text = p.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise InputError(f"{p}: airframe file not found") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(f"{p}: cannot read airframe file ({e.__class__.__name__})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{p}: not valid TOML ({e})") from None
+    return airframe_from_dict(doc, str(p))
+
+
+def airframe_to_dict(a: Airframe) -> dict[str, Any]:
+    """Inverse of :func:`airframe_from_dict` (for writing a TOML file with tomli_w)."""
+    d: dict[str, Any] = {
+        "name": a.name,
+        "mass": a.mass,
+        "inertia": {"Ixx": a.Ixx, "Iyy": a.Iyy, "Izz": a.Izz, "Ixz": a.Ixz},
+        "geometry": {"S": a.S, "b": a.b, "c": a.c},
+        "imu_lever_arm": list(a.imu_lever_arm),
+        "servo": [
+            {
+                "name": s.name, "channel": s.channel, "pwm_min": s.pwm_min, "pwm_trim": s.pwm_trim,
+                "pwm_max": s.pwm_max, "deflection_at_pwm_min_deg": math.degrees(s.deflection_at_min),
+                "deflection_at_pwm_max_deg": math.degrees(s.deflection_at_max),
+                "limit_deg": [math.degrees(s.limit_min), math.degrees(s.limit_max)], "mix": dict(s.mix),
+            }
+            for s in a.servos
+        ],
+    }
+    if a.throttle:
+        d["throttle"] = {"channel": a.throttle.channel, "pwm_min": a.throttle.pwm_min, "pwm_max": a.throttle.pwm_max}
+    if a.thrust:
+        d["thrust"] = {"T_static": a.thrust.T_static, "V_zero": a.thrust.V_zero, "exponent": a.thrust.exponent}
+    if a.notes:
+        d["notes"] = a.notes
+    return d

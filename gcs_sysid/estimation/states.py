@@ -1,0 +1,62 @@
+"""Smoothed flight states on a uniform time grid: the estimation layer's output."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["STATE_KEYS", "FlightStates"]
+
+#: Keys of :attr:`FlightStates.data`, all arrays of shape (T,), SI units.
+STATE_KEYS = (
+    "phi", "theta", "psi",            # rad, Euler angles 3-2-1
+    "p", "q", "r",                    # rad/s, body rates (gyro bias removed)
+    "p_dot", "q_dot", "r_dot",        # rad/s^2
+    "u", "v", "w",                    # m/s, body-axis velocity relative to the ground
+    "vn", "ve", "vd",                 # m/s, NED ground velocity
+    "ax", "ay", "az",                 # m/s^2, specific force at the CG, body axes (accel bias and lever arm removed)
+    "V", "alpha", "beta",             # true airspeed m/s, rad, rad
+    "qbar", "rho",                    # Pa, kg/m^3
+    "wn", "we", "wd",                 # m/s, wind (air velocity over ground) NED
+    "alt",                            # m, altitude AMSL (or relative if that is all there is)
+    "delta_e", "delta_a", "delta_r",  # rad
+    "delta_t",                        # 0..1
+)
+
+
+@dataclass
+class FlightStates:
+    """States smoothed by the EKF + RTS pass, sampled on a uniform grid.
+
+    Attributes:
+        t: vehicle time, s, shape (T,), uniform spacing ``1/rate_hz``.
+        rate_hz: grid rate.
+        data: key (see :data:`STATE_KEYS`) -> array (T,). A key absent from the
+            dict could not be estimated (listed in ``missing``).
+        sigma: key -> 1-sigma uncertainty (T,) where the smoother provides one.
+        valid: (T,) bool, True where all inputs needed for coefficients were present
+            and the aircraft was flying (V above a floor).
+        sources: key -> one-line description of where it came from
+            (e.g. ``"V": "VFR_HUD airspeed (EAS) -> TAS with rho from SCALED_PRESSURE"``).
+        missing: keys or inputs not available, with why.
+        notes: other one-line remarks for the report (e.g. stream rate too low).
+    """
+
+    t: np.ndarray
+    rate_hz: float
+    data: dict[str, np.ndarray]
+    sigma: dict[str, np.ndarray] = field(default_factory=dict)
+    valid: np.ndarray | None = None
+    sources: dict[str, str] = field(default_factory=dict)
+    missing: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        return self.data[key]
+
+    def __contains__(self, key: str) -> bool:
+        return key in self.data
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
