@@ -1,0 +1,243 @@
+"""The replay job: log -> states -> coefficients -> GP -> confidence map -> suggestions -> report.
+
+This module only wires the layers together; each stage lives in its own package.
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterator
+
+import numpy as np
+
+from .aero import compute_coefficients
+from .aero.table import COEFFICIENTS, MOMENT_COEFFICIENTS, CoefficientTable
+from .airframe import load_airframe
+from .errors import DataError, InputError
+from .estimation import estimate_states
+from .estimation.states import FlightStates
+from .result import ReplayResult
+from .telemetry import read_log
+
+__all__ = ["ReplayOptions", "run_replay", "held_out_mask", "error_pct", "identifiability"]
+
+#: Fewest valid rows the GP is fitted on.
+MIN_TRAIN_ROWS = 50
+
+
+@dataclass(frozen=True)
+class ReplayOptions:
+    """Options of :func:`run_replay`.
+
+    Attributes:
+        rate_hz: estimation grid rate, Hz.
+        holdout: fraction of the valid flight time, taken as the last contiguous segment, never fitted.
+        t_from, t_to: vehicle-time window in s (None = open).
+        model_in: directory of a saved model state to continue from (incremental update).
+        n_inducing: inducing points of the global GP (None = the GP's default).
+        progress: show rich progress bars.
+        write: write the report files (False for tests that only need the result).
+    """
+
+    rate_hz: float = 50.0
+    holdout: float = 0.2
+    t_from: float | None = None
+    t_to: float | None = None
+    model_in: str | None = None
+    n_inducing: int | None = None
+    progress: bool = True
+    write: bool = True
+
+
+def error_pct(estimate: np.ndarray, reference: np.ndarray) -> float:
+    """Coefficient error ``100 * RMS(estimate - reference) / RMS(reference)`` (DEVELOPERS.md), NaN-safe.
+
+    Args:
+        estimate, reference: arrays of shape (T,).
+    """
+    m = np.isfinite(estimate) & np.isfinite(reference)
+    if not m.any():
+        return float("nan")
+    ref = float(np.sqrt(np.mean(reference[m] ** 2)))
+    return 100.0 * float(np.sqrt(np.mean((estimate[m] - reference[m]) ** 2))) / ref if ref > 0 else float("nan")
+
+
+def held_out_mask(t: np.ndarray, valid: np.ndarray, fraction: float) -> np.ndarray:
+    """The last contiguous ``fraction`` of the valid flight time, as a (T,) bool mask.
+
+    Raises:
+        InputError: fraction outside [0, 0.9].
+    """
+    if not 0.0 <= fraction <= 0.9:
+        raise InputError(f"--holdout must lie in [0, 0.9], got {fraction}")
+    mask = np.zeros(len(t), bool)
+    if fraction == 0 or not valid.any():
+        return mask
+    tv = t[valid]
+    cut = tv[0] + (1.0 - fraction) * (tv[-1] - tv[0])
+    mask[valid & (t >= cut)] = True
+    return mask
+
+
+def identifiability(states: FlightStates, table: CoefficientTable) -> dict[str, tuple[bool, str]]:
+    """Whether each coefficient can be identified from these data, with the reason when not.
+
+    Uses the estimation layer's verdicts (``FlightStates.identifiability``: e.g. rate derivatives
+    cannot be formed from 4 Hz gyro data) and checks that each coefficient has finite data.
+    """
+    verdict = dict(getattr(states, "identifiability", {}) or {})
+    out: dict[str, tuple[bool, str]] = {}
+    n_valid = int(table.valid.sum())
+    for i, name in enumerate(COEFFICIENTS):
+        ok, why = verdict.get(name, (True, ""))
+        if ok:
+            finite = np.isfinite(table.Y[table.valid, i]).sum() if n_valid else 0
+            if finite < MIN_TRAIN_ROWS:
+                ok, why = False, f"only {finite} valid samples (need {MIN_TRAIN_ROWS})"
+        out[name] = (bool(ok), str(why))
+    return out
+
+
+@contextmanager
+def _stage(name: str, timings: dict[str, float], bar) -> Iterator[Callable[[float], None]]:
+    t0 = time.perf_counter()
+    task = bar.add_task(name, total=1.0) if bar is not None else None
+
+    def progress(frac: float) -> None:
+        if bar is not None:
+            bar.update(task, completed=min(max(frac, 0.0), 1.0))
+
+    try:
+        yield progress
+    finally:
+        timings[name] = time.perf_counter() - t0
+        if bar is not None:
+            bar.update(task, completed=1.0)
+
+
+def _progress_bar(enabled: bool):
+    if not enabled:
+        return None
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(TextColumn("{task.description:<22}"), BarColumn(), TimeElapsedColumn(), transient=False)
+
+
+def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
+               options: ReplayOptions = ReplayOptions()) -> ReplayResult:
+    """Replay a flight log end to end and (optionally) write the report into ``out_dir``.
+
+    Args:
+        log: .tlog or DataFlash .bin path.
+        airframe_path: airframe TOML file.
+        out_dir: output directory (created).
+        options: see :class:`ReplayOptions`.
+
+    Returns:
+        The :class:`~gcs_sysid.result.ReplayResult` that the report renders.
+
+    Raises:
+        InputError: unreadable log or airframe, bad options.
+        DataError: the log holds nothing the pipeline can use (e.g. no IMU and no attitude).
+    """
+    from .envelope import confidence_map
+    from .gp import GPConfig, fit_gp, load_gp
+    from .maneuvers import suggest_maneuvers
+    from .report import write_report
+
+    airframe = load_airframe(airframe_path)
+    out = Path(out_dir)
+    timings: dict[str, float] = {}
+    notes: list[str] = []
+    bar = _progress_bar(options.progress)
+    if bar is not None:
+        bar.start()
+    try:
+        with _stage("decode log", timings, bar) as prog:
+            flight = read_log(log, progress=prog)
+        if options.t_from is not None or options.t_to is not None:
+            if options.t_from is not None and options.t_to is not None and options.t_to <= options.t_from:
+                raise InputError(f"--to ({options.t_to}) must be after --from ({options.t_from})")
+            flight = flight.window(options.t_from, options.t_to)
+        with _stage("estimate states", timings, bar) as prog:
+            states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog)
+        with _stage("coefficients", timings, bar):
+            table = compute_coefficients(states, airframe)
+        ident = identifiability(states, table)
+        held = held_out_mask(table.t, table.valid, options.holdout)
+        train = table.valid & ~held
+        fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
+        pred_mean = np.full(table.Y.shape, np.nan)
+        pred_sigma = np.full(table.Y.shape, np.nan)
+        model = None
+        envelope = None
+        suggestions = []
+        gp_summary: dict = {}
+        if int(train.sum()) < MIN_TRAIN_ROWS or not fit_cols:
+            notes.append(f"no model fitted: {int(train.sum())} valid training samples "
+                         f"and {len(fit_cols)} identifiable coefficients")
+        else:
+            X_train = table.X[train]
+            Y_train = table.Y[train][:, fit_cols]
+            ok_rows = np.all(np.isfinite(X_train), axis=1) & np.all(np.isfinite(Y_train), axis=1)
+            X_train, Y_train = X_train[ok_rows], Y_train[ok_rows]
+            with _stage("learn GP", timings, bar):
+                if options.model_in:
+                    model = load_gp(Path(options.model_in))
+                    if model.n_outputs != len(fit_cols):
+                        raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
+                                         f"this flight identifies {len(fit_cols)}")
+                    model = model.update(X_train, Y_train)
+                    notes.append(f"model continued from {options.model_in} (incremental update, "
+                                 f"{len(X_train)} new samples)")
+                else:
+                    cfg = GPConfig() if options.n_inducing is None else GPConfig(n_inducing=options.n_inducing)
+                    model, _history = fit_gp(X_train, Y_train, cfg)
+            with _stage("predict", timings, bar):
+                rows = table.valid & np.all(np.isfinite(table.X), axis=1)
+                if rows.any():
+                    mean, var = model.predict(table.X[rows])
+                    pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
+                    pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
+            gp_summary = model.summary()
+            gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
+            with _stage("confidence map", timings, bar):
+                envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
+            with _stage("suggest maneuvers", timings, bar):
+                suggestions = suggest_maneuvers(envelope, model, table, airframe)
+        metrics: dict[str, dict[str, float]] = {}
+        for i, name in enumerate(COEFFICIENTS):
+            y = table.Y[:, i]
+            metrics[name] = {
+                "error_pct_heldout": error_pct(pred_mean[held, i], y[held]),
+                "error_pct_train": error_pct(pred_mean[train, i], y[train]),
+                "rms_measured": float(np.sqrt(np.nanmean(y[table.valid] ** 2))) if table.valid.any() else float("nan"),
+                "n_heldout": int(np.isfinite(pred_mean[held, i]).sum()),
+                "n_train": int(train.sum()),
+            }
+        weak_moments = [c for c in MOMENT_COEFFICIENTS if not ident[c][0]]
+        if weak_moments:
+            notes.append("not identified: " + "; ".join(f"{c} ({ident[c][1]})" for c in weak_moments))
+        model_path = ""
+        if model is not None and options.write:
+            model_path = str(out / "model")
+            model.save(Path(model_path))
+        result = ReplayResult(
+            log_path=str(log), airframe_name=airframe.name, airframe_path=str(airframe_path),
+            vehicle=dict(flight.vehicle), window=(options.t_from, options.t_to),
+            summaries=dict(flight.summaries), messages=dict(flight.messages), states=states, table=table,
+            held_out=held, train=train, pred_mean=pred_mean, pred_sigma=pred_sigma, metrics=metrics,
+            identifiable=ident, envelope=envelope, suggestions=list(suggestions), gp_summary=gp_summary,
+            model_path=model_path, missing=list(states.missing),
+            notes=list(flight.warnings) + list(states.notes) + list(table.notes) + notes, timings=timings,
+        )
+        if options.write:
+            with _stage("write report", timings, bar):
+                write_report(result, out)
+        return result
+    finally:
+        if bar is not None:
+            bar.stop()
