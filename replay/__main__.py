@@ -1,0 +1,60 @@
+"""``python -m replay LOG --link udpout:127.0.0.1:14550 [--speed 1.0] [--from S --to S]``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from gcs_sysid.errors import SysidError
+from replay.player import open_link, play, read_packets
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the player; returns the exit code (0 ok, 2 bad log or link, 130 interrupted)."""
+    ap = argparse.ArgumentParser(prog="python -m replay",
+                                 description="Stream a recorded MAVLink telemetry log (.tlog) onto a link.")
+    ap.add_argument("log", help="the .tlog file")
+    ap.add_argument("--link", default="udpout:127.0.0.1:14550",
+                    help="pymavlink connection string: udpout:HOST:PORT, tcp:HOST:PORT, udpin:..., or a serial "
+                         "device (default %(default)s)")
+    ap.add_argument("--baud", type=int, default=115200, help="serial baud rate (default %(default)s)")
+    ap.add_argument("--speed", type=float, default=1.0, help="time scale: 1 real time, 0 as fast as possible")
+    ap.add_argument("--from", dest="t_from", type=float, default=None, metavar="S",
+                    help="start S seconds after the log's first record")
+    ap.add_argument("--to", dest="t_to", type=float, default=None, metavar="S",
+                    help="stop S seconds after the log's first record")
+    ap.add_argument("-q", "--quiet", action="store_true", help="no summary line")
+    args = ap.parse_args(argv)
+    try:
+        if args.speed < 0:
+            raise SysidError(f"--speed {args.speed}: must be >= 0 (0 = as fast as possible)")
+        if args.t_from is not None and args.t_to is not None and args.t_to < args.t_from:
+            raise SysidError(f"--to {args.t_to} is before --from {args.t_from}")
+        bad = [0]
+        packets = read_packets(args.log, bad)
+        first = next(packets)  # reads and checks the log before the link is opened
+        link = open_link(args.link, args.baud)
+        t0 = time.monotonic()
+
+        def chain():
+            yield first
+            yield from packets
+
+        try:
+            n = play(chain(), link.write, args.speed, args.t_from, args.t_to)
+        finally:
+            link.close()
+    except SysidError as exc:
+        print(f"replay: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    if not args.quiet:
+        extra = f", {bad[0]} corrupt record(s) skipped" if bad[0] else ""
+        print(f"replay: sent {n} packets from {args.log} to {args.link} in {time.monotonic() - t0:.1f} s{extra}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
