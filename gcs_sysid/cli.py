@@ -55,6 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--maneuvers", required=True, help="flight plan TOML file (docs/sim.md)")
     s.add_argument("--out", required=True, help="output .tlog path")
     s.add_argument("--seed", type=int, default=None, help="random seed (overrides the plan's)")
+    s.add_argument("--truth", default=None, help="also write the true states and coefficients to this .npz")
 
     f = sub.add_parser("fit", help="equation-error least squares + stepwise regression -> model file")
     f.add_argument("log")
@@ -93,7 +94,7 @@ def _cmd_replay(a: argparse.Namespace) -> int:
 def _cmd_simulate(a: argparse.Namespace) -> int:
     from .sim import run_simulate
 
-    res = run_simulate(a.airframe, a.model, a.maneuvers, a.out, seed=a.seed)
+    res = run_simulate(a.airframe, a.model, a.maneuvers, a.out, seed=a.seed, truth_path=a.truth)
     print(f"wrote {a.out} ({res.t[-1] - res.t[0]:.0f} s of flight)")
     return 0
 

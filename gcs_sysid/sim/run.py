@@ -1,0 +1,42 @@
+"""``gcs-sysid simulate``: airframe, model and plan files in, telemetry log out."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..airframe import load_airframe
+from .model_file import load_model
+from .plan import load_plan
+from .flight import SimResult, simulate
+from .tlog import write_tlog
+
+__all__ = ["run_simulate"]
+
+
+def run_simulate(airframe_path: str | Path, model_path: str | Path, plan_path: str | Path, out_path: str | Path,
+                 seed: int | None = None, truth_path: str | Path | None = None) -> SimResult:
+    """Simulate the plan and write the tlog (and, optionally, the truth ``.npz``).
+
+    Args:
+        airframe_path: airframe TOML (``docs/airframe.md``).
+        model_path: aero model TOML (``docs/model-file.md``).
+        plan_path: maneuver plan TOML (``docs/sim.md``).
+        out_path: the .tlog to write.
+        seed: overrides the plan's seed.
+        truth_path: where to save the truth (``SimResult.save_truth``), or None.
+
+    Returns:
+        the :class:`SimResult`.
+
+    Raises:
+        InputError: a file is missing or malformed (one line naming the file and field).
+        DataError: the aircraft cannot be trimmed at a setpoint of the plan.
+    """
+    airframe = load_airframe(airframe_path)
+    model = load_model(model_path)
+    plan = load_plan(plan_path)
+    result = simulate(airframe, model, plan, seed=seed)
+    write_tlog(result, out_path, airframe)
+    if truth_path is not None:
+        result.save_truth(truth_path)
+    return result
