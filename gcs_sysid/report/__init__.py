@@ -1,0 +1,44 @@
+"""Renderers of a :class:`~gcs_sysid.result.ReplayResult`: HTML, Markdown, CSV, JSON.
+
+Results are data, reports are renderers (as pyinstrument's ``Session`` and its renderers): the
+result can be saved (:func:`save_result`) and re-rendered later (:func:`load_result`) without
+recomputing. Contents and file formats: ``docs/report.md``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..result import ReplayResult
+from .html import render_html
+from .markdown import render_markdown
+from .store import load_result, save_result
+from .tables import CSV_COLUMNS, write_csv, write_suggestions_json
+
+__all__ = ["write_report", "save_result", "load_result", "CSV_COLUMNS"]
+
+
+def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True) -> dict[str, Path]:
+    """Write the report files into ``out_dir`` (created).
+
+    Args:
+        result: the replay result.
+        out_dir: output directory.
+        save: also save the result itself (``out_dir/result/result.{json,npz}``) for re-rendering.
+
+    Returns:
+        name -> path for ``report.html``, ``summary.md``, ``coefficients.csv``, ``suggestions.json``
+        (keys ``html``, ``markdown``, ``csv``, ``suggestions``) and, with ``save``, ``result_json``
+        and ``result_npz``.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files = {
+        "csv": write_csv(result, out / "coefficients.csv"),
+        "suggestions": write_suggestions_json(result, out / "suggestions.json"),
+        "markdown": render_markdown(result, out / "summary.md"),
+        "html": render_html(result, out / "report.html"),
+    }
+    if save:
+        files.update(save_result(result, out / "result"))
+    return files

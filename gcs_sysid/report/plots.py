@@ -1,0 +1,221 @@
+"""The report's figures, drawn with matplotlib's object API on the Agg canvas (no pyplot state).
+
+Every function returns PNG bytes; the HTML renderer embeds them as base64.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import LogNorm
+from matplotlib.figure import Figure
+
+from ..aero.table import COEFFICIENTS, REGRESSORS
+from ..envelope import EnvelopeSlice
+from ..result import ReplayResult
+from .tables import ANGLES
+
+__all__ = ["png", "streams_figure", "states_figure", "coefficients_figure", "correlation_figure",
+           "envelope_figure", "suggestions_figure"]
+
+_MAX_POINTS = 4000
+_HELD = "#f4d03f"
+
+
+def png(fig: Figure, dpi: int = 96) -> bytes:
+    """Render a figure to PNG bytes."""
+    FigureCanvasAgg(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    return buf.getvalue()
+
+
+def _stride(n: int) -> int:
+    return max(1, int(math.ceil(n / _MAX_POINTS)))
+
+
+def _shade(ax, t: np.ndarray, mask: np.ndarray, label: str | None = None) -> None:
+    """Shade the spans of t where mask is True."""
+    if not mask.any():
+        return
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(int), 0]))
+    for k, (a, b) in enumerate(zip(edges[::2], edges[1::2])):
+        ax.axvspan(t[a], t[b - 1], color=_HELD, alpha=0.25, lw=0, label=label if k == 0 else None)
+
+
+def _scale(name: str) -> tuple[float, str]:
+    return (180 / math.pi, "deg") if name in ANGLES else (1.0, "m/s" if name == "V" else "-")
+
+
+def streams_figure(r: ReplayResult) -> bytes:
+    """Timeline of each stream: coverage, gaps in red, rate in the label."""
+    ss = sorted(r.summaries.values(), key=lambda s: s.name)
+    fig = Figure(figsize=(10, 0.35 * max(len(ss), 3) + 1.0), layout="constrained")
+    ax = fig.add_subplot()
+    for i, s in enumerate(ss):
+        if math.isfinite(s.t_start):
+            ax.plot([s.t_start, s.t_end], [i, i], color="#2c7fb8", lw=6, solid_capstyle="butt")
+        for a, b in s.gaps:
+            ax.plot([a, b], [i, i], color="#d7301f", lw=6, solid_capstyle="butt")
+    ax.set_yticks(range(len(ss)), [f"{s.name} ({s.rate_hz:.1f} Hz)" for s in ss])
+    ax.invert_yaxis()
+    ax.set_xlabel("vehicle time since boot (s)")
+    ax.set_title("Streams: coverage (blue) and gaps (red)", loc="left", fontsize=10)
+    ax.grid(axis="x", alpha=0.3)
+    return png(fig)
+
+
+def states_figure(r: ReplayResult) -> bytes:
+    """Attitude, rates, air data and controls over time (held-out segment shaded)."""
+    st = r.states
+    k = _stride(len(st.t))
+    t = st.t[::k]
+    held = r.held_out[::k] if len(r.held_out) == len(st.t) else np.zeros(len(t), bool)
+    panels = [("Attitude (deg)", [("phi", "roll"), ("theta", "pitch"), ("psi", "yaw")], 180 / math.pi),
+              ("Body rates (deg/s)", [("p", "p"), ("q", "q"), ("r", "r")], 180 / math.pi),
+              ("Airspeed (m/s)", [("V", "V true")], 1.0),
+              ("Air angles (deg)", [("alpha", "alpha"), ("beta", "beta")], 180 / math.pi),
+              ("Controls (deg)", [("delta_e", "delta_e"), ("delta_a", "delta_a"), ("delta_r", "delta_r")], 180 / math.pi)]
+    fig = Figure(figsize=(10, 9.5), layout="constrained")
+    axes = fig.subplots(len(panels), 1, sharex=True)
+    for ax, (title, keys, sc) in zip(axes, panels):
+        for key, lab in keys:
+            if key in st.data:
+                ax.plot(t, np.asarray(st.data[key])[::k] * sc, lw=0.9, label=lab)
+            else:
+                ax.plot([], [], label=f"{lab} (missing)")
+        if title.startswith("Controls") and "delta_t" in st.data:
+            tw = ax.twinx()
+            tw.plot(t, np.asarray(st.data["delta_t"])[::k] * 100, lw=0.8, color="0.5", ls="--", label="throttle")
+            tw.set_ylabel("throttle (%)", fontsize=8)
+            tw.set_ylim(-5, 105)
+        _shade(ax, t, held)
+        ax.set_ylabel(title, fontsize=8)
+        ax.legend(loc="upper right", fontsize=7, ncol=3)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("vehicle time since boot (s)")
+    return png(fig)
+
+
+def coefficients_figure(r: ReplayResult) -> bytes:
+    """Measured coefficients vs model mean with 2-sigma bands; held-out segment shaded."""
+    tb = r.table
+    k = _stride(len(tb.t))
+    t = tb.t[::k]
+    held = r.held_out[::k]
+    fig = Figure(figsize=(10, 10), layout="constrained")
+    axes = fig.subplots(6, 1, sharex=True)
+    for j, (ax, c) in enumerate(zip(axes, COEFFICIENTS)):
+        y = np.where(tb.valid, tb.Y[:, j], np.nan)[::k]
+        mu, sd = r.pred_mean[::k, j], r.pred_sigma[::k, j]
+        if np.isfinite(mu).any():
+            ax.fill_between(t, mu - 2 * sd, mu + 2 * sd, color="#3182bd", alpha=0.25, lw=0, label="model 2 sigma")
+            ax.plot(t, mu, lw=1.0, color="#08519c", label="model mean")
+        else:
+            ax.text(0.5, 0.5, "no model for " + c + ": " + r.identifiable.get(c, (True, "not fitted"))[1],
+                    transform=ax.transAxes, ha="center", va="center", fontsize=8, color="#b30000")
+        ax.plot(t, y, lw=0.7, color="#d95f02", label="measured", zorder=3)
+        _shade(ax, t, held, "held out" if j == 0 else None)
+        ax.set_ylabel(c)
+        ax.grid(alpha=0.3)
+        fin = y[np.isfinite(y)]
+        if fin.size:   # robust limits: a few spikes must not flatten the plot
+            lo, hi = np.quantile(fin, [0.005, 0.995])
+            pad = 0.25 * (hi - lo) + 1e-9
+            ax.set_ylim(lo - pad, hi + pad)
+    h, lab = axes[0].get_legend_handles_labels()
+    fig.legend(h, lab, loc="outside upper right", fontsize=8, ncol=4)
+    axes[-1].set_xlabel("vehicle time since boot (s)")
+    return png(fig)
+
+
+def correlation_figure(matrix: np.ndarray, names: list[str]) -> bytes:
+    """Output correlation matrix of the multi-output GP."""
+    m = np.asarray(matrix, float)
+    fig = Figure(figsize=(4.2, 3.6), layout="constrained")
+    ax = fig.add_subplot()
+    im = ax.imshow(m, vmin=-1, vmax=1, cmap="RdBu_r")
+    ax.set_xticks(range(len(names)), names)
+    ax.set_yticks(range(len(names)), names)
+    for i in range(m.shape[0]):
+        for j in range(m.shape[1]):
+            ax.text(j, i, f"{m[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                    color="white" if abs(m[i, j]) > 0.6 else "black")
+    fig.colorbar(im, ax=ax, shrink=0.8)
+    ax.set_title("GP output correlation", fontsize=10)
+    return png(fig)
+
+
+def envelope_figure(r: ReplayResult, sl: EnvelopeSlice) -> bytes:
+    """One slice: data coverage, then per coefficient sigma/spread with flagged cells hatched and outlined."""
+    env = r.envelope
+    sx, sy = sl.axes
+    fx, ux = _scale(sx)
+    fy, uy = _scale(sy)
+    xe, ye = sl.x_edges * fx, sl.y_edges * fy
+    xc, yc = sl.x_centers * fx, sl.y_centers * fy
+    Xt = r.table.X[r.train]
+    px, py = Xt[:, REGRESSORS.index(sx)] * fx, Xt[:, REGRESSORS.index(sy)] * fy
+    k = max(1, len(px) // 1500)
+    fig = Figure(figsize=(13, 6.2))
+    fig.subplots_adjust(left=0.05, right=0.93, bottom=0.08, top=0.9, wspace=0.28, hspace=0.38)
+    axes = fig.subplots(2, 4).ravel()
+    ax = axes[0]
+    cnt = np.where(sl.counts > 0, sl.counts, np.nan)
+    vmax = float(np.nanmax(cnt)) if np.isfinite(cnt).any() else 2.0
+    im0 = ax.pcolormesh(xe, ye, cnt, cmap="Greens", norm=LogNorm(vmin=1, vmax=max(2.0, vmax)))
+    ax.plot(px[::k], py[::k], ".", ms=1.5, color="0.2", alpha=0.5)
+    ax.set_title("training data: samples per cell", fontsize=9)
+    cb = fig.colorbar(im0, ax=ax, fraction=0.046, pad=0.03)
+    cb.ax.tick_params(labelsize=7)
+    vmax = max(1.0, 1.5 * max(env.thresholds.get(c, 0.5) for c in env.outputs))
+    im = None
+    for ax, c in zip(axes[1:], env.outputs):
+        im = ax.pcolormesh(xe, ye, sl.rel_sigma[c], cmap="magma_r", vmin=0, vmax=vmax)
+        ax.plot(px[::k], py[::k], ".", ms=1, color="#1f78b4", alpha=0.35)
+        flag = sl.flagged(c).astype(float)
+        if flag.any() and not flag.all():
+            ax.contourf(xc, yc, flag, levels=[0.5, 1.5], colors="none", hatches=["///"])
+            ax.contour(xc, yc, flag, levels=[0.5], colors="#00bcd4", linewidths=1.3)
+        elif flag.all():
+            ax.contourf(xc, yc, flag + np.linspace(0, 1e-6, flag.size).reshape(flag.shape), levels=[0.5, 1.5],
+                        colors="none", hatches=["///"])
+        ax.set_title(f"{c}: sigma/spread, score {env.scores.get(c, float('nan')):.2f}", fontsize=9)
+    if im is not None:
+        cb = fig.colorbar(im, ax=list(axes[1:1 + len(env.outputs)]), fraction=0.02, pad=0.02)
+        cb.set_label("predictive sigma / RMS spread", fontsize=8)
+    for ax in axes[1 + len(env.outputs):]:
+        ax.axis("off")
+    for ax in axes[:1 + len(env.outputs)]:
+        ax.set_xlabel(f"{sx} ({ux})", fontsize=8)
+        ax.set_ylabel(f"{sy} ({uy})", fontsize=8)
+        ax.tick_params(labelsize=7)
+    fig.suptitle(f"{sx} x {sy}: other regressors at their medians; hatched + outlined = flagged "
+                 "(high sigma or no data)", fontsize=10)
+    return png(fig)
+
+
+def suggestions_figure(r: ReplayResult, limit: int = 6) -> bytes:
+    """Input waveforms (deviation from trim, deg) of the top suggestions."""
+    ss = r.suggestions[:limit]
+    n = len(ss)
+    cols = 2 if n > 1 else 1
+    rows = int(math.ceil(n / cols))
+    fig = Figure(figsize=(10, 2.3 * rows + 0.5), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    names = {"delta_e": "elevator", "delta_a": "aileron", "delta_r": "rudder"}
+    for ax, s in zip(axes, ss):
+        for c, u in s.u.items():
+            ax.plot(s.t, np.degrees(u), lw=1.2, drawstyle="steps-post" if s.kind != "multisine" else "default",
+                    label=names.get(c, c))
+        ax.set_title(f"#{s.rank} {s.kind} for {', '.join(s.coefficients)}", fontsize=9, loc="left")
+        ax.set_ylabel("deflection (deg)", fontsize=8)
+        ax.set_xlabel("time (s)", fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right")
+    for ax in axes[n:]:
+        ax.axis("off")
+    return png(fig)
