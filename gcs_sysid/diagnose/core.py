@@ -1,0 +1,272 @@
+"""Diagnose a simulation model against measured coefficients: name the cause, extend, measure the gain.
+
+The model under test ("the simulation") is held against the measured
+coefficient table. Candidate causes from the catalogue compete on held-out data
+(see :mod:`gcs_sysid.diagnose.candidates`); the best is accepted when its
+held-out score beats the complexity penalty by a margin and it removes a
+meaningful share of the residual, then the search repeats on what is left.
+Accepted aero terms are re-estimated jointly and written into the extended
+model; what no cause explains is reported as ``unexplained`` with its size and
+where in the envelope and in time it lives. Nothing is ever named without
+held-out support.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..aero.table import COEFFICIENTS, CoefficientTable
+from ..airframe import Airframe
+from ..errors import DataError
+from .candidates import Fitted, Scorer, fit_aero_terms, fit_delays, fit_sensor_causes, fit_stuck
+from .context import DiagContext, ModelDict
+from .evidence import maneuver_for, unexplained_report
+from .regression import ols
+from .terms import term_matrix
+
+__all__ = ["Diagnosis", "diagnose"]
+
+
+@dataclass
+class Diagnosis:
+    """Result of :func:`diagnose` (plain data; ``to_json`` gives the diagnosis.json document).
+
+    Attributes:
+        findings: accepted causes, dicts with ``cause coefficient estimate std_error evidence gain``
+            (and ``onset_s``), ordered by gain.
+        unexplained: per-coefficient residual left after the findings (size, where, above_threshold).
+        data: facts on the data, the split, equation- and output-error gains, separation advice.
+        model: the model under test; model_extended: with the accepted aero terms (re-estimated).
+        t, X, residual_before, residual_after, train, test: arrays for the report ((T,), (T,10), (T,6)).
+        fitted: the accepted :class:`Fitted` objects; rivals: the best of the others in the last round.
+    """
+
+    findings: list[dict]
+    unexplained: list[dict]
+    data: dict
+    model: ModelDict
+    model_extended: ModelDict
+    t: np.ndarray = field(repr=False)
+    X: np.ndarray = field(repr=False)
+    residual_before: np.ndarray = field(repr=False)
+    residual_after: np.ndarray = field(repr=False)
+    train: np.ndarray = field(repr=False)
+    test: np.ndarray = field(repr=False)
+    fitted: list[Fitted] = field(default_factory=list, repr=False)
+    output_error: dict | None = None
+
+    def to_json(self) -> dict:
+        """The ``diagnosis.json`` document (schema in docs/diagnose.md)."""
+        return {"findings": self.findings, "unexplained": self.unexplained, "data": self.data}
+
+
+def _eq_error(R0, R1, test) -> dict:
+    out = {}
+    for j, c in enumerate(COEFFICIENTS):
+        b = float(np.sqrt(np.mean(R0[test, j] ** 2)))
+        a = float(np.sqrt(np.mean(R1[test, j] ** 2)))
+        out[c] = {"rms_before": b, "rms_after": a, "percent": float(100 * (1 - a / b)) if b > 0 else 0.0}
+    return out
+
+
+def _reestimate(ctx: DiagContext, R_final: np.ndarray, accepted: list[Fitted]) -> None:
+    """Re-estimate the accepted aero terms of each coefficient jointly (coloured std errors)."""
+    by_coef: dict[str, list[Fitted]] = {}
+    for f in accepted:
+        if f.kind == "aero":
+            by_coef.setdefault(f.cause.split(":")[0], []).append(f)
+    for coef, fs in by_coef.items():
+        j = COEFFICIENTS.index(coef)
+        terms = [f.labels[0] for f in fs]
+        Phi = term_matrix(ctx.X, terms)
+        base = R_final[:, j] + sum(-f.delta[:, j] for f in fs)      # residual without these corrections
+        res = ols(Phi[ctx.train], base[ctx.train], terms=[f"x{i}" for i in range(len(terms))])
+        for i, f in enumerate(fs):
+            th = float(res.theta[i])
+            old = f.evidence["model_value"]
+            f.params = np.array([th])
+            f.estimate, f.std_error = old + th, float(res.std_error[i])
+            f.evidence["correction"] = th
+            f.model_update = {coef: {terms[i]: th}}
+            new_delta = np.zeros_like(f.delta)
+            new_delta[:, j] = -th * Phi[:, i]
+            R_final += new_delta - f.delta
+            f.delta = new_delta
+
+
+def _finding(f: Fitted, rivals: list[Fitted]) -> dict:
+    main = f.coefficient
+    ev = {"score": float(f.score), "t_statistic": float(f.estimate / f.std_error) if f.std_error > 0 else None,
+          "parameters": {k: float(v) for k, v in zip(f.labels, f.params)},
+          "gain_by_coefficient": f.gains, **f.evidence}
+    close = [r for r in rivals if r.cause != f.cause and r.score > 0.9 * f.score]
+    ev["rivals"] = [{"cause": r.cause, "score": float(r.score), "gain_percent": float(r.gain_percent)}
+                    for r in rivals[:4] if r.cause != f.cause]
+    ev["separable"] = not close
+    if close:
+        ev["separate_by"] = [maneuver_for(f.cause)] + [maneuver_for(r.cause) for r in close[:2]]
+    out = {"cause": f.cause, "coefficient": main, "estimate": float(f.estimate), "std_error": float(f.std_error),
+           "evidence": ev, "gain": dict(f.gains.get(main, {"rms_before": 0.0, "rms_after": 0.0, "percent": 0.0}))}
+    if f.onset_s is not None:
+        out["onset_s"] = float(f.onset_s)
+    return out
+
+
+def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *, train=None, test=None,
+             max_findings: int = 3, min_score: float = 30.0, min_gain_pct: float = 10.0,
+             min_rows: int = 500, unexplained_threshold_pct: float = 20.0, output_error: bool = True,
+             min_gain_oe_pct: float = 45.0,
+             progress=None) -> Diagnosis:
+    """Hold a model against measured coefficients, name the cause(s), extend the model.
+
+    Args:
+        table: measured coefficients and regressors (T rows).
+        airframe: the airframe the coefficients were computed with.
+        model: the model under test (``AeroModel`` or ``{coef: {term: value}}``).
+        states: the :class:`~gcs_sysid.estimation.states.FlightStates` behind the table
+            (needed for wind, inertia and CG causes and for output error); optional.
+        train, test: (T,) masks; default interleaved 8-s blocks, every third held out.
+        max_findings: most causes accepted (greedy, best first).
+        min_score: held-out penalised log-likelihood ratio a cause must exceed.
+        min_gain_pct: held-out RMS reduction (percent) it must bring to its main coefficient.
+        min_gain_oe_pct: the same for a cause seen in output error (``wind``): open-loop errors are
+            dominated by turbulence, whose mean over a minute is itself a small "wind", so the bar is higher.
+        min_rows: fewest valid rows accepted.
+        unexplained_threshold_pct: share of the remaining held-out residual that must be
+            predictable from the regressors for ``unexplained`` to be flagged above threshold.
+        output_error: with ``states``, test the ``wind`` cause and measure the output-error gain by
+            simulating short windows (:mod:`gcs_sysid.diagnose.output_error`; needs ``gcs_sysid.sim``).
+        progress: optional callable ``progress(message)``.
+
+    Returns:
+        :class:`Diagnosis`.
+
+    Raises:
+        DataError: too few valid rows, or no held-out rows.
+    """
+    t0 = time.perf_counter()
+    say = progress or (lambda msg: None)
+    ctx = DiagContext.build(table, airframe, model, states, train, test)
+    if ctx.valid.sum() < min_rows or ctx.train.sum() < min_rows // 2 or ctx.test.sum() < min_rows // 4:
+        raise DataError(f"diagnose: {int(ctx.valid.sum())} valid rows ({int(ctx.train.sum())} training, "
+                        f"{int(ctx.test.sum())} held out); need at least {min_rows} (about "
+                        f"{min_rows / 50:.0f} s at 50 Hz of flight with excitation)")
+    model0 = {c: dict(v) for c, v in ctx.model.items()}
+    R0 = ctx.Y - ctx.model_values()
+    R = R0.copy()
+    accepted: list[Fitted] = []
+    last_rivals: list[Fitted] = []
+    rounds = []
+    for rnd in range(max_findings):
+        say(f"diagnose: round {rnd + 1}, fitting candidate causes")
+        scorer = Scorer(ctx, R)
+        cands = fit_aero_terms(ctx, R, scorer) + fit_delays(ctx, R, scorer) + fit_stuck(ctx, R, scorer) \
+            + fit_sensor_causes(ctx, R, scorer)
+        cands = [c for c in cands if np.isfinite(c.score) and c.cause not in {a.cause for a in accepted}]
+        for c in cands:                      # a quadratic aero term must beat a simpler one by 10 %
+            if c.kind == "aero" and ("*" in c.labels[0] or "^2" in c.labels[0]) and c.score > 0:
+                c.score *= 0.9
+        cands.sort(key=lambda c: c.score, reverse=True)
+        rounds.append([{"cause": c.cause, "score": float(c.score), "gain_percent": float(c.gain_percent)}
+                       for c in cands[:8]])
+        if not cands:
+            break
+        best = cands[0]
+        last_rivals = cands[1:]
+        if best.score < min_score or best.gain_percent < min_gain_pct:
+            break
+        best.evidence["rivals_at_acceptance"] = rounds[-1][1:5]
+        accepted.append(best)
+        R = R + best.delta
+        if best.model_update:
+            for coef, upd in best.model_update.items():
+                for term, d in upd.items():
+                    ctx.model[coef][term] = ctx.model[coef].get(term, 0.0) + d
+    ext = {c: dict(v) for c, v in model0.items()}
+    if accepted:
+        _reestimate(ctx, R, accepted)
+        for f in accepted:
+            for coef, upd in (f.model_update or {}).items():
+                for term, d in upd.items():
+                    ext[coef][term] = ext[coef].get(term, 0.0) + d
+    findings = [_finding(f, [r for r in last_rivals] if i == 0 else []) for i, f in enumerate(accepted)]
+    oe_states = states if (output_error and states is not None and hasattr(states, "t")) else None
+    wind_info = None
+    if oe_states is not None and "wind" not in {f["cause"] for f in findings}:
+        say("diagnose: output error, wind")
+        wind_info = _wind_finding(ctx, oe_states, airframe, min_score, min_gain_oe_pct)
+        if wind_info and wind_info.get("accepted"):
+            findings.append(wind_info["finding"])
+    findings.sort(key=lambda d: d["gain"].get("percent", 0.0), reverse=True)
+    unexplained = unexplained_report(ctx, R, threshold_pct=unexplained_threshold_pct)
+    separation = []
+    for fd in findings:
+        if not fd["evidence"]["separable"]:
+            separation.append(f"{fd['cause']} cannot be told apart from "
+                              + ", ".join(r["cause"] for r in fd["evidence"]["rivals"][:2])
+                              + " on these data; fly: " + "; ".join(fd["evidence"]["separate_by"]))
+    for u in ("delta_e", "delta_a", "delta_r"):
+        if np.std(ctx.x(u)[ctx.valid]) < np.radians(0.5):
+            separation.append(f"{u} barely moves (std below 0.5 deg): causes that act through it (its derivatives, "
+                              f"delay:{u}, stuck:{u}) cannot be seen; fly: {maneuver_for('delay:' + u)}")
+    if not findings and any(u["above_threshold"] for u in unexplained):
+        separation.append("the residual is structured but no single catalogue cause explains it on held-out "
+                          "data; see 'unexplained' for where it lives")
+    data = {
+        "n_rows": int(len(ctx.t)), "n_valid": int(ctx.valid.sum()), "n_train": int(ctx.train.sum()),
+        "n_held_out": int(ctx.test.sum()),
+        "t_range_s": [float(ctx.t[ctx.valid][0]), float(ctx.t[ctx.valid][-1])],
+        "rate_hz": float(1.0 / np.median(np.diff(ctx.t))),
+        "held_out": "interleaved blocks" if train is None else "given",
+        "equation_error": _eq_error(R0, R, ctx.test),
+        "candidate_rounds": rounds,
+        "thresholds": {"min_score": min_score, "min_gain_pct": min_gain_pct, "min_gain_oe_pct": min_gain_oe_pct,
+                       "unexplained_threshold_pct": unexplained_threshold_pct},
+        "separation": separation,
+        "notes": list(ctx.notes) + list(getattr(table, "notes", [])),
+        "timings": {"diagnose_s": float(time.perf_counter() - t0)},
+    }
+    if wind_info is not None:
+        data["wind_candidate"] = {k: v for k, v in wind_info.items() if k != "finding"}
+    diag = Diagnosis(findings, unexplained, data, model0, ext, ctx.t, ctx.X, R0, R, ctx.train, ctx.test, accepted)
+    if oe_states is not None:
+        from .output_error import output_error_gain
+
+        say("diagnose: output error before / after")
+        t1 = time.perf_counter()
+        diag.output_error = output_error_gain(diag, oe_states, airframe)
+        data["output_error"] = {k: v for k, v in diag.output_error.items() if k != "windows_plot"}
+        data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
+    data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)
+    return diag
+
+
+def _wind_finding(ctx: DiagContext, states, airframe, min_score: float, min_gain_pct: float) -> dict | None:
+    """Score the output-error ``wind`` cause; a finding dict when it passes the same tests as the others."""
+    from types import SimpleNamespace
+
+    from ..sim.model_file import AeroModel
+    from .output_error import wind_candidate
+
+    if not all(k in states for k in ("wn", "we", "u", "v", "w", "alt")):
+        return None
+    wc = wind_candidate(SimpleNamespace(t=ctx.t, train=ctx.train, test=ctx.test), states, airframe,
+                        AeroModel(ctx.model, "model"))
+    if wc is None:
+        return None
+    main = max(wc["gains"], key=lambda k: wc["gains"][k]["percent"])
+    ok = (wc["score"] >= min_score and wc["gains"][main]["percent"] >= min_gain_pct
+          and wc["estimate"] > max(3 * wc["std_error"], 0.5))
+    wc["accepted"] = bool(ok)
+    if ok:
+        wc["finding"] = {"cause": "wind", "coefficient": main, "estimate": wc["estimate"], "std_error": wc["std_error"],
+                         "evidence": {"domain": "output error (simulation without wind vs measured states)",
+                                      "score": wc["score"], "wind_ned_mps": wc["wind_ned"], "wind_ned": wc["wind_ned"],
+                                      "from_deg": wc["from_deg"], "gain_by_state": wc["gains"],
+                                      "separable": True, "rivals": []},
+                         "gain": dict(wc["gains"][main])}
+    return wc
+

@@ -1,0 +1,174 @@
+"""Render a :class:`~gcs_sysid.diagnose.core.Diagnosis` as one self-contained HTML page.
+
+Plots (matplotlib, embedded as base64 PNG): equation-error residual of each
+coefficient over time before and after the findings (held-out blocks shaded),
+the residual over the envelope (alpha vs V), and the output-error windows
+(simulated vs measured states, before and after).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..aero.table import COEFFICIENTS
+
+__all__ = ["write_report", "render_html"]
+
+_CSS = """body{font-family:sans-serif;max-width:1100px;margin:1em auto;color:#222}
+table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}
+th{background:#eee}.warn{color:#a40}.ok{color:#070}img{max-width:100%}code{background:#f4f4f4}"""
+
+
+def _png(fig) -> str:
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=72, bbox_inches="tight")
+    plt.close(fig)
+    return f'<img src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">'
+
+
+def _thin(mask: np.ndarray, n: int) -> np.ndarray:
+    """At most ``n`` evenly spread True entries of ``mask`` (plots stay light)."""
+    idx = np.nonzero(mask)[0]
+    out = np.zeros_like(mask)
+    out[idx[:: max(1, len(idx) // n)]] = True
+    return out
+
+
+def _fig_time(d) -> str:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axs = plt.subplots(6, 1, figsize=(11, 12), sharex=True)
+    t = d.t
+    v = _thin(d.train | d.test, 4000)
+    for j, (ax, c) in enumerate(zip(axs, COEFFICIENTS)):
+        ax.plot(t[v], d.residual_before[v, j], ".", ms=1.5, color="tab:red", label="before")
+        ax.plot(t[v], d.residual_after[v, j], ".", ms=1.5, color="tab:blue", label="after")
+        lo, hi = np.nanmin(d.residual_before[v, j]), np.nanmax(d.residual_before[v, j])
+        ax.fill_between(t[::5], lo, hi, where=d.test[::5], color="0.9", step="mid", zorder=0)
+        ax.set_ylabel(f"{c} residual")
+    axs[0].legend(loc="upper right", markerscale=8)
+    axs[-1].set_xlabel("vehicle time (s); shaded: held out")
+    return _png(fig)
+
+
+def _fig_envelope(d) -> str:
+    import matplotlib.pyplot as plt
+
+    fig, axs = plt.subplots(2, 6, figsize=(15, 5), sharex=True, sharey=True)
+    v = _thin(d.train | d.test, 1500)
+    a = np.degrees(d.X[v, 0])
+    V = d.X[v, 9]
+    for j, c in enumerate(COEFFICIENTS):
+        for i, (R, lab) in enumerate(((d.residual_before, "before"), (d.residual_after, "after"))):
+            r = R[v, j]
+            lim = np.nanpercentile(np.abs(d.residual_before[v, j]), 98) or 1.0
+            sc = axs[i, j].scatter(a, V, c=r, s=2, cmap="coolwarm", vmin=-lim, vmax=lim)
+            axs[i, j].set_title(f"{c} {lab}", fontsize=9)
+        fig.colorbar(sc, ax=axs[:, j], shrink=0.6)
+    for ax in axs[1]:
+        ax.set_xlabel("alpha (deg)")
+    for ax in axs[:, 0]:
+        ax.set_ylabel("V (m/s)")
+    return _png(fig)
+
+
+def _fig_output_error(oe: dict) -> str:
+    import matplotlib.pyplot as plt
+
+    wins = oe.get("windows_plot") or []
+    if not wins:
+        return ""
+    keys = oe.get("states", [])
+    fig, axs = plt.subplots(len(keys), len(wins), figsize=(4 * len(wins), 1.6 * len(keys)), squeeze=False)
+    for i, w in enumerate(wins):
+        for k, key in enumerate(keys):
+            ax = axs[k, i]
+            ax.plot(w["t"], w["measured"][key], "k", lw=1, label="measured")
+            ax.plot(w["t"], w["before"][key], "tab:red", lw=1, label="model")
+            if "after" in w:
+                ax.plot(w["t"], w["after"][key], "tab:blue", lw=1, label="extended")
+            if i == 0:
+                ax.set_ylabel(key)
+    axs[0, 0].legend(fontsize=7)
+    return _png(fig)
+
+
+def _table(rows, cols) -> str:
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in cols)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r) + "</tr>" for r in rows)
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _f(x, fmt="{:.4g}"):
+    return fmt.format(x) if isinstance(x, (int, float)) and x is not None else str(x)
+
+
+def render_html(d) -> str:
+    """The report as an HTML string (all images inline)."""
+    data = d.data
+    parts = [f"<html><head><meta charset='utf-8'><title>gcs-sysid diagnosis</title><style>{_CSS}</style></head><body>",
+             "<h1>Simulation diagnosis</h1>",
+             f"<p>Log <code>{html.escape(str(data.get('log', '')))}</code>, model "
+             f"<code>{html.escape(str(data.get('model', '')))}</code>; {data['n_valid']} valid samples at "
+             f"{data['rate_hz']:.0f} Hz ({data['n_train']} training, {data['n_held_out']} held out in interleaved "
+             f"blocks), t = {data['t_range_s'][0]:.1f}..{data['t_range_s'][1]:.1f} s.</p>",
+             "<h2>Findings</h2>"]
+    if d.findings:
+        parts.append(_table([[f["cause"], f["coefficient"], _f(f["estimate"]), _f(f["std_error"]),
+                              f.get("onset_s", ""), _f(f["gain"].get("rms_before")), _f(f["gain"].get("rms_after")),
+                              _f(f["gain"].get("percent"), "{:.0f} %"),
+                              "yes" if f["evidence"].get("separable", True) else "NO"] for f in d.findings],
+                            ["cause", "coefficient", "estimate", "std error", "onset (s)", "held-out RMS before",
+                             "after", "gain", "separable"]))
+    else:
+        parts.append("<p class='ok'>No cause from the catalogue explains the residual better than noise on held-out "
+                     "data: no finding.</p>")
+    for s in data.get("separation", []):
+        parts.append(f"<p class='warn'>{html.escape(s)}</p>")
+    parts.append("<h2>Equation error on held-out data (per coefficient)</h2>")
+    ee = data["equation_error"]
+    parts.append(_table([[c, _f(ee[c]["rms_before"]), _f(ee[c]["rms_after"]), _f(ee[c]["percent"], "{:.0f} %")]
+                         for c in COEFFICIENTS], ["coefficient", "RMS before", "RMS after", "gain"]))
+    parts.append("<h2>Unexplained residual</h2>")
+    parts.append(_table([[u["coefficient"], _f(u["rms"]), _f(u["percent_of_measured"], "{:.1f} %"),
+                          _f(u["structured_percent"], "{:.0f} %"), "YES" if u["above_threshold"] else "no",
+                          u["where"].get("correlated_with"), u["where"].get("alpha_deg"), u["where"].get("V_mps"),
+                          u["where"].get("time_s")] for u in d.unexplained],
+                        ["coefficient", "RMS", "of measured", "structured", "above threshold", "most correlated with",
+                         "worst alpha bin (deg)", "worst V bin (m/s)", "worst 5 s"]))
+    oe = d.output_error or {}
+    parts.append("<h2>Output error (simulation driven by the measured controls)</h2>")
+    if oe.get("available"):
+        rows = [[k, _f(v["rms_before"]), _f(v.get("rms_after")), _f(v.get("percent"), "{:.0f} %")]
+                for k, v in oe["states_rms"].items()]
+        parts.append(f"<p>{oe['n_windows']} windows of {oe['window_s']:.1f} s from measured initial states; "
+                     "RMS of simulated minus measured over all held-out windows.</p>")
+        parts.append(_table(rows, ["state", "RMS before", "RMS after", "gain"]))
+        parts.append(_fig_output_error(oe))
+    else:
+        parts.append(f"<p>Not available: {html.escape(str(oe.get('reason', 'not run')))}</p>")
+    parts.append("<h2>Equation-error residual over time</h2>" + _fig_time(d))
+    parts.append("<h2>Residual over the envelope</h2>" + _fig_envelope(d))
+    parts.append("<h2>Candidates, best first, per round</h2>")
+    for i, r in enumerate(data.get("candidate_rounds", [])):
+        parts.append(f"<p>Round {i + 1}</p>" + _table([[c["cause"], _f(c["score"], "{:.1f}"),
+                                                          _f(c["gain_percent"], "{:.1f} %")] for c in r],
+                                                       ["cause", "held-out score", "gain"]))
+    parts.append("<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])
+                 + "</pre></body></html>")
+    return "\n".join(parts)
+
+
+def write_report(d, path) -> None:
+    """Write the report to ``path``."""
+    Path(path).write_text(render_html(d), encoding="utf-8")

@@ -1,0 +1,152 @@
+"""The ``fit`` and ``diagnose`` jobs: log -> states -> coefficients -> model file / diagnosis directory."""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..airframe import Airframe, load_airframe
+from ..errors import DataError, InputError
+
+__all__ = ["Measurements", "load_measurements", "run_fit", "run_diagnose"]
+
+
+@dataclass
+class Measurements:
+    """A log taken through the replay front end: the flight, airframe, states and coefficients."""
+
+    flight: object
+    airframe: Airframe
+    states: object
+    table: object
+    timings: dict
+
+
+def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
+    """The servo channels the airframe names must be in the log."""
+    if not flight.has("servo"):
+        raise DataError(f"{log}: no servo outputs (SERVO_OUTPUT_RAW / RCOU): cannot tell the control inputs")
+    srv = flight["servo"]
+    missing = []
+    for s in airframe.servos:
+        key = f"pwm{s.channel}"
+        if key not in srv.fields or not np.any(np.asarray(srv[key]) > 0):
+            missing.append(f"{s.name} (channel {s.channel})")
+    if missing:
+        raise InputError(f"{log}: airframe '{airframe.name}' does not match the log: servo channel(s) "
+                         f"{', '.join(missing)} carry no PWM; check the [[servo]] channels in "
+                         f"{airframe.source or 'the airframe file'}")
+
+
+def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
+                      progress=None) -> Measurements:
+    """Decode a log and compute its coefficient table (the replay pipeline's first stages).
+
+    Args:
+        log: .tlog or DataFlash .bin path.
+        airframe_path: airframe TOML.
+        t_from, t_to: vehicle-time window, s (None = open).
+
+    Raises:
+        InputError, DataError: from the stages, or an airframe whose servo channels
+            are absent from the log.
+    """
+    from ..aero import compute_coefficients
+    from ..estimation import estimate_states
+    from ..telemetry import read_log
+
+    tm: dict[str, float] = {}
+    t0 = time.perf_counter()
+    airframe = load_airframe(airframe_path)
+    flight = read_log(log)
+    tm["decode_s"] = time.perf_counter() - t0
+    if t_from is not None or t_to is not None:
+        if t_from is not None and t_to is not None and t_to <= t_from:
+            raise InputError(f"--from {t_from} must be before --to {t_to}")
+        flight = flight.window(t_from, t_to)
+    _check_airframe_matches(flight, airframe, str(log))
+    t1 = time.perf_counter()
+    states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
+                             if progress is not None else None)
+    tm["estimate_s"] = time.perf_counter() - t1
+    t2 = time.perf_counter()
+    table = compute_coefficients(states, airframe)
+    tm["coefficients_s"] = time.perf_counter() - t2
+    return Measurements(flight, airframe, states, table, tm)
+
+
+def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
+            progress=None):
+    """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
+
+    Also writes ``<out>.fit.json`` with the per-coefficient statistics.
+
+    Returns:
+        (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
+    """
+    from ..sim.model_file import save_model
+    from .fit import fit_model
+
+    meas = load_measurements(log, airframe_path, t_from, t_to, progress)
+    model, report = fit_model(meas.table, name=Path(out_path).stem)
+    model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
+    out = Path(out_path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    save_model(model, out, header=report.header())
+    out.with_suffix(".fit.json").write_text(json.dumps(report.to_json(), indent=1, default=float))
+    return model, report
+
+
+def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None = None,
+                 t_to: float | None = None, progress=None, output_error: bool = True, **kw):
+    """``gcs-sysid diagnose``: hold the model against the log; write diagnosis.json, model_extended.toml, report.html.
+
+    Args:
+        log, airframe_path, model_path: inputs. out_dir: directory (created).
+        t_from, t_to: vehicle-time window, s.
+        output_error: also run the output-error comparison (needs ``gcs_sysid.sim.propagate``).
+        **kw: passed to :func:`gcs_sysid.diagnose.core.diagnose`.
+
+    Returns:
+        the :class:`~gcs_sysid.diagnose.core.Diagnosis`.
+    """
+    from ..sim.model_file import AeroModel, load_model, save_model
+    from .core import diagnose
+    from .report import write_report
+
+    t0 = time.perf_counter()
+    model = load_model(model_path)
+    meas = load_measurements(log, airframe_path, t_from, t_to, progress)
+    diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=output_error,
+                    progress=progress, **kw)
+    diag.data.update({"log": str(log), "airframe": str(airframe_path), "model": str(model_path),
+                      "window_s": [t_from, t_to]})
+    diag.data["timings"].update(meas.timings)
+    diag.data["timings"]["total_s"] = time.perf_counter() - t0
+    diag.data["estimation_notes"] = list(getattr(meas.states, "notes", [])) + \
+        list(getattr(meas.states, "missing", []))
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    ext = AeroModel(diag.model_extended, (model.name or "model") + "-extended",
+                    "extended by gcs-sysid diagnose: " + (", ".join(f["cause"] for f in diag.findings) or "no change"))
+    header = "Model extended by gcs-sysid diagnose.\n" + "\n".join(
+        f"{f['cause']}: estimate {f['estimate']:.4g} +- {f['std_error']:.2g}, held-out gain "
+        f"{f['gain'].get('percent', 0):.0f} %" for f in diag.findings)
+    save_model(ext, out / "model_extended.toml", header=header)
+    (out / "diagnosis.json").write_text(json.dumps(diag.to_json(), indent=1, default=_json_default))
+    write_report(diag, out / "report.html")
+    return diag
+
+
+def _json_default(o):
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.bool_):
+        return bool(o)
+    raise TypeError(f"not JSON-able: {type(o).__name__}")
