@@ -41,6 +41,10 @@ class FlightStates:
             (e.g. ``"V": "VFR_HUD airspeed (EAS) -> TAS with rho from SCALED_PRESSURE"``).
         missing: keys or inputs not available, with why.
         notes: other one-line remarks for the report (e.g. stream rate too low).
+        identifiability: quantity -> ``(ok, reason)`` for what later stages may
+            trust: keys ``"rate_derivatives"``, ``"moment_coefficients"``,
+            ``"force_coefficients"``, ``"alpha"``, ``"beta"``, ``"controls"`` and
+            one per coefficient ``"CX"`` ... ``"Cn"`` (e.g. ``(False, "gyro at 4.2 Hz: ...")``).
     """
 
     t: np.ndarray
@@ -51,6 +55,7 @@ class FlightStates:
     sources: dict[str, str] = field(default_factory=dict)
     missing: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    identifiability: dict[str, tuple[bool, str]] = field(default_factory=dict)
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self.data[key]

@@ -1,0 +1,113 @@
+"""Body-axis aerodynamic coefficients and regressors from smoothed flight states.
+
+Forces from the specific force at the CG (the accelerometer measures
+``(aerodynamic + thrust force) / m``)::
+
+    CX = (m ax - T) / (qbar S),   CY = m ay / (qbar S),   CZ = m az / (qbar S)
+
+with ``T`` the thrust along body x from the airframe's thrust model (without
+one, CX includes thrust). Moments from Euler's equations with the full inertia
+tensor ``[[Ixx, 0, -Ixz], [0, Iyy, 0], [-Ixz, 0, Izz]]`` (``M = I w_dot + w x I w``)::
+
+    L = Ixx p_dot - Ixz (r_dot + p q) + (Izz - Iyy) q r
+    M = Iyy q_dot + (Ixx - Izz) p r + Ixz (p^2 - r^2)
+    N = Izz r_dot - Ixz (p_dot - q r) + (Iyy - Ixx) p q
+    Cl = L / (qbar S b),   Cm = M / (qbar S c),   Cn = N / (qbar S b)
+
+Regressors: alpha, beta, ``p_hat = p b / (2V)``, ``q_hat = q c / (2V)``,
+``r_hat = r b / (2V)``, delta_e, delta_a, delta_r, delta_t, V.
+
+References:
+    Stevens, Lewis and Johnson, *Aircraft Control and Simulation*, 3rd ed.,
+    Wiley 2016, ch. 1 (rigid-body moment equations with Ixz).
+    Klein and Morelli, *Aircraft System Identification*, AIAA 2006, ch. 3
+    (equations of motion; coefficients from measured accelerations and rates).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..airframe import Airframe
+from ..estimation.states import FlightStates
+from .table import REGRESSORS, CoefficientTable
+
+__all__ = ["compute_coefficients", "aero_moments", "QBAR_MIN"]
+
+QBAR_MIN = 5.0  #: Pa; rows with a smaller dynamic pressure are not valid (coefficients blow up)
+
+
+def aero_moments(airframe: Airframe, p, q, r, p_dot, q_dot, r_dot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Aerodynamic (plus propulsive) moments L, M, N in N m from rates and accelerations.
+
+    Args:
+        airframe: inertia Ixx, Iyy, Izz, Ixz in kg m^2.
+        p, q, r: body rates, rad/s, arrays of one shape.
+        p_dot, q_dot, r_dot: angular accelerations, rad/s^2.
+
+    Returns:
+        ``(L, M, N)`` in N m, each of the inputs' shape.
+
+    Source: Stevens, Lewis and Johnson (2016) ch. 1; ``M = I w_dot + w x (I w)`` expanded.
+    """
+    Ixx, Iyy, Izz, Ixz = airframe.Ixx, airframe.Iyy, airframe.Izz, airframe.Ixz
+    L = Ixx * p_dot - Ixz * (r_dot + p * q) + (Izz - Iyy) * q * r
+    M = Iyy * q_dot + (Ixx - Izz) * p * r + Ixz * (p**2 - r**2)
+    N = Izz * r_dot - Ixz * (p_dot - q * r) + (Iyy - Ixx) * p * q
+    return L, M, N
+
+
+def compute_coefficients(states: FlightStates, airframe: Airframe) -> CoefficientTable:
+    """Measured coefficients CX CY CZ Cl Cm Cn and the regressors on the states' grid.
+
+    Args:
+        states: smoothed states (``ax ay az p q r p_dot q_dot r_dot V alpha beta
+            qbar delta_*``); a missing key makes the columns that need it NaN.
+        airframe: mass, inertia, S, b, c and the optional thrust model.
+
+    Returns:
+        :class:`~gcs_sysid.aero.table.CoefficientTable` with ``X`` (T, 10) in the
+        order of :data:`REGRESSORS`, ``Y`` (T, 6) in the order of
+        :data:`COEFFICIENTS`; ``valid`` = ``states.valid`` and every entry finite
+        and ``qbar > QBAR_MIN``.
+
+    Source: Klein and Morelli (2006) ch. 3; Stevens, Lewis and Johnson (2016) ch. 1.
+    """
+    T = len(states)
+    nan = np.full(T, np.nan)
+    get = lambda k: np.asarray(states.data[k], float) if k in states.data else nan  # noqa: E731
+    notes: list[str] = []
+    V, qbar = get("V"), get("qbar")
+    S, b, c, m = airframe.S, airframe.b, airframe.c, airframe.mass
+    with np.errstate(invalid="ignore", divide="ignore"):
+        qS = np.where(qbar > 0, qbar * S, np.nan)
+        if airframe.thrust is not None and "delta_t" in states.data:
+            thrust = airframe.thrust.thrust(get("delta_t"), V)
+            notes.append("CX has the airframe's static-thrust model removed "
+                         f"(T = {airframe.thrust.T_static:g} N * delta_t^{airframe.thrust.exponent:g} "
+                         f"* (1 - V/{airframe.thrust.V_zero:g}))")
+        else:
+            thrust = np.zeros(T)
+            why = "airframe has no thrust model" if airframe.thrust is None else "no throttle signal"
+            notes.append(f"CX includes thrust: {why}")
+        CX = (m * get("ax") - thrust) / qS
+        CY = m * get("ay") / qS
+        CZ = m * get("az") / qS
+        p, q, r = get("p"), get("q"), get("r")
+        L, M, N = aero_moments(airframe, p, q, r, get("p_dot"), get("q_dot"), get("r_dot"))
+        Cl, Cm, Cn = L / (qS * b), M / (qS * c), N / (qS * b)
+        hat = {"p_hat": p * b / (2 * V), "q_hat": q * c / (2 * V), "r_hat": r * b / (2 * V)}
+    cols = {**hat, **{k: get(k) for k in REGRESSORS if k not in hat}}
+    X = np.stack([cols[k] for k in REGRESSORS], axis=1)
+    Y = np.stack([CX, CY, CZ, Cl, Cm, Cn], axis=1)
+    valid = np.ones(T, bool) if states.valid is None else np.asarray(states.valid, bool).copy()
+    valid &= np.isfinite(X).all(axis=1) & np.isfinite(Y).all(axis=1) & (np.nan_to_num(qbar) > QBAR_MIN)
+    for k in ("ax", "ay", "az", "p", "q", "r", "p_dot", "q_dot", "r_dot", "V", "qbar", "alpha", "beta",
+              "delta_e", "delta_a", "delta_r", "delta_t"):
+        if k not in states.data:
+            notes.append(f"no {k} in the states: the columns that need it are NaN")
+    for key, coeffs in (("moment_coefficients", "Cl Cm Cn"), ("force_coefficients", "CX CY CZ")):
+        ok, why = states.identifiability.get(key, (True, ""))
+        if not ok:
+            notes.append(f"{coeffs} not identifiable: {why}")
+    return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes)

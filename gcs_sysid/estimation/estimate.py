@@ -1,0 +1,359 @@
+"""The estimation stage: from a decoded :class:`Flight` to smoothed :class:`FlightStates`.
+
+Order of work (``docs/estimation.md``): align on a grid -> attitude and gyro
+bias (EKF + RTS) -> rates and angular accelerations (RTS) -> lever-arm
+correction of the accelerometers -> ground velocity and accel bias (KF + RTS)
+-> density, airspeed, wind, alpha, beta, qbar -> controls from servo PWM ->
+validity and identifiability flags. Whatever is missing is listed in
+``missing`` with why; only a log with neither IMU nor attitude raises.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from ..airframe import Airframe
+from ..errors import DataError
+from ..telemetry.types import Flight
+from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
+from .align import Aligned, align_flight, events
+from .ekf import dcm, smooth_attitude
+from .smoothers import smooth_level, smooth_rates, smooth_velocity
+from .kalman import noise_std
+from .states import FlightStates
+
+__all__ = ["estimate_states", "V_FLOOR", "RATE_OK_HZ", "RATE_MIN_HZ"]
+
+V_FLOOR = 8.0        #: airspeed (m/s) above which the aircraft counts as flying (or half its typical speed if lower)
+RATE_OK_HZ = 20.0    #: gyro rate from which angular accelerations are trusted
+RATE_MIN_HZ = 10.0   #: below this rate they are not identifiable at all
+_STREAM_ADVICE = ("raise the telemetry stream rates to 50 Hz (ArduPilot SRx_RAW_SENS for RAW_IMU, SRx_EXTRA1 for "
+                  "ATTITUDE, SRx_RC_CHAN for SERVO_OUTPUT_RAW, SRx_POSITION, SRx_EXTRA2) or use the DataFlash log")
+
+
+def _stack(al: Aligned, stream: str, fields: tuple[str, ...]) -> np.ndarray | None:
+    if not al.has(stream) or not all(f in al.values[stream] for f in fields):
+        return None
+    x = np.stack([al.values[stream][f] for f in fields], axis=1)
+    return x if np.isfinite(x).all(axis=1).sum() >= 10 else None
+
+
+def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
+                    progress: Callable[[float], None] | None = None) -> FlightStates:
+    """Smooth the states of a flight on a uniform grid.
+
+    Args:
+        flight: decoded flight with canonical streams (``docs/architecture.md``).
+        airframe: mass properties, servo maps and IMU lever arm.
+        rate_hz: grid rate, Hz (capped at the IMU rate).
+        progress: optional ``callable(fraction)`` called as stages finish.
+
+    Returns:
+        :class:`FlightStates`; keys that could not be estimated are absent from
+        ``data`` and listed in ``missing``.
+
+    Raises:
+        DataError: neither an IMU nor an attitude stream, or fewer than 10 grid points.
+    """
+    prog = progress or (lambda f: None)
+    src = flight.path
+    if not (flight.has("imu") or flight.has("attitude")):
+        raise DataError(f"{src}: no IMU (RAW_IMU, SCALED_IMU*, HIGHRES_IMU or DataFlash IMU) and no attitude "
+                        "(ATTITUDE or ATT) stream: no states can be estimated")
+    al = align_flight(flight, rate_hz)
+    t, rate = al.t, al.rate_hz
+    dt = 1.0 / rate
+    T = len(t)
+    if T < 10:
+        raise DataError(f"{src}: only {T} grid points at {rate:.1f} Hz; the log is too short to estimate states")
+    data: dict[str, np.ndarray] = {}
+    sigma: dict[str, np.ndarray] = {}
+    sources: dict[str, str] = {}
+    missing: list[str] = []
+    notes: list[str] = []
+    ident: dict[str, tuple[bool, str]] = {}
+    prog(0.1)
+
+    # --- gyro and attitude ------------------------------------------------------------------
+    gyro = _stack(al, "imu", ("p", "q", "r"))
+    gyro_src, gyro_rate = "imu", al.rates.get("imu", 0.0)
+    if gyro is None:
+        gyro = _stack(al, "attitude", ("p", "q", "r"))
+        gyro_src, gyro_rate = "attitude", al.rates.get("attitude", 0.0)
+        if gyro is not None:
+            notes.append("no IMU gyro: body rates from ATTITUDE rollspeed/pitchspeed/yawspeed (already "
+                         "bias-corrected by the autopilot)")
+    att_stream = "attitude" if flight.has("attitude") else ("ekf" if flight.has("ekf") else None)
+    att = None
+    if att_stream is not None and all(f in flight[att_stream] for f in ("roll", "pitch", "yaw")):
+        att = events(flight[att_stream], ("roll", "pitch", "yaw"), t, angles=("roll", "pitch", "yaw"))
+        if not np.isfinite(att).all(axis=1).any():
+            att = None
+    bias = np.zeros((T, 3))
+    euler = None
+    if gyro is not None:
+        sg = float(np.median([noise_std(gyro[:, i], 2e-4) for i in range(3)]))
+    if att is not None and gyro is not None:
+        A = smooth_attitude(dt, gyro, att, sg)
+        euler, esig = A.euler, A.euler_sigma
+        if gyro_src == "imu":
+            bias = A.gyro_bias
+            notes.append("gyro bias (EKF, mean) p q r = " + ", ".join(f"{b:+.4f}" for b in bias.mean(0)) + " rad/s")
+        src_att = f"EKF (filterpy) + RTS: {gyro_src} gyro integrated, updated by {att_stream.upper()} attitude"
+    elif att is not None:
+        euler = np.stack([al.get(att_stream, f) for f in ("roll", "pitch", "yaw")], axis=1)
+        esig = np.full((T, 3), np.nan)
+        src_att = f"{att_stream.upper()} attitude interpolated (no gyro to smooth it)"
+    if euler is not None:
+        for i, k in enumerate(("phi", "theta", "psi")):
+            data[k], sigma[k], sources[k] = euler[:, i], esig[:, i], src_att
+    else:
+        missing.append("phi theta psi: no attitude stream (ATTITUDE / ATT / EKF); the IMU alone cannot level")
+    prog(0.35)
+
+    # --- rates and angular accelerations ------------------------------------------------------
+    W = Wd = None
+    if gyro is not None:
+        Rr = smooth_rates(dt, gyro - bias)
+        W, Wd = Rr.rate, Rr.accel
+        for i, k in enumerate(("p", "q", "r")):
+            data[k], sigma[k] = W[:, i], Rr.rate_sigma[:, i]
+            data[k + "_dot"], sigma[k + "_dot"] = Wd[:, i], Rr.accel_sigma[:, i]
+            sources[k] = f"{gyro_src} gyro minus EKF bias, RTS-smoothed (rate/acceleration/jerk model)"
+            sources[k + "_dot"] = (f"RTS-smoothed derivative of the {gyro_src} gyro, bandwidth "
+                                   f"{Rr.bandwidth_hz[i]:g} Hz (maximum likelihood)")
+        notes.append("rate smoother bandwidth p q r = " + ", ".join(f"{b:g}" for b in Rr.bandwidth_hz)
+                     + " Hz; gyro noise = " + ", ".join(f"{s:.4f}" for s in Rr.noise_std) + " rad/s")
+    else:
+        missing.append("p q r p_dot q_dot r_dot: no gyro (IMU) and no rates in ATTITUDE")
+    if gyro_rate < RATE_MIN_HZ:
+        reason = (f"gyro at {gyro_rate:.1f} Hz: p_dot q_dot r_dot (and so Cl Cm Cn) are not identifiable at this "
+                  f"rate; {_STREAM_ADVICE}")
+        ident["rate_derivatives"] = (False, reason)
+        notes.append(reason)
+    elif gyro_rate < RATE_OK_HZ:
+        reason = (f"gyro at {gyro_rate:.1f} Hz: angular accelerations are band-limited to about "
+                  f"{0.35 * min(gyro_rate, rate):.1f} Hz, moment coefficients marginal; {_STREAM_ADVICE}")
+        ident["rate_derivatives"] = (True, reason)
+        notes.append(reason)
+    else:
+        ident["rate_derivatives"] = (True, f"gyro at {gyro_rate:.0f} Hz")
+    prog(0.55)
+
+    # --- specific force at the CG, velocity, accel bias ------------------------------------------
+    acc = _stack(al, "imu", ("ax", "ay", "az"))
+    f_cg = None
+    if acc is not None:
+        r_arm = np.asarray(airframe.imu_lever_arm, float)
+        f_cg = acc.copy()
+        if W is not None and np.any(r_arm != 0):
+            # a_cg = a_imu - omega_dot x r - omega x (omega x r)
+            f_cg = acc - np.cross(Wd, r_arm) - np.cross(W, np.cross(W, r_arm))
+            notes.append("accelerometers moved to the CG (lever arm " + ", ".join(f"{x:g}" for x in r_arm) + " m)")
+    else:
+        missing.append("ax ay az: no accelerometer (IMU) stream")
+    vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
+        "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
+    vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")
+    v_ned = None
+    C = dcm(*euler.T) if euler is not None else None
+    abias = np.zeros((T, 3))
+    if vsrc is not None:
+        if vsrc == "local_position":
+            notes.append("no GPS velocity: using LOCAL_POSITION_NED (the autopilot's EKF velocity)")
+        vmeas = events(flight[vsrc], vfields, t)
+        if f_cg is not None and C is not None:
+            sa = float(np.median([noise_std(f_cg[:, i], 1e-3) for i in range(3)]))
+            Vel = smooth_velocity(dt, C, f_cg, vmeas, sa)
+            v_ned, vsig, abias = Vel.v_ned, Vel.v_sigma, Vel.accel_bias
+            vs = f"KF + RTS: accelerometers (attitude-rotated) integrated, updated by {vsrc} velocity"
+            notes.append("accelerometer bias (KF, mean) x y z = " + ", ".join(f"{b:+.3f}" for b in abias.mean(0))
+                         + " m/s^2")
+        else:
+            v_ned = np.stack([al.get(vsrc, f) for f in vfields], axis=1)
+            vsig = np.full((T, 3), 0.2)
+            vs = f"{vsrc} velocity interpolated (no accelerometer/attitude to smooth it)"
+        for i, k in enumerate(("vn", "ve", "vd")):
+            data[k], sigma[k], sources[k] = v_ned[:, i], vsig[:, i], vs
+        if C is not None:
+            vb = np.einsum("tji,tj->ti", C, v_ned)
+            for i, k in enumerate(("u", "v", "w")):
+                data[k], sources[k] = vb[:, i], "C' (v_ned) with the smoothed attitude"
+        else:
+            missing.append("u v w: no attitude to rotate the ground velocity into body axes")
+    else:
+        missing.append("vn ve vd u v w: no GPS (GLOBAL_POSITION_INT / GPS) or LOCAL_POSITION_NED velocity")
+    if f_cg is not None:
+        f_corr = f_cg - abias
+        for i, k in enumerate(("ax", "ay", "az")):
+            data[k] = f_corr[:, i]
+            sigma[k] = np.full(T, noise_std(f_cg[:, i], 1e-3))
+            sources[k] = "IMU specific force at the CG (lever arm removed)" + (
+                ", minus the KF accelerometer bias" if v_ned is not None and C is not None else "")
+    prog(0.75)
+
+    # --- air data -------------------------------------------------------------------------------
+    alt = al.get("gps", "alt")
+    alt_src = "GPS altitude AMSL"
+    if not np.isfinite(alt).any():
+        alt, alt_src = al.get("vfr_hud", "alt"), "VFR_HUD altitude"
+    press = al.get("pressure", "press_abs")
+    if not np.isfinite(alt).any() and np.isfinite(press).any():
+        alt, alt_src = pressure_altitude(press), "pressure altitude (ISA)"
+    if np.isfinite(alt).any():
+        data["alt"], sources["alt"] = alt, alt_src
+    else:
+        missing.append("alt: no GPS, VFR_HUD or pressure altitude")
+    # The logged baro temperature is the sensor's own (board) temperature, typically 5-15 K above the
+    # outside air: static pressure is used with the ISA temperature at the pressure altitude instead.
+    rho = density(press)
+    rho_isa = isa(np.nan_to_num(alt, nan=0.0))[2]
+    have_p = np.isfinite(rho)
+    rho = np.where(have_p, rho, rho_isa)
+    sources["rho"] = ("p/(R T) from SCALED_PRESSURE/BARO press_abs with the ISA temperature at the pressure "
+                      "altitude" if have_p.any() else "ISA at the " + alt_src)
+    temp = al.get("pressure", "temperature")
+    if have_p.any() and np.isfinite(temp).any():
+        dT = float(np.nanmedian(temp) - np.nanmedian(isa(pressure_altitude(press[have_p]))[1]))
+        notes.append(f"baro temperature is {dT:+.1f} K from the ISA at the pressure altitude; not used for "
+                     "density (it is the sensor's board temperature)")
+    if not have_p.all() and have_p.any():
+        sources["rho"] += "; ISA where no pressure sample"
+    data["rho"] = rho
+    eas = al.get("airspeed", "eas")
+    eas_src, eas_stream = "airspeed (SCALED_PRESSURE press_diff / ARSP) EAS", ("airspeed", "eas")
+    if not np.isfinite(eas).any():
+        eas, eas_src = al.get("vfr_hud", "airspeed"), "VFR_HUD airspeed (ArduPilot: EAS)"
+        eas_stream = ("vfr_hud", "airspeed")
+    gs = np.linalg.norm(v_ned[:, :2], axis=1) if v_ned is not None else np.full(T, np.nan)
+    if np.isfinite(eas).any() and np.nanmax(eas) < 1.0 and np.nanmax(gs) > 5.0:
+        eas = np.full(T, np.nan)
+        notes.append("airspeed reads 0 throughout while the aircraft moves: pitot ignored")
+    tas = tas_from_eas(eas, rho)
+    have_tas = np.isfinite(tas).sum() >= 10
+    wind_ap = _stack(al, "wind", ("wn", "we", "wd"))
+    wind = None
+    k_pitot = None
+    if v_ned is not None:
+        fly = have_tas & np.isfinite(tas) & (np.nan_to_num(tas) > min(V_FLOOR, 0.5 * np.nanpercentile(tas, 90)))\
+            if have_tas else None
+        if fly is not None and fly.sum() >= 10:
+            try:
+                We = estimate_wind(t, v_ned, tas, fly, prior=wind_ap, C=C)
+                wind, wsig = We.wind, We.sigma
+                sources["wind"] = ("least squares over 30 s windows: |v_gps - w| = k V_tas, beta ~ 0 on average" +
+                                   (" (autopilot WIND/XKF2 only as a weak prior)" if wind_ap is not None else ""))
+                kn = (f"pitot scale k = {We.scale:.3f} +- {We.scale_sigma:.3f}" if np.isfinite(We.scale_sigma)
+                      else "pitot scale kept at 1 (too few turns to separate it from the wind)")
+                notes.append(f"{kn}; mean wind N E = {wind[:, 0].mean():+.2f}, {wind[:, 1].mean():+.2f} m/s")
+                k_pitot = We.scale
+            except ValueError:
+                wind = None
+        if wind is None and wind_ap is not None:
+            wind = np.stack([np.interp(t, t[np.isfinite(wind_ap[:, i])], wind_ap[np.isfinite(wind_ap[:, i]), i])
+                             for i in range(3)], axis=1)
+            wsig = np.full((T, 3), 1.0)
+            sources["wind"] = "autopilot's wind estimate (WIND / XKF2), no usable airspeed to estimate our own"
+            notes.append("wind taken from the autopilot's estimate (no usable airspeed): V, alpha, beta inherit "
+                         "its errors")
+        if wind is None:
+            wind, wsig = np.zeros((T, 3)), np.full((T, 3), 5.0)
+            sources["wind"] = "assumed calm: no airspeed and no autopilot wind estimate"
+            notes.append("no airspeed and no wind estimate: calm air assumed, V alpha beta are ground-relative")
+        for i, k in enumerate(("wn", "we", "wd")):
+            data[k], sigma[k] = wind[:, i], wsig[:, i]
+    V = alpha = beta = None
+    if v_ned is not None and C is not None:
+        vb, V, alpha, beta = air_angles(C, v_ned, wind)
+        sources["V"] = "|C'(v_gps - wind)| (smoothed GPS velocity minus wind; the pitot calibrates the wind)"
+        if k_pitot is not None:
+            # gusts along the flight path: what the pitot sees beyond the windowed wind, smoothed (zero phase)
+            # on the pitot's own samples (interpolated samples would have correlated noise)
+            ev = events(flight[eas_stream[0]], (eas_stream[1],), t)[:, 0]
+            j = np.nonzero(np.isfinite(ev) & fly)[0]
+            d = np.zeros(T)
+            if len(j) >= 10:
+                dj = smooth_level(float(np.median(np.diff(t[j]))), k_pitot * tas_from_eas(ev[j], rho[j]) - V[j])
+                d = np.interp(t, t[j], np.nan_to_num(dj))
+            vb[:, 0] += d
+            V = np.linalg.norm(vb, axis=1)
+            alpha = np.arctan2(vb[:, 2], vb[:, 0])
+            beta = np.arcsin(np.clip(vb[:, 1] / np.maximum(V, 1e-9), -1.0, 1.0))
+            sources["V"] += " + the smoothed pitot excess (longitudinal gusts)"
+        sources["alpha"] = "atan2(w_a, u_a) of the air-relative body velocity"
+        sources["beta"] = "asin(v_a / V) of the air-relative body velocity"
+        ident["alpha"] = (True, "reconstructed from GPS velocity, attitude and wind")
+        ident["beta"] = (True, "reconstructed from GPS velocity, attitude and wind")
+    else:
+        if have_tas:
+            V = tas
+            sources["V"] = eas_src + " -> TAS with " + sources["rho"].split(" (")[0]
+        if flight.has("aoa_ssa"):
+            alpha, beta = al.get("aoa_ssa", "alpha"), al.get("aoa_ssa", "beta")
+            for k in ("alpha", "beta"):
+                sources[k] = "AOA_SSA/AOA: the autopilot's own lagged estimate (fallback, not a vane)"
+            ident["alpha"] = (True, "autopilot's AOA estimate (lagged), fallback")
+            ident["beta"] = (False, "autopilot's sideslip estimate only: poor, not a measurement")
+            notes.append("alpha and beta from AOA_SSA/AOA, the autopilot's lagged estimate: fallback only")
+        else:
+            missing.append("alpha beta: no GPS velocity with attitude and no AOA_SSA")
+            ident["alpha"] = ident["beta"] = (False, "no GPS velocity with attitude and no AOA_SSA")
+    if V is not None:
+        data["V"] = V
+        data["qbar"] = 0.5 * rho * V**2
+        sources["qbar"] = "0.5 rho V^2"
+    else:
+        missing.append("V qbar: no airspeed and no GPS velocity with attitude")
+    if alpha is not None:
+        data["alpha"], data["beta"] = alpha, beta
+    prog(0.9)
+
+    # --- controls -------------------------------------------------------------------------------
+    servo_rate = al.rates.get("servo", 0.0)
+    if al.has("servo"):
+        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels if f"pwm{ch}" in al.values["servo"]}
+        ctrl = airframe.controls_from_pwm(pwm)
+        for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
+            if k in ctrl:
+                data[k], sources[k] = ctrl[k], f"servo PWM (zero-order hold) through the {airframe.name} servo map"
+    for k in ("delta_e", "delta_a", "delta_r"):
+        if k not in data:
+            missing.append(f"{k}: no servo output (SERVO_OUTPUT_RAW / RCOU) for its channel(s)")
+    if "delta_t" not in data:
+        thr = al.get("vfr_hud", "throttle")
+        if airframe.throttle is None:
+            data["delta_t"], sources["delta_t"] = np.zeros(T), "0: the airframe has no throttle (glider)"
+        elif np.isfinite(thr).any():
+            data["delta_t"], sources["delta_t"] = thr, "VFR_HUD throttle (no throttle servo output)"
+        else:
+            missing.append("delta_t: no throttle servo output and no VFR_HUD throttle")
+    if servo_rate and servo_rate < RATE_MIN_HZ:
+        ident["controls"] = (False, f"servo outputs at {servo_rate:.1f} Hz: control steps are smeared; "
+                                    f"{_STREAM_ADVICE}")
+        notes.append(ident["controls"][1])
+    else:
+        ident["controls"] = (al.has("servo"), f"servo outputs at {servo_rate:.0f} Hz" if servo_rate else "no servo")
+
+    # --- validity --------------------------------------------------------------------------------
+    need = ("p", "q", "r", "p_dot", "q_dot", "r_dot", "ax", "ay", "az", "V", "alpha", "beta", "qbar",
+            "delta_e", "delta_a", "delta_r", "delta_t")
+    valid = np.ones(T, bool)
+    for k in need:
+        valid &= np.isfinite(data[k]) if k in data else False
+    if V is not None and np.isfinite(V).any():
+        floor = min(V_FLOOR, 0.5 * float(np.nanpercentile(V, 90)))
+        valid &= np.nan_to_num(V) > floor
+        notes.append(f"airborne where V > {floor:.1f} m/s: {valid.mean() * 100:.0f} % of the grid valid")
+    ident["force_coefficients"] = (f_cg is not None and V is not None,
+                                   "accelerometers and airspeed present" if f_cg is not None and V is not None
+                                   else "no accelerometer or no airspeed")
+    ok_m = ident["rate_derivatives"][0] and gyro is not None and V is not None
+    ident["moment_coefficients"] = (ok_m, ident["rate_derivatives"][1] if gyro is not None else "no gyro")
+    for c in ("CX", "CY", "CZ"):          # per coefficient, as the pipeline reads them
+        ident[c] = ident["force_coefficients"]
+    for c in ("Cl", "Cm", "Cn"):
+        ident[c] = ident["moment_coefficients"]
+    prog(1.0)
+    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident)
