@@ -1,0 +1,69 @@
+"""Chunked, compiled evaluation of the layers over many rows (one compiled shape per chunk size)."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .local import LocalParams, LocalStore, local_predict_chunk, neighbours
+from .sparse import GlobalParams, GlobalPosterior, Stats, add_stats, posterior, predict_global_chunk, stats_of
+
+__all__ = ["global_stats", "global_predict", "local_predict", "global_posterior"]
+
+_stats_jit = jax.jit(stats_of)
+_predict_jit = jax.jit(predict_global_chunk)
+global_posterior = jax.jit(posterior)
+
+
+def _chunks(n: int, size: int):
+    for start in range(0, n, size):
+        yield start, min(start + size, n)
+
+
+def _pad(a: np.ndarray, size: int) -> np.ndarray:
+    if len(a) == size:
+        return a
+    pad = np.zeros((size - len(a),) + a.shape[1:], a.dtype)
+    return np.concatenate([a, pad], 0)
+
+
+def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: int) -> Stats:
+    """Sufficient statistics of all rows, accumulated over zero-padded chunks of ``batch`` rows."""
+    size = int(min(batch, max(len(Xs), 1)))
+    total = None
+    for a, b in _chunks(len(Xs), size):
+        w = _pad(np.ones(b - a), size)
+        st = _stats_jit(params, jnp.asarray(_pad(Xs[a:b], size)), jnp.asarray(_pad(Ys[a:b], size)), jnp.asarray(w))
+        total = st if total is None else add_stats(total, st)
+    if total is None:
+        st = _stats_jit(params, jnp.zeros((1, Xs.shape[1])), jnp.zeros((1, Ys.shape[1])), jnp.zeros(1))
+        total = st
+    return total
+
+
+def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, batch: int
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Latent mean and variance ``(N, P)`` of the global layer at standardised ``Xs``."""
+    P = params.A.shape[0]
+    mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
+    size = int(min(batch, max(len(Xs), 1)))
+    for a, b in _chunks(len(Xs), size):
+        m, v = _predict_jit(params, post, jnp.asarray(_pad(Xs[a:b], size)))
+        mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
+    return mean, var
+
+
+def local_predict(params: LocalParams, store: LocalStore, Xs: np.ndarray, batch: int
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Latent mean and variance ``(N, P)`` of the local layer at standardised ``Xs``."""
+    P = store.resid.shape[1]
+    mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
+    size = int(min(batch, max(len(Xs), 1)))
+    for a, b in _chunks(len(Xs), size):
+        idx, zq = neighbours(store, Xs[a:b])
+        args = (_pad(Xs[a:b], size), _pad(zq, size), _pad(store.X[idx], size), _pad(store.z[idx], size),
+                _pad(store.resid[idx], size))
+        m, v = local_predict_chunk(params, *map(jnp.asarray, args))
+        mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
+    return mean, var

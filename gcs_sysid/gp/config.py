@@ -1,0 +1,85 @@
+"""Settings of the local + global GP."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+from ..errors import InputError
+
+__all__ = ["GPConfig"]
+
+
+@dataclass(frozen=True)
+class GPConfig:
+    """How :func:`gcs_sysid.gp.fit_gp` builds the model.
+
+    Attributes:
+        n_inducing: inducing points ``M`` of the global layer (the feature space has
+            ``P*M + P*(D+1)`` dimensions; keep ``P*M`` below ~1500).
+        n_inducing_hyper: inducing points while learning the hyperparameters (the cost
+            of a step grows as ``(P*M)^3``); the final posterior uses ``n_inducing`` points
+            chosen again with the learned length-scales. None: ``n_inducing``.
+        n_train_max: rows (random subset) used to learn hyperparameters; the posterior
+            then uses every row.
+        steps: Adam steps on the VFE bound (half before and half after re-selecting the
+            inducing points when ``reselect``).
+        learning_rate: Adam step size (unconstrained, log-scale parameters).
+        rank: rank ``R`` of the shared part ``L L^T`` of the coregionalisation matrix.
+        inducing: ``"mi"`` (greedy mutual information), ``"kmeans"`` or ``"random"``.
+        mi_pool: candidates for the mutual-information selection.
+        reselect: re-run the selection with the learned length-scales halfway.
+        train_inducing: also optimise the inducing inputs ``Z``.
+        linear_mean: include the linear (stability-and-control-derivative) mean.
+        prior_std: prior std of the linear-mean weights, standardised units.
+        jitter: added to the diagonal of ``Kmm``.
+        local: add the local non-stationary layer.
+        local_neighbours: neighbours ``K`` per local prediction.
+        local_batch: neighbourhoods in the local composite likelihood.
+        local_steps: Adam steps for the local hyperparameters.
+        batch_size: rows per compiled chunk when computing statistics and predictions.
+        seed: seed of every random choice.
+    """
+
+    n_inducing: int = 128
+    n_inducing_hyper: int | None = 64
+    n_train_max: int = 2000
+    steps: int = 300
+    learning_rate: float = 0.05
+    rank: int = 2
+    inducing: str = "mi"
+    mi_pool: int = 1500
+    reselect: bool = True
+    train_inducing: bool = False
+    linear_mean: bool = True
+    prior_std: float = 3.0
+    jitter: float = 1e-6
+    local: bool = True
+    local_neighbours: int = 32
+    local_batch: int = 128
+    local_steps: int = 150
+    batch_size: int = 2048
+    seed: int = 0
+
+    def __post_init__(self):
+        if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
+            raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, got {self.n_inducing_hyper!r}")
+        for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool"):
+            if int(getattr(self, name)) < 1:
+                raise InputError(f"GPConfig.{name} must be a positive integer, got {getattr(self, name)!r}")
+        for name in ("steps", "local_steps", "rank"):
+            if int(getattr(self, name)) < 0:
+                raise InputError(f"GPConfig.{name} must be >= 0, got {getattr(self, name)!r}")
+        if self.inducing not in ("mi", "kmeans", "random"):
+            raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
+        if not (self.learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0):
+            raise InputError("GPConfig: learning_rate and jitter must be > 0 and prior_std >= 0")
+
+    def to_dict(self) -> dict:
+        """JSON-able settings."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "GPConfig":
+        """Inverse of :meth:`to_dict`; unknown keys are ignored (files from newer versions)."""
+        known = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in d.items() if k in known})

@@ -1,0 +1,257 @@
+"""The fitted local + global GP: prediction, incremental update, expected variance, summary."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import jax
+import numpy as np
+
+from ..jaxconfig import enable_x64
+from .batching import global_posterior, global_predict, global_stats, local_predict
+from .config import GPConfig
+from .local import LocalParams, LocalStore, build_store
+from .scaling import Standardiser, check_inputs, check_training
+from .sparse import GlobalParams, GlobalPosterior, Stats, add_stats, elbo
+
+__all__ = ["LocalGlobalGP"]
+
+_elbo_jit = jax.jit(elbo)
+
+
+@dataclass(frozen=True)
+class LocalGlobalGP:
+    """Local + global approximated dependent multi-output GP (immutable; methods return new models).
+
+    Prediction ``y_p(x) = m_global,p(x) + m_local,p(x)`` with variance
+    ``var_global,p + var_local,p (+ noise_p)``: the global layer is the sparse ICM GP with a
+    linear mean (:mod:`gcs_sysid.gp.sparse`), the local layer the nearest-neighbour
+    non-stationary GP on its residual (:mod:`gcs_sysid.gp.local`). All arrays are in
+    standardised units inside; the methods take and return data units.
+
+    Attributes:
+        config: the settings it was fitted with.
+        scaler: input/output standardisation.
+        params: global hyperparameters. stats: sufficient statistics of the data seen.
+        post: global posterior (derived from ``params`` and ``stats``).
+        local_params, store: the local layer (None when ``config.local`` is False).
+        input_names, output_names: column names.
+        n_hyper: rows used for hyperparameter learning.
+        notes: one-line remarks made while fitting.
+    """
+
+    config: GPConfig
+    scaler: Standardiser
+    params: GlobalParams
+    stats: Stats
+    post: GlobalPosterior
+    local_params: LocalParams | None
+    store: LocalStore | None
+    input_names: tuple[str, ...]
+    output_names: tuple[str, ...]
+    n_hyper: int = 0
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    # ---------------------------------------------------------------- shapes
+    @property
+    def n_inputs(self) -> int:
+        """Number of regressors ``D``."""
+        return int(self.scaler.x_mean.shape[0])
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs ``P``."""
+        return int(self.scaler.y_mean.shape[0])
+
+    @property
+    def n_used(self) -> int:
+        """Rows the posterior is conditioned on."""
+        return int(round(float(self.stats.n)))
+
+    # ------------------------------------------------------------ prediction
+    def _standardise_query(self, X) -> tuple[np.ndarray, np.ndarray]:
+        X = check_inputs(X, self.n_inputs, "X")
+        ok = np.isfinite(X).all(1)
+        return self.scaler.x(X[ok]), ok
+
+    def _finish(self, ok, mean_s, var_s):
+        mean = np.full((len(ok), self.n_outputs), np.nan)
+        var = np.full_like(mean, np.nan)
+        mean[ok], var[ok] = self.scaler.y_back(mean_s, var_s)
+        return mean, var
+
+    def predict(self, X, include_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Predictive mean and variance of the coefficients.
+
+        Args:
+            X: ``(N, D)`` regressors in data units (rows with NaN give NaN outputs).
+            include_noise: add the observation noise (of the local layer when present).
+
+        Returns:
+            ``(mean (N, P), var (N, P))`` in the outputs' units (variance in units squared).
+
+        Raises:
+            InputError: ``X`` is not ``(N, D)``.
+        """
+        enable_x64()
+        Xs, ok = self._standardise_query(X)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size)
+        noise = np.asarray(self.params.noise)
+        if self.local_params is not None and self.store is not None:
+            ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
+            mean, var = mean + ml, var + vl
+            noise = np.asarray(self.local_params.noise)
+        if include_noise:
+            var = var + noise[None, :]
+        return self._finish(ok, mean, var)
+
+    def predict_global(self, X, include_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Mean and variance ``(N, P)`` of the global layer alone (linear mean + sparse ICM GP)."""
+        enable_x64()
+        Xs, ok = self._standardise_query(X)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size)
+        if include_noise:
+            var = var + np.asarray(self.params.noise)[None, :]
+        return self._finish(ok, mean, var)
+
+    # ------------------------------------------------------------ conditioning
+    def _with_stats(self, stats: Stats) -> "LocalGlobalGP":
+        return replace(self, stats=stats, post=global_posterior(self.params, stats))
+
+    def update(self, X_new, Y_new) -> "LocalGlobalGP":
+        """Condition on new rows without refitting hyperparameters.
+
+        The global layer's sufficient statistics are sums over rows (``Phi Phi^T``,
+        ``Phi Y`` ...; :class:`gcs_sysid.gp.sparse.Stats`), so the new posterior equals the
+        one computed from all rows at once with the same hyperparameters. The local layer
+        adds the rows to its store and recomputes the residuals of the updated global mean.
+        The standardisation is kept.
+
+        Args:
+            X_new: ``(N, D)`` regressors. Y_new: ``(N, P)`` coefficients, data units.
+
+        Returns:
+            A new :class:`LocalGlobalGP`.
+
+        Raises:
+            InputError: wrong shapes. DataError: no finite row.
+        """
+        enable_x64()
+        X_new, Y_new, notes = check_training(X_new, Y_new, self.n_inputs, self.n_outputs)
+        Xs, Ys = self.scaler.x(X_new), self.scaler.y(Y_new)
+        stats = add_stats(self.stats, global_stats(self.params, Xs, Ys, self.config.batch_size))
+        model = self._with_stats(stats)
+        if model.store is not None:
+            X_all = np.vstack([self.store.X, Xs])
+            Y_all = np.vstack([self.store.resid + self._global_mean_s(self.store.X), Ys])
+            resid = Y_all - model._global_mean_s(X_all)
+            model = replace(model, store=build_store(X_all, resid, self.store.metric, self.store.k))
+        return replace(model, notes=self.notes + tuple(notes))
+
+    def _global_mean_s(self, Xs: np.ndarray) -> np.ndarray:
+        return global_predict(self.params, self.post, Xs, self.config.batch_size)[0]
+
+    def variance_after(self, X_extra, X_query, include_noise: bool = True) -> np.ndarray:
+        """Predictive variance at ``X_query`` if noisy observations were added at ``X_extra``.
+
+        The variance of a GP does not depend on the observed values, so the statistics of
+        ``X_extra`` (with any ``Y``) are added to the global layer (a rank-``P*E`` change of
+        the posterior precision, refactored) and its points to the local layer's store.
+
+        Args:
+            X_extra: ``(E, D)`` candidate regressors (e.g. a maneuver's trajectory).
+            X_query: ``(Q, D)`` where the variance is wanted.
+
+        Returns:
+            ``(Q, P)`` predictive variance, data units squared.
+        """
+        enable_x64()
+        Xe, _ = self._standardise_query(X_extra)
+        if len(Xe) == 0:
+            return self.predict(X_query, include_noise)[1]
+        zeros = np.zeros((len(Xe), self.n_outputs))
+        extra = self._with_stats(add_stats(self.stats, global_stats(self.params, Xe, zeros, self.config.batch_size)))
+        if self.store is not None:
+            X_all = np.vstack([self.store.X, Xe])
+            store = build_store(X_all, np.vstack([self.store.resid, zeros]), self.store.metric, self.store.k)
+            extra = replace(extra, store=store)
+        return extra.predict(X_query, include_noise)[1]
+
+    # ------------------------------------------------------------ reporting
+    def output_correlation(self) -> np.ndarray:
+        """Correlation ``(P, P)`` between the outputs' global GP parts, from ``B``."""
+        B = np.asarray(self.params.B)
+        s = np.sqrt(np.diag(B))
+        return B / np.outer(s, s)
+
+    def linear_derivatives(self) -> tuple[np.ndarray, np.ndarray]:
+        """Posterior-mean linear part of the model in data units.
+
+        Returns:
+            ``(intercept (P,), slopes (P, D))``: ``y_p ~ intercept_p + slopes_p . x`` (the GP
+            adds the nonlinear rest; inactive inputs have slope 0).
+        """
+        P, D = self.n_outputs, self.n_inputs
+        K = self.post.b.shape[0]
+        mu = np.asarray(jax.scipy.linalg.cho_solve((self.post.L, True), self.post.b))
+        W = float(self.params.prior_std) * mu[K - P * (D + 1):].reshape(P, D + 1)
+        sc = self.scaler
+        slopes = sc.y_std[:, None] * W[:, 1:] / sc.x_std[None, :] * sc.active[None, :]
+        intercept = sc.y_mean + sc.y_std * W[:, 0] - slopes @ sc.x_mean
+        return intercept, slopes
+
+    def elbo(self) -> float:
+        """VFE bound on the log marginal likelihood of all rows seen (standardised units)."""
+        return float(_elbo_jit(self.params, self.stats))
+
+    def summary(self) -> dict[str, Any]:
+        """Hyperparameters and sizes, JSON-able (data units unless marked standardised)."""
+        sc = self.scaler
+        ls = np.asarray(self.params.lengthscale)
+        names = self.input_names
+
+        def scales(values):
+            return {n: (float(v * s) if a else None) for n, v, s, a in zip(names, values, sc.x_std, sc.active)}
+
+        B = np.asarray(self.params.B)
+        intercept, slopes = self.linear_derivatives()
+        out: dict[str, Any] = {
+            "kind": "LocalGlobalGP",
+            "approximation": "VFE (Titsias 2009), intrinsic coregionalisation, linear mean",
+            "inputs": list(names), "outputs": list(self.output_names),
+            "inactive_inputs": [n for n, a in zip(names, sc.active) if not a],
+            "n_inducing": int(self.params.Z.shape[0]), "n_used": self.n_used, "n_hyper": int(self.n_hyper),
+            "elbo": self.elbo(), "elbo_per_point": self.elbo() / max(self.n_used * self.n_outputs, 1),
+            "global": {
+                "lengthscales": scales(ls),
+                "lengthscales_standardised": {n: float(v) for n, v in zip(names, ls)},
+                "B_standardised": B.tolist(),
+                "output_correlation": self.output_correlation().tolist(),
+                "signal_std": dict(zip(self.output_names, (np.sqrt(np.diag(B)) * sc.y_std).tolist())),
+                "noise_std": dict(zip(self.output_names, (np.sqrt(np.asarray(self.params.noise)) * sc.y_std).tolist())),
+                "linear_intercept": dict(zip(self.output_names, intercept.tolist())),
+                "linear_derivatives": {o: dict(zip(names, row.tolist())) for o, row in zip(self.output_names, slopes)},
+            },
+            "local": None,
+            "notes": list(self.notes),
+        }
+        if self.local_params is not None and self.store is not None:
+            lp = self.local_params
+            out["local"] = {
+                "neighbours": int(self.store.k), "n_stored": int(len(self.store.X)),
+                "lengthscales": scales(np.asarray(lp.lengthscale)),
+                "beta": float(lp.beta),
+                "signal_std": dict(zip(self.output_names, (np.sqrt(np.asarray(lp.amp)) * sc.y_std).tolist())),
+                "noise_std": dict(zip(self.output_names, (np.sqrt(np.asarray(lp.noise)) * sc.y_std).tolist())),
+            }
+        return out
+
+    def save(self, path) -> str:
+        """Write the model to ``<path>.npz`` (arrays) and ``<path>.json`` (settings); no pickle.
+
+        Returns the npz path. See :func:`gcs_sysid.gp.load_gp`.
+        """
+        from .io import save_model
+
+        return save_model(self, path)

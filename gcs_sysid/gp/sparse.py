@@ -1,0 +1,253 @@
+"""Global layer: sparse (VFE) intrinsic-coregionalisation GP with a Bayesian linear mean.
+
+Model, in standardised units (``x`` of shape ``(D,)``, ``P`` outputs)::
+
+    y_p(x) = xa(x)^T W_p + f_p(x) + eps_p,   xa = [1, x],  eps_p ~ N(0, sigma_p^2)
+    f(x) = A g(x),  A A^T = B = L L^T + diag(kappa),  g_q ~ GP(0, k) independent (ICM)
+    W_p ~ N(0, v I)   (the stability-and-control-derivative model as an explicit basis,
+                        Rasmussen and Williams 2006, sec. 2.7)
+
+Inducing variables ``u_q = g_q(Z)`` at ``M`` points ``Z``, whitened ``u_q = Lm w_q``
+with ``Kmm = Lm Lm^T`` (so ``Kuu = I_P kron Kmm`` for the latent ``g``, and
+``B kron Kmm`` for ``f``). With ``phi(x) = Lm^{-1} k(Z, x)`` the projected model is a
+Bayesian linear model in ``theta = [w (P*M); W / sqrt(v) (P*(D+1))]``, prior ``N(0, I)``,
+with feature ``psi_p(x) = [a_p kron phi(x); sqrt(v) e_p kron xa(x)]`` for output ``p``.
+Its posterior precision and projection::
+
+    Lambda = I + sum_{n,p} psi_p(x_n) psi_p(x_n)^T / sigma_p^2,   b = sum_{n,p} psi_p(x_n) y_np / sigma_p^2
+
+depend on the data only through the additive sufficient statistics (:class:`Stats`)
+``C = Phi Phi^T, E = Phi Xa, F = Xa^T Xa, Rphi = Phi Y, Rx = Xa^T Y, yy = sum y^2, n``,
+and are assembled with Kronecker products (``G kron C`` with ``G = A^T diag(1/sigma^2) A``).
+Titsias (2009), "Variational learning of inducing variables in sparse Gaussian
+processes", AISTATS, eq. 9 (collapsed bound); the multi-output form follows Alvarez,
+Luengo, Titsias and Lawrence (2010), "Efficient multioutput Gaussian processes through
+variational inducing kernels", AISTATS.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import jax
+import jax.numpy as jnp
+from jax.scipy.linalg import cho_solve, solve_triangular
+
+from .kernels import ARDSquaredExponential
+
+__all__ = ["GlobalParams", "Stats", "GlobalPosterior", "stats_of", "add_stats", "elbo", "logdet_quad", "posterior",
+           "predict_global_chunk", "design"]
+
+_LOG2PI = float(jnp.log(2.0 * jnp.pi))
+
+
+@jax.tree_util.register_dataclass
+@dataclass(frozen=True)
+class GlobalParams:
+    """Hyperparameters of the global layer (constrained values).
+
+    Attributes:
+        lengthscale: ``(D,)`` ARD length-scales (standardised inputs).
+        A: ``(P, P)`` lower Cholesky factor of the coregionalisation matrix ``B``.
+        noise: ``(P,)`` noise variances ``sigma_p^2``.
+        Z: ``(M, D)`` inducing inputs.
+        prior_std: scalar ``sqrt(v)``, prior std of the linear-mean weights.
+        jitter: scalar added to the diagonal of ``Kmm``.
+    """
+
+    lengthscale: jax.Array
+    A: jax.Array
+    noise: jax.Array
+    Z: jax.Array
+    prior_std: jax.Array
+    jitter: jax.Array
+
+    @property
+    def B(self) -> jax.Array:
+        """Coregionalisation matrix ``(P, P)``."""
+        return self.A @ self.A.T
+
+
+@jax.tree_util.register_dataclass
+@dataclass(frozen=True)
+class Stats:
+    """Additive sufficient statistics of the data for fixed hyperparameters (whitened features).
+
+    Attributes: C ``(M, M)``, E ``(M, D+1)``, F ``(D+1, D+1)``, Rphi ``(M, P)``, Rx ``(D+1, P)``,
+    yy ``(P,)``, n scalar (rows).
+    """
+
+    C: jax.Array
+    E: jax.Array
+    F: jax.Array
+    Rphi: jax.Array
+    Rx: jax.Array
+    yy: jax.Array
+    n: jax.Array
+
+
+@jax.tree_util.register_dataclass
+@dataclass(frozen=True)
+class GlobalPosterior:
+    """Posterior of the global layer, ready for prediction.
+
+    Attributes:
+        Lm: ``(M, M)`` Cholesky factor of ``Kmm``.
+        L: ``(K, K)`` Cholesky factor of the posterior precision ``Lambda`` (K = P*M + P*(D+1)).
+        b: ``(K,)`` projection of the data.
+        weights: ``(M+D+1, P)`` predictive-mean weights on ``u = [phi(x); xa(x)]``.
+        H: ``(P, M+D+1, M+D+1)`` posterior covariance of ``S_p^T theta`` per output.
+    """
+
+    Lm: jax.Array
+    L: jax.Array
+    b: jax.Array
+    weights: jax.Array
+    H: jax.Array
+
+
+def design(Xs: jax.Array) -> jax.Array:
+    """Linear-mean design matrix ``xa = [1, x]`` of shape ``(N, D+1)``."""
+    return jnp.concatenate([jnp.ones((Xs.shape[0], 1), Xs.dtype), Xs], axis=1)
+
+
+def _chol_kmm(params: GlobalParams) -> jax.Array:
+    Z = params.Z
+    Kmm = ARDSquaredExponential(params.lengthscale)(Z, Z)
+    return jnp.linalg.cholesky(Kmm + params.jitter * jnp.eye(Z.shape[0], dtype=Z.dtype))
+
+
+def _features(params: GlobalParams, Lm: jax.Array, Xs: jax.Array) -> jax.Array:
+    """Whitened features ``phi = Lm^{-1} k(Z, X)`` of shape ``(M, N)``."""
+    Kzx = ARDSquaredExponential(params.lengthscale)(params.Z, Xs)
+    return solve_triangular(Lm, Kzx, lower=True)
+
+
+def stats_of(params: GlobalParams, Xs: jax.Array, Ys: jax.Array, weight: jax.Array | None = None) -> Stats:
+    """Sufficient statistics of ``(Xs (N, D), Ys (N, P))``; rows with ``weight`` 0 count as absent.
+
+    ``weight`` ``(N,)`` of 0/1 lets padded batches keep one compiled shape.
+    """
+    Lm = _chol_kmm(params)
+    Phi = _features(params, Lm, Xs)
+    Xa = design(Xs)
+    w = jnp.ones(Xs.shape[0], Xs.dtype) if weight is None else weight
+    Phiw, Xaw = Phi * w[None, :], Xa * w[:, None]
+    return Stats(C=Phiw @ Phi.T, E=Phiw @ Xa, F=Xaw.T @ Xa, Rphi=Phiw @ Ys, Rx=Xaw.T @ Ys,
+                 yy=jnp.sum(w[:, None] * Ys * Ys, 0), n=jnp.sum(w))
+
+
+def add_stats(a: Stats, b: Stats) -> Stats:
+    """Statistics of the union of two data sets (they are sums over rows)."""
+    return jax.tree_util.tree_map(jnp.add, a, b)
+
+
+def _assemble(params: GlobalParams, st: Stats) -> tuple[jax.Array, jax.Array]:
+    """Posterior precision ``Lambda (K, K)`` and projection ``b (K,)`` from statistics."""
+    A, sv = params.A, params.prior_std
+    dinv = 1.0 / params.noise
+    G = A.T @ (dinv[:, None] * A)                       # (Q, Q): sum_p a_p a_p^T / sigma_p^2
+    ww = jnp.kron(G, st.C)
+    wo = sv * jnp.kron(A.T * dinv[None, :], st.E)        # rows (q, m), cols (p, j)
+    oo = sv * sv * jnp.kron(jnp.diag(dinv), st.F)
+    lam = jnp.block([[ww, wo], [wo.T, oo]])
+    lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
+    bw = ((st.Rphi * dinv[None, :]) @ A).T.reshape(-1)    # b_{q,m} = sum_p A_pq Rphi_mp / sigma_p^2
+    bo = sv * (st.Rx * dinv[None, :]).T.reshape(-1)       # b_{p,j} = sqrt(v) Rx_jp / sigma_p^2
+    return lam, jnp.concatenate([bw, bo])
+
+
+@jax.custom_vjp
+def logdet_quad(lam: jax.Array, b: jax.Array) -> tuple[jax.Array, jax.Array]:
+    """``(log|Lambda|, b^T Lambda^{-1} b)`` for symmetric positive definite ``Lambda (K, K)``.
+
+    Forward by Cholesky; the gradient in closed form, ``d log|Lambda| = Lambda^{-1}``,
+    ``d quad / d Lambda = -mu mu^T``, ``d quad / d b = 2 mu`` with ``mu = Lambda^{-1} b``
+    (Rasmussen and Williams 2006, eq. 5.9; Petersen and Pedersen, *The Matrix Cookbook*,
+    eqs. 57 and 61), which is several times cheaper on CPU than differentiating the
+    Cholesky factorisation.
+    """
+    return _logdet_quad_fwd(lam, b)[0]
+
+
+def _logdet_quad_fwd(lam, b):
+    L = jnp.linalg.cholesky(lam)
+    mu = cho_solve((L, True), b)
+    inv = cho_solve((L, True), jnp.eye(lam.shape[0], dtype=lam.dtype))
+    return (2.0 * jnp.sum(jnp.log(jnp.diag(L))), b @ mu), (mu, inv)
+
+
+def _logdet_quad_bwd(res, g):
+    mu, inv = res
+    g_logdet, g_quad = g
+    return g_logdet * inv - g_quad * jnp.outer(mu, mu), 2.0 * g_quad * mu
+
+
+logdet_quad.defvjp(_logdet_quad_fwd, _logdet_quad_bwd)
+
+
+def elbo(params: GlobalParams, st: Stats) -> jax.Array:
+    """Collapsed VFE bound (Titsias 2009, eq. 9) on ``log p(y)``, a scalar.
+
+    ``log N(y | 0, Psi Psi^T + Sigma) - 0.5 sum_p B_pp / sigma_p^2 (n - tr(Phi Phi^T))``,
+    with the Gaussian term by the matrix determinant lemma and Woodbury identity in the
+    ``K``-dimensional feature space.
+    """
+    lam, b = _assemble(params, st)
+    P = params.noise.shape[0]
+    logdet, bmb = logdet_quad(lam, b)
+    quad = jnp.sum(st.yy / params.noise) - bmb
+    loglik = -0.5 * (st.n * P * _LOG2PI + st.n * jnp.sum(jnp.log(params.noise)) + logdet + quad)
+    bdiag = jnp.sum(params.A**2, 1)
+    trace = -0.5 * jnp.sum(bdiag / params.noise) * (st.n - jnp.trace(st.C))
+    return loglik + trace
+
+
+def _selectors(params: GlobalParams, M: int) -> jax.Array:
+    """``S_p`` of shape ``(P, K, M+D+1)``: ``psi_p(x) = S_p [phi(x); xa(x)]``."""
+    A = params.A
+    P = A.shape[0]
+    D1 = params.Z.shape[1] + 1
+    eyeM, eyeD = jnp.eye(M, dtype=A.dtype), jnp.eye(D1, dtype=A.dtype)
+
+    def one(p):
+        top = jnp.kron(A[p][:, None], eyeM)                                  # (P*M, M)
+        bot = params.prior_std * jnp.kron(jax.nn.one_hot(p, P, dtype=A.dtype)[:, None], eyeD)
+        return jnp.block([[top, jnp.zeros((P * M, D1), A.dtype)], [jnp.zeros((P * D1, M), A.dtype), bot]])
+
+    return jax.vmap(one)(jnp.arange(P))
+
+
+def posterior(params: GlobalParams, st: Stats) -> GlobalPosterior:
+    """Gaussian posterior of ``theta`` given statistics, in predictive form.
+
+    Mean ``Lambda^{-1} b`` (cho_solve), covariance ``Lambda^{-1}``; per output
+    ``H_p = (L^{-1} S_p)^T (L^{-1} S_p) = S_p^T Lambda^{-1} S_p``.
+    """
+    Lm = _chol_kmm(params)
+    lam, b = _assemble(params, st)
+    L = jnp.linalg.cholesky(lam)
+    mu = cho_solve((L, True), b)
+    S = _selectors(params, params.Z.shape[0])
+    weights = jnp.einsum("pkj,k->jp", S, mu)
+    V = jax.vmap(lambda s: solve_triangular(L, s, lower=True))(S)
+    H = jnp.einsum("pkj,pki->pji", V, V)
+    return GlobalPosterior(Lm=Lm, L=L, b=b, weights=weights, H=H)
+
+
+def predict_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array
+                         ) -> tuple[jax.Array, jax.Array]:
+    """Latent mean and variance ``(N, P)`` of ``xa^T W_p + f_p`` at standardised ``Xs (N, D)``.
+
+    ``var_p = B_pp (1 - |phi|^2) + u^T H_p u`` with ``u = [phi; xa]`` (Titsias 2009, eq. 6,
+    in whitened form). Noise is not included.
+    """
+    Kzx = ARDSquaredExponential(params.lengthscale)(params.Z, Xs)
+    phi = solve_triangular(post.Lm, Kzx, lower=True)             # (M, N)
+    u = jnp.concatenate([phi, design(Xs).T], axis=0)             # (M+D1, N)
+    mean = u.T @ post.weights
+    bdiag = jnp.sum(params.A**2, 1)
+    prior_rest = bdiag[None, :] * jnp.maximum(1.0 - jnp.sum(phi * phi, 0), 0.0)[:, None]
+    explained = jnp.einsum("pij,in,jn->np", post.H, u, u)
+    var = jnp.maximum(prior_rest + explained, 1e-12 * bdiag[None, :])
+    return mean, var

@@ -1,0 +1,49 @@
+"""Seeded flight-like data and small, fast GP settings shared by the gp tests (a helper module, not tests)."""
+
+import numpy as np
+
+from gcs_sysid.gp import GPConfig
+
+#: Derivative model (rows CX CY CZ Cl Cm Cn; columns bias, alpha beta p_hat q_hat r_hat d_e d_a d_r d_t V).
+DERIVATIVES = np.array([
+    [-0.03, 0.25, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.10, 0.002],
+    [0.0, 0.0, -0.35, 0.0, 0.0, 0.25, 0.0, 0.0, 0.15, 0.0, 0.0],
+    [-0.25, -4.5, 0.0, 0.0, -6.0, 0.0, -0.35, 0.0, 0.0, 0.0, 0.0],
+    [0.0, 0.0, -0.05, -0.45, 0.0, 0.10, 0.0, -0.20, 0.004, 0.0, 0.0],
+    [0.02, -0.6, 0.0, 0.0, -12.0, 0.0, -1.1, 0.0, 0.0, 0.0, 0.0],
+    [0.0, 0.0, 0.07, -0.03, 0.0, -0.12, 0.0, 0.01, -0.06, 0.0, 0.0],
+])
+
+#: Small settings: every fitted model in the gp tests shares these shapes (one compile each).
+FAST = GPConfig(n_inducing=24, n_train_max=300, steps=150, learning_rate=0.1, mi_pool=300, local_neighbours=16,
+                local_batch=32, local_steps=30, batch_size=256)
+
+
+def flight_regressors(n: int, seed: int, rate_hz: float = 20.0) -> np.ndarray:
+    """Smooth random regressors ``(n, 10)`` near trim (rad, -, m/s), like a sysid flight."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / rate_hz
+
+    def smooth(scale, offset=0.0):
+        f, ph = rng.uniform(0.05, 0.8, 4), rng.uniform(0, 2 * np.pi, 4)
+        return offset + scale * np.sum(np.sin(2 * np.pi * f[:, None] * t + ph[:, None]), 0) / 2.0
+
+    return np.column_stack([
+        smooth(np.radians(3.0), np.radians(4.0)), smooth(np.radians(2.0)), smooth(0.02), smooth(0.01),
+        smooth(0.01), smooth(np.radians(3.0), np.radians(-2.0)), smooth(np.radians(3.0)), smooth(np.radians(2.5)),
+        np.clip(smooth(0.1, 0.55), 0, 1), smooth(2.0, 18.0)])
+
+
+def linear_truth(X: np.ndarray) -> np.ndarray:
+    """Coefficients ``(n, 6)`` of the derivative model at ``X``."""
+    return np.column_stack([np.ones(len(X)), X]) @ DERIVATIVES.T
+
+
+def nonlinear_truth(X: np.ndarray) -> np.ndarray:
+    """Linear model plus smooth nonlinear terms (a lift-curve bend in CZ and Cm, a beta^2 drag term in CX)."""
+    Y = linear_truth(X)
+    alpha, beta = X[:, 0], X[:, 1]
+    Y[:, 0] += -2.0 * beta**2
+    Y[:, 2] += 30.0 * np.maximum(alpha - np.radians(5.0), 0.0) ** 2
+    Y[:, 4] += -0.3 * np.sin(alpha * 25.0)
+    return Y
