@@ -13,7 +13,7 @@ Rauch-Tung-Striebel pass (offline, zero phase lag):
    bias-corrected gyro integral between nodes with the smoothed node values as
    end conditions (drift-corrected integration). The bias and the node attitude
    are slow; the fast part comes from the gyro, as it would in the full-rate filter.
-2. :func:`~gcs_sysid.estimation.smoothers.smooth_rates`: per axis, a linear rate / acceleration / jerk model
+2. :func:`~gcs_sysid.estimation.rates.smooth_rates`: per axis, a linear rate / acceleration / jerk model
    (white snap) measured by the bias-corrected gyro, at the full grid rate with
    steady-state gains (:func:`~gcs_sysid.estimation.kalman.steady_state_smoother`,
    exact for this time-invariant model). The smoother bandwidth is chosen per

@@ -20,7 +20,8 @@ from ..telemetry.types import Flight
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
-from .smoothers import smooth_level, smooth_rates, smooth_velocity
+from .rates import smooth_rates, smooth_specific_force
+from .smoothers import smooth_level, smooth_velocity
 from .kalman import noise_std
 from .states import FlightStates
 
@@ -113,19 +114,64 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         missing.append("phi theta psi: no attitude stream (ATTITUDE / ATT / EKF); the IMU alone cannot level")
     prog(0.35)
 
+    # --- controls -------------------------------------------------------------------------------
+    servo_rate = al.rates.get("servo", 0.0)
+    if al.has("servo"):
+        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels if f"pwm{ch}" in al.values["servo"]}
+        ctrl = airframe.controls_from_pwm(pwm)
+        for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
+            if k in ctrl:
+                data[k], sources[k] = ctrl[k], f"servo PWM (zero-order hold) through the {airframe.name} servo map"
+    for k in ("delta_e", "delta_a", "delta_r"):
+        if k not in data:
+            missing.append(f"{k}: no servo output (SERVO_OUTPUT_RAW / RCOU) for its channel(s)")
+    if "delta_t" not in data:
+        thr = al.get("vfr_hud", "throttle")
+        if airframe.throttle is None:
+            data["delta_t"], sources["delta_t"] = np.zeros(T), "0: the airframe has no throttle (glider)"
+        elif np.isfinite(thr).any():
+            data["delta_t"], sources["delta_t"] = thr, "VFR_HUD throttle (no throttle servo output)"
+        else:
+            missing.append("delta_t: no throttle servo output and no VFR_HUD throttle")
+    if servo_rate and servo_rate < RATE_MIN_HZ:
+        ident["controls"] = (False, f"servo outputs at {servo_rate:.1f} Hz: control steps are smeared; "
+                                    f"{_STREAM_ADVICE}")
+        notes.append(ident["controls"][1])
+    else:
+        ident["controls"] = (al.has("servo"), f"servo outputs at {servo_rate:.0f} Hz" if servo_rate else "no servo")
+
     # --- rates and angular accelerations ------------------------------------------------------
     W = Wd = None
+    in_lag = None
+    # control commands as known inputs: angular accelerations and forces jump where they step; their
+    # effectiveness scales with the dynamic pressure, here from the pitot's EAS (0.5 rho0 EAS^2)
+    cnames = [k for k in ("delta_e", "delta_a", "delta_r", "delta_t")
+              if k in data and ident["controls"][0] and sources[k].startswith("servo")]
+    U = np.stack([data[k] for k in cnames], axis=1) if cnames else None
+    eas_q = al.get("airspeed", "eas")
+    if not np.isfinite(eas_q).any():
+        eas_q = al.get("vfr_hud", "airspeed")
+    qbar_eas = 0.5 * 1.225 * eas_q**2 if np.isfinite(eas_q).sum() >= 10 else None
     if gyro is not None:
-        Rr = smooth_rates(dt, gyro - bias)
+        Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas)
+        in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):
             data[k], sigma[k] = W[:, i], Rr.rate_sigma[:, i]
             data[k + "_dot"], sigma[k + "_dot"] = Wd[:, i], Rr.accel_sigma[:, i]
-            sources[k] = f"{gyro_src} gyro minus EKF bias, RTS-smoothed (rate/acceleration/jerk model)"
+            inputs = f", jumps at steps of {' '.join(cnames)}" if cnames else ""
+            sources[k] = f"{gyro_src} gyro minus EKF bias, RTS-smoothed (rate/acceleration/jerk model{inputs})"
             sources[k + "_dot"] = (f"RTS-smoothed derivative of the {gyro_src} gyro, bandwidth "
-                                   f"{Rr.bandwidth_hz[i]:g} Hz (maximum likelihood)")
+                                   f"{Rr.bandwidth_hz[i]:g} Hz (maximum likelihood){inputs}")
         notes.append("rate smoother bandwidth p q r = " + ", ".join(f"{b:g}" for b in Rr.bandwidth_hz)
                      + " Hz; gyro noise = " + ", ".join(f"{s:.4f}" for s in Rr.noise_std) + " rad/s")
+        if cnames:
+            unit = "rad/s^2 per Pa rad" if qbar_eas is not None else "rad/s^2 per rad"
+            notes.append("control steps taken as known inputs (" + ", ".join(cnames) + "); step effectiveness "
+                         f"({unit}) p q r: " + "; ".join(
+                             ", ".join(f"{e:+.3g}" for e in row) for row in Rr.effectiveness)
+                         + "; delay of their effect (maximum likelihood) = "
+                         + ", ".join(f"{lg * dt:.2f}" for lg in Rr.input_lag) + " s")
     else:
         missing.append("p q r p_dot q_dot r_dot: no gyro (IMU) and no rates in ATTITUDE")
     if gyro_rate < RATE_MIN_HZ:
@@ -186,12 +232,17 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     else:
         missing.append("vn ve vd u v w: no GPS (GLOBAL_POSITION_INT / GPS) or LOCAL_POSITION_NED velocity")
     if f_cg is not None:
-        f_corr = f_cg - abias
+        # the velocity filter above needs the raw samples (white noise); the coefficients get the smoothed ones
+        f_s, f_sig, f_noise = smooth_specific_force(dt, f_cg, controls=U, scale=qbar_eas, input_lag=in_lag)
+        f_corr = f_s - abias
         for i, k in enumerate(("ax", "ay", "az")):
             data[k] = f_corr[:, i]
-            sigma[k] = np.full(T, noise_std(f_cg[:, i], 1e-3))
-            sources[k] = "IMU specific force at the CG (lever arm removed)" + (
+            sigma[k] = f_sig[:, i]
+            sources[k] = "IMU specific force at the CG (lever arm removed), RTS-smoothed" + (
+                " with jumps at control steps" if cnames else "") + (
                 ", minus the KF accelerometer bias" if v_ned is not None and C is not None else "")
+        notes.append("accelerometer noise (maximum likelihood) x y z = " + ", ".join(f"{x:.3f}" for x in f_noise)
+                     + " m/s^2")
     prog(0.75)
 
     # --- air data -------------------------------------------------------------------------------
@@ -309,32 +360,6 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     if alpha is not None:
         data["alpha"], data["beta"] = alpha, beta
     prog(0.9)
-
-    # --- controls -------------------------------------------------------------------------------
-    servo_rate = al.rates.get("servo", 0.0)
-    if al.has("servo"):
-        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels if f"pwm{ch}" in al.values["servo"]}
-        ctrl = airframe.controls_from_pwm(pwm)
-        for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
-            if k in ctrl:
-                data[k], sources[k] = ctrl[k], f"servo PWM (zero-order hold) through the {airframe.name} servo map"
-    for k in ("delta_e", "delta_a", "delta_r"):
-        if k not in data:
-            missing.append(f"{k}: no servo output (SERVO_OUTPUT_RAW / RCOU) for its channel(s)")
-    if "delta_t" not in data:
-        thr = al.get("vfr_hud", "throttle")
-        if airframe.throttle is None:
-            data["delta_t"], sources["delta_t"] = np.zeros(T), "0: the airframe has no throttle (glider)"
-        elif np.isfinite(thr).any():
-            data["delta_t"], sources["delta_t"] = thr, "VFR_HUD throttle (no throttle servo output)"
-        else:
-            missing.append("delta_t: no throttle servo output and no VFR_HUD throttle")
-    if servo_rate and servo_rate < RATE_MIN_HZ:
-        ident["controls"] = (False, f"servo outputs at {servo_rate:.1f} Hz: control steps are smeared; "
-                                    f"{_STREAM_ADVICE}")
-        notes.append(ident["controls"][1])
-    else:
-        ident["controls"] = (al.has("servo"), f"servo outputs at {servo_rate:.0f} Hz" if servo_rate else "no servo")
 
     # --- validity --------------------------------------------------------------------------------
     need = ("p", "q", "r", "p_dot", "q_dot", "r_dot", "ax", "ay", "az", "V", "alpha", "beta", "qbar",

@@ -1,4 +1,4 @@
-"""Linear smoothers: body rates and angular accelerations, slowly varying levels, velocity and accel bias.
+"""Linear smoothers: slowly varying levels, velocity and accel bias (rates: :mod:`.rates`).
 
 See :mod:`gcs_sysid.estimation.ekf` for the order of work and ``docs/estimation.md``
 for the choices. References as there, plus Harvey, *Forecasting, Structural Time
@@ -7,109 +7,15 @@ Series Models and the Kalman Filter*, CUP 1989 (local level model, concentrated 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.common import Q_continuous_white_noise
 
 from .ekf import G0
 from .kalman import kalman_filter, rts_smoother, steady_state, steady_state_smoother
 from .nodes import fill_between_nodes, integrate, interp_nodes, node_indices, segments, to_nodes
 
-__all__ = ["BANDWIDTHS_HZ", "RateEstimate", "smooth_rates", "smooth_level", "VelocityEstimate", "smooth_velocity"]
-
-#: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
-BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
-
-
-# ---------------------------------------------------------------------------- rates
-
-
-@dataclass
-class RateEstimate:
-    """Smoothed body rates and angular accelerations.
-
-    Attributes:
-        rate, rate_sigma: (T, 3) p q r and 1-sigma, rad/s (NaN where no gyro).
-        accel, accel_sigma: (T, 3) p_dot q_dot r_dot and 1-sigma, rad/s^2.
-        bandwidth_hz: (3,) smoother bandwidth chosen per axis (maximum likelihood).
-        noise_std: (3,) gyro white-noise standard deviation (maximum likelihood), rad/s.
-    """
-
-    rate: np.ndarray
-    rate_sigma: np.ndarray
-    accel: np.ndarray
-    accel_sigma: np.ndarray
-    bandwidth_hz: np.ndarray
-    noise_std: np.ndarray
-
-
-def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
-                 bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ) -> RateEstimate:
-    """Body rates and their derivatives from bias-corrected gyro samples.
-
-    Per axis the state is ``[w, w_dot, w_ddot]`` with white snap of spectral
-    density ``q``; the measurement is ``w`` with white noise ``sigma^2``. The
-    smoother's bandwidth is about ``omega_c = (q / (sigma^2 dt))^(1/6)`` and its
-    means depend only on that ratio, so each candidate bandwidth fixes the ratio
-    and the scale ``sigma^2`` is profiled out of the innovation likelihood
-    (``sigma^2 = mean(y^2 / S)``); the best candidate per axis is smoothed.
-    Records are split at gaps (NaN) and each piece smoothed on its own.
-
-    Args:
-        dt: grid step, s.
-        rates: (T, 3) gyro minus bias, rad/s, NaN where missing.
-        noise_floor: smallest gyro noise assumed, rad/s (quantisation).
-        bandwidths_hz: candidate bandwidths, Hz.
-
-    Returns:
-        :class:`RateEstimate`.
-
-    Source: Bar-Shalom et al. (2001) ch. 6 (white-noise kinematic models);
-    Klein and Morelli (2006) ch. 10 (smoothed derivatives, no phase lag);
-    Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
-    CUP 1989, ch. 3 (concentrating the scale out of the likelihood).
-    """
-    T = len(rates)
-    F = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
-    H = np.array([[1.0, 0.0, 0.0]])
-    bws = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
-    nb = len(bws)
-    q0 = Q_continuous_white_noise(dim=3, dt=dt, spectral_density=1.0)
-    # unit measurement noise; q = dt * omega_c^6 sets the ratio
-    gains = [steady_state(F, dt * (2 * np.pi * f) ** 6 * q0, H, np.eye(1)) for f in bws]
-    out = {k: np.full((T, 3), np.nan) for k in ("w", "ws", "wd", "wds")}
-    bw_best = np.full(3, np.nan)
-    sig_best = np.full(3, np.nan)
-    S = np.array([g.S[0, 0] for g in gains])
-    for i in range(3):
-        segs = segments(np.isfinite(rates[:, i]), 10)
-        if not segs:
-            continue
-        ssq = np.zeros(nb)
-        n = 0
-        for sg in segs:   # forward passes of all candidates: innovations only
-            z = rates[sg, i][:, None]
-            x0 = np.array([z[0, 0], 0.0, 0.0])
-            for c, g in enumerate(gains):
-                _, innov = steady_state_smoother(F, g, H, z, x0, smooth=False)
-                ssq[c] += float((innov[:, 0] ** 2).sum()) / S[c]
-            n += len(z)
-        s2 = np.maximum(ssq / n, noise_floor**2)     # profiled measurement-noise variance
-        ll = -0.5 * n * (np.log(s2) + np.log(S))
-        b = int(np.argmax(ll))
-        bw_best[i] = bws[b]
-        sig_best[i] = math.sqrt(s2[b])
-        g = gains[b]
-        for sg in segs:
-            z = rates[sg, i][:, None]
-            xs, _ = steady_state_smoother(F, g, H, z, np.array([z[0, 0], 0.0, 0.0]))
-            out["w"][sg, i] = xs[:, 0]
-            out["wd"][sg, i] = xs[:, 1]
-            out["ws"][sg, i] = math.sqrt(s2[b] * g.Ps[0, 0])
-            out["wds"][sg, i] = math.sqrt(s2[b] * g.Ps[1, 1])
-    return RateEstimate(out["w"], out["ws"], out["wd"], out["wds"], bw_best, sig_best)
+__all__ = ["smooth_level", "VelocityEstimate", "smooth_velocity"]
 
 
 def smooth_level(dt: float, z: np.ndarray, bandwidths_hz: tuple[float, ...] = (0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 4.0),

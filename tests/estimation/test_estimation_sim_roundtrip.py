@@ -45,11 +45,18 @@ def test_air_data_and_forces_match_the_simulation(roundtrip):
         assert _rel(filtfilt(b, a, tab.y(c)), filtfilt(b, a, ref), m) < (0.1 if c == "CY" else 0.05), c
 
 
-def test_angular_accelerations_in_band(roundtrip):
-    res, st, _ = roundtrip
-    b, a = butter(4, 5.0 / 25.0)
+def test_angular_accelerations_and_moments_match_the_instantaneous_truth(roundtrip):
+    # The simulation's actuators are ideal: the angular accelerations jump at every control step. The
+    # smoother takes the servo commands as known inputs, so the jumps land on the right sample and the
+    # estimate is compared with the instantaneous truth, sample by sample, no low-pass (before the
+    # input-aware model: 25-45 % on p_dot and Cl). A finite-difference reference (np.gradient of the
+    # sampled rates) would itself be 10-30 % off here: it puts half of each jump on the previous sample.
+    res, st, tab = roundtrip
     m = np.zeros(len(st.t), bool)
     m[150:-150] = True
     for k in ("p", "q", "r"):
-        ref = filtfilt(b, a, np.interp(st.t, res.t, np.gradient(res.truth[k], res.t)))
-        assert _rel(filtfilt(b, a, st[k + "_dot"]), ref, m) < 0.08, k
+        ref = np.interp(st.t, res.t, res.truth[k + "_dot"])
+        assert _rel(st[k + "_dot"], ref, m) < 0.06, k
+    m &= tab.valid
+    for i, c in enumerate(("Cl", "Cm", "Cn")):
+        assert _rel(tab.y(c), np.interp(st.t, res.t, res.Y[:, 3 + i]), m) < 0.08, c

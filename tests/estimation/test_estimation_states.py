@@ -8,7 +8,7 @@ from gcs_sysid.airframe import airframe_from_dict
 from gcs_sysid.errors import DataError
 from gcs_sysid.estimation import estimate_states
 from gcs_sysid.estimation.ekf import smooth_attitude
-from gcs_sysid.estimation.smoothers import smooth_rates
+from gcs_sysid.estimation.rates import smooth_rates
 
 LEVER = (0.05, 0.0, -0.02)
 

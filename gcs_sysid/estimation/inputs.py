@@ -1,0 +1,104 @@
+"""Control commands as known inputs of the rate and force smoothers: response columns and delays.
+
+The columns are the deterministic responses (acceleration and its exact
+integral) to unit coefficients of each control's step and decaying transients;
+see :mod:`gcs_sysid.estimation.rates` for the model and the references.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.signal import lfilter
+
+__all__ = ["control_columns", "prepare_inputs", "shift", "lagged"]
+
+
+def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tuple[int, ...] = (0, 1),
+                    decays: tuple[float, ...] = (0.0, 10.0)) -> tuple[np.ndarray, np.ndarray]:
+    """Acceleration and rate responses to unit coefficients of each scaled, lagged control.
+
+    Column ``j = (c * len(lags) + l) * len(decays) + d``, with ``lambda = decays[d]``
+    (1/s) and ``delta = delta_c(k - lag)`` (held at its first value before the
+    lagged record starts):
+
+    - ``lambda = 0`` (a step): acceleration ``A_k = s_k (delta_k - delta_0)``, the
+      control moment itself, jumping where the control steps;
+    - ``lambda > 0`` (a decaying transient): each change ``s_k (delta_k - delta_{k-1})``
+      starts an acceleration ``exp(-lambda (t - t_k))``:
+      ``A_k = exp(-lambda dt) A_{k-1} + s_k (delta_k - delta_{k-1})``. Together
+      with the step this lets the *jerk* jump too (``-lambda`` times the
+      transient's share), as after a step the damping moment builds up at
+      once (roll rate: ``p_dot = L_da da exp(L_p t)``).
+
+    Acceleration ``A_k`` is the value at ``t_k``, held (step) or decaying over
+    ``[t_k, t_k + dt)``; the rate ``W`` is its exact integral:
+    ``W_{k+1} = W_k + A_k (1 - exp(-lambda dt)) / lambda`` (``dt A_k`` for a step).
+
+    Args:
+        dt: grid step, s.
+        controls: (n, m) control deflections (any unit), finite.
+        scale: (n,) effectiveness scale (dynamic pressure), finite.
+        lags: input lags in grid steps.
+        decays: decay rates of the transients, 1/s (0: a step).
+
+    Returns:
+        ``(A, W)``, each (n, m * len(lags) * len(decays)).
+    """
+    n, m = controls.shape
+    ncol = m * len(lags) * len(decays)
+    A = np.zeros((n, ncol))
+    W = np.zeros((n, ncol))
+    for c in range(m):
+        for li, lag in enumerate(lags):
+            dl = np.concatenate([np.full(min(lag, n), controls[0, c]), controls[:n - lag, c]])
+            for di, lam in enumerate(decays):
+                j = (c * len(lags) + li) * len(decays) + di
+                if lam == 0.0:
+                    A[:, j] = scale * (dl - dl[0])
+                    inc = dt
+                else:
+                    ch = scale * np.diff(dl, prepend=dl[0])
+                    rho = math.exp(-lam * dt)
+                    A[:, j] = lfilter([1.0], [1.0, -rho], ch)
+                    inc = (1.0 - rho) / lam
+                W[1:, j] = inc * np.cumsum(A[:-1, j])
+    return A, W
+
+
+def prepare_inputs(T: int, controls, scale) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Controls that move (T, nc), the mask of those among the given ones, and the filled scale (T,)."""
+    if controls is None:
+        return np.zeros((T, 0)), np.zeros(0, bool), np.ones(T)
+    U = np.asarray(controls, float).reshape(len(controls), -1)
+    if len(U) != T:
+        raise ValueError(f"controls have {len(U)} rows, the signal {T}")
+    moving = np.array([np.isfinite(U[:, c]).any() and np.nanmax(U[:, c]) > np.nanmin(U[:, c])
+                       for c in range(U.shape[1])], bool)
+    U = U[:, moving]
+    s = np.ones(T)
+    if scale is not None and U.shape[1]:
+        s = np.asarray(scale, float)
+        if len(s) != T:
+            raise ValueError(f"scale has {len(s)} rows, the signal {T}")
+        f = np.isfinite(s)
+        s = np.interp(np.arange(T), np.nonzero(f)[0], s[f]) if f.any() else np.ones(T)
+    return U, moving, s
+
+
+def shift(X: np.ndarray, lag: int) -> np.ndarray:
+    """Rows of ``X`` moved ``lag`` steps later, zeros in front (a delayed zero-state response)."""
+    if lag == 0:
+        return X
+    Y = np.zeros_like(X)
+    Y[lag:] = X[:len(X) - lag]
+    return Y
+
+
+def lagged(X: np.ndarray, nd: int, lag: np.ndarray) -> np.ndarray:
+    """Columns of each control (blocks of ``nd``) delayed by that control's lag."""
+    if not np.any(lag):
+        return X
+    return np.concatenate([shift(X[:, k * nd:(k + 1) * nd], int(lag[k])) for k in range(len(lag))], axis=1) \
+        if len(lag) else X

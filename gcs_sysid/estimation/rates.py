@@ -1,0 +1,399 @@
+"""Body rates and angular accelerations that jump where the controls step.
+
+With ideal or fast actuators a control step changes the control moment within
+one grid step, so the angular acceleration *jumps* while the rate only kinks.
+A smoother whose model has a continuous acceleration (white snap) smears that
+jump over its memory (about 0.2 s at 6 Hz): the measured Cl Cm Cn are wrong
+exactly where the control derivatives are identified, and those come out
+attenuated in regression. Here the control commands, which are known inputs,
+enter the model.
+
+Model, per axis, on the uniform grid (``k`` = grid step, ``dt``)::
+
+    w_dot(t) = a~(t) + sum_c sum_j b_cj g_cj(t),    [w, a~, a~_dot] nominal (white snap)
+    z_k = w(t_k) + v_k                              (gyro minus bias)
+
+For every control ``c`` (delayed by ``l_c`` grid steps) the input shapes
+``g_cj`` are a step ``qbar (delta_c - delta_c(0))`` (``j = 0``) and decaying
+transients started by each change ``qbar Delta delta_c`` (``exp(-lambda_j t)``,
+``lambda_j`` in :data:`DECAYS`), see :func:`control_columns`: the acceleration
+jumps by ``sum_j b_cj qbar Delta delta`` at the step and its slope (the jerk)
+jumps too. The coefficients ``b`` (per axis, control and shape) are unknown and
+estimated with the states: ``x = x~ + X b`` where ``X`` is the deterministic
+response to the controls (acceleration ``A b`` and its exact integral ``W b``),
+and ``x~`` follows the nominal
+time-invariant model. Because everything is linear this is a *regression
+effect* in a state-space model (Harvey 1989, sec. 3.4; Durbin and Koopman
+2012, sec. 6.2; de Jong 1991): the innovations of ``z - W b`` are those of ``z``
+minus the innovations of the columns of ``W``, so ``b`` is the generalised
+least-squares solution of the innovations on the column innovations (diffuse
+prior), then ``z - W b`` is smoothed with the nominal steady-state gains and
+``W b`` (rate) and ``A b`` (acceleration) are added back. The result is the
+mean of the Kalman filter + RTS smoother of the augmented model (``b`` as
+constant states with a diffuse prior; the tests check it against a dense
+generalised least-squares reference), but every pass is a compiled LTI filter
+(``scipy.signal.lfilter``): about 1 s for three axes, four controls and a
+10-minute 50 Hz flight.
+
+The jump sits exactly at the grid step of the (delayed) control change; the smoother
+stays zero phase. Where the controls do not move the model is the nominal one.
+Smooth inputs (multisines) sampled and held at the grid rate are staircases
+too; their many small steps carry the same ``b``.
+
+The bandwidth of the nominal model is chosen per axis by the diffuse profile
+likelihood (de Jong 1991) over a ladder of candidates, with ``b`` re-estimated
+for each candidate; then the delay ``l_c`` of each control (a servo or output
+delay, 0 ... ``max_delay_s``) by the same likelihood summed over the axes
+(coordinate ascent; a change must beat the BIC penalty of one parameter).
+
+References:
+    Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
+    CUP 1989, sec. 3.4 (explanatory variables and interventions), ch. 3
+    (concentrated likelihood).
+    Durbin and Koopman, *Time Series Analysis by State Space Methods*, 2nd ed.,
+    OUP 2012, sec. 6.2 (regression effects, augmented filter and smoother).
+    de Jong, "The diffuse Kalman filter", Annals of Statistics 19(2), 1991,
+    doi:10.1214/aos/1176348139 (diffuse likelihood).
+    Bar-Shalom, Li and Kirubarajan (2001) ch. 6 (white-noise kinematic models);
+    Klein and Morelli, *Aircraft System Identification*, AIAA 2006, ch. 10.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.common import Q_continuous_white_noise
+from scipy.signal import lfilter, ss2tf
+
+from .inputs import control_columns, lagged, prepare_inputs, shift
+from .kalman import SteadyState, steady_state, steady_state_smoother
+from .nodes import segments
+
+__all__ = ["BANDWIDTHS_HZ", "DECAYS", "RateEstimate", "smooth_rates", "smooth_specific_force", "control_columns"]
+
+#: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
+BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
+#: Decay rates (1/s) of the control transients: a basis for the response shape after a step (the roll,
+#: pitch and yaw damping of small aircraft lie within it); measured on the simulation in docs/estimation.md.
+DECAYS = (2.0, 5.0, 12.0, 30.0)
+
+
+@dataclass
+class RateEstimate:
+    """Smoothed body rates and angular accelerations.
+
+    Attributes:
+        rate, rate_sigma: (T, 3) p q r and 1-sigma, rad/s (NaN where no gyro).
+        accel, accel_sigma: (T, 3) p_dot q_dot r_dot and 1-sigma, rad/s^2.
+        bandwidth_hz: (3,) smoother bandwidth chosen per axis (maximum likelihood).
+        noise_std: (3,) gyro white-noise standard deviation (maximum likelihood), rad/s.
+        effectiveness: (3, m) acceleration jump per unit scaled control step (rad/s^2 per unit
+            of ``scale * control``: the step and transient coefficients summed over the lags;
+            with ``scale`` = qbar in Pa and the controls in rad, times ``I / (S b)`` it is a
+            control derivative), per control given; NaN for a control that never moves.
+        effectiveness_sigma: (3, m) 1-sigma of ``effectiveness``.
+        input_lag: (m,) delay of each given control's effect, grid steps (maximum likelihood
+            or as given); NaN for a control that never moves.
+    """
+
+    rate: np.ndarray
+    rate_sigma: np.ndarray
+    accel: np.ndarray
+    accel_sigma: np.ndarray
+    bandwidth_hz: np.ndarray
+    noise_std: np.ndarray
+    effectiveness: np.ndarray
+    effectiveness_sigma: np.ndarray
+    input_lag: np.ndarray
+
+
+def _innovation_filter(F: np.ndarray, g: SteadyState, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Transfer function (num, den) from measurements to innovations of the constant-gain filter.
+
+    State ``s_k = x_{k-1}``: ``s_{k+1} = (I - K H) F s_k + K z_k``, innovation ``y_k = z_k - H F s_k``.
+    """
+    A = (np.eye(len(F)) - g.K @ H) @ F
+    num, den = ss2tf(A, g.K, -H @ F, np.eye(1))
+    return num[0], den
+
+
+def _solve(GG: np.ndarray, Ge: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """GLS solution, inverse Gram and log-determinant of a (possibly rank-poor) Gram matrix."""
+    m = len(Ge)
+    if m == 0:
+        return np.zeros(0), np.zeros((0, 0)), 0.0
+    ridge = 1e-10 * max(float(np.trace(GG)) / m, 1e-300)
+    M = GG + ridge * np.eye(m)
+    L = np.linalg.cholesky(M)
+    Minv = np.linalg.inv(L).T @ np.linalg.inv(L)       # m is at most a few dozen
+    return Minv @ Ge, Minv, 2.0 * float(np.log(np.diag(L)).sum())
+
+
+def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray) -> np.ndarray:
+    """Constant-gain RTS smoother of many scalar records at once, from a zero prior mean.
+
+    The same passes as :func:`~gcs_sysid.estimation.kalman.steady_state_smoother` (with
+    ``x0 = 0``) for each column of ``Z`` (n, m), vectorised over the columns.
+
+    Returns:
+        Smoothed states (n, Nx, m).
+    """
+    n, m = Z.shape
+    nx = F.shape[0]
+    A = (np.eye(nx) - g.K @ H) @ F
+    x = np.empty((n, nx, m))
+    for j in range(nx):      # forward: x_k = A x_{k-1} + K z_k, zero initial state
+        num, den = ss2tf(A, g.K, A[j:j + 1], g.K[j:j + 1])
+        x[:, j] = lfilter(num[0], den, Z, axis=0)
+    Cg = g.C
+    M = np.eye(nx) - Cg @ F
+    xr = x[::-1]
+    xs = np.zeros((n, nx, m))
+    for i in range(nx):      # backward: xs_k = C xs_{k+1} + M x_k, from xs_T = F x_{T-1}
+        for j in range(nx):
+            num, den = ss2tf(Cg, M[:, i:i + 1], Cg[j:j + 1], M[j:j + 1, i:i + 1])
+            xs[:, j] += lfilter(num[0], den, xr[:, i], axis=0)
+    v = F @ x[-1]            # zero-input response of the end condition, until it has decayed
+    scale = max(float(np.abs(v).max()), 1e-300)
+    for k in range(n):
+        if not np.abs(v).max() > 1e-15 * scale:
+            break
+        xs[k] += Cg @ v
+        v = Cg @ v
+    return xs[::-1]
+
+
+def _profile(GG, Ge, ee, n, m, S, noise_floor):
+    """GLS fit and diffuse profile log-likelihood (de Jong 1991) of the innovations on the columns."""
+    beta, Minv, logdet = _solve(GG, Ge)
+    rss = max(ee - float(Ge @ beta), 0.0)
+    s2 = max(rss / max(n - m, 1), noise_floor**2)      # profiled measurement-noise variance
+    return -0.5 * ((n - m) * np.log(s2) + n * np.log(S) + logdet), beta, Minv, s2
+
+
+def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, lag: np.ndarray | None,
+                        max_lag: int, decays: tuple[float, ...], noise_floor: float,
+                        bandwidths_hz: tuple[float, ...], order: int) -> dict[str, np.ndarray]:
+    """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
+
+    ``order`` is the derivative of the measured signal that the control columns
+    enter: 1 for rates (the acceleration jumps), 0 for forces (the measured
+    specific force itself jumps). ``lag``: input delay per control in grid steps
+    (None: 0), the start of a search over 0 ... ``max_lag`` (none if 0) by the
+    likelihood summed over the axes, coordinate ascent over the controls at each
+    axis' bandwidth; a change must raise the log-likelihood by more than the BIC
+    penalty of one parameter, ``0.5 log(n)``, so a control with little effect
+    keeps its delay.
+    """
+    T, d = Z.shape
+    F = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+    H = np.array([[1.0, 0.0, 0.0]])
+    bws = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
+    q0 = Q_continuous_white_noise(dim=3, dt=dt, spectral_density=1.0)
+    # unit measurement noise; q = dt * omega_c^6 sets the ratio
+    gains = [steady_state(F, dt * (2 * np.pi * f) ** 6 * q0, H, np.eye(1)) for f in bws]
+    tfs = [_innovation_filter(F, g, H) for g in gains]
+    S = np.array([g.S[0, 0] for g in gains])
+    ok_u = np.isfinite(U).all(axis=1)
+    all_decays = (0.0,) + tuple(decays)
+    nd, nc = len(all_decays), U.shape[1]
+    m = nc * nd
+    lag = np.zeros(nc, int) if lag is None else np.asarray(lag, int)
+    out = {k: np.full((T, d), np.nan) for k in ("x", "xs", "xd", "xds")}
+    out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), beta=np.full((d, m), np.nan),
+               cov=np.full((d, m, m), np.nan), lag=lag)
+    axes = []            # per axis: segments, columns, and at the chosen bandwidth the innovations
+    for i in range(d):
+        segs = segments(np.isfinite(Z[:, i]) & ok_u, 10)
+        if not segs:
+            continue
+        cols, inn = [], []
+        GG, Ge, ee, n = np.zeros((len(bws), m, m)), np.zeros((len(bws), m)), np.zeros(len(bws)), 0
+        for sg in segs:
+            A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays)
+            # measured part, and the parts of the signal and of its derivative (undelayed)
+            cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
+            z = Z[sg, i][:, None]
+            x0 = np.array([z[0, 0], 0.0, 0.0])
+            per = []
+            for c, (g, (num, den)) in enumerate(zip(gains, tfs)):   # all candidates: innovations only
+                _, e = steady_state_smoother(F, g, H, z, x0, smooth=False)
+                G = lfilter(num, den, cols[-1][0], axis=0) if m else cols[-1][0]
+                per.append((G / math.sqrt(S[c]), e[:, 0] / math.sqrt(S[c])))
+                Gl = lagged(per[-1][0], nd, lag)
+                GG[c] += Gl.T @ Gl
+                Ge[c] += Gl.T @ per[-1][1]
+                ee[c] += float(per[-1][1] @ per[-1][1])
+            inn.append(per)
+            n += len(z)
+        lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor)[0] for c in range(len(bws))]
+        c = int(np.argmax(lls))
+        axes.append((i, segs, cols, [per[c] for per in inn], c, n))
+
+    def grams(lagv):
+        """Per axis: the lagged column innovations per segment and their Gram matrices."""
+        st = []
+        for i, segs, cols, inn, c, n in axes:
+            Gls = [lagged(G, nd, lagv) for G, _ in inn]
+            st.append([Gls, sum(G.T @ G for G in Gls), sum(G.T @ e for G, (_, e) in zip(Gls, inn)),
+                       sum(float(e @ e) for _, e in inn)])
+        return st
+
+    if nc and max_lag > 0 and axes:
+        cur = grams(lag)
+        best = sum(_profile(GG, Ge, ee, ax[-1], m, S[ax[4]], noise_floor)[0]
+                   for ax, (_, GG, Ge, ee) in zip(axes, cur))
+        penalty = 0.5 * math.log(sum(a[-1] for a in axes))
+        for _ in range(2):                       # coordinate ascent over the controls' delays
+            before = lag.copy()
+            for k in range(nc):
+                kb = slice(k * nd, (k + 1) * nd)
+                for cand in range(max_lag + 1):
+                    if cand == lag[k]:
+                        continue
+                    ll, trial = 0.0, []
+                    for ax, (Gls, GG, Ge, ee), (_, _, _, inn, c, n) in zip(axes, cur, axes):
+                        # only the block of control k changes: its rows and columns of the Gram matrix
+                        Gk = [shift(G[:, kb], cand) for G, _ in inn]
+                        cross = sum(g.T @ G for g, G in zip(Gk, Gls))
+                        GG2, Ge2 = GG.copy(), Ge.copy()
+                        GG2[kb, :] = cross
+                        GG2[:, kb] = cross.T
+                        GG2[kb, kb] = sum(g.T @ g for g in Gk)
+                        Ge2[kb] = sum(g.T @ e for g, (_, e) in zip(Gk, inn))
+                        ll += _profile(GG2, Ge2, ee, n, m, S[c], noise_floor)[0]
+                    if ll > best + penalty:
+                        best = ll
+                        lag = lag.copy()
+                        lag[k] = cand
+                        cur = grams(lag)
+            if np.array_equal(before, lag):
+                break
+        out["lag"] = lag
+    for i, segs, cols, inn, c, n in axes:
+        GG, Ge, ee = np.zeros((m, m)), np.zeros(m), 0.0
+        for G, e in inn:
+            Gl = lagged(G, nd, lag)
+            GG += Gl.T @ Gl
+            Ge += Gl.T @ e
+            ee += float(e @ e)
+        _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor)
+        out["bw"][i], out["sig"][i] = bws[c], math.sqrt(s2)
+        out["beta"][i], out["cov"][i] = beta, s2 * Minv
+        g = gains[c]
+        for sg, (Mz, X0, X1) in zip(segs, cols):
+            Mz, X0, X1 = (lagged(X, nd, lag) for X in (Mz, X0, X1))
+            z = Z[sg, i][:, None] - (Mz @ beta)[:, None]
+            xs, _ = steady_state_smoother(F, g, H, z, np.array([z[0, 0], 0.0, 0.0]))
+            out["x"][sg, i] = xs[:, 0] + X0 @ beta
+            out["xd"][sg, i] = xs[:, 1] + X1 @ beta
+            var0 = np.full(len(z), s2 * g.Ps[0, 0])
+            var1 = np.full(len(z), s2 * g.Ps[1, 1])
+            if m:
+                # the coefficients' own uncertainty: x = x~(z - Mz b) + X b, so an error db moves the
+                # states by (X - smoother(Mz)) db
+                xj = _smooth_columns(F, g, H, Mz)
+                D0, D1 = X0 - xj[:, 0], X1 - xj[:, 1]
+                C = s2 * Minv
+                var0 += ((D0 @ C) * D0).sum(axis=1)
+                var1 += ((D1 @ C) * D1).sum(axis=1)
+            out["xs"][sg, i] = np.sqrt(var0)
+            out["xds"][sg, i] = np.sqrt(var1)
+    return out
+
+
+def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
+                 bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
+                 scale: np.ndarray | None = None, max_delay_s: float = 0.2,
+                 input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS) -> RateEstimate:
+    """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
+
+    Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
+    spectral density ``q``, measured by ``w`` with white noise ``sigma^2``; the
+    controls add acceleration steps and decaying transients of estimated size
+    (module docstring, :func:`control_columns`). Each candidate bandwidth
+    ``omega_c = (q / (sigma^2 dt))^(1/6)`` fixes the ratio ``q / sigma^2``; the
+    scale ``sigma^2`` and the input coefficients are profiled out of the diffuse
+    likelihood and the best bandwidth per axis is smoothed. Records are split at
+    gaps (NaN in the gyro or the controls); the input coefficients are shared by
+    the pieces.
+
+    Args:
+        dt: grid step, s.
+        rates: (T, 3) gyro minus bias, rad/s, NaN where missing.
+        noise_floor: smallest gyro noise assumed, rad/s (quantisation).
+        bandwidths_hz: candidate bandwidths, Hz.
+        controls: optional (T, m) control commands held over each grid step (rad), e.g.
+            delta_e delta_a delta_r delta_t; columns that never change are not used.
+        scale: optional (T,) effectiveness scale, e.g. the dynamic pressure from the
+            pitot (Pa); default 1. NaN is filled by interpolation.
+        max_delay_s: longest input delay searched per control, s (a servo or output delay;
+            maximum likelihood over whole grid steps 0 ... max_delay_s).
+        input_lag: optional delay per given control, grid steps: fixed if ``max_delay_s`` is 0,
+            else the start of the search.
+        decays: decay rates of the control transients, 1/s.
+
+    Returns:
+        :class:`RateEstimate`.
+
+    Raises:
+        ValueError: ``controls`` or ``scale`` of the wrong length.
+
+    Source: module docstring; Harvey (1989) sec. 3.4; de Jong (1991).
+    """
+    T = len(rates)
+    U, moving, s = prepare_inputs(T, controls, scale)
+    lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
+    o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
+                            tuple(decays), noise_floor, bandwidths_hz, order=1)
+    nctl = len(moving)
+    eff = np.full((3, nctl), np.nan)
+    eff_sig = np.full((3, nctl), np.nan)
+    lags = np.full(nctl, np.nan)
+    nd = 1 + len(decays)
+    for k, ctl in enumerate(np.nonzero(moving)[0]):   # the jump: step + transients at the (delayed) step
+        sel = np.arange(k * nd, (k + 1) * nd)
+        eff[:, ctl] = o["beta"][:, sel].sum(axis=1)
+        eff_sig[:, ctl] = np.sqrt(np.maximum(o["cov"][:, sel][:, :, sel].sum(axis=(1, 2)), 0.0))
+        lags[ctl] = o["lag"][k]
+    return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags)
+
+
+def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
+                          bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
+                          scale: np.ndarray | None = None, max_delay_s: float = 0.2,
+                          input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Zero-phase smoothing of the specific force, jumping where the controls step.
+
+    The same model as :func:`smooth_rates` one derivative lower: the measured
+    specific force is a smooth part (``[f, f_dot, f_ddot]``, white snap) plus
+    steps and decaying transients at the control changes (a control *force*,
+    e.g. ``CZ_delta_e``, appears at once), measured with white noise (the
+    accelerometer noise and vibration). Bandwidth per axis by the diffuse
+    likelihood, as there.
+
+    Args:
+        dt: grid step, s.
+        f: (T, 3) specific force, m/s^2, NaN where missing.
+        noise_floor: smallest accelerometer noise assumed, m/s^2.
+        bandwidths_hz, controls, scale, max_delay_s, input_lag, decays: as :func:`smooth_rates`
+            (pass the rates' ``input_lag`` as the start: the same servo delays unless the
+            forces clearly say otherwise, e.g. for the throttle, which hardly moves the rates).
+
+    Returns:
+        ``(f_smooth, f_sigma, noise_std)``: (T, 3), (T, 3) in m/s^2 and (3,) the
+        accelerometer white noise (maximum likelihood), m/s^2.
+
+    Raises:
+        ValueError: ``controls`` or ``scale`` of the wrong length.
+
+    Source: module docstring; Klein and Morelli (2006) ch. 10.
+    """
+    U, moving, s = prepare_inputs(len(f), controls, scale)
+    lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
+    o = _smooth_with_inputs(dt, np.asarray(f, float), U, s, lag, int(round(max_delay_s / dt)),
+                            tuple(decays), noise_floor, bandwidths_hz, order=0)
+    return o["x"], o["xs"], o["sig"]
