@@ -64,7 +64,7 @@ def test_report_files_written(roundtrip):
         assert (rep / name).stat().st_size > 0, name
     header = (rep / "coefficients.csv").read_text().splitlines()[0].split(",")
     assert header[0] == "time_s" and "Cm_pred" in header and "Cn_sigma" in header and header[-1] == "held_out"
-    assert result.model_path and Path(result.model_path).exists()
+    assert result.model_path and Path(result.model_path + ".npz").exists() and Path(result.model_path + ".json").exists()
 
 
 def test_model_state_continues(roundtrip, tmp_path):
