@@ -16,7 +16,7 @@ import numpy as np
 from .aero import compute_coefficients
 from .aero.table import COEFFICIENTS, MOMENT_COEFFICIENTS, CoefficientTable
 from .airframe import load_airframe
-from .errors import DataError, InputError
+from .errors import InputError
 from .estimation import estimate_states
 from .estimation.states import FlightStates
 from .result import ReplayResult
@@ -26,6 +26,8 @@ __all__ = ["ReplayOptions", "run_replay", "held_out_mask", "error_pct", "identif
 
 #: Fewest valid rows the GP is fitted on.
 MIN_TRAIN_ROWS = 50
+#: Held-out error (%) above which the report warns that a coefficient's model does not generalise.
+POOR_HELDOUT_PCT = 50.0
 
 
 @dataclass(frozen=True)
@@ -218,6 +220,13 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 "n_heldout": int(np.isfinite(pred_mean[held, i]).sum()),
                 "n_train": int(train.sum()),
             }
+        poor = [c for c in COEFFICIENTS if ident[c][0] and metrics[c]["error_pct_heldout"] > POOR_HELDOUT_PCT]
+        if poor:
+            notes.append("the model does not predict the held-out segment for " + ", ".join(
+                f"{c} ({metrics[c]['error_pct_heldout']:.0f} %)" for c in poor)
+                + ": these estimates are not trustworthy; likely causes: forces the airframe file does not "
+                  "model (thrust without a thrust model, VTOL lift motors), too few samples or too little "
+                  "excitation, or a held-out segment outside the trained envelope")
         weak_moments = [c for c in MOMENT_COEFFICIENTS if not ident[c][0]]
         if weak_moments:
             notes.append("not identified: " + "; ".join(f"{c} ({ident[c][1]})" for c in weak_moments))

@@ -101,7 +101,9 @@ def compute_coefficients(states: FlightStates, airframe: Airframe) -> Coefficien
     X = np.stack([cols[k] for k in REGRESSORS], axis=1)
     Y = np.stack([CX, CY, CZ, Cl, Cm, Cn], axis=1)
     valid = np.ones(T, bool) if states.valid is None else np.asarray(states.valid, bool).copy()
-    valid &= np.isfinite(X).all(axis=1) & np.isfinite(Y).all(axis=1) & (np.nan_to_num(qbar) > QBAR_MIN)
+    # a row is valid when its regressors and force coefficients are finite; the moment columns may be NaN
+    # where the rate derivatives could not be formed (the pipeline fits only identifiable columns)
+    valid &= np.isfinite(X).all(axis=1) & np.isfinite(Y[:, :3]).all(axis=1) & (np.nan_to_num(qbar) > QBAR_MIN)
     for k in ("ax", "ay", "az", "p", "q", "r", "p_dot", "q_dot", "r_dot", "V", "qbar", "alpha", "beta",
               "delta_e", "delta_a", "delta_r", "delta_t"):
         if k not in states.data:

@@ -24,7 +24,8 @@ class CoefficientTable:
         X: regressors, shape (T, 10), columns :data:`REGRESSORS` (rad, -, -, -, -,
             rad, rad, rad, 0..1, m/s).
         Y: measured coefficients, shape (T, 6), columns :data:`COEFFICIENTS`.
-        valid: (T,) bool, rows usable for learning (airborne, all inputs present).
+        valid: (T,) bool, rows usable for learning: airborne, regressors and force coefficients finite.
+            The moment columns of Y may still be NaN there (rate derivatives not formed, e.g. 4 Hz data).
         qbar: dynamic pressure, Pa, shape (T,).
         notes: one-line remarks (e.g. "CX includes thrust: airframe has no thrust model").
     """

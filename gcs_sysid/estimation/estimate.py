@@ -122,8 +122,14 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
             if k in ctrl:
                 data[k], sources[k] = ctrl[k], f"servo PWM (zero-order hold) through the {airframe.name} servo map"
-    for k in ("delta_e", "delta_a", "delta_r"):
-        if k not in data:
+    mix = airframe.mixing
+    for i, k in enumerate(("delta_e", "delta_a", "delta_r")):
+        if k in data:
+            continue
+        if not np.any(mix[i] != 0.0):  # the aircraft has no such surface (a flying wing has no rudder)
+            data[k], sources[k] = np.zeros(T), f"0: the {airframe.name} airframe has no servo driving {k}"
+            notes.append(f"{k} = 0: the airframe has no servo mixed into it")
+        else:
             missing.append(f"{k}: no servo output (SERVO_OUTPUT_RAW / RCOU) for its channel(s)")
     if "delta_t" not in data:
         thr = al.get("vfr_hud", "throttle")
@@ -362,7 +368,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     prog(0.9)
 
     # --- validity --------------------------------------------------------------------------------
-    need = ("p", "q", "r", "p_dot", "q_dot", "r_dot", "ax", "ay", "az", "V", "alpha", "beta", "qbar",
+    # rows need the regressors and the force inputs; the rate derivatives are not required, so that
+    # a log too slow for them (4 Hz telemetry) still yields the force coefficients
+    need = ("p", "q", "r", "ax", "ay", "az", "V", "alpha", "beta", "qbar",
             "delta_e", "delta_a", "delta_r", "delta_t")
     valid = np.ones(T, bool)
     for k in need:
