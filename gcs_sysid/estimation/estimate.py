@@ -139,7 +139,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             data["delta_t"], sources["delta_t"] = thr, "VFR_HUD throttle (no throttle servo output)"
         else:
             missing.append("delta_t: no throttle servo output and no VFR_HUD throttle")
-    if servo_rate and servo_rate < RATE_MIN_HZ:
+    if servo_rate and servo_rate < 0.95 * RATE_MIN_HZ:
         ident["controls"] = (False, f"servo outputs at {servo_rate:.1f} Hz: control steps are smeared; "
                                     f"{_STREAM_ADVICE}")
         notes.append(ident["controls"][1])
@@ -180,7 +180,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                          + ", ".join(f"{lg * dt:.2f}" for lg in Rr.input_lag) + " s")
     else:
         missing.append("p q r p_dot q_dot r_dot: no gyro (IMU) and no rates in ATTITUDE")
-    if gyro_rate < RATE_MIN_HZ:
+    if gyro_rate < 0.95 * RATE_MIN_HZ:  # 5 % margin: a nominal 10 Hz stream logs 9.9-10.1 Hz
         reason = (f"gyro at {gyro_rate:.1f} Hz: p_dot q_dot r_dot (and so Cl Cm Cn) are not identifiable at this "
                   f"rate; {_STREAM_ADVICE}")
         ident["rate_derivatives"] = (False, reason)
@@ -382,8 +382,16 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     ident["force_coefficients"] = (f_cg is not None and V is not None,
                                    "accelerometers and airspeed present" if f_cg is not None and V is not None
                                    else "no accelerometer or no airspeed")
-    ok_m = ident["rate_derivatives"][0] and gyro is not None and V is not None
-    ident["moment_coefficients"] = (ok_m, ident["rate_derivatives"][1] if gyro is not None else "no gyro")
+    # moment coefficients need the angular accelerations AND control outputs fast enough to resolve the
+    # control derivatives that dominate Cl Cm Cn (3 Hz servo telemetry smears every step)
+    if gyro is None:
+        ident["moment_coefficients"] = (False, "no gyro")
+    elif not ident["rate_derivatives"][0]:
+        ident["moment_coefficients"] = ident["rate_derivatives"]
+    elif not ident["controls"][0] and servo_rate:
+        ident["moment_coefficients"] = (False, ident["controls"][1])
+    else:
+        ident["moment_coefficients"] = (V is not None, ident["rate_derivatives"][1] if V is not None else "no airspeed")
     for c in ("CX", "CY", "CZ"):          # per coefficient, as the pipeline reads them
         ident[c] = ident["force_coefficients"]
     for c in ("Cl", "Cm", "Cn"):
