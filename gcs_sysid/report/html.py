@@ -147,7 +147,7 @@ def render_html(r: ReplayResult, path: Path) -> Path:
         "data": data,
         "states": _img(plots.states_figure(r), "states") + '<p class="muted">Held-out segment shaded yellow.</p>',
         "coefficients": _img(plots.coefficients_figure(r), "coefficients")
-        + '<p class="muted">Measured (grey), model mean (blue) with 2-sigma band; held-out segment shaded yellow '
+        + '<p class="muted">Measured (orange), model mean (blue) with 2-sigma band; held-out segment shaded yellow '
           '(never used for fitting).</p>',
         "errors": "<p>Error = 100 RMS(model - measured) / RMS(measured) on the held-out segment; thesis floor "
                   f"{tables.THESIS_FLOOR_PCT['forces']} % (forces), {tables.THESIS_FLOOR_PCT['moments']} % (moments).</p>"
