@@ -1,7 +1,7 @@
 """Benchmark: ``diagnose`` of a 10-minute 50 Hz flight (target: under 60 s on 2 cores).
 
 Simulates a 600-s sysid flight of the sample trainer with a hidden ``Cm:alpha`` error
-(light turbulence, default sensor noise), writes the tlog, then times ``run_diagnose``
+(calm-morning turbulence W20 = 1.5 m/s, default sensor noise), writes the tlog, then times ``run_diagnose``
 end to end and by stage, with bare pymavlink decoding of the same log as the baseline
 measured in the same run. Usage: ``python benchmarks/bench_diagnose.py [--minutes 10]``.
 """
@@ -43,7 +43,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         log = Path(tmp) / "bench.tlog"
         t0 = time.perf_counter()
-        r = simulate(af, m, plan_from_dict(plan_doc(duration=60.0 * args.minutes, seed=3)),
+        r = simulate(af, m, plan_from_dict(plan_doc(duration=60.0 * args.minutes, seed=3, turbulence=1.5)),
                      effects=effects("Cm:alpha", 0.3))
         write_tlog(r, log, af)
         t_sim = time.perf_counter() - t0

@@ -43,6 +43,10 @@ def main() -> None:
         t0 = time.perf_counter()
         try:
             meas = load_measurements(log, args.airframe)
+            marks = [(t, txt) for t, txt in meas.flight.statustext
+                     if any(w in txt.lower() for w in ("fail", "fault", "emerg", "engine", "stuck"))]
+            print("   log messages naming a failure: " + ("; ".join(f"{t:.1f} s '{txt}'" for t, txt in marks[:5])
+                                                       if marks else "none (no labelled fault time in the tlog)"))
             tv = meas.table.t[meas.table.valid]
             if len(tv) < 100:
                 print(f"   only {len(tv)} valid rows: cannot diagnose")
@@ -56,6 +60,9 @@ def main() -> None:
         except SysidError as e:
             print(f"   error: {e}")
             continue
+        print(f"   valid rows {doc['data']['n_valid']} over {doc['data']['t_range_s'][0]:.0f}-"
+              f"{doc['data']['t_range_s'][1]:.0f} s at {doc['data']['rate_hz']:.0f} Hz; turbulence projection "
+              f"{'on' if doc['data'].get('turbulence', {}).get('active') else 'off'}")
         for f in doc["findings"]:
             print(f"   finding {f['cause']:16s} estimate {f['estimate']:.4g} +- {f['std_error']:.2g} "
                   f"gain {f['gain'].get('percent', 0):.0f} % onset {f.get('onset_s', '')}")

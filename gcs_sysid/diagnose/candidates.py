@@ -23,6 +23,7 @@ from scipy.optimize import least_squares
 
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from .causes import transforms
+from .evidence import noise_residual
 from .context import DiagContext
 from .regression import colored_covariance, effective_samples
 from .terms import VOCABULARY, term_factors, term_matrix
@@ -76,31 +77,43 @@ class Fitted:
 
 
 class Scorer:
-    """Held-out scoring against the current residual ``R`` (T, 6)."""
+    """Held-out scoring against the current residual ``R`` (T, 6).
 
-    def __init__(self, ctx: DiagContext, R: np.ndarray):
+    With a :class:`~gcs_sysid.diagnose.turbulence.GustProjector` ``proj``, residual and
+    corrections are compared after projecting out the angle errors the reconstruction
+    cannot see (turbulence); ``proj=None`` compares them as they are.
+    """
+
+    def __init__(self, ctx: DiagContext, R: np.ndarray, proj=None):
         self.ctx, self.R = ctx, R
+        self.proj = proj if proj is not None else (lambda D: D)
+        self.Rp = self.proj(R)
         te = ctx.test
         self.active = ctx.active
-        self.sse0 = np.sum(R[te] ** 2, axis=0)
-        self.neff = np.array([effective_samples(R[te, j]) for j in range(6)])
+        self.sse0 = np.sum(self.Rp[te] ** 2, axis=0)
+        # effective samples of the noise: what a quadratic in all regressors (ridge, fitted on the
+        # training rows) leaves on the held-out rows; one value per coefficient for every candidate,
+        # so candidates are ranked by their held-out sum of squares
+        noise = noise_residual(ctx, self.Rp)
+        self.neff = np.array([effective_samples(noise[:, j]) for j in range(6)])
         self.n_pen = float(np.mean(self.neff))
+
+    def rows(self, D: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        """Projection of ``D`` (N, 6) given on the rows ``mask`` (per row, for fitting)."""
+        return self.proj.rows(D, mask) if hasattr(self.proj, "rows") else D
 
     def score(self, delta: np.ndarray, k: int) -> tuple[float, dict]:
         te = self.ctx.test
+        delta = self.proj(np.where(self.active[None, :], delta, 0.0))
         delta = np.where(self.active[None, :], delta, 0.0)
-        sse1 = np.sum((self.R[te] + delta[te]) ** 2, axis=0)
+        sse1 = np.sum((self.Rp[te] + delta[te]) ** 2, axis=0)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(self.sse0 > 0, self.sse0 / np.maximum(sse1, 1e-300), 1.0)
-        # effective samples of what is left after the correction (the noise under the hypothesis)
-        neff = self.neff.copy()
-        for j in np.nonzero(np.any(delta[te] != 0, axis=0))[0]:
-            neff[j] = effective_samples(self.R[te, j] + delta[te, j])
-        ll = float(np.sum(neff / 2 * np.log(ratio)))
+        ll = float(np.sum(self.neff * self.active / 2 * np.log(ratio)))
         s = ll - k / 2 * np.log(max(self.n_pen, 2.0))
         gains = {}
         for j, c in enumerate(COEFFICIENTS):
-            if np.any(delta[te, j] != 0):
+            if np.any(np.abs(delta[te, j]) > 1e-12 * (np.sqrt(self.sse0[j] / te.sum()) + 1e-300)):
                 b, a = np.sqrt(self.sse0[j] / te.sum()), np.sqrt(sse1[j] / te.sum())
                 gains[c] = {"rms_before": float(b), "rms_after": float(a),
                             "percent": float(100 * (1 - a / b)) if b > 0 else 0.0}
@@ -136,28 +149,49 @@ def fit_aero_terms(ctx: DiagContext, R: np.ndarray, scorer: Scorer, top: int = 4
     """
     tr, te = ctx.train, ctx.test
     Phi = term_matrix(ctx.X, VOCABULARY)
-    Ptr, Pte = Phi[tr], Phi[te]
+    proj = scorer.proj
+    Rp = scorer.Rp
+    w = ctx.weight
     rank = []
     for j, coef in enumerate(COEFFICIENTS):
         if not ctx.active[j]:
             continue
-        den = np.sum(Ptr**2, axis=0)
-        ok = (den > 0) & (np.std(Pte, axis=0) + np.abs(np.mean(Pte, axis=0)) > 0)
-        th = np.where(ok, Ptr.T @ R[tr, j] / np.where(den > 0, den, 1), 0.0)
-        # residual after = R - th*phi  ->  sse1 = sse0 - 2 th phi'R + th^2 phi'phi
-        sse1 = scorer.sse0[j] - 2 * th * (Pte.T @ R[te, j]) + th**2 * np.sum(Pte**2, axis=0)
-        ll = scorer.neff[j] / 2 * np.log(scorer.sse0[j] / np.maximum(sse1, 1e-300))
+        # projected columns of the correction "term k in coefficient j": B (T, 6, K)
+        if getattr(proj, "active", False):
+            a = proj.H[:, :, j, None] * Phi[:, None, :]                       # (T, k, K)
+            a = a - a[proj.mean_rows].mean(axis=0) if proj.keep_mean else a
+            B = -np.einsum("tcm,tmK->tcK", proj.G, a)
+            B[:, j, :] += Phi
+            B *= ctx.active[None, :, None]
+        else:
+            B = np.zeros((len(ctx.t), 6, Phi.shape[1]))
+            B[:, j, :] = Phi
+        Bw = B * np.sqrt(w)[None, :, None]
+        Rw = Rp * np.sqrt(w)[None, :]
+        den = np.einsum("tcK,tcK->K", Bw[tr], Bw[tr])
+        num = np.einsum("tcK,tc->K", Bw[tr], Rw[tr])
+        ok = (den > 1e-300) & (np.std(Phi[te], axis=0) + np.abs(np.mean(Phi[te], axis=0)) > 0)
+        # correction delta = -th * B: fitted on the training rows
+        th = np.where(ok, num / np.where(ok, den, 1.0), 0.0)
+        # held-out weighted sse after, per coefficient j only for the ranking
+        Bt = B[te]
+        sse_after = np.sum((Rp[te, :, None] - th[None, None, :] * Bt) ** 2, axis=0)   # (6, K)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ll = np.sum(scorer.neff[:, None] / 2 * np.log(np.where(scorer.sse0[:, None] > 0, scorer.sse0[:, None]
+                        / np.maximum(sse_after, 1e-300), 1.0)) * ctx.active[:, None], axis=0)
         for k in np.nonzero(ok)[0]:
             rank.append((float(ll[k]), coef, VOCABULARY[k], float(th[k]), j, k))
     rank.sort(reverse=True)
     out = []
     for ll, coef, term, th, j, k in rank[:top]:
         phi = Phi[:, k]
-        # refit with the coloured covariance
-        v = R[tr, j] - th * phi[tr]
-        cov = colored_covariance(phi[tr, None], v)
         delta = np.zeros_like(R)
         delta[:, j] = -th * phi
+        # coloured covariance of the (projected, weighted) fit
+        Dp = scorer.rows(delta[tr], tr)
+        v = _weighted(ctx, Rp[tr] + Dp)
+        Jw = _weighted(ctx, (-Dp / th if th != 0 else Dp)[:, :, None])
+        cov = colored_covariance(Jw, v)
         f = Fitted(f"{coef}:{term}", "aero", np.array([th]), cov, [term], delta,
                    model_update={coef: {term: th}})
         f.score, f.gains = scorer.score(delta, 1)
@@ -203,8 +237,8 @@ def fit_delays(ctx: DiagContext, R: np.ndarray, scorer: Scorer, max_delay_s: flo
             continue
 
         def sse(tau):
-            d = _delay_delta(ctx, u, tau)
-            return float(np.sum(ctx.weight * (R[tr] + d[tr]) ** 2))
+            d = scorer.rows(_delay_delta(ctx, u, tau)[tr], tr)
+            return float(np.sum(ctx.weight * (scorer.Rp[tr] + d) ** 2))
 
         vals = np.array([sse(tau) for tau in taus])
         k = int(np.argmin(vals))
@@ -216,8 +250,8 @@ def fit_delays(ctx: DiagContext, R: np.ndarray, scorer: Scorer, max_delay_s: flo
                 tau = taus[k] + 0.5 * dt * (y0 - y2) / den
         delta = _delay_delta(ctx, u, tau)
         h = 0.25 * dt
-        J = (_delay_delta(ctx, u, tau + h) - _delay_delta(ctx, u, tau - h))[tr] / (2 * h)
-        v = _weighted(ctx, R[tr] + delta[tr])
+        J = scorer.rows((_delay_delta(ctx, u, tau + h) - _delay_delta(ctx, u, tau - h))[tr] / (2 * h), tr)
+        v = _weighted(ctx, scorer.Rp[tr] + scorer.rows(delta[tr], tr))
         f = Fitted(f"delay:{u}", "delay", np.array([tau]), np.zeros((1, 1)), ["tau_s"], delta)
         _finish(ctx, scorer, f, _weighted(ctx, J[:, :, None]), v)
         f.estimate, f.std_error = float(tau), float(np.sqrt(f.cov[0, 0]))
@@ -257,11 +291,14 @@ def fit_stuck(ctx: DiagContext, R: np.ndarray, scorer: Scorer, min_after_s: floa
         if not np.any(g[ctx.valid]):
             continue
         w = ctx.weight
-        y = R + g * uu[:, None]                           # residual after = y - g * delta_s
+        allrows = np.ones(len(ctx.t), bool)
+        g = scorer.rows(g, allrows)
+        Rs = scorer.rows(R, allrows)
+        y = Rs + g * uu[:, None]                          # residual after = y - g * delta_s
         a = np.sum(w * g**2, axis=1)[v_rows]
         b = np.sum(w * g * y, axis=1)[v_rows]
         c = np.sum(w * y**2, axis=1)[v_rows]
-        r0 = np.sum(w * R**2, axis=1)[v_rows]
+        r0 = np.sum(w * Rs**2, axis=1)[v_rows]
         A, B, C = (np.cumsum(x[::-1])[::-1] for x in (a, b, c))
         P = np.concatenate([[0.0], np.cumsum(r0)])[:-1]
         total = P + C - B**2 / np.maximum(A, 1e-300)
@@ -278,10 +315,13 @@ def fit_stuck(ctx: DiagContext, R: np.ndarray, scorer: Scorer, min_after_s: floa
         onset = float(t_v[k])
         after = ctx.t >= onset
         m = ctx.train & after
+        if m.sum() < 10:                                  # no training rows after the onset to fit it on
+            continue
         gw = (np.sqrt(w) * g)[m].T.ravel()
         yw = (np.sqrt(w) * y)[m].T.ravel()
         us = float(gw @ yw / max(gw @ gw, 1e-300))
-        delta = np.where(after[:, None], -g * (us - uu[:, None]), 0.0)
+        g_raw = (ctx.model_values(Xp) - ctx.model_values(Xm)) / (2 * h)
+        delta = np.where(after[:, None], -g_raw * (us - uu[:, None]), 0.0)
         f = Fitted(f"stuck:{u}", "stuck", np.array([us, onset]), np.zeros((2, 2)), ["delta_stuck", "onset_s"],
                    delta, onset_s=onset)
         cov1 = colored_covariance(gw[:, None], yw - gw * us)
@@ -297,15 +337,18 @@ def fit_stuck(ctx: DiagContext, R: np.ndarray, scorer: Scorer, min_after_s: floa
 # --------------------------------------------------------------------------- sensors, wind, mass properties
 
 
-def fit_sensor_causes(ctx: DiagContext, R: np.ndarray, scorer: Scorer) -> list[Fitted]:
-    """Fit each sensor / wind / mass-property cause by nonlinear least squares on the training rows."""
+def fit_sensor_causes(ctx: DiagContext, R: np.ndarray, scorer: Scorer, exclude=()) -> list[Fitted]:
+    """Fit each sensor / wind / mass-property cause by nonlinear least squares on the training rows.
+
+    ``exclude``: causes left out (sensor causes judged by data compatibility instead).
+    """
     tr = ctx.train
     sub = ctx.rows(tr)
-    Rt = R[tr]
+    Rt = scorer.Rp[tr]
     out = []
-    for cause in transforms(ctx):
+    for cause in [c for c in transforms(ctx) if c.cause not in exclude]:
         def fun(p, cause=cause):
-            return _weighted(sub, Rt + cause.delta(sub, p))
+            return _weighted(sub, Rt + scorer.rows(cause.delta(sub, p), tr))
 
         try:
             sol = least_squares(fun, cause.p0, x_scale=cause.scale, method="lm" if len(Rt) * 6 > cause.n_params

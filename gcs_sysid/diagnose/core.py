@@ -25,6 +25,7 @@ from .candidates import Fitted, Scorer, fit_aero_terms, fit_delays, fit_sensor_c
 from .context import DiagContext, ModelDict
 from .evidence import maneuver_for, unexplained_report
 from .regression import ols
+from .turbulence import gust_projector
 from .terms import term_matrix
 
 __all__ = ["Diagnosis", "diagnose"]
@@ -72,8 +73,15 @@ def _eq_error(R0, R1, test) -> dict:
     return out
 
 
-def _reestimate(ctx: DiagContext, R_final: np.ndarray, accepted: list[Fitted]) -> None:
-    """Re-estimate the accepted aero terms of each coefficient jointly (coloured std errors)."""
+def _reestimate(ctx: DiagContext, R_final: np.ndarray, accepted: list[Fitted], proj=None) -> None:
+    """Re-estimate the accepted aero terms of each coefficient jointly (coloured std errors).
+
+    With a gust projector the fit is on the projected, weighted residuals of all six
+    coefficients (the same space the candidates were scored in).
+    """
+    P = proj if proj is not None else (lambda D: D)
+    sw = np.sqrt(ctx.weight)
+    tr = ctx.train
     by_coef: dict[str, list[Fitted]] = {}
     for f in accepted:
         if f.kind == "aero":
@@ -82,8 +90,16 @@ def _reestimate(ctx: DiagContext, R_final: np.ndarray, accepted: list[Fitted]) -
         j = COEFFICIENTS.index(coef)
         terms = [f.labels[0] for f in fs]
         Phi = term_matrix(ctx.X, terms)
-        base = R_final[:, j] + sum(-f.delta[:, j] for f in fs)      # residual without these corrections
-        res = ols(Phi[ctx.train], base[ctx.train], terms=[f"x{i}" for i in range(len(terms))])
+        base = R_final + sum(-f.delta for f in fs)      # residual without these corrections
+        cols = []
+        for i in range(len(terms)):
+            D = np.zeros_like(base)
+            D[:, j] = Phi[:, i]
+            cols.append((P(D)[tr] * sw).T.ravel())
+        z = (P(base)[tr] * sw).T.ravel()
+        A = np.column_stack(cols)
+        keep = np.any(A != 0, axis=1)
+        res = ols(A[keep], z[keep], terms=[f"x{i}" for i in range(len(terms))])
         for i, f in enumerate(fs):
             th = float(res.theta[i])
             old = f.evidence["model_value"]
@@ -118,7 +134,7 @@ def _finding(f: Fitted, rivals: list[Fitted]) -> dict:
 def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *, train=None, test=None,
              max_findings: int = 3, min_score: float = 30.0, min_gain_pct: float = 10.0,
              min_rows: int = 500, unexplained_threshold_pct: float = 20.0, output_error: bool = True,
-             min_gain_oe_pct: float = 45.0,
+             min_gain_oe_pct: float = 45.0, project_gusts: bool = True, flight=None,
              progress=None) -> Diagnosis:
     """Hold a model against measured coefficients, name the cause(s), extend the model.
 
@@ -139,6 +155,11 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             predictable from the regressors for ``unexplained`` to be flagged above threshold.
         output_error: with ``states``, test the ``wind`` cause and measure the output-error gain by
             simulating short windows (:mod:`gcs_sysid.diagnose.output_error`; needs ``gcs_sysid.sim``).
+        project_gusts: profile out the angle errors of the reconstruction (turbulence) before
+            scoring (:mod:`gcs_sysid.diagnose.turbulence`; only when the data show them).
+        flight: the decoded flight behind ``states``; with it the sensor causes (air data, pitot,
+            gyro, accelerometer) are judged by data compatibility (:mod:`gcs_sysid.diagnose.compat`)
+            instead of in the coefficients.
         progress: optional callable ``progress(message)``.
 
     Returns:
@@ -156,15 +177,20 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                         f"{min_rows / 50:.0f} s at 50 Hz of flight with excitation)")
     model0 = {c: dict(v) for c, v in ctx.model.items()}
     R0 = ctx.Y - ctx.model_values()
+    proj = gust_projector(ctx, R0) if project_gusts else None
+    if proj is not None and proj.active:
+        ctx.weight = np.where(ctx.active, 1.0 / proj.sigma**2, 0.0)
+    else:
+        proj = None
     R = R0.copy()
     accepted: list[Fitted] = []
     last_rivals: list[Fitted] = []
     rounds = []
     for rnd in range(max_findings):
         say(f"diagnose: round {rnd + 1}, fitting candidate causes")
-        scorer = Scorer(ctx, R)
+        scorer = Scorer(ctx, R, proj)
         cands = fit_aero_terms(ctx, R, scorer) + fit_delays(ctx, R, scorer) + fit_stuck(ctx, R, scorer) \
-            + fit_sensor_causes(ctx, R, scorer)
+            + fit_sensor_causes(ctx, R, scorer, exclude=SENSOR_CAUSES if flight is not None else ())
         cands = [c for c in cands if np.isfinite(c.score) and c.cause not in {a.cause for a in accepted}]
         for c in cands:                      # a quadratic aero term must beat a simpler one by 10 %
             if c.kind == "aero" and ("*" in c.labels[0] or "^2" in c.labels[0]) and c.score > 0:
@@ -187,7 +213,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                     ctx.model[coef][term] = ctx.model[coef].get(term, 0.0) + d
     ext = {c: dict(v) for c, v in model0.items()}
     if accepted:
-        _reestimate(ctx, R, accepted)
+        _reestimate(ctx, R, accepted, proj)
         for f in accepted:
             for coef, upd in (f.model_update or {}).items():
                 for term, d in upd.items():
@@ -200,8 +226,21 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         wind_info = _wind_finding(ctx, oe_states, airframe, min_score, min_gain_oe_pct)
         if wind_info and wind_info.get("accepted"):
             findings.append(wind_info["finding"])
+    compat = []
+    if flight is not None and states is not None and hasattr(states, "t"):
+        say("diagnose: sensor data compatibility")
+        gust = None
+        if proj is not None:
+            e = proj.angles(np.nan_to_num(R0))
+            e = np.where(ctx.valid[:, None], e - e[ctx.train].mean(axis=0), 0.0)
+            gust = {n: e[:, i] for i, n in enumerate(proj.names)}
+        compat = _compat_findings(ctx, flight, states, airframe, min_score, min_gain_pct, gust)
+        findings += [c for c in compat if c["accepted"]]
+    for f in findings:
+        f.pop("accepted", None)
     findings.sort(key=lambda d: d["gain"].get("percent", 0.0), reverse=True)
-    unexplained = unexplained_report(ctx, R, threshold_pct=unexplained_threshold_pct)
+    P = proj if proj is not None else (lambda D: D)
+    unexplained = unexplained_report(ctx, P(R), threshold_pct=unexplained_threshold_pct)
     separation = []
     for fd in findings:
         if not fd["evidence"]["separable"]:
@@ -221,7 +260,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         "t_range_s": [float(ctx.t[ctx.valid][0]), float(ctx.t[ctx.valid][-1])],
         "rate_hz": float(1.0 / np.median(np.diff(ctx.t))),
         "held_out": "interleaved blocks" if train is None else "given",
-        "equation_error": _eq_error(R0, R, ctx.test),
+        "equation_error": _eq_error(P(R0), P(R), ctx.test),
+        "equation_error_raw": _eq_error(R0, R, ctx.test),
+        "turbulence": proj.summary() if proj is not None else {"active": False},
         "candidate_rounds": rounds,
         "thresholds": {"min_score": min_score, "min_gain_pct": min_gain_pct, "min_gain_oe_pct": min_gain_oe_pct,
                        "unexplained_threshold_pct": unexplained_threshold_pct},
@@ -229,6 +270,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         "notes": list(ctx.notes) + list(getattr(table, "notes", [])),
         "timings": {"diagnose_s": float(time.perf_counter() - t0)},
     }
+    if compat:
+        data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],
+                                      "gain_percent": c["gain"]["percent"]} for c in compat]
     if wind_info is not None:
         data["wind_candidate"] = {k: v for k, v in wind_info.items() if k != "finding"}
     diag = Diagnosis(findings, unexplained, data, model0, ext, ctx.t, ctx.X, R0, R, ctx.train, ctx.test, accepted)
@@ -242,6 +286,42 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)
     return diag
+
+
+SENSOR_CAUSES = ("bias:airspeed", "scale:airspeed", "bias:alpha", "bias:beta", "bias:gyro_x", "bias:gyro_y",
+                 "bias:gyro_z", "bias:accel_x", "bias:accel_y", "bias:accel_z")
+
+
+def _compat_findings(ctx: DiagContext, flight, states, airframe, min_score: float, min_gain_pct: float,
+                     gust=None) -> list[dict]:
+    """Sensor causes by data compatibility, each marked ``accepted`` when it passes the usual tests."""
+    from .compat import compatibility_candidates
+
+    t = np.asarray(states.t, float)
+    if len(t) == len(ctx.t) and np.allclose(t, ctx.t):
+        tr, te = ctx.train, ctx.test
+    else:
+        tr = np.interp(t, ctx.t, ctx.train.astype(float)) > 0.5
+        te = np.interp(t, ctx.t, ctx.test.astype(float)) > 0.5
+        gust = {k: np.interp(t, ctx.t, v) for k, v in gust.items()} if gust else None
+    cands = compatibility_candidates(flight, states, airframe, tr, te, gust)
+    cands.sort(key=lambda c: c["score"], reverse=True)
+    # one finding per sensor: the best of bias and scale for the pitot
+    seen = set()
+    for c in cands:
+        sensor = "airspeed" if c["cause"].endswith(":airspeed") else c["cause"]
+        tstat = c["evidence"].get("t_statistic")
+        c["accepted"] = bool(sensor not in seen and c["score"] >= min_score and c["gain"]["percent"] >= min_gain_pct
+                             and tstat is not None and abs(tstat) >= 3.0)
+        rivals = [r for r in cands if r is not c and r["cause"].split(":")[-1] == c["cause"].split(":")[-1]]
+        c["evidence"].update({"score": c["score"], "separable": not any(r["score"] > 0.9 * c["score"] for r in rivals),
+                              "rivals": [{"cause": r["cause"], "score": r["score"],
+                                          "gain_percent": r["gain"]["percent"]} for r in rivals]})
+        if not c["evidence"]["separable"]:
+            c["evidence"]["separate_by"] = [maneuver_for(c["cause"])]
+        if c["accepted"]:
+            seen.add(sensor)
+    return cands
 
 
 def _wind_finding(ctx: DiagContext, states, airframe, min_score: float, min_gain_pct: float) -> dict | None:

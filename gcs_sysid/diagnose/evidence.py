@@ -8,7 +8,7 @@ from ..aero.table import COEFFICIENTS, REGRESSORS
 from .context import DiagContext
 from .terms import VOCABULARY, term_factors, term_matrix
 
-__all__ = ["unexplained_report", "maneuver_for"]
+__all__ = ["unexplained_report", "maneuver_for", "noise_residual"]
 
 _AXIS_MANEUVER = {
     "alpha": "elevator 3-2-1-1 or doublets at several airspeeds (vary alpha)",
@@ -74,6 +74,19 @@ def _ridge_design(ctx: DiagContext):
     return A, np.linalg.cholesky(G)
 
 
+def noise_residual(ctx: DiagContext, R: np.ndarray) -> np.ndarray:
+    """Held-out residual (N_test, 6) left by a ridge quadratic in all regressors fitted on the training rows.
+
+    What no catalogue aero term could explain: the noise level against which candidates are judged.
+    """
+    from scipy.linalg import cho_solve
+
+    A, L = _ridge_design(ctx)
+    tr, te = ctx.train, ctx.test
+    th = cho_solve((L, True), A[tr].T @ np.nan_to_num(R[tr]))
+    return np.nan_to_num(R[te]) - A[te] @ th
+
+
 def _structured_share(ctx: DiagContext, r: np.ndarray, A: np.ndarray, L: np.ndarray) -> float:
     """Share (0..1) of the held-out residual that a quadratic in the regressors, fitted on training, predicts."""
     from scipy.linalg import cho_solve
@@ -85,13 +98,16 @@ def _structured_share(ctx: DiagContext, r: np.ndarray, A: np.ndarray, L: np.ndar
     return float(max(0.0, 1.0 - e1 / e0)) if e0 > 0 else 0.0
 
 
-def unexplained_report(ctx: DiagContext, R: np.ndarray, threshold_pct: float = 20.0) -> list[dict]:
+def unexplained_report(ctx: DiagContext, R: np.ndarray, threshold_pct: float = 20.0,
+                       min_size_pct: float = 2.0) -> list[dict]:
     """Per coefficient: size of the held-out residual and where it lives.
 
     ``structured_percent`` is the share of the held-out residual variance a
     quadratic in all regressors (ridge, fitted on the training rows) predicts;
     the entry is ``above_threshold`` when it reaches ``threshold_pct``, i.e. the
-    residual is systematic, not noise. ``where`` gives the regressor most
+    residual is systematic, not noise, and that systematic part is at least
+    ``min_size_pct`` percent of the RMS of the measured coefficient (smaller is
+    below what a model of the coefficient is expected to reach). ``where`` gives the regressor most
     correlated with the residual, the alpha and V bins and the 5-s time window
     with the largest RMS.
     """
@@ -137,5 +153,8 @@ def unexplained_report(ctx: DiagContext, R: np.ndarray, threshold_pct: float = 2
         out.append({"coefficient": coef, "rms": rms, "rms_measured": rms_y,
                     "percent_of_measured": float(100 * rms / rms_y) if rms_y > 0 else None,
                     "structured_percent": float(100 * share),
-                    "above_threshold": bool(100 * share >= threshold_pct), "where": where})
+                    "structured_percent_of_measured": float(100 * np.sqrt(share) * rms / rms_y) if rms_y > 0 else 0.0,
+                    "above_threshold": bool(100 * share >= threshold_pct
+                                            and np.sqrt(share) * rms >= min_size_pct / 100 * rms_y),
+                    "where": where})
     return out

@@ -178,6 +178,8 @@ def _after_inputs(diag, airframe):
     af, delays, stuck, cg, wind, corr = airframe, {}, {}, None, np.zeros(3), {}
     for f in diag.findings:
         c, est = f["cause"], f["estimate"]
+        if f["evidence"].get("domain") == "data compatibility":
+            continue                      # a sensor error: the reconstruction the windows start from is not affected
         kind, _, what = c.partition(":")
         p = f["evidence"].get("parameters", {})
         if kind == "delay":

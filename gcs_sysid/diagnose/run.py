@@ -122,7 +122,7 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     model = load_model(model_path)
     meas = load_measurements(log, airframe_path, t_from, t_to, progress)
     diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=output_error,
-                    progress=progress, **kw)
+                    flight=meas.flight, progress=progress, **kw)
     diag.data.update({"log": str(log), "airframe": str(airframe_path), "model": str(model_path),
                       "window_s": [t_from, t_to]})
     diag.data["timings"].update(meas.timings)

@@ -1,9 +1,11 @@
 """Simulated test flights for the diagnosis tests: a dense-excitation plan and hidden effects.
 
 The plan flies ~90 s of multisines on all three surfaces plus throttle, with
-3-2-1-1s and doublets in between, two airspeeds and two headings (so wind,
-airspeed and alpha-dependent causes are all excited), light Dryden turbulence
-and the default sensor noise.
+3-2-1-1s and doublets in between (surface amplitudes 4-7 deg, as
+``data/plans/sysid-trainer.toml``), two airspeeds and two headings (so wind,
+airspeed and alpha-dependent causes are all excited), calm-morning Dryden
+turbulence (W20 = 1.5 m/s: sysid flights are flown in calm air) and the default
+sensor noise.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ AIRFRAME = ROOT / "data" / "airframes" / "sim-trainer.toml"
 MODEL = ROOT / "data" / "models" / "sim-trainer.toml"
 
 
-def plan_doc(duration: float = 96.0, seed: int = 7, turbulence: str | float = "light") -> dict:
+def plan_doc(duration: float = 90.0, seed: int = 7, turbulence: str | float = 1.5) -> dict:
     """A plan document (``docs/sim.md``) with dense excitation from t = 30 s."""
     t0 = 30.0
     man = []
@@ -71,6 +73,12 @@ def effects(cause: str, value) -> Effects:
         return Effects(airspeed_scale=value)
     if cause == "bias:alpha":
         return Effects(alpha_bias=value)
+    if cause == "bias:beta":
+        return Effects(beta_bias=value)
+    if cause.startswith("bias:gyro_") or cause.startswith("bias:accel_"):
+        v = [0.0, 0.0, 0.0]
+        v["xyz".index(cause[-1])] = value
+        return Effects(gyro_bias=tuple(v)) if "gyro" in cause else Effects(accel_bias=tuple(v))
     if cause == "wind":
         return Effects(wind_ned=tuple(value))
     if cause == "mass":
