@@ -78,13 +78,28 @@ def _score(res0_te, res1_te, k):
                       "percent": float(100 * (1 - a / b)) if b > 0 else 0.0}
 
 
-def _offset(cause, state, y, ref, train, test, unit, extra=None):
-    """Constant offset of ``y - ref`` (arrays on the grid): fitted on train, scored held out."""
+#: Smallest offset each check can resolve, whatever its statistics say: below it the reconstruction's
+#: own systematic error is as large (alpha/beta: a 0.2 m/s wind-estimate error at the flight's airspeed,
+#: added in ``_aoa``; gyro: the attitude-kinematics rate after smoothing; accelerometer: the GPS
+#: velocity derivative with ~0.05 m/s velocity noise over the averaging window).
+RESOLUTION = {"rad/s": 0.002, "m/s^2": 0.05}
+WIND_ERROR_MPS = 0.2
+
+
+def _offset(cause, state, y, ref, train, test, unit, extra=None, resolution=None):
+    """Constant offset of ``y - ref`` (arrays on the grid): fitted on train, scored held out.
+
+    Returns None (no candidate) when the data are too few or the offset is below ``resolution``
+    (default ``RESOLUTION[unit]``), the size the reconstruction itself cannot vouch for.
+    """
     d = y - ref
     tr, te = train & np.isfinite(d), test & np.isfinite(d)
     if tr.sum() < 20 or te.sum() < 10:
         return None
     b = float(np.mean(d[tr]))
+    floor = RESOLUTION.get(unit, 0.0) if resolution is None else resolution
+    if abs(b) < floor:
+        return None
     se = float(np.std(d[tr]) / np.sqrt(effective_samples(d[tr])))
     score, gain = _score(d[te], d[te] - b, 1)
     ev = {"domain": "data compatibility", "parameters": {cause: b}, "unit": unit,
@@ -124,7 +139,9 @@ def _aoa(flight, states, train, test, corrections=None):
                 best = (v, tau, ref)
         if best is None:
             continue
-        f = _offset(f"bias:{name}", name, y, best[2], train, test, "rad",
+        V = np.asarray(states["V"], float) if "V" in states else np.array([20.0])
+        res = WIND_ERROR_MPS / max(float(np.nanmedian(V)), 5.0)   # rad: a wind error seen as an angle
+        f = _offset(f"bias:{name}", name, y, best[2], train, test, "rad", resolution=res, extra=
                     {"sensor": f"AOA_SSA {name} (autopilot estimate) vs {name} reconstructed from GPS velocity, "
                                "attitude and wind" + (" plus the gust angle seen by the coefficients"
                                                       if gust is not None else ""), "lag_s": float(best[1])})
