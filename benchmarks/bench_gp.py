@@ -6,7 +6,13 @@ warm repeats of fit and of predict over all N rows, the held-out error, and each
 resident memory (each N in its own process). Baseline in the same run: the exact dense GP
 (same prior and hyperparameters, O((N P)^3)) against the sparse global layer on N = 1000
 rows, time ratio and agreement. Also: inducing points chosen by mutual information vs
-k-means vs random (VFE bound and held-out error, same hyperparameters).
+k-means vs random (VFE bound and held-out error, same hyperparameters). And the maneuver
+ranking: 24 candidate trajectories of 64 rows, variance at 256 query rows, by the batched
+closed-form ``global_variance_after_many`` against the exact ``variance_after`` per candidate
+(baseline, same run), with their largest difference on the global layer.
+
+Each worker runs as the replay pipeline does: one OpenBLAS thread (``limit_blas_threads``) and
+the persistent compilation cache in a fresh, empty directory, so "cold fit" includes compiling.
 
 Run: ``python benchmarks/bench_gp.py`` (``--quick`` for one repeat and N = 3000, 10000).
 """
@@ -162,25 +168,56 @@ def run_selection(n: int = 3000, m: int = 64) -> dict:
     return out
 
 
+def run_ranking(n: int = 10000, candidates: int = 24) -> dict:
+    """Batched global-layer ranking vs one exact ``variance_after`` per candidate."""
+    from gcs_sysid.gp import GPConfig, fit_gp
+
+    X, Y, _ = flight(n, seed=3)
+    model, _ = fit_gp(X, Y, GPConfig())
+    rng = np.random.default_rng(5)
+    extras = [X[i:i + 64] + 0.5 * X.std(0) * rng.standard_normal(10) for i in rng.choice(n - 64, candidates)]
+    query = X[rng.choice(n, 256)] + X.std(0)
+    model.global_variance_after_many(extras[:1], [query])          # warm (compiles nothing; numpy)
+    t = time.perf_counter()
+    out = model.global_variance_after_many(extras, [query] * candidates)
+    batched = time.perf_counter() - t
+    model.variance_after(extras[0], query)                          # compile outside the timing
+    times, diffs = [], []
+    for k in range(3):
+        t = time.perf_counter()
+        model.variance_after(extras[k], query)
+        times.append(time.perf_counter() - t)
+        ref = model.update(extras[k], np.zeros((64, 6))).predict_global(query, include_noise=False)[1]
+        diffs.append(float(np.max(np.abs(out[k][1] - ref) / ref)))
+    per = statistics.median(times)
+    return {"candidates": candidates, "batched_s": batched, "exact_per_candidate_s": per,
+            "exact_all_s_estimate": per * candidates, "ratio": per * candidates / batched,
+            "max_rel_diff_global": max(diffs)}
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args(argv)
-    from gcs_sysid.jaxconfig import enable_x64
+    from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
 
     enable_x64()
     if args.worker:
+        import tempfile
+
+        limit_blas_threads(1)
+        enable_compilation_cache(tempfile.mkdtemp(prefix="gcs-sysid-bench-jax-"))
         kind, value = args.worker.split(":")
         res = {"size": lambda: run_size(int(value), args.repeats), "baseline": lambda: run_baseline(int(value)),
-               "selection": lambda: run_selection(int(value))}[kind]()
+               "selection": lambda: run_selection(int(value)), "ranking": lambda: run_ranking(int(value))}[kind]()
         res["peak_rss_mib"] = peak_rss_mib()
         print(json.dumps(res))
         return
     sizes = (3000, 10000) if args.quick else (3000, 10000, 30000)
     repeats = 1 if args.quick else args.repeats
-    jobs = [("baseline", 1000)] + [("size", n) for n in sizes] + [("selection", 3000)]
+    jobs = [("baseline", 1000)] + [("size", n) for n in sizes] + [("selection", 3000), ("ranking", 10000)]
     results = {}
     for kind, value in jobs:
         out = subprocess.run([sys.executable, __file__, "--worker", f"{kind}:{value}", "--repeats", str(repeats)],
@@ -198,6 +235,10 @@ def main(argv=None):
     s = results["selection:3000"]
     for k, v in ((k, v) for k, v in s.items() if isinstance(v, dict)):
         print(f"  inducing by {k:>6}: ELBO {v['elbo_median']:.1f}, mean held-out error {v['mean_err_pct_median']:.2f} %")
+    r = results["ranking:10000"]
+    print(f"  ranking {r['candidates']} maneuvers: batched {r['batched_s']:.3f} s, exact variance_after "
+          f"{r['exact_per_candidate_s']:.3f} s each (~{r['exact_all_s_estimate']:.1f} s), ratio {r['ratio']:.0f}x, "
+          f"largest relative difference on the global layer {r['max_rel_diff_global']:.1e}")
 
 
 if __name__ == "__main__":

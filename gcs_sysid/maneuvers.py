@@ -20,11 +20,14 @@ multisine on several surfaces when several axes are weak there):
    modes (Morelli 2003). Amplitude so the response stays linear (target alpha/q, p, beta
    excursions and bank angle), raised to reach the region's deflection or rate if needed, capped
    by a fraction of the surface authority left at trim.
-5. Ranking: the regressor trajectory the maneuver would produce is passed to
-   ``model.variance_after(X_extra, X_region)``; the relative reduction of the predictive variance
-   at the region's points, weighted towards the weakest coefficients (lowest confidence score), is
-   the priority (active learning by variance reduction: MacKay, "Information-based objective
-   functions for active data selection", Neural Computation 4(4), 1992).
+5. Ranking: the regressor trajectory the maneuver would produce is passed to the model, which
+   returns the predictive variance at the region's points after observing it
+   (``model.global_variance_after_many`` for the package's GP: all candidates in one batched,
+   closed-form update of the global layer; ``model.variance_after`` for any other model); the
+   relative reduction of the variance at the region's points, weighted towards the weakest
+   coefficients (lowest confidence score), is the priority (active learning by variance
+   reduction: MacKay, "Information-based objective functions for active data selection",
+   Neural Computation 4(4), 1992).
 """
 
 from __future__ import annotations
@@ -531,18 +534,17 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
     ctx = _Context(model, envelope, airframe, cfg, d, at_ref, assumed, dict(envelope.reference), rho,
                    _authority(airframe), weight, float(np.median(dts)) if dts.size else 0.02)
     regions.sort(key=lambda r: -r.mean_rel_sigma * weight[r.coefficient])
-    candidates = []
+    designs = []      # (gi, kind, controls, targets, lead, design, X_extra, query index)
+    queries = []      # per group: (Xq padded, coefficient -> row slice)
     for gi, grp in enumerate(_group(regions[:cfg.max_regions])):
         coefs = sorted({r.coefficient for r in grp}, key=lambda c: (-weight[c], c not in MOMENT_COEFFICIENTS, c))
         pts = {c: np.vstack([r.points for r in grp if r.coefficient == c]) for c in coefs}
-        Xq = np.vstack([pts[c] for c in coefs])
         sl = {}
         k0 = 0
         for c in coefs:
             sl[c] = slice(k0, k0 + len(pts[c]))
             k0 += len(pts[c])
-        Xq = _pad(Xq, cfg.query_bucket)
-        var0 = model_variance(model.predict, Xq)
+        queries.append((_pad(np.vstack([pts[c] for c in coefs]), cfg.query_bucket), sl))
         by_surface: dict[str, list[str]] = {}
         for c in coefs:
             s = _surface_for(c, ctx.authority)
@@ -554,17 +556,18 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
         for kind, controls, targets in plans:
             lead = next(r for r in grp if r.coefficient == targets[0])
             out = _design(ctx, kind, controls, targets, lead)
-            if out is None:
-                continue
-            design, X_extra = out
-            var1 = model_variance(model.variance_after, X_extra, Xq)
-            red = {}
-            for c in targets:
-                j = outs.index(c)
-                v0 = float(np.mean(var0[sl[c], j]))
-                red[c] = float(np.clip(1.0 - np.mean(var1[sl[c], j]) / v0, 0.0, 1.0)) if v0 > 0 else 0.0
-            prio = sum(weight[c] * red[c] for c in targets) / np.sqrt(len(targets))
-            candidates.append((prio, gi, kind, controls, targets, lead, design, red))
+            if out is not None:
+                designs.append((gi, kind, controls, targets, lead, out[0], out[1]))
+    candidates = []
+    for (gi, kind, controls, targets, lead, design, _), (var0, var1) in zip(designs, _variances(model, designs, queries)):
+        sl = queries[gi][1]
+        red = {}
+        for c in targets:
+            j = outs.index(c)
+            v0 = float(np.mean(var0[sl[c], j]))
+            red[c] = float(np.clip(1.0 - np.mean(var1[sl[c], j]) / v0, 0.0, 1.0)) if v0 > 0 else 0.0
+        prio = sum(weight[c] * red[c] for c in targets) / np.sqrt(len(targets))
+        candidates.append((prio, gi, kind, controls, targets, lead, design, red))
     candidates.sort(key=lambda x: -x[0])
     chosen, seen = [], set()
     for prio, gi, kind, controls, targets, lead, design, red in candidates:
@@ -578,6 +581,30 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
         if len(chosen) >= max_suggestions:
             break
     return chosen
+
+
+def _variances(model: Any, designs: list, queries: list) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(variance before, variance after) at each candidate's query points, latent where possible.
+
+    A model with ``global_variance_after_many`` (:class:`gcs_sysid.gp.LocalGlobalGP`) ranks all
+    candidates in one batched call on its global layer (closed-form Woodbury update; the
+    nearest-neighbour local layer is left out of both numbers); any other model is asked
+    ``predict`` once per query set and ``variance_after`` once per candidate.
+    """
+    if not designs:
+        return []
+    batched = getattr(model, "global_variance_after_many", None)
+    if batched is not None:
+        return [tuple(np.asarray(v, float) for v in pair)
+                for pair in batched([d[6] for d in designs], [queries[d[0]][0] for d in designs])]
+    before: dict[int, np.ndarray] = {}
+    out = []
+    for d in designs:
+        gi = d[0]
+        if gi not in before:
+            before[gi] = model_variance(model.predict, queries[gi][0])
+        out.append((before[gi], model_variance(model.variance_after, d[6], queries[gi][0])))
+    return out
 
 
 def _suggestion(rank: int, ctx: _Context, prio: float, kind: str, controls: tuple[str, ...],

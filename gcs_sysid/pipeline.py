@@ -147,6 +147,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     """
     from .envelope import confidence_map
     from .gp import GPConfig, fit_gp, load_gp
+    from .jaxconfig import enable_compilation_cache, limit_blas_threads
     from .maneuvers import suggest_maneuvers
     from .report import write_report
 
@@ -187,6 +188,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             ok_rows = np.all(np.isfinite(X_train), axis=1) & np.all(np.isfinite(Y_train), axis=1)
             X_train, Y_train = X_train[ok_rows], Y_train[ok_rows]
             with _stage("learn GP", timings, bar):
+                # compiled GP programs are cached on disk (only the first run on a machine compiles);
+                # one BLAS thread: the GP's many small factorisations run faster without hand-offs
+                enable_compilation_cache()
+                limit_blas_threads(1)
                 if options.model_in:
                     model = load_gp(Path(options.model_in))
                     if model.n_outputs != len(fit_cols):

@@ -13,6 +13,7 @@ Public API::
     mean_g, var_g = model.predict_global(X)
     model = model.update(X_new, Y_new)        # incremental, hyperparameters kept
     var_after = model.variance_after(X_extra, X_query)
+    pairs = model.global_variance_after_many(X_extras, X_queries)   # batched, for ranking
     model.save("dir/gp"); model = load_gp("dir/gp")
 """
 

@@ -21,9 +21,12 @@ class GPConfig:
             chosen again with the learned length-scales. None: ``n_inducing``.
         n_train_max: rows (random subset) used to learn hyperparameters; the posterior
             then uses every row.
-        steps: Adam steps on the VFE bound (half before and half after re-selecting the
+        steps: most Adam steps on the VFE bound (half before and half after re-selecting the
             inducing points when ``reselect``).
         learning_rate: Adam step size (unconstrained, log-scale parameters).
+        tol: early stopping: an Adam run (global or local) stops when the mean loss (per data
+            point and output) of the last 10 steps improved by less than this on the 10 before;
+            0 runs every step.
         rank: rank ``R`` of the shared part ``L L^T`` of the coregionalisation matrix.
         inducing: ``"mi"`` (greedy mutual information), ``"kmeans"`` or ``"random"``.
         mi_pool: candidates for the mutual-information selection.
@@ -35,28 +38,31 @@ class GPConfig:
         local: add the local non-stationary layer.
         local_neighbours: neighbours ``K`` per local prediction.
         local_batch: neighbourhoods in the local composite likelihood.
-        local_steps: Adam steps for the local hyperparameters.
+        local_steps: most Adam steps for the local hyperparameters.
+        local_learning_rate: their Adam step size.
         batch_size: rows per compiled chunk when computing statistics and predictions.
         seed: seed of every random choice.
     """
 
     n_inducing: int = 128
-    n_inducing_hyper: int | None = 64
-    n_train_max: int = 2000
-    steps: int = 300
+    n_inducing_hyper: int | None = 32
+    n_train_max: int = 1000
+    steps: int = 200
     learning_rate: float = 0.05
+    tol: float = 1e-3
     rank: int = 2
     inducing: str = "mi"
-    mi_pool: int = 1500
+    mi_pool: int = 800
     reselect: bool = True
     train_inducing: bool = False
     linear_mean: bool = True
     prior_std: float = 3.0
     jitter: float = 1e-6
     local: bool = True
-    local_neighbours: int = 32
-    local_batch: int = 128
-    local_steps: int = 150
+    local_neighbours: int = 16
+    local_batch: int = 64
+    local_steps: int = 40
+    local_learning_rate: float = 0.1
     batch_size: int = 2048
     seed: int = 0
 
@@ -71,8 +77,9 @@ class GPConfig:
                 raise InputError(f"GPConfig.{name} must be >= 0, got {getattr(self, name)!r}")
         if self.inducing not in ("mi", "kmeans", "random"):
             raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
-        if not (self.learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0):
-            raise InputError("GPConfig: learning_rate and jitter must be > 0 and prior_std >= 0")
+        if not (self.learning_rate > 0 and self.local_learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0
+                and self.tol >= 0):
+            raise InputError("GPConfig: learning rates and jitter must be > 0, prior_std and tol >= 0")
 
     def to_dict(self) -> dict:
         """JSON-able settings."""

@@ -6,12 +6,12 @@ Steps (each one a plain function of arrays):
 2. initialise ``B`` and the noise from the residual covariance of a ridge least-squares
    fit of the linear mean, length-scales ``0.5 sqrt(D)``;
 3. choose the inducing inputs (greedy mutual information, :mod:`gcs_sysid.gp.selection`);
-4. Adam on ``-ELBO / (n P)`` over a random subset of ``n_train_max`` rows (compiled
-   ``lax.scan``); re-select the inducing inputs with the learned length-scales and
-   continue (``reselect``);
+4. Adam on ``-ELBO / (n P)`` over a random subset of ``n_train_max`` rows (one compiled
+   step in a Python loop, early stopping on a plateau of the bound, ``GPConfig.tol``);
+   re-select the inducing inputs with the learned length-scales and continue (``reselect``);
 5. the global posterior from the sufficient statistics of every row;
 6. the local layer: residuals of the global mean, k-d tree, Adam on the composite
-   local likelihood.
+   local likelihood from a variogram start (nugget from nearest-neighbour differences).
 """
 
 from __future__ import annotations
@@ -98,14 +98,25 @@ def _adam_step(loss, raw, opt_state, lr, args):
     return keep(new_raw, raw), keep(new_state, opt_state), value
 
 
-def _adam(loss, raw, opt_state, lr, args, n_steps: int):
-    """``n_steps`` compiled Adam steps (a Python loop over one compiled step compiles faster
-    and, on CPU, runs faster than ``lax.scan`` here). Returns ``(raw, opt_state, losses)``."""
+def _adam(loss, raw, opt_state, lr, args, n_steps: int, tol: float = 0.0, window: int = 10):
+    """Up to ``n_steps`` compiled Adam steps (a Python loop over one compiled step compiles faster
+    and, on CPU, runs faster than ``lax.scan`` here). Returns ``(raw, opt_state, losses)``.
+
+    Early stopping: every ``window`` steps the mean loss of the last window is compared with the
+    window before; when it improved by less than ``tol`` (the loss is per data point, so ``tol``
+    is in nats per point and output) the optimisation stops. ``tol = 0`` runs all steps.
+    """
     values = []
     lr = jnp.asarray(lr)
-    for _ in range(n_steps):
+    prev = np.inf
+    for k in range(n_steps):
         raw, opt_state, value = _adam_step(loss, raw, opt_state, lr, args)
         values.append(value)
+        if tol > 0 and (k + 1) % window == 0 and k + 1 < n_steps:
+            cur = float(np.mean(np.asarray(jax.device_get(values[-window:]))))
+            if np.isfinite(cur) and np.isfinite(prev) and prev - cur < tol:
+                break
+            prev = cur
     return raw, opt_state, np.asarray(jax.device_get(values))
 
 
@@ -140,12 +151,21 @@ def _fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHisto
     centres = rng.choice(len(Xs), min(cfg.local_batch, len(Xs)), replace=False)
     idx, _ = neighbours(store, Xs[centres])
     args = (jnp.asarray(Xs[idx]), jnp.asarray(store.z[idx]), jnp.asarray(resid[idx]))
+    # start from the empirical variogram: half the mean squared residual difference between each
+    # centre and its nearest stored neighbour estimates the nugget (noise), the rest of the residual
+    # variance is signal (Cressie 1993, Statistics for Spatial Data, sec. 2.4)
     v = np.maximum(resid.var(0), 1e-8)
+    if idx.shape[1] > 1:
+        nugget = 0.5 * np.mean((resid[idx[:, 0]] - resid[idx[:, 1]]) ** 2, 0)
+        noise0 = np.clip(nugget, 0.01 * v, 0.9 * v)
+    else:
+        noise0 = 0.5 * v
     raw = {"log_ls": jnp.log(jnp.maximum(0.25 * params.lengthscale, 1e-3)), "beta": jnp.asarray(0.0),
-           "log_amp": jnp.log(jnp.asarray(0.5 * v)), "log_noise": jnp.log(jnp.asarray(0.5 * v))}
+           "log_amp": jnp.log(jnp.asarray(np.maximum(v - noise0, 0.1 * v))), "log_noise": jnp.log(jnp.asarray(noise0))}
     if cfg.local_steps > 0:
-        opt_state = optax.adam(cfg.learning_rate).init(raw)
-        raw, _, values = _adam(_local_loss, raw, opt_state, cfg.learning_rate, args, int(cfg.local_steps))
+        opt_state = optax.adam(cfg.local_learning_rate).init(raw)
+        raw, _, values = _adam(_local_loss, raw, opt_state, cfg.local_learning_rate, args, int(cfg.local_steps),
+                               cfg.tol)
         history.local_loss.extend(np.asarray(values).tolist())
     return _constrain_local(raw), store
 
@@ -208,7 +228,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     for stage, n_steps in enumerate((first, cfg.steps - first)):
         if n_steps <= 0:
             continue
-        raw, opt_state, values = _adam(_global_loss, raw, opt_state, cfg.learning_rate, (fixed, Xh, Yh), int(n_steps))
+        raw, opt_state, values = _adam(_global_loss, raw, opt_state, cfg.learning_rate, (fixed, Xh, Yh), int(n_steps),
+                                       cfg.tol)
         history.elbo.extend((-np.asarray(values) * Xh.shape[0] * P).tolist())
         if stage == 0 and cfg.reselect and cfg.steps > first and not cfg.train_inducing:
             fixed = reselect(raw, fixed, Mh)

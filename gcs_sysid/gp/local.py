@@ -75,7 +75,7 @@ def build_store(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int) -
     pts = Xs * metric
     tree = cKDTree(pts)
     kk = min(k + 1, len(Xs))
-    dist, _ = tree.query(pts, k=kk)
+    dist, _ = tree.query(pts, k=kk, workers=-1)
     dist = np.asarray(dist).reshape(len(Xs), kk)
     logrho = np.log(np.maximum(dist[:, 1:].mean(1) if kk > 1 else np.ones(len(Xs)), 1e-12))
     z_mean = float(logrho.mean())
@@ -84,7 +84,7 @@ def build_store(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int) -
 
 def neighbours(store: LocalStore, Xq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Indices ``(Q, k)`` of the stored neighbours of ``Xq (Q, D)`` and the queries' ``z (Q,)``."""
-    dist, idx = store.tree.query(Xq * store.metric, k=store.k)
+    dist, idx = store.tree.query(Xq * store.metric, k=store.k, workers=-1)
     dist = np.asarray(dist).reshape(len(Xq), store.k)
     idx = np.asarray(idx).reshape(len(Xq), store.k)
     z = np.log(np.maximum(dist.mean(1), 1e-12)) - store.z_mean

@@ -178,6 +178,49 @@ class LocalGlobalGP:
             extra = replace(extra, store=store)
         return extra.predict(X_query, include_noise)[1]
 
+    def global_variance_after_many(self, X_extras, X_queries, include_noise: bool = False
+                                   ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Global-layer variance at query sets before and after observing each of ``C`` candidates.
+
+        The batched, closed-form (Woodbury) counterpart of :meth:`variance_after` for ranking
+        many candidates: only the global layer is updated (the local layer, a nearest-neighbour
+        correction of the residual, is left out of both numbers), and the global posterior
+        precision is not refactored (:mod:`gcs_sysid.gp.ranking`). Each pair equals
+        ``predict_global(X_query)[1]`` and ``update(X_extra, Y).predict_global(X_query)[1]``.
+
+        Args:
+            X_extras: ``C`` arrays ``(E_c, D)`` of candidate regressors, data units (NaN rows ignored).
+            X_queries: ``C`` arrays ``(Q_c, D)``; the same array object may be passed for several
+                candidates (its features are then computed once).
+            include_noise: add the global layer's noise variance.
+
+        Returns:
+            ``C`` pairs ``(var_before (Q_c, P), var_after (Q_c, P))``, data units squared (NaN for
+            query rows with a NaN).
+
+        Raises:
+            InputError: arrays that are not ``(N, D)``; ValueError: list lengths differ.
+        """
+        from .ranking import global_variance_after_many
+
+        enable_x64()
+        qs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        ext, qry, oks = [], [], []
+        for Xe, Xq in zip(X_extras, X_queries):
+            ext.append(self._standardise_query(Xe)[0])
+            if id(Xq) not in qs:
+                qs[id(Xq)] = self._standardise_query(Xq)
+            Xs, ok = qs[id(Xq)]
+            qry.append(Xs)
+            oks.append(ok)
+        if len(X_extras) != len(X_queries):
+            raise ValueError("global_variance_after_many: one query set per candidate")
+        noise = np.asarray(self.params.noise)[None, :] if include_noise else 0.0
+        out = []
+        for (v0, v1), ok in zip(global_variance_after_many(self, ext, qry), oks):
+            out.append((self._finish(ok, v0, v0 + noise)[1], self._finish(ok, v1, v1 + noise)[1]))
+        return out
+
     # ------------------------------------------------------------ reporting
     def output_correlation(self) -> np.ndarray:
         """Correlation ``(P, P)`` between the outputs' global GP parts, from ``B``."""

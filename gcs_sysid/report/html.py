@@ -116,9 +116,9 @@ def _envelope(r: ReplayResult) -> str:
            'median values. Cells are flagged (hatched, outlined) where sigma/spread exceeds the threshold or no '
            'training sample lies nearby. Confidence score = 1 - mean(min(sigma/spread, 1)) over all cells.</p>',
            _table(tables.score_rows(r))]
-    for sl in env.slices:
+    for sl, fig in zip(env.slices, plots.envelope_figures(r, list(env.slices))):
         out.append(f"<h3>{html.escape(sl.axes[0])} x {html.escape(sl.axes[1])}</h3>")
-        out.append(_img(plots.envelope_figure(r, sl), f"{sl.axes[0]} x {sl.axes[1]}"))
+        out.append(_img(fig, f"{sl.axes[0]} x {sl.axes[1]}"))
     return "".join(out)
 
 

@@ -19,9 +19,11 @@ from ..result import ReplayResult
 from .tables import ANGLES
 
 __all__ = ["png", "streams_figure", "states_figure", "coefficients_figure", "correlation_figure",
-           "envelope_figure", "suggestions_figure"]
+           "envelope_figure", "envelope_figures", "suggestions_figure"]
 
 _MAX_POINTS = 4000
+#: Training samples drawn over an envelope panel (decimated evenly; the counts panel shows them all).
+_MAX_SCATTER = 800
 _HELD = "#f4d03f"
 
 
@@ -31,6 +33,11 @@ def png(fig: Figure, dpi: int = 96) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     return buf.getvalue()
+
+
+def _grid_kw(extent) -> dict:
+    """imshow settings for a uniform (ny, nx) cell grid spanning ``extent`` (row 0 at the bottom)."""
+    return {"extent": extent, "origin": "lower", "aspect": "auto", "interpolation": "nearest"}
 
 
 def _stride(n: int) -> int:
@@ -151,51 +158,85 @@ def correlation_figure(matrix: np.ndarray, names: list[str]) -> bytes:
 
 def envelope_figure(r: ReplayResult, sl: EnvelopeSlice) -> bytes:
     """One slice: data coverage, then per coefficient sigma/spread with flagged cells hatched and outlined."""
+    return envelope_figures(r, [sl])[0]
+
+
+def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes]:
+    """:func:`envelope_figure` of each slice, drawn on one reused figure.
+
+    Building a figure of eight panels with colorbars costs more than drawing it, so the panels,
+    colorbars and labels are made once and each slice only swaps the images' data and extent,
+    the scatter of training samples, the flagged-cell contours and the texts.
+    """
     env = r.envelope
-    sx, sy = sl.axes
-    fx, ux = _scale(sx)
-    fy, uy = _scale(sy)
-    xe, ye = sl.x_edges * fx, sl.y_edges * fy
-    xc, yc = sl.x_centers * fx, sl.y_centers * fy
-    Xt = r.table.X[r.train]
-    px, py = Xt[:, REGRESSORS.index(sx)] * fx, Xt[:, REGRESSORS.index(sy)] * fy
-    k = max(1, len(px) // 1500)
+    if not slices:
+        return []
+    outs = list(env.outputs)
     fig = Figure(figsize=(13, 6.2))
     fig.subplots_adjust(left=0.05, right=0.93, bottom=0.08, top=0.9, wspace=0.28, hspace=0.38)
     axes = fig.subplots(2, 4).ravel()
-    ax = axes[0]
-    cnt = np.where(sl.counts > 0, sl.counts, np.nan)
-    vmax = float(np.nanmax(cnt)) if np.isfinite(cnt).any() else 2.0
-    im0 = ax.pcolormesh(xe, ye, cnt, cmap="Greens", norm=LogNorm(vmin=1, vmax=max(2.0, vmax)))
-    ax.plot(px[::k], py[::k], ".", ms=1.5, color="0.2", alpha=0.5)
-    ax.set_title("training data: samples per cell", fontsize=9)
-    cb = fig.colorbar(im0, ax=ax, fraction=0.046, pad=0.03)
+    blank = np.full(slices[0].counts.shape, np.nan)
+    im0 = axes[0].imshow(blank, cmap="Greens", norm=LogNorm(vmin=1, vmax=2.0), **_grid_kw((0, 1, 0, 1)))
+    dots0, = axes[0].plot([], [], ".", ms=1.5, color="0.2", alpha=0.5)
+    axes[0].set_title("training data: samples per cell", fontsize=9)
+    cb = fig.colorbar(im0, ax=axes[0], fraction=0.046, pad=0.03)
     cb.ax.tick_params(labelsize=7)
-    vmax = max(1.0, 1.5 * max(env.thresholds.get(c, 0.5) for c in env.outputs))
-    im = None
-    for ax, c in zip(axes[1:], env.outputs):
-        im = ax.pcolormesh(xe, ye, sl.rel_sigma[c], cmap="magma_r", vmin=0, vmax=vmax)
-        ax.plot(px[::k], py[::k], ".", ms=1, color="#1f78b4", alpha=0.35)
-        flag = sl.flagged(c).astype(float)
-        if flag.any() and not flag.all():
-            ax.contourf(xc, yc, flag, levels=[0.5, 1.5], colors="none", hatches=["///"])
-            ax.contour(xc, yc, flag, levels=[0.5], colors="#00bcd4", linewidths=1.3)
-        elif flag.all():
-            ax.contourf(xc, yc, flag + np.linspace(0, 1e-6, flag.size).reshape(flag.shape), levels=[0.5, 1.5],
-                        colors="none", hatches=["///"])
+    vmax = max(1.0, 1.5 * max(env.thresholds.get(c, 0.5) for c in outs))
+    ims, dots = [], []
+    for ax, c in zip(axes[1:], outs):
+        ims.append(ax.imshow(blank, cmap="magma_r", vmin=0, vmax=vmax, **_grid_kw((0, 1, 0, 1))))
+        dots.append(ax.plot([], [], ".", ms=1, color="#1f78b4", alpha=0.35)[0])
         ax.set_title(f"{c}: sigma/spread, score {env.scores.get(c, float('nan')):.2f}", fontsize=9)
-    if im is not None:
-        cb = fig.colorbar(im, ax=list(axes[1:1 + len(env.outputs)]), fraction=0.02, pad=0.02)
+    if ims:
+        cb = fig.colorbar(ims[-1], ax=list(axes[1:1 + len(outs)]), fraction=0.02, pad=0.02)
         cb.set_label("predictive sigma / RMS spread", fontsize=8)
-    for ax in axes[1 + len(env.outputs):]:
+    for ax in axes[1 + len(outs):]:
         ax.axis("off")
-    for ax in axes[:1 + len(env.outputs)]:
-        ax.set_xlabel(f"{sx} ({ux})", fontsize=8)
-        ax.set_ylabel(f"{sy} ({uy})", fontsize=8)
+    used = axes[:1 + len(outs)]
+    for ax in used:
         ax.tick_params(labelsize=7)
-    fig.suptitle(f"{sx} x {sy}: other regressors at their medians; hatched + outlined = flagged "
-                 "(high sigma or no data)", fontsize=10)
-    return png(fig)
+        ax.locator_params(nbins=4)
+    title = fig.suptitle("", fontsize=10)
+    Xt = r.table.X[r.train]
+    k = max(1, len(Xt) // _MAX_SCATTER)
+    pngs, marks = [], []
+    for sl in slices:
+        for m in marks:
+            m.remove()
+        marks = []
+        sx, sy = sl.axes
+        fx, ux = _scale(sx)
+        fy, uy = _scale(sy)
+        xe, ye = sl.x_edges * fx, sl.y_edges * fy
+        xc, yc = sl.x_centers * fx, sl.y_centers * fy
+        px, py = Xt[::k, REGRESSORS.index(sx)] * fx, Xt[::k, REGRESSORS.index(sy)] * fy
+        extent = (xe[0], xe[-1], ye[0], ye[-1])   # the grid is uniform: imshow draws it faster than pcolormesh
+        cnt = np.where(sl.counts > 0, sl.counts, np.nan)
+        cmax = float(np.nanmax(cnt)) if np.isfinite(cnt).any() else 2.0
+        im0.set_data(cnt)
+        im0.set_extent(extent)
+        im0.set_clim(1, max(2.0, cmax))
+        dots0.set_data(px, py)
+        for ax, c, im, dt in zip(axes[1:], outs, ims, dots):
+            im.set_data(sl.rel_sigma[c])
+            im.set_extent(extent)
+            dt.set_data(px, py)
+            flag = sl.flagged(c).astype(float)
+            if flag.any() and not flag.all():
+                marks.append(ax.contourf(xc, yc, flag, levels=[0.5, 1.5], colors="none", hatches=["///"]))
+                marks.append(ax.contour(xc, yc, flag, levels=[0.5], colors="#00bcd4", linewidths=1.3))
+            elif flag.all():
+                marks.append(ax.contourf(xc, yc, flag + np.linspace(0, 1e-6, flag.size).reshape(flag.shape),
+                                         levels=[0.5, 1.5], colors="none", hatches=["///"]))
+        for ax in used:
+            ax.set_xlim(extent[0], extent[1])
+            ax.set_ylim(extent[2], extent[3])
+            ax.set_xlabel(f"{sx} ({ux})", fontsize=8)
+            ax.set_ylabel(f"{sy} ({uy})", fontsize=8)
+        title.set_text(f"{sx} x {sy}: other regressors at their medians; hatched + outlined = flagged "
+                       "(high sigma or no data)")
+        pngs.append(png(fig))
+    return pngs
 
 
 def suggestions_figure(r: ReplayResult, limit: int = 6) -> bytes:

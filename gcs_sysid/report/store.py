@@ -52,6 +52,17 @@ def _nan(v: Any) -> float:
     return float("nan") if v is None else float(v)
 
 
+def _savez_fast(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """``numpy.savez_compressed`` with zlib level 1 instead of 6: the same .npz format (read by
+    ``numpy.load``), a few per cent larger for float data and several times faster to write."""
+    import zipfile
+
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
+        for k, v in arrays.items():
+            with zf.open(f"{k}.npy", "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asarray(v), allow_pickle=False)
+
+
 def save_result(result: ReplayResult, path: str | Path) -> dict[str, Path]:
     """Write ``path/result.json`` and ``path/result.npz`` (directory created).
 
@@ -73,7 +84,7 @@ def save_result(result: ReplayResult, path: str | Path) -> dict[str, Path]:
     for k, v in st.sigma.items():
         arrays[f"sigma__{k}"] = np.asarray(v)
     npz = out / "result.npz"
-    np.savez_compressed(npz, **{k: np.asarray(v) for k, v in arrays.items()})
+    _savez_fast(npz, arrays)
     doc = {
         "format": "gcs-sysid ReplayResult", "version": FORMAT_VERSION,
         "log_path": result.log_path, "airframe_name": result.airframe_name, "airframe_path": result.airframe_path,

@@ -1,0 +1,61 @@
+"""Run-time settings of the GP: early stopping, the persistent compilation cache, BLAS threads."""
+
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gp_data import FAST, flight_regressors, linear_truth
+from gcs_sysid.errors import InputError
+from gcs_sysid.gp import GPConfig, fit_gp
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_early_stopping_stops_on_a_plateau_and_tol_zero_runs_every_step():
+    X = flight_regressors(200, seed=3)
+    Y = linear_truth(X) + 1e-3 * np.random.default_rng(4).standard_normal((200, 6))
+    cfg = replace(FAST, steps=120, local=False, reselect=False)
+    _, every = fit_gp(X, Y, replace(cfg, tol=0.0))
+    _, early = fit_gp(X, Y, replace(cfg, tol=10.0))      # any window improves by less than 10 nats/point
+    assert len(every.elbo) == 120
+    assert len(early.elbo) == 20                          # two windows of 10 steps, then the plateau test stops it
+    np.testing.assert_allclose(early.elbo, every.elbo[:20], rtol=1e-9)
+
+
+def test_negative_tol_is_rejected():
+    with pytest.raises(InputError, match="tol"):
+        GPConfig(tol=-1.0)
+
+
+def _child(code: str, env: dict) -> str:
+    full = dict(os.environ, PYTHONPATH=str(REPO), **env)
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=full, check=True,
+                          timeout=120).stdout
+
+
+def test_compilation_cache_is_written_and_can_be_switched_off(tmp_path):
+    code = ("import jax, jax.numpy as jnp\n"
+            "from gcs_sysid.jaxconfig import enable_compilation_cache\n"
+            "print(enable_compilation_cache(min_compile_time_s=0.0))\n"
+            "jax.jit(lambda x: jnp.linalg.cholesky(x @ x.T + 3 * jnp.eye(3)))(jnp.ones((3, 3))).block_until_ready()\n")
+    out = _child(code, {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")})
+    assert out.strip() == str(tmp_path / "jax")
+    assert any(p.is_file() for p in (tmp_path / "jax").rglob("*"))     # a compiled program was stored
+    assert _child(code, {"GCS_SYSID_JAX_CACHE": "off"}).strip() == "None"
+
+
+def test_limit_blas_threads_sets_every_loaded_openblas_to_one_thread():
+    code = ("import os, numpy as np, scipy.linalg\n"
+            "from gcs_sysid.jaxconfig import limit_blas_threads\n"
+            "n = limit_blas_threads(1)\n"
+            "maps = open('/proc/self/maps').read() if os.path.exists('/proc/self/maps') else ''\n"
+            "libs = {l.split()[-1] for l in maps.splitlines() if 'openblas' in os.path.basename(l.split()[-1]).lower()}\n"
+            "a = np.random.default_rng(0).standard_normal((50, 50))\n"
+            "print(n, len(libs), float(np.abs(np.linalg.solve(a, a) - np.eye(50)).max()) < 1e-8)\n")
+    n, n_libs, ok = _child(code, {}).split()
+    assert int(n) == int(n_libs) and ok == "True"     # each loaded OpenBLAS was found and set; results unchanged
