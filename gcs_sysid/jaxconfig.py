@@ -88,49 +88,29 @@ def enable_compilation_cache(path: str | os.PathLike | None = None, min_compile_
     return target
 
 
-_OPENBLAS_SETTERS = ("scipy_openblas_set_num_threads64_", "scipy_openblas_set_num_threads",
-                     "openblas_set_num_threads64_", "openblas_set_num_threads")
+
+
+_BLAS_LIMIT = None  # keeps the threadpoolctl limiter alive
 
 
 def limit_blas_threads(n: int = 1) -> int:
-    """Set the thread count of every OpenBLAS loaded by NumPy and SciPy (which JAX's CPU
-    LAPACK calls use) to ``n`` (process-wide; idempotent).
+    """Set the thread count of every BLAS loaded by NumPy and SciPy (which JAX's CPU LAPACK
+    calls use) to ``n`` (process-wide; idempotent), with threadpoolctl.
 
-    Works on Linux (the loaded libraries are found in ``/proc/self/maps`` and their
-    ``*openblas_set_num_threads*`` entry point is called through ctypes, as threadpoolctl
-    does); elsewhere, or with another BLAS, it does nothing. ``OPENBLAS_NUM_THREADS`` set
-    before start-up has the same effect.
+    OpenBLAS's own threading made the GP's many small matrix operations 10-35x slower on a
+    2-core machine (a 32x32 triangular solve took 8 ms instead of 0.23 ms; ``docs/gp.md``).
+    ``OPENBLAS_NUM_THREADS=1`` set before start-up has the same effect.
 
     Args:
         n: threads per BLAS call (>= 1).
 
     Returns:
-        The number of OpenBLAS libraries changed (0 when none was found).
+        The number of BLAS libraries changed.
     """
-    import ctypes
+    import numpy  # noqa: F401  (loads NumPy's BLAS)
+    import scipy.linalg  # noqa: F401  (loads SciPy's BLAS)
+    from threadpoolctl import threadpool_info, threadpool_limits
 
-    import numpy  # noqa: F401  (loads NumPy's OpenBLAS)
-    import scipy.linalg  # noqa: F401  (loads SciPy's OpenBLAS)
-
-    n = max(int(n), 1)
-    try:
-        with open("/proc/self/maps") as f:
-            paths = {line.split()[-1] for line in f
-                     if len(line.split()) >= 6 and "openblas" in os.path.basename(line.split()[-1]).lower()}
-    except OSError:
-        return 0
-    changed = 0
-    for path in sorted(paths):
-        try:
-            lib = ctypes.CDLL(path)
-        except OSError:
-            continue
-        for name in _OPENBLAS_SETTERS:
-            fn = getattr(lib, name, None)
-            if fn is not None:
-                fn.argtypes = [ctypes.c_int]
-                fn.restype = None
-                fn(n)
-                changed += 1
-                break
-    return changed
+    global _BLAS_LIMIT
+    _BLAS_LIMIT = threadpool_limits(limits=max(int(n), 1), user_api="blas")
+    return sum(1 for lib in threadpool_info() if lib.get("user_api") == "blas")

@@ -8,6 +8,12 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+# Compiled JAX programs go to a cache private to this test session (inherited by the CLI
+# subprocesses), so the suite neither reads nor fills the user's cache.
+import tempfile  # noqa: E402
+
+os.environ.setdefault("GCS_SYSID_JAX_CACHE", tempfile.mkdtemp(prefix="gcs-sysid-jax-"))
+
 from pathlib import Path
 
 import pytest
