@@ -12,6 +12,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from ..envelope import EnvelopeSlice
@@ -31,7 +32,8 @@ def png(fig: Figure, dpi: int = 96) -> bytes:
     """Render a figure to PNG bytes."""
     FigureCanvasAgg(fig)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
+    # zlib level 1: the figures are flat colours, so files grow a little and encoding is ~3x faster
+    fig.savefig(buf, format="png", dpi=dpi, pil_kwargs={"compress_level": 1})
     return buf.getvalue()
 
 
@@ -60,7 +62,9 @@ def _scale(name: str) -> tuple[float, str]:
 def streams_figure(r: ReplayResult) -> bytes:
     """Timeline of each stream: coverage, gaps in red, rate in the label."""
     ss = sorted(r.summaries.values(), key=lambda s: s.name)
-    fig = Figure(figsize=(10, 0.35 * max(len(ss), 3) + 1.0), layout="constrained")
+    h = 0.35 * max(len(ss), 3) + 1.0
+    fig = Figure(figsize=(10, h))   # fixed margins: constrained layout costs more than the drawing
+    fig.subplots_adjust(left=0.2, right=0.98, bottom=0.55 / h, top=1 - 0.35 / h)
     ax = fig.add_subplot()
     for i, s in enumerate(ss):
         if math.isfinite(s.t_start):
@@ -86,7 +90,8 @@ def states_figure(r: ReplayResult) -> bytes:
               ("Airspeed (m/s)", [("V", "V true")], 1.0),
               ("Air angles (deg)", [("alpha", "alpha"), ("beta", "beta")], 180 / math.pi),
               ("Controls (deg)", [("delta_e", "delta_e"), ("delta_a", "delta_a"), ("delta_r", "delta_r")], 180 / math.pi)]
-    fig = Figure(figsize=(10, 9.5), layout="constrained")
+    fig = Figure(figsize=(10, 9.5))
+    fig.subplots_adjust(left=0.08, right=0.93, bottom=0.055, top=0.99, hspace=0.12)
     axes = fig.subplots(len(panels), 1, sharex=True)
     for ax, (title, keys, sc) in zip(axes, panels):
         for key, lab in keys:
@@ -113,7 +118,8 @@ def coefficients_figure(r: ReplayResult) -> bytes:
     k = _stride(len(tb.t))
     t = tb.t[::k]
     held = r.held_out[::k]
-    fig = Figure(figsize=(10, 10), layout="constrained")
+    fig = Figure(figsize=(10, 10))
+    fig.subplots_adjust(left=0.08, right=0.98, bottom=0.05, top=0.955, hspace=0.12)
     axes = fig.subplots(6, 1, sharex=True)
     for j, (ax, c) in enumerate(zip(axes, COEFFICIENTS)):
         y = np.where(tb.valid, tb.Y[:, j], np.nan)[::k]
@@ -134,7 +140,7 @@ def coefficients_figure(r: ReplayResult) -> bytes:
             pad = 0.25 * (hi - lo) + 1e-9
             ax.set_ylim(lo - pad, hi + pad)
     h, lab = axes[0].get_legend_handles_labels()
-    fig.legend(h, lab, loc="outside upper right", fontsize=8, ncol=4)
+    fig.legend(h, lab, loc="upper right", bbox_to_anchor=(0.98, 1.0), fontsize=8, ncol=4, frameon=False)
     axes[-1].set_xlabel("vehicle time since boot (s)")
     return png(fig)
 
@@ -142,7 +148,8 @@ def coefficients_figure(r: ReplayResult) -> bytes:
 def correlation_figure(matrix: np.ndarray, names: list[str]) -> bytes:
     """Output correlation matrix of the multi-output GP."""
     m = np.asarray(matrix, float)
-    fig = Figure(figsize=(4.2, 3.6), layout="constrained")
+    fig = Figure(figsize=(4.2, 3.6))
+    fig.subplots_adjust(left=0.1, right=0.95, bottom=0.08, top=0.92)
     ax = fig.add_subplot()
     im = ax.imshow(m, vmin=-1, vmax=1, cmap="RdBu_r")
     ax.set_xticks(range(len(names)), names)
@@ -164,39 +171,50 @@ def envelope_figure(r: ReplayResult, sl: EnvelopeSlice) -> bytes:
 def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes]:
     """:func:`envelope_figure` of each slice, drawn on one reused figure.
 
-    Building a figure of eight panels with colorbars costs more than drawing it, so the panels,
-    colorbars and labels are made once and each slice only swaps the images' data and extent,
-    the scatter of training samples, the flagged-cell contours and the texts.
+    Each slice is one strip: training-sample counts per cell, then sigma/spread of each
+    coefficient, all on the slice's axes. Building panels with colorbars costs more than drawing
+    them, and tick labels dominate the drawing, so the panels, colorbars and labels are made once
+    (tick labels on the first panel's y axis only: the panels share their axes), and each slice
+    only swaps the images' data and extent, the decimated scatter of training samples, the
+    flagged-cell contours and the axis labels.
     """
     env = r.envelope
     if not slices:
         return []
     outs = list(env.outputs)
-    fig = Figure(figsize=(13, 6.2))
-    fig.subplots_adjust(left=0.05, right=0.93, bottom=0.08, top=0.9, wspace=0.28, hspace=0.38)
-    axes = fig.subplots(2, 4).ravel()
+    n = 1 + len(outs)
+    w = 1.72 * n + 1.2   # figure width (in); margins below in inches, so any number of panels fits
+    fig = Figure(figsize=(w, 2.55))
+    fig.subplots_adjust(left=1.0 / w, right=1 - 0.86 / w, bottom=0.2, top=0.8, wspace=0.08)
+    axes = list(np.atleast_1d(fig.subplots(1, n, sharex=True, sharey=True)).ravel())
     blank = np.full(slices[0].counts.shape, np.nan)
     im0 = axes[0].imshow(blank, cmap="Greens", norm=LogNorm(vmin=1, vmax=2.0), **_grid_kw((0, 1, 0, 1)))
-    dots0, = axes[0].plot([], [], ".", ms=1.5, color="0.2", alpha=0.5)
-    axes[0].set_title("training data: samples per cell", fontsize=9)
-    cb = fig.colorbar(im0, ax=axes[0], fraction=0.046, pad=0.03)
-    cb.ax.tick_params(labelsize=7)
+    dots0, = axes[0].plot([], [], ".", ms=1.2, color="0.2", alpha=0.5)
+    axes[0].set_title("samples per cell", fontsize=8)
+    cax0 = fig.add_axes((0.066 / w, 0.2, 0.08 / w, 0.6))   # counts bar at the far left
+    cax0.yaxis.set_ticks_position("left")
+    cax0.yaxis.set_label_position("left")
+    cb = fig.colorbar(im0, cax=cax0)
+    cb.formatter = FuncFormatter(lambda v, _: f"{v:g}")   # plain labels: no mathtext parsing
+    cb.minorformatter = NullFormatter()
+    cb.ax.tick_params(labelsize=6)
+    cb.set_label("samples", fontsize=7)
     vmax = max(1.0, 1.5 * max(env.thresholds.get(c, 0.5) for c in outs))
     ims, dots = [], []
     for ax, c in zip(axes[1:], outs):
         ims.append(ax.imshow(blank, cmap="magma_r", vmin=0, vmax=vmax, **_grid_kw((0, 1, 0, 1))))
-        dots.append(ax.plot([], [], ".", ms=1, color="#1f78b4", alpha=0.35)[0])
-        ax.set_title(f"{c}: sigma/spread, score {env.scores.get(c, float('nan')):.2f}", fontsize=9)
+        dots.append(ax.plot([], [], ".", ms=0.8, color="#1f78b4", alpha=0.35)[0])
+        ax.set_title(f"{c} (score {env.scores.get(c, float('nan')):.2f})", fontsize=8)
+        ax.yaxis.set_visible(False)   # shared with the first panel; not drawing it saves its ticks
     if ims:
-        cb = fig.colorbar(ims[-1], ax=list(axes[1:1 + len(outs)]), fraction=0.02, pad=0.02)
-        cb.set_label("predictive sigma / RMS spread", fontsize=8)
-    for ax in axes[1 + len(outs):]:
-        ax.axis("off")
-    used = axes[:1 + len(outs)]
-    for ax in used:
-        ax.tick_params(labelsize=7)
-        ax.locator_params(nbins=4)
-    title = fig.suptitle("", fontsize=10)
+        cax = fig.add_axes((1 - 0.70 / w, 0.2, 0.093 / w, 0.6))   # sigma bar at the right
+        cb = fig.colorbar(ims[-1], cax=cax)
+        cb.ax.tick_params(labelsize=6)
+        cb.set_label("sigma / spread", fontsize=7)
+    for ax in axes:
+        ax.tick_params(labelsize=6, length=2, pad=1)
+        ax.locator_params(nbins=3)
+    title = fig.text(0.5, 0.97, "", ha="center", va="top", fontsize=8)
     Xt = r.table.X[r.train]
     k = max(1, len(Xt) // _MAX_SCATTER)
     pngs, marks = [], []
@@ -224,17 +242,16 @@ def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes
             flag = sl.flagged(c).astype(float)
             if flag.any() and not flag.all():
                 marks.append(ax.contourf(xc, yc, flag, levels=[0.5, 1.5], colors="none", hatches=["///"]))
-                marks.append(ax.contour(xc, yc, flag, levels=[0.5], colors="#00bcd4", linewidths=1.3))
+                marks.append(ax.contour(xc, yc, flag, levels=[0.5], colors="#00bcd4", linewidths=1.0))
             elif flag.all():
                 marks.append(ax.contourf(xc, yc, flag + np.linspace(0, 1e-6, flag.size).reshape(flag.shape),
                                          levels=[0.5, 1.5], colors="none", hatches=["///"]))
-        for ax in used:
-            ax.set_xlim(extent[0], extent[1])
-            ax.set_ylim(extent[2], extent[3])
-            ax.set_xlabel(f"{sx} ({ux})", fontsize=8)
-            ax.set_ylabel(f"{sy} ({uy})", fontsize=8)
+        axes[0].set_xlim(extent[0], extent[1])   # shared by all panels
+        axes[0].set_ylim(extent[2], extent[3])
+        axes[0].set_xlabel(f"{sx} ({ux})", fontsize=7, labelpad=1)
+        axes[0].set_ylabel(f"{sy} ({uy})", fontsize=7, labelpad=1)
         title.set_text(f"{sx} x {sy}: other regressors at their medians; hatched + outlined = flagged "
-                       "(high sigma or no data)")
+                       "(high sigma/spread or no data)")
         pngs.append(png(fig))
     return pngs
 
@@ -245,7 +262,9 @@ def suggestions_figure(r: ReplayResult, limit: int = 6) -> bytes:
     n = len(ss)
     cols = 2 if n > 1 else 1
     rows = int(math.ceil(n / cols))
-    fig = Figure(figsize=(10, 2.3 * rows + 0.5), layout="constrained")
+    h = 2.3 * rows + 0.5
+    fig = Figure(figsize=(10, h))
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.5 / h, top=1 - 0.35 / h, wspace=0.18, hspace=0.6)
     axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
     names = {"delta_e": "elevator", "delta_a": "aileron", "delta_r": "rudder"}
     for ax, s in zip(axes, ss):

@@ -53,11 +53,12 @@ def _nan(v: Any) -> float:
 
 
 def _savez_fast(path: Path, arrays: dict[str, np.ndarray]) -> None:
-    """``numpy.savez_compressed`` with zlib level 1 instead of 6: the same .npz format (read by
-    ``numpy.load``), a few per cent larger for float data and several times faster to write."""
+    """``numpy.savez`` (stored, not deflated) without pickling: the float arrays of a flight
+    deflate by only ~23 % (19 MB to 15 MB for a 10-minute 50 Hz flight) and deflating them cost
+    ~0.35 s of the report stage, so they are stored as they are. Read by ``numpy.load``."""
     import zipfile
 
-    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_STORED) as zf:
         for k, v in arrays.items():
             with zf.open(f"{k}.npy", "w", force_zip64=True) as f:
                 np.lib.format.write_array(f, np.asarray(v), allow_pickle=False)
@@ -100,7 +101,8 @@ def save_result(result: ReplayResult, path: str | Path) -> dict[str, Path]:
         "table": {"notes": tb.notes},
     }
     js = out / "result.json"
-    js.write_text(json.dumps(jsonable(doc), indent=1, allow_nan=False))
+    # no indent: json's C encoder only runs without it (several times faster on the envelope grids)
+    js.write_text(json.dumps(jsonable(doc), allow_nan=False, separators=(",", ":")))
     return {"result_json": js, "result_npz": npz}
 
 
