@@ -29,7 +29,7 @@ from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
 AIRFRAMES = {
     "alfa": REPO / "data/airframes/carbon-z-t28.toml",
     "vtol": REPO / "data/airframes/arduplane-sitl-vtol.toml",
-    "arduplane": REPO / "data/airframes/arduplane-sitl-vtol.toml",
+    "arduplane": REPO / "data/airframes/arduplane-sitl-plane.toml",
 }
 
 
