@@ -93,6 +93,8 @@ def kalman_filter(x0: np.ndarray, P0: np.ndarray, F: np.ndarray, Q: np.ndarray, 
     Q_t = Q.ndim == 4
     P = np.broadcast_to(P0, (B, nx, nx)).copy()
     R = np.broadcast_to(R, (B, nz, nz))
+    if B == 1:
+        return _filter_one(x0[0], P[0], F, F_t, Q, Q_t, H, R[0], z[:, 0], None if u is None else u[:, 0])
     x = x0.copy()
     xs = np.empty((T, B, nx))
     Ps = np.empty((T, B, nx, nx))
@@ -144,6 +146,44 @@ def kalman_filter(x0: np.ndarray, P0: np.ndarray, F: np.ndarray, Q: np.ndarray, 
     return FilterResult(xs, Ps, xps, Pps, ll)
 
 
+def _filter_one(x, P, F, F_t, Q, Q_t, H, R, z, u) -> FilterResult:
+    """:func:`kalman_filter` for one filter (``B = 1``) on plain vectors and matrices.
+
+    The same equations; at these sizes numpy's per-call overhead is the cost, and the
+    batched step's masks and stacked solves cost about twice the arithmetic of one filter.
+    """
+    T, nz = z.shape
+    nx = len(x)
+    xs, Ps = np.empty((T, 1, nx)), np.empty((T, 1, nx, nx))
+    xps, Pps = np.empty((T, 1, nx)), np.empty((T, 1, nx, nx))
+    ll = 0.0
+    eye = np.eye(nx)
+    ok_all = np.isfinite(z).all(axis=1)
+    Qc = Q if Q_t or Q.ndim == 2 else Q[0]
+    Ht = H.T
+    for k in range(T):
+        Fk = F[k] if F_t else F
+        x = Fk @ x                                         # x- = F x (+ u)
+        if u is not None:
+            x = x + u[k]
+        P = Fk @ P @ Fk.T + (Qc[k, 0] if Q_t else Qc)      # P- = F P F' + Q
+        xps[k, 0] = x
+        Pps[k, 0] = P
+        if ok_all[k]:
+            PHt = P @ Ht                                   # (nx, nz)
+            S = H @ PHt + R                                # S = H P- H' + R
+            y = z[k] - H @ x                               # innovation
+            sol = np.linalg.solve(S, np.column_stack([PHt.T, y]))   # [S^-1 H P-, S^-1 y]
+            K = sol[:, :nx].T                              # K = P- H' S^-1
+            x = x + K @ y
+            IKH = eye - K @ H
+            P = IKH @ P @ IKH.T + K @ R @ K.T              # Joseph form
+            ll += -0.5 * (float(y @ sol[:, nx]) + np.linalg.slogdet(S)[1] + nz * np.log(2 * np.pi))
+        xs[k, 0] = x
+        Ps[k, 0] = P
+    return FilterResult(xs, Ps, xps, Pps, np.array([ll]))
+
+
 def rts_smoother(res: FilterResult, F: np.ndarray, wrap: tuple[int, ...] = ()) -> tuple[np.ndarray, np.ndarray]:
     """Rauch-Tung-Striebel fixed-interval smoother over a :class:`FilterResult`.
 
@@ -166,6 +206,19 @@ def rts_smoother(res: FilterResult, F: np.ndarray, wrap: tuple[int, ...] = ()) -
     xs = res.x.copy()
     Ps = res.P.copy()
     widx = list(wrap)
+    if xs.shape[1] == 1:                                   # one filter: plain vectors and matrices
+        x1, P1, xp1, Pp1 = res.x[:, 0], res.P[:, 0], res.xp[:, 0], res.Pp[:, 0]
+        xn, Pn = xs[T - 1, 0], Ps[T - 1, 0]
+        for k in range(T - 2, -1, -1):
+            Fk1 = F[k + 1] if F_t else F
+            Ct = np.linalg.solve(Pp1[k + 1], Fk1 @ P1[k])
+            d = xn - xp1[k + 1]
+            if widx:
+                d[widx] = np.mod(d[widx] + np.pi, 2 * np.pi) - np.pi
+            xn = x1[k] + Ct.T @ d
+            Pn = P1[k] + Ct.T @ (Pn - Pp1[k + 1]) @ Ct
+            xs[k, 0], Ps[k, 0] = xn, Pn
+        return xs, Ps
     for k in range(T - 2, -1, -1):
         Fk1 = F[k + 1] if F_t else F
         Pp = res.Pp[k + 1]

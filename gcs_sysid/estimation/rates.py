@@ -68,7 +68,7 @@ from filterpy.common import Q_continuous_white_noise
 from scipy.signal import lfilter, ss2tf
 
 from .inputs import control_columns, lagged, prepare_inputs, shift
-from .kalman import SteadyState, steady_state, steady_state_smoother
+from .kalman import SteadyState, lti_response, steady_state, steady_state_smoother
 from .nodes import segments
 
 __all__ = ["BANDWIDTHS_HZ", "DECAYS", "RateEstimate", "smooth_rates", "smooth_specific_force", "control_columns"]
@@ -119,6 +119,12 @@ def _innovation_filter(F: np.ndarray, g: SteadyState, H: np.ndarray) -> tuple[np
     return num[0], den
 
 
+def _lfilter_columns(num: np.ndarray, den: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """``lfilter`` down the rows of ``X (n, m)``, run on a contiguous transposed copy (each column
+    then streams through memory: ~20 % faster than ``axis=0`` on the row-major array; same values)."""
+    return lfilter(num, den, np.ascontiguousarray(X.T), axis=-1).T
+
+
 def _solve(GG: np.ndarray, Ge: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """GLS solution, inverse Gram and log-determinant of a (possibly rank-poor) Gram matrix."""
     m = len(Ge)
@@ -146,7 +152,7 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray)
     x = np.empty((n, nx, m))
     for j in range(nx):      # forward: x_k = A x_{k-1} + K z_k, zero initial state
         num, den = ss2tf(A, g.K, A[j:j + 1], g.K[j:j + 1])
-        x[:, j] = lfilter(num[0], den, Z, axis=0)
+        x[:, j] = _lfilter_columns(num[0], den, Z)
     Cg = g.C
     M = np.eye(nx) - Cg @ F
     xr = x[::-1]
@@ -154,7 +160,7 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray)
     for i in range(nx):      # backward: xs_k = C xs_{k+1} + M x_k, from xs_T = F x_{T-1}
         for j in range(nx):
             num, den = ss2tf(Cg, M[:, i:i + 1], Cg[j:j + 1], M[j:j + 1, i:i + 1])
-            xs[:, j] += lfilter(num[0], den, xr[:, i], axis=0)
+            xs[:, j] += _lfilter_columns(num[0], den, xr[:, i])
     v = F @ x[-1]            # zero-input response of the end condition, until it has decayed
     scale = max(float(np.abs(v).max()), 1e-300)
     for k in range(n):
@@ -219,8 +225,9 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             x0 = np.array([z[0, 0], 0.0, 0.0])
             per = []
             for c, (g, (num, den)) in enumerate(zip(gains, tfs)):   # all candidates: innovations only
-                _, e = steady_state_smoother(F, g, H, z, x0, smooth=False)
-                G = lfilter(num, den, cols[-1][0], axis=0) if m else cols[-1][0]
+                # innovations only: one transfer function, not the filter's three states as well
+                e = lti_response((np.eye(3) - g.K @ H) @ F, g.K, -H @ F, np.eye(1), z, x0)
+                G = _lfilter_columns(num, den, cols[-1][0]) if m else cols[-1][0]
                 per.append((G / math.sqrt(S[c]), e[:, 0] / math.sqrt(S[c])))
                 Gl = lagged(per[-1][0], nd, lag)
                 GG[c] += Gl.T @ Gl

@@ -7,12 +7,14 @@ import jax.numpy as jnp
 import numpy as np
 
 from .local import LocalParams, LocalStore, local_predict_chunk, neighbours
-from .sparse import GlobalParams, GlobalPosterior, Stats, add_stats, posterior, predict_global_chunk, stats_of
+from .sparse import (GlobalParams, GlobalPosterior, Stats, add_stats, mean_global_chunk, posterior,
+                     predict_global_chunk, stats_of)
 
-__all__ = ["global_stats", "global_predict", "local_predict", "global_posterior"]
+__all__ = ["global_stats", "global_predict", "global_mean", "local_predict", "global_posterior"]
 
 _stats_jit = jax.jit(stats_of)
 _predict_jit = jax.jit(predict_global_chunk)
+_mean_jit = jax.jit(mean_global_chunk)
 global_posterior = jax.jit(posterior)
 
 
@@ -52,6 +54,15 @@ def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, 
         m, v = _predict_jit(params, post, jnp.asarray(_pad(Xs[a:b], size)))
         mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
     return mean, var
+
+
+def global_mean(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, batch: int) -> np.ndarray:
+    """Latent mean ``(N, P)`` of the global layer at standardised ``Xs`` (no variance: cheaper)."""
+    mean = np.empty((len(Xs), params.A.shape[0]))
+    size = int(min(batch, max(len(Xs), 1)))
+    for a, b in _chunks(len(Xs), size):
+        mean[a:b] = np.asarray(_mean_jit(params, post, jnp.asarray(_pad(Xs[a:b], size))))[: b - a]
+    return mean
 
 
 def local_predict(params: LocalParams, store: LocalStore, Xs: np.ndarray, batch: int

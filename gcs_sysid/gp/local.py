@@ -140,15 +140,25 @@ shared_nll.defvjp(_shared_nll_fwd, _shared_nll_bwd)
 
 
 def _one_query(params: LocalParams, xq, zq, Xn, zn, rn):
-    """Mean and variance ``(P,)`` of the residual at one query from its ``K`` neighbours."""
+    """Mean and variance ``(P,)`` of the residual at one query from its ``K`` neighbours.
+
+    One Cholesky factor ``L_p L_p^T = amp_p Kc + noise_p I`` per output and one triangular
+    solve for ``[k_*, r_p]`` give ``mean_p = amp_p v_p^T u_p`` and ``var_p = amp_p - amp_p^2
+    v_p^T v_p`` with ``v_p = L_p^{-1} k_*``, ``u_p = L_p^{-1} r_p`` (Rasmussen and Williams
+    2006, Algorithm 2.1). On CPU the ``P`` batched ``K x K`` factorisations cost about half of
+    one symmetric eigendecomposition shared by the outputs (measured at ``K = 16, P = 6``).
+    """
     kern = GibbsKernel(params.lengthscale, params.beta)
     An = _aug(Xn, zn)
-    w, U = _shared_eig(kern(An, An))                                   # (K,), (K, K)
-    kq = kern(_aug(xq[None], zq[None]), An)[0] @ U                     # U^T k_*, (K,)
-    lam = params.amp[:, None] * w[None, :] + params.noise[:, None]     # (P, K)
-    c = rn.T @ U                                                       # (P, K)
-    mean = params.amp * jnp.sum(kq[None, :] * c / lam, 1)
-    var = params.amp - params.amp**2 * jnp.sum(kq[None, :] ** 2 / lam, 1)
+    Kc = kern(An, An)                                                  # (K, K)
+    kq = kern(_aug(xq[None], zq[None]), An)[0]                         # (K,)
+    eye = jnp.eye(Kc.shape[0], dtype=Kc.dtype)
+    L = jnp.linalg.cholesky(params.amp[:, None, None] * Kc[None] + params.noise[:, None, None] * eye)
+    rhs = jnp.stack([jnp.broadcast_to(kq, rn.T.shape), rn.T], -1)     # (P, K, 2)
+    S = jax.scipy.linalg.solve_triangular(L, rhs, lower=True)
+    v, u = S[..., 0], S[..., 1]
+    mean = params.amp * jnp.sum(v * u, 1)
+    var = params.amp - params.amp**2 * jnp.sum(v * v, 1)
     return mean, jnp.maximum(var, 1e-12 * params.amp)
 
 

@@ -9,7 +9,7 @@ import jax
 import numpy as np
 
 from ..jaxconfig import enable_x64
-from .batching import global_posterior, global_predict, global_stats, local_predict
+from .batching import global_mean, global_posterior, global_predict, global_stats, local_predict
 from .config import GPConfig
 from .local import LocalParams, LocalStore, build_store
 from .scaling import Standardiser, check_inputs, check_training
@@ -150,7 +150,7 @@ class LocalGlobalGP:
         return replace(model, notes=self.notes + tuple(notes))
 
     def _global_mean_s(self, Xs: np.ndarray) -> np.ndarray:
-        return global_predict(self.params, self.post, Xs, self.config.batch_size)[0]
+        return global_mean(self.params, self.post, Xs, self.config.batch_size)
 
     def variance_after(self, X_extra, X_query, include_noise: bool = True) -> np.ndarray:
         """Predictive variance at ``X_query`` if noisy observations were added at ``X_extra``.

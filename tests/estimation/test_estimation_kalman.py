@@ -96,3 +96,24 @@ def test_noise_std_recovers_white_noise_under_a_slow_signal():
     y = 0.5 * np.sin(2 * np.pi * 0.3 * t) + rng.normal(0, 0.01, len(t))
     assert noise_std(y) == pytest.approx(0.01, rel=0.05)
     assert noise_std(np.full(100, 1.0), floor=1e-3) == 1e-3
+
+
+def test_single_filter_path_matches_batched_with_per_step_models_and_inputs():
+    # B = 1 runs a separate loop on plain matrices; a batch of two copies takes the batched one
+    rng = np.random.default_rng(3)
+    T, nx = 200, 3
+    F = F3[None] + 0.01 * rng.normal(size=(T, nx, nx))
+    Q = np.stack([Q_continuous_white_noise(3, DT, q) for q in rng.uniform(5.0, 50.0, T)])[:, None]
+    H, R = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.diag([0.05**2, 0.2**2])
+    z = np.stack([_signal(T, rng), _signal(T, rng, missing=False)], 1)[:, None, :]
+    u = 0.01 * rng.normal(size=(T, 1, nx))
+    one = kalman_filter(np.zeros((1, nx)), np.eye(nx), F, Q, H, R, z, u=u)
+    two = kalman_filter(np.zeros((2, nx)), np.eye(nx), F, np.repeat(Q, 2, 1), H, R, np.repeat(z, 2, 1),
+                        u=np.repeat(u, 2, 1))
+    for a, b in ((one.x, two.x), (one.P, two.P), (one.xp, two.xp), (one.Pp, two.Pp)):
+        np.testing.assert_allclose(a[:, 0], b[:, 1], rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(one.loglik[0], two.loglik[1], rtol=1e-10)
+    xs1, Ps1 = rts_smoother(one, F, wrap=(0,))
+    xs2, Ps2 = rts_smoother(two, F, wrap=(0,))
+    np.testing.assert_allclose(xs1[:, 0], xs2[:, 1], rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(Ps1[:, 0], Ps2[:, 1], rtol=1e-10, atol=1e-12)
