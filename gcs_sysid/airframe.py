@@ -24,14 +24,14 @@ acting along body x through the CG.
 from __future__ import annotations
 
 import math
-import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from .errors import InputError
+from .tomlfile import read_toml
 
 __all__ = [
     "CONTROLS",
@@ -380,18 +380,7 @@ def load_airframe(path: str | Path) -> Airframe:
         InputError: the file is missing, not TOML, or a field is invalid (the
             message names the file and the field).
     """
-    p = Path(path)
-    try:
-        text = p.read_bytes().decode("utf-8")
-    except FileNotFoundError:
-        raise InputError(f"{p}: airframe file not found") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"{p}: cannot read airframe file ({e.__class__.__name__})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(f"{p}: not valid TOML ({e})") from None
-    return airframe_from_dict(doc, str(p))
+    return airframe_from_dict(read_toml(path, "airframe file"), str(path))
 
 
 def airframe_to_dict(a: Airframe) -> dict[str, Any]:

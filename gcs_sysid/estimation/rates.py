@@ -260,7 +260,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                 for cand in range(max_lag + 1):
                     if cand == lag[k]:
                         continue
-                    ll, trial = 0.0, []
+                    ll = 0.0
                     for ax, (Gls, GG, Ge, ee), (_, _, _, inn, c, n) in zip(axes, cur, axes):
                         # only the block of control k changes: its rows and columns of the Gram matrix
                         Gk = [shift(G[:, kb], cand) for G, _ in inn]

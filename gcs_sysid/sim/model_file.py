@@ -34,7 +34,6 @@ API (shared by ``sim`` and ``diagnose``; ``diagnose fit`` writes this format):
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -43,6 +42,7 @@ import numpy as np
 
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from ..errors import InputError
+from ..tomlfile import read_toml
 
 __all__ = [
     "VOCABULARY",
@@ -263,16 +263,7 @@ def load_model(path: str | Path) -> AeroModel:
     Raises:
         InputError: missing file, not TOML, or invalid content (names file and term).
     """
-    p = Path(path)
-    try:
-        doc = tomllib.loads(p.read_bytes().decode("utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{p}: model file not found") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"{p}: cannot read model file ({e.__class__.__name__})") from None
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(f"{p}: not valid TOML ({e})") from None
-    return model_from_dict(doc, str(p))
+    return model_from_dict(read_toml(path, "model file"), str(path))
 
 
 def save_model(model: AeroModel, path: str | Path, header: str = "") -> None:

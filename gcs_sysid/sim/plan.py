@@ -8,12 +8,12 @@ the log: the flight starts at ``start_time_s`` (default 30 s) and lasts
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import InputError
+from ..tomlfile import read_toml
 from ..signals import KINDS, duration_of, multisine_frequencies
 from .effects import CONTROL_NAMES, Effects, effects_from_dict
 from .environment import W20_BY_INTENSITY
@@ -229,13 +229,4 @@ def load_plan(path: str | Path) -> Plan:
     Raises:
         InputError: missing file, not TOML, or an invalid field.
     """
-    p = Path(path)
-    try:
-        doc = tomllib.loads(p.read_bytes().decode("utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{p}: plan file not found") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"{p}: cannot read plan file ({e.__class__.__name__})") from None
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(f"{p}: not valid TOML ({e})") from None
-    return plan_from_dict(doc, str(p))
+    return plan_from_dict(read_toml(path, "plan file"), str(path))

@@ -10,8 +10,6 @@ stream names and fields are listed in ``docs/architecture.md`` (section
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Mapping
-
 import numpy as np
 
 __all__ = ["Stream", "StreamSummary", "Flight"]
