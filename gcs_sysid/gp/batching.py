@@ -1,9 +1,12 @@
-"""Chunked, compiled evaluation of the layers over many rows (one compiled shape per chunk size)."""
+"""Chunked, compiled evaluation of the layers over many rows (one compiled shape per chunk size).
+
+Host (NumPy) arrays go to the compiled functions as they are: ``jnp.asarray`` of a NumPy array
+would compile a small conversion program per shape in every fresh process.
+"""
 
 from __future__ import annotations
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 from .local import LocalParams, LocalStore, local_predict_chunk, neighbours
@@ -16,6 +19,7 @@ _stats_jit = jax.jit(stats_of)
 _predict_jit = jax.jit(predict_global_chunk)
 _mean_jit = jax.jit(mean_global_chunk)
 global_posterior = jax.jit(posterior)
+_add_jit = jax.jit(add_stats)
 
 
 def _chunks(n: int, size: int):
@@ -36,10 +40,10 @@ def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: in
     total = None
     for a, b in _chunks(len(Xs), size):
         w = _pad(np.ones(b - a), size)
-        st = _stats_jit(params, jnp.asarray(_pad(Xs[a:b], size)), jnp.asarray(_pad(Ys[a:b], size)), jnp.asarray(w))
-        total = st if total is None else add_stats(total, st)
+        st = _stats_jit(params, _pad(Xs[a:b], size), _pad(Ys[a:b], size), w)
+        total = st if total is None else _add_jit(total, st)
     if total is None:
-        st = _stats_jit(params, jnp.zeros((1, Xs.shape[1])), jnp.zeros((1, Ys.shape[1])), jnp.zeros(1))
+        st = _stats_jit(params, np.zeros((1, Xs.shape[1])), np.zeros((1, Ys.shape[1])), np.zeros(1))
         total = st
     return total
 
@@ -51,7 +55,7 @@ def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, 
     mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
     size = int(min(batch, max(len(Xs), 1)))
     for a, b in _chunks(len(Xs), size):
-        m, v = _predict_jit(params, post, jnp.asarray(_pad(Xs[a:b], size)))
+        m, v = _predict_jit(params, post, _pad(Xs[a:b], size))
         mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
     return mean, var
 
@@ -61,7 +65,7 @@ def global_mean(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, bat
     mean = np.empty((len(Xs), params.A.shape[0]))
     size = int(min(batch, max(len(Xs), 1)))
     for a, b in _chunks(len(Xs), size):
-        mean[a:b] = np.asarray(_mean_jit(params, post, jnp.asarray(_pad(Xs[a:b], size))))[: b - a]
+        mean[a:b] = np.asarray(_mean_jit(params, post, _pad(Xs[a:b], size)))[: b - a]
     return mean
 
 
@@ -75,6 +79,6 @@ def local_predict(params: LocalParams, store: LocalStore, Xs: np.ndarray, batch:
         idx, zq = neighbours(store, Xs[a:b])
         args = (_pad(Xs[a:b], size), _pad(zq, size), _pad(store.X[idx], size), _pad(store.z[idx], size),
                 _pad(store.resid[idx], size))
-        m, v = local_predict_chunk(params, *map(jnp.asarray, args))
+        m, v = local_predict_chunk(params, *args)
         mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
     return mean, var

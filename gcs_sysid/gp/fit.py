@@ -71,6 +71,14 @@ def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
                         Z=Z, prior_std=fixed["prior_std"], jitter=fixed["jitter"])
 
 
+_constrain_global_jit = jax.jit(constrain_global)
+
+
+#: Adam's initial state (zero moments; it does not depend on the step size), built by one compiled
+#: call: in a fresh process every eager JAX operation first compiles a small program of its own.
+_adam_init = jax.jit(optax.adam(1.0).init)
+
+
 def _global_loss(raw, fixed, Xs, Ys):
     params = constrain_global(raw, fixed)
     return -elbo(params, stats_of(params, Xs, Ys)) / (Xs.shape[0] * Ys.shape[1])
@@ -83,6 +91,9 @@ def _local_loss(raw, Xn, zn, rn):
 def _constrain_local(raw) -> LocalParams:
     return LocalParams(lengthscale=jnp.exp(raw["log_ls"]), beta=1.5 * jnp.tanh(raw["beta"]),
                        amp=jnp.exp(raw["log_amp"]) + _NOISE_FLOOR, noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR)
+
+
+_constrain_local_jit = jax.jit(_constrain_local)
 
 
 @partial(jax.jit, static_argnames=("loss",))
@@ -107,7 +118,7 @@ def _adam(loss, raw, opt_state, lr, args, n_steps: int, tol: float = 0.0, window
     is in nats per point and output) the optimisation stops. ``tol = 0`` runs all steps.
     """
     values = []
-    lr = jnp.asarray(lr)
+    lr = np.float64(lr)   # one strongly typed scalar: the compiled step is reused, never re-traced
     prev = np.inf
     for k in range(n_steps):
         raw, opt_state, value = _adam_step(loss, raw, opt_state, lr, args)
@@ -125,7 +136,7 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     P = Ys.shape[1]
     R = Ys
     if cfg.linear_mean:
-        Xa = np.asarray(design(jnp.asarray(Xs)))
+        Xa = np.concatenate([np.ones((len(Xs), 1)), Xs], axis=1)   # design(): [1, x]
         W = np.linalg.solve(Xa.T @ Xa + 1e-3 * np.eye(Xa.shape[1]), Xa.T @ Ys)
         R = Ys - Xa @ W
     Cr = np.cov(R.T).reshape(P, P) + 1e-6 * np.eye(P)
@@ -135,13 +146,14 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((P, 0))
     kappa = np.maximum(np.diag(B0) - np.sum(L0**2, 1), 0.1 * np.diag(B0)) + 1e-4
     n_active = max(int(active.sum()), 1)
-    raw = {"log_ls": jnp.full(Xs.shape[1], np.log(0.5 * np.sqrt(n_active))), "L": jnp.asarray(L0),
-           "log_kappa": jnp.log(jnp.asarray(kappa)), "log_noise": jnp.log(0.3 * jnp.asarray(np.diag(Cr)) + 1e-4)}
+    # host arrays moved once with device_put (jnp.asarray of a NumPy array compiles a program per shape)
+    raw = {"log_ls": np.full(Xs.shape[1], np.log(0.5 * np.sqrt(n_active))), "L": np.asarray(L0, float),
+           "log_kappa": np.log(kappa), "log_noise": np.log(0.3 * np.diag(Cr) + 1e-4)}
     if cfg.train_inducing:
-        raw["Z"] = jnp.asarray(Z)
-    fixed = {"active": jnp.asarray(active), "Z": jnp.asarray(Z), "prior_std": jnp.asarray(cfg.prior_std if cfg.linear_mean else 0.0),
-             "jitter": jnp.asarray(cfg.jitter)}
-    return raw, fixed
+        raw["Z"] = np.asarray(Z, float)
+    fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
+             "prior_std": np.float64(cfg.prior_std if cfg.linear_mean else 0.0), "jitter": np.float64(cfg.jitter)}
+    return jax.device_put(raw), jax.device_put(fixed)
 
 
 def _fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory):
@@ -150,7 +162,7 @@ def _fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHisto
     rng = np.random.default_rng(cfg.seed + 7)
     centres = rng.choice(len(Xs), min(cfg.local_batch, len(Xs)), replace=False)
     idx, _ = neighbours(store, Xs[centres])
-    args = (jnp.asarray(Xs[idx]), jnp.asarray(store.z[idx]), jnp.asarray(resid[idx]))
+    args = jax.device_put((Xs[idx], store.z[idx], resid[idx]))
     # start from the empirical variogram: half the mean squared residual difference between each
     # centre and its nearest stored neighbour estimates the nugget (noise), the rest of the residual
     # variance is signal (Cressie 1993, Statistics for Spatial Data, sec. 2.4)
@@ -160,14 +172,15 @@ def _fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHisto
         noise0 = np.clip(nugget, 0.01 * v, 0.9 * v)
     else:
         noise0 = 0.5 * v
-    raw = {"log_ls": jnp.log(jnp.maximum(0.25 * params.lengthscale, 1e-3)), "beta": jnp.asarray(0.0),
-           "log_amp": jnp.log(jnp.asarray(np.maximum(v - noise0, 0.1 * v))), "log_noise": jnp.log(jnp.asarray(noise0))}
+    raw = jax.device_put({"log_ls": np.log(np.maximum(0.25 * np.asarray(params.lengthscale), 1e-3)),
+                          "beta": np.float64(0.0), "log_amp": np.log(np.maximum(v - noise0, 0.1 * v)),
+                          "log_noise": np.log(noise0)})
     if cfg.local_steps > 0:
-        opt_state = optax.adam(cfg.local_learning_rate).init(raw)
+        opt_state = _adam_init(raw)
         raw, _, values = _adam(_local_loss, raw, opt_state, cfg.local_learning_rate, args, int(cfg.local_steps),
                                cfg.tol)
         history.local_loss.extend(np.asarray(values).tolist())
-    return _constrain_local(raw), store
+    return _constrain_local_jit(raw), store
 
 
 def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=None
@@ -207,7 +220,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if M < cfg.n_inducing:
         notes.append(f"gp: only {len(Xs)} rows; using {M} inducing points instead of {cfg.n_inducing}")
     sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
-    Xh, Yh = jnp.asarray(Xs[sub]), jnp.asarray(Ys[sub])
+    Xh, Yh = jax.device_put((Xs[sub], Ys[sub]))
 
     Mh = M if cfg.train_inducing or cfg.n_inducing_hyper is None else int(min(cfg.n_inducing_hyper, M))
     ls0 = np.full(D, 0.5 * np.sqrt(max(int(scaler.active.sum()), 1)))
@@ -216,15 +229,16 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["init"] = time.perf_counter() - t0
 
     def reselect(raw, fixed, m):
-        p = constrain_global(raw, fixed)
-        nugget = float(np.mean(np.asarray(p.noise) / (np.diag(np.asarray(p.B)) + np.asarray(p.noise))))
+        p = _constrain_global_jit(raw, fixed)
+        bdiag = np.sum(np.asarray(p.A) ** 2, 1)
+        nugget = float(np.mean(np.asarray(p.noise) / (bdiag + np.asarray(p.noise))))
         Z = select_inducing(Xs, m, np.asarray(p.lengthscale), cfg.inducing, cfg.mi_pool, nugget=max(nugget, 1e-4),
                             seed=cfg.seed)
-        return dict(fixed, Z=jnp.asarray(Z))
+        return dict(fixed, Z=jax.device_put(Z))
 
     t1 = time.perf_counter()
     first = cfg.steps // 2 if cfg.reselect else cfg.steps
-    opt_state = optax.adam(cfg.learning_rate).init(raw)
+    opt_state = _adam_init(raw)
     for stage, n_steps in enumerate((first, cfg.steps - first)):
         if n_steps <= 0:
             continue
@@ -235,7 +249,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
             fixed = reselect(raw, fixed, Mh)
     if Mh < M:
         fixed = reselect(raw, fixed, M)
-    params = constrain_global(raw, fixed)
+    params = _constrain_global_jit(raw, fixed)
     history.timings["hyperparameters"] = time.perf_counter() - t1
 
     t2 = time.perf_counter()

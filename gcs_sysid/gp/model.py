@@ -7,6 +7,7 @@ from typing import Any
 
 import jax
 import numpy as np
+from scipy.linalg import cho_solve
 
 from ..jaxconfig import enable_x64
 from .batching import global_mean, global_posterior, global_predict, global_stats, local_predict
@@ -224,7 +225,8 @@ class LocalGlobalGP:
     # ------------------------------------------------------------ reporting
     def output_correlation(self) -> np.ndarray:
         """Correlation ``(P, P)`` between the outputs' global GP parts, from ``B``."""
-        B = np.asarray(self.params.B)
+        A = np.asarray(self.params.A)
+        B = A @ A.T
         s = np.sqrt(np.diag(B))
         return B / np.outer(s, s)
 
@@ -237,7 +239,7 @@ class LocalGlobalGP:
         """
         P, D = self.n_outputs, self.n_inputs
         K = self.post.b.shape[0]
-        mu = np.asarray(jax.scipy.linalg.cho_solve((self.post.L, True), self.post.b))
+        mu = cho_solve((np.asarray(self.post.L), True), np.asarray(self.post.b))
         W = float(self.params.prior_std) * mu[K - P * (D + 1):].reshape(P, D + 1)
         sc = self.scaler
         slopes = sc.y_std[:, None] * W[:, 1:] / sc.x_std[None, :] * sc.active[None, :]
@@ -257,7 +259,8 @@ class LocalGlobalGP:
         def scales(values):
             return {n: (float(v * s) if a else None) for n, v, s, a in zip(names, values, sc.x_std, sc.active)}
 
-        B = np.asarray(self.params.B)
+        A = np.asarray(self.params.A)
+        B = A @ A.T
         intercept, slopes = self.linear_derivatives()
         out: dict[str, Any] = {
             "kind": "LocalGlobalGP",

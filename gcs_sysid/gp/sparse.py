@@ -27,6 +27,7 @@ variational inducing kernels", AISTATS.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import jax
@@ -38,7 +39,7 @@ from .kernels import ARDSquaredExponential
 __all__ = ["GlobalParams", "Stats", "GlobalPosterior", "stats_of", "add_stats", "elbo", "logdet_quad", "posterior",
            "mean_global_chunk", "predict_global_chunk", "design"]
 
-_LOG2PI = float(jnp.log(2.0 * jnp.pi))
+_LOG2PI = math.log(2.0 * math.pi)
 
 
 @jax.tree_util.register_dataclass
