@@ -19,6 +19,7 @@ from .airframe import load_airframe
 from .errors import InputError
 from .estimation import estimate_states
 from .estimation.states import FlightStates
+from .parallel import Helper, Job
 from .result import ReplayResult
 from .telemetry import read_log
 
@@ -42,6 +43,8 @@ class ReplayOptions:
         n_inducing: inducing points of the global GP (None = the GP's default).
         progress: show rich progress bars.
         write: write the report files (False for tests that only need the result).
+        parallel: use a second process for the independent work (figures, one smoother;
+            :mod:`gcs_sysid.parallel`) when more than one CPU is usable; results are the same.
     """
 
     rate_hz: float = 50.0
@@ -52,6 +55,7 @@ class ReplayOptions:
     n_inducing: int | None = None
     progress: bool = True
     write: bool = True
+    parallel: bool = True
 
 
 def error_pct(estimate: np.ndarray, reference: np.ndarray) -> float:
@@ -150,28 +154,42 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     from .jaxconfig import enable_compilation_cache, limit_blas_threads
     from .maneuvers import suggest_maneuvers
     from .report import write_report
+    from .report.tables import correlation_of
 
     airframe = load_airframe(airframe_path)
     out = Path(out_dir)
     timings: dict[str, float] = {}
     notes: list[str] = []
+    # the worker decodes part of the log, smooths the specific force, then draws the figures
+    helper = Helper(enabled=None if options.parallel else False, warm=("gcs_sysid.telemetry.tlog_scan",))
+    figures: dict[str, Job] = {}
+
+    def draw(name: str, function: str, *args) -> None:
+        if options.write:
+            figures[name] = helper.submit(f"gcs_sysid.report.plots:{function}", *args)
+
     bar = _progress_bar(options.progress)
     if bar is not None:
         bar.start()
+    ok = False
     try:
         with _stage("decode log", timings, bar) as prog:
-            flight = read_log(log, progress=prog)
+            flight = read_log(log, progress=prog, helper=helper)
+        helper.preload(["gcs_sysid.estimation.rates"])   # for the specific-force smoother, next
         if options.t_from is not None or options.t_to is not None:
             if options.t_from is not None and options.t_to is not None and options.t_to <= options.t_from:
                 raise InputError(f"--to ({options.t_to}) must be after --from ({options.t_from})")
             flight = flight.window(options.t_from, options.t_to)
         with _stage("estimate states", timings, bar) as prog:
-            states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog)
+            states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper)
+        helper.preload(["gcs_sysid.report.plots"])   # matplotlib for the figures, while the GP is fitted
         with _stage("coefficients", timings, bar):
             table = compute_coefficients(states, airframe)
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
+        draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
+        draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
         pred_mean = np.full(table.Y.shape, np.nan)
         pred_sigma = np.full(table.Y.shape, np.nan)
@@ -211,10 +229,17 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
             gp_summary = model.summary()
             gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
+            draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma, held, ident)
+            corr = correlation_of(gp_summary, gp_summary["outputs"])
+            if corr is not None:
+                draw("correlation", "correlation_figure", *corr)
             with _stage("confidence map", timings, bar):
                 envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
+            draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("suggest maneuvers", timings, bar):
                 suggestions = suggest_maneuvers(envelope, model, table, airframe)
+            if suggestions:
+                draw("suggestions", "suggestions_figure", list(suggestions))
         metrics: dict[str, dict[str, float]] = {}
         for i, name in enumerate(COEFFICIENTS):
             y = table.Y[:, i]
@@ -250,8 +275,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         )
         if options.write:
             with _stage("write report", timings, bar):
-                write_report(result, out)
+                write_report(result, out, figures=figures)
+        ok = True
         return result
     finally:
+        helper.close(wait=ok)
         if bar is not None:
             bar.stop()

@@ -16,11 +16,12 @@ import numpy as np
 
 from ..airframe import Airframe
 from ..errors import DataError
+from ..parallel import Helper
 from ..telemetry.types import Flight
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
-from .rates import smooth_rates, smooth_specific_force
+from .rates import smooth_rates
 from .smoothers import smooth_level, smooth_velocity
 from .kalman import noise_std
 from .states import FlightStates
@@ -42,7 +43,7 @@ def _stack(al: Aligned, stream: str, fields: tuple[str, ...]) -> np.ndarray | No
 
 
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
-                    progress: Callable[[float], None] | None = None) -> FlightStates:
+                    progress: Callable[[float], None] | None = None, helper: Helper | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -50,6 +51,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         airframe: mass properties, servo maps and IMU lever arm.
         rate_hz: grid rate, Hz (capped at the IMU rate).
         progress: optional ``callable(fraction)`` called as stages finish.
+        helper: a :class:`~gcs_sysid.parallel.Helper` whose worker smooths the specific force while
+            this process runs the velocity filter and the air data (None: all here; same results).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -206,6 +209,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             notes.append("accelerometers moved to the CG (lever arm " + ", ".join(f"{x:g}" for x in r_arm) + " m)")
     else:
         missing.append("ax ay az: no accelerometer (IMU) stream")
+    if f_cg is not None:   # needs nothing from the velocity filter and the air data below: in the helper's
+        # worker (when there is one) while this process runs them; collected at the end
+        sf_job = (helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
+                                                          f_cg, controls=U, scale=qbar_eas, input_lag=in_lag)
     vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
         "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
     vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")
@@ -237,18 +244,6 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             missing.append("u v w: no attitude to rotate the ground velocity into body axes")
     else:
         missing.append("vn ve vd u v w: no GPS (GLOBAL_POSITION_INT / GPS) or LOCAL_POSITION_NED velocity")
-    if f_cg is not None:
-        # the velocity filter above needs the raw samples (white noise); the coefficients get the smoothed ones
-        f_s, f_sig, f_noise = smooth_specific_force(dt, f_cg, controls=U, scale=qbar_eas, input_lag=in_lag)
-        f_corr = f_s - abias
-        for i, k in enumerate(("ax", "ay", "az")):
-            data[k] = f_corr[:, i]
-            sigma[k] = f_sig[:, i]
-            sources[k] = "IMU specific force at the CG (lever arm removed), RTS-smoothed" + (
-                " with jumps at control steps" if cnames else "") + (
-                ", minus the KF accelerometer bias" if v_ned is not None and C is not None else "")
-        notes.append("accelerometer noise (maximum likelihood) x y z = " + ", ".join(f"{x:.3f}" for x in f_noise)
-                     + " m/s^2")
     prog(0.75)
 
     # --- air data -------------------------------------------------------------------------------
@@ -365,6 +360,18 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         missing.append("V qbar: no airspeed and no GPS velocity with attitude")
     if alpha is not None:
         data["alpha"], data["beta"] = alpha, beta
+    if f_cg is not None:
+        # the velocity filter needs the raw samples (white noise); the coefficients get the smoothed ones
+        f_s, f_sig, f_noise = sf_job.result()
+        f_corr = f_s - abias
+        for i, k in enumerate(("ax", "ay", "az")):
+            data[k] = f_corr[:, i]
+            sigma[k] = f_sig[:, i]
+            sources[k] = "IMU specific force at the CG (lever arm removed), RTS-smoothed" + (
+                " with jumps at control steps" if cnames else "") + (
+                ", minus the KF accelerometer bias" if v_ned is not None and C is not None else "")
+        notes.append("accelerometer noise (maximum likelihood) x y z = " + ", ".join(f"{x:.3f}" for x in f_noise)
+                     + " m/s^2")
     prog(0.9)
 
     # --- validity --------------------------------------------------------------------------------

@@ -18,13 +18,15 @@ from .tables import CSV_COLUMNS, write_csv, write_suggestions_json
 __all__ = ["write_report", "save_result", "load_result", "CSV_COLUMNS"]
 
 
-def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True) -> dict[str, Path]:
+def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
+                 figures: dict | None = None) -> dict[str, Path]:
     """Write the report files into ``out_dir`` (created).
 
     Args:
         result: the replay result.
         out_dir: output directory.
         save: also save the result itself (``out_dir/result/result.{json,npz}``) for re-rendering.
+        figures: figures drawn elsewhere, or jobs drawing them (see :func:`~gcs_sysid.report.html.render_html`).
 
     Returns:
         name -> path for ``report.html``, ``summary.md``, ``coefficients.csv``, ``suggestions.json``
@@ -37,8 +39,8 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True) -
         "csv": write_csv(result, out / "coefficients.csv"),
         "suggestions": write_suggestions_json(result, out / "suggestions.json"),
         "markdown": render_markdown(result, out / "summary.md"),
-        "html": render_html(result, out / "report.html"),
     }
     if save:
         files.update(save_result(result, out / "result"))
+    files["html"] = render_html(result, out / "report.html", figures)   # last: figures may still be drawing
     return files

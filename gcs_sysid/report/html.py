@@ -6,10 +6,8 @@ import base64
 import html
 from pathlib import Path
 
-import numpy as np
-
 from ..result import ReplayResult
-from . import plots, tables
+from . import tables
 
 __all__ = ["render_html", "SECTIONS"]
 
@@ -91,23 +89,21 @@ def _notes(r: ReplayResult) -> str:
     return "".join(parts) or '<p class="muted">Nothing missing: all six coefficients identified.</p>'
 
 
-def _model(r: ReplayResult) -> str:
+def _model(r: ReplayResult, fig) -> str:
     gs = r.gp_summary
     if not gs:
         return '<p class="muted">No model was fitted.</p>'
     out = [_kv(tables.gp_rows(r))]
-    g = gs.get("global") or {}
-    corr = g.get("output_correlation", gs.get("output_correlation"))
-    names = list(gs.get("outputs") or (r.envelope.outputs if r.envelope is not None else []))
-    if corr is not None and len(names) == np.asarray(corr).shape[0]:
-        out.append(_img(plots.correlation_figure(np.asarray(corr, float), names), "output correlation"))
+    corr = fig("correlation")
+    if corr is not None:
+        out.append(_img(corr, "output correlation"))
     ls = tables.lengthscale_rows(r)
     if ls:
         out.append("<h3>Length-scales (data units; - = input inactive)</h3>" + _table(ls))
     return "".join(out)
 
 
-def _envelope(r: ReplayResult) -> str:
+def _envelope(r: ReplayResult, fig) -> str:
     env = r.envelope
     if env is None:
         return '<p class="muted">No confidence map (no model was fitted).</p>'
@@ -116,48 +112,64 @@ def _envelope(r: ReplayResult) -> str:
            'median values. Cells are flagged (hatched, outlined) where sigma/spread exceeds the threshold or no '
            'training sample lies nearby. Confidence score = 1 - mean(min(sigma/spread, 1)) over all cells.</p>',
            _table(tables.score_rows(r))]
-    for sl, fig in zip(env.slices, plots.envelope_figures(r, list(env.slices))):
+    for sl, png in zip(env.slices, fig("envelope") or []):
         out.append(f"<h3>{html.escape(sl.axes[0])} x {html.escape(sl.axes[1])}</h3>")
-        out.append(_img(fig, f"{sl.axes[0]} x {sl.axes[1]}"))
+        out.append(_img(png, f"{sl.axes[0]} x {sl.axes[1]}"))
     return "".join(out)
 
 
-def _suggestions(r: ReplayResult) -> str:
+def _suggestions(r: ReplayResult, fig) -> str:
     if not r.suggestions:
         return '<p class="muted">No suggestions: nothing was flagged, or no model was fitted.</p>'
     reasons = "".join(f"<li><strong>#{s.rank}</strong> {html.escape(s.reason)}</li>" for s in r.suggestions)
     return (_table(tables.suggestion_rows(r)) + "<h3>Why</h3>" + f'<ol class="reasons" style="list-style:none;padding-left:0">{reasons}</ol>'
-            + "<h3>Input waveforms (deviation from trim)</h3>" + _img(plots.suggestions_figure(r), "waveforms")
+            + "<h3>Input waveforms (deviation from trim)</h3>" + _img(fig("suggestions"), "waveforms")
             + '<p class="muted">Amplitudes keep the response near-linear (target alpha, q, p, beta excursions) '
               'within the surface travel; pulse widths follow the mode frequencies (doublet 2.3/w_n, 3-2-1-1 '
               '1.6/w_n, Jategaonkar 2006 sec. 2.5). Expected reduction: predictive variance at the region\'s '
               'points after adding the simulated maneuver, relative to now.</p>')
 
 
-def render_html(r: ReplayResult, path: Path) -> Path:
-    """Write report.html for ``r`` to ``path``."""
+def render_html(r: ReplayResult, path: Path, figures: dict | None = None) -> Path:
+    """Write report.html for ``r`` to ``path``.
+
+    Args:
+        figures: figures drawn elsewhere, by the names of :data:`~gcs_sysid.report.plots.FIGURES`:
+            the value, or a job whose ``result()`` gives it (the pipeline draws them in its worker
+            process, :class:`gcs_sysid.parallel.Job`); the others are drawn here.
+    """
+    given = figures or {}
+
+    def fig(name: str):
+        if name not in given:
+            from . import plots   # matplotlib only where figures are drawn
+
+            return plots.figure(r, name)
+        v = given[name]
+        return v.result() if hasattr(v, "result") else v
+
     title = f"gcs-sysid replay: {Path(r.log_path).name}"
     msgs = sorted(r.messages.items(), key=lambda kv: -kv[1])
-    data = (_table(tables.stream_rows(r), "no streams decoded") + _img(plots.streams_figure(r), "streams")
+    data = (_table(tables.stream_rows(r), "no streams decoded") + _img(fig("streams"), "streams")
             + "<h3>Messages in the log</h3>"
             + _table([{"message": k, "count": tables.fmt(v)} for k, v in msgs[:40]], "no messages counted"))
     body = {
         "summary": _kv(tables.facts(r)),
         "notes": _notes(r),
         "data": data,
-        "states": _img(plots.states_figure(r), "states") + '<p class="muted">Held-out segment shaded yellow.</p>',
-        "coefficients": _img(plots.coefficients_figure(r), "coefficients")
+        "states": _img(fig("states"), "states") + '<p class="muted">Held-out segment shaded yellow.</p>',
+        "coefficients": _img(fig("coefficients"), "coefficients")
         + '<p class="muted">Measured (orange), model mean (blue) with 2-sigma band; held-out segment shaded yellow '
           '(never used for fitting).</p>',
         "errors": "<p>Error = 100 RMS(model - measured) / RMS(measured) on the held-out segment; thesis floor "
                   f"{tables.THESIS_FLOOR_PCT['forces']} % (forces), {tables.THESIS_FLOOR_PCT['moments']} % (moments).</p>"
                   + _table(tables.error_rows(r)),
-        "model": _model(r),
-        "envelope": _envelope(r),
+        "model": _model(r, fig),
+        "envelope": _envelope(r, fig),
         "regions": _table(tables.region_rows(r), "no regions flagged")
         + (f'<p class="muted">{len(r.envelope.regions)} regions (coefficient x location) in all; the most uncertain '
            'locations are shown, all are in suggestions.json.</p>' if r.envelope is not None else ""),
-        "suggestions": _suggestions(r),
+        "suggestions": _suggestions(r, fig),
     }
     nav = "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t in SECTIONS)
     sections = "".join(_section(a, t, body[a]) for a, t in SECTIONS)

@@ -1,6 +1,9 @@
 """The report's figures, drawn with matplotlib's object API on the Agg canvas (no pyplot state).
 
-Every function returns PNG bytes; the HTML renderer embeds them as base64.
+Every function takes plain data (the parts of a :class:`~gcs_sysid.result.ReplayResult` it
+draws) and returns PNG bytes, which the HTML renderer embeds as base64. Taking the parts rather
+than the whole result lets the pipeline draw each figure in its worker process as soon as its
+data exist (:mod:`gcs_sysid.parallel`); :func:`all_figures` draws them all from a result.
 """
 
 from __future__ import annotations
@@ -14,13 +17,18 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-from ..aero.table import COEFFICIENTS, REGRESSORS
-from ..envelope import EnvelopeSlice
+from ..aero.table import COEFFICIENTS, REGRESSORS, CoefficientTable
+from ..envelope import EnvelopeMap, EnvelopeSlice
+from ..estimation.states import FlightStates
 from ..result import ReplayResult
-from .tables import ANGLES
+from ..telemetry.types import StreamSummary
+from .tables import ANGLES, correlation_of
 
 __all__ = ["png", "streams_figure", "states_figure", "coefficients_figure", "correlation_figure",
-           "envelope_figure", "envelope_figures", "suggestions_figure"]
+           "envelope_figure", "envelope_figures", "suggestions_figure", "figure", "all_figures", "FIGURES"]
+
+#: Names of the figures :func:`all_figures` returns (``"envelope"`` is a list, one PNG per slice).
+FIGURES = ("streams", "states", "coefficients", "correlation", "envelope", "suggestions")
 
 _MAX_POINTS = 4000
 #: Training samples drawn over an envelope panel (decimated evenly; the counts panel shows them all).
@@ -59,9 +67,9 @@ def _scale(name: str) -> tuple[float, str]:
     return (180 / math.pi, "deg") if name in ANGLES else (1.0, "m/s" if name == "V" else "-")
 
 
-def streams_figure(r: ReplayResult) -> bytes:
+def streams_figure(summaries: dict[str, StreamSummary]) -> bytes:
     """Timeline of each stream: coverage, gaps in red, rate in the label."""
-    ss = sorted(r.summaries.values(), key=lambda s: s.name)
+    ss = sorted(summaries.values(), key=lambda s: s.name)
     h = 0.35 * max(len(ss), 3) + 1.0
     fig = Figure(figsize=(10, h))   # fixed margins: constrained layout costs more than the drawing
     fig.subplots_adjust(left=0.2, right=0.98, bottom=0.55 / h, top=1 - 0.35 / h)
@@ -79,12 +87,12 @@ def streams_figure(r: ReplayResult) -> bytes:
     return png(fig)
 
 
-def states_figure(r: ReplayResult) -> bytes:
-    """Attitude, rates, air data and controls over time (held-out segment shaded)."""
-    st = r.states
+def states_figure(states: FlightStates, held_out: np.ndarray) -> bytes:
+    """Attitude, rates, air data and controls over time (held-out segment, ``(T,)`` bool, shaded)."""
+    st = states
     k = _stride(len(st.t))
     t = st.t[::k]
-    held = r.held_out[::k] if len(r.held_out) == len(st.t) else np.zeros(len(t), bool)
+    held = held_out[::k] if len(held_out) == len(st.t) else np.zeros(len(t), bool)
     panels = [("Attitude (deg)", [("phi", "roll"), ("theta", "pitch"), ("psi", "yaw")], 180 / math.pi),
               ("Body rates (deg/s)", [("p", "p"), ("q", "q"), ("r", "r")], 180 / math.pi),
               ("Airspeed (m/s)", [("V", "V true")], 1.0),
@@ -112,23 +120,29 @@ def states_figure(r: ReplayResult) -> bytes:
     return png(fig)
 
 
-def coefficients_figure(r: ReplayResult) -> bytes:
-    """Measured coefficients vs model mean with 2-sigma bands; held-out segment shaded."""
-    tb = r.table
+def coefficients_figure(table: CoefficientTable, pred_mean: np.ndarray, pred_sigma: np.ndarray,
+                        held_out: np.ndarray, identifiable: dict[str, tuple[bool, str]]) -> bytes:
+    """Measured coefficients vs model mean with 2-sigma bands; held-out segment shaded.
+
+    Args:
+        table: measured coefficients. pred_mean, pred_sigma: ``(T, 6)`` model mean and 1-sigma.
+        held_out: ``(T,)`` bool. identifiable: coefficient -> (bool, reason), shown where there is no model.
+    """
+    tb = table
     k = _stride(len(tb.t))
     t = tb.t[::k]
-    held = r.held_out[::k]
+    held = held_out[::k]
     fig = Figure(figsize=(10, 10))
     fig.subplots_adjust(left=0.08, right=0.98, bottom=0.05, top=0.955, hspace=0.12)
     axes = fig.subplots(6, 1, sharex=True)
     for j, (ax, c) in enumerate(zip(axes, COEFFICIENTS)):
         y = np.where(tb.valid, tb.Y[:, j], np.nan)[::k]
-        mu, sd = r.pred_mean[::k, j], r.pred_sigma[::k, j]
+        mu, sd = pred_mean[::k, j], pred_sigma[::k, j]
         if np.isfinite(mu).any():
             ax.fill_between(t, mu - 2 * sd, mu + 2 * sd, color="#3182bd", alpha=0.25, lw=0, label="model 2 sigma")
             ax.plot(t, mu, lw=1.0, color="#08519c", label="model mean")
         else:
-            ax.text(0.5, 0.5, "no model for " + c + ": " + r.identifiable.get(c, (True, "not fitted"))[1],
+            ax.text(0.5, 0.5, "no model for " + c + ": " + identifiable.get(c, (True, "not fitted"))[1],
                     transform=ax.transAxes, ha="center", va="center", fontsize=8, color="#b30000")
         ax.plot(t, y, lw=0.7, color="#d95f02", label="measured", zorder=3)
         _shade(ax, t, held, "held out" if j == 0 else None)
@@ -163,12 +177,13 @@ def correlation_figure(matrix: np.ndarray, names: list[str]) -> bytes:
     return png(fig)
 
 
-def envelope_figure(r: ReplayResult, sl: EnvelopeSlice) -> bytes:
+def envelope_figure(envelope: EnvelopeMap, X_train: np.ndarray, sl: EnvelopeSlice) -> bytes:
     """One slice: data coverage, then per coefficient sigma/spread with flagged cells hatched and outlined."""
-    return envelope_figures(r, [sl])[0]
+    return envelope_figures(envelope, X_train, [sl])[0]
 
 
-def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes]:
+def envelope_figures(envelope: EnvelopeMap, X_train: np.ndarray, slices: list[EnvelopeSlice] | None = None
+                     ) -> list[bytes]:
     """:func:`envelope_figure` of each slice, drawn on one reused figure.
 
     Each slice is one strip: training-sample counts per cell, then sigma/spread of each
@@ -178,7 +193,8 @@ def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes
     only swaps the images' data and extent, the decimated scatter of training samples, the
     flagged-cell contours and the axis labels.
     """
-    env = r.envelope
+    env = envelope
+    slices = list(env.slices) if slices is None else list(slices)
     if not slices:
         return []
     outs = list(env.outputs)
@@ -215,7 +231,7 @@ def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes
         ax.tick_params(labelsize=6, length=2, pad=1)
         ax.locator_params(nbins=3)
     title = fig.text(0.5, 0.97, "", ha="center", va="top", fontsize=8)
-    Xt = r.table.X[r.train]
+    Xt = X_train
     k = max(1, len(Xt) // _MAX_SCATTER)
     pngs, marks = [], []
     for sl in slices:
@@ -256,9 +272,10 @@ def envelope_figures(r: ReplayResult, slices: list[EnvelopeSlice]) -> list[bytes
     return pngs
 
 
-def suggestions_figure(r: ReplayResult, limit: int = 6) -> bytes:
-    """Input waveforms (deviation from trim, deg) of the top suggestions."""
-    ss = r.suggestions[:limit]
+def suggestions_figure(suggestions: list, limit: int = 6) -> bytes:
+    """Input waveforms (deviation from trim, deg) of the top ``limit`` suggestions
+    (:class:`~gcs_sysid.maneuvers.Suggestion`)."""
+    ss = suggestions[:limit]
     n = len(ss)
     cols = 2 if n > 1 else 1
     rows = int(math.ceil(n / cols))
@@ -279,3 +296,31 @@ def suggestions_figure(r: ReplayResult, limit: int = 6) -> bytes:
     for ax in axes[n:]:
         ax.axis("off")
     return png(fig)
+
+
+def figure(r: ReplayResult, name: str) -> bytes | list[bytes] | None:
+    """The report figure ``name`` (one of :data:`FIGURES`) for ``r``; None where there is nothing
+    to draw (no model, no confidence map, no suggestions). ``"envelope"`` is a list, one PNG per slice.
+
+    Raises:
+        KeyError: unknown name.
+    """
+    if name == "streams":
+        return streams_figure(r.summaries)
+    if name == "states":
+        return states_figure(r.states, r.held_out)
+    if name == "coefficients":
+        return coefficients_figure(r.table, r.pred_mean, r.pred_sigma, r.held_out, r.identifiable)
+    if name == "correlation":
+        corr = correlation_of(r.gp_summary, list(r.envelope.outputs) if r.envelope is not None else [])
+        return correlation_figure(*corr) if corr is not None else None
+    if name == "envelope":
+        return envelope_figures(r.envelope, r.table.X[r.train]) if r.envelope is not None else None
+    if name == "suggestions":
+        return suggestions_figure(r.suggestions) if r.suggestions else None
+    raise KeyError(f"unknown report figure {name!r} (expected one of {', '.join(FIGURES)})")
+
+
+def all_figures(r: ReplayResult) -> dict[str, bytes | list[bytes] | None]:
+    """Every figure of the report for ``r``, by the names in :data:`FIGURES`."""
+    return {name: figure(r, name) for name in FIGURES}

@@ -16,7 +16,7 @@ from .store import jsonable
 
 __all__ = ["THESIS_FLOOR_PCT", "CSV_COLUMNS", "fmt", "fmt_axis", "facts", "stream_rows", "error_rows",
            "score_rows", "region_rows", "suggestion_rows", "gp_rows", "lengthscale_rows", "write_csv",
-           "write_suggestions_json", "ANGLES"]
+           "write_suggestions_json", "correlation_of", "ANGLES"]
 
 #: Held-out error floor reported by the thesis this project follows (forces, moments), %.
 THESIS_FLOOR_PCT = {"forces": 19.8, "moments": 23.8}
@@ -201,3 +201,13 @@ def write_suggestions_json(r: ReplayResult, path: Path) -> Path:
     }
     path.write_text(json.dumps(jsonable(doc), indent=1, allow_nan=False))
     return path
+
+
+def correlation_of(gp_summary: dict, outputs: list[str]) -> tuple[np.ndarray, list[str]] | None:
+    """The GP's output correlation matrix and its names from a model summary, or None."""
+    g = gp_summary.get("global") or {}
+    corr = g.get("output_correlation", gp_summary.get("output_correlation"))
+    names = list(gp_summary.get("outputs") or outputs)
+    if corr is None or len(names) != np.asarray(corr).shape[0]:
+        return None
+    return np.asarray(corr, float), names

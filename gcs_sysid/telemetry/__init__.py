@@ -62,7 +62,7 @@ def _looks_like_text(head: bytes) -> bool:
     return sum(32 <= b < 127 or b in (9, 10, 13) for b in sample) > 0.95 * len(sample)
 
 
-def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None = None) -> Flight:
+def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None = None, helper=None) -> Flight:
     """Decode a flight log to typed SI streams on the vehicle clock.
 
     The format is detected from the content (:func:`detect_format`); .tlog files are framed here
@@ -74,6 +74,8 @@ def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None =
     Args:
         path: the log file.
         progress: optional callable taking the fraction of the file decoded (0..1).
+        helper: optional :class:`gcs_sysid.parallel.Helper`: its worker decodes the second part of a
+            .tlog while this process decodes the first (same result).
 
     Returns:
         A :class:`Flight` with streams named as in ``docs/architecture.md`` ("Canonical streams"),
@@ -92,7 +94,7 @@ def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None =
     else:
         from gcs_sysid.telemetry.tlog_reader import read_tlog
 
-        flight = read_tlog(str(p), p.read_bytes(), progress)
+        flight = read_tlog(str(p), p.read_bytes(), progress, helper)
     if not flight.streams:
         seen = ", ".join(sorted(k for k in flight.messages if k != "BAD_DATA")[:8]) or "nothing"
         raise InputError(f"{p}: no usable messages decoded (found {seen}); expected IMU, attitude, "

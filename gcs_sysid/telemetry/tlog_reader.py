@@ -18,7 +18,8 @@ from gcs_sysid.errors import InputError
 from gcs_sysid.telemetry.assemble import finish_flight
 from gcs_sysid.telemetry.clock import VehicleClock
 from gcs_sysid.telemetry.mavlink_streams import IMU_PREFERENCE, RHO0, SPECS, wanted_fields
-from gcs_sysid.telemetry.tlog_scan import TlogScan, scan_tlog
+from gcs_sysid.telemetry.tlog_scan import TlogScan
+from gcs_sysid.telemetry.tlog_split import scan_tlog_split
 from gcs_sysid.telemetry.types import Flight, Stream
 
 __all__ = ["read_tlog"]
@@ -62,13 +63,15 @@ def _select(col, src: int | None):
     return seq[m], stamp[m], [r for r, k in zip(col.rows, m) if k]
 
 
-def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None = None) -> Flight:
+def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None = None, helper=None) -> Flight:
     """Decode a tlog already read into memory.
 
     Args:
         path: file name, for messages.
         data: file content.
         progress: optional callable(fraction done).
+        helper: a :class:`gcs_sysid.parallel.Helper` whose worker scans the second part of the file
+            (:mod:`gcs_sysid.telemetry.tlog_split`; the result is the same); None: one scan here.
 
     Returns:
         The :class:`Flight` (format ``"tlog"``).
@@ -77,7 +80,7 @@ def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None =
         InputError: no MAVLink record could be framed, or none of the records carries a message
             the tool uses.
     """
-    scan = scan_tlog(data, wanted_fields(), progress)
+    scan = scan_tlog_split(data, wanted_fields(), helper, progress)
     if scan.records == 0:
         raise InputError(f"{path}: no MAVLink packets found; expected a MAVLink telemetry log (.tlog: "
                          "8-byte timestamp before each MAVLink v1/v2 packet)")

@@ -76,6 +76,9 @@ class TlogScan:
         bad_data: packets that failed their CRC or broke the framing.
         truncated: the file ends inside a record.
         records: records framed.
+        end: offset where the scan stopped (``len(data)``, or the ``stop`` record boundary).
+        first, last: message name -> ``(packet bytes, stamp_us)`` of the first and the last packet
+            of each wanted type that was kept (to join the scans of two parts of a file).
     """
 
     collected: dict[str, Collected]
@@ -84,6 +87,9 @@ class TlogScan:
     bad_data: int
     truncated: bool
     records: int
+    end: int = 0
+    first: dict[str, tuple[bytes, int]] = field(default_factory=dict)
+    last: dict[str, tuple[bytes, int]] = field(default_factory=dict)
 
 
 def _record(data: bytes, pos: int) -> tuple[int, int, int] | None:
@@ -148,13 +154,15 @@ def find_sync(data: bytes, start: int, ref_us: int | None, limit: int | None = N
 
 
 def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
-              progress: Callable[[float], None] | None = None) -> TlogScan:
+              progress: Callable[[float], None] | None = None, stop: int | None = None) -> TlogScan:
     """Frame every record of a tlog and decode the wanted message types.
 
     Args:
         data: the whole file.
         wanted: message name -> field names to collect, in order (wire units).
         progress: optional callable given the fraction of the file done (0..1).
+        stop: end the scan at the first record that starts at or after this offset
+            (:attr:`TlogScan.end` tells where it ended); None: scan to the end.
 
     Returns:
         A :class:`TlogScan`. Never raises on bad bytes: they are counted as ``BAD_DATA``.
@@ -174,18 +182,21 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
         getters[_NAME_TO_ID[name]] = (get, col)
     counts: dict[int, int] = {}
     dups: dict[int, int] = {}
+    first: dict[int, tuple[bytes, int]] = {}
     last: dict[int, tuple[bytes, int]] = {}
     bad = 0
+    limit = n if stop is None else min(int(stop), n)
     truncated = False
     records = 0
     step = max(n // 100, 1 << 16)
     next_report = step
     pos = find_sync(data, 0, None)
     if pos is None:
-        return TlogScan(collected, {}, {}, 0, False, 0)
+        return TlogScan(collected, {}, {}, 0, False, 0, end=n)
     ref = int.from_bytes(data[pos:pos + 8], "big")
     prefix = data[pos:pos + 3]
-    while pos < n:
+    stopped = n
+    while pos < limit:
         if pos + _MIN_RECORD > n:
             truncated = True
             break
@@ -234,6 +245,8 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
                 dups[mid] = dups.get(mid, 0) + 1
             else:
                 last[mid] = (buf, stamp)
+                if prev is None:
+                    first[mid] = last[mid]
                 try:
                     msg = decode(bytearray(buf))
                 except Exception:  # pymavlink raises MAVError, struct.error, ... on bad packets
@@ -252,11 +265,15 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
                 col.rows.append(get(msg))
         pos = end
         if progress is not None and pos >= next_report:
-            progress(min(pos / n, 1.0))
+            progress(min(pos / limit, 1.0))
             next_report = pos + step
+    else:
+        stopped = min(pos, n)   # reached ``stop`` (or the end); a break above consumed the rest of the file
     if progress is not None:
         progress(1.0)
     names = {msg_name(k): v for k, v in counts.items()}
     if bad:
         names["BAD_DATA"] = bad
-    return TlogScan(collected, names, {msg_name(k): v for k, v in dups.items()}, bad, truncated, records)
+    return TlogScan(collected, names, {msg_name(k): v for k, v in dups.items()}, bad, truncated, records,
+                    end=stopped, first={msg_name(k): v for k, v in first.items()},
+                    last={msg_name(k): v for k, v in last.items()})

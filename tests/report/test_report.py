@@ -122,3 +122,26 @@ def test_partial_result_says_what_is_missing(partial_result, tmp_path):
     with open(files["csv"]) as f:
         rows = list(csv.reader(f))
     assert rows[1][rows[0].index("Cm_pred")] == "nan"
+
+
+def test_figures_from_the_worker_make_the_same_page(replay_result, tmp_path):
+    """The pipeline draws the figures in its worker process: same PNG bytes, same report.html."""
+    from gcs_sysid.parallel import Helper
+    from gcs_sysid.report import plots
+
+    r = replay_result
+    with Helper(enabled=True) as h:
+        jobs = {
+            "streams": h.submit("gcs_sysid.report.plots:streams_figure", r.summaries),
+            "states": h.submit("gcs_sysid.report.plots:states_figure", r.states, r.held_out),
+            "coefficients": h.submit("gcs_sysid.report.plots:coefficients_figure", r.table, r.pred_mean,
+                                     r.pred_sigma, r.held_out, r.identifiable),
+            "envelope": h.submit("gcs_sysid.report.plots:envelope_figures", r.envelope, r.table.X[r.train]),
+            "suggestions": h.submit("gcs_sysid.report.plots:suggestions_figure", r.suggestions),
+        }
+        assert jobs["states"].result() == plots.figure(r, "states")
+        assert jobs["envelope"].result() == plots.figure(r, "envelope")
+        a = write_report(r, tmp_path / "worker", save=False, figures=jobs)["html"].read_text()
+    assert all(j.ran_in_worker for j in jobs.values())
+    b = write_report(r, tmp_path / "here", save=False)["html"].read_text()
+    assert a == b

@@ -1,0 +1,100 @@
+"""Scanning a tlog in two parts at once: this process the head, a helper's worker the tail.
+
+Decoding is the one stage of a replay that only reads the file, so it splits cleanly: the
+file is cut at a record boundary (:func:`~gcs_sysid.telemetry.tlog_scan.find_sync` near
+:data:`HEAD_FRACTION` of its length), the worker (:class:`gcs_sysid.parallel.Helper`) scans
+the tail while this process scans the head up to the cut, and the two
+:class:`~gcs_sysid.telemetry.tlog_scan.TlogScan` are joined: record numbers of the tail are
+shifted by the records of the head, counts added, and a tail packet that repeats the head's
+last packet of its type (byte for byte, within 2 s) is dropped as a duplicate, as one scan
+would have done.
+
+The join is exact when the head's scan ends on the cut. When it does not (the cut sat on
+bytes that only looked like a record, in a corrupt file), the head's scan runs on to the end
+of the file by itself and the worker's result is not used, so the result is always that of
+one scan of the whole file.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from gcs_sysid.telemetry.tlog_scan import TlogScan, find_sync, scan_tlog
+
+__all__ = ["HEAD_FRACTION", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
+
+#: Share of the file this process scans; the worker starts about 0.1 s later and hands back its rows.
+HEAD_FRACTION = 0.55
+#: Files smaller than this are scanned in one piece (the hand-over would cost more than it saves).
+MIN_SPLIT_BYTES = 1 << 20
+
+
+def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
+    """The scan of a file from the scans of its head (ending on a record boundary) and its tail.
+
+    Args:
+        head: scan of ``data[:cut]`` (its :attr:`~TlogScan.end` is the cut).
+        tail: scan of ``data[cut:]``.
+
+    Returns:
+        The joined :class:`TlogScan`; ``end``, ``first`` and ``last`` describe the whole file.
+    """
+    counts = dict(head.counts)
+    dups = dict(head.duplicates)
+    for k, v in tail.counts.items():
+        counts[k] = counts.get(k, 0) + v
+    for k, v in tail.duplicates.items():
+        dups[k] = dups.get(k, 0) + v
+    collected = {}
+    for name in head.collected.keys() | tail.collected.keys():
+        h, t = head.collected.get(name), tail.collected.get(name)
+        if t is None or not t.seq:
+            collected[name] = h if h is not None else t
+            continue
+        drop = 0
+        prev, nxt = head.last.get(name), tail.first.get(name)
+        if prev is not None and nxt is not None and prev[0] == nxt[0] and nxt[1] - prev[1] < 2_000_000:
+            drop = 1   # the tail's first packet repeats the head's last: one scan counts it as a duplicate
+            dups[name] = dups.get(name, 0) + 1
+        off = head.records
+        if h is None:
+            h = type(t)()
+        h.seq.extend(s + off for s in t.seq[drop:])
+        h.stamp_us.extend(t.stamp_us[drop:])
+        h.src.extend(t.src[drop:])
+        h.rows.extend(t.rows[drop:])
+        collected[name] = h
+    bad = head.bad_data + tail.bad_data
+    if bad:
+        counts["BAD_DATA"] = bad
+    first = dict(tail.first)
+    first.update(head.first)
+    last = dict(head.last)
+    last.update(tail.last)
+    return TlogScan(collected, counts, dups, bad, tail.truncated, head.records + tail.records, end=tail.end + head.end,
+                    first=first, last=last)
+
+
+def scan_tlog_split(data: bytes, wanted: dict[str, tuple[str, ...]], helper,
+                    progress: Callable[[float], None] | None = None) -> TlogScan:
+    """:func:`~gcs_sysid.telemetry.tlog_scan.scan_tlog` of ``data``, the tail scanned by ``helper``'s worker.
+
+    Args:
+        data: the whole file. wanted: message name -> fields (as for ``scan_tlog``).
+        helper: a :class:`gcs_sysid.parallel.Helper`; without a worker (or for a small file) one scan.
+        progress: optional callable given the fraction of the head done (0..1).
+
+    Returns:
+        The same :class:`TlogScan` as one scan of the whole file.
+    """
+    n = len(data)
+    if helper is None or not helper.parallel or n < MIN_SPLIT_BYTES:
+        return scan_tlog(data, wanted, progress)
+    cut = find_sync(data, int(HEAD_FRACTION * n), None)
+    if cut is None or cut <= 0:
+        return scan_tlog(data, wanted, progress)
+    job = helper.submit("gcs_sysid.telemetry.tlog_scan:scan_tlog", data[cut:], wanted)
+    head = scan_tlog(data, wanted, progress, stop=cut)
+    if head.end != cut:   # the head ran past the cut (it was no record boundary) or ended early
+        return scan_tlog(data, wanted, progress)
+    return join_scans(head, job.result())
