@@ -3,13 +3,15 @@
 Target (issue 2): the whole pipeline within 3x the bare decode time of the same log measured in
 the same run, and peak memory under 1 GiB.
 
-    python benchmarks/bench_replay.py [--repeats 3] [--minutes 10]
+    python benchmarks/bench_replay.py [--repeats 3] [--minutes 10] [--serial]
 
 It simulates the flight once (cached in benchmarks/out/), then alternates: a bare pymavlink decode
 (``mavutil.mavlink_connection`` + ``recv_match()`` until the end, no processing) and the full
 ``run_replay`` (decode, estimation, coefficients, GP fit and prediction, confidence map,
 suggestions, report), each in a fresh subprocess so that JAX compilation and imports count and the
-peak resident memory of each run can be read. Medians and the ratio are printed.
+peak resident memory of each run can be read: the replay's own and its worker process's
+(:mod:`gcs_sysid.parallel`), and their sum sampled every 10 ms (what the replay held at once). ``--serial`` also times the
+replay without its worker. Medians and the ratio are printed.
 """
 
 from __future__ import annotations
@@ -17,10 +19,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
+import threading
 import time
 import tomllib
 from pathlib import Path
@@ -40,13 +42,15 @@ print(time.perf_counter() - t0, n)
 """
 
 PIPELINE = """
-import json, sys, time
+import json, resource, sys, time
 t0 = time.perf_counter()
-from gcs_sysid.jaxconfig import enable_x64
-enable_x64()
-from gcs_sysid.pipeline import ReplayOptions, run_replay
-r = run_replay(sys.argv[1], sys.argv[2], sys.argv[3], ReplayOptions(progress=False))
-print(json.dumps({"wall": time.perf_counter() - t0, "timings": r.timings,
+from gcs_sysid.pipeline import ReplayOptions, run_replay   # as `gcs-sysid replay` does: JAX is set up inside
+r = run_replay(sys.argv[1], sys.argv[2], sys.argv[3], ReplayOptions(progress=False, parallel=sys.argv[4] == "1"))
+wall = time.perf_counter() - t0
+# peak RSS of this process and of its worker (a waited-for child), KiB on Linux
+print(json.dumps({"wall": wall, "timings": r.timings,
+                  "rss_main": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+                  "rss_worker": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024,
                   "errors": {k: v["error_pct_heldout"] for k, v in r.metrics.items()}}))
 """
 
@@ -78,38 +82,71 @@ def make_flight(minutes: float) -> Path:
     return path
 
 
+def _rss_tree_mib(pid: int) -> float:
+    """Resident memory of ``pid`` and its descendants now (Linux /proc), MiB; 0 where unreadable."""
+    total, todo = 0.0, [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            with open(f"/proc/{p}/status") as f:
+                total += next(int(x.split()[1]) for x in f if x.startswith("VmRSS")) / 1024.0
+            with open(f"/proc/{p}/task/{p}/children") as f:
+                todo.extend(int(c) for c in f.read().split())
+        except (OSError, StopIteration, ValueError):
+            continue
+    return total
+
+
 def run_child(code: str, *args: str) -> tuple[str, float]:
-    """Run ``code`` in a fresh interpreter; returns its stdout and its peak RSS in MiB."""
+    """Run ``code`` in a fresh interpreter; returns the last line of its stdout and the largest
+    resident memory of it and its descendants together, sampled every 10 ms (MiB)."""
     env = dict(os.environ, PYTHONPATH=str(REPO))
-    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    p = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, check=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    # ru_maxrss of children is the max over all waited-for children: it only tells this child's peak
-    # when that exceeds all earlier ones, so the pipeline (the larger) runs are what it reports.
-    return p.stdout.strip().splitlines()[-1], max(after, before) / 1024.0
+    p = subprocess.Popen([sys.executable, "-c", code, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, env=env)
+    peak = [0.0]
+
+    def sample():
+        while p.poll() is None:
+            peak[0] = max(peak[0], _rss_tree_mib(p.pid))
+            time.sleep(0.01)
+
+    th = threading.Thread(target=sample, daemon=True)
+    th.start()
+    out, err = p.communicate()
+    th.join()
+    if p.returncode:
+        raise subprocess.CalledProcessError(p.returncode, "benchmark child", out, err)
+    return out.strip().splitlines()[-1], peak[0]
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--minutes", type=float, default=10.0)
+    ap.add_argument("--serial", action="store_true", help="also time the replay without its worker process")
     a = ap.parse_args()
     t0 = time.perf_counter()
     log = make_flight(a.minutes)
     print(f"flight: {log} ({log.stat().st_size / 1e6:.1f} MB), made in {time.perf_counter() - t0:.1f} s")
-    decode, pipe, peak, stages = [], [], 0.0, []
+    decode, pipe, serial, stages = [], [], [], []
+    peak_main = peak_worker = peak_tree = 0.0
+    airframe = str(REPO / "data/airframes/sim-trainer.toml")
     for i in range(a.repeats):
-        out, _ = run_child(DECODE, str(log))
-        secs, n = out.split()
+        secs, n = run_child(DECODE, str(log))[0].split()
         decode.append(float(secs))
-        out, rss = run_child(PIPELINE, str(log), str(REPO / "data/airframes/sim-trainer.toml"),
-                             str(OUT / f"report-{i}"))
+        out, tree = run_child(PIPELINE, str(log), airframe, str(OUT / f"report-{i}"), "1")
         r = json.loads(out)
+        peak_tree = max(peak_tree, tree)
         pipe.append(r["wall"])
         stages.append(r["timings"])
-        peak = max(peak, rss)
-        print(f"run {i + 1}: bare decode {float(secs):6.2f} s ({n} messages) | pipeline {r['wall']:6.2f} s "
-              f"| peak RSS so far {rss:6.0f} MiB")
+        peak_main, peak_worker = max(peak_main, r["rss_main"]), max(peak_worker, r["rss_worker"])
+        line = (f"run {i + 1}: bare decode {float(secs):6.2f} s ({n} messages) | pipeline {r['wall']:6.2f} s "
+                f"| peak RSS {r['rss_main']:4.0f} + worker {r['rss_worker']:4.0f} MiB, together {tree:4.0f} MiB")
+        if a.serial:
+            s = json.loads(run_child(PIPELINE, str(log), airframe, str(OUT / f"report-serial-{i}"), "0")[0])
+            serial.append(s["wall"])
+            line += f" | serial {s['wall']:6.2f} s"
+        print(line)
     md, mp = statistics.median(decode), statistics.median(pipe)
     print("\nstage medians (s): " + ", ".join(
         f"{k} {statistics.median(s[k] for s in stages):.2f}" for k in stages[0]))
@@ -117,7 +154,12 @@ def main() -> None:
     print(f"\nbare pymavlink decode  median {md:7.2f} s")
     print(f"gcs-sysid replay       median {mp:7.2f} s  (incl. interpreter start, imports, JIT)")
     print(f"ratio pipeline/decode  {mp / md:7.2f}x   (target <= 3x)")
-    print(f"peak RSS (pipeline)    {peak:7.0f} MiB (target < 1024 MiB)")
+    if serial:
+        ms = statistics.median(serial)
+        print(f"without the worker     median {ms:7.2f} s  ({ms / md:.2f}x decode; GCS_SYSID_PARALLEL=0)")
+    # the two peaks need not coincide: their sum bounds what the replay held; the sampled total is what it held
+    print(f"peak RSS               {peak_tree:7.0f} MiB main and worker together, sampled (target < 1024 MiB); "
+          f"separate peaks {peak_main:.0f} + {peak_worker:.0f} MiB")
 
 
 if __name__ == "__main__":

@@ -123,11 +123,13 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code (0 ok, 2 user error, 1 internal error)."""
     ap = build_parser()
     a = ap.parse_args(argv)
-    from .jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
+    if a.command != "replay":   # the replay sets these up itself, once its worker is decoding (so that
+        # importing JAX overlaps the decoding)
+        from .jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
 
-    enable_x64()
-    limit_blas_threads(1)        # small matrices: BLAS threading costs more than it gains (docs/gp.md)
-    enable_compilation_cache()   # later runs load compiled JAX programs instead of recompiling
+        enable_x64()
+        limit_blas_threads(1)        # small matrices: BLAS threading costs more than it gains (docs/gp.md)
+        enable_compilation_cache()   # later runs load compiled JAX programs instead of recompiling
     try:
         return COMMANDS[a.command](a)
     except SysidError as e:

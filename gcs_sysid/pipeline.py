@@ -5,6 +5,7 @@ This module only wires the layers together; each stage lives in its own package.
 
 from __future__ import annotations
 
+import importlib
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -17,7 +18,6 @@ from .aero import compute_coefficients
 from .aero.table import COEFFICIENTS, MOMENT_COEFFICIENTS, CoefficientTable
 from .airframe import load_airframe
 from .errors import InputError
-from .estimation import estimate_states
 from .estimation.states import FlightStates
 from .parallel import Helper, Job
 from .result import ReplayResult
@@ -124,6 +124,19 @@ def _stage(name: str, timings: dict[str, float], bar) -> Iterator[Callable[[floa
             bar.update(task, completed=1.0)
 
 
+def _load_stages() -> None:
+    """Import the modules of the stages after decoding (JAX, optax, SciPy, filterpy: about a second)
+    and set up JAX (64-bit) and BLAS (one thread: the many small factorisations of the smoothers and
+    the GP run faster without hand-offs, and the worker has the other core; ``docs/gp.md``)."""
+    from .jaxconfig import enable_x64, limit_blas_threads
+
+    enable_x64()
+    limit_blas_threads(1)
+    for m in ("gcs_sysid.estimation.estimate", "gcs_sysid.gp", "gcs_sysid.envelope", "gcs_sysid.maneuvers",
+              "gcs_sysid.report"):
+        importlib.import_module(m)
+
+
 def _progress_bar(enabled: bool):
     if not enabled:
         return None
@@ -149,13 +162,6 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         InputError: unreadable log or airframe, bad options.
         DataError: the log holds nothing the pipeline can use (e.g. no IMU and no attitude).
     """
-    from .envelope import confidence_map
-    from .gp import GPConfig, fit_gp, load_gp
-    from .jaxconfig import enable_compilation_cache, limit_blas_threads
-    from .maneuvers import suggest_maneuvers
-    from .report import write_report
-    from .report.tables import correlation_of
-
     airframe = load_airframe(airframe_path)
     out = Path(out_dir)
     timings: dict[str, float] = {}
@@ -174,7 +180,16 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     ok = False
     try:
         with _stage("decode log", timings, bar) as prog:
-            flight = read_log(log, progress=prog, helper=helper)
+            # the stages' imports (about a second) run here while the worker decodes most of the log
+            flight = read_log(log, progress=prog, helper=helper, meanwhile=_load_stages)
+        from .envelope import confidence_map
+        from .estimation import estimate_states
+        from .gp import GPConfig, fit_gp, load_gp
+        from .jaxconfig import enable_compilation_cache
+        from .maneuvers import suggest_maneuvers
+        from .report import write_report
+        from .report.tables import correlation_of
+
         helper.preload(["gcs_sysid.estimation.rates"])   # for the specific-force smoother, next
         if options.t_from is not None or options.t_to is not None:
             if options.t_from is not None and options.t_to is not None and options.t_to <= options.t_from:
@@ -206,10 +221,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             ok_rows = np.all(np.isfinite(X_train), axis=1) & np.all(np.isfinite(Y_train), axis=1)
             X_train, Y_train = X_train[ok_rows], Y_train[ok_rows]
             with _stage("learn GP", timings, bar):
-                # compiled GP programs are cached on disk (only the first run on a machine compiles);
-                # one BLAS thread: the GP's many small factorisations run faster without hand-offs
+                # compiled GP programs are cached on disk (only the first run on a machine compiles)
                 enable_compilation_cache()
-                limit_blas_threads(1)
                 if options.model_in:
                     model = load_gp(Path(options.model_in))
                     if model.n_outputs != len(fit_cols):

@@ -62,7 +62,8 @@ def _looks_like_text(head: bytes) -> bool:
     return sum(32 <= b < 127 or b in (9, 10, 13) for b in sample) > 0.95 * len(sample)
 
 
-def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None = None, helper=None) -> Flight:
+def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None = None, helper=None,
+             meanwhile: Callable[[], None] | None = None) -> Flight:
     """Decode a flight log to typed SI streams on the vehicle clock.
 
     The format is detected from the content (:func:`detect_format`); .tlog files are framed here
@@ -76,6 +77,8 @@ def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None =
         progress: optional callable taking the fraction of the file decoded (0..1).
         helper: optional :class:`gcs_sysid.parallel.Helper`: its worker decodes the second part of a
             .tlog while this process decodes the first (same result).
+        meanwhile: optional callable run once, while the worker decodes (before this process does;
+            for a .bin log or without a worker, simply first): the caller's own preparation.
 
     Returns:
         A :class:`Flight` with streams named as in ``docs/architecture.md`` ("Canonical streams"),
@@ -90,11 +93,13 @@ def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None =
     if fmt == "bin":
         from gcs_sysid.telemetry.dataflash import read_dataflash
 
+        if meanwhile is not None:
+            meanwhile()
         flight = read_dataflash(str(p), progress)
     else:
         from gcs_sysid.telemetry.tlog_reader import read_tlog
 
-        flight = read_tlog(str(p), p.read_bytes(), progress, helper)
+        flight = read_tlog(str(p), p.read_bytes(), progress, helper, meanwhile)
     if not flight.streams:
         seen = ", ".join(sorted(k for k in flight.messages if k != "BAD_DATA")[:8]) or "nothing"
         raise InputError(f"{p}: no usable messages decoded (found {seen}); expected IMU, attitude, "

@@ -63,7 +63,8 @@ def _select(col, src: int | None):
     return seq[m], stamp[m], [r for r, k in zip(col.rows, m) if k]
 
 
-def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None = None, helper=None) -> Flight:
+def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None = None, helper=None,
+              meanwhile: Callable[[], None] | None = None) -> Flight:
     """Decode a tlog already read into memory.
 
     Args:
@@ -72,6 +73,7 @@ def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None =
         progress: optional callable(fraction done).
         helper: a :class:`gcs_sysid.parallel.Helper` whose worker scans the second part of the file
             (:mod:`gcs_sysid.telemetry.tlog_split`; the result is the same); None: one scan here.
+        meanwhile: optional callable run once while the worker scans (see ``scan_tlog_split``).
 
     Returns:
         The :class:`Flight` (format ``"tlog"``).
@@ -80,7 +82,7 @@ def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None =
         InputError: no MAVLink record could be framed, or none of the records carries a message
             the tool uses.
     """
-    scan = scan_tlog_split(data, wanted_fields(), helper, progress)
+    scan = scan_tlog_split(data, wanted_fields(), helper, progress, meanwhile)
     if scan.records == 0:
         raise InputError(f"{path}: no MAVLink packets found; expected a MAVLink telemetry log (.tlog: "
                          "8-byte timestamp before each MAVLink v1/v2 packet)")

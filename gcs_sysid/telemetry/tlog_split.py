@@ -21,10 +21,12 @@ from typing import Callable
 
 from gcs_sysid.telemetry.tlog_scan import TlogScan, find_sync, scan_tlog
 
-__all__ = ["HEAD_FRACTION", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
+__all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
 
 #: Share of the file this process scans; the worker starts about 0.1 s later and hands back its rows.
 HEAD_FRACTION = 0.55
+#: The same when the caller has its own work to do first (``meanwhile``: the replay's imports, ~1 s).
+HEAD_FRACTION_BUSY = 0.2
 #: Files smaller than this are scanned in one piece (the hand-over would cost more than it saves).
 MIN_SPLIT_BYTES = 1 << 20
 
@@ -76,24 +78,30 @@ def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
 
 
 def scan_tlog_split(data: bytes, wanted: dict[str, tuple[str, ...]], helper,
-                    progress: Callable[[float], None] | None = None) -> TlogScan:
+                    progress: Callable[[float], None] | None = None,
+                    meanwhile: Callable[[], None] | None = None) -> TlogScan:
     """:func:`~gcs_sysid.telemetry.tlog_scan.scan_tlog` of ``data``, the tail scanned by ``helper``'s worker.
 
     Args:
         data: the whole file. wanted: message name -> fields (as for ``scan_tlog``).
         helper: a :class:`gcs_sysid.parallel.Helper`; without a worker (or for a small file) one scan.
         progress: optional callable given the fraction of the head done (0..1).
+        meanwhile: optional callable run once, after the tail went to the worker and before the
+            head is scanned (the caller's own preparation, e.g. its imports, overlaps the tail).
 
     Returns:
         The same :class:`TlogScan` as one scan of the whole file.
     """
     n = len(data)
-    if helper is None or not helper.parallel or n < MIN_SPLIT_BYTES:
-        return scan_tlog(data, wanted, progress)
-    cut = find_sync(data, int(HEAD_FRACTION * n), None)
-    if cut is None or cut <= 0:
+    fraction = HEAD_FRACTION if meanwhile is None else HEAD_FRACTION_BUSY
+    cut = find_sync(data, int(fraction * n), None) if helper is not None and helper.parallel else None
+    if n < MIN_SPLIT_BYTES or cut is None or cut <= 0:
+        if meanwhile is not None:
+            meanwhile()
         return scan_tlog(data, wanted, progress)
     job = helper.submit("gcs_sysid.telemetry.tlog_scan:scan_tlog", data[cut:], wanted)
+    if meanwhile is not None:
+        meanwhile()
     head = scan_tlog(data, wanted, progress, stop=cut)
     if head.end != cut:   # the head ran past the cut (it was no record boundary) or ended early
         return scan_tlog(data, wanted, progress)
