@@ -26,6 +26,7 @@ import importlib
 import os
 import pickle
 import queue
+import signal
 import subprocess
 import sys
 import threading
@@ -239,6 +240,9 @@ def _import(modules: Sequence[str]) -> int:
 
 def _serve() -> None:
     """The worker's loop: read a job from stdin, run it, write ``(key, ok, value)`` to stdout."""
+    # Ctrl-C reaches the whole process group: the caller handles it (and stops this worker); the worker
+    # must not die of it mid-job with a traceback of its own. It ends at EOF, when the caller closes or dies.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     inp = sys.stdin.buffer
     out = os.fdopen(os.dup(sys.stdout.fileno()), "wb")
     os.dup2(sys.stderr.fileno(), sys.stdout.fileno())   # stray prints go to stderr, not into the results

@@ -89,3 +89,15 @@ def test_read_log_with_helper_equals_without(helper):
         np.testing.assert_array_equal(a.streams[k].t, b.streams[k].t)
         for f in a.streams[k].fields:
             np.testing.assert_array_equal(a.streams[k].fields[f], b.streams[k].fields[f])
+
+
+@pytest.mark.parametrize("parallel", [True, False])
+def test_meanwhile_runs_once_before_the_head(data, parallel):
+    """The caller's own work (the replay's imports) runs once, while the worker scans the tail."""
+    calls = []
+    with Helper(enabled=parallel) as h:
+        scan = scan_tlog_split(data, wanted_fields(), h, progress=lambda f: calls.append(("progress", f)),
+                               meanwhile=lambda: calls.append(("meanwhile", None)))
+    assert [c for c in calls if c[0] == "meanwhile"] == [("meanwhile", None)]
+    assert calls[0] == ("meanwhile", None)   # before any of the head was scanned
+    _same(scan, scan_tlog(data, wanted_fields()))
