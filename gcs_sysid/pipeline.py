@@ -43,8 +43,9 @@ class ReplayOptions:
         n_inducing: inducing points of the global GP (None = the GP's default).
         progress: show rich progress bars.
         write: write the report files (False for tests that only need the result).
-        parallel: use a second process for the independent work (figures, one smoother;
-            :mod:`gcs_sysid.parallel`) when more than one CPU is usable; results are the same.
+        parallel: use a second process for the work beside the main chain (decoding most of a
+            .tlog, the specific-force smoother, the report's figures; :mod:`gcs_sysid.parallel`)
+            when more than one CPU is usable; the results are the same.
     """
 
     rate_hz: float = 50.0
