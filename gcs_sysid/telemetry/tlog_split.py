@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from gcs_sysid.telemetry.tlog_scan import TlogScan, find_sync, scan_tlog
+from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, find_sync, scan_tlog
 
 __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
 
@@ -39,7 +39,8 @@ def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
         tail: scan of ``data[cut:]``.
 
     Returns:
-        The joined :class:`TlogScan`; ``end``, ``first`` and ``last`` describe the whole file.
+        The joined :class:`TlogScan`; ``end``, ``first`` and ``last`` describe the whole file. The
+        head's per-type row lists are extended in place (no copy of the rows), so ``head`` is used up.
     """
     counts = dict(head.counts)
     dups = dict(head.duplicates)
@@ -60,7 +61,7 @@ def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
             dups[name] = dups.get(name, 0) + 1
         off = head.records
         if h is None:
-            h = type(t)()
+            h = Collected()
         h.seq.extend(s + off for s in t.seq[drop:])
         h.stamp_us.extend(t.stamp_us[drop:])
         h.src.extend(t.src[drop:])
