@@ -1,4 +1,7 @@
-"""``python -m replay LOG --link udpout:127.0.0.1:14550 [--speed 1.0] [--from S --to S]``."""
+"""``python -m replay LOG --link udpout:127.0.0.1:14550 [--speed 1.0] [--from S --to S]``.
+
+Installed as the console command ``gcs-sysid-player`` (same arguments).
+"""
 
 from __future__ import annotations
 
@@ -8,6 +11,28 @@ import time
 
 from gcs_sysid.errors import SysidError
 from replay.player import open_link, play, read_packets
+from replay.vehicle import VehicleResponder, packet_source, recorded_rates
+
+
+def _vehicle_ids(packets) -> tuple[int, int]:
+    """(system, component) of the vehicle: the sender of ATTITUDE, else the most frequent non-GCS one."""
+    from collections import Counter
+
+    att = Counter(packet_source(p.data) for p in packets if p.name == "ATTITUDE")
+    if att:
+        return att.most_common(1)[0][0]
+    other = Counter(packet_source(p.data) for p in packets)
+    ids = [s for s, _ in other.most_common() if s[0] != 255]
+    return ids[0] if ids else (1, 1)
+
+
+def _responder(packets, link, quiet: bool) -> VehicleResponder:
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+    sysid, compid = _vehicle_ids(packets)
+    mav = mavlink.MAVLink(None, srcSystem=sysid, srcComponent=compid)
+    rates = recorded_rates(packets, (sysid, compid))
+    return VehicleResponder(mav, rates, link.write)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -24,6 +49,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="start S seconds after the log's first record")
     ap.add_argument("--to", dest="t_to", type=float, default=None, metavar="S",
                     help="stop S seconds after the log's first record")
+    ap.add_argument("--no-answer", action="store_true",
+                    help="do not answer rate requests (by default the player answers SET_MESSAGE_INTERVAL and "
+                         "REQUEST_DATA_STREAM like a vehicle, within the recorded rates)")
     ap.add_argument("-q", "--quiet", action="store_true", help="no summary line")
     args = ap.parse_args(argv)
     try:
@@ -32,17 +60,25 @@ def main(argv: list[str] | None = None) -> int:
         if args.t_from is not None and args.t_to is not None and args.t_to < args.t_from:
             raise SysidError(f"--to {args.t_to} is before --from {args.t_from}")
         bad = [0]
-        packets = read_packets(args.log, bad)
-        first = next(packets)  # reads and checks the log before the link is opened
+        packets = list(read_packets(args.log, bad))  # reads and checks the log before the link is opened
         link = open_link(args.link, args.baud)
+        responder = None if args.no_answer else _responder(packets, link, args.quiet)
         t0 = time.monotonic()
 
-        def chain():
-            yield first
-            yield from packets
+        def poll() -> None:
+            for _ in range(100):   # bounded: a flood of requests cannot stall the stream
+                msg = link.recv_msg()
+                if msg is None:
+                    return
+                if msg.get_type() != "BAD_DATA":
+                    responder.handle(msg)
+                    while responder.log and not args.quiet:
+                        print(f"replay: request: {responder.log.pop(0)}", file=sys.stderr, flush=True)
 
         try:
-            n = play(chain(), link.write, args.speed, args.t_from, args.t_to)
+            n = play(packets, link.write, args.speed, args.t_from, args.t_to,
+                     poll=poll if responder is not None else None,
+                     allow=responder.allow if responder is not None else None)
         finally:
             link.close()
     except SysidError as exc:

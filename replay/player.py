@@ -14,7 +14,10 @@ from typing import Callable, Iterable, Iterator
 
 from gcs_sysid.errors import InputError
 
-__all__ = ["Packet", "read_packets", "open_link", "play"]
+__all__ = ["Packet", "read_packets", "open_link", "play", "POLL_S"]
+
+POLL_S = 0.01
+"""Longest wait (s) between two looks at what the far end sent."""
 
 
 @dataclass(frozen=True)
@@ -83,7 +86,7 @@ def open_link(link: str, baud: int = 115200):
         raise InputError(f"--link {link}: is a file; expected a link such as udpout:127.0.0.1:14550, "
                          "tcp:HOST:PORT or a serial device")
     try:
-        return mavutil.mavlink_connection(link, baud=baud, input=False, source_system=255)
+        return mavutil.mavlink_connection(link, baud=baud, input=False, source_system=255, robust_parsing=True)
     except Exception as exc:  # socket.gaierror, ValueError, serial.SerialException ...
         raise InputError(f"--link {link}: cannot open ({type(exc).__name__}: {exc}); expected e.g. "
                          "udpout:127.0.0.1:14550, tcp:HOST:PORT or /dev/ttyUSB0") from None
@@ -91,7 +94,8 @@ def open_link(link: str, baud: int = 115200):
 
 def play(packets: Iterable[Packet], send: Callable[[bytes], object], speed: float = 1.0,
          t_from: float | None = None, t_to: float | None = None,
-         sleep: Callable[[float], None] = time.sleep, clock: Callable[[], float] = time.monotonic) -> int:
+         sleep: Callable[[float], None] = time.sleep, clock: Callable[[], float] = time.monotonic,
+         poll: Callable[[], object] | None = None, allow: Callable[[str, float], bool] | None = None) -> int:
     """Send packets with their recorded spacing divided by ``speed``.
 
     Args:
@@ -100,6 +104,9 @@ def play(packets: Iterable[Packet], send: Callable[[bytes], object], speed: floa
         speed: 1.0 real time, 2.0 twice as fast, 0 as fast as possible.
         t_from, t_to: window in s from the log's first record (None: open end).
         sleep, clock: injectable for tests.
+        poll: called while waiting (at least every :data:`POLL_S`) and every 64 packets when
+            sending as fast as possible: handles what the far end sends (requests).
+        allow: ``allow(name, stamp)`` says whether a packet is sent (rate requests); None: all.
 
     Returns:
         The number of packets sent.
@@ -109,7 +116,7 @@ def play(packets: Iterable[Packet], send: Callable[[bytes], object], speed: floa
     sent = 0
     first = None
     start_stamp = start_wall = None
-    for pk in packets:
+    for i, pk in enumerate(packets):
         if first is None:
             first = pk.stamp
         rel = pk.stamp - first
@@ -123,8 +130,15 @@ def play(packets: Iterable[Packet], send: Callable[[bytes], object], speed: floa
             # a stamp going backwards (a merged log) is sent at once, not waited for
             due = start_wall + max(pk.stamp - start_stamp, 0.0) / speed
             wait = due - clock()
-            if wait > 0:
-                sleep(wait)
+            while wait > 0:
+                sleep(min(wait, POLL_S) if poll is not None else wait)
+                if poll is not None:
+                    poll()
+                wait = due - clock()
+        elif poll is not None and i % 64 == 0:
+            poll()
+        if allow is not None and not allow(pk.name, pk.stamp):
+            continue
         send(pk.data)
         sent += 1
     return sent
