@@ -69,6 +69,10 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--model", required=True, help="the simulation's aerodynamic model TOML file")
     d.add_argument("--out", required=True, help="output directory")
     _window_args(d)
+
+    from .live.cli import add_listen_parser
+
+    add_listen_parser(sub)
     return ap
 
 
@@ -116,7 +120,14 @@ def _cmd_diagnose(a: argparse.Namespace) -> int:
     return 0
 
 
-COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose}
+def _cmd_listen(a: argparse.Namespace) -> int:
+    from .live.cli import cmd_listen
+
+    return cmd_listen(a)
+
+
+COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
+            "listen": _cmd_listen}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,62 @@
+"""``gcs-sysid listen CONNECTION --airframe A --out DIR`` (argument parsing; the work is in :mod:`.session`)."""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["add_listen_parser", "cmd_listen"]
+
+
+def add_listen_parser(sub) -> argparse.ArgumentParser:
+    """Add the ``listen`` subcommand to the CLI's subparsers (documented in docs/live.md)."""
+    p = sub.add_parser("listen", help="listen to a live MAVLink link (SITL, telemetry radio, router), learn while "
+                                      "the aircraft flies, and speak back as a MAVLink component")
+    p.add_argument("connection", help="pymavlink connection: udpin:0.0.0.0:14550, udpout:HOST:PORT, tcp:HOST:5760, "
+                                      "tcpin:0.0.0.0:5760, /dev/ttyUSB0 (with --baud) or /dev/ttyUSB0,57600")
+    p.add_argument("--airframe", required=True, help="airframe TOML file (docs/airframe.md)")
+    p.add_argument("--out", required=True, help="output directory: raw.tlog, session.json, report.md, model/")
+    p.add_argument("--baud", type=int, default=57600, help="serial baud rate (default 57600)")
+    p.add_argument("--duration", type=float, default=None, metavar="S", help="stop after S seconds (default: Ctrl-C)")
+    p.add_argument("--window", type=float, default=30.0, metavar="S",
+                   help="seconds of data smoothed per learning step (default 30)")
+    p.add_argument("--step", type=float, default=10.0, metavar="S", help="seconds between learning steps (default 10)")
+    p.add_argument("--lag", type=float, default=3.0, metavar="S",
+                   help="newest seconds left for the next step, the smoother's future context (default 3)")
+    p.add_argument("--min-rows", type=int, default=500, help="samples before the GP is first fitted (default 500)")
+    p.add_argument("--inducing", type=int, default=None, help="inducing points of the global GP")
+    p.add_argument("--silence", type=float, default=30.0, metavar="S",
+                   help="report the link as silent after S seconds without a packet (default 30)")
+    p.add_argument("--no-learn", action="store_true", help="only log, monitor and request rates")
+    p.add_argument("--no-request", action="store_true", help="do not ask the vehicle for message rates")
+    p.add_argument("--no-component", action="store_true",
+                   help="do not send HEARTBEAT/STATUSTEXT/NAMED_VALUE_FLOAT nor serve parameters")
+    p.add_argument("--sysid", type=int, default=None, help="component's system id (default: the vehicle's)")
+    p.add_argument("--compid", type=int, default=191, help="component id (default 191, onboard computer)")
+    p.add_argument("--no-mavsdk", action="store_true",
+                   help="serve parameters with pymavlink's PARAM protocol instead of MAVSDK's server")
+    p.add_argument("--quiet", action="store_true", help="no live console")
+    return p
+
+
+def cmd_listen(a: argparse.Namespace) -> int:
+    """Run ``listen`` from parsed arguments; prints where the report went. Returns 0."""
+    from ..errors import InputError
+    from .learner import LearnOptions
+    from .session import ListenOptions, run_listen
+
+    for name, v in (("--sysid", a.sysid), ("--compid", a.compid)):
+        if v is not None and not 1 <= v <= 255:
+            raise InputError(f"{name} {v}: must lie in 1..255")
+    learn = None if a.no_learn else LearnOptions(window_s=a.window, step_s=a.step, lag_s=a.lag,
+                                                 min_rows=a.min_rows, n_inducing=a.inducing)
+    opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
+                         component=not a.no_component, system_id=a.sysid, component_id=a.compid,
+                         duration_s=a.duration, silence_s=a.silence, console=not a.quiet,
+                         use_mavsdk=not a.no_mavsdk)
+    snap = run_listen(a.airframe, a.out, opts)
+    print(f"raw log: {snap['raw_log']} ({snap['raw_records']} packets); report: {a.out}/report.md")
+    if snap.get("samples_learned") is not None:
+        print(f"learned {snap['samples_learned']} samples; model: {snap.get('model', 'none')}")
+    for c in snap.get("costs", []):
+        print(f"  {c}")
+    return 0

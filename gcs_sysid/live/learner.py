@@ -1,0 +1,281 @@
+"""The incremental pipeline of a live session: records in, coefficient rows learned by the GP.
+
+The same stages as the replay (:mod:`gcs_sysid.pipeline`), run causally on a lagging window:
+
+1. every received record (tlog stamp + raw packet) is appended to a window of the last
+   ``window_s`` seconds (tlog stamp time, i.e. arrival time);
+2. every ``step_s`` seconds of stamp time the window's bytes are decoded by the telemetry layer's
+   own tlog decoder (:func:`gcs_sysid.telemetry.tlog_reader.read_tlog`: no second decoder), the
+   states are estimated with the smoother (:func:`gcs_sysid.estimation.estimate_states`) and the
+   coefficients computed (:func:`gcs_sysid.aero.compute_coefficients`);
+3. the rows between the last learned vehicle time and ``lag_s`` before the window's end (the
+   smoother has had its future context for them) are new: the first ``min_rows`` of them fit the GP
+   (:func:`gcs_sysid.gp.fit_gp`), later ones go to its incremental update (``model.update``);
+4. every ``refresh_every`` steps the confidence map and the maneuver suggestions are refreshed.
+
+The schedule is driven by the records' stamps, never by the processing's wall clock, so feeding the
+records of a session's ``raw.tlog`` again (:func:`learn_from_tlog`) gives the same windows, the same
+rows and the same model.
+"""
+
+from __future__ import annotations
+
+import struct
+import time
+from collections import deque
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..aero.table import COEFFICIENTS, REGRESSORS, CoefficientTable
+from ..airframe import Airframe
+from ..errors import InputError, SysidError
+
+__all__ = ["LearnOptions", "Learner", "learn_from_tlog", "iter_tlog_records"]
+
+
+@dataclass(frozen=True)
+class LearnOptions:
+    """Schedule and sizes of the incremental pipeline.
+
+    Attributes:
+        window_s: stamp time (s) of records decoded and smoothed per step.
+        step_s: stamp time (s) between steps.
+        lag_s: rows within this vehicle time (s) of the window's end wait for the next step (the
+            smoother's future context).
+        rate_hz: estimation grid, Hz.
+        min_rows: rows collected before the GP is first fitted.
+        refresh_every: steps between refreshes of the confidence map and the suggestions.
+        max_rows: learned rows kept for the confidence map (every other one is dropped when full).
+        n_inducing: inducing points of the global GP (None: the GP's default).
+    """
+
+    window_s: float = 30.0
+    step_s: float = 10.0
+    lag_s: float = 3.0
+    rate_hz: float = 50.0
+    min_rows: int = 500
+    refresh_every: int = 3
+    max_rows: int = 20000
+    n_inducing: int | None = None
+
+    def __post_init__(self):
+        if not (0 < self.step_s and self.lag_s >= 0 and self.window_s >= self.step_s + 2 * self.lag_s):
+            raise InputError(f"--window {self.window_s} s must cover --step {self.step_s} s plus "
+                             f"twice --lag {self.lag_s} s (and --step must be > 0)")
+
+
+@dataclass
+class Learner:
+    """Incremental learner fed with tlog records.
+
+    Args:
+        airframe: the airframe.
+        options: :class:`LearnOptions`.
+
+    Attributes:
+        model: the GP (None until ``min_rows`` rows were learned).
+        outputs: coefficient names of the model's output columns.
+        X, Y, t: learned rows kept (bounded by ``max_rows``), shapes (N, 10), (N, 6), (N,).
+        n_learned: rows given to the GP so far.
+        envelope, suggestions: the latest confidence map and maneuver suggestions.
+        identifiable: coefficient -> (ok, why) of the latest window.
+        notes: what happened (reboots, skipped windows), in order.
+        steps: steps run; timings: stage -> seconds of the last step.
+    """
+
+    airframe: Airframe
+    options: LearnOptions = field(default_factory=LearnOptions)
+    model: object = None
+    outputs: tuple[str, ...] = ()
+    n_learned: int = 0
+    envelope: object = None
+    suggestions: list = field(default_factory=list)
+    identifiable: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    steps: int = 0
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self):
+        from ..jaxconfig import enable_x64, limit_blas_threads
+
+        enable_x64()             # the GP's numerics need float64 (docs/gp.md); the replay does the same
+        limit_blas_threads(1)    # small factorisations: one BLAS thread is faster (docs/gp.md)
+        self._window: deque = deque()
+        self._next_step_us: int | None = None
+        self._t_done: float | None = None
+        self.X = np.zeros((0, len(REGRESSORS)))
+        self.Y = np.zeros((0, len(COEFFICIENTS)))
+        self.t = np.zeros(0)
+        self._pending: list[tuple[np.ndarray, np.ndarray]] = []
+
+    # --- feeding -----------------------------------------------------------------------------
+
+    def feed(self, stamp_us: int, packet: bytes) -> bool:
+        """Add one record; run a step when its stamp reaches the schedule. Returns True if a step ran."""
+        w = self._window
+        w.append((stamp_us, packet))
+        if self._next_step_us is None:
+            self._next_step_us = stamp_us + int(self.options.window_s * 1e6)
+        horizon = stamp_us - int(self.options.window_s * 1e6)
+        while w and w[0][0] < horizon:
+            w.popleft()
+        if stamp_us >= self._next_step_us:
+            self._next_step_us = stamp_us + int(self.options.step_s * 1e6)
+            self.step()
+            return True
+        return False
+
+    def finish(self) -> None:
+        """Learn what is left in the window (at the end of a session): rows up to its very end."""
+        if self._window:
+            self.step(final=True)
+
+    # --- one step ----------------------------------------------------------------------------
+
+    def step(self, final: bool = False) -> None:
+        """Decode, smooth and learn the current window (see the module docstring)."""
+        from ..aero import compute_coefficients
+        from ..estimation import estimate_states
+        from ..pipeline import identifiability
+        from ..telemetry.tlog_reader import read_tlog
+
+        t0 = time.perf_counter()
+        data = b"".join(struct.pack(">Q", s) + p for s, p in self._window)
+        self.steps += 1
+        try:
+            flight = read_tlog("live window", data)
+            if not flight.streams:
+                raise SysidError("no usable messages in the window")
+            states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz)
+            table = compute_coefficients(states, self.airframe)
+        except SysidError as exc:
+            self.notes.append(f"step {self.steps}: window skipped ({exc})")
+            return
+        t1 = time.perf_counter()
+        self.identifiable = identifiability(states, table)
+        if not len(table.t):
+            return
+        end = table.t[-1] if final else table.t[-1] - self.options.lag_s
+        start = self._t_done
+        if start is not None and end < start - 1.0:
+            # the vehicle clock started again (a reboot): this window's times are on a new axis
+            self.notes.append(f"step {self.steps}: vehicle time went back from {start:.1f} s to "
+                              f"{table.t[-1]:.1f} s (reboot): learning resumes on the new clock")
+            start = table.t[0] + self.options.lag_s
+        rows = table.valid & (table.t <= end) & np.all(np.isfinite(table.X), axis=1)
+        if start is not None:
+            rows &= table.t > start
+        self._t_done = max(end, start) if start is not None else end
+        self._learn(table, rows)
+        t2 = time.perf_counter()
+        if self.model is not None and (final or self.steps % self.options.refresh_every == 0):
+            self.refresh()
+        self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": time.perf_counter() - t2}
+
+    def _learn(self, table: CoefficientTable, rows: np.ndarray) -> None:
+        from ..gp import GPConfig, fit_gp
+
+        if not rows.any():
+            return
+        X, Y, t = table.X[rows], table.Y[rows], table.t[rows]
+        self._keep(X, Y, t)
+        if self.model is None:
+            self._pending.append((X, Y))
+            n = sum(len(x) for x, _ in self._pending)
+            if n < self.options.min_rows:
+                return
+            Xa = np.concatenate([x for x, _ in self._pending])
+            Ya = np.concatenate([y for _, y in self._pending])
+            cols = [i for i, c in enumerate(COEFFICIENTS) if self.identifiable.get(c, (True, ""))[0]
+                    and np.isfinite(Ya[:, i]).mean() > 0.5]
+            if not cols:
+                return
+            self._pending = []
+            ok = np.all(np.isfinite(Ya[:, cols]), axis=1)
+            self.outputs = tuple(COEFFICIENTS[i] for i in cols)
+            cfg = GPConfig() if self.options.n_inducing is None else GPConfig(n_inducing=self.options.n_inducing)
+            self.model, _ = fit_gp(Xa[ok], Ya[ok][:, cols], cfg)
+            self.n_learned += int(ok.sum())
+            self.notes.append(f"step {self.steps}: GP fitted on {int(ok.sum())} rows "
+                              f"({', '.join(self.outputs)})")
+            return
+        cols = [COEFFICIENTS.index(c) for c in self.outputs]
+        ok = np.all(np.isfinite(Y[:, cols]), axis=1)
+        if ok.any():
+            self.model = self.model.update(X[ok], Y[ok][:, cols])
+            self.n_learned += int(ok.sum())
+
+    def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray) -> None:
+        self.X = np.concatenate([self.X, X])
+        self.Y = np.concatenate([self.Y, Y])
+        self.t = np.concatenate([self.t, t])
+        if len(self.t) > self.options.max_rows:   # thin evenly: the flown envelope stays covered
+            self.X, self.Y, self.t = self.X[::2], self.Y[::2], self.t[::2]
+
+    def table(self) -> CoefficientTable:
+        """The learned rows kept, as a :class:`CoefficientTable` (all rows valid)."""
+        n = len(self.t)
+        return CoefficientTable(self.t.copy(), self.X.copy(), self.Y.copy(), np.ones(n, bool),
+                                np.full(n, np.nan), ["rows learned by a live session"])
+
+    def refresh(self) -> None:
+        """Recompute the confidence map and the maneuver suggestions from the model and kept rows."""
+        from ..envelope import confidence_map
+        from ..maneuvers import suggest_maneuvers
+
+        table = self.table()
+        if self.model is None or len(table.t) < 2:
+            return
+        try:
+            self.envelope = confidence_map(self.model, table, table.valid, outputs=self.outputs)
+            self.suggestions = list(suggest_maneuvers(self.envelope, self.model, table, self.airframe))
+        except SysidError as exc:
+            self.notes.append(f"step {self.steps}: confidence map not refreshed ({exc})")
+
+    def confidence(self) -> dict[str, float]:
+        """Coefficient -> confidence score in [0, 1] from the latest map (empty before the first)."""
+        return dict(self.envelope.scores) if self.envelope is not None else {}
+
+
+def iter_tlog_records(path: str | Path):
+    """Yield ``(stamp_us, packet bytes)`` of a tlog's well-framed records, in file order.
+
+    Uses the telemetry layer's framing (:func:`gcs_sysid.telemetry.tlog_scan.find_sync`) to resync
+    after corrupt bytes.
+    """
+    from ..telemetry.tlog_scan import find_sync
+
+    data = Path(path).read_bytes()
+    pos, n = 0, len(data)
+    while pos + 16 <= n:
+        magic = data[pos + 8]
+        if magic == 0xFD and pos + 9 < n:
+            plen = 12 + data[pos + 9] + (13 if data[pos + 10] & 1 else 0)
+        elif magic == 0xFE:
+            plen = 8 + data[pos + 9]
+        else:
+            nxt = find_sync(data, pos + 1, None)
+            if nxt is None:
+                return
+            pos = nxt
+            continue
+        if pos + 8 + plen > n:
+            return
+        yield int.from_bytes(data[pos:pos + 8], "big"), data[pos + 8:pos + 8 + plen]
+        pos += 8 + plen
+
+
+def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions = LearnOptions()) -> Learner:
+    """Feed a tlog (e.g. a live session's ``raw.tlog``) through a fresh :class:`Learner`.
+
+    Returns:
+        The learner after :meth:`Learner.finish`: the model a live session with the same records
+        and options ends with.
+    """
+    learner = Learner(airframe, options)
+    for stamp_us, packet in iter_tlog_records(path):
+        learner.feed(stamp_us, packet)
+    learner.finish()
+    return learner

@@ -1,0 +1,57 @@
+"""The report of a live session: ``session.json`` (the data) and ``report.md`` (its rendering)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+__all__ = ["write_session_report", "render_markdown"]
+
+
+def _clean(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    return x
+
+
+def render_markdown(snap: dict) -> str:
+    """Markdown rendering of a session snapshot (``session.json``)."""
+    lines = ["# gcs-sysid live session", "",
+             f"- link: `{snap['connection']}`, vehicle: {snap.get('vehicle')}",
+             f"- packets received and kept in `raw.tlog`: {snap['raw_records']} "
+             f"(corrupt byte runs skipped: {snap['bad_data']}; missed by sequence number: {snap['seq_lost']})",
+             f"- ended by: {'Ctrl-C' if snap.get('interrupted') else 'end of duration'}"]
+    if "samples_learned" in snap:
+        lines.append(f"- samples learned: {snap['samples_learned']} in {snap['steps']} steps; "
+                     f"model: `{snap.get('model', 'none (too few samples)')}`")
+    lines += ["", "## Rates", "", "| message | mean received Hz | asked Hz | request | short at check |",
+              "|---|---|---|---|---|"]
+    asked, mean = snap.get("asked", {}), snap.get("mean_rates", {})
+    short = snap.get("shortfalls", {})
+    for n in sorted(set(asked) | set(mean)):
+        s = f"{short[n][1]:.1f} Hz" if n in short else ""
+        lines.append(f"| {n} | {mean.get(n, 0.0):.1f} | {asked.get(n, '')} | {snap['requests'].get(n, '')} | {s} |")
+    if snap.get("costs"):
+        lines += ["", "What the rates cost:", ""] + [f"- {c}" for c in snap["costs"]]
+    if snap.get("confidence"):
+        lines += ["", "## Confidence", "", "| coefficient | score |", "|---|---|"]
+        lines += [f"| {k} | {v:.2f} |" for k, v in snap["confidence"].items() if v is not None]
+    if snap.get("top_suggestion"):
+        lines += ["", "## Next maneuver", "", snap["top_suggestion"]]
+    notes = list(snap.get("events", [])) + list(snap.get("learner_notes", []))
+    if notes:
+        lines += ["", "## What happened", ""] + [f"- {n}" for n in notes]
+    return "\n".join(lines) + "\n"
+
+
+def write_session_report(snap: dict, out_dir: str | Path) -> None:
+    """Write ``session.json`` and ``report.md`` into ``out_dir``."""
+    out = Path(out_dir)
+    clean = _clean(snap)
+    (out / "session.json").write_text(json.dumps(clean, indent=1, default=str))
+    (out / "report.md").write_text(render_markdown(clean))

@@ -1,0 +1,284 @@
+"""A live session: link -> raw log -> incremental learner, with the component speaking back.
+
+Threads: the link receiver (:class:`gcs_sysid.telemetry.live.LinkReceiver`) writes every packet to
+``raw.tlog`` first and queues it; the learner thread feeds the queue, in arrival order, to the
+:class:`~gcs_sysid.live.learner.Learner` (so a slow GP step never blocks the link: the queue grows
+and is drained after); the calling thread runs the schedule (requests, heartbeat, status texts,
+console) every :data:`TICK_S` until the duration ends or Ctrl-C, then writes the report.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from ..errors import InputError
+from .learner import LearnOptions, Learner
+
+__all__ = ["ListenOptions", "LiveSession", "run_listen", "TICK_S"]
+
+TICK_S = 0.25
+
+
+@dataclass(frozen=True)
+class ListenOptions:
+    """Options of :func:`run_listen`.
+
+    Attributes:
+        connection: pymavlink connection string; baud: serial baud rate.
+        learn: the learner's schedule (:class:`LearnOptions`); None: log and monitor only.
+        request: ask the vehicle for the sysid rates.
+        rates: message -> asked rate, Hz (None: the component's ``SID_*_HZ`` parameters).
+        component: run the MAVLink component (heartbeat, status texts, confidence, parameters).
+        system_id, component_id: the component's ids (None system: the vehicle's, once seen).
+        duration_s: stop after this wall time (None: until Ctrl-C).
+        silence_s: a gap longer than this is reported as a silence.
+        console: show the rich live console.
+        use_mavsdk: serve parameters with MAVSDK (else pymavlink's PARAM protocol).
+    """
+
+    connection: str
+    baud: int = 57600
+    learn: LearnOptions | None = field(default_factory=LearnOptions)
+    request: bool = True
+    rates: dict[str, float] | None = None
+    component: bool = True
+    system_id: int | None = None
+    component_id: int = 191
+    duration_s: float | None = None
+    silence_s: float = 30.0
+    console: bool = True
+    use_mavsdk: bool = True
+
+
+class LiveSession:
+    """One listening session (see the module docstring). Use :func:`run_listen` from code.
+
+    Args:
+        airframe: the loaded airframe.
+        out_dir: output directory (``raw.tlog``, ``session.json``, ``report.md``, ``model/``).
+        options: :class:`ListenOptions`.
+        link: an open link (default: opened from ``options.connection``).
+    """
+
+    def __init__(self, airframe, out_dir: str | Path, options: ListenOptions, link=None):
+        from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+        from ..component import DEFAULT_PARAMS
+        from ..telemetry.live import LinkReceiver, RawLog, open_link
+        from .requests import RateRequester, rates_from_params
+
+        self.options = options
+        self.out = Path(out_dir)
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.link = link if link is not None else open_link(options.connection, options.baud)
+        self.raw = RawLog(self.out / "raw.tlog")
+        self.learner = Learner(airframe, options.learn) if options.learn is not None else None
+        self._q: queue.Queue = queue.Queue()
+        self._msgs: queue.Queue = queue.Queue()
+        self.receiver = LinkReceiver(self.link, self.raw, [self._on_packet], silence_s=options.silence_s)
+        self.params = {k: v for k, (v, _) in DEFAULT_PARAMS.items()}
+        mav = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+        self.requester = RateRequester(mav, self.receiver.send, options.rates or rates_from_params(self.params)) \
+            if options.request else None
+        self.component = None
+        self.events: list[str] = []
+        self.texts: list[str] = []
+        self._told_suggestion = ""
+        self._told_events = 0
+        self._learner_error: str | None = None
+        self._stop = threading.Event()
+        self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
+        self.started = time.time()
+
+    # --- threads ------------------------------------------------------------------------------
+
+    def _on_packet(self, stamp_us: int, buf: bytes, msg) -> None:   # receiver thread: return fast
+        if self.learner is not None:
+            self._q.put((stamp_us, buf))
+        if msg.get_type() in ("COMMAND_ACK", "PARAM_REQUEST_LIST", "PARAM_REQUEST_READ", "PARAM_SET",
+                              "HEARTBEAT", "PARAM_EXT_REQUEST_LIST", "PARAM_EXT_REQUEST_READ", "PARAM_EXT_SET"):
+            self._msgs.put(msg)
+
+    def _learn_loop(self) -> None:
+        while True:
+            item = self._q.get()
+            if item is None:
+                return
+            try:
+                self.learner.feed(*item)
+            except Exception as exc:   # a bug in a stage must not stop the link or lose the log
+                self._learner_error = f"{type(exc).__name__}: {exc}"
+                self.learner.notes.append(f"learning stopped: {self._learner_error}")
+                while self._q.get() is not None:
+                    pass
+                return
+
+    # --- schedule -----------------------------------------------------------------------------
+
+    def _ensure_component(self) -> None:
+        from ..component import SysidComponent
+
+        if self.component is not None or not self.options.component:
+            return
+        vehicle = self.receiver.stats.vehicle
+        sysid = self.options.system_id if self.options.system_id is not None else (vehicle[0] if vehicle else None)
+        if sysid is None:
+            return
+        self.component = SysidComponent(self.receiver.send, sysid, self.options.component_id, self.params,
+                                        use_mavsdk=self.options.use_mavsdk)
+
+    def tick(self) -> None:
+        """One round of the schedule (requests, component, texts); called every :data:`TICK_S`."""
+        st = self.receiver.stats
+        now = time.time()
+        if self.requester is not None and self.requester.target is None and st.vehicle is not None:
+            self.requester.target = st.vehicle
+        self._ensure_component()
+        while True:
+            try:
+                msg = self._msgs.get_nowait()
+            except queue.Empty:
+                break
+            if self.requester is not None:
+                self.requester.handle(msg)
+            if self.component is not None:
+                self.component.handle(msg)
+        if self.requester is not None:
+            self.requester.tick(lambda: st.rates(now))
+        for _, text in st.events[self._told_events:]:
+            self.events.append(text)
+            self._say(text, 4 if ("reboot" in text or "silent" in text) else 6)
+            if "reboot" in text and self.requester is not None:
+                self.requester.restart()   # a rebooted vehicle forgot the rates it was asked for
+        self._told_events = len(st.events)
+        if self.requester is not None:
+            for line in self.requester.log:
+                self.events.append(line)
+            self.requester.log.clear()
+        if self.component is not None:
+            self.component.tick()
+            self.component.refresh_params()
+        learner = self.learner
+        if learner is not None and learner.suggestions:
+            top = learner.suggestions[0].reason
+            if top != self._told_suggestion:
+                self._told_suggestion = top
+                self._say("sysid: " + top, 6)
+                if self.component is not None:
+                    self.component.confidence(learner.confidence())
+                    low = [c for c, v in learner.confidence().items() if v < self.params["SID_CONF_MIN"]]
+                    if low:
+                        self._say("sysid: low confidence " + ", ".join(low), 4)
+
+    def _say(self, text: str, severity: int) -> None:
+        self.texts.append(text)
+        if self.component is not None:
+            self.component.statustext(text, severity)
+
+    def snapshot(self) -> dict:
+        """What the console and the report show (JSON-able)."""
+        st = self.receiver.stats
+        now = time.time()
+        learner = self.learner
+        req = self.requester
+        snap = {
+            "connection": self.options.connection,
+            "link": ("no data yet" if not st.last_s else
+                     "silent" if now - st.last_s > min(self.options.silence_s, 3.0) else "receiving"),
+            "vehicle": list(st.vehicle) if st.vehicle else None,
+            "elapsed_s": now - self.started,
+            "packets": st.records, "raw_log": str(self.raw.path), "raw_records": self.raw.records,
+            "bad_data": st.bad_data, "seq_lost": st.seq_lost,
+            "rates": {k: round(v, 2) for k, v in sorted(st.rates(now).items())},
+            "mean_rates": {k: round(v, 2) for k, v in st.mean_rates().items()},
+            "asked": dict(req.rates) if req else {},
+            "requests": dict(req.result) if req else {},
+            "shortfalls": {k: list(v) for k, v in req.shortfalls.items()} if req else {},
+            "costs": list(req.costs) if req else [],
+            "events": list(self.events), "texts_sent": list(self.texts),
+            "params": dict(self.params),
+            "param_backend": self.component.param_backend if self.component else None,
+            "component_sent": dict(self.component.sent) if self.component else {},
+        }
+        if learner is not None:
+            snap.update({
+                "samples_learned": learner.n_learned, "steps": learner.steps, "queue": self._q.qsize(),
+                "outputs": list(learner.outputs), "confidence": learner.confidence(),
+                "identifiable": {k: list(v) for k, v in learner.identifiable.items()},
+                "top_suggestion": learner.suggestions[0].reason if learner.suggestions else None,
+                "learner_notes": list(learner.notes), "timings": dict(learner.timings),
+            })
+        return snap
+
+    # --- run ----------------------------------------------------------------------------------
+
+    def run(self, on_tick: Callable[[dict], None] | None = None) -> dict:
+        """Listen until the duration ends or Ctrl-C; then finish learning and write the report.
+
+        Returns:
+            The final :meth:`snapshot` (also written to ``session.json``).
+        """
+        self.receiver.start()
+        if self.learner is not None:
+            self._learn_thread.start()
+        interrupted = False
+        try:
+            while self.options.duration_s is None or time.time() - self.started < self.options.duration_s:
+                time.sleep(TICK_S)
+                self.tick()
+                if on_tick is not None:
+                    on_tick(self.snapshot())
+        except KeyboardInterrupt:
+            interrupted = True
+        return self.close(interrupted)
+
+    def close(self, interrupted: bool = False) -> dict:
+        """Stop the link, drain the learner (finishing the last window), save the model and the report."""
+        self.receiver.stop()
+        try:
+            self.tick()
+        except Exception:
+            pass
+        if self.learner is not None and self._learn_thread.is_alive():
+            self._q.put(None)
+            self._learn_thread.join()
+            if self._learner_error is None:
+                self.learner.finish()
+        if self.component is not None:
+            self.component.close()
+        self.link.close()
+        self.raw.close()
+        snap = self.snapshot()
+        snap["interrupted"] = interrupted
+        if self.learner is not None and self.learner.model is not None:
+            self.learner.model.save(self.out / "model")
+            snap["model"] = str(self.out / "model")
+        from .report import write_session_report
+
+        write_session_report(snap, self.out)
+        return snap
+
+
+def run_listen(airframe_path: str | Path, out_dir: str | Path, options: ListenOptions) -> dict:
+    """Listen on ``options.connection`` (see :class:`ListenOptions`) with the rich console if asked.
+
+    Raises:
+        InputError: bad airframe, link or options.
+    """
+    from ..airframe import load_airframe
+
+    airframe = load_airframe(airframe_path)
+    if options.duration_s is not None and options.duration_s <= 0:
+        raise InputError(f"--duration {options.duration_s}: must be > 0 s")
+    session = LiveSession(airframe, out_dir, options)
+    if not options.console:
+        return session.run()
+    from .console import LiveConsole
+
+    with LiveConsole() as console:
+        return session.run(on_tick=console.update)
