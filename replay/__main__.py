@@ -6,6 +6,7 @@ Installed as the console command ``gcs-sysid-player`` (same arguments).
 from __future__ import annotations
 
 import argparse
+import struct
 import sys
 import time
 
@@ -26,7 +27,7 @@ def _vehicle_ids(packets) -> tuple[int, int]:
     return ids[0] if ids else (1, 1)
 
 
-def _responder(packets, link, quiet: bool) -> VehicleResponder:
+def _responder(packets, link) -> VehicleResponder:
     from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
     sysid, compid = _vehicle_ids(packets)
@@ -52,6 +53,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-answer", action="store_true",
                     help="do not answer rate requests (by default the player answers SET_MESSAGE_INTERVAL and "
                          "REQUEST_DATA_STREAM like a vehicle, within the recorded rates)")
+    ap.add_argument("--received", default=None, metavar="FILE",
+                    help="write what the far end sends (requests, status texts) to this .tlog")
+    ap.add_argument("--linger", type=float, default=0.0, metavar="S",
+                    help="keep answering and recording what arrives for S seconds after the last packet")
     ap.add_argument("-q", "--quiet", action="store_true", help="no summary line")
     args = ap.parse_args(argv)
     try:
@@ -62,8 +67,9 @@ def main(argv: list[str] | None = None) -> int:
         bad = [0]
         packets = list(read_packets(args.log, bad))  # reads and checks the log before the link is opened
         link = open_link(args.link, args.baud)
-        responder = None if args.no_answer else _responder(packets, link, args.quiet)
+        responder = None if args.no_answer else _responder(packets, link)
         t0 = time.monotonic()
+        received = open(args.received, "wb") if args.received else None
 
         def poll() -> None:
             for _ in range(100):   # bounded: a flood of requests cannot stall the stream
@@ -71,16 +77,28 @@ def main(argv: list[str] | None = None) -> int:
                 if msg is None:
                     return
                 if msg.get_type() != "BAD_DATA":
-                    responder.handle(msg)
-                    while responder.log and not args.quiet:
+                    if received is not None:
+                        received.write(struct.pack(">Q", int(time.time() * 1e6)) + bytes(msg.get_msgbuf()))
+                        received.flush()
+                    if responder is not None:
+                        responder.handle(msg)
+                    while responder is not None and responder.log and not args.quiet:
                         print(f"replay: request: {responder.log.pop(0)}", file=sys.stderr, flush=True)
 
         try:
             n = play(packets, link.write, args.speed, args.t_from, args.t_to,
-                     poll=poll if responder is not None else None,
+                     poll=poll if (responder is not None or received is not None) else None,
                      allow=responder.allow if responder is not None else None)
+            end = time.monotonic() + args.linger
+            while True:
+                poll()
+                if time.monotonic() >= end:
+                    break
+                time.sleep(0.01)
         finally:
             link.close()
+            if received is not None:
+                received.close()
     except SysidError as exc:
         print(f"replay: error: {exc}", file=sys.stderr)
         return 2

@@ -228,7 +228,8 @@ class LiveSession:
             self._learn_thread.start()
         interrupted = False
         try:
-            while self.options.duration_s is None or time.time() - self.started < self.options.duration_s:
+            while not self._stop.is_set() and (self.options.duration_s is None
+                                               or time.time() - self.started < self.options.duration_s):
                 time.sleep(TICK_S)
                 self.tick()
                 if on_tick is not None:
@@ -236,6 +237,10 @@ class LiveSession:
         except KeyboardInterrupt:
             interrupted = True
         return self.close(interrupted)
+
+    def stop(self) -> None:
+        """Ask :meth:`run` to end (from another thread) as at the end of the duration."""
+        self._stop.set()
 
     def close(self, interrupted: bool = False) -> dict:
         """Stop the link, drain the learner (finishing the last window), save the model and the report."""
