@@ -224,8 +224,7 @@ class LiveSession:
             The final :meth:`snapshot` (also written to ``session.json``).
         """
         self.receiver.start()
-        if self.learner is not None:
-            self._learn_thread.start()
+        self.start_learning()
         interrupted = False
         try:
             while not self._stop.is_set() and (self.options.duration_s is None
@@ -237,6 +236,11 @@ class LiveSession:
         except KeyboardInterrupt:
             interrupted = True
         return self.close(interrupted)
+
+    def start_learning(self) -> None:
+        """Start the learner thread (once; :meth:`run` does it, a host that feeds packets calls it)."""
+        if self.learner is not None and not self._learn_thread.is_alive() and self._learn_thread.ident is None:
+            self._learn_thread.start()
 
     def stop(self) -> None:
         """Ask :meth:`run` to end (from another thread) as at the end of the duration."""
