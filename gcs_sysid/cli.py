@@ -134,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code (0 ok, 2 user error, 1 internal error)."""
     ap = build_parser()
     a = ap.parse_args(argv)
-    if a.command != "replay":   # the replay sets these up itself, once its worker is decoding (so that
+    if a.command not in ("replay", "listen"):   # replay and listen set these up themselves (so that
         # importing JAX overlaps the decoding)
         from .jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
 
