@@ -21,6 +21,13 @@ def render(snap: dict):
     if "samples_learned" in snap:
         head.add_row("learned", f"{snap['samples_learned']} samples, {snap['steps']} steps",
                      "queue", str(snap["queue"]))
+    e = snap.get("edge") or {}
+    if "q" in e:
+        d = 180 / 3.141592653589793
+        head.add_row("live edge", f"p q r {e['p'] * d:.1f} {e['q'] * d:.1f} {e['r'] * d:.1f} deg/s, "
+                     f"q_dot {e['q_dot'] * d:.0f} deg/s^2",
+                     "air", f"EAS {e.get('eas', float('nan')):.1f} m/s, alpha(AP) "
+                     f"{e.get('alpha_ap', float('nan')) * d:.1f} deg")
     rates = Table("message", "Hz", "asked", "request", title="rates", expand=False)
     asked = snap.get("asked", {})
     for name in sorted(set(asked) | set(snap["rates"])):

@@ -17,11 +17,14 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import InputError
+from ..telemetry.live import sample_of
+from .edge import LiveEdge
 from .learner import LearnOptions, Learner
 
 __all__ = ["ListenOptions", "LiveSession", "run_listen", "TICK_S"]
 
 TICK_S = 0.25
+_EDGE = {"RAW_IMU", "SCALED_IMU", "HIGHRES_IMU", "ATTITUDE", "VFR_HUD", "AOA_SSA"}
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,7 @@ class LiveSession:
         self.link = link if link is not None else open_link(options.connection, options.baud)
         self.raw = RawLog(self.out / "raw.tlog")
         self.learner = Learner(airframe, options.learn) if options.learn is not None else None
+        self.edge = LiveEdge()
         self._q: queue.Queue = queue.Queue()
         self._msgs: queue.Queue = queue.Queue()
         self.receiver = LinkReceiver(self.link, self.raw, [self._on_packet], silence_s=options.silence_s)
@@ -100,6 +104,12 @@ class LiveSession:
     def _on_packet(self, stamp_us: int, buf: bytes, msg) -> None:   # receiver thread: return fast
         if self.learner is not None:
             self._q.put((stamp_us, buf))
+        name = msg.get_type()
+        if name in _EDGE and (self.receiver.stats.vehicle is None
+                              or (msg.get_srcSystem(), msg.get_srcComponent()) == self.receiver.stats.vehicle):
+            t = getattr(msg, "time_boot_ms", None)
+            t = t * 1e-3 if t is not None else (msg.time_usec * 1e-6 if hasattr(msg, "time_usec") else None)
+            self.edge.feed(name, sample_of(msg), t)
         if msg.get_type() in ("COMMAND_ACK", "PARAM_REQUEST_LIST", "PARAM_REQUEST_READ", "PARAM_SET",
                               "HEARTBEAT", "PARAM_EXT_REQUEST_LIST", "PARAM_EXT_REQUEST_READ", "PARAM_EXT_SET"):
             self._msgs.put(msg)
@@ -200,6 +210,7 @@ class LiveSession:
             "requests": dict(req.result) if req else {},
             "shortfalls": {k: list(v) for k, v in req.shortfalls.items()} if req else {},
             "costs": list(req.costs) if req else [],
+            "edge": {k: round(v, 4) for k, v in self.edge.values.items()},
             "events": list(self.events), "texts_sent": list(self.texts),
             "params": dict(self.params),
             "param_backend": self.component.param_backend if self.component else None,
