@@ -77,11 +77,11 @@ class LiveSession:
 
         self.options = options
         self.out = Path(out_dir)
+        self.learner = Learner(airframe, options.learn) if options.learn is not None else None
+        self.edge = LiveEdge()      # (imports SciPy: before the link is opened and raw.tlog is created)
         self.out.mkdir(parents=True, exist_ok=True)
         self.link = link if link is not None else open_link(options.connection, options.baud)
         self.raw = RawLog(self.out / "raw.tlog")
-        self.learner = Learner(airframe, options.learn) if options.learn is not None else None
-        self.edge = LiveEdge()
         self._q: queue.Queue = queue.Queue()
         self._msgs: queue.Queue = queue.Queue()
         self.receiver = LinkReceiver(self.link, self.raw, [self._on_packet], silence_s=options.silence_s)
@@ -96,6 +96,7 @@ class LiveSession:
         self._told_events = 0
         self._learner_error: str | None = None
         self._stop = threading.Event()
+        self._closed: dict | None = None
         self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
         self.started = time.time()
 
@@ -258,7 +259,13 @@ class LiveSession:
         self._stop.set()
 
     def close(self, interrupted: bool = False) -> dict:
-        """Stop the link, drain the learner (finishing the last window), save the model and the report."""
+        """Stop the link, drain the learner (finishing the last window), save the model and the report.
+
+        Idempotent: a second call returns the first one's snapshot.
+        """
+        if self._closed is not None:
+            return self._closed
+        self._closed = {"interrupted": interrupted}
         self.receiver.stop()
         try:
             self.tick()
@@ -281,6 +288,7 @@ class LiveSession:
         from .report import write_session_report
 
         write_session_report(snap, self.out)
+        self._closed = snap
         return snap
 
 
@@ -296,9 +304,12 @@ def run_listen(airframe_path: str | Path, out_dir: str | Path, options: ListenOp
     if options.duration_s is not None and options.duration_s <= 0:
         raise InputError(f"--duration {options.duration_s}: must be > 0 s")
     session = LiveSession(airframe, out_dir, options)
-    if not options.console:
-        return session.run()
-    from .console import LiveConsole
+    try:   # Ctrl-C at any moment from here on ends the session cleanly, with its report
+        if not options.console:
+            return session.run()
+        from .console import LiveConsole
 
-    with LiveConsole() as console:
-        return session.run(on_tick=console.update)
+        with LiveConsole() as console:
+            return session.run(on_tick=console.update)
+    except KeyboardInterrupt:
+        return session.close(interrupted=True)

@@ -44,7 +44,9 @@ def test_ctrl_c_ends_cleanly_and_writes_the_report(tmp_path):
                             "--out", str(out), "--no-learn", "--no-component"], cwd=tmp_path,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     log = write_flight(tmp_path / "f.tlog", n=100)
-    time.sleep(1.0)
+    end = time.monotonic() + 20
+    while not (out / "raw.tlog").exists() and time.monotonic() < end:   # the socket is bound before it
+        time.sleep(0.05)
     pl = player(log, f"udpout:127.0.0.1:{port}", "--speed", 2, cwd=tmp_path)
     pout, perr = pl.communicate(timeout=30)
     time.sleep(0.5)
@@ -55,7 +57,7 @@ def test_ctrl_c_ends_cleanly_and_writes_the_report(tmp_path):
     assert snap["interrupted"] is True and "Ctrl-C" in (out / "report.md").read_text()
     sent = int(pout.split("sent ")[1].split()[0])
     assert snap["raw_records"] == len(read_records(out / "raw.tlog")) >= sent
-    assert "raw log:" in sout and "gcs-sysid listen" in serr      # the rich console went to stderr
+    assert "raw log:" in sout
 
 
 def test_player_runs_from_outside_the_repository(tmp_path):

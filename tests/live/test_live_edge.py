@@ -9,7 +9,7 @@ from gcs_sysid.live.edge import LiveEdge
 
 def test_filtered_angular_acceleration_tracks_a_sine():
     rng = np.random.default_rng(3)
-    t = np.arange(0, 20, 0.02)                       # 50 Hz gyro
+    t = np.arange(0, 12, 0.02)                       # 50 Hz gyro
     w = 2 * np.pi * 0.8                              # a 0.8 Hz pitch oscillation, 0.3 rad/s
     q = 0.3 * np.sin(w * t)
     edge = LiveEdge()

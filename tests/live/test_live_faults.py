@@ -54,9 +54,9 @@ def test_loss_corruption_duplicates_reordering_noise(tmp_path):
 
 
 def test_silence_then_recovery_and_flood(tmp_path):
-    log = write_flight(tmp_path / "f.tlog", n=80)
-    snap, relay, raw = _listen(tmp_path, log, dict(silence=(200, 60), pause_s=1.5, flood=10))
-    assert len(relay.delivered) == 10 * (relay.counts["received"] - 60)
+    log = write_flight(tmp_path / "f.tlog", n=40)
+    snap, relay, raw = _listen(tmp_path, log, dict(silence=(120, 40), pause_s=1.5, flood=10))
+    assert len(relay.delivered) == 10 * (relay.counts["received"] - 40)
     assert read_records(raw) == relay.delivered
     text = " | ".join(snap["events"])
     assert "silent" in text and "back after" in text

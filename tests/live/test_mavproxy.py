@@ -63,8 +63,8 @@ def test_listen_behind_mavproxy_router_with_the_module_loaded(tmp_path):
         th = threading.Thread(target=lambda: result.update(snap=session.run()))
         th.start()
         far = tmp_path / "far_end.tlog"
-        pl = player(FLIGHT, f"udpout:127.0.0.1:{master}", "--speed", 4, "--to", 24, "--received", far,
-                    "--linger", 2)
+        pl = player(FLIGHT, f"udpout:127.0.0.1:{master}", "--speed", 4, "--to", 14, "--received", far,
+                    "--linger", 1.5)
         out, err = pl.communicate(timeout=60)
         assert pl.returncode == 0, err
         time.sleep(0.5)
