@@ -29,7 +29,7 @@ import threading
 import time
 from typing import Callable
 
-__all__ = ["DEFAULT_PARAMS", "COMP_ID", "SysidComponent", "ParamTable", "chunk_text", "conf_name"]
+__all__ = ["DEFAULT_PARAMS", "COMP_ID", "SysidComponent", "ParamTable", "chunk_text", "conf_name", "targets"]
 
 COMP_ID = 191   #: MAV_COMP_ID_ONBOARD_COMPUTER
 _MAV_TYPE_ONBOARD_CONTROLLER = 18
@@ -47,9 +47,16 @@ DEFAULT_PARAMS: dict[str, tuple[float, str]] = {
     "SID_AIR_HZ": (25.0, "SCALED_PRESSURE, GLOBAL_POSITION_INT, LOCAL_POSITION_NED rate asked, Hz"),
     "SID_SLOW_HZ": (10.0, "VFR_HUD, RC_CHANNELS, AOA_SSA rate asked, Hz"),
     "SID_CONF_MIN": (0.5, "confidence score below which a coefficient is reported (alert), 0..1"),
-    "SID_TARGETS": (63.0, "bit mask of target coefficients: 1 CX, 2 CY, 4 CZ, 8 Cl, 16 Cm, 32 Cn"),
-    "SID_STEP_S": (10.0, "seconds between learning steps"),
+    "SID_TARGETS": (63.0, "bit mask of the coefficients reported (confidence values, alerts): "
+                           "1 CX, 2 CY, 4 CZ, 8 Cl, 16 Cm, 32 Cn"),
 }
+
+
+def targets(mask: float) -> tuple[str, ...]:
+    """Coefficient names selected by the ``SID_TARGETS`` bit mask (1 CX, 2 CY, 4 CZ, 8 Cl, 16 Cm, 32 Cn)."""
+    names = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
+    m = int(mask)
+    return tuple(n for i, n in enumerate(names) if m & (1 << i))
 
 
 def conf_name(coefficient: str) -> str:

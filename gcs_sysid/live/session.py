@@ -17,7 +17,9 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import InputError
+from ..component import targets
 from ..telemetry.live import sample_of
+from .requests import rates_from_params
 from .edge import LiveEdge
 from .learner import LearnOptions, Learner
 
@@ -173,18 +175,31 @@ class LiveSession:
             self.requester.log.clear()
         if self.component is not None:
             self.component.tick()
-            self.component.refresh_params()
+            self._params_changed(dict(self.params), self.component.refresh_params())
         learner = self.learner
         if learner is not None and learner.suggestions:
             top = learner.suggestions[0].reason
             if top != self._told_suggestion:
                 self._told_suggestion = top
                 self._say("sysid: " + top, 6)
+                wanted = targets(self.params["SID_TARGETS"])
+                conf = {c: v for c, v in learner.confidence().items() if c in wanted}
                 if self.component is not None:
-                    self.component.confidence(learner.confidence())
-                    low = [c for c, v in learner.confidence().items() if v < self.params["SID_CONF_MIN"]]
-                    if low:
-                        self._say("sysid: low confidence " + ", ".join(low), 4)
+                    self.component.confidence(conf)
+                low = [c for c, v in conf.items() if v < self.params["SID_CONF_MIN"]]
+                if low:
+                    self._say("sysid: low confidence " + ", ".join(low), 4)
+
+    def _params_changed(self, before: dict[str, float], now: dict[str, float]) -> None:
+        """A ground station set parameters: note it; new rates are asked of the vehicle again."""
+        changed = {k: v for k, v in now.items() if before.get(k) != v}
+        if not changed:
+            return
+        self.params.update(changed)
+        self.events.append("parameters set: " + ", ".join(f"{k}={v:g}" for k, v in changed.items()))
+        if self.requester is not None and any(k.endswith("_HZ") for k in changed):
+            self.requester.rates = rates_from_params(now)
+            self.requester.restart()
 
     def _say(self, text: str, severity: int) -> None:
         self.texts.append(text)

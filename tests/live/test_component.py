@@ -109,3 +109,20 @@ print(json.dumps({{"list": names, "set": [m.param_id, m.param_value] if m else N
         th.join(5)
         comp.close()
         link.close()
+
+
+def test_rate_parameters_set_from_a_ground_station_are_asked_again(tmp_path):
+    from gcs_sysid.airframe import load_airframe
+    from gcs_sysid.live.session import ListenOptions, LiveSession
+    from helpers import AIRFRAME
+
+    port = free_port()
+    s = LiveSession(load_airframe(AIRFRAME), tmp_path, ListenOptions(f"udpin:127.0.0.1:{port}", learn=None,
+                                                                     component=False, console=False))
+    try:
+        s.requester.result["RAW_IMU"] = "accepted"
+        s._params_changed(dict(s.params), dict(s.params, SID_IMU_HZ=20.0, SID_TARGETS=16.0))
+        assert s.requester.rates["RAW_IMU"] == 20.0 and s.requester.result == {}
+        assert s.params["SID_TARGETS"] == 16.0 and "SID_IMU_HZ=20" in s.events[-1]
+    finally:
+        s.close()
