@@ -56,6 +56,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", required=True, help="output .tlog path")
     s.add_argument("--seed", type=int, default=None, help="random seed (overrides the plan's)")
     s.add_argument("--truth", default=None, help="also write the true states and coefficients to this .npz")
+    s.add_argument("--live", default=None, metavar="CONNECTION",
+                   help="then stream the flight onto this link as a stand-in vehicle (docs/live.md)")
+    s.add_argument("--speed", type=float, default=1.0, help="with --live: 1 real time, 0 as fast as possible")
 
     f = sub.add_parser("fit", help="equation-error least squares + stepwise regression -> model file")
     f.add_argument("log")
@@ -100,6 +103,10 @@ def _cmd_simulate(a: argparse.Namespace) -> int:
 
     res = run_simulate(a.airframe, a.model, a.maneuvers, a.out, seed=a.seed, truth_path=a.truth)
     print(f"wrote {a.out} ({res.t[-1] - res.t[0]:.0f} s of flight)")
+    if a.live:
+        from .live.stream import stream_tlog
+
+        print(f"streamed {stream_tlog(a.out, a.live, a.speed)} packets to {a.live}")
     return 0
 
 
