@@ -194,7 +194,8 @@ class Learner:
             Ya = np.concatenate([y for _, y in self._pending])
             cols = [i for i, c in enumerate(COEFFICIENTS) if self.identifiable.get(c, (True, ""))[0]
                     and np.isfinite(Ya[:, i]).mean() > 0.5]
-            if not cols:
+            if not cols:   # nothing identifiable yet: keep only the newest min_rows rows waiting
+                self._pending = [(Xa[-self.options.min_rows:], Ya[-self.options.min_rows:])]
                 return
             self._pending = []
             ok = np.all(np.isfinite(Ya[:, cols]), axis=1)
