@@ -12,6 +12,7 @@ import pytest
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.live.session import ListenOptions, LiveSession
 from gcs_sysid.telemetry.live import open_link
+from replay.player import read_packets
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "telemetry"))
 from tlog_factory import TlogWriter, write_flight  # noqa: E402
@@ -69,3 +70,25 @@ def test_vehicle_reboot_is_reported(tmp_path):
     snap, relay, raw = _listen(tmp_path, log, {})
     assert read_records(raw) == relay.delivered
     assert any("reboot" in e and "time_boot_ms fell" in e for e in snap["events"])
+
+
+def test_tcp_link_keeps_every_packet(tmp_path):
+    """tcpin: listener, the player connecting with tcp: (a reliable link: all it sent is in raw.tlog)."""
+    log = write_flight(tmp_path / "f.tlog", n=50)
+    port = free_port()
+    opts = ListenOptions(connection=f"tcpin:127.0.0.1:{port}", learn=None, request=False, component=False,
+                         console=False, duration_s=60)
+    session = LiveSession(load_airframe(AIRFRAME), tmp_path / "out", opts)
+    result = {}
+    th = threading.Thread(target=lambda: result.update(snap=session.run()))
+    th.start()
+    proc = player(log, f"tcp:127.0.0.1:{port}", "--speed", 4, "--no-answer")
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    sent = int(re.search(r"sent (\d+) packets", out).group(1))
+    deadline = time.monotonic() + 10
+    while session.receiver.stats.records < sent and time.monotonic() < deadline:
+        time.sleep(0.05)
+    session.stop()
+    th.join(30)
+    assert read_records(tmp_path / "out" / "raw.tlog") == [p.data for p in read_packets(str(log))]
