@@ -34,6 +34,9 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
     p.add_argument("--compid", type=int, default=191, help="component id (default 191, onboard computer)")
     p.add_argument("--no-mavsdk", action="store_true",
                    help="serve parameters with pymavlink's PARAM protocol instead of MAVSDK's server")
+    p.add_argument("--can", default=None, metavar="INTERFACE:CHANNEL",
+                   help="also log and decode a DroneCAN bus (python-can: socketcan:can0, slcan:/dev/ttyACM0, "
+                        "virtual:NAME) into DIR/can.log; needs the 'can' extra")
     p.add_argument("--quiet", action="store_true", help="no live console")
     return p
 
@@ -52,7 +55,7 @@ def cmd_listen(a: argparse.Namespace) -> int:
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
                          component=not a.no_component, system_id=a.sysid, component_id=a.compid,
                          duration_s=a.duration, silence_s=a.silence, console=not a.quiet,
-                         use_mavsdk=not a.no_mavsdk)
+                         use_mavsdk=not a.no_mavsdk, can=a.can)
     snap = run_listen(a.airframe, a.out, opts)
     print(f"raw log: {snap['raw_log']} ({snap['raw_records']} packets); report: {a.out}/report.md")
     if snap.get("samples_learned") is not None:

@@ -26,6 +26,10 @@ def render_markdown(snap: dict) -> str:
              f"- packets received and kept in `raw.tlog`: {snap['raw_records']} "
              f"(corrupt byte runs skipped: {snap['bad_data']}; missed by sequence number: {snap['seq_lost']})",
              f"- ended by: {'Ctrl-C' if snap.get('interrupted') else 'end of duration'}"]
+    if snap.get("can"):
+        c = snap["can"]
+        lines.append(f"- CAN: {c['frames']} frames in `{c['log']}`, DroneCAN transfers {c['transfers']}, "
+                     f"failed {c['bad']} (decoded and logged; not yet used by the estimation)")
     if "samples_learned" in snap:
         lines.append(f"- samples learned: {snap['samples_learned']} in {snap['steps']} steps; "
                      f"model: `{snap.get('model', 'none (too few samples)')}`")

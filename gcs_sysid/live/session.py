@@ -44,6 +44,8 @@ class ListenOptions:
         silence_s: a gap longer than this is reported as a silence.
         console: show the rich live console.
         use_mavsdk: serve parameters with MAVSDK (else pymavlink's PARAM protocol).
+        can: ``INTERFACE:CHANNEL`` of a CAN bus to log (``DIR/can.log``) and decode (DroneCAN actuator
+            status and air data, :mod:`gcs_sysid.telemetry.can`) beside the MAVLink link.
     """
 
     connection: str
@@ -58,6 +60,7 @@ class ListenOptions:
     silence_s: float = 30.0
     console: bool = True
     use_mavsdk: bool = True
+    can: str | None = None
 
 
 class LiveSession:
@@ -83,6 +86,11 @@ class LiveSession:
         self.edge = LiveEdge()      # (imports SciPy: before the link is opened and raw.tlog is created)
         self.out.mkdir(parents=True, exist_ok=True)
         self.link = link if link is not None else open_link(options.connection, options.baud)
+        self.can = None
+        if options.can:
+            from ..telemetry.can import CanListener, open_bus
+
+            self.can = CanListener(open_bus(options.can), self.out / "can.log")
         self.raw = RawLog(self.out / "raw.tlog")
         self._q: queue.Queue = queue.Queue()
         self._msgs: queue.Queue = queue.Queue()
@@ -227,6 +235,7 @@ class LiveSession:
             "shortfalls": {k: list(v) for k, v in req.shortfalls.items()} if req else {},
             "costs": list(req.costs) if req else [],
             "edge": {k: round(v, 4) for k, v in self.edge.values.items()},
+            "can": self.can.summary() if self.can is not None else None,
             "events": list(self.events), "texts_sent": list(self.texts),
             "params": dict(self.params),
             "param_backend": self.component.param_backend if self.component else None,
@@ -251,6 +260,8 @@ class LiveSession:
             The final :meth:`snapshot` (also written to ``session.json``).
         """
         self.receiver.start()
+        if self.can is not None:
+            self.can.start()
         self.start_learning()
         interrupted = False
         try:
@@ -282,6 +293,8 @@ class LiveSession:
             return self._closed
         self._closed = {"interrupted": interrupted}
         self.receiver.stop()
+        if self.can is not None:
+            self.can.stop()
         try:
             self.tick()
         except Exception:

@@ -1,0 +1,220 @@
+"""DroneCAN on a CAN bus (python-can) or in a CAN log: measured surface positions and air data.
+
+DroneCAN servos report ``uavcan.equipment.actuator.Status`` (``position``: the measured surface or
+servo position, rad), airspeed sensors ``uavcan.equipment.air_data.IndicatedAirspeed`` (m/s),
+``TrueAirspeed`` (m/s) and ``RawAirData`` (``differential_pressure`` Pa). Frames are read with
+python-can (any interface: ``socketcan``, ``slcan``, ``virtual`` ...; or a log through
+``can.LogReader``: .asc, .blf, .log, .csv ...), multi-frame transfers are reassembled and decoded
+with the ``dronecan`` library (``TransferManager``, ``Transfer.from_frames``: CRC and toggle checked),
+and the values become :class:`~gcs_sysid.telemetry.types.Stream` objects in SI units on the bus
+clock (python-can message timestamps, s).
+
+Both libraries are in the ``can`` extra (``pip install gcs-sysid[can]``); without them the
+functions here raise :class:`~gcs_sysid.errors.InputError` saying so.
+
+References:
+    DroneCAN specification, https://dronecan.github.io/Specification/ (transfer layout, 4.2);
+    data types ``uavcan.equipment.actuator.Status`` (1011) and ``uavcan.equipment.air_data.*``.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+
+from gcs_sysid.errors import InputError
+from gcs_sysid.telemetry.types import Stream
+
+__all__ = ["CanDecoder", "read_can_log", "CanListener", "open_bus", "frames_of"]
+
+_ACTUATOR = "uavcan.equipment.actuator.Status"
+_IAS = "uavcan.equipment.air_data.IndicatedAirspeed"
+_TAS = "uavcan.equipment.air_data.TrueAirspeed"
+_RAW = "uavcan.equipment.air_data.RawAirData"
+
+
+def _libs():
+    try:
+        import can
+        import dronecan
+    except ImportError:
+        raise InputError("CAN needs python-can and dronecan: pip install 'gcs-sysid[can]'") from None
+    return can, dronecan
+
+
+@dataclass
+class CanDecoder:
+    """Reassembles and decodes DroneCAN transfers from python-can messages.
+
+    Attributes:
+        samples: stream name -> field -> list of (t s, value) (SI).
+        counts: DroneCAN type name -> transfers decoded; ``bad`` transfers failing their checks;
+        frames: CAN frames seen (extended ids only: DroneCAN uses 29-bit ids).
+    """
+
+    samples: dict = field(default_factory=lambda: defaultdict(lambda: defaultdict(list)))
+    counts: Counter = field(default_factory=Counter)
+    bad: int = 0
+    frames: int = 0
+
+    def __post_init__(self):
+        _, dronecan = _libs()
+        self._dc = dronecan
+        self._tm = dronecan.transport.TransferManager()
+
+    def feed(self, msg) -> None:
+        """One python-can ``Message``."""
+        if not msg.is_extended_id or msg.is_error_frame or msg.is_remote_frame:
+            return
+        self.frames += 1
+        dc = self._dc
+        frame = dc.transport.Frame(msg.arbitration_id, bytes(msg.data), msg.timestamp, msg.timestamp,
+                                   getattr(msg, "is_fd", False))
+        try:
+            frames = self._tm.receive_frame(frame)
+            if not frames:
+                return
+            tr = dc.transport.Transfer()
+            tr.from_frames(frames)
+        except Exception:   # TransferError, CRC or a type this dialect does not know
+            self.bad += 1
+            return
+        payload = tr.payload
+        kind = dc.get_dronecan_data_type(payload).full_name if payload is not None else "unknown"
+        self.counts[kind] += 1
+        t = float(frames[0].ts_monotonic)
+        s = self.samples
+        if kind == _ACTUATOR:
+            s[f"actuator{int(payload.actuator_id)}"]["pos"].append((t, float(payload.position)))
+        elif kind == _IAS:
+            s["can_airspeed"]["ias"].append((t, float(payload.indicated_airspeed)))
+        elif kind == _TAS:
+            s["can_airspeed"]["tas"].append((t, float(payload.true_airspeed)))
+        elif kind == _RAW:
+            s["can_airspeed"]["diff_pressure"].append((t, float(payload.differential_pressure)))
+
+    def streams(self) -> dict[str, Stream]:
+        """The decoded samples as streams: ``actuator<id>`` (``pos`` rad, one stream per actuator id,
+        on its own report times) and ``can_airspeed`` (``ias``/``tas`` m/s, ``diff_pressure`` Pa).
+
+        Fields of one stream share the times of its first field (sorted by name); the others (from
+        other messages) are linearly interpolated onto them.
+        """
+        out = {}
+        for name, fields in self.samples.items():
+            keys = sorted(fields)
+            t0 = np.array([t for t, _ in fields[keys[0]]])
+            order = np.argsort(t0, kind="stable")
+            t = t0[order]
+            vals = {}
+            for k in keys:
+                tk = np.array([x for x, _ in fields[k]])
+                vk = np.array([v for _, v in fields[k]])
+                o = np.argsort(tk, kind="stable")
+                vals[k] = np.interp(t, tk[o], vk[o]) if k != keys[0] else vk[order]
+            out[name] = Stream(name, "DroneCAN", t, vals)
+        return out
+
+
+def read_can_log(path: str | Path) -> tuple[dict[str, Stream], CanDecoder]:
+    """Decode a CAN log (any format ``can.LogReader`` reads) into streams.
+
+    Raises:
+        InputError: missing file, unreadable format, or no DroneCAN transfer in it.
+    """
+    can, _ = _libs()
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"{p}: no such file; expected a CAN log (.asc, .blf, .log, .csv)")
+    dec = CanDecoder()
+    try:
+        for msg in can.LogReader(str(p)):
+            dec.feed(msg)
+    except (ValueError, OSError, NotImplementedError) as exc:
+        raise InputError(f"{p}: cannot be read as a CAN log ({exc})") from None
+    if not dec.counts:
+        raise InputError(f"{p}: {dec.frames} CAN frames but no DroneCAN transfer decoded; expected "
+                         "actuator Status or air-data messages")
+    return dec.streams(), dec
+
+
+def open_bus(spec: str):
+    """Open a python-can bus from ``INTERFACE:CHANNEL`` (e.g. ``socketcan:can0``, ``virtual:sim``).
+
+    Raises:
+        InputError: malformed spec or a bus that cannot be opened.
+    """
+    can, _ = _libs()
+    if ":" not in spec:
+        raise InputError(f"--can {spec}: expected INTERFACE:CHANNEL, e.g. socketcan:can0 or slcan:/dev/ttyACM0")
+    interface, channel = spec.split(":", 1)
+    try:
+        return can.Bus(interface=interface, channel=channel, receive_own_messages=False)
+    except Exception as exc:
+        raise InputError(f"--can {spec}: cannot open the CAN bus ({type(exc).__name__}: {exc})") from None
+
+
+class CanListener:
+    """Reads a CAN bus in a thread: every frame to ``log_path`` (python-can's logger, format by
+    extension, e.g. ``can.log``), DroneCAN transfers decoded into :attr:`decoder`.
+
+    Args:
+        bus: an open python-can bus (:func:`open_bus`).
+        log_path: where every received frame is written.
+    """
+
+    def __init__(self, bus, log_path: str | Path):
+        can, _ = _libs()
+        self.bus = bus
+        self.log_path = Path(log_path)
+        self._writer = can.Logger(str(self.log_path))
+        self.decoder = CanDecoder()
+        self.received = 0
+        self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._t = threading.Thread(target=self._run, name="gcs-sysid-can", daemon=True)
+
+    def start(self) -> "CanListener":
+        self._t.start()
+        return self
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            msg = self.bus.recv(timeout=0.1)
+            if msg is None:
+                continue
+            with self._lock:
+                self._writer.on_message_received(msg)
+                self.received += 1
+                self.decoder.feed(msg)
+
+    def summary(self) -> dict:
+        """Frames received, transfers decoded by type, failed transfers."""
+        with self._lock:
+            return {"frames": self.received, "transfers": dict(self.decoder.counts), "bad": self.decoder.bad,
+                    "log": str(self.log_path)}
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._t.join(5)
+        with self._lock:
+            self._writer.stop()
+        self.bus.shutdown()
+
+
+def frames_of(payloads: Iterable, source_node_id: int = 20):
+    """python-can messages carrying DroneCAN ``payloads`` (for tests and simulators): each payload
+    one transfer (transfer ids counting up), split into frames by ``dronecan``."""
+    can, dronecan = _libs()
+    out = []
+    for i, p in enumerate(payloads):
+        tr = dronecan.transport.Transfer(payload=p, source_node_id=source_node_id, transfer_id=i % 32,
+                                         service_not_message=False)
+        for f in tr.to_frames():
+            out.append(can.Message(arbitration_id=f.message_id, data=bytes(f.bytes), is_extended_id=True))
+    return out
