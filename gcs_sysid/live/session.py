@@ -82,32 +82,39 @@ class LiveSession:
 
         self.options = options
         self.out = Path(out_dir)
-        self.learner = Learner(airframe, options.learn) if options.learn is not None else None
-        self.edge = LiveEdge()      # (imports SciPy: before the link is opened and raw.tlog is created)
-        self.out.mkdir(parents=True, exist_ok=True)
-        self.link = link if link is not None else open_link(options.connection, options.baud)
-        self.can = None
-        if options.can:
-            from ..telemetry.can import CanListener, open_bus
+        self.link = link if link is not None else open_link(options.connection, options.baud)   # fail fast
+        try:
+            # heavy imports (JAX, SciPy) before raw.tlog exists: once it does, Ctrl-C is handled (run_listen);
+            # packets arriving meanwhile wait in the socket's buffer
+            self.learner = Learner(airframe, options.learn) if options.learn is not None else None
+            self.edge = LiveEdge()
+            self.out.mkdir(parents=True, exist_ok=True)
+            self.can = None
+            if options.can:
+                from ..telemetry.can import CanListener, open_bus
 
-            self.can = CanListener(open_bus(options.can), self.out / "can.log")
-        self.raw = RawLog(self.out / "raw.tlog")
-        self._q: queue.Queue = queue.Queue()
-        self._msgs: queue.Queue = queue.Queue()
-        self.receiver = LinkReceiver(self.link, self.raw, [self._on_packet], silence_s=options.silence_s)
-        self.params = {k: v for k, (v, _) in DEFAULT_PARAMS.items()}
-        mav = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
-        self.requester = RateRequester(mav, self.receiver.send, options.rates or rates_from_params(self.params)) \
-            if options.request else None
-        self.component = None
-        self.events: list[str] = []
-        self.texts: list[str] = []
-        self._told_suggestion = ""
-        self._told_events = 0
-        self._learner_error: str | None = None
-        self._stop = threading.Event()
-        self._closed: dict | None = None
-        self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
+                self.can = CanListener(open_bus(options.can), self.out / "can.log")
+            self.raw = RawLog(self.out / "raw.tlog")
+            self._q: queue.Queue = queue.Queue()
+            self._msgs: queue.Queue = queue.Queue()
+            self.receiver = LinkReceiver(self.link, self.raw, [self._on_packet], silence_s=options.silence_s)
+            self.params = {k: v for k, (v, _) in DEFAULT_PARAMS.items()}
+            mav = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+            self.requester = RateRequester(mav, self.receiver.send, options.rates or rates_from_params(self.params)) \
+                if options.request else None
+            self.component = None
+            self.events: list[str] = []
+            self.texts: list[str] = []
+            self._told_suggestion = ""
+            self._told_events = 0
+            self._learner_error: str | None = None
+            self._stop = threading.Event()
+            self._closed: dict | None = None
+            self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
+        except BaseException:   # a bad CAN bus, Ctrl-C during the imports: give the link back
+            if link is None:
+                self.link.close()
+            raise
         self.started = time.time()
 
     # --- threads ------------------------------------------------------------------------------

@@ -13,14 +13,16 @@ from mavsdk.plugins.param import Param, ParamError, ProtocolVersion
 
 
 def main() -> int:
-    port, sysid, compid, name, value = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), sys.argv[4], float(sys.argv[5])
+    port, sysid, compid = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
+    name, value = sys.argv[4], float(sys.argv[5])
     log_subscribe(lambda *a: True)
     sdk = Mavsdk(Configuration.create_with_component_type(ComponentType.GROUND_STATION))
     sdk.add_any_connection(f"udpout://127.0.0.1:{port}")
     deadline = time.monotonic() + 10
     system = None
     while system is None and time.monotonic() < deadline:
-        system = next((s for s in sdk.get_systems() if s.get_system_id() == sysid and compid in s.component_ids()), None)
+        system = next((s for s in sdk.get_systems()
+                       if s.get_system_id() == sysid and compid in s.component_ids()), None)
         time.sleep(0.1)
     if system is None:
         print(json.dumps({"error": "no system"}))

@@ -16,7 +16,7 @@ from gcs_sysid.telemetry.live import open_link
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from helpers import free_port  # noqa: E402
+from live_helpers import free_port  # noqa: E402
 
 
 def _parse(packets):
@@ -114,7 +114,7 @@ print(json.dumps({{"list": names, "set": [m.param_id, m.param_value] if m else N
 def test_rate_parameters_set_from_a_ground_station_are_asked_again(tmp_path):
     from gcs_sysid.airframe import load_airframe
     from gcs_sysid.live.session import ListenOptions, LiveSession
-    from helpers import AIRFRAME
+    from live_helpers import AIRFRAME
 
     port = free_port()
     s = LiveSession(load_airframe(AIRFRAME), tmp_path, ListenOptions(f"udpin:127.0.0.1:{port}", learn=None,

@@ -2,7 +2,8 @@
 (packets re-encoded with pymavlink), fed record by record; no model is fitted (min_rows too high), so
 only the decode -> smooth -> coefficients -> row selection path runs."""
 
-import struct
+import sys
+from pathlib import Path
 
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
@@ -10,7 +11,8 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.live.learner import LearnOptions, Learner, iter_tlog_records
 
-from helpers import AIRFRAME, FLIGHT
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from live_helpers import AIRFRAME, FLIGHT  # noqa: E402
 
 
 def _rebooted_records(t_from=40.0, t_reboot=70.0, t_to=100.0, back_s=65.0):

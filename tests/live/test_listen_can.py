@@ -18,7 +18,7 @@ from gcs_sysid.live.session import ListenOptions, LiveSession  # noqa: E402
 from gcs_sysid.telemetry.can import frames_of, read_can_log  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from helpers import AIRFRAME, free_port  # noqa: E402
+from live_helpers import AIRFRAME, free_port  # noqa: E402
 
 
 def test_listen_logs_and_decodes_a_can_bus(tmp_path):

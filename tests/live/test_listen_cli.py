@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from helpers import AIRFRAME, FLIGHT, free_port, player, read_records  # noqa: E402
+from live_helpers import AIRFRAME, FLIGHT, free_port, player, read_records  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "telemetry"))
 from tlog_factory import write_flight  # noqa: E402

@@ -19,7 +19,7 @@ from gcs_sysid.telemetry.live import open_link
 from replay.player import read_packets
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from helpers import AIRFRAME, FLIGHT, free_port, player, read_records  # noqa: E402
+from live_helpers import AIRFRAME, FLIGHT, free_port, player, read_records  # noqa: E402
 
 LEARN = LearnOptions(window_s=3.0, step_s=2.0, lag_s=1.0, min_rows=300, refresh_every=100, n_inducing=24)
 

@@ -17,7 +17,7 @@ from replay.player import read_packets
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "telemetry"))
 from tlog_factory import TlogWriter, write_flight  # noqa: E402
 
-from helpers import AIRFRAME, FaultyRelay, free_port, player, read_records  # noqa: E402
+from live_helpers import AIRFRAME, FaultyRelay, free_port, player, read_records  # noqa: E402
 
 
 def _listen(tmp_path, log, relay_kw, speed=4.0, silence_s=0.5, player_args=()):

@@ -20,7 +20,7 @@ from gcs_sysid.telemetry.live import open_link
 from replay.player import read_packets
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from helpers import AIRFRAME, FLIGHT, free_port, player, read_records  # noqa: E402
+from live_helpers import AIRFRAME, FLIGHT, free_port, player, read_records  # noqa: E402
 
 MAVPROXY = Path(sys.executable).with_name("mavproxy.py")
 pytestmark = pytest.mark.skipif(not MAVPROXY.exists(), reason="MAVProxy (test extra) not installed")

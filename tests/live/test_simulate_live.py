@@ -9,7 +9,7 @@ import tomli_w
 from pymavlink import mavutil
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from helpers import AIRFRAME, REPO, free_port  # noqa: E402
+from live_helpers import AIRFRAME, REPO, free_port  # noqa: E402
 
 
 @pytest.mark.slow   # the simulation's start-up (JAX, SciPy) costs ~20 s of wall time on a shared 2-core machine
