@@ -4,6 +4,7 @@ Target (issue 10): 2,000 msg/s sustained, per-message handling p99 under 5 ms, n
 missing from raw.tlog, the GP work (in its own thread) never starving the link.
 
     python benchmarks/bench_live.py [--rate 2000] [--seconds 60] [--no-learn]
+    python benchmarks/bench_live.py --soak --rate 500 --seconds 120    # memory curve (RSS every 5 s)
 
 The log player (`gcs-sysid-player`, a subprocess) streams the sample flight (258 msg/s recorded) at
 rate/258 x onto 127.0.0.1; first a bare pymavlink receive loop (``recv_msg`` until the stream ends,
@@ -83,10 +84,15 @@ def listen(speed: float, seconds: float, learn: bool, out_dir: Path) -> dict:
     session = LiveSession(load_airframe(AIRFRAME), out_dir, opts, link=open_link(opts.connection))
     session.receiver.handle_s = __import__("collections").deque(maxlen=1_000_000)
     qmax = [0]
+    rss: list[tuple[float, float]] = []
 
     def watch():
+        t_last = -1e9
         while not session._stop.is_set():
             qmax[0] = max(qmax[0], session._q.qsize())
+            if time.perf_counter() - t_last >= 5.0:
+                t_last = time.perf_counter()
+                rss.append((round(t_last - t0, 1), _rss_mib()))
             time.sleep(0.05)
 
     result = {}
@@ -109,7 +115,17 @@ def listen(speed: float, seconds: float, learn: bool, out_dir: Path) -> dict:
             "handle_ms": {"median": q(0.5), "p99": q(0.99), "max": h[-1] * 1e3, "n": len(h)},
             "learner_queue_max": qmax[0], "steps": result["snap"].get("steps"),
             "samples_learned": result["snap"].get("samples_learned"), "stream_s": t_stream,
-            "drain_after_stream_s": t_total - t_stream}
+            "drain_after_stream_s": t_total - t_stream, "rss_mib_every_5s": rss,
+            "rss_growth_mib_after_first_minute": (max(r for _, r in rss) - next((r for t, r in rss if t >= 60),
+                                                                                rss[-1][1])) if rss else None}
+
+
+def _rss_mib() -> float:
+    """Resident memory of this process, MiB (Linux /proc)."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024.0
+    return float("nan")
 
 
 def main() -> int:
@@ -117,18 +133,20 @@ def main() -> int:
     ap.add_argument("--rate", type=float, default=2000.0, help="messages/s to stream (default 2000)")
     ap.add_argument("--seconds", type=float, default=60.0, help="seconds of streaming (default 60)")
     ap.add_argument("--no-learn", action="store_true")
+    ap.add_argument("--soak", action="store_true", help="skip the baseline; report the memory curve")
     ap.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "live"))
     a = ap.parse_args()
     speed = a.rate / RECORDED_RATE
     if a.seconds * speed > 215:
         a.seconds = 215 / speed
-    base = baseline(speed, a.seconds)
+    base = {"received": 0} if a.soak else baseline(speed, a.seconds)
     out_dir = Path(a.out)
     if (out_dir / "raw.tlog").exists():
         (out_dir / "raw.tlog").unlink()
     live = listen(speed, a.seconds, not a.no_learn, out_dir)
     live["handle_p99_under_5ms"] = live["handle_ms"]["p99"] < 5.0
-    live["lost_vs_baseline"] = base["received"] - live["received_in_raw_tlog"]
+    if not a.soak:
+        live["lost_vs_baseline"] = base["received"] - live["received_in_raw_tlog"]
     print(json.dumps({"rate_asked": a.rate, "speed": speed, "baseline": base, "listen": live}, indent=1))
     return 0
 
