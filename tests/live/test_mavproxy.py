@@ -51,7 +51,7 @@ def test_listen_behind_mavproxy_router_with_the_module_loaded(tmp_path):
     with open(mp_log, "w") as log:
         mp = subprocess.Popen([sys.executable, str(MAVPROXY), f"--master=udpin:127.0.0.1:{master}",
                                f"--out=udpout:127.0.0.1:{out_port}", "--daemon", f"--state-basedir={tmp_path}",
-                               f"--cmd=module load gcs_sysid.mavproxy_sysid:{kwargs}"],
+                               f"--cmd=module load gcs_sysid.mavproxy_sysid:{kwargs}; sysid status; sysid save"],
                               cwd=tmp_path, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                               env=dict(os.environ, PYTHONUNBUFFERED="1"))
     try:
@@ -94,5 +94,8 @@ def test_listen_behind_mavproxy_router_with_the_module_loaded(tmp_path):
         assert far_end[("HEARTBEAT", 1, comp)] >= 2 and far_end[("STATUSTEXT", 1, comp)] >= 1, far_end
     # rate requests reached the stand-in vehicle through MAVProxy and were answered
     assert set(result["snap"]["requests"].values()) == {"accepted"}
+    # the module's commands answered (given at start-up: no data, no model yet)
+    text = mp_log.read_text()
+    assert "sysid: no data yet, 0 packets" in text and "sysid: no model yet" in text
     # the module wrote its report when MAVProxy shut down
     assert "packets received and kept" in (module_out / "report.md").read_text()
