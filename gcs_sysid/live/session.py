@@ -280,6 +280,10 @@ class LiveSession:
                     on_tick(self.snapshot())
         except KeyboardInterrupt:
             interrupted = True
+        except Exception as exc:   # a bug in the schedule: still stop cleanly and write the report
+            self.events.append(f"session stopped by an internal error: {type(exc).__name__}: {exc}")
+            self.close(False)
+            raise
         return self.close(interrupted)
 
     def start_learning(self) -> None:

@@ -278,4 +278,8 @@ class LinkReceiver:
             self._boot_ms[src] = boot if last is None or boot < last - 1000 or boot > last else last
         st.seq_lost = int(getattr(self.link, "mav_loss", 0))
         for c in self.consumers:
-            c(stamp_us, buf, msg)
+            try:
+                c(stamp_us, buf, msg)
+            except Exception as exc:   # a consumer's bug must not stop the logging of the link
+                if len(st.events) < 1000:
+                    self._event(f"error handling {name}: {type(exc).__name__}: {exc}")

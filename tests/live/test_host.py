@@ -36,3 +36,23 @@ def test_feed_tick_status_report_save_close(tmp_path):
     assert {"HEARTBEAT", "COMMAND_LONG"} <= kinds
     host.feed(last)                                 # after close: ignored, no error
     assert len(read_records(tmp_path / "out" / "raw.tlog")) == n
+
+
+def test_a_consumer_error_does_not_stop_the_raw_log(tmp_path):
+    from gcs_sysid.telemetry.live import LinkReceiver, RawLog
+
+    log = write_flight(tmp_path / "f.tlog", n=10)
+    raw = RawLog(tmp_path / "raw.tlog")
+
+    def broken(stamp_us, buf, msg):
+        raise ValueError("boom")
+
+    rx = LinkReceiver(None, raw, [broken])
+    src = mavutil.mavlink_connection(str(log), dialect="ardupilotmega")
+    n = 0
+    while (m := src.recv_match()) is not None:
+        rx.handle(m, 1.0 + n)
+        n += 1
+    raw.close()
+    assert len(read_records(tmp_path / "raw.tlog")) == n
+    assert sum("boom" in e for _, e in rx.stats.events) == n
