@@ -34,9 +34,16 @@ def _pad(a: np.ndarray, size: int) -> np.ndarray:
     return np.concatenate([a, pad], 0)
 
 
+def _bucket(n: int) -> int:
+    """Chunk length for ``n`` rows: the next power of two (at least 16), so that updates of varying
+    sizes reuse a few compiled programs instead of compiling one per size."""
+    return max(16, 1 << (max(int(n), 1) - 1).bit_length())
+
+
 def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: int) -> Stats:
-    """Sufficient statistics of all rows, accumulated over zero-padded chunks of ``batch`` rows."""
-    size = int(min(batch, max(len(Xs), 1)))
+    """Sufficient statistics of all rows, accumulated over zero-padded chunks of ``batch`` rows
+    (fewer rows: one chunk padded to the next power of two)."""
+    size = int(min(batch, _bucket(len(Xs))))
     total = None
     for a, b in _chunks(len(Xs), size):
         w = _pad(np.ones(b - a), size)
