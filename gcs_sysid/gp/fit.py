@@ -157,6 +157,20 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     return jax.device_put(raw), jax.device_put(fixed)
 
 
+def _unconstrain(p: GlobalParams, cfg: GPConfig) -> dict:
+    """Unconstrained values near ``p`` (inverse of :func:`constrain_global`; ``B`` split as the initial
+    values are: its leading ``rank`` eigenpairs in ``L``, the rest of the diagonal in ``kappa``)."""
+    A = np.asarray(p.A)
+    B = A @ A.T
+    w, V = np.linalg.eigh(B)
+    r = int(min(cfg.rank, len(B)))
+    L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((len(B), 0))
+    kappa = np.maximum(np.diag(B) - np.sum(L0**2, 1), 0.1 * np.diag(B)) - _NOISE_FLOOR
+    return {"log_ls": np.log(np.asarray(p.lengthscale)), "L": np.asarray(L0, float),
+            "log_kappa": np.log(np.maximum(kappa, 1e-8)),
+            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
+
+
 def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory):
     """Local layer on the rows ``Xs (N, D)`` with global residuals ``resid (N, P)`` (standardised).
 
@@ -189,7 +203,7 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
 
 
 def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig, M: int,
-                 history: FitHistory) -> GlobalParams:
+                 history: FitHistory, start: GlobalParams | None = None) -> GlobalParams:
     """Global hyperparameters by Adam on the VFE bound over a random subset of ``n_train_max`` rows.
 
     Args:
@@ -199,6 +213,8 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
             information with the learned length-scales when larger than the ``n_inducing_hyper``
             used while learning (0: keep those).
         history: receives the bound after each step and the timings of the stage.
+        start: warm start (a refresh): the length-scales, noise and coregionalisation to start
+            from instead of the ridge-regression initial values.
 
     Returns:
         :class:`GlobalParams` (constrained).
@@ -213,9 +229,11 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     Mh = M if cfg.train_inducing or cfg.n_inducing_hyper is None else int(min(cfg.n_inducing_hyper, M))
     if M == 0:
         Mh = int(min(cfg.n_inducing_hyper or cfg.n_inducing, len(Xs)))
-    ls0 = np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1)))
+    ls0 = np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) if start is None else np.asarray(start.lengthscale)
     Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
     raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z)
+    if start is not None:
+        raw = jax.device_put(dict(jax.device_get(raw), **_unconstrain(start, cfg)))
     history.timings["init"] = time.perf_counter() - t0
 
     def reselect(raw, fixed, m):
@@ -282,7 +300,9 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
     n_hyper = int(min(cfg.n_train_max, len(Xs)))
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
-    rows = RowStore.empty(D, P, np.asarray(params.lengthscale), cfg.store_cell, cfg.store_max, cfg.seed).add(Xs, Ys)
+    rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.lengthscale), cfg.store_cell, cfg.store_max,
+                                  cfg.seed).add_dropped(Xs, Ys)
+    evicted = global_stats(params, Xd, Yd, cfg.batch_size) if len(Xd) else None
     if len(rows) < len(Xs):
         notes.append(f"gp: the local layer keeps {len(rows)} of {len(Xs)} rows (store_max), thinned by region")
 
@@ -300,5 +320,5 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["total"] = time.perf_counter() - t0
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
-                          n_hyper=n_hyper, notes=tuple(notes), rows=rows)
+                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted)
     return model, history

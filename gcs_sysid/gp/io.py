@@ -50,9 +50,11 @@ def save_model(model: LocalGlobalGP, path) -> str:
     arrays.update({"stats_" + k: np.asarray(getattr(model.stats, k)) for k in _STATS})
     if model.local_params is not None:
         arrays.update({"local_" + k: np.asarray(getattr(model.local_params, k)) for k in _LOCAL})
+    if model.evicted is not None:
+        arrays.update({"evicted_" + k: np.asarray(getattr(model.evicted, k)) for k in _STATS})
     rows = model.rows
     if rows is not None:
-        arrays.update({"rows_X": rows.X, "rows_Y": rows.Y, "rows_priority": rows.priority,
+        arrays.update({"rows_X": rows.X, "rows_Y": rows.Y, "rows_priority": rows.priority, "rows_weight": rows.weight,
                        "rows_cell_scale": rows.cell_scale})
     npz.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(npz, **arrays)
@@ -95,6 +97,7 @@ def load_gp(path) -> LocalGlobalGP:
         scaler = Standardiser.from_arrays(a)
         params = GlobalParams(**{k: jnp.asarray(a["global_" + k]) for k in _GLOBAL})
         stats = Stats(**{k: jnp.asarray(a["stats_" + k]) for k in _STATS})
+        evicted = Stats(**{k: jnp.asarray(a["evicted_" + k]) for k in _STATS}) if "evicted_C" in a else None
     except (KeyError, ValueError, OSError) as exc:
         raise InputError(f"{npz}: GP model arrays missing or unreadable ({exc})") from None
     config = GPConfig.from_dict(meta.get("config", {}))
@@ -106,8 +109,8 @@ def load_gp(path) -> LocalGlobalGP:
         if "rows_X" in a:
             r = meta.get("rows") or {}
             rows = RowStore(a["rows_X"], a["rows_Y"], a["rows_priority"], a["rows_cell_scale"],
-                            int(r.get("capacity", config.store_max)), int(r.get("seen", len(a["rows_X"]))),
-                            int(r.get("seed", config.seed)))
+                            int(r.get("capacity", config.store_max)), a["rows_weight"],
+                            int(r.get("seen", len(a["rows_X"]))), int(r.get("seed", config.seed)))
         elif "store_X" in a:      # version 1: the local store's rows and residuals; targets = residual + global mean
             store = build_store(a["store_X"], a["store_resid"], a["store_metric"], int(meta["local_k"]))
             Y = a["store_resid"] + global_mean(params, post, a["store_X"], config.batch_size)
@@ -119,4 +122,5 @@ def load_gp(path) -> LocalGlobalGP:
         raise InputError(f"{npz}: GP model's stored rows missing or unreadable ({exc})") from None
     return LocalGlobalGP(config, scaler, params, stats, post, local_params, store,
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
-                         tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)))
+                         tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
+                         evicted=evicted)

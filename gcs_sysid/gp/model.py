@@ -53,6 +53,9 @@ class LocalGlobalGP:
         notes: one-line remarks made while fitting.
         rows: the capped, region-thinned training rows (:class:`gcs_sysid.gp.rowstore.RowStore`).
         since_refresh: rows conditioned on since the hyperparameters were last learned.
+        evicted: the part of ``stats`` from rows no longer stored (None: none). When the
+            inducing inputs or length-scales change, the stored rows' statistics are computed
+            again exactly and only this part is carried by the streaming projection.
     """
 
     config: GPConfig
@@ -68,6 +71,7 @@ class LocalGlobalGP:
     notes: tuple[str, ...] = field(default_factory=tuple)
     rows: RowStore | None = None
     since_refresh: int = 0
+    evicted: Stats | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -192,7 +196,7 @@ class LocalGlobalGP:
         X_new, Y_new, notes = check_training(X_new, Y_new, self.n_inputs, self.n_outputs)
         Xs, Ys = self.scaler.x(X_new), self.scaler.y(Y_new)
         cfg = self.config
-        params, stats = self.params, self.stats
+        params, stats, evicted = self.params, self.stats, self.evicted
         if exchange and cfg.swap_max > 0 and self.rows is not None:
             Z_old, ls, jitter = np.asarray(params.Z), np.asarray(params.lengthscale), float(params.jitter)
             pool = self.rows.X[self.rows.sample(cfg.swap_pool, seed=self.rows.seen)]
@@ -201,25 +205,38 @@ class LocalGlobalGP:
             if swaps:
                 R = projection(chol_kmm(Z_old, ls, jitter), Z_old, Z_new, ls, jitter)
                 stats = project_stats(stats, R)
+                evicted = None if evicted is None else project_stats(evicted, R)
                 params = replace(params, Z=jax.device_put(Z_new))
         stats = _add_jit(stats, global_stats(params, Xs, Ys, cfg.batch_size))
-        rows = self.rows.add(Xs, Ys) if self.rows is not None else None
-        model = replace(self, params=params, stats=stats, _post=None, _store=None, rows=rows,
+        rows = self.rows
+        if rows is not None:
+            rows, Xd, Yd = rows.add_dropped(Xs, Ys)
+            if len(Xd):
+                gone = global_stats(params, Xd, Yd, cfg.batch_size)
+                evicted = gone if evicted is None else _add_jit(evicted, gone)
+        model = replace(self, params=params, stats=stats, _post=None, _store=None, rows=rows, evicted=evicted,
                         since_refresh=self.since_refresh + len(Xs), notes=self.notes + tuple(notes))
         if cfg.hyper_every > 0 and model.since_refresh >= cfg.hyper_every:
             model = model.refresh_hyperparameters()
         return model
 
-    def refresh_hyperparameters(self) -> "LocalGlobalGP":
-        """Learn the hyperparameters again on the stored rows, keeping the inducing inputs.
+    def refresh_hyperparameters(self, reselect: bool = True) -> "LocalGlobalGP":
+        """Learn the hyperparameters again on the stored rows; optionally choose the inducing inputs again.
 
         The global hyperparameters are learned as in :func:`gcs_sysid.gp.fit_gp` (Adam on the
-        VFE bound, ``n_train_max`` random stored rows, ``n_inducing_hyper`` points by mutual
-        information); the statistics of all rows seen are carried to the new length-scales by
-        the streaming projection (Bui et al. 2017, :func:`gcs_sysid.gp.streaming.projection`
-        with ``Z_new = Z_old``), exact for the new ``B``, noise and linear-mean prior. The
-        local layer is learned again on the stored rows' residuals. Cost independent of the
-        rows seen (a fit on at most ``store_max`` rows' subset).
+        VFE bound over ``n_train_max`` random stored rows with ``n_inducing_hyper`` points chosen
+        by mutual information), starting from the current values. With ``reselect`` the ``M``
+        inducing inputs are then chosen again by mutual information among the stored rows (a
+        region-thinned sample of all rows seen, so the points follow the envelope flown). The
+        statistics are then computed again: exactly for the stored rows, and for the rows no
+        longer stored (``evicted``, thinned from dense regions) by the streaming projection to the
+        new length-scales and inducing inputs (Bui et al. 2017,
+        :func:`gcs_sysid.gp.streaming.projection`); exact for all rows while none was evicted.
+        The local layer is learned again on the stored rows' residuals. The cost does not depend
+        on the rows seen (``O(store_max M^2)`` plus a fit's hyperparameter stage).
+
+        Args:
+            reselect: choose the inducing inputs again (False: keep them).
 
         Returns:
             A new :class:`LocalGlobalGP`.
@@ -236,12 +253,19 @@ class LocalGlobalGP:
             raise DataError("gp: need at least 3 stored rows to refresh the hyperparameters")
         cfg = self.config
         history = FitHistory()
-        new = learn_global(rows.X, rows.Y, self.scaler.active, cfg, 0, history)
-        Z, jitter = np.asarray(self.params.Z), float(self.params.jitter)
-        R = projection(chol_kmm(Z, np.asarray(self.params.lengthscale), jitter), Z, Z, np.asarray(new.lengthscale),
-                       jitter)
-        params = replace(new, Z=self.params.Z)
-        model = replace(self, params=params, stats=project_stats(self.stats, R), _post=None, _store=None,
+        M = int(self.params.Z.shape[0])
+        new = learn_global(rows.X, rows.Y, self.scaler.active, replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M)),
+                           M if reselect else 0, history, start=self.params)
+        Z_old, jitter = np.asarray(self.params.Z), float(self.params.jitter)
+        Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
+        params = replace(new, Z=jax.device_put(Z_new))
+        stats, evicted = global_stats(params, rows.X, rows.Y, cfg.batch_size), None
+        if self.evicted is not None:
+            R = projection(chol_kmm(Z_old, np.asarray(self.params.lengthscale), jitter), Z_old, Z_new,
+                           np.asarray(new.lengthscale), jitter)
+            evicted = project_stats(self.evicted, R)
+            stats = _add_jit(stats, evicted)
+        model = replace(self, params=params, stats=stats, evicted=evicted, _post=None, _store=None,
                         since_refresh=0, n_hyper=int(min(cfg.n_train_max, len(rows))))
         if self.local_params is not None:
             resid = rows.Y - model._global_mean_s(rows.X)

@@ -58,6 +58,9 @@ class RowStore:
     Attributes:
         X: ``(N, D)`` standardised regressors. Y: ``(N, P)`` standardised coefficients.
         priority: ``(N,)`` uniform random priorities (higher: kept longer within a cell).
+        weight: ``(N,)`` rows seen that each stored row stands for (1 on arrival; when rows leave a
+            cell their weight is shared equally by the rows it keeps, so a cell's weights sum to
+            the rows seen in it).
         cell_scale: ``(D,)`` multiplier of ``X`` giving grid coordinates (``1 / (lengthscale * width)``).
         capacity: most rows kept.
         seen: rows offered in all (kept or not).
@@ -69,15 +72,21 @@ class RowStore:
     priority: np.ndarray
     cell_scale: np.ndarray
     capacity: int
+    weight: np.ndarray | None = None
     seen: int = 0
     seed: int = 0
+
+    def __post_init__(self):
+        if self.weight is None:
+            object.__setattr__(self, "weight", np.ones(len(self.X)))
 
     @classmethod
     def empty(cls, n_inputs: int, n_outputs: int, lengthscale: np.ndarray, cell_width: float, capacity: int,
               seed: int = 0) -> "RowStore":
         """An empty store; cells are ``cell_width`` length-scales ``(D,)`` wide (standardised units)."""
         scale = 1.0 / (np.asarray(lengthscale, float) * float(cell_width))
-        return cls(np.zeros((0, n_inputs)), np.zeros((0, n_outputs)), np.zeros(0), scale, int(capacity), 0, int(seed))
+        return cls(np.zeros((0, n_inputs)), np.zeros((0, n_outputs)), np.zeros(0), scale, int(capacity), np.zeros(0),
+                   0, int(seed))
 
     def __len__(self) -> int:
         return int(self.X.shape[0])
@@ -96,14 +105,22 @@ class RowStore:
 
         Rows keep their arrival order (so a store under capacity is the training rows as given).
         """
+        return self.add_dropped(Xs, Ys)[0]
+
+    def add_dropped(self, Xs: np.ndarray, Ys: np.ndarray) -> tuple["RowStore", np.ndarray, np.ndarray]:
+        """As :meth:`add`, also returning the rows dropped by the thinning, ``(store, X (K, D), Y (K, P))``."""
         rng = np.random.default_rng((self.seed, self.seen))
         X = np.vstack([self.X, Xs])
         Y = np.vstack([self.Y, Ys])
         pr = np.concatenate([self.priority, rng.random(len(Xs))])
-        out = replace(self, X=X, Y=Y, priority=pr, seen=self.seen + len(Xs))
-        return out._thinned() if len(X) > self.capacity else out
+        w = np.concatenate([self.weight, np.ones(len(Xs))])
+        out = replace(self, X=X, Y=Y, priority=pr, weight=w, seen=self.seen + len(Xs))
+        if len(X) <= self.capacity:
+            return out, X[:0], Y[:0]
+        store, keep = out._thinned()
+        return store, X[~keep], Y[~keep]
 
-    def _thinned(self) -> "RowStore":
+    def _thinned(self) -> tuple["RowStore", np.ndarray]:
         scale = self.cell_scale
         while True:
             store = replace(self, cell_scale=scale)
@@ -117,7 +134,11 @@ class RowStore:
         rank = np.empty(len(order), np.int64)
         rank[order] = np.arange(len(order)) - start[inv[order]]
         keep = rank < L
-        return replace(store, X=self.X[keep], Y=self.Y[keep], priority=self.priority[keep])
+        # the dropped rows' weight goes to the rows their cell keeps (every cell keeps >= 1 row)
+        lost = np.bincount(inv, weights=np.where(keep, 0.0, self.weight), minlength=len(counts))
+        kept = np.bincount(inv, weights=keep.astype(float), minlength=len(counts))
+        w = self.weight + lost[inv] / np.maximum(kept[inv], 1.0)
+        return replace(store, X=self.X[keep], Y=self.Y[keep], priority=self.priority[keep], weight=w[keep]), keep
 
     def sample(self, m: int, seed: int = 0) -> np.ndarray:
         """Indices ``(min(m, N),)`` of a random subset of the stored rows (sorted)."""
@@ -126,4 +147,4 @@ class RowStore:
 
     def nbytes(self) -> int:
         """Bytes held by the arrays."""
-        return int(self.X.nbytes + self.Y.nbytes + self.priority.nbytes + self.cell_scale.nbytes)
+        return int(self.X.nbytes + self.Y.nbytes + self.priority.nbytes + self.weight.nbytes + self.cell_scale.nbytes)
