@@ -403,6 +403,10 @@ class LocalGlobalGP:
                 "linear_derivatives": {o: dict(zip(names, row.tolist())) for o, row in zip(self.output_names, slopes)},
             },
             "local": None,
+            "streaming": None if self.rows is None else {
+                "rows_seen": int(self.rows.seen), "rows_stored": len(self.rows), "store_max": int(self.rows.capacity),
+                "rows_evicted": int(round(float(self.evicted.n))) if self.evicted is not None else 0,
+                "since_refresh": int(self.since_refresh)},
             "notes": list(self.notes),
         }
         if self.local_params is not None and self.store is not None:
