@@ -254,8 +254,9 @@ class LocalGlobalGP:
         cfg = self.config
         history = FitHistory()
         M = int(self.params.Z.shape[0])
-        new = learn_global(rows.X, rows.Y, self.scaler.active, replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M)),
-                           M if reselect else 0, history, start=self.params)
+        hyper_cfg = replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M))   # the fit's compiled shapes
+        new = learn_global(rows.X, rows.Y, self.scaler.active, hyper_cfg, M if reselect else 0, history,
+                           start=self.params)
         Z_old, jitter = np.asarray(self.params.Z), float(self.params.jitter)
         Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
         params = replace(new, Z=jax.device_put(Z_new))

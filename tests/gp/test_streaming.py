@@ -5,7 +5,6 @@ from dataclasses import replace
 
 import jax
 import numpy as np
-import pytest
 
 from gp_data import FAST, flight_regressors, nonlinear_truth
 from gcs_sysid.gp import fit_gp, load_gp
