@@ -4,8 +4,9 @@ The local layer conditions on stored rows and the hyperparameter refresh re-lear
 so the store must keep covering every part of the flight envelope already flown, however long
 the session. Rows are binned on a grid in the scaled regressor space (standardised inputs divided
 by the global length-scales at fit time, cells ``cell_width`` length-scales wide). While the store
-holds at most ``capacity`` rows nothing is removed. Beyond it each cell keeps at most ``L`` rows,
-``L`` the largest integer with ``sum_c min(n_c, L) <= capacity`` (water-filling): sparse cells (the
+holds at most ``capacity`` rows nothing is removed. Beyond it the store is thinned to 95 % of the
+capacity: each cell keeps at most ``L`` rows, ``L`` the largest integer with
+``sum_c min(n_c, L) <= 0.95 capacity`` (water-filling): sparse cells (the
 edge of the envelope, a region just explored) keep every row and only the densest cells (trim,
 long straight legs) are thinned. When the occupied cells alone would exceed ``capacity / 4`` the
 grid is coarsened (cell width doubled) so every cell keeps at least four rows.
@@ -26,6 +27,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 __all__ = ["RowStore", "per_cell_limit"]
+
+#: a full store is thinned to this fraction of its capacity, so the thinning (a sort of the stored
+#: rows) runs once per ``(1 - _HEADROOM) * capacity`` new rows rather than on every update
+_HEADROOM = 0.95
 
 #: odd 64-bit multipliers hashing a cell's integer coordinates to one int64 (wrapping arithmetic)
 _HASH = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0xD6E8FEB86659FD93,
@@ -117,10 +122,11 @@ class RowStore:
         out = replace(self, X=X, Y=Y, priority=pr, weight=w, seen=self.seen + len(Xs))
         if len(X) <= self.capacity:
             return out, X[:0], Y[:0]
-        store, keep = out._thinned()
+        store, keep = out._thinned(int(self.capacity * _HEADROOM))
         return store, X[~keep], Y[~keep]
 
-    def _thinned(self) -> tuple["RowStore", np.ndarray]:
+    def _thinned(self, target: int) -> tuple["RowStore", np.ndarray]:
+        """Thin to at most ``target`` rows; also returns the mask of the rows kept."""
         scale = self.cell_scale
         while True:
             store = replace(self, cell_scale=scale)
@@ -128,7 +134,7 @@ class RowStore:
             if len(counts) <= max(self.capacity // 4, 1):
                 break
             scale = scale * 0.5                     # coarsen: twice as wide cells
-        L = per_cell_limit(counts, self.capacity)
+        L = per_cell_limit(counts, target)
         order = np.lexsort((-self.priority, inv))   # by cell, then by decreasing priority
         start = np.concatenate([[0], np.cumsum(counts)[:-1]])
         rank = np.empty(len(order), np.int64)
