@@ -187,7 +187,7 @@ def run_ranking(n: int = 10000, candidates: int = 24) -> dict:
         t = time.perf_counter()
         model.variance_after(extras[k], query)
         times.append(time.perf_counter() - t)
-        ref = model.update(extras[k], np.zeros((64, 6))).predict_global(query, include_noise=False)[1]
+        ref = model.update(extras[k], np.zeros((64, 6)), exchange=False).predict_global(query, include_noise=False)[1]
         diffs.append(float(np.max(np.abs(out[k][1] - ref) / ref)))
     per = statistics.median(times)
     return {"candidates": candidates, "batched_s": batched, "exact_per_candidate_s": per,

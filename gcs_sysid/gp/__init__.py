@@ -11,7 +11,8 @@ Public API::
     model, history = fit_gp(X, Y, GPConfig())
     mean, var = model.predict(X)              # (N, P), (N, P)
     mean_g, var_g = model.predict_global(X)
-    model = model.update(X_new, Y_new)        # incremental, hyperparameters kept
+    model = model.update(X_new, Y_new)        # streaming, bounded memory (inducing exchange, capped row store)
+    model = model.refresh_hyperparameters()   # on request, or every GPConfig.hyper_every rows
     var_after = model.variance_after(X_extra, X_query)
     pairs = model.global_variance_after_many(X_extras, X_queries)   # batched, for ranking
     model.save("dir/gp"); model = load_gp("dir/gp")

@@ -34,12 +34,21 @@ def _pad(a: np.ndarray, size: int) -> np.ndarray:
     return np.concatenate([a, pad], 0)
 
 
-def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: int) -> Stats:
-    """Sufficient statistics of all rows, accumulated over zero-padded chunks of ``batch`` rows."""
-    size = int(min(batch, max(len(Xs), 1)))
+def _bucket(n: int) -> int:
+    """Chunk length for ``n`` rows: the next power of two (at least 16), so that updates of varying
+    sizes reuse a few compiled programs instead of compiling one per size."""
+    return max(16, 1 << (max(int(n), 1) - 1).bit_length())
+
+
+def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: int,
+                 weight: np.ndarray | None = None) -> Stats:
+    """Sufficient statistics of all rows, accumulated over zero-padded chunks of ``batch`` rows
+    (fewer rows: one chunk padded to the next power of two). ``weight (N,)``: each row counted
+    that many times (default 1)."""
+    size = int(min(batch, _bucket(len(Xs))))
     total = None
     for a, b in _chunks(len(Xs), size):
-        w = _pad(np.ones(b - a), size)
+        w = _pad(np.ones(b - a) if weight is None else np.asarray(weight[a:b], float), size)
         st = _stats_jit(params, _pad(Xs[a:b], size), _pad(Ys[a:b], size), w)
         total = st if total is None else _add_jit(total, st)
     if total is None:
@@ -53,7 +62,7 @@ def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, 
     """Latent mean and variance ``(N, P)`` of the global layer at standardised ``Xs``."""
     P = params.A.shape[0]
     mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
-    size = int(min(batch, max(len(Xs), 1)))
+    size = int(min(batch, _bucket(len(Xs))))
     for a, b in _chunks(len(Xs), size):
         m, v = _predict_jit(params, post, _pad(Xs[a:b], size))
         mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
@@ -63,7 +72,7 @@ def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, 
 def global_mean(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, batch: int) -> np.ndarray:
     """Latent mean ``(N, P)`` of the global layer at standardised ``Xs`` (no variance: cheaper)."""
     mean = np.empty((len(Xs), params.A.shape[0]))
-    size = int(min(batch, max(len(Xs), 1)))
+    size = int(min(batch, _bucket(len(Xs))))
     for a, b in _chunks(len(Xs), size):
         mean[a:b] = np.asarray(_mean_jit(params, post, _pad(Xs[a:b], size)))[: b - a]
     return mean
@@ -74,7 +83,7 @@ def local_predict(params: LocalParams, store: LocalStore, Xs: np.ndarray, batch:
     """Latent mean and variance ``(N, P)`` of the local layer at standardised ``Xs``."""
     P = store.resid.shape[1]
     mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
-    size = int(min(batch, max(len(Xs), 1)))
+    size = int(min(batch, _bucket(len(Xs))))
     for a, b in _chunks(len(Xs), size):
         idx, zq = neighbours(store, Xs[a:b])
         args = (_pad(Xs[a:b], size), _pad(zq, size), _pad(store.X[idx], size), _pad(store.z[idx], size),

@@ -42,6 +42,20 @@ class GPConfig:
         local_learning_rate: their Adam step size.
         batch_size: rows per compiled chunk when computing statistics and predictions.
         seed: seed of every random choice.
+        store_max: most training rows kept for the local layer and hyperparameter refreshes
+            (:mod:`gcs_sysid.gp.rowstore`): beyond it the densest regions are thinned, so the
+            saved state and memory stop growing. The default keeps every row of a 10-minute
+            50 Hz flight (the replay path is unchanged) and ~4 MiB of rows.
+        store_cell: width of the thinning grid's cells in global length-scales (standardised).
+        swap_max: most new rows per :meth:`LocalGlobalGP.update` considered for replacing an
+            inducing point (mutual-information exchange, :mod:`gcs_sysid.gp.streaming`); 0: the
+            inducing points never change after the fit.
+        swap_threshold: least unexplained prior variance ``sigma^2(x | Z)`` (standardised,
+            of 1) of a new row for it to be considered.
+        swap_pool: stored rows standing for the unselected set in the exchange criterion.
+        hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
+            again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
+            on request.
     """
 
     n_inducing: int = 128
@@ -65,6 +79,12 @@ class GPConfig:
     local_learning_rate: float = 0.1
     batch_size: int = 2048
     seed: int = 0
+    store_max: int = 30000
+    store_cell: float = 0.5
+    swap_max: int = 2
+    swap_threshold: float = 0.1
+    swap_pool: int = 256
+    hyper_every: int = 0
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
@@ -72,7 +92,11 @@ class GPConfig:
         for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool"):
             if int(getattr(self, name)) < 1:
                 raise InputError(f"GPConfig.{name} must be a positive integer, got {getattr(self, name)!r}")
-        for name in ("steps", "local_steps", "rank"):
+        if int(self.store_max) < 16:
+            raise InputError(f"GPConfig.store_max must be at least 16 rows, got {self.store_max!r}")
+        if not (self.store_cell > 0 and 0 <= self.swap_threshold <= 1):
+            raise InputError("GPConfig: store_cell must be > 0 and swap_threshold within [0, 1]")
+        for name in ("steps", "local_steps", "rank", "swap_max", "swap_pool", "hyper_every"):
             if int(getattr(self, name)) < 0:
                 raise InputError(f"GPConfig.{name} must be >= 0, got {getattr(self, name)!r}")
         if self.inducing not in ("mi", "kmeans", "random"):

@@ -31,11 +31,12 @@ from .config import GPConfig
 from .kernels import coregionalisation
 from .local import LocalParams, build_store, local_objective, neighbours
 from .model import LocalGlobalGP
+from .rowstore import RowStore
 from .scaling import Standardiser, check_training
 from .selection import random_points, select_inducing
 from .sparse import GlobalParams, design, elbo, stats_of
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global"]
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local"]
 
 _NOISE_FLOOR = 1e-6
 
@@ -156,7 +157,25 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     return jax.device_put(raw), jax.device_put(fixed)
 
 
-def _fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory):
+def _unconstrain(p: GlobalParams, cfg: GPConfig) -> dict:
+    """Unconstrained values near ``p`` (inverse of :func:`constrain_global`; ``B`` split as the initial
+    values are: its leading ``rank`` eigenpairs in ``L``, the rest of the diagonal in ``kappa``)."""
+    A = np.asarray(p.A)
+    B = A @ A.T
+    w, V = np.linalg.eigh(B)
+    r = int(min(cfg.rank, len(B)))
+    L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((len(B), 0))
+    kappa = np.maximum(np.diag(B) - np.sum(L0**2, 1), 0.1 * np.diag(B)) - _NOISE_FLOOR
+    return {"log_ls": np.log(np.asarray(p.lengthscale)), "L": np.asarray(L0, float),
+            "log_kappa": np.log(np.maximum(kappa, 1e-8)),
+            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
+
+
+def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory):
+    """Local layer on the rows ``Xs (N, D)`` with global residuals ``resid (N, P)`` (standardised).
+
+    Returns ``(LocalParams, LocalStore)``; the loss history is appended to ``history``.
+    """
     metric = 1.0 / np.asarray(params.lengthscale)
     store = build_store(Xs, resid, metric, cfg.local_neighbours)
     rng = np.random.default_rng(cfg.seed + 7)
@@ -181,6 +200,63 @@ def _fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHisto
                                cfg.tol)
         history.local_loss.extend(np.asarray(values).tolist())
     return _constrain_local_jit(raw), store
+
+
+def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig, M: int,
+                 history: FitHistory, start: GlobalParams | None = None) -> GlobalParams:
+    """Global hyperparameters by Adam on the VFE bound over a random subset of ``n_train_max`` rows.
+
+    Args:
+        Xs: ``(N, D)``, Ys: ``(N, P)`` standardised rows (the fit's rows, or the stored rows of a
+            streaming model). active: ``(D,)`` inputs that vary.
+        cfg: settings. M: inducing points of the returned parameters, chosen again by mutual
+            information with the learned length-scales when larger than the ``n_inducing_hyper``
+            used while learning (0: keep those).
+        history: receives the bound after each step and the timings of the stage.
+        start: warm start (a refresh): the length-scales, noise and coregionalisation to start
+            from instead of the ridge-regression initial values.
+
+    Returns:
+        :class:`GlobalParams` (constrained).
+    """
+    D = Xs.shape[1]
+    P = Ys.shape[1]
+    t0 = time.perf_counter()
+    sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
+    Xh, Yh = jax.device_put((Xs[sub], Ys[sub]))
+
+    M = int(min(M, len(Xs)))
+    Mh = M if cfg.train_inducing or cfg.n_inducing_hyper is None else int(min(cfg.n_inducing_hyper, M))
+    if M == 0:
+        Mh = int(min(cfg.n_inducing_hyper or cfg.n_inducing, len(Xs)))
+    ls0 = np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) if start is None else np.asarray(start.lengthscale)
+    Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
+    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z)
+    if start is not None:
+        raw = jax.device_put(dict(jax.device_get(raw), **_unconstrain(start, cfg)))
+    history.timings["init"] = time.perf_counter() - t0
+
+    def reselect(raw, fixed, m):
+        p = _constrain_global_jit(raw, fixed)
+        bdiag = np.sum(np.asarray(p.A) ** 2, 1)
+        nugget = float(np.mean(np.asarray(p.noise) / (bdiag + np.asarray(p.noise))))
+        Z = select_inducing(Xs, m, np.asarray(p.lengthscale), cfg.inducing, cfg.mi_pool, nugget=max(nugget, 1e-4),
+                            seed=cfg.seed)
+        return dict(fixed, Z=jax.device_put(Z))
+
+    first = cfg.steps // 2 if cfg.reselect else cfg.steps
+    opt_state = _adam_init(raw)
+    for stage, n_steps in enumerate((first, cfg.steps - first)):
+        if n_steps <= 0:
+            continue
+        raw, opt_state, values = _adam(_global_loss, raw, opt_state, cfg.learning_rate, (fixed, Xh, Yh), int(n_steps),
+                                       cfg.tol)
+        history.elbo.extend((-np.asarray(values) * Xh.shape[0] * P).tolist())
+        if stage == 0 and cfg.reselect and cfg.steps > first and not cfg.train_inducing:
+            fixed = reselect(raw, fixed, Mh)
+    if Mh < M:
+        fixed = reselect(raw, fixed, M)
+    return _constrain_global_jit(raw, fixed)
 
 
 def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=None
@@ -219,38 +295,16 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     M = int(min(cfg.n_inducing, len(Xs)))
     if M < cfg.n_inducing:
         notes.append(f"gp: only {len(Xs)} rows; using {M} inducing points instead of {cfg.n_inducing}")
-    sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
-    Xh, Yh = jax.device_put((Xs[sub], Ys[sub]))
-
-    Mh = M if cfg.train_inducing or cfg.n_inducing_hyper is None else int(min(cfg.n_inducing_hyper, M))
-    ls0 = np.full(D, 0.5 * np.sqrt(max(int(scaler.active.sum()), 1)))
-    Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
-    raw, fixed = _init_global(Xs[sub], Ys[sub], scaler.active, cfg, Z)
-    history.timings["init"] = time.perf_counter() - t0
-
-    def reselect(raw, fixed, m):
-        p = _constrain_global_jit(raw, fixed)
-        bdiag = np.sum(np.asarray(p.A) ** 2, 1)
-        nugget = float(np.mean(np.asarray(p.noise) / (bdiag + np.asarray(p.noise))))
-        Z = select_inducing(Xs, m, np.asarray(p.lengthscale), cfg.inducing, cfg.mi_pool, nugget=max(nugget, 1e-4),
-                            seed=cfg.seed)
-        return dict(fixed, Z=jax.device_put(Z))
-
     t1 = time.perf_counter()
-    first = cfg.steps // 2 if cfg.reselect else cfg.steps
-    opt_state = _adam_init(raw)
-    for stage, n_steps in enumerate((first, cfg.steps - first)):
-        if n_steps <= 0:
-            continue
-        raw, opt_state, values = _adam(_global_loss, raw, opt_state, cfg.learning_rate, (fixed, Xh, Yh), int(n_steps),
-                                       cfg.tol)
-        history.elbo.extend((-np.asarray(values) * Xh.shape[0] * P).tolist())
-        if stage == 0 and cfg.reselect and cfg.steps > first and not cfg.train_inducing:
-            fixed = reselect(raw, fixed, Mh)
-    if Mh < M:
-        fixed = reselect(raw, fixed, M)
-    params = _constrain_global_jit(raw, fixed)
-    history.timings["hyperparameters"] = time.perf_counter() - t1
+    params = learn_global(Xs, Ys, scaler.active, cfg, M, history)
+    history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
+    n_hyper = int(min(cfg.n_train_max, len(Xs)))
+    # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
+    rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.lengthscale), cfg.store_cell, cfg.store_max,
+                                  cfg.seed).add_dropped(Xs, Ys)
+    evicted = global_stats(params, Xd, Yd, cfg.batch_size) if len(Xd) else None
+    if len(rows) < len(Xs):
+        notes.append(f"gp: the local layer keeps {len(rows)} of {len(Xs)} rows (store_max), thinned by region")
 
     t2 = time.perf_counter()
     stats = global_stats(params, Xs, Ys, cfg.batch_size)
@@ -260,11 +314,11 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     local_params, store = None, None
     if cfg.local:
         t3 = time.perf_counter()
-        resid = Ys - global_mean(params, post, Xs, cfg.batch_size)
-        local_params, store = _fit_local(cfg, params, Xs, resid, history)
+        resid = rows.Y - global_mean(params, post, rows.X, cfg.batch_size)
+        local_params, store = fit_local(cfg, params, rows.X, resid, history)
         history.timings["local"] = time.perf_counter() - t3
     history.timings["total"] = time.perf_counter() - t0
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
-                          n_hyper=int(len(sub)), notes=tuple(notes))
+                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted)
     return model, history

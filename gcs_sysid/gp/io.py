@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import jax.numpy as jnp
@@ -10,17 +11,18 @@ import numpy as np
 
 from ..errors import InputError
 from ..jaxconfig import enable_x64
-from .batching import global_posterior
+from .batching import global_mean, global_posterior
 from .config import GPConfig
 from .local import LocalParams, build_store
 from .model import LocalGlobalGP
+from .rowstore import RowStore
 from .scaling import Standardiser
 from .sparse import GlobalParams, Stats
 
 __all__ = ["save_model", "load_gp"]
 
 FORMAT = "gcs-sysid-gp"
-VERSION = 1
+VERSION = 2   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
 _GLOBAL = ("lengthscale", "A", "noise", "Z", "prior_std", "jitter")
 _STATS = ("C", "E", "F", "Rphi", "Rx", "yy", "n")
 _LOCAL = ("lengthscale", "beta", "amp", "noise")
@@ -36,6 +38,9 @@ def _paths(path) -> tuple[Path, Path]:
 def save_model(model: LocalGlobalGP, path) -> str:
     """Write ``model`` to ``<path>.npz`` and ``<path>.json`` (a ``.npz``/``.json`` suffix is replaced).
 
+    The state is bounded: hyperparameters, the global statistics (``O(M^2)``) and at most
+    ``config.store_max`` stored rows, however many rows the model has seen.
+
     Returns:
         The npz path as a string.
     """
@@ -43,15 +48,22 @@ def save_model(model: LocalGlobalGP, path) -> str:
     arrays = model.scaler.to_arrays()
     arrays.update({"global_" + k: np.asarray(getattr(model.params, k)) for k in _GLOBAL})
     arrays.update({"stats_" + k: np.asarray(getattr(model.stats, k)) for k in _STATS})
-    if model.local_params is not None and model.store is not None:
+    if model.local_params is not None:
         arrays.update({"local_" + k: np.asarray(getattr(model.local_params, k)) for k in _LOCAL})
-        arrays.update({"store_X": model.store.X, "store_resid": model.store.resid, "store_metric": model.store.metric})
+    if model.evicted is not None:
+        arrays.update({"evicted_" + k: np.asarray(getattr(model.evicted, k)) for k in _STATS})
+    rows = model.rows
+    if rows is not None:
+        arrays.update({"rows_X": rows.X, "rows_Y": rows.Y, "rows_priority": rows.priority, "rows_weight": rows.weight,
+                       "rows_cell_scale": rows.cell_scale})
     npz.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(npz, **arrays)
     meta = {"format": FORMAT, "version": VERSION, "config": model.config.to_dict(),
             "input_names": list(model.input_names), "output_names": list(model.output_names),
             "n_hyper": model.n_hyper, "notes": list(model.notes),
-            "local_k": int(model.store.k) if model.store is not None else None,
+            "local_k": int(model.config.local_neighbours) if model.local_params is not None else None,
+            "rows": None if rows is None else {"capacity": rows.capacity, "seen": rows.seen, "seed": rows.seed},
+            "since_refresh": int(model.since_refresh),
             "summary": model.summary()}
     js.write_text(json.dumps(meta, indent=1))
     return str(npz)
@@ -85,13 +97,30 @@ def load_gp(path) -> LocalGlobalGP:
         scaler = Standardiser.from_arrays(a)
         params = GlobalParams(**{k: jnp.asarray(a["global_" + k]) for k in _GLOBAL})
         stats = Stats(**{k: jnp.asarray(a["stats_" + k]) for k in _STATS})
+        evicted = Stats(**{k: jnp.asarray(a["evicted_" + k]) for k in _STATS}) if "evicted_C" in a else None
     except (KeyError, ValueError, OSError) as exc:
         raise InputError(f"{npz}: GP model arrays missing or unreadable ({exc})") from None
     config = GPConfig.from_dict(meta.get("config", {}))
-    local_params, store = None, None
+    post = global_posterior(params, stats)
+    local_params, store, rows = None, None, None
     if "local_lengthscale" in a:
         local_params = LocalParams(**{k: jnp.asarray(a["local_" + k]) for k in _LOCAL})
-        store = build_store(a["store_X"], a["store_resid"], a["store_metric"], int(meta["local_k"]))
-    return LocalGlobalGP(config, scaler, params, stats, global_posterior(params, stats), local_params, store,
+    try:
+        if "rows_X" in a:
+            r = meta.get("rows") or {}
+            rows = RowStore(a["rows_X"], a["rows_Y"], a["rows_priority"], a["rows_cell_scale"],
+                            int(r.get("capacity", config.store_max)), a["rows_weight"],
+                            int(r.get("seen", len(a["rows_X"]))), int(r.get("seed", config.seed)))
+        elif "store_X" in a:      # version 1: the local store's rows and residuals; targets = residual + global mean
+            store = build_store(a["store_X"], a["store_resid"], a["store_metric"], int(meta["local_k"]))
+            Y = a["store_resid"] + global_mean(params, post, a["store_X"], config.batch_size)
+            rows = RowStore.empty(len(a["scaler_x_mean"]), Y.shape[1], np.asarray(params.lengthscale),
+                                  config.store_cell, max(config.store_max, len(Y)), config.seed)
+            rows = replace(rows, X=a["store_X"], Y=Y, priority=np.random.default_rng(config.seed).random(len(Y)),
+                           seen=len(Y))
+    except (KeyError, ValueError) as exc:
+        raise InputError(f"{npz}: GP model's stored rows missing or unreadable ({exc})") from None
+    return LocalGlobalGP(config, scaler, params, stats, post, local_params, store,
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
-                         tuple(meta.get("notes", [])))
+                         tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
+                         evicted=evicted)

@@ -13,12 +13,15 @@ from ..jaxconfig import enable_x64
 from .batching import global_mean, global_posterior, global_predict, global_stats, local_predict
 from .config import GPConfig
 from .local import LocalParams, LocalStore, build_store
+from .rowstore import RowStore
 from .scaling import Standardiser, check_inputs, check_training
 from .sparse import GlobalParams, GlobalPosterior, Stats, add_stats, elbo
+from .streaming import chol_kmm, exchange_inducing, project_stats, projection
 
 __all__ = ["LocalGlobalGP"]
 
 _elbo_jit = jax.jit(elbo)
+_add_jit = jax.jit(add_stats)
 
 
 @dataclass(frozen=True)
@@ -31,28 +34,61 @@ class LocalGlobalGP:
     non-stationary GP on its residual (:mod:`gcs_sysid.gp.local`). All arrays are in
     standardised units inside; the methods take and return data units.
 
+    Bounded for streaming (``docs/gp.md``, "Streaming"): the global layer keeps only its
+    statistics (``O(M^2)``), the local layer's rows live in a region-thinned store of at most
+    ``config.store_max`` rows (``rows``), and :meth:`update` may exchange inducing points.
+    The posterior and the local layer's k-d tree are derived data, computed when first needed
+    after an update (``post``, ``store``), so an update costs ``O(E M^2)`` and the
+    ``O((P M)^3)`` refactorisation is paid once per prediction, not once per update.
+
     Attributes:
         config: the settings it was fitted with.
         scaler: input/output standardisation.
         params: global hyperparameters. stats: sufficient statistics of the data seen.
-        post: global posterior (derived from ``params`` and ``stats``).
-        local_params, store: the local layer (None when ``config.local`` is False).
+        post: global posterior (derived from ``params`` and ``stats``; property).
+        local_params, store: the local layer (None when ``config.local`` is False; ``store``
+            is derived from ``rows``, a property).
         input_names, output_names: column names.
         n_hyper: rows used for hyperparameter learning.
         notes: one-line remarks made while fitting.
+        rows: the capped, region-thinned training rows (:class:`gcs_sysid.gp.rowstore.RowStore`).
+        since_refresh: rows conditioned on since the hyperparameters were last learned.
+        evicted: the part of ``stats`` from rows no longer stored (None: none). When the
+            inducing inputs or length-scales change, the stored rows' statistics are computed
+            again exactly and only this part is carried by the streaming projection.
     """
 
     config: GPConfig
     scaler: Standardiser
     params: GlobalParams
     stats: Stats
-    post: GlobalPosterior
+    _post: GlobalPosterior | None
     local_params: LocalParams | None
-    store: LocalStore | None
+    _store: LocalStore | None
     input_names: tuple[str, ...]
     output_names: tuple[str, ...]
     n_hyper: int = 0
     notes: tuple[str, ...] = field(default_factory=tuple)
+    rows: RowStore | None = None
+    since_refresh: int = 0
+    evicted: Stats | None = None
+
+    # ------------------------------------------------------------ derived
+    @property
+    def post(self) -> GlobalPosterior:
+        """Global posterior from ``params`` and ``stats`` (computed on first use and kept)."""
+        if self._post is None:
+            object.__setattr__(self, "_post", global_posterior(self.params, self.stats))
+        return self._post
+
+    @property
+    def store(self) -> LocalStore | None:
+        """The local layer's indexed rows with residuals of the global mean (computed on first use)."""
+        if self._store is None and self.local_params is not None and self.rows is not None and len(self.rows):
+            resid = self.rows.Y - self._global_mean_s(self.rows.X)
+            metric = 1.0 / np.asarray(self.params.lengthscale)
+            object.__setattr__(self, "_store", build_store(self.rows.X, resid, metric, self.config.local_neighbours))
+        return self._store
 
     # ---------------------------------------------------------------- shapes
     @property
@@ -118,22 +154,40 @@ class LocalGlobalGP:
 
     # ------------------------------------------------------------ conditioning
     def _with_stats(self, stats: Stats) -> "LocalGlobalGP":
-        return replace(self, stats=stats, post=global_posterior(self.params, stats))
+        return replace(self, stats=stats, _post=global_posterior(self.params, stats))
 
-    def update(self, X_new, Y_new) -> "LocalGlobalGP":
-        """Condition on new rows without refitting hyperparameters.
+    def _mi_nugget(self) -> float:
+        """Relative noise of the mutual-information criterion (as in the fit's selection)."""
+        bdiag = np.sum(np.asarray(self.params.A) ** 2, 1)
+        noise = np.asarray(self.params.noise)
+        return max(float(np.mean(noise / (bdiag + noise))), 1e-4)
 
-        The global layer's sufficient statistics are sums over rows (``Phi Phi^T``,
-        ``Phi Y`` ...; :class:`gcs_sysid.gp.sparse.Stats`), so the new posterior equals the
-        one computed from all rows at once with the same hyperparameters. The local layer
-        adds the rows to its store and recomputes the residuals of the updated global mean.
-        The standardisation is kept.
+    def update(self, X_new, Y_new, exchange: bool = True) -> "LocalGlobalGP":
+        """Condition on new rows; memory and saved state stay bounded.
+
+        1. *Inducing points* (``exchange`` and ``config.swap_max > 0``): up to ``swap_max`` of
+           the new rows least explained by ``Z`` (``sigma^2(x | Z) > swap_threshold``) may each
+           replace the inducing point that mutual information ranks most redundant
+           (:func:`gcs_sysid.gp.streaming.exchange_inducing`); the statistics of the rows seen
+           so far are then carried to the new points by the streaming sparse GP projection of
+           Bui, Nguyen and Turner (2017) (:func:`gcs_sysid.gp.streaming.project_stats`).
+        2. *Global layer*: the new rows' statistics are added (sums over rows). With no
+           exchange the posterior equals the one computed from all rows at once with the same
+           hyperparameters (Titsias 2009), exactly.
+        3. *Local layer*: the rows join the region-thinned store (at most ``store_max`` rows,
+           :mod:`gcs_sysid.gp.rowstore`); residuals and the k-d tree are recomputed when next needed.
+        4. *Hyperparameters*: learned again on the stored rows every ``config.hyper_every`` rows
+           (0: only through :meth:`refresh_hyperparameters`).
+
+        The standardisation is kept. Cost ``O(E M^2)`` for ``E`` rows, plus ``O(M^3)`` when an
+        exchange is considered; the posterior (``O((P M)^3)``) is refactored at the next prediction.
 
         Args:
             X_new: ``(N, D)`` regressors. Y_new: ``(N, P)`` coefficients, data units.
+            exchange: allow inducing-point replacement (False: exact conditioning, ``Z`` kept).
 
         Returns:
-            A new :class:`LocalGlobalGP`.
+            A new :class:`LocalGlobalGP` (this one is unchanged).
 
         Raises:
             InputError: wrong shapes. DataError: no finite row.
@@ -141,14 +195,84 @@ class LocalGlobalGP:
         enable_x64()
         X_new, Y_new, notes = check_training(X_new, Y_new, self.n_inputs, self.n_outputs)
         Xs, Ys = self.scaler.x(X_new), self.scaler.y(Y_new)
-        stats = add_stats(self.stats, global_stats(self.params, Xs, Ys, self.config.batch_size))
-        model = self._with_stats(stats)
-        if model.store is not None:
-            X_all = np.vstack([self.store.X, Xs])
-            Y_all = np.vstack([self.store.resid + self._global_mean_s(self.store.X), Ys])
-            resid = Y_all - model._global_mean_s(X_all)
-            model = replace(model, store=build_store(X_all, resid, self.store.metric, self.store.k))
-        return replace(model, notes=self.notes + tuple(notes))
+        cfg = self.config
+        params, stats, evicted = self.params, self.stats, self.evicted
+        if exchange and cfg.swap_max > 0 and self.rows is not None:
+            Z_old, ls, jitter = np.asarray(params.Z), np.asarray(params.lengthscale), float(params.jitter)
+            pool = self.rows.X[self.rows.sample(cfg.swap_pool, seed=self.rows.seen)]
+            Z_new, swaps = exchange_inducing(Z_old, ls, Xs, pool, self._mi_nugget(), cfg.swap_threshold,
+                                             cfg.swap_max)
+            if swaps:
+                R = projection(chol_kmm(Z_old, ls, jitter), Z_old, Z_new, ls, jitter)
+                stats = project_stats(stats, R)
+                evicted = None if evicted is None else project_stats(evicted, R)
+                params = replace(params, Z=jax.device_put(Z_new))
+        stats = _add_jit(stats, global_stats(params, Xs, Ys, cfg.batch_size))
+        rows = self.rows
+        if rows is not None:
+            rows, Xd, Yd = rows.add_dropped(Xs, Ys)
+            if len(Xd):
+                gone = global_stats(params, Xd, Yd, cfg.batch_size)
+                evicted = gone if evicted is None else _add_jit(evicted, gone)
+        model = replace(self, params=params, stats=stats, _post=None, _store=None, rows=rows, evicted=evicted,
+                        since_refresh=self.since_refresh + len(Xs), notes=self.notes + tuple(notes))
+        if cfg.hyper_every > 0 and model.since_refresh >= cfg.hyper_every:
+            model = model.refresh_hyperparameters()
+        return model
+
+    def refresh_hyperparameters(self, reselect: bool = True) -> "LocalGlobalGP":
+        """Learn the hyperparameters again on the stored rows; optionally choose the inducing inputs again.
+
+        The global hyperparameters are learned as in :func:`gcs_sysid.gp.fit_gp` (Adam on the
+        VFE bound over ``n_train_max`` random stored rows with ``n_inducing_hyper`` points chosen
+        by mutual information), starting from the current values. With ``reselect`` the ``M``
+        inducing inputs are then chosen again by mutual information among the stored rows (a
+        region-thinned sample of all rows seen, so the points follow the envelope flown). The
+        statistics are then computed again: exactly for the stored rows, and for the rows no
+        longer stored (``evicted``, thinned from dense regions) by the streaming projection to the
+        new length-scales and inducing inputs (Bui et al. 2017,
+        :func:`gcs_sysid.gp.streaming.projection`); exact for all rows while none was evicted.
+        The local layer is learned again on the stored rows' residuals. The cost does not depend
+        on the rows seen (``O(store_max M^2)`` plus a fit's hyperparameter stage).
+
+        Args:
+            reselect: choose the inducing inputs again (False: keep them).
+
+        Returns:
+            A new :class:`LocalGlobalGP`.
+
+        Raises:
+            DataError: fewer than 3 stored rows.
+        """
+        from ..errors import DataError
+        from .fit import FitHistory, fit_local, learn_global
+
+        enable_x64()
+        rows = self.rows
+        if rows is None or len(rows) < 3:
+            raise DataError("gp: need at least 3 stored rows to refresh the hyperparameters")
+        cfg = self.config
+        history = FitHistory()
+        M = int(self.params.Z.shape[0])
+        hyper_cfg = replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M))   # the fit's compiled shapes
+        new = learn_global(rows.X, rows.Y, self.scaler.active, hyper_cfg, M if reselect else 0, history,
+                           start=self.params)
+        Z_old, jitter = np.asarray(self.params.Z), float(self.params.jitter)
+        Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
+        params = replace(new, Z=jax.device_put(Z_new))
+        stats, evicted = global_stats(params, rows.X, rows.Y, cfg.batch_size), None
+        if self.evicted is not None:
+            R = projection(chol_kmm(Z_old, np.asarray(self.params.lengthscale), jitter), Z_old, Z_new,
+                           np.asarray(new.lengthscale), jitter)
+            evicted = project_stats(self.evicted, R)
+            stats = _add_jit(stats, evicted)
+        model = replace(self, params=params, stats=stats, evicted=evicted, _post=None, _store=None,
+                        since_refresh=0, n_hyper=int(min(cfg.n_train_max, len(rows))))
+        if self.local_params is not None:
+            resid = rows.Y - model._global_mean_s(rows.X)
+            local_params, store = fit_local(cfg, params, rows.X, resid, history)
+            model = replace(model, local_params=local_params, _store=store)
+        return model
 
     def _global_mean_s(self, Xs: np.ndarray) -> np.ndarray:
         return global_mean(self.params, self.post, Xs, self.config.batch_size)
@@ -176,7 +300,7 @@ class LocalGlobalGP:
         if self.store is not None:
             X_all = np.vstack([self.store.X, Xe])
             store = build_store(X_all, np.vstack([self.store.resid, zeros]), self.store.metric, self.store.k)
-            extra = replace(extra, store=store)
+            extra = replace(extra, _store=store)
         return extra.predict(X_query, include_noise)[1]
 
     def global_variance_after_many(self, X_extras, X_queries, include_noise: bool = False
@@ -187,7 +311,7 @@ class LocalGlobalGP:
         many candidates: only the global layer is updated (the local layer, a nearest-neighbour
         correction of the residual, is left out of both numbers), and the global posterior
         precision is not refactored (:mod:`gcs_sysid.gp.ranking`). Each pair equals
-        ``predict_global(X_query)[1]`` and ``update(X_extra, Y).predict_global(X_query)[1]``.
+        ``predict_global(X_query)[1]`` and ``update(X_extra, Y, exchange=False).predict_global(X_query)[1]``.
 
         Args:
             X_extras: ``C`` arrays ``(E_c, D)`` of candidate regressors, data units (NaN rows ignored).
@@ -280,6 +404,10 @@ class LocalGlobalGP:
                 "linear_derivatives": {o: dict(zip(names, row.tolist())) for o, row in zip(self.output_names, slopes)},
             },
             "local": None,
+            "streaming": None if self.rows is None else {
+                "rows_seen": int(self.rows.seen), "rows_stored": len(self.rows), "store_max": int(self.rows.capacity),
+                "rows_evicted": int(round(float(self.evicted.n))) if self.evicted is not None else 0,
+                "since_refresh": int(self.since_refresh)},
             "notes": list(self.notes),
         }
         if self.local_params is not None and self.store is not None:

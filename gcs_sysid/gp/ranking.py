@@ -20,7 +20,7 @@ and both ``T_p`` and ``Psi^T Lambda^{-1} Psi`` are products of the candidate's f
 ``O(P^2 E J^2 + (P E)^2 P J + (P E)^3)`` instead of ``O((P M)^3)``: the query variance is
 ``var_p(x) - |R_p u(x)|^2`` with ``R_p = chol(C)^{-1} T_p``.
 
-The result equals ``model.update(X_e, any Y).predict_global(X_query)`` (a test).
+The result equals ``model.update(X_e, any Y, exchange=False).predict_global(X_query)`` (a test).
 """
 
 from __future__ import annotations

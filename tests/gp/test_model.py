@@ -44,14 +44,14 @@ def test_linear_function_of_ten_inputs_is_recovered_to_one_percent():
 def test_update_equals_conditioning_on_all_rows_with_the_same_hyperparameters(flight, fitted):
     X, Y, _ = flight
     model, _ = fitted
-    updated = model.update(X[400:500], Y[400:500])
+    updated = model.update(X[400:500], Y[400:500], exchange=False)
     assert updated.n_used == 500 and model.n_used == 400  # immutable: the original is unchanged
     # reference: statistics of all 500 rows at once, local store rebuilt from scratch
     Xs, Ys = model.scaler.x(X[:500]), model.scaler.y(Y[:500])
     stats = global_stats(model.params, Xs, Ys, 64)
     post = global_posterior(model.params, stats)
     resid = Ys - global_predict(model.params, post, Xs, 64)[0]
-    ref = replace(model, stats=stats, post=post, store=build_store(Xs, resid, model.store.metric, model.store.k))
+    ref = replace(model, stats=stats, _post=post, _store=build_store(Xs, resid, model.store.metric, model.store.k))
     for a, b in zip(updated.predict(X[500:]), ref.predict(X[500:])):
         np.testing.assert_allclose(a, b, rtol=1e-7, atol=1e-12)
     for a, b in zip(updated.predict_global(X[500:]), ref.predict_global(X[500:])):
@@ -68,7 +68,7 @@ def test_variance_after_shrinks_variance_near_new_points_only(flight, fitted):
     assert np.all(after[:5] < 0.5 * before[:5])
     np.testing.assert_allclose(after[5:], before[5:], rtol=0.05)
     # it is the variance of the model updated with any values at X_extra
-    upd = model.update(X_extra, np.zeros((len(X_extra), 6))).predict(np.vstack([far, X[:5]]), include_noise=False)[1]
+    upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(np.vstack([far, X[:5]]), include_noise=False)[1]
     np.testing.assert_allclose(after, upd, rtol=1e-7)
 
 
@@ -84,7 +84,7 @@ def test_batched_global_variance_after_equals_updated_global_layer(flight, fitte
     for Xe, (before, after) in zip(extras, out):
         np.testing.assert_allclose(before, before0, rtol=1e-8, equal_nan=True)
         ref = before0 if len(Xe) == 0 else \
-            model.update(Xe, np.zeros((len(Xe), 6))).predict_global(queries, include_noise=False)[1]
+            model.update(Xe, np.zeros((len(Xe), 6)), exchange=False).predict_global(queries, include_noise=False)[1]
         np.testing.assert_allclose(after, ref, rtol=1e-6, equal_nan=True)
         assert np.all(np.isnan(after[-1])) and np.all(after[:-1] <= before[:-1] * (1 + 1e-9))
     assert np.all(out[0][1][:5] < 0.5 * out[0][0][:5])     # observing far away shrinks the variance there
