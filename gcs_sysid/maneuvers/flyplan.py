@@ -29,7 +29,7 @@ def _floor(x: float, nd: int = 3) -> float:
 def plan_document(suggestions: Sequence[Suggestion], name: str = "fly-next", altitude_m: float = 150.0,
                   ground_m: float = 50.0, heading_deg: float = 90.0, start_time_s: float = 30.0,
                   speed_settle_s: float = 10.0, gap_s: float = 4.0, seed: int = 1,
-                  wind_mps: float = 0.0, w20_mps: float = 0.0) -> dict[str, Any]:
+                  wind_mps: float = 0.0, w20_mps: float = 0.0, duration_s: float | None = None) -> dict[str, Any]:
     """The plan document (a dict for ``tomli_w``) flying ``suggestions`` in order.
 
     Args:
@@ -38,12 +38,14 @@ def plan_document(suggestions: Sequence[Suggestion], name: str = "fly-next", alt
         start_time_s: vehicle time of the first sample. speed_settle_s: s held at a new airspeed before
             its input. gap_s: s between inputs at one airspeed. seed: noise seed.
         wind_mps, w20_mps: steady wind (from the west) and turbulence intensity at 20 ft (m/s).
+        duration_s: fixed flight length, s (None: as long as the maneuvers need plus 3 s).
 
     Returns:
         the document; :func:`gcs_sysid.sim.plan_from_dict` accepts it.
 
     Raises:
-        InputError: no suggestions, or a suggestion with zero duration or amplitude.
+        InputError: no suggestions, a suggestion with zero duration or amplitude, or a fixed
+            ``duration_s`` too short for the maneuvers.
     """
     if not suggestions:
         raise InputError("no suggestions to turn into a plan")
@@ -71,8 +73,11 @@ def plan_document(suggestions: Sequence[Suggestion], name: str = "fly-next", alt
             length = s.input_s
         mans.append(m)
         t += length + gap_s
+    need = round(t + 3.0 - start_time_s, 3)
+    if duration_s is not None and duration_s < need:
+        raise InputError(f"the maneuvers need {need:g} s of flight, more than the {duration_s:g} s asked for")
     doc: dict[str, Any] = {
-        "name": name, "duration_s": round(t + 3.0 - start_time_s, 3), "rate_hz": 50.0, "internal_rate_hz": 200.0,
+        "name": name, "duration_s": float(duration_s) if duration_s is not None else need, "rate_hz": 50.0, "internal_rate_hz": 200.0,
         "start_time_s": start_time_s, "seed": int(seed),
         "initial": {"airspeed_mps": round(V0, 2), "altitude_m": altitude_m, "heading_deg": heading_deg},
         "home": {"lat_deg": 47.3977, "lon_deg": 8.5456, "alt_m": ground_m},
