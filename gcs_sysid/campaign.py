@@ -58,6 +58,8 @@ class CampaignConfig:
         gp_steps: Adam steps of the GP fit.
         local: the GP's local layer.
         targets: coefficients to target (None: all, moments first).
+        refit: re-learn the GP (hyperparameters, inducing points) on all data after each flight
+            instead of the incremental update (for comparison; the product updates incrementally).
     """
 
     flights: int = 4
@@ -70,6 +72,7 @@ class CampaignConfig:
     gp_steps: int = 80
     local: bool = True
     targets: tuple[str, ...] | None = None
+    refit: bool = False
 
     def __post_init__(self):
         if self.flights < 2:
@@ -274,6 +277,7 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
         say(f"seed {seed}: flight 1 (standard) errors " + " ".join(f"{c} {e:.0f}%" for c, e in row1["errors_pct"].items()))
         arms: dict[str, list[dict]] = {"suggested": [row1], "standard": [row1]}
         violations: list[str] = []
+        flown_bad: list[str] = []
         for arm in ("suggested", "standard"):
             model, X, Y, sug = model1, f1.X, f1.Y, sug1
             for k in range(2, config.flights + 1):
@@ -299,8 +303,10 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
                                               b["amps"] or None, f"std{k}")
                     flown = []
                 fl = _fly(airframe, truth, doc, config.rate_hz, rng)
-                model = model.update(fl.X, fl.Y)
+                if arm == "suggested" and flown:
+                    flown_bad += [f"seed {seed} flight {k}: {b}" for b in _flown_check(fl.peaks, lim)]
                 X, Y = np.vstack([X, fl.X]), np.vstack([Y, fl.Y])
+                model = _fit(X, Y, config, seed) if config.refit else model.update(fl.X, fl.Y)
                 row = {"flight": k, "kind": arm, "errors_pct": _errors(model, X_test, Y_test),
                        "sigma": _sigma_in(model, regions), "peaks": fl.peaks,
                        "flown": [{"rank": s.rank, "kind": s.kind, "controls": list(s.controls),
@@ -312,7 +318,7 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
                 if arm == "suggested" and k < config.flights:
                     _, sug = _suggest(model, X, Y, airframe, config, lim)
         budget = arms.pop("_budget", [])
-        runs.append({"seed": seed, "arms": arms, "budget": budget, "violations": violations,
+        runs.append({"seed": seed, "arms": arms, "budget": budget, "violations": violations, "flown_outside": flown_bad,
                      "target": None if top is None else {"coefficient": top.coefficients[0], "region": top.region,
                                                          "fix": top.fix}})
     doc = {"airframe": str(airframe_path), "truth_model": str(model_path), "config": _cfg_dict(config),
@@ -328,6 +334,23 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
         (out / "campaign.md").write_text(campaign_markdown(doc), encoding="utf-8")
         (out / "campaign.png").write_bytes(campaign_figure(doc))
     return doc
+
+
+def _flown_check(peaks: dict[str, float], lim) -> list[str]:
+    """What the simulation actually flew beyond the limits during a suggested flight (autopilot included)."""
+    out = []
+    if peaks["V_min"] < lim.V_min - 0.5:
+        out.append(f"flew {peaks['V_min']:.1f} m/s, below V_min {lim.V_min:.1f}")
+    if peaks["V_max"] > lim.V_max + 0.5:
+        out.append(f"flew {peaks['V_max']:.1f} m/s, above V_max {lim.V_max:.1f}")
+    if peaks["alpha_max_deg"] > math.degrees(lim.alpha_max) + 0.5:
+        out.append(f"flew alpha {peaks['alpha_max_deg']:.1f} deg, above {math.degrees(lim.alpha_max):.1f}")
+    if peaks["n_max"] > lim.n_max or peaks["n_min"] < lim.n_min:
+        out.append(f"flew {peaks['n_min']:.2f} to {peaks['n_max']:.2f} g, outside {lim.n_min:.2f} to {lim.n_max:.2f}")
+    for c, th in lim.throw.items():
+        if peaks[f"defl_max_deg.{c}"] > math.degrees(th) + 0.5:
+            out.append(f"{c} reached {peaks[f'defl_max_deg.{c}']:.1f} deg (autopilot + input), throw {math.degrees(th):.1f}")
+    return out
 
 
 def _cfg_dict(c: CampaignConfig) -> dict:
@@ -352,11 +375,13 @@ def _acceptance(runs: list[dict], lim) -> dict[str, Any]:
             r["moment_errors_standard"] = {c: b[n]["errors_pct"][c] for c in MOMENT_COEFFICIENTS}
             r["moments_better"] = bool(all(s[n]["errors_pct"][c] < b[n]["errors_pct"][c] for c in MOMENT_COEFFICIENTS))
         r["inside_limits"] = not run["violations"]
+        r["flown_inside_limits"] = not run.get("flown_outside")
         per.append(r)
     return {"per_seed": per,
             "sigma_2x_all": all(p.get("sigma_2x", False) for p in per),
             "moments_better_all": all(p.get("moments_better", False) for p in per),
-            "inside_limits_all": all(p["inside_limits"] for p in per)}
+            "inside_limits_all": all(p["inside_limits"] for p in per),
+            "flown_inside_limits_all": all(p["flown_inside_limits"] for p in per)}
 
 
 def campaign_markdown(doc: dict) -> str:
@@ -372,8 +397,8 @@ def campaign_markdown(doc: dict) -> str:
         drop = (f"{p['sigma_drop_suggested']:.2e} / {p['sigma_drop_standard']:.2e}" if "sigma_drop_suggested" in p else "-")
         L.append(f"| {p['seed']} | {drop} | {p.get('sigma_2x', '-')} | {me} | {p.get('moments_better', '-')} | "
                  f"{p['inside_limits']} |")
-    L += ["", f"All seeds: sigma 2x {acc['sigma_2x_all']}, moments lower {acc['moments_better_all']}, inside limits "
-              f"{acc['inside_limits_all']}.", ""]
+    L += ["", f"All seeds: sigma 2x {acc['sigma_2x_all']}, moments lower {acc['moments_better_all']}, designed inside "
+              f"limits {acc['inside_limits_all']}, flown inside limits {acc['flown_inside_limits_all']}.", ""]
     for run in doc["runs"]:
         L += [f"## Seed {run['seed']}", ""]
         if run["target"]:
@@ -391,7 +416,9 @@ def campaign_markdown(doc: dict) -> str:
                          + f" | {fl} |")
             L.append("")
         if run["violations"]:
-            L += ["Limit violations:", ""] + [f"- {v}" for v in run["violations"]] + [""]
+            L += ["Designed peaks outside the limits:", ""] + [f"- {v}" for v in run["violations"]] + [""]
+        if run.get("flown_outside"):
+            L += ["Flown (simulated, autopilot included) outside the limits:", ""] + [f"- {v}" for v in run["flown_outside"]] + [""]
     return "\n".join(L) + "\n"
 
 

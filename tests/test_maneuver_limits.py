@@ -34,6 +34,13 @@ def setup():
     return tab, train, model, env, load_airframe(AIRFRAME)
 
 
+@pytest.fixture(scope="module")
+def full(setup):
+    """Suggestions over the whole map (one design-and-rank run shared by several tests)."""
+    tab, train, model, env, af = setup
+    return suggest_maneuvers(env, model, tab, af, max_suggestions=30, config=ManeuverConfig(max_regions=12))
+
+
 def _doc(**limits):
     doc = airframe_to_dict(load_airframe(AIRFRAME))
     doc["limits"] = limits
@@ -137,9 +144,9 @@ def test_out_of_reach_region_offers_nearest_safe_condition(setup):
     assert sug.context["out_of_reach"] and "below V_min 12.0" in sug.context["out_of_reach"][0]
 
 
-def test_lateral_axes_and_moment_first_weighting(setup):
+def test_lateral_axes_and_moment_first_weighting(setup, full):
     tab, train, model, env, af = setup
-    sug = suggest_maneuvers(env, model, tab, af, max_suggestions=30, config=ManeuverConfig(max_regions=24))
+    sug = full
     surfaces = {c for s in sug for c in s.controls}
     assert {"delta_a", "delta_r"} <= surfaces
     assert any(s.kind == "multisine" and s.controls == ("delta_e", "delta_a", "delta_r") for s in sug)
@@ -153,7 +160,7 @@ def test_lateral_axes_and_moment_first_weighting(setup):
     assert g and sum(x["regions"] for x in g) > len(g)
     assert all(x["fix"].split()[0] in ("elevator", "aileron", "rudder") for x in g)
     # the user can target any coefficient (a force here)
-    only = suggest_maneuvers(env, model, tab, af, config=ManeuverConfig(targets=("CY",)))
+    only = suggest_maneuvers(env, model, tab, af, config=ManeuverConfig(targets=("CY",), max_regions=4))
     assert only and all(s.coefficients == ("CY",) for s in only)
     with pytest.raises(InputError, match="target coefficients"):
         suggest_maneuvers(env, model, tab, af, config=ManeuverConfig(targets=("Cq",)))
@@ -167,17 +174,17 @@ def test_quality_gate_keeps_failing_coefficients_out(setup):
     assert "excitation" in gate["Cl"]["fix"] and "not identified" in gate["CY"]["why"]
     err = {c: 10.0 for c in COEFFICIENTS}
     err["Cl"] = 330.0
-    sug = suggest_maneuvers(env, model, tab, af, max_suggestions=30, heldout_error_pct=err)
+    sug = suggest_maneuvers(env, model, tab, af, max_suggestions=30, heldout_error_pct=err,
+                            config=ManeuverConfig(max_regions=6))
     assert sug and all("Cl" not in s.coefficients for s in sug)
     assert "Cl" in sug.context["gated"] and sug.context["weights"]["Cl"] == 0.0
 
 
-def test_plan_file_flies_the_suggestions_exactly(setup, tmp_path):
+def test_plan_file_flies_the_suggestions_exactly(full):
     from gcs_sysid.signals import waveform
     from gcs_sysid.sim import plan_from_dict
 
-    tab, train, model, env, af = setup
-    sug = suggest_maneuvers(env, model, tab, af, max_suggestions=6, config=ManeuverConfig(max_regions=12))
+    sug = full
     doc = plan_document(sug[:4])
     plan = plan_from_dict(doc, "fly.toml")
     assert len(plan.maneuvers) == 4

@@ -92,10 +92,13 @@ def test_weakest_coefficients_first(setup, weak, strong):
     regs = [_region(env, c, ("alpha", "V"), slice(n - 4, n), slice(0, 4)) for c in weak + strong]
     scores = {**{c: 0.1 for c in weak}, **{c: 0.9 for c in strong}}
     e2 = dataclasses.replace(env, regions=regs, scores=scores)
-    sug = suggest_maneuvers(e2, model, tab, af)
+    sug = suggest_maneuvers(e2, model, tab, af, config=ManeuverConfig(targets=("CX", "CY", "CZ", "Cl", "Cm", "Cn")))
     assert sug[0].coefficients[0] in weak
     top_weak = sum(c in weak for c in sug[0].coefficients)
     assert top_weak >= 1 and sug[0].priority > sug[-1].priority
+    # by default the moment coefficients lead even when the forces are weaker
+    default = suggest_maneuvers(e2, model, tab, af)
+    assert default[0].coefficients[0] in ("Cl", "Cm", "Cn")
 
 
 def test_mode_frequency_sets_pulse_width(setup):

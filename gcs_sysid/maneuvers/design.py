@@ -47,6 +47,9 @@ class ManeuverConfig:
         min_amplitude_deg: smallest useful amplitude; a candidate that cannot reach it within the limits
             is dropped.
         alpha_room_deg: the trim alpha of a condition stays this far below alpha_max.
+        V_margin: test points stay this fraction of the airspeed range inside [V_min, V_max] (the
+            trim at the edge is an extrapolation of the identified model).
+        trim_margin_deg: surface travel kept free beyond the estimated trim deflection (its error).
         edge_fraction: a pulse edge may last at most this fraction of the pulse at the surface rate limit.
         max_regions: regions (most uncertain, weakest coefficients first) turned into candidates.
         sample_hz: rate at which the response is simulated (x5 internally).
@@ -67,7 +70,9 @@ class ManeuverConfig:
     target_beta_deg: float = 4.0
     max_bank_deg: float = 30.0
     min_amplitude_deg: float = 1.0
-    alpha_room_deg: float = 3.0
+    alpha_room_deg: float = 4.0
+    V_margin: float = 0.1
+    trim_margin_deg: float = 4.0
     edge_fraction: float = 0.2
     max_regions: int = 24
     sample_hz: float = 10.0
@@ -140,12 +145,15 @@ def flight_condition(ctx: Context, center: dict[str, float], axes: tuple[str, ..
         why.append(f"V {V:.1f} m/s is below V_min {lim.V_min:.1f} m/s")
     if V > lim.V_max:
         why.append(f"V {V:.1f} m/s is above V_max {lim.V_max:.1f} m/s")
-    V = float(np.clip(V, lim.V_min, lim.V_max))
+    m = cfg.V_margin * (lim.V_max - lim.V_min)
+    if lim.V_min <= V < lim.V_min + m or lim.V_max - m < V <= lim.V_max:
+        why.append(f"V {V:.1f} m/s is within {100 * cfg.V_margin:.0f} % of the airspeed range of a limit")
+    V = float(np.clip(V, lim.V_min + m, lim.V_max - m))
     if trim_alpha(ctx, V) > alpha_cap and _cz(ctx, alpha_cap) < 0:   # speed up until trim alpha leaves room
         V_safe = float(np.sqrt(_lift0(ctx) / _cz(ctx, alpha_cap)))
         if V_safe > V:
             why.append(f"trim alpha at {V:.1f} m/s leaves less than {cfg.alpha_room_deg:g} deg to alpha_max")
-            V = min(V_safe, lim.V_max)
+            V = min(V_safe, lim.V_max - m)
     alpha = trim_alpha(ctx, V)
     d, ref = ctx.d, ctx.ref
     de = ref["delta_e"] - (ctx.at_ref["Cm"] + d[("Cm", "alpha")] * (alpha - ref["alpha"])) / d[("Cm", "delta_e")]
@@ -254,7 +262,7 @@ def design(ctx: Context, kind: str, controls: tuple[str, ...], region: FlaggedRe
         amps[c] = max(lin, reach)
     # the limits: throw and surface rate per control, then alpha and load factor for all together
     for c in controls:
-        room = lim.throw.get(c, 0.0) - abs(base[c])
+        room = lim.throw.get(c, 0.0) - abs(base[c]) - math.radians(cfg.trim_margin_deg)
         if kind == "multisine":
             slope = max(np.max(np.abs(np.diff(unit[c]))) / dt, 1e-9)
             rate_cap = lim.rate.get(c, np.inf) / slope

@@ -178,10 +178,12 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
     if not regions:
         return SuggestionList([], context)
     context["groups"], context["out_of_reach"] = _fix_groups(ctx, regions)
-    regions.sort(key=lambda r: -r.mean_rel_sigma * weight[r.coefficient])
+    regions.sort(key=lambda r: (r.coefficient not in MOMENT_COEFFICIENTS and not cfg.targets,
+                                -r.mean_rel_sigma * weight[r.coefficient]))
     designs, queries = [], []
     for gi, grp in enumerate(_locations(regions[:cfg.max_regions])):
-        coefs = sorted({r.coefficient for r in grp}, key=lambda c: (-weight[c], c not in MOMENT_COEFFICIENTS, c))
+        coefs = sorted({r.coefficient for r in grp}, key=lambda c: (c not in MOMENT_COEFFICIENTS and not cfg.targets,
+                                                                      -weight[c], c))
         pts = {c: np.vstack([r.points for r in grp if r.coefficient == c]) for c in coefs}
         sl, k0 = {}, 0
         for c in coefs:
