@@ -5,7 +5,8 @@
    fix first (data, rates, airframe file).
 2. Weights: weakest coefficients (lowest confidence score) first, moment coefficients (Cl Cm Cn)
    ahead of forces (``force_weight``), or only the coefficients the user targets.
-3. Candidates per location (regions of one slice that overlap): a doublet and a 3-2-1-1 on each
+3. Regions are taken in turn from each weighted coefficient (its most uncertain first), so every
+   axis has candidates. Candidates per location (regions of one slice that overlap): a doublet and a 3-2-1-1 on each
    surface that drives a weak coefficient there (elevator for CX CZ Cm, aileron for Cl, rudder for
    CY Cn) and one orthogonal multisine on all surfaces at once (Morelli 2003).
 4. Score: the regressor trajectory each candidate would produce (linear model of the identified
@@ -14,6 +15,7 @@
    candidates in one batched closed-form update; ``variance_after`` for any other model). Priority
    = weighted mean relative reduction (active learning by variance reduction: MacKay,
    "Information-based objective functions for active data selection", Neural Computation 4(4), 1992).
+   Each targeted coefficient's best candidate is kept first (moments first), the rest by priority.
 5. Flagged regions are grouped by what would fix them (surface x flight condition) so the report
    shows a few fixes instead of one row per coefficient and region.
 """
@@ -178,8 +180,9 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
     if not regions:
         return SuggestionList([], context)
     context["groups"], context["out_of_reach"] = _fix_groups(ctx, regions)
-    regions.sort(key=lambda r: (r.coefficient not in MOMENT_COEFFICIENTS and not cfg.targets,
-                                -r.mean_rel_sigma * weight[r.coefficient]))
+    order = sorted({r.coefficient for r in regions},
+                   key=lambda c: (c not in MOMENT_COEFFICIENTS and not cfg.targets, -weight[c], c))
+    regions = _interleave(regions, order)
     designs, queries = [], []
     for gi, grp in enumerate(_locations(regions[:cfg.max_regions])):
         coefs = sorted({r.coefficient for r in grp}, key=lambda c: (c not in MOMENT_COEFFICIENTS and not cfg.targets,
@@ -215,16 +218,27 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
         prio = sum(weight[c] * red[c] for c in tgts) / np.sqrt(len(tgts))
         candidates.append((prio, gi, kind, controls, tgts, lead, dsg, red))
     candidates.sort(key=lambda x: -x[0])
-    chosen, seen = SuggestionList([], context), set()
-    for prio, gi, kind, controls, tgts, lead, dsg, red in candidates:
+    picked, seen = [], set()
+
+    def take(cand) -> bool:
+        prio, gi, kind, controls, tgts, lead, dsg, red = cand
         fc = dsg["fc"]
         same = (kind, controls, round(fc["V"]), tuple(round(math.degrees(a)) for a in dsg["amps"].values()))
         if (gi, controls) in seen or same in seen:   # one per location and surface set; no repeats
-            continue
+            return False
         seen.update({(gi, controls), same})
-        chosen.append(_suggestion(len(chosen) + 1, ctx, prio, kind, controls, tgts, lead, dsg, red))
-        if len(chosen) >= max_suggestions:
+        picked.append(cand)
+        return True
+
+    for c in order:   # every targeted axis gets its best candidate first (moments first), then by priority
+        if len(picked) < max_suggestions:
+            next((True for cand in candidates if cand[4][0] == c and cand[0] > 0 and take(cand)), None)
+    for cand in candidates:
+        if len(picked) >= max_suggestions:
             break
+        take(cand)
+    picked.sort(key=lambda x: -x[0])
+    chosen = SuggestionList([_suggestion(i + 1, ctx, *cand) for i, cand in enumerate(picked)], context)
     for g in context["groups"]:
         g["suggestions"] = [s.rank for s in chosen if s.fix == g["fix"]]
     return chosen
@@ -265,6 +279,20 @@ def _fix_groups(ctx: Context, regions: list[FlaggedRegion]) -> tuple[list[dict],
     return out, oor
 
 
+def _interleave(regions: list[FlaggedRegion], order: list[str]) -> list[FlaggedRegion]:
+    """Regions taken in turn from each coefficient (in ``order``), each coefficient's most uncertain first,
+    so that every axis has candidates within ``max_regions``."""
+    per: dict[str, list[FlaggedRegion]] = {c: [] for c in order}
+    for r in sorted(regions, key=lambda r: -r.mean_rel_sigma):
+        per[r.coefficient].append(r)
+    out: list[FlaggedRegion] = []
+    while any(per.values()):
+        for c in order:
+            if per[c]:
+                out.append(per[c].pop(0))
+    return out
+
+
 def _variances(model: Any, designs: list, queries: list) -> list[tuple[np.ndarray, np.ndarray]]:
     """(variance before, variance after) at each candidate's query points, latent where possible.
 
@@ -288,7 +316,7 @@ def _variances(model: Any, designs: list, queries: list) -> list[tuple[np.ndarra
     return out
 
 
-def _suggestion(rank: int, ctx: Context, prio: float, kind: str, controls: tuple[str, ...],
+def _suggestion(rank: int, ctx: Context, prio: float, gi: int, kind: str, controls: tuple[str, ...],
                 targets: tuple[str, ...], region: FlaggedRegion, dsg: dict, red: dict) -> Suggestion:
     fc, amps, ex = dsg["fc"], dsg["amps"], dsg["expected"]
     mean_red = float(np.mean([red[c] for c in targets]))
