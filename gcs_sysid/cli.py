@@ -76,6 +76,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--flights", type=int, default=4, help="flights per arm, the first standard (default 4)")
     c.add_argument("--seeds", default="1", help="comma-separated seeds, one campaign each (default 1)")
     c.add_argument("--out", required=True, help="output directory (campaign.json, campaign.md, campaign.png)")
+    c.add_argument("--refit", action="store_true", help="re-learn the GP after each flight instead of updating it")
     return ap
 
 
@@ -126,7 +127,7 @@ def _cmd_diagnose(a: argparse.Namespace) -> int:
 def _cmd_campaign(a: argparse.Namespace) -> int:
     from .campaign import run_campaign_cli
 
-    return run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out)
+    return run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit)
 
 
 COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose,

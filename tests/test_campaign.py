@@ -33,7 +33,7 @@ def test_impossible_requests_are_one_line_errors(args, match, tmp_path, capsys):
 
 
 def test_config_rejects_impossible_settings():
-    with pytest.raises(InputError, match="at least 30 s"):
+    with pytest.raises(InputError, match="at least 82 s"):
         CampaignConfig(flight_s=0.0)
     with pytest.raises(InputError, match="at least one seed"):
         CampaignConfig(seeds=())
@@ -52,10 +52,11 @@ def _check(doc):
     return acc
 
 
+@pytest.mark.slow
 def test_campaign_fast(tmp_path):
-    """One seed, two flights per arm, small GP: the first acceptance check and the limits, end to end."""
-    cfg = CampaignConfig(flights=2, seeds=(1,), flight_s=60.0, max_suggestions=2, n_inducing=24, gp_steps=30,
-                         local=False)
+    """One seed, two flights per arm, small GP: the first acceptance check and the limits, end to end
+    (about 60 s on an idle 2-core machine: slow-marked, as the default suite's budget is shared)."""
+    cfg = CampaignConfig(flights=2, seeds=(1,), max_suggestions=2, n_inducing=16, gp_steps=20, local=False)
     doc = run_campaign(AIRFRAME, TRUTH, tmp_path, cfg, progress=None)
     _check(doc)
     for name in ("campaign.json", "campaign.md", "campaign.png"):

@@ -50,7 +50,7 @@ class CampaignConfig:
             raise InputError(f"--flights must be at least 2 (one standard, then suggested), got {self.flights}")
         if not self.seeds:
             raise InputError("at least one seed is needed")
-        if not self.flight_s >= 30.0:
-            raise InputError(f"flight length must be at least 30 s, got {self.flight_s}")
+        if not self.flight_s >= 82.0:
+            raise InputError(f"flight length must be at least 82 s (the validation flight's), got {self.flight_s}")
 
 

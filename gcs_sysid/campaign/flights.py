@@ -59,12 +59,13 @@ def standard_doc(V0: float, cfg: CampaignConfig, seed: int, throw: dict[str, flo
                 return {**_base_doc(name, V0, cfg.flight_s, seed, cfg.w20_mps), "maneuver": mans}, used
 
 
-def validation_doc(lim, throw: dict[str, float], name: str) -> dict:
-    """Multisines on all surfaces at three airspeeds across the limits (no turbulence)."""
+def validation_doc(lim, throw: dict[str, float], name: str, duration_s: float = 90.0) -> dict:
+    """Multisines on all surfaces at three airspeeds across the limits (no turbulence), in a flight of
+    ``duration_s`` (>= 82 s; the campaign's flight length, so the simulation compiles once)."""
     Vs = [lim.V_min + 0.15 * (lim.V_max - lim.V_min), 0.5 * (lim.V_min + lim.V_max), lim.V_max - 0.15 * (lim.V_max - lim.V_min)]
     ctl = [c for c in ("delta_e", "delta_a", "delta_r") if c in throw]
     amp = {"delta_e": 3.0, "delta_a": 6.0, "delta_r": 8.0}
-    doc = _base_doc(name, Vs[0], 3 * 26.0 + 4.0, 777, 0.0)
+    doc = _base_doc(name, Vs[0], max(duration_s, 3 * 26.0 + 4.0), 777, 0.0)
     doc["setpoint"], doc["maneuver"] = [], []
     for i, V in enumerate(Vs):
         t0 = 30.0 + i * 26.0

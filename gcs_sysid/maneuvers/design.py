@@ -72,7 +72,7 @@ class ManeuverConfig:
     min_amplitude_deg: float = 1.0
     alpha_room_deg: float = 4.0
     V_margin: float = 0.1
-    trim_margin_deg: float = 4.0
+    trim_margin_deg: float = 5.0
     edge_fraction: float = 0.2
     max_regions: int = 24
     sample_hz: float = 10.0
