@@ -96,9 +96,10 @@ def test_limits_default_from_flown_envelope_and_say_so(setup):
 def test_every_suggestion_inside_limits_and_peaks_checked(setup):
     tab, train, model, env, af = setup
     tight = airframe_from_dict(_doc(V_min_mps=14.0, V_max_mps=22.0, n_max=1.4, alpha_max_deg=9.0,
-                                    throw_deg={"delta_e": 6.0, "delta_a": 8.0, "delta_r": 8.0},
+                                    throw_deg={"delta_e": 10.0, "delta_a": 10.0, "delta_r": 12.0},
                                     rate_dps={"delta_e": 80.0, "delta_a": 120.0, "delta_r": 120.0}))
-    sug = suggest_maneuvers(env, model, tab, tight, max_suggestions=30, config=ManeuverConfig(max_regions=12))
+    sug = suggest_maneuvers(env, model, tab, tight, max_suggestions=30,
+                            config=ManeuverConfig(max_regions=12, min_reduction=0.0))
     assert sug
     lim = effective_limits(tight, tab, train)
     kinds = set()
@@ -136,7 +137,7 @@ def test_out_of_reach_region_offers_nearest_safe_condition(setup):
     tab, train, model, env, af = setup
     slow = _region(env, "Cm", ("alpha", "V"), {"alpha": math.radians(16.0), "V": 8.0})
     e2 = dataclasses.replace(env, regions=[slow])
-    sug = suggest_maneuvers(e2, model, tab, af)
+    sug = suggest_maneuvers(e2, model, tab, af, config=ManeuverConfig(min_reduction=0.0))
     assert sug
     for s in sug:
         assert s.flight_condition["V"] >= 12.0 and s.flight_condition["alpha_deg"] <= 12.0 - 3.0 + 1e-6
@@ -148,6 +149,7 @@ def test_lateral_axes_and_moment_first_weighting(setup, full):
     tab, train, model, env, af = setup
     sug = full
     surfaces = {c for s in sug for c in s.controls}
+    assert all(s.expected_reduction >= 0.01 for s in sug)   # nothing suggested that teaches nothing
     assert {"delta_a", "delta_r"} <= surfaces
     assert any(s.kind == "multisine" and s.controls == ("delta_e", "delta_a", "delta_r") for s in sug)
     assert sug[0].coefficients[0] in ("Cl", "Cm", "Cn")

@@ -62,6 +62,8 @@ class ManeuverConfig:
         force_weight: ranking weight of a force coefficient relative to a moment coefficient (Cl Cm Cn
             lead by default: they are what the method exists for).
         gate_pct: a coefficient whose held-out error exceeds this (%) is not ranked (quality gate).
+        min_reduction: a candidate whose expected variance reduction (mean over its targets) is below
+            this fraction teaches the model nothing worth a flight and is not suggested.
     """
 
     target_alpha_deg: float = 3.0
@@ -86,6 +88,7 @@ class ManeuverConfig:
     targets: tuple[str, ...] | None = None
     force_weight: float = 0.35
     gate_pct: float = 50.0
+    min_reduction: float = 0.01
 
 
 @dataclass

@@ -216,7 +216,8 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
             v0 = float(np.mean(var0[sl[c], j]))
             red[c] = float(np.clip(1.0 - np.mean(var1[sl[c], j]) / v0, 0.0, 1.0)) if v0 > 0 else 0.0
         prio = sum(weight[c] * red[c] for c in tgts) / np.sqrt(len(tgts))
-        candidates.append((prio, gi, kind, controls, tgts, lead, dsg, red))
+        if np.mean([red[c] for c in tgts]) >= cfg.min_reduction:
+            candidates.append((prio, gi, kind, controls, tgts, lead, dsg, red))
     candidates.sort(key=lambda x: -x[0])
     picked, seen = [], set()
 
@@ -232,7 +233,8 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
 
     for c in order:   # every targeted axis gets its best candidate first (moments first), then by priority
         if len(picked) < max_suggestions:
-            next((True for cand in candidates if cand[4][0] == c and cand[0] > 0 and take(cand)), None)
+            next((True for cand in candidates if cand[4][0] == c and cand[7][c] >= cfg.min_reduction
+                  and take(cand)), None)
     for cand in candidates:
         if len(picked) >= max_suggestions:
             break
