@@ -104,3 +104,4 @@ def write_plan(suggestions: Sequence[Suggestion], path: str | Path, **kw: Any) -
     p = Path(path)
     p.write_text(head + tomli_w.dumps(doc), encoding="utf-8")
     return p
+
