@@ -10,7 +10,8 @@ expected response and the regressor trajectory it would produce.
   in the frequency domain", IFAC SYSID 2003; Morelli and Klein 2016, ch. 9).
 - Amplitude: sized for a near-linear response (target alpha/q, p, beta excursions, bank), raised to
   reach the region where the surface allows, then scaled down (the model is linear in the input)
-  until the expected peaks respect every limit: alpha_max, n_max / n_min, throw, surface rate
+  until the expected peaks respect every limit: alpha_max and n_max / n_min with 30 % of the headroom
+  kept in reserve, throw (less a trim margin), surface rate
   (a pulse edge may take at most 20 % of the pulse at the rate limit). A candidate whose smallest
   useful amplitude cannot be flown within the limits is dropped.
 """
@@ -62,6 +63,8 @@ class ManeuverConfig:
         force_weight: ranking weight of a force coefficient relative to a moment coefficient (Cl Cm Cn
             lead by default: they are what the method exists for).
         gate_pct: a coefficient whose held-out error exceeds this (%) is not ranked (quality gate).
+        headroom: fraction of the alpha and load-factor headroom a design may use (the linear model and
+            the autopilot's own commands make the flown peaks larger than the designed ones).
         min_reduction: a candidate whose expected variance reduction (mean over its targets) is below
             this fraction teaches the model nothing worth a flight and is not suggested.
     """
@@ -89,6 +92,7 @@ class ManeuverConfig:
     force_weight: float = 0.35
     gate_pct: float = 50.0
     min_reduction: float = 0.01
+    headroom: float = 0.7
 
 
 @dataclass
@@ -282,14 +286,14 @@ def design(ctx: Context, kind: str, controls: tuple[str, ...], region: FlaggedRe
     if resp is None:
         return None
     pk = _peaks(ctx, resp, u, base, fc, dt)
-    k = 1.0
-    a_up = math.degrees(lim.alpha_max) - fc["alpha_deg"]
+    k, h = 1.0, cfg.headroom
+    a_up = h * (math.degrees(lim.alpha_max) - fc["alpha_deg"])
     if pk["alpha_max_deg"] - fc["alpha_deg"] > a_up:
         k = min(k, a_up / (pk["alpha_max_deg"] - fc["alpha_deg"]))
-    if pk["n_max"] - 1.0 > lim.n_max - 1.0:
-        k = min(k, (lim.n_max - 1.0) / (pk["n_max"] - 1.0))
-    if 1.0 - pk["n_min"] > 1.0 - lim.n_min:
-        k = min(k, (1.0 - lim.n_min) / (1.0 - pk["n_min"]))
+    if pk["n_max"] - 1.0 > h * (lim.n_max - 1.0):
+        k = min(k, h * (lim.n_max - 1.0) / (pk["n_max"] - 1.0))
+    if 1.0 - pk["n_min"] > h * (1.0 - lim.n_min):
+        k = min(k, h * (1.0 - lim.n_min) / (1.0 - pk["n_min"]))
     if k < 1.0:
         notes.append(f"amplitudes scaled by {k:.2f} to keep alpha and load factor inside the limits")
         amps = {c: a * k for c, a in amps.items()}
