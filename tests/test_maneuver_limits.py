@@ -99,7 +99,7 @@ def test_every_suggestion_inside_limits_and_peaks_checked(setup):
                                     throw_deg={"delta_e": 10.0, "delta_a": 10.0, "delta_r": 12.0},
                                     rate_dps={"delta_e": 80.0, "delta_a": 120.0, "delta_r": 120.0}))
     sug = suggest_maneuvers(env, model, tab, tight, max_suggestions=30,
-                            config=ManeuverConfig(max_regions=12, min_reduction=0.0))
+                            config=ManeuverConfig(max_regions=12, min_reduction=0.0, min_relative_reduction=0.0))
     assert sug
     lim = effective_limits(tight, tab, train)
     kinds = set()
@@ -149,7 +149,8 @@ def test_lateral_axes_and_moment_first_weighting(setup, full):
     tab, train, model, env, af = setup
     sug = full
     surfaces = {c for s in sug for c in s.controls}
-    assert all(s.expected_reduction >= 0.01 for s in sug)   # nothing suggested that teaches nothing
+    best = max(s.expected_reduction for s in sug)   # nothing suggested that teaches next to nothing
+    assert all(s.expected_reduction >= 0.1 * best - 1e-12 for s in sug)
     assert {"delta_a", "delta_r"} <= surfaces
     assert any(s.kind == "multisine" and s.controls == ("delta_e", "delta_a", "delta_r") for s in sug)
     assert sug[0].coefficients[0] in ("Cl", "Cm", "Cn")

@@ -65,8 +65,9 @@ class ManeuverConfig:
         gate_pct: a coefficient whose held-out error exceeds this (%) is not ranked (quality gate).
         headroom: fraction of the alpha and load-factor headroom a design may use (the linear model and
             the autopilot's own commands make the flown peaks larger than the designed ones).
-        min_reduction: a candidate whose expected variance reduction (mean over its targets) is below
-            this fraction teaches the model nothing worth a flight and is not suggested.
+        min_reduction, min_relative_reduction: a candidate whose expected variance reduction (mean over
+            its targets) is below ``max(min_reduction, min_relative_reduction x the best candidate's)``
+            teaches the model next to nothing and is not suggested.
     """
 
     target_alpha_deg: float = 3.0
@@ -91,7 +92,8 @@ class ManeuverConfig:
     targets: tuple[str, ...] | None = None
     force_weight: float = 0.35
     gate_pct: float = 50.0
-    min_reduction: float = 0.01
+    min_reduction: float = 1e-4
+    min_relative_reduction: float = 0.1
     headroom: float = 0.7
 
 

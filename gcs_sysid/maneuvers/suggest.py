@@ -216,8 +216,10 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
             v0 = float(np.mean(var0[sl[c], j]))
             red[c] = float(np.clip(1.0 - np.mean(var1[sl[c], j]) / v0, 0.0, 1.0)) if v0 > 0 else 0.0
         prio = sum(weight[c] * red[c] for c in tgts) / np.sqrt(len(tgts))
-        if np.mean([red[c] for c in tgts]) >= cfg.min_reduction:
-            candidates.append((prio, gi, kind, controls, tgts, lead, dsg, red))
+        candidates.append((prio, gi, kind, controls, tgts, lead, dsg, red))
+    best = max((float(np.mean(list(c[7].values()))) for c in candidates), default=0.0)
+    floor = max(cfg.min_reduction, cfg.min_relative_reduction * best)
+    candidates = [c for c in candidates if np.mean([c[7][t] for t in c[4]]) >= floor]
     candidates.sort(key=lambda x: -x[0])
     picked, seen = [], set()
 
@@ -233,8 +235,7 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
 
     for c in order:   # every targeted axis gets its best candidate first (moments first), then by priority
         if len(picked) < max_suggestions:
-            next((True for cand in candidates if cand[4][0] == c and cand[7][c] >= cfg.min_reduction
-                  and take(cand)), None)
+            next((True for cand in candidates if cand[4][0] == c and cand[7][c] >= floor and take(cand)), None)
     for cand in candidates:
         if len(picked) >= max_suggestions:
             break
@@ -244,6 +245,11 @@ def suggest_maneuvers(envelope: EnvelopeMap, model: Any, table: CoefficientTable
     for g in context["groups"]:
         g["suggestions"] = [s.rank for s in chosen if s.fix == g["fix"]]
     return chosen
+
+
+def _pct(x: float) -> str:
+    """A fraction as a percentage with two significant digits (0.0022 -> '0.22 %')."""
+    return f"{100 * x:.2g} %" if x < 0.1 else f"{100 * x:.0f} %"
 
 
 def _fix_of(ctx: Context, r: FlaggedRegion) -> tuple[str, dict, str]:
@@ -281,11 +287,20 @@ def _fix_groups(ctx: Context, regions: list[FlaggedRegion]) -> tuple[list[dict],
     return out, oor
 
 
+#: Regressors each surface moves (directly or through the mode it excites); a region on a slice of two
+#: of them can be reached by that surface's inputs.
+_REACH = {"delta_e": {"alpha", "q_hat", "delta_e", "V"},
+          "delta_a": {"p_hat", "delta_a", "beta", "r_hat", "alpha", "V"},
+          "delta_r": {"r_hat", "delta_r", "beta", "p_hat", "alpha", "V"}}
+
+
 def _interleave(regions: list[FlaggedRegion], order: list[str]) -> list[FlaggedRegion]:
-    """Regions taken in turn from each coefficient (in ``order``), each coefficient's most uncertain first,
-    so that every axis has candidates within ``max_regions``."""
+    """Regions taken in turn from each coefficient (in ``order``), so that every axis has candidates
+    within ``max_regions``; per coefficient, regions its own surface can reach first (a roll input cannot
+    reach a pitch-rate corner), most uncertain first."""
     per: dict[str, list[FlaggedRegion]] = {c: [] for c in order}
-    for r in sorted(regions, key=lambda r: -r.mean_rel_sigma):
+    reach = lambda r: set(r.axes) <= _REACH[SURFACE_OF[r.coefficient]]  # noqa: E731
+    for r in sorted(regions, key=lambda r: (not reach(r), -r.mean_rel_sigma)):
         per[r.coefficient].append(r)
     out: list[FlaggedRegion] = []
     while any(per.values()):
@@ -338,7 +353,7 @@ def _suggestion(rank: int, ctx: Context, prio: float, gi: int, kind: str, contro
               f"(1-g trim, alpha {fc['alpha_deg']:.1f} deg); excites the {mode_txt}; expected peaks "
               f"p {ex['p_max_dps']:.0f}, q {ex['q_max_dps']:.0f}, r {ex['r_max_dps']:.0f} deg/s, "
               f"alpha {ex['alpha_max_deg']:.1f} deg, {ex['n_min']:.2f}-{ex['n_max']:.2f} g; "
-              f"expected variance reduction {100 * mean_red:.0f} %")
+              f"expected variance reduction {_pct(mean_red)}")
     notes = list(dsg["notes"])
     if dsg["out_of_reach"]:
         notes.insert(0, dsg["out_of_reach"])

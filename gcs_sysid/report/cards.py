@@ -51,7 +51,8 @@ def card_fields(s) -> list[tuple[str, str]]:
     region = s.region.get("description") or ", ".join(s.region.get("axes", []))
     out.append(("why", f"{', '.join(s.coefficients)} poorly known at {region} "
                        f"(sigma {s.region.get('mean_rel_sigma', float('nan')):.2f} x spread)"))
-    out.append(("will reduce", ", ".join(f"{c} variance by {100 * v:.0f} %" for c, v in s.reductions.items())
+    pct = lambda v: f"{100 * v:.2g} %" if v < 0.1 else f"{100 * v:.0f} %"  # noqa: E731
+    out.append(("will reduce", ", ".join(f"{c} variance by {pct(v)}" for c, v in s.reductions.items())
                 + " in that region (model's own estimate)"))
     for n in s.notes:
         out.append(("note", n))

@@ -143,7 +143,8 @@ def suggestion_rows(r: ReplayResult) -> list[dict[str, str]]:
                      "peak p/q/r (deg/s)": "/".join(f"{s.expected[k]:.0f}" for k in ("p_max_dps", "q_max_dps", "r_max_dps"))
                      if s.expected else "-",
                      "load factor (g)": f"{s.expected['n_min']:.2f}-{s.expected['n_max']:.2f}" if s.expected else "-",
-                     "expected variance reduction": f"{100 * s.expected_reduction:.0f} %"})
+                     "expected variance reduction": (f"{100 * s.expected_reduction:.2g} %" if s.expected_reduction < 0.1
+                                                     else f"{100 * s.expected_reduction:.0f} %")})
     return rows
 
 
