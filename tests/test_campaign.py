@@ -52,10 +52,9 @@ def _check(doc):
     return acc
 
 
-@pytest.mark.slow
 def test_campaign_fast(tmp_path):
     """One seed, two flights per arm, small GP: the first acceptance check and the limits, end to end
-    (about 60 s on an idle 2-core machine: slow-marked, as the default suite's budget is shared)."""
+    (about 30 s on the 2-core machine)."""
     cfg = CampaignConfig(flights=2, seeds=(1,), max_suggestions=2, n_inducing=16, gp_steps=20, local=False)
     doc = run_campaign(AIRFRAME, TRUTH, tmp_path, cfg, progress=None)
     _check(doc)
