@@ -24,7 +24,7 @@ acting along body x through the CG.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -38,6 +38,7 @@ __all__ = [
     "Servo",
     "Throttle",
     "ThrustModel",
+    "Limits",
     "Airframe",
     "load_airframe",
     "airframe_from_dict",
@@ -141,6 +142,42 @@ def _array_module(*xs):
 
 
 @dataclass(frozen=True)
+class Limits:
+    """Flight and surface limits that no suggested maneuver may exceed (the airframe's ``[limits]``).
+
+    Every field is optional in the file; a missing one is None here and is filled in from the flown
+    envelope by :func:`gcs_sysid.maneuvers.limits.effective_limits` (which says so).
+
+    Attributes:
+        V_min, V_max: airspeed range, m/s (true airspeed).
+        n_max: largest load factor, g (positive; the push-over side is limited to ``2 - n_max``).
+        alpha_max: largest angle of attack, rad.
+        throw: control -> largest deflection from neutral a maneuver may command, rad.
+        rate: control -> largest surface rate, rad/s.
+    """
+
+    V_min: float | None = None
+    V_max: float | None = None
+    n_max: float | None = None
+    alpha_max: float | None = None
+    throw: Mapping[str, float] = field(default_factory=dict)
+    rate: Mapping[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The file's ``[limits]`` table (degrees at the edge), missing fields left out."""
+        d: dict[str, Any] = {}
+        for key, v, scale in (("V_min_mps", self.V_min, 1.0), ("V_max_mps", self.V_max, 1.0),
+                              ("n_max", self.n_max, 1.0), ("alpha_max_deg", self.alpha_max, 180 / math.pi)):
+            if v is not None:
+                d[key] = float(v) * scale
+        if self.throw:
+            d["throw_deg"] = {k: math.degrees(v) for k, v in self.throw.items()}
+        if self.rate:
+            d["rate_dps"] = {k: math.degrees(v) for k, v in self.rate.items()}
+        return d
+
+
+@dataclass(frozen=True)
 class Airframe:
     """Mass properties, reference geometry, servos and thrust of one aircraft.
 
@@ -156,6 +193,7 @@ class Airframe:
         imu_lever_arm: IMU position relative to the CG in body axes, m, shape (3,).
         source: path of the file it was read from ("" if built in code).
         notes: free-text provenance of the values.
+        limits: the ``[limits]`` table (:class:`Limits`), or None when the file has none.
     """
 
     name: str
@@ -173,6 +211,13 @@ class Airframe:
     imu_lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
     source: str = ""
     notes: str = ""
+    limits: Limits | None = None
+
+    @property
+    def authority(self) -> dict[str, float]:
+        """Control -> largest deflection (rad) the servos can give that control both ways (mixing x limits)."""
+        return {cn: float(sum(abs(s.mix.get(cn, 0.0)) * min(-s.limit_min, s.limit_max) for s in self.servos))
+                for cn in CONTROLS}
 
     @property
     def inertia(self) -> np.ndarray:
@@ -267,7 +312,7 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
             the message names the file and the field.
     """
     src = source
-    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes"}
+    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes", "limits"}
     for k in doc:
         if k not in known:
             raise InputError(f"{src}: unknown top-level field '{k}' (expected one of {sorted(known)})")
@@ -369,8 +414,53 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     notes = doc.get("notes", "")
     if not isinstance(notes, str):
         raise InputError(f"{src}: notes must be a string")
-    return Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
-                    tuple(float(x) for x in arm), source, notes)
+    af = Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
+                  tuple(float(x) for x in arm), source, notes)
+    if "limits" in doc:
+        af = replace(af, limits=_limits(doc["limits"], af, src))
+    return af
+
+
+def _limits(d: Any, af: Airframe, src: str) -> Limits:
+    """Parse and check the ``[limits]`` table against itself and the servos (docs/airframe.md)."""
+    if not isinstance(d, Mapping):
+        raise InputError(f"{src}: [limits] must be a table (V_min_mps, V_max_mps, n_max, alpha_max_deg, "
+                         f"throw_deg, rate_dps)")
+    known = {"V_min_mps", "V_max_mps", "n_max", "alpha_max_deg", "throw_deg", "rate_dps"}
+    for k in d:
+        if k not in known:
+            raise InputError(f"{src}: [limits] unknown field '{k}' (expected one of {', '.join(sorted(known))})")
+    val = {k: (_req(d, k, "[limits]", src, positive=True) if k in d else None)
+           for k in ("V_min_mps", "V_max_mps", "n_max", "alpha_max_deg")}
+    if val["V_min_mps"] is not None and val["V_max_mps"] is not None and not val["V_min_mps"] < val["V_max_mps"]:
+        raise InputError(f"{src}: [limits] V_min_mps ({val['V_min_mps']:g}) must be below V_max_mps "
+                         f"({val['V_max_mps']:g})")
+    if val["n_max"] is not None and not 1.0 < val["n_max"] <= 15.0:
+        raise InputError(f"{src}: [limits] n_max must lie in (1, 15] g (level flight is 1 g), got {val['n_max']:g}")
+    if val["alpha_max_deg"] is not None and not val["alpha_max_deg"] <= 40.0:
+        raise InputError(f"{src}: [limits] alpha_max_deg must lie in (0, 40] deg, got {val['alpha_max_deg']:g}")
+    auth = af.authority
+    per: dict[str, dict[str, float]] = {}
+    for key, unit in (("throw_deg", "deg"), ("rate_dps", "deg/s")):
+        t = d.get(key, {})
+        if not isinstance(t, Mapping):
+            raise InputError(f"{src}: [limits] {key} must be a table keyed by {', '.join(CONTROLS)}, "
+                             f"e.g. {key} = {{ delta_e = 15 }}")
+        per[key] = {}
+        for c, v in t.items():
+            if c not in CONTROLS:
+                raise InputError(f"{src}: [limits] {key} key '{c}' is not one of {', '.join(CONTROLS)}")
+            v = _req(t, c, f"[limits] {key}", src, positive=True)
+            if key == "throw_deg":
+                if auth[c] <= 0:
+                    raise InputError(f"{src}: [limits] throw_deg.{c} is given but no [[servo]] drives {c}")
+                if math.radians(v) > auth[c] + 1e-9:
+                    raise InputError(f"{src}: [limits] throw_deg.{c} = {v:g} deg exceeds the servos' travel "
+                                     f"({math.degrees(auth[c]):.1f} deg from limit_deg and mix)")
+            per[key][c] = math.radians(v)
+    alpha = val["alpha_max_deg"]
+    return Limits(val["V_min_mps"], val["V_max_mps"], val["n_max"],
+                  None if alpha is None else math.radians(alpha), per["throw_deg"], per["rate_dps"])
 
 
 def load_airframe(path: str | Path) -> Airframe:
@@ -407,4 +497,6 @@ def airframe_to_dict(a: Airframe) -> dict[str, Any]:
         d["thrust"] = {"T_static": a.thrust.T_static, "V_zero": a.thrust.V_zero, "exponent": a.thrust.exponent}
     if a.notes:
         d["notes"] = a.notes
+    if a.limits is not None:
+        d["limits"] = a.limits.to_dict()
     return d

@@ -73,6 +73,14 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", required=True, help="output directory")
     _window_args(d)
 
+    c = sub.add_parser("campaign", help="closed-loop campaign in the simulation: suggested vs standard flights")
+    c.add_argument("--airframe", required=True, help="airframe TOML with a [limits] table")
+    c.add_argument("--model", required=True, help="truth aerodynamic model TOML (docs/model-file.md)")
+    c.add_argument("--flights", type=int, default=4, help="flights per arm, the first standard (default 4)")
+    c.add_argument("--seeds", default="1", help="comma-separated seeds, one campaign each (default 1)")
+    c.add_argument("--out", required=True, help="output directory (campaign.json, campaign.md, campaign.png)")
+    c.add_argument("--refit", action="store_true", help="re-learn the GP after each flight instead of updating it")
+
     from .live.cli import add_listen_parser
 
     add_listen_parser(sub)
@@ -133,8 +141,14 @@ def _cmd_listen(a: argparse.Namespace) -> int:
     return cmd_listen(a)
 
 
+def _cmd_campaign(a: argparse.Namespace) -> int:
+    from .campaign import run_campaign_cli
+
+    return run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit)
+
+
 COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
-            "listen": _cmd_listen}
+            "listen": _cmd_listen, "campaign": _cmd_campaign}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -251,7 +251,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
             draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("suggest maneuvers", timings, bar):
-                suggestions = suggest_maneuvers(envelope, model, table, airframe)
+                gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
+                suggestions = suggest_maneuvers(envelope, model, table, airframe, heldout_error_pct=gate,
+                                                identifiable=ident)
             if suggestions:
                 draw("suggestions", "suggestions_figure", list(suggestions))
         metrics: dict[str, dict[str, float]] = {}
@@ -283,7 +285,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             vehicle=dict(flight.vehicle), window=(options.t_from, options.t_to),
             summaries=dict(flight.summaries), messages=dict(flight.messages), states=states, table=table,
             held_out=held, train=train, pred_mean=pred_mean, pred_sigma=pred_sigma, metrics=metrics,
-            identifiable=ident, envelope=envelope, suggestions=list(suggestions), gp_summary=gp_summary,
+            identifiable=ident, envelope=envelope, suggestions=suggestions, gp_summary=gp_summary,
             model_path=model_path, missing=list(states.missing),
             notes=list(flight.warnings) + list(states.notes) + list(table.notes) + notes, timings=timings,
         )

@@ -37,6 +37,7 @@ __all__ = [
     "relative_peak_factor",
     "duration_of",
     "waveform",
+    "check_amplitudes",
 ]
 
 #: Maneuver kinds understood by :func:`waveform` and :func:`duration_of`.
@@ -267,3 +268,29 @@ def waveform(kind: str, t: np.ndarray, start: float, amplitude: float, pulse_wid
             raise InputError("maneuver 'multisine' needs duration_s and band_hz = [f_low, f_high]")
         return multisine(t, start, duration, band, amplitude, n_inputs, index)
     raise InputError(f"unknown maneuver kind '{kind}' (expected one of {', '.join(KINDS)})")
+
+
+def check_amplitudes(maneuvers, authority: dict[str, float], where: str, airframe_name: str = "") -> None:
+    """Refuse inputs that ask a surface for more than its servos can give.
+
+    Args:
+        maneuvers: objects with ``controls`` (names) and ``amplitude`` (rad per control), e.g. the
+            ``maneuvers`` of a :class:`gcs_sysid.sim.Plan`.
+        authority: control -> travel in rad (:attr:`gcs_sysid.airframe.Airframe.authority`); controls
+            not in it (throttle) are not checked here.
+        where: the plan's name for the message. airframe_name: for the message.
+
+    Raises:
+        InputError: one line naming the maneuver, the control, the amplitude asked and the travel, or a
+            surface that no servo drives.
+    """
+    for i, m in enumerate(maneuvers):
+        for c, a in zip(m.controls, m.amplitude):
+            if c not in authority:
+                continue
+            w = f"{where}: [[maneuver]] #{i + 1}"
+            if authority[c] <= 0:
+                raise InputError(f"{w} excites {c}, but no servo of airframe '{airframe_name}' drives it")
+            if abs(a) > authority[c] + 1e-9:
+                raise InputError(f"{w} asks {c} for {np.degrees(abs(a)):.1f} deg, beyond the surface's travel of "
+                                 f"{np.degrees(authority[c]):.1f} deg (airframe '{airframe_name}': limit_deg x mix)")

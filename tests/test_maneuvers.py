@@ -92,10 +92,13 @@ def test_weakest_coefficients_first(setup, weak, strong):
     regs = [_region(env, c, ("alpha", "V"), slice(n - 4, n), slice(0, 4)) for c in weak + strong]
     scores = {**{c: 0.1 for c in weak}, **{c: 0.9 for c in strong}}
     e2 = dataclasses.replace(env, regions=regs, scores=scores)
-    sug = suggest_maneuvers(e2, model, tab, af)
+    sug = suggest_maneuvers(e2, model, tab, af, config=ManeuverConfig(targets=("CX", "CY", "CZ", "Cl", "Cm", "Cn")))
     assert sug[0].coefficients[0] in weak
     top_weak = sum(c in weak for c in sug[0].coefficients)
     assert top_weak >= 1 and sug[0].priority > sug[-1].priority
+    # by default the moment coefficients lead even when the forces are weaker
+    default = suggest_maneuvers(e2, model, tab, af)
+    assert default[0].coefficients[0] in ("Cl", "Cm", "Cn")
 
 
 def test_mode_frequency_sets_pulse_width(setup):
@@ -124,11 +127,14 @@ def test_no_rudder_uses_aileron_for_yaw(setup):
     tab, _, model, env, af = setup
     doc = airframe_to_dict(af)
     doc["servo"] = [s for s in doc["servo"] if s["name"] != "rudder"]
+    for k in ("throw_deg", "rate_dps"):
+        doc["limits"][k].pop("delta_r")
     flying_wing = airframe_from_dict(doc)
     n = len(env.slices[0].x_centers)
     e2 = dataclasses.replace(env, regions=[_region(env, "Cn", ("beta", "delta_r"), slice(n - 4, n), slice(n - 4, n))])
     sug = suggest_maneuvers(e2, model, tab, flying_wing)
-    assert sug and all(s.controls == ("delta_a",) for s in sug)
+    assert sug and all("delta_a" in s.controls and "delta_r" not in s.controls for s in sug)
+    assert any(s.controls == ("delta_a",) for s in sug)
 
 
 def test_batched_ranking_of_the_package_gp_equals_one_update_per_candidate():

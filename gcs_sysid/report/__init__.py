@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..result import ReplayResult
+from .cards import render_testcards_html, render_testcards_md, write_flynext_plan
 from .html import render_html
 from .markdown import render_markdown
 from .store import load_result, save_result
@@ -29,9 +30,10 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
         figures: figures drawn elsewhere, or jobs drawing them (see :func:`~gcs_sysid.report.html.render_html`).
 
     Returns:
-        name -> path for ``report.html``, ``summary.md``, ``coefficients.csv``, ``suggestions.json``
-        (keys ``html``, ``markdown``, ``csv``, ``suggestions``) and, with ``save``, ``result_json``
-        and ``result_npz``.
+        name -> path for ``report.html``, ``summary.md``, ``coefficients.csv``, ``suggestions.json``,
+        ``testcards.md``, ``testcards.html`` and, when there are suggestions, ``flynext_plan.toml``
+        (keys ``html``, ``markdown``, ``csv``, ``suggestions``, ``testcards_md``, ``testcards_html``,
+        ``plan``) and, with ``save``, ``result_json`` and ``result_npz``.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -39,7 +41,12 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
         "csv": write_csv(result, out / "coefficients.csv"),
         "suggestions": write_suggestions_json(result, out / "suggestions.json"),
         "markdown": render_markdown(result, out / "summary.md"),
+        "testcards_md": render_testcards_md(result, out / "testcards.md"),
+        "testcards_html": render_testcards_html(result, out / "testcards.html"),
     }
+    plan = write_flynext_plan(result, out / "flynext_plan.toml")
+    if plan is not None:
+        files["plan"] = plan
     if save:
         files.update(save_result(result, out / "result"))
     files["html"] = render_html(result, out / "report.html", figures)   # last: figures may still be drawing

@@ -8,13 +8,14 @@ from pathlib import Path
 
 from ..result import ReplayResult
 from . import tables
+from .cards import CARDS_CSS, cards_html, context_of, group_rows
 
 __all__ = ["render_html", "SECTIONS"]
 
 #: (anchor, title) of the page's sections, in order.
-SECTIONS = (("summary", "Summary"), ("notes", "What is missing / notes"), ("data", "Data"),
+SECTIONS = (("flynext", "Fly next"), ("summary", "Summary"), ("notes", "What is missing / notes"), ("data", "Data"),
             ("states", "States"), ("coefficients", "Coefficients"), ("errors", "Held-out error"),
-            ("model", "GP model"), ("envelope", "Envelope confidence"), ("regions", "Flagged regions"),
+            ("model", "GP model"), ("envelope", "Envelope confidence"), ("regions", "Flagged regions, grouped by fix"),
             ("suggestions", "Maneuver suggestions"))
 
 _CSS = """
@@ -36,6 +37,7 @@ img{max-width:100%;height:auto;display:block;margin:8px 0}
 .bad{color:#b30000;font-weight:600}.good{color:#1b7a3a;font-weight:600}
 ol.reasons li{margin:6px 0;font-size:13px}
 """
+_CSS += CARDS_CSS
 
 
 def _img(data: bytes, alt: str) -> str:
@@ -125,9 +127,20 @@ def _suggestions(r: ReplayResult, fig) -> str:
     return (_table(tables.suggestion_rows(r)) + "<h3>Why</h3>" + f'<ol class="reasons" style="list-style:none;padding-left:0">{reasons}</ol>'
             + "<h3>Input waveforms (deviation from trim)</h3>" + _img(fig("suggestions"), "waveforms")
             + '<p class="muted">Amplitudes keep the response near-linear (target alpha, q, p, beta excursions) '
-              'within the surface travel; pulse widths follow the mode frequencies (doublet 2.3/w_n, 3-2-1-1 '
+              'and inside the limits (alpha_max, load factor, throw, surface rate); pulse widths follow the mode frequencies (doublet 2.3/w_n, 3-2-1-1 '
               '1.6/w_n, Jategaonkar 2006 sec. 2.5). Expected reduction: predictive variance at the region\'s '
               'points after adding the simulated maneuver, relative to now.</p>')
+
+
+def _regions(r: ReplayResult) -> str:
+    groups = group_rows(context_of(r))
+    if groups:
+        return ("<p>Flagged regions (coefficient x location, the quality-gated coefficients left out) grouped by "
+                "the input that would fix them; rates in deg/s at the group's airspeed.</p>" + _table(groups)
+                + f'<p class="muted">{len(r.envelope.regions)} regions in all, each in suggestions.json.</p>')
+    return _table(tables.region_rows(r), "no regions flagged") + (
+        f'<p class="muted">{len(r.envelope.regions)} regions (coefficient x location) in all; the most uncertain '
+        'locations are shown, all are in suggestions.json.</p>' if r.envelope is not None else "")
 
 
 def render_html(r: ReplayResult, path: Path, figures: dict | None = None) -> Path:
@@ -154,6 +167,7 @@ def render_html(r: ReplayResult, path: Path, figures: dict | None = None) -> Pat
             + "<h3>Messages in the log</h3>"
             + _table([{"message": k, "count": tables.fmt(v)} for k, v in msgs[:40]], "no messages counted"))
     body = {
+        "flynext": cards_html(r),
         "summary": _kv(tables.facts(r)),
         "notes": _notes(r),
         "data": data,
@@ -166,9 +180,7 @@ def render_html(r: ReplayResult, path: Path, figures: dict | None = None) -> Pat
                   + _table(tables.error_rows(r)),
         "model": _model(r, fig),
         "envelope": _envelope(r, fig),
-        "regions": _table(tables.region_rows(r), "no regions flagged")
-        + (f'<p class="muted">{len(r.envelope.regions)} regions (coefficient x location) in all; the most uncertain '
-           'locations are shown, all are in suggestions.json.</p>' if r.envelope is not None else ""),
+        "regions": _regions(r),
         "suggestions": _suggestions(r, fig),
     }
     nav = "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t in SECTIONS)

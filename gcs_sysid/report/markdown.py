@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..result import ReplayResult
 from . import tables
+from .cards import cards_markdown, context_of, group_rows
 
 __all__ = ["render_markdown"]
 
@@ -25,7 +26,8 @@ def _table(rows: list[dict[str, str]], empty: str = "none") -> str:
 
 def render_markdown(r: ReplayResult, path: Path) -> Path:
     """Write summary.md for ``r`` to ``path``."""
-    L = [f"# gcs-sysid replay: {Path(r.log_path).name}", "", "## Summary", ""]
+    L = [f"# gcs-sysid replay: {Path(r.log_path).name}", "", "## Fly next", ""] + cards_markdown(r, level=2)
+    L += ["## Summary", ""]
     L += [f"- **{k}**: {_esc(v)}" for k, v in tables.facts(r)]
     L += ["", "## What is missing / notes", ""]
     bad = [f"{c}: {why}" for c, (ok, why) in r.identifiable.items() if not ok]
@@ -43,7 +45,9 @@ def render_markdown(r: ReplayResult, path: Path) -> Path:
     if ls:
         L += ["", _table(ls)]
     L += ["", "## Envelope confidence", "", _table(tables.score_rows(r), "no confidence map")]
-    L += ["## Flagged regions", "", _table(tables.region_rows(r), "no regions flagged")]
+    groups = group_rows(context_of(r))
+    L += ["## Flagged regions, grouped by fix", "",
+          _table(groups) if groups else _table(tables.region_rows(r), "no regions flagged")]
     L += ["## Maneuver suggestions", "", _table(tables.suggestion_rows(r), "no suggestions")]
     L += [f"{s.rank}. {_esc(s.reason)}" for s in r.suggestions]
     path.write_text("\n".join(L) + "\n", encoding="utf-8")

@@ -18,7 +18,7 @@ from ..aero.table import CoefficientTable
 from ..envelope import EnvelopeMap
 from ..errors import InputError
 from ..estimation.states import FlightStates
-from ..maneuvers import Suggestion
+from ..maneuvers import Suggestion, SuggestionList
 from ..result import ReplayResult
 from ..telemetry.types import StreamSummary
 
@@ -94,7 +94,8 @@ def save_result(result: ReplayResult, path: str | Path) -> dict[str, Path]:
         "messages": result.messages, "metrics": result.metrics,
         "identifiable": {k: [bool(v[0]), str(v[1])] for k, v in result.identifiable.items()},
         "envelope": result.envelope.to_dict() if result.envelope is not None else None,
-        "suggestions": [s.to_dict() for s in result.suggestions], "gp_summary": result.gp_summary,
+        "suggestions": [s.to_dict() for s in result.suggestions],
+        "suggestion_context": getattr(result.suggestions, "context", {}), "gp_summary": result.gp_summary,
         "model_path": result.model_path, "missing": result.missing, "notes": result.notes,
         "timings": result.timings,
         "states": {"rate_hz": st.rate_hz, "sources": st.sources, "missing": st.missing, "notes": st.notes},
@@ -146,7 +147,8 @@ def load_result(path: str | Path) -> ReplayResult:
         states=states, table=table, held_out=a["held_out"].astype(bool), train=a["train"].astype(bool),
         pred_mean=a["pred_mean"], pred_sigma=a["pred_sigma"], metrics=metrics,
         identifiable={k: (bool(v[0]), str(v[1])) for k, v in doc["identifiable"].items()}, envelope=env,
-        suggestions=[Suggestion.from_dict(s) for s in doc["suggestions"]], gp_summary=dict(doc["gp_summary"]),
+        suggestions=SuggestionList([Suggestion.from_dict(s) for s in doc["suggestions"]],
+                                   doc.get("suggestion_context") or {}), gp_summary=dict(doc["gp_summary"]),
         model_path=doc["model_path"], missing=list(doc["missing"]), notes=list(doc["notes"]),
         timings={k: _nan(v) for k, v in doc["timings"].items()},
     )

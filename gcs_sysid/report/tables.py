@@ -140,7 +140,11 @@ def suggestion_rows(r: ReplayResult) -> list[dict[str, str]]:
                      "amplitude (deg)": ", ".join(f"{math.degrees(a):.1f}" for a in s.amplitudes_rad.values()),
                      "pulse (s)": "-" if s.kind == "multisine" else fmt(s.pulse_width_s, 2), "duration (s)": fmt(s.duration_s, 1),
                      "V (m/s)": fmt(fc.get("V"), 1), "alpha (deg)": fmt(fc.get("alpha_deg"), 1),
-                     "expected variance reduction": f"{100 * s.expected_reduction:.0f} %"})
+                     "peak p/q/r (deg/s)": "/".join(f"{s.expected[k]:.0f}" for k in ("p_max_dps", "q_max_dps", "r_max_dps"))
+                     if s.expected else "-",
+                     "load factor (g)": f"{s.expected['n_min']:.2f}-{s.expected['n_max']:.2f}" if s.expected else "-",
+                     "expected variance reduction": (f"{100 * s.expected_reduction:.2g} %" if s.expected_reduction < 0.1
+                                                     else f"{100 * s.expected_reduction:.0f} %")})
     return rows
 
 
@@ -198,6 +202,7 @@ def write_suggestions_json(r: ReplayResult, path: Path) -> Path:
         "suggestions": [s.to_dict() for s in r.suggestions],
         "regions": [g.to_dict() for g in env.regions] if env is not None else [],
         "not_identified": {c: why for c, (ok, why) in r.identifiable.items() if not ok},
+        **{k: v for k, v in (getattr(r.suggestions, "context", None) or {}).items()},
     }
     path.write_text(json.dumps(jsonable(doc), indent=1, allow_nan=False))
     return path

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..airframe import load_airframe
+from ..signals import check_amplitudes
 from .model_file import load_model
 from .plan import load_plan
 from .flight import SimResult, simulate
@@ -29,12 +30,14 @@ def run_simulate(airframe_path: str | Path, model_path: str | Path, plan_path: s
         the :class:`SimResult`.
 
     Raises:
-        InputError: a file is missing or malformed (one line naming the file and field).
+        InputError: a file is missing or malformed (one line naming the file and field), or a
+            maneuver asks a surface for more than its travel.
         DataError: the aircraft cannot be trimmed at a setpoint of the plan.
     """
     airframe = load_airframe(airframe_path)
     model = load_model(model_path)
     plan = load_plan(plan_path)
+    check_amplitudes(plan.maneuvers, airframe.authority, plan.source or str(plan_path), airframe.name)
     result = simulate(airframe, model, plan, seed=seed)
     write_tlog(result, out_path, airframe)
     if truth_path is not None:
