@@ -137,6 +137,15 @@ def _faults_section(findings: list[dict], summary: dict | None) -> str:
     return "\n".join(out)
 
 
+def _search_section(search: list[dict]) -> str:
+    """What the wide-library search adds to each coefficient (terms by block PRESS, gain held out)."""
+    out = ["<h2>Beyond the catalogue: wide-library search (block PRESS on training rows, gain held out)</h2>"]
+    rows = [[e["coefficient"], ", ".join(f"{x['term']} = {x['estimate']:.4g} +- {x['std_error']:.2g}" for x in e["terms"])
+             or "nothing", _f(e["held_out"]["percent"], "{:.0f} %"), e["n_candidates"]] for e in search]
+    out.append(_table(rows, ["coefficient", "terms selected", "held-out gain", "candidates"]))
+    return "\n".join(out)
+
+
 def render_html(d) -> str:
     """The report as an HTML string (all images inline)."""
     data = d.data
@@ -165,6 +174,8 @@ def render_html(d) -> str:
                      "<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])
                      + "</pre></body></html>")
         return "\n".join(parts)
+    if data.get("search") is not None:
+        parts.append(_search_section(data["search"]))
     parts.append("<h2>Equation error on held-out data (per coefficient)</h2>")
     ee = data["equation_error"]
     parts.append(_table([[c, _f(ee[c]["rms_before"]), _f(ee[c]["rms_after"]), _f(ee[c]["percent"], "{:.0f} %")]
