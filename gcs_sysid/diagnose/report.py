@@ -132,6 +132,9 @@ def _faults_section(findings: list[dict], summary: dict | None) -> str:
             [[c["control"], c["channel"], _f(c.get("pwm_frozen_us"), "{:.0f}"), _f(c["frozen_from_s"], "{:.1f}"),
               _f(c["frozen_to_s"], "{:.1f}"), "yes" if c["accepted"] else "no", c["why"]] for c in summary["checked"]],
             ["control", "channel", "PWM (us)", "from (s)", "to (s)", "fault", "why"]))
+    for r in summary.get("coefficient_stuck_rejected", []):
+        out.append(f"<p>Set aside: {html.escape(r['cause'])} from {r['onset_s']:.1f} s in the coefficients: "
+                   f"{html.escape(r['why'])}.</p>")
     for m in summary.get("missing", []):
         out.append(f"<p class='warn'>Missing: {html.escape(m)}</p>")
     return "\n".join(out)

@@ -238,25 +238,41 @@ def test_sim_clean_log_has_no_fault(sim_logs):
     assert faults == [] and summary["missing"] == []
 
 
-def test_diagnose_cli_reports_the_fault(sim_logs, tmp_path):
-    """simulate -> tlog (PARAM_VALUE / STATUSTEXT stripped) -> ``gcs-sysid diagnose`` -> diagnosis.json and report."""
-    from gcs_sysid.cli import main
-
-    path, _ = sim_logs("delta_e", 80.0)
-    stripped = tmp_path / "stripped.tlog"
-    counts = strip_tlog(path, stripped)
-    assert counts["PARAM_VALUE"] > 0 and counts["STATUSTEXT"] > 0 and counts["kept"] > 1000
-    assert main(["diagnose", str(stripped), "--airframe", str(AIRFRAME), "--model", str(MODEL),
-                 "--out", str(tmp_path / "diag"), "--from", "50"]) == 0
-    doc = json.loads((tmp_path / "diag" / "diagnosis.json").read_text())
+def _check_diagnosis_dir(out):
+    doc = json.loads((out / "diagnosis.json").read_text())
     faults = [f for f in doc["findings"] if f.get("kind") == "fault"]
     assert [f["cause"] for f in faults] == ["stuck:delta_e"]
     assert doc["findings"][0]["cause"] == "stuck:delta_e"                 # faults are listed first
     assert faults[0]["onset_s"] == pytest.approx(80.0, abs=0.1)
     assert faults[0]["evidence"]["channels"] == [2]
     assert doc["data"]["faults"]["checked"]
-    html = (tmp_path / "diag" / "report.html").read_text()
+    html = (out / "report.html").read_text()
     assert "stuck:delta_e" in html and "Actuator and engine faults" in html
+
+
+def test_diagnose_reports_the_fault(sim_logs, tmp_path):
+    """simulate -> tlog (PARAM_VALUE / STATUSTEXT stripped) -> run_diagnose -> diagnosis.json and report."""
+    from gcs_sysid.diagnose.run import run_diagnose
+
+    path, _ = sim_logs("delta_e", 80.0)
+    stripped = tmp_path / "stripped.tlog"
+    counts = strip_tlog(path, stripped)
+    assert counts["PARAM_VALUE"] > 0 and counts["STATUSTEXT"] > 0 and counts["kept"] > 1000
+    run_diagnose(stripped, AIRFRAME, MODEL, tmp_path / "diag", t_from=50.0, output_error=False)
+    _check_diagnosis_dir(tmp_path / "diag")
+
+
+@pytest.mark.slow
+def test_diagnose_cli_reports_the_fault(sim_logs, tmp_path):
+    """The same through ``gcs-sysid diagnose`` as a user runs it (output error included)."""
+    from gcs_sysid.cli import main
+
+    path, _ = sim_logs("delta_e", 80.0)
+    stripped = tmp_path / "stripped.tlog"
+    strip_tlog(path, stripped)
+    assert main(["diagnose", str(stripped), "--airframe", str(AIRFRAME), "--model", str(MODEL),
+                 "--out", str(tmp_path / "diag"), "--from", "50"]) == 0
+    _check_diagnosis_dir(tmp_path / "diag")
 
 
 def test_strip_keeps_everything_else(sim_logs, tmp_path):
