@@ -289,3 +289,17 @@ def test_strip_keeps_everything_else(sim_logs, tmp_path):
             assert np.array_equal(v, after[name][k], equal_nan=True)
     with pytest.raises(InputError, match="no such tlog"):
         strip_tlog(tmp_path / "missing.tlog", tmp_path / "x.tlog")
+
+
+def test_plan_effects_disable_round_trip():
+    from gcs_sysid.sim.effects import Effects, effects_from_dict
+
+    e = effects_from_dict({"disable_s": {"delta_r": 70.0, "delta_t": 90.0}, "disable_at": {"delta_r": 0.3}})
+    assert e.disable == (INF, INF, 70.0, 90.0) and e.disable_at == (0.0, 0.0, 0.3, 0.0)
+    assert e.causes() == ["stuck:delta_r", "thrust_loss"]
+    assert effects_from_dict(e.to_dict()) == e
+    assert Effects().causes() == []
+    with pytest.raises(InputError, match="disable_at needs disable_s"):
+        effects_from_dict({"disable_at": {"delta_e": 0.1}})
+    with pytest.raises(InputError, match="disable_s key 'aileron'"):
+        effects_from_dict({"disable_s": {"aileron": 3.0}})
