@@ -303,3 +303,15 @@ def test_plan_effects_disable_round_trip():
         effects_from_dict({"disable_at": {"delta_e": 0.1}})
     with pytest.raises(InputError, match="disable_s key 'aileron'"):
         effects_from_dict({"disable_s": {"aileron": 3.0}})
+
+
+def test_too_few_rows_for_coefficients_still_reports_faults(sim_logs, tmp_path):
+    """A log too short for the coefficient-level diagnosis gets a partial one with its faults."""
+    from gcs_sysid.diagnose.run import run_diagnose
+
+    path, _ = sim_logs("delta_e", 80.0)
+    d = run_diagnose(path, AIRFRAME, MODEL, tmp_path / "diag", t_from=60.0, min_rows=100_000)
+    assert [f["cause"] for f in d.findings] == ["stuck:delta_e"]
+    doc = json.loads((tmp_path / "diag" / "diagnosis.json").read_text())
+    assert doc["data"]["coefficient_diagnosis"].startswith("not run:") and doc["unexplained"] == []
+    assert "Coefficient-level diagnosis not run" in (tmp_path / "diag" / "report.html").read_text()
