@@ -315,3 +315,20 @@ def test_too_few_rows_for_coefficients_still_reports_faults(sim_logs, tmp_path):
     doc = json.loads((tmp_path / "diag" / "diagnosis.json").read_text())
     assert doc["data"]["coefficient_diagnosis"].startswith("not run:") and doc["unexplained"] == []
     assert "Coefficient-level diagnosis not run" in (tmp_path / "diag" / "report.html").read_text()
+
+
+@pytest.mark.slow
+def test_surface_off_its_servo_is_not_set_aside(tmp_path):
+    """The older stuck mode (the servo keeps moving, the surface does not): found in the coefficients, kept."""
+    from diag_flights import effects
+
+    from gcs_sysid.diagnose.run import run_diagnose
+    from gcs_sysid.sim import load_model, plan_from_dict, simulate, write_tlog
+
+    af = load_airframe(AIRFRAME)
+    r = simulate(af, load_model(MODEL), plan_from_dict(plan_doc(duration=96.0, seed=11)),
+                 effects=effects("stuck:delta_a", 70.0))
+    write_tlog(r, tmp_path / "stuck.tlog", af)
+    d = run_diagnose(tmp_path / "stuck.tlog", AIRFRAME, MODEL, tmp_path / "diag", output_error=False)
+    assert d.findings[0]["cause"] == "stuck:delta_a" and d.findings[0].get("kind") != "fault"
+    assert not d.data["faults"].get("coefficient_stuck_rejected")
