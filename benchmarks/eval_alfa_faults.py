@@ -115,7 +115,7 @@ def main() -> int:
                     run_fit(ref, args.airframe, models[ref])
                 stripped = tmp / f"stripped-{log.name}"
                 row["stripped"] = strip_tlog(log, stripped)
-                d = run_diagnose(stripped, args.airframe, models[ref], tmp / f"diag-{log.stem}")
+                run_diagnose(stripped, args.airframe, models[ref], tmp / f"diag-{log.stem}")
                 doc = json.loads((tmp / f"diag-{log.stem}" / "diagnosis.json").read_text())
             except SysidError as e:
                 row.update(error=str(e), passed=False)
