@@ -71,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--airframe", required=True)
     d.add_argument("--model", required=True, help="the simulation's aerodynamic model TOML file")
     d.add_argument("--out", required=True, help="output directory")
+    d.add_argument("--search", action="store_true", help="also search a wide term library (docs/diagnose.md)")
     _window_args(d)
 
     c = sub.add_parser("campaign", help="closed-loop campaign in the simulation: suggested vs standard flights")
@@ -129,7 +130,7 @@ def _cmd_fit(a: argparse.Namespace) -> int:
 def _cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnose import run_diagnose
 
-    diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to)
+    diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to, search=a.search)
     findings = diag.get("findings", []) if isinstance(diag, dict) else getattr(diag, "findings", [])
     print(f"wrote {Path(a.out) / 'diagnosis.json'}: {len(findings)} finding(s)")
     return 0

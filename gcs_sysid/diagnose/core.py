@@ -22,8 +22,10 @@ from ..aero.table import COEFFICIENTS, CoefficientTable
 from ..airframe import Airframe
 from ..errors import DataError
 from .candidates import Fitted, Scorer, fit_aero_terms, fit_delays, fit_sensor_causes, fit_stuck
-from .context import DiagContext, ModelDict
+from .context import DiagContext, ModelDict, model_as_dict
 from .evidence import maneuver_for, unexplained_report
+from .fault_merge import merge_faults, set_aside_answering
+from .faults import FaultThresholds, detect_faults
 from .regression import ols
 from .turbulence import gust_projector
 from .terms import term_matrix
@@ -135,6 +137,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
              max_findings: int = 3, min_score: float = 30.0, min_gain_pct: float = 10.0,
              min_rows: int = 500, unexplained_threshold_pct: float = 20.0, output_error: bool = True,
              min_gain_oe_pct: float = 45.0, project_gusts: bool = True, flight=None,
+             fault_thresholds: FaultThresholds | None = None, search: bool = False,
              progress=None) -> Diagnosis:
     """Hold a model against measured coefficients, name the cause(s), extend the model.
 
@@ -159,19 +162,28 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             scoring (:mod:`gcs_sysid.diagnose.turbulence`; only when the data show them).
         flight: the decoded flight behind ``states``; with it the sensor causes (air data, pitot,
             gyro, accelerometer) are judged by data compatibility (:mod:`gcs_sysid.diagnose.compat`)
-            instead of in the coefficients.
+            instead of in the coefficients, and actuator / engine faults are read from the servo
+            outputs against the autopilot's demand (:mod:`gcs_sysid.diagnose.faults`; findings with
+            ``kind = "fault"``, listed first).
+        fault_thresholds: thresholds of the fault detection (default: the frozen ones).
+        search: also search a wide candidate library for what each coefficient's residual still needs
+            (:mod:`gcs_sysid.diagnose.search`: forward stepwise by block PRESS on the training rows, gain
+            measured once on the held-out rows); reported in ``data["search"]``, never as a named cause.
         progress: optional callable ``progress(message)``.
 
     Returns:
         :class:`Diagnosis`.
 
     Raises:
-        DataError: too few valid rows, or no held-out rows.
+        DataError: too few valid rows, or no held-out rows (with ``flight``, a partial diagnosis with
+            the telemetry faults only is returned instead, ``data["coefficient_diagnosis"]`` saying why).
     """
     t0 = time.perf_counter()
     say = progress or (lambda msg: None)
     ctx = DiagContext.build(table, airframe, model, states, train, test)
     if ctx.valid.sum() < min_rows or ctx.train.sum() < min_rows // 2 or ctx.test.sum() < min_rows // 4:
+        if flight is not None:                # the telemetry faults need no coefficients: a partial result
+            return _faults_only(ctx, model, flight, airframe, fault_thresholds, min_rows, t0)
         raise DataError(f"diagnose: {int(ctx.valid.sum())} valid rows ({int(ctx.train.sum())} training, "
                         f"{int(ctx.test.sum())} held out); need at least {min_rows} (about "
                         f"{min_rows / 50:.0f} s at 50 Hz of flight with excitation)")
@@ -236,9 +248,19 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             gust = {n: e[:, i] for i, n in enumerate(proj.names)}
         compat = _compat_findings(ctx, flight, states, airframe, min_score, min_gain_pct, gust)
         findings += [c for c in compat if c["accepted"]]
+    fault_summary = None
+    if flight is not None:
+        say("diagnose: actuator and engine faults in the telemetry")
+        faults, fault_summary = detect_faults(flight, airframe, fault_thresholds)
+        findings, rejected = set_aside_answering(ctx, findings, faults)
+        if rejected:
+            fault_summary["coefficient_stuck_rejected"] = rejected
+        findings = merge_faults(findings, faults)
     for f in findings:
         f.pop("accepted", None)
-    findings.sort(key=lambda d: d["gain"].get("percent", 0.0), reverse=True)
+    # faults seen in the telemetry first (by onset), then the causes by held-out gain
+    findings.sort(key=lambda d: (d.get("kind") != "fault", d.get("onset_s", 0.0) if d.get("kind") == "fault"
+                                 else -d["gain"].get("percent", 0.0)))
     P = proj if proj is not None else (lambda D: D)
     unexplained = unexplained_report(ctx, P(R), threshold_pct=unexplained_threshold_pct)
     separation = []
@@ -270,6 +292,15 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         "notes": list(ctx.notes) + list(getattr(table, "notes", [])),
         "timings": {"diagnose_s": float(time.perf_counter() - t0)},
     }
+    if fault_summary is not None:
+        data["faults"] = fault_summary
+    if search:
+        from .search import search_residual
+
+        say("diagnose: searching the wide candidate library")
+        t1 = time.perf_counter()
+        data["search"] = search_residual(ctx, R)
+        data["timings"]["search_s"] = float(time.perf_counter() - t1)
     if compat:
         data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],
                                       "gain_percent": c["gain"]["percent"]} for c in compat]
@@ -286,6 +317,23 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)
     return diag
+
+
+def _faults_only(ctx: DiagContext, model, flight, airframe, thresholds, min_rows: int, t0: float) -> Diagnosis:
+    """Partial diagnosis when the coefficient table is too short: the telemetry faults only."""
+    faults, summary = detect_faults(flight, airframe, thresholds)
+    why = (f"not run: {int(ctx.valid.sum())} valid rows ({int(ctx.train.sum())} training, {int(ctx.test.sum())} "
+           f"held out); need at least {min_rows} (about {min_rows / 50:.0f} s at 50 Hz of flight with excitation)")
+    tv = ctx.t[ctx.valid] if ctx.valid.any() else ctx.t
+    data = {"n_rows": int(len(ctx.t)), "n_valid": int(ctx.valid.sum()), "n_train": int(ctx.train.sum()),
+            "n_held_out": int(ctx.test.sum()), "t_range_s": [float(tv[0]), float(tv[-1])] if len(tv) else [0.0, 0.0],
+            "rate_hz": float(1.0 / np.median(np.diff(ctx.t))) if len(ctx.t) > 1 else 0.0,
+            "coefficient_diagnosis": why, "faults": summary, "separation": [], "notes": list(ctx.notes),
+            "timings": {"diagnose_s": float(time.perf_counter() - t0)}}
+    m0 = {c: dict(v) for c, v in model_as_dict(model).items()}
+    z = np.zeros((0, 6))
+    return Diagnosis(faults, [], data, m0, {c: dict(v) for c, v in m0.items()}, ctx.t[:0], ctx.X[:0], z, z,
+                     ctx.train[:0], ctx.test[:0])
 
 
 SENSOR_CAUSES = ("bias:airspeed", "scale:airspeed", "bias:alpha", "bias:beta", "bias:gyro_x", "bias:gyro_y",

@@ -8,7 +8,7 @@ from ..aero.table import COEFFICIENTS, REGRESSORS
 from .context import DiagContext
 from .terms import VOCABULARY, term_factors, term_matrix
 
-__all__ = ["unexplained_report", "maneuver_for", "noise_residual"]
+__all__ = ["unexplained_report", "maneuver_for", "noise_residual", "binned_structure"]
 
 _AXIS_MANEUVER = {
     "alpha": "elevator 3-2-1-1 or doublets at several airspeeds (vary alpha)",
@@ -98,18 +98,77 @@ def _structured_share(ctx: DiagContext, r: np.ndarray, A: np.ndarray, L: np.ndar
     return float(max(0.0, 1.0 - e1 / e0)) if e0 > 0 else 0.0
 
 
+def _bin_index(x: np.ndarray, ref: np.ndarray, n_bins: int) -> np.ndarray:
+    """Quantile-bin index (T,) of ``x`` with edges from ``ref`` (the training rows)."""
+    edges = np.quantile(ref, np.linspace(0, 1, n_bins + 1)[1:-1])
+    return np.searchsorted(edges, x, side="right")
+
+
+def binned_structure(ctx: DiagContext, r: np.ndarray, n_bins: int = 8, shrink: float = 10.0) -> dict:
+    """Structure of a residual that no polynomial needs to describe: held-out share predicted by cell means.
+
+    For every regressor and every pair of regressors, the valid rows are cut into quantile
+    cells (``n_bins`` per regressor, edges from the training rows); the residual's mean in
+    each cell, shrunk towards 0 by ``n / (n + shrink)``, is fitted on the training rows and
+    predicts the held-out rows. The best projection's share of the held-out residual
+    (``1 - SSE_after / SSE_before``) says how much of the residual is a function of the
+    flight condition, whatever its shape (a sin-shaped term, a hysteresis loop split by the
+    sign of a rate...), which a quadratic misses.
+
+    Args:
+        ctx: diagnosis context (regressors, training and held-out rows).
+        r: residual of one coefficient, (T,).
+        n_bins: cells per regressor. shrink: pseudo-count of the shrinkage.
+
+    Returns:
+        ``{"share": 0..1, "regressors": [names], "cell": {name: [lo, hi]}, "cell_mean": float}``
+        (alpha and beta ranges in degrees, with ``_deg`` appended to the name).
+    """
+    tr, te, v = ctx.train, ctx.test, ctx.valid
+    r = np.nan_to_num(r)
+    e0 = float(np.sum(r[te] ** 2))
+    best = {"share": 0.0, "regressors": [], "cell": {}, "cell_mean": 0.0}
+    if e0 <= 0 or tr.sum() < 4 * n_bins or te.sum() < n_bins:
+        return best
+    cols = [i for i in range(len(REGRESSORS)) if np.ptp(ctx.X[tr, i]) > 0]
+    idx = {i: _bin_index(np.nan_to_num(ctx.X[:, i]), ctx.X[tr, i], n_bins) for i in cols}
+    combos = [(i,) for i in cols] + [(i, j) for a, i in enumerate(cols) for j in cols[a + 1:]]
+    for combo in combos:
+        cell = np.zeros(len(r), int)
+        for i in combo:
+            cell = cell * n_bins + idx[i]
+        m = n_bins ** len(combo)
+        n = np.bincount(cell[tr], minlength=m)
+        mean = np.bincount(cell[tr], weights=r[tr], minlength=m) / np.maximum(n, 1) * (n / (n + shrink))
+        share = 1.0 - float(np.sum((r[te] - mean[cell[te]]) ** 2)) / e0
+        if share > best["share"]:
+            k = int(np.argmax(np.abs(mean) * (n >= shrink)))
+            where = {}
+            for pos, i in enumerate(combo):
+                b = (k // n_bins ** (len(combo) - 1 - pos)) % n_bins
+                x = ctx.X[v & (cell == k), i]
+                scale, name = (np.degrees(1.0), REGRESSORS[i] + "_deg") if REGRESSORS[i] in ("alpha", "beta") \
+                    else (1.0, REGRESSORS[i])
+                where[name] = [float(np.min(x) * scale), float(np.max(x) * scale)] if x.size else [float(b), float(b)]
+            best = {"share": share, "regressors": [REGRESSORS[i] for i in combo], "cell": where,
+                    "cell_mean": float(mean[k])}
+    return best
+
+
 def unexplained_report(ctx: DiagContext, R: np.ndarray, threshold_pct: float = 20.0,
                        min_size_pct: float = 2.0) -> list[dict]:
     """Per coefficient: size of the held-out residual and where it lives.
 
-    ``structured_percent`` is the share of the held-out residual variance a
-    quadratic in all regressors (ridge, fitted on the training rows) predicts;
+    ``structured_percent`` is the share of the held-out residual variance that a
+    quadratic in all regressors (ridge, fitted on the training rows) or cell means over
+    any one or two regressors (:func:`binned_structure`, for shapes no polynomial
+    follows) predict, whichever is larger;
     the entry is ``above_threshold`` when it reaches ``threshold_pct``, i.e. the
     residual is systematic, not noise, and that systematic part is at least
     ``min_size_pct`` percent of the RMS of the measured coefficient (smaller is
     below what a model of the coefficient is expected to reach). ``where`` gives the regressor most
     correlated with the residual, the alpha and V bins and the 5-s time window
-    with the largest RMS.
+    with the largest RMS; ``where["structure"]`` the projection and cell where the structure lives.
     """
     te = ctx.test
     out = []
@@ -121,7 +180,9 @@ def unexplained_report(ctx: DiagContext, R: np.ndarray, threshold_pct: float = 2
         y = ctx.Y[te, j]
         rms = float(np.sqrt(np.mean(r[te] ** 2)))
         rms_y = float(np.sqrt(np.mean(y**2)))
-        share = _structured_share(ctx, r, A, L)
+        share_q = _structured_share(ctx, r, A, L)
+        binned = binned_structure(ctx, r)
+        share = max(share_q, binned["share"])
         corr = {}
         for i, name in enumerate(REGRESSORS):
             x = ctx.X[te, i]
@@ -144,6 +205,9 @@ def unexplained_report(ctx: DiagContext, R: np.ndarray, threshold_pct: float = 2
             rmsw = np.sqrt(np.where(nw > 0, rw / nw, 0.0))
         w = int(np.argmax(rmsw))
         where["time_s"] = [float(ctx.t[0] + 5.0 * w), float(ctx.t[0] + 5.0 * (w + 1))]
+        where["structure"] = {"quadratic_percent": float(100 * share_q), "binned_percent": float(100 * binned["share"]),
+                              "regressors": binned["regressors"], "cell": binned["cell"],
+                              "cell_mean": binned["cell_mean"]}
         if not ctx.active[j]:
             out.append({"coefficient": coef, "rms": rms, "rms_measured": rms_y,
                         "percent_of_measured": float(100 * rms / rms_y) if rms_y > 0 else None,

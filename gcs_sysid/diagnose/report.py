@@ -110,7 +110,43 @@ def _table(rows, cols) -> str:
 
 
 def _f(x, fmt="{:.4g}"):
-    return fmt.format(x) if isinstance(x, (int, float)) and x is not None else str(x)
+    if x is None:
+        return ""
+    return fmt.format(x) if isinstance(x, (int, float)) else str(x)
+
+
+def _faults_section(findings: list[dict], summary: dict | None) -> str:
+    """Actuator and engine faults read from the telemetry: what was found, every frozen run looked at."""
+    out = ["<h2>Actuator and engine faults (servo outputs against the autopilot's demand)</h2>"]
+    if summary is None:
+        return out[0] + "<p>Not looked for (no decoded flight given).</p>"
+    faults = [f for f in findings if f.get("kind") == "fault"]
+    if faults:
+        out.append(_table([[f["cause"], ", ".join(map(str, f["evidence"].get("channels", []))), _f(f["onset_s"], "{:.2f}"),
+                            f.get("summary", "")] for f in faults],
+                          ["cause", "servo channel(s)", "onset (s)", "evidence"]))
+    else:
+        out.append("<p class='ok'>No servo output froze while the autopilot kept demanding.</p>")
+    if summary.get("checked"):
+        out.append("<p>Frozen runs looked at:</p>" + _table(
+            [[c["control"], c["channel"], _f(c.get("pwm_frozen_us"), "{:.0f}"), _f(c["frozen_from_s"], "{:.1f}"),
+              _f(c["frozen_to_s"], "{:.1f}"), "yes" if c["accepted"] else "no", c["why"]] for c in summary["checked"]],
+            ["control", "channel", "PWM (us)", "from (s)", "to (s)", "fault", "why"]))
+    for r in summary.get("coefficient_stuck_rejected", []):
+        out.append(f"<p>Set aside: {html.escape(r['cause'])} from {r['onset_s']:.1f} s in the coefficients: "
+                   f"{html.escape(r['why'])}.</p>")
+    for m in summary.get("missing", []):
+        out.append(f"<p class='warn'>Missing: {html.escape(m)}</p>")
+    return "\n".join(out)
+
+
+def _search_section(search: list[dict]) -> str:
+    """What the wide-library search adds to each coefficient (terms by block PRESS, gain held out)."""
+    out = ["<h2>Beyond the catalogue: wide-library search (block PRESS on training rows, gain held out)</h2>"]
+    rows = [[e["coefficient"], ", ".join(f"{x['term']} = {x['estimate']:.4g} +- {x['std_error']:.2g}" for x in e["terms"])
+             or "nothing", _f(e["held_out"]["percent"], "{:.0f} %"), e["n_candidates"]] for e in search]
+    out.append(_table(rows, ["coefficient", "terms selected", "held-out gain", "candidates"]))
+    return "\n".join(out)
 
 
 def render_html(d) -> str:
@@ -135,6 +171,14 @@ def render_html(d) -> str:
                      "data: no finding.</p>")
     for s in data.get("separation", []):
         parts.append(f"<p class='warn'>{html.escape(s)}</p>")
+    parts.append(_faults_section(d.findings, data.get("faults")))
+    if "coefficient_diagnosis" in data:
+        parts.append(f"<p class='warn'>Coefficient-level diagnosis {html.escape(data['coefficient_diagnosis'])}</p>"
+                     "<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])
+                     + "</pre></body></html>")
+        return "\n".join(parts)
+    if data.get("search") is not None:
+        parts.append(_search_section(data["search"]))
     parts.append("<h2>Equation error on held-out data (per coefficient)</h2>")
     ee = data["equation_error"]
     parts.append(_table([[c, _f(ee[c]["rms_before"]), _f(ee[c]["rms_after"]), _f(ee[c]["percent"], "{:.0f} %")]

@@ -135,8 +135,11 @@ def gust_projector(ctx: DiagContext, R: np.ndarray, iters: int = 4, min_ratio: f
     for _ in range(iters):
         w = act / sig**2
         GW = G * w[None, :, None]                                 # (T, 6, k)
-        A = np.einsum("tck,tcl->tkl", GW, G) + 1e-12 * np.eye(k)
-        Ainv = np.linalg.inv(A)
+        A = np.einsum("tck,tcl->tkl", GW, G)
+        A = np.where(np.isfinite(A), A, 0.0)
+        # relative ridge: rows where the loadings are (nearly) collinear or zero stay invertible
+        scale = np.trace(A, axis1=1, axis2=2)[:, None, None] / k
+        Ainv = np.linalg.inv(A + (1e-9 * scale + 1e-12) * np.eye(k))
         H = np.einsum("tkl,tcl->tkc", Ainv, GW)
         P = GustProjector(G, H, tr, True, sig, np.zeros(k), np.zeros(k), names)
         Rp = P(Rn)

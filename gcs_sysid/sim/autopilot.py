@@ -81,7 +81,9 @@ def autopilot_step(g: Gains, x, V, sp, ff, integ, held, openm, dt, lo, hi):
         dt: update interval s; lo, hi: (4,) command limits.
 
     Returns:
-        (commands (4,) before maneuver inputs, new integ (3,), new held (4,)).
+        (commands (4,) before maneuver inputs, new integ (3,), new held (4,), demand (4,)): demand is
+        what ArduPlane reports in NAV_CONTROLLER_OUTPUT: bank and pitch demands (rad), altitude
+        error (m) and airspeed error (m/s), both target minus current.
     """
     phi, theta, psi = euler_from_quat(x[6:10])
     p, q, r = x[10], x[11], x[12]
@@ -104,4 +106,4 @@ def autopilot_step(g: Gains, x, V, sp, ff, integ, held, openm, dt, lo, hi):
                      ff[4] + g.K_V * e_V + g.K_iV * integ[2]])
     cmd = jnp.clip(cmd, lo, hi)
     out = jnp.where(openm > 0.5, held, cmd)
-    return out, integ, out
+    return out, integ, out, jnp.stack([phi_c, theta_c, e_h, e_V])

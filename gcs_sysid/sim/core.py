@@ -38,7 +38,10 @@ __all__ = ["Loop", "Schedule", "run_loop", "turbulence_init"]
 class Loop(NamedTuple):
     """Per-flight constants (arrays): t0 vehicle time of tick 0 (s), dt tick (s),
     delay tau rate lo hi stuck (4,) per control, wind (3,) steady NED m/s,
-    turb_L turb_sigma (3,) Dryden scale lengths (m) and rms (m/s)."""
+    turb_L turb_sigma (3,) Dryden scale lengths (m) and rms (m/s), disable disable_at (4,):
+    ArduPlane-like output failure, the vehicle time (s) from which a channel's output
+    (what is logged and what the actuator receives) is held at ``disable_at`` while the
+    autopilot's demand goes on (inf: never)."""
 
     t0: jnp.ndarray
     dt: jnp.ndarray
@@ -51,6 +54,8 @@ class Loop(NamedTuple):
     wind: jnp.ndarray
     turb_L: jnp.ndarray
     turb_sigma: jnp.ndarray
+    disable: jnp.ndarray
+    disable_at: jnp.ndarray
 
 
 class Schedule(NamedTuple):
@@ -117,7 +122,9 @@ def run_loop(P: Params, loop: Loop, gains: Gains, sched: Schedule, x0, act0, tur
         use_autopilot: True: autopilot + maneuvers; False: commands ``sched.u_ext``.
 
     Returns:
-        dict of arrays with leading axis T: ``x`` (T,13), ``act`` (T,4), ``cmd`` (T,4), ``gust`` (T,3).
+        dict of arrays with leading axis T: ``x`` (T,13), ``act`` (T,4), ``cmd`` (T,4), ``gust`` (T,3),
+        ``demand`` (T,4) the autopilot's bank / pitch demand (rad), altitude and airspeed errors (zeros
+        without the autopilot).
     """
     h = loop.dt / n_sub
     idx4 = jnp.arange(4)
@@ -146,10 +153,13 @@ def run_loop(P: Params, loop: Loop, gains: Gains, sched: Schedule, x0, act0, tur
         gust_next = jnp.where(on, _gust(turb, loop.turb_L, loop.turb_sigma, V0)[0], 0.0)
         if use_autopilot:
             V, *_ = air_data(x, loop.wind, gust)
-            ap, integ, held = autopilot_step(gains, x, V, sp, ff, integ, held, openm, loop.dt, loop.lo, loop.hi)
+            ap, integ, held, demand = autopilot_step(gains, x, V, sp, ff, integ, held, openm, loop.dt, loop.lo,
+                                                     loop.hi)
             cmd = jnp.clip(ap + man, loop.lo, loop.hi)
         else:
             cmd = u_ext
+            demand = jnp.zeros(4)
+        cmd = jnp.where(t_k >= loop.disable, loop.disable_at, cmd)      # the output fails, the demand goes on
         hist = jnp.concatenate([hist[1:], cmd[None]], axis=0)
 
         def body(c, n):
@@ -160,7 +170,7 @@ def run_loop(P: Params, loop: Loop, gains: Gains, sched: Schedule, x0, act0, tur
             return (x_, a_, hist_, t_), a
 
         (x_new, act_new, hist, _), acts = jax.lax.scan(body, (x, act, hist, t_k), jnp.arange(n_sub))
-        out = {"x": x, "act": acts[0], "cmd": cmd, "gust": gust}
+        out = {"x": x, "act": acts[0], "cmd": cmd, "gust": gust, "demand": demand}
         return (x_new, act_new, hist, integ, held, turb, k + 1), out
 
     hist0 = jnp.tile(act0[None], (hist_len, 1))

@@ -12,7 +12,14 @@ Meaning of each field (the truth, compared with the nominal inputs):
 - ``aero``: (coef, term, delta) added to the model's value of that term.
 - ``delay``, ``lag``: pure delay and first-order lag time constant (s) of the
   actuator of each control (delta_e, delta_a, delta_r, delta_t).
-- ``stuck``: vehicle time (s) from which the surface stays where it is (inf: never).
+- ``stuck``: vehicle time (s) from which the surface stays where it is (inf: never), under
+  a logged command that keeps moving (a surface that comes off its servo).
+- ``disable``, ``disable_at``: ArduPlane's fault injection (``DISABLE_ELEVATOR`` ...,
+  ``DISABLE_THROTTLE``): from vehicle time ``disable`` (s; inf: never) the channel's
+  *output* is held at ``disable_at`` (rad for surfaces, 0 = trim; throttle fraction,
+  0 = floor), so the log shows the frozen servo output while the autopilot's demand,
+  and what it does to the other channels, goes on. A surface reads as ``stuck:<control>``,
+  the throttle as ``thrust_loss``.
 - ``airspeed_bias`` (m/s), ``airspeed_scale``: measured EAS = scale * EAS + bias.
 - ``alpha_bias``, ``beta_bias`` (rad): added to the logged AOA_SSA estimate.
 - ``gyro_bias`` (rad/s), ``accel_bias`` (m/s^2): body x y z, added to RAW_IMU.
@@ -51,6 +58,8 @@ class Effects:
     delay: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     lag: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     stuck: tuple[float, float, float, float] = (_INF, _INF, _INF, _INF)
+    disable: tuple[float, float, float, float] = (_INF, _INF, _INF, _INF)
+    disable_at: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     airspeed_bias: float = 0.0
     airspeed_scale: float = 1.0
     alpha_bias: float = 0.0
@@ -90,6 +99,8 @@ class Effects:
         out += [f"delay:{n}" for n, d in zip(CONTROL_NAMES, self.delay) if d > 0]
         out += [f"delay:{n}" for n, d in zip(CONTROL_NAMES, self.lag) if d > 0 and f"delay:{n}" not in out]
         out += [f"stuck:{n}" for n, s in zip(CONTROL_NAMES, self.stuck) if math.isfinite(s)]
+        out += [f"stuck:{n}" if n != "delta_t" else "thrust_loss" for n, s in zip(CONTROL_NAMES, self.disable)
+                if math.isfinite(s) and f"stuck:{n}" not in out]
         out += ["bias:airspeed"] if self.airspeed_bias else []
         out += ["scale:airspeed"] if self.airspeed_scale != 1.0 else []
         out += ["bias:alpha"] if self.alpha_bias else []
@@ -112,6 +123,10 @@ class Effects:
                 d[key] = {n: v for n, v in zip(CONTROL_NAMES, vals) if v}
         if any(math.isfinite(s) for s in self.stuck):
             d["stuck_s"] = {n: s for n, s in zip(CONTROL_NAMES, self.stuck) if math.isfinite(s)}
+        if any(math.isfinite(s) for s in self.disable):
+            d["disable_s"] = {n: s for n, s in zip(CONTROL_NAMES, self.disable) if math.isfinite(s)}
+            if any(self.disable_at):
+                d["disable_at"] = {n: v for n, v in zip(CONTROL_NAMES, self.disable_at) if v}
         bias = {"airspeed": self.airspeed_bias, "alpha": self.alpha_bias, "beta": self.beta_bias}
         bias.update({f"gyro_{a}": v for a, v in zip(_AXES, self.gyro_bias)})
         bias.update({f"accel_{a}": v for a, v in zip(_AXES, self.accel_bias)})
@@ -163,7 +178,7 @@ def effects_from_dict(doc: Mapping[str, Any], source: str = "<plan>") -> Effects
             or a value of the wrong type (the message names the file and key).
     """
     w = f"{source}: [effects]"
-    known = {"aero", "delay_s", "lag_s", "stuck_s", "bias", "scale", "wind_ned", "mass_delta_kg",
+    known = {"aero", "delay_s", "lag_s", "stuck_s", "disable_s", "disable_at", "bias", "scale", "wind_ned", "mass_delta_kg",
              "inertia_delta", "cg_offset_m"}
     for k in doc:
         if k not in known:
@@ -185,6 +200,12 @@ def effects_from_dict(doc: Mapping[str, Any], source: str = "<plan>") -> Effects
             kw[attr] = _per_name(doc[key], CONTROL_NAMES, f"{w} {key}", 0.0, nonneg=True)
     if "stuck_s" in doc:
         kw["stuck"] = _per_name(doc["stuck_s"], CONTROL_NAMES, f"{w} stuck_s", _INF)
+    if "disable_s" in doc:
+        kw["disable"] = _per_name(doc["disable_s"], CONTROL_NAMES, f"{w} disable_s", _INF)
+    if "disable_at" in doc:
+        kw["disable_at"] = _per_name(doc["disable_at"], CONTROL_NAMES, f"{w} disable_at", 0.0)
+        if "disable_s" not in doc:
+            raise InputError(f"{w} disable_at needs disable_s (the onset of each disabled output)")
     if "bias" in doc:
         names = ("airspeed", "alpha", "beta") + tuple(f"gyro_{a}" for a in _AXES) + tuple(f"accel_{a}" for a in _AXES)
         b = _per_name(doc["bias"], names, f"{w} bias", 0.0)

@@ -65,6 +65,8 @@ class SimResult:
         plan, effects, seed: what was flown.
         airframe, model: nominal inputs; truth_airframe, truth_model: with the effects applied.
         trims: the trim of each setpoint.
+        demand: what the autopilot asked for (NAV_CONTROLLER_OUTPUT): ``roll`` and ``pitch`` demands
+            (rad), ``alt_error`` (m) and ``aspd_error`` (m/s), target minus current, each (T,).
     """
 
     t: np.ndarray
@@ -82,6 +84,7 @@ class SimResult:
     truth_airframe: Airframe
     truth_model: AeroModel
     trims: list[Trim] = field(default_factory=list)
+    demand: dict[str, np.ndarray] = field(default_factory=dict)
 
     def save_truth(self, path: str | Path) -> None:
         """Write truth, regressors, coefficients and commands to a compressed ``.npz``.
@@ -131,7 +134,7 @@ def _post(P: Params, x, act, wind, gust):
 def _loop(t0, dt, effects: Effects, lo, hi, rate, wind, L, sigma) -> Loop:
     f = lambda v: jnp.asarray(np.asarray(v, float))  # noqa: E731
     return Loop(f(t0), f(dt), f(effects.delay), f(effects.lag), f(rate), f(lo), f(hi), f(effects.stuck), f(wind),
-                f(L), f(sigma))
+                f(L), f(sigma), f(effects.disable), f(effects.disable_at))
 
 
 def _hist_len(effects: Effects, dt: float) -> int:
@@ -205,10 +208,12 @@ def simulate(airframe: Airframe, model: AeroModel, plan: Plan, effects: Effects 
                    use_autopilot=True)
     truth, X, Y = _split(_post(P, out["x"], out["act"], jnp.asarray(wind), out["gust"]))
     cmd = np.asarray(out["cmd"])
+    dem = np.asarray(out["demand"])
     sensors = make_sensors(t, truth, np.asarray(airframe.imu_lever_arm), eff, sens_cfg, rng, plan.rate_hz,
                            plan.home, tuple(wind))
     return SimResult(t, plan.rate_hz, truth, X, Y, {c: cmd[:, i] for i, c in enumerate(CONTROL_NAMES)}, sensors,
-                     plan, eff, seed, airframe, model, af_true, m_true, trims)
+                     plan, eff, seed, airframe, model, af_true, m_true, trims,
+                     {k: dem[:, i] for i, k in enumerate(("roll", "pitch", "alt_error", "aspd_error"))})
 
 
 def state_from_measurements(phi: float, theta: float, psi: float, p: float, q: float, r: float, alt: float,

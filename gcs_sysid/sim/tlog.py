@@ -14,13 +14,16 @@ commands; actuator delay and lag act after it) at 50 Hz, SCALED_PRESSURE (hPa,
 cdegC), GLOBAL_POSITION_INT (degE7, mm, cm/s, cdeg) and LOCAL_POSITION_NED at
 25 Hz, VFR_HUD (airspeed = EAS, as ArduPilot), RC_CHANNELS and AOA_SSA (the
 autopilot's estimate, deg) at 10 Hz, WIND (direction the wind blows *from*, deg)
-at 2 Hz, PARAM_VALUE for the stream-rate parameters and a STATUSTEXT at the start.
+at 2 Hz, NAV_CONTROLLER_OUTPUT (the autopilot's bank and pitch demands, deg, altitude error m
+and airspeed error times 100, as ArduPlane sends it) at the VFR_HUD rate, PARAM_VALUE for the
+stream-rate parameters and a STATUSTEXT at the start.
 Rates are those of :data:`gcs_sysid.sim.sensors.STREAM_RATES_HZ`, as whole
 decimations of the plan rate.
 """
 
 from __future__ import annotations
 
+import bisect
 import math
 import struct
 from pathlib import Path
@@ -88,12 +91,15 @@ def write_tlog(result, path: str | Path, airframe: Airframe | None = None, syste
     add("RC_CHANNELS", "rc", 8)
     add("AOA_SSA", "aoa_ssa", 9)
     add("WIND", "wind", 10)
+    if result.demand:
+        add("NAV_CONTROLLER_OUTPUT", "vfr_hud", 11)
     events.sort()
 
     att, imu, prs, gps, lpn, aoa, wnd = (sen[k] for k in ("attitude", "imu", "pressure", "gps", "local_position",
                                                            "aoa_ssa", "wind"))
     eas = sen["airspeed"]["eas"]
     gps_dec = decimation(rate, "gps")
+    sp_start = [sp.start for sp in result.plan.setpoints]
     n = 0
     with open(path, "wb") as f:
         sink = _Sink(f)
@@ -157,6 +163,13 @@ def write_tlog(result, path: str | Path, airframe: Airframe | None = None, syste
                 if thr_ch:
                     ch[thr_ch - 1] = _i(pwm[thr_ch][j], 0, 65535)
                 msg = mav.rc_channels_encode(ms, 16, *ch, 255)
+            elif name == "NAV_CONTROLLER_OUTPUT":
+                dem = result.demand
+                sp = result.plan.setpoints[max(0, bisect.bisect_right(sp_start, ts) - 1)]
+                hdg = _i(math.degrees(sp.heading) % 360.0, 0, 359)
+                msg = mav.nav_controller_output_encode(math.degrees(dem["roll"][j]), math.degrees(dem["pitch"][j]),
+                                                       hdg, hdg, 0, float(dem["alt_error"][j]),
+                                                       float(100.0 * dem["aspd_error"][j]), 0.0)
             elif name == "AOA_SSA":
                 msg = mav.aoa_ssa_encode(us, math.degrees(aoa["alpha"][j]), math.degrees(aoa["beta"][j]))
             else:  # WIND

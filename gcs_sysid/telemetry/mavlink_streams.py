@@ -112,6 +112,14 @@ def _simstate(v: np.ndarray) -> dict[str, np.ndarray]:
             "p": v[:, 6], "q": v[:, 7], "r": v[:, 8], "lat": v[:, 9] * _E7, "lon": v[:, 10] * _E7}
 
 
+def _nav_controller(v: np.ndarray) -> dict[str, np.ndarray]:
+    # deg -> rad; alt_error m (target minus current); aspd_error: ArduPlane sends the airspeed error
+    # (target minus current) times 100, i.e. cm/s, although the message definition says m/s
+    # (GCS_Plane.cpp send_nav_controller_output) -> m/s
+    return {"roll_demand": v[:, 0] * _D2R, "pitch_demand": v[:, 1] * _D2R, "alt_error": v[:, 2],
+            "aspd_error": v[:, 3] * 0.01}
+
+
 def _heartbeat(v: np.ndarray) -> dict[str, np.ndarray]:
     # base_mode bit 7 (128): MAV_MODE_FLAG_SAFETY_ARMED
     return {"custom_mode": v[:, 3], "armed": ((v[:, 2].astype(np.int64) & 128) > 0).astype(float)}
@@ -142,6 +150,8 @@ SPECS: dict[str, MsgSpec] = {
     "WIND": MsgSpec("wind", ("direction", "speed", "speed_z"), None, _wind),
     "SIMSTATE": MsgSpec("sim_truth", ("roll", "pitch", "yaw", "xacc", "yacc", "zacc", "xgyro", "ygyro",
                                       "zgyro", "lat", "lng"), None, _simstate),
+    "NAV_CONTROLLER_OUTPUT": MsgSpec("nav", ("nav_roll", "nav_pitch", "alt_error", "aspd_error"), None,
+                                     _nav_controller),
     "HEARTBEAT": MsgSpec("mode", ("type", "autopilot", "base_mode", "custom_mode"), None, _heartbeat),
 }
 
