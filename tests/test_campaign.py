@@ -68,9 +68,8 @@ def test_campaign_fast(tmp_path):
 @pytest.mark.slow
 def test_campaign_acceptance_three_seeds(tmp_path):
     """The issue's acceptance: several seeds, turbulence and noise on, three suggested vs three standard flights
-    (GP re-learned after each flight: with the incremental update check 2 is marginal on Cn, docs/maneuvers.md)."""
-    doc = run_campaign(AIRFRAME, TRUTH, tmp_path, CampaignConfig(flights=4, seeds=(1, 2, 3), refit=True),
-                       progress=None)
+    with the product's incremental update (new rows added, hyperparameters refreshed after each flight)."""
+    doc = run_campaign(AIRFRAME, TRUTH, tmp_path, CampaignConfig(flights=4, seeds=(1, 2, 3)), progress=None)
     acc = _check(doc)
     assert acc["sigma_2x_all"] and acc["inside_limits_all"]
     assert acc["moments_better_all"], acc["per_seed"]

@@ -9,7 +9,9 @@
    *suggested*: map the confidence, :func:`gcs_sysid.maneuvers.suggest_maneuvers`, fly the top
    suggestions (as many as fit the flight) with :func:`gcs_sysid.sim.simulate`;
    *standard*: a standard doublet set with the same input-time and amplitude budget;
-   after each flight the model is updated incrementally (``model.update``, hyperparameters kept);
+   after each flight the model is updated incrementally (``model.update``, then
+   ``refresh_hyperparameters()``; sigma is read before the refresh, at the hyperparameters the
+   flight was designed with);
 4. per flight and arm: held-out error of each coefficient against the truth
    (``100 RMS(model - truth) / RMS(truth)``) and the mean latent predictive sigma in the regions
    flagged after flight 1; whether every suggestion respected the limits (designed peaks and the

@@ -109,13 +109,19 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
                 if arm == "suggested" and flown:
                     flown_bad += [f"seed {seed} flight {k}: {b}" for b in flown_check(fl.peaks, lim)]
                 X, Y = np.vstack([X, fl.X]), np.vstack([Y, fl.Y])
-                model = fit(X, Y, config, seed) if config.refit else model.update(fl.X, fl.Y)
+                if config.refit:
+                    model = conditioned = fit(X, Y, config, seed)
+                else:
+                    # what the flight taught, under the hyperparameters it was designed with: sigma
+                    # is compared at fixed hyperparameters (a refresh rescales the variance itself)
+                    conditioned = model.update(fl.X, fl.Y)
+                    model = conditioned.refresh_hyperparameters()
                 row = {"flight": k, "kind": arm, "errors_pct": errors(model, X_test, Y_test),
-                       "sigma": sigma_in(model, regions), "peaks": fl.peaks,
+                       "sigma": sigma_in(conditioned, regions), "peaks": fl.peaks,
                        "flown": [{"rank": s.rank, "kind": s.kind, "controls": list(s.controls),
                                   "coefficients": list(s.coefficients), "V": s.flight_condition["V"]} for s in flown]}
                 if target_pts is not None:
-                    row["target_sigma"] = sigma_in(model, {top.coefficients[0]: target_pts})[top.coefficients[0]]
+                    row["target_sigma"] = sigma_in(conditioned, {top.coefficients[0]: target_pts})[top.coefficients[0]]
                 arms[arm].append(row)
                 say(f"seed {seed}: flight {k} ({arm}) errors " + " ".join(f"{c} {e:.0f}%" for c, e in row["errors_pct"].items()))
                 if arm == "suggested" and k < config.flights:
@@ -128,7 +134,7 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
            "limits": lim.to_dict(), "identification": "true regressors + coefficient noise COEF_NOISE "
                                                       f"{COEF_NOISE.tolist()} at {config.rate_hz:g} Hz; after each flight the GP is "
                                                       + ("re-learned on all data" if config.refit else
-                                                         "updated incrementally (hyperparameters of flight 1 kept)"),
+                                                         "updated incrementally (the new rows added; sigma read at the hyperparameters the flight was designed with; then hyperparameters and inducing points refreshed on the stored rows for the errors and the next design)"),
            "runs": runs, "acceptance": _acceptance(runs, lim)}
     if out_dir is not None:
         out = Path(out_dir)
