@@ -1,4 +1,4 @@
-"""Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose``.
+"""Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose | predict``.
 
 Errors a user can cause (bad file, missing field, data that cannot support an
 estimate) print one line ``gcs-sysid: error: ...`` on stderr and exit with code 2,
@@ -69,6 +69,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--model", required=True, help="the simulation's aerodynamic model TOML file")
     d.add_argument("--out", required=True, help="output directory")
     _window_args(d)
+
+    pr = sub.add_parser("predict", help="evaluate a saved model at given flight conditions (CSV in, CSV out)")
+    pr.add_argument("model_dir", help="replay output directory holding model.npz/model.json (or the model prefix)")
+    pr.add_argument("--inputs", required=True, help="CSV with columns " + " ".join(
+        ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "delta_a", "delta_r", "delta_t", "V")) + " (SI)")
+    pr.add_argument("--out", required=True, help="output CSV: inputs plus <C>_mean, <C>_sigma, <C>_sigma_obs")
     return ap
 
 
@@ -116,7 +122,15 @@ def _cmd_diagnose(a: argparse.Namespace) -> int:
     return 0
 
 
-COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose}
+def _cmd_predict(a: argparse.Namespace) -> int:
+    from .predict import run_predict
+
+    pred = run_predict(a.model_dir, a.inputs, a.out)
+    print(f"wrote {a.out} ({len(pred.X)} conditions, {', '.join(pred.outputs)})")
+    return 0
+
+
+COMMANDS = {"predict": _cmd_predict, "replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose}
 
 
 def main(argv: list[str] | None = None) -> int:
