@@ -1,0 +1,65 @@
+"""The project's real path (read_log -> estimate_states -> compute_coefficients) on a JSBSim flight,
+scored against JSBSim's exact truth.
+
+Thresholds FROZEN on 2026-11-21 from the first measurement (c172x, 40 s, light turbulence, seed 1,
+AOA_SSA = ArduPilot's AHRS estimate): measured CX 1.8, CY 5.6, CZ 0.9, Cl 20.3, Cm 19.0, Cn 13.7 %;
+alpha 0.24 deg, beta 0.20 deg RMS error. Thresholds are those values with a margin for platform
+differences; they guard against regressions, they are NOT the issue's acceptance targets (forces
+3 %, moments 8 %), which today's estimator misses on the moments (docs/benchmarks.md).
+Do not retune them to pass: change them only with a new measurement recorded in docs/jsbsim.md.
+"""
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight
+from gcs_sysid.aero import compute_coefficients
+from gcs_sysid.airframe import load_airframe
+from gcs_sysid.estimation import estimate_states
+from gcs_sysid.telemetry import read_log
+
+from scoring import score_table
+
+#: Frozen 2026-11-21 (see the module docstring): % for coefficients, deg RMS for the air angles.
+THRESHOLDS = {"CX": 3.0, "CY": 8.0, "CZ": 2.0, "Cl": 27.0, "Cm": 25.0, "Cn": 18.0,
+              "alpha_deg": 0.35, "beta_deg": 0.30}
+
+
+def _measure(files):
+    af = load_airframe(files.airframe)
+    states = estimate_states(read_log(files.tlog), af)
+    return compute_coefficients(states, af)
+
+
+@pytest.fixture(scope="module")
+def measured(fast_flight):
+    return _measure(fast_flight), load_truth(fast_flight.truth)
+
+
+def test_measured_coefficients_and_air_data_against_truth(measured):
+    table, truth = measured
+    assert table.valid.mean() > 0.9
+    s = score_table(table, truth)
+    bad = {k: round(v, 2) for k, v in s.items() if not v <= THRESHOLDS[k]}
+    assert not bad, f"above the frozen thresholds {THRESHOLDS}: {bad} (all: {s})"
+
+
+def test_the_score_fails_against_wrong_truth(measured):
+    """The same comparison against sign-flipped truth exceeds every threshold: the test can fail."""
+    table, truth = measured
+    s = score_table(table, truth, sign=-1.0)
+    assert all(s[k] > THRESHOLDS[k] for k in THRESHOLDS), s
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("aircraft,turbulence,aoa", [("sgs", "light", "ahrs"), ("c172x", "moderate", "ahrs"),
+                                                     ("pa28", "light", "vane")])
+def test_longer_flights_are_measured(tmp_path, aircraft, turbulence, aoa):
+    """Two minutes on the other aircraft and at moderate turbulence: the path runs and the force
+    coefficients stay within 3x the fast thresholds (a smoke check; the figures are in
+    docs/benchmarks.md, from benchmarks/eval_jsbsim.py)."""
+    files = make_flight(FlightConfig(aircraft, duration_s=120.0, turbulence=turbulence, seed=2), tmp_path, aoa=aoa)
+    s = score_table(_measure(files), load_truth(files.truth))
+    for k in ("CX", "CY", "CZ"):
+        assert s[k] < 3 * THRESHOLDS[k], s
+    assert np.isfinite([s[k] for k in ("Cl", "Cm", "Cn")]).all()
