@@ -23,7 +23,8 @@ References:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, asdict
+import os
+from dataclasses import asdict, dataclass, field
 from typing import Mapping
 
 import jsbsim
@@ -113,11 +114,17 @@ def load_model(spec: AircraftSpec, dt: float, seed: int = 0) -> jsbsim.FGFDMExec
     fdm.set_debug_level(0)
     if not fdm.load_model(spec.model):
         raise RuntimeError(f"JSBSim could not load model '{spec.model}'")
+    # the models' own <output> elements (the c172x writes JSBout172B.csv into the cwd) go nowhere
+    for n in range(16):
+        try:
+            if not fdm.get_output_filename(n):
+                break
+        except Exception:       # no output n: JSBSim raises (IndexError/RuntimeError by version)
+            break
+        fdm.set_output_filename(n, os.devnull)
+    fdm.disable_output()
     fdm.set_dt(dt)
     fdm["simulation/randomseed"] = int(seed)
-    mb = fdm.get_mass_balance()
-    for i in range(mb.get_num_point_masses() if hasattr(mb, "get_num_point_masses") else 0):
-        pass
     i = 0
     while True:
         key = f"inertia/pointmass-location-Y-inches[{i}]"
