@@ -110,6 +110,7 @@ def load_model(spec: AircraftSpec, dt: float, seed: int = 0) -> jsbsim.FGFDMExec
     its right wing tip): the project's airframe file has no Ixy/Iyz, and JSBSim's moments of
     those products of inertia would otherwise be an error no estimator could remove.
     """
+    jsbsim.FGJSBBase().debug_lvl = 0      # no start-up banner on stdout
     fdm = jsbsim.FGFDMExec(None)          # root dir: the wheel's packaged aircraft/engine/systems
     fdm.set_debug_level(0)
     if not fdm.load_model(spec.model):

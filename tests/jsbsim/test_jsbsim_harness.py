@@ -74,8 +74,12 @@ def test_tlog_carries_the_ardupilot_streams_and_the_surfaces(fast_flight):
         assert np.max(np.abs(ctl[k] - ref)) < np.radians(0.1), k
 
 
-def test_flights_are_reproducible_per_seed():
-    """JSBSim's turbulence is seeded: the same seed flies the same flight, another seed another."""
+def test_flights_are_reproducible_per_seed(tmp_path, monkeypatch):
+    """JSBSim's turbulence is seeded: the same seed flies the same flight, another seed another;
+    JSBSim writes nothing into the working directory (the c172x model has an <output> element)."""
+    monkeypatch.chdir(tmp_path)
+    fly(FlightConfig("c172x", duration_s=1.0))
+    assert not list(tmp_path.iterdir())
     a, b, c = (fly(FlightConfig("sgs", duration_s=5.0, seed=s)) for s in (3, 3, 4))
     np.testing.assert_array_equal(a.truth["wn"], b.truth["wn"])
     assert np.abs(a.truth["wn"] - c.truth["wn"]).max() > 0.01
