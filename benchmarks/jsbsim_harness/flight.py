@@ -140,22 +140,30 @@ def load_model(spec: AircraftSpec, dt: float, seed: int = 0) -> jsbsim.FGFDMExec
 
 
 def _segments(spec: AircraftSpec, duration: float) -> list[tuple[str, int, float, float, float]]:
-    """(kind, axis, start s, amplitude rad, pulse s or period s) of the maneuvers, repeated to fill
-    ``duration``. Axis 0 delta_e, 1 delta_a, 2 delta_r."""
+    """(kind, axis, start s, amplitude rad, pulse s or period s) of the maneuvers. Axis 0 delta_e,
+    1 delta_a, 2 delta_r, -1 all three (multisine).
+
+    The first 80 % of the flight repeats a block of single-axis 3-2-1-1s and doublets and a
+    three-axis multisine (alternating signs); the last 20 % (the replay's held-out segment) is one
+    three-axis multisine, so that the held-out segment excites every axis."""
     ae, aa, ar = np.radians(spec.amplitude_deg)
     pe, pa, pr = spec.pulse_s
     block = [("3211", 0, ae, pe), ("doublet", 1, aa, pa), ("doublet", 2, ar, pr), ("3211", 1, aa, pa),
-             ("3211", 2, ar, pr), ("doublet", 0, ae * 1.5, pe), ("multisine", -1, 0.0, 16.0)]
+             ("3211", 2, ar, pr), ("doublet", 0, ae * 1.5, pe), ("multisine", -1, 1.0, 16.0)]
     out, t, k = [], 2.0, 0
+    train_end = 0.8 * duration
     while True:
         kind, axis, amp, w = block[k % len(block)]
         length = {"3211": 7 * w, "doublet": 2 * w, "multisine": w}[kind]
-        if t + length > duration - 1.0:
+        if t + length > train_end - 1.0:
             break
         sgn = -1.0 if (k // len(block)) % 2 else 1.0     # alternate signs on repeats
         out.append((kind, axis, t, sgn * amp, w))
         t += length + (3.0 if kind != "multisine" else 2.0)
         k += 1
+    last = duration - train_end - 1.5
+    if last >= 4.0:
+        out.append(("multisine", -1, train_end + 0.75, 1.0, last))
     return out
 
 
@@ -163,14 +171,15 @@ def maneuver_inputs(spec: AircraftSpec, t: np.ndarray, duration: float, scale: f
     """Maneuver deflections added to the autopilot's, rad, shape (T, 3): delta_e, delta_a, delta_r.
 
     3-2-1-1s and doublets on each axis in turn, then an orthogonal phase-optimised multisine on all
-    three axes together (0.1-1.5 Hz, ``gcs_sysid.signals``), repeated with alternating signs.
+    three axes together (0.1-1.5 Hz, ``gcs_sysid.signals``), repeated with alternating signs; the last
+    20 % of the flight is one three-axis multisine (see :func:`_segments`).
     """
     u = np.zeros((len(t), 3))
     amps = np.radians(spec.amplitude_deg) * scale
     for kind, axis, start, amp, w in _segments(spec, duration):
         if kind == "multisine":
             for j in range(3):
-                u[:, j] += multisine(t, start, w, (0.1, 1.5), 0.8 * amps[j] * np.sign(amp or 1.0), 3, j)
+                u[:, j] += multisine(t, start, w, (max(0.1, 3.0 / w), 1.5), 0.8 * amps[j] * np.sign(amp), 3, j)
         elif kind == "3211":
             u[:, axis] += three_two_one_one(t, start, w, amp * scale)
         else:
