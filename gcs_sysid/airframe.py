@@ -156,6 +156,10 @@ class Airframe:
         imu_lever_arm: IMU position relative to the CG in body axes, m, shape (3,).
         source: path of the file it was read from ("" if built in code).
         notes: free-text provenance of the values.
+        air_angles: what the log's AOA_SSA / AOA angles are: ``"estimate"`` (the autopilot's own
+            lagged estimate from velocity and wind; the default, ArduPilot's AHRS) or ``"vane"``
+            (measured by vanes at the CG; the estimator then uses them as alpha and beta).
+            ``[air_data] angles`` in the file.
     """
 
     name: str
@@ -173,6 +177,7 @@ class Airframe:
     imu_lever_arm: tuple[float, float, float] = (0.0, 0.0, 0.0)
     source: str = ""
     notes: str = ""
+    air_angles: str = "estimate"
 
     @property
     def inertia(self) -> np.ndarray:
@@ -267,7 +272,8 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
             the message names the file and the field.
     """
     src = source
-    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes"}
+    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes",
+             "air_data"}
     for k in doc:
         if k not in known:
             raise InputError(f"{src}: unknown top-level field '{k}' (expected one of {sorted(known)})")
@@ -369,8 +375,15 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     notes = doc.get("notes", "")
     if not isinstance(notes, str):
         raise InputError(f"{src}: notes must be a string")
+    air = doc.get("air_data", {})
+    if not isinstance(air, Mapping) or set(air) - {"angles"}:
+        raise InputError(f"{src}: [air_data] must be a table with only 'angles' (\"estimate\" or \"vane\")")
+    angles = air.get("angles", "estimate")
+    if angles not in ("estimate", "vane"):
+        raise InputError(f"{src}: [air_data] angles must be \"estimate\" (autopilot's AOA_SSA estimate) or "
+                         f"\"vane\" (AOA_SSA/AOA carry vane measurements), got {angles!r}")
     return Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
-                    tuple(float(x) for x in arm), source, notes)
+                    tuple(float(x) for x in arm), source, notes, angles)
 
 
 def load_airframe(path: str | Path) -> Airframe:
@@ -407,4 +420,6 @@ def airframe_to_dict(a: Airframe) -> dict[str, Any]:
         d["thrust"] = {"T_static": a.thrust.T_static, "V_zero": a.thrust.V_zero, "exponent": a.thrust.exponent}
     if a.notes:
         d["notes"] = a.notes
+    if a.air_angles != "estimate":
+        d["air_data"] = {"angles": a.air_angles}
     return d

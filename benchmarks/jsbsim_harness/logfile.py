@@ -54,7 +54,12 @@ def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs") -> int:
 
 
 def make_flight(config: FlightConfig, out_dir: str | Path, aoa: str = "ahrs", stem: str | None = None) -> FlightFiles:
-    """Fly ``config`` and write ``<stem>.tlog`` and ``<stem>-truth.npz`` into ``out_dir``."""
+    """Fly ``config`` and write ``<stem>.tlog`` and ``<stem>-truth.npz`` into ``out_dir``.
+
+    With ``aoa="vane"`` the airframe is the aircraft's file plus ``[air_data] angles = "vane"``
+    (``docs/airframe.md``: the log's AOA_SSA are vane measurements), written as
+    ``<stem>-airframe.toml``; otherwise the checked-in ``data/airframes/jsbsim-<name>.toml``.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     stem = stem or f"{config.aircraft}-{config.turbulence}-s{config.seed}-{aoa}"
@@ -62,4 +67,9 @@ def make_flight(config: FlightConfig, out_dir: str | Path, aoa: str = "ahrs", st
     tlog, truth = out / f"{stem}.tlog", out / f"{stem}-truth.npz"
     write_log(rec, tlog, aoa)
     save_truth(rec, truth)
-    return FlightFiles(tlog, truth, aircraft(config.aircraft).airframe_path, rec)
+    airframe = aircraft(config.aircraft).airframe_path
+    if aoa == "vane":
+        vane = out / f"{stem}-airframe.toml"
+        vane.write_text(airframe.read_text() + '\n[air_data]\nangles = "vane"\n')
+        airframe = vane
+    return FlightFiles(tlog, truth, airframe, rec)
