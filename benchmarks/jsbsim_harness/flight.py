@@ -63,6 +63,10 @@ class FlightConfig:
         log_rate_hz: truth and fast-stream rate, Hz (a whole divisor of ``sim_rate_hz``).
         settle_s: unlogged flight before the log starts, s (the autopilot settles the glide).
         amplitude_scale: multiplies the aircraft's maneuver amplitudes.
+        servo_tau_s: time constant of the servos, s: the surfaces follow the commands (autopilot +
+            maneuvers) through a first-order lag with a rate limit of ``servo_rate_deg_s`` (JSBSim's
+            stock models move their surfaces instantly). 0 = ideal servos.
+        servo_rate_deg_s: servo rate limit, deg/s of the project's deflection.
     """
 
     aircraft: str = "c172x"
@@ -74,6 +78,8 @@ class FlightConfig:
     log_rate_hz: float = 50.0
     settle_s: float = 15.0
     amplitude_scale: float = 1.0
+    servo_tau_s: float = 0.04
+    servo_rate_deg_s: float = 300.0
 
     def __post_init__(self):
         if self.turbulence not in TURBULENCE:
@@ -265,6 +271,10 @@ def fly(config: FlightConfig) -> Recording:
     theta_ref0 = fdm["attitude/theta-rad"]
     psi_ref = fdm["attitude/psi-rad"]
     de_int = 0.0
+    servo = np.zeros(3)          # surface positions the servos hold (project deltas), rad
+    first = True
+    a_servo = 1.0 - np.exp(-dt / config.servo_tau_s) if config.servo_tau_s > 0 else 1.0
+    max_step = np.radians(config.servo_rate_deg_s) * dt
     n_settle = int(round(config.settle_s * config.sim_rate_hz))
     n_log = int(round(config.duration_s * config.log_rate_hz))
     t_log = np.arange(n_log) / config.log_rate_hz
@@ -285,6 +295,11 @@ def fly(config: FlightConfig) -> Recording:
         phi_ref = float(np.clip(-0.5 * psi_err, -0.2, 0.2))     # weak heading hold
         da = k_phi * (phi - phi_ref) + k_p * p + man[1]
         dr = k_r * r + man[2]
+        cmd = np.array([de, da, dr])
+        if first:
+            servo, first = cmd.copy(), False
+        servo = servo + np.clip(a_servo * (cmd - servo), -max_step, max_step)   # lag + rate limit
+        de, da, dr = servo
         fdm["fcs/elevator-cmd-norm"] = float(np.clip(de * spec.elevator_sign * spec.cmd_per_rad[0], -1, 1))
         fdm["fcs/aileron-cmd-norm"] = float(np.clip(da * spec.aileron_sign * spec.cmd_per_rad[1], -1, 1))
         fdm["fcs/rudder-cmd-norm"] = float(np.clip(dr * spec.rudder_sign * spec.cmd_per_rad[2], -1, 1))
