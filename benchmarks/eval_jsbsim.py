@@ -19,6 +19,7 @@ Usage::
     python benchmarks/eval_jsbsim.py                        # small grid (2 tuning aircraft + held-out, 1 seed)
     python benchmarks/eval_jsbsim.py --aircraft c172x sgs pa28 --seeds 1 2 3 --turbulence light moderate
     python benchmarks/eval_jsbsim.py --aoa vane             # AOA_SSA = exact vane angles
+    python benchmarks/eval_jsbsim.py --summarize results.jsonl   # markdown table of --json results
 
 ``pa28`` is the held-out aircraft: it was not used to set up the harness, the estimator or any
 threshold. Results are appended as JSON lines to ``--json`` when given.
@@ -94,6 +95,37 @@ def _fmt(d: dict) -> str:
     return " ".join(f"{d[c]:6.1f}" for c in COEFFICIENTS)
 
 
+def summarize(paths: list[str]) -> str:
+    """Markdown table of JSON lines written by ``--json``: per aircraft, turbulence and AOA variant,
+    the median over seeds of each score (coefficient errors in %, coverage in %, air data in deg)."""
+    rows = [json.loads(line) for p in paths for line in open(p) if line.strip()]
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["aircraft"], r["turbulence"], r["aoa"]), []).append(r)
+    head = ("| aircraft | turb. | AOA_SSA | seeds | score | " + " | ".join(COEFFICIENTS)
+            + " | cov95 % | alpha / beta err deg (signal) |")
+    out = [head, "|" + "---|" * (head.count("|") - 1)]
+    for (ac, turb, aoa), rs in groups.items():
+        med = lambda k, c=None: float(np.nanmedian([r[k][c] if c else r[k] for r in rs]))   # noqa: E731
+        for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
+                         ("ls", "stepwise LS")):
+            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}"}.get(k, "")
+            air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
+                   f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
+            name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
+            out.append(f"| {name} | {turb} | {aoa} | {len(rs)} | {label} | "
+                       + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
+    for turb in sorted({r["turbulence"] for r in rows}):
+        for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
+                         ("ls", "stepwise LS")):
+            rs = [r for r in rows if r["turbulence"] == turb]
+            f = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[:3]])
+            m = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[3:]])
+            out.append(f"\n{turb}, {label}: median over all flights and coefficients: forces {f:.1f} %, "
+                       f"moments {m:.1f} % (thesis real flights: {THESIS_FORCES} %, {THESIS_MOMENTS} %)")
+    return "\n".join(out)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"])
@@ -103,7 +135,12 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
+    ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
+                    help="only print the markdown table of earlier --json results (medians over seeds)")
     a = ap.parse_args(argv)
+    if a.summarize:
+        print(summarize(a.summarize))
+        return 0
     work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
     rows = []
     print(f"{'flight':32s} {'':5s} " + " ".join(f"{c:>6s}" for c in COEFFICIENTS) + "   cov95  alpha/beta err deg")
