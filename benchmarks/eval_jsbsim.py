@@ -6,7 +6,8 @@ real replay (``run_replay``: decode, EKF/RTS, coefficients, GP on the first 80 %
 and the project's stepwise least-squares fit (``run_fit`` on the training window), and prints,
 against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on the held-out segment):
 
-  meas   the measured coefficients themselves
+  meas   the measured coefficients themselves (``meas_all`` in the JSON: on all valid rows;
+         ``meas_true_accel``: on all rows with JSBSim's angular accelerations put in, a diagnosis)
   gp     the replay's model predictions at the measured regressors
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
@@ -74,6 +75,17 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
     row["meas_all"] = _errs(tab.Y[ok], Yt[ok])
+    # diagnosis: the measured coefficients again with JSBSim's angular accelerations in the states
+    from gcs_sysid.aero import compute_coefficients
+    from gcs_sysid.airframe import load_airframe
+
+    st = res.states
+    saved = {k: st.data[k] for k in ("p_dot", "q_dot", "r_dot")}
+    for k in saved:
+        st.data[k] = np.interp(st.t, truth.t, truth.fields[k])
+    tab_acc = compute_coefficients(st, load_airframe(files.airframe))
+    st.data.update(saved)
+    row["meas_true_accel"] = _errs(tab_acc.Y[ok], Yt[ok])
     row["gp"] = _errs(res.pred_mean[h], Yt[h])
     row["cov_gp"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]))
     model = load_gp(Path(res.model_path))
