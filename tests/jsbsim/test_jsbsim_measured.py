@@ -13,7 +13,6 @@ differences; they guard against regressions, they are NOT the issue's acceptance
 Do not retune them to pass: change them only with a new measurement recorded in docs/jsbsim.md.
 """
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight
@@ -55,15 +54,30 @@ def test_the_score_fails_against_wrong_truth(measured):
     assert all(s[k] > THRESHOLDS[k] for k in THRESHOLDS), s
 
 
+#: Slow cases (120 s, seed 2), thresholds FROZEN on 2026-11-21 from their first measurement on the
+#: final harness (measured: sgs light CX 5.4, CY 3.4, CZ 0.5, Cl 16.0, Cm 10.6, Cn 7.8 %, alpha /
+#: beta 0.41 / 0.53 deg; c172x moderate CX 3.6, CY 11.5, CZ 7.0, Cl 19.9, Cm 26.7, Cn 11.4 %,
+#: 2.37 / 2.97 deg; pa28 (held out) light with vanes CX 1.1, CY 5.8, CZ 0.8, Cl 16.9, Cm 17.3,
+#: Cn 7.9 %, 0.10 / 0.10 deg), with a margin of about a third.
+SLOW_CASES = {
+    ("sgs", "light", "ahrs"): {"CX": 7.5, "CY": 5.0, "CZ": 1.0, "Cl": 21.0, "Cm": 14.0, "Cn": 10.5,
+                               "alpha_deg": 0.55, "beta_deg": 0.7},
+    ("c172x", "moderate", "ahrs"): {"CX": 5.0, "CY": 15.0, "CZ": 9.5, "Cl": 26.0, "Cm": 35.0, "Cn": 15.0,
+                                    "alpha_deg": 3.2, "beta_deg": 4.0},
+    ("pa28", "light", "vane"): {"CX": 1.5, "CY": 8.0, "CZ": 1.2, "Cl": 22.0, "Cm": 23.0, "Cn": 10.5,
+                                "alpha_deg": 0.15, "beta_deg": 0.15},
+}
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("aircraft,turbulence,aoa", [("sgs", "light", "ahrs"), ("c172x", "moderate", "ahrs"),
-                                                     ("pa28", "light", "vane")])
-def test_longer_flights_are_measured(tmp_path, aircraft, turbulence, aoa):
-    """Two minutes on the other aircraft and at moderate turbulence: the path runs and the force
-    coefficients stay within 3x the fast thresholds (a smoke check; the figures are in
-    docs/benchmarks.md, from benchmarks/eval_jsbsim.py)."""
+@pytest.mark.parametrize("case", list(SLOW_CASES), ids=lambda c: "-".join(c))
+def test_longer_flights_are_measured(tmp_path, case):
+    """Two minutes on the glider, at moderate turbulence, and on the held-out pa28 with vanes
+    (airframe ``[air_data] angles = "vane"``) against their frozen thresholds; the full figures are
+    in docs/benchmarks.md (benchmarks/eval_jsbsim.py)."""
+    aircraft, turbulence, aoa = case
     files = make_flight(FlightConfig(aircraft, duration_s=120.0, turbulence=turbulence, seed=2), tmp_path, aoa=aoa)
     s = score_table(_measure(files), load_truth(files.truth))
-    for k in ("CX", "CY", "CZ"):
-        assert s[k] < 3 * THRESHOLDS[k], s
-    assert np.isfinite([s[k] for k in ("Cl", "Cm", "Cn")]).all()
+    limits = SLOW_CASES[case]
+    bad = {k: round(v, 2) for k, v in s.items() if not v <= limits[k]}
+    assert not bad, f"above the frozen thresholds {limits}: {bad}"
