@@ -133,12 +133,25 @@ def predict_conditions(model, X: np.ndarray, output_names=None) -> Predictions:
 
 
 def _output_names(prefix: Path, n: int) -> tuple[str, ...]:
+    """Coefficient names of the model's ``n`` outputs: the model file's names when they are
+    coefficient names; else the replay's record beside it (``result/result.json``, ``gp_summary.outputs``:
+    a replay fits only the coefficients it can identify and saves the model with generic names)."""
     import json
 
-    try:
-        names = json.loads(prefix.with_name(prefix.name + ".json").read_text()).get("output_names")
-    except (OSError, ValueError):
-        names = None
+    def read(path: Path):
+        try:
+            return json.loads(path.read_text())
+        except (OSError, ValueError):
+            return None
+
+    meta = read(prefix.with_name(prefix.name + ".json")) or {}
+    names = meta.get("output_names") if isinstance(meta, dict) else None
+    if isinstance(names, list) and len(names) == n and all(x in COEFFICIENTS for x in names):
+        return tuple(names)
+    rec = read(prefix.parent / "result" / "result.json")
+    outs = rec.get("gp_summary", {}).get("outputs") if isinstance(rec, dict) else None
+    if isinstance(outs, list) and len(outs) == n and all(x in COEFFICIENTS for x in outs):
+        return tuple(outs)
     if isinstance(names, list) and len(names) == n:
         return tuple(str(x) for x in names)
     return tuple(COEFFICIENTS[:n]) if n == len(COEFFICIENTS) else tuple(f"y{i}" for i in range(n))

@@ -100,3 +100,19 @@ def test_predict_errors_are_one_line(tmp_path):
     r = subprocess.run([sys.executable, "-m", "gcs_sysid.cli", "predict", str(tmp_path / "nothing"), "--inputs",
                         str(cond), "--out", str(tmp_path / "p.csv")], capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "no saved model" in r.stderr
+
+
+def test_output_names_come_from_the_replay_record_when_the_model_has_generic_names(tmp_path):
+    """A replay that identifies only some coefficients saves the model with names y0, y1...; the
+    replay's record beside it names them."""
+    import json
+
+    from gcs_sysid.predict import _output_names
+
+    (tmp_path / "model.json").write_text(json.dumps({"output_names": ["y0", "y1"]}))
+    assert _output_names(tmp_path / "model", 2) == ("y0", "y1")
+    (tmp_path / "result").mkdir()
+    (tmp_path / "result" / "result.json").write_text(json.dumps({"gp_summary": {"outputs": ["CX", "CZ"]}}))
+    assert _output_names(tmp_path / "model", 2) == ("CX", "CZ")
+    (tmp_path / "model.json").write_text(json.dumps({"output_names": list(COEFFICIENTS)}))
+    assert _output_names(tmp_path / "model", 6) == COEFFICIENTS
