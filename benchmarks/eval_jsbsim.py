@@ -39,15 +39,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight  # noqa: E402
+from benchmarks.jsbsim_harness import FlightConfig, coefficient_errors, load_truth, make_flight  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
-from gcs_sysid.pipeline import ReplayOptions, error_pct, run_replay  # noqa: E402
+from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
 
 THESIS_FORCES, THESIS_MOMENTS = 19.8, 23.8
 
 
 def _errs(est: np.ndarray, ref: np.ndarray) -> dict[str, float]:
-    return {c: error_pct(est[:, i], ref[:, i]) for i, c in enumerate(COEFFICIENTS)}
+    return coefficient_errors(est, ref)
 
 
 def _coverage(mean, sigma, ref) -> float:

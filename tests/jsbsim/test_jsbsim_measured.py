@@ -21,7 +21,7 @@ from gcs_sysid.airframe import load_airframe
 from gcs_sysid.estimation import estimate_states
 from gcs_sysid.telemetry import read_log
 
-from scoring import score_table
+from benchmarks.jsbsim_harness.scoring import score_table
 
 #: Frozen 2026-11-21 (see the module docstring): % for coefficients, deg RMS for the air angles.
 THRESHOLDS = {"CX": 3.0, "CY": 13.0, "CZ": 2.0, "Cl": 20.0, "Cm": 19.0, "Cn": 13.0,
