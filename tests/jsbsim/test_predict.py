@@ -38,7 +38,7 @@ def fitted_dir(fast_flight, tmp_path_factory):
     af = load_airframe(fast_flight.airframe)
     table = compute_coefficients(estimate_states(read_log(fast_flight.tlog), af), af)
     ok = table.valid & np.isfinite(table.X).all(1) & np.isfinite(table.Y).all(1)
-    model, _ = fit_gp(table.X[ok][::2], table.Y[ok][::2], GPConfig(n_inducing=32))
+    model, _ = fit_gp(table.X[ok][::2], table.Y[ok][::2], GPConfig(n_inducing=32, steps=60, local_steps=15))
     out = tmp_path_factory.mktemp("fitted")
     model.save(out / "model")
     return out, table.t[ok][::2]
