@@ -1,7 +1,7 @@
 """Airframe files (``data/airframes/jsbsim-<name>.toml``) for the harness's aircraft, from JSBSim.
 
 Mass, inertia (JSBSim's ``inertia/ixz-slugs_ft2`` has the opposite sign of the project's
-``Ixz = integral x z dm``; checked against ``J w_dot + w x J w`` on the SGS), reference geometry
+``Ixz = integral x z dm``; found by fitting ``J w_dot + w x J w`` to the moments), reference geometry
 (``metrics/Sw-sqft``, ``bw-ft``, ``cbarw-ft``) and a servo map in ArduPlane's output order (1 aileron,
 2 elevator, 3 throttle, 4 rudder; PWM above trim = roll right / pitch up / yaw right) whose ends are
 the aircraft's full-command deflections. The files are generated once by
