@@ -194,6 +194,10 @@ class Airframe:
         source: path of the file it was read from ("" if built in code).
         notes: free-text provenance of the values.
         limits: the ``[limits]`` table (:class:`Limits`), or None when the file has none.
+        air_angles: what the log's AOA_SSA / AOA angles are: ``"estimate"`` (the autopilot's own
+            lagged estimate from velocity and wind; the default, ArduPilot's AHRS) or ``"vane"``
+            (measured by vanes at the CG; the estimator then uses them as alpha and beta).
+            ``[air_data] angles`` in the file.
     """
 
     name: str
@@ -212,6 +216,7 @@ class Airframe:
     source: str = ""
     notes: str = ""
     limits: Limits | None = None
+    air_angles: str = "estimate"
 
     @property
     def authority(self) -> dict[str, float]:
@@ -312,7 +317,8 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
             the message names the file and the field.
     """
     src = source
-    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes", "limits"}
+    known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes",
+             "limits", "air_data"}
     for k in doc:
         if k not in known:
             raise InputError(f"{src}: unknown top-level field '{k}' (expected one of {sorted(known)})")
@@ -414,8 +420,15 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     notes = doc.get("notes", "")
     if not isinstance(notes, str):
         raise InputError(f"{src}: notes must be a string")
+    air = doc.get("air_data", {})
+    if not isinstance(air, Mapping) or set(air) - {"angles"}:
+        raise InputError(f"{src}: [air_data] must be a table with only 'angles' (\"estimate\" or \"vane\")")
+    angles = air.get("angles", "estimate")
+    if angles not in ("estimate", "vane"):
+        raise InputError(f"{src}: [air_data] angles must be \"estimate\" (autopilot's AOA_SSA estimate) or "
+                         f"\"vane\" (AOA_SSA/AOA carry vane measurements), got {angles!r}")
     af = Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
-                  tuple(float(x) for x in arm), source, notes)
+                  tuple(float(x) for x in arm), source, notes, air_angles=angles)
     if "limits" in doc:
         af = replace(af, limits=_limits(doc["limits"], af, src))
     return af
@@ -499,4 +512,6 @@ def airframe_to_dict(a: Airframe) -> dict[str, Any]:
         d["notes"] = a.notes
     if a.limits is not None:
         d["limits"] = a.limits.to_dict()
+    if a.air_angles != "estimate":
+        d["air_data"] = {"angles": a.air_angles}
     return d

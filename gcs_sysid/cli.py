@@ -1,4 +1,4 @@
-"""Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose``.
+"""Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose | predict``.
 
 Errors a user can cause (bad file, missing field, data that cannot support an
 estimate) print one line ``gcs-sysid: error: ...`` on stderr and exit with code 2,
@@ -74,6 +74,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--search", action="store_true", help="also search a wide term library (docs/diagnose.md)")
     _window_args(d)
 
+    pr = sub.add_parser("predict", help="evaluate a saved model at given flight conditions (CSV in, CSV out)")
+    pr.add_argument("model_dir", help="replay output directory holding model.npz/model.json (or the model prefix)")
+    pr.add_argument("--inputs", required=True, help="CSV with columns " + " ".join(
+        ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "delta_a", "delta_r", "delta_t", "V")) + " (SI)")
+    pr.add_argument("--out", required=True, help="output CSV: inputs plus <C>_mean, <C>_sigma, <C>_sigma_obs")
+
     c = sub.add_parser("campaign", help="closed-loop campaign in the simulation: suggested vs standard flights")
     c.add_argument("--airframe", required=True, help="airframe TOML with a [limits] table")
     c.add_argument("--model", required=True, help="truth aerodynamic model TOML (docs/model-file.md)")
@@ -148,8 +154,16 @@ def _cmd_campaign(a: argparse.Namespace) -> int:
     return run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit)
 
 
+def _cmd_predict(a: argparse.Namespace) -> int:
+    from .predict import run_predict
+
+    pred = run_predict(a.model_dir, a.inputs, a.out)
+    print(f"wrote {a.out} ({len(pred.X)} conditions, {', '.join(pred.outputs)})")
+    return 0
+
+
 COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
-            "listen": _cmd_listen, "campaign": _cmd_campaign}
+            "listen": _cmd_listen, "campaign": _cmd_campaign, "predict": _cmd_predict}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -42,6 +42,25 @@ def _stack(al: Aligned, stream: str, fields: tuple[str, ...]) -> np.ndarray | No
     return x if np.isfinite(x).all(axis=1).sum() >= 10 else None
 
 
+def _vane_angles(flight: Flight, airframe: Airframe, al):
+    """``(alpha, beta, note)`` on the grid from the vanes when the airframe says AOA_SSA/AOA are vane
+    measurements (``[air_data] angles = "vane"``) and the log has them; else None.
+
+    The vanes are taken as at the CG (no boom lever-arm or upwash correction) and as fast enough that
+    linear interpolation of their samples is the angle (a vane's own lag is not removed).
+    """
+    if getattr(airframe, "air_angles", "estimate") != "vane" or not flight.has("aoa_ssa"):
+        return None
+    alpha, beta = al.get("aoa_ssa", "alpha"), al.get("aoa_ssa", "beta")
+    if not (np.isfinite(alpha).any() and np.isfinite(beta).any()):
+        return None
+    n = len(flight["aoa_ssa"].t)
+    span = float(flight["aoa_ssa"].t[-1] - flight["aoa_ssa"].t[0]) if n > 1 else 0.0
+    rate = (n - 1) / span if span > 0 else float("nan")
+    return alpha, beta, (f"alpha and beta from the vanes (AOA_SSA/AOA at {rate:.0f} Hz; airframe "
+                         f"[air_data] angles = \"vane\"); V and the wind still from GPS, attitude and pitot")
+
+
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     progress: Callable[[float], None] | None = None, helper: Helper | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
@@ -338,11 +357,25 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         sources["beta"] = "asin(v_a / V) of the air-relative body velocity"
         ident["alpha"] = (True, "reconstructed from GPS velocity, attitude and wind")
         ident["beta"] = (True, "reconstructed from GPS velocity, attitude and wind")
+        vanes = _vane_angles(flight, airframe, al)
+        if vanes is not None:
+            alpha, beta, note = vanes
+            for k in ("alpha", "beta"):
+                sources[k] = "vanes (AOA_SSA/AOA; airframe [air_data] angles = \"vane\"), linear interpolation"
+                ident[k] = (True, "measured by vanes")
+            notes.append(note)
     else:
         if have_tas:
             V = tas
             sources["V"] = eas_src + " -> TAS with " + sources["rho"].split(" (")[0]
-        if flight.has("aoa_ssa"):
+        vanes = _vane_angles(flight, airframe, al)
+        if vanes is not None:
+            alpha, beta, note = vanes
+            for k in ("alpha", "beta"):
+                sources[k] = "vanes (AOA_SSA/AOA; airframe [air_data] angles = \"vane\"), linear interpolation"
+                ident[k] = (True, "measured by vanes")
+            notes.append(note)
+        elif flight.has("aoa_ssa"):
             alpha, beta = al.get("aoa_ssa", "alpha"), al.get("aoa_ssa", "beta")
             for k in ("alpha", "beta"):
                 sources[k] = "AOA_SSA/AOA: the autopilot's own lagged estimate (fallback, not a vane)"

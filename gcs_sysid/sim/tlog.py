@@ -27,12 +27,13 @@ import bisect
 import math
 import struct
 from pathlib import Path
+from typing import Mapping
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from ..airframe import Airframe
 from .effects import CONTROL_NAMES
-from .sensors import decimation
+from .sensors import STREAM_RATES_HZ
 
 __all__ = ["write_tlog", "LOG_EPOCH_S"]
 
@@ -55,7 +56,8 @@ def _i(x, lo=-32768, hi=32767) -> int:
     return int(min(max(round(float(x)), lo), hi))
 
 
-def write_tlog(result, path: str | Path, airframe: Airframe | None = None, system_id: int = 1) -> int:
+def write_tlog(result, path: str | Path, airframe: Airframe | None = None, system_id: int = 1,
+               rates_hz: Mapping[str, float] | None = None) -> int:
     """Write ``result`` (a :class:`gcs_sysid.sim.flight.SimResult`) as a .tlog.
 
     Args:
@@ -63,10 +65,18 @@ def write_tlog(result, path: str | Path, airframe: Airframe | None = None, syste
         path: output file.
         airframe: airframe whose servo map turns commands into PWM (default ``result.airframe``).
         system_id: MAVLink system id.
+        rates_hz: stream -> rate overriding :data:`~gcs_sysid.sim.sensors.STREAM_RATES_HZ` (the
+            sensor streams of ``result`` must have been sampled at the same decimations; the
+            JSBSim harness in ``benchmarks/`` sends AOA_SSA at 50 Hz this way).
 
     Returns:
         number of packets written.
     """
+    rates = {**STREAM_RATES_HZ, **(rates_hz or {})}
+
+    def decimation(rate_hz: float, stream: str) -> int:
+        return max(1, int(round(rate_hz / rates[stream])))
+
     af = airframe or result.airframe
     t = result.t
     T = len(t)

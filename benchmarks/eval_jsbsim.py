@@ -1,0 +1,182 @@
+"""Score gcs-sysid against JSBSim's exact truth: aircraft x seeds x turbulence levels.
+
+For each flight (``benchmarks.jsbsim_harness``: a stock JSBSim aircraft gliding through 3-2-1-1s,
+doublets and multisines on all axes in Milspec turbulence, logged as an ArduPilot .tlog) it runs the
+real replay (``run_replay``: decode, EKF/RTS, coefficients, GP on the first 80 %, held-out last 20 %)
+and the project's stepwise least-squares fit (``run_fit`` on the training window), and prints,
+against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on the held-out segment):
+
+  meas   the measured coefficients themselves (``meas_all`` in the JSON: on all valid rows;
+         ``meas_true_accel``: on all rows with JSBSim's angular accelerations put in, a diagnosis)
+  gp     the replay's model predictions at the measured regressors
+  true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
+  ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
+  cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
+         true: the model's sigma without noise), averaged over the six coefficients
+  air    alpha and beta RMS errors of the reconstructed air data, deg (all valid rows)
+
+Usage::
+
+    python benchmarks/eval_jsbsim.py                        # small grid (2 tuning aircraft + held-out, 1 seed)
+    python benchmarks/eval_jsbsim.py --aircraft c172x sgs pa28 --seeds 1 2 3 --turbulence light moderate
+    python benchmarks/eval_jsbsim.py --aoa vane             # AOA_SSA = exact vane angles
+    python benchmarks/eval_jsbsim.py --summarize results.jsonl   # markdown table of --json results
+
+``pa28`` is the held-out aircraft: it was not used to set up the harness, the estimator or any
+threshold. Results are appended as JSON lines to ``--json`` when given.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.jsbsim_harness import FlightConfig, coefficient_errors, load_truth, make_flight  # noqa: E402
+from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
+from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
+
+THESIS_FORCES, THESIS_MOMENTS = 19.8, 23.8
+
+
+def _errs(est: np.ndarray, ref: np.ndarray) -> dict[str, float]:
+    return coefficient_errors(est, ref)
+
+
+def _coverage(mean, sigma, ref) -> float:
+    m = np.isfinite(mean) & np.isfinite(sigma) & np.isfinite(ref)
+    return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
+
+
+def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path) -> dict:
+    """One flight scored (see the module docstring); returns a JSON-able dict."""
+    from gcs_sysid.diagnose import run_fit
+    from gcs_sysid.gp import load_gp
+
+    t0 = time.perf_counter()
+    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa)
+    t_fly = time.perf_counter() - t0
+    truth = load_truth(files.truth)
+    out = work / f"{files.tlog.stem}-replay"
+    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False))
+    t_replay = time.perf_counter() - t0 - t_fly
+    tab, held = res.table, res.held_out
+    Xt, Yt = truth.at(tab.t)
+    ok = tab.valid & np.isfinite(Yt).all(1)
+    h = held & ok
+    row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
+                 "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
+    row["meas"] = _errs(tab.Y[h], Yt[h])
+    row["meas_all"] = _errs(tab.Y[ok], Yt[ok])
+    # diagnosis: the measured coefficients again with JSBSim's angular accelerations in the states
+    from gcs_sysid.aero import compute_coefficients
+    from gcs_sysid.airframe import load_airframe
+
+    st = res.states
+    saved = {k: st.data[k] for k in ("p_dot", "q_dot", "r_dot")}
+    for k in saved:
+        st.data[k] = np.interp(st.t, truth.t, truth.fields[k])
+    tab_acc = compute_coefficients(st, load_airframe(files.airframe))
+    st.data.update(saved)
+    row["meas_true_accel"] = _errs(tab_acc.Y[ok], Yt[ok])
+    row["gp"] = _errs(res.pred_mean[h], Yt[h])
+    row["cov_gp"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]))
+    model = load_gp(Path(res.model_path))
+    mt, vt = model.predict(Xt[h], include_noise=False)
+    row["true"] = _errs(np.asarray(mt), Yt[h])
+    row["cov_true"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i])
+                                        for i in range(6)]))
+    t_cut = float(tab.t[h][0])
+    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut)
+    row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
+    row["alpha_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 0] - Xt[ok, 0]) ** 2))))
+    row["beta_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 1] - Xt[ok, 1]) ** 2))))
+    row["alpha_rms_deg"] = float(np.degrees(np.std(Xt[ok, 0])))
+    row["beta_rms_deg"] = float(np.degrees(np.sqrt(np.mean(Xt[ok, 1] ** 2))))
+    return row
+
+
+def _fmt(d: dict) -> str:
+    return " ".join(f"{d[c]:6.1f}" for c in COEFFICIENTS)
+
+
+def summarize(paths: list[str]) -> str:
+    """Markdown table of JSON lines written by ``--json``: per aircraft, turbulence and AOA variant,
+    the median over seeds of each score (coefficient errors in %, coverage in %, air data in deg)."""
+    rows = [json.loads(line) for p in paths for line in open(p) if line.strip()]
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["aircraft"], r["turbulence"], r["aoa"]), []).append(r)
+    head = ("| aircraft | turb. | AOA_SSA | seeds | score | " + " | ".join(COEFFICIENTS)
+            + " | cov95 % | alpha / beta err deg (signal) |")
+    out = [head, "|" + "---|" * (head.count("|") - 1)]
+    for (ac, turb, aoa), rs in groups.items():
+        med = lambda k, c=None: float(np.nanmedian([r[k][c] if c else r[k] for r in rs]))   # noqa: E731
+        for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
+                         ("ls", "stepwise LS")):
+            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}"}.get(k, "")
+            air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
+                   f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
+            name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
+            out.append(f"| {name} | {turb} | {aoa} | {len(rs)} | {label} | "
+                       + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
+    for turb in sorted({r["turbulence"] for r in rows}):
+        for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
+                         ("ls", "stepwise LS")):
+            rs = [r for r in rows if r["turbulence"] == turb]
+            f = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[:3]])
+            m = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[3:]])
+            out.append(f"\n{turb}, {label}: median over all flights and coefficients: forces {f:.1f} %, "
+                       f"moments {m:.1f} % (thesis real flights: {THESIS_FORCES} %, {THESIS_MOMENTS} %)")
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"])
+    ap.add_argument("--seeds", nargs="+", type=int, default=[1])
+    ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
+    ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
+    ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
+    ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
+    ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
+    ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
+                    help="only print the markdown table of earlier --json results (medians over seeds)")
+    a = ap.parse_args(argv)
+    if a.summarize:
+        print(summarize(a.summarize))
+        return 0
+    work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
+    rows = []
+    print(f"{'flight':32s} {'':5s} " + " ".join(f"{c:>6s}" for c in COEFFICIENTS) + "   cov95  alpha/beta err deg")
+    for ac in a.aircraft:
+        for turb in a.turbulence:
+            for seed in a.seeds:
+                row = evaluate(ac, seed, turb, a.aoa, a.duration, work)
+                rows.append(row)
+                name = f"{ac} {turb} s{seed} {a.aoa}"
+                print(f"{name:32s} meas  {_fmt(row['meas'])}")
+                print(f"{'':32s} gp    {_fmt(row['gp'])}   {row['cov_gp']:5.1f}  "
+                      f"{row['alpha_deg']:.2f}/{row['beta_deg']:.2f} (signal {row['alpha_rms_deg']:.2f}/"
+                      f"{row['beta_rms_deg']:.2f})")
+                print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}")
+                print(f"{'':32s} ls    {_fmt(row['ls'])}", flush=True)
+                if a.json:
+                    with open(a.json, "a") as f:
+                        f.write(json.dumps(row) + "\n")
+    forces = [r[k][c] for r in rows for k in ("gp",) for c in COEFFICIENTS[:3]]
+    moments = [r[k][c] for r in rows for k in ("gp",) for c in COEFFICIENTS[3:]]
+    print(f"median held-out model error: forces {np.nanmedian(forces):.1f} % (thesis real flight {THESIS_FORCES}), "
+          f"moments {np.nanmedian(moments):.1f} % (thesis {THESIS_MOMENTS})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,105 @@
+"""Stock JSBSim aircraft flown by the harness: model name, trim point, sign map, autopilot gains.
+
+JSBSim models do not share one sign convention for their surface positions (the c172x's
+``fcs/aileron-*-pos-rad`` come in pairs, the SGS moves one aileron property only),
+so each aircraft carries the signs that turn JSBSim's positions into the project's conventions
+(``docs/conventions.md``: delta_e trailing edge down, delta_a right aileron trailing edge down,
+delta_r trailing edge left, all positive). The signs were read from each model's response to a
+positive command (``docs/jsbsim.md``) and are checked against the truth in
+``tests/jsbsim/test_harness.py`` (Cm_delta_e, Cl_delta_a, Cn_delta_r all negative).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["AircraftSpec", "AIRCRAFT", "TUNING_AIRCRAFT", "HELD_OUT_AIRCRAFT", "aircraft"]
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@dataclass(frozen=True)
+class AircraftSpec:
+    """One stock JSBSim aircraft and how the harness flies it.
+
+    Attributes:
+        name: harness name (also the airframe file ``data/airframes/jsbsim-<name>.toml``).
+        model: JSBSim model directory name shipped by the ``jsbsim`` wheel.
+        airspeed_kts: calibrated airspeed of the glide, kt (JSBSim's ``ic/vc-kts``).
+        altitude_ft: initial altitude above sea level, ft.
+        elevator_sign: delta_e = sign * ``fcs/elevator-pos-rad``.
+        aileron_sign: delta_a = sign * 0.5 * (left - right) of the two JSBSim aileron position
+            properties, or sign * left when the model has only one (``aileron_props[1]`` None;
+            the right aileron is then the mirror of the left).
+        aileron_props: (left, right) JSBSim aileron position properties, rad.
+        rudder_sign: delta_r = sign * ``fcs/rudder-pos-rad``.
+        cmd_per_rad: (elevator, aileron, rudder) JSBSim normalised command (-1..1) per rad of the
+            raw JSBSim deflection (the autopilot thinks in the project's deflections; the command
+            is ``delta * sign * cmd_per_rad``).
+        amplitude_deg: (delta_e, delta_a, delta_r) maneuver amplitudes, deg.
+        pulse_s: (pitch, roll, yaw) pulse width of doublets and 3-2-1-1s, s.
+        gains: autopilot gains (k_theta, k_q, k_v, k_phi, k_p, k_r), rad/rad, rad/(rad/s), rad/(m/s).
+        notes: provenance.
+    """
+
+    name: str
+    model: str
+    airspeed_kts: float
+    altitude_ft: float
+    elevator_sign: float
+    aileron_sign: float
+    aileron_props: tuple[str, str | None]
+    rudder_sign: float
+    cmd_per_rad: tuple[float, float, float]
+    amplitude_deg: tuple[float, float, float]
+    pulse_s: tuple[float, float, float]
+    gains: tuple[float, float, float, float, float, float] = (1.0, 0.3, 0.01, 0.4, 0.1, 0.4)
+    notes: str = ""
+
+    @property
+    def airframe_path(self) -> Path:
+        """The airframe file the pipeline reads for this aircraft."""
+        return REPO / "data" / "airframes" / f"jsbsim-{self.name}.toml"
+
+
+_DEG = 57.29577951308232
+
+#: Aircraft the harness knows. ``c172x`` and ``sgs`` were used to set up the harness and the test
+#: thresholds; ``pa28`` is kept out of all tuning (``HELD_OUT_AIRCRAFT``).
+AIRCRAFT: dict[str, AircraftSpec] = {
+    "c172x": AircraftSpec(
+        name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0,
+        aileron_props=("fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"), rudder_sign=1.0,
+        cmd_per_rad=(_DEG / 19.48, _DEG / 17.35, _DEG / 16.0),
+        amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0),
+        notes="Cessna 172 (JSBSim c172x), engine shut down, gliding; lateral point masses emptied"),
+    "sgs": AircraftSpec(
+        name="sgs", model="SGS", airspeed_kts=50.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None),
+        rudder_sign=1.0, cmd_per_rad=(_DEG / 28.0, _DEG / 20.0, _DEG / 16.0),
+        amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.8, 0.9, 1.0),
+        notes="Schweizer SGS 2-33 glider (JSBSim SGS)"),
+    "pa28": AircraftSpec(
+        name="pa28", model="pa28", airspeed_kts=80.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0,
+        aileron_props=("fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"), rudder_sign=1.0,
+        cmd_per_rad=(_DEG / 23.0, _DEG / 22.5, _DEG / 27.0),
+        amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0),
+        notes="Piper PA-28 (JSBSim pa28), engine shut down, gliding; held out of all tuning"),
+}
+TUNING_AIRCRAFT = ("c172x", "sgs")
+HELD_OUT_AIRCRAFT = ("pa28",)
+
+
+def aircraft(name: str) -> AircraftSpec:
+    """The spec called ``name``.
+
+    Raises:
+        KeyError: unknown name (the message lists the known ones).
+    """
+    try:
+        return AIRCRAFT[name]
+    except KeyError:
+        raise KeyError(f"unknown aircraft '{name}' (known: {', '.join(AIRCRAFT)})") from None

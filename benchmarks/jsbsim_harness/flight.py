@@ -1,0 +1,331 @@
+"""Fly a stock JSBSim aircraft through system-identification maneuvers and record the exact truth.
+
+The aircraft glides (engines shut down, so that every non-gravity force is aerodynamic and the
+pipeline's CX needs no thrust model) from a calibrated-airspeed initial condition, a simple
+stabilising autopilot (pitch attitude with airspeed hold, wings level, yaw damper) holds it while
+the maneuver inputs are added to the autopilot's surface commands (as ArduPlane's SYSID mode adds
+them to the controller outputs), and the sum reaches JSBSim through first-order, rate-limited servos. JSBSim's MIL-F-8785C (``Milspec``) Dryden turbulence, with its
+rotational components, and a steady wind act on it.
+
+Truth (SI, body axes x fwd / y right / z down, NED) is read from JSBSim's own properties at every
+log tick: aerodynamic forces ``forces/fb{x,y,z}-aero-lbs`` and moments ``moments/{l,m,n}-aero-lbsft``
+(JSBSim transfers the moments from its aerodynamic reference point to the CG, ``FGAerodynamics``;
+checked against ``J w_dot + w x J w``: 1e-11 on the minisgs, 0.2 % with the rounded airframe file in
+``tests/jsbsim``), ``aero/alpha-rad``,
+``aero/beta-rad``, ``velocities/vt-fps``, ``aero/qbar-psf``, the inertial body rates
+``velocities/{p,q,r}i-rad_sec`` and their derivatives, and ``atmosphere/total-wind-*-fps``
+(steady wind plus turbulence, the velocity of the air over the ground).
+
+References:
+    Berndt, J. S. et al., *JSBSim Reference Manual* (jsbsim.sourceforge.net / jsbsim-team.github.io),
+    axes, units and property names. MIL-F-8785C, sec. 3.7 (turbulence models).
+    Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 9 (inputs).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass, field
+from typing import Mapping
+
+import jsbsim
+import numpy as np
+
+from gcs_sysid.signals import doublet, multisine, three_two_one_one
+
+from .aircraft import AircraftSpec, aircraft
+
+__all__ = ["FlightConfig", "Recording", "fly", "load_model", "maneuver_inputs", "TURBULENCE",
+           "LBF", "FT", "SLUG", "SLUG_FT2"]
+
+LBF = 4.4482216152605      # N per lbf
+FT = 0.3048                # m per ft
+SLUG = 14.593902937        # kg per slug
+SLUG_FT2 = SLUG * FT * FT  # kg m^2 per slug ft^2
+KT = 0.514444              # m/s per kt
+
+#: Turbulence levels: (JSBSim Milspec severity index, wind speed at 20 ft in kt). MIL-F-8785C
+#: gives 15 kt (light), 30 kt (moderate) and 45 kt (severe) at 20 ft; the severity index selects
+#: the probability of exceedance for the medium/high-altitude model.
+TURBULENCE = {"none": (0, 0.0), "light": (1, 15.0), "moderate": (3, 30.0)}
+
+
+@dataclass(frozen=True)
+class FlightConfig:
+    """What to fly.
+
+    Attributes:
+        aircraft: harness aircraft name (:data:`benchmarks.jsbsim_harness.aircraft.AIRCRAFT`).
+        duration_s: logged flight time after the settling phase, s.
+        turbulence: ``"none"``, ``"light"`` or ``"moderate"`` (:data:`TURBULENCE`).
+        seed: seeds JSBSim's turbulence (``simulation/randomseed``) and, in ``sensors``, the noise.
+        wind_ned: steady wind, the air's velocity over the ground, NED, m/s.
+        sim_rate_hz: JSBSim integration rate, Hz.
+        log_rate_hz: truth and fast-stream rate, Hz (a whole divisor of ``sim_rate_hz``).
+        settle_s: unlogged flight before the log starts, s (the autopilot settles the glide).
+        amplitude_scale: multiplies the aircraft's maneuver amplitudes.
+        servo_tau_s: time constant of the servos, s: the surfaces follow the commands (autopilot +
+            maneuvers) through a first-order lag with a rate limit of ``servo_rate_deg_s`` (JSBSim's
+            stock models move their surfaces instantly). 0 = ideal servos.
+        servo_rate_deg_s: servo rate limit, deg/s of the project's deflection.
+    """
+
+    aircraft: str = "c172x"
+    duration_s: float = 120.0
+    turbulence: str = "light"
+    seed: int = 0
+    wind_ned: tuple[float, float, float] = (3.0, -2.0, 0.0)
+    sim_rate_hz: float = 200.0
+    log_rate_hz: float = 50.0
+    settle_s: float = 15.0
+    amplitude_scale: float = 1.0
+    servo_tau_s: float = 0.04
+    servo_rate_deg_s: float = 300.0
+
+    def __post_init__(self):
+        if self.turbulence not in TURBULENCE:
+            raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}, got '{self.turbulence}'")
+        if abs(self.sim_rate_hz / self.log_rate_hz - round(self.sim_rate_hz / self.log_rate_hz)) > 1e-9:
+            raise ValueError(f"log_rate_hz {self.log_rate_hz} must divide sim_rate_hz {self.sim_rate_hz}")
+        if not self.duration_s > 0:
+            raise ValueError(f"duration_s must be > 0, got {self.duration_s}")
+
+
+@dataclass
+class Recording:
+    """A flown flight: truth on the log grid, SI.
+
+    Attributes:
+        t: vehicle time, s, shape (T,), starting at 0 at the end of the settling phase.
+        truth: name -> (T,) arrays (see :data:`TRUTH_FIELDS` in ``truth.py`` for the list).
+        constants: mass kg, Ixx Iyy Izz Ixz kg m^2 (project convention, Ixz = integral x z dm),
+            S m^2, b m, c m, home lat/lon rad and ground altitude m.
+        config: the :class:`FlightConfig`.
+    """
+
+    t: np.ndarray
+    truth: dict[str, np.ndarray]
+    constants: dict[str, float]
+    config: FlightConfig
+    meta: dict = field(default_factory=dict)
+
+
+def load_model(spec: AircraftSpec, dt: float, seed: int = 0) -> jsbsim.FGFDMExec:
+    """A JSBSim executive with ``spec``'s model loaded from the wheel's own data (no network).
+
+    Point masses off the aircraft's centre plane are emptied (the c172x carries an 80 lb mass at
+    its right wing tip): the project's airframe file has no Ixy/Iyz, and JSBSim's moments of
+    those products of inertia would otherwise be an error no estimator could remove.
+    """
+    jsbsim.FGJSBBase().debug_lvl = 0      # no start-up banner on stdout
+    fdm = jsbsim.FGFDMExec(None)          # root dir: the wheel's packaged aircraft/engine/systems
+    fdm.set_debug_level(0)
+    if not fdm.load_model(spec.model):
+        raise RuntimeError(f"JSBSim could not load model '{spec.model}'")
+    # the models' own <output> elements (the c172x writes JSBout172B.csv into the cwd) go nowhere
+    for n in range(16):
+        try:
+            if not fdm.get_output_filename(n):
+                break
+        except Exception:       # no output n: JSBSim raises (IndexError/RuntimeError by version)
+            break
+        fdm.set_output_filename(n, os.devnull)
+    fdm.disable_output()
+    fdm.set_dt(dt)
+    fdm["simulation/randomseed"] = int(seed)
+    i = 0
+    while True:
+        key = f"inertia/pointmass-location-Y-inches[{i}]"
+        try:
+            y = fdm[key]
+        except KeyError:
+            break
+        if abs(y) > 1e-6:
+            fdm[f"inertia/pointmass-weight-lbs[{i}]"] = 0.0
+        i += 1
+    return fdm
+
+
+def _segments(spec: AircraftSpec, duration: float) -> list[tuple[str, int, float, float, float]]:
+    """(kind, axis, start s, amplitude rad, pulse s or period s) of the maneuvers. Axis 0 delta_e,
+    1 delta_a, 2 delta_r, -1 all three (multisine).
+
+    The first 80 % of the flight repeats a block of single-axis 3-2-1-1s and doublets and a
+    three-axis multisine (alternating signs); the last 20 % (the replay's held-out segment) is one
+    three-axis multisine, so that the held-out segment excites every axis."""
+    ae, aa, ar = np.radians(spec.amplitude_deg)
+    pe, pa, pr = spec.pulse_s
+    block = [("3211", 0, ae, pe), ("doublet", 1, aa, pa), ("doublet", 2, ar, pr), ("3211", 1, aa, pa),
+             ("3211", 2, ar, pr), ("doublet", 0, ae * 1.5, pe), ("multisine", -1, 1.0, 16.0)]
+    out, t, k = [], 2.0, 0
+    train_end = 0.8 * duration
+    while True:
+        kind, axis, amp, w = block[k % len(block)]
+        length = {"3211": 7 * w, "doublet": 2 * w, "multisine": w}[kind]
+        if t + length > train_end - 1.0:
+            break
+        sgn = -1.0 if (k // len(block)) % 2 else 1.0     # alternate signs on repeats
+        out.append((kind, axis, t, sgn * amp, w))
+        t += length + (3.0 if kind != "multisine" else 2.0)
+        k += 1
+    last = duration - train_end - 1.5
+    if last >= 4.0:
+        out.append(("multisine", -1, train_end + 0.75, 1.0, last))
+    return out
+
+
+def maneuver_inputs(spec: AircraftSpec, t: np.ndarray, duration: float, scale: float = 1.0) -> np.ndarray:
+    """Maneuver deflections added to the autopilot's, rad, shape (T, 3): delta_e, delta_a, delta_r.
+
+    3-2-1-1s and doublets on each axis in turn, then an orthogonal phase-optimised multisine on all
+    three axes together (0.1-1.5 Hz, ``gcs_sysid.signals``), repeated with alternating signs; the last
+    20 % of the flight is one three-axis multisine (see :func:`_segments`).
+    """
+    u = np.zeros((len(t), 3))
+    amps = np.radians(spec.amplitude_deg) * scale
+    for kind, axis, start, amp, w in _segments(spec, duration):
+        if kind == "multisine":
+            for j in range(3):
+                u[:, j] += multisine(t, start, w, (max(0.1, 3.0 / w), 1.5), 0.8 * amps[j] * np.sign(amp), 3, j)
+        elif kind == "3211":
+            u[:, axis] += three_two_one_one(t, start, w, amp * scale)
+        else:
+            u[:, axis] += doublet(t, start, w, amp * scale)
+    return u
+
+
+_PROPS = {
+    "phi": ("attitude/phi-rad", 1.0), "theta": ("attitude/theta-rad", 1.0), "psi": ("attitude/psi-rad", 1.0),
+    "p": ("velocities/pi-rad_sec", 1.0), "q": ("velocities/qi-rad_sec", 1.0), "r": ("velocities/ri-rad_sec", 1.0),
+    "p_dot": ("accelerations/pidot-rad_sec2", 1.0), "q_dot": ("accelerations/qidot-rad_sec2", 1.0),
+    "r_dot": ("accelerations/ridot-rad_sec2", 1.0),
+    "p_aero": ("velocities/p-aero-rad_sec", 1.0), "q_aero": ("velocities/q-aero-rad_sec", 1.0),
+    "r_aero": ("velocities/r-aero-rad_sec", 1.0),
+    "u": ("velocities/u-fps", FT), "v": ("velocities/v-fps", FT), "w": ("velocities/w-fps", FT),
+    "vn": ("velocities/v-north-fps", FT), "ve": ("velocities/v-east-fps", FT), "vd": ("velocities/v-down-fps", FT),
+    "V": ("velocities/vt-fps", FT), "alpha": ("aero/alpha-rad", 1.0), "beta": ("aero/beta-rad", 1.0),
+    "qbar": ("aero/qbar-psf", LBF / FT**2), "rho": ("atmosphere/rho-slugs_ft3", SLUG / FT**3),
+    "press_abs": ("atmosphere/P-psf", LBF / FT**2), "temperature": ("atmosphere/T-R", 5.0 / 9.0),
+    "wn": ("atmosphere/total-wind-north-fps", FT), "we": ("atmosphere/total-wind-east-fps", FT),
+    "wd": ("atmosphere/total-wind-down-fps", FT),
+    "lat": ("position/lat-geod-rad", 1.0), "lon": ("position/long-gc-rad", 1.0), "alt": ("position/h-sl-meters", 1.0),
+    "Fx_aero": ("forces/fbx-aero-lbs", LBF), "Fy_aero": ("forces/fby-aero-lbs", LBF),
+    "Fz_aero": ("forces/fbz-aero-lbs", LBF),
+    "Fx_total": ("forces/fbx-total-lbs", LBF), "Fy_total": ("forces/fby-total-lbs", LBF),
+    "Fz_total": ("forces/fbz-total-lbs", LBF),
+    "L_aero": ("moments/l-aero-lbsft", LBF * FT), "M_aero": ("moments/m-aero-lbsft", LBF * FT),
+    "N_aero": ("moments/n-aero-lbsft", LBF * FT),
+    "L_total": ("moments/l-total-lbsft", LBF * FT), "M_total": ("moments/m-total-lbsft", LBF * FT),
+    "N_total": ("moments/n-total-lbsft", LBF * FT),
+    "elevator_pos": ("fcs/elevator-pos-rad", 1.0), "rudder_pos": ("fcs/rudder-pos-rad", 1.0),
+    "mass": ("inertia/mass-slugs", SLUG),
+}
+
+
+def _set_ic(fdm: jsbsim.FGFDMExec, spec: AircraftSpec, cfg: FlightConfig) -> None:
+    fdm["ic/h-sl-ft"] = spec.altitude_ft
+    fdm["ic/vc-kts"] = spec.airspeed_kts
+    fdm["ic/gamma-deg"] = -4.0
+    fdm["ic/psi-true-deg"] = 30.0
+    fdm["ic/lat-geod-deg"] = 47.397742
+    fdm["ic/long-gc-deg"] = 8.545594
+    wn, we, wd = cfg.wind_ned
+    fdm["atmosphere/wind-north-fps"] = wn / FT
+    fdm["atmosphere/wind-east-fps"] = we / FT
+    fdm["atmosphere/wind-down-fps"] = wd / FT
+    sev, w20 = TURBULENCE[cfg.turbulence]
+    fdm["atmosphere/turb-type"] = 3 if sev else 0            # 3 = ttMilspec (Dryden form)
+    fdm["atmosphere/turbulence/milspec/severity"] = sev
+    fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20 * KT / FT
+    if not fdm.run_ic():
+        raise RuntimeError(f"JSBSim could not initialise {spec.model}")
+    for i in range(fdm.get_propulsion().get_num_engines()):
+        fdm[f"propulsion/engine[{i}]/set-running"] = 0
+    fdm["fcs/throttle-cmd-norm"] = 0.0
+    fdm["fcs/mixture-cmd-norm"] = 0.0
+
+
+def _deflections(fdm: jsbsim.FGFDMExec, spec: AircraftSpec) -> tuple[float, float, float]:
+    """(delta_e, delta_a, delta_r) in the project's conventions, rad."""
+    de = spec.elevator_sign * fdm["fcs/elevator-pos-rad"]
+    left, right = spec.aileron_props
+    raw = 0.5 * (fdm[left] - fdm[right]) if right else fdm[left]
+    return de, spec.aileron_sign * raw, spec.rudder_sign * fdm["fcs/rudder-pos-rad"]
+
+
+def fly(config: FlightConfig) -> Recording:
+    """Fly ``config`` and return the truth on the log grid.
+
+    Raises:
+        ValueError: unknown aircraft or bad configuration.
+        RuntimeError: JSBSim failed to load or initialise the model, or the aircraft left the
+            flight envelope (airspeed below half or above twice the initial value, bank beyond
+            70 deg), which means the autopilot or the maneuvers need retuning for it.
+    """
+    spec = aircraft(config.aircraft)
+    dt = 1.0 / config.sim_rate_hz
+    dec = int(round(config.sim_rate_hz / config.log_rate_hz))
+    fdm = load_model(spec, dt, config.seed)
+    _set_ic(fdm, spec, config)
+    k_th, k_q, k_v, k_phi, k_p, k_r = spec.gains
+    v_ref = fdm["velocities/vt-fps"] * FT
+    theta_ref0 = fdm["attitude/theta-rad"]
+    psi_ref = fdm["attitude/psi-rad"]
+    de_int = 0.0
+    servo = np.zeros(3)          # surface positions the servos hold (project deltas), rad
+    first = True
+    a_servo = 1.0 - np.exp(-dt / config.servo_tau_s) if config.servo_tau_s > 0 else 1.0
+    max_step = np.radians(config.servo_rate_deg_s) * dt
+    n_settle = int(round(config.settle_s * config.sim_rate_hz))
+    n_log = int(round(config.duration_s * config.log_rate_hz))
+    t_log = np.arange(n_log) / config.log_rate_hz
+    u_man = maneuver_inputs(spec, t_log, config.duration_s, config.amplitude_scale)
+    rec = {k: np.empty(n_log) for k in list(_PROPS) + ["delta_e", "delta_a", "delta_r", "delta_t"]}
+    n_total = n_settle + n_log * dec
+    for i in range(n_total):
+        j = (i - n_settle) // dec
+        man = u_man[j] if i >= n_settle else np.zeros(3)
+        theta, q, V = fdm["attitude/theta-rad"], fdm["velocities/q-rad_sec"], fdm["velocities/vt-fps"] * FT
+        phi, p, r = fdm["attitude/phi-rad"], fdm["velocities/p-rad_sec"], fdm["velocities/r-rad_sec"]
+        theta_ref0 += 0.2 * k_v * (V - v_ref) * dt            # slow trim of the pitch reference
+        theta_ref = theta_ref0 + k_v * (V - v_ref)
+        e_th = theta - theta_ref
+        de_int += 0.5 * k_th * e_th * dt
+        de = de_int + k_th * e_th + k_q * q + man[0]
+        psi_err = (fdm["attitude/psi-rad"] - psi_ref + np.pi) % (2 * np.pi) - np.pi
+        phi_ref = float(np.clip(-0.5 * psi_err, -0.2, 0.2))     # weak heading hold
+        da = k_phi * (phi - phi_ref) + k_p * p + man[1]
+        dr = k_r * r + man[2]
+        cmd = np.array([de, da, dr])
+        if first:
+            servo, first = cmd.copy(), False
+        servo = servo + np.clip(a_servo * (cmd - servo), -max_step, max_step)   # lag + rate limit
+        de, da, dr = servo
+        fdm["fcs/elevator-cmd-norm"] = float(np.clip(de * spec.elevator_sign * spec.cmd_per_rad[0], -1, 1))
+        fdm["fcs/aileron-cmd-norm"] = float(np.clip(da * spec.aileron_sign * spec.cmd_per_rad[1], -1, 1))
+        fdm["fcs/rudder-cmd-norm"] = float(np.clip(dr * spec.rudder_sign * spec.cmd_per_rad[2], -1, 1))
+        if not fdm.run():
+            raise RuntimeError(f"JSBSim stopped at t = {i * dt:.2f} s")
+        if i >= n_settle and (i - n_settle) % dec == dec - 1:
+            for k, (prop, scale) in _PROPS.items():
+                rec[k][j] = fdm[prop] * scale
+            rec["delta_e"][j], rec["delta_a"][j], rec["delta_r"][j] = _deflections(fdm, spec)
+            rec["delta_t"][j] = 0.0
+            if not (0.5 * v_ref < rec["V"][j] < 2 * v_ref) or abs(rec["phi"][j]) > np.radians(70):
+                raise RuntimeError(f"{spec.name}: left the envelope at t = {t_log[j]:.1f} s "
+                                   f"(V {rec['V'][j]:.1f} m/s, bank {np.degrees(rec['phi'][j]):.0f} deg)")
+    left, right = spec.aileron_props
+    const = {"mass": float(fdm["inertia/mass-slugs"] * SLUG),
+             "Ixx": float(fdm["inertia/ixx-slugs_ft2"] * SLUG_FT2),
+             "Iyy": float(fdm["inertia/iyy-slugs_ft2"] * SLUG_FT2),
+             "Izz": float(fdm["inertia/izz-slugs_ft2"] * SLUG_FT2),
+             "Ixz": float(-fdm["inertia/ixz-slugs_ft2"] * SLUG_FT2),   # JSBSim's sign is the opposite
+             "Ixy": float(-fdm["inertia/ixy-slugs_ft2"] * SLUG_FT2),
+             "Iyz": float(-fdm["inertia/iyz-slugs_ft2"] * SLUG_FT2),
+             "S": float(fdm["metrics/Sw-sqft"] * FT**2), "b": float(fdm["metrics/bw-ft"] * FT),
+             "c": float(fdm["metrics/cbarw-ft"] * FT),
+             "home_lat": float(rec["lat"][0]), "home_lon": float(rec["lon"][0]), "home_alt": 0.0}
+    meta = {"config": asdict(config), "aircraft": asdict(spec) | {"airframe_path": str(spec.airframe_path)},
+            "jsbsim_version": jsbsim.__version__}
+    meta["aircraft"].pop("airframe_path", None)
+    return Recording(t=t_log, truth=rec, constants=const, config=config, meta=meta)

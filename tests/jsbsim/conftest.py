@@ -1,0 +1,25 @@
+"""Fixtures of the JSBSim truth tests: one short flight shared by the module tests.
+
+The harness lives in ``benchmarks/jsbsim_harness`` (outside the package, so truth cannot reach the
+pipeline); the repository root is put on the import path for it.
+"""
+
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from benchmarks.jsbsim_harness import FlightConfig, make_flight  # noqa: E402
+
+#: The fast flight: c172x gliding, 40 s logged, light Milspec turbulence, seed 1, AHRS AOA_SSA.
+FAST = FlightConfig("c172x", duration_s=40.0, turbulence="light", seed=1)
+
+
+@pytest.fixture(scope="session")
+def fast_flight(tmp_path_factory):
+    """(FlightFiles) of the fast flight: .tlog, truth .npz, airframe, recording."""
+    return make_flight(FAST, tmp_path_factory.mktemp("jsbsim"))

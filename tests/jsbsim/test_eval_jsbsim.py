@@ -1,0 +1,44 @@
+"""benchmarks/eval_jsbsim.py: the markdown summary of its JSON lines, and (slow) one scored flight."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from benchmarks import eval_jsbsim
+from gcs_sysid.aero.table import COEFFICIENTS
+
+KEYS = ("meas", "gp", "true", "ls")
+
+
+def _row(ac, seed, base):
+    errs = {k: {c: base + seed + i for i, c in enumerate(COEFFICIENTS)} for k in KEYS}
+    return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": seed, **errs, "cov_gp": 80.0 + seed,
+            "cov_true": 90.0, "alpha_deg": 0.1 * seed, "beta_deg": 0.2, "alpha_rms_deg": 0.5, "beta_rms_deg": 1.0}
+
+
+def test_summary_is_the_median_over_seeds(tmp_path):
+    p = tmp_path / "r.jsonl"
+    p.write_text("\n".join(json.dumps(_row("c172x", s, 10.0)) for s in (1, 2, 6)) + "\n"
+                 + json.dumps(_row("pa28", 1, 50.0)) + "\n")
+    text = eval_jsbsim.summarize([str(p)])
+    lines = [ln for ln in text.splitlines() if ln.startswith("| c172x") and "| measured |" in ln]
+    assert len(lines) == 1
+    cells = [c.strip() for c in lines[0].split("|")]
+    # median over seeds 1, 2, 6 of base + seed + i: base + 2 + i
+    assert cells[6:12] == [f"{10.0 + 2 + i:.1f}" for i in range(6)]
+    assert "0.20 / 0.20" in lines[0]
+    assert any(ln.startswith("| pa28 (held out)") for ln in text.splitlines())
+    assert "forces" in text and "19.8" in text
+
+
+@pytest.mark.slow
+def test_one_flight_is_scored(tmp_path):
+    row = eval_jsbsim.evaluate("sgs", 4, "light", "vane", 40.0, tmp_path)
+    for k in KEYS + ("meas_all", "meas_true_accel"):
+        assert set(row[k]) == set(COEFFICIENTS)
+        assert all(math.isfinite(v) for v in row[k].values()), (k, row[k])
+    assert max(row["meas_true_accel"][c] for c in ("Cl", "Cm", "Cn")) < 2.0   # truth accelerations: exact moments
+    assert row["alpha_deg"] < 0.2 and 0 <= row["cov_gp"] <= 100
+    assert np.isfinite(row["beta_rms_deg"])

@@ -1,0 +1,85 @@
+"""The JSBSim harness itself: exact truth consistent with rigid-body dynamics, sign conventions,
+generated airframe files, the .tlog as the pipeline decodes it."""
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import (AIRCRAFT, FlightConfig, fly, load_truth, truth_coefficients,
+                                       truth_regressors)
+from benchmarks.jsbsim_harness.airframes import airframe_doc
+from gcs_sysid.airframe import load_airframe
+from gcs_sysid.telemetry import read_log
+
+
+def test_truth_moments_are_about_the_cg_with_the_airframe_inertia(fast_flight):
+    """JSBSim's aero moments equal J w_dot + w x J w with the airframe file's J (so the Ixz sign,
+    the point masses and the moment reference point are right), and the specific force times the
+    mass equals the aero force (a glide: no other non-gravity force)."""
+    tr, af = fast_flight.recording.truth, load_airframe(fast_flight.airframe)
+    J = af.inertia
+    w = np.stack([tr["p"], tr["q"], tr["r"]], 1)
+    wd = np.stack([tr["p_dot"], tr["q_dot"], tr["r_dot"]], 1)
+    M = np.stack([tr["L_aero"], tr["M_aero"], tr["N_aero"]], 1)
+    rhs = wd @ J.T + np.cross(w, w @ J.T)
+    rel = np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
+    assert (rel < 2e-3).all(), rel          # airframe values are rounded to 6 digits
+    for a in "xyz":
+        np.testing.assert_allclose(tr[f"F{a}_aero"], tr[f"F{a}_total"], atol=1e-9)
+    assert af.mass == pytest.approx(fast_flight.recording.constants["mass"], rel=1e-5)
+
+
+def test_truth_signs_follow_the_project_conventions(fast_flight):
+    """Least squares on the exact truth: Cm_delta_e, Cl_delta_a, Cn_delta_r, Cm_alpha, Cl_p < 0 and
+    Cn_beta > 0 in the project's conventions (docs/conventions.md)."""
+    rec = fast_flight.recording
+    X, Y = truth_regressors(rec), truth_coefficients(rec)
+
+    def slopes(y, cols):
+        A = np.c_[np.ones(len(y)), X[:, cols]]
+        return np.linalg.lstsq(A, y, rcond=None)[0][1:]
+
+    cm = slopes(Y[:, 4], [0, 3, 5])          # alpha, q_hat, delta_e
+    cl = slopes(Y[:, 3], [1, 2, 4, 6, 7])    # beta, p_hat, r_hat, delta_a, delta_r
+    cn = slopes(Y[:, 5], [1, 2, 4, 6, 7])
+    assert cm[0] < 0 and cm[2] < 0
+    assert cl[1] < 0 and cl[3] < 0
+    assert cn[0] > 0 and cn[4] < 0
+
+
+@pytest.mark.parametrize("name", list(AIRCRAFT))
+def test_airframe_files_match_jsbsim(name):
+    """The checked-in airframe files are what the generator makes from the JSBSim model now."""
+    spec = AIRCRAFT[name]
+    doc, af = airframe_doc(spec), load_airframe(spec.airframe_path)
+    assert af.mass == pytest.approx(doc["mass"], rel=1e-6)
+    np.testing.assert_allclose(np.diag(af.inertia), [doc["inertia"][k] for k in ("Ixx", "Iyy", "Izz")], rtol=1e-6)
+    assert -af.inertia[0, 2] == pytest.approx(doc["inertia"]["Ixz"], rel=1e-6, abs=1e-9)
+    assert (af.S, af.b, af.c) == pytest.approx(tuple(doc["geometry"][k] for k in "Sbc"), rel=1e-6)
+
+
+def test_tlog_carries_the_ardupilot_streams_and_the_surfaces(fast_flight):
+    """The pipeline decodes the harness's .tlog: 50 Hz IMU/attitude/servo/AOA_SSA, GPS, pressure,
+    wind; the servo PWM maps back to JSBSim's deflections within PWM quantisation."""
+    flight = read_log(fast_flight.tlog)
+    for name, rate in (("imu", 50), ("attitude", 50), ("servo", 50), ("aoa_ssa", 50), ("gps", 25),
+                       ("airspeed", 25), ("wind", 2)):
+        s = flight.streams[name]
+        assert np.median(np.diff(s.t)) == pytest.approx(1.0 / rate, rel=0.05), name
+    af = load_airframe(fast_flight.airframe)
+    servo = flight.streams["servo"]
+    ctl = af.controls_from_pwm({c: servo.fields[f"pwm{c}"] for c in af.channels})
+    truth = load_truth(fast_flight.truth)
+    for k, i in (("delta_e", 5), ("delta_a", 6), ("delta_r", 7)):
+        ref = np.interp(servo.t, truth.t, truth.X[:, i])
+        assert np.max(np.abs(ctl[k] - ref)) < np.radians(0.1), k
+
+
+def test_flights_are_reproducible_per_seed(tmp_path, monkeypatch):
+    """JSBSim's turbulence is seeded: the same seed flies the same flight, another seed another;
+    JSBSim writes nothing into the working directory (the c172x model has an <output> element)."""
+    monkeypatch.chdir(tmp_path)
+    fly(FlightConfig("c172x", duration_s=1.0))
+    assert not list(tmp_path.iterdir())
+    a, b, c = (fly(FlightConfig("sgs", duration_s=5.0, seed=s)) for s in (3, 3, 4))
+    np.testing.assert_array_equal(a.truth["wn"], b.truth["wn"])
+    assert np.abs(a.truth["wn"] - c.truth["wn"]).max() > 0.01

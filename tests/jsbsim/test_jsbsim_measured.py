@@ -1,0 +1,83 @@
+"""The project's real path (read_log -> estimate_states -> compute_coefficients) on a JSBSim flight,
+scored against JSBSim's exact truth.
+
+Thresholds FROZEN on 2026-11-21 from the first measurement on the final harness flight (c172x,
+40 s, light turbulence, seed 1, AOA_SSA = ArduPilot's AHRS estimate, 0.04 s servos, last 20 % a
+three-axis multisine): measured CX 1.7, CY 9.1, CZ 0.9, Cl 15.1, Cm 14.0, Cn 9.2 %; alpha 0.24 deg,
+beta 0.21 deg RMS error. The harness changed twice before that, for realism, not to pass (history
+in docs/jsbsim.md): first schedule, ideal servos: CX 1.8, CY 5.6, CZ 0.9, Cl 20.3, Cm 19.0,
+Cn 13.7 %; final multisine, ideal servos: CX 1.7, CY 9.3, CZ 0.9, Cl 17.7, Cm 17.4, Cn 11.9 %.
+Thresholds are those values with a margin for platform
+differences; they guard against regressions, they are NOT the issue's acceptance targets (forces
+3 %, moments 8 %), which today's estimator misses on the moments (docs/benchmarks.md).
+Do not retune them to pass: change them only with a new measurement recorded in docs/jsbsim.md.
+"""
+
+import pytest
+
+from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight
+from gcs_sysid.aero import compute_coefficients
+from gcs_sysid.airframe import load_airframe
+from gcs_sysid.estimation import estimate_states
+from gcs_sysid.telemetry import read_log
+
+from benchmarks.jsbsim_harness.scoring import score_table
+
+#: Frozen 2026-11-21 (see the module docstring): % for coefficients, deg RMS for the air angles.
+THRESHOLDS = {"CX": 3.0, "CY": 13.0, "CZ": 2.0, "Cl": 20.0, "Cm": 19.0, "Cn": 13.0,
+              "alpha_deg": 0.35, "beta_deg": 0.30}
+
+
+def _measure(files):
+    af = load_airframe(files.airframe)
+    states = estimate_states(read_log(files.tlog), af)
+    return compute_coefficients(states, af)
+
+
+@pytest.fixture(scope="module")
+def measured(fast_flight):
+    return _measure(fast_flight), load_truth(fast_flight.truth)
+
+
+def test_measured_coefficients_and_air_data_against_truth(measured):
+    table, truth = measured
+    assert table.valid.mean() > 0.9
+    s = score_table(table, truth)
+    bad = {k: round(v, 2) for k, v in s.items() if not v <= THRESHOLDS[k]}
+    assert not bad, f"above the frozen thresholds {THRESHOLDS}: {bad} (all: {s})"
+
+
+def test_the_score_fails_against_wrong_truth(measured):
+    """The same comparison against sign-flipped truth exceeds every threshold: the test can fail."""
+    table, truth = measured
+    s = score_table(table, truth, sign=-1.0)
+    assert all(s[k] > THRESHOLDS[k] for k in THRESHOLDS), s
+
+
+#: Slow cases (120 s, seed 2), thresholds FROZEN on 2026-11-21 from their first measurement on the
+#: final harness (measured: sgs light CX 5.4, CY 3.4, CZ 0.5, Cl 16.0, Cm 10.6, Cn 7.8 %, alpha /
+#: beta 0.41 / 0.53 deg; c172x moderate CX 3.6, CY 11.5, CZ 7.0, Cl 19.9, Cm 26.7, Cn 11.4 %,
+#: 2.37 / 2.97 deg; pa28 (held out) light with vanes CX 1.1, CY 5.8, CZ 0.8, Cl 16.9, Cm 17.3,
+#: Cn 7.9 %, 0.10 / 0.10 deg), with a margin of about a third.
+SLOW_CASES = {
+    ("sgs", "light", "ahrs"): {"CX": 7.5, "CY": 5.0, "CZ": 1.0, "Cl": 21.0, "Cm": 14.0, "Cn": 10.5,
+                               "alpha_deg": 0.55, "beta_deg": 0.7},
+    ("c172x", "moderate", "ahrs"): {"CX": 5.0, "CY": 15.0, "CZ": 9.5, "Cl": 26.0, "Cm": 35.0, "Cn": 15.0,
+                                    "alpha_deg": 3.2, "beta_deg": 4.0},
+    ("pa28", "light", "vane"): {"CX": 1.5, "CY": 8.0, "CZ": 1.2, "Cl": 22.0, "Cm": 23.0, "Cn": 10.5,
+                                "alpha_deg": 0.15, "beta_deg": 0.15},
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", list(SLOW_CASES), ids=lambda c: "-".join(c))
+def test_longer_flights_are_measured(tmp_path, case):
+    """Two minutes on the glider, at moderate turbulence, and on the held-out pa28 with vanes
+    (airframe ``[air_data] angles = "vane"``) against their frozen thresholds; the full figures are
+    in docs/benchmarks.md (benchmarks/eval_jsbsim.py)."""
+    aircraft, turbulence, aoa = case
+    files = make_flight(FlightConfig(aircraft, duration_s=120.0, turbulence=turbulence, seed=2), tmp_path, aoa=aoa)
+    s = score_table(_measure(files), load_truth(files.truth))
+    limits = SLOW_CASES[case]
+    bad = {k: round(v, 2) for k, v in s.items() if not v <= limits[k]}
+    assert not bad, f"above the frozen thresholds {limits}: {bad}"
