@@ -1,4 +1,4 @@
-"""Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose | predict``.
+"""Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose | predict | campaign | listen``.
 
 Errors a user can cause (bad file, missing field, data that cannot support an
 estimate) print one line ``gcs-sysid: error: ...`` on stderr and exit with code 2,
