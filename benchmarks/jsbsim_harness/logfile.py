@@ -48,6 +48,7 @@ def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs") -> int:
         t=rec.t, rate_hz=rec.config.log_rate_hz, sensors=make_sensors(rec, aoa), airframe=af,
         commands={k: tr[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t")},
         truth={"psi": tr["psi"]}, seed=rec.config.seed,
+        demand={},   # the harness's stabiliser demand is not recorded: no NAV_CONTROLLER_OUTPUT
         plan=SimpleNamespace(name=f"jsbsim {spec.model} {rec.config.turbulence}",
                              setpoints=[SimpleNamespace(airspeed=float(tr["V"].mean()))]))
     return write_tlog(result, path, af, rates_hz=SENSOR_RATES_HZ)

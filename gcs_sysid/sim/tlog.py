@@ -109,7 +109,7 @@ def write_tlog(result, path: str | Path, airframe: Airframe | None = None, syste
                                                            "aoa_ssa", "wind"))
     eas = sen["airspeed"]["eas"]
     gps_dec = decimation(rate, "gps")
-    sp_start = [sp.start for sp in result.plan.setpoints]
+    sp_start = [sp.start for sp in result.plan.setpoints] if result.demand else []   # for NAV_CONTROLLER_OUTPUT
     n = 0
     with open(path, "wb") as f:
         sink = _Sink(f)
