@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, find_sync, scan_tlog
+from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, _crc_ok, find_sync, scan_tlog
 
 __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
 
@@ -78,6 +78,22 @@ def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
                     first=first, last=last)
 
 
+def _sound_cut(data: bytes, start: int, tries: int = 64) -> int | None:
+    """A record boundary at or after ``start`` whose record passes its CRC, or None.
+
+    One scan never looks back past a sound record (it resynchronises at most from just after the start
+    of the record before a damaged one), so a scan starting there sees what one scan of the whole file
+    sees from there on.
+    """
+    pos = start
+    for _ in range(tries):
+        cut = find_sync(data, pos, None)
+        if cut is None or _crc_ok(data, cut):
+            return cut
+        pos = cut + 1
+    return None
+
+
 def scan_tlog_split(data: bytes, wanted: dict[str, tuple[str, ...]], helper,
                     progress: Callable[[float], None] | None = None,
                     meanwhile: Callable[[], None] | None = None) -> TlogScan:
@@ -95,7 +111,7 @@ def scan_tlog_split(data: bytes, wanted: dict[str, tuple[str, ...]], helper,
     """
     n = len(data)
     fraction = HEAD_FRACTION if meanwhile is None else HEAD_FRACTION_BUSY
-    cut = find_sync(data, int(fraction * n), None) if helper is not None and helper.parallel else None
+    cut = _sound_cut(data, int(fraction * n)) if helper is not None and helper.parallel else None
     if n < MIN_SPLIT_BYTES or cut is None or cut <= 0:
         if meanwhile is not None:
             meanwhile()
