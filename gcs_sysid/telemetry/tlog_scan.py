@@ -322,7 +322,8 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
                 col.stamp_us.append(stamp)
                 col.src.append(src)
                 col.rows.append(get(msg))
-        good = pos
+        if fixed_stamp is None:
+            good = pos
         pos = end
         if progress is not None and pos >= next_report:
             progress(min(pos / limit, 1.0))
