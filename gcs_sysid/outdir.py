@@ -305,7 +305,8 @@ class StagedFiles:
             try:
                 final.parent.mkdir(parents=True, exist_ok=True)
                 _remove_stale(final.parent, final.name)
-                fd, tmp = tempfile.mkstemp(prefix=f".{final.name}{_PARTIAL}{os.getpid()}-", dir=final.parent)
+                fd, tmp = tempfile.mkstemp(prefix=f".{final.name}{_PARTIAL}{os.getpid()}-", suffix=final.suffix,
+                                           dir=final.parent)
                 os.close(fd)
             except OSError as exc:
                 self._drop()
