@@ -155,9 +155,15 @@ def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None =
         stext = [(float(t), str(r[1]).rstrip("\x00")) for t, r in zip(ts, rows)]
     params = params_of(sel)
     damage = [w for w in clock.warnings if w.startswith("reboot")]
-    if repaired:
-        damage.append(f"{repaired:,} damaged log time stamp(s) (the 8 bytes before a sound packet) replaced "
-                      "by their neighbours' time")
+    if repaired or scan.bad_stamps:
+        damage.append(f"{repaired + scan.bad_stamps:,} damaged log time stamp(s) (the 8 bytes before a sound "
+                      "packet) replaced by their neighbours' time")
+    if scan.seq_lost:
+        damage.append(f"{scan.seq_lost:,} packet(s) missing from the MAVLink sequence numbers (dropped on the "
+                      "link, lost to corrupt bytes, or cut out of the file)")
+    if scan.seq_disorder:
+        damage.append(f"{scan.seq_disorder:,} packet(s) out of sequence (MAVLink sequence number repeated or "
+                      "going back: duplicated, reordered or spliced data)")
     if scan.bad_data:
         damage.append(f"{scan.bad_data:,} corrupt packet(s) (BAD_DATA: bad CRC or broken framing) skipped; "
                       f"decoding resumed after each ({scan.records:,} sound records kept)")

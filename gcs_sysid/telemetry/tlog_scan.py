@@ -29,7 +29,8 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink
 from pymavlink.generator.mavcrc import mcrf4xx as _fast_crc
 from pymavlink.generator.mavcrc import x25crc
 
-__all__ = ["MAX_STAMP_JUMP_US", "Collected", "TlogScan", "find_sync", "scan_tlog", "msgid_of", "msg_name"]
+__all__ = ["MAX_STAMP_JUMP_US", "Collected", "TlogScan", "find_sync", "scan_tlog", "seq_step", "msgid_of",
+           "msg_name"]
 
 MAX_STAMP_JUMP_US = 3 * 24 * 3600 * 1_000_000
 """Largest jump between consecutive tlog stamps still taken as in sync (3 days, as pymavlink)."""
@@ -91,6 +92,13 @@ class TlogScan:
         end: offset where the scan stopped (``len(data)``, or the ``stop`` record boundary).
         first, last: message name -> ``(packet bytes, stamp_us)`` of the first and the last packet
             of each wanted type that was kept (to join the scans of two parts of a file).
+        seq_lost: packets missing from the senders' MAVLink sequence numbers (each sender counts its
+            packets modulo 256; a forward jump of ``d`` means ``d - 1`` packets lost on the link, to
+            corrupt bytes, or cut out of the file).
+        seq_disorder: packets whose sequence number repeats or goes back (duplicated, reordered or
+            spliced data).
+        seq_first, seq_last: sender ``src`` -> its first and last sequence number (to join scans).
+        bad_stamps: sound packets kept behind a damaged log stamp (given the stamp before them).
     """
 
     collected: dict[str, Collected]
@@ -102,6 +110,21 @@ class TlogScan:
     end: int = 0
     first: dict[str, tuple[bytes, int]] = field(default_factory=dict)
     last: dict[str, tuple[bytes, int]] = field(default_factory=dict)
+    seq_lost: int = 0
+    seq_disorder: int = 0
+    seq_first: dict[int, int] = field(default_factory=dict)
+    seq_last: dict[int, int] = field(default_factory=dict)
+    bad_stamps: int = 0
+
+
+def seq_step(prev: int, nxt: int) -> tuple[int, int]:
+    """(lost, disorder) between two consecutive sequence numbers of one sender (see :class:`TlogScan`)."""
+    d = (nxt - prev) & 255
+    if d == 1:
+        return 0, 0
+    if 1 < d < 128:
+        return d - 1, 0
+    return 0, 1
 
 
 def _record(data: bytes, pos: int) -> tuple[int, int, int] | None:
@@ -236,6 +259,10 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
     unchecked = -1   # start of the previous record when it was framed on its length byte alone (no CRC)
     unchecked_mid = -1
     good = pos       # start of the last record taken
+    seqs: dict[int, int] = {}
+    seq_first: dict[int, int] = {}
+    glitch: dict[int, tuple[int, int, int, int]] = {}   # src -> (seq, seq before it, lost, disorder) of a jump
+    lost = disorder = bad_stamps = 0
     while pos < limit:
         if pos + _MIN_RECORD > n:
             truncated = True
@@ -262,6 +289,7 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
             elif end <= n and _crc_ok(data, pos):
                 # a sound packet behind a damaged stamp: keep it, at the stamp of the record before it
                 fixed_stamp = int.from_bytes(data[good:good + 8], "big")
+                bad_stamps += 1
             else:
                 end = -1
         past_end = end > n
@@ -287,6 +315,24 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
             continue
         records += 1
         counts[mid] = counts.get(mid, 0) + 1
+        sq = data[pos + 10] if mk == _V1 else data[pos + 12]
+        prev_sq = seqs.get(src, -1)
+        seqs[src] = sq
+        if prev_sq < 0:
+            seq_first[src] = sq
+        elif (prev_sq + 1) & 255 != sq:
+            g = glitch.pop(src, None)
+            base = prev_sq
+            if g is not None and g[0] == prev_sq:
+                # the previous packet jumped too: its sequence byte is taken as damaged, and the step is
+                # counted from the last number before it (a run of damaged numbers counts as one step)
+                lost -= g[2]
+                disorder -= g[3]
+                base = g[1]
+            dl, dd = seq_step(base, sq)
+            lost += dl
+            disorder += dd
+            glitch[src] = (sq, base, dl, dd)
         ent = getters.get(mid)
         if ent is None:
             unchecked, unchecked_mid = pos, mid
@@ -337,4 +383,5 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
         names["BAD_DATA"] = bad
     return TlogScan(collected, names, {msg_name(k): v for k, v in dups.items()}, bad, truncated, records,
                     end=stopped, first={msg_name(k): v for k, v in first.items()},
-                    last={msg_name(k): v for k, v in last.items()})
+                    last={msg_name(k): v for k, v in last.items()}, seq_lost=lost, seq_disorder=disorder,
+                    seq_first=seq_first, seq_last=seqs, bad_stamps=bad_stamps)

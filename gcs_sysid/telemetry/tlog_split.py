@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, _crc_ok, find_sync, scan_tlog
+from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, _crc_ok, find_sync, scan_tlog, seq_step
 
 __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
 
@@ -74,8 +74,18 @@ def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
     first.update(head.first)
     last = dict(head.last)
     last.update(tail.last)
+    lost, disorder = head.seq_lost + tail.seq_lost, head.seq_disorder + tail.seq_disorder
+    for src, sq in tail.seq_first.items():   # the step across the cut, as one scan sees it
+        if src in head.seq_last:
+            dl, dd = seq_step(head.seq_last[src], sq)
+            lost, disorder = lost + dl, disorder + dd
+    seq_first = dict(tail.seq_first)
+    seq_first.update(head.seq_first)
+    seq_last = dict(head.seq_last)
+    seq_last.update(tail.seq_last)
     return TlogScan(collected, counts, dups, bad, tail.truncated, head.records + tail.records, end=tail.end + head.end,
-                    first=first, last=last)
+                    first=first, last=last, seq_lost=lost, seq_disorder=disorder, seq_first=seq_first,
+                    seq_last=seq_last, bad_stamps=head.bad_stamps + tail.bad_stamps)
 
 
 def _sound_cut(data: bytes, start: int, tries: int = 64) -> int | None:
