@@ -200,14 +200,20 @@ COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "
 CHECKS = {"replay": _check_replay, "simulate": _check_simulate, "fit": _check_fit, "diagnose": _check_diagnose}
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, handle_signals: bool = True) -> int:
     """Run the CLI; returns the exit code (0 ok, 1 internal error, 2 user error; a signal ends the
-    process itself with 130 for SIGINT, 143 for SIGTERM)."""
+    process itself with 130 for SIGINT, 143 for SIGTERM).
+
+    Args:
+        argv: the arguments (None: ``sys.argv[1:]``).
+        handle_signals: install :mod:`gcs_sysid.stopping` (SIGINT/SIGTERM end the process at once);
+            False for callers that keep their own handlers (tests running commands in-process).
+    """
     import threading
 
     from . import stopping
 
-    if threading.current_thread() is threading.main_thread():
+    if handle_signals and threading.current_thread() is threading.main_thread():
         stopping.install()
     ap = build_parser()
     a = ap.parse_args(argv)
