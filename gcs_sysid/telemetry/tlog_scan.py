@@ -258,7 +258,8 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
     stopped = n
     unchecked = -1   # start of the previous record when it was framed on its length byte alone (no CRC)
     unchecked_mid = -1
-    good = pos       # start of the last record taken
+    good = pos       # start of the last record taken with a sound stamp
+    fixed_at = fixed_stamp = -1   # a record kept behind a damaged stamp, and the stamp it is given
     seqs: dict[int, int] = {}
     seq_first: dict[int, int] = {}
     glitch: dict[int, tuple[int, int, int, int]] = {}   # src -> (seq, seq before it, lost, disorder) of a jump
@@ -281,19 +282,18 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
             break
         else:
             end = -1
-        fixed_stamp = None
         if end >= 0 and data[pos:pos + 3] != prefix:
             stamp = int.from_bytes(data[pos:pos + 8], "big")
             if abs(stamp - ref) <= MAX_STAMP_JUMP_US:
                 ref, prefix = stamp, data[pos:pos + 3]
             elif end <= n and _crc_ok(data, pos):
                 # a sound packet behind a damaged stamp: keep it, at the stamp of the record before it
-                fixed_stamp = int.from_bytes(data[good:good + 8], "big")
+                fixed_at, fixed_stamp = pos, int.from_bytes(data[good:good + 8], "big")
                 bad_stamps += 1
             else:
                 end = -1
-        past_end = end > n
-        if end < 0 or past_end:
+        if end < 0 or end > n:
+            past_end = end > n
             back = pos + 1
             if unchecked >= 0 and not _crc_ok(data, unchecked):
                 # the previous record was framed by its length byte alone and its packet is damaged: the
@@ -339,7 +339,7 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
         else:
             unchecked = -1
             buf = data[pos + 8:end]
-            stamp = int.from_bytes(data[pos:pos + 8], "big") if fixed_stamp is None else fixed_stamp
+            stamp = int.from_bytes(data[pos:pos + 8], "big") if pos != fixed_at else fixed_stamp
             prev = last.get(mid)
             if prev is not None and prev[0] == buf and stamp - prev[1] < 2_000_000:
                 dups[mid] = dups.get(mid, 0) + 1
@@ -368,7 +368,7 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
                 col.stamp_us.append(stamp)
                 col.src.append(src)
                 col.rows.append(get(msg))
-        if fixed_stamp is None:
+        if pos != fixed_at:
             good = pos
         pos = end
         if progress is not None and pos >= next_report:
