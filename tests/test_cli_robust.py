@@ -216,3 +216,20 @@ def test_truncated_tlog_no_numeric_warnings(tmp_path):
     assert "truncated" in p.stdout
     assert p.stderr == "", p.stderr
     assert "truncated" in (out / "summary.md").read_text()
+
+
+def test_sigint_stops_simulate_without_a_partial_file(tmp_path):
+    """Another command, another kind of output (a single file written under a temporary name)."""
+    out = tmp_path / "flight.tlog"
+    out.write_bytes(b"earlier flight")
+    proc = subprocess.Popen([sys.executable, "-m", "gcs_sysid.cli", "simulate", "--airframe", AIRFRAME,
+                             "--model", MODEL, "--maneuvers", DATA / "plans" / "sysid-trainer.toml", "--out", out],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    _wait_for(proc, tmp_path, None)
+    time.sleep(1.0)
+    t0 = time.monotonic()
+    os.killpg(proc.pid, signal.SIGINT)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and time.monotonic() - t0 < 3.0, (proc.returncode, stderr)
+    assert len(stderr.strip().splitlines()) == 1 and "Traceback" not in stderr
+    assert out.read_bytes() == b"earlier flight" and partials(tmp_path) == []

@@ -185,6 +185,10 @@ def test_fuzz_200_damaged_copies(tmp_path, capsys, in_process):
     results = []
     for seed in range(1000, 1000 + n):
         results.append(run_case(seed, tmp_path, capsys))
+        with capsys.disabled():   # progress, one line per copy (seen with -s or in the terminal)
+            r = results[-1]
+            print(f"\nfuzz case {seed}: {r['base']} {'+'.join(r['kinds'])}: replay {r['replay']}, "
+                  f"diagnose {r['diagnose']}", end="", flush=True)
         for p in tmp_path.iterdir():   # keep the disk use small
             if p.is_file():
                 p.unlink()
