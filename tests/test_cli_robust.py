@@ -69,12 +69,10 @@ def test_bad_options_are_refused_before_decoding(tmp_path):
         (["--out", existing], ["--out", "is an existing file"]),
         (["--out", existing / "o"], ["--out", "not a folder"]),
         (["--out", tmp_path / "o", "--rate", "0"], ["--rate", "got 0"]),
-        (["--out", tmp_path / "o", "--rate", "nan"], ["--rate"]),
         (["--out", tmp_path / "o", "--from", "200", "--to", "100"], ["--to", "--from"]),
         (["--out", tmp_path / "o", "--holdout", "1.5"], ["--holdout", "1.5"]),
         (["--out", tmp_path / "o", "--model", tmp_path / "none" / "model"], ["--model", "model.npz"]),
         (["--out", tmp_path / "o", "--inducing", "0"], ["--inducing"]),
-        (["--out", tmp_path / "o", "--rate", "fast"], ["--rate", "'fast'"]),
     ]
     worst = 0.0
     for extra, frags in cases:
@@ -187,35 +185,24 @@ def test_signal_at_any_stage(tmp_path, moment, sig):
     assert not [k for k in kids if _alive(k)], "a worker process outlived the replay"
 
 
-def test_corrupt_tlog_is_reported_on_the_console(tmp_path):
-    """Every 50th byte corrupted: the console, not only the report, says how many packets were bad."""
+def test_damaged_tlog_is_reported_on_the_console(tmp_path):
+    """Every 50th byte corrupted and the file cut inside a record: the console, not only the report, says
+    how many packets were bad and that the log is truncated; no numeric warning leaks to stderr."""
     log = tmp_path / "f.tlog"
     write_tlog(log, seconds=20)
     data = bytearray(log.read_bytes())
     for i in range(49, len(data), 50):
         data[i] ^= 0xFF
     bad = tmp_path / "bad.tlog"
-    bad.write_bytes(bytes(data))
+    bad.write_bytes(bytes(data[: int(0.8 * len(data))]))
     out = tmp_path / "o"
     p, _ = cli("replay", bad, "--airframe", AIRFRAME, "--out", out, "--quiet", "--from", "12", "--to", "14")
-    assert p.returncode in (0, 2), p.stderr
-    assert "corrupt packet" in p.stdout and "damaged log:" in p.stdout, p.stdout
-    if p.returncode == 0:
-        assert "corrupt packet" in (out / "summary.md").read_text()
-    assert "Warning" not in p.stderr and "Traceback" not in p.stderr
-
-
-def test_truncated_tlog_no_numeric_warnings(tmp_path):
-    """A log cut inside a record: decoded, the truncation is on the console, no numpy warnings leak."""
-    data = FLIGHT.read_bytes()
-    cut = tmp_path / "cut.tlog"
-    cut.write_bytes(data[: len(data) // 12 + 7])
-    out = tmp_path / "o"
-    p, _ = cli("replay", cut, "--airframe", AIRFRAME, "--out", out, "--quiet", "--inducing", "16")
     assert p.returncode == 0, p.stderr
-    assert "truncated" in p.stdout
-    assert p.stderr == "", p.stderr
-    assert "truncated" in (out / "summary.md").read_text()
+    notes = [ln for ln in p.stdout.splitlines() if ln.startswith("damaged log:")]
+    assert any("corrupt packet" in n for n in notes) and any("truncated" in n for n in notes), p.stdout
+    summary = (out / "summary.md").read_text()
+    assert "corrupt packet" in summary and "truncated" in summary
+    assert p.stderr == "", p.stderr   # no numpy warnings, no traceback
 
 
 def test_sigint_stops_simulate_without_a_partial_file(tmp_path):
