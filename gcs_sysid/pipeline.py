@@ -263,7 +263,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 # compiled GP programs are cached on disk (only the first run on a machine compiles)
                 enable_compilation_cache()
                 if options.model_in:
-                    model = load_gp(Path(options.model_in))
+                    model = load_gp(check_model_state(options.model_in))   # DIR is taken as DIR/model
                     if model.n_outputs != len(fit_cols):
                         raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
                                          f"this flight identifies {len(fit_cols)}")
