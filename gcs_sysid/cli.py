@@ -1,14 +1,18 @@
 """Command-line interface: ``gcs-sysid replay | simulate | fit | diagnose | predict | campaign | listen``.
 
-Errors a user can cause (bad file, missing field, data that cannot support an
-estimate) print one line ``gcs-sysid: error: ...`` on stderr and exit with code 2,
-without a traceback. ``--debug`` shows the traceback of any error.
+Errors a user can cause (bad file, missing field, bad option, data that cannot support an
+estimate) print one line ``gcs-sysid: error: ...`` on stderr and exit with code 2, without a
+traceback; options and paths are checked before any work (:mod:`gcs_sysid.options`,
+:mod:`gcs_sysid.outdir`). Ctrl-C and SIGTERM end any command at once with 130 / 143 and one line
+(:mod:`gcs_sysid.stopping`). ``--debug`` shows the traceback of any error. Exit codes are listed
+in ``docs/cli.md``.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 from .errors import SysidError
@@ -17,6 +21,20 @@ __all__ = ["main", "build_parser"]
 
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``gcs-sysid: error: ...``, exit 2) instead of usage + error."""
+
+    def error(self, message: str):
+        where = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
+        print(f"gcs-sysid: error: {where}{message} (see gcs-sysid {where[:-2]} --help)".replace("  ", " "),
+              file=sys.stderr)
+        sys.exit(EXIT_USER_ERROR)
+
+
+def _say(line: str) -> None:
+    print(line, flush=True)
 
 
 def _window_args(p: argparse.ArgumentParser) -> None:
@@ -28,7 +46,7 @@ def _window_args(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (documented in docs/cli.md)."""
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="gcs-sysid",
         description="UAV system identification from MAVLink telemetry: aerodynamic coefficients, "
                     "a Gaussian-process model with uncertainty, and maneuver suggestions.",
@@ -94,23 +112,61 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _cmd_replay(a: argparse.Namespace) -> int:
-    from .pipeline import ReplayOptions, run_replay
+def _replay_options(a: argparse.Namespace):
+    from .pipeline import ReplayOptions
 
-    opts = ReplayOptions(rate_hz=a.rate, holdout=a.holdout, t_from=a.t_from, t_to=a.t_to,
-                         model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet)
-    result = run_replay(a.log, a.airframe, a.out, opts)
+    return ReplayOptions(rate_hz=a.rate, holdout=a.holdout, t_from=a.t_from, t_to=a.t_to,
+                         model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say)
+
+
+def _check_replay(a: argparse.Namespace) -> None:
+    from .pipeline import check_replay
+
+    check_replay(a.log, a.airframe, a.out, _replay_options(a))
+
+
+def _cmd_replay(a: argparse.Namespace) -> int:
+    from .pipeline import MIN_TRAIN_ROWS, run_replay
+
+    result = run_replay(a.log, a.airframe, a.out, _replay_options(a))
     out = Path(a.out)
     print(f"report: {out / 'report.html'}")
+    fitted = bool(result.gp_summary)
     for name, m in result.metrics.items():
         ok, why = result.identifiable.get(name, (True, ""))
-        if ok and m.get("n_heldout", 0) > 0:
-            print(f"  {name:3s} held-out error {m['error_pct_heldout']:6.1f} %")
-        else:
+        if not ok:
             print(f"  {name:3s} not identified: {why}")
+        elif m.get("n_heldout", 0) > 0:
+            print(f"  {name:3s} held-out error {m['error_pct_heldout']:6.1f} %")
+        elif not fitted:
+            print(f"  {name:3s} no model fitted: {m.get('n_train', 0)} valid training samples "
+                  f"(need {MIN_TRAIN_ROWS})")
+        elif a.holdout == 0:
+            print(f"  {name:3s} no held-out error: --holdout 0")
+        else:
+            print(f"  {name:3s} no held-out error: no valid samples in the held-out segment")
     if result.suggestions:
         print(f"next maneuver: {result.suggestions[0].reason}")
     return 0
+
+
+def _check_window(a: argparse.Namespace) -> None:
+    from .options import check_log, check_window
+
+    check_window(a.t_from, a.t_to)
+    check_log(a.log)
+
+
+def _check_simulate(a: argparse.Namespace) -> None:
+    from .options import check_input_file
+    from .outdir import check_out_file
+
+    check_input_file(a.airframe, "--airframe", "an airframe TOML file (docs/airframe.md)")
+    check_input_file(a.model, "--model", "an aerodynamic model TOML file (docs/model-file.md)")
+    check_input_file(a.maneuvers, "--maneuvers", "a flight plan TOML file (docs/sim.md)")
+    check_out_file(a.out, "--out")
+    if a.truth is not None:
+        check_out_file(a.truth, "--truth")
 
 
 def _cmd_simulate(a: argparse.Namespace) -> int:
@@ -125,18 +181,42 @@ def _cmd_simulate(a: argparse.Namespace) -> int:
     return 0
 
 
+def _check_fit(a: argparse.Namespace) -> None:
+    from .airframe import load_airframe
+    from .outdir import check_out_file
+
+    _check_window(a)
+    load_airframe(a.airframe)
+    out = Path(a.out)
+    check_out_file(out, "--out")
+    check_out_file(out.with_suffix(".fit.json"), "--out")
+
+
 def _cmd_fit(a: argparse.Namespace) -> int:
     from .diagnose import run_fit
 
-    run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to)
+    run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say)
     print(f"wrote {a.out}")
     return 0
+
+
+def _check_diagnose(a: argparse.Namespace) -> None:
+    from .airframe import load_airframe
+    from .diagnose.run import DIAGNOSE_OUTPUTS
+    from .outdir import check_out_dir
+    from .sim.model_file import load_model
+
+    _check_window(a)
+    load_airframe(a.airframe)
+    load_model(a.model)
+    check_out_dir(a.out, "--out", DIAGNOSE_OUTPUTS)
 
 
 def _cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnose import run_diagnose
 
-    diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to, search=a.search)
+    diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to, search=a.search,
+                        notify=_say)
     findings = diag.get("findings", []) if isinstance(diag, dict) else getattr(diag, "findings", [])
     print(f"wrote {Path(a.out) / 'diagnosis.json'}: {len(findings)} finding(s)")
     return 0
@@ -150,43 +230,115 @@ def _cmd_listen(a: argparse.Namespace) -> int:
 
 def _cmd_campaign(a: argparse.Namespace) -> int:
     from .campaign import run_campaign_cli
+    from .outdir import StagedDir
 
-    return run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit)
+    with StagedDir(a.out, "campaign", ("campaign.json", "campaign.md", "campaign.png")) as stage:
+        rc = run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit, write_to=stage.path)
+    return rc
 
 
 def _cmd_predict(a: argparse.Namespace) -> int:
+    from .outdir import StagedFiles
     from .predict import run_predict
 
-    pred = run_predict(a.model_dir, a.inputs, a.out)
+    with StagedFiles(a.out) as stage:   # the CSV appears complete or not at all
+        pred = run_predict(a.model_dir, a.inputs, stage.path(a.out))
     print(f"wrote {a.out} ({len(pred.X)} conditions, {', '.join(pred.outputs)})")
     return 0
 
 
+def _check_listen(a: argparse.Namespace) -> None:
+    from .options import check_input_file
+
+    check_input_file(a.airframe, "--airframe", "an airframe TOML file (docs/airframe.md)")
+    out = Path(a.out)
+    if out.exists() and not out.is_dir():
+        from .errors import InputError
+
+        raise InputError(f"--out {out}: is an existing file; expected a folder for raw.tlog and the session's "
+                         "outputs (an existing raw.tlog there is appended to, never overwritten)")
+
+
+def _check_campaign(a: argparse.Namespace) -> None:
+    from .options import check_input_file
+    from .outdir import check_out_dir
+
+    check_input_file(a.airframe, "--airframe", "an airframe TOML file with a [limits] table (docs/airframe.md)")
+    check_input_file(a.model, "--model", "a truth aerodynamic model TOML file (docs/model-file.md)")
+    check_out_dir(a.out, "--out", owned=("campaign.json", "campaign.md", "campaign.png"))
+
+
+def _check_predict(a: argparse.Namespace) -> None:
+    from .options import check_input_file
+    from .outdir import check_out_file
+
+    check_input_file(a.inputs, "--inputs", "a CSV of flight conditions (docs/cli.md, predict)")
+    check_out_file(a.out, "--out")
+
+
 COMMANDS = {"replay": _cmd_replay, "simulate": _cmd_simulate, "fit": _cmd_fit, "diagnose": _cmd_diagnose,
             "listen": _cmd_listen, "campaign": _cmd_campaign, "predict": _cmd_predict}
+#: Checks of every option and path, run before any work (a command without one checks inside its job).
+CHECKS = {"replay": _check_replay, "simulate": _check_simulate, "fit": _check_fit, "diagnose": _check_diagnose,
+          "listen": _check_listen, "campaign": _check_campaign, "predict": _check_predict}
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (0 ok, 2 user error, 1 internal error)."""
+def _sigterm_as_interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def main(argv: list[str] | None = None, handle_signals: bool = True) -> int:
+    """Run the CLI; returns the exit code (0 ok, 1 internal error, 2 user error; a signal ends the
+    process itself with 130 for SIGINT, 143 for SIGTERM).
+
+    Args:
+        argv: the arguments (None: ``sys.argv[1:]``).
+        handle_signals: install :mod:`gcs_sysid.stopping` (SIGINT/SIGTERM end the process at once);
+            False for callers that keep their own handlers (tests running commands in-process).
+    """
+    import threading
+
+    from . import stopping
+
     ap = build_parser()
     a = ap.parse_args(argv)
-    if a.command not in ("replay", "listen"):   # replay and listen set these up themselves (so that
-        # importing JAX overlaps the decoding)
-        from .jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
+    if handle_signals and threading.current_thread() is threading.main_thread():
+        if a.command == "listen":
+            # a live session ends on Ctrl-C by writing its report (gcs_sysid.live.session): SIGTERM does the same
+            import signal
 
-        enable_x64()
-        limit_blas_threads(1)        # small matrices: BLAS threading costs more than it gains (docs/gp.md)
-        enable_compilation_cache()   # later runs load compiled JAX programs instead of recompiling
+            signal.signal(signal.SIGTERM, _sigterm_as_interrupt)
+        else:
+            stopping.install()
     try:
-        return COMMANDS[a.command](a)
+        with warnings.catch_warnings():
+            # numerical warnings (overflow, invalid value in a reduction ...) never reach the console: the
+            # stages turn real numerical problems into notes with their cause
+            warnings.simplefilter("ignore")
+            if a.command in CHECKS:
+                CHECKS[a.command](a)
+            if a.command not in ("replay", "listen"):   # these set it up themselves, once its worker is decoding
+                # (so that importing JAX overlaps the decoding)
+                from .jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
+
+                enable_x64()
+                limit_blas_threads(1)        # small matrices: BLAS threading costs more than it gains
+                enable_compilation_cache()   # later runs load compiled JAX programs instead of recompiling
+            return COMMANDS[a.command](a)
     except SysidError as e:
         if a.debug:
             raise
         print(f"gcs-sysid: error: {e}", file=sys.stderr)
         return EXIT_USER_ERROR
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:   # only without stopping.install (listen, or not the main thread)
         print("gcs-sysid: interrupted", file=sys.stderr)
         return 130
+    except OSError as e:   # a file the user named cannot be written or read (disk full, permissions)
+        if a.debug:
+            raise
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"gcs-sysid: error: {where}{e.strerror or e}", file=sys.stderr)
+        return EXIT_USER_ERROR
     except Exception as e:  # a bug: say so in one line, keep the traceback behind --debug
         if a.debug:
             raise

@@ -33,6 +33,8 @@ import threading
 from concurrent.futures import Future
 from typing import Any, Sequence
 
+from . import stopping
+
 __all__ = ["Helper", "Job", "WorkerError", "call", "default_enabled"]
 
 #: Set to ``0`` to run every job in the calling process (debugging, profiling).
@@ -121,12 +123,15 @@ class Helper:
             # the caller's import path, so that the worker imports the same gcs_sysid; no nested workers
             # and one BLAS thread: it is the spare core, the caller keeps the other one busy
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p), **{PARALLEL_ENV: "0"},
-                       OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+                       OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+                       PYTHONWARNINGS="ignore")   # the caller reports problems; the worker's console stays quiet
             self._proc = subprocess.Popen([sys.executable, "-m", "gcs_sysid.parallel"], stdin=subprocess.PIPE,
                                           stdout=subprocess.PIPE, env=env)
         except OSError:
             self._proc = None
             return
+        # stopped by a signal (gcs_sysid.stopping): the worker goes at once, with the caller
+        self._stop_token = stopping.register(self._kill)
         # the writer pickles and sends in the background (a large job must not block the caller while the
         # worker is busy); the reader hands results to the futures
         threading.Thread(target=self._write, name="gcs-sysid-helper-writer", daemon=True).start()
@@ -206,6 +211,15 @@ class Helper:
         for fut in pending.values():
             fut.set_exception(WorkerError(why))
 
+    def _kill(self) -> None:
+        proc = self._proc
+        if proc is not None:
+            try:
+                proc.kill()
+                proc.wait(timeout=0.5)
+            except (OSError, subprocess.TimeoutExpired):
+                pass
+
     def close(self, wait: bool = True) -> None:
         """Stop the worker.
 
@@ -216,6 +230,7 @@ class Helper:
         proc, self._proc = self._proc, None
         if proc is None:
             return
+        stopping.unregister(self._stop_token)
         self._outbox.put(None)
         if not wait:
             proc.kill()
@@ -238,11 +253,44 @@ def _import(modules: Sequence[str]) -> int:
     return os.getpid()
 
 
+def _die_with_parent() -> None:
+    """Linux: have the kernel send SIGKILL to this worker when its parent dies (no stray worker)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
 def _serve() -> None:
-    """The worker's loop: read a job from stdin, run it, write ``(key, ok, value)`` to stdout."""
+    """The worker's loop: read a job from stdin, run it, write ``(key, ok, value)`` to stdout.
+
+    It ends quietly (no traceback) at EOF, when its pipes break (the caller is gone) and on SIGTERM.
+    """
     # Ctrl-C reaches the whole process group: the caller handles it (and stops this worker); the worker
     # must not die of it mid-job with a traceback of its own. It ends at EOF, when the caller closes or dies.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)   # a write to a closed pipe ends the worker silently
+    _die_with_parent()
+    import warnings
+
+    warnings.simplefilter("ignore")
+    try:
+        _loop()
+    except (BrokenPipeError, EOFError, OSError, pickle.UnpicklingError):
+        pass   # the caller went away
+    finally:
+        try:
+            sys.stderr.flush()
+        except (OSError, ValueError):
+            pass
+        os._exit(0)
+
+
+def _loop() -> None:
     inp = sys.stdin.buffer
     out = os.fdopen(os.dup(sys.stdout.fileno()), "wb")
     os.dup2(sys.stderr.fileno(), sys.stdout.fileno())   # stray prints go to stderr, not into the results

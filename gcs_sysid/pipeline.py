@@ -19,11 +19,18 @@ from .aero.table import COEFFICIENTS, MOMENT_COEFFICIENTS, CoefficientTable
 from .airframe import load_airframe
 from .errors import InputError
 from .estimation.states import FlightStates
+from .options import check_holdout, check_log, check_model_state, check_positive_int, check_rate, check_window
+from .outdir import StagedDir, check_out_dir
 from .parallel import Helper, Job
 from .result import ReplayResult
-from .telemetry import read_log
+from .telemetry import cut_window, read_log
 
-__all__ = ["ReplayOptions", "run_replay", "held_out_mask", "error_pct", "identifiability"]
+__all__ = ["ReplayOptions", "REPLAY_OUTPUTS", "check_replay", "run_replay", "held_out_mask", "error_pct",
+           "identifiability"]
+
+#: What a replay writes into its output folder (an existing folder holding only these may be replaced).
+REPLAY_OUTPUTS = ("report.html", "summary.md", "coefficients.csv", "suggestions.json", "result", "model.npz",
+                  "model.json")
 
 #: Fewest valid rows the GP is fitted on.
 MIN_TRAIN_ROWS = 50
@@ -46,6 +53,8 @@ class ReplayOptions:
         parallel: use a second process for the work beside the main chain (decoding most of a
             .tlog, the specific-force smoother, the report's figures; :mod:`gcs_sysid.parallel`)
             when more than one CPU is usable; the results are the same.
+        notify: called with each one-line note the user should see at once (the damage found in the
+            log, :attr:`gcs_sysid.telemetry.Flight.damage`); None: notes go to the report only.
     """
 
     rate_hz: float = 50.0
@@ -57,6 +66,28 @@ class ReplayOptions:
     progress: bool = True
     write: bool = True
     parallel: bool = True
+    notify: Callable[[str], None] | None = None
+
+
+def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
+                 options: ReplayOptions = ReplayOptions()):
+    """Check every input and option of a replay before any work; returns the loaded airframe.
+
+    Raises:
+        InputError: one line naming the option or file and what was expected (the log's first bytes
+            are read to tell its format; nothing is decoded).
+    """
+    check_rate(options.rate_hz)
+    check_holdout(options.holdout)
+    check_window(options.t_from, options.t_to)
+    check_positive_int(options.n_inducing, "--inducing")
+    if options.model_in:
+        check_model_state(options.model_in)
+    check_log(log)
+    airframe = load_airframe(airframe_path)
+    if out_dir is not None and options.write:
+        check_out_dir(out_dir, "--out", REPLAY_OUTPUTS)
+    return airframe
 
 
 def error_pct(estimate: np.ndarray, reference: np.ndarray) -> float:
@@ -159,12 +190,19 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     Returns:
         The :class:`~gcs_sysid.result.ReplayResult` that the report renders.
 
+    The outputs are written into a staging folder beside ``out_dir`` and moved into place when all
+    are written (:class:`gcs_sysid.outdir.StagedDir`): a failed or interrupted replay leaves
+    ``out_dir`` as it was, and a finished one leaves only its own files there.
+
     Raises:
-        InputError: unreadable log or airframe, bad options.
-        DataError: the log holds nothing the pipeline can use (e.g. no IMU and no attitude).
+        InputError: unreadable log or airframe, bad options or output folder (all checked before
+            the log is decoded: :func:`check_replay`).
+        DataError: the log holds nothing the pipeline can use (e.g. no IMU and no attitude), or the
+            window lies outside it.
     """
-    airframe = load_airframe(airframe_path)
+    airframe = check_replay(log, airframe_path, out_dir, options)
     out = Path(out_dir)
+    stage = StagedDir(out, "replay", REPLAY_OUTPUTS) if options.write else None
     timings: dict[str, float] = {}
     notes: list[str] = []
     # the worker decodes part of the log, smooths the specific force, then draws the figures
@@ -192,10 +230,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         from .report.tables import correlation_of
 
         helper.preload(["gcs_sysid.estimation.rates"])   # for the specific-force smoother, next
-        if options.t_from is not None or options.t_to is not None:
-            if options.t_from is not None and options.t_to is not None and options.t_to <= options.t_from:
-                raise InputError(f"--to ({options.t_to}) must be after --from ({options.t_from})")
-            flight = flight.window(options.t_from, options.t_to)
+        if options.notify is not None:
+            for note in flight.damage:
+                options.notify(f"damaged log: {note}")
+        flight = cut_window(flight, options.t_from, options.t_to)
         with _stage("estimate states", timings, bar) as prog:
             states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper)
         helper.preload(["gcs_sysid.report.plots"])   # matplotlib for the figures, while the GP is fitted
@@ -225,7 +263,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 # compiled GP programs are cached on disk (only the first run on a machine compiles)
                 enable_compilation_cache()
                 if options.model_in:
-                    model = load_gp(Path(options.model_in))
+                    model = load_gp(check_model_state(options.model_in))   # DIR is taken as DIR/model
                     if model.n_outputs != len(fit_cols):
                         raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
                                          f"this flight identifies {len(fit_cols)}")
@@ -277,9 +315,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         if weak_moments:
             notes.append("not identified: " + "; ".join(f"{c} ({ident[c][1]})" for c in weak_moments))
         model_path = ""
-        if model is not None and options.write:
+        if model is not None and stage is not None:
             model_path = str(out / "model")
-            model.save(Path(model_path))
+            model.save(stage.path / "model")
         result = ReplayResult(
             log_path=str(log), airframe_name=airframe.name, airframe_path=str(airframe_path),
             vehicle=dict(flight.vehicle), window=(options.t_from, options.t_to),
@@ -289,12 +327,15 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             model_path=model_path, missing=list(states.missing),
             notes=list(flight.warnings) + list(states.notes) + list(table.notes) + notes, timings=timings,
         )
-        if options.write:
+        if stage is not None:
             with _stage("write report", timings, bar):
-                write_report(result, out, figures=figures)
+                write_report(result, stage.path, figures=figures)
+                stage.commit()
         ok = True
         return result
     finally:
+        if stage is not None and not ok:
+            stage.abort()
         helper.close(wait=ok)
         if bar is not None:
             bar.stop()

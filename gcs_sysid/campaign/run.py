@@ -178,8 +178,12 @@ def _acceptance(runs: list[dict], lim) -> dict[str, Any]:
             "flown_inside_limits_all": all(p["flown_inside_limits"] for p in per)}
 
 
-def run_campaign_cli(airframe: str, model: str, flights: int, seeds: str, out: str, refit: bool = False) -> int:
+def run_campaign_cli(airframe: str, model: str, flights: int, seeds: str, out: str, refit: bool = False,
+                     write_to: str | Path | None = None) -> int:
     """``gcs-sysid campaign``: parse the seeds, run, print the acceptance lines; returns the exit code.
+
+    ``write_to``: where the files are written (the CLI's staging folder, moved to ``out`` when
+    complete); None writes into ``out``.
 
     Raises:
         InputError: seeds that are not comma-separated non-negative integers, or see :func:`run_campaign`.
@@ -190,7 +194,8 @@ def run_campaign_cli(airframe: str, model: str, flights: int, seeds: str, out: s
         raise InputError(f"--seeds must be comma-separated integers, got {seeds!r}") from None
     if not seed_list or min(seed_list) < 0:
         raise InputError(f"--seeds must be comma-separated non-negative integers, got {seeds!r}")
-    doc = run_campaign(airframe, model, out, CampaignConfig(flights=flights, seeds=seed_list, refit=refit))
+    doc = run_campaign(airframe, model, out if write_to is None else write_to,
+                       CampaignConfig(flights=flights, seeds=seed_list, refit=refit))
     acc = doc["acceptance"]
     print(f"wrote {Path(out) / 'campaign.md'}: sigma drop >= 2x standard: {acc['sigma_2x_all']}; "
           f"Cl Cm Cn error below standard: {acc['moments_better_all']}; designed inside limits: "

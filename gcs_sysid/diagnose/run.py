@@ -11,6 +11,10 @@ import numpy as np
 
 from ..airframe import Airframe, load_airframe
 from ..errors import DataError, InputError
+from ..outdir import StagedDir, StagedFiles
+
+#: What ``diagnose`` writes into its output folder.
+DIAGNOSE_OUTPUTS = ("diagnosis.json", "model_extended.toml", "report.html")
 
 __all__ = ["Measurements", "load_measurements", "run_fit", "run_diagnose"]
 
@@ -43,31 +47,34 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
 
 
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
-                      progress=None) -> Measurements:
+                      progress=None, notify=None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
         log: .tlog or DataFlash .bin path.
         airframe_path: airframe TOML.
         t_from, t_to: vehicle-time window, s (None = open).
+        notify: called with one line per damage found in the log (None: not shown).
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
-            are absent from the log.
+            are absent from the log, or a window outside the log.
     """
     from ..aero import compute_coefficients
     from ..estimation import estimate_states
-    from ..telemetry import read_log
+    from ..options import check_window
+    from ..telemetry import cut_window, read_log
 
     tm: dict[str, float] = {}
     t0 = time.perf_counter()
+    check_window(t_from, t_to)
     airframe = load_airframe(airframe_path)
     flight = read_log(log)
     tm["decode_s"] = time.perf_counter() - t0
-    if t_from is not None or t_to is not None:
-        if t_from is not None and t_to is not None and t_to <= t_from:
-            raise InputError(f"--from {t_from} must be before --to {t_to}")
-        flight = flight.window(t_from, t_to)
+    if notify is not None:
+        for note in flight.damage:
+            notify(f"damaged log: {note}")
+    flight = cut_window(flight, t_from, t_to)
     _check_airframe_matches(flight, airframe, str(log))
     t1 = time.perf_counter()
     states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
@@ -80,10 +87,12 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
 
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
-            progress=None):
+            progress=None, notify=None):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
-    Also writes ``<out>.fit.json`` with the per-coefficient statistics.
+    Also writes ``<out>.fit.json`` with the per-coefficient statistics (and the damage found in the
+    log, ``log_damage``). Both files are written under temporary names and renamed into place at
+    the end (:class:`gcs_sysid.outdir.StagedFiles`); ``--out`` is checked before the log is decoded.
 
     Returns:
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
@@ -91,36 +100,51 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     from ..sim.model_file import save_model
     from .fit import fit_model
 
-    meas = load_measurements(log, airframe_path, t_from, t_to, progress)
-    model, report = fit_model(meas.table, name=Path(out_path).stem)
-    model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
     out = Path(out_path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    save_model(model, out, header=report.header())
-    out.with_suffix(".fit.json").write_text(json.dumps(report.to_json(), indent=1, default=float))
+    with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
+        model, report = fit_model(meas.table, name=Path(out_path).stem)
+        model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
+        save_model(model, stage.path(out), header=report.header())
+        doc = report.to_json()
+        if meas.flight.damage and isinstance(doc, dict):
+            doc["log_damage"] = list(meas.flight.damage)
+        stage.path(out.with_suffix(".fit.json")).write_text(json.dumps(doc, indent=1, default=float))
     return model, report
 
 
 def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None = None,
-                 t_to: float | None = None, progress=None, output_error: bool = True, **kw):
+                 t_to: float | None = None, progress=None, output_error: bool = True, notify=None, **kw):
     """``gcs-sysid diagnose``: hold the model against the log; write diagnosis.json, model_extended.toml, report.html.
 
     Args:
         log, airframe_path, model_path: inputs. out_dir: directory (created).
         t_from, t_to: vehicle-time window, s.
         output_error: also run the output-error comparison (needs ``gcs_sysid.sim.propagate``).
+        notify: called with one line per damage found in the log (None: not shown).
         **kw: passed to :func:`gcs_sysid.diagnose.core.diagnose`.
 
     Returns:
         the :class:`~gcs_sysid.diagnose.core.Diagnosis`.
     """
-    from ..sim.model_file import AeroModel, load_model, save_model
+    from ..sim.model_file import load_model
     from .core import diagnose
-    from .report import write_report
 
     t0 = time.perf_counter()
     model = load_model(model_path)
-    meas = load_measurements(log, airframe_path, t_from, t_to, progress)
+    with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
+        diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
+                              output_error, progress, t0, kw)
+    return diag
+
+
+def _diagnose_into(out, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to, output_error,
+                   progress, t0, kw):
+    """Run the diagnosis and write its files into ``out`` (the staging folder)."""
+    from ..sim.model_file import AeroModel, save_model
+    from .report import write_report
+
     diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=output_error,
                     flight=meas.flight, progress=progress, **kw)
     diag.data.update({"log": str(log), "airframe": str(airframe_path), "model": str(model_path),
@@ -129,8 +153,7 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     diag.data["timings"]["total_s"] = time.perf_counter() - t0
     diag.data["estimation_notes"] = list(getattr(meas.states, "notes", [])) + \
         list(getattr(meas.states, "missing", []))
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    diag.data["log_damage"] = list(meas.flight.damage)
     ext = AeroModel(diag.model_extended, (model.name or "model") + "-extended",
                     "extended by gcs-sysid diagnose: " + (", ".join(f["cause"] for f in diag.findings) or "no change"))
     header = "Model extended by gcs-sysid diagnose.\n" + "\n".join(

@@ -10,10 +10,10 @@ import os
 from pathlib import Path
 from typing import Callable
 
-from gcs_sysid.errors import InputError
+from gcs_sysid.errors import DataError, InputError
 from gcs_sysid.telemetry.types import Flight, Stream, StreamSummary
 
-__all__ = ["read_log", "detect_format", "Flight", "Stream", "StreamSummary"]
+__all__ = ["read_log", "detect_format", "cut_window", "Flight", "Stream", "StreamSummary"]
 
 _DF_HEAD = b"\xa3\x95"
 _SNIFF = 1 << 16
@@ -105,3 +105,32 @@ def read_log(path: str | os.PathLike, progress: Callable[[float], None] | None =
         raise InputError(f"{p}: no usable messages decoded (found {seen}); expected IMU, attitude, "
                          "air data or servo messages")
     return flight
+
+
+def cut_window(flight: Flight, t_from: float | None, t_to: float | None) -> Flight:
+    """``flight`` restricted to the vehicle-time window ``[t_from, t_to]`` s (None: open end).
+
+    Raises:
+        DataError: the window lies outside the log's span (the message gives the span), or holds
+            fewer than 2 samples of every stream.
+    """
+    if t_from is None and t_to is None:
+        return flight
+    t0, t1 = flight.t_range
+
+    def span() -> str:
+        what = " ".join(f"{o} {v:g}" for o, v in (("--from", t_from), ("--to", t_to)) if v is not None)
+        return f"{flight.path}: window {what}"
+
+    if not (t0 == t0 and t1 == t1):   # no samples at all (NaN range)
+        raise DataError(f"{span()}: the log holds no timed samples")
+    lo = -float("inf") if t_from is None else float(t_from)
+    hi = float("inf") if t_to is None else float(t_to)
+    if hi < t0 or lo > t1:
+        raise DataError(f"{span()} is outside the log's {t0:.0f}-{t1:.0f} s (vehicle time since boot); "
+                        "expected a window that overlaps it")
+    cut = flight.window(t_from, t_to)
+    if not any(len(s) >= 2 for s in cut.streams.values()):
+        raise DataError(f"{span()} holds fewer than 2 samples of any stream (the log spans "
+                        f"{t0:.0f}-{t1:.0f} s); expected a longer window")
+    return cut

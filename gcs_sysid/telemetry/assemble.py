@@ -5,13 +5,16 @@ from __future__ import annotations
 from gcs_sysid.telemetry.clock import sort_unique
 from gcs_sysid.telemetry.types import Flight, Stream, StreamSummary
 
-__all__ = ["finish_flight"]
+__all__ = ["finish_flight", "GAP_STREAMS"]
+
+#: Streams whose gaps count as damage (the ones every estimate needs).
+GAP_STREAMS = ("imu", "attitude", "servo", "airspeed")
 
 
 def finish_flight(path: str, fmt: str, streams: dict[str, Stream], dropped: dict[str, int],
                   vehicle: dict[str, object], params: dict[str, float], messages: dict[str, int],
                   warnings: list[str], statustext: list[tuple[float, str]],
-                  imu_sources: str, servo_sources: str) -> Flight:
+                  imu_sources: str, servo_sources: str, damage: list[str] | None = None) -> Flight:
     """Sort every stream by vehicle time, drop repeated times, and build the :class:`Flight`.
 
     Args:
@@ -20,6 +23,9 @@ def finish_flight(path: str, fmt: str, streams: dict[str, Stream], dropped: dict
         dropped: source message -> samples already dropped upstream (byte-identical packets).
         vehicle, params, messages, warnings, statustext: as in :class:`Flight`.
         imu_sources, servo_sources: message names quoted in the "missing" warnings.
+        damage: the reader's notes on damage to the file (corrupt packets, truncation, clock jumps);
+            the dropped samples and the gaps of the main streams are added here. Every damage note
+            is also one of the warnings.
 
     Returns:
         The flight, with :attr:`Flight.summaries` filled; ``dropped`` in each summary counts the
@@ -37,12 +43,22 @@ def finish_flight(path: str, fmt: str, streams: dict[str, Stream], dropped: dict
         summaries[name] = StreamSummary.of(s, n_drop)
         if n_drop:
             total_dropped[name] = n_drop
+    damage = list(damage or [])
     if total_dropped:
-        warnings.append("dropped duplicated or out-of-order samples: "
-                        + ", ".join(f"{k} {v}" for k, v in total_dropped.items()))
+        damage.append("dropped duplicated or out-of-order samples: "
+                      + ", ".join(f"{k} {v}" for k, v in total_dropped.items()))
+    gaps = []
+    for name in GAP_STREAMS:
+        g = summaries[name].gaps if name in summaries else []
+        if g:
+            a, b = max(g, key=lambda ab: ab[1] - ab[0])
+            gaps.append(f"{name} {len(g)} (longest {b - a:.1f} s from {a:.1f} s)")
+    if gaps:
+        damage.append("time gaps in the data (no samples for more than 5 periods and 0.5 s): " + ", ".join(gaps))
+    warnings.extend(d for d in damage if d not in warnings)
     if "imu" not in out:
         warnings.append(f"no IMU data ({imu_sources}): accelerations and body rates are missing")
     if "servo" not in out:
         warnings.append(f"no servo output data ({servo_sources}): control deflections are missing")
     return Flight(path, fmt, out, summaries, vehicle, params, messages, warnings,
-                  sorted(statustext, key=lambda x: x[0]))
+                  sorted(statustext, key=lambda x: x[0]), damage)

@@ -164,15 +164,51 @@ def read_dataflash(path: str, progress: Callable[[float], None] | None = None) -
     if progress is not None:
         progress(1.0)
     bad = chatter["text"].count("bad header")
+    damage = [w for w in warnings if w.startswith("DataFlash decoding stopped early")]
     if bad:
         counts["BAD_DATA"] = bad
-        warnings.append(f"{bad} corrupt byte(s) skipped (bad DataFlash headers); decoding resumed after each")
+        damage.append(f"{bad:,} corrupt byte(s) skipped (bad DataFlash headers); decoding resumed after each")
+    unknown = chatter["text"].count("unknown msg type")
+    end_note = _end_of_log(reader)
+    if end_note:
+        damage.append(end_note)
+    elif unknown:
+        damage.append("DataFlash indexing stopped at a record of an unknown type (a damaged header): "
+                      "the rest of the log was not read")
     if not counts or not sum(counts.values()):
         raise InputError(f"{path}: no DataFlash messages could be decoded; expected an ArduPilot .bin log")
-    return _assemble(path, plans, rows, texts, counts, warnings)
+    return _assemble(path, plans, rows, texts, counts, warnings, damage)
 
 
-def _assemble(path, plans, rows, texts, counts, warnings) -> Flight:
+def _end_of_log(reader) -> str | None:
+    """A note when the log ends inside a record (truncated) or stops before its end, else None.
+
+    The end of the last complete record is the largest ``offset + length`` over the records that
+    DFReader indexed. A record running past the end of the file, or the start of a record header
+    (0xA3 0x95) in the bytes after it, means the file was cut off mid-record; other bytes after it
+    (not the 0x00 / 0xFF padding of block logs) were not read.
+    """
+    size = int(getattr(reader, "data_len", 0) or 0)
+    ends = []
+    for mtype, offs in enumerate(getattr(reader, "offsets", []) or []):
+        fmt = reader.formats.get(mtype)
+        if offs and fmt is not None and getattr(fmt, "len", None):
+            ends.append((offs[-1] + int(fmt.len), fmt.name))
+    if not ends or size <= 0:
+        return None
+    last, name = max(ends)
+    if last > size:
+        return (f"log is truncated (ends inside a {name} record at byte {size:,}): kept the records "
+                "before it")
+    tail = bytes(reader.data_map[last:size])
+    if not tail.strip(b"\x00\xff"):
+        return None
+    if tail[:2] == b"\xa3\x95"[:len(tail[:2])] and len(tail) < 3 + 256:
+        return f"log is truncated (ends inside a record header at byte {size:,}): kept the records before it"
+    return f"{len(tail):,} byte(s) after the last complete record at byte {last:,} could not be read"
+
+
+def _assemble(path, plans, rows, texts, counts, warnings, damage=()) -> Flight:
     arrays = {k: np.asarray(v, float) for k, v in rows.items()}
     clock = None
     if arrays:
@@ -181,6 +217,7 @@ def _assemble(path, plans, rows, texts, counts, warnings) -> Flight:
         # no separate log clock in DataFlash: use TimeUS itself for the spacing at a reboot
         clock = VehicleClock.from_track(seq, raw, raw, "vehicle clock (TimeUS)", float(raw.min()))
         warnings.extend(clock.warnings)
+        damage = [w for w in clock.warnings if w.startswith("reboot")] + list(damage)
     streams: dict[str, Stream] = {}
     for (name, inst), v in sorted(arrays.items(), key=lambda kv: (list(DF_SPECS).index(kv[0][0]), kv[0][1])):
         if name == "NKF1" and any(k[0] == "XKF1" for k in arrays):
@@ -207,4 +244,4 @@ def _assemble(path, plans, rows, texts, counts, warnings) -> Flight:
                 if key in fws:
                     vehicle["mav_type"] = mav_type
     return finish_flight(path, "bin", streams, {}, vehicle, params, counts, warnings, stext,
-                         imu_sources="IMU", servo_sources="RCOU")
+                         imu_sources="IMU", servo_sources="RCOU", damage=list(damage))

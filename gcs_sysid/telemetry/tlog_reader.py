@@ -87,6 +87,7 @@ def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None =
         raise InputError(f"{path}: no MAVLink packets found; expected a MAVLink telemetry log (.tlog: "
                          "8-byte timestamp before each MAVLink v1/v2 packet)")
     warnings: list[str] = []
+    repaired = _repair_stamps(scan)
     src = _main_source(scan)
     sel = {n: _select(c, src) for n, c in scan.collected.items() if c.seq}
     sel = {n: s for n, s in sel.items() if len(s[0])}
@@ -153,13 +154,65 @@ def read_tlog(path: str, data: bytes, progress: Callable[[float], None] | None =
         ts = clock.map_untimed(seq, stamp)
         stext = [(float(t), str(r[1]).rstrip("\x00")) for t, r in zip(ts, rows)]
     params = params_of(sel)
+    damage = [w for w in clock.warnings if w.startswith("reboot")]
+    if repaired or scan.bad_stamps:
+        damage.append(f"{repaired + scan.bad_stamps:,} damaged log time stamp(s) (the 8 bytes before a sound "
+                      "packet) replaced by their neighbours' time")
+    if scan.seq_lost:
+        damage.append(f"{scan.seq_lost:,} packet(s) missing from the MAVLink sequence numbers (dropped on the "
+                      "link, lost to corrupt bytes, or cut out of the file)")
+    if scan.seq_disorder:
+        damage.append(f"{scan.seq_disorder:,} packet(s) out of sequence (MAVLink sequence number repeated or "
+                      "going back: duplicated, reordered or spliced data)")
     if scan.bad_data:
-        warnings.append(f"{scan.bad_data} corrupt packet(s) (BAD_DATA: bad CRC or broken framing) skipped; "
-                        "decoding resumed after each")
+        damage.append(f"{scan.bad_data:,} corrupt packet(s) (BAD_DATA: bad CRC or broken framing) skipped; "
+                      f"decoding resumed after each ({scan.records:,} sound records kept)")
     if scan.truncated:
-        warnings.append(f"log is truncated (ends inside a record): kept the {scan.records} records before it")
+        damage.append(f"log is truncated (ends inside a record): kept the {scan.records:,} records before it")
     return finish_flight(path, "tlog", streams, dropped, vehicle, params, dict(scan.counts), warnings, stext,
-                         imu_sources="HIGHRES_IMU, SCALED_IMU*, RAW_IMU", servo_sources="SERVO_OUTPUT_RAW")
+                         imu_sources="HIGHRES_IMU, SCALED_IMU*, RAW_IMU", servo_sources="SERVO_OUTPUT_RAW",
+                         damage=damage)
+
+
+#: Records on each side whose log stamps vote in :func:`_repair_stamps`.
+_STAMP_HALF_WINDOW = 3
+#: A log stamp further than this from the median of its neighbours is taken as damaged, us.
+_STAMP_TOLERANCE_US = 1_000_000
+
+
+def _repair_stamps(scan: TlogScan) -> int:
+    """Replace damaged log stamps of the collected packets; returns how many were replaced.
+
+    A tlog's 8-byte stamp is not covered by the packet's CRC, so a sound packet can carry a damaged
+    stamp (bytes flipped below the top three, which :func:`~gcs_sysid.telemetry.tlog_scan.scan_tlog`
+    checks). Stamps follow the order of the records; one further than :data:`_STAMP_TOLERANCE_US`
+    from the median of the :data:`_STAMP_HALF_WINDOW` records on each side is replaced by that median.
+    """
+    cols = [c for c in scan.collected.values() if len(c.seq) > 0]
+    if not cols:
+        return 0
+    seq = np.concatenate([np.asarray(c.seq, np.int64) for c in cols])
+    st = np.concatenate([np.asarray(c.stamp_us, np.int64) for c in cols])
+    if len(st) < 2 * _STAMP_HALF_WINDOW + 1:
+        return 0
+    order = np.argsort(seq, kind="stable")
+    s = st[order]
+    padded = np.pad(s, _STAMP_HALF_WINDOW, mode="edge")
+    med = np.median(np.lib.stride_tricks.sliding_window_view(padded, 2 * _STAMP_HALF_WINDOW + 1), axis=1)
+    bad = np.abs(s - med) > _STAMP_TOLERANCE_US
+    n = int(bad.sum())
+    if not n:
+        return 0
+    s = s.copy()
+    s[bad] = med[bad].astype(np.int64)
+    fixed = np.empty_like(st)
+    fixed[order] = s
+    k = 0
+    for c in cols:
+        m = len(c.seq)
+        c.stamp_us = fixed[k:k + m].tolist()
+        k += m
+    return n
 
 
 def _build_clock(arrays, log_t0: float, warnings: list[str]) -> VehicleClock:

@@ -26,8 +26,11 @@ from operator import attrgetter
 from typing import Callable
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
+from pymavlink.generator.mavcrc import mcrf4xx as _fast_crc
+from pymavlink.generator.mavcrc import x25crc
 
-__all__ = ["MAX_STAMP_JUMP_US", "Collected", "TlogScan", "find_sync", "scan_tlog", "msgid_of", "msg_name"]
+__all__ = ["MAX_STAMP_JUMP_US", "Collected", "TlogScan", "find_sync", "scan_tlog", "seq_step", "msgid_of",
+           "msg_name"]
 
 MAX_STAMP_JUMP_US = 3 * 24 * 3600 * 1_000_000
 """Largest jump between consecutive tlog stamps still taken as in sync (3 days, as pymavlink)."""
@@ -35,6 +38,16 @@ MAX_STAMP_JUMP_US = 3 * 24 * 3600 * 1_000_000
 _V1, _V2 = 0xFE, 0xFD
 _MIN_RECORD = 8 + 8  # stamp + shortest v1 packet (no payload)
 _NAME_TO_ID = {cls.msgname: mid for mid, cls in mavlink.mavlink_map.items()}
+
+
+def _crc16(buf: bytes, crc: int) -> int:
+    """CRC-16/MCRF4XX of ``buf`` continuing from ``crc`` (MAVLink's X.25 checksum; fastcrc when installed)."""
+    if _fast_crc is not None:
+        return _fast_crc(bytes(buf), crc)
+    x = x25crc()
+    x.crc = crc
+    x.accumulate(bytes(buf))
+    return x.crc
 
 
 def msgid_of(name: str) -> int:
@@ -79,6 +92,13 @@ class TlogScan:
         end: offset where the scan stopped (``len(data)``, or the ``stop`` record boundary).
         first, last: message name -> ``(packet bytes, stamp_us)`` of the first and the last packet
             of each wanted type that was kept (to join the scans of two parts of a file).
+        seq_lost: packets missing from the senders' MAVLink sequence numbers (each sender counts its
+            packets modulo 256; a forward jump of ``d`` means ``d - 1`` packets lost on the link, to
+            corrupt bytes, or cut out of the file).
+        seq_disorder: packets whose sequence number repeats or goes back (duplicated, reordered or
+            spliced data).
+        seq_first, seq_last: sender ``src`` -> its first and last sequence number (to join scans).
+        bad_stamps: sound packets kept behind a damaged log stamp (given the stamp before them).
     """
 
     collected: dict[str, Collected]
@@ -90,6 +110,21 @@ class TlogScan:
     end: int = 0
     first: dict[str, tuple[bytes, int]] = field(default_factory=dict)
     last: dict[str, tuple[bytes, int]] = field(default_factory=dict)
+    seq_lost: int = 0
+    seq_disorder: int = 0
+    seq_first: dict[int, int] = field(default_factory=dict)
+    seq_last: dict[int, int] = field(default_factory=dict)
+    bad_stamps: int = 0
+
+
+def seq_step(prev: int, nxt: int) -> tuple[int, int]:
+    """(lost, disorder) between two consecutive sequence numbers of one sender (see :class:`TlogScan`)."""
+    d = (nxt - prev) & 255
+    if d == 1:
+        return 0, 0
+    if 1 < d < 128:
+        return d - 1, 0
+    return 0, 1
 
 
 def _record(data: bytes, pos: int) -> tuple[int, int, int] | None:
@@ -126,14 +161,39 @@ def _chain_ok(data: bytes, pos: int, ref_us: int | None, depth: int = 3) -> bool
     return True
 
 
-def find_sync(data: bytes, start: int, ref_us: int | None, limit: int | None = None) -> int | None:
-    """First offset ``>= start`` where three tlog records chain consistently.
+def _crc_ok(data: bytes, pos: int) -> bool:
+    """True if the MAVLink packet of the record at ``pos`` passes its CRC (with the dialect's crc_extra).
+
+    A packet of an id the dialect does not define, or one running past the end of ``data``, fails.
+    """
+    rec = _record(data, pos)
+    if rec is None:
+        return False
+    mid, ln, _src = rec
+    cls = mavlink.mavlink_map.get(mid)
+    if cls is None or pos + ln > len(data):
+        return False
+    hdr = 6 if data[pos + 8] == _V1 else 10
+    body_end = pos + 8 + hdr + data[pos + 9]
+    crc = _crc16(data[pos + 9:body_end], 0xFFFF)
+    crc = _crc16(bytes((cls.crc_extra,)), crc)
+    return crc == (data[body_end] | (data[body_end + 1] << 8))
+
+
+def find_sync(data: bytes, start: int, ref_us: int | None, limit: int | None = None,
+              crc: bool = False) -> int | None:
+    """First offset ``>= start`` where a tlog record starts: three records chain consistently, or
+    (with ``crc``) the record's packet passes its CRC.
 
     Args:
         data: whole file.
         start: first candidate offset.
-        ref_us: last good stamp (us) the next ones must lie near, or None at the start of a file.
+        ref_us: last good stamp (us) the chained stamps must lie near, or None at the start of a file.
         limit: give up after this many bytes (None: search to the end).
+        crc: also accept a single record whose packet passes its CRC (what pymavlink's byte-wise
+            parser accepts), whatever its neighbours; used to resynchronise inside a damaged file,
+            where the next records may be damaged too. Off for telling the format of a file and
+            for choosing where to split one (a chain of three is the stricter test).
 
     Returns:
         The offset, or None when no consistent record was found.
@@ -147,7 +207,7 @@ def find_sync(data: bytes, start: int, ref_us: int | None, limit: int | None = N
         if not cands:
             return None
         p = min(cands)
-        if _chain_ok(data, p - 8, ref_us):
+        if (crc and _crc_ok(data, p - 8)) or _chain_ok(data, p - 8, ref_us):
             return p - 8
         p += 1
     return None
@@ -196,6 +256,14 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
     ref = int.from_bytes(data[pos:pos + 8], "big")
     prefix = data[pos:pos + 3]
     stopped = n
+    unchecked = -1   # start of the previous record when it was framed on its length byte alone (no CRC)
+    unchecked_mid = -1
+    good = pos       # start of the last record taken with a sound stamp
+    fixed_at = fixed_stamp = -1   # a record kept behind a damaged stamp, and the stamp it is given
+    seqs: dict[int, int] = {}
+    seq_first: dict[int, int] = {}
+    glitch: dict[int, tuple[int, int, int, int]] = {}   # src -> (seq, seq before it, lost, disorder) of a jump
+    lost = disorder = bad_stamps = 0
     while pos < limit:
         if pos + _MIN_RECORD > n:
             truncated = True
@@ -216,53 +284,92 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
             end = -1
         if end >= 0 and data[pos:pos + 3] != prefix:
             stamp = int.from_bytes(data[pos:pos + 8], "big")
-            if abs(stamp - ref) > MAX_STAMP_JUMP_US:
-                end = -1
-            else:
+            if abs(stamp - ref) <= MAX_STAMP_JUMP_US:
                 ref, prefix = stamp, data[pos:pos + 3]
-        if end > n:
-            # the last record runs past the end of file: truncated, unless the framing is lost
-            nxt = find_sync(data, pos + 1, ref)
+            elif end <= n and _crc_ok(data, pos):
+                # a sound packet behind a damaged stamp: keep it, at the stamp of the record before it
+                fixed_at, fixed_stamp = pos, int.from_bytes(data[good:good + 8], "big")
+                bad_stamps += 1
+            else:
+                end = -1
+        if end < 0 or end > n:
+            past_end = end > n
+            back = pos + 1
+            if unchecked >= 0 and not _crc_ok(data, unchecked):
+                # the previous record was framed by its length byte alone and its packet is damaged: the
+                # damage may have started there (a wrong length lands here), so search again from just
+                # after its start rather than from here, which would skip the records in between
+                counts[unchecked_mid] -= 1
+                records -= 1
+                back = unchecked + 1
+            unchecked = -1
+            nxt = find_sync(data, back, ref, crc=True)
             if nxt is None:
-                truncated = True
+                if past_end:
+                    truncated = True   # the last record runs past the end of the file
+                else:
+                    bad += 1
                 break
-            end = -1
-        if end < 0:
             bad += 1
-            nxt = find_sync(data, pos + 1, ref)
-            if nxt is None:
-                break
             pos = nxt
             continue
         records += 1
         counts[mid] = counts.get(mid, 0) + 1
+        sq = data[pos + 10] if mk == _V1 else data[pos + 12]
+        prev_sq = seqs.get(src, -1)
+        seqs[src] = sq
+        if prev_sq < 0:
+            seq_first[src] = sq
+        elif (prev_sq + 1) & 255 != sq:
+            g = glitch.pop(src, None)
+            base = prev_sq
+            if g is not None and g[0] == prev_sq:
+                # the previous packet jumped too: its sequence byte is taken as damaged, and the step is
+                # counted from the last number before it (a run of damaged numbers counts as one step)
+                lost -= g[2]
+                disorder -= g[3]
+                base = g[1]
+            dl, dd = seq_step(base, sq)
+            lost += dl
+            disorder += dd
+            glitch[src] = (sq, base, dl, dd)
         ent = getters.get(mid)
-        if ent is not None:
+        if ent is None:
+            unchecked, unchecked_mid = pos, mid
+        else:
+            unchecked = -1
             buf = data[pos + 8:end]
-            stamp = int.from_bytes(data[pos:pos + 8], "big")
+            stamp = int.from_bytes(data[pos:pos + 8], "big") if pos != fixed_at else fixed_stamp
             prev = last.get(mid)
             if prev is not None and prev[0] == buf and stamp - prev[1] < 2_000_000:
                 dups[mid] = dups.get(mid, 0) + 1
             else:
-                last[mid] = (buf, stamp)
-                if prev is None:
-                    first[mid] = last[mid]
                 try:
                     msg = decode(bytearray(buf))
                 except Exception:  # pymavlink raises MAVError, struct.error, ... on bad packets
                     counts[mid] -= 1
                     records -= 1
                     bad += 1
-                    nxt = find_sync(data, pos + 1, ref)
+                    # a damaged packet whose length byte holds (the next record starts where it says):
+                    # only this packet is lost; otherwise search from the next byte
+                    if end == n or _chain_ok(data, end, ref, depth=1):
+                        pos = end
+                        continue
+                    nxt = find_sync(data, pos + 1, ref, crc=True)
                     if nxt is None:
                         break
                     pos = nxt
                     continue
+                last[mid] = (buf, stamp)
+                if prev is None:
+                    first[mid] = last[mid]
                 get, col = ent
                 col.seq.append(records)
                 col.stamp_us.append(stamp)
                 col.src.append(src)
                 col.rows.append(get(msg))
+        if pos != fixed_at:
+            good = pos
         pos = end
         if progress is not None and pos >= next_report:
             progress(min(pos / limit, 1.0))
@@ -276,4 +383,5 @@ def scan_tlog(data: bytes, wanted: dict[str, tuple[str, ...]],
         names["BAD_DATA"] = bad
     return TlogScan(collected, names, {msg_name(k): v for k, v in dups.items()}, bad, truncated, records,
                     end=stopped, first={msg_name(k): v for k, v in first.items()},
-                    last={msg_name(k): v for k, v in last.items()})
+                    last={msg_name(k): v for k, v in last.items()}, seq_lost=lost, seq_disorder=disorder,
+                    seq_first=seq_first, seq_last=seqs, bad_stamps=bad_stamps)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, find_sync, scan_tlog
+from gcs_sysid.telemetry.tlog_scan import Collected, TlogScan, _crc_ok, find_sync, scan_tlog, seq_step
 
 __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_split", "join_scans"]
 
@@ -74,8 +74,34 @@ def join_scans(head: TlogScan, tail: TlogScan) -> TlogScan:
     first.update(head.first)
     last = dict(head.last)
     last.update(tail.last)
+    lost, disorder = head.seq_lost + tail.seq_lost, head.seq_disorder + tail.seq_disorder
+    for src, sq in tail.seq_first.items():   # the step across the cut, as one scan sees it
+        if src in head.seq_last:
+            dl, dd = seq_step(head.seq_last[src], sq)
+            lost, disorder = lost + dl, disorder + dd
+    seq_first = dict(tail.seq_first)
+    seq_first.update(head.seq_first)
+    seq_last = dict(head.seq_last)
+    seq_last.update(tail.seq_last)
     return TlogScan(collected, counts, dups, bad, tail.truncated, head.records + tail.records, end=tail.end + head.end,
-                    first=first, last=last)
+                    first=first, last=last, seq_lost=lost, seq_disorder=disorder, seq_first=seq_first,
+                    seq_last=seq_last, bad_stamps=head.bad_stamps + tail.bad_stamps)
+
+
+def _sound_cut(data: bytes, start: int, tries: int = 64) -> int | None:
+    """A record boundary at or after ``start`` whose record passes its CRC, or None.
+
+    One scan never looks back past a sound record (it resynchronises at most from just after the start
+    of the record before a damaged one), so a scan starting there sees what one scan of the whole file
+    sees from there on.
+    """
+    pos = start
+    for _ in range(tries):
+        cut = find_sync(data, pos, None)
+        if cut is None or _crc_ok(data, cut):
+            return cut
+        pos = cut + 1
+    return None
 
 
 def scan_tlog_split(data: bytes, wanted: dict[str, tuple[str, ...]], helper,
@@ -95,7 +121,7 @@ def scan_tlog_split(data: bytes, wanted: dict[str, tuple[str, ...]], helper,
     """
     n = len(data)
     fraction = HEAD_FRACTION if meanwhile is None else HEAD_FRACTION_BUSY
-    cut = find_sync(data, int(fraction * n), None) if helper is not None and helper.parallel else None
+    cut = _sound_cut(data, int(fraction * n)) if helper is not None and helper.parallel else None
     if n < MIN_SPLIT_BYTES or cut is None or cut <= 0:
         if meanwhile is not None:
             meanwhile()

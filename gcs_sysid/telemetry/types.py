@@ -102,6 +102,9 @@ class Flight:
         messages: message type -> count of every message seen (including unknown / BAD_DATA).
         warnings: one-line notes on what was odd or missing (reboots, wraps, bad data).
         statustext: (t, text) pairs from STATUSTEXT / MSG.
+        damage: the notes among ``warnings`` that say the log itself is damaged: corrupt packets,
+            truncation, dropped (duplicated or out-of-order) samples, time jumps and gaps
+            (empty for an intact log). Shown on the console as well as in the report.
     """
 
     path: str
@@ -113,6 +116,7 @@ class Flight:
     messages: dict[str, int] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     statustext: list[tuple[float, str]] = field(default_factory=list)
+    damage: list[str] = field(default_factory=list)
 
     def has(self, name: str) -> bool:
         """True if stream ``name`` exists and has at least 2 samples."""
@@ -134,4 +138,5 @@ class Flight:
         return Flight(self.path, self.format, {k: s.window(t0, t1) for k, s in self.streams.items()},
                       dict(self.summaries), dict(self.vehicle), dict(self.params), dict(self.messages),
                       list(self.warnings), [x for x in self.statustext
-                                            if (t0 is None or x[0] >= t0) and (t1 is None or x[0] <= t1)])
+                                            if (t0 is None or x[0] >= t0) and (t1 is None or x[0] <= t1)],
+                      list(self.damage))

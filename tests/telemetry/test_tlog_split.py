@@ -28,6 +28,7 @@ def data() -> bytes:
 def _same(a, b):
     assert a.counts == b.counts and a.duplicates == b.duplicates
     assert (a.bad_data, a.truncated, a.records) == (b.bad_data, b.truncated, b.records)
+    assert (a.seq_lost, a.seq_disorder, a.bad_stamps) == (b.seq_lost, b.seq_disorder, b.bad_stamps)
     assert a.collected.keys() == b.collected.keys()
     for k in a.collected:
         ca, cb = a.collected[k], b.collected[k]

@@ -1,0 +1,150 @@
+"""Ending a command at once on Ctrl-C (SIGINT) or SIGTERM, whatever it is doing.
+
+Python turns SIGINT into a ``KeyboardInterrupt`` raised wherever the main thread happens to be,
+which is not always somewhere that can stop the program: raised inside a garbage-collection
+callback (JAX registers one) or a ``__del__``, it is printed as "Exception ignored" and the run goes
+on; raised inside a long compiled call (an XLA program, a BLAS factorisation), it waits for the call
+to return. So the CLI does not raise: :func:`install` lets the C-level signal handler write the
+signal number to a pipe (:func:`signal.set_wakeup_fd`), and a watcher thread, which does not wait
+for the main thread to reach Python code, runs the registered clean-ups (remove a half-written
+output folder, stop the worker process), prints one line and ends the process with ``128 + signal``
+(130 for SIGINT, 143 for SIGTERM).
+
+Clean-ups are registered by what creates something to clean (:mod:`gcs_sysid.outdir`,
+:mod:`gcs_sysid.parallel`); :func:`critical` marks a short section that must not be cut in half
+(moving finished outputs into place): a stop waits for it to end.
+
+References:
+    Python documentation, ``signal.set_wakeup_fd`` and "Note on Signal Handlers and Exceptions",
+    https://docs.python.org/3/library/signal.html
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import signal
+import sys
+import threading
+from contextlib import contextmanager
+from typing import Callable, Iterator
+
+__all__ = ["install", "installed", "register", "unregister", "critical", "EXIT_SIGINT", "EXIT_SIGTERM"]
+
+EXIT_SIGINT = 128 + signal.SIGINT     # 130
+EXIT_SIGTERM = 128 + signal.SIGTERM   # 143
+
+_cleanups: dict[int, Callable[[], str | None]] = {}
+_ids = itertools.count()
+_lock = threading.Lock()                 # guards _cleanups
+_critical = threading.RLock()            # held while outputs are moved into place
+_installed = False
+_stopping = threading.Event()
+
+
+def register(cleanup: Callable[[], str | None]) -> int:
+    """Run ``cleanup()`` if the process is stopped by a signal; returns a token for :func:`unregister`.
+
+    A clean-up may return a few words for the one line printed at the stop (e.g. "report: left as it
+    was"). Clean-ups run in the watcher thread, newest first, each at most once; an exception in one is
+    ignored. They must be quick (well under a second) and must not take locks the main thread may hold.
+    """
+    with _lock:
+        key = next(_ids)
+        _cleanups[key] = cleanup
+    return key
+
+
+def unregister(token: int) -> None:
+    """Forget a clean-up registered with :func:`register` (no error if it is gone)."""
+    with _lock:
+        _cleanups.pop(token, None)
+
+
+@contextmanager
+def critical() -> Iterator[None]:
+    """A section a stop must not cut in half (it waits until the section ends, then stops)."""
+    with _critical:
+        yield
+
+
+def installed() -> bool:
+    """Whether :func:`install` has set up the handlers in this process."""
+    return _installed
+
+
+def _stop(signum: int) -> None:
+    """Clean up, say so in one line and end the process with ``128 + signum``."""
+    if _stopping.is_set():
+        return
+    _stopping.set()
+    with _critical:   # a commit in progress finishes first (it takes milliseconds)
+        with _lock:
+            todo = list(_cleanups.values())[::-1]
+            _cleanups.clear()
+        notes = []
+        for fn in todo:
+            try:
+                note = fn()
+            except BaseException:   # noqa: BLE001 - nothing may stop the stop
+                note = None
+            if note:
+                notes.append(str(note))
+        what = "interrupted (Ctrl-C)" if signum == signal.SIGINT else \
+            f"stopped by {signal.Signals(signum).name}"
+        if notes:
+            what += "; " + "; ".join(notes)
+        try:
+            if sys.stdout is not None and sys.stdout.isatty():
+                os.write(sys.stdout.fileno(), b"\x1b[?25h\n")   # show the cursor a progress bar hid
+        except (OSError, ValueError):
+            pass
+        try:
+            os.write(2, f"gcs-sysid: {what}\n".encode())
+        except OSError:
+            pass
+        os._exit(128 + signum)
+
+
+def _watch(fd: int) -> None:
+    while True:
+        try:
+            data = os.read(fd, 64)
+        except InterruptedError:
+            continue
+        except OSError:
+            return
+        if not data:
+            return
+        for b in data:
+            if b in (signal.SIGINT, signal.SIGTERM):
+                _stop(b)
+
+
+def _python_handler(signum, frame) -> None:
+    # The watcher does the work; this handler only replaces Python's default (KeyboardInterrupt), and
+    # covers a watcher that is not running.
+    if not _watcher_alive():
+        _stop(signum)
+
+
+_watcher: threading.Thread | None = None
+
+
+def _watcher_alive() -> bool:
+    return _watcher is not None and _watcher.is_alive()
+
+
+def install() -> None:
+    """Handle SIGINT and SIGTERM as described above (main thread only; idempotent)."""
+    global _installed, _watcher
+    if _installed:
+        return
+    r, w = os.pipe()
+    os.set_blocking(w, False)
+    _watcher = threading.Thread(target=_watch, args=(r,), name="gcs-sysid-signals", daemon=True)
+    _watcher.start()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, _python_handler)
+    signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+    _installed = True
