@@ -296,6 +296,16 @@ def main(argv: list[str] | None = None, handle_signals: bool = True) -> int:
         handle_signals: install :mod:`gcs_sysid.stopping` (SIGINT/SIGTERM end the process at once);
             False for callers that keep their own handlers (tests running commands in-process).
     """
+    from . import stopping
+
+    try:
+        return _main(argv, handle_signals)
+    except stopping.Stopped:   # a signal: the watcher thread cleans up and ends the process
+        stopping.park()
+        raise   # not reached
+
+
+def _main(argv: list[str] | None, handle_signals: bool) -> int:
     import threading
 
     from . import stopping

@@ -10,7 +10,11 @@ for the main thread to reach Python code, runs the registered clean-ups (remove 
 output folder, stop the worker process), prints one line and ends the process with ``128 + signal``
 (130 for SIGINT, 143 for SIGTERM).
 
-Clean-ups are registered by what creates something to clean (:mod:`gcs_sysid.outdir`,
+Before the clean-ups run, the main thread is stopped at its next Python instruction: the watcher
+raises :class:`Stopped` in it (CPython's asynchronous exception), and the command's entry point
+catches it and :func:`park` s, so that no writer puts back a folder the clean-up just removed; from
+then on only the one line reaches stderr (the rest goes to the null device). Clean-ups are
+registered by what creates something to clean (:mod:`gcs_sysid.outdir`,
 :mod:`gcs_sysid.parallel`); :func:`critical` marks a short section that must not be cut in half
 (moving finished outputs into place): a stop waits for it to end.
 
@@ -29,7 +33,8 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator
 
-__all__ = ["install", "installed", "register", "unregister", "critical", "EXIT_SIGINT", "EXIT_SIGTERM"]
+__all__ = ["install", "installed", "register", "unregister", "critical", "park", "Stopped", "EXIT_SIGINT",
+           "EXIT_SIGTERM"]
 
 EXIT_SIGINT = 128 + signal.SIGINT     # 130
 EXIT_SIGTERM = 128 + signal.SIGTERM   # 143
@@ -40,6 +45,36 @@ _lock = threading.Lock()                 # guards _cleanups
 _critical = threading.RLock()            # held while outputs are moved into place
 _installed = False
 _stopping = threading.Event()
+_parked = threading.Event()              # the main thread has stopped working (:func:`park`)
+
+#: How long the watcher waits for the main thread to park before it cleans up anyway (a thread inside
+#: a long compiled call writes no files; it is stopped at its next Python instruction).
+PARK_WAIT_S = 0.5
+
+
+class Stopped(BaseException):
+    """Raised in the main thread by a stop, so that it writes nothing more while its outputs are removed.
+
+    Not an :class:`Exception`: no ``except Exception`` on the way up catches it. The command's entry
+    point catches it and calls :func:`park`.
+    """
+
+
+def park() -> None:
+    """Called by the main thread that caught :class:`Stopped`: wait here until the watcher ends the process."""
+    _parked.set()
+    while True:
+        threading.Event().wait(3600.0)
+
+
+def _interrupt_main() -> None:
+    """Raise :class:`Stopped` in the main thread at its next bytecode (CPython's asynchronous exception)."""
+    import ctypes
+
+    main = threading.main_thread()
+    if threading.current_thread() is main or main.ident is None:
+        return
+    ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(main.ident), ctypes.py_object(Stopped))
 
 
 def register(cleanup: Callable[[], str | None]) -> int:
@@ -78,7 +113,18 @@ def _stop(signum: int) -> None:
     if _stopping.is_set():
         return
     _stopping.set()
+    try:   # from here on only this line reaches the console: the main thread, stopped in the middle of
+        # whatever it did (a garbage-collection callback, a __del__), may print "Exception ignored ..."
+        err = os.dup(2)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 2)
+    except OSError:
+        err = 2
     with _critical:   # a commit in progress finishes first (it takes milliseconds)
+        # the main thread stops writing before its staging outputs are removed: otherwise a writer that
+        # creates its folder (mkdir(parents=True)) puts the staging folder back after the clean-up
+        _interrupt_main()
+        _parked.wait(PARK_WAIT_S)
         with _lock:
             todo = list(_cleanups.values())[::-1]
             _cleanups.clear()
@@ -100,7 +146,7 @@ def _stop(signum: int) -> None:
         except (OSError, ValueError):
             pass
         try:
-            os.write(2, f"gcs-sysid: {what}\n".encode())
+            os.write(err, f"gcs-sysid: {what}\n".encode())
         except OSError:
             pass
         os._exit(128 + signum)
