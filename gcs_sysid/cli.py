@@ -65,6 +65,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--model", dest="model_in", default=None,
                    help="model state saved by an earlier replay (DIR/model): continue learning from it")
     r.add_argument("--inducing", type=int, default=None, help="number of inducing points of the global GP")
+    r.add_argument("--target", default=None, metavar="C[,C...]",
+                   help="coefficients the maneuver suggestions target, e.g. Cl,Cn (default: all, moment "
+                        "coefficients first)")
     r.add_argument("--quiet", action="store_true", help="no progress display")
 
     s = sub.add_parser("simulate", help="simulate a flight with the project's 6-DOF model and write a tlog")
@@ -116,7 +119,8 @@ def _replay_options(a: argparse.Namespace):
     from .pipeline import ReplayOptions
 
     return ReplayOptions(rate_hz=a.rate, holdout=a.holdout, t_from=a.t_from, t_to=a.t_to,
-                         model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say)
+                         model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say,
+                         targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")))
 
 
 def _check_replay(a: argparse.Namespace) -> None:

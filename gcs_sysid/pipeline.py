@@ -53,6 +53,8 @@ class ReplayOptions:
         parallel: use a second process for the work beside the main chain (decoding most of a
             .tlog, the specific-force smoother, the report's figures; :mod:`gcs_sysid.parallel`)
             when more than one CPU is usable; the results are the same.
+        targets: coefficients the maneuver suggestions target (None: all, moment coefficients
+            first; :class:`gcs_sysid.maneuvers.ManeuverConfig`).
         notify: called with each one-line note the user should see at once (the damage found in the
             log, :attr:`gcs_sysid.telemetry.Flight.damage`); None: notes go to the report only.
     """
@@ -67,6 +69,7 @@ class ReplayOptions:
     write: bool = True
     parallel: bool = True
     notify: Callable[[str], None] | None = None
+    targets: tuple[str, ...] | None = None
 
 
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
@@ -81,6 +84,11 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     check_holdout(options.holdout)
     check_window(options.t_from, options.t_to)
     check_positive_int(options.n_inducing, "--inducing")
+    if options.targets is not None:
+        bad = [c for c in options.targets if c not in COEFFICIENTS]
+        if bad or not options.targets:
+            raise InputError(f"--target {','.join(options.targets)}: expected comma-separated coefficients "
+                             f"among {', '.join(COEFFICIENTS)}")
     if options.model_in:
         check_model_state(options.model_in)
     check_log(log)
@@ -225,7 +233,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         from .estimation import estimate_states
         from .gp import GPConfig, fit_gp, load_gp
         from .jaxconfig import enable_compilation_cache
-        from .maneuvers import suggest_maneuvers
+        from .maneuvers import ManeuverConfig, suggest_maneuvers
         from .report import write_report
         from .report.tables import correlation_of
 
@@ -290,8 +298,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
-                suggestions = suggest_maneuvers(envelope, model, table, airframe, heldout_error_pct=gate,
-                                                identifiable=ident)
+                cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
+                suggestions = suggest_maneuvers(envelope, model, table, airframe, config=cfg,
+                                                heldout_error_pct=gate, identifiable=ident)
             if suggestions:
                 draw("suggestions", "suggestions_figure", list(suggestions))
         metrics: dict[str, dict[str, float]] = {}

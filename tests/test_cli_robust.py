@@ -73,6 +73,7 @@ def test_bad_options_are_refused_before_decoding(tmp_path):
         (["--out", tmp_path / "o", "--holdout", "1.5"], ["--holdout", "1.5"]),
         (["--out", tmp_path / "o", "--model", tmp_path / "none" / "model"], ["--model", "model.npz"]),
         (["--out", tmp_path / "o", "--inducing", "0"], ["--inducing"]),
+        (["--out", tmp_path / "o", "--target", "Cl,Cq"], ["--target", "Cl,Cq", "among CX"]),
     ]
     worst = 0.0
     for extra, frags in cases:
@@ -97,6 +98,12 @@ def test_other_commands_check_their_outputs_first(tmp_path):
     p, _ = cli("fit", FLIGHT, "--airframe", AIRFRAME, "--out", f / "m.toml")
     one_line_error(p, "--out", "not a folder")
     p, _ = cli("diagnose", FLIGHT, "--airframe", AIRFRAME, "--model", MODEL, "--out", f)
+    one_line_error(p, "--out", "is an existing file")
+    p, _ = cli("campaign", "--airframe", AIRFRAME, "--model", MODEL, "--out", f)
+    one_line_error(p, "--out", "is an existing file")
+    p, _ = cli("predict", tmp_path / "nomodel", "--inputs", tmp_path / "none.csv", "--out", tmp_path / "p.csv")
+    one_line_error(p, "--inputs", "no such file")
+    p, _ = cli("listen", "udpin:127.0.0.1:1", "--airframe", AIRFRAME, "--out", f)
     one_line_error(p, "--out", "is an existing file")
     p, _ = cli("diagnose", FLIGHT, "--airframe", AIRFRAME, "--model", tmp_path / "nomodel.toml", "--out", d)
     one_line_error(p, "nomodel.toml")

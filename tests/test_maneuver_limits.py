@@ -209,3 +209,15 @@ def test_plan_file_flies_the_suggestions_exactly(full):
         plan_document([zero])
     with pytest.raises(InputError, match="more than the 5 s"):
         plan_document(sug[:2], duration_s=5.0)
+
+
+def test_replay_targets_only_the_coefficients_asked_for(tmp_path):
+    """``replay --target Cn`` (ReplayOptions.targets): every suggestion of the sample flight aims at Cn."""
+    from gcs_sysid.pipeline import ReplayOptions, run_replay
+
+    data = Path(__file__).resolve().parents[1] / "data"
+    r = run_replay(data / "flights" / "sim-trainer-sysid.tlog", data / "airframes" / "sim-trainer.toml", tmp_path,
+                   ReplayOptions(progress=False, write=False, parallel=False, t_from=40.0, t_to=160.0,
+                                 targets=("Cn",)))
+    assert r.suggestions, "no suggestion for Cn"
+    assert all(set(s.coefficients) == {"Cn"} for s in r.suggestions), [s.coefficients for s in r.suggestions]

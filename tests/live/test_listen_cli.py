@@ -20,7 +20,7 @@ GCS = [sys.executable, "-m", "gcs_sysid"]
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["udpin:127.0.0.1:{port}", "--airframe", "{missing}"], "not found"),
+    (["udpin:127.0.0.1:{port}", "--airframe", "{missing}"], "no such file"),
     (["{flight}", "--airframe", "{airframe}"], "is a log file"),
     (["udpin:127.0.0.1:notaport", "--airframe", "{airframe}"], "cannot open the link"),
     (["udpin:127.0.0.1:{port}", "--airframe", "{airframe}", "--window", "5", "--step", "10"], "--window"),
