@@ -42,6 +42,20 @@ def _stack(al: Aligned, stream: str, fields: tuple[str, ...]) -> np.ndarray | No
     return x if np.isfinite(x).all(axis=1).sum() >= 10 else None
 
 
+def _take_vanes(vanes, sources: dict, ident: dict, notes: list) -> tuple[np.ndarray, np.ndarray]:
+    """Use the vane angles of :func:`_vane_angles` as alpha and beta; records their source and note.
+
+    Returns:
+        alpha, beta in rad, each of shape (T,).
+    """
+    alpha, beta, note = vanes
+    for k in ("alpha", "beta"):
+        sources[k] = "vanes (AOA_SSA/AOA; airframe [air_data] angles = \"vane\"), linear interpolation"
+        ident[k] = (True, "measured by vanes")
+    notes.append(note)
+    return alpha, beta
+
+
 def _vane_angles(flight: Flight, airframe: Airframe, al):
     """``(alpha, beta, note)`` on the grid from the vanes when the airframe says AOA_SSA/AOA are vane
     measurements (``[air_data] angles = "vane"``) and the log has them; else None.
@@ -359,22 +373,14 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         ident["beta"] = (True, "reconstructed from GPS velocity, attitude and wind")
         vanes = _vane_angles(flight, airframe, al)
         if vanes is not None:
-            alpha, beta, note = vanes
-            for k in ("alpha", "beta"):
-                sources[k] = "vanes (AOA_SSA/AOA; airframe [air_data] angles = \"vane\"), linear interpolation"
-                ident[k] = (True, "measured by vanes")
-            notes.append(note)
+            alpha, beta = _take_vanes(vanes, sources, ident, notes)
     else:
         if have_tas:
             V = tas
             sources["V"] = eas_src + " -> TAS with " + sources["rho"].split(" (")[0]
         vanes = _vane_angles(flight, airframe, al)
         if vanes is not None:
-            alpha, beta, note = vanes
-            for k in ("alpha", "beta"):
-                sources[k] = "vanes (AOA_SSA/AOA; airframe [air_data] angles = \"vane\"), linear interpolation"
-                ident[k] = (True, "measured by vanes")
-            notes.append(note)
+            alpha, beta = _take_vanes(vanes, sources, ident, notes)
         elif flight.has("aoa_ssa"):
             alpha, beta = al.get("aoa_ssa", "alpha"), al.get("aoa_ssa", "beta")
             for k in ("alpha", "beta"):
