@@ -211,7 +211,20 @@ class _Blocked:
             signal.pthread_sigmask(signal.SIG_SETMASK, self._old)
 
 
-class StagedDir:
+class _Staged:
+    """Context manager of the staged outputs: ``commit()`` on success, ``abort()`` on any exception."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.abort()
+
+
+class StagedDir(_Staged):
     """An output folder written beside its place and moved there when complete.
 
     Args:
@@ -274,17 +287,8 @@ class StagedDir:
         if not self.committed:
             shutil.rmtree(self.path, ignore_errors=True)
 
-    def __enter__(self) -> "StagedDir":
-        return self
 
-    def __exit__(self, exc_type, *exc) -> None:
-        if exc_type is None:
-            self.commit()
-        else:
-            self.abort()
-
-
-class StagedFiles:
+class StagedFiles(_Staged):
     """Output files written to temporary names beside them and renamed into place together.
 
     Args:
@@ -345,12 +349,3 @@ class StagedFiles:
         stopping.unregister(self._token)
         if not self.committed:
             self._drop()
-
-    def __enter__(self) -> "StagedFiles":
-        return self
-
-    def __exit__(self, exc_type, *exc) -> None:
-        if exc_type is None:
-            self.commit()
-        else:
-            self.abort()

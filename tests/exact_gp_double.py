@@ -135,3 +135,17 @@ def synthetic_table(n=600, rate_hz=20.0, seed=0):
     Y = Y + 0.03 * Y.std(0) * rng.standard_normal(Y.shape)
     qbar = 0.5 * 1.2 * X[:, -1] ** 2
     return CoefficientTable(t, X, Y, np.ones(n, bool), qbar, ["synthetic table for tests"])
+
+
+def envelope_setup(airframe_path):
+    """The maneuver tests' common case: a synthetic table, the exact GP double fitted on all but its
+    last 80 rows, the confidence map and the airframe. Returns (table, train_mask, model, envelope, airframe)."""
+    from gcs_sysid.airframe import load_airframe
+    from gcs_sysid.envelope import EnvelopeConfig, confidence_map
+
+    tab = synthetic_table(n=400, seed=2)
+    train = np.ones(len(tab.t), bool)
+    train[-80:] = False
+    model = fit_double(tab.X[train], tab.Y[train], rel_lengthscale=2.0, max_points=200)
+    env = confidence_map(model, tab, train, EnvelopeConfig(n_grid=16))
+    return tab, train, model, env, load_airframe(airframe_path)

@@ -11,7 +11,7 @@ import pytest
 
 from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS
 from gcs_sysid.airframe import airframe_from_dict, airframe_to_dict, load_airframe
-from gcs_sysid.envelope import EnvelopeConfig, FlaggedRegion, confidence_map
+from gcs_sysid.envelope import FlaggedRegion
 from gcs_sysid.errors import InputError
 from gcs_sysid.maneuvers import (ManeuverConfig, check_peaks, effective_limits, plan_document, quality_gate,
                                  suggest_maneuvers)
@@ -26,12 +26,7 @@ AIRFRAME = DATA / "airframes" / "sim-trainer.toml"
 
 @pytest.fixture(scope="module")
 def setup():
-    tab = double.synthetic_table(n=400, seed=2)
-    train = np.ones(len(tab.t), bool)
-    train[-80:] = False
-    model = double.fit_double(tab.X[train], tab.Y[train], rel_lengthscale=2.0, max_points=200)
-    env = confidence_map(model, tab, train, EnvelopeConfig(n_grid=16))
-    return tab, train, model, env, load_airframe(AIRFRAME)
+    return double.envelope_setup(AIRFRAME)
 
 
 @pytest.fixture(scope="module")

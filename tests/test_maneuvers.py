@@ -23,12 +23,7 @@ AIRFRAME = Path(__file__).resolve().parents[1] / "data" / "airframes" / "sim-tra
 
 @pytest.fixture(scope="module")
 def setup():
-    tab = double.synthetic_table(n=400, seed=2)
-    train = np.ones(len(tab.t), bool)
-    train[-80:] = False
-    model = double.fit_double(tab.X[train], tab.Y[train], rel_lengthscale=2.0, max_points=200)
-    env = confidence_map(model, tab, train, EnvelopeConfig(n_grid=16))
-    return tab, train, model, env, load_airframe(AIRFRAME)
+    return double.envelope_setup(AIRFRAME)
 
 
 def _region(env, coef, axes, x_sel, y_sel, mean_rel=0.8):
