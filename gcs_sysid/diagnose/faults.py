@@ -40,6 +40,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..airframe import Airframe
+from .saturation import saturation_check
 
 __all__ = ["FaultThresholds", "detect_faults", "frozen_runs"]
 
@@ -70,6 +71,15 @@ class FaultThresholds:
         min_energy_loss_m: and the specific energy (h + V^2 / 2g) must fall by at least this much during the run.
         secondary_after_s: a channel that goes flat more than this long after an earlier fault is reported
             with that fault (``evidence.after_it``), not as a finding of its own.
+        sat_stop_tol_us: a frozen output within this of an end stop (PWM range or deflection limit) is at its stop.
+        sat_fit_s: window before the run, s, on which the demand model of the channel is fitted.
+        sat_min_beyond: share of the run with the attitude error pushing the output into the stop, for saturation.
+        sat_min_r2: a demand model explaining at least this share of the PWM variance before the run vetoes
+            saturation when it puts the demand inside the throw for more than ``1 - sat_min_beyond`` of the run.
+        sat_min_t: |t| the error term of the demand model needs before the error's sign is trusted.
+        sat_min_toward: share of the run with the attitude moving towards the demand, for saturation.
+            (The ``sat_*`` thresholds were set on the project's simulation, after the ALFA evaluation of the
+            others; :mod:`gcs_sysid.diagnose.saturation`.)
     """
 
     pwm_tol_us: float = 0.5
@@ -89,6 +99,12 @@ class FaultThresholds:
     max_drop_s: float = 1.5
     min_energy_loss_m: float = 5.0
     secondary_after_s: float = 1.0
+    sat_stop_tol_us: float = 3.0
+    sat_fit_s: float = 30.0
+    sat_min_r2: float = 0.8
+    sat_min_beyond: float = 0.8
+    sat_min_t: float = 3.0
+    sat_min_toward: float = 0.6
 
 
 def frozen_runs(t: np.ndarray, pwm: np.ndarray, tol: float, min_s: float, min_n: int) -> list[tuple[int, int]]:
@@ -201,8 +217,11 @@ def _surface_candidates(flight, airframe: Airframe, th: FaultThresholds, checked
                 ev["rate_std_before_dps"] = float(np.degrees(_std(_window(tr, rr[rate_key], t0 - th.before_s, t0))))
                 if ev["rate_std_during_dps"] >= th.min_rate_std_dps:
                     reasons.append(f"{rate_key} keeps moving (std {ev['rate_std_during_dps']:.1f} deg/s)")
+            err = None
             if nav is not None and att is not None and f"{att_key}_demand" in nav.fields:
-                e = np.asarray(nav[f"{att_key}_demand"], float) - _on(att, att_key, nav.t)
+                att_n = _on(att, att_key, nav.t)
+                e = np.asarray(nav[f"{att_key}_demand"], float) - att_n
+                err = (np.asarray(nav.t, float), e, att_n)
                 ev["attitude_error_std_deg"] = float(np.degrees(_std(_window(nav.t, e, t0, t1))))
                 if ev["attitude_error_std_deg"] >= th.min_error_std_deg:
                     reasons.append(f"the autopilot's {att_key} error keeps moving "
@@ -218,6 +237,14 @@ def _surface_candidates(flight, airframe: Airframe, th: FaultThresholds, checked
                 if np.isfinite(c) and abs(c) >= th.min_twin_corr and sd >= th.min_twin_std_us:
                     reasons.append(f"twin channel {o.channel} ({o.name}) moved with it before (corr {c:+.2f}) "
                                    f"and keeps moving (std {sd:.0f} us)")
+            twin_moving = any("twin channel" in r for r in reasons)
+            stop = saturation_check(t, pwm, i0, i1, s, err, (tr, rr[rate_key]) if rates is not None else None, th) \
+                if reasons else None
+            if stop is not None:
+                ev["end_stop"] = stop
+            if stop is not None and stop["saturated"] and not twin_moving:
+                checked.append({**ev, "control": u, "accepted": False, "saturation": True, "why": stop["why"]})
+                continue                               # a later run of this channel may still be a failure
             ok = bool(reasons)
             checked.append({**ev, "control": u, "accepted": ok,
                             "why": "; ".join(reasons) if ok else "the demand on the axis did not move either"})

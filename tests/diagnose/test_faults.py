@@ -340,3 +340,62 @@ def test_surface_off_its_servo_is_not_set_aside(tmp_path):
     f = d.findings[0]
     if f.get("kind") == "fault":                                  # folded: the coefficient-level fit is kept
         assert f["evidence"]["coefficient_level"]["gain"]["percent"] >= 50.0
+
+
+# --------------------------------------------------------------------------- saturation against a failure
+
+
+def _narrow_aileron_airframe(path, throw_deg: float = 0.6):
+    """The sim trainer with an aileron that has only +-``throw_deg`` of travel (its end stops, as limit_deg)."""
+    txt = AIRFRAME.read_text()
+    assert "mix = { delta_a = 1.0 }" in txt and "delta_a = 15.0," in txt
+    txt = txt.replace("delta_a = 15.0,", f"delta_a = {throw_deg},").replace(
+        "mix = { delta_a = 1.0 }", f"limit_deg = [{-throw_deg}, {throw_deg}]\nmix = {{ delta_a = 1.0 }}", 1)
+    path.write_text(txt)
+    return load_airframe(path)
+
+
+@pytest.fixture(scope="module")
+def saturated_log(tmp_path_factory):
+    """A 150-degree turn with +-0.6 deg of aileron: the roll loop rides its end stops while rolling in and out."""
+    from gcs_sysid.sim import load_model, plan_from_dict, simulate, write_tlog
+
+    d = tmp_path_factory.mktemp("saturation")
+    af = _narrow_aileron_airframe(d / "narrow.toml")
+    doc = plan_doc(duration=96.0, seed=11)
+    doc["maneuver"] = [m for m in doc["maneuver"] if "delta_a" not in m.get("controls", [m.get("control")])]
+    doc["setpoint"] = [{"start_s": 60.0, "airspeed_mps": 17.0, "heading_deg": 150.0}]
+    r = simulate(af, load_model(MODEL), plan_from_dict(doc))
+    write_tlog(r, d / "saturated.tlog", af)
+    return d / "saturated.tlog", r, af
+
+
+def test_saturated_surface_is_not_a_fault(saturated_log):
+    """Output flat at its end stop because the roll loop asks for more: no finding; the runs say saturation."""
+    path, r, af = saturated_log
+    stop = np.radians(0.6)
+    at_stop = np.abs(np.abs(r.commands["delta_a"]) - stop) < 1e-9
+    assert at_stop.mean() > 0.1 and r.effects.causes() == []               # it rides the stops, nothing failed
+    flight = read_log(path)
+    faults, summary = detect_faults(flight, af)
+    assert faults == [], [(f["cause"], f["summary"]) for f in faults]
+    sat = [c for c in summary["checked"] if c.get("saturation")]
+    assert sat and all(c["control"] == "delta_a" and c["channel"] == 1 for c in sat)
+    assert all(c["end_stop"]["saturated"] and c["end_stop"]["push_share"] >= 0.8 for c in sat)
+    assert {c["end_stop"]["side"] for c in sat} == {-1, 1}                  # rolling in and rolling out
+    # the same runs without the saturation rule are what the detector called stuck before: the test can fail
+    no_rule = replace(FaultThresholds(), sat_min_beyond=1.01)
+    assert [f["cause"] for f in detect_faults(flight, af, no_rule)[0]] == ["stuck:delta_a"]
+
+
+def test_surface_stuck_at_full_throw_is_a_fault(sim_logs):
+    """Aileron output frozen at its end stop (1900 us) while the roll demand moves within the throw: stuck."""
+    path, r = sim_logs("delta_a", 70.0, -np.radians(20.0))
+    af = load_airframe(AIRFRAME)
+    faults, summary = detect_faults(read_log(path), af)
+    assert [f["cause"] for f in faults] == ["stuck:delta_a"], summary["checked"]
+    f = faults[0]
+    assert f["onset_s"] == pytest.approx(70.0, abs=0.1) and f["evidence"]["channels"] == [1]
+    stop = f["evidence"]["servos"][0]["end_stop"]
+    assert stop["at_stop_us"] == 1900.0 and not stop["saturated"]
+    assert stop["push_share"] < 0.8 or stop["toward_share"] < 0.6
