@@ -27,6 +27,7 @@ from .evidence import maneuver_for, unexplained_report
 from .fault_merge import merge_faults, set_aside_answering
 from .faults import FaultThresholds, detect_faults
 from .regression import ols
+from .residual_gp import residual_structure
 from .turbulence import gust_projector
 from .terms import term_matrix
 
@@ -263,6 +264,13 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                  else -d["gain"].get("percent", 0.0)))
     P = proj if proj is not None else (lambda D: D)
     unexplained = unexplained_report(ctx, P(R), threshold_pct=unexplained_threshold_pct)
+    say("diagnose: residual GP (where structure remains)")
+    t_gp = time.perf_counter()
+    residual_gp = residual_structure(ctx, P(R), threshold_pct=unexplained_threshold_pct)
+    for u in unexplained:
+        if u["coefficient"] in residual_gp:
+            u["gp"] = residual_gp[u["coefficient"]]
+    gp_s = time.perf_counter() - t_gp
     separation = []
     for fd in findings:
         if not fd["evidence"]["separable"]:
@@ -273,7 +281,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         if np.std(ctx.x(u)[ctx.valid]) < np.radians(0.5):
             separation.append(f"{u} barely moves (std below 0.5 deg): causes that act through it (its derivatives, "
                               f"delay:{u}, stuck:{u}) cannot be seen; fly: {maneuver_for('delay:' + u)}")
-    if not findings and any(u["above_threshold"] for u in unexplained):
+    if not findings and any(u["above_threshold"] or u.get("gp", {}).get("structured") for u in unexplained):
         separation.append("the residual is structured but no single catalogue cause explains it on held-out "
                           "data; see 'unexplained' for where it lives")
     data = {
@@ -290,7 +298,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                        "unexplained_threshold_pct": unexplained_threshold_pct},
         "separation": separation,
         "notes": list(ctx.notes) + list(getattr(table, "notes", [])),
-        "timings": {"diagnose_s": float(time.perf_counter() - t0)},
+        "timings": {"diagnose_s": float(time.perf_counter() - t0), "residual_gp_s": float(gp_s)},
     }
     if fault_summary is not None:
         data["faults"] = fault_summary
