@@ -61,10 +61,14 @@ class Diagnosis:
     test: np.ndarray = field(repr=False)
     fitted: list[Fitted] = field(default_factory=list, repr=False)
     output_error: dict | None = None
+    model_inadequacy: list[dict] | None = None
 
     def to_json(self) -> dict:
         """The ``diagnosis.json`` document (schema in docs/diagnose.md)."""
-        return {"findings": self.findings, "unexplained": self.unexplained, "data": self.data}
+        doc = {"findings": self.findings, "unexplained": self.unexplained, "data": self.data}
+        if self.model_inadequacy is not None:                 # only with reference flights
+            doc["model_inadequacy"] = self.model_inadequacy
+        return doc
 
 
 def _eq_error(R0, R1, test) -> dict:
@@ -139,7 +143,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
              min_rows: int = 500, unexplained_threshold_pct: float = 20.0, output_error: bool = True,
              min_gain_oe_pct: float = 45.0, project_gusts: bool = True, flight=None,
              fault_thresholds: FaultThresholds | None = None, search: bool = False,
-             progress=None) -> Diagnosis:
+             references=None, progress=None) -> Diagnosis:
     """Hold a model against measured coefficients, name the cause(s), extend the model.
 
     Args:
@@ -170,6 +174,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         search: also search a wide candidate library for what each coefficient's residual still needs
             (:mod:`gcs_sysid.diagnose.search`: forward stepwise by block PRESS on the training rows, gain
             measured once on the held-out rows); reported in ``data["search"]``, never as a named cause.
+        references: reference flights (:class:`~gcs_sysid.diagnose.differential.Reference`; the flight(s)
+            the model was fitted on): differential diagnosis (:mod:`gcs_sysid.diagnose.differential`):
+            findings also present there move to ``model_inadequacy``, the rest are changes (with onset
+            where the data show one); ``data["differential"]`` holds the comparison.
         progress: optional callable ``progress(message)``.
 
     Returns:
@@ -323,6 +331,15 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         diag.output_error = output_error_gain(diag, oe_states, airframe)
         data["output_error"] = {k: v for k, v in diag.output_error.items() if k != "windows_plot"}
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
+    if references:
+        from .differential import differential
+
+        say("diagnose: differential against the reference flight(s)")
+        t1 = time.perf_counter()
+        data["differential"] = differential(diag, list(references), airframe,
+                                            threshold_pct=unexplained_threshold_pct)
+        diag.model_inadequacy = data["differential"]["model_inadequacy"]
+        data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)
     return diag
 

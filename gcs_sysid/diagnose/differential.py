@@ -1,0 +1,321 @@
+"""Differential diagnosis: what the model never captured against what changed since the reference flight.
+
+A model fitted on a reference flight and held against a new flight leaves two kinds of residual:
+
+- **model inadequacy**: structure the model never had; it is in the reference flight's residual
+  too (a term outside the fit's vocabulary, a tabulated stall break, a sensor calibration that was
+  already wrong). It is not news about the aircraft; it is the extension the model needs.
+- **a change**: something that is in the new flight and not in the reference (damage, icing, a
+  CG shift, a sensor that drifted, a surface that failed), often with an onset inside the flight.
+
+:func:`differential` takes the diagnosis of the new flight (:func:`gcs_sysid.diagnose.core.diagnose`)
+and the reference flight(s), each turned into the same coefficient table and residual against the
+*same* model. Every finding of the new flight is re-estimated on each reference with the same
+correction (an aero term by least squares on the reference residual, coloured-residual standard
+errors, Morelli and Klein sec. 5.3; any other cause by its own fit in
+:mod:`gcs_sysid.diagnose.candidates`) and compared, in units of its correction from the model's
+(or airframe's) value:
+
+- present in every reference with a consistent size (significant there, ``|t| >= 3``, and
+  ``|c_flight - c_ref| <= 3 sqrt(se_f^2 + se_r^2) + 0.25 |c_flight|``): **model inadequacy**;
+  reported with where in the envelope it acts (the regressors of the term, the 10-90 % range of the
+  rows where its contribution is at least half its largest), how large (RMS of the contribution,
+  percent of the measured coefficient), and the extension (the term and the value that fixes it,
+  the inverse-variance mean of flight and references);
+- otherwise **changed**: it stays a named finding, with ``evidence.differential`` giving the
+  reference value and the change, and an onset where it has one. Telemetry faults and coefficient-
+  level stuck surfaces carry their own onset; for the others the onset is found by a change-point
+  in the cause's amplitude over 4-s blocks (each block's least-squares amplitude of the finding's
+  own correction; a step from about 0 to the full amplitude, accepted when it lowers the weighted
+  squared error by at least ``min_step_chi2`` against "present from the start").
+
+Structure the residual GP (:mod:`gcs_sysid.diagnose.residual_gp`) finds in the new flight is
+compared the same way: structured in the same coefficient in a reference too means model
+inadequacy outside the library (with its region), structured only in the new flight means an
+unexplained change. Neither ever gets a cause name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..aero.table import COEFFICIENTS, REGRESSORS
+from .context import DiagContext
+from .regression import ols
+from .residual_gp import residual_structure
+from .terms import term_factors, term_matrix
+
+__all__ = ["Reference", "differential", "onset_of_change"]
+
+
+@dataclass
+class Reference:
+    """A reference flight (the one the model was fitted on, or another flight of the same aircraft).
+
+    Attributes:
+        table: its :class:`~gcs_sysid.aero.table.CoefficientTable`.
+        states: its FlightStates (needed for the causes that use states: inertia, CG, wind); optional.
+        flight: its decoded Flight (for sensor causes judged by data compatibility); optional.
+        label: how it is named in the report (the log's file name).
+    """
+
+    table: object
+    states: object = None
+    flight: object = None
+    label: str = "reference"
+    extra: dict = field(default_factory=dict)
+
+
+def _null_value(cause: str, airframe) -> float:
+    """The value of a cause's headline estimate that means "nothing there"."""
+    if cause == "mass":
+        return float(airframe.mass)
+    if cause.startswith("inertia:"):
+        return float(getattr(airframe, cause[8:]))
+    if cause.startswith("scale:"):
+        return 1.0
+    return 0.0
+
+
+def _refit_aero(ctx: DiagContext, R: np.ndarray, coef: str, term: str) -> tuple[float, float] | None:
+    """Correction (and std error) of ``coef:term`` fitted on a residual; None when the term is not excited."""
+    j = COEFFICIENTS.index(coef)
+    if not ctx.active[j]:
+        return None
+    m = ctx.valid & np.isfinite(R[:, j])
+    phi = term_matrix(ctx.X, [term])[:, 0]
+    if m.sum() < 50 or np.std(phi[m]) == 0 and term != "1":
+        return None
+    res = ols(phi[m, None], R[m, j], terms=[term])
+    return float(res.theta[0]), float(res.std_error[0])
+
+
+def _refit_other(ctx: DiagContext, R: np.ndarray, finding: dict, ref: Reference, airframe) -> tuple | None:
+    """Headline estimate (and std error) of a non-aero cause on the reference, by its own fit."""
+    from .candidates import Scorer, fit_delays, fit_sensor_causes
+
+    cause = finding["cause"]
+    if finding.get("evidence", {}).get("domain") == "data compatibility":
+        if ref.flight is None or ref.states is None:
+            return None
+        from .core import _compat_findings
+
+        cands = _compat_findings(ctx, ref.flight, ref.states, airframe, 0.0, 0.0)
+        hit = [c for c in cands if c["cause"] == cause]
+        return (float(hit[0]["estimate"]), float(hit[0]["std_error"])) if hit else None
+    scorer = Scorer(ctx, R, None)
+    cands = fit_delays(ctx, R, scorer) if cause.startswith("delay:") else fit_sensor_causes(ctx, R, scorer)
+    hit = [c for c in cands if c.cause == cause]
+    if not hit or not np.isfinite(hit[0].std_error):
+        return None
+    return float(hit[0].estimate), float(hit[0].std_error)
+
+
+def onset_of_change(t: np.ndarray, R_without: np.ndarray, delta: np.ndarray, valid: np.ndarray,
+                    block_s: float = 4.0, min_step_chi2: float = 25.0, max_before: float = 0.3) -> dict:
+    """When a correction starts to be needed: a step change-point in its amplitude over time blocks.
+
+    In each block the amplitude ``a`` of the correction is fitted by least squares,
+    ``R_without ~ -a delta`` (1 where the cause acts at full size, 0 where it is absent), with
+    variance ``s^2 / sum(delta^2)`` from the block's scatter. A step ``a = 0`` before block ``k``
+    and ``a = mean`` after is compared with "the same amplitude throughout" by the weighted squared
+    error; the best ``k`` is the onset when it lowers that error by at least ``min_step_chi2`` and the
+    amplitude before it is below ``max_before`` (a cause that is there from the start has no onset).
+
+    Args:
+        t: (T,) vehicle time, s. R_without: (T, 6) residual without this correction (weighted per
+            coefficient by the caller). delta: (T, 6) the correction at full size. valid: (T,) rows.
+        block_s: block length, s. min_step_chi2: required improvement. max_before: largest amplitude before.
+
+    Returns:
+        ``{"onset_s": float | None, "chi2_gain": float, "amplitude_before": float, "amplitude_after": float,
+        "blocks": [[t0, a, se], ...]}``.
+    """
+    b = np.floor((t - t[0]) / block_s).astype(int)
+    rows = []
+    for k in np.unique(b[valid]):
+        m = valid & (b == k)
+        d = delta[m].ravel()
+        r = R_without[m].ravel()
+        dd = float(d @ d)
+        if m.sum() < 20 or dd <= 0:
+            continue
+        a = -float(r @ d) / dd
+        s2 = float(np.mean((r + a * d) ** 2))
+        rows.append((float(t[m][0]), a, np.sqrt(s2 / dd)))
+    out = {"onset_s": None, "chi2_gain": 0.0, "amplitude_before": None, "amplitude_after": None,
+           "blocks": [list(r) for r in rows]}
+    if len(rows) < 4:
+        return out
+    tb, a, se = (np.array(x) for x in zip(*rows))
+    w = 1.0 / np.maximum(se, 1e-12) ** 2
+    mean_all = float(np.sum(w * a) / np.sum(w))
+    e_all = float(np.sum(w * (a - mean_all) ** 2))
+    best = (0.0, None, None, None)
+    for k in range(2, len(a) - 1):
+        after = float(np.sum(w[k:] * a[k:]) / np.sum(w[k:]))
+        e = float(np.sum(w[:k] * a[:k] ** 2) + np.sum(w[k:] * (a[k:] - after) ** 2))
+        before = float(np.sum(w[:k] * a[:k]) / np.sum(w[:k]))
+        if e_all - e > best[0] and abs(before) < max_before and after > 0.5:
+            best = (e_all - e, k, before, after)
+    gain, k, before, after = best
+    out["chi2_gain"] = float(gain)
+    if k is not None and gain >= min_step_chi2:
+        out.update({"onset_s": float(tb[k]), "amplitude_before": before, "amplitude_after": after})
+    return out
+
+
+def _where(ctx_X: np.ndarray, valid: np.ndarray, term: str, contribution: np.ndarray) -> dict:
+    """Region of the envelope where an aero term's contribution is at least half its largest (10-90 %)."""
+    m = valid & np.isfinite(contribution)
+    c = np.abs(contribution[m])
+    if not c.size or c.max() <= 0:
+        return {}
+    sel = c >= 0.5 * np.percentile(c, 99)
+    out = {}
+    for i in dict.fromkeys(term_factors(term)) if term != "1" else []:
+        x = ctx_X[m, i][sel]
+        name = REGRESSORS[i]
+        if name in ("alpha", "beta"):
+            x, name = np.degrees(x), name + "_deg"
+        out[name] = [float(np.percentile(x, 10)), float(np.percentile(x, 90))]
+    return out
+
+
+def _residual_of(ctx: DiagContext) -> np.ndarray:
+    return np.where(ctx.valid[:, None], ctx.Y - ctx.model_values(), np.nan)
+
+
+def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
+                 consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0) -> dict:
+    """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
+
+    Args:
+        diag: the new flight's :class:`~gcs_sysid.diagnose.core.Diagnosis` (its ``findings`` are
+            rewritten: inadequacies are moved out, changes get ``evidence.differential``).
+        references: one or more :class:`Reference` flights of the same aircraft, held against the
+            same model (``diag.model``).
+        airframe: the airframe.
+        threshold_pct: structured share for the residual GP on the references.
+        consistent_rel, min_t: the "same in the reference" test (see the module docstring).
+        min_step_chi2: onset change-point acceptance.
+
+    Returns:
+        The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
+        (list), ``changed`` (list of cause names with their reference comparison), ``not_compared``,
+        ``unexplained`` (per coefficient: ``"in the reference too"`` or ``"only in this flight"``).
+
+    Raises:
+        DataError: a reference with too few valid rows (from the table checks).
+    """
+    refs = []
+    for ref in references:
+        ctx = DiagContext.build(ref.table, airframe, diag.model, ref.states, None, None)
+        refs.append((ref, ctx, _residual_of(ctx)))
+    doc: dict = {"references": [{"label": r.label, "n_valid": int(c.valid.sum()),
+                                 "t_range_s": [float(c.t[c.valid][0]), float(c.t[c.valid][-1])]}
+                                for r, c, _ in refs],
+                 "model_inadequacy": [], "changed": [], "not_compared": [], "unexplained": {}}
+    fitted = {f.cause: f for f in diag.fitted}
+    valid = np.isfinite(diag.residual_after).all(axis=1)
+    sig = np.nanstd(np.where(valid[:, None], diag.residual_after, np.nan), axis=0)
+    sig = np.where(sig > 0, sig, 1.0)
+    keep = []
+    for f in diag.findings:
+        cause = f["cause"]
+        if f.get("kind") == "fault" or cause.startswith("stuck:") or cause == "wind":
+            why = "an event in this flight (telemetry fault or stuck surface)" if cause != "wind" \
+                else "the air of this flight (wind is a flight condition)"
+            f["evidence"]["differential"] = {"verdict": "changed", "why": why}
+            doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"), "why": why})
+            keep.append(f)
+            continue
+        is_aero = cause.split(":")[0] in COEFFICIENTS
+        null = 0.0 if is_aero else _null_value(cause, airframe)
+        c_f = (f["evidence"].get("correction", f["estimate"] - null) if is_aero else f["estimate"] - null)
+        se_f = float(f["std_error"])
+        comps = []
+        for ref, ctx, R in refs:
+            if is_aero:
+                coef, term = cause.split(":", 1)
+                got = _refit_aero(ctx, R, coef, term)
+            else:
+                got = _refit_other(ctx, R, f, ref, airframe)
+                got = (got[0] - null, got[1]) if got is not None else None
+            if got is None:
+                comps.append({"label": ref.label, "compared": False})
+                continue
+            c_r, se_r = got
+            same = abs(c_r) >= min_t * se_r and np.sign(c_r) == np.sign(c_f) and \
+                abs(c_f - c_r) <= 3.0 * np.hypot(se_f, se_r) + consistent_rel * abs(c_f)
+            comps.append({"label": ref.label, "compared": True, "correction": c_r, "std_error": se_r,
+                          "same": bool(same)})
+        compared = [c for c in comps if c["compared"]]
+        if not compared:
+            f["evidence"]["differential"] = {"verdict": "not compared", "references": comps}
+            doc["not_compared"].append(cause)
+            keep.append(f)
+            continue
+        if all(c["same"] for c in compared):
+            w = np.array([1 / se_f**2] + [1 / c["std_error"] ** 2 for c in compared])
+            v = np.array([c_f] + [c["correction"] for c in compared])
+            pooled = float(np.sum(w * v) / np.sum(w))
+            item = {"cause": cause, "coefficient": f["coefficient"], "in_flight": {"correction": c_f, "std_error": se_f},
+                    "in_references": compared, "gain": f.get("gain", {}),
+                    "extension": {"cause": cause, "correction": pooled, "std_error": float(1 / np.sqrt(np.sum(w))),
+                                  "value": (f["evidence"].get("model_value", 0.0) + pooled) if is_aero
+                                  else null + pooled}}
+            if is_aero:
+                coef, term = cause.split(":", 1)
+                j = COEFFICIENTS.index(coef)
+                contrib = pooled * term_matrix(diag.X, [term])[:, 0]
+                rms_c = float(np.sqrt(np.nanmean(contrib[valid] ** 2)))
+                rms_y = float(np.sqrt(np.nanmean(diag.residual_before[valid, j] ** 2))) if valid.any() else 0.0
+                item.update({"where": _where(diag.X, valid, term, contrib), "rms_contribution": rms_c,
+                             "rms_residual_before": rms_y,
+                             "summary": f"{coef} needs {term} ({pooled:+.4g}) in this flight and in "
+                                        f"{len(compared)} reference flight(s): the model never had it"})
+            else:
+                item["summary"] = (f"{cause} ({f['estimate']:.4g}) is in the reference flight(s) too: present when "
+                                   "the model was fitted, not a change")
+            doc["model_inadequacy"].append(item)
+            continue
+        # changed: keep the finding, with the comparison and an onset where the data show one
+        info = {"verdict": "changed", "references": comps}
+        if f.get("onset_s") is None and cause in fitted:
+            fd = fitted[cause].delta
+            R_wo = (diag.residual_after - fd) / sig
+            on = onset_of_change(diag.t, np.nan_to_num(R_wo), np.nan_to_num(fd / sig), valid,
+                                 min_step_chi2=min_step_chi2)
+            info["onset_search"] = {k: v for k, v in on.items() if k != "blocks"}
+            if on["onset_s"] is not None:
+                f["onset_s"] = on["onset_s"]
+                if is_aero:                            # its size once it is there
+                    coef, term = cause.split(":", 1)
+                    j = COEFFICIENTS.index(coef)
+                    m = valid & (diag.t >= on["onset_s"])
+                    phi = term_matrix(diag.X, [term])[:, 0]
+                    res = ols(phi[m, None], (diag.residual_after - fd)[m, j], terms=[term])
+                    info["after_onset"] = {"estimate": float(f["evidence"].get("model_value", 0.0) + res.theta[0]),
+                                           "std_error": float(res.std_error[0])}
+        f["evidence"]["differential"] = info
+        doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"),
+                               "reference_corrections": [c.get("correction") for c in compared]})
+        keep.append(f)
+    diag.findings[:] = keep
+    # structure no term explains: in the references too, or only here
+    ref_gp = [residual_structure(ctx, np.nan_to_num(R), threshold_pct=threshold_pct) for _, ctx, R in refs]
+    for u in diag.unexplained:
+        g = u.get("gp")
+        if not g or not g.get("structured"):
+            continue
+        coef = u["coefficient"]
+        also = [r.label for (r, _, _), rg in zip(refs, ref_gp) if rg.get(coef, {}).get("structured")]
+        verdict = "in the reference too: model inadequacy outside the library" if also \
+            else "only in this flight: an unexplained change"
+        u["differential"] = verdict
+        doc["unexplained"][coef] = {"verdict": verdict, "references_with_it": also, "region": g["region"],
+                                    "structured_percent": g["structured_percent"], "rms_gp_mean": g["rms_gp_mean"]}
+    return doc
