@@ -93,6 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--model", required=True, help="the simulation's aerodynamic model TOML file")
     d.add_argument("--out", required=True, help="output directory")
     d.add_argument("--search", action="store_true", help="also search a wide term library (docs/diagnose.md)")
+    d.add_argument("--reference", action="append", metavar="LOG", help="a reference flight (repeatable; default: "
+                   "the flight(s) the model was fitted on, from <model>.fit.json): differential diagnosis")
+    d.add_argument("--no-reference", action="store_true", help="no differential diagnosis")
     _window_args(d)
 
     pr = sub.add_parser("predict", help="evaluate a saved model at given flight conditions (CSV in, CSV out)")
@@ -213,6 +216,11 @@ def _check_diagnose(a: argparse.Namespace) -> None:
     _check_window(a)
     load_airframe(a.airframe)
     load_model(a.model)
+    from .errors import InputError
+
+    for r in a.reference or []:
+        if not Path(r).is_file():
+            raise InputError(f"--reference {r}: no such log file")
     check_out_dir(a.out, "--out", DIAGNOSE_OUTPUTS)
 
 
@@ -220,7 +228,7 @@ def _cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnose import run_diagnose
 
     diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to, search=a.search,
-                        notify=_say)
+                        notify=_say, references=[] if a.no_reference else a.reference)
     findings = diag.get("findings", []) if isinstance(diag, dict) else getattr(diag, "findings", [])
     print(f"wrote {Path(a.out) / 'diagnosis.json'}: {len(findings)} finding(s)")
     return 0

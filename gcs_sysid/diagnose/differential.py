@@ -47,7 +47,7 @@ from .regression import ols
 from .residual_gp import residual_structure
 from .terms import term_factors, term_matrix
 
-__all__ = ["Reference", "differential", "onset_of_change"]
+__all__ = ["Reference", "differential", "onset_of_change", "fit_record", "reference_logs"]
 
 
 @dataclass
@@ -319,3 +319,58 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         doc["unexplained"][coef] = {"verdict": verdict, "references_with_it": also, "region": g["region"],
                                     "structured_percent": g["structured_percent"], "rms_gp_mean": g["rms_gp_mean"]}
     return doc
+
+
+def fit_record(log, t_from: float | None, t_to: float | None) -> dict:
+    """What ``gcs-sysid fit`` records about the flight a model was fitted on (``<model>.fit.json``).
+
+    Enough to find the flight again and re-derive its residual against the model: the log's absolute
+    path, its SHA-256 and the vehicle-time window.
+    """
+    import hashlib
+    from pathlib import Path
+
+    p = Path(str(log)).resolve()
+    h = hashlib.sha256()
+    with open(p, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return {"log": str(p), "sha256": h.hexdigest(), "window_s": [t_from, t_to]}
+
+
+def reference_logs(model_path, given=None) -> tuple[list[dict], list[str]]:
+    """The reference flights of a diagnosis: those given, else those the model's fit recorded.
+
+    Args:
+        model_path: the model file; its ``<model>.fit.json`` (written by ``gcs-sysid fit``) is read for
+            ``reference_flights`` when ``given`` is None.
+        given: log paths (``--reference``, whole logs), or None (use the record), or ``[]`` (none).
+
+    Returns:
+        (list of ``{"log", "window_s"}``, notes): a recorded flight whose file is missing or changed
+        (SHA-256) is left out with a note saying so and how to pass it.
+    """
+    import json
+    from pathlib import Path
+
+    if given is not None:
+        return [{"log": str(g), "window_s": [None, None]} for g in given], []
+    rec = Path(str(model_path)).with_suffix(".fit.json")
+    if not rec.is_file():
+        return [], []
+    try:
+        flights = json.loads(rec.read_text()).get("reference_flights", [])
+    except (ValueError, OSError, AttributeError):
+        return [], [f"{rec}: unreadable; no reference flight used (pass --reference LOG)"]
+    out, notes = [], []
+    for f in flights:
+        p = Path(f.get("log", ""))
+        if not p.is_file():
+            notes.append(f"reference flight {p} (recorded in {rec.name}) not found: no differential diagnosis "
+                         "against it; pass --reference LOG")
+            continue
+        if f.get("sha256") and fit_record(p, None, None)["sha256"] != f["sha256"]:
+            notes.append(f"reference flight {p} changed since the fit (SHA-256 differs): not used")
+            continue
+        out.append({"log": str(p), "window_s": list(f.get("window_s") or [None, None])})
+    return out, notes

@@ -107,6 +107,10 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
         model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
         save_model(model, stage.path(out), header=report.header())
         doc = report.to_json()
+        if isinstance(doc, dict):                 # which flight: diagnose finds it again (differential diagnosis)
+            from .differential import fit_record
+
+            doc["reference_flights"] = [fit_record(log, t_from, t_to)]
         if meas.flight.damage and isinstance(doc, dict):
             doc["log_damage"] = list(meas.flight.damage)
         stage.path(out.with_suffix(".fit.json")).write_text(json.dumps(doc, indent=1, default=float))
@@ -114,7 +118,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
 
 
 def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None = None,
-                 t_to: float | None = None, progress=None, output_error: bool = True, notify=None, **kw):
+                 t_to: float | None = None, progress=None, output_error: bool = True, notify=None,
+                 references=None, **kw):
     """``gcs-sysid diagnose``: hold the model against the log; write diagnosis.json, model_extended.toml, report.html.
 
     Args:
@@ -122,6 +127,8 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
         t_from, t_to: vehicle-time window, s.
         output_error: also run the output-error comparison (needs ``gcs_sysid.sim.propagate``).
         notify: called with one line per damage found in the log (None: not shown).
+        references: reference flight logs for the differential diagnosis (``--reference``); None: the
+            flight(s) recorded in ``<model>.fit.json`` by ``gcs-sysid fit``, when found; ``[]``: none.
         **kw: passed to :func:`gcs_sysid.diagnose.core.diagnose`.
 
     Returns:
@@ -134,9 +141,22 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     model = load_model(model_path)
     with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
+        kw = {**kw, **_references(model_path, airframe_path, references, progress)}
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag
+
+
+def _references(model_path, airframe_path, given, progress) -> dict:
+    """``diagnose`` keyword arguments for the reference flights (loaded through the same front end)."""
+    from .differential import Reference, reference_logs
+
+    logs, notes = reference_logs(model_path, given)
+    refs = []
+    for r in logs:
+        m = load_measurements(r["log"], airframe_path, *r["window_s"], progress)
+        refs.append(Reference(m.table, m.states, m.flight, label=Path(r["log"]).name))
+    return {"references": refs, "reference_notes": notes} if (refs or notes) else {}
 
 
 def _diagnose_into(out, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to, output_error,
@@ -145,8 +165,11 @@ def _diagnose_into(out, diagnose, meas, model, log, airframe_path, model_path, t
     from ..sim.model_file import AeroModel, save_model
     from .report import write_report
 
+    notes = kw.pop("reference_notes", [])
     diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=output_error,
                     flight=meas.flight, progress=progress, **kw)
+    if notes:
+        diag.data["reference_notes"] = notes
     diag.data.update({"log": str(log), "airframe": str(airframe_path), "model": str(model_path),
                       "window_s": [t_from, t_to]})
     diag.data["timings"].update(meas.timings)

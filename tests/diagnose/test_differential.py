@@ -79,3 +79,57 @@ def test_onset_search_finds_a_step_and_not_a_constant():
     assert on["onset_s"] == pytest.approx(40.0, abs=4.0) and on["amplitude_after"] == pytest.approx(1.0, abs=0.1)
     always = onset_of_change(t, -delta + rng.normal(0, 0.3, delta.shape), delta, np.ones(t.size, bool))
     assert always["onset_s"] is None
+
+
+def test_reference_flights_recorded_by_fit_are_found_again(tmp_path):
+    """``fit`` records the flight (path, SHA-256, window); ``diagnose`` uses it only while it is the same file."""
+    import json
+
+    from gcs_sysid.diagnose.differential import fit_record, reference_logs
+
+    log = tmp_path / "ref.tlog"
+    log.write_bytes(b"\xfe" * 1000)
+    model = tmp_path / "m.toml"
+    rec = fit_record(log, 10.0, None)
+    assert rec["log"] == str(log.resolve()) and len(rec["sha256"]) == 64 and rec["window_s"] == [10.0, None]
+    assert reference_logs(model) == ([], [])                               # no record: no reference
+    model.with_suffix(".fit.json").write_text(json.dumps({"reference_flights": [rec]}))
+    assert reference_logs(model) == ([{"log": str(log.resolve()), "window_s": [10.0, None]}], [])
+    assert reference_logs(model, ["other.tlog"])[0] == [{"log": "other.tlog", "window_s": [None, None]}]
+    assert reference_logs(model, []) == ([], [])                           # --no-reference
+    log.write_bytes(b"\xfd" * 1000)
+    refs, notes = reference_logs(model)
+    assert refs == [] and "changed since the fit" in notes[0]
+    log.unlink()
+    refs, notes = reference_logs(model)
+    assert refs == [] and "not found" in notes[0] and "--reference" in notes[0]
+
+
+@pytest.mark.slow
+def test_cli_fit_then_diagnose_uses_the_fitted_flight(tmp_path):
+    """simulate two flights -> ``gcs-sysid fit`` on the clean one -> ``gcs-sysid diagnose`` the other: the
+    hidden delay is a change (not in the fitted flight), compared against the flight the fit recorded."""
+    import json
+
+    from diag_flights import effects, plan_doc
+
+    from gcs_sysid.cli import main
+    from gcs_sysid.sim import load_model, plan_from_dict, simulate, write_tlog
+
+    from diag_flights import MODEL
+
+    af = load_airframe(AIRFRAME)
+    truth = load_model(MODEL)
+    for name, seed, eff in (("ref", 7, effects(None, None)), ("flight", 8, effects("delay:delta_e", 0.08))):
+        r = simulate(af, truth, plan_from_dict(plan_doc(duration=90.0, seed=seed)), effects=eff)
+        write_tlog(r, tmp_path / f"{name}.tlog", af)
+    assert main(["fit", str(tmp_path / "ref.tlog"), "--airframe", str(AIRFRAME), "--out",
+                 str(tmp_path / "m.toml"), "--from", "30"]) == 0
+    assert main(["diagnose", str(tmp_path / "flight.tlog"), "--airframe", str(AIRFRAME), "--model",
+                 str(tmp_path / "m.toml"), "--out", str(tmp_path / "d"), "--from", "30"]) == 0
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    diff = doc["data"]["differential"]
+    assert diff["references"][0]["label"] == "ref.tlog"
+    assert "model_inadequacy" in doc
+    top = doc["findings"][0]
+    assert top["cause"] == "delay:delta_e" and top["evidence"]["differential"]["verdict"] == "changed"
