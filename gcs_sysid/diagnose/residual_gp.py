@@ -174,7 +174,7 @@ def residual_structure(ctx, R: np.ndarray, threshold_pct: float = 20.0, min_size
         if not ctx.active[j]:
             continue
         r = np.nan_to_num(R[:, j])
-        gp = fit_exact_gp(Z[tr_idx], r[tr_idx], restarts=1)
+        gp = fit_exact_gp(Z[tr_idx], r[tr_idx], restarts=0)
         pred = gp.predict(Z[te_idx])
         e0 = float(np.sum(r[te_idx] ** 2))
         e1 = float(np.sum((r[te_idx] - pred) ** 2))
