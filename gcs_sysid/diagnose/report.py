@@ -149,6 +149,28 @@ def _search_section(search: list[dict]) -> str:
     return "\n".join(out)
 
 
+def _region(r: dict) -> str:
+    return ", ".join(f"{k} {v[0]:.3g}..{v[1]:.3g}" for k, v in (r or {}).items())
+
+
+def _differential_section(diff: dict) -> str:
+    """Model inadequacy (also in the reference flights) against changes (only in this flight)."""
+    out = ["<h2>Against the reference flight(s): model inadequacy or a change</h2>",
+           "<p>References: " + html.escape(", ".join(r["label"] for r in diff["references"])) + "</p>"]
+    if diff["model_inadequacy"]:
+        out.append(_table([[m["cause"], _f(m["extension"]["value"]), _f(m["extension"]["std_error"]),
+                            _region(m.get("where")), _f(m.get("rms_contribution")), html.escape(m["summary"])]
+                           for m in diff["model_inadequacy"]],
+                          ["never captured (in the references too)", "extension: value", "std error", "where",
+                           "RMS of the term", "summary"]))
+    out.append(_table([[c["cause"], _f(c.get("onset_s")) if c.get("onset_s") is not None else "from the start"]
+                       for c in diff["changed"]] or [["nothing", ""]], ["changed since the reference", "onset (s)"]))
+    for coef, u in diff.get("unexplained", {}).items():
+        out.append(f"<p>{coef}: structure no term explains, {html.escape(u['verdict'])} "
+                   f"({u['structured_percent']:.0f} % of the held-out residual; region {_region(u['region'])}).</p>")
+    return "\n".join(out)
+
+
 def render_html(d) -> str:
     """The report as an HTML string (all images inline)."""
     data = d.data
@@ -177,6 +199,8 @@ def render_html(d) -> str:
                      "<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])
                      + "</pre></body></html>")
         return "\n".join(parts)
+    if data.get("differential") is not None:
+        parts.append(_differential_section(data["differential"]))
     if data.get("search") is not None:
         parts.append(_search_section(data["search"]))
     parts.append("<h2>Equation error on held-out data (per coefficient)</h2>")
@@ -187,9 +211,11 @@ def render_html(d) -> str:
     parts.append(_table([[u["coefficient"], _f(u["rms"]), _f(u["percent_of_measured"], "{:.1f} %"),
                           _f(u["structured_percent"], "{:.0f} %"), "YES" if u["above_threshold"] else "no",
                           u["where"].get("correlated_with"), u["where"].get("alpha_deg"), u["where"].get("V_mps"),
-                          u["where"].get("time_s")] for u in d.unexplained],
+                          u["where"].get("time_s"),
+                          (f"{u['gp']['structured_percent']:.0f} %: " + _region(u["gp"]["region"]))
+                          if u.get("gp", {}).get("structured") else "no"] for u in d.unexplained],
                         ["coefficient", "RMS", "of measured", "structured", "above threshold", "most correlated with",
-                         "worst alpha bin (deg)", "worst V bin (m/s)", "worst 5 s"]))
+                         "worst alpha bin (deg)", "worst V bin (m/s)", "worst 5 s", "residual GP: structure, region"]))
     oe = d.output_error or {}
     parts.append("<h2>Output error (simulation driven by the measured controls)</h2>")
     if oe.get("available"):

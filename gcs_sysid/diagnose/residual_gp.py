@@ -158,6 +158,14 @@ def residual_structure(ctx, R: np.ndarray, threshold_pct: float = 20.0, min_size
         coefficients (alpha, beta in degrees, V in m/s, rates normalised); ``{}`` entries are left out
         when there are too few rows.
     """
+    from threadpoolctl import threadpool_limits
+
+    # many small factorisations: BLAS threads cost more than they give (docs/gp.md); restored on return
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _residual_structure(ctx, R, threshold_pct, min_size_pct, n_fit, n_eval, relevant_l)
+
+
+def _residual_structure(ctx, R, threshold_pct, min_size_pct, n_fit, n_eval, relevant_l) -> dict:
     cols = [REGRESSORS.index(n) for n in GP_INPUTS]
     X = np.nan_to_num(ctx.X[:, cols])
     tr_idx = _thin(ctx.train & ctx.valid, n_fit)
