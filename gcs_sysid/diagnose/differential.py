@@ -262,7 +262,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             w = np.array([1 / se_f**2] + [1 / c["std_error"] ** 2 for c in compared])
             v = np.array([c_f] + [c["correction"] for c in compared])
             pooled = float(np.sum(w * v) / np.sum(w))
-            item = {"cause": cause, "coefficient": f["coefficient"], "in_flight": {"correction": c_f, "std_error": se_f},
+            item = {"cause": cause, "coefficient": f["coefficient"],
+                    "in_flight": {"correction": c_f, "std_error": se_f},
                     "in_references": compared, "gain": f.get("gain", {}),
                     "extension": {"cause": cause, "correction": pooled, "std_error": float(1 / np.sqrt(np.sum(w))),
                                   "value": (f["evidence"].get("model_value", 0.0) + pooled) if is_aero
