@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aero.table import COEFFICIENTS, REGRESSORS
+from ..errors import SysidError
 from .context import DiagContext
 from .regression import ols
 from .residual_gp import residual_structure
@@ -242,8 +243,11 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 coef, term = cause.split(":", 1)
                 got = _refit_aero(ctx, R, coef, term)
             else:
-                got = _refit_other(ctx, R, f, ref, airframe)
-                got = (got[0] - null, got[1]) if got is not None else None
+                try:                                   # a fit that fails on the reference compares nothing
+                    got = _refit_other(ctx, ctx.Y - ctx.model_values(), f, ref, airframe)
+                except (KeyError, ValueError, ArithmeticError, np.linalg.LinAlgError, SysidError):
+                    got = None
+                got = (got[0] - null, got[1]) if got is not None and np.all(np.isfinite(got)) else None
             if got is None:
                 comps.append({"label": ref.label, "compared": False})
                 continue
