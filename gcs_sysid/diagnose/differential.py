@@ -85,8 +85,8 @@ def _refit_aero(ctx: DiagContext, R: np.ndarray, coef: str, term: str) -> tuple[
     j = COEFFICIENTS.index(coef)
     if not ctx.active[j]:
         return None
-    m = ctx.valid & np.isfinite(R[:, j])
     phi = term_matrix(ctx.X, [term])[:, 0]
+    m = ctx.valid & np.isfinite(R[:, j]) & np.isfinite(phi)
     if m.sum() < 50 or np.std(phi[m]) == 0 and term != "1":
         return None
     res = ols(phi[m, None], R[m, j], terms=[term])
