@@ -133,3 +133,15 @@ def test_cli_fit_then_diagnose_uses_the_fitted_flight(tmp_path):
     assert "model_inadequacy" in doc
     top = doc["findings"][0]
     assert top["cause"] == "delay:delta_e" and top["evidence"]["differential"]["verdict"] == "changed"
+
+
+def test_missing_reference_log_is_a_one_line_error_before_decoding(tmp_path, capsys):
+    from diag_flights import MODEL, ROOT
+
+    from gcs_sysid.cli import main
+
+    rc = main(["diagnose", str(ROOT / "data" / "flights" / "sim-trainer-sysid.tlog"), "--airframe", str(AIRFRAME), "--model", str(MODEL),
+               "--out", str(tmp_path / "d"), "--reference", str(tmp_path / "nope.tlog")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "--reference" in err[0] and "nope.tlog" in err[0]
+    assert not (tmp_path / "d").exists()
