@@ -45,7 +45,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
+from scipy.signal import butter, lfilter, sosfiltfilt
 
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
@@ -74,6 +74,7 @@ class AxisFit:
         tau_s: gust correlation time, s (maximum likelihood).
         gust_sigma: stationary 1-sigma of the gust angle, rad.
         noise_sigma: 1-sigma of the force-derived angle per sample, rad.
+        ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
     """
 
     name: str
@@ -85,6 +86,7 @@ class AxisFit:
     tau_s: float = float("nan")
     gust_sigma: float = float("nan")
     noise_sigma: float = float("nan")
+    ratio: float = float("nan")
 
 
 @dataclass
@@ -140,17 +142,26 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
     n = sum(s.stop - s.start for s in segs)
     for tau in taus:
         phi = float(np.exp(-dt / tau))
-        F = np.array([[phi]])
         for ratio in ratios:
-            g = steady_state(F, np.array([[ratio * (1.0 - phi * phi)]]), H, R)
+            # scalar steady state in closed form (r = 1): Pp^2 + Pp ((1 - phi^2) - q) - q = 0
+            q = ratio * (1.0 - phi * phi)
+            h = (1.0 - phi * phi) - q
+            Pp = 0.5 * (-h + np.sqrt(h * h + 4.0 * q))
+            S, K = Pp + 1.0, Pp / (Pp + 1.0)
             ssq = 0.0
-            for sg in segs:
-                _, innov = steady_state_smoother(F, g, H, z[sg, None], np.zeros(1), smooth=False)
-                ssq += float((innov**2).sum()) / g.S[0, 0]
-            ll = -0.5 * n * (np.log(max(ssq / n, 1e-300)) + np.log(g.S[0, 0]))
+            for sg in segs:          # x_k = (1 - K) phi x_{k-1} + K z_k from x_{-1} = 0; e_k = z_k - phi x_{k-1}
+                zs = z[sg]
+                x = lfilter([K], [1.0, -(1.0 - K) * phi], zs)
+                e = zs.copy()
+                e[1:] -= phi * x[:-1]
+                ssq += float(np.square(e).sum()) / S     # not e @ e: a BLAS call per candidate
+            ll = -0.5 * n * (np.log(max(ssq / n, 1e-300)) + np.log(S))
             if best is None or ll > best[0]:
-                best = (ll, tau, ratio, F, g, ssq / n)
-    _, tau, ratio, F, g, s2 = best
+                best = (ll, tau, ratio, ssq / n)
+    _, tau, ratio, s2 = best
+    phi = float(np.exp(-dt / tau))
+    F = np.array([[phi]])
+    g = steady_state(F, np.array([[ratio * (1.0 - phi * phi)]]), H, R)
     out = np.full(len(z), np.nan)
     sig = np.full(len(z), np.nan)
     for sg in segs:
@@ -209,10 +220,16 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             slope = sign * np.maximum(sign * slope, 0.5 * abs(a1))    # never flatter than half the mean slope
         z = np.full(len(kin), np.nan)
         z[m] = ang[m] + (coeff[m] - model) / slope - kin[m]     # force-derived angle minus the kinematic one
-        g, gs, tau, s_g, s_v = _gust_smoother(dt, z, segs, TAUS_S, RATIOS)
+        if fit is None:
+            taus, ratios = TAUS_S, RATIOS
+        else:                    # later passes search only next to the first pass's choice
+            it, ir = TAUS_S.index(fit.tau_s), RATIOS.index(fit.ratio)
+            taus, ratios = TAUS_S[max(it - 1, 0):it + 2], RATIOS[max(ir - 1, 0):ir + 2]
+        g, gs, tau, s_g, s_v = _gust_smoother(dt, z, segs, taus, ratios)
         ang = np.where(m, kin + g, kin)
         sig = gs
-        fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v)
+        fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
+            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))])
     return ang, sig, fit
 
 
