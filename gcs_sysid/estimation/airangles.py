@@ -57,7 +57,9 @@ RATIOS = (0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)   #: candidate gust / mea
 MIN_T_STAT = 8.0      #: |CY_beta|, |CZ_alpha| must exceed this many standard errors
 MIN_SEGMENT_S = 5.0   #: shortest contiguous record that is aided, s
 MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
-HIGHPASS_HZ = 0.15    #: the model's slopes are fitted above this frequency, Hz
+HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz
+SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
+SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
 
 
 @dataclass
@@ -75,6 +77,7 @@ class AxisFit:
         gust_sigma: stationary 1-sigma of the gust angle, rad.
         noise_sigma: 1-sigma of the force-derived angle per sample, rad.
         ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
+        mean_shift: constant added to the kinematic angle (beta: its mean error, from CY0 ~ 0), rad.
     """
 
     name: str
@@ -87,6 +90,7 @@ class AxisFit:
     gust_sigma: float = float("nan")
     noise_sigma: float = float("nan")
     ratio: float = float("nan")
+    mean_shift: float = 0.0
 
 
 @dataclass
@@ -172,10 +176,13 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
 
 
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
-          use: np.ndarray, passes: int, sign: float, quadratic: bool) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          use: np.ndarray, passes: int, sign: float, quadratic: bool,
+          symmetric: bool) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
-    curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error)."""
+    curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
+    ``symmetric`` takes the constant as ~0 (CY of a symmetric airframe) so that it measures the mean
+    error of the kinematic angle."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -214,6 +221,15 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         # measurement linearised at the current angle (one Gauss-Newton step per pass: iterated EKF):
         # angle_f = angle + (C_meas - C_model(angle)) / C_model'(angle)
         model = c0 + A[m] @ cr
+        shift = 0.0
+        if symmetric and fit is None:
+            # the constant CY0 = CY_beta * (mean error of the kinematic sideslip) + asymmetry; a symmetric
+            # airframe's own CY0 is ~0 (prior SIGMA_CY0), the kinematic mean sideslip error ~ SIGMA_BETA_MEAN:
+            # the posterior mean of that error moves the whole angle (the Gauss-Markov gust cannot)
+            sb2 = SIGMA_BETA_MEAN**2
+            shift = a1 * sb2 * c0 / (a1 * a1 * sb2 + SIGMA_CY0**2)
+            kin = np.where(m, kin + shift, kin)
+            ang = np.where(m, ang + shift, ang)
         slope = np.full(m.sum(), a1)
         if quadratic:
             slope = slope + 2.0 * c[2] * (ang[m] - ctr)
@@ -229,7 +245,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         ang = np.where(m, kin + g, kin)
         sig = gs
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
-            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))])
+            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], shift if fit is None else fit.mean_shift)
     return ang, sig, fit
 
 
@@ -270,8 +286,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     lon = {"q_hat": q_hat, "delta_e": get("delta_e"), "delta_t": get("delta_t")}
     lat = {"p_hat": p_hat, "r_hat": r_hat, "delta_a": get("delta_a"), "delta_r": get("delta_r"),
            "delta_t": get("delta_t")}
-    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True)
-    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False)
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False)
+    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, True)
     return AidedAngles(a, be, a_sig, b_sig, (fa, fb))
 
 
