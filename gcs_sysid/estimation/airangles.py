@@ -57,6 +57,7 @@ RATIOS = (0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)   #: candidate gust / mea
 MIN_T_STAT = 8.0      #: |CY_beta|, |CZ_alpha| must exceed this many standard errors
 MIN_SEGMENT_S = 5.0   #: shortest contiguous record that is aided, s
 MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
+MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, Hz
 HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz
 SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
 SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
@@ -77,6 +78,7 @@ class AxisFit:
         gust_sigma: stationary 1-sigma of the gust angle, rad.
         noise_sigma: 1-sigma of the force-derived angle per sample, rad.
         ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
+        r2: share of the measured coefficient's variance above :data:`HIGHPASS_HZ` that the model explains.
         mean_shift: constant added to the kinematic angle (beta: its mean error, from CY0 ~ 0), rad.
     """
 
@@ -90,6 +92,7 @@ class AxisFit:
     gust_sigma: float = float("nan")
     noise_sigma: float = float("nan")
     ratio: float = float("nan")
+    r2: float = float("nan")
     mean_shift: float = 0.0
 
 
@@ -208,7 +211,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         # slopes from the band above HIGHPASS_HZ, where the kinematic angle is good (its gust errors are
         # slow: the turbulence scale over the airspeed); the constant from the full band with them fixed
         Ah, yh = _highpass(dt, A, segs), _highpass(dt, coeff[:, None], segs)[:, 0]
-        cr, csr, _ = _lstsq(Ah[m], yh[m])
+        cr, csr, res = _lstsq(Ah[m], yh[m])
+        r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
         a1, t_stat = c[1], abs(c[1]) / max(cs[1], 1e-300)
@@ -245,7 +249,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         ang = np.where(m, kin + g, kin)
         sig = gs
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
-            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], shift if fit is None else fit.mean_shift)
+            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift)
     return ang, sig, fit
 
 
@@ -269,11 +273,17 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     Returns:
         :class:`AidedAngles`; an axis whose slope is not identified (wrong sign or fewer than
         :data:`MIN_T_STAT` standard errors), or with under :data:`MIN_VALID_S` s of usable data,
-        keeps its kinematic angle (``AxisFit.used`` False, ``reason`` says why).
+        or a grid slower than :data:`MIN_RATE_HZ`, keeps its kinematic angle (``AxisFit.used``
+        False, ``reason`` says why).
 
     Source: Jategaonkar (2015) ch. 5 and 7; Morelli and Klein (2016) ch. 6-7 (module docstring).
     """
     T = len(alpha_kin)
+    if 1.0 / dt < 0.95 * MIN_RATE_HZ:      # 5 % margin for a nominal 20 Hz stream
+        why = (f"samples at {1.0 / dt:.1f} Hz: below {MIN_RATE_HZ:g} Hz the control and rate terms of CY, CZ are "
+               "smeared and the force model is not trusted")
+        nan = np.full(T, np.nan)
+        return AidedAngles(alpha_kin, beta_kin, nan, nan.copy(), (AxisFit("alpha", False, why), AxisFit("beta", False, why)))
     with np.errstate(invalid="ignore", divide="ignore"):
         k = mass / (qbar * S)
         CY = k * f_body[:, 1]
@@ -300,7 +310,7 @@ def describe(res: AidedAngles) -> list[str]:
             out.append(f"{ax.name}: kinematic only (specific-force aiding fell back: {ax.reason})")
             continue
         terms = ", ".join(f"{cname}_{n} = {v:+.3g}" for n, v in zip(ax.columns[1:], ax.coef[1:]))
-        out.append(f"{ax.name} aided by the specific force ({cname} = {ax.coef[0]:+.3g} + linear in "
+        out.append(f"{ax.name} aided by the specific force (R2 {ax.r2:.2f}; {cname} = {ax.coef[0]:+.3g} + linear in "
                    f"{', '.join(ax.columns[1:])}: {terms}); gust state: tau {ax.tau_s:g} s, "
                    f"{np.degrees(ax.gust_sigma):.2f} deg; force-derived {ax.name} noise "
                    f"{np.degrees(ax.noise_sigma):.2f} deg per sample")
