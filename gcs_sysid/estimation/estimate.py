@@ -93,8 +93,7 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
         if ax.used:
             sources[k] += src.format(c="CZ(alpha, q_hat, delta_e)" if k == "alpha" else
                                      "CY(beta, p_hat, r_hat, delta_a, delta_r)")
-            sigma[k] = np.where(np.isfinite(Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma),
-                                Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma, np.nan)
+            sigma[k] = Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma     # NaN where not aided
     if any(ax.used for ax in Ai.axes):      # the gusts found belong to the wind: w = v_ground - C v_air
         ca, sa, cb, sb = np.cos(Ai.alpha), np.sin(Ai.alpha), np.cos(Ai.beta), np.sin(Ai.beta)
         vb = V[:, None] * np.stack([ca * cb, sb, sa * cb], axis=1)
