@@ -18,6 +18,7 @@ from ..airframe import Airframe
 from ..errors import DataError
 from ..parallel import Helper
 from ..telemetry.types import Flight
+from .airangles import aided_air_angles, describe
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
@@ -75,8 +76,39 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
                          f"[air_data] angles = \"vane\"); V and the wind still from GPS, attitude and pitot")
 
 
+def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes):
+    """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
+    records sources, sigma and notes (and the gusts in the wind); returns ``(alpha, beta)``."""
+    if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
+        notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
+                     "control outputs)")
+        return alpha, beta
+    ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
+    Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
+                          airframe.b, airframe.c, fly & np.isfinite(V))
+    notes.extend(describe(Ai))
+    src = ("; gusts from the specific force: {c} model fitted on this flight, gust angle a Gauss-Markov state, "
+           "Kalman + RTS smoother")
+    for ax, k in zip(Ai.axes, ("alpha", "beta")):
+        if ax.used:
+            sources[k] += src.format(c="CZ(alpha, q_hat, delta_e)" if k == "alpha" else
+                                     "CY(beta, p_hat, r_hat, delta_a, delta_r)")
+            sigma[k] = Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma     # NaN where not aided
+    if any(ax.used for ax in Ai.axes):      # the gusts found belong to the wind: w = v_ground - C v_air
+        ca, sa, cb, sb = np.cos(Ai.alpha), np.sin(Ai.alpha), np.cos(Ai.beta), np.sin(Ai.beta)
+        vb = V[:, None] * np.stack([ca * cb, sb, sa * cb], axis=1)
+        w = v_ned - np.einsum("tij,tj->ti", C, vb)
+        good = np.isfinite(w).all(axis=1)
+        for i, k in enumerate(("wn", "we", "wd")):
+            if k in data:
+                data[k] = np.where(good, w[:, i], data[k])
+        sources["wind"] = sources.get("wind", "") + "; plus the gusts found by the specific-force aiding"
+    return Ai.alpha, Ai.beta
+
+
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
-                    progress: Callable[[float], None] | None = None, helper: Helper | None = None) -> FlightStates:
+                    progress: Callable[[float], None] | None = None, helper: Helper | None = None,
+                    aid_air_angles: bool = True) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -86,6 +118,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         progress: optional ``callable(fraction)`` called as stages finish.
         helper: a :class:`~gcs_sysid.parallel.Helper` whose worker smooths the specific force while
             this process runs the velocity filter and the air data (None: all here; same results).
+        aid_air_angles: aid the kinematic alpha and beta with the specific force
+            (:mod:`gcs_sysid.estimation.airangles`; False: kinematic only, for comparisons).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -374,6 +408,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         vanes = _vane_angles(flight, airframe, al)
         if vanes is not None:
             alpha, beta = _take_vanes(vanes, sources, ident, notes)
+        elif aid_air_angles:
+            alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
+                                      fly, C, v_ned, sources, sigma, notes)
     else:
         if have_tas:
             V = tas

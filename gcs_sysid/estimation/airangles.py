@@ -1,0 +1,317 @@
+"""Air angles aided by the specific force: the gusts that kinematics cannot see.
+
+The kinematic air angles (:func:`gcs_sysid.estimation.airdata.air_angles`: GPS velocity minus a
+slowly varying wind, rotated into body axes) miss the turbulence across and normal to the flight
+path. The accelerometers do not: the side force measures beta through ``CY_beta`` and the normal
+force measures alpha through ``CZ_alpha``. Here the two are fused, per axis, in a state-space
+model in which the gust is a *state*, not noise (the filter-error idea, Jategaonkar 2015 ch. 5
+and 7; Morelli and Klein 2016 ch. 6-7):
+
+    state        g_k = alpha_true - alpha_kin   (resp. beta),  g_{k+1} = phi g_k + w_k
+                 (first-order Gauss-Markov, the Dryden spectrum's low-order form:
+                 phi = exp(-dt / tau), stationary variance s_g^2)
+    measurement  z_k = (CZ_meas_k - CZ_rest_k) / CZ_alpha - alpha_kin_k = g_k + v_k
+                 CZ_meas = m a_z / (qbar S), CZ_rest = the linear model without its alpha term
+                 (resp. CY with beta, p_hat, r_hat, delta_a, delta_r)
+
+The aerodynamic model is identified from the same flight by linear least squares: a first pass
+regresses the measured coefficients on the kinematic angles, the smoother gives new angles, and a
+second pass regresses on those (the kinematic angles' gust errors attenuate ``CY_beta``; the second
+pass removes most of that). The correlation time ``tau`` and the ratio ``s_g^2 / var(v)`` are
+chosen per axis by maximum likelihood over a small grid (the noise scale profiled out, as in
+:func:`gcs_sysid.estimation.smoothers.smooth_level`); the linear model is time-invariant, so the
+steady-state Kalman filter and RTS smoother (:func:`gcs_sysid.estimation.kalman.steady_state_smoother`,
+checked against filterpy's ``KalmanFilter`` + ``rts_smoother`` in the tests) give the exact
+smoothed means in compiled code. Low frequencies stay with the kinematics (the Gauss-Markov state
+reverts to zero), so a constant force-model bias (accelerometer bias, asymmetry) does not move the
+angles; the gusts come from the accelerometers.
+
+Circularity: the angles are then partly built from the same force measurements that the model
+learns ``CY(beta)`` and ``CZ(alpha)`` from. Judge it on held-out truth (``docs/benchmarks.md``),
+not on the angle error alone.
+
+References:
+    Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5 (filter error
+    method, process noise for turbulence) and ch. 7 (flight path reconstruction).
+    Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 6 (equation error) and
+    ch. 7 (output error; turbulence).
+    MIL-F-8785C (1980) sec. 3.7 (Dryden turbulence model; gust correlation time L / V).
+    Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*, CUP 1989 ch. 3
+    (concentrated likelihood).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import butter, lfilter, sosfiltfilt
+
+from .kalman import steady_state, steady_state_smoother
+from .nodes import segments
+
+__all__ = ["TAUS_S", "RATIOS", "AxisFit", "AidedAngles", "aided_air_angles", "describe"]
+
+TAUS_S = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)     #: candidate gust correlation times, s
+RATIOS = (0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)   #: candidate gust / measurement variance ratios
+MIN_T_STAT = 8.0      #: |CY_beta|, |CZ_alpha| must exceed this many standard errors
+MIN_SEGMENT_S = 5.0   #: shortest contiguous record that is aided, s
+MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
+MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, Hz
+HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz
+SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
+SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
+
+
+@dataclass
+class AxisFit:
+    """One axis of :func:`aided_air_angles` (alpha from CZ, or beta from CY).
+
+    Attributes:
+        name: ``"alpha"`` or ``"beta"``.
+        used: whether the specific force aided this axis (False: kinematic angle kept).
+        reason: why not, or a summary of the fit.
+        columns: regressor names of the linear model, the first is the constant.
+        coef: (P,) model coefficients of the last pass; coef[1] is CZ_alpha or CY_beta (1/rad).
+        coef_sigma: (P,) their standard errors.
+        tau_s: gust correlation time, s (maximum likelihood).
+        gust_sigma: stationary 1-sigma of the gust angle, rad.
+        noise_sigma: 1-sigma of the force-derived angle per sample, rad.
+        ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
+        r2: share of the measured coefficient's variance above :data:`HIGHPASS_HZ` that the model explains.
+        mean_shift: constant added to the kinematic angle (beta: its mean error, from CY0 ~ 0), rad.
+    """
+
+    name: str
+    used: bool
+    reason: str
+    columns: tuple[str, ...] = ()
+    coef: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    coef_sigma: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    tau_s: float = float("nan")
+    gust_sigma: float = float("nan")
+    noise_sigma: float = float("nan")
+    ratio: float = float("nan")
+    r2: float = float("nan")
+    mean_shift: float = 0.0
+
+
+@dataclass
+class AidedAngles:
+    """Result of :func:`aided_air_angles`.
+
+    Attributes:
+        alpha, beta: (T,) air angles, rad (the kinematic ones where an axis was not aided).
+        alpha_sigma, beta_sigma: (T,) 1-sigma, rad (NaN where not aided).
+        axes: the two :class:`AxisFit` (alpha, beta).
+    """
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    alpha_sigma: np.ndarray
+    beta_sigma: np.ndarray
+    axes: tuple[AxisFit, AxisFit]
+
+
+def _lstsq(A: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares ``y ~ A c``; returns (c, standard errors, residuals)."""
+    c, *_ = np.linalg.lstsq(A, y, rcond=None)
+    e = y - A @ c
+    dof = max(len(y) - A.shape[1], 1)
+    s2 = float(e @ e) / dof
+    try:
+        cov = np.linalg.inv(A.T @ A) * s2
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(A.T @ A) * s2
+    return c, np.sqrt(np.maximum(np.diag(cov), 0.0)), e
+
+
+def _highpass(dt: float, X: np.ndarray, segs: list[slice]) -> np.ndarray:
+    """Zero-phase second-order Butterworth high-pass at :data:`HIGHPASS_HZ` of the columns of ``X``
+    (T, P) on each segment (NaN elsewhere)."""
+    sos = butter(2, HIGHPASS_HZ, btype="highpass", fs=1.0 / dt, output="sos")
+    out = np.full(X.shape, np.nan)
+    for sg in segs:
+        out[sg] = sosfiltfilt(sos, X[sg] - X[sg].mean(axis=0), axis=0, padtype="odd",
+                              padlen=min(3 * int(1.0 / (HIGHPASS_HZ * dt)), sg.stop - sg.start - 1))
+    return out
+
+
+def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, ...],
+                   ratios: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """Smooth ``z = g + v`` (g first-order Gauss-Markov, v white) on each segment.
+
+    Returns ``(g_smoothed (T,), g_sigma (T,), tau_s, gust_sigma, noise_sigma)``; NaN outside the
+    segments. The model's two ratios are chosen by the concentrated likelihood (scale profiled out).
+    """
+    H, R = np.eye(1), np.eye(1)
+    best = None
+    n = sum(s.stop - s.start for s in segs)
+    for tau in taus:
+        phi = float(np.exp(-dt / tau))
+        for ratio in ratios:
+            # scalar steady state in closed form (r = 1): Pp^2 + Pp ((1 - phi^2) - q) - q = 0
+            q = ratio * (1.0 - phi * phi)
+            h = (1.0 - phi * phi) - q
+            Pp = 0.5 * (-h + np.sqrt(h * h + 4.0 * q))
+            S, K = Pp + 1.0, Pp / (Pp + 1.0)
+            ssq = 0.0
+            for sg in segs:          # x_k = (1 - K) phi x_{k-1} + K z_k from x_{-1} = 0; e_k = z_k - phi x_{k-1}
+                zs = z[sg]
+                x = lfilter([K], [1.0, -(1.0 - K) * phi], zs)
+                e = zs.copy()
+                e[1:] -= phi * x[:-1]
+                ssq += float(np.square(e).sum()) / S     # not e @ e: a BLAS call per candidate
+            ll = -0.5 * n * (np.log(max(ssq / n, 1e-300)) + np.log(S))
+            if best is None or ll > best[0]:
+                best = (ll, tau, ratio, ssq / n)
+    _, tau, ratio, s2 = best
+    phi = float(np.exp(-dt / tau))
+    F = np.array([[phi]])
+    g = steady_state(F, np.array([[ratio * (1.0 - phi * phi)]]), H, R)
+    out = np.full(len(z), np.nan)
+    sig = np.full(len(z), np.nan)
+    for sg in segs:
+        xs, _ = steady_state_smoother(F, g, H, z[sg, None], np.zeros(1))
+        out[sg] = xs[:, 0]
+        sig[sg] = np.sqrt(g.Ps[0, 0] * s2)
+    return out, sig, tau, float(np.sqrt(ratio * s2)), float(np.sqrt(s2))
+
+
+def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
+          use: np.ndarray, passes: int, sign: float, quadratic: bool,
+          symmetric: bool) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+    """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
+    of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
+    curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
+    ``symmetric`` takes the constant as ~0 (CY of a symmetric airframe) so that it measures the mean
+    error of the kinematic angle."""
+    cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
+    ok = use & np.isfinite(kin) & np.isfinite(coeff)
+    for k in cols:
+        ok &= np.isfinite(others[k])
+    segs = segments(ok, max(int(round(MIN_SEGMENT_S / dt)), 10))
+    n_ok = sum(s.stop - s.start for s in segs)
+    if n_ok * dt < MIN_VALID_S:
+        return kin, np.full(len(kin), np.nan), AxisFit(
+            name, False, f"{n_ok * dt:.0f} s of usable flight with airspeed, accelerometers, rates and controls "
+                         f"(needs {MIN_VALID_S:.0f} s in pieces of {MIN_SEGMENT_S:.0f} s)")
+    m = np.zeros(len(kin), bool)
+    for s in segs:
+        m[s] = True
+    ang = kin.copy()
+    sig = np.full(len(kin), np.nan)
+    names = ("1", name) + ((f"({name} - {name}0)^2",) if quadratic else ()) + tuple(cols)
+    nq = 2 if quadratic else 1
+    fit = None
+    ctr = float(np.mean(kin[m]))
+    X_other = np.column_stack([others[k] for k in cols]) if cols else np.zeros((len(kin), 0))
+    for _ in range(passes):
+        A = np.column_stack([ang] + ([(ang - ctr) ** 2] if quadratic else []) + [X_other])
+        # slopes from the band above HIGHPASS_HZ, where the kinematic angle is good (its gust errors are
+        # slow: the turbulence scale over the airspeed); the constant from the full band with them fixed
+        Ah, yh = _highpass(dt, A, segs), _highpass(dt, coeff[:, None], segs)[:, 0]
+        cr, csr, res = _lstsq(Ah[m], yh[m])
+        r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
+        c0 = float(np.mean(coeff[m] - A[m] @ cr))
+        c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
+        a1, t_stat = c[1], abs(c[1]) / max(cs[1], 1e-300)
+        if sign * a1 <= 0 or t_stat < MIN_T_STAT:
+            if fit is None:
+                return kin, sig, AxisFit(name, False, f"{'CZ_alpha' if name == 'alpha' else 'CY_beta'} not "
+                                         f"identified from this flight ({a1:+.3g} 1/rad, {t_stat:.1f} standard "
+                                         f"errors; too little {name} excitation)", names, c, cs)
+            break
+        # measurement linearised at the current angle (one Gauss-Newton step per pass: iterated EKF):
+        # angle_f = angle + (C_meas - C_model(angle)) / C_model'(angle)
+        model = c0 + A[m] @ cr
+        shift = 0.0
+        if symmetric and fit is None:
+            # the constant CY0 = CY_beta * (mean error of the kinematic sideslip) + asymmetry; a symmetric
+            # airframe's own CY0 is ~0 (prior SIGMA_CY0), the kinematic mean sideslip error ~ SIGMA_BETA_MEAN:
+            # the posterior mean of that error moves the whole angle (the Gauss-Markov gust cannot)
+            sb2 = SIGMA_BETA_MEAN**2
+            shift = a1 * sb2 * c0 / (a1 * a1 * sb2 + SIGMA_CY0**2)
+            kin = np.where(m, kin + shift, kin)
+            ang = np.where(m, ang + shift, ang)
+        slope = np.full(m.sum(), a1)
+        if quadratic:
+            slope = slope + 2.0 * c[2] * (ang[m] - ctr)
+            slope = sign * np.maximum(sign * slope, 0.5 * abs(a1))    # never flatter than half the mean slope
+        z = np.full(len(kin), np.nan)
+        z[m] = ang[m] + (coeff[m] - model) / slope - kin[m]     # force-derived angle minus the kinematic one
+        if fit is None:
+            taus, ratios = TAUS_S, RATIOS
+        else:                    # later passes search only next to the first pass's choice
+            it, ir = TAUS_S.index(fit.tau_s), RATIOS.index(fit.ratio)
+            taus, ratios = TAUS_S[max(it - 1, 0):it + 2], RATIOS[max(ir - 1, 0):ir + 2]
+        g, gs, tau, s_g, s_v = _gust_smoother(dt, z, segs, taus, ratios)
+        ang = np.where(m, kin + g, kin)
+        sig = gs
+        fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
+            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift)
+    return ang, sig, fit
+
+
+def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: np.ndarray, qbar: np.ndarray,
+                     f_body: np.ndarray, rates: np.ndarray, controls: dict[str, np.ndarray], mass: float,
+                     S: float, b: float, c: float, use: np.ndarray, passes: int = 2) -> AidedAngles:
+    """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
+
+    Args:
+        dt: grid step, s.
+        alpha_kin, beta_kin: (T,) kinematic angle of attack and sideslip, rad.
+        V: (T,) true airspeed, m/s. qbar: (T,) dynamic pressure, Pa.
+        f_body: (T, 3) specific force at the CG, body axes, m/s^2 (bias removed; white noise is fine).
+        rates: (T, 3) body rates p q r, rad/s.
+        controls: ``delta_e``, ``delta_a``, ``delta_r`` (rad) and optionally ``delta_t`` (0..1), each (T,);
+            a missing or constant one is left out of the models.
+        mass: kg. S: wing area, m^2. b: span, m. c: mean aerodynamic chord, m.
+        use: (T,) bool, the airborne samples to fit and aid.
+        passes: least-squares / smoother passes (the first on the kinematic angles).
+
+    Returns:
+        :class:`AidedAngles`; an axis whose slope is not identified (wrong sign or fewer than
+        :data:`MIN_T_STAT` standard errors), or with under :data:`MIN_VALID_S` s of usable data,
+        or a grid slower than :data:`MIN_RATE_HZ`, keeps its kinematic angle (``AxisFit.used``
+        False, ``reason`` says why).
+
+    Source: Jategaonkar (2015) ch. 5 and 7; Morelli and Klein (2016) ch. 6-7 (module docstring).
+    """
+    T = len(alpha_kin)
+    if 1.0 / dt < 0.95 * MIN_RATE_HZ:      # 5 % margin for a nominal 20 Hz stream
+        why = (f"samples at {1.0 / dt:.1f} Hz: below {MIN_RATE_HZ:g} Hz the control and rate terms of CY, CZ are "
+               "smeared and the force model is not trusted")
+        nan = np.full(T, np.nan)
+        return AidedAngles(alpha_kin, beta_kin, nan, nan.copy(), (AxisFit("alpha", False, why), AxisFit("beta", False, why)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = mass / (qbar * S)
+        CY = k * f_body[:, 1]
+        CZ = k * f_body[:, 2]
+        Vs = np.where(V > 1.0, V, np.nan)
+        p_hat, q_hat, r_hat = (rates[:, 0] * b / (2 * Vs), rates[:, 1] * c / (2 * Vs), rates[:, 2] * b / (2 * Vs))
+    u = use & np.isfinite(qbar) & (qbar > 1.0)
+    z0 = np.zeros(T)
+    get = lambda n: np.asarray(controls[n], float) if n in controls else z0   # noqa: E731
+    lon = {"q_hat": q_hat, "delta_e": get("delta_e"), "delta_t": get("delta_t")}
+    lat = {"p_hat": p_hat, "r_hat": r_hat, "delta_a": get("delta_a"), "delta_r": get("delta_r"),
+           "delta_t": get("delta_t")}
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False)
+    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, True)
+    return AidedAngles(a, be, a_sig, b_sig, (fa, fb))
+
+
+def describe(res: AidedAngles) -> list[str]:
+    """One note per axis for ``FlightStates.notes``: the model, the gust parameters, or why it fell back."""
+    out = []
+    for ax in res.axes:
+        cname = "CZ" if ax.name == "alpha" else "CY"
+        if not ax.used:
+            out.append(f"{ax.name}: kinematic only (specific-force aiding fell back: {ax.reason})")
+            continue
+        terms = ", ".join(f"{cname}_{n} = {v:+.3g}" for n, v in zip(ax.columns[1:], ax.coef[1:]))
+        out.append(f"{ax.name} aided by the specific force (R2 {ax.r2:.2f}; {cname} = {ax.coef[0]:+.3g} + linear in "
+                   f"{', '.join(ax.columns[1:])}: {terms}); gust state: tau {ax.tau_s:g} s, "
+                   f"{np.degrees(ax.gust_sigma):.2f} deg; force-derived {ax.name} noise "
+                   f"{np.degrees(ax.noise_sigma):.2f} deg per sample")
+    return out
