@@ -16,7 +16,7 @@ __all__ = ["control_columns", "prepare_inputs", "shift", "lagged"]
 
 
 def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tuple[int, ...] = (0, 1),
-                    decays: tuple[float, ...] = (0.0, 10.0)) -> tuple[np.ndarray, np.ndarray]:
+                    decays: tuple[float, ...] = (0.0, 10.0), hold: str = "zoh") -> tuple[np.ndarray, np.ndarray]:
     """Acceleration and rate responses to unit coefficients of each scaled, lagged control.
 
     Column ``j = (c * len(lags) + l) * len(decays) + d``, with ``lambda = decays[d]``
@@ -55,6 +55,9 @@ def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tu
             dl = np.concatenate([np.full(min(lag, n), controls[0, c]), controls[:n - lag, c]])
             for di, lam in enumerate(decays):
                 j = (c * len(lags) + li) * len(decays) + di
+                if hold == "foh":
+                    A[:, j], W[:, j] = _foh_column(dt, scale * dl, lam)
+                    continue
                 if lam == 0.0:
                     A[:, j] = scale * (dl - dl[0])
                     inc = dt
@@ -64,6 +67,27 @@ def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tu
                     A[:, j] = lfilter([1.0], [1.0, -rho], ch)
                     inc = (1.0 - rho) / lam
                 W[1:, j] = inc * np.cumsum(A[:-1, j])
+    return A, W
+
+
+def _foh_column(dt: float, u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray]:
+    """Acceleration at the grid points and its exact integral for a control moving linearly between
+    its samples (first-order hold): ``lam = 0`` the control itself (minus its first value),
+    ``lam > 0`` the exact response of ``a_dot = -lam a + u_dot`` (a decaying transient)."""
+    n = len(u)
+    du = np.diff(u, prepend=u[0])                    # change over the interval ending at k
+    if lam == 0.0:
+        A = u - u[0]
+        W = np.zeros(n)
+        W[1:] = np.cumsum(0.5 * dt * (A[:-1] + A[1:]))
+        return A, W
+    rho = math.exp(-lam * dt)
+    g = (1.0 - rho) / (lam * dt)                     # a ramp's contribution over one interval
+    A = lfilter([g], [1.0, -rho], du)
+    # integral over [t_k, t_k+1]: A_k (1 - rho) / lam + r (dt - (1 - rho) / lam) / lam, r = du_{k+1} / dt
+    inc = A[:-1] * (1.0 - rho) / lam + du[1:] / dt * (dt - (1.0 - rho) / lam) / lam
+    W = np.zeros(n)
+    W[1:] = np.cumsum(inc)
     return A, W
 
 

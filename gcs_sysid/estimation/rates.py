@@ -71,13 +71,15 @@ from .inputs import control_columns, lagged, prepare_inputs, shift
 from .kalman import SteadyState, lti_response, steady_state, steady_state_smoother
 from .nodes import segments
 
-__all__ = ["BANDWIDTHS_HZ", "DECAYS", "RateEstimate", "smooth_rates", "smooth_specific_force", "control_columns"]
+__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "RateEstimate", "smooth_rates", "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
 #: Decay rates (1/s) of the control transients: a basis for the response shape after a step (the roll,
 #: pitch and yaw damping of small aircraft lie within it); measured on the simulation in docs/estimation.md.
 DECAYS = (2.0, 5.0, 12.0, 30.0)
+#: How a logged control may move between its samples; the likelihood picks one per record (module docstring).
+HOLDS = ("zoh", "foh")
 
 
 @dataclass
@@ -96,6 +98,10 @@ class RateEstimate:
         effectiveness_sigma: (3, m) 1-sigma of ``effectiveness``.
         input_lag: (m,) delay of each given control's effect, grid steps (maximum likelihood
             or as given); NaN for a control that never moves.
+        hold: how the logged controls move between their samples, chosen by the likelihood
+            (:data:`HOLDS`): ``"zoh"`` steps at the samples (ideal or fast servos fed the logged
+            commands), ``"foh"`` linear between them (logged surface positions, or servos slower
+            than the log rate).
     """
 
     rate: np.ndarray
@@ -107,6 +113,7 @@ class RateEstimate:
     effectiveness: np.ndarray
     effectiveness_sigma: np.ndarray
     input_lag: np.ndarray
+    hold: str = "zoh"
 
 
 def _innovation_filter(F: np.ndarray, g: SteadyState, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -181,7 +188,8 @@ def _profile(GG, Ge, ee, n, m, S, noise_floor):
 
 def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, lag: np.ndarray | None,
                         max_lag: int, decays: tuple[float, ...], noise_floor: float,
-                        bandwidths_hz: tuple[float, ...], order: int) -> dict[str, np.ndarray]:
+                        bandwidths_hz: tuple[float, ...], order: int,
+                        hold: tuple[str, ...] = ("zoh", "foh")) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -210,34 +218,44 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     out = {k: np.full((T, d), np.nan) for k in ("x", "xs", "xd", "xds")}
     out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), beta=np.full((d, m), np.nan),
                cov=np.full((d, m, m), np.nan), lag=lag)
-    axes = []            # per axis: segments, columns, and at the chosen bandwidth the innovations
+    holds = tuple(hold) if m else ("zoh",)
+    per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
+    ll_hold = dict.fromkeys(holds, 0.0)
     for i in range(d):
         segs = segments(np.isfinite(Z[:, i]) & ok_u, 10)
         if not segs:
             continue
-        cols, inn = [], []
-        GG, Ge, ee, n = np.zeros((len(bws), m, m)), np.zeros((len(bws), m)), np.zeros(len(bws)), 0
+        ez = []            # the measurement's innovations per segment and candidate (the same for every hold)
         for sg in segs:
-            A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays)
-            # measured part, and the parts of the signal and of its derivative (undelayed)
-            cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
             z = Z[sg, i][:, None]
             x0 = np.array([z[0, 0], 0.0, 0.0])
-            per = []
-            for c, (g, (num, den)) in enumerate(zip(gains, tfs)):   # all candidates: innovations only
-                # innovations only: one transfer function, not the filter's three states as well
-                e = lti_response((np.eye(3) - g.K @ H) @ F, g.K, -H @ F, np.eye(1), z, x0)
-                G = _lfilter_columns(num, den, cols[-1][0]) if m else cols[-1][0]
-                per.append((G / math.sqrt(S[c]), e[:, 0] / math.sqrt(S[c])))
-                Gl = lagged(per[-1][0], nd, lag)
-                GG[c] += Gl.T @ Gl
-                Ge[c] += Gl.T @ per[-1][1]
-                ee[c] += float(per[-1][1] @ per[-1][1])
-            inn.append(per)
-            n += len(z)
-        lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor)[0] for c in range(len(bws))]
-        c = int(np.argmax(lls))
-        axes.append((i, segs, cols, [per[c] for per in inn], c, n))
+            # innovations only: one transfer function, not the filter's three states as well
+            ez.append([lti_response((np.eye(3) - g.K @ H) @ F, g.K, -H @ F, np.eye(1), z, x0)[:, 0] / math.sqrt(S[c])
+                       for c, g in enumerate(gains)])
+        n = sum(len(e[0]) for e in ez)
+        for h in holds:
+            cols, inn = [], []
+            GG, Ge, ee = np.zeros((len(bws), m, m)), np.zeros((len(bws), m)), np.zeros(len(bws))
+            for sg, es in zip(segs, ez):
+                A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays, h)
+                # measured part, and the parts of the signal and of its derivative (undelayed)
+                cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
+                per = []
+                for c, (num, den) in enumerate(tfs):   # all candidates
+                    G = _lfilter_columns(num, den, cols[-1][0]) if m else cols[-1][0]
+                    per.append((G / math.sqrt(S[c]), es[c]))
+                    Gl = lagged(per[-1][0], nd, lag)
+                    GG[c] += Gl.T @ Gl
+                    Ge[c] += Gl.T @ per[-1][1]
+                    ee[c] += float(per[-1][1] @ per[-1][1])
+                inn.append(per)
+            lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor)[0] for c in range(len(bws))]
+            c = int(np.argmax(lls))
+            ll_hold[h] += lls[c]
+            per_hold[h].append((i, segs, cols, [per[c] for per in inn], c, n))
+    best_hold = max(holds, key=lambda h: ll_hold[h])   # the same hold for every axis: how the servo moves
+    axes = per_hold[best_hold]
+    out["hold"] = best_hold
 
     def grams(lagv):
         """Per axis: the lagged column innovations per segment and their Gram matrices."""
@@ -314,7 +332,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
 def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
-                 input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS) -> RateEstimate:
+                 input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
+                 holds: tuple[str, ...] = HOLDS) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -354,7 +373,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
     U, moving, s = prepare_inputs(T, controls, scale)
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
-                            tuple(decays), noise_floor, bandwidths_hz, order=1)
+                            tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds))
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
@@ -365,14 +384,15 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         eff[:, ctl] = o["beta"][:, sel].sum(axis=1)
         eff_sig[:, ctl] = np.sqrt(np.maximum(o["cov"][:, sel][:, :, sel].sum(axis=(1, 2)), 0.0))
         lags[ctl] = o["lag"][k]
-    return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags)
+    return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags,
+                        o.get("hold", "zoh"))
 
 
 def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
                           bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
                           scale: np.ndarray | None = None, max_delay_s: float = 0.2,
-                          input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS
-                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                          input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
+                          holds: tuple[str, ...] = HOLDS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Zero-phase smoothing of the specific force, jumping where the controls step.
 
     The same model as :func:`smooth_rates` one derivative lower: the measured
@@ -402,5 +422,5 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
     U, moving, s = prepare_inputs(len(f), controls, scale)
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(f, float), U, s, lag, int(round(max_delay_s / dt)),
-                            tuple(decays), noise_floor, bandwidths_hz, order=0)
+                            tuple(decays), noise_floor, bandwidths_hz, order=0, hold=tuple(holds))
     return o["x"], o["xs"], o["sig"]
