@@ -178,6 +178,10 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray)
     return xs[::-1]
 
 
+def _segkey(segs: list[slice]) -> tuple:
+    return tuple((sg.start, sg.stop) for sg in segs)
+
+
 def _profile(GG, Ge, ee, n, m, S, noise_floor):
     """GLS fit and diffuse profile log-likelihood (de Jong 1991) of the innovations on the columns."""
     beta, Minv, logdet = _solve(GG, Ge)
@@ -221,6 +225,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     holds = tuple(hold) if m else ("zoh",)
     per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
     ll_hold = dict.fromkeys(holds, 0.0)
+    colcache: dict = {}
     for i in range(d):
         segs = segments(np.isfinite(Z[:, i]) & ok_u, 10)
         if not segs:
@@ -234,21 +239,29 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                        for c, g in enumerate(gains)])
         n = sum(len(e[0]) for e in ez)
         for h in holds:
-            cols, inn = [], []
-            GG, Ge, ee = np.zeros((len(bws), m, m)), np.zeros((len(bws), m)), np.zeros(len(bws))
-            for sg, es in zip(segs, ez):
-                A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays, h)
-                # measured part, and the parts of the signal and of its derivative (undelayed)
-                cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
-                per = []
-                for c, (num, den) in enumerate(tfs):   # all candidates
-                    G = _lfilter_columns(num, den, cols[-1][0]) if m else cols[-1][0]
-                    per.append((G / math.sqrt(S[c]), es[c]))
-                    Gl = lagged(per[-1][0], nd, lag)
-                    GG[c] += Gl.T @ Gl
-                    Ge[c] += Gl.T @ per[-1][1]
-                    ee[c] += float(per[-1][1] @ per[-1][1])
-                inn.append(per)
+            key = (_segkey(segs), h)
+            if key not in colcache:     # the columns and their Gram matrices are the same for every axis
+                cols, Gs = [], []       # with the same segments (the usual case): filtered once, not per axis
+                GG = np.zeros((len(bws), m, m))
+                for sg in segs:
+                    A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays, h)
+                    # measured part, and the parts of the signal and of its derivative (undelayed)
+                    cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
+                    Gs.append([])
+                    for c, (num, den) in enumerate(tfs):   # all candidates
+                        G = (_lfilter_columns(num, den, cols[-1][0]) if m else cols[-1][0]) / math.sqrt(S[c])
+                        Gs[-1].append(G)
+                        Gl = lagged(G, nd, lag)
+                        GG[c] += Gl.T @ Gl
+                colcache[key] = (cols, Gs, GG)
+            cols, Gs, GG = colcache[key]
+            Ge, ee = np.zeros((len(bws), m)), np.zeros(len(bws))
+            inn = []
+            for Gseg, es in zip(Gs, ez):
+                inn.append(list(zip(Gseg, es)))
+                for c in range(len(bws)):
+                    Ge[c] += lagged(Gseg[c], nd, lag).T @ es[c]
+                    ee[c] += float(es[c] @ es[c])
             lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor)[0] for c in range(len(bws))]
             c = int(np.argmax(lls))
             ll_hold[h] += lls[c]
@@ -266,12 +279,16 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     out["hold"] = best_hold
 
     def grams(lagv):
-        """Per axis: the lagged column innovations per segment and their Gram matrices."""
-        st = []
+        """Per axis: the lagged column innovations per segment and their Gram matrices (the Gram
+        matrix shared by axes with the same segments and bandwidth)."""
+        st, memo = [], {}
         for i, segs, cols, inn, c, n in axes:
-            Gls = [lagged(G, nd, lagv) for G, _ in inn]
-            st.append([Gls, sum(G.T @ G for G in Gls), sum(G.T @ e for G, (_, e) in zip(Gls, inn)),
-                       sum(float(e @ e) for _, e in inn)])
+            kk = (_segkey(segs), c)
+            if kk not in memo:
+                Gls = [lagged(G, nd, lagv) for G, _ in inn]
+                memo[kk] = (Gls, sum(G.T @ G for G in Gls))
+            Gls, GG = memo[kk]
+            st.append([Gls, GG, sum(G.T @ e for G, (_, e) in zip(Gls, inn)), sum(float(e @ e) for _, e in inn)])
         return st
 
     if nc and max_lag > 0 and axes:
@@ -287,14 +304,21 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                     if cand == lag[k]:
                         continue
                     ll = 0.0
-                    for ax, (Gls, GG, Ge, ee), (_, _, _, inn, c, n) in zip(axes, cur, axes):
+                    memo = {}
+                    for ax, (Gls, GG, Ge, ee), (_, segs, _, inn, c, n) in zip(axes, cur, axes):
                         # only the block of control k changes: its rows and columns of the Gram matrix
-                        Gk = [shift(G[:, kb], cand) for G, _ in inn]
-                        cross = sum(g.T @ G for g, G in zip(Gk, Gls))
-                        GG2, Ge2 = GG.copy(), Ge.copy()
-                        GG2[kb, :] = cross
-                        GG2[:, kb] = cross.T
-                        GG2[kb, kb] = sum(g.T @ g for g in Gk)
+                        # (the same for axes with the same segments and bandwidth: computed once)
+                        kk = (_segkey(segs), c)
+                        if kk not in memo:
+                            Gk = [shift(G[:, kb], cand) for G, _ in inn]
+                            GG2 = GG.copy()
+                            cross = sum(g.T @ G for g, G in zip(Gk, Gls))
+                            GG2[kb, :] = cross
+                            GG2[:, kb] = cross.T
+                            GG2[kb, kb] = sum(g.T @ g for g in Gk)
+                            memo[kk] = (Gk, GG2)
+                        Gk, GG2 = memo[kk]
+                        Ge2 = Ge.copy()
                         Ge2[kb] = sum(g.T @ e for g, (_, e) in zip(Gk, inn))
                         ll += _profile(GG2, Ge2, ee, n, m, S[c], noise_floor)[0]
                     if ll > best + penalty:
@@ -305,6 +329,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             if np.array_equal(before, lag):
                 break
         out["lag"] = lag
+    xjcache: dict = {}
     for i, segs, cols, inn, c, n in axes:
         GG, Ge, ee = np.zeros((m, m)), np.zeros(m), 0.0
         for G, e in inn:
@@ -327,7 +352,10 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             if m:
                 # the coefficients' own uncertainty: x = x~(z - Mz b) + X b, so an error db moves the
                 # states by (X - smoother(Mz)) db
-                xj = _smooth_columns(F, g, H, Mz)
+                kk = (sg.start, sg.stop, c)   # the same for axes with the same segment and bandwidth
+                if kk not in xjcache:
+                    xjcache[kk] = _smooth_columns(F, g, H, Mz)
+                xj = xjcache[kk]
                 D0, D1 = X0 - xj[:, 0], X1 - xj[:, 1]
                 C = s2 * Minv
                 var0 += ((D0 @ C) * D0).sum(axis=1)
