@@ -21,7 +21,7 @@ from ..telemetry.types import Flight
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
-from .rates import smooth_rates
+from .rates import normal_force_input, smooth_rates
 from .smoothers import smooth_level, smooth_velocity
 from .kalman import noise_std
 from .states import FlightStates
@@ -195,7 +195,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         eas_q = al.get("vfr_hud", "airspeed")
     qbar_eas = 0.5 * 1.225 * eas_q**2 if np.isfinite(eas_q).sum() >= 10 else None
     if gyro is not None:
-        Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas)
+        acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
+        Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
+                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]))
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):

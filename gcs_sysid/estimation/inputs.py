@@ -124,5 +124,6 @@ def lagged(X: np.ndarray, nd: int, lag: np.ndarray) -> np.ndarray:
     """Columns of each control (blocks of ``nd``) delayed by that control's lag."""
     if not np.any(lag):
         return X
-    return np.concatenate([shift(X[:, k * nd:(k + 1) * nd], int(lag[k])) for k in range(len(lag))], axis=1) \
-        if len(lag) else X
+    # columns after the controls' blocks (measured signals) are not delayed
+    return np.concatenate([shift(X[:, k * nd:(k + 1) * nd], int(lag[k])) for k in range(len(lag))]
+                          + [X[:, len(lag) * nd:]], axis=1)

@@ -65,13 +65,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from filterpy.common import Q_continuous_white_noise
-from scipy.signal import lfilter, ss2tf
+from scipy.signal import butter, filtfilt, lfilter, ss2tf
 
 from .inputs import control_columns, lagged, prepare_inputs, shift
 from .kalman import SteadyState, lti_response, steady_state, steady_state_smoother
 from .nodes import segments
 
-__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "RateEstimate", "smooth_rates", "smooth_specific_force", "control_columns"]
+__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
@@ -80,6 +80,8 @@ BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
 DECAYS = (2.0, 5.0, 12.0, 30.0)
 #: How a logged control may move between its samples; the likelihood picks one per record (module docstring).
 HOLDS = ("zoh", "foh")
+#: Log-likelihood gain per sample that steps ("zoh") must show over linear motion ("foh") to be chosen.
+ZOH_EVIDENCE = 0.01
 
 
 @dataclass
@@ -178,6 +180,15 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray)
     return xs[::-1]
 
 
+def _aux_columns(dt: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Acceleration columns ``x - x_0`` of measured signals (n, k), linear between samples, and their
+    exact (trapezoid) integrals."""
+    A = x - x[0]
+    W = np.zeros_like(A)
+    W[1:] = np.cumsum(0.5 * dt * (A[:-1] + A[1:]), axis=0)
+    return A, W
+
+
 def _segkey(segs: list[slice]) -> tuple:
     return tuple((sg.start, sg.stop) for sg in segs)
 
@@ -193,7 +204,7 @@ def _profile(GG, Ge, ee, n, m, S, noise_floor):
 def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, lag: np.ndarray | None,
                         max_lag: int, decays: tuple[float, ...], noise_floor: float,
                         bandwidths_hz: tuple[float, ...], order: int,
-                        hold: tuple[str, ...] = ("zoh", "foh")) -> dict[str, np.ndarray]:
+                        hold: tuple[str, ...] = ("zoh", "foh"), aux: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -214,15 +225,17 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     gains = [steady_state(F, dt * (2 * np.pi * f) ** 6 * q0, H, np.eye(1)) for f in bws]
     tfs = [_innovation_filter(F, g, H) for g in gains]
     S = np.array([g.S[0, 0] for g in gains])
-    ok_u = np.isfinite(U).all(axis=1)
+    aux = np.zeros((T, 0)) if aux is None else np.asarray(aux, float).reshape(T, -1)
+    ok_u = np.isfinite(U).all(axis=1) & np.isfinite(aux).all(axis=1)
     all_decays = (0.0,) + tuple(decays)
     nd, nc = len(all_decays), U.shape[1]
-    m = nc * nd
     lag = np.zeros(nc, int) if lag is None else np.asarray(lag, int)
     out = {k: np.full((T, d), np.nan) for k in ("x", "xs", "xd", "xds")}
-    out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), beta=np.full((d, m), np.nan),
-               cov=np.full((d, m, m), np.nan), lag=lag)
-    holds = tuple(hold) if m else ("zoh",)
+    out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), lag=lag)
+    holds = tuple(hold) if nc else ("foh",)
+    # the measured signals (aux) only with smooth controls: low-passed, they would smear the jumps that
+    # ideal actuators (zoh) make in them (the project's simulation: q_dot 2.7 -> 5.0 % with them)
+    m_of = {h: nc * nd + (aux.shape[1] if h == "foh" else 0) for h in holds}
     per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
     ll_hold = dict.fromkeys(holds, 0.0)
     colcache: dict = {}
@@ -240,11 +253,15 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
         n = sum(len(e[0]) for e in ez)
         for h in holds:
             key = (_segkey(segs), h)
+            m = m_of[h]
             if key not in colcache:     # the columns and their Gram matrices are the same for every axis
                 cols, Gs = [], []       # with the same segments (the usual case): filtered once, not per axis
                 GG = np.zeros((len(bws), m, m))
                 for sg in segs:
                     A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays, h)
+                    if m > nc * nd:             # measured signals: continuous, linear between samples
+                        Ax, Wx = _aux_columns(dt, aux[sg])
+                        A, W = np.concatenate([A, Ax], 1), np.concatenate([W, Wx], 1)
                     # measured part, and the parts of the signal and of its derivative (undelayed)
                     cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
                     Gs.append([])
@@ -266,17 +283,20 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             c = int(np.argmax(lls))
             ll_hold[h] += lls[c]
             per_hold[h].append((i, segs, cols, [per[c] for per in inn], c, n))
-    # the same hold for every axis (it is how the servos move). Steps need the evidence: no servo moves
-    # within one sample, so "zoh" (ideal actuators fed the logged commands, as in the project's own
-    # simulation, where it wins by thousands) is taken only when it beats "foh" by more than a BIC
-    # penalty of one parameter per axis, 0.5 log(n) each; on JSBSim's smooth surfaces foh wins by 10-20
-    # in light turbulence, and within 3 either way in moderate turbulence, where it is still the better one
+    # the same hold for every axis (it is how the servos move). Steps need decisive evidence: no servo
+    # moves within one sample, so "zoh" (ideal actuators fed the logged commands, as in the project's own
+    # simulation, where it gains about 0.4 per sample) is taken only when it beats "foh" by more than
+    # ZOH_EVIDENCE per sample (and a BIC penalty, 0.5 log n) on every axis together; on JSBSim's servos
+    # the two lie within +-0.005 per sample, foh giving the better accelerations throughout (docs/estimation.md)
     best_hold = holds[0]
     if len(holds) > 1:
-        pen = {h: sum(0.5 * math.log(max(a[-1], 2)) for a in per_hold[h]) if h == "zoh" else 0.0 for h in holds}
+        pen = {h: sum(max(0.5 * math.log(max(a[-1], 2)), ZOH_EVIDENCE * a[-1]) for a in per_hold[h])
+               if h == "zoh" else 0.0 for h in holds}
         best_hold = max(holds, key=lambda h: ll_hold[h] - pen[h])
     axes = per_hold[best_hold]
     out["hold"] = best_hold
+    m = m_of[best_hold]
+    out.update(beta=np.full((d, m), np.nan), cov=np.full((d, m, m), np.nan))
 
     def grams(lagv):
         """Per axis: the lagged column innovations per segment and their Gram matrices (the Gram
@@ -369,7 +389,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
                  input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
-                 holds: tuple[str, ...] = HOLDS) -> RateEstimate:
+                 holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -396,6 +416,12 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         input_lag: optional delay per given control, grid steps: fixed if ``max_delay_s`` is 0,
             else the start of the search.
         decays: decay rates of the control transients, 1/s.
+        holds: the candidate motions of the controls between their samples (:data:`HOLDS`), one
+            chosen for all axes by the likelihood (steps only with decisive evidence,
+            :data:`ZOH_EVIDENCE`).
+        aux: optional (T, k) measured signals that enter the angular accelerations linearly and at
+            once, linear between samples, one coefficient per axis and signal, not delayed and not
+            scaled (e.g. :func:`normal_force_input`); NaN rows are left out like gyro gaps.
 
     Returns:
         :class:`RateEstimate`.
@@ -409,7 +435,8 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
     U, moving, s = prepare_inputs(T, controls, scale)
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
-                            tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds))
+                            tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds),
+                            aux=aux)
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
@@ -422,6 +449,39 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         lags[ctl] = o["lag"][k]
     return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags,
                         o.get("hold", "zoh"))
+
+
+def normal_force_input(dt: float, az: np.ndarray, cutoff_hz: float = 6.0) -> np.ndarray | None:
+    """The measured normal specific force as a known input of the rate smoother, zero-phase low-passed.
+
+    ``az`` carries what the gyros cannot: the angle-of-attack changes that gusts make (``CZ_alpha
+    alpha``), which drive the pitching moment through ``Cm_alpha alpha`` at the same instant. Passed
+    as ``aux`` to :func:`smooth_rates`, the smoother fits one coefficient per axis (a ratio like
+    ``M_alpha / Z_alpha``) by the same likelihood as the controls' and the angular acceleration gets
+    that part at the accelerometer's bandwidth, not the smoother's. A second-order Butterworth filter
+    run forwards and backwards (``scipy.signal.filtfilt``) at ``min(cutoff_hz, 0.25 / dt)`` keeps the
+    accelerometer's white noise and vibration out; gaps stay NaN.
+
+    Args:
+        dt: grid step, s.
+        az: (T,) body-z specific force, m/s^2, NaN where missing.
+        cutoff_hz: low-pass cut-off, Hz.
+
+    Returns:
+        (T, 1) filtered ``az`` in m/s^2, or None when fewer than 30 samples are finite.
+
+    Source: Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 5 and 11
+    (measured accelerations as regressors; zero-phase smoothing before differentiation).
+    """
+    az = np.asarray(az, float)
+    ok = np.isfinite(az)
+    if ok.sum() < 30:
+        return None
+    x = np.interp(np.arange(len(az)), np.nonzero(ok)[0], az[ok])
+    b, a = butter(2, min(cutoff_hz, 0.25 / dt) * 2.0 * dt)
+    y = filtfilt(b, a, x)
+    y[~ok] = np.nan
+    return y[:, None]
 
 
 def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
