@@ -21,7 +21,7 @@ from ..telemetry.types import Flight
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
-from .rates import normal_force_input, smooth_rates
+from .rates import HOLDS, normal_force_input, smooth_rates
 from .smoothers import smooth_level, smooth_velocity
 from .kalman import noise_std
 from .states import FlightStates
@@ -249,7 +249,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     if f_cg is not None:   # needs nothing from the velocity filter and the air data below: in the helper's
         # worker (when there is one) while this process runs them; collected at the end
         sf_job = (helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
-                                                          f_cg, controls=U, scale=qbar_eas, input_lag=in_lag)
+                                                          f_cg, controls=U, scale=qbar_eas, input_lag=in_lag,
+                                                          holds=(Rr.hold,) if in_lag is not None else HOLDS)
     vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
         "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
     vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")
