@@ -36,12 +36,20 @@ def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tu
     ``[t_k, t_k + dt)``; the rate ``W`` is its exact integral:
     ``W_{k+1} = W_k + A_k (1 - exp(-lambda dt)) / lambda`` (``dt A_k`` for a step).
 
+    With ``hold="foh"`` the control moves linearly between its samples instead
+    (a servo's smooth motion): the step column is ``s_k (delta_k - delta_0)`` at
+    the grid points, linear between them, and the transients are the exact
+    responses of ``a_dot = -lambda a + d/dt (s delta)`` to that ramp
+    (:func:`_foh_column`); ``W`` is again the exact integral (Franklin, Powell
+    and Workman 1998, sec. 6.3, first-order hold).
+
     Args:
         dt: grid step, s.
         controls: (n, m) control deflections (any unit), finite.
         scale: (n,) effectiveness scale (dynamic pressure), finite.
         lags: input lags in grid steps.
         decays: decay rates of the transients, 1/s (0: a step).
+        hold: ``"zoh"`` (held over each step) or ``"foh"`` (linear between samples).
 
     Returns:
         ``(A, W)``, each (n, m * len(lags) * len(decays)).

@@ -40,6 +40,21 @@ stays zero phase. Where the controls do not move the model is the nominal one.
 Smooth inputs (multisines) sampled and held at the grid rate are staircases
 too; their many small steps carry the same ``b``.
 
+How a logged control moves between its samples is chosen by the same
+likelihood (:data:`HOLDS`): ``"zoh"`` holds it (ideal actuators fed the logged
+commands: the acceleration jumps at the sample, as in the project's simulation),
+``"foh"`` moves it linearly to the next sample (logged surface positions of real
+servos, or servos slower than the log rate: JSBSim's flights). Taken as steps, a
+smooth surface motion made the smoother overshoot JSBSim's angular accelerations
+(regression slope 1.08, Cl Cm 11-14 % off); with the linear hold the slope is
+1.00 and Cl Cm Cn 4-9 %. Steps are chosen only with decisive evidence
+(:data:`ZOH_EVIDENCE` per sample; they gain 0.43 per sample on the simulation).
+With the linear hold, measured signals ``aux`` may enter the acceleration too
+(one coefficient per axis, linear between samples, no delay): the replay passes
+the low-passed normal specific force (:func:`normal_force_input`), which shows
+the gust-driven angle of attack, and so ``Cm_alpha alpha``, at the instant it
+acts (Morelli and Klein 2016, ch. 5: measured accelerations as regressors).
+
 The bandwidth of the nominal model is chosen per axis by the diffuse profile
 likelihood (de Jong 1991) over a ladder of candidates, with ``b`` re-estimated
 for each candidate; then the delay ``l_c`` of each control (a servo or output
@@ -56,6 +71,10 @@ References:
     doi:10.1214/aos/1176348139 (diffuse likelihood).
     Bar-Shalom, Li and Kirubarajan (2001) ch. 6 (white-noise kinematic models);
     Klein and Morelli, *Aircraft System Identification*, AIAA 2006, ch. 10.
+    Franklin, Powell and Workman, *Digital Control of Dynamic Systems*, 3rd ed.,
+    1998, sec. 6.3 (zero- and first-order hold equivalents).
+    Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 5
+    (equation error with measured accelerations), ch. 11 (data smoothing).
 """
 
 from __future__ import annotations
