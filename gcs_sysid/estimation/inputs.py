@@ -64,7 +64,8 @@ def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tu
             for di, lam in enumerate(decays):
                 j = (c * len(lags) + li) * len(decays) + di
                 if hold == "foh":
-                    A[:, j], W[:, j] = _foh_column(dt, scale * dl, lam)
+                    x = scale * (dl - dl[0]) if lam == 0.0 else scale * np.diff(dl, prepend=dl[0])
+                    A[:, j], W[:, j] = _foh_column(dt, x, lam)
                     continue
                 if lam == 0.0:
                     A[:, j] = scale * (dl - dl[0])
@@ -78,23 +79,22 @@ def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tu
     return A, W
 
 
-def _foh_column(dt: float, u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray]:
+def _foh_column(dt: float, x: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray]:
     """Acceleration at the grid points and its exact integral for a control moving linearly between
-    its samples (first-order hold): ``lam = 0`` the control itself (minus its first value),
-    ``lam > 0`` the exact response of ``a_dot = -lam a + u_dot`` (a decaying transient)."""
-    n = len(u)
-    du = np.diff(u, prepend=u[0])                    # change over the interval ending at k
+    its samples (first-order hold). ``lam = 0``: ``x`` (n,) is the step column itself,
+    ``s_k (delta_k - delta_0)``; ``lam > 0``: ``x`` (n,) holds the scaled changes ``s_k (delta_k -
+    delta_{k-1})``, each spread evenly over the interval before sample ``k``, and the column is the
+    exact response of ``a_dot = -lam a + (the control's rate)`` to them (a decaying transient)."""
+    n = len(x)
+    W = np.zeros(n)
     if lam == 0.0:
-        A = u - u[0]
-        W = np.zeros(n)
-        W[1:] = np.cumsum(0.5 * dt * (A[:-1] + A[1:]))
-        return A, W
+        W[1:] = np.cumsum(0.5 * dt * (x[:-1] + x[1:]))
+        return x, W
     rho = math.exp(-lam * dt)
     g = (1.0 - rho) / (lam * dt)                     # a ramp's contribution over one interval
-    A = lfilter([g], [1.0, -rho], du)
-    # integral over [t_k, t_k+1]: A_k (1 - rho) / lam + r (dt - (1 - rho) / lam) / lam, r = du_{k+1} / dt
-    inc = A[:-1] * (1.0 - rho) / lam + du[1:] / dt * (dt - (1.0 - rho) / lam) / lam
-    W = np.zeros(n)
+    A = lfilter([g], [1.0, -rho], x)
+    # integral over [t_k, t_k+1]: A_k (1 - rho) / lam + r (dt - (1 - rho) / lam) / lam, r = x_{k+1} / dt
+    inc = A[:-1] * (1.0 - rho) / lam + x[1:] / dt * (dt - (1.0 - rho) / lam) / lam
     W[1:] = np.cumsum(inc)
     return A, W
 
