@@ -197,7 +197,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     if gyro is not None:
         acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
         Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
-                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]))
+                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,))
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):

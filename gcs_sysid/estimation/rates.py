@@ -50,8 +50,9 @@ smooth surface motion made the smoother overshoot JSBSim's angular accelerations
 1.00 and Cl Cm Cn 4-9 %. Steps are chosen only with decisive evidence
 (:data:`ZOH_EVIDENCE` per sample; they gain 0.43 per sample on the simulation).
 With the linear hold, measured signals ``aux`` may enter the acceleration too
-(one coefficient per axis, linear between samples, no delay): the replay passes
-the low-passed normal specific force (:func:`normal_force_input`), which shows
+(one coefficient per axis that takes them, linear between samples, no delay): the
+replay passes the low-passed normal specific force (:func:`normal_force_input`) to
+the pitch axis only, where it shows
 the gust-driven angle of attack, and so ``Cm_alpha alpha``, at the instant it
 acts (Morelli and Klein 2016, ch. 5: measured accelerations as regressors).
 
@@ -212,9 +213,16 @@ def _segkey(segs: list[slice]) -> tuple:
     return tuple((sg.start, sg.stop) for sg in segs)
 
 
-def _profile(GG, Ge, ee, n, m, S, noise_floor):
-    """GLS fit and diffuse profile log-likelihood (de Jong 1991) of the innovations on the columns."""
-    beta, Minv, logdet = _solve(GG, Ge)
+def _profile(GG, Ge, ee, n, m, S, noise_floor, sel=None):
+    """GLS fit and diffuse profile log-likelihood (de Jong 1991) of the innovations on the columns
+    (only the columns ``sel`` when given: the others get coefficient 0 and no variance)."""
+    if sel is not None and len(sel) < m:
+        b, Mi, logdet = _solve(GG[np.ix_(sel, sel)], Ge[sel])
+        beta, Minv = np.zeros(m), np.zeros((m, m))
+        beta[sel], Minv[np.ix_(sel, sel)] = b, Mi
+        m = len(sel)
+    else:
+        beta, Minv, logdet = _solve(GG, Ge)
     rss = max(ee - float(Ge @ beta), 0.0)
     s2 = max(rss / max(n - m, 1), noise_floor**2)      # profiled measurement-noise variance
     return -0.5 * ((n - m) * np.log(s2) + n * np.log(S) + logdet), beta, Minv, s2
@@ -223,7 +231,8 @@ def _profile(GG, Ge, ee, n, m, S, noise_floor):
 def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, lag: np.ndarray | None,
                         max_lag: int, decays: tuple[float, ...], noise_floor: float,
                         bandwidths_hz: tuple[float, ...], order: int,
-                        hold: tuple[str, ...] = ("zoh", "foh"), aux: np.ndarray | None = None) -> dict[str, np.ndarray]:
+                        hold: tuple[str, ...] = ("zoh", "foh"), aux: np.ndarray | None = None,
+                        aux_axes: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -255,6 +264,10 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     # the measured signals (aux) only with smooth controls: low-passed, they would smear the jumps that
     # ideal actuators (zoh) make in them (the project's simulation: q_dot 2.7 -> 5.0 % with them)
     m_of = {h: nc * nd + (aux.shape[1] if h == "foh" else 0) for h in holds}
+
+    def sel_of(i, m):
+        """Columns of axis ``i``: the controls', and the measured signals' if the axis takes them."""
+        return None if m == nc * nd or aux_axes is None or i in aux_axes else np.arange(nc * nd)
     per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
     ll_hold = dict.fromkeys(holds, 0.0)
     colcache: dict = {}
@@ -298,7 +311,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                 for c in range(len(bws)):
                     Ge[c] += lagged(Gseg[c], nd, lag).T @ es[c]
                     ee[c] += float(es[c] @ es[c])
-            lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor)[0] for c in range(len(bws))]
+            lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor, sel_of(i, m))[0]
+                   for c in range(len(bws))]
             c = int(np.argmax(lls))
             ll_hold[h] += lls[c]
             per_hold[h].append((i, segs, cols, [per[c] for per in inn], c, n))
@@ -332,7 +346,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
 
     if nc and max_lag > 0 and axes:
         cur = grams(lag)
-        best = sum(_profile(GG, Ge, ee, ax[-1], m, S[ax[4]], noise_floor)[0]
+        best = sum(_profile(GG, Ge, ee, ax[-1], m, S[ax[4]], noise_floor, sel_of(ax[0], m))[0]
                    for ax, (_, GG, Ge, ee) in zip(axes, cur))
         penalty = 0.5 * math.log(sum(a[-1] for a in axes))
         for _ in range(2):                       # coordinate ascent over the controls' delays
@@ -344,7 +358,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         continue
                     ll = 0.0
                     memo = {}
-                    for ax, (Gls, GG, Ge, ee), (_, segs, _, inn, c, n) in zip(axes, cur, axes):
+                    for ax, (Gls, GG, Ge, ee), (i, segs, _, inn, c, n) in zip(axes, cur, axes):
                         # only the block of control k changes: its rows and columns of the Gram matrix
                         # (the same for axes with the same segments and bandwidth: computed once)
                         kk = (_segkey(segs), c)
@@ -359,7 +373,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         Gk, GG2 = memo[kk]
                         Ge2 = Ge.copy()
                         Ge2[kb] = sum(g.T @ e for g, (_, e) in zip(Gk, inn))
-                        ll += _profile(GG2, Ge2, ee, n, m, S[c], noise_floor)[0]
+                        ll += _profile(GG2, Ge2, ee, n, m, S[c], noise_floor, sel_of(i, m))[0]
                     if ll > best + penalty:
                         best = ll
                         lag = lag.copy()
@@ -376,7 +390,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             GG += Gl.T @ Gl
             Ge += Gl.T @ e
             ee += float(e @ e)
-        _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor)
+        _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor, sel_of(i, m))
         out["bw"][i], out["sig"][i] = bws[c], math.sqrt(s2)
         out["beta"][i], out["cov"][i] = beta, s2 * Minv
         g = gains[c]
@@ -408,7 +422,8 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
                  input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
-                 holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None) -> RateEstimate:
+                 holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None,
+                 aux_axes: tuple[int, ...] | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -441,6 +456,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         aux: optional (T, k) measured signals that enter the angular accelerations linearly and at
             once, linear between samples, one coefficient per axis and signal, not delayed and not
             scaled (e.g. :func:`normal_force_input`); NaN rows are left out like gyro gaps.
+        aux_axes: the axes (0 p, 1 q, 2 r) that take ``aux``; None: all.
 
     Returns:
         :class:`RateEstimate`.
@@ -455,7 +471,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
                             tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds),
-                            aux=aux)
+                            aux=aux, aux_axes=aux_axes)
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
@@ -475,7 +491,8 @@ def normal_force_input(dt: float, az: np.ndarray, cutoff_hz: float = 6.0) -> np.
 
     ``az`` carries what the gyros cannot: the angle-of-attack changes that gusts make (``CZ_alpha
     alpha``), which drive the pitching moment through ``Cm_alpha alpha`` at the same instant. Passed
-    as ``aux`` to :func:`smooth_rates`, the smoother fits one coefficient per axis (a ratio like
+    as ``aux`` to :func:`smooth_rates` for the pitch axis (``aux_axes=(1,)``: on roll and yaw it would
+    stand in for turn dynamics it does not cause), the smoother fits one coefficient (a ratio like
     ``M_alpha / Z_alpha``) by the same likelihood as the controls' and the angular acceleration gets
     that part at the accelerometer's bandwidth, not the smoother's. A second-order Butterworth filter
     run forwards and backwards (``scipy.signal.filtfilt``) at ``min(cutoff_hz, 0.25 / dt)`` keeps the
