@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from gcs_sysid.estimation.rates import smooth_rates
+from gcs_sysid.estimation.rates import normal_force_input, smooth_rates
 
 DT = 0.02
 
@@ -66,3 +66,32 @@ def test_smooth_surface_motion_gives_no_overshoot(servo_roll):
     slope_s = np.polyfit(pd[m], steps.accel[m, 0], 1)[0]
     err_s = np.sqrt(np.mean((steps.accel[m, 0] - pd[m]) ** 2) / np.mean(pd[m] ** 2))
     assert slope_s > 1.05 and err_s > 0.1, (slope_s, err_s)
+
+
+def test_the_normal_force_carries_the_gust_pitching_moment():
+    # a pitch axis whose acceleration has a gust part M_alpha alpha_g(t) (alpha_g: white noise through two
+    # 2.5 Hz first-order filters, mostly above the smoother's bandwidth) that the accelerometer sees as Z_alpha
+    # alpha_g at the same instant; the elevator a smooth servo as above
+    rng = np.random.default_rng(5)
+    T, sub = 3000, 20
+    h = DT / sub
+    a = np.exp(-h * 2 * np.pi * 2.5)
+    alpha_g = lfilter([1 - a], [1, -a], lfilter([1 - a], [1, -a], rng.normal(0, 0.5, T * sub)))
+    z_gyro, pd_servo, de = _servo_roll(T=T, seed=6, noise=0.0)
+    gust_acc = -12.0 * alpha_g                          # M_alpha alpha, rad/s^2
+    e = np.exp(-2.0 * h)
+    q_gust = lfilter([0.0, (e - 1) / -2.0], [1, -e], gust_acc)    # with some pitch damping (-2 1/s)
+    qd = pd_servo + (gust_acc - 2.0 * q_gust)[::sub]
+    z = z_gyro + q_gust[::sub] + rng.normal(0, 0.005, T)
+    az = -80.0 * alpha_g[::sub] - 9.81 + rng.normal(0, 0.05, T)   # Z_alpha alpha, m/s^2
+    Z = np.stack([z] * 3, 1)
+    aux = normal_force_input(DT, az)
+    plain = smooth_rates(DT, Z, controls=de[:, None])
+    R = smooth_rates(DT, Z, controls=de[:, None], aux=aux, aux_axes=(1,))
+    m = slice(100, -100)
+    err = lambda x: float(np.sqrt(np.mean((x[m] - qd[m]) ** 2) / np.mean(qd[m] ** 2)))   # noqa: E731
+    assert R.hold == "foh"
+    # measured 3.4 % with it, 5.8 % without
+    assert err(R.accel[:, 1]) < 0.7 * err(plain.accel[:, 1]), (err(R.accel[:, 1]), err(plain.accel[:, 1]))
+    # the other axes do not take it: the same as without
+    np.testing.assert_allclose(R.accel[:, 0], plain.accel[:, 0])
