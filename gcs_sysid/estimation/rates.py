@@ -91,7 +91,8 @@ from .inputs import control_columns, lagged, prepare_inputs, shift
 from .kalman import SteadyState, lti_response, steady_state, steady_state_smoother
 from .nodes import segments
 
-__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
+__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "ZOH_EVIDENCE", "RateEstimate", "normal_force_input", "smooth_rates",
+           "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
