@@ -1,6 +1,7 @@
 """Control commands as known inputs of the rate and force smoothers: response columns and delays.
 
-The columns are the deterministic responses (acceleration and its exact
+Also the measured signals that enter the rate smoother beside the controls (:func:`aux_columns`,
+:func:`normal_force_input`). The columns are the deterministic responses (acceleration and its exact
 integral) to unit coefficients of each control's step and decaying transients;
 see :mod:`gcs_sysid.estimation.rates` for the model and the references.
 """
@@ -10,9 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import lfilter
+from scipy.signal import butter, filtfilt, lfilter
 
-__all__ = ["control_columns", "prepare_inputs", "shift", "lagged"]
+__all__ = ["control_columns", "aux_columns", "normal_force_input", "prepare_inputs", "shift", "lagged"]
 
 
 def control_columns(dt: float, controls: np.ndarray, scale: np.ndarray, lags: tuple[int, ...] = (0, 1),
@@ -97,6 +98,49 @@ def _foh_column(dt: float, x: np.ndarray, lam: float) -> tuple[np.ndarray, np.nd
     inc = A[:-1] * (1.0 - rho) / lam + x[1:] / dt * (dt - (1.0 - rho) / lam) / lam
     W[1:] = np.cumsum(inc)
     return A, W
+
+
+def aux_columns(dt: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Acceleration columns ``x - x_0`` of measured signals (n, k), linear between samples, and their
+    exact (trapezoid) integrals."""
+    A = x - x[0]
+    W = np.zeros_like(A)
+    W[1:] = np.cumsum(0.5 * dt * (A[:-1] + A[1:]), axis=0)
+    return A, W
+
+
+def normal_force_input(dt: float, az: np.ndarray, cutoff_hz: float = 6.0) -> np.ndarray | None:
+    """The measured normal specific force as a known input of the rate smoother, zero-phase low-passed.
+
+    ``az`` carries what the gyros cannot: the angle-of-attack changes that gusts make (``CZ_alpha
+    alpha``), which drive the pitching moment through ``Cm_alpha alpha`` at the same instant. Passed
+    as ``aux`` to :func:`smooth_rates` for the pitch axis (``aux_axes=(1,)``: on roll and yaw it would
+    stand in for turn dynamics it does not cause), the smoother fits one coefficient (a ratio like
+    ``M_alpha / Z_alpha``) by the same likelihood as the controls' and the angular acceleration gets
+    that part at the accelerometer's bandwidth, not the smoother's. A second-order Butterworth filter
+    run forwards and backwards (``scipy.signal.filtfilt``) at ``min(cutoff_hz, 0.25 / dt)`` keeps the
+    accelerometer's white noise and vibration out; gaps stay NaN.
+
+    Args:
+        dt: grid step, s.
+        az: (T,) body-z specific force, m/s^2, NaN where missing.
+        cutoff_hz: low-pass cut-off, Hz.
+
+    Returns:
+        (T, 1) filtered ``az`` in m/s^2, or None when fewer than 30 samples are finite.
+
+    Source: Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 5 and 11
+    (measured accelerations as regressors; zero-phase smoothing before differentiation).
+    """
+    az = np.asarray(az, float)
+    ok = np.isfinite(az)
+    if ok.sum() < 30:
+        return None
+    x = np.interp(np.arange(len(az)), np.nonzero(ok)[0], az[ok])
+    b, a = butter(2, min(cutoff_hz, 0.25 / dt) * 2.0 * dt)
+    y = filtfilt(b, a, x)
+    y[~ok] = np.nan
+    return y[:, None]
 
 
 def prepare_inputs(T: int, controls, scale) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -85,9 +85,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from filterpy.common import Q_continuous_white_noise
-from scipy.signal import butter, filtfilt, lfilter, ss2tf
+from scipy.signal import lfilter, ss2tf
 
-from .inputs import control_columns, lagged, prepare_inputs, shift
+from .inputs import aux_columns, control_columns, lagged, normal_force_input, prepare_inputs, shift
 from .kalman import SteadyState, lti_response, steady_state, steady_state_smoother
 from .nodes import segments
 
@@ -201,15 +201,6 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray)
     return xs[::-1]
 
 
-def _aux_columns(dt: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Acceleration columns ``x - x_0`` of measured signals (n, k), linear between samples, and their
-    exact (trapezoid) integrals."""
-    A = x - x[0]
-    W = np.zeros_like(A)
-    W[1:] = np.cumsum(0.5 * dt * (A[:-1] + A[1:]), axis=0)
-    return A, W
-
-
 def _segkey(segs: list[slice]) -> tuple:
     return tuple((sg.start, sg.stop) for sg in segs)
 
@@ -293,7 +284,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                 for sg in segs:
                     A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays, h)
                     if m > nc * nd:             # measured signals: continuous, linear between samples
-                        Ax, Wx = _aux_columns(dt, aux[sg])
+                        Ax, Wx = aux_columns(dt, aux[sg])
                         A, W = np.concatenate([A, Ax], 1), np.concatenate([W, Wx], 1)
                     # measured part, and the parts of the signal and of its derivative (undelayed)
                     cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
@@ -485,40 +476,6 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         lags[ctl] = o["lag"][k]
     return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags,
                         o.get("hold", "zoh"))
-
-
-def normal_force_input(dt: float, az: np.ndarray, cutoff_hz: float = 6.0) -> np.ndarray | None:
-    """The measured normal specific force as a known input of the rate smoother, zero-phase low-passed.
-
-    ``az`` carries what the gyros cannot: the angle-of-attack changes that gusts make (``CZ_alpha
-    alpha``), which drive the pitching moment through ``Cm_alpha alpha`` at the same instant. Passed
-    as ``aux`` to :func:`smooth_rates` for the pitch axis (``aux_axes=(1,)``: on roll and yaw it would
-    stand in for turn dynamics it does not cause), the smoother fits one coefficient (a ratio like
-    ``M_alpha / Z_alpha``) by the same likelihood as the controls' and the angular acceleration gets
-    that part at the accelerometer's bandwidth, not the smoother's. A second-order Butterworth filter
-    run forwards and backwards (``scipy.signal.filtfilt``) at ``min(cutoff_hz, 0.25 / dt)`` keeps the
-    accelerometer's white noise and vibration out; gaps stay NaN.
-
-    Args:
-        dt: grid step, s.
-        az: (T,) body-z specific force, m/s^2, NaN where missing.
-        cutoff_hz: low-pass cut-off, Hz.
-
-    Returns:
-        (T, 1) filtered ``az`` in m/s^2, or None when fewer than 30 samples are finite.
-
-    Source: Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 5 and 11
-    (measured accelerations as regressors; zero-phase smoothing before differentiation).
-    """
-    az = np.asarray(az, float)
-    ok = np.isfinite(az)
-    if ok.sum() < 30:
-        return None
-    x = np.interp(np.arange(len(az)), np.nonzero(ok)[0], az[ok])
-    b, a = butter(2, min(cutoff_hz, 0.25 / dt) * 2.0 * dt)
-    y = filtfilt(b, a, x)
-    y[~ok] = np.nan
-    return y[:, None]
 
 
 def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
