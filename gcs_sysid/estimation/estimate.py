@@ -22,7 +22,7 @@ from .airangles import aided_air_angles, describe
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
-from .rates import smooth_rates
+from .rates import HOLDS, normal_force_input, smooth_rates
 from .smoothers import smooth_level, smooth_velocity
 from .kalman import noise_std
 from .states import FlightStates
@@ -229,7 +229,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         eas_q = al.get("vfr_hud", "airspeed")
     qbar_eas = 0.5 * 1.225 * eas_q**2 if np.isfinite(eas_q).sum() >= 10 else None
     if gyro is not None:
-        Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas)
+        acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
+        Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
+                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,))
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):
@@ -247,7 +249,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                          f"({unit}) p q r: " + "; ".join(
                              ", ".join(f"{e:+.3g}" for e in row) for row in Rr.effectiveness)
                          + "; delay of their effect (maximum likelihood) = "
-                         + ", ".join(f"{lg * dt:.2f}" for lg in Rr.input_lag) + " s")
+                         + ", ".join(f"{lg * dt:.2f}" for lg in Rr.input_lag) + " s; between samples the controls "
+                         + ("step (ideal servos)" if Rr.hold == "zoh" else "move linearly (servo motion)")
+                         + " (likelihood)")
     else:
         missing.append("p q r p_dot q_dot r_dot: no gyro (IMU) and no rates in ATTITUDE")
     if gyro_rate < 0.95 * RATE_MIN_HZ:  # 5 % margin: a nominal 10 Hz stream logs 9.9-10.1 Hz
@@ -279,7 +283,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     if f_cg is not None:   # needs nothing from the velocity filter and the air data below: in the helper's
         # worker (when there is one) while this process runs them; collected at the end
         sf_job = (helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
-                                                          f_cg, controls=U, scale=qbar_eas, input_lag=in_lag)
+                                                          f_cg, controls=U, scale=qbar_eas, input_lag=in_lag,
+                                                          holds=(Rr.hold,) if in_lag is not None else HOLDS)
     vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
         "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
     vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")
