@@ -86,6 +86,13 @@ class Learner:
         identifiable: coefficient -> (ok, why) of the latest window.
         notes: what happened (reboots, skipped windows), in order.
         steps: steps run; timings: stage -> seconds of the last step.
+        can_source: optional callable returning DroneCAN streams on the host clock (the session's
+            :meth:`~gcs_sysid.telemetry.can.CanListener.streams`, or a decoded ``can.log``); each window
+            then gets them merged on its vehicle time (:mod:`gcs_sysid.telemetry.can_merge`; only CAN
+            samples stamped up to the window's last record, so a replay of ``raw.tlog`` + ``can.log``
+            sees what the session saw), and measured surface positions replace PWM per the airframe's
+            ``[[can_actuator]]`` map.
+        control_sources: control -> where the latest window's deflections came from (PWM or CAN).
     """
 
     airframe: Airframe
@@ -99,6 +106,8 @@ class Learner:
     notes: list[str] = field(default_factory=list)
     steps: int = 0
     timings: dict[str, float] = field(default_factory=dict)
+    can_source: object = None
+    control_sources: dict = field(default_factory=dict)
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -152,7 +161,10 @@ class Learner:
             flight = read_tlog("live window", data)
             if not flight.streams:
                 raise SysidError("no usable messages in the window")
+            if self.can_source is not None:
+                flight = self._merge_can(flight, data)
             states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz)
+            self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
         except SysidError as exc:
             self.notes.append(f"step {self.steps}: window skipped ({exc})")
@@ -177,6 +189,25 @@ class Learner:
         if self.model is not None and (final or self.steps % self.options.refresh_every == 0):
             self.refresh()
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": time.perf_counter() - t2}
+
+    def _merge_can(self, flight, data: bytes):
+        """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
+        from ..telemetry.can_merge import host_clock_of_tlog, merge_can_streams
+
+        last = self._window[-1][0] * 1e-6
+        streams = {}
+        for name, st in self.can_source().items():
+            m = st.t <= last
+            if m.sum() >= 2:
+                streams[name] = type(st)(st.name, st.source, st.t[m], {k: v[m] for k, v in st.fields.items()})
+        if not streams:
+            return flight
+        try:
+            return merge_can_streams(flight, streams, host_clock_of_tlog("live window", data), 0.0, "CAN bus")
+        except InputError as exc:
+            if not any(n.startswith("CAN not merged") for n in self.notes):
+                self.notes.append(f"CAN not merged (step {self.steps}): {exc}")
+            return flight
 
     def _learn(self, table: CoefficientTable, rows: np.ndarray) -> None:
         from ..gp import GPConfig, fit_gp
@@ -272,14 +303,26 @@ def iter_tlog_records(path: str | Path):
         pos += 8 + plen
 
 
-def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions = LearnOptions()) -> Learner:
+def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions = LearnOptions(),
+                    can_log: str | Path | None = None) -> Learner:
     """Feed a tlog (e.g. a live session's ``raw.tlog``) through a fresh :class:`Learner`.
+
+    Args:
+        path: the tlog.
+        airframe: the airframe.
+        options: the schedule.
+        can_log: the session's ``can.log`` (or any CAN log on the same host clock), merged per window.
 
     Returns:
         The learner after :meth:`Learner.finish`: the model a live session with the same records
         and options ends with.
     """
     learner = Learner(airframe, options)
+    if can_log is not None:
+        from ..telemetry.can import read_can_log
+
+        streams, _ = read_can_log(can_log)
+        learner.can_source = lambda: streams
     for stamp_us, packet in iter_tlog_records(path):
         learner.feed(stamp_us, packet)
     learner.finish()

@@ -93,7 +93,10 @@ class LiveSession:
             if options.can:
                 from ..telemetry.can import CanListener, open_bus
 
-                self.can = CanListener(open_bus(options.can), self.out / "can.log")
+                keep = 2.0 * options.learn.window_s if options.learn is not None else 60.0
+                self.can = CanListener(open_bus(options.can), self.out / "can.log", keep_s=max(keep, 60.0))
+                if self.learner is not None:   # measured surface positions and airspeed into each window
+                    self.learner.can_source = self.can.streams
             self.raw = RawLog(self.out / "raw.tlog")
             self._q: queue.Queue = queue.Queue()
             self._msgs: queue.Queue = queue.Queue()
@@ -255,6 +258,7 @@ class LiveSession:
                 "identifiable": {k: list(v) for k, v in learner.identifiable.items()},
                 "top_suggestion": learner.suggestions[0].reason if learner.suggestions else None,
                 "learner_notes": list(learner.notes), "timings": dict(learner.timings),
+                "control_sources": dict(learner.control_sources),
             })
         return snap
 

@@ -130,3 +130,19 @@ def test_airframe_can_actuator_map(tmp_path):
     doc["can_actuator"] = [{"id": 2, "servo": "elevator"}, {"id": 2, "servo": "rudder"}]
     with pytest.raises(InputError, match="listed twice"):
         airframe_from_dict(doc, "a.toml")
+
+
+def test_bounded_decoder_keeps_the_recent_samples():
+    from gcs_sysid.telemetry.can import TRIM_EVERY, CanDecoder
+
+    Status = dronecan.uavcan.equipment.actuator.Status
+    dec = CanDecoder(keep_s=10.0)
+    n = 3 * TRIM_EVERY
+    for i in range(n):
+        for m in frames_of([Status(actuator_id=1, position=0.0)], source_node_id=20 + i % 2):
+            m.timestamp = 0.1 * i
+            dec.feed(m)
+    t = dec.streams()["actuator1"].t
+    assert dec.counts["uavcan.equipment.actuator.Status"] == n
+    assert len(t) < TRIM_EVERY + 120 and t[-1] == pytest.approx(0.1 * (n - 1))
+    assert t[0] >= 0.1 * (n - 1) - 10.0 - 0.1 * TRIM_EVERY
