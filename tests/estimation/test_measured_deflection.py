@@ -139,3 +139,39 @@ def test_live_learner_merges_the_can_log_per_window(flown):
         idx = np.clip(np.round((learner.t - sim.t[0]) * sim.rate_hz).astype(int), 0, len(sim.t) - 1)
         return np.sqrt(np.mean((learner.X[:, 5] - sim.truth["delta_e"][idx]) ** 2))
     assert err(with_can) < 0.25 * err(without)
+
+
+def _cli(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "gcs_sysid.cli", *map(str, args)], capture_output=True, text=True,
+                          timeout=600)
+
+
+def _airframe_file(af, path):
+    import tomli_w
+
+    from gcs_sysid.airframe import airframe_to_dict
+
+    path.write_bytes(tomli_w.dumps(airframe_to_dict(af)).encode())
+    return path
+
+
+def test_replay_can_log_errors_are_one_line(flown, tmp_path):
+    sim, tlog, can_log, af_can = flown
+    af = _airframe_file(af_can, tmp_path / "af.toml")
+    p = _cli("replay", tlog, "--airframe", af, "--out", tmp_path / "o", "--quiet", "--can-log", tmp_path / "no.blf")
+    assert p.returncode == 2 and p.stderr.strip().count("\n") == 0, p.stderr
+    assert "--can-log" in p.stderr and "no such file" in p.stderr and not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow
+def test_replay_with_can_log_end_to_end(flown, tmp_path):
+    """``gcs-sysid replay --can-log``: the report's notes say what was merged and where delta_e came from."""
+    sim, tlog, can_log, af_can = flown
+    af = _airframe_file(af_can, tmp_path / "af.toml")
+    p = _cli("replay", tlog, "--airframe", af, "--out", tmp_path / "o", "--quiet", "--can-log", can_log)
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "o" / "summary.md").read_text()
+    assert "merged actuator10" in text and "DroneCAN actuator 11" in text
