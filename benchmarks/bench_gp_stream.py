@@ -126,6 +126,16 @@ def run_envelope(n: int = 28600) -> dict:
     mean = model.predict(X[test])[0]
     stream_cpu, stream_wall = time.process_time() - c0, time.perf_counter() - t0
     streamed = error_pct(mean, Yt[test])
+    from gcs_sysid.gp.streaming import RefreshBudget, light_refresh
+
+    light = {}
+    for name, budget in (("light", RefreshBudget()), ("light_reselect", RefreshBudget(reselect=True))):
+        light_refresh(model, RefreshBudget(steps=2, rows=budget.rows, local_steps=2))   # compile its shapes
+        c0, t0 = time.process_time(), time.perf_counter()
+        lm = light_refresh(model, budget)
+        lmean = lm.predict(X[test])[0]
+        light[name] = {"cpu_s": time.process_time() - c0, "wall_s": time.perf_counter() - t0,
+                       "err_pct": error_pct(lmean, Yt[test]), "budget": budget.__dict__}
     c0, t0 = time.process_time(), time.perf_counter()
     model = model.refresh_hyperparameters()
     mean = model.predict(X[test])[0]
@@ -141,7 +151,12 @@ def run_envelope(n: int = 28600) -> dict:
             "err_refreshed_pct": refreshed.round(2).tolist(), "err_refit_pct": full.round(2).tolist(),
             "ratio_streamed": float(streamed.mean() / full.mean()), "ratio_refreshed": float(refreshed.mean() / full.mean()),
             "stream_cpu_s": stream_cpu, "stream_wall_s": stream_wall, "refresh_cpu_s": refresh_cpu,
-            "refresh_wall_s": refresh_wall, "refit_cpu_s": refit_cpu, "refit_wall_s": refit_wall}
+            "refresh_wall_s": refresh_wall, "refit_cpu_s": refit_cpu, "refit_wall_s": refit_wall,
+            "refresh_over_refit_cpu": refresh_cpu / refit_cpu,
+            **{f"{k}_{f}": (v[f].round(2).tolist() if f == "err_pct" else v[f]) for k, v in light.items()
+               for f in ("cpu_s", "wall_s", "err_pct", "budget")},
+            **{f"{k}_ratio_to_refit": float(v["err_pct"].mean() / full.mean()) for k, v in light.items()},
+            **{f"{k}_cpu_over_refit": v["cpu_s"] / refit_cpu for k, v in light.items()}}
 
 
 def main(argv=None):
@@ -182,6 +197,10 @@ def main(argv=None):
                   f"refit {res['ratio_streamed']:.2f}, CPU {res['stream_cpu_s']:.1f} s for {res['rows_new']} rows), + refresh "
                   f"{res['err_refreshed_pct']} (ratio {res['ratio_refreshed']:.2f}, CPU {res['refresh_cpu_s']:.1f} s), "
                   f"full refit {res['err_refit_pct']} (CPU {res['refit_cpu_s']:.1f} s)")
+            for k in ("light", "light_reselect"):
+                print(f"  {k} refresh {res[k + '_budget']}: {res[k + '_err_pct']} (ratio to refit "
+                      f"{res[k + '_ratio_to_refit']:.2f}), CPU {res[k + '_cpu_s']:.2f} s = "
+                      f"{res[k + '_cpu_over_refit']:.2f} of the refit (full refresh: {res['refresh_over_refit_cpu']:.2f})")
         else:
             for p in res["points"]:
                 print(f"  {p['rows_seen']:>7} rows: RSS {p['rss_mib']:.0f} MiB, stored {p['rows_stored']}, saved "

@@ -52,6 +52,10 @@ class LearnOptions:
         refresh_every: steps between refreshes of the confidence map and the suggestions.
         max_rows: learned rows kept for the confidence map (every other one is dropped when full).
         n_inducing: inducing points of the global GP (None: the GP's default).
+        hyper_every: rows learned between light hyperparameter refreshes of the GP
+            (:func:`gcs_sysid.gp.streaming.light_refresh`: warm start, 40 Adam steps on 1,000 stored
+            rows; so the length-scales follow an envelope that grows); 0: never.
+        max_window_s: longest window (stamp time) a step decodes when steps were coalesced (below).
     """
 
     window_s: float = 30.0
@@ -62,6 +66,8 @@ class LearnOptions:
     refresh_every: int = 3
     max_rows: int = 20000
     n_inducing: int | None = None
+    hyper_every: int = 15000
+    max_window_s: float | None = None
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -93,6 +99,14 @@ class Learner:
             sees what the session saw), and measured surface positions replace PWM per the airframe's
             ``[[can_actuator]]`` map.
         control_sources: control -> where the latest window's deflections came from (PWM or CAN).
+        behind: optional callable, True while the learner is behind its input (the session: too many
+            records queued). Then a due step is *coalesced* into the next one (the window keeps every
+            record since the start of the last window decoded, up to ``max_window_s``, so no row is
+            left out; one smoothing pass over the longer window instead of several overlapping ones)
+            and the confidence map and suggestions wait until it has caught up. Neither happens when
+            it keeps up, so a session that never fell behind learns exactly what a replay of its
+            ``raw.tlog`` learns (:func:`learn_from_tlog`); ``coalesced`` counts the steps merged.
+        coalesced, refreshes_deferred: steps merged and map refreshes put off while behind.
     """
 
     airframe: Airframe
@@ -108,6 +122,9 @@ class Learner:
     timings: dict[str, float] = field(default_factory=dict)
     can_source: object = None
     control_sources: dict = field(default_factory=dict)
+    behind: object = None
+    coalesced: int = 0
+    refreshes_deferred: int = 0
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -122,6 +139,10 @@ class Learner:
         self.Y = np.zeros((0, len(COEFFICIENTS)))
         self.t = np.zeros(0)
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
+        self._hold_us: int | None = None         # keep records from here while steps are coalesced
+        self._last_step_us: int | None = None
+        self._refresh_due = False
+        self._since_hyper = 0
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -129,13 +150,24 @@ class Learner:
         """Add one record; run a step when its stamp reaches the schedule. Returns True if a step ran."""
         w = self._window
         w.append((stamp_us, packet))
+        opt = self.options
         if self._next_step_us is None:
-            self._next_step_us = stamp_us + int(self.options.window_s * 1e6)
-        horizon = stamp_us - int(self.options.window_s * 1e6)
+            self._next_step_us = stamp_us + int(opt.window_s * 1e6)
+        horizon = stamp_us - int(opt.window_s * 1e6)
+        if self._hold_us is not None:   # steps coalesced: keep the records since the last window's start
+            longest = opt.max_window_s if opt.max_window_s is not None else 4.0 * opt.window_s
+            horizon = max(min(horizon, self._hold_us), stamp_us - int(longest * 1e6))
         while w and w[0][0] < horizon:
             w.popleft()
         if stamp_us >= self._next_step_us:
-            self._next_step_us = stamp_us + int(self.options.step_s * 1e6)
+            self._next_step_us = stamp_us + int(opt.step_s * 1e6)
+            if self.behind is not None and self._last_step_us is not None and self.behind():
+                if self._hold_us is None:
+                    self._hold_us = self._last_step_us - int(opt.window_s * 1e6)
+                self.coalesced += 1
+                return False
+            self._hold_us = None
+            self._last_step_us = stamp_us
             self.step()
             return True
         return False
@@ -186,8 +218,13 @@ class Learner:
         self._t_done = max(end, start) if start is not None else end
         self._learn(table, rows)
         t2 = time.perf_counter()
-        if self.model is not None and (final or self.steps % self.options.refresh_every == 0):
-            self.refresh()
+        if self.model is not None and (final or self._refresh_due or self.steps % self.options.refresh_every == 0):
+            if not final and self.behind is not None and self.behind():
+                self._refresh_due = True            # the map and suggestions wait until caught up
+                self.refreshes_deferred += 1
+            else:
+                self._refresh_due = False
+                self.refresh()
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": time.perf_counter() - t2}
 
     def _merge_can(self, flight, data: bytes):
@@ -242,6 +279,20 @@ class Learner:
         if ok.any():
             self.model = self.model.update(X[ok], Y[ok][:, cols])
             self.n_learned += int(ok.sum())
+            self._since_hyper += int(ok.sum())
+            if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
+                self._refresh_hyper()
+
+    def _refresh_hyper(self) -> None:
+        """A light hyperparameter refresh of the GP (warm start, few steps; ``docs/live.md``)."""
+        from ..gp.streaming import RefreshBudget, light_refresh
+
+        self._since_hyper = 0
+        try:
+            self.model = light_refresh(self.model, RefreshBudget())
+            self.notes.append(f"step {self.steps}: GP hyperparameters refreshed (light) after {self.n_learned} rows")
+        except SysidError as exc:
+            self.notes.append(f"step {self.steps}: GP hyperparameters not refreshed ({exc})")
 
     def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray) -> None:
         self.X = np.concatenate([self.X, X])
