@@ -69,6 +69,11 @@ def surface_controls(al: Aligned, airframe: Airframe, pwm: Mapping[int, np.ndarr
             how[s.name] = "pwm"
             if act is not None:
                 notes.append(f"{s.name}: no DroneCAN actuator {act.actuator_id} in the data; commanded PWM used")
+    unmapped = sorted(n for n in al.values if n.startswith("actuator")
+                      and n[len("actuator"):] not in {str(c.actuator_id) for c in airframe.can_actuators})
+    if unmapped:
+        notes.append(f"DroneCAN {', '.join(unmapped)} in the data but not in the airframe's [[can_actuator]] map: "
+                     "not used (docs/airframe.md)")
     out: dict[str, np.ndarray] = {}
     sources: dict[str, str] = {}
     for cn in CONTROLS:

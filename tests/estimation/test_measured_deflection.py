@@ -121,6 +121,8 @@ def test_servo_without_its_actuator_falls_back_to_pwm(flown):
     assert "DroneCAN" in states.sources["delta_e"]
     assert states.sources["delta_r"].startswith("servo PWM") and states.sources["delta_a"].startswith("servo PWM")
     assert any("no DroneCAN actuator 99 in the data; commanded PWM used" in n for n in states.notes)
+    assert any("actuator10, actuator12 in the data but not in the airframe's [[can_actuator]] map" in n
+               for n in states.notes)
 
 
 def test_live_learner_merges_the_can_log_per_window(flown):
