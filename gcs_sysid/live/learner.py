@@ -104,9 +104,12 @@ class Learner:
             record since the start of the last window decoded, up to ``max_window_s``, so no row is
             left out; one smoothing pass over the longer window instead of several overlapping ones)
             and the confidence map and suggestions wait until it has caught up. Neither happens when
-            it keeps up, so a session that never fell behind learns exactly what a replay of its
-            ``raw.tlog`` learns (:func:`learn_from_tlog`); ``coalesced`` counts the steps merged.
+            it keeps up; the stamps of the steps merged are kept (``coalesced_at``, in
+            ``session.json`` as ``coalesced_at_us``), so a replay of ``raw.tlog`` given them
+            (:func:`learn_from_tlog`'s ``coalesced_at``) follows the same schedule and learns exactly
+            what the session learned.
         coalesced, refreshes_deferred: steps merged and map refreshes put off while behind.
+        coalesced_at: stamps (us) of the records at which a due step was merged into the next.
     """
 
     airframe: Airframe
@@ -125,6 +128,7 @@ class Learner:
     behind: object = None
     coalesced: int = 0
     refreshes_deferred: int = 0
+    coalesced_at: list = field(default_factory=list)
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -143,6 +147,8 @@ class Learner:
         self._last_step_us: int | None = None
         self._refresh_due = False
         self._since_hyper = 0
+        self._due_us = 0
+        self._replayed: set | None = None     # coalesced stamps of a session being replayed
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -161,10 +167,12 @@ class Learner:
             w.popleft()
         if stamp_us >= self._next_step_us:
             self._next_step_us = stamp_us + int(opt.step_s * 1e6)
+            self._due_us = stamp_us
             if self.behind is not None and self._last_step_us is not None and self.behind():
                 if self._hold_us is None:
                     self._hold_us = self._last_step_us - int(opt.window_s * 1e6)
                 self.coalesced += 1
+                self.coalesced_at.append(int(stamp_us))
                 return False
             self._hold_us = None
             self._last_step_us = stamp_us
@@ -219,7 +227,7 @@ class Learner:
         self._learn(table, rows)
         t2 = time.perf_counter()
         if self.model is not None and (final or self._refresh_due or self.steps % self.options.refresh_every == 0):
-            if not final and self.behind is not None and self.behind():
+            if not final and self.behind is not None and self._replayed is None and self.behind():
                 self._refresh_due = True            # the map and suggestions wait until caught up
                 self.refreshes_deferred += 1
             else:
@@ -355,7 +363,7 @@ def iter_tlog_records(path: str | Path):
 
 
 def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions = LearnOptions(),
-                    can_log: str | Path | None = None) -> Learner:
+                    can_log: str | Path | None = None, coalesced_at=None) -> Learner:
     """Feed a tlog (e.g. a live session's ``raw.tlog``) through a fresh :class:`Learner`.
 
     Args:
@@ -363,12 +371,17 @@ def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions 
         airframe: the airframe.
         options: the schedule.
         can_log: the session's ``can.log`` (or any CAN log on the same host clock), merged per window.
+        coalesced_at: the session's ``coalesced_at_us`` (``session.json``): the steps it merged while
+            behind are merged here too, so the schedule and the model are the session's.
 
     Returns:
         The learner after :meth:`Learner.finish`: the model a live session with the same records
         and options ends with.
     """
     learner = Learner(airframe, options)
+    if coalesced_at:
+        learner._replayed = {int(x) for x in coalesced_at}
+        learner.behind = lambda: learner._due_us in learner._replayed
     if can_log is not None:
         from ..telemetry.can import read_can_log
 

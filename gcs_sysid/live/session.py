@@ -265,6 +265,7 @@ class LiveSession:
                 "learner_notes": list(learner.notes), "timings": dict(learner.timings),
                 "control_sources": dict(learner.control_sources), "steps_coalesced": learner.coalesced,
                 "map_refreshes_deferred": learner.refreshes_deferred,
+                "coalesced_at_us": list(learner.coalesced_at),
             })
         return snap
 
