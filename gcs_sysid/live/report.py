@@ -40,8 +40,8 @@ def render_markdown(snap: dict) -> str:
                      f"model: `{snap.get('model', 'none (too few samples)')}`")
         if snap.get("steps_coalesced") or snap.get("map_refreshes_deferred"):
             lines.append(f"- the learner fell behind: {snap.get('steps_coalesced', 0)} steps coalesced, "
-                         f"{snap.get('map_refreshes_deferred', 0)} map refreshes deferred (a replay of `raw.tlog` "
-                         "follows the steady schedule, so its model may differ slightly)")
+                         f"{snap.get('map_refreshes_deferred', 0)} map refreshes deferred (to replay `raw.tlog` on the "
+                         "same schedule pass `coalesced_at_us` to `learn_from_tlog`)")
     lines += ["", "## Rates", "", "| message | mean received Hz | asked Hz | request | short at check |",
               "|---|---|---|---|---|"]
     asked, mean = snap.get("asked", {}), snap.get("mean_rates", {})
