@@ -13,6 +13,9 @@ fresh directory):
   50-row batches into a default-budget model (M = 128, ``store_max`` 30,000 rows, hyperparameters
   refreshed every 60,000 rows); at ten points: resident memory (VmRSS), rows stored, saved-state size,
   and the held-out error on the last 2,000 rows of the flight; the update cost per sample over the run.
+* ``refresh``: the envelope case's streamed model refreshed under several budgets (the full
+  ``refresh_hyperparameters`` and :func:`gcs_sysid.gp.streaming.light_refresh` budgets): CPU seconds and
+  held-out error in the new region against the refit.
 * ``envelope``: fit on the envelope flown (alpha below its 70th percentile, 20,000 rows), stream the
   new region's rows (50-row batches), then one hyperparameter refresh, against ``fit_gp`` on all rows
   (the baseline, same run): held-out error in the new region and CPU seconds of each step.
@@ -126,6 +129,16 @@ def run_envelope(n: int = 28600) -> dict:
     mean = model.predict(X[test])[0]
     stream_cpu, stream_wall = time.process_time() - c0, time.perf_counter() - t0
     streamed = error_pct(mean, Yt[test])
+    from gcs_sysid.gp.streaming import RefreshBudget, light_refresh
+
+    light = {}
+    for name, budget in (("light", RefreshBudget()), ("light_reselect", RefreshBudget(reselect=True))):
+        light_refresh(model, RefreshBudget(steps=2, rows=budget.rows, local_steps=2))   # compile its shapes
+        c0, t0 = time.process_time(), time.perf_counter()
+        lm = light_refresh(model, budget)
+        lmean = lm.predict(X[test])[0]
+        light[name] = {"cpu_s": time.process_time() - c0, "wall_s": time.perf_counter() - t0,
+                       "err_pct": error_pct(lmean, Yt[test]), "budget": budget.__dict__}
     c0, t0 = time.process_time(), time.perf_counter()
     model = model.refresh_hyperparameters()
     mean = model.predict(X[test])[0]
@@ -141,14 +154,54 @@ def run_envelope(n: int = 28600) -> dict:
             "err_refreshed_pct": refreshed.round(2).tolist(), "err_refit_pct": full.round(2).tolist(),
             "ratio_streamed": float(streamed.mean() / full.mean()), "ratio_refreshed": float(refreshed.mean() / full.mean()),
             "stream_cpu_s": stream_cpu, "stream_wall_s": stream_wall, "refresh_cpu_s": refresh_cpu,
-            "refresh_wall_s": refresh_wall, "refit_cpu_s": refit_cpu, "refit_wall_s": refit_wall}
+            "refresh_wall_s": refresh_wall, "refit_cpu_s": refit_cpu, "refit_wall_s": refit_wall,
+            "refresh_over_refit_cpu": refresh_cpu / refit_cpu,
+            **{f"{k}_{f}": (v[f].round(2).tolist() if f == "err_pct" else v[f]) for k, v in light.items()
+               for f in ("cpu_s", "wall_s", "err_pct", "budget")},
+            **{f"{k}_ratio_to_refit": float(v["err_pct"].mean() / full.mean()) for k, v in light.items()},
+            **{f"{k}_cpu_over_refit": v["cpu_s"] / refit_cpu for k, v in light.items()}}
+
+
+def run_refresh_grid(n: int = 28600) -> dict:
+    """The envelope case's streamed model refreshed under several budgets (CPU s and error against a refit)."""
+    from gcs_sysid.gp import GPConfig, fit_gp
+    from gcs_sysid.gp.streaming import RefreshBudget, light_refresh
+
+    X, Y, Yt = flight(n, seed=7)
+    flown = X[:, 0] < np.quantile(X[:, 0], 0.7)
+    new = np.flatnonzero(~flown)
+    test = new[::4]
+    train_new = np.setdiff1d(new, test)
+    model, _ = fit_gp(X[flown], Y[flown], GPConfig())
+    for a in range(0, len(train_new), 50):
+        r = train_new[a:a + 50]
+        model = model.update(X[r], Y[r])
+    model.predict(X[test])
+    c0 = time.process_time()
+    refit, _ = fit_gp(np.vstack([X[flown], X[train_new]]), np.vstack([Y[flown], Y[train_new]]), GPConfig())
+    refit_cpu = time.process_time() - c0
+    full = error_pct(refit.predict(X[test])[0], Yt[test])
+    out = {"refit_cpu_s": refit_cpu, "err_refit_pct": full.round(2).tolist(), "variants": []}
+    variants = [None, RefreshBudget(), RefreshBudget(40, 400, 40), RefreshBudget(80, 400, 40), RefreshBudget(20, 1000, 40),
+                RefreshBudget(40, 400, 10), RefreshBudget(40, 400, 0)]
+    for b in variants:
+        if b is not None:   # compile this budget's shapes first
+            light_refresh(model, RefreshBudget(2, b.rows, min(2, b.local_steps)))
+        c0 = time.process_time()
+        m2 = model.refresh_hyperparameters() if b is None else light_refresh(model, b)
+        cpu = time.process_time() - c0
+        e = error_pct(m2.predict(X[test])[0], Yt[test])
+        out["variants"].append({"budget": "full" if b is None else b.__dict__, "cpu_s": cpu,
+                                "cpu_over_refit": cpu / refit_cpu, "err_pct": e.round(2).tolist(),
+                                "err_over_refit": float(e.mean() / full.mean())})
+    return out
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--rows", type=int, default=180000)
-    ap.add_argument("--only", choices=("latency", "soak", "envelope"))
+    ap.add_argument("--only", choices=("latency", "soak", "envelope", "refresh"))
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
@@ -159,12 +212,12 @@ def main(argv=None):
         enable_compilation_cache(tempfile.mkdtemp(prefix="gcs-sysid-bench-jax-"))
         kind, value = args.worker.split(":")
         res = {"latency": lambda: run_latency(), "soak": lambda: run_soak(int(value)),
-               "envelope": lambda: run_envelope()}[kind]()
+               "envelope": lambda: run_envelope(), "refresh": lambda: run_refresh_grid()}[kind]()
         res["peak_rss_mib"] = __import__("resource").getrusage(__import__("resource").RUSAGE_SELF).ru_maxrss / 1024
         print(json.dumps(res))
         return
     rows = 36000 if args.quick else args.rows
-    jobs = [("latency", 0), ("envelope", 0), ("soak", rows)]
+    jobs = [("latency", 0), ("envelope", 0), ("refresh", 0), ("soak", rows)]
     if args.only:
         jobs = [j for j in jobs if j[0] == args.only]
     for kind, value in jobs:
@@ -182,6 +235,14 @@ def main(argv=None):
                   f"refit {res['ratio_streamed']:.2f}, CPU {res['stream_cpu_s']:.1f} s for {res['rows_new']} rows), + refresh "
                   f"{res['err_refreshed_pct']} (ratio {res['ratio_refreshed']:.2f}, CPU {res['refresh_cpu_s']:.1f} s), "
                   f"full refit {res['err_refit_pct']} (CPU {res['refit_cpu_s']:.1f} s)")
+            for k in ("light", "light_reselect"):
+                print(f"  {k} refresh {res[k + '_budget']}: {res[k + '_err_pct']} (ratio to refit "
+                      f"{res[k + '_ratio_to_refit']:.2f}), CPU {res[k + '_cpu_s']:.2f} s = "
+                      f"{res[k + '_cpu_over_refit']:.2f} of the refit (full refresh: {res['refresh_over_refit_cpu']:.2f})")
+        elif kind == "refresh":
+            for v in res["variants"]:
+                print(f"  refresh {v['budget']}: {v['err_pct']} (error / refit {v['err_over_refit']:.2f}), CPU "
+                      f"{v['cpu_s']:.2f} s = {v['cpu_over_refit']:.2f} of the refit ({res['refit_cpu_s']:.2f} s)")
         else:
             for p in res["points"]:
                 print(f"  {p['rows_seen']:>7} rows: RSS {p['rss_mib']:.0f} MiB, stored {p['rows_stored']}, saved "

@@ -115,6 +115,8 @@ def listen(speed: float, seconds: float, learn: bool, out_dir: Path) -> dict:
             "handle_ms": {"median": q(0.5), "p99": q(0.99), "max": h[-1] * 1e3, "n": len(h)},
             "learner_queue_max": qmax[0], "steps": result["snap"].get("steps"),
             "samples_learned": result["snap"].get("samples_learned"), "stream_s": t_stream,
+            "steps_coalesced": result["snap"].get("steps_coalesced"),
+            "map_refreshes_deferred": result["snap"].get("map_refreshes_deferred"),
             "drain_after_stream_s": t_total - t_stream, "rss_mib_every_5s": rss,
             "rss_growth_mib_after_first_minute": (max(r for _, r in rss) - next((r for t, r in rss if t >= 60),
                                                                                 rss[-1][1])) if rss else None}

@@ -39,6 +39,7 @@ __all__ = [
     "Throttle",
     "ThrustModel",
     "Limits",
+    "CanActuator",
     "Airframe",
     "load_airframe",
     "airframe_from_dict",
@@ -194,6 +195,8 @@ class Airframe:
         source: path of the file it was read from ("" if built in code).
         notes: free-text provenance of the values.
         limits: the ``[limits]`` table (:class:`Limits`), or None when the file has none.
+        can_actuators: the ``[[can_actuator]]`` map (:class:`CanActuator`): which DroneCAN actuator id
+            measures which servo's surface; empty when the file has none.
         air_angles: what the log's AOA_SSA / AOA angles are: ``"estimate"`` (the autopilot's own
             lagged estimate from velocity and wind; the default, ArduPilot's AHRS) or ``"vane"``
             (measured by vanes at the CG; the estimator then uses them as alpha and beta).
@@ -217,6 +220,7 @@ class Airframe:
     notes: str = ""
     limits: Limits | None = None
     air_angles: str = "estimate"
+    can_actuators: tuple["CanActuator", ...] = ()
 
     @property
     def authority(self) -> dict[str, float]:
@@ -318,7 +322,7 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     """
     src = source
     known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes",
-             "limits", "air_data"}
+             "limits", "air_data", "can_actuator"}
     for k in doc:
         if k not in known:
             raise InputError(f"{src}: unknown top-level field '{k}' (expected one of {sorted(known)})")
@@ -431,6 +435,8 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
                   tuple(float(x) for x in arm), source, notes, air_angles=angles)
     if "limits" in doc:
         af = replace(af, limits=_limits(doc["limits"], af, src))
+    if "can_actuator" in doc:
+        af = replace(af, can_actuators=_can_actuators(doc["can_actuator"], af, src))
     return af
 
 
@@ -514,4 +520,75 @@ def airframe_to_dict(a: Airframe) -> dict[str, Any]:
         d["limits"] = a.limits.to_dict()
     if a.air_angles != "estimate":
         d["air_data"] = {"angles": a.air_angles}
+    if a.can_actuators:
+        d["can_actuator"] = [{"id": c.actuator_id, "servo": c.servo, "sign": c.sign, "scale": c.scale,
+                              "zero_deg": math.degrees(c.zero)} for c in a.can_actuators]
     return d
+
+
+# ----------------------------------------------------------------------------- DroneCAN actuator map
+
+
+@dataclass(frozen=True)
+class CanActuator:
+    """Which DroneCAN actuator measures which servo's surface (``[[can_actuator]]``, docs/airframe.md).
+
+    A DroneCAN servo reports ``uavcan.equipment.actuator.Status.position`` (rad for a rotary servo, by
+    the servo's own sign and zero). The surface deflection of servo :attr:`servo`, by the surface's own
+    sign convention (the ``[[servo]]`` table's), is::
+
+        deflection = sign * scale * (position - zero)        [rad]
+
+    Attributes:
+        actuator_id: DroneCAN ``actuator_id`` (0..255).
+        servo: name of the ``[[servo]]`` whose surface it measures.
+        sign: +1 or -1 (servo sense against the surface convention).
+        scale: surface rad per reported rad (linkage ratio), > 0.
+        zero: reported position at zero surface deflection, rad.
+    """
+
+    actuator_id: int
+    servo: str
+    sign: float = 1.0
+    scale: float = 1.0
+    zero: float = 0.0
+
+    def deflection(self, position: np.ndarray) -> np.ndarray:
+        """Surface deflection (rad) from reported positions (rad), any shape."""
+        return self.sign * self.scale * (np.asarray(position, float) - self.zero)
+
+
+def _can_actuators(d: Any, af: Airframe, src: str) -> tuple[CanActuator, ...]:
+    """Parse and check the ``[[can_actuator]]`` tables against the servos."""
+    if not isinstance(d, list) or not d:
+        raise InputError(f"{src}: can_actuator must be [[can_actuator]] tables with id, servo, sign, scale")
+    names = {s.name for s in af.servos}
+    out: list[CanActuator] = []
+    for i, t in enumerate(d):
+        where = f"[[can_actuator]] #{i + 1}"
+        if not isinstance(t, Mapping):
+            raise InputError(f"{src}: {where} must be a table")
+        extra = set(t) - {"id", "servo", "sign", "scale", "zero_deg"}
+        if extra:
+            raise InputError(f"{src}: {where} unknown field '{sorted(extra)[0]}' (expected id, servo, sign, scale, "
+                             f"zero_deg)")
+        aid = t.get("id")
+        if isinstance(aid, bool) or not isinstance(aid, int) or not 0 <= aid <= 255:
+            raise InputError(f"{src}: {where} field 'id' must be a DroneCAN actuator id 0..255, got {aid!r}")
+        servo = t.get("servo")
+        if servo not in names:
+            raise InputError(f"{src}: {where} field 'servo' must name a [[servo]] ({', '.join(sorted(names))}), "
+                             f"got {servo!r}")
+        sign = t.get("sign", 1)
+        if isinstance(sign, bool) or sign not in (1, -1):
+            raise InputError(f"{src}: {where} field 'sign' must be 1 or -1, got {sign!r}")
+        scale = _opt(t, "scale", 1.0, where, src)
+        if scale <= 0:
+            raise InputError(f"{src}: {where} field 'scale' must be > 0 (the sign goes in 'sign'), got {scale:g}")
+        zero = math.radians(_opt(t, "zero_deg", 0.0, where, src))
+        if any(c.actuator_id == aid for c in out):
+            raise InputError(f"{src}: {where} actuator id {aid} is listed twice")
+        if any(c.servo == servo for c in out):
+            raise InputError(f"{src}: {where} servo '{servo}' already has an actuator")
+        out.append(CanActuator(int(aid), servo, float(sign), scale, zero))
+    return tuple(out)

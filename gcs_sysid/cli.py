@@ -68,6 +68,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--target", default=None, metavar="C[,C...]",
                    help="coefficients the maneuver suggestions target, e.g. Cl,Cn (default: all, moment "
                         "coefficients first)")
+    r.add_argument("--can-log", default=None, metavar="FILE",
+                   help="recorded CAN log (.log/.asc/.blf/.csv): DroneCAN actuator positions and airspeed (docs/live.md)")
+    r.add_argument("--can-offset", type=float, default=None, metavar="S",
+                   help="seconds added to the CAN log's times (default 0 with a .tlog; required with a .bin)")
     r.add_argument("--quiet", action="store_true", help="no progress display")
 
     s = sub.add_parser("simulate", help="simulate a flight with the project's 6-DOF model and write a tlog")
@@ -123,7 +127,8 @@ def _replay_options(a: argparse.Namespace):
 
     return ReplayOptions(rate_hz=a.rate, holdout=a.holdout, t_from=a.t_from, t_to=a.t_to,
                          model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say,
-                         targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")))
+                         targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")),
+                         can_log=a.can_log, can_offset=a.can_offset)
 
 
 def _check_replay(a: argparse.Namespace) -> None:

@@ -57,6 +57,9 @@ class ReplayOptions:
             first; :class:`gcs_sysid.maneuvers.ManeuverConfig`).
         notify: called with each one-line note the user should see at once (the damage found in the
             log, :attr:`gcs_sysid.telemetry.Flight.damage`); None: notes go to the report only.
+        can_log: a recorded CAN log (DroneCAN actuator status, airspeed) merged on the vehicle time
+            axis (:mod:`gcs_sysid.telemetry.can_merge`); None: none.
+        can_offset: s added to the CAN log's times (None: 0 with a .tlog; required with a .bin).
     """
 
     rate_hz: float = 50.0
@@ -70,6 +73,8 @@ class ReplayOptions:
     parallel: bool = True
     notify: Callable[[str], None] | None = None
     targets: tuple[str, ...] | None = None
+    can_log: str | None = None
+    can_offset: float | None = None
 
 
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
@@ -92,6 +97,10 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.model_in:
         check_model_state(options.model_in)
     check_log(log)
+    if options.can_log is not None:
+        from .telemetry.can_merge import check_can_log
+
+        check_can_log(options.can_log, log, options.can_offset)
     airframe = load_airframe(airframe_path)
     if out_dir is not None and options.write:
         check_out_dir(out_dir, "--out", REPLAY_OUTPUTS)
@@ -241,6 +250,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         if options.notify is not None:
             for note in flight.damage:
                 options.notify(f"damaged log: {note}")
+        if options.can_log is not None:
+            from .telemetry.can_merge import merge_can_log
+
+            flight = merge_can_log(flight, log, options.can_log, options.can_offset)
         flight = cut_window(flight, options.t_from, options.t_to)
         with _stage("estimate states", timings, bar) as prog:
             states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper)

@@ -25,6 +25,7 @@ from .ekf import dcm, smooth_attitude
 from .rates import HOLDS, normal_force_input, smooth_rates
 from .smoothers import smooth_level, smooth_velocity
 from .kalman import noise_std
+from .measured import surface_controls
 from .states import FlightStates
 
 __all__ = ["estimate_states", "V_FLOOR", "RATE_OK_HZ", "RATE_MIN_HZ"]
@@ -186,12 +187,14 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
 
     # --- controls -------------------------------------------------------------------------------
     servo_rate = al.rates.get("servo", 0.0)
-    if al.has("servo"):
-        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels if f"pwm{ch}" in al.values["servo"]}
-        ctrl = airframe.controls_from_pwm(pwm)
+    if al.has("servo") or airframe.can_actuators:   # measured surface positions (DroneCAN) beat PWM
+        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels
+               if al.has("servo") and f"pwm{ch}" in al.values["servo"]}
+        ctrl, csrc, cnotes = surface_controls(al, airframe, pwm)
         for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
             if k in ctrl:
-                data[k], sources[k] = ctrl[k], f"servo PWM (zero-order hold) through the {airframe.name} servo map"
+                data[k], sources[k] = ctrl[k], csrc[k]
+        notes.extend(cnotes)
     mix = airframe.mixing
     for i, k in enumerate(("delta_e", "delta_a", "delta_r")):
         if k in data:

@@ -37,12 +37,15 @@ does no selection work.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, solve_triangular
 
 from .sparse import Stats
 
-__all__ = ["se_kernel", "chol_kmm", "projection", "project_stats", "exchange_inducing"]
+__all__ = ["se_kernel", "chol_kmm", "projection", "project_stats", "exchange_inducing", "RefreshBudget",
+           "light_refresh"]
 
 
 def se_kernel(X1: np.ndarray, X2: np.ndarray, lengthscale: np.ndarray) -> np.ndarray:
@@ -146,3 +149,51 @@ def exchange_inducing(Z: np.ndarray, lengthscale: np.ndarray, candidates: np.nda
         rest_z[drop] = rest_c[j]
         swaps += 1
     return Z, swaps
+
+
+@dataclass(frozen=True)
+class RefreshBudget:
+    """How much a light hyperparameter refresh (:func:`light_refresh`) may do.
+
+    Attributes:
+        steps: most Adam steps on the VFE bound (the full refresh: ``GPConfig.steps``, 200).
+        rows: random stored rows the bound is evaluated on (full: ``n_train_max``, 1000).
+        local_steps: most Adam steps of the local layer, from its variogram start as in a fit (full:
+            ``local_steps``, 40); its store is rebuilt on the new global residuals either way.
+        reselect: choose the ``M`` inducing inputs again by mutual information (full: yes). Without it
+            the streamed exchange (:func:`exchange_inducing`) has already kept them on the envelope.
+    """
+
+    steps: int = 40
+    rows: int = 1000
+    local_steps: int = 40
+    reselect: bool = False
+
+
+def light_refresh(model, budget: RefreshBudget = RefreshBudget()):
+    """A hyperparameter refresh at a fraction of a full one's cost: warm start, few steps, a subset.
+
+    The refresh of :meth:`gcs_sysid.gp.LocalGlobalGP.refresh_hyperparameters` (Adam on the VFE bound,
+    then the statistics again, the local layer again) run under a smaller budget: ``budget.steps``
+    Adam steps (one run, no halfway re-selection) warm-started from the current hyperparameters on
+    ``budget.rows`` random stored rows, the inducing inputs kept unless ``budget.reselect``. A warm
+    start is most of the work already done: the bound is near its optimum except along the
+    length-scales the new region changed, which the first tens of steps move (Adam at the fit's
+    learning rate, 0.05 in log length-scale per step). The statistics are still recomputed exactly
+    for the stored rows (``O(store_max M^2)``; the projection for evicted rows as before).
+
+    Args:
+        model: a :class:`gcs_sysid.gp.LocalGlobalGP` with stored rows.
+        budget: :class:`RefreshBudget`.
+
+    Returns:
+        The refreshed model, with the original :class:`~gcs_sysid.gp.GPConfig`.
+
+    Raises:
+        DataError: fewer than 3 stored rows (as the full refresh).
+    """
+    cfg = model.config
+    light = replace(cfg, steps=int(budget.steps), n_train_max=int(min(budget.rows, cfg.n_train_max)),
+                    reselect=False, local_steps=int(budget.local_steps))
+    new = replace(model, config=light).refresh_hyperparameters(reselect=budget.reselect)
+    return replace(new, config=cfg)

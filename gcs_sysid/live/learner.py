@@ -52,6 +52,10 @@ class LearnOptions:
         refresh_every: steps between refreshes of the confidence map and the suggestions.
         max_rows: learned rows kept for the confidence map (every other one is dropped when full).
         n_inducing: inducing points of the global GP (None: the GP's default).
+        hyper_every: rows learned between light hyperparameter refreshes of the GP
+            (:func:`gcs_sysid.gp.streaming.light_refresh`: warm start, 40 Adam steps on 1,000 stored
+            rows; so the length-scales follow an envelope that grows); 0: never.
+        max_window_s: longest window (stamp time) a step decodes when steps were coalesced (below).
     """
 
     window_s: float = 30.0
@@ -62,6 +66,8 @@ class LearnOptions:
     refresh_every: int = 3
     max_rows: int = 20000
     n_inducing: int | None = None
+    hyper_every: int = 15000
+    max_window_s: float | None = None
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -86,6 +92,24 @@ class Learner:
         identifiable: coefficient -> (ok, why) of the latest window.
         notes: what happened (reboots, skipped windows), in order.
         steps: steps run; timings: stage -> seconds of the last step.
+        can_source: optional callable returning DroneCAN streams on the host clock (the session's
+            :meth:`~gcs_sysid.telemetry.can.CanListener.streams`, or a decoded ``can.log``); each window
+            then gets them merged on its vehicle time (:mod:`gcs_sysid.telemetry.can_merge`; only CAN
+            samples stamped up to the window's last record, so a replay of ``raw.tlog`` + ``can.log``
+            sees what the session saw), and measured surface positions replace PWM per the airframe's
+            ``[[can_actuator]]`` map.
+        control_sources: control -> where the latest window's deflections came from (PWM or CAN).
+        behind: optional callable, True while the learner is behind its input (the session: too many
+            records queued). Then a due step is *coalesced* into the next one (the window keeps every
+            record since the start of the last window decoded, up to ``max_window_s``, so no row is
+            left out; one smoothing pass over the longer window instead of several overlapping ones)
+            and the confidence map and suggestions wait until it has caught up. Neither happens when
+            it keeps up; the stamps of the steps merged are kept (``coalesced_at``, in
+            ``session.json`` as ``coalesced_at_us``), so a replay of ``raw.tlog`` given them
+            (:func:`learn_from_tlog`'s ``coalesced_at``) follows the same schedule and learns exactly
+            what the session learned.
+        coalesced, refreshes_deferred: steps merged and map refreshes put off while behind.
+        coalesced_at: stamps (us) of the records at which a due step was merged into the next.
     """
 
     airframe: Airframe
@@ -99,6 +123,12 @@ class Learner:
     notes: list[str] = field(default_factory=list)
     steps: int = 0
     timings: dict[str, float] = field(default_factory=dict)
+    can_source: object = None
+    control_sources: dict = field(default_factory=dict)
+    behind: object = None
+    coalesced: int = 0
+    refreshes_deferred: int = 0
+    coalesced_at: list = field(default_factory=list)
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -113,6 +143,12 @@ class Learner:
         self.Y = np.zeros((0, len(COEFFICIENTS)))
         self.t = np.zeros(0)
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
+        self._hold_us: int | None = None         # keep records from here while steps are coalesced
+        self._last_step_us: int | None = None
+        self._refresh_due = False
+        self._since_hyper = 0
+        self._due_us = 0
+        self._replayed: set | None = None     # coalesced stamps of a session being replayed
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -120,13 +156,26 @@ class Learner:
         """Add one record; run a step when its stamp reaches the schedule. Returns True if a step ran."""
         w = self._window
         w.append((stamp_us, packet))
+        opt = self.options
         if self._next_step_us is None:
-            self._next_step_us = stamp_us + int(self.options.window_s * 1e6)
-        horizon = stamp_us - int(self.options.window_s * 1e6)
+            self._next_step_us = stamp_us + int(opt.window_s * 1e6)
+        horizon = stamp_us - int(opt.window_s * 1e6)
+        if self._hold_us is not None:   # steps coalesced: keep the records since the last window's start
+            longest = opt.max_window_s if opt.max_window_s is not None else 4.0 * opt.window_s
+            horizon = max(min(horizon, self._hold_us), stamp_us - int(longest * 1e6))
         while w and w[0][0] < horizon:
             w.popleft()
         if stamp_us >= self._next_step_us:
-            self._next_step_us = stamp_us + int(self.options.step_s * 1e6)
+            self._next_step_us = stamp_us + int(opt.step_s * 1e6)
+            self._due_us = stamp_us
+            if self.behind is not None and self._last_step_us is not None and self.behind():
+                if self._hold_us is None:
+                    self._hold_us = self._last_step_us - int(opt.window_s * 1e6)
+                self.coalesced += 1
+                self.coalesced_at.append(int(stamp_us))
+                return False
+            self._hold_us = None
+            self._last_step_us = stamp_us
             self.step()
             return True
         return False
@@ -152,7 +201,10 @@ class Learner:
             flight = read_tlog("live window", data)
             if not flight.streams:
                 raise SysidError("no usable messages in the window")
+            if self.can_source is not None:
+                flight = self._merge_can(flight, data)
             states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz)
+            self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
         except SysidError as exc:
             self.notes.append(f"step {self.steps}: window skipped ({exc})")
@@ -174,9 +226,33 @@ class Learner:
         self._t_done = max(end, start) if start is not None else end
         self._learn(table, rows)
         t2 = time.perf_counter()
-        if self.model is not None and (final or self.steps % self.options.refresh_every == 0):
-            self.refresh()
+        if self.model is not None and (final or self._refresh_due or self.steps % self.options.refresh_every == 0):
+            if not final and self.behind is not None and self._replayed is None and self.behind():
+                self._refresh_due = True            # the map and suggestions wait until caught up
+                self.refreshes_deferred += 1
+            else:
+                self._refresh_due = False
+                self.refresh()
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": time.perf_counter() - t2}
+
+    def _merge_can(self, flight, data: bytes):
+        """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
+        from ..telemetry.can_merge import host_clock_of_tlog, merge_can_streams
+
+        last = self._window[-1][0] * 1e-6
+        streams = {}
+        for name, st in self.can_source().items():
+            m = st.t <= last
+            if m.sum() >= 2:
+                streams[name] = type(st)(st.name, st.source, st.t[m], {k: v[m] for k, v in st.fields.items()})
+        if not streams:
+            return flight
+        try:
+            return merge_can_streams(flight, streams, host_clock_of_tlog("live window", data), 0.0, "CAN bus")
+        except InputError as exc:
+            if not any(n.startswith("CAN not merged") for n in self.notes):
+                self.notes.append(f"CAN not merged (step {self.steps}): {exc}")
+            return flight
 
     def _learn(self, table: CoefficientTable, rows: np.ndarray) -> None:
         from ..gp import GPConfig, fit_gp
@@ -211,6 +287,20 @@ class Learner:
         if ok.any():
             self.model = self.model.update(X[ok], Y[ok][:, cols])
             self.n_learned += int(ok.sum())
+            self._since_hyper += int(ok.sum())
+            if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
+                self._refresh_hyper()
+
+    def _refresh_hyper(self) -> None:
+        """A light hyperparameter refresh of the GP (warm start, few steps; ``docs/live.md``)."""
+        from ..gp.streaming import RefreshBudget, light_refresh
+
+        self._since_hyper = 0
+        try:
+            self.model = light_refresh(self.model, RefreshBudget())
+            self.notes.append(f"step {self.steps}: GP hyperparameters refreshed (light) after {self.n_learned} rows")
+        except SysidError as exc:
+            self.notes.append(f"step {self.steps}: GP hyperparameters not refreshed ({exc})")
 
     def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray) -> None:
         self.X = np.concatenate([self.X, X])
@@ -272,14 +362,31 @@ def iter_tlog_records(path: str | Path):
         pos += 8 + plen
 
 
-def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions = LearnOptions()) -> Learner:
+def learn_from_tlog(path: str | Path, airframe: Airframe, options: LearnOptions = LearnOptions(),
+                    can_log: str | Path | None = None, coalesced_at=None) -> Learner:
     """Feed a tlog (e.g. a live session's ``raw.tlog``) through a fresh :class:`Learner`.
+
+    Args:
+        path: the tlog.
+        airframe: the airframe.
+        options: the schedule.
+        can_log: the session's ``can.log`` (or any CAN log on the same host clock), merged per window.
+        coalesced_at: the session's ``coalesced_at_us`` (``session.json``): the steps it merged while
+            behind are merged here too, so the schedule and the model are the session's.
 
     Returns:
         The learner after :meth:`Learner.finish`: the model a live session with the same records
         and options ends with.
     """
     learner = Learner(airframe, options)
+    if coalesced_at:
+        learner._replayed = {int(x) for x in coalesced_at}
+        learner.behind = lambda: learner._due_us in learner._replayed
+    if can_log is not None:
+        from ..telemetry.can import read_can_log
+
+        streams, _ = read_can_log(can_log)
+        learner.can_source = lambda: streams
     for stamp_us, packet in iter_tlog_records(path):
         learner.feed(stamp_us, packet)
     learner.finish()

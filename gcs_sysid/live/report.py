@@ -29,10 +29,19 @@ def render_markdown(snap: dict) -> str:
     if snap.get("can"):
         c = snap["can"]
         lines.append(f"- CAN: {c['frames']} frames in `{c['log']}`, DroneCAN transfers {c['transfers']}, "
-                     f"failed {c['bad']} (decoded and logged; not yet used by the estimation)")
+                     f"failed {c['bad']}")
+        src = snap.get("control_sources") or {}
+        measured = [k for k, v in src.items() if "DroneCAN" in v]
+        lines.append("- controls measured by DroneCAN actuators (latest window): "
+                     + (", ".join(measured) if measured else "none (no [[can_actuator]] map, or no actuator "
+                        "in the data: commanded PWM used)"))
     if "samples_learned" in snap:
         lines.append(f"- samples learned: {snap['samples_learned']} in {snap['steps']} steps; "
                      f"model: `{snap.get('model', 'none (too few samples)')}`")
+        if snap.get("steps_coalesced") or snap.get("map_refreshes_deferred"):
+            lines.append(f"- the learner fell behind: {snap.get('steps_coalesced', 0)} steps coalesced, "
+                         f"{snap.get('map_refreshes_deferred', 0)} map refreshes deferred (to replay `raw.tlog` on the "
+                         "same schedule pass `coalesced_at_us` to `learn_from_tlog`)")
     lines += ["", "## Rates", "", "| message | mean received Hz | asked Hz | request | short at check |",
               "|---|---|---|---|---|"]
     asked, mean = snap.get("asked", {}), snap.get("mean_rates", {})

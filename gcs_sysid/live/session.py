@@ -29,6 +29,9 @@ TICK_S = 0.25
 _EDGE = {"RAW_IMU", "SCALED_IMU", "HIGHRES_IMU", "ATTITUDE", "VFR_HUD", "AOA_SSA"}
 
 
+BEHIND_RECORDS = 2000
+"""Records waiting for the learner beyond which it counts as behind (1 s at 2,000 msg/s)."""
+
 @dataclass(frozen=True)
 class ListenOptions:
     """Options of :func:`run_listen`.
@@ -93,7 +96,10 @@ class LiveSession:
             if options.can:
                 from ..telemetry.can import CanListener, open_bus
 
-                self.can = CanListener(open_bus(options.can), self.out / "can.log")
+                keep = 2.0 * options.learn.window_s if options.learn is not None else 60.0
+                self.can = CanListener(open_bus(options.can), self.out / "can.log", keep_s=max(keep, 60.0))
+                if self.learner is not None:   # measured surface positions and airspeed into each window
+                    self.learner.can_source = self.can.streams
             self.raw = RawLog(self.out / "raw.tlog")
             self._q: queue.Queue = queue.Queue()
             self._msgs: queue.Queue = queue.Queue()
@@ -111,6 +117,8 @@ class LiveSession:
             self._stop = threading.Event()
             self._closed: dict | None = None
             self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
+            if self.learner is not None:   # behind: coalesce steps, defer the map (Learner.behind)
+                self.learner.behind = lambda: self._q.qsize() > BEHIND_RECORDS
         except BaseException:   # a bad CAN bus, Ctrl-C during the imports: give the link back
             if link is None:
                 self.link.close()
@@ -255,6 +263,9 @@ class LiveSession:
                 "identifiable": {k: list(v) for k, v in learner.identifiable.items()},
                 "top_suggestion": learner.suggestions[0].reason if learner.suggestions else None,
                 "learner_notes": list(learner.notes), "timings": dict(learner.timings),
+                "control_sources": dict(learner.control_sources), "steps_coalesced": learner.coalesced,
+                "map_refreshes_deferred": learner.refreshes_deferred,
+                "coalesced_at_us": list(learner.coalesced_at),
             })
         return snap
 

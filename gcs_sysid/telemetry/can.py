@@ -32,6 +32,7 @@ from gcs_sysid.telemetry.types import Stream
 
 __all__ = ["CanDecoder", "read_can_log", "CanListener", "open_bus", "frames_of"]
 
+TRIM_EVERY = 1000   #: transfers between trims of a bounded decoder's samples
 _ACTUATOR = "uavcan.equipment.actuator.Status"
 _IAS = "uavcan.equipment.air_data.IndicatedAirspeed"
 _TAS = "uavcan.equipment.air_data.TrueAirspeed"
@@ -55,17 +56,30 @@ class CanDecoder:
         samples: stream name -> field -> list of (t s, value) (SI).
         counts: DroneCAN type name -> transfers decoded; ``bad`` transfers failing their checks;
         frames: CAN frames seen (extended ids only: DroneCAN uses 29-bit ids).
+        keep_s: samples older than this (s, bus clock) behind the newest are dropped (checked every
+            :data:`TRIM_EVERY` transfers), so a live session's memory stays bounded; None keeps all
+            (reading a log).
     """
 
     samples: dict = field(default_factory=lambda: defaultdict(lambda: defaultdict(list)))
     counts: Counter = field(default_factory=Counter)
     bad: int = 0
     frames: int = 0
+    keep_s: float | None = None
 
     def __post_init__(self):
         _, dronecan = _libs()
         self._dc = dronecan
         self._tm = dronecan.transport.TransferManager()
+        self._since_trim = 0
+        self._newest = -np.inf
+
+    def _trim(self) -> None:
+        horizon = self._newest - self.keep_s
+        for fields in self.samples.values():
+            for k, lst in fields.items():
+                if lst and lst[0][0] < horizon:
+                    fields[k] = [x for x in lst if x[0] >= horizon]
 
     def feed(self, msg) -> None:
         """One python-can ``Message``."""
@@ -89,6 +103,12 @@ class CanDecoder:
         self.counts[kind] += 1
         t = float(frames[0].ts_monotonic)
         s = self.samples
+        if self.keep_s is not None:
+            self._newest = max(self._newest, t)
+            self._since_trim += 1
+            if self._since_trim >= TRIM_EVERY:
+                self._since_trim = 0
+                self._trim()
         if kind == _ACTUATOR:
             s[f"actuator{int(payload.actuator_id)}"]["pos"].append((t, float(payload.position)))
         elif kind == _IAS:
@@ -166,14 +186,15 @@ class CanListener:
     Args:
         bus: an open python-can bus (:func:`open_bus`).
         log_path: where every received frame is written.
+        keep_s: decoded samples kept in memory, s of bus time (None: all); the log keeps every frame.
     """
 
-    def __init__(self, bus, log_path: str | Path):
+    def __init__(self, bus, log_path: str | Path, keep_s: float | None = None):
         can, _ = _libs()
         self.bus = bus
         self.log_path = Path(log_path)
         self._writer = can.Logger(str(self.log_path))
-        self.decoder = CanDecoder()
+        self.decoder = CanDecoder(keep_s=keep_s)
         self.received = 0
         self._stop = threading.Event()
         self._lock = threading.Lock()
@@ -192,6 +213,11 @@ class CanListener:
                 self._writer.on_message_received(msg)
                 self.received += 1
                 self.decoder.feed(msg)
+
+    def streams(self) -> dict[str, Stream]:
+        """A snapshot of the decoded streams (bus clock; :meth:`CanDecoder.streams`), thread-safe."""
+        with self._lock:
+            return self.decoder.streams()
 
     def summary(self) -> dict:
         """Frames received, transfers decoded by type, failed transfers."""

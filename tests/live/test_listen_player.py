@@ -71,7 +71,8 @@ def test_listen_matches_replay_and_speaks_back(tmp_path):
     # the live model = the model learned again from raw.tlog (same windows, rows, fit, updates)
     live = session.learner
     assert live.model is not None and snap["samples_learned"] > 1000 and live.steps >= 3
-    again = learn_from_tlog(tmp_path / "live" / "raw.tlog", airframe, LEARN)
+    again = learn_from_tlog(tmp_path / "live" / "raw.tlog", airframe, LEARN,
+                            coalesced_at=snap["coalesced_at_us"])   # steps merged while behind, if any
     assert again.n_learned == live.n_learned and again.outputs == live.outputs
     m1, v1 = live.model.predict(live.X)
     m2, v2 = again.model.predict(live.X)
