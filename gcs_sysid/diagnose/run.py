@@ -114,7 +114,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
 
 
 def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None = None,
-                 t_to: float | None = None, progress=None, output_error: bool = True, notify=None, **kw):
+                 t_to: float | None = None, progress=None, output_error: bool = True, notify=None,
+                 reference_log=None, **kw):
     """``gcs-sysid diagnose``: hold the model against the log; write diagnosis.json, model_extended.toml, report.html.
 
     Args:
@@ -122,6 +123,8 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
         t_from, t_to: vehicle-time window, s.
         output_error: also run the output-error comparison (needs ``gcs_sysid.sim.propagate``).
         notify: called with one line per damage found in the log (None: not shown).
+        reference_log: the log the model was fitted on (same airframe): with ``search=True`` the
+            sparse search is differential against it (:mod:`gcs_sysid.diagnose.sparse`).
         **kw: passed to :func:`gcs_sysid.diagnose.core.diagnose`.
 
     Returns:
@@ -134,6 +137,9 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     model = load_model(model_path)
     with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
+        if reference_log is not None:
+            ref = load_measurements(reference_log, airframe_path, progress=progress, notify=notify)
+            kw["search_reference"] = (ref.table, ref.states)
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag
