@@ -113,33 +113,41 @@ def _library(ctx: DiagContext, knots=None) -> tuple[list[str], np.ndarray]:
     return candidate_library(ctx, lags_s=_LAGS_S, alpha_knots=knots)
 
 
-def _ridge_cv(Phi: np.ndarray, r: np.ndarray, folds: int, max_rows: int,
-              lambdas=(1e-4, 1e-3, 1e-2, 1e-1, 1.0)) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """Ridge regression of ``r`` on all standardised candidates, the ridge chosen by block CV.
+def _ridge_cv(Phi: np.ndarray, Y: np.ndarray, folds: int, max_rows: int,
+              lambdas=(1e-4, 1e-3, 1e-2, 1e-1, 1.0)) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Ridge regression of each column of ``Y`` on all standardised candidates, the ridge chosen by block CV.
+
+    One eigendecomposition per fold serves every ridge and every column.
+
+    Args:
+        Phi: (N, K) candidates. Y: (N, m) targets.
 
     Returns:
-        (w (K,), column means (K,), column scales (K,), chosen relative ridge).
+        (W (K, m), column means (K,), column scales (K,), chosen relative ridge per column (m,)).
     """
-    rows = np.arange(len(r))[:: max(1, int(np.ceil(len(r) / max_rows)))]
+    rows = np.arange(len(Y))[:: max(1, int(np.ceil(len(Y) / max_rows)))]
     mu = Phi[rows].mean(axis=0)
     sc = Phi[rows].std(axis=0)
     sc = np.where(sc > 0, sc, 1.0)
     A = (Phi[rows] - mu) / sc
-    y = r[rows] - r[rows].mean()
-    fold = np.minimum((np.arange(rows.size) * folds) // rows.size, folds - 1)
-    Gk = np.stack([A[fold == k].T @ A[fold == k] for k in range(folds)])
-    bk = np.stack([A[fold == k].T @ y[fold == k] for k in range(folds)])
-    G, b, n = Gk.sum(0), bk.sum(0), A.shape[0]
-    best, best_e = lambdas[0], np.inf
-    for lam in lambdas:
-        e = 0.0
-        for k in range(folds):
-            w = np.linalg.solve(G - Gk[k] + lam * n * np.eye(G.shape[0]), b - bk[k])
-            res = y[fold == k] - A[fold == k] @ w
-            e += res @ res
-        if e < best_e:
-            best, best_e = lam, e
-    return np.linalg.solve(G + best * n * np.eye(G.shape[0]), b), mu, sc, float(best)
+    Yc = Y[rows] - Y[rows].mean(axis=0)
+    n = A.shape[0]
+    fold = np.minimum((np.arange(n) * folds) // n, folds - 1)
+    lam = np.asarray(lambdas, float)
+    err = np.zeros((lam.size, Y.shape[1]))
+    for k in range(folds):
+        m = fold == k
+        ev, U = np.linalg.eigh(A[~m].T @ A[~m])
+        bU = U.T @ (A[~m].T @ Yc[~m])                       # (K, m)
+        AU = A[m] @ U                                       # (n_k, K)
+        for i, l in enumerate(lam):
+            W = bU / (np.maximum(ev, 0.0) + l * n)[:, None]
+            err[i] += np.sum((Yc[m] - AU @ W) ** 2, axis=0)
+    best = lam[np.argmin(err, axis=0)]
+    ev, U = np.linalg.eigh(A.T @ A)
+    bU = U.T @ (A.T @ Yc)
+    W = U @ (bU / (np.maximum(ev, 0.0)[:, None] + best[None, :] * n))
+    return W, mu, sc, best
 
 
 def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
@@ -206,15 +214,17 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         rnames, rPhi = _library(rctx, knots)
         rtr, rte = _segments(rctx, segment_frac)
         Rr = np.nan_to_num(np.asarray(Rr, float))
+        rows = np.r_[rtr, rte]
+        ridge = _ridge_cv(rPhi[rows], Rr[rows], folds, max_rows) if th.get("inadequacy", "ridge") == "ridge" \
+            and rtr.size >= 20 * folds else None
         for j, coef in enumerate(COEFFICIENTS):
             if not (ctx.active[j] and rctx.active[j]) or rtr.size < 20 * folds:
                 continue
-            rows = np.r_[rtr, rte]
-            if th.get("inadequacy", "ridge") == "ridge":
-                w, mu, sc, lam = _ridge_cv(rPhi[rows], Rr[rows, j], folds, max_rows)
-                base[:, j] = ((Phi - mu) / sc) @ w
-                result["inadequacy"].append({"coefficient": coef, "model": "ridge", "lambda": lam,
-                                             "rms_explained": float(np.std(((rPhi[rows] - mu) / sc) @ w))})
+            if ridge is not None:
+                W, mu, sc, lam = ridge
+                base[:, j] = ((Phi - mu) / sc) @ W[:, j]
+                result["inadequacy"].append({"coefficient": coef, "model": "ridge", "lambda": float(lam[j]),
+                                             "rms_explained": float(np.std(((rPhi[rows] - mu) / sc) @ W[:, j]))})
             else:
                 idx = {n: i for i, n in enumerate(names)}
                 entry, _ = _fit_coefficient(rnames, rPhi, Rr[:, j], rows, rte[:0], folds, th, max_rows)
