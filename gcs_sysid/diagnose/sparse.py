@@ -24,9 +24,10 @@ and never named (flights differ by offsets that are no term). Three steps:
 
 Each coefficient's first selected term gets a *score*, the fractional drop of the block PRESS it
 gives, and the terms of all coefficients are ranked by it. A term is *named* when its score is
-at least ``min_press_drop`` and the untouched-segment gain of its coefficient is at least
-``min_gain_pct`` (thresholds in :data:`THRESHOLDS`, frozen on 2026-11-21 before the final
-evaluation). Lag terms of one surface name ``delay:<surface>`` with the lag as the estimate.
+at least ``min_press_drop``, the untouched-segment gain of its coefficient is at least
+``min_gain_pct`` and its estimate is at least ``min_abs_t`` coloured standard errors from zero
+(thresholds in :data:`THRESHOLDS`, frozen on 2026-11-21 at 21:35 UTC before the final evaluation;
+set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag terms of one surface name ``delay:<surface>`` with the lag as the estimate.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
-              "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge"}
+              "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -243,8 +244,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             entry, _ = _fit_coefficient(names, Phi, Rd[:, j], tr, te, folds, th, max_rows)
             entry["coefficient"] = coef
             entries.append(entry)
-            if entry["terms"] and entry["score"] >= th["min_press_drop"] \
-                    and entry["held_out"]["percent"] >= th["min_gain_pct"]:
+            t0 = entry["terms"][0] if entry["terms"] else None
+            if t0 and entry["score"] >= th["min_press_drop"] and entry["held_out"]["percent"] >= th["min_gain_pct"] \
+                    and t0["std_error"] > 0 and abs(t0["estimate"]) >= th["min_abs_t"] * t0["std_error"]:
                 cands.append((entry["score"], coef, entry))
         if rnd == 0:
             result["coefficients"] = entries
