@@ -109,17 +109,18 @@ def score_case(findings: list[dict], truth: dict) -> dict:
 
 
 def _cases(aircraft, seeds, clean_seeds, pairs):
-    """First seed's effects, the clean flights and the pairs, then the other seeds (partial runs stay balanced)."""
+    """Large sizes of the first seed, the clean flights and the pairs, then the small sizes, then the
+    other seeds (a run cut short stays balanced over effects)."""
     for ac in aircraft:
         for k, seed in enumerate(seeds):
-            for name in EFFECTS:
-                for size in SIZES[name]:
-                    yield ac, seed, [Effect(name, size)]
-            if k == 0:
-                for cs in clean_seeds:
-                    yield ac, cs, []
-                for (a, b) in pairs:
-                    yield ac, seed, [Effect(a, SIZES[a][1]), Effect(b, SIZES[b][1])]
+            for i in (1, 0):
+                for name in EFFECTS:
+                    yield ac, seed, [Effect(name, SIZES[name][i])]
+                if k == 0 and i == 1:
+                    for cs in clean_seeds:
+                        yield ac, cs, []
+                    for (a, b) in pairs:
+                        yield ac, seed, [Effect(a, SIZES[a][1]), Effect(b, SIZES[b][1])]
 
 
 def main(argv=None) -> int:
