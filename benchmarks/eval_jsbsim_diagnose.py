@@ -37,7 +37,7 @@ if str(REPO) not in sys.path:
 from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "main"]
+__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -123,6 +123,37 @@ def _cases(aircraft, seeds, clean_seeds, pairs):
                         yield ac, seed, [Effect(a, SIZES[a][1]), Effect(b, SIZES[b][1])]
 
 
+def summarize(paths: list[str]) -> str:
+    """A markdown table of ``results.jsonl`` files: per aircraft and effect, cases passing each score."""
+    recs = [json.loads(ln) for p in paths for ln in Path(p).read_text().splitlines() if ln.strip()]
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for r in recs:
+        key = "clean" if not r["effects"] else " + ".join(e[0] for e in r["effects"])
+        groups.setdefault((r["aircraft"], key), []).append(r)
+    out = ["| aircraft | injected | cases | top | estimate within 25 % | gain >= 50 % | all three | 2-se coverage | what was named (estimate - model, truth) |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for (ac, key), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "clean", kv[0][1])):
+        if key == "clean":
+            ok = sum(r["score"]["ok"] for r in rs)
+            named = sorted({c for r in rs for c in r["score"].get("named", [])})
+            out.append(f"| {ac} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | {', '.join(named) or '-'} |")
+            continue
+        rows = [e for r in rs for e in r["score"].get("effects", [])]
+        n = len(rows)
+        found = [e for e in rows if e["found"]]
+        desc = "; ".join(
+            f"s{r['seed']} " + ", ".join(
+                f"{e['cause']} {e['estimate']:.3g} ({e['value']:.3g})" if e["found"] else
+                f"[{', '.join(r['score'].get('named', [])[:2]) or 'nothing'}] ({e['value']:.3g})"
+                for e in r["score"].get("effects", []))
+            for r in rs)
+        out.append(f"| {ac} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
+                   f"{sum(bool(e.get('est')) for e in rows)}/{n} | {sum(bool(e.get('gain')) for e in rows)}/{n} | "
+                   f"{sum(bool(r['score']['ok']) for r in rs)}/{len(rs)} | "
+                   f"{sum(bool(e.get('cover')) for e in found)}/{len(found)} | {desc} |")
+    return "\n".join(out)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
@@ -131,7 +162,11 @@ def main(argv=None) -> int:
     p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
     p.add_argument("--pairs", nargs="*", default=["Cm:alpha^2,Cn:delta_a", "Cl:alpha*beta,delay:delta_e"])
     p.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "diag-effects"))
+    p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
     a = p.parse_args(argv)
+    if a.summary:
+        print(summarize(a.summary))
+        return 0
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     pairs = [tuple(x.split(",")) for x in a.pairs]

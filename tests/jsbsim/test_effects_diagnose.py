@@ -111,3 +111,21 @@ def test_more_effects_are_found(tmp_path, ac, name):
     findings, truth, _ = diagnose_case(ac, 2, [Effect(name, SIZES[name][1])], tmp_path, model_path, ref)
     sc = score_case(findings, truth)
     assert sc["effects"][0]["top"] and sc["effects"][0].get("est"), sc
+
+
+def test_summary_table_counts_each_score(tmp_path):
+    from benchmarks.eval_jsbsim_diagnose import summarize
+
+    hit = {"cause": "Cn:delta_a", "value": -0.06, "found": True, "top": True, "estimate": -0.058,
+           "std_error": 0.002, "est": True, "gain_pct": 70.0, "gain": True, "cover": True}
+    miss = {"cause": "Cn:delta_a", "value": -0.03, "found": False, "top": False}
+    recs = [{"aircraft": "c172x", "seed": 1, "effects": [["Cn:delta_a", -0.06]], "score": {"ok": True, "effects": [hit], "named": ["Cn:delta_a"]}},
+            {"aircraft": "c172x", "seed": 2, "effects": [["Cn:delta_a", -0.03]], "score": {"ok": False, "effects": [miss], "named": ["CX:alpha"]}},
+            {"aircraft": "c172x", "seed": 11, "effects": [], "score": {"ok": False, "named": ["CX:alpha"]}}]
+    p = tmp_path / "r.jsonl"
+    p.write_text("\n".join(json.dumps(r) for r in recs) + "\n")
+    lines = summarize([str(p)]).splitlines()
+    row = next(ln for ln in lines if "| Cn:delta_a |" in ln)
+    assert "| 2 | 1/2 | 1/2 | 1/2 | 1/2 | 1/1 |" in row and "[CX:alpha]" in row
+    clean = next(ln for ln in lines if "| clean |" in ln)
+    assert "no named cause 0/1" in clean and "CX:alpha" in clean
