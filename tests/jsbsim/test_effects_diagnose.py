@@ -19,7 +19,7 @@ from gcs_sysid.diagnose import diagnose, run_fit
 from gcs_sysid.diagnose.run import load_measurements
 from gcs_sysid.sim.model_file import load_model
 
-SHORT_S = 60.0
+SHORT_S = 90.0
 
 
 def _stock(name):
@@ -49,7 +49,7 @@ def test_xml_edits_add_the_terms_and_leave_the_stock_file_alone():
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
-    """A clean 60-s c172x flight (seed 100) and the model fitted on it."""
+    """A clean 90-s c172x flight (seed 100) and the model fitted on it."""
     out = tmp_path_factory.mktemp("effects")
     files = make_effect_flight(FlightConfig("c172x", duration_s=SHORT_S, seed=100), [], out, stem="ref")
     run_fit(files.tlog, files.airframe, out / "ref.toml")
