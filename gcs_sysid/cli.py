@@ -93,6 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--model", required=True, help="the simulation's aerodynamic model TOML file")
     d.add_argument("--out", required=True, help="output directory")
     d.add_argument("--search", action="store_true", help="also search a wide term library (docs/diagnose.md)")
+    d.add_argument("--reference", metavar="LOG", help="with --search: the log the model was fitted on "
+                   "(differential sparse search, docs/diagnose.md)")
     _window_args(d)
 
     pr = sub.add_parser("predict", help="evaluate a saved model at given flight conditions (CSV in, CSV out)")
@@ -214,13 +216,17 @@ def _check_diagnose(a: argparse.Namespace) -> None:
     load_airframe(a.airframe)
     load_model(a.model)
     check_out_dir(a.out, "--out", DIAGNOSE_OUTPUTS)
+    if getattr(a, "reference", None) and not Path(a.reference).is_file():
+        from .errors import InputError
+
+        raise InputError(f"--reference {a.reference}: no such log file; expected the .tlog/.bin the model was fitted on")
 
 
 def _cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnose import run_diagnose
 
     diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to, search=a.search,
-                        notify=_say)
+                        notify=_say, reference_log=getattr(a, "reference", None))
     findings = diag.get("findings", []) if isinstance(diag, dict) else getattr(diag, "findings", [])
     print(f"wrote {Path(a.out) / 'diagnosis.json'}: {len(findings)} finding(s)")
     return 0

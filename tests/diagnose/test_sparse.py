@@ -71,3 +71,15 @@ def test_merge_puts_sensor_causes_first_and_drops_unconfirmed_terms():
     out = merge_findings(findings, sparse)
     assert [f["cause"] for f in out] == ["bias:airspeed", "Cn:delta_a"]
     assert out[1]["source"] == "sparse search"
+
+
+def test_cli_reference_log_must_exist(tmp_path, capsys):
+    from diag_flights import MODEL
+
+    from gcs_sysid.cli import main
+
+    log = AIRFRAME.parents[1] / "flights" / "sim-trainer-sysid.tlog"
+    rc = main(["diagnose", str(log), "--airframe", str(AIRFRAME), "--model", str(MODEL), "--out",
+               str(tmp_path / "out"), "--search", "--reference", str(tmp_path / "missing.tlog")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "--reference" in err[0] and "missing.tlog" in err[0], err
