@@ -26,7 +26,7 @@ Each coefficient's first selected term gets a *score*, the fractional drop of th
 gives, and the terms of all coefficients are ranked by it. A term is *named* when its score is
 at least ``min_press_drop``, the untouched-segment gain of its coefficient is at least
 ``min_gain_pct`` and its estimate is at least ``min_abs_t`` coloured standard errors from zero
-(thresholds in :data:`THRESHOLDS`, frozen on 2026-11-21 at 21:35 UTC before the final evaluation;
+(thresholds in :data:`THRESHOLDS`, frozen on 2026-11-21 at 21:30 UTC before the final evaluation;
 set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag terms of one surface name ``delay:<surface>`` with the lag as the estimate.
 """
 
