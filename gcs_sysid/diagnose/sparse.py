@@ -44,7 +44,8 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
-              "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0}
+              "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
+              "hierarchy_tol": 0.03}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -98,6 +99,61 @@ def select_terms(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: in
         th = stlsq(A, r, threshold)
         sel = [k for k, v in zip(sel, th) if v != 0.0]
     return sel, res["press"]
+
+
+def _block_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]) -> float:
+    """Block PRESS of least squares on columns ``cols`` of ``A`` (each fold predicted from the others)."""
+    p = 0.0
+    for k in range(int(fold.max()) + 1):
+        m = fold == k
+        th = np.linalg.lstsq(A[~m][:, cols], r[~m], rcond=None)[0]
+        p += float(np.sum((r[m] - A[m][:, cols] @ th) ** 2))
+    return p
+
+
+def _parents(name: str, index: dict[str, int]) -> list[int]:
+    """Library columns of the terms one factor lower than monomial ``name`` (``alpha*delta_t`` -> ``alpha``, ``delta_t``)."""
+    if "(" in name or name == "alpha_dot_hat":
+        return []
+    factors = []
+    for part in name.split("*"):
+        base, _, pw = part.partition("^")
+        factors += [base] * (int(pw) if pw else 1)
+    out = []
+    for i in range(len(factors)):
+        rest = factors[:i] + factors[i + 1:]
+        if not rest:
+            continue
+        parts = [n if rest.count(n) == 1 else f"{n}^{rest.count(n)}" for n in dict.fromkeys(rest)]
+        cand = "*".join(parts)
+        if cand in index:
+            out.append(index[cand])
+    return out
+
+
+def _prefer_lower_degree(A, r, fold, sel, names, tol):
+    """Replace a selected monomial by a term one factor lower when the block PRESS rises by less than ``tol``.
+
+    A product stands in for its factor when the other factor hardly moves (``alpha*delta_t`` for
+    ``alpha`` at near-constant throttle); as in the fit's stepwise rule, the simpler term wins.
+    """
+    index = {n: i for i, n in enumerate(names)}
+    sel = list(sel)
+    changed = True
+    while changed:
+        changed = False
+        base = _block_press(A, r, fold, sel)
+        for i, k in enumerate(sel):
+            for par in _parents(names[k], index):
+                if par in sel:
+                    continue
+                trial = sel[:i] + [par] + sel[i + 1:]
+                if _block_press(A, r, fold, trial) <= (1 + tol) * base:
+                    sel, changed = trial, True
+                    break
+            if changed:
+                break
+    return sel
 
 
 def _segments(ctx: DiagContext, segment_frac: float) -> tuple[np.ndarray, np.ndarray]:
@@ -159,6 +215,8 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
     fold = np.minimum((np.arange(sub.size) * folds) // sub.size, folds - 1)
     Pc = Phi[sub] - Phi[tr].mean(axis=0)
     sel, press = select_terms(Pc, r[sub], fold, th["max_terms"], th["min_step_gain"], th["stlsq_threshold"])
+    if sel and th.get("hierarchy_tol", 0.0) > 0:
+        sel = _prefer_lower_degree(Pc, r[sub], fold, sel, names, th["hierarchy_tol"])
     before = float(np.sqrt(np.mean(r[te] ** 2))) if te.size else 0.0
     out = {"terms": [], "press": press, "score": 0.0,
            "held_out": {"rms_before": before, "rms_after": before, "percent": 0.0}}
