@@ -403,6 +403,30 @@ def reference_context(reference, airframe, model) -> tuple[DiagContext, np.ndarr
     return rctx, rctx.Y - rctx.model_values()
 
 
+def _factors(term: str) -> list[str] | None:
+    """Factors of a monomial name (``alpha^2*beta`` -> alpha alpha beta); None for other terms."""
+    if "(" in term or term in ("1", "alpha_dot_hat"):
+        return None
+    out = []
+    for part in term.split("*"):
+        base, _, pw = part.partition("^")
+        out += [base] * (int(pw) if pw.isdigit() else 1)
+    return out
+
+
+def _factors_within(simple: str, product: str) -> bool:
+    """True when monomial ``simple`` is ``product`` with one or more factors left out."""
+    a, b = _factors(simple), _factors(product)
+    if a is None or b is None or len(a) >= len(b):
+        return False
+    rest = list(b)
+    for x in a:
+        if x not in rest:
+            return False
+        rest.remove(x)
+    return True
+
+
 def merge_findings(findings: list[dict], sparse: dict) -> list[dict]:
     """The diagnosis' findings with the sparse search's named terms put first.
 
@@ -414,7 +438,15 @@ def merge_findings(findings: list[dict], sparse: dict) -> list[dict]:
     """
     keep_first = [f for f in findings if f.get("evidence", {}).get("domain") == "data compatibility"
                   or f["cause"].startswith(("stuck:", "thrust_loss", "wind"))]
-    named = [dict(f, source="sparse search") for f in sparse.get("findings", [])]
+    named = []
+    for f in sparse.get("findings", []):
+        # hierarchy: a catalogue term of the same coefficient made of a subset of this product's
+        # factors (``Cm:alpha`` for ``Cm:alpha*delta_t``) was scored on held-out data and is simpler
+        coef, _, term = f["cause"].partition(":")
+        sub = next((g for g in findings if g["cause"].startswith(coef + ":")
+                    and _factors_within(g["cause"].split(":", 1)[1], term)), None)
+        named.append(dict(sub, source="catalogue (simpler than the search's " + f["cause"] + ")")
+                     if sub is not None else dict(f, source="sparse search"))
     causes = {f["cause"] for f in keep_first + named}
     rest = [f for f in findings if f not in keep_first and f["cause"] in causes]
     return keep_first + named + [f for f in rest if f["cause"] not in {n["cause"] for n in named}]

@@ -83,3 +83,12 @@ def test_cli_reference_log_must_exist(tmp_path, capsys):
                str(tmp_path / "out"), "--search", "--reference", str(tmp_path / "missing.tlog")])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and "--reference" in err[0] and "missing.tlog" in err[0], err
+
+
+def test_merge_keeps_the_simpler_catalogue_term():
+    cat = {"cause": "Cm:alpha", "coefficient": "Cm", "evidence": {}}
+    sparse = {"findings": [{"cause": "Cm:alpha*delta_t", "coefficient": "Cm", "evidence": {}}]}
+    out = merge_findings([cat], sparse)
+    assert [f["cause"] for f in out] == ["Cm:alpha"] and out[0]["source"].startswith("catalogue")
+    other = {"cause": "Cm:beta", "coefficient": "Cm", "evidence": {}}
+    assert [f["cause"] for f in merge_findings([other], sparse)] == ["Cm:alpha*delta_t"]
