@@ -3,7 +3,7 @@
 Simulates a 600-s sysid flight of the sample trainer with a hidden ``Cm:alpha`` error
 (calm-morning turbulence W20 = 1.5 m/s, default sensor noise), writes the tlog, then times ``run_diagnose``
 end to end and by stage, with bare pymavlink decoding of the same log as the baseline
-measured in the same run. Usage: ``python benchmarks/bench_diagnose.py [--minutes 10]``.
+measured in the same run. Usage: ``python benchmarks/bench_diagnose.py [--minutes 10] [--search]``.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ def bare_decode(path) -> tuple[float, int]:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--minutes", type=float, default=10.0)
+    ap.add_argument("--search", action="store_true", help="also the wide-library and sparse searches (--search)")
     args = ap.parse_args()
     from diag_flights import AIRFRAME, MODEL, effects, plan_doc
 
@@ -49,7 +50,7 @@ def main() -> None:
         t_sim = time.perf_counter() - t0
         t_dec, n_msg = bare_decode(log)
         t0 = time.perf_counter()
-        d = run_diagnose(log, AIRFRAME, MODEL, Path(tmp) / "out")
+        d = run_diagnose(log, AIRFRAME, MODEL, Path(tmp) / "out", search=args.search)
         t_diag = time.perf_counter() - t0
     print(f"flight: {args.minutes:g} min at 50 Hz, {len(r.t)} samples, {n_msg} MAVLink messages "
           f"(simulated and written in {t_sim:.1f} s)")

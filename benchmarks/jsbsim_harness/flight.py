@@ -110,8 +110,11 @@ class Recording:
     meta: dict = field(default_factory=dict)
 
 
-def load_model(spec: AircraftSpec, dt: float, seed: int = 0) -> jsbsim.FGFDMExec:
+def load_model(spec: AircraftSpec, dt: float, seed: int = 0, aircraft_path: str | None = None) -> jsbsim.FGFDMExec:
     """A JSBSim executive with ``spec``'s model loaded from the wheel's own data (no network).
+
+    ``aircraft_path``: a folder holding ``<model>/<model>.xml`` to load instead of the wheel's
+    (an edited copy, ``effects.py``); engines and systems still come from the wheel.
 
     Point masses off the aircraft's centre plane are emptied (the c172x carries an 80 lb mass at
     its right wing tip): the project's airframe file has no Ixy/Iyz, and JSBSim's moments of
@@ -120,6 +123,8 @@ def load_model(spec: AircraftSpec, dt: float, seed: int = 0) -> jsbsim.FGFDMExec
     jsbsim.FGJSBBase().debug_lvl = 0      # no start-up banner on stdout
     fdm = jsbsim.FGFDMExec(None)          # root dir: the wheel's packaged aircraft/engine/systems
     fdm.set_debug_level(0)
+    if aircraft_path is not None:
+        fdm.set_aircraft_path(str(aircraft_path))
     if not fdm.load_model(spec.model):
         raise RuntimeError(f"JSBSim could not load model '{spec.model}'")
     # the models' own <output> elements (the c172x writes JSBout172B.csv into the cwd) go nowhere
@@ -253,8 +258,10 @@ def _deflections(fdm: jsbsim.FGFDMExec, spec: AircraftSpec) -> tuple[float, floa
     return de, spec.aileron_sign * raw, spec.rudder_sign * fdm["fcs/rudder-pos-rad"]
 
 
-def fly(config: FlightConfig) -> Recording:
+def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
     """Fly ``config`` and return the truth on the log grid.
+
+    ``aircraft_path``: load an edited copy of the model from there (:func:`load_model`).
 
     Raises:
         ValueError: unknown aircraft or bad configuration.
@@ -265,7 +272,7 @@ def fly(config: FlightConfig) -> Recording:
     spec = aircraft(config.aircraft)
     dt = 1.0 / config.sim_rate_hz
     dec = int(round(config.sim_rate_hz / config.log_rate_hz))
-    fdm = load_model(spec, dt, config.seed)
+    fdm = load_model(spec, dt, config.seed, aircraft_path)
     _set_ic(fdm, spec, config)
     k_th, k_q, k_v, k_phi, k_p, k_r = spec.gains
     v_ref = fdm["velocities/vt-fps"] * FT

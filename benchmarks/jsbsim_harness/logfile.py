@@ -33,19 +33,21 @@ class FlightFiles:
     recording: Recording
 
 
-def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs") -> int:
+def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs", sensors: dict | None = None) -> int:
     """Write ``rec`` as a .tlog; returns the number of packets.
 
     Args:
         rec: the flight.
         path: output .tlog.
         aoa: AOA_SSA variant, ``"ahrs"`` or ``"vane"`` (:func:`~benchmarks.jsbsim_harness.sensors.make_sensors`).
+        sensors: the sensor streams to write (default ``make_sensors(rec, aoa)``; ``effects.py``
+            passes them with a sensor error added).
     """
     spec = aircraft(rec.config.aircraft)
     af = load_airframe(spec.airframe_path)
     tr = rec.truth
     result = SimpleNamespace(
-        t=rec.t, rate_hz=rec.config.log_rate_hz, sensors=make_sensors(rec, aoa), airframe=af,
+        t=rec.t, rate_hz=rec.config.log_rate_hz, sensors=make_sensors(rec, aoa) if sensors is None else sensors, airframe=af,
         commands={k: tr[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t")},
         truth={"psi": tr["psi"]}, seed=rec.config.seed,
         demand={},   # the harness's stabiliser demand is not recorded: no NAV_CONTROLLER_OUTPUT

@@ -143,7 +143,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
              min_rows: int = 500, unexplained_threshold_pct: float = 20.0, output_error: bool = True,
              min_gain_oe_pct: float = 45.0, project_gusts: bool = True, flight=None,
              fault_thresholds: FaultThresholds | None = None, search: bool = False,
-             references=None, progress=None) -> Diagnosis:
+             references=None, search_reference=None, progress=None) -> Diagnosis:
     """Hold a model against measured coefficients, name the cause(s), extend the model.
 
     Args:
@@ -173,11 +173,16 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         fault_thresholds: thresholds of the fault detection (default: the frozen ones).
         search: also search a wide candidate library for what each coefficient's residual still needs
             (:mod:`gcs_sysid.diagnose.search`: forward stepwise by block PRESS on the training rows, gain
-            measured once on the held-out rows); reported in ``data["search"]``, never as a named cause.
+            measured once on the held-out rows; reported in ``data["search"]``, never as a named cause),
+            and run the sparse search of :mod:`gcs_sysid.diagnose.sparse` (``data["sparse"]``), whose
+            named terms lead the findings (:func:`~gcs_sysid.diagnose.sparse.merge_findings`).
         references: reference flights (:class:`~gcs_sysid.diagnose.differential.Reference`; the flight(s)
             the model was fitted on): differential diagnosis (:mod:`gcs_sysid.diagnose.differential`):
             findings also present there move to ``model_inadequacy``, the rest are changes (with onset
             where the data show one); ``data["differential"]`` holds the comparison.
+        search_reference: ``(table, states)`` of the flight the model was fitted on, for the
+            differential sparse search (None: the first of ``references`` when given, else not
+            differential).
         progress: optional callable ``progress(message)``.
 
     Returns:
@@ -316,6 +321,12 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         say("diagnose: searching the wide candidate library")
         t1 = time.perf_counter()
         data["search"] = search_residual(ctx, R)
+        from .sparse import merge_findings, reference_context, sparse_search
+
+        if search_reference is None and references:   # the first reference flight makes the search differential
+            search_reference = (references[0].table, references[0].states)
+        data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0))
+        findings[:] = merge_findings(findings, data["sparse"])
         data["timings"]["search_s"] = float(time.perf_counter() - t1)
     if compat:
         data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],

@@ -27,19 +27,22 @@ import numpy as np
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from .context import DiagContext
 
-__all__ = ["candidate_library", "press_stepwise", "search_residual"]
+__all__ = ["candidate_library", "alpha_quantile_knots", "press_stepwise", "search_residual"]
 
 _BASE = ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "delta_a", "delta_r", "delta_t")
 
 
 def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
-                      lags_s: tuple[float, ...] = (0.05, 0.1, 0.2)) -> tuple[list[str], np.ndarray]:
+                      lags_s: tuple[float, ...] = (0.05, 0.1, 0.2),
+                      alpha_knots: np.ndarray | None = None) -> tuple[list[str], np.ndarray]:
     """The candidate terms, evaluated on every row.
 
     Args:
         ctx: the diagnosis context (regressors on a uniform time grid, training rows).
         degree: highest monomial degree. n_hinges: hinges in alpha at training quantiles.
         lags_s: lags of the surface lag corrections, s.
+        alpha_knots: hinge positions in alpha, rad (default: the ``n_hinges`` inner quantiles of
+            the training rows' alpha); give another flight's to share one library between flights.
 
     Returns:
         (names, Phi): names (K,) and values (T, K); constant columns left out.
@@ -58,8 +61,9 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
             out.append(v)
     a = cols["alpha"]
     tr = ctx.train
-    for q in np.linspace(0, 1, n_hinges + 2)[1:-1]:
-        ak = float(np.quantile(a[tr], q)) if tr.any() else 0.0
+    if alpha_knots is None:
+        alpha_knots = alpha_quantile_knots(ctx, n_hinges)
+    for ak in alpha_knots:
         names.append(f"max(0,alpha-{np.degrees(ak):.1f}deg)")
         out.append(np.maximum(0.0, a - ak))
     t = ctx.t
@@ -74,6 +78,13 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
     Phi = np.column_stack(out)
     keep = np.ptp(Phi[ctx.valid], axis=0) > 0 if ctx.valid.any() else np.zeros(Phi.shape[1], bool)
     return [n for n, k in zip(names, keep) if k], Phi[:, keep]
+
+
+def alpha_quantile_knots(ctx: DiagContext, n_hinges: int = 4) -> np.ndarray:
+    """The ``n_hinges`` inner quantiles of alpha on the training rows, rad (zeros without training rows)."""
+    a = np.nan_to_num(ctx.X[:, REGRESSORS.index("alpha")])
+    qs = np.linspace(0, 1, n_hinges + 2)[1:-1]
+    return np.quantile(a[ctx.train], qs) if ctx.train.any() else np.zeros(n_hinges)
 
 
 def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: int = 6,

@@ -1,0 +1,215 @@
+"""Hidden effects injected into JSBSim flights: does ``diagnose`` name them? (issue 9, items 2 and 5)
+
+For each aircraft: ``gcs-sysid fit`` (the library's :func:`run_fit`) on a clean 120-s reference
+flight (seed 100), then ``diagnose --search`` (differential against the reference flight, no
+output error) on 120-s flights with one effect of :mod:`benchmarks.jsbsim_harness.effects`
+injected, over seeds x sizes x effects, plus clean flights and two effects at once. The truth
+(``-effects.json``) is read only here, after the diagnosis.
+
+Score per case:
+  * ``top``: the injected cause is the top finding (for two effects: both among the findings);
+  * ``est``: the estimate within 25 % of the injected value (aero terms: estimate minus the
+    reference model's value of the term, i.e. the change);
+  * ``gain``: held-out gain of that finding >= 50 %;
+  * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);
+  * clean flights: ``ok`` when no cause is named.
+
+Usage::
+
+    python -m benchmarks.eval_jsbsim_diagnose --aircraft c172x sgs --seeds 1 2 3 --out benchmarks/out/diag
+    python -m benchmarks.eval_jsbsim_diagnose --aircraft pa28 --seeds 1 --out benchmarks/out/diag-pa28
+
+Prints a table and writes one JSON line per case to ``<out>/results.jsonl``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
+from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
+
+__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "main"]
+
+DURATION_S = 120.0
+REF_SEED = 100
+
+
+def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | None = None):
+    """:func:`make_effect_flight`, or the files already in ``out`` from an earlier run of the same case."""
+    from benchmarks.jsbsim_harness.aircraft import aircraft
+    from benchmarks.jsbsim_harness.logfile import FlightFiles
+
+    tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
+    stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
+    tlog = out / f"{stem}.tlog"
+    done = tlog.with_name(stem + "-effects.json")
+    if tlog.exists() and done.exists() and json.loads(done.read_text())["config"]["duration_s"] == config.duration_s:
+        return FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None)
+    return make_effect_flight(config, effects, out, stem=stem)
+
+
+def reference_model(ac: str, out: Path, duration_s: float = DURATION_S):
+    """Fly the clean reference flight, fit the model; returns (files, model path, measurements)."""
+    from gcs_sysid.diagnose import run_fit
+    from gcs_sysid.diagnose.run import load_measurements
+
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED), [], out, stem=f"{ac}-ref")
+    model_path = out / f"{ac}-ref-model.toml"
+    run_fit(files.tlog, files.airframe, model_path)
+    return files, model_path, load_measurements(files.tlog, files.airframe)
+
+
+def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_path: Path, ref_meas,
+                  duration_s: float = DURATION_S) -> tuple[list[dict], dict, float]:
+    """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis)."""
+    from gcs_sysid.diagnose import diagnose
+    from gcs_sysid.diagnose.run import load_measurements
+    from gcs_sysid.sim.model_file import load_model
+
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed), effects, out)
+    truth = json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text())
+    t0 = time.perf_counter()
+    meas = load_measurements(files.tlog, files.airframe)
+    diag = diagnose(meas.table, meas.airframe, load_model(model_path), meas.states, output_error=False,
+                    flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states))
+    return diag.findings, truth, time.perf_counter() - t0
+
+
+def score_case(findings: list[dict], truth: dict) -> dict:
+    """Scores of one case against its injected truth (see the module docstring)."""
+    inj = truth["injected"]
+    causes = [f["cause"] for f in findings]
+    if not inj:
+        return {"ok": not causes, "named": causes}
+    rows = []
+    for k, e in enumerate(inj):
+        f = next((f for f in findings if f["cause"] == e["cause"]), None)
+        row = {"cause": e["cause"], "value": e["value"], "found": f is not None,
+               "top": (causes[:1] == [e["cause"]]) if len(inj) == 1 else f is not None}
+        if f is not None:
+            est = f["estimate"] - (f.get("model_value", 0.0) if ":" in e["cause"] and not
+                                   e["cause"].startswith(("delay:", "bias:")) else 0.0)
+            se = float(f.get("std_error") or 0.0)
+            row.update(estimate=est, std_error=se, est=abs(est - e["value"]) <= 0.25 * abs(e["value"]),
+                       gain_pct=float(f["gain"].get("percent", 0.0)),
+                       gain=float(f["gain"].get("percent", 0.0)) >= 50.0,
+                       cover=se > 0 and abs(est - e["value"]) <= 2 * se)
+        rows.append(row)
+    return {"ok": all(r["top"] and r.get("est") and r.get("gain") for r in rows), "effects": rows,
+            "named": causes}
+
+
+def _cases(aircraft, seeds, clean_seeds, pairs):
+    """Large sizes of the first seed, the clean flights and the pairs, then the small sizes, then the
+    other seeds (a run cut short stays balanced over effects)."""
+    for ac in aircraft:
+        for k, seed in enumerate(seeds):
+            for i in (1, 0):
+                for name in EFFECTS:
+                    yield ac, seed, [Effect(name, SIZES[name][i])]
+                if k == 0 and i == 1:
+                    for cs in clean_seeds:
+                        yield ac, cs, []
+                    for (a, b) in pairs:
+                        yield ac, seed, [Effect(a, SIZES[a][1]), Effect(b, SIZES[b][1])]
+
+
+def summarize(paths: list[str]) -> str:
+    """A markdown table of ``results.jsonl`` files: per aircraft and effect, cases passing each score."""
+    recs = [json.loads(ln) for p in paths for ln in Path(p).read_text().splitlines() if ln.strip()]
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for r in recs:
+        key = "clean" if not r["effects"] else " + ".join(e[0] for e in r["effects"])
+        groups.setdefault((r["aircraft"], key), []).append(r)
+    out = ["| aircraft | injected | cases | top | estimate within 25 % | gain >= 50 % | all three | 2-se coverage | what was named (estimate - model, truth) |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for (ac, key), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "clean", kv[0][1])):
+        if key == "clean":
+            ok = sum(r["score"]["ok"] for r in rs)
+            named = sorted({c for r in rs for c in r["score"].get("named", [])})
+            out.append(f"| {ac} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | {', '.join(named) or '-'} |")
+            continue
+        rows = [e for r in rs for e in r["score"].get("effects", [])]
+        n = len(rows)
+        found = [e for e in rows if e["found"]]
+        desc = "; ".join(
+            f"s{r['seed']} " + ", ".join(
+                f"{e['cause']} {e['estimate']:.3g} ({e['value']:.3g})" if e["found"] else
+                f"[{', '.join(r['score'].get('named', [])[:2]) or 'nothing'}] ({e['value']:.3g})"
+                for e in r["score"].get("effects", []))
+            for r in rs)
+        out.append(f"| {ac} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
+                   f"{sum(bool(e.get('est')) for e in rows)}/{n} | {sum(bool(e.get('gain')) for e in rows)}/{n} | "
+                   f"{sum(bool(r['score']['ok']) for r in rs)}/{len(rs)} | "
+                   f"{sum(bool(e.get('cover')) for e in found)}/{len(found)} | {desc} |")
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
+    p.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
+    p.add_argument("--clean-seeds", nargs="+", type=int, default=[11, 12, 13, 14, 15])
+    p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
+    p.add_argument("--pairs", nargs="*", default=["Cm:alpha^2,Cn:delta_a", "Cl:alpha*beta,delay:delta_e"])
+    p.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "diag-effects"))
+    p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
+    a = p.parse_args(argv)
+    if a.summary:
+        print(summarize(a.summary))
+        return 0
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    pairs = [tuple(x.split(",")) for x in a.pairs]
+    refs = {}
+    lines = []
+    with open(out / "results.jsonl", "a") as fh:
+        for ac, seed, effects in _cases(a.aircraft, a.seeds, a.clean_seeds, pairs):
+            if a.effects and effects and not all(e.name in a.effects for e in effects):
+                continue
+            if ac not in refs:
+                refs[ac] = reference_model(ac, out)
+            _, model_path, ref_meas = refs[ac]
+            try:
+                findings, truth, secs = diagnose_case(ac, seed, effects, out, model_path, ref_meas)
+                sc = score_case(findings, truth)
+            except RuntimeError as exc:       # the aircraft left the envelope with that effect
+                sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
+            rec = {"aircraft": ac, "seed": seed, "effects": [[e.name, e.value] for e in effects],
+                   "score": sc, "diagnose_s": secs,
+                   "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
+                                | {"gain_pct": f.get("gain", {}).get("percent")} for f in findings]}
+            fh.write(json.dumps(rec, default=float) + "\n")
+            fh.flush()
+            lines.append(rec)
+            tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
+            ests = "; ".join(f"{r['cause']} est {r.get('estimate', float('nan')):.4g} (truth {r['value']:.4g}, "
+                             f"se {r.get('std_error', float('nan')):.2g}) gain {r.get('gain_pct', float('nan')):.0f}%"
+                             for r in sc.get("effects", []))
+            print(f"{ac:6s} s{seed:<3d} {tag:36s} {'PASS' if sc['ok'] else 'fail'}  named={sc.get('named')} {ests}"
+                  f"  [{secs:.0f} s]", flush=True)
+    eff = [r for r in lines if r["effects"]]
+    clean = [r for r in lines if not r["effects"]]
+    rows = [e for r in eff for e in r["score"].get("effects", [])]
+    if rows:
+        n = len(rows)
+        print(f"\neffect cases {len(eff)}: top {sum(r['top'] for r in rows)}/{n}, est within 25 % "
+              f"{sum(bool(r.get('est')) for r in rows)}/{n}, gain >= 50 % {sum(bool(r.get('gain')) for r in rows)}/{n}, "
+              f"all three {sum(bool(r['ok']) for r in (x['score'] for x in eff))}/{len(eff)}, "
+              f"2-sigma coverage {sum(bool(r.get('cover')) for r in rows if r['found'])}/{sum(r['found'] for r in rows)}")
+    if clean:
+        print(f"clean flights: no named cause {sum(r['score']['ok'] for r in clean)}/{len(clean)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

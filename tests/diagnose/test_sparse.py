@@ -1,0 +1,94 @@
+"""The differential sparse search (gcs_sysid/diagnose/sparse.py) on the project's synthetic flights."""
+
+import numpy as np
+import pytest
+
+from gcs_sysid.airframe import load_airframe
+from gcs_sysid.diagnose.context import DiagContext
+from gcs_sysid.diagnose.sparse import merge_findings, sparse_search, stlsq
+
+from diag_flights import AIRFRAME
+from diag_synthetic import BASE, measured
+
+
+@pytest.fixture(scope="module")
+def airframe():
+    return load_airframe(AIRFRAME)
+
+
+def _ctx(airframe, effects=(), seed=5, inadequacy=None):
+    """A synthetic flight of BASE with ``effects`` added to Y and an ``inadequacy`` shared with the reference."""
+    table, states = measured(BASE, seed=seed, hidden=None, duration=90.0)
+    for j, f in list(effects) + list(inadequacy or []):
+        table.Y[:, j] += f(table)
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    return ctx, ctx.Y - ctx.model_values()
+
+
+def test_stlsq_recovers_a_sparse_vector_and_prunes_the_rest():
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(800, 30))
+    theta = np.zeros(30)
+    theta[[2, 17]] = [0.8, -0.5]
+    y = A @ theta + 0.05 * rng.normal(size=800)
+    th = stlsq(A, y, threshold=0.1)
+    assert set(np.nonzero(th)[0]) == {2, 17}
+    assert th[[2, 17]] == pytest.approx([0.8, -0.5], abs=0.02)
+    assert stlsq(A, 0.01 * rng.normal(size=800), threshold=0.5).tolist() == [0.0] * 30
+
+
+# shared model inadequacy: present in the reference flight and in the flight under test
+_INADEQUATE = [(4, lambda t: -0.8 * np.maximum(0.0, t.x("alpha") - np.radians(4.0)))]
+
+
+def test_two_effects_at_once_are_both_named_and_the_shared_inadequacy_is_not(airframe):
+    ref = _ctx(airframe, seed=4, inadequacy=_INADEQUATE)
+    ctx, R = _ctx(airframe, [(5, lambda t: -0.08 * t.x("delta_a")), (3, lambda t: 2.0 * t.x("alpha") * t.x("beta"))],
+                  seed=5, inadequacy=_INADEQUATE)
+    res = sparse_search(ctx, R, reference=ref)
+    causes = {f["cause"]: f for f in res["findings"]}
+    assert set(causes) == {"Cn:delta_a", "Cl:alpha*beta"}, [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
+    assert causes["Cn:delta_a"]["estimate"] - causes["Cn:delta_a"]["model_value"] == pytest.approx(-0.08, rel=0.25)
+    assert causes["Cl:alpha*beta"]["estimate"] - causes["Cl:alpha*beta"]["model_value"] == pytest.approx(2.0, rel=0.25)
+    assert all(f["gain"]["percent"] >= 50 for f in causes.values()), [(c, f["gain"]) for c, f in causes.items()]
+    assert res["differential"] and res["segment"]["untouched_rows"] > 0
+    # without the reference, the same inadequacy is named as a cause of the flight: the differential step matters
+    alone = sparse_search(ctx, R)
+    assert any(f["coefficient"] == "Cm" for f in alone["findings"])
+
+
+def test_nothing_changed_nothing_named(airframe):
+    ref = _ctx(airframe, seed=4, inadequacy=_INADEQUATE)
+    ctx, R = _ctx(airframe, seed=6, inadequacy=_INADEQUATE)
+    res = sparse_search(ctx, R, reference=ref)
+    assert res["findings"] == [], [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
+
+
+def test_merge_puts_sensor_causes_first_and_drops_unconfirmed_terms():
+    findings = [{"cause": "cg_offset", "evidence": {}}, {"cause": "bias:airspeed", "evidence": {"domain": "data compatibility"}},
+                {"cause": "Cn:delta_a", "evidence": {}}]
+    sparse = {"findings": [{"cause": "Cn:delta_a", "evidence": {"domain": "sparse search"}}]}
+    out = merge_findings(findings, sparse)
+    assert [f["cause"] for f in out] == ["bias:airspeed", "Cn:delta_a"]
+    assert out[1]["source"] == "sparse search"
+
+
+def test_cli_reference_log_must_exist(tmp_path, capsys):
+    from diag_flights import MODEL
+
+    from gcs_sysid.cli import main
+
+    log = AIRFRAME.parents[1] / "flights" / "sim-trainer-sysid.tlog"
+    rc = main(["diagnose", str(log), "--airframe", str(AIRFRAME), "--model", str(MODEL), "--out",
+               str(tmp_path / "out"), "--search", "--reference", str(tmp_path / "missing.tlog")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "--reference" in err[0] and "missing.tlog" in err[0], err
+
+
+def test_merge_keeps_the_simpler_catalogue_term():
+    cat = {"cause": "Cm:alpha", "coefficient": "Cm", "evidence": {}}
+    sparse = {"findings": [{"cause": "Cm:alpha*delta_t", "coefficient": "Cm", "evidence": {}}]}
+    out = merge_findings([cat], sparse)
+    assert [f["cause"] for f in out] == ["Cm:alpha"] and out[0]["source"].startswith("catalogue")
+    other = {"cause": "Cm:beta", "coefficient": "Cm", "evidence": {}}
+    assert [f["cause"] for f in merge_findings([other], sparse)] == ["Cm:alpha*delta_t"]

@@ -1,0 +1,131 @@
+"""Hidden effects injected into JSBSim (benchmarks/jsbsim_harness/effects.py) and found by the
+differential sparse search of ``diagnose --search`` (gcs_sysid/diagnose/sparse.py); issue 9.
+
+Default suite: the XML edits themselves (no flight), the injected Cn:delta_a seen in the exact
+truth, one short flight with adverse yaw found as the top finding, and a clean flight on which
+the search must name nothing. Slow: more effects on both tuning aircraft.
+"""
+
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.eval_jsbsim_diagnose import score_case
+from benchmarks.jsbsim_harness import FlightConfig, aircraft
+from benchmarks.jsbsim_harness.effects import SIZES, Effect, inject_xml, make_effect_flight, stock_model_dir
+from gcs_sysid.diagnose import diagnose, run_fit
+from gcs_sysid.diagnose.run import load_measurements
+from gcs_sysid.sim.model_file import load_model
+
+SHORT_S = 90.0
+
+
+def _stock(name):
+    spec = aircraft(name)
+    return spec, ET.parse(stock_model_dir(spec) / f"{spec.model}.xml").getroot()
+
+
+def test_xml_edits_add_the_terms_and_leave_the_stock_file_alone():
+    spec, root = _stock("c172x")
+    before = ET.tostring(root)
+    new = inject_xml(root, spec, [Effect("Cn:delta_a", -0.06), Effect("delay:delta_e", 0.1),
+                                  Effect("CY:scale", 1.3)])
+    assert ET.tostring(root) == before                                   # a copy is edited
+    yaw = next(a for a in new.iter("axis") if a.get("name") == "YAW")
+    f = yaw.find("function[@name='aero/coefficient/injected_Cn_delta_a']")
+    assert f is not None and float(f.find("product/value").text) == pytest.approx(0.5 * -0.06 * spec.aileron_sign)
+    aero = new.find("aerodynamics")
+    props = [p.text.strip() for p in aero.iter("property")]
+    assert "fcs/elevator-pos-rad" not in props and "fcs/elevator-pos-delayed-rad" in props
+    delay = new.find("flight_control/channel/actuator/delay")
+    assert delay.get("type") == "frames" and delay.text == "20"          # 0.1 s at 200 Hz
+    side = next(a for a in new.iter("axis") if a.get("name") == "SIDE")
+    assert all(fn.find("product/value").text == "1.3" for fn in side.findall("function"))
+    with pytest.raises(ValueError, match="unknown effect"):
+        Effect("Cm:sin(alpha)", 1.0)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """A clean 90-s c172x flight (seed 100) and the model fitted on it."""
+    out = tmp_path_factory.mktemp("effects")
+    files = make_effect_flight(FlightConfig("c172x", duration_s=SHORT_S, seed=100), [], out, stem="ref")
+    run_fit(files.tlog, files.airframe, out / "ref.toml")
+    return out, load_model(out / "ref.toml"), load_measurements(files.tlog, files.airframe)
+
+
+def _diagnose(reference, effects, seed):
+    out, model, ref = reference
+    files = make_effect_flight(FlightConfig("c172x", duration_s=SHORT_S, seed=seed), effects, out)
+    truth = json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text())
+    meas = load_measurements(files.tlog, files.airframe)
+    diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=False, search=True,
+                    search_reference=(ref.table, ref.states))
+    return diag, truth, files
+
+
+def test_adverse_yaw_is_the_top_finding_with_its_size(reference):
+    diag, truth, files = _diagnose(reference, [Effect("Cn:delta_a", SIZES["Cn:delta_a"][1])], seed=2)
+    # the effect is in the exact truth: Cn against delta_a moved by the injected amount
+    d = np.load(files.truth, allow_pickle=True)
+    X, Y = d["X"], d["Y"]
+    A = np.column_stack([np.ones(len(X)), X[:, 1], X[:, 2], X[:, 4], X[:, 6], X[:, 7]])
+    cn_da = np.linalg.lstsq(A, Y[:, 5], rcond=None)[0][4]
+    assert cn_da == pytest.approx(-0.005 - 0.06, abs=0.01)
+    sc = score_case(diag.findings, truth)
+    assert diag.findings and diag.findings[0]["cause"] == "Cn:delta_a", sc
+    row = sc["effects"][0]
+    assert row["est"], row                                       # within 25 % of -0.06
+    assert diag.data["sparse"]["differential"]
+
+
+def test_clean_flight_gets_no_named_term(reference):
+    diag, truth, _ = _diagnose(reference, [], seed=3)
+    assert truth["injected"] == []
+    assert diag.data["sparse"]["findings"] == [], diag.data["sparse"]["findings"]
+    aero = [f["cause"] for f in diag.findings if f["cause"].split(":")[0] in ("CX", "CY", "CZ", "Cl", "Cm", "Cn")]
+    assert aero == [], diag.findings
+
+
+def test_score_case_fails_a_wrong_or_invented_cause():
+    truth = {"injected": [{"cause": "Cn:delta_a", "value": -0.06}]}
+    good = [{"cause": "Cn:delta_a", "estimate": -0.065, "std_error": 0.003, "model_value": -0.005,
+             "gain": {"percent": 70.0}}]
+    assert score_case(good, truth)["ok"]
+    assert not score_case([{"cause": "cg_offset", "estimate": 0.1, "std_error": 0.01, "gain": {"percent": 80}}]
+                          + good, truth)["ok"]
+    off = [dict(good[0], estimate=-0.02)]
+    assert not score_case(off, truth)["ok"]
+    assert not score_case(good, {"injected": []})["ok"]        # a clean flight with a named cause
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ac,name", [("c172x", "delay:delta_e"), ("sgs", "Cn:delta_a"), ("sgs", "CY:scale"),
+                                     ("c172x", "Cl:alpha*beta")])
+def test_more_effects_are_found(tmp_path, ac, name):
+    from benchmarks.eval_jsbsim_diagnose import diagnose_case, reference_model
+
+    _, model_path, ref = reference_model(ac, tmp_path)
+    findings, truth, _ = diagnose_case(ac, 2, [Effect(name, SIZES[name][1])], tmp_path, model_path, ref)
+    sc = score_case(findings, truth)
+    assert sc["effects"][0]["top"] and sc["effects"][0].get("est"), sc
+
+
+def test_summary_table_counts_each_score(tmp_path):
+    from benchmarks.eval_jsbsim_diagnose import summarize
+
+    hit = {"cause": "Cn:delta_a", "value": -0.06, "found": True, "top": True, "estimate": -0.058,
+           "std_error": 0.002, "est": True, "gain_pct": 70.0, "gain": True, "cover": True}
+    miss = {"cause": "Cn:delta_a", "value": -0.03, "found": False, "top": False}
+    recs = [{"aircraft": "c172x", "seed": 1, "effects": [["Cn:delta_a", -0.06]], "score": {"ok": True, "effects": [hit], "named": ["Cn:delta_a"]}},
+            {"aircraft": "c172x", "seed": 2, "effects": [["Cn:delta_a", -0.03]], "score": {"ok": False, "effects": [miss], "named": ["CX:alpha"]}},
+            {"aircraft": "c172x", "seed": 11, "effects": [], "score": {"ok": False, "named": ["CX:alpha"]}}]
+    p = tmp_path / "r.jsonl"
+    p.write_text("\n".join(json.dumps(r) for r in recs) + "\n")
+    lines = summarize([str(p)]).splitlines()
+    row = next(ln for ln in lines if "| Cn:delta_a |" in ln)
+    assert "| 2 | 1/2 | 1/2 | 1/2 | 1/2 | 1/1 |" in row and "[CX:alpha]" in row
+    clean = next(ln for ln in lines if "| clean |" in ln)
+    assert "no named cause 0/1" in clean and "CX:alpha" in clean
