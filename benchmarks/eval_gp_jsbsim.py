@@ -16,7 +16,8 @@ the held-out rows against the truth:
 Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
 ``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),
 ``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the default
-settings), ``global`` = ``nigp`` without the local layer, ``indep`` six
+settings), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
+of the least-squares model (LS as the prior mean), ``indep`` six
 independent one-output GPs (same settings, each its own hyperparameters), and ``ls`` (cached).
 
 Usage::
@@ -44,7 +45,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 
-VARIANTS = ("diag", "full", "nigp", "global", "indep", "ls")
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "ls")
 
 
 def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
@@ -86,6 +87,8 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=variant == "full", input_noise=False)
     if variant == "nigp":
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "lsres":
+        return replace(base, noise_correlation=True, input_noise=True)
     if variant == "global":
         return replace(base, noise_correlation=True, input_noise=True, local=False)
     raise ValueError(variant)
@@ -112,9 +115,10 @@ def score(path: Path, variants, base: GPConfig = GPConfig()) -> list[dict]:
             mean = np.column_stack([m for m, _ in parts])
             sig = np.sqrt(np.column_stack([s for _, s in parts]))
         else:
-            model, _ = fit_gp(X[tr], Y[tr], _config(v, base))
+            prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
+            model, _ = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
             m, var = model.predict(X[h], include_noise=False)
-            mean, sig = m, np.sqrt(var)
+            mean, sig = m + prior[h], np.sqrt(var)
             c = model.output_correlation()
             corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
         e, cv = errors(mean, Yt[h]), coverage(mean, sig, Yt[h])

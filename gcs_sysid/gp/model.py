@@ -312,19 +312,20 @@ class LocalGlobalGP:
             X_query: ``(Q, D)`` where the variance is wanted.
 
         Returns:
-            ``(Q, P)`` predictive variance, data units squared.
+            ``(Q, P)`` predictive variance, data units squared, without the input-noise term
+            (what more data can reduce; ``predict(..., input_noise=False)``).
         """
         enable_x64()
         Xe, _ = self._standardise_query(X_extra)
         if len(Xe) == 0:
-            return self.predict(X_query, include_noise)[1]
+            return self.predict(X_query, include_noise, input_noise=False)[1]
         zeros = np.zeros((len(Xe), self.n_outputs))
         extra = self._with_stats(add_stats(self.stats, global_stats(self.params, Xe, zeros, self.config.batch_size)))
         if self.store is not None:
             X_all = np.vstack([self.store.X, Xe])
             store = build_store(X_all, np.vstack([self.store.resid, zeros]), self.store.metric, self.store.k)
             extra = replace(extra, _store=store)
-        return extra.predict(X_query, include_noise)[1]
+        return extra.predict(X_query, include_noise, input_noise=False)[1]
 
     def global_variance_after_many(self, X_extras, X_queries, include_noise: bool = False
                                    ) -> list[tuple[np.ndarray, np.ndarray]]:
