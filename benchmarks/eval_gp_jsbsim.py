@@ -10,7 +10,8 @@ the held-out rows against the truth:
 
   err     100 * RMS(model - truth) / RMS(truth) per coefficient, model at the measured regressors
   cov     share of the truth inside the model's 95 % band (sigma without observation noise: the truth
-          has none), per coefficient, and the median over the six
+          has none), per coefficient, and the median over the six; ``cov_noise``: with the noise (the
+          band the replay reports)
   corr    the largest |learned output correlation| of the global layer (``output_correlation``)
 
 Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
@@ -94,39 +95,41 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
     raise ValueError(variant)
 
 
-def score(path: Path, variants, base: GPConfig = GPConfig()) -> list[dict]:
-    """Every variant on one cached flight; one JSON-able dict per variant."""
+def score(path: Path, variants, base: GPConfig = GPConfig()):
+    """Every variant on one cached flight; yields one JSON-able dict per variant."""
     d = np.load(path)
     X, Y, Xt, Yt = d["X"], d["Y"], d["Xt"], d["Yt"]
     ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
     tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
     h = d["held"] & ok
     meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
-    rows = []
     for v in variants:
         t0 = time.perf_counter()
         corr = float("nan")
         if v == "ls":
             mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
+            sig_n = sig
         elif v == "indep":
             cfg = _config(v, base)
             parts = [fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0].predict(X[h], False)
                      for p in range(Y.shape[1])]
             mean = np.column_stack([m for m, _ in parts])
             sig = np.sqrt(np.column_stack([s for _, s in parts]))
+            sig_n = sig * np.nan
         else:
             prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
             model, _ = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
             m, var = model.predict(X[h], include_noise=False)
             mean, sig = m + prior[h], np.sqrt(var)
+            sig_n = np.sqrt(model.predict(X[h])[1])                         # with the observation noise (the replay's band)
             c = model.output_correlation()
             corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
-        e, cv = errors(mean, Yt[h]), coverage(mean, sig, Yt[h])
-        rows.append(dict(meta, variant=v, err=dict(zip(COEFFICIENTS, e.round(2).tolist())),
-                         cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())), max_corr=corr,
+        e, cv, cvn = errors(mean, Yt[h]), coverage(mean, sig, Yt[h]), coverage(mean, sig_n, Yt[h])
+        yield (dict(meta, variant=v, err=dict(zip(COEFFICIENTS, e.round(2).tolist())),
+                         cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())),
+                         cov_noise=dict(zip(COEFFICIENTS, cvn.round(1).tolist())), max_corr=corr,
                          meas=dict(zip(COEFFICIENTS, errors(Y[h], Yt[h]).round(2).tolist())),
                          t_fit_s=round(time.perf_counter() - t0, 2)))
-    return rows
 
 
 def summarize(paths) -> str:
@@ -135,15 +138,18 @@ def summarize(paths) -> str:
     groups: dict[tuple, list[dict]] = {}
     for r in rows:
         groups.setdefault((r["aircraft"], r["turbulence"], r["aoa"], r["variant"]), []).append(r)
-    head = "| aircraft | turb. | AOA_SSA | model | seeds | " + " | ".join(COEFFICIENTS) + " | cov95 % (median) | max corr |"
+    head = ("| aircraft | turb. | AOA_SSA | model | seeds | " + " | ".join(COEFFICIENTS)
+            + " | cov95 % latent (min-max) | cov95 % with noise (min-max) | max corr |")
     out = [head, "|" + "---|" * (head.count("|") - 1)]
     for (ac, turb, aoa, v), rs in sorted(groups.items()):
         med = lambda k, c: float(np.nanmedian([r[k][c] for r in rs]))   # noqa: E731
-        cov = float(np.nanmedian([np.nanmedian(list(r["cov"].values())) for r in rs]))
+        def cov(key):
+            vals = [x for r in rs for x in r.get(key, {}).values() if np.isfinite(x)]
+            return f"{np.median(vals):.0f} ({min(vals):.0f}-{max(vals):.0f})" if vals else ""
         corr = float(np.nanmedian([r["max_corr"] for r in rs]))
         name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
         out.append(f"| {name} | {turb} | {aoa} | {v} | {len(rs)} | " + " | ".join(f"{med('err', c):.1f}" for c in COEFFICIENTS)
-                   + f" | {'' if np.isnan(cov) else f'{cov:.0f}'} | {'' if np.isnan(corr) else f'{corr:.2f}'} |")
+                   + f" | {cov('cov')} | {cov('cov_noise')} | {'' if np.isnan(corr) else f'{corr:.2f}'} |")
     # pairwise: joint (full) vs independent, GP vs least squares, per flight and coefficient
     by = {}
     for r in rows:

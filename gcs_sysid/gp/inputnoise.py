@@ -42,7 +42,9 @@ def _gradient_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array) 
     alpha = solve_triangular(post.Lm.T, post.weights[:M], lower=False)          # (M, P)
     K = ARDSquaredExponential(params.lengthscale)(Xs, params.Z)                 # (N, M)
     KA = K @ alpha                                                              # (N, P)
-    KZA = jnp.einsum("nm,md,mp->ndp", K, params.Z, alpha)                      # (N, D, P)
+    M, D, P = params.Z.shape[0], params.Z.shape[1], alpha.shape[1]
+    ZA = (params.Z[:, :, None] * alpha[:, None, :]).reshape(M, D * P)             # one GEMM for all d, p
+    KZA = (K @ ZA).reshape(-1, D, P)                                            # (N, D, P)
     g = (KZA - Xs[:, :, None] * KA[:, None, :]) / (params.lengthscale**2)[None, :, None]
     return jnp.transpose(g + post.weights[M + 1:][None], (0, 2, 1))            # (N, P, D)
 

@@ -176,3 +176,13 @@ def test_saved_model_keeps_noise_and_input_noise_and_version_2_files_load(noisy_
     for a, b in zip(old.predict(X_meas[:20]), back.predict(X_meas[:20])):
         np.testing.assert_allclose(a, b, rtol=1e-9)
     assert back.elbo() == pytest.approx(old.elbo(), rel=1e-10)
+
+
+def test_mean_gradient_equals_autodiff_of_the_global_mean(noisy_input_case):
+    from gcs_sysid.gp.inputnoise import mean_gradient
+
+    model, X_meas, _, _ = noisy_input_case
+    Xs = model.scaler.x(X_meas[:7])
+    got = mean_gradient(model.params, model.post, Xs, batch=4)            # two chunks, one padded
+    ref = jax.vmap(jax.jacfwd(lambda x: sparse.mean_global_chunk(model.params, model.post, x[None])[0]))(jnp.asarray(Xs))
+    np.testing.assert_allclose(got, np.asarray(ref), rtol=1e-8, atol=1e-10)
