@@ -126,7 +126,8 @@ class LocalGlobalGP:
 
         Args:
             X: ``(N, D)`` regressors in data units (rows with NaN give NaN outputs).
-            include_noise: add the observation noise (of the local layer when present).
+            include_noise: add the observation noise: per output the larger of the global
+                layer's likelihood noise and the local layer's nugget.
             input_noise: the regressors are estimates (a flight's table): add the variance that
                 their errors carry through the mean's slope, ``grad m^T Sigma_x grad m``
                 (McHutchon and Rasmussen 2011, eq. 4; when ``input_var`` was learned). False for
@@ -145,7 +146,11 @@ class LocalGlobalGP:
         if self.local_params is not None and self.store is not None:
             ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
             mean, var = mean + ml, var + vl
-            noise = np.asarray(self.local_params.noise)
+            # the larger of the two layers' noise variances: the local nugget, learned from
+            # nearest-neighbour differences of 50 Hz rows that share a gust's error, sees only the
+            # white part of the noise; the global layer's likelihood noise also holds the coloured
+            # part (docs/gp.md, "Noise"; measured on JSBSim flights, docs/benchmarks.md)
+            noise = np.maximum(noise, np.asarray(self.local_params.noise))
         if include_noise:
             var = var + noise[None, :]
         if input_noise and self.input_var is not None and len(Xs):
