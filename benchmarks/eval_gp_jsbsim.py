@@ -77,8 +77,9 @@ def errors(est: np.ndarray, ref: np.ndarray) -> np.ndarray:
 
 
 def coverage(mean: np.ndarray, sigma: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """Share (%) of ``ref`` inside ``mean +- 1.96 sigma``, per column ``(P,)``."""
-    return 100.0 * np.mean(np.abs(mean - ref) <= 1.96 * sigma, 0)
+    """Share (%) of ``ref`` inside ``mean +- 1.96 sigma``, per column ``(P,)`` (NaN without a sigma)."""
+    out = 100.0 * np.mean(np.abs(mean - ref) <= 1.96 * sigma, 0)
+    return np.where(np.all(np.isnan(sigma), 0), np.nan, out)
 
 
 def _config(variant: str, base: GPConfig) -> GPConfig:
@@ -148,7 +149,8 @@ def summarize(paths) -> str:
     for (ac, turb, aoa, v), rs in sorted(groups.items()):
         med = lambda k, c: float(np.nanmedian([r[k][c] for r in rs]))   # noqa: E731
         def cov(key):
-            vals = [x for r in rs for x in r.get(key, {}).values() if np.isfinite(x)]
+            vals = [x for r in rs if r["variant"] != "ls" for x in r.get(key, {}).values()
+                    if x is not None and np.isfinite(x)]
             return f"{np.median(vals):.0f} ({min(vals):.0f}-{max(vals):.0f})" if vals else ""
         corr = float(np.nanmedian([r["max_corr"] for r in rs]))
         name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
