@@ -16,8 +16,8 @@ the held-out rows against the truth:
 
 Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
 ``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),
-``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the default
-settings), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
+``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the shipped
+default is the input noise without ``full``, for the replay's speed), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
 of the least-squares model (LS as the prior mean), ``indep`` six
 independent one-output GPs (same settings, each its own hyperparameters), and ``ls`` (cached).
 

@@ -55,7 +55,9 @@ class GPConfig:
         swap_pool: stored rows standing for the unselected set in the exchange criterion.
         noise_correlation: learn a full ``P x P`` noise covariance in the likelihood of the
             global layer (cross-correlated noise: a gust moves several coefficients at once),
-            not only one variance per output; ``docs/gp.md``, "Noise".
+            not only one variance per output; ``docs/gp.md``, "Noise". Off by default: on the
+            JSBSim flights it lowered the errors a little (0.1-1.5 points) but costs ~0.2 s CPU
+            per fit in the replay, which is at its speed limit (``docs/benchmarks.md``).
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
@@ -91,7 +93,7 @@ class GPConfig:
     swap_threshold: float = 0.1
     swap_pool: int = 256
     hyper_every: int = 0
-    noise_correlation: bool = True
+    noise_correlation: bool = False
     input_noise: bool = True
 
     def __post_init__(self):

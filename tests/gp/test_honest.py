@@ -61,7 +61,7 @@ def _independent_outputs(n, rho, seed):
     return X, F + rng.standard_normal((n, 3)) @ np.linalg.cholesky(C).T, F
 
 
-CFG = replace(FAST, local=False, input_noise=False)
+CFG = replace(FAST, local=False, input_noise=False, noise_correlation=True)
 
 
 def test_correlated_noise_is_learned_in_the_likelihood_not_the_output_covariance():
