@@ -140,6 +140,8 @@ def score(path: Path, variants, base: GPConfig = GPConfig()):
 def summarize(paths) -> str:
     """Markdown table (medians over seeds) of ``--json`` lines."""
     rows = [json.loads(line) for p in paths for line in open(p) if line.strip()]
+    last = {(r["aircraft"], r["seed"], r["turbulence"], r["aoa"], r["variant"]): r for r in rows}   # a rerun replaces
+    rows = list(last.values())
     groups: dict[tuple, list[dict]] = {}
     for r in rows:
         groups.setdefault((r["aircraft"], r["turbulence"], r["aoa"], r["variant"]), []).append(r)
@@ -160,7 +162,8 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("full", "ls"), ("nigp", "ls"), ("full", "diag")):
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("full", "ls"), ("nigp", "ls"), ("full", "diag"),
+                 ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]
         if pairs:
             wins = sum(x < y for x, y in pairs)
