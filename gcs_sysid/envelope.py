@@ -294,10 +294,11 @@ def model_variance(fn: Any, *args: Any) -> np.ndarray:
     import inspect
 
     try:
-        takes = "include_noise" in inspect.signature(fn).parameters
+        params = inspect.signature(fn).parameters
     except (TypeError, ValueError):
-        takes = False
-    out = fn(*args, include_noise=False) if takes else fn(*args)
+        params = {}
+    kw = {k: False for k in ("include_noise", "input_noise") if k in params}   # epistemic only (docs/gp.md)
+    out = fn(*args, **kw)
     return np.asarray(out[1] if isinstance(out, tuple) else out, float)
 
 

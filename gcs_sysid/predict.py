@@ -125,8 +125,9 @@ def predict_conditions(model, X: np.ndarray, output_names=None) -> Predictions:
         X: regressors, (N, 10), SI.
         output_names: names of the model's outputs (default: the first P of :data:`COEFFICIENTS`).
     """
-    mean, var_obs = model.predict(X, include_noise=True)
-    _, var = model.predict(X, include_noise=False)
+    # the user's conditions are exact (no estimated regressors): no input-noise variance (docs/gp.md)
+    mean, var_obs = model.predict(X, include_noise=True, input_noise=False)
+    _, var = model.predict(X, include_noise=False, input_noise=False)
     names = tuple(output_names or COEFFICIENTS[: model.n_outputs])
     return Predictions(np.asarray(X), names, np.asarray(mean), np.sqrt(np.asarray(var)),
                        np.sqrt(np.asarray(var_obs)))

@@ -53,6 +53,14 @@ class GPConfig:
         swap_threshold: least unexplained prior variance ``sigma^2(x | Z)`` (standardised,
             of 1) of a new row for it to be considered.
         swap_pool: stored rows standing for the unselected set in the exchange criterion.
+        noise_correlation: learn a full ``P x P`` noise covariance in the likelihood of the
+            global layer (cross-correlated noise: a gust moves several coefficients at once),
+            not only one variance per output; ``docs/gp.md``, "Noise". Off by default: on the
+            JSBSim flights it lowered the errors a little (0.1-1.5 points) but costs ~0.2 s CPU
+            per fit in the replay, which is at its speed limit (``docs/benchmarks.md``).
+        input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
+            and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
+            regressors (``docs/gp.md``, "Noisy inputs").
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -85,6 +93,8 @@ class GPConfig:
     swap_threshold: float = 0.1
     swap_pool: int = 256
     hyper_every: int = 0
+    noise_correlation: bool = False
+    input_noise: bool = True
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:

@@ -29,7 +29,7 @@ def exact_covariance(params: GlobalParams, X1: jnp.ndarray, X2: jnp.ndarray) -> 
 
 def _noisy(params: GlobalParams, Xs):
     N, P = Xs.shape[0], params.A.shape[0]
-    K = exact_covariance(params, Xs, Xs) + jnp.diag(jnp.repeat(params.noise, N))
+    K = exact_covariance(params, Xs, Xs) + jnp.kron(params.noise_cov(), jnp.eye(N, dtype=Xs.dtype))
     return jnp.linalg.cholesky(K), N, P
 
 

@@ -26,8 +26,9 @@ import numpy as np
 import optax
 
 from ..jaxconfig import enable_x64
-from .batching import global_mean, global_posterior, global_stats
+from .batching import global_mean, global_posterior, global_predict, global_stats
 from .config import GPConfig
+from .inputnoise import fit_input_noise, mean_gradient
 from .kernels import coregionalisation
 from .local import LocalParams, build_store, local_objective, neighbours
 from .model import LocalGlobalGP
@@ -36,7 +37,8 @@ from .scaling import Standardiser, check_training
 from .selection import random_points, select_inducing
 from .sparse import GlobalParams, design, elbo, stats_of
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local"]
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local", "noise_correlation_factor",
+           "learn_input_noise"]
 
 _NOISE_FLOOR = 1e-6
 
@@ -69,7 +71,20 @@ def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
     B = coregionalisation(raw["L"], jnp.exp(raw["log_kappa"]) + _NOISE_FLOOR)
     Z = raw["Z"] if "Z" in raw else fixed["Z"]
     return GlobalParams(lengthscale=ls, A=jnp.linalg.cholesky(B), noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR,
-                        Z=Z, prior_std=fixed["prior_std"], jitter=fixed["jitter"])
+                        Z=Z, prior_std=fixed["prior_std"], jitter=fixed["jitter"],
+                        noise_chol=noise_correlation_factor(raw["noise_off"]) if "noise_off" in raw else None)
+
+
+def noise_correlation_factor(off: jax.Array) -> jax.Array:
+    """Lower Cholesky factor ``R (P, P)`` of a correlation matrix from unconstrained ``off (P, P)``.
+
+    ``R = normalise_rows(I + tril(off, -1))``: every row has unit norm, so ``R R^T`` has a unit
+    diagonal and is positive definite for any ``off`` (the "unit-diagonal Cholesky" map of
+    Pinheiro and Bates 1996, "Unconstrained parametrizations for variance-covariance matrices",
+    Stat. Comput. 6:289-296); ``off = 0`` is independent noise.
+    """
+    U = jnp.eye(off.shape[0], dtype=off.dtype) + jnp.tril(off, -1)
+    return U / jnp.sqrt(jnp.sum(U * U, axis=1, keepdims=True))
 
 
 _constrain_global_jit = jax.jit(constrain_global)
@@ -150,6 +165,8 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     # host arrays moved once with device_put (jnp.asarray of a NumPy array compiles a program per shape)
     raw = {"log_ls": np.full(Xs.shape[1], np.log(0.5 * np.sqrt(n_active))), "L": np.asarray(L0, float),
            "log_kappa": np.log(kappa), "log_noise": np.log(0.3 * np.diag(Cr) + 1e-4)}
+    if cfg.noise_correlation:
+        raw["noise_off"] = np.zeros((P, P))
     if cfg.train_inducing:
         raw["Z"] = np.asarray(Z, float)
     fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
@@ -166,9 +183,13 @@ def _unconstrain(p: GlobalParams, cfg: GPConfig) -> dict:
     r = int(min(cfg.rank, len(B)))
     L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((len(B), 0))
     kappa = np.maximum(np.diag(B) - np.sum(L0**2, 1), 0.1 * np.diag(B)) - _NOISE_FLOOR
-    return {"log_ls": np.log(np.asarray(p.lengthscale)), "L": np.asarray(L0, float),
-            "log_kappa": np.log(np.maximum(kappa, 1e-8)),
-            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
+    out = {"log_ls": np.log(np.asarray(p.lengthscale)), "L": np.asarray(L0, float),
+           "log_kappa": np.log(np.maximum(kappa, 1e-8)),
+           "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
+    if cfg.noise_correlation:
+        R = np.eye(len(B)) if p.noise_chol is None else np.asarray(p.noise_chol)
+        out["noise_off"] = np.tril(R / np.diag(R)[:, None], -1)    # inverse of noise_correlation_factor
+    return out
 
 
 def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory):
@@ -311,6 +332,12 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
+    input_var = None
+    if cfg.input_noise:
+        t4 = time.perf_counter()
+        input_var = learn_input_noise(params, post, Xs, Ys, scaler.active, cfg)
+        history.timings["input_noise"] = time.perf_counter() - t4
+
     local_params, store = None, None
     if cfg.local:
         t3 = time.perf_counter()
@@ -320,5 +347,17 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["total"] = time.perf_counter() - t0
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
-                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted)
+                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var)
     return model, history
+
+
+def learn_input_noise(params: GlobalParams, post, Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray,
+                      cfg: GPConfig) -> np.ndarray:
+    """Input-noise variances ``(D,)`` (standardised) on ``n_train_max`` random rows of ``Xs (N, D)``,
+    ``Ys (N, P)``: the global layer's residuals, latent variances and slopes there, then
+    :func:`gcs_sysid.gp.inputnoise.fit_input_noise` (McHutchon and Rasmussen 2011)."""
+    sub = random_points(len(Xs), cfg.n_train_max, cfg.seed + 11)
+    m, v = global_predict(params, post, Xs[sub], cfg.batch_size)
+    grad = mean_gradient(params, post, Xs[sub], cfg.batch_size)
+    input_var, _ = fit_input_noise(Ys[sub] - m, v, grad, np.asarray(active, bool), np.asarray(params.noise))
+    return input_var

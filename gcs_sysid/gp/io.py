@@ -22,7 +22,9 @@ from .sparse import GlobalParams, Stats
 __all__ = ["save_model", "load_gp"]
 
 FORMAT = "gcs-sysid-gp"
-VERSION = 2   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
+VERSION = 3   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
+#               3: optional global_noise_chol (cross-correlated noise) and input_var (NIGP);
+#                  stats_yy is (P, P), was its diagonal (P,)
 _GLOBAL = ("lengthscale", "A", "noise", "Z", "prior_std", "jitter")
 _STATS = ("C", "E", "F", "Rphi", "Rx", "yy", "n")
 _LOCAL = ("lengthscale", "beta", "amp", "noise")
@@ -47,6 +49,10 @@ def save_model(model: LocalGlobalGP, path) -> str:
     npz, js = _paths(path)
     arrays = model.scaler.to_arrays()
     arrays.update({"global_" + k: np.asarray(getattr(model.params, k)) for k in _GLOBAL})
+    if model.input_var is not None:
+        arrays["input_var"] = np.asarray(model.input_var)
+    if model.params.noise_chol is not None:
+        arrays["global_noise_chol"] = np.asarray(model.params.noise_chol)
     arrays.update({"stats_" + k: np.asarray(getattr(model.stats, k)) for k in _STATS})
     if model.local_params is not None:
         arrays.update({"local_" + k: np.asarray(getattr(model.local_params, k)) for k in _LOCAL})
@@ -67,6 +73,15 @@ def save_model(model: LocalGlobalGP, path) -> str:
             "summary": model.summary()}
     js.write_text(json.dumps(meta, indent=1))
     return str(npz)
+
+
+def _stats(a: dict, prefix: str) -> Stats:
+    """Statistics from the arrays; a version <= 2 file's ``yy`` (its diagonal, ``(P,)``) becomes ``diag(yy)``,
+    exact for those files' independent noise (only the diagonal enters their likelihood)."""
+    d = {k: np.asarray(a[prefix + k]) for k in _STATS}
+    if d["yy"].ndim == 1:
+        d["yy"] = np.diag(d["yy"])
+    return Stats(**{k: jnp.asarray(v) for k, v in d.items()})
 
 
 def load_gp(path) -> LocalGlobalGP:
@@ -95,9 +110,10 @@ def load_gp(path) -> LocalGlobalGP:
         with np.load(npz, allow_pickle=False) as f:
             a = {k: f[k] for k in f.files}
         scaler = Standardiser.from_arrays(a)
-        params = GlobalParams(**{k: jnp.asarray(a["global_" + k]) for k in _GLOBAL})
-        stats = Stats(**{k: jnp.asarray(a["stats_" + k]) for k in _STATS})
-        evicted = Stats(**{k: jnp.asarray(a["evicted_" + k]) for k in _STATS}) if "evicted_C" in a else None
+        params = GlobalParams(**{k: jnp.asarray(a["global_" + k]) for k in _GLOBAL},
+                              noise_chol=jnp.asarray(a["global_noise_chol"]) if "global_noise_chol" in a else None)
+        stats = _stats(a, "stats_")
+        evicted = _stats(a, "evicted_") if "evicted_C" in a else None
     except (KeyError, ValueError, OSError) as exc:
         raise InputError(f"{npz}: GP model arrays missing or unreadable ({exc})") from None
     config = GPConfig.from_dict(meta.get("config", {}))
@@ -123,4 +139,4 @@ def load_gp(path) -> LocalGlobalGP:
     return LocalGlobalGP(config, scaler, params, stats, post, local_params, store,
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
                          tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
-                         evicted=evicted)
+                         evicted=evicted, input_var=a.get("input_var"))

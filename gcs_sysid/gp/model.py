@@ -53,6 +53,8 @@ class LocalGlobalGP:
         notes: one-line remarks made while fitting.
         rows: the capped, region-thinned training rows (:class:`gcs_sysid.gp.rowstore.RowStore`).
         since_refresh: rows conditioned on since the hyperparameters were last learned.
+        input_var: ``(D,)`` input-noise variances of the regressors (standardised; NIGP,
+            :mod:`gcs_sysid.gp.inputnoise`), None when not learned.
         evicted: the part of ``stats`` from rows no longer stored (None: none). When the
             inducing inputs or length-scales change, the stored rows' statistics are computed
             again exactly and only this part is carried by the streaming projection.
@@ -72,6 +74,7 @@ class LocalGlobalGP:
     rows: RowStore | None = None
     since_refresh: int = 0
     evicted: Stats | None = None
+    input_var: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -118,12 +121,17 @@ class LocalGlobalGP:
         mean[ok], var[ok] = self.scaler.y_back(mean_s, var_s)
         return mean, var
 
-    def predict(self, X, include_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    def predict(self, X, include_noise: bool = True, input_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance of the coefficients.
 
         Args:
             X: ``(N, D)`` regressors in data units (rows with NaN give NaN outputs).
-            include_noise: add the observation noise (of the local layer when present).
+            include_noise: add the observation noise: per output the larger of the global
+                layer's likelihood noise and the local layer's nugget.
+            input_noise: the regressors are estimates (a flight's table): add the variance that
+                their errors carry through the mean's slope, ``grad m^T Sigma_x grad m``
+                (McHutchon and Rasmussen 2011, eq. 4; when ``input_var`` was learned). False for
+                exact conditions (a user's flight condition, the truth's regressors).
 
         Returns:
             ``(mean (N, P), var (N, P))`` in the outputs' units (variance in units squared).
@@ -138,10 +146,25 @@ class LocalGlobalGP:
         if self.local_params is not None and self.store is not None:
             ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
             mean, var = mean + ml, var + vl
-            noise = np.asarray(self.local_params.noise)
+            # the larger of the two layers' noise variances: the local nugget, learned from
+            # nearest-neighbour differences of 50 Hz rows that share a gust's error, sees only the
+            # white part of the noise; the global layer's likelihood noise also holds the coloured
+            # part (docs/gp.md, "Noise"; measured on JSBSim flights, docs/benchmarks.md)
+            noise = np.maximum(noise, np.asarray(self.local_params.noise))
         if include_noise:
             var = var + noise[None, :]
+        if input_noise and self.input_var is not None and len(Xs):
+            var = var + self.input_variance_s(Xs)
         return self._finish(ok, mean, var)
+
+    def input_variance_s(self, Xs: np.ndarray) -> np.ndarray:
+        """``grad m_p^T Sigma_x grad m_p`` ``(N, P)`` at standardised ``Xs (N, D)`` (standardised units;
+        zeros when no input noise was learned). Source: McHutchon and Rasmussen (2011), eq. 4."""
+        from .inputnoise import mean_gradient, slope_variance
+
+        if self.input_var is None:
+            return np.zeros((len(Xs), self.n_outputs))
+        return slope_variance(mean_gradient(self.params, self.post, Xs, self.config.batch_size), self.input_var)
 
     def predict_global(self, X, include_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance ``(N, P)`` of the global layer alone (linear mean + sparse ICM GP)."""
@@ -268,6 +291,11 @@ class LocalGlobalGP:
             stats = _add_jit(stats, evicted)
         model = replace(self, params=params, stats=stats, evicted=evicted, _post=None, _store=None,
                         since_refresh=0, n_hyper=int(min(cfg.n_train_max, len(rows))))
+        if cfg.input_noise:
+            from .fit import learn_input_noise
+
+            model = replace(model, input_var=learn_input_noise(params, model.post, rows.X, rows.Y, self.scaler.active,
+                                                               cfg))
         if self.local_params is not None:
             resid = rows.Y - model._global_mean_s(rows.X)
             local_params, store = fit_local(cfg, params, rows.X, resid, history)
@@ -289,19 +317,20 @@ class LocalGlobalGP:
             X_query: ``(Q, D)`` where the variance is wanted.
 
         Returns:
-            ``(Q, P)`` predictive variance, data units squared.
+            ``(Q, P)`` predictive variance, data units squared, without the input-noise term
+            (what more data can reduce; ``predict(..., input_noise=False)``).
         """
         enable_x64()
         Xe, _ = self._standardise_query(X_extra)
         if len(Xe) == 0:
-            return self.predict(X_query, include_noise)[1]
+            return self.predict(X_query, include_noise, input_noise=False)[1]
         zeros = np.zeros((len(Xe), self.n_outputs))
         extra = self._with_stats(add_stats(self.stats, global_stats(self.params, Xe, zeros, self.config.batch_size)))
         if self.store is not None:
             X_all = np.vstack([self.store.X, Xe])
             store = build_store(X_all, np.vstack([self.store.resid, zeros]), self.store.metric, self.store.k)
             extra = replace(extra, _store=store)
-        return extra.predict(X_query, include_noise)[1]
+        return extra.predict(X_query, include_noise, input_noise=False)[1]
 
     def global_variance_after_many(self, X_extras, X_queries, include_noise: bool = False
                                    ) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -354,6 +383,12 @@ class LocalGlobalGP:
         s = np.sqrt(np.diag(B))
         return B / np.outer(s, s)
 
+    def noise_correlation(self) -> np.ndarray:
+        """Correlation ``(P, P)`` of the global layer's observation noise (identity: independent noise)."""
+        S = np.asarray(self.params.noise_cov())
+        d = np.sqrt(np.diag(S))
+        return S / np.outer(d, d)
+
     def linear_derivatives(self) -> tuple[np.ndarray, np.ndarray]:
         """Posterior-mean linear part of the model in data units.
 
@@ -400,6 +435,8 @@ class LocalGlobalGP:
                 "output_correlation": self.output_correlation().tolist(),
                 "signal_std": dict(zip(self.output_names, (np.sqrt(np.diag(B)) * sc.y_std).tolist())),
                 "noise_std": dict(zip(self.output_names, (np.sqrt(np.asarray(self.params.noise)) * sc.y_std).tolist())),
+                "noise_correlation": self.noise_correlation().tolist(),
+                "input_noise_std": None if self.input_var is None else scales(np.sqrt(np.asarray(self.input_var))),
                 "linear_intercept": dict(zip(self.output_names, intercept.tolist())),
                 "linear_derivatives": {o: dict(zip(names, row.tolist())) for o, row in zip(self.output_names, slopes)},
             },

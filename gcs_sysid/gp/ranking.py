@@ -95,7 +95,8 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
     Hc = cross_covariances(model) if Hc is None else Hc
     P = int(model.params.noise.shape[0])
     J = Hc.shape[0] // P
-    sig = np.sqrt(np.asarray(model.params.noise))
+    Ls = np.linalg.cholesky(np.asarray(model.params.noise_cov()))
+    Wn = solve_triangular(Ls, np.eye(len(Ls)), lower=True)            # (P, P) whitening Ls^{-1}, lower
     bdiag = np.sum(np.asarray(model.params.A) ** 2, 1)
     M = int(model.params.Z.shape[0])
     out = []
@@ -118,11 +119,16 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
             continue
         Ue = _features(model, Xe)                              # (J, E)
         E = Ue.shape[1]
-        # T = Psi^T Lambda^{-1} S (P E, P J): block row q is Ue^T H_{q,:} / sigma_q
-        T = np.vstack([(Ue.T / sig[q]) @ Hc[q * J:(q + 1) * J] for q in range(P)])
+        # whitened candidate features: output q of a row is sum_p Wn_qp psi_p (Wn = chol(Sigma)^{-1},
+        # diag(1/sigma) for independent noise). T = Psi^T Lambda^{-1} S (P E, P J): block row q is
+        # sum_p Wn_qp Ue^T H_{p,:}
+        T0 = [Ue.T @ Hc[p * J:(p + 1) * J] for p in range(P)]
+        T = np.vstack([sum(Wn[q, p] * T0[p] for p in range(P) if Wn[q, p] != 0.0) for q in range(P)])
         Cm = np.eye(P * E)
-        for p in range(P):
-            Cm[:, p * E:(p + 1) * E] += T[:, p * J:(p + 1) * J] @ Ue / sig[p]
+        for q2 in range(P):
+            for p in range(P):
+                if Wn[q2, p] != 0.0:
+                    Cm[:, q2 * E:(q2 + 1) * E] += Wn[q2, p] * (T[:, p * J:(p + 1) * J] @ Ue)
         try:
             Lc = cho_factor(0.5 * (Cm + Cm.T), lower=True, check_finite=False)[0]
             R = solve_triangular(Lc, T, lower=True, check_finite=False)              # (P E, P J)
@@ -136,7 +142,9 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
             # 2013, sec. 6.1: least squares and the normal equations).
             if V is None:
                 V = _whitened_selectors(model)
-            W = np.hstack([V[:, p * J:(p + 1) * J] @ Ue / sig[p] for p in range(P)])   # (K, P E)
+            VU = [V[:, p * J:(p + 1) * J] @ Ue for p in range(P)]
+            W = np.hstack([sum(Wn[q, p] * VU[p] for p in range(P) if Wn[q, p] != 0.0)
+                           for q in range(P)])                                               # (K, P E)
             Uw, sv, _ = np.linalg.svd(W, full_matrices=False)
             R = (sv / np.sqrt(1.0 + sv**2))[:, None] * (Uw.T @ V)
         red = np.empty_like(v0)

@@ -54,6 +54,9 @@ class GlobalParams:
         Z: ``(M, D)`` inducing inputs.
         prior_std: scalar ``sqrt(v)``, prior std of the linear-mean weights.
         jitter: scalar added to the diagonal of ``Kmm``.
+        noise_chol: ``(P, P)`` lower Cholesky factor ``R`` of the noise *correlation* matrix
+            (rows of unit norm): the noise covariance is ``Sigma = D^1/2 R R^T D^1/2`` with
+            ``D = diag(noise)``. The identity (the default) is independent noise per output.
     """
 
     lengthscale: jax.Array
@@ -62,11 +65,27 @@ class GlobalParams:
     Z: jax.Array
     prior_std: jax.Array
     jitter: jax.Array
+    noise_chol: jax.Array | None = None
 
     @property
     def B(self) -> jax.Array:
         """Coregionalisation matrix ``(P, P)``."""
         return self.A @ self.A.T
+
+    def noise_cov(self) -> jax.Array:
+        """Noise covariance ``Sigma (P, P)`` (diagonal ``noise`` when ``noise_chol`` is None)."""
+        if self.noise_chol is None:
+            return jnp.diag(self.noise)
+        s = jnp.sqrt(self.noise)
+        return (s[:, None] * self.noise_chol) @ (s[:, None] * self.noise_chol).T
+
+    def noise_precision(self) -> tuple[jax.Array, jax.Array]:
+        """``(Sigma^{-1} (P, P), log|Sigma|)``; by the Cholesky factor ``D^1/2 R`` (a triangular solve)."""
+        if self.noise_chol is None:
+            return jnp.diag(1.0 / self.noise), jnp.sum(jnp.log(self.noise))
+        Ls = jnp.sqrt(self.noise)[:, None] * self.noise_chol
+        Li = solve_triangular(Ls, jnp.eye(Ls.shape[0], dtype=Ls.dtype), lower=True)
+        return Li.T @ Li, 2.0 * jnp.sum(jnp.log(jnp.diag(Ls)))
 
 
 @jax.tree_util.register_dataclass
@@ -75,7 +94,8 @@ class Stats:
     """Additive sufficient statistics of the data for fixed hyperparameters (whitened features).
 
     Attributes: C ``(M, M)``, E ``(M, D+1)``, F ``(D+1, D+1)``, Rphi ``(M, P)``, Rx ``(D+1, P)``,
-    yy ``(P,)``, n scalar (rows).
+    yy ``(P, P)`` (``sum_n y_n y_n^T``; files of version <= 2 held its diagonal ``(P,)`` only,
+    enough for independent noise), n scalar (rows).
     """
 
     C: jax.Array
@@ -135,7 +155,7 @@ def stats_of(params: GlobalParams, Xs: jax.Array, Ys: jax.Array, weight: jax.Arr
     w = jnp.ones(Xs.shape[0], Xs.dtype) if weight is None else weight
     Phiw, Xaw = Phi * w[None, :], Xa * w[:, None]
     return Stats(C=Phiw @ Phi.T, E=Phiw @ Xa, F=Xaw.T @ Xa, Rphi=Phiw @ Ys, Rx=Xaw.T @ Ys,
-                 yy=jnp.sum(w[:, None] * Ys * Ys, 0), n=jnp.sum(w))
+                 yy=(w[:, None] * Ys).T @ Ys, n=jnp.sum(w))
 
 
 def add_stats(a: Stats, b: Stats) -> Stats:
@@ -143,18 +163,26 @@ def add_stats(a: Stats, b: Stats) -> Stats:
     return jax.tree_util.tree_map(jnp.add, a, b)
 
 
-def _assemble(params: GlobalParams, st: Stats) -> tuple[jax.Array, jax.Array]:
-    """Posterior precision ``Lambda (K, K)`` and projection ``b (K,)`` from statistics."""
+def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tuple[jax.Array, jax.Array]:
+    """Posterior precision ``Lambda (K, K)`` and projection ``b (K,)`` from statistics.
+
+    With the noise precision ``N = Sigma^{-1}`` (``P x P``; diagonal for independent noise)
+    ``Lambda = I + sum_n Psi_n^T N Psi_n`` and ``b = sum_n Psi_n^T N y_n``, ``Psi_n`` the
+    ``(P, K)`` features of row ``n``; in blocks ``(A^T N A) kron C``, ``sqrt(v) (A^T N) kron E``,
+    ``v N kron F`` (a cross-correlated noise only replaces ``diag(1/sigma^2)`` by ``N``).
+    """
     A, sv = params.A, params.prior_std
-    dinv = 1.0 / params.noise
-    G = A.T @ (dinv[:, None] * A)                       # (Q, Q): sum_p a_p a_p^T / sigma_p^2
+    if N is None:
+        N = params.noise_precision()[0]
+    G = A.T @ N @ A                                      # (Q, Q): sum_pp' a_p N_pp' a_p'^T
     ww = jnp.kron(G, st.C)
-    wo = sv * jnp.kron(A.T * dinv[None, :], st.E)        # rows (q, m), cols (p, j)
-    oo = sv * sv * jnp.kron(jnp.diag(dinv), st.F)
+    wo = sv * jnp.kron(A.T @ N, st.E)                   # rows (q, m), cols (p, j)
+    oo = sv * sv * jnp.kron(N, st.F)
     lam = jnp.block([[ww, wo], [wo.T, oo]])
     lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
-    bw = ((st.Rphi * dinv[None, :]) @ A).T.reshape(-1)    # b_{q,m} = sum_p A_pq Rphi_mp / sigma_p^2
-    bo = sv * (st.Rx * dinv[None, :]).T.reshape(-1)       # b_{p,j} = sqrt(v) Rx_jp / sigma_p^2
+    RN = st.Rphi @ N                                     # (M, P): sum_n phi_n (N y_n)^T
+    bw = (RN @ A).T.reshape(-1)                          # b_{q,m} = sum_p A_pq (Rphi N)_mp
+    bo = sv * (st.Rx @ N).T.reshape(-1)                  # b_{p,j} = sqrt(v) (Rx N)_jp
     return lam, jnp.concatenate([bw, bo])
 
 
@@ -190,17 +218,21 @@ logdet_quad.defvjp(_logdet_quad_fwd, _logdet_quad_bwd)
 def elbo(params: GlobalParams, st: Stats) -> jax.Array:
     """Collapsed VFE bound (Titsias 2009, eq. 9) on ``log p(y)``, a scalar.
 
-    ``log N(y | 0, Psi Psi^T + Sigma) - 0.5 sum_p B_pp / sigma_p^2 (n - tr(Phi Phi^T))``,
+    ``log N(y | 0, Psi Psi^T + I_n kron Sigma) - 0.5 tr(Sigma^{-1} B) (n - tr(Phi Phi^T))``
+    (``Sigma`` the ``P x P`` noise covariance, :meth:`GlobalParams.noise_cov`; for independent
+    noise the trace term is ``sum_p B_pp / sigma_p^2 (n - tr C)``),
     with the Gaussian term by the matrix determinant lemma and Woodbury identity in the
     ``K``-dimensional feature space.
     """
-    lam, b = _assemble(params, st)
+    N, logdet_noise = params.noise_precision()
+    lam, b = _assemble(params, st, N)
     P = params.noise.shape[0]
     logdet, bmb = logdet_quad(lam, b)
-    quad = jnp.sum(st.yy / params.noise) - bmb
-    loglik = -0.5 * (st.n * P * _LOG2PI + st.n * jnp.sum(jnp.log(params.noise)) + logdet + quad)
-    bdiag = jnp.sum(params.A**2, 1)
-    trace = -0.5 * jnp.sum(bdiag / params.noise) * (st.n - jnp.trace(st.C))
+    yy = st.yy if st.yy.ndim == 2 else jnp.diag(st.yy)
+    quad = jnp.sum(N * yy) - bmb                        # sum_n y_n^T N y_n - b^T Lambda^{-1} b
+    loglik = -0.5 * (st.n * P * _LOG2PI + st.n * logdet_noise + logdet + quad)
+    # residual covariance of f given u is B (k(x,x) - |phi(x)|^2): trace term tr(N B) (n - tr C)
+    trace = -0.5 * jnp.sum(N * params.B) * (st.n - jnp.trace(st.C))
     return loglik + trace
 
 

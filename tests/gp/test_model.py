@@ -63,12 +63,13 @@ def test_variance_after_shrinks_variance_near_new_points_only(flight, fitted):
     model, _ = fitted
     far = X[:5] + 6 * X.std(0)          # outside the envelope: the model knows little there
     X_extra = np.repeat(far, 3, axis=0)
-    before = model.predict(np.vstack([far, X[:5]]), include_noise=False)[1]
+    before = model.predict(np.vstack([far, X[:5]]), include_noise=False, input_noise=False)[1]
     after = model.variance_after(X_extra, np.vstack([far, X[:5]]), include_noise=False)
     assert np.all(after[:5] < 0.5 * before[:5])
     np.testing.assert_allclose(after[5:], before[5:], rtol=0.05)
     # it is the variance of the model updated with any values at X_extra
-    upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(np.vstack([far, X[:5]]), include_noise=False)[1]
+    upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(np.vstack([far, X[:5]]), include_noise=False,
+                                                                                      input_noise=False)[1]
     np.testing.assert_allclose(after, upd, rtol=1e-7)
 
 

@@ -36,7 +36,7 @@ def dense_vfe_predict(params, Xs, Ys, Xq):
         return np.column_stack([np.ones(len(X)), X])
 
     N, P = len(Xs), B.shape[0]
-    K = np.kron(B, Q(Xs, Xs)) + v * np.kron(np.eye(P), xa(Xs) @ xa(Xs).T) + np.diag(np.repeat(p.noise, N))
+    K = np.kron(B, Q(Xs, Xs)) + v * np.kron(np.eye(P), xa(Xs) @ xa(Xs).T) + np.kron(np.asarray(params.noise_cov()), np.eye(N))   # Sigma kron I (full noise)
     Kq = np.kron(B, Q(Xq, Xs)) + v * np.kron(np.eye(P), xa(Xq) @ xa(Xs).T)
     mean = (Kq @ np.linalg.solve(K, Ys.T.reshape(-1))).reshape(P, -1).T
     qq = np.sum(se_kernel(Xq, Z, ls) * np.linalg.solve(Kzz, se_kernel(Z, Xq, ls)).T, 1)
@@ -189,7 +189,9 @@ def test_state_is_bounded_once_the_budget_is_full(tmp_path):
             sizes.append(sum(f[k].nbytes for k in f.files))
         stored.append(len(model.rows))
     assert max(stored) <= 250 and model.rows.seen == 1500 and model.n_used == 1500
-    assert max(sizes[4:]) <= max(sizes[:4])                     # flat once full (here after ~300 rows)
+    # flat once full (here after ~300 rows): the store holds 95-100 % of its capacity after a thinning,
+    # so the size varies by a few stored rows, and does not grow with the rows seen
+    assert max(sizes[4:]) <= 1.03 * max(sizes[:4]) and max(sizes[4:]) <= 1.03 * min(sizes[4:])
     loaded = load_gp(path)
     for a, b in zip(model.predict(X[:50]), loaded.predict(X[:50])):
         np.testing.assert_allclose(a, b, rtol=1e-9)

@@ -63,7 +63,7 @@ def _check_cli(out, truth, times, tmp_path):
     mean = np.array([[float(r[f"{c}_mean"]) for c in COEFFICIENTS] for r in rows])
     sigma = np.array([[float(r[f"{c}_sigma"]) for c in COEFFICIENTS] for r in rows])
     sigma_obs = np.array([[float(r[f"{c}_sigma_obs"]) for c in COEFFICIENTS] for r in rows])
-    m_ref, v_ref = load_gp(out / "model").predict(X, include_noise=False)
+    m_ref, v_ref = load_gp(out / "model").predict(X, include_noise=False, input_noise=False)   # exact conditions
     np.testing.assert_allclose(mean, m_ref, rtol=1e-6, atol=1e-9)
     np.testing.assert_allclose(sigma, np.sqrt(v_ref), rtol=1e-6, atol=1e-12)
     assert (sigma_obs >= sigma).all() and (sigma > 0).all()

@@ -1,0 +1,211 @@
+"""The GP alone against JSBSim's exact truth: variants, joint vs six independent GPs, vs least squares.
+
+``benchmarks/eval_jsbsim.py`` scores the whole replay; this script isolates the GP. It first caches,
+per flight, what the replay estimated (the coefficient table: regressors ``X``, measured coefficients
+``Y``, the training rows and the held-out last 20 %), the truth on the same grid and the project's
+stepwise least-squares model (``gcs-sysid fit`` on the training window) evaluated on it (``--make``;
+one ``.npz`` per flight under ``--cache``). Then it fits GP variants on the training rows of each
+cached table (``fit_gp``, the replay's settings unless a variant says otherwise) and scores them on
+the held-out rows against the truth:
+
+  err     100 * RMS(model - truth) / RMS(truth) per coefficient, model at the measured regressors
+  cov     share of the truth inside the model's 95 % band (sigma without observation noise: the truth
+          has none), per coefficient, and the median over the six; ``cov_noise``: with the noise (the
+          band the replay reports)
+  corr    the largest |learned output correlation| of the global layer (``output_correlation``)
+
+Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
+``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),
+``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the shipped
+default is the input noise without ``full``, for the replay's speed), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
+of the least-squares model (LS as the prior mean), ``indep`` six
+independent one-output GPs (same settings, each its own hyperparameters), and ``ls`` (cached).
+
+Usage::
+
+    python benchmarks/eval_gp_jsbsim.py --make --aircraft c172x sgs --seeds 1 2 --turbulence light moderate
+    python benchmarks/eval_gp_jsbsim.py --variants diag full nigp indep ls --json /tmp/gp.jsonl
+    python benchmarks/eval_gp_jsbsim.py --summarize /tmp/gp.jsonl
+
+``pa28`` is the held-out aircraft: make and score it once, after the settings are frozen.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
+from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
+
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "ls")
+
+
+def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
+    """Fly, replay and fit least squares once; save the table, truth and LS predictions (``.npz``)."""
+    from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight
+    from gcs_sysid.diagnose import run_fit
+    from gcs_sysid.pipeline import ReplayOptions, run_replay
+
+    name = f"{aircraft}-{seed}-{turbulence}-{aoa}"
+    work = cache / ("work-" + name)
+    work.mkdir(parents=True, exist_ok=True)
+    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa)
+    truth = load_truth(files.truth)
+    res = run_replay(files.tlog, files.airframe, work / "rep", ReplayOptions(progress=False))
+    tab, held = res.table, res.held_out
+    Xt, Yt = truth.at(tab.t)
+    t_cut = float(tab.t[held & tab.valid][0])
+    ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut)
+    out = cache / f"{name}.npz"
+    np.savez(out, t=tab.t, X=tab.X, Y=tab.Y, valid=tab.valid, held=held, train=res.train, Xt=Xt, Yt=Yt,
+             gp_mean=res.pred_mean, gp_sigma=res.pred_sigma, ls=ls_model.evaluate(tab.X))
+    return out
+
+
+def errors(est: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """``100 RMS(est - ref) / RMS(ref)`` per column ``(P,)`` (the project's error metric)."""
+    return 100.0 * np.sqrt(np.mean((est - ref) ** 2, 0)) / np.sqrt(np.mean(ref**2, 0))
+
+
+def coverage(mean: np.ndarray, sigma: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """Share (%) of ``ref`` inside ``mean +- 1.96 sigma``, per column ``(P,)`` (NaN without a sigma)."""
+    out = 100.0 * np.mean(np.abs(mean - ref) <= 1.96 * sigma, 0)
+    return np.where(np.all(np.isnan(sigma), 0), np.nan, out)
+
+
+def _config(variant: str, base: GPConfig) -> GPConfig:
+    if variant == "diag":
+        return replace(base, noise_correlation=False, input_noise=False)
+    if variant in ("full", "indep"):
+        return replace(base, noise_correlation=variant == "full", input_noise=False)
+    if variant == "nigp":
+        return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "lsres":
+        return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "global":
+        return replace(base, noise_correlation=True, input_noise=True, local=False)
+    raise ValueError(variant)
+
+
+def score(path: Path, variants, base: GPConfig = GPConfig()):
+    """Every variant on one cached flight; yields one JSON-able dict per variant."""
+    d = np.load(path)
+    X, Y, Xt, Yt = d["X"], d["Y"], d["Xt"], d["Yt"]
+    ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
+    tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
+    h = d["held"] & ok
+    meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
+    for v in variants:
+        t0 = time.perf_counter()
+        corr = float("nan")
+        if v == "ls":
+            mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
+            sig_n = sig_g = sig
+        elif v == "indep":
+            cfg = _config(v, base)
+            parts = [fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0].predict(X[h], False)
+                     for p in range(Y.shape[1])]
+            mean = np.column_stack([m for m, _ in parts])
+            sig = np.sqrt(np.column_stack([s for _, s in parts]))
+            sig_n = sig_g = sig * np.nan
+        else:
+            prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
+            model, _ = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
+            m, var = model.predict(X[h], include_noise=False)
+            mean, sig = m + prior[h], np.sqrt(var)
+            sig_n = np.sqrt(model.predict(X[h])[1])                         # with the observation noise (the replay's band)
+            # with the global layer's noise variance sigma_p^2 (the likelihood's) instead of the local nugget
+            sig_g = np.sqrt(var + np.asarray(model.params.noise)[None, :] * model.scaler.y_std**2)
+            c = model.output_correlation()
+            corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
+        e, cv, cvn = errors(mean, Yt[h]), coverage(mean, sig, Yt[h]), coverage(mean, sig_n, Yt[h])
+        yield (dict(meta, variant=v, err=dict(zip(COEFFICIENTS, e.round(2).tolist())),
+                         cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())),
+                         cov_noise=dict(zip(COEFFICIENTS, cvn.round(1).tolist())),
+                         cov_gnoise=dict(zip(COEFFICIENTS, coverage(mean, sig_g, Yt[h]).round(1).tolist())),
+                         max_corr=corr,
+                         meas=dict(zip(COEFFICIENTS, errors(Y[h], Yt[h]).round(2).tolist())),
+                         t_fit_s=round(time.perf_counter() - t0, 2)))
+
+
+def summarize(paths) -> str:
+    """Markdown table (medians over seeds) of ``--json`` lines."""
+    rows = [json.loads(line) for p in paths for line in open(p) if line.strip()]
+    last = {(r["aircraft"], r["seed"], r["turbulence"], r["aoa"], r["variant"]): r for r in rows}   # a rerun replaces
+    rows = list(last.values())
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["aircraft"], r["turbulence"], r["aoa"], r["variant"]), []).append(r)
+    head = ("| aircraft | turb. | AOA_SSA | model | seeds | " + " | ".join(COEFFICIENTS)
+            + " | cov95 % latent (min-max) | with local noise | with global noise | max corr |")
+    out = [head, "|" + "---|" * (head.count("|") - 1)]
+    for (ac, turb, aoa, v), rs in sorted(groups.items()):
+        med = lambda k, c: float(np.nanmedian([r[k][c] for r in rs]))   # noqa: E731
+        def cov(key):
+            vals = [x for r in rs if r["variant"] != "ls" for x in r.get(key, {}).values()
+                    if x is not None and np.isfinite(x)]
+            return f"{np.median(vals):.0f} ({min(vals):.0f}-{max(vals):.0f})" if vals else ""
+        corr = float(np.nanmedian([r["max_corr"] for r in rs]))
+        name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
+        out.append(f"| {name} | {turb} | {aoa} | {v} | {len(rs)} | " + " | ".join(f"{med('err', c):.1f}" for c in COEFFICIENTS)
+                   + f" | {cov('cov')} | {cov('cov_noise')} | {cov('cov_gnoise')} | {'' if np.isnan(corr) else f'{corr:.2f}'} |")
+    # pairwise: joint (full) vs independent, GP vs least squares, per flight and coefficient
+    by = {}
+    for r in rows:
+        by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("full", "ls"), ("nigp", "ls"), ("full", "diag"),
+                 ("nigp", "diag"), ("diag", "ls")):
+        pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]
+        if pairs:
+            wins = sum(x < y for x, y in pairs)
+            out.append(f"\n{a} better than {b}: {wins} of {len(pairs)} flight x coefficient pairs "
+                       f"(median error {np.median([x for x, _ in pairs]):.1f} vs {np.median([y for _, y in pairs]):.1f} %)")
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
+    ap.add_argument("--make", action="store_true", help="fly, replay and cache the flights first")
+    ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
+    ap.add_argument("--seeds", nargs="+", type=int, default=[1])
+    ap.add_argument("--turbulence", nargs="+", default=["light"])
+    ap.add_argument("--aoa", nargs="+", default=["ahrs"], choices=("ahrs", "vane"))
+    ap.add_argument("--duration", type=float, default=90.0)
+    ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS)
+    ap.add_argument("--json", default=None, help="append one JSON line per flight and variant")
+    ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
+    a = ap.parse_args(argv)
+    if a.summarize:
+        print(summarize(a.summarize))
+        return 0
+    cache = Path(a.cache)
+    cache.mkdir(parents=True, exist_ok=True)
+    for ac in a.aircraft:
+        for turb in a.turbulence:
+            for aoa in a.aoa:
+                for seed in a.seeds:
+                    path = cache / f"{ac}-{seed}-{turb}-{aoa}.npz"
+                    if a.make or not path.is_file():
+                        path = make(ac, seed, turb, aoa, a.duration, cache)
+                    for r in score(path, a.variants):
+                        print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
+                              + "  cov " + " ".join(f"{r['cov'][c]:5.1f}" for c in COEFFICIENTS)
+                              + f"  corr {r['max_corr']:.2f}  {r['t_fit_s']:.1f} s", flush=True)
+                        if a.json:
+                            with open(a.json, "a") as f:
+                                f.write(json.dumps(r) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
