@@ -320,7 +320,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         f_body: (T, 3) specific force at the CG, body axes, m/s^2 (bias removed; white noise is fine).
         rates: (T, 3) body rates p q r, rad/s.
         controls: ``delta_e``, ``delta_a``, ``delta_r`` (rad) and optionally ``delta_t`` (0..1), each (T,);
-            a missing or constant one is left out of the models.
+            a missing or constant one is left out of the models; ``delta_t`` is no regressor, a varying
+            one only keeps the sideslip mean (no CY0 ~ 0 prior for a powered flight).
         mass: kg. S: wing area, m^2. b: span, m. c: mean aerodynamic chord, m.
         use: (T,) bool, the airborne samples to fit and aid.
         passes: least-squares / smoother passes (the first on the kinematic angles).
