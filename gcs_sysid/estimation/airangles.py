@@ -61,6 +61,8 @@ MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, 
 HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz
 SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
 SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
+MEAN_BLOCK_S = 5.0    #: block length for the standard error of the CY constant (correlated residuals), s
+MOMENT_MARGIN = 0.0   #: the aided angle is kept if its moment-fit residual is at most (1 + this) x the kinematic one
 
 
 @dataclass
@@ -80,6 +82,9 @@ class AxisFit:
         ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
         r2: share of the measured coefficient's variance above :data:`HIGHPASS_HZ` that the model explains.
         mean_shift: constant added to the kinematic angle (beta: its mean error, from CY0 ~ 0), rad.
+        shift_note: why the sideslip mean was or was not moved (beta only; empty for alpha).
+        moment_rss: (kinematic, aided) residual variance of the moment cross-check, each as a share of
+            the moment coefficients' variance (NaN: no moments given).
     """
 
     name: str
@@ -94,6 +99,8 @@ class AxisFit:
     ratio: float = float("nan")
     r2: float = float("nan")
     mean_shift: float = 0.0
+    shift_note: str = ""
+    moment_rss: tuple[float, float] = (float("nan"), float("nan"))
 
 
 @dataclass
@@ -113,8 +120,8 @@ class AidedAngles:
     axes: tuple[AxisFit, AxisFit]
 
 
-def _lstsq(A: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least squares ``y ~ A c``; returns (c, standard errors, residuals)."""
+def _lstsq(A: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares ``y ~ A c``; returns (c, standard errors, residuals, covariance of c)."""
     c, *_ = np.linalg.lstsq(A, y, rcond=None)
     e = y - A @ c
     dof = max(len(y) - A.shape[1], 1)
@@ -123,7 +130,26 @@ def _lstsq(A: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
         cov = np.linalg.inv(A.T @ A) * s2
     except np.linalg.LinAlgError:
         cov = np.linalg.pinv(A.T @ A) * s2
-    return c, np.sqrt(np.maximum(np.diag(cov), 0.0)), e
+    return c, np.sqrt(np.maximum(np.diag(cov), 0.0)), e, cov
+
+
+def _block_mean_var(e: np.ndarray, segs: list[slice], n: int) -> float:
+    """Variance of the mean of ``e`` (T,) over ``segs`` from the scatter of means of blocks of ``n`` samples
+    (the residuals are correlated: gusts); ``inf`` with fewer than 3 blocks."""
+    means = [float(e[s][i:i + n].mean()) for s in segs for i in range(0, s.stop - s.start - n + 1, n)]
+    return float(np.var(means, ddof=1)) / len(means) if len(means) >= 3 else float("inf")
+
+
+def _moment_rss(angle: np.ndarray, X_other: np.ndarray, moments: list[np.ndarray], m: np.ndarray) -> float:
+    """Residual variance of the linear moment model(s) ``[1, angle, X_other]`` on ``m``, as a share of each
+    moment coefficient's variance, averaged over ``moments`` (each (T,))."""
+    A = np.column_stack([np.ones(m.sum()), angle[m], X_other[m]])
+    out = []
+    for M in moments:
+        y = M[m]
+        c, *_ = np.linalg.lstsq(A, y, rcond=None)
+        out.append(float(np.var(y - A @ c)) / max(float(np.var(y)), 1e-300))
+    return float(np.mean(out))
 
 
 def _highpass(dt: float, X: np.ndarray, segs: list[slice]) -> np.ndarray:
@@ -179,17 +205,21 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
 
 
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
-          use: np.ndarray, passes: int, sign: float, quadratic: bool,
-          symmetric: bool) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
+          moments: list[np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
     ``symmetric`` takes the constant as ~0 (CY of a symmetric airframe) so that it measures the mean
-    error of the kinematic angle."""
+    error of the kinematic angle (not with a varying throttle: a propeller side force); ``moments``: the
+    moment coefficients that depend on this angle (Cm; Cl, Cn), for the cross-check against the kinematic
+    angle (None: none)."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
         ok &= np.isfinite(others[k])
+    if moments is not None:
+        ok &= np.all([np.isfinite(M) for M in moments], axis=0)
     segs = segments(ok, max(int(round(MIN_SEGMENT_S / dt)), 10))
     n_ok = sum(s.stop - s.start for s in segs)
     if n_ok * dt < MIN_VALID_S:
@@ -199,8 +229,10 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     m = np.zeros(len(kin), bool)
     for s in segs:
         m[s] = True
+    kin0 = kin
     ang = kin.copy()
     sig = np.full(len(kin), np.nan)
+    shift_note = ""
     names = ("1", name) + ((f"({name} - {name}0)^2",) if quadratic else ()) + tuple(cols)
     nq = 2 if quadratic else 1
     fit = None
@@ -211,7 +243,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         # slopes from the band above HIGHPASS_HZ, where the kinematic angle is good (its gust errors are
         # slow: the turbulence scale over the airspeed); the constant from the full band with them fixed
         Ah, yh = _highpass(dt, A, segs), _highpass(dt, coeff[:, None], segs)[:, 0]
-        cr, csr, res = _lstsq(Ah[m], yh[m])
+        cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
         r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
@@ -229,9 +261,16 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         if symmetric and fit is None:
             # the constant CY0 = CY_beta * (mean error of the kinematic sideslip) + asymmetry; a symmetric
             # airframe's own CY0 is ~0 (prior SIGMA_CY0), the kinematic mean sideslip error ~ SIGMA_BETA_MEAN:
-            # the posterior mean of that error moves the whole angle (the Gauss-Markov gust cannot)
+            # the posterior mean of that error moves the whole angle (the Gauss-Markov gust cannot). The
+            # constant is itself uncertain: the slopes' errors times the regressors' means, and the gusts
+            # (correlated residuals: the scatter of 5-s block means); a short record moves little.
+            Am = A[m].mean(axis=0)
+            var_c0 = float(Am @ cov_r @ Am) + _block_mean_var(coeff[m] - model, [slice(0, int(m.sum()))],
+                                                              max(int(round(MEAN_BLOCK_S / dt)), 1))
             sb2 = SIGMA_BETA_MEAN**2
-            shift = a1 * sb2 * c0 / (a1 * a1 * sb2 + SIGMA_CY0**2)
+            shift = a1 * sb2 * c0 / (a1 * a1 * sb2 + SIGMA_CY0**2 + var_c0)
+            shift_note = (f"sideslip mean moved by {np.degrees(shift):+.2f} deg (CY0 = {c0:+.4f} +- "
+                          f"{np.sqrt(var_c0):.4f} against a symmetric airframe's ~0)")
             kin = np.where(m, kin + shift, kin)
             ang = np.where(m, ang + shift, ang)
         slope = np.full(m.sum(), a1)
@@ -249,13 +288,29 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         ang = np.where(m, kin + g, kin)
         sig = gs
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
-            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift)
+            np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift,
+            shift_note if fit is None else fit.shift_note)
+    if moments is not None and fit is not None:
+        # cross-check that does not use the forces: the moments depend on the angle too (Cm_alpha; Cl_beta,
+        # Cn_beta) and are measured by the gyro, not by the accelerometers the aiding used. If the aided
+        # angle explains them worse than the kinematic one, the force model misled the aiding (e.g.
+        # turbulence on a scale so short that the kinematic angle is poor above HIGHPASS_HZ too: the slopes
+        # are then attenuated and the collinear terms take over): keep the kinematic angle.
+        rk, ra = _moment_rss(kin0, X_other, moments, m), _moment_rss(ang, X_other, moments, m)
+        fit.moment_rss = (rk, ra)
+        if ra > (1.0 + MOMENT_MARGIN) * rk:
+            mname = "Cm" if name == "alpha" else "Cl, Cn"
+            fit.used = False
+            fit.reason = (f"the aided {name} fits {mname} worse than the kinematic one (residual {100 * ra:.1f} % "
+                          f"vs {100 * rk:.1f} % of the variance): the force model is not trusted")
+            return kin0, np.full(len(kin0), np.nan), fit
     return ang, sig, fit
 
 
 def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: np.ndarray, qbar: np.ndarray,
                      f_body: np.ndarray, rates: np.ndarray, controls: dict[str, np.ndarray], mass: float,
-                     S: float, b: float, c: float, use: np.ndarray, passes: int = 2) -> AidedAngles:
+                     S: float, b: float, c: float, use: np.ndarray, passes: int = 2,
+                     rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -265,16 +320,21 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         f_body: (T, 3) specific force at the CG, body axes, m/s^2 (bias removed; white noise is fine).
         rates: (T, 3) body rates p q r, rad/s.
         controls: ``delta_e``, ``delta_a``, ``delta_r`` (rad) and optionally ``delta_t`` (0..1), each (T,);
-            a missing or constant one is left out of the models.
+            a missing or constant one is left out of the models; ``delta_t`` is no regressor, a varying
+            one only keeps the sideslip mean (no CY0 ~ 0 prior for a powered flight).
         mass: kg. S: wing area, m^2. b: span, m. c: mean aerodynamic chord, m.
         use: (T,) bool, the airborne samples to fit and aid.
         passes: least-squares / smoother passes (the first on the kinematic angles).
+        rate_dot: (T, 3) body angular accelerations p_dot q_dot r_dot, rad/s^2, and ``inertia`` (3, 3)
+            the body inertia tensor, kg m^2: with both, the moment coefficients (Euler's equations)
+            cross-check each aided axis (Cm for alpha; Cl, Cn for beta): an aided angle that explains
+            them worse than the kinematic one is dropped (``AxisFit.moment_rss``). None: no check.
 
     Returns:
         :class:`AidedAngles`; an axis whose slope is not identified (wrong sign or fewer than
         :data:`MIN_T_STAT` standard errors), or with under :data:`MIN_VALID_S` s of usable data,
-        or a grid slower than :data:`MIN_RATE_HZ`, keeps its kinematic angle (``AxisFit.used``
-        False, ``reason`` says why).
+        or a grid slower than :data:`MIN_RATE_HZ`, or that fails the moment cross-check, keeps its
+        kinematic angle (``AxisFit.used`` False, ``reason`` says why).
 
     Source: Jategaonkar (2015) ch. 5 and 7; Morelli and Klein (2016) ch. 6-7 (module docstring).
     """
@@ -293,11 +353,26 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     u = use & np.isfinite(qbar) & (qbar > 1.0)
     z0 = np.zeros(T)
     get = lambda n: np.asarray(controls[n], float) if n in controls else z0   # noqa: E731
-    lon = {"q_hat": q_hat, "delta_e": get("delta_e"), "delta_t": get("delta_t")}
-    lat = {"p_hat": p_hat, "r_hat": r_hat, "delta_a": get("delta_a"), "delta_r": get("delta_r"),
-           "delta_t": get("delta_t")}
-    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False)
-    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, True)
+    # no delta_t: the thrust acts along body x (in CX); a propeller's normal and side forces are second
+    # order, and an autopilot's throttle follows the airspeed, i.e. the gusts, slowly: a throttle slope
+    # fitted in the band is then spurious and, applied to the slow throttle changes, moves the angles
+    # (the sim trainer with w20 = 2 m/s: CZ_delta_t = +1.3 against 0, alpha error 1.0 deg against 0.55)
+    lon = {"q_hat": q_hat, "delta_e": get("delta_e")}
+    lat = {"p_hat": p_hat, "r_hat": r_hat, "delta_a": get("delta_a"), "delta_r": get("delta_r")}
+    dthr = get("delta_t")
+    powered = bool(np.nanstd(dthr[use]) > 1e-9) if use.any() else False
+    mom_lon = mom_lat = None
+    if rate_dot is not None and inertia is not None:
+        Mb = rate_dot @ inertia.T + np.cross(rates, rates @ inertia.T)     # M = I w_dot + w x I w, N m
+        with np.errstate(invalid="ignore", divide="ignore"):
+            qS = qbar * S
+            mom_lon = [Mb[:, 1] / (qS * c)]
+            mom_lat = [Mb[:, 0] / (qS * b), Mb[:, 2] / (qS * b)]
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon)
+    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
+    if powered and fb.used:
+        fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
+                         "fin, P-factor) breaks the CY0 ~ 0 prior")
     return AidedAngles(a, be, a_sig, b_sig, (fa, fb))
 
 
@@ -309,9 +384,14 @@ def describe(res: AidedAngles) -> list[str]:
         if not ax.used:
             out.append(f"{ax.name}: kinematic only (specific-force aiding fell back: {ax.reason})")
             continue
+        check = ""
+        if np.isfinite(ax.moment_rss[1]):
+            check = (f"; moment cross-check: residual {100 * ax.moment_rss[1]:.1f} % aided vs "
+                     f"{100 * ax.moment_rss[0]:.1f} % kinematic")
         terms = ", ".join(f"{cname}_{n} = {v:+.3g}" for n, v in zip(ax.columns[1:], ax.coef[1:]))
         out.append(f"{ax.name} aided by the specific force (R2 {ax.r2:.2f}; {cname} = {ax.coef[0]:+.3g} + linear in "
                    f"{', '.join(ax.columns[1:])}: {terms}); gust state: tau {ax.tau_s:g} s, "
                    f"{np.degrees(ax.gust_sigma):.2f} deg; force-derived {ax.name} noise "
-                   f"{np.degrees(ax.noise_sigma):.2f} deg per sample")
+                   f"{np.degrees(ax.noise_sigma):.2f} deg per sample{check}"
+                   + (f"; {ax.shift_note}" if ax.shift_note else ""))
     return out

@@ -77,7 +77,8 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
                          f"[air_data] angles = \"vane\"); V and the wind still from GPS, attitude and pitot")
 
 
-def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes):
+def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
+                Wd=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
     records sources, sigma and notes (and the gusts in the wind); returns ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
@@ -86,7 +87,7 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
         return alpha, beta
     ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
     Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
-                          airframe.b, airframe.c, fly & np.isfinite(V))
+                          airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia)
     notes.extend(describe(Ai))
     src = ("; gusts from the specific force: {c} model fitted on this flight, gust angle a Gauss-Markov state, "
            "Kalman + RTS smoother")
@@ -418,7 +419,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             alpha, beta = _take_vanes(vanes, sources, ident, notes)
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
-                                      fly, C, v_ned, sources, sigma, notes)
+                                      fly, C, v_ned, sources, sigma, notes, Wd)
     else:
         if have_tas:
             V = tas

@@ -123,3 +123,60 @@ def test_slow_logs_fall_back_and_the_sideslip_mean_comes_from_cy0():
     res = _run(rec)
     assert abs(np.degrees(np.mean(res.beta - beta))) < 0.3
     assert abs(np.degrees(res.axes[1].mean_shift) + 1.0) < 0.3
+
+
+def _with_moments(rec, alpha, beta, seed=4):
+    """Add angular accelerations whose moment coefficients depend on the true angles (Cm_alpha, Cl_beta,
+    Cn_beta), with noise; the rates are zero, so M = I w_dot."""
+    rng = np.random.default_rng(seed)
+    T = len(alpha)
+    inertia = np.diag([1300.0, 1800.0, 2700.0])
+    qS = rec["qbar"] * S
+    Cl = -0.09 * beta - 0.2 * rec["controls"]["delta_a"] + 0.01 * rec["controls"]["delta_r"]
+    Cm = 0.02 - 0.8 * alpha - 1.1 * rec["controls"]["delta_e"]
+    Cn = 0.07 * beta - 0.07 * rec["controls"]["delta_r"]
+    M = np.stack([Cl * qS * B, Cm * qS * C, Cn * qS * B], axis=1)
+    rec["rate_dot"] = M / np.diag(inertia) + rng.normal(0, 0.02, (T, 3))
+    rec["inertia"] = inertia
+    return rec
+
+
+def test_moment_cross_check_keeps_good_aiding_and_drops_misled_aiding():
+    """The moments (gyro, not accelerometers) judge the aided angle against the kinematic one: kept when
+    the force model is right; dropped, with a note, when a normal force that is not aerodynamic (here a
+    slow 1.5 m/s^2 disturbance: an unmodelled force, e.g. a propeller or a bad accelerometer) fools it."""
+    rec, alpha, beta = _record()
+    rec = _with_moments(rec, alpha, beta)
+    kw = dict(rate_dot=rec["rate_dot"], inertia=rec["inertia"])
+    T = len(alpha)
+    good = aided_air_angles(DT, rec["alpha_kin"], rec["beta_kin"], rec["V"], rec["qbar"], rec["f_body"],
+                            rec["rates"], rec["controls"], MASS, S, B, C, np.ones(T, bool), **kw)
+    assert all(ax.used for ax in good.axes), describe(good)
+    for ax in good.axes:
+        assert ax.moment_rss[1] < ax.moment_rss[0], ax.moment_rss     # the aided angles explain the moments better
+    assert all("moment cross-check" in n for n in describe(good))
+    bad_f = rec["f_body"].copy()
+    bad_f[:, 2] += _gauss_markov(np.random.default_rng(9), T, 4.0, 1.5)
+    bad = aided_air_angles(DT, rec["alpha_kin"], rec["beta_kin"], rec["V"], rec["qbar"], bad_f,
+                           rec["rates"], rec["controls"], MASS, S, B, C, np.ones(T, bool), **kw)
+    fa, fb = bad.axes
+    assert fb.used and not fa.used, describe(bad)
+    assert "fits Cm worse than the kinematic one" in fa.reason
+    np.testing.assert_array_equal(bad.alpha, rec["alpha_kin"])
+    assert np.isnan(bad.alpha_sigma).all()
+
+
+def test_varying_throttle_keeps_the_sideslip_mean_and_stays_out_of_the_force_model():
+    """With a varying throttle the CY0 ~ 0 prior does not hold (propeller side force): the sideslip mean
+    stays with the kinematics; and delta_t is no regressor of CY, CZ (the autopilot's throttle follows
+    the gusts: a spurious slope)."""
+    rec, alpha, beta = _record()
+    rec["beta_kin"] = rec["beta_kin"] + np.radians(1.0)
+    T = len(alpha)
+    rec["controls"]["delta_t"] = 0.5 + 0.1 * np.sin(2 * np.pi * np.arange(T) * DT / 30.0)
+    res = _run(rec)
+    fa, fb = res.axes
+    assert fa.used and fb.used
+    assert fb.mean_shift == 0.0 and "sideslip mean kept: the throttle varies" in fb.shift_note
+    assert abs(np.degrees(np.mean(res.beta - beta)) - 1.0) < 0.3          # the 1 deg error stays
+    assert "delta_t" not in fa.columns and "delta_t" not in fb.columns
