@@ -1,8 +1,8 @@
 """Give the C heap's free pages back to the system after a learner step.
 
-A learner step builds and drops tens of MiB of short-lived objects: the window's decoded MAVLink
-messages (Python objects, one per message; a coalesced window holds up to four windows of them),
-the smoother's arrays, the hyperparameter refresh's temporaries. CPython and NumPy take that memory
+A learner step builds and drops tens of MiB of short-lived objects: the window's decode (up to
+~17 MiB for a coalesced window four windows long), the smoother's arrays, the confidence map's and
+the hyperparameter refresh's temporaries. CPython and NumPy take that memory
 from glibc's ``malloc``, and glibc keeps freed chunks in its arenas for reuse: it returns memory to
 the system only from the top of the main heap, so once long-lived objects (the row stores, the
 k-d tree, compiled programs) are interleaved with the freed chunks, the resident size stays at the
