@@ -31,6 +31,7 @@ import numpy as np
 from ..aero.table import COEFFICIENTS, REGRESSORS, CoefficientTable
 from ..airframe import Airframe
 from ..errors import InputError, SysidError
+from .heap import release_free_heap
 
 __all__ = ["LearnOptions", "Learner", "learn_from_tlog", "iter_tlog_records"]
 
@@ -56,6 +57,9 @@ class LearnOptions:
             (:func:`gcs_sysid.gp.streaming.light_refresh`: warm start, 40 Adam steps on 1,000 stored
             rows; so the length-scales follow an envelope that grows); 0: never.
         max_window_s: longest window (stamp time) a step decodes when steps were coalesced (below).
+        trim_heap: after each step that decoded a window, give the C heap's free pages back to the
+            system (:func:`gcs_sysid.live.heap.release_free_heap`), so the resident size follows what
+            is held, not the high-water mark of the longest window or refresh so far.
     """
 
     window_s: float = 30.0
@@ -68,6 +72,7 @@ class LearnOptions:
     n_inducing: int | None = None
     hyper_every: int = 15000
     max_window_s: float | None = None
+    trim_heap: bool = True
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -233,7 +238,12 @@ class Learner:
             else:
                 self._refresh_due = False
                 self.refresh()
-        self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": time.perf_counter() - t2}
+        t3 = time.perf_counter()
+        del data, flight, states, table          # the window's temporaries, before the trim
+        if self.options.trim_heap:
+            release_free_heap()
+        self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": t3 - t2,
+                        "trim": time.perf_counter() - t3}
 
     def _merge_can(self, flight, data: bytes):
         """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
