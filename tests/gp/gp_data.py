@@ -47,3 +47,21 @@ def nonlinear_truth(X: np.ndarray) -> np.ndarray:
     Y[:, 2] += 30.0 * np.maximum(alpha - np.radians(5.0), 0.0) ** 2
     Y[:, 4] += -0.3 * np.sin(alpha * 25.0)
     return Y
+
+
+def error_pct(est: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """Per-output ``100 * RMS(est - ref) / RMS(ref)``, shape ``(6,)``."""
+    return 100 * np.sqrt(np.mean((est - ref) ** 2, 0)) / np.sqrt(np.mean(ref ** 2, 0))
+
+
+def envelope_expansion_case(seed: int = 41):
+    """Issue 10's envelope-expansion case: ``(X, Yt, Y, flown, test, train_new)``: 2,000 rows, the
+    envelope flown is alpha below its 70th percentile, the new region above it (every 4th row held
+    out for scoring, the rest streamed in); ``Y`` = truth plus 2 % noise."""
+    X = flight_regressors(2000, seed=seed)
+    Yt = nonlinear_truth(X)
+    Y = Yt + 0.02 * Yt.std(0) * np.random.default_rng(seed + 1).standard_normal(Yt.shape)
+    flown = X[:, 0] < np.quantile(X[:, 0], 0.7)
+    new = np.flatnonzero(~flown)
+    test = new[::4]
+    return X, Yt, Y, flown, test, np.setdiff1d(new, test)

@@ -9,24 +9,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from gp_data import FAST, flight_regressors, nonlinear_truth
+from gp_data import FAST, envelope_expansion_case, error_pct
 from gcs_sysid.gp import fit_gp
 from gcs_sysid.gp.streaming import RefreshBudget, light_refresh
 
 
-def error_pct(est, ref):
-    return 100 * np.sqrt(np.mean((est - ref) ** 2, 0)) / np.sqrt(np.mean(ref ** 2, 0))
-
-
 @pytest.mark.slow   # ~30 s alone (a fit, 20 updates, a refresh, a refit: their compilations)
 def test_light_refresh_in_a_new_region_is_within_20_percent_of_a_refit():
-    X = flight_regressors(2000, seed=41)
-    Yt = nonlinear_truth(X)
-    Y = Yt + 0.02 * Yt.std(0) * np.random.default_rng(42).standard_normal(Yt.shape)
-    flown = X[:, 0] < np.quantile(X[:, 0], 0.7)
-    new = np.flatnonzero(~flown)
-    test = new[::4]
-    train_new = np.setdiff1d(new, test)
+    X, Yt, Y, flown, test, train_new = envelope_expansion_case()
     cfg = replace(FAST, hyper_every=0)
     model, _ = fit_gp(X[flown], Y[flown], cfg)
     for a in range(0, len(train_new), 50):

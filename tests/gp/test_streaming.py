@@ -6,7 +6,7 @@ from dataclasses import replace
 import jax
 import numpy as np
 
-from gp_data import FAST, flight_regressors, nonlinear_truth
+from gp_data import FAST, envelope_expansion_case, error_pct, flight_regressors, nonlinear_truth
 from gcs_sysid.gp import fit_gp, load_gp
 from gcs_sysid.gp import sparse
 from gcs_sysid.gp.rowstore import RowStore, per_cell_limit
@@ -15,10 +15,6 @@ from gcs_sysid.gp.streaming import exchange_inducing, project_stats, projection,
 
 posterior, stats_of, predict_chunk = jax.jit(sparse.posterior), jax.jit(sparse.stats_of), \
     jax.jit(sparse.predict_global_chunk)
-
-
-def error_pct(est, ref):
-    return 100 * np.sqrt(np.mean((est - ref) ** 2, 0)) / np.sqrt(np.mean(ref**2, 0))
 
 
 def dense_vfe_predict(params, Xs, Ys, Xq):
@@ -205,13 +201,7 @@ def test_envelope_expansion_streamed_is_within_20_percent_of_a_full_refit():
     updated, 50 rows at a time as on a link, on a region not flown before (higher alpha, where the
     lift curve bends); the hyperparameters refresh on schedule (every 400 rows). Its held-out error
     there is within 20 % of a full refit on all the rows (the cost of both: benchmarks/bench_gp_stream.py)."""
-    X = flight_regressors(2000, seed=41)
-    Yt = nonlinear_truth(X)
-    Y = Yt + 0.02 * Yt.std(0) * np.random.default_rng(42).standard_normal(Yt.shape)
-    flown = X[:, 0] < np.quantile(X[:, 0], 0.7)
-    new = np.flatnonzero(~flown)
-    test = new[::4]
-    train_new = np.setdiff1d(new, test)
+    X, Yt, Y, flown, test, train_new = envelope_expansion_case()
     cfg = replace(FAST, hyper_every=400)
     model, _ = fit_gp(X[flown], Y[flown], cfg)
     before = error_pct(model.predict(X[test])[0], Yt[test])
