@@ -112,14 +112,20 @@ def run_soak(rows: int) -> dict:
             "rss_growth_mib_after_first_point": points[-1]["rss_mib"] - points[0]["rss_mib"]}
 
 
-def run_envelope(n: int = 28600) -> dict:
-    from gcs_sysid.gp import GPConfig, fit_gp
-
+def envelope_split(n: int):
+    """The envelope-expansion case: ``(X, Y, Yt, flown, test, train_new)``; the envelope flown is alpha
+    below its 70th percentile, the new region above it (every 4th row held out, the rest streamed)."""
     X, Y, Yt = flight(n, seed=7)
     flown = X[:, 0] < np.quantile(X[:, 0], 0.7)
     new = np.flatnonzero(~flown)
     test = new[::4]
-    train_new = np.setdiff1d(new, test)
+    return X, Y, Yt, flown, test, np.setdiff1d(new, test)
+
+
+def run_envelope(n: int = 28600) -> dict:
+    from gcs_sysid.gp import GPConfig, fit_gp
+
+    X, Y, Yt, flown, test, train_new = envelope_split(n)
     model, _ = fit_gp(X[flown], Y[flown], GPConfig())
     before = error_pct(model.predict(X[test])[0], Yt[test])
     c0, t0 = time.process_time(), time.perf_counter()
@@ -167,11 +173,7 @@ def run_refresh_grid(n: int = 28600) -> dict:
     from gcs_sysid.gp import GPConfig, fit_gp
     from gcs_sysid.gp.streaming import RefreshBudget, light_refresh
 
-    X, Y, Yt = flight(n, seed=7)
-    flown = X[:, 0] < np.quantile(X[:, 0], 0.7)
-    new = np.flatnonzero(~flown)
-    test = new[::4]
-    train_new = np.setdiff1d(new, test)
+    X, Y, Yt, flown, test, train_new = envelope_split(n)
     model, _ = fit_gp(X[flown], Y[flown], GPConfig())
     for a in range(0, len(train_new), 50):
         r = train_new[a:a + 50]
