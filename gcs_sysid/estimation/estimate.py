@@ -23,7 +23,7 @@ from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude,
 from .align import Aligned, align_flight, events
 from .ekf import dcm, smooth_attitude
 from .rates import HOLDS, normal_force_input, smooth_rates
-from .smoothers import smooth_level, smooth_velocity
+from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
 from .states import FlightStates
@@ -110,7 +110,7 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
 
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     progress: Callable[[float], None] | None = None, helper: Helper | None = None,
-                    aid_air_angles: bool = True) -> FlightStates:
+                    aid_air_angles: bool = True, earth: str = "wgs84") -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -122,6 +122,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             this process runs the velocity filter and the air data (None: all here; same results).
         aid_air_angles: aid the kinematic alpha and beta with the specific force
             (:mod:`gcs_sysid.estimation.airangles`; False: kinematic only, for comparisons).
+        earth: the velocity filter's Earth: ``"wgs84"`` (WGS-84 normal gravity, Coriolis and transport
+            rate at the GPS latitude and height; a flat Earth where the log has no GPS latitude) or
+            ``"flat"`` (non-rotating, standard gravity: the project's own simulation's world).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -129,7 +132,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
 
     Raises:
         DataError: neither an IMU nor an attitude stream, or fewer than 10 grid points.
+        ValueError: ``earth`` not ``"wgs84"`` or ``"flat"``.
     """
+    if earth not in ("wgs84", "flat"):
+        raise ValueError(f"earth must be 'wgs84' or 'flat', got '{earth}'")
     prog = progress or (lambda f: None)
     src = flight.path
     if not (flight.has("imu") or flight.has("attitude")):
@@ -301,9 +307,22 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         vmeas = events(flight[vsrc], vfields, t)
         if f_cg is not None and C is not None:
             sa = float(np.median([noise_std(f_cg[:, i], 1e-3) for i in range(3)]))
-            Vel = smooth_velocity(dt, C, f_cg, vmeas, sa)
+            lat = al.get("gps", "lat") if earth == "wgs84" else np.full(T, np.nan)
+            round_earth = bool(np.isfinite(lat).any())
+            Vel = smooth_velocity(dt, C, f_cg, vmeas, sa, lat=lat if round_earth else None,
+                                  alt=al.get("gps", "alt"))
             v_ned, vsig, abias = Vel.v_ned, Vel.v_sigma, Vel.accel_bias
             vs = f"KF + RTS: accelerometers (attitude-rotated) integrated, updated by {vsrc} velocity"
+            if round_earth:
+                la = float(np.degrees(np.nanmedian(lat)))
+                g = float(normal_gravity(np.radians(la), np.nanmedian(np.nan_to_num(al.get("gps", "alt")))))
+                vs += f"; WGS-84 gravity ({g:.4f} m/s^2), Coriolis and transport rate at latitude {la:.2f} deg"
+            else:
+                vs += "; flat non-rotating Earth, standard gravity"
+                notes.append("velocity filter: flat non-rotating Earth with standard gravity (" + (
+                    "no GPS latitude" if earth == "wgs84" else "earth=\"flat\"") + "): the Coriolis "
+                    "acceleration (about 1e-4 s^-1 x the ground speed) goes into the accelerometer bias and "
+                    "from there into the force coefficients")
             notes.append("accelerometer bias (KF, mean) x y z = " + ", ".join(f"{b:+.3f}" for b in abias.mean(0))
                          + " m/s^2")
         else:

@@ -2,7 +2,17 @@
 
 See :mod:`gcs_sysid.estimation.ekf` for the order of work and ``docs/estimation.md``
 for the choices. References as there, plus Harvey, *Forecasting, Structural Time
-Series Models and the Kalman Filter*, CUP 1989 (local level model, concentrated likelihood).
+Series Models and the Kalman Filter*, CUP 1989 (local level model, concentrated likelihood),
+and Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*,
+2nd ed., Artech House 2013, sec. 2.4.7 (WGS-84 normal gravity) and sec. 5.4 (the local-navigation-frame
+velocity equation: Coriolis and transport rate).
+
+The Earth model matters for the *force* coefficients: the velocity filter's accelerometer bias takes
+whatever the kinematic model leaves out. With a flat, non-rotating Earth and standard gravity the
+Coriolis acceleration ``-2 omega_ie x v`` (about 0.006 m/s^2 across the track at 40 m/s and 47 deg
+latitude) and the gravity difference (9.8038 vs 9.80665 m/s^2 at 1.8 km there) end up in the bias,
+and so, with the opposite sign, in the bias-corrected specific force: on JSBSim's c172x that was a
+0.006 m/s^2 offset in ``ay``, 2.9 % of the lateral force's RMS (docs/estimation.md).
 """
 
 from __future__ import annotations
@@ -15,7 +25,14 @@ from .ekf import G0
 from .kalman import kalman_filter, rts_smoother, steady_state, steady_state_smoother
 from .nodes import fill_between_nodes, integrate, interp_nodes, node_indices, segments, to_nodes
 
-__all__ = ["smooth_level", "VelocityEstimate", "smooth_velocity"]
+__all__ = ["smooth_level", "VelocityEstimate", "smooth_velocity", "normal_gravity", "earth_acceleration",
+           "OMEGA_IE"]
+
+#: Earth rotation rate (WGS-84), rad/s.
+OMEGA_IE = 7.292115e-5
+_A, _B = 6378137.0, 6356752.31425          # WGS-84 semi-major / semi-minor axes, m
+_F, _E2 = 1.0 / 298.257223563, 6.69437999014e-3   # flattening, first eccentricity squared
+_MU = 3.986004418e14                       # Earth gravitational constant, m^3/s^2
 
 
 def smooth_level(dt: float, z: np.ndarray, bandwidths_hz: tuple[float, ...] = (0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 4.0),
@@ -59,6 +76,60 @@ def smooth_level(dt: float, z: np.ndarray, bandwidths_hz: tuple[float, ...] = (0
     return out
 
 
+# ---------------------------------------------------------------------------- Earth model
+
+
+def normal_gravity(lat: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """Magnitude of the WGS-84 normal gravity (gravitation plus centrifugal) along the local down axis.
+
+    Somigliana's formula on the ellipsoid, then the second-order height correction.
+
+    Args:
+        lat: geodetic latitude, rad, any shape.
+        h: height above the ellipsoid, m, same shape (AMSL is close enough: the geoid height changes g
+            by less than 3e-5 m/s^2).
+
+    Returns:
+        gravity, m/s^2, the shape of ``lat`` (9.7803 at the equator, 9.8322 at the poles, at h = 0).
+
+    Source: Groves (2013) eqs. 2.134 (Somigliana) and 2.139 (height dependence).
+    """
+    s2 = np.sin(lat) ** 2
+    g0 = 9.7803253359 * (1.0 + 0.001931853 * s2) / np.sqrt(1.0 - _E2 * s2)
+    m = OMEGA_IE**2 * _A**2 * _B / _MU
+    return g0 * (1.0 - 2.0 / _A * (1.0 + _F + m - 2.0 * _F * s2) * h + 3.0 * h**2 / _A**2)
+
+
+def earth_acceleration(lat: np.ndarray, h: np.ndarray, v_ned: np.ndarray) -> np.ndarray:
+    """What the Earth adds to ``C f`` in the NED velocity equation: gravity, Coriolis and transport rate.
+
+    ``v_dot = C f + g(lat, h) - (2 omega_ie + omega_en) x v`` with ``omega_ie`` the Earth rate and
+    ``omega_en`` the transport rate (the NED frame turning as the aircraft moves over the curved Earth),
+    both in NED.
+
+    Args:
+        lat: (T,) geodetic latitude, rad.
+        h: (T,) height, m.
+        v_ned: (T, 3) ground velocity vn ve vd, m/s.
+
+    Returns:
+        (T, 3) acceleration, NED, m/s^2 (the down component is about +9.8).
+
+    Source: Groves (2013) eq. 5.54 (local-navigation-frame velocity update), eqs. 2.105-2.106 (radii of
+    curvature), 5.44 (transport rate).
+    """
+    lat, h = np.asarray(lat, float), np.asarray(h, float)
+    sl, cl = np.sin(lat), np.cos(lat)
+    d = np.sqrt(1.0 - _E2 * sl**2)
+    RN, RE = _A * (1.0 - _E2) / d**3, _A / d          # meridian and transverse radii of curvature
+    vn, ve, vd = v_ned[:, 0], v_ned[:, 1], v_ned[:, 2]
+    w_ie = np.stack([OMEGA_IE * cl, np.zeros_like(cl), -OMEGA_IE * sl], axis=1)
+    w_en = np.stack([ve / (RE + h), -vn / (RN + h), -ve * np.tan(lat) / (RE + h)], axis=1)
+    out = -np.cross(2.0 * w_ie + w_en, v_ned)
+    out[:, 2] += normal_gravity(lat, h)
+    return out
+
+
 # ---------------------------------------------------------------------------- velocity
 
 
@@ -80,7 +151,8 @@ class VelocityEstimate:
 
 def smooth_velocity(dt: float, C: np.ndarray, f_body: np.ndarray, v_meas: np.ndarray, sigma_accel: float,
                     sigma_vel: float = 0.15, sigma_bias_walk: float = 2e-3, sigma_bias0: float = 0.3,
-                    node_hz: float = 10.0) -> VelocityEstimate:
+                    node_hz: float = 10.0, lat: np.ndarray | None = None,
+                    alt: np.ndarray | None = None) -> VelocityEstimate:
     """Ground velocity and accelerometer bias by a linear time-varying Kalman filter + RTS.
 
     State ``[vn, ve, vd, b_x, b_y, b_z]`` on nodes (at most ``node_hz``); between
@@ -99,9 +171,14 @@ def smooth_velocity(dt: float, C: np.ndarray, f_body: np.ndarray, v_meas: np.nda
         sigma_bias_walk: accel bias random walk, m/s^2/sqrt(s).
         sigma_bias0: prior 1-sigma of the accel bias, m/s^2.
         node_hz: highest node rate, Hz.
+        lat: optional (T,) geodetic latitude, rad (NaN where missing: interpolated; all NaN: flat Earth).
+        alt: optional (T,) height, m, with ``lat`` (NaN interpolated; missing: 0).
 
     Returns:
         :class:`VelocityEstimate`.
+
+    Raises:
+        ValueError: ``lat`` or ``alt`` not of length T.
 
     Source: Klein and Morelli (2006) ch. 10 (flight-path reconstruction);
     Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
@@ -111,7 +188,7 @@ def smooth_velocity(dt: float, C: np.ndarray, f_body: np.ndarray, v_meas: np.nda
     good = np.isfinite(f_body).all(axis=1) & np.isfinite(C).all(axis=(1, 2))
     Cz = np.where(good[:, None, None], C, 0.0)
     a = np.einsum("tij,tj->ti", Cz, np.nan_to_num(f_body))
-    a[:, 2] += G0
+    a += _earth_term(T, lat, alt, v_meas)
     a[~good] = 0.0
     nodes = node_indices(T, dt, node_hz)
     J = len(nodes)
@@ -144,3 +221,30 @@ def smooth_velocity(dt: float, C: np.ndarray, f_body: np.ndarray, v_meas: np.nda
     a_corr = a - np.einsum("tij,tj->ti", Cz, bias)
     v = fill_between_nodes(nodes, xs[:, :3], integrate(a_corr, dt))
     return VelocityEstimate(v, interp_nodes(nodes, sd[:, :3], T), bias, interp_nodes(nodes, sd[:, 3:], T))
+
+
+def _fill(x: np.ndarray) -> np.ndarray | None:
+    """(T,) with NaN linearly interpolated (ends held); None if nothing is finite."""
+    ok = np.isfinite(x)
+    if not ok.any():
+        return None
+    i = np.arange(len(x))
+    return np.interp(i, i[ok], x[ok])
+
+
+def _earth_term(T: int, lat, alt, v_meas: np.ndarray) -> np.ndarray:
+    """(T, 3) gravity (+ Coriolis and transport rate where the latitude is known), NED, m/s^2."""
+    flat = np.zeros((T, 3))
+    flat[:, 2] = G0
+    if lat is None:
+        return flat
+    for name, x in (("lat", lat), ("alt", alt)):
+        if x is not None and len(x) != T:
+            raise ValueError(f"smooth_velocity: {name} has {len(x)} samples, expected {T} (one per grid step)")
+    la = _fill(np.asarray(lat, float))
+    if la is None:
+        return flat
+    h = _fill(np.asarray(alt, float)) if alt is not None else None
+    h = np.zeros(T) if h is None else h
+    v = np.stack([_fill(v_meas[:, i]) if np.isfinite(v_meas[:, i]).any() else np.zeros(T) for i in range(3)], 1)
+    return earth_acceleration(la, h, v)
