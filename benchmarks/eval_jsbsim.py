@@ -7,7 +7,10 @@ and the project's stepwise least-squares fit (``run_fit`` on the training window
 against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on the held-out segment):
 
   meas   the measured coefficients themselves (``meas_all`` in the JSON: on all valid rows;
-         ``meas_true_accel``: on all rows with JSBSim's angular accelerations put in, a diagnosis)
+         ``meas_true_accel``: on all rows with JSBSim's angular accelerations put in, a diagnosis;
+         ``meas_offset``: the mean of the held-out error, % of the truth's RMS, the part of ``meas``
+         an offset explains; ``meas_flat``: held-out, re-estimated with a flat non-rotating Earth,
+         ``estimate_states(earth="flat")``, what the velocity filter's Earth model changes)
   gp     the replay's model predictions at the measured regressors
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
@@ -86,6 +89,14 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     tab_acc = compute_coefficients(st, load_airframe(files.airframe))
     st.data.update(saved)
     row["meas_true_accel"] = _errs(tab_acc.Y[ok], Yt[ok])
+    rms = np.sqrt(np.mean(Yt[h] ** 2, axis=0))
+    row["meas_offset"] = {c: float(100.0 * np.mean(tab.Y[h, i] - Yt[h, i]) / rms[i]) for i, c in enumerate(COEFFICIENTS)}
+    from gcs_sysid.estimation import estimate_states
+    from gcs_sysid.telemetry import read_log
+
+    af = load_airframe(files.airframe)
+    tab_flat = compute_coefficients(estimate_states(read_log(files.tlog), af, earth="flat"), af)
+    row["meas_flat"] = _errs(tab_flat.Y[h], Yt[h])
     row["gp"] = _errs(res.pred_mean[h], Yt[h])
     row["cov_gp"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]))
     model = load_gp(Path(res.model_path))
@@ -163,6 +174,7 @@ def main(argv=None) -> int:
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")
+                print(f"{'':32s} flat  {_fmt(row['meas_flat'])}   (measured, flat-Earth velocity filter)")
                 print(f"{'':32s} gp    {_fmt(row['gp'])}   {row['cov_gp']:5.1f}  "
                       f"{row['alpha_deg']:.2f}/{row['beta_deg']:.2f} (signal {row['alpha_rms_deg']:.2f}/"
                       f"{row['beta_rms_deg']:.2f})")
