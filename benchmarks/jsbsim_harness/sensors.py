@@ -3,9 +3,14 @@
 Streams follow :func:`gcs_sysid.sim.sensors.make_sensors` (same names, fields and units, so that
 :func:`gcs_sysid.sim.tlog.write_tlog` writes them), sampled from the JSBSim truth:
 
-* ``imu`` 50 Hz: specific force at the CG, ``F_non-gravity / m`` from JSBSim's total body forces
-  (the IMU sits at the CG), gyro = inertial body rates; white noise and a constant bias per seed;
-  magnetometer from the attitude.
+* ``imu`` 50 Hz: specific force at the IMU, ``F_non-gravity / m`` from JSBSim's total body forces
+  (JSBSim's accelerometer-equivalent output at the CG: with the WGS-84 gravity, Coriolis and transport
+  rate it closes JSBSim's own NED velocity equation to 2e-5 m/s^2 across the track,
+  ``tests/jsbsim/test_jsbsim_earth.py``) plus, for an IMU away from the CG (``imu_offset``, which
+  the airframe file's ``imu_lever_arm`` must then state), ``omega_dot x r + omega x (omega x r)``
+  with JSBSim's inertial body rates and their derivatives; by default the IMU sits at the CG, as the
+  checked-in airframe files say (``imu_lever_arm = [0, 0, 0]``). Gyro = inertial body rates; white
+  noise and a constant bias per seed; magnetometer from the attitude.
 * ``attitude`` 50 Hz (AHRS: truth + small noise), ``gps`` / ``local_position`` 25 Hz (position
   random walk, velocity white noise), ``pressure`` 25 Hz (static pressure from JSBSim's
   atmosphere; ``diff_pressure`` = pitot dynamic pressure ``0.5 rho0 EAS^2`` with EAS noise),
@@ -62,13 +67,18 @@ def _walk(rng: np.random.Generator, n: int, dt: float, sigma: float, tau: float)
     return y
 
 
-def make_sensors(rec: Recording, aoa: str = "ahrs", seed: int | None = None) -> dict[str, dict[str, np.ndarray]]:
+def make_sensors(rec: Recording, aoa: str = "ahrs", seed: int | None = None,
+                 imu_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> dict[str, dict[str, np.ndarray]]:
     """Sensor streams of a recorded flight (same layout as :func:`gcs_sysid.sim.sensors.make_sensors`).
 
     Args:
         rec: the flight (truth at ``rec.config.log_rate_hz``, which must be 50 Hz).
         aoa: ``"ahrs"`` (ArduPilot's estimate) or ``"vane"`` (exact angles + noise).
-        seed: noise seed (default ``rec.config.seed``).
+        seed: noise seed (default ``rec.config.seed``); the noise does not depend on ``imu_offset``.
+        imu_offset: IMU position from the CG, body axes, m: the accelerometers measure
+            ``f_cg + omega_dot x r + omega x (omega x r)`` (rigid body; Stevens, Lewis and Johnson
+            2016, sec. 1.9). A log written with an offset needs an airframe file whose
+            ``imu_lever_arm`` says so.
 
     Returns:
         stream -> {"t": (N,), field: (N,)}, SI (see the module docstring).
@@ -97,8 +107,12 @@ def make_sensors(rec: Recording, aoa: str = "ahrs", seed: int | None = None) -> 
     n = len(t[s])
     R = body_from_ned(tr["phi"], tr["theta"], tr["psi"])
     imu = {"t": t[s]}
-    for a, F in zip("xyz", ("Fx_total", "Fy_total", "Fz_total")):
-        imu[f"a{a}"] = tr[F][s] / m + rng.normal(0.0, 0.03) + noise(0.05, n)
+    r_imu = np.asarray(imu_offset, float)
+    w = np.stack([tr[k] for k in "pqr"], 1)[s]
+    wd = np.stack([tr[k + "_dot"] for k in "pqr"], 1)[s]
+    arm = np.cross(wd, r_imu) + np.cross(w, np.cross(w, r_imu))     # zero at the CG
+    for i, (a, F) in enumerate(zip("xyz", ("Fx_total", "Fy_total", "Fz_total"))):
+        imu[f"a{a}"] = tr[F][s] / m + arm[:, i] + rng.normal(0.0, 0.03) + noise(0.05, n)
     for k in "pqr":
         imu[k] = tr[k][s] + rng.normal(0.0, 0.001) + noise(0.005, n)
     mag = np.einsum("nij,j->ni", R[s], np.array([0.21, 0.0, 0.43]))
