@@ -48,9 +48,9 @@ def test_the_flat_earth_shows_the_coriolis_offset(offsets):
 def test_jsbsim_truth_closes_the_velocity_equation_with_the_earth_model(fast_flight):
     """The harness's accelerometer-equivalent truth (total non-gravity force / mass at the CG, which
     its IMU logs) with the attitude and JSBSim's NED velocity: ``v_dot = C f + g - (2 w_ie + w_en) x v``
-    holds to a mean 1e-3 m/s^2 per axis (measured on the 90 s flight: 1e-5, 5e-5, 2e-4), and a flat
-    non-rotating Earth with standard gravity leaves the Coriolis and gravity terms (2.6e-3, 5.4e-3,
-    -5.8e-3 there): the harness's IMU is the one JSBSim's rigid body would carry at the CG."""
+    holds to a mean 1e-3 m/s^2 per axis (measured on this 40 s flight: -9e-5, 9e-5, 3.9e-4 N E D), and a
+    flat non-rotating Earth with standard gravity leaves the Coriolis and gravity terms (-2.7e-3,
+    5.5e-3, -5.7e-3): the harness's IMU is the one JSBSim's rigid body would carry at the CG."""
     from benchmarks.jsbsim_harness.sensors import body_from_ned
     from gcs_sysid.estimation.smoothers import earth_acceleration
 
