@@ -315,7 +315,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             vs = f"KF + RTS: accelerometers (attitude-rotated) integrated, updated by {vsrc} velocity"
             if round_earth:
                 la = float(np.degrees(np.nanmedian(lat)))
-                g = float(normal_gravity(np.radians(la), np.nanmedian(np.nan_to_num(al.get("gps", "alt")))))
+                h_gps = al.get("gps", "alt")
+                h_med = float(np.nanmedian(h_gps)) if np.isfinite(h_gps).any() else 0.0
+                g = float(normal_gravity(np.radians(la), h_med))
                 vs += f"; WGS-84 gravity ({g:.4f} m/s^2), Coriolis and transport rate at latitude {la:.2f} deg"
             else:
                 vs += "; flat non-rotating Earth, standard gravity"
