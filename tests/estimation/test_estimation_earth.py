@@ -76,3 +76,10 @@ def test_latitude_of_the_wrong_length_is_refused():
     # all-NaN latitude: the flat Earth, no error
     est = smooth_velocity(0.02, C, f, vm, 0.05, lat=np.full(200, np.nan), alt=alt)
     assert np.isfinite(est.v_ned).all()
+
+
+def test_unknown_earth_is_refused():
+    from gcs_sysid.estimation import estimate_states
+
+    with pytest.raises(ValueError, match="earth must be 'wgs84' or 'flat', got 'round'"):
+        estimate_states(None, None, earth="round")
