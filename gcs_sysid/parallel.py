@@ -18,6 +18,11 @@ needs (matplotlib, for the figures).
 Nothing depends on the worker being there: with one CPU, with ``enabled=False`` or
 ``GCS_SYSID_PARALLEL=0``, or when the worker cannot be started or dies, each job runs in
 the calling process instead, with the same result (the functions are pure).
+
+One user keeps state in the worker between jobs: a live session's learner
+(:mod:`gcs_sysid.live.remote`, jobs in order on one worker). Without a worker its jobs run here
+as well; if the worker dies mid-session, the learner it held is gone and the next job says so
+(:class:`~gcs_sysid.errors.SysidError`) instead of running here on a state it does not have.
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ _EDGE = {"RAW_IMU", "SCALED_IMU", "HIGHRES_IMU", "ATTITUDE", "VFR_HUD", "AOA_SSA
 BEHIND_RECORDS = 2000
 """Records waiting for the learner beyond which it counts as behind (1 s at 2,000 msg/s)."""
 
-BATCH_S = 0.05
+BATCH_S = 0.25
 """Seconds the learner thread lets records gather before it sends a batch to the learner's process."""
 
 @dataclass(frozen=True)
