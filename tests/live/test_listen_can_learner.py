@@ -10,7 +10,7 @@ ground station's clock as on a real aircraft. Samples the bus would have sent be
 not sent.
 
 Asserted on content: the learned rows' delta_e come from DroneCAN and are the surfaces (not the lagged
-PWM); the learned rows equal those of the same session replayed from its ``raw.tlog`` + ``can.log``
+PWM); the learned rows equal (to 1e-5) those of the same session replayed from its ``raw.tlog`` + ``can.log``
 (``learn_from_tlog(can_log=)``); the elevator derivative of a least-squares fit to the learned rows
 (Cm_delta_e) differs from the PWM-only replay's and is the closer to the simulation's truth (-0.9).
 """
@@ -151,15 +151,16 @@ def test_listen_with_a_live_can_bus_learns_the_measured_deflections(tmp_path):
     live = session.learner
     assert live.steps >= 4 and len(live.t) > 500
 
-    # the same session replayed from its raw.tlog + can.log learns the same rows
+    # the same session replayed from its raw.tlog + can.log learns the same rows (to 1e-5)
     again = learn_from_tlog(tmp_path / "live" / "raw.tlog", af_can, LEARN, can_log=tmp_path / "live" / "can.log",
                             coalesced_at=snap["coalesced_at_us"])
     assert np.array_equal(again.t, live.t)
     # not bit for bit: can.log keeps the frames' stamps to the microsecond, the live decoder had them exact
+    # (measured: regressors within 5e-7 rad, coefficients equal); allowed: 1e-5 (rad for the deflections)
     dx = np.nanmax(np.abs(again.X - live.X), axis=0)
     dy = np.nanmax(np.abs(again.Y - live.Y), axis=0)
     print("max |replay - live|: X", dx, "Y", dy)
-    assert np.all(dx < 1e-6) and np.all(dy < 1e-6), (dx, dy)
+    assert np.all(dx < 1e-5) and np.all(dy < 1e-5), (dx, dy)
     assert np.array_equal(np.isnan(again.Y), np.isnan(live.Y))
     # ... and the commanded PWM alone (the same raw.tlog, no CAN) does not: the lag is in its regressors
     pwm = learn_from_tlog(tmp_path / "live" / "raw.tlog", replace(af, can_actuators=()), LEARN)
