@@ -151,7 +151,8 @@ class LiveSession:
         if parallel:
             from .remote import WARM, RemoteLearner
 
-            self.helper = Helper(enabled=True, warm=WARM)
+            # SIGTERM to the process group ends a listen cleanly, with the learner's model: the worker holds on
+            self.helper = Helper(enabled=True, warm=WARM, hold_sigterm=True)
             if self.helper.parallel:
                 return RemoteLearner(airframe, options.learn, self.helper,
                                      can_keep_s if self.can is not None else None, BEHIND_RECORDS)
