@@ -18,6 +18,11 @@ needs (matplotlib, for the figures).
 Nothing depends on the worker being there: with one CPU, with ``enabled=False`` or
 ``GCS_SYSID_PARALLEL=0``, or when the worker cannot be started or dies, each job runs in
 the calling process instead, with the same result (the functions are pure).
+
+One user keeps state in the worker between jobs: a live session's learner
+(:mod:`gcs_sysid.live.remote`, jobs in order on one worker). Without a worker its jobs run here
+as well; if the worker dies mid-session, the learner it held is gone and the next job says so
+(:class:`~gcs_sysid.errors.SysidError`) instead of running here on a state it does not have.
 """
 
 from __future__ import annotations
@@ -39,6 +44,7 @@ __all__ = ["Helper", "Job", "WorkerError", "call", "default_enabled"]
 
 #: Set to ``0`` to run every job in the calling process (debugging, profiling).
 PARALLEL_ENV = "GCS_SYSID_PARALLEL"
+_HOLD_TERM_ENV = "GCS_SYSID_WORKER_HOLDS_SIGTERM"   # set by Helper(hold_sigterm=True) for its worker
 
 
 class WorkerError(RuntimeError):
@@ -100,6 +106,10 @@ class Helper:
     Args:
         enabled: start a worker (None: :func:`default_enabled`).
         warm: modules the worker imports as soon as it starts.
+        hold_sigterm: the worker ignores SIGTERM (sent to the whole process group by ``timeout``, a
+            service manager, ``kill -TERM -PGID``), so that a caller which ends cleanly on SIGTERM can
+            still collect what the worker holds (a live session's learner); the caller stops it with
+            :meth:`close`, and the kernel kills it if the caller dies.
 
     Use as a context manager, or call :meth:`close`::
 
@@ -109,7 +119,7 @@ class Helper:
             png = job.result()
     """
 
-    def __init__(self, enabled: bool | None = None, warm: Sequence[str] = ()):
+    def __init__(self, enabled: bool | None = None, warm: Sequence[str] = (), hold_sigterm: bool = False):
         self._proc: subprocess.Popen | None = None
         self._pending: dict[int, Future] = {}
         self._lock = threading.Lock()
@@ -124,7 +134,8 @@ class Helper:
             # and one BLAS thread: it is the spare core, the caller keeps the other one busy
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p), **{PARALLEL_ENV: "0"},
                        OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-                       PYTHONWARNINGS="ignore")   # the caller reports problems; the worker's console stays quiet
+                       PYTHONWARNINGS="ignore",   # the caller reports problems; the worker's console stays quiet
+                       **{_HOLD_TERM_ENV: "1" if hold_sigterm else "0"})
             self._proc = subprocess.Popen([sys.executable, "-m", "gcs_sysid.parallel"], stdin=subprocess.PIPE,
                                           stdout=subprocess.PIPE, env=env)
         except OSError:
@@ -267,12 +278,14 @@ def _die_with_parent() -> None:
 def _serve() -> None:
     """The worker's loop: read a job from stdin, run it, write ``(key, ok, value)`` to stdout.
 
-    It ends quietly (no traceback) at EOF, when its pipes break (the caller is gone) and on SIGTERM.
+    It ends quietly (no traceback) at EOF, when its pipes break (the caller is gone) and on SIGTERM
+    (unless started with ``hold_sigterm``).
     """
     # Ctrl-C reaches the whole process group: the caller handles it (and stops this worker); the worker
     # must not die of it mid-job with a traceback of its own. It ends at EOF, when the caller closes or dies.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    hold = os.environ.get(_HOLD_TERM_ENV, "0") == "1"   # the caller ends cleanly on SIGTERM and needs this worker
+    signal.signal(signal.SIGTERM, signal.SIG_IGN if hold else signal.SIG_DFL)
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)   # a write to a closed pipe ends the worker silently
     _die_with_parent()
     import warnings

@@ -94,7 +94,11 @@ class HostedSession:
     def save(self) -> Path | None:
         """Save the model now into ``out_dir/model``; returns the path or None without a model."""
         learner = self.session.learner
-        if learner is None or learner.model is None:
+        if learner is None:
+            return None
+        if hasattr(learner, "save"):   # the learner runs in the worker process (live.remote)
+            return self.session.out / "model" if learner.save(self.session.out / "model") else None
+        if learner.model is None:
             return None
         learner.model.save(self.session.out / "model")
         return self.session.out / "model"

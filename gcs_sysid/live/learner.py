@@ -247,7 +247,7 @@ class Learner:
 
     def _merge_can(self, flight, data: bytes):
         """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
-        from ..telemetry.can_merge import host_clock_of_tlog, merge_can_streams
+        from ..telemetry.can_merge import can_host_clock, host_clock_of_tlog, merge_can_streams
 
         last = self._window[-1][0] * 1e-6
         streams = {}
@@ -257,8 +257,11 @@ class Learner:
                 streams[name] = type(st)(st.name, st.source, st.t[m], {k: v[m] for k, v in st.fields.items()})
         if not streams:
             return flight
-        try:
-            return merge_can_streams(flight, streams, host_clock_of_tlog("live window", data), 0.0, "CAN bus")
+        try:   # DroneCAN time sync when its master is the vehicle, else the window's time_boot_ms
+            clock, why = can_host_clock(streams, host_clock_of_tlog("live window", data))
+            if why and not any(n.startswith("DroneCAN GlobalTimeSync") for n in self.notes):
+                self.notes.append(why)
+            return merge_can_streams(flight, streams, clock, 0.0, "CAN bus")
         except InputError as exc:
             if not any(n.startswith("CAN not merged") for n in self.notes):
                 self.notes.append(f"CAN not merged (step {self.steps}): {exc}")

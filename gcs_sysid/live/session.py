@@ -5,6 +5,12 @@ Threads: the link receiver (:class:`gcs_sysid.telemetry.live.LinkReceiver`) writ
 :class:`~gcs_sysid.live.learner.Learner` (so a slow GP step never blocks the link: the queue grows
 and is drained after); the calling thread runs the schedule (requests, heartbeat, status texts,
 console) every :data:`TICK_S` until the duration ends or Ctrl-C, then writes the report.
+
+The learner itself runs in the spare worker process (:mod:`gcs_sysid.parallel`) when there is one
+(:class:`~gcs_sysid.live.remote.RemoteLearner`): the learner thread here then only sends it the
+queued records in batches, so the estimation and the GP do not hold this process's interpreter
+lock against the receiver. ``session.learner`` is the learner's copy of its status while the session
+runs and the :class:`~gcs_sysid.live.learner.Learner` itself (with its model) after :meth:`LiveSession.close`.
 """
 
 from __future__ import annotations
@@ -32,6 +38,9 @@ _EDGE = {"RAW_IMU", "SCALED_IMU", "HIGHRES_IMU", "ATTITUDE", "VFR_HUD", "AOA_SSA
 BEHIND_RECORDS = 2000
 """Records waiting for the learner beyond which it counts as behind (1 s at 2,000 msg/s)."""
 
+BATCH_S = 0.25
+"""Seconds the learner thread lets records gather before it sends a batch to the learner's process."""
+
 @dataclass(frozen=True)
 class ListenOptions:
     """Options of :func:`run_listen`.
@@ -49,6 +58,8 @@ class ListenOptions:
         use_mavsdk: serve parameters with MAVSDK (else pymavlink's PARAM protocol).
         can: ``INTERFACE:CHANNEL`` of a CAN bus to log (``DIR/can.log``) and decode (DroneCAN actuator
             status and air data, :mod:`gcs_sysid.telemetry.can`) beside the MAVLink link.
+        parallel: run the learner in a worker process (None: when more than one CPU is usable and
+            ``GCS_SYSID_PARALLEL`` is not 0, :func:`gcs_sysid.parallel.default_enabled`).
     """
 
     connection: str
@@ -64,6 +75,7 @@ class ListenOptions:
     console: bool = True
     use_mavsdk: bool = True
     can: str | None = None
+    parallel: bool | None = None
 
 
 class LiveSession:
@@ -86,20 +98,20 @@ class LiveSession:
         self.options = options
         self.out = Path(out_dir)
         self.link = link if link is not None else open_link(options.connection, options.baud)   # fail fast
+        self.helper = None
+        self.can = None
         try:
-            # heavy imports (JAX, SciPy) before raw.tlog exists: once it does, Ctrl-C is handled (run_listen);
-            # packets arriving meanwhile wait in the socket's buffer
-            self.learner = Learner(airframe, options.learn) if options.learn is not None else None
-            self.edge = LiveEdge()
+            # heavy imports (JAX, SciPy; in the worker when there is one) before raw.tlog exists: once it does,
+            # Ctrl-C is handled (run_listen); packets arriving meanwhile wait in the socket's buffer
             self.out.mkdir(parents=True, exist_ok=True)
-            self.can = None
+            keep = max(2.0 * options.learn.window_s if options.learn is not None else 60.0, 60.0)
             if options.can:
                 from ..telemetry.can import CanListener, open_bus
 
-                keep = 2.0 * options.learn.window_s if options.learn is not None else 60.0
-                self.can = CanListener(open_bus(options.can), self.out / "can.log", keep_s=max(keep, 60.0))
-                if self.learner is not None:   # measured surface positions and airspeed into each window
-                    self.learner.can_source = self.can.streams
+                self.can = CanListener(open_bus(options.can), self.out / "can.log", keep_s=keep)
+            self.learner = self._start_learner(airframe, options, keep) if options.learn is not None else None
+            self._remote = self.learner is not None and not isinstance(self.learner, Learner)
+            self.edge = LiveEdge()
             self.raw = RawLog(self.out / "raw.tlog")
             self._q: queue.Queue = queue.Queue()
             self._msgs: queue.Queue = queue.Queue()
@@ -117,19 +129,46 @@ class LiveSession:
             self._stop = threading.Event()
             self._closed: dict | None = None
             self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
-            if self.learner is not None:   # behind: coalesce steps, defer the map (Learner.behind)
+            if isinstance(self.learner, Learner):   # behind: coalesce steps, defer the map (Learner.behind)
                 self.learner.behind = lambda: self._q.qsize() > BEHIND_RECORDS
         except BaseException:   # a bad CAN bus, Ctrl-C during the imports: give the link back
+            if getattr(self, "learner", None) is not None and not isinstance(self.learner, Learner):
+                self.learner.close()
+            if self.helper is not None:
+                self.helper.close(wait=False)
+            if self.can is not None:
+                self.can.bus.shutdown()
             if link is None:
                 self.link.close()
             raise
         self.started = time.time()
+
+    def _start_learner(self, airframe, options: ListenOptions, can_keep_s: float):
+        """The learner: in the worker process when there is one (:class:`RemoteLearner`), else here."""
+        from ..parallel import Helper, default_enabled
+
+        parallel = default_enabled() if options.parallel is None else options.parallel
+        if parallel:
+            from .remote import WARM, RemoteLearner
+
+            # SIGTERM to the process group ends a listen cleanly, with the learner's model: the worker holds on
+            self.helper = Helper(enabled=True, warm=WARM, hold_sigterm=True)
+            if self.helper.parallel:
+                return RemoteLearner(airframe, options.learn, self.helper,
+                                     can_keep_s if self.can is not None else None, BEHIND_RECORDS)
+            self.helper = None   # the worker could not start: learn here
+        learner = Learner(airframe, options.learn)
+        if self.can is not None:   # measured surface positions and airspeed into each window
+            learner.can_source = self.can.streams
+        return learner
 
     # --- threads ------------------------------------------------------------------------------
 
     def _on_packet(self, stamp_us: int, buf: bytes, msg) -> None:   # receiver thread: return fast
         if self.learner is not None:
             self._q.put((stamp_us, buf))
+            if self._remote:
+                self.learner.record_queued()
         name = msg.get_type()
         if name in _EDGE and (self.receiver.stats.vehicle is None
                               or (msg.get_srcSystem(), msg.get_srcComponent()) == self.receiver.stats.vehicle):
@@ -141,6 +180,8 @@ class LiveSession:
             self._msgs.put(msg)
 
     def _learn_loop(self) -> None:
+        if not isinstance(self.learner, Learner):
+            return self._send_loop()
         while True:
             item = self._q.get()
             if item is None:
@@ -148,11 +189,40 @@ class LiveSession:
             try:
                 self.learner.feed(*item)
             except Exception as exc:   # a bug in a stage must not stop the link or lose the log
-                self._learner_error = f"{type(exc).__name__}: {exc}"
-                self.learner.notes.append(f"learning stopped: {self._learner_error}")
-                while self._q.get() is not None:
-                    pass
+                self._learner_stopped(exc)
                 return
+
+    def _send_loop(self) -> None:
+        """The learner thread with the learner in the worker: send what is queued in batches, in order."""
+        learner, q = self.learner, self._q
+        end = False
+        while not end:
+            item = q.get()
+            if item is None:
+                return
+            time.sleep(BATCH_S)   # let a batch gather (the learner's schedule counts stamps, not batches)
+            batch = [item]
+            for _ in range(q.qsize()):
+                item = q.get_nowait()
+                if item is None:
+                    end = True
+                    break
+                batch.append(item)
+            try:
+                learner.feed_batch(batch, self.can.drain() if self.can is not None else ())
+            except Exception as exc:   # a bug in a stage, the worker gone: the link and the log go on
+                self._learner_stopped(exc)
+                return
+
+    def _learner_stopped(self, exc: Exception) -> None:
+        self._learner_error = f"{type(exc).__name__}: {exc}"
+        note = f"learning stopped: {self._learner_error}"
+        if isinstance(self.learner, Learner):
+            self.learner.notes.append(note)
+        else:
+            self.learner.note(note)
+        while self._q.get() is not None:
+            pass
 
     # --- schedule -----------------------------------------------------------------------------
 
@@ -258,7 +328,8 @@ class LiveSession:
         }
         if learner is not None:
             snap.update({
-                "samples_learned": learner.n_learned, "steps": learner.steps, "queue": self._q.qsize(),
+                "samples_learned": learner.n_learned, "steps": learner.steps,
+                "queue": self._q.qsize() + getattr(learner, "in_flight", 0),
                 "outputs": list(learner.outputs), "confidence": learner.confidence(),
                 "identifiable": {k: list(v) for k, v in learner.identifiable.items()},
                 "top_suggestion": learner.suggestions[0].reason if learner.suggestions else None,
@@ -266,6 +337,7 @@ class LiveSession:
                 "control_sources": dict(learner.control_sources), "steps_coalesced": learner.coalesced,
                 "map_refreshes_deferred": learner.refreshes_deferred,
                 "coalesced_at_us": list(learner.coalesced_at),
+                "learner_in": "worker process" if self._remote else "this process",
             })
         return snap
 
@@ -325,7 +397,17 @@ class LiveSession:
             self._q.put(None)
             self._learn_thread.join()
             if self._learner_error is None:
-                self.learner.finish()
+                if isinstance(self.learner, Learner):
+                    self.learner.finish()
+                else:   # the learner comes back from its process, with its model
+                    try:
+                        self.learner = self.learner.finish(self.can.drain() if self.can is not None else ())
+                    except Exception as exc:
+                        self.learner.note(f"learning stopped: {type(exc).__name__}: {exc}")
+        if self._remote and not isinstance(self.learner, Learner):
+            self.learner.close()   # not finished (it stopped, or never started): its shared counter goes
+        if self.helper is not None:
+            self.helper.close(wait=False)
         if self.component is not None:
             self.component.close()
         self.link.close()

@@ -2,7 +2,9 @@
 
 DroneCAN servos report ``uavcan.equipment.actuator.Status`` (``position``: the measured surface or
 servo position, rad), airspeed sensors ``uavcan.equipment.air_data.IndicatedAirspeed`` (m/s),
-``TrueAirspeed`` (m/s) and ``RawAirData`` (``differential_pressure`` Pa). Frames are read with
+``TrueAirspeed`` (m/s) and ``RawAirData`` (``differential_pressure`` Pa); a time-sync master's
+``uavcan.protocol.GlobalTimeSync`` gives pairs (receive time, master time) in the stream
+``can_timesync`` (``master`` s; :func:`gcs_sysid.telemetry.can_merge.host_clock_of_timesync`). Frames are read with
 python-can (any interface: ``socketcan``, ``slcan``, ``virtual`` ...; or a log through
 ``can.LogReader``: .asc, .blf, .log, .csv ...), multi-frame transfers are reassembled and decoded
 with the ``dronecan`` library (``TransferManager``, ``Transfer.from_frames``: CRC and toggle checked),
@@ -30,13 +32,15 @@ import numpy as np
 from gcs_sysid.errors import InputError
 from gcs_sysid.telemetry.types import Stream
 
-__all__ = ["CanDecoder", "read_can_log", "CanListener", "open_bus", "frames_of"]
+__all__ = ["CanDecoder", "CanSamples", "read_can_log", "CanListener", "open_bus", "frames_of", "streams_of"]
 
 TRIM_EVERY = 1000   #: transfers between trims of a bounded decoder's samples
 _ACTUATOR = "uavcan.equipment.actuator.Status"
 _IAS = "uavcan.equipment.air_data.IndicatedAirspeed"
 _TAS = "uavcan.equipment.air_data.TrueAirspeed"
 _RAW = "uavcan.equipment.air_data.RawAirData"
+_SYNC = "uavcan.protocol.GlobalTimeSync"
+SYNC_MAX_PERIOD_S = 1.1   #: a time-sync message pairs with the previous one only within this (spec: 1.1 s)
 
 
 def _libs():
@@ -59,6 +63,8 @@ class CanDecoder:
         keep_s: samples older than this (s, bus clock) behind the newest are dropped (checked every
             :data:`TRIM_EVERY` transfers), so a live session's memory stays bounded; None keeps all
             (reading a log).
+        new: None, or a list that every decoded sample is also appended to as
+            ``(stream, field, t s, value)`` until :meth:`drain` takes them.
     """
 
     samples: dict = field(default_factory=lambda: defaultdict(lambda: defaultdict(list)))
@@ -66,6 +72,7 @@ class CanDecoder:
     bad: int = 0
     frames: int = 0
     keep_s: float | None = None
+    new: list | None = None
 
     def __post_init__(self):
         _, dronecan = _libs()
@@ -73,6 +80,7 @@ class CanDecoder:
         self._tm = dronecan.transport.TransferManager()
         self._since_trim = 0
         self._newest = -np.inf
+        self._sync_last: dict[int, tuple[int, float]] = {}   # master node -> (transfer id, receive time)
 
     def _trim(self) -> None:
         horizon = self._newest - self.keep_s
@@ -110,35 +118,110 @@ class CanDecoder:
                 self._since_trim = 0
                 self._trim()
         if kind == _ACTUATOR:
-            s[f"actuator{int(payload.actuator_id)}"]["pos"].append((t, float(payload.position)))
+            sample = (f"actuator{int(payload.actuator_id)}", "pos", t, float(payload.position))
         elif kind == _IAS:
-            s["can_airspeed"]["ias"].append((t, float(payload.indicated_airspeed)))
+            sample = ("can_airspeed", "ias", t, float(payload.indicated_airspeed))
         elif kind == _TAS:
-            s["can_airspeed"]["tas"].append((t, float(payload.true_airspeed)))
+            sample = ("can_airspeed", "tas", t, float(payload.true_airspeed))
         elif kind == _RAW:
-            s["can_airspeed"]["diff_pressure"].append((t, float(payload.differential_pressure)))
+            sample = ("can_airspeed", "diff_pressure", t, float(payload.differential_pressure))
+        elif kind == _SYNC:
+            sample = self._time_sync(int(tr.source_node_id), int(tr.transfer_id), t,
+                                     int(payload.previous_transmission_timestamp_usec))
+            if sample is None:
+                return
+        else:
+            return
+        s[sample[0]][sample[1]].append(sample[2:])
+        if self.new is not None:
+            self.new.append(sample)
+
+    def _time_sync(self, node: int, tid: int, t: float, prev_usec: int):
+        """A ``uavcan.protocol.GlobalTimeSync`` from master ``node`` received at ``t``: the pair (receive time of
+        the master's previous sync message, the master's time when it sent it), or None.
+
+        DroneCAN specification, "Time synchronization" (``uavcan.protocol.GlobalTimeSync``): each message
+        carries the master's exact transmission time of the *previous* one; it pairs with the receive time
+        of that one if the transfer ids are consecutive and it came within 1.1 s (else it only starts a pair).
+        """
+        last = self._sync_last.get(node)
+        self._sync_last[node] = (tid, t)
+        if last is None or prev_usec == 0 or (last[0] + 1) % 32 != tid or not 0 < t - last[1] <= SYNC_MAX_PERIOD_S:
+            return None
+        return ("can_timesync", "master", last[1], prev_usec * 1e-6)
+
+    def drain(self) -> list[tuple[str, str, float, float]]:
+        """The samples decoded since the last call, as ``(stream, field, t s, value)`` (SI), in decoding
+        order; empty unless ``new`` was set to a list. For a consumer in another process
+        (:class:`CanSamples`), so that only what is new crosses the pipe."""
+        if self.new is None:
+            return []
+        out, self.new = self.new, []
+        return out
 
     def streams(self) -> dict[str, Stream]:
-        """The decoded samples as streams: ``actuator<id>`` (``pos`` rad, one stream per actuator id,
-        on its own report times) and ``can_airspeed`` (``ias``/``tas`` m/s, ``diff_pressure`` Pa).
+        """The decoded samples as streams (:func:`streams_of`)."""
+        return streams_of(self.samples)
 
-        Fields of one stream share the times of its first field (sorted by name); the others (from
-        other messages) are linearly interpolated onto them.
-        """
-        out = {}
-        for name, fields in self.samples.items():
-            keys = sorted(fields)
-            t0 = np.array([t for t, _ in fields[keys[0]]])
-            order = np.argsort(t0, kind="stable")
-            t = t0[order]
-            vals = {}
-            for k in keys:
-                tk = np.array([x for x, _ in fields[k]])
-                vk = np.array([v for _, v in fields[k]])
-                o = np.argsort(tk, kind="stable")
-                vals[k] = np.interp(t, tk[o], vk[o]) if k != keys[0] else vk[order]
-            out[name] = Stream(name, "DroneCAN", t, vals)
-        return out
+
+def streams_of(samples: dict) -> dict[str, Stream]:
+    """Decoded samples as streams: ``actuator<id>`` (``pos`` rad, one stream per actuator id, on its own
+    report times) and ``can_airspeed`` (``ias``/``tas`` m/s, ``diff_pressure`` Pa).
+
+    Args:
+        samples: stream name -> field -> list of ``(t s, value)`` (:attr:`CanDecoder.samples`).
+
+    Fields of one stream share the times of its first field (sorted by name); the others (from
+    other messages) are linearly interpolated onto them.
+    """
+    out = {}
+    for name, fields in samples.items():
+        keys = sorted(k for k in fields if fields[k])
+        if not keys:
+            continue
+        t0 = np.array([t for t, _ in fields[keys[0]]])
+        order = np.argsort(t0, kind="stable")
+        t = t0[order]
+        vals = {}
+        for k in keys:
+            tk = np.array([x for x, _ in fields[k]])
+            vk = np.array([v for _, v in fields[k]])
+            o = np.argsort(tk, kind="stable")
+            vals[k] = np.interp(t, tk[o], vk[o]) if k != keys[0] else vk[order]
+        out[name] = Stream(name, "DroneCAN", t, vals)
+    return out
+
+
+@dataclass
+class CanSamples:
+    """Decoded DroneCAN samples gathered from :meth:`CanDecoder.drain` (e.g. in the learner's process),
+    bounded like a live decoder's.
+
+    Attributes:
+        keep_s: samples older than this (s, bus clock) behind the newest are dropped at each
+            :meth:`add`; None keeps all.
+        samples: stream name -> field -> list of ``(t s, value)``, as :attr:`CanDecoder.samples`.
+    """
+
+    keep_s: float | None = None
+    samples: dict = field(default_factory=lambda: defaultdict(lambda: defaultdict(list)))
+
+    def add(self, new: Iterable[tuple[str, str, float, float]]) -> None:
+        """Add ``(stream, field, t s, value)`` samples (:meth:`CanDecoder.drain`), then drop old ones."""
+        newest = -np.inf
+        for name, key, t, v in new:
+            self.samples[name][key].append((t, v))
+            newest = max(newest, t)
+        if self.keep_s is not None and np.isfinite(newest):
+            horizon = newest - self.keep_s
+            for fields in self.samples.values():
+                for k, lst in fields.items():
+                    if lst and lst[0][0] < horizon:
+                        fields[k] = [x for x in lst if x[0] >= horizon]
+
+    def streams(self) -> dict[str, Stream]:
+        """The samples as streams (:func:`streams_of`)."""
+        return streams_of(self.samples)
 
 
 def read_can_log(path: str | Path) -> tuple[dict[str, Stream], CanDecoder]:
@@ -218,6 +301,17 @@ class CanListener:
         """A snapshot of the decoded streams (bus clock; :meth:`CanDecoder.streams`), thread-safe."""
         with self._lock:
             return self.decoder.streams()
+
+    def drain(self) -> list[tuple[str, str, float, float]]:
+        """The samples decoded since the last call (:meth:`CanDecoder.drain`; the first call switches
+        the collection on and returns what the decoder holds), thread-safe."""
+        with self._lock:
+            dec = self.decoder
+            if dec.new is None:
+                dec.new = []
+                return [(n, k, t, v) for n, fields in dec.samples.items() for k, lst in fields.items()
+                        for t, v in lst]
+            return dec.drain()
 
     def summary(self) -> dict:
         """Frames received, transfers decoded by type, failed transfers."""

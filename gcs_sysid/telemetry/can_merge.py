@@ -43,10 +43,13 @@ from .mavlink_streams import SPECS
 from .tlog_scan import scan_tlog
 from .types import Flight, Stream, StreamSummary
 
-__all__ = ["HostClock", "host_clock_of_tlog", "merge_can_streams", "merge_can_log", "check_can_log", "RHO0"]
+__all__ = ["HostClock", "host_clock_of_tlog", "host_clock_of_timesync", "can_host_clock", "merge_can_streams",
+           "merge_can_log", "check_can_log", "RHO0", "TIMESYNC_AGREE_S"]
 
 RHO0 = 1.225   #: ISA sea-level density, kg/m^3 (EAS definition)
 _BIN_S = 10.0
+TIMESYNC_AGREE_S = 1.0
+"""A GlobalTimeSync master's clock is taken as the vehicle's when its map is within this of the tlog's (s)."""
 
 
 @dataclass(frozen=True)
@@ -135,6 +138,62 @@ def host_clock_of_tlog(path: str | Path, data: bytes | None = None) -> HostClock
     how = (f"host clock mapped to vehicle time through the tlog's time_boot_ms ({len(starts)} segment(s), upper "
            f"envelope of the offset per {_BIN_S:g} s, drift {Bs[0] * 1e6:+.0f} ppm, spread {spread * 1e3:.1f} ms)")
     return HostClock(np.array(starts), np.array(h0s), np.array(As), np.array(Bs), spread, how)
+
+
+def host_clock_of_timesync(st: Stream | None) -> HostClock | None:
+    """The host-clock -> vehicle-time map from DroneCAN time sync, when the master's clock is the vehicle's.
+
+    ``st`` is the decoder's ``can_timesync`` stream: at each receive time ``t`` (host s) of a master's
+    ``uavcan.protocol.GlobalTimeSync`` message, ``master`` its transmission time on the master's clock
+    (s; ArduPilot's flight controller sends its time since boot, the clock of ``time_boot_ms``). The
+    offset ``master - host`` is the clock offset minus the reception delay, so as with the tlog its
+    upper envelope per 10 s bin is fitted by a line; the master's time going back (a reboot) starts a
+    new segment. Against the tlog's map this one has no telemetry-link delay in it (a radio's tens of ms
+    that the envelope cannot remove when they are constant), only the CAN bus's and the host's reception.
+
+    Returns:
+        The map, or None when ``st`` is None or has fewer than two pairs.
+    """
+    if st is None or len(st) < 2 or "master" not in st:
+        return None
+    h, m = np.asarray(st.t, float), np.asarray(st["master"], float)
+    cut = np.flatnonzero(np.diff(m) < -1.0) + 1          # the master's clock went back: rebooted
+    starts, h0s, As, Bs, spreads = [], [], [], [], []
+    for k, (i, j) in enumerate(zip(np.concatenate([[0], cut]), np.concatenate([cut, [len(h)]]))):
+        if j - i < 1:
+            continue
+        h0, a, b, rms = _envelope_line(h[i:j], m[i:j] - h[i:j])
+        starts.append(h[i] if k > 0 else -np.inf)
+        h0s.append(h0), As.append(a), Bs.append(b), spreads.append(rms)
+    spread = float(max(spreads))
+    how = (f"host clock mapped to vehicle time through DroneCAN GlobalTimeSync ({len(h)} pairs, {len(starts)} "
+           f"segment(s), drift {Bs[-1] * 1e6:+.0f} ppm, spread {spread * 1e3:.1f} ms)")
+    return HostClock(np.array(starts), np.array(h0s), np.array(As), np.array(Bs), spread, how)
+
+
+def can_host_clock(can_streams: dict[str, Stream], tlog_clock: HostClock) -> tuple[HostClock, str | None]:
+    """The map to use for CAN samples: DroneCAN time sync when present and on the vehicle's clock, else the tlog's.
+
+    The time-sync master need not be the flight controller (a GNSS node may serve UTC): its map is used
+    only where it agrees with the tlog's (fitted on ``time_boot_ms``) within :data:`TIMESYNC_AGREE_S` at
+    the time-sync pairs' host times (median); otherwise the tlog's map is used and a note says why.
+
+    Args:
+        can_streams: decoded CAN streams (:meth:`gcs_sysid.telemetry.can.CanDecoder.streams`).
+        tlog_clock: the tlog's map (:func:`host_clock_of_tlog`).
+
+    Returns:
+        ``(clock, note)``: the map, and None or one line saying why time sync was not used.
+    """
+    sync = host_clock_of_timesync(can_streams.get("can_timesync"))
+    if sync is None:
+        return tlog_clock, None
+    h = np.asarray(can_streams["can_timesync"].t, float)
+    gap = float(np.median(np.abs(sync.to_vehicle(h) - tlog_clock.to_vehicle(h))))
+    if gap > TIMESYNC_AGREE_S:
+        return tlog_clock, (f"DroneCAN GlobalTimeSync not used: its master's clock differs from the vehicle's "
+                            f"time_boot_ms by {gap:.3g} s (not the flight controller's); {tlog_clock.how}")
+    return sync, None
 
 
 def _on_vehicle_time(st: Stream, clock: HostClock, offset: float, t_lo: float, t_hi: float) -> Stream:
@@ -243,11 +302,15 @@ def merge_can_log(flight: Flight, log_path: str | Path, can_path: str | Path, of
     from .can import read_can_log
 
     streams, _ = read_can_log(can_path)
-    if flight.format == "tlog":
+    note = None
+    if flight.format == "tlog" and offset is None:
+        clock, note = can_host_clock(streams, host_clock_of_tlog(log_path))
+    elif flight.format == "tlog":   # a CAN log on another clock, placed by hand: its time sync is not compared
         clock = host_clock_of_tlog(log_path)
     elif offset is None:
         raise InputError(f"--can-log {can_path}: a {flight.format} log has no host clock to align the CAN log "
                          "with; give --can-offset SECONDS (CAN time + offset = vehicle time)")
     else:
         clock = HostClock.fixed(0.0)
-    return merge_can_streams(flight, streams, clock, 0.0 if offset is None else float(offset), f"--can-log {can_path}")
+    merged = merge_can_streams(flight, streams, clock, 0.0 if offset is None else float(offset), f"--can-log {can_path}")
+    return replace(merged, warnings=merged.warnings + [note]) if note else merged

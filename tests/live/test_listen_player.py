@@ -15,6 +15,7 @@ from pymavlink import mavutil
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.live.learner import LearnOptions, learn_from_tlog
 from gcs_sysid.live.session import ListenOptions, LiveSession
+from gcs_sysid.parallel import default_enabled
 from gcs_sysid.telemetry.live import open_link
 from replay.player import read_packets
 
@@ -68,7 +69,9 @@ def test_listen_matches_replay_and_speaks_back(tmp_path):
     texts = [m.text for m in msgs if m.get_type() == "STATUSTEXT"]
     assert any(t.startswith("vehicle: system 1") for t in texts)
 
-    # the live model = the model learned again from raw.tlog (same windows, rows, fit, updates)
+    # the live model = the model learned again from raw.tlog (same windows, rows, fit, updates), the live
+    # one learned in the worker process (gcs_sysid.live.remote) where there is one
+    assert snap["learner_in"] == ("worker process" if default_enabled() else "this process")
     live = session.learner
     assert live.model is not None and snap["samples_learned"] > 1000 and live.steps >= 3
     again = learn_from_tlog(tmp_path / "live" / "raw.tlog", airframe, LEARN,
