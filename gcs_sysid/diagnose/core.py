@@ -226,10 +226,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                        for c in cands[:8]])
         if not cands:
             break
-        best = cands[0]
-        last_rivals = cands[1:]
-        if best.score < min_score or best.gain_percent < min_gain_pct:
+        best = _first_passing(ctx, R, proj, cands, min_score, min_gain_pct, rounds[-1])
+        if best is None:
             break
+        last_rivals = [c for c in cands if c is not best]
         best.evidence["rivals_at_acceptance"] = rounds[-1][1:5]
         accepted.append(best)
         R = R + best.delta
@@ -252,7 +252,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         wind_info = _wind_finding(ctx, oe_states, airframe, min_score, min_gain_oe_pct)
         if wind_info and wind_info.get("accepted"):
             findings.append(wind_info["finding"])
-    compat = []
+    compat, pitot, calibration = [], None, []
     if flight is not None and states is not None and hasattr(states, "t"):
         say("diagnose: sensor data compatibility")
         gust = None
@@ -260,8 +260,13 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             e = proj.angles(np.nan_to_num(R0))
             e = np.where(ctx.valid[:, None], e - e[ctx.train].mean(axis=0), 0.0)
             gust = {n: e[:, i] for i, n in enumerate(proj.names)}
-        compat = _compat_findings(ctx, flight, states, airframe, min_score, min_gain_pct, gust)
+        compat = _compat_findings(ctx, flight, states, airframe, min_score, min_gain_pct, gust, references)
         findings += [c for c in compat if c["accepted"]]
+        calibration = [c["evidence"]["calibration_note"] for c in compat if "calibration_note" in c["evidence"]]
+        say("diagnose: pitot causes on their whole signature")
+        from .pitot import airspeed_cause
+
+        pitot = airspeed_cause(ctx, R0, proj, flight, references, airframe, model0, min_score, min_gain_pct)
     fault_summary = None
     if flight is not None:
         say("diagnose: actuator and engine faults in the telemetry")
@@ -328,6 +333,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0))
         findings[:] = merge_findings(findings, data["sparse"])
         data["timings"]["search_s"] = float(time.perf_counter() - t1)
+    if calibration:
+        data["calibration"] = calibration
+    if pitot is not None:
+        findings[:] = _with_pitot(findings, pitot, data)
     if compat:
         data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],
                                       "gain_percent": c["gain"]["percent"]} for c in compat]
@@ -355,6 +364,46 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
     return diag
 
 
+def _first_passing(ctx: DiagContext, R, proj, cands: list[Fitted], min_score: float, min_gain_pct: float,
+                   summary: list[dict]) -> Fitted | None:
+    """The best candidate that passes the thresholds; a physical cause must also pass
+    :func:`gcs_sysid.diagnose.physical.physical_gate` (set aside otherwise, noted in ``summary``)."""
+    from .physical import is_physical, physical_gate
+
+    for c in cands:
+        if c.score < min_score or c.gain_percent < min_gain_pct:
+            return None
+        if not is_physical(c.cause):
+            return c
+        gate = physical_gate(ctx, R, c.delta, len(c.params), proj)
+        c.evidence["physical_gate"] = {"why": gate["why"], "implied": gate["signature"]["implied"],
+                                       "versus_terms": gate["versus_terms"]}
+        if gate["passed"]:
+            return c
+        for row in summary:
+            if row["cause"] == c.cause:
+                row["set_aside"] = gate["why"]
+    return None
+
+
+def _with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
+    """Findings with an accepted pitot cause first; the aero terms it explains are its symptoms."""
+    data["pitot"] = {"candidates": [{k: (v if k != "gate" else {"why": v["why"], "signature": v["signature"],
+                                                                  "versus_terms": v["versus_terms"]})
+                                     for k, v in c.items()} for c in pitot["candidates"]]}
+    if pitot["calibration"]:
+        data.setdefault("calibration", []).extend(pitot["calibration"])
+    f = pitot["finding"]
+    if f is None:
+        return findings
+    implied = set(f["evidence"]["signature"]["implied"])
+    symptoms = [g for g in findings if g["cause"].split(":")[0] in implied and g.get("kind") != "fault"
+                and g.get("evidence", {}).get("domain") not in ("data compatibility", "physical signature")]
+    f["evidence"]["explains"] = [g["cause"] for g in symptoms]
+    return [g for g in findings if g.get("kind") == "fault"] + [f] + \
+        [g for g in findings if g.get("kind") != "fault" and g not in symptoms]
+
+
 def _faults_only(ctx: DiagContext, model, flight, airframe, thresholds, min_rows: int, t0: float) -> Diagnosis:
     """Partial diagnosis when the coefficient table is too short: the telemetry faults only."""
     faults, summary = detect_faults(flight, airframe, thresholds)
@@ -377,34 +426,32 @@ SENSOR_CAUSES = ("bias:airspeed", "scale:airspeed", "bias:alpha", "bias:beta", "
 
 
 def _compat_findings(ctx: DiagContext, flight, states, airframe, min_score: float, min_gain_pct: float,
-                     gust=None) -> list[dict]:
-    """Sensor causes by data compatibility, each marked ``accepted`` when it passes the usual tests."""
-    from .compat import compatibility_candidates
+                     gust=None, references=None) -> list[dict]:
+    """Sensor causes by data compatibility, each marked ``accepted`` when it passes the gates of
+    :func:`gcs_sysid.diagnose.compat.judge` (three-way split, honest standard errors, differential
+    against the reference flights that carry their decoded flight)."""
+    from .compat import compatibility_candidates, judge
+    from .physical import split_held_out
 
+    acc, gain = split_held_out(ctx.t, ctx.test)
     t = np.asarray(states.t, float)
     if len(t) == len(ctx.t) and np.allclose(t, ctx.t):
-        tr, te = ctx.train, ctx.test
+        tr, te, g = ctx.train, acc, gain
     else:
-        tr = np.interp(t, ctx.t, ctx.train.astype(float)) > 0.5
-        te = np.interp(t, ctx.t, ctx.test.astype(float)) > 0.5
+        tr, te, g = (np.interp(t, ctx.t, m.astype(float)) > 0.5 for m in (ctx.train, acc, gain))
         gust = {k: np.interp(t, ctx.t, v) for k, v in gust.items()} if gust else None
-    cands = compatibility_candidates(flight, states, airframe, tr, te, gust)
-    cands.sort(key=lambda c: c["score"], reverse=True)
-    # one finding per sensor: the best of bias and scale for the pitot
-    seen = set()
+    cands = compatibility_candidates(flight, states, airframe, tr, te, gust, gain_rows=g)
+    ref_cands = []
+    for ref in references or ():
+        if getattr(ref, "flight", None) is None or getattr(ref, "states", None) is None:
+            continue
+        allr = np.isfinite(np.asarray(ref.states.t, float))
+        ref_cands.append((ref.label, compatibility_candidates(ref.flight, ref.states, airframe, allr, allr,
+                                                              floors=False)))
+    judge(cands, ref_cands, min_score, min_gain_pct)
     for c in cands:
-        sensor = "airspeed" if c["cause"].endswith(":airspeed") else c["cause"]
-        tstat = c["evidence"].get("t_statistic")
-        c["accepted"] = bool(sensor not in seen and c["score"] >= min_score and c["gain"]["percent"] >= min_gain_pct
-                             and tstat is not None and abs(tstat) >= 3.0)
-        rivals = [r for r in cands if r is not c and r["cause"].split(":")[-1] == c["cause"].split(":")[-1]]
-        c["evidence"].update({"score": c["score"], "separable": not any(r["score"] > 0.9 * c["score"] for r in rivals),
-                              "rivals": [{"cause": r["cause"], "score": r["score"],
-                                          "gain_percent": r["gain"]["percent"]} for r in rivals]})
         if not c["evidence"]["separable"]:
             c["evidence"]["separate_by"] = [maneuver_for(c["cause"])]
-        if c["accepted"]:
-            seen.add(sensor)
     return cands
 
 
