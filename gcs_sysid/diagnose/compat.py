@@ -345,7 +345,7 @@ def compatibility_candidates(flight, states, airframe, train, test, corrections=
 
 
 #: |t| a sensor offset needs with its honest standard error (coloured scatter and the reconstruction's
-#: systematic error in quadrature); frozen 2026-11-22 00:35 UTC with :mod:`gcs_sysid.diagnose.physical`.
+#: systematic error in quadrature); frozen 2026-11-22 00:15 UTC with :mod:`gcs_sysid.diagnose.physical`.
 MIN_T_SENSOR = 3.0
 
 

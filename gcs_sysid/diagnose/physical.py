@@ -25,7 +25,7 @@ are split in two by :func:`split_held_out`: alternate held-out blocks are the *a
 comparison and the reported untouched gain). With the training rows (the *selection*) that makes
 three disjoint sets.
 
-The thresholds below were frozen on 2026-11-22 at 00:35 UTC, before the final evaluation
+The thresholds below were frozen on 2026-11-22 at 00:15 UTC, before the final evaluation
 (``benchmarks/eval_jsbsim_diagnose.py``); pa28 was kept out of their tuning.
 """
 
