@@ -28,7 +28,12 @@ is estimated.
 
 Each cause is fitted on the training rows and scored on the held-out rows with
 the same held-out likelihood ratio and BIC penalty as the equation-error causes;
-``gain`` is the held-out RMS of the compatibility residual before and after.
+``gain`` is the held-out RMS of the compatibility residual before and after. The
+diagnosis passes the acceptance rows as ``test`` and the untouched rows as
+``gain_rows`` (:func:`gcs_sysid.diagnose.physical.split_held_out`). Standard errors
+are honest: the coloured-residual error and the reconstruction's systematic error
+(``RESOLUTION``) in quadrature. :func:`judge` decides which are named causes and
+which are calibration notes (the same offset in the reference flight).
 """
 
 from __future__ import annotations

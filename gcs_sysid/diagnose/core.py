@@ -8,7 +8,9 @@ meaningful share of the residual, then the search repeats on what is left.
 Accepted aero terms are re-estimated jointly and written into the extended
 model; what no cause explains is reported as ``unexplained`` with its size and
 where in the envelope and in time it lives. Nothing is ever named without
-held-out support.
+held-out support. A physical cause (cg_offset, inertia, mass, the pitot) must also show its
+signature in every coefficient it implies and beat term-level explanations on rows neither the
+fit nor the acceptance saw (:mod:`gcs_sysid.diagnose.physical`, :mod:`gcs_sysid.diagnose.pitot`).
 """
 
 from __future__ import annotations
@@ -169,7 +171,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             gyro, accelerometer) are judged by data compatibility (:mod:`gcs_sysid.diagnose.compat`)
             instead of in the coefficients, and actuator / engine faults are read from the servo
             outputs against the autopilot's demand (:mod:`gcs_sysid.diagnose.faults`; findings with
-            ``kind = "fault"``, listed first).
+            ``kind = "fault"``, listed first). With it the pitot is also judged on the coefficients
+            (:func:`gcs_sysid.diagnose.pitot.airspeed_cause`; ``data["pitot"]``), and sensor offsets the
+            reference flights had too go to ``data["calibration"]``, not to the findings.
         fault_thresholds: thresholds of the fault detection (default: the frozen ones).
         search: also search a wide candidate library for what each coefficient's residual still needs
             (:mod:`gcs_sysid.diagnose.search`: forward stepwise by block PRESS on the training rows, gain

@@ -16,7 +16,7 @@ Its signature is then:
 - **differential**: the same fit on the reference flight(s) must give a different value; a pitot
   bias the reference flight had too is a calibration note, not a change.
 
-Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:35 UTC):
+Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:15 UTC):
 ``MIN_T`` on the fit's coloured-residual t statistic, and the systematic error of the autopilot's
 wind estimate ``WIND_SYSTEMATIC_MPS`` in the wind check.
 
