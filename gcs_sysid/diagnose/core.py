@@ -27,6 +27,7 @@ from .candidates import Fitted, Scorer, fit_aero_terms, fit_delays, fit_sensor_c
 from .context import DiagContext, ModelDict, model_as_dict
 from .evidence import maneuver_for, unexplained_report
 from .fault_merge import merge_faults, set_aside_answering
+from .physical import first_passing
 from .faults import FaultThresholds, detect_faults
 from .regression import ols
 from .residual_gp import residual_structure
@@ -230,7 +231,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                        for c in cands[:8]])
         if not cands:
             break
-        best = _first_passing(ctx, R, proj, cands, min_score, min_gain_pct, rounds[-1])
+        best = first_passing(ctx, R, proj, cands, min_score, min_gain_pct, rounds[-1])
         if best is None:
             break
         last_rivals = [c for c in cands if c is not best]
@@ -268,7 +269,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         findings += [c for c in compat if c["accepted"]]
         calibration = [c["evidence"]["calibration_note"] for c in compat if "calibration_note" in c["evidence"]]
         say("diagnose: pitot causes on their whole signature")
-        from .pitot import airspeed_cause
+        from .pitot import airspeed_cause, with_pitot
 
         pitot = airspeed_cause(ctx, R0, proj, flight, references, airframe, model0, min_score, min_gain_pct)
     fault_summary = None
@@ -340,7 +341,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
     if calibration:
         data["calibration"] = calibration
     if pitot is not None:
-        findings[:] = _with_pitot(findings, pitot, data)
+        findings[:] = with_pitot(findings, pitot, data)
     if compat:
         data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],
                                       "gain_percent": c["gain"]["percent"]} for c in compat]
@@ -366,46 +367,6 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)
     return diag
-
-
-def _first_passing(ctx: DiagContext, R, proj, cands: list[Fitted], min_score: float, min_gain_pct: float,
-                   summary: list[dict]) -> Fitted | None:
-    """The best candidate that passes the thresholds; a physical cause must also pass
-    :func:`gcs_sysid.diagnose.physical.physical_gate` (set aside otherwise, noted in ``summary``)."""
-    from .physical import is_physical, physical_gate
-
-    for c in cands:
-        if c.score < min_score or c.gain_percent < min_gain_pct:
-            return None
-        if not is_physical(c.cause):
-            return c
-        gate = physical_gate(ctx, R, c.delta, len(c.params), proj)
-        c.evidence["physical_gate"] = {"why": gate["why"], "implied": gate["signature"]["implied"],
-                                       "versus_terms": gate["versus_terms"]}
-        if gate["passed"]:
-            return c
-        for row in summary:
-            if row["cause"] == c.cause:
-                row["set_aside"] = gate["why"]
-    return None
-
-
-def _with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
-    """Findings with an accepted pitot cause first; the aero terms it explains are its symptoms."""
-    data["pitot"] = {"candidates": [{k: (v if k != "gate" else {"why": v["why"], "signature": v["signature"],
-                                                                  "versus_terms": v["versus_terms"]})
-                                     for k, v in c.items()} for c in pitot["candidates"]]}
-    if pitot["calibration"]:
-        data.setdefault("calibration", []).extend(pitot["calibration"])
-    f = pitot["finding"]
-    if f is None:
-        return findings
-    implied = set(f["evidence"]["signature"]["implied"])
-    symptoms = [g for g in findings if g["cause"].split(":")[0] in implied and g.get("kind") != "fault"
-                and g.get("evidence", {}).get("domain") not in ("data compatibility", "physical signature")]
-    f["evidence"]["explains"] = [g["cause"] for g in symptoms]
-    return [g for g in findings if g.get("kind") == "fault"] + [f] + \
-        [g for g in findings if g.get("kind") != "fault" and g not in symptoms]
 
 
 def _faults_only(ctx: DiagContext, model, flight, airframe, thresholds, min_rows: int, t0: float) -> Diagnosis:

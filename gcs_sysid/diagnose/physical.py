@@ -41,7 +41,7 @@ from .regression import ols
 from .terms import VOCABULARY, term_matrix
 
 __all__ = ["PHYSICAL_CAUSES", "MIN_T_IMPLIED", "AMPLITUDE_TOL", "split_held_out", "with_test",
-           "coefficient_signature", "beats_terms", "physical_gate", "is_physical"]
+           "coefficient_signature", "beats_terms", "physical_gate", "is_physical", "first_passing"]
 
 #: Catalogue causes that act on several coefficients through the airframe's physics and must show their
 #: whole signature (:func:`physical_gate`). The single-sensor offsets (alpha, beta, gyro, accelerometer)
@@ -234,3 +234,33 @@ def physical_gate(ctx: DiagContext, R: np.ndarray, delta: np.ndarray, n_params: 
         "beats the term-level explanation " + " + ".join(vt["terms"]) + " on the untouched rows" if vt["beats"]
         else "the term-level explanation " + " + ".join(vt["terms"]) + " does as well on the untouched rows")
     return {"passed": bool(passed), "signature": sig, "versus_terms": vt, "why": why}
+
+
+def first_passing(ctx: DiagContext, R, proj, cands: list, min_score: float, min_gain_pct: float,
+                  summary: list[dict]):
+    """The best candidate (:class:`~gcs_sysid.diagnose.candidates.Fitted`, sorted best first) that passes
+    the thresholds; a physical cause must also pass :func:`physical_gate`.
+
+    Args:
+        ctx: context. R: (T, 6) current residual. proj: gust projector or None.
+        cands: candidates sorted by held-out score. min_score, min_gain_pct: the diagnosis' thresholds.
+        summary: the round's summary rows (``{"cause", ...}``): a physical cause set aside gets
+            ``set_aside`` (why).
+
+    Returns:
+        the accepted candidate, or None when the best remaining one is below the thresholds.
+    """
+    for c in cands:
+        if c.score < min_score or c.gain_percent < min_gain_pct:
+            return None
+        if not is_physical(c.cause):
+            return c
+        gate = physical_gate(ctx, R, c.delta, len(c.params), proj)
+        c.evidence["physical_gate"] = {"why": gate["why"], "implied": gate["signature"]["implied"],
+                                       "versus_terms": gate["versus_terms"]}
+        if gate["passed"]:
+            return c
+        for row in summary:
+            if row["cause"] == c.cause:
+                row["set_aside"] = gate["why"]
+    return None

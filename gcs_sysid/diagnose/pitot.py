@@ -36,7 +36,7 @@ from .context import DiagContext
 from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
 
-__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "airspeed_cause", "wind_shift"]
+__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "airspeed_cause", "wind_shift", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
@@ -189,3 +189,30 @@ def _reference_values(references, airframe, model, cause: str) -> list[dict]:
             out.append({"label": getattr(ref, "label", "reference"), "estimate": float(f.estimate),
                         "std_error": float(f.std_error)})
     return out
+
+
+def with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
+    """Findings with an accepted pitot cause first; the aero terms of its implied coefficients are its
+    symptoms (``evidence.explains``) and leave the list. Writes ``data["pitot"]`` (the candidates and
+    their checks) and appends its calibration notes to ``data["calibration"]``.
+
+    Args:
+        findings: the diagnosis' findings. pitot: from :func:`airspeed_cause`. data: ``Diagnosis.data``.
+
+    Returns:
+        the new findings list.
+    """
+    data["pitot"] = {"candidates": [{k: (v if k != "gate" else {"why": v["why"], "signature": v["signature"],
+                                                                  "versus_terms": v["versus_terms"]})
+                                     for k, v in c.items()} for c in pitot["candidates"]]}
+    if pitot["calibration"]:
+        data.setdefault("calibration", []).extend(pitot["calibration"])
+    f = pitot["finding"]
+    if f is None:
+        return findings
+    implied = set(f["evidence"]["signature"]["implied"])
+    symptoms = [g for g in findings if g["cause"].split(":")[0] in implied and g.get("kind") != "fault"
+                and g.get("evidence", {}).get("domain") not in ("data compatibility", "physical signature")]
+    f["evidence"]["explains"] = [g["cause"] for g in symptoms]
+    return [g for g in findings if g.get("kind") == "fault"] + [f] + \
+        [g for g in findings if g.get("kind") != "fault" and g not in symptoms]
