@@ -79,8 +79,13 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     truth = json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text())
     t0 = time.perf_counter()
     meas = load_measurements(files.tlog, files.airframe)
+    from gcs_sysid.diagnose.differential import Reference
+
+    # as the CLI does with the flight recorded in <model>.fit.json: the reference carries its decoded
+    # flight, so sensor causes are compared with it too (a bias it had is a calibration note)
     diag = diagnose(meas.table, meas.airframe, load_model(model_path), meas.states, output_error=False,
-                    flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states))
+                    flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states),
+                    references=[Reference(ref_meas.table, ref_meas.states, ref_meas.flight, label=f"{ac}-ref")])
     return diag.findings, truth, time.perf_counter() - t0
 
 

@@ -8,7 +8,9 @@ taken into account, ``R_after = R + delta(params)``. The physics of each:
 * ``bias:airspeed`` b / ``scale:airspeed`` s: the measured V is ``V_true + b`` or
   ``s * V_true``; qbar, the normalised rates and the thrust used for CX were
   computed with it, so ``C_true = C_meas (V_meas / V_true)^2`` (plus the thrust
-  difference) and ``p_hat_true = p_hat (V_meas / V_true)``.
+  difference) and ``p_hat_true = p_hat (V_meas / V_true)``. The bias is taken out of
+  the body-x air velocity, where the estimation put the pitot's excess, so alpha and
+  beta move with V (``alpha_true ~ alpha (V + b) / V``).
 * ``bias:alpha`` / ``bias:beta`` b: the regressor is shifted, ``alpha_true = alpha - b``.
 * ``bias:gyro_x`` (y, z) b: the rate regressor and the gyroscopic terms of
   Euler's equations used ``p + b``.
@@ -60,8 +62,25 @@ def _airspeed(ctx: DiagContext, V_true: np.ndarray):
     return X, Y
 
 
+def _air_velocity_body(ctx) -> np.ndarray:
+    """(T, 3) air-relative velocity in body axes from V, alpha, beta, m/s."""
+    V, al, be = ctx.x("V"), ctx.x("alpha"), ctx.x("beta")
+    return np.column_stack([V * np.cos(al) * np.cos(be), V * np.sin(be), V * np.sin(al) * np.cos(be)])
+
+
 def t_bias_airspeed(ctx, p):
-    return _airspeed(ctx, ctx.x("V") - p[0])
+    """A pitot reading ``b`` m/s high. The estimation layer builds the air-relative velocity from GPS
+    minus wind and adds the pitot's excess along the body x axis (``gcs_sysid.estimation.estimate``), so
+    the bias sits in ``u``: the true air velocity is ``(u - b, v, w)``, which moves V, alpha and beta
+    together (alpha by about ``-alpha b / V``). Checked against JSBSim's exact truth: V +2.00 m/s,
+    alpha -0.26 deg at 6.5 deg, every coefficient times ``(V / (V + b))^2``."""
+    va = _air_velocity_body(ctx)
+    vt = va - np.array([p[0], 0.0, 0.0])[None, :]
+    V_true = np.maximum(np.linalg.norm(vt, axis=1), 1e-3)
+    X, Y = _airspeed(ctx, V_true)
+    X[:, iA] = np.arctan2(vt[:, 2], vt[:, 0])
+    X[:, iB] = np.arcsin(np.clip(vt[:, 1] / V_true, -1.0, 1.0))
+    return X, Y
 
 
 def t_scale_airspeed(ctx, p):

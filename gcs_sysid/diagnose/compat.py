@@ -28,7 +28,12 @@ is estimated.
 
 Each cause is fitted on the training rows and scored on the held-out rows with
 the same held-out likelihood ratio and BIC penalty as the equation-error causes;
-``gain`` is the held-out RMS of the compatibility residual before and after.
+``gain`` is the held-out RMS of the compatibility residual before and after. The
+diagnosis passes the acceptance rows as ``test`` and the untouched rows as
+``gain_rows`` (:func:`gcs_sysid.diagnose.physical.split_held_out`). Standard errors
+are honest: the coloured-residual error and the reconstruction's systematic error
+(``RESOLUTION``) in quadrature. :func:`judge` decides which are named causes and
+which are calibration notes (the same offset in the reference flight).
 """
 
 from __future__ import annotations
@@ -39,7 +44,7 @@ from scipy.signal import lfilter
 
 from .regression import colored_covariance, effective_samples
 
-__all__ = ["compatibility_candidates"]
+__all__ = ["compatibility_candidates", "judge", "MIN_T_SENSOR"]
 
 G0 = 9.80665
 
@@ -86,30 +91,46 @@ RESOLUTION = {"rad/s": 0.002, "m/s^2": 0.05}
 WIND_ERROR_MPS = 0.2
 
 
-def _offset(cause, state, y, ref, train, test, unit, extra=None, resolution=None):
+def _honest(se: float, systematic: float) -> float:
+    """Standard error with the reconstruction's systematic error in quadrature (coloured part ``se``)."""
+    return float(np.hypot(se, systematic))
+
+
+def _offset(cause, state, y, ref, train, test, unit, extra=None, resolution=None, opts=None):
     """Constant offset of ``y - ref`` (arrays on the grid): fitted on train, scored held out.
 
-    Returns None (no candidate) when the data are too few or the offset is below ``resolution``
-    (default ``RESOLUTION[unit]``), the size the reconstruction itself cannot vouch for.
+    The standard error is honest: the coloured-residual error of the mean (``effective_samples``) and
+    the reconstruction's systematic error (``resolution``, default ``RESOLUTION[unit]``) in quadrature.
+    ``opts``: ``{"gain_rows": (T,) mask}`` adds the gain on those untouched rows
+    (``evidence.gain_untouched``); ``{"floors": False}`` keeps offsets below the resolution (for the
+    differential comparison with a reference flight).
+
+    Returns None (no candidate) when the data are too few or (with floors) the offset is below the
+    resolution, the size the reconstruction itself cannot vouch for.
     """
+    opts = opts or {}
     d = y - ref
     tr, te = train & np.isfinite(d), test & np.isfinite(d)
     if tr.sum() < 20 or te.sum() < 10:
         return None
     b = float(np.mean(d[tr]))
     floor = RESOLUTION.get(unit, 0.0) if resolution is None else resolution
-    if abs(b) < floor:
+    if abs(b) < floor and opts.get("floors", True):
         return None
-    se = float(np.std(d[tr]) / np.sqrt(effective_samples(d[tr])))
+    se_c = float(np.std(d[tr]) / np.sqrt(effective_samples(d[tr])))
+    se = _honest(se_c, floor)
     score, gain = _score(d[te], d[te] - b, 1)
     ev = {"domain": "data compatibility", "parameters": {cause: b}, "unit": unit,
-          "t_statistic": b / se if se > 0 else None}
+          "t_statistic": b / se if se > 0 else None, "std_error_coloured": se_c, "systematic_error": floor}
+    g = opts.get("gain_rows")
+    if g is not None and (g & np.isfinite(d)).sum() >= 10:
+        ev["gain_untouched"] = _score(d[g & np.isfinite(d)], d[g & np.isfinite(d)] - b, 1)[1]
     ev.update(extra or {})
     return {"cause": cause, "coefficient": state, "estimate": b, "std_error": se, "score": score,
             "gain": gain, "evidence": ev}
 
 
-def _aoa(flight, states, train, test, corrections=None):
+def _aoa(flight, states, train, test, corrections=None, opts=None):
     out = []
     if not flight.has("aoa_ssa"):
         return out
@@ -141,7 +162,7 @@ def _aoa(flight, states, train, test, corrections=None):
             continue
         V = np.asarray(states["V"], float) if "V" in states else np.array([20.0])
         res = WIND_ERROR_MPS / max(float(np.nanmedian(V)), 5.0)   # rad: a wind error seen as an angle
-        f = _offset(f"bias:{name}", name, y, best[2], train, test, "rad", resolution=res, extra=
+        f = _offset(f"bias:{name}", name, y, best[2], train, test, "rad", resolution=res, opts=opts, extra=
                     {"sensor": f"AOA_SSA {name} (autopilot estimate) vs {name} reconstructed from GPS velocity, "
                                "attitude and wind" + (" plus the gust angle seen by the coefficients"
                                                       if gust is not None else ""), "lag_s": float(best[1])})
@@ -150,7 +171,7 @@ def _aoa(flight, states, train, test, corrections=None):
     return out
 
 
-def _airspeed(flight, states, train, test):
+def _airspeed(flight, states, train, test, opts=None):
     if not all(k in states for k in ("vn", "ve", "vd", "phi", "theta", "psi", "rho")):
         return []
     stream = "airspeed" if flight.has("airspeed") and "eas" in flight["airspeed"].fields else "vfr_hud"
@@ -196,18 +217,45 @@ def _airspeed(flight, states, train, test):
     r0 = resid(fits["none"][0], "bias", np.nonzero(te)[0])[1]
     for kind, cause in (("bias", "bias:airspeed"), ("scale", "scale:airspeed")):
         p, J, fun = fits[kind]
+        vif = _vif(J, 2)
+        if not vif < MAX_VIF:      # the pitot error cannot be told from the wind on these headings
+            continue
         r1 = resid(p, kind, np.nonzero(te)[0])[1]
         score, gain = _score(r0, r1, 1)
         cov = colored_covariance(J, fun)
-        se = float(np.sqrt(max(cov[2, 2], 0.0)))
+        se_c = float(np.sqrt(max(cov[2, 2], 0.0)))
+        sys_err = WIND_ERROR_MPS if kind == "bias" else WIND_ERROR_MPS / max(float(np.median(tas[tr])), 5.0)
+        se = _honest(se_c, sys_err)
+        extra = {"std_error_coloured": se_c, "systematic_error": sys_err, "vif_against_wind": vif}
+        g = (opts or {}).get("gain_rows")
+        if g is not None and (g & ok).sum() >= 20:
+            gi = np.nonzero(g & ok)[0]
+            extra["gain_untouched"] = _score(resid(fits["none"][0], "bias", gi)[1], resid(p, kind, gi)[1], 1)[1]
         out.append({"cause": cause, "coefficient": "V", "estimate": float(p[2]), "std_error": se, "score": score,
-                    "gain": gain, "evidence": {"domain": "data compatibility", "unit": "m/s" if kind == "bias" else "",
+                    "gain": gain, "evidence": {**extra, "domain": "data compatibility",
+                                               "unit": "m/s" if kind == "bias" else "",
                                                "parameters": {"wn": float(p[0]), "we": float(p[1]), kind: float(p[2])},
                                                "sensor": "pitot true airspeed vs |v_gps - w| with one steady wind "
                                                          "(sideslip zero on average)",
                                                "t_statistic": (p[2] - (0.0 if kind == "bias" else 1.0)) / se
                                                if se > 0 else None}})
     return out
+
+
+#: Largest variance-inflation factor of the pitot parameter against the wind (Morelli and Klein sec. 5.4,
+#: collinearity: VIF >= 10 means the parameter is mostly a combination of the others). With few
+#: heading changes a pitot bias and a headwind are the same thing to this check; the coefficients then
+#: judge it (:mod:`gcs_sysid.diagnose.pitot`).
+MAX_VIF = 10.0
+
+
+def _vif(J: np.ndarray, k: int) -> float:
+    """Variance-inflation factor of parameter ``k`` of a least-squares Jacobian ``J`` (N, K)."""
+    A = J.T @ J
+    try:
+        return float(np.linalg.inv(A)[k, k] * A[k, k])
+    except np.linalg.LinAlgError:
+        return float("inf")
 
 
 def _euler_rates(phi, theta, psi, dt):
@@ -219,7 +267,7 @@ def _euler_rates(phi, theta, psi, dt):
     return np.column_stack([p, q, r])
 
 
-def _gyro_accel(flight, states, airframe, train, test, avg_s=1.0):
+def _gyro_accel(flight, states, airframe, train, test, avg_s=1.0, opts=None):
     out = []
     if not flight.has("imu"):
         return out
@@ -238,8 +286,8 @@ def _gyro_accel(flight, states, airframe, train, test, avg_s=1.0):
                 if k not in imu.fields:
                     continue
                 g = _movavg(_interp(t, imu.t, np.asarray(imu[k], float)), n)
-                f = _offset(f"bias:gyro_{ax}", k, g, _movavg(kin[:, i], n), train, test, "rad/s",
-                            {"sensor": f"IMU gyro {k} vs the rate from the attitude kinematics (1 s averages)"})
+                f = _offset(f"bias:gyro_{ax}", k, g, _movavg(kin[:, i], n), train, test, "rad/s", opts=opts,
+                            extra={"sensor": f"IMU gyro {k} vs the rate from the attitude kinematics (1 s averages)"})
                 if f:
                     out.append(f)
     if all(k in states for k in ("vn", "ve", "vd", "phi", "theta", "psi")) and \
@@ -258,13 +306,14 @@ def _gyro_accel(flight, states, airframe, train, test, avg_s=1.0):
             f_imu = f_imu - np.cross(Wd, arm) - np.cross(W, np.cross(W, arm))
         for i, ax in enumerate("xyz"):
             f = _offset(f"bias:accel_{ax}", f"a{ax}", _movavg(f_imu[:, i], n), _movavg(f_gps[:, i], n), train, test,
-                        "m/s^2", {"sensor": f"IMU specific force {ax} vs C'(dv_gps/dt - g) (1 s averages)"})
+                        "m/s^2", opts=opts, extra={"sensor": f"IMU specific force {ax} vs C'(dv_gps/dt - g) (1 s averages)"})
             if f:
                 out.append(f)
     return out
 
 
-def compatibility_candidates(flight, states, airframe, train, test, corrections=None) -> list[dict]:
+def compatibility_candidates(flight, states, airframe, train, test, corrections=None, gain_rows=None,
+                             floors: bool = True) -> list[dict]:
     """Fit and score the sensor causes by data compatibility.
 
     Args:
@@ -275,22 +324,98 @@ def compatibility_candidates(flight, states, airframe, train, test, corrections=
         corrections: optional ``{"alpha": (T,), "beta": (T,)}`` zero-mean gust angles (rad) the
             reconstruction misses, as the coefficients see them
             (:meth:`gcs_sysid.diagnose.turbulence.GustProjector.angles`), added to the reconstruction.
+        gain_rows: (T,) untouched rows (neither fitted nor scored on): each candidate's
+            ``evidence.gain_untouched`` is measured there once.
+        floors: False keeps offsets below the reconstruction's resolution (to compare with a reference).
 
     Returns:
         candidate dicts ``cause coefficient estimate std_error score gain evidence`` (``coefficient`` is
         the sensor's quantity: ``alpha``, ``beta``, ``V``, ``p`` ... ``ax`` ...).
     """
+    opts = {"gain_rows": gain_rows, "floors": floors}
     out = []
     try:
-        out += _aoa(flight, states, train, test, corrections)
+        out += _aoa(flight, states, train, test, corrections, opts)
     except (ValueError, np.linalg.LinAlgError):
         pass
     try:
-        out += _airspeed(flight, states, train, test)
+        out += _airspeed(flight, states, train, test, opts)
     except (ValueError, np.linalg.LinAlgError):
         pass
     try:
-        out += _gyro_accel(flight, states, airframe, train, test)
+        out += _gyro_accel(flight, states, airframe, train, test, opts=opts)
     except (ValueError, np.linalg.LinAlgError):
         pass
     return [c for c in out if np.isfinite(c["score"]) and np.isfinite(c["estimate"])]
+
+
+#: |t| a sensor offset needs with its honest standard error (coloured scatter and the reconstruction's
+#: systematic error in quadrature); frozen 2026-11-22 00:15 UTC with :mod:`gcs_sysid.diagnose.physical`.
+MIN_T_SENSOR = 3.0
+
+
+def judge(cands: list[dict], references: list[tuple[str, list[dict]]], min_score: float,
+          min_gain_pct: float) -> list[str]:
+    """Mark each compatibility candidate ``accepted`` (a named cause) or not, in place.
+
+    A sensor cause is named when all hold:
+
+    - significant: ``|t| >= MIN_T_SENSOR`` with the honest standard error;
+    - accepted on the acceptance rows: held-out score ``>= min_score`` and gain ``>= min_gain_pct``;
+    - the gain on the untouched rows (``evidence.gain_untouched``, when measured) ``>= min_gain_pct``;
+    - differential: against every reference flight where the same check could be made, the change
+      ``c - c_ref`` is at least 3 standard errors (``sqrt(se^2 + se_ref^2)``). A bias the reference
+      has too is a **calibration note** (``evidence.differential.verdict = "calibration"``): the
+      sensor needs calibrating, but nothing changed;
+    - and it is the best-scoring accepted cause of its sensor (pitot: bias or scale).
+
+    Args:
+        cands: from :func:`compatibility_candidates` on the flight (updated in place: ``accepted``,
+            ``evidence.differential``, ``evidence.rivals``, ``evidence.separable``).
+        references: ``(label, candidates)`` per reference flight, from :func:`compatibility_candidates`
+            with ``floors=False`` on all its rows.
+        min_score, min_gain_pct: the diagnosis' acceptance thresholds.
+
+    Returns:
+        the calibration notes (one line each).
+    """
+    cands.sort(key=lambda c: c["score"], reverse=True)
+    notes, seen = [], set()
+    for c in cands:
+        ev = c["evidence"]
+        sensor = "airspeed" if c["cause"].endswith(":airspeed") else c["cause"]
+        tstat = ev.get("t_statistic")
+        checks = {"significant": tstat is not None and abs(tstat) >= MIN_T_SENSOR,
+                  "accepted_on_acceptance_rows": c["score"] >= min_score and c["gain"]["percent"] >= min_gain_pct,
+                  "gain_untouched": ev.get("gain_untouched", {"percent": 100.0})["percent"] >= min_gain_pct}
+        comps = []
+        for label, rc in references:
+            hit = next((r for r in rc if r["cause"] == c["cause"]), None)
+            if hit is None:
+                continue
+            dlt = c["estimate"] - hit["estimate"]
+            sig = float(np.hypot(c["std_error"], hit["std_error"]))
+            comps.append({"label": label, "estimate": float(hit["estimate"]), "std_error": float(hit["std_error"]),
+                          "change": float(dlt), "same": bool(abs(dlt) < 3.0 * sig)})
+        if comps and all(x["same"] for x in comps):
+            ev["differential"] = {"verdict": "calibration", "references": comps,
+                                  "why": "the reference flight(s) had the same offset: present when the model was "
+                                         "fitted, a calibration to correct, not a change"}
+            checks["changed_since_reference"] = False
+        elif comps:
+            ev["differential"] = {"verdict": "changed", "references": comps}
+        else:
+            ev["differential"] = {"verdict": "not compared" if references else "no reference flight"}
+        ev["checks"] = {k: bool(v) for k, v in checks.items()}
+        c["accepted"] = bool(sensor not in seen and all(checks.values()))
+        if ev["differential"]["verdict"] == "calibration" and checks["significant"] and sensor not in seen:
+            ev["calibration_note"] = (f"{c['cause']} = {c['estimate']:.3g} +- {c['std_error']:.2g} {ev.get('unit', '')}, "
+                                      "the same in the reference flight(s): a calibration note, not a cause")
+            notes.append(ev["calibration_note"])
+        rivals = [r for r in cands if r is not c and r["cause"].split(":")[-1] == c["cause"].split(":")[-1]]
+        ev.update({"score": c["score"], "separable": not any(r["score"] > 0.9 * c["score"] for r in rivals),
+                   "rivals": [{"cause": r["cause"], "score": r["score"], "gain_percent": r["gain"]["percent"]}
+                              for r in rivals]})
+        if c["accepted"]:
+            seen.add(sensor)
+    return notes

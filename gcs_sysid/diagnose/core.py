@@ -8,7 +8,9 @@ meaningful share of the residual, then the search repeats on what is left.
 Accepted aero terms are re-estimated jointly and written into the extended
 model; what no cause explains is reported as ``unexplained`` with its size and
 where in the envelope and in time it lives. Nothing is ever named without
-held-out support.
+held-out support. A physical cause (cg_offset, inertia, mass, the pitot) must also show its
+signature in every coefficient it implies and beat term-level explanations on rows neither the
+fit nor the acceptance saw (:mod:`gcs_sysid.diagnose.physical`, :mod:`gcs_sysid.diagnose.pitot`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from .candidates import Fitted, Scorer, fit_aero_terms, fit_delays, fit_sensor_c
 from .context import DiagContext, ModelDict, model_as_dict
 from .evidence import maneuver_for, unexplained_report
 from .fault_merge import merge_faults, set_aside_answering
+from .physical import first_passing
 from .faults import FaultThresholds, detect_faults
 from .regression import ols
 from .residual_gp import residual_structure
@@ -169,7 +172,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             gyro, accelerometer) are judged by data compatibility (:mod:`gcs_sysid.diagnose.compat`)
             instead of in the coefficients, and actuator / engine faults are read from the servo
             outputs against the autopilot's demand (:mod:`gcs_sysid.diagnose.faults`; findings with
-            ``kind = "fault"``, listed first).
+            ``kind = "fault"``, listed first). With it the pitot is also judged on the coefficients
+            (:func:`gcs_sysid.diagnose.pitot.airspeed_cause`; ``data["pitot"]``), and sensor offsets the
+            reference flights had too go to ``data["calibration"]``, not to the findings.
         fault_thresholds: thresholds of the fault detection (default: the frozen ones).
         search: also search a wide candidate library for what each coefficient's residual still needs
             (:mod:`gcs_sysid.diagnose.search`: forward stepwise by block PRESS on the training rows, gain
@@ -226,10 +231,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                        for c in cands[:8]])
         if not cands:
             break
-        best = cands[0]
-        last_rivals = cands[1:]
-        if best.score < min_score or best.gain_percent < min_gain_pct:
+        best = first_passing(ctx, R, proj, cands, min_score, min_gain_pct, rounds[-1])
+        if best is None:
             break
+        last_rivals = [c for c in cands if c is not best]
         best.evidence["rivals_at_acceptance"] = rounds[-1][1:5]
         accepted.append(best)
         R = R + best.delta
@@ -252,7 +257,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         wind_info = _wind_finding(ctx, oe_states, airframe, min_score, min_gain_oe_pct)
         if wind_info and wind_info.get("accepted"):
             findings.append(wind_info["finding"])
-    compat = []
+    compat, pitot, calibration = [], None, []
     if flight is not None and states is not None and hasattr(states, "t"):
         say("diagnose: sensor data compatibility")
         gust = None
@@ -260,8 +265,13 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             e = proj.angles(np.nan_to_num(R0))
             e = np.where(ctx.valid[:, None], e - e[ctx.train].mean(axis=0), 0.0)
             gust = {n: e[:, i] for i, n in enumerate(proj.names)}
-        compat = _compat_findings(ctx, flight, states, airframe, min_score, min_gain_pct, gust)
+        compat = _compat_findings(ctx, flight, states, airframe, min_score, min_gain_pct, gust, references)
         findings += [c for c in compat if c["accepted"]]
+        calibration = [c["evidence"]["calibration_note"] for c in compat if "calibration_note" in c["evidence"]]
+        say("diagnose: pitot causes on their whole signature")
+        from .pitot import airspeed_cause, with_pitot
+
+        pitot = airspeed_cause(ctx, R0, proj, flight, references, airframe, model0, min_score, min_gain_pct)
     fault_summary = None
     if flight is not None:
         say("diagnose: actuator and engine faults in the telemetry")
@@ -328,6 +338,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0))
         findings[:] = merge_findings(findings, data["sparse"])
         data["timings"]["search_s"] = float(time.perf_counter() - t1)
+    if calibration:
+        data["calibration"] = calibration
+    if pitot is not None:
+        findings[:] = with_pitot(findings, pitot, data)
     if compat:
         data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],
                                       "gain_percent": c["gain"]["percent"]} for c in compat]
@@ -377,34 +391,32 @@ SENSOR_CAUSES = ("bias:airspeed", "scale:airspeed", "bias:alpha", "bias:beta", "
 
 
 def _compat_findings(ctx: DiagContext, flight, states, airframe, min_score: float, min_gain_pct: float,
-                     gust=None) -> list[dict]:
-    """Sensor causes by data compatibility, each marked ``accepted`` when it passes the usual tests."""
-    from .compat import compatibility_candidates
+                     gust=None, references=None) -> list[dict]:
+    """Sensor causes by data compatibility, each marked ``accepted`` when it passes the gates of
+    :func:`gcs_sysid.diagnose.compat.judge` (three-way split, honest standard errors, differential
+    against the reference flights that carry their decoded flight)."""
+    from .compat import compatibility_candidates, judge
+    from .physical import split_held_out
 
+    acc, gain = split_held_out(ctx.t, ctx.test)
     t = np.asarray(states.t, float)
     if len(t) == len(ctx.t) and np.allclose(t, ctx.t):
-        tr, te = ctx.train, ctx.test
+        tr, te, g = ctx.train, acc, gain
     else:
-        tr = np.interp(t, ctx.t, ctx.train.astype(float)) > 0.5
-        te = np.interp(t, ctx.t, ctx.test.astype(float)) > 0.5
+        tr, te, g = (np.interp(t, ctx.t, m.astype(float)) > 0.5 for m in (ctx.train, acc, gain))
         gust = {k: np.interp(t, ctx.t, v) for k, v in gust.items()} if gust else None
-    cands = compatibility_candidates(flight, states, airframe, tr, te, gust)
-    cands.sort(key=lambda c: c["score"], reverse=True)
-    # one finding per sensor: the best of bias and scale for the pitot
-    seen = set()
+    cands = compatibility_candidates(flight, states, airframe, tr, te, gust, gain_rows=g)
+    ref_cands = []
+    for ref in references or ():
+        if getattr(ref, "flight", None) is None or getattr(ref, "states", None) is None:
+            continue
+        allr = np.isfinite(np.asarray(ref.states.t, float))
+        ref_cands.append((ref.label, compatibility_candidates(ref.flight, ref.states, airframe, allr, allr,
+                                                              floors=False)))
+    judge(cands, ref_cands, min_score, min_gain_pct)
     for c in cands:
-        sensor = "airspeed" if c["cause"].endswith(":airspeed") else c["cause"]
-        tstat = c["evidence"].get("t_statistic")
-        c["accepted"] = bool(sensor not in seen and c["score"] >= min_score and c["gain"]["percent"] >= min_gain_pct
-                             and tstat is not None and abs(tstat) >= 3.0)
-        rivals = [r for r in cands if r is not c and r["cause"].split(":")[-1] == c["cause"].split(":")[-1]]
-        c["evidence"].update({"score": c["score"], "separable": not any(r["score"] > 0.9 * c["score"] for r in rivals),
-                              "rivals": [{"cause": r["cause"], "score": r["score"],
-                                          "gain_percent": r["gain"]["percent"]} for r in rivals]})
         if not c["evidence"]["separable"]:
             c["evidence"]["separate_by"] = [maneuver_for(c["cause"])]
-        if c["accepted"]:
-            seen.add(sensor)
     return cands
 
 

@@ -85,7 +85,10 @@ def _refit_aero(ctx: DiagContext, R: np.ndarray, coef: str, term: str) -> tuple[
     j = COEFFICIENTS.index(coef)
     if not ctx.active[j]:
         return None
-    phi = term_matrix(ctx.X, [term])[:, 0]
+    try:
+        phi = term_matrix(ctx.X, [term])[:, 0]
+    except SysidError:                  # a term outside the vocabulary (a breakpoint of the sparse search)
+        return None
     m = ctx.valid & np.isfinite(R[:, j]) & np.isfinite(phi)
     if m.sum() < 50 or np.std(phi[m]) == 0 and term != "1":
         return None
@@ -231,6 +234,16 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 else "the air of this flight (wind is a flight condition)"
             f["evidence"]["differential"] = {"verdict": "changed", "why": why}
             doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"), "why": why})
+            keep.append(f)
+            continue
+        judged = f.get("evidence", {}).get("differential")
+        if judged is not None and f["evidence"].get("domain") in ("data compatibility", "physical signature"):
+            # a sensor or pitot cause judged against the references already (compat.judge, pitot)
+            if judged.get("verdict") == "changed":
+                doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"),
+                                       "reference_corrections": [c.get("estimate") for c in judged.get("references", [])]})
+            else:
+                doc["not_compared"].append(cause)
             keep.append(f)
             continue
         is_aero = cause.split(":")[0] in COEFFICIENTS
