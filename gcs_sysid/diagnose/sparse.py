@@ -45,7 +45,7 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out). Added and
-#: frozen on 2026-11-22 at 00:35 UTC, before that day's evaluation (the others unchanged):
+#: frozen on 2026-11-22 at 00:18 UTC (commit after cb17844), before that day's evaluation (the others unchanged):
 #: ``scale_coefficients`` (the coefficients that get a ``scale:<coef>`` candidate),
 #: ``min_scale_change`` (a scale is named only when ``|k - 1|`` is at least this: the AHRS sideslip
 #: carries scale errors of -1.8 to +1.7 % on the c172x tuning flights, which a smaller side-force
