@@ -28,6 +28,13 @@ at least ``min_press_drop``, the untouched-segment gain of its coefficient is at
 ``min_gain_pct`` and its estimate is at least ``min_abs_t`` coloured standard errors from zero
 (thresholds in :data:`THRESHOLDS`, frozen on 2026-11-21 at 21:30 UTC before the final evaluation;
 set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag terms of one surface name ``delay:<surface>`` with the lag as the estimate.
+
+Added 2026-11-22 (issue 9): before step 2 an angle-of-attack error of the autopilot's AOA_SSA
+(``e0 + e1/V + e2 alpha/V``, from its wind estimate) is fitted on CX and CZ through the model's
+own derivatives and removed from every coefficient (:func:`angle_nuisance`); CY's library holds
+the model's own CY, a ``scale:CY`` candidate named with the factor as its estimate; reported
+standard errors are Morelli and Klein's all-lags form (sec. 5.3), the naming test keeps the
+Bartlett-window one the thresholds were frozen with.
 """
 
 from __future__ import annotations
@@ -41,7 +48,8 @@ from .context import DiagContext
 from .regression import ols
 from .search import alpha_quantile_knots, candidate_library, press_stepwise
 
-__all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context"]
+__all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
+           "angle_nuisance"]
 
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out). Added and
