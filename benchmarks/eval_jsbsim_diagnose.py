@@ -9,7 +9,8 @@ injected, over seeds x sizes x effects, plus clean flights and two effects at on
 Score per case:
   * ``top``: the injected cause is the top finding (for two effects: both among the findings);
   * ``est``: the estimate within 25 % of the injected value (aero terms: estimate minus the
-    reference model's value of the term, i.e. the change);
+    reference model's value of the term, i.e. the change; ``CY:scale``, named ``scale:CY``: the
+    estimated factor minus 1 against the injected factor minus 1);
   * ``gain``: held-out gain of that finding >= 50 %;
   * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);
   * clean flights: ``ok`` when no cause is named.
@@ -41,6 +42,10 @@ __all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "main"
 
 DURATION_S = 120.0
 REF_SEED = 100
+#: Flight plan of every flight, reference and test alike (``benchmarks/jsbsim_harness/flight.py``:
+#: ``"sweep"`` spans alpha with a speed sweep and steady-heading sideslips; ``"standard"`` was the
+#: plan of the 2026-11-21 runs).
+PLAN = "sweep"
 
 
 def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | None = None):
@@ -50,32 +55,35 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
 
     tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
     stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
+    if config.plan != "standard":
+        stem += f"-{config.plan}"
     tlog = out / f"{stem}.tlog"
     done = tlog.with_name(stem + "-effects.json")
-    if tlog.exists() and done.exists() and json.loads(done.read_text())["config"]["duration_s"] == config.duration_s:
+    if tlog.exists() and done.exists() and json.loads(done.read_text())["config"]["duration_s"] == config.duration_s \
+            and json.loads(done.read_text())["config"].get("plan", "standard") == config.plan:
         return FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None)
     return make_effect_flight(config, effects, out, stem=stem)
 
 
-def reference_model(ac: str, out: Path, duration_s: float = DURATION_S):
+def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: str = PLAN):
     """Fly the clean reference flight, fit the model; returns (files, model path, measurements)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.diagnose.run import load_measurements
 
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED), [], out, stem=f"{ac}-ref")
-    model_path = out / f"{ac}-ref-model.toml"
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan), [], out, stem=f"{ac}-ref")
+    model_path = out / f"{ac}-ref-{plan}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
     return files, model_path, load_measurements(files.tlog, files.airframe)
 
 
 def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_path: Path, ref_meas,
-                  duration_s: float = DURATION_S) -> tuple[list[dict], dict, float]:
+                  duration_s: float = DURATION_S, plan: str = PLAN) -> tuple[list[dict], dict, float]:
     """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis)."""
     from gcs_sysid.diagnose import diagnose
     from gcs_sysid.diagnose.run import load_measurements
     from gcs_sysid.sim.model_file import load_model
 
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed), effects, out)
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan), effects, out)
     truth = json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text())
     t0 = time.perf_counter()
     meas = load_measurements(files.tlog, files.airframe)
@@ -167,6 +175,8 @@ def main(argv=None) -> int:
     p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
     p.add_argument("--pairs", nargs="*", default=["Cm:alpha^2,Cn:delta_a", "Cl:alpha*beta,delay:delta_e"])
     p.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "diag-effects"))
+    p.add_argument("--plan", default=PLAN, choices=("standard", "sweep"),
+                   help="flight plan of every flight (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
     a = p.parse_args(argv)
     if a.summary:
@@ -182,14 +192,14 @@ def main(argv=None) -> int:
             if a.effects and effects and not all(e.name in a.effects for e in effects):
                 continue
             if ac not in refs:
-                refs[ac] = reference_model(ac, out)
+                refs[ac] = reference_model(ac, out, plan=a.plan)
             _, model_path, ref_meas = refs[ac]
             try:
-                findings, truth, secs = diagnose_case(ac, seed, effects, out, model_path, ref_meas)
+                findings, truth, secs = diagnose_case(ac, seed, effects, out, model_path, ref_meas, plan=a.plan)
                 sc = score_case(findings, truth)
             except RuntimeError as exc:       # the aircraft left the envelope with that effect
                 sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
-            rec = {"aircraft": ac, "seed": seed, "effects": [[e.name, e.value] for e in effects],
+            rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs,
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
                                 | {"gain_pct": f.get("gain", {}).get("percent")} for f in findings]}

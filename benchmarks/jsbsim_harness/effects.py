@@ -8,7 +8,7 @@ touched) or a sensor error added to the logged streams:
 | ``Cm:alpha^2`` | PITCH axis: ``+ k alpha^2`` (qbar S c) | ``Cm:alpha^2`` = ``k`` (1/rad^2) |
 | ``Cl:alpha*beta`` | ROLL axis: ``+ k alpha beta`` (qbar S b) | ``Cl:alpha*beta`` = ``k`` (1/rad^2) |
 | ``Cn:delta_a`` | YAW axis: ``+ k delta_a`` with the project's delta_a (qbar S b) | ``Cn:delta_a`` = ``k`` (1/rad) |
-| ``CY:scale`` | every SIDE-axis function times ``k`` | ``CY:beta`` = ``(k - 1) CY_beta`` (CY_beta of the stock model, least squares on the exact truth) |
+| ``CY:scale`` | every SIDE-axis function times ``k`` | ``scale:CY`` = ``k - 1``, the change of the factor on the whole side force (also kept: the change of CY_beta, ``(k - 1) CY_beta`` of the stock model by least squares on the exact truth) |
 | ``delay:delta_e`` | the aerodynamics read ``fcs/elevator-pos-rad`` through a pure delay of ``k`` s (an FCS ``actuator`` with a ``<delay>`` of whole frames); the logged surface position is not delayed | ``delay:delta_e`` = ``k`` (s) |
 | ``bias:airspeed`` | sensor side: the logged pitot airspeed (SCALED_PRESSURE, VFR_HUD) reads ``k`` m/s too high in TAS | ``bias:airspeed`` = ``k`` (m/s TAS) |
 
@@ -244,8 +244,8 @@ def make_effect_flight(config: FlightConfig, effects: list[Effect], out_dir: str
         if e.name == "CY:scale":
             cyb = side_force_beta({"X": truth_regressors(rec), "Y": truth_coefficients(rec)})
             stock = cyb / e.value
-            injected.append({"effect": e.name, "cause": "CY:beta", "value": (e.value - 1.0) * stock,
-                             "unit": "1/rad", "scale": e.value, "stock_CY_beta": stock})
+            injected.append({"effect": e.name, "cause": "scale:CY", "value": e.value - 1.0, "unit": "1",
+                             "scale": e.value, "CY_beta_change": (e.value - 1.0) * stock, "stock_CY_beta": stock})
         else:
             unit = {"Cm:alpha^2": "1/rad^2", "Cl:alpha*beta": "1/rad^2", "Cn:delta_a": "1/rad",
                     "delay:delta_e": "s", "bias:airspeed": "m/s"}[e.name]

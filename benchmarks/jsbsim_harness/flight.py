@@ -35,8 +35,8 @@ from gcs_sysid.signals import doublet, multisine, three_two_one_one
 
 from .aircraft import AircraftSpec, aircraft
 
-__all__ = ["FlightConfig", "Recording", "fly", "load_model", "maneuver_inputs", "TURBULENCE",
-           "LBF", "FT", "SLUG", "SLUG_FT2"]
+__all__ = ["FlightConfig", "Recording", "fly", "load_model", "maneuver_inputs", "speed_schedule",
+           "sideslip_holds", "PLANS", "TURBULENCE", "LBF", "FT", "SLUG", "SLUG_FT2"]
 
 LBF = 4.4482216152605      # N per lbf
 FT = 0.3048                # m per ft
@@ -48,6 +48,28 @@ KT = 0.514444              # m/s per kt
 #: gives 15 kt (light), 30 kt (moderate) and 45 kt (severe) at 20 ft; the severity index selects
 #: the probability of exceedance for the medium/high-altitude model.
 TURBULENCE = {"none": (0, 0.0), "light": (1, 15.0), "moderate": (3, 30.0)}
+
+#: Flight plans: ``"standard"`` holds one trim airspeed; ``"sweep"`` adds a speed sweep (several
+#: trim airspeeds, reached by slow pull-ups and push-overs) and steady-heading sideslips at each of
+#: them, so that alpha spans several degrees and sideslip happens at different alpha
+#: (:func:`speed_schedule`, :func:`sideslip_holds`).
+PLANS = ("standard", "sweep")
+
+#: The sweep's trim airspeeds: (start as a fraction of the logged duration, airspeed / initial
+#: airspeed). The last 20 % of the flight (the held-out segment) holds two levels of its own.
+#: Within every aircraft's envelope: the slowest, 0.75 of the initial calibrated airspeed, is
+#: 60 kt on the c172x and pa28 (power-off stall, flaps up, about 48-50 kt) and 37.5 kt on the
+#: SGS 2-33 (stall about 27 kt); the fastest, 1.12, is 90 kt (c172x, pa28; never-exceed 158-
+#: 160 kt) and 56 kt (SGS 2-33; never-exceed 85 kt). Faster levels were tried: the SGS's glide
+#: cannot reach 1.25 (its drag grows as the autopilot pushes, and alpha went to -12 deg).
+SWEEP_LEVELS = ((0.0, 1.0), (0.07, 0.75), (0.27, 1.12), (0.47, 0.82), (0.64, 1.08), (0.81, 0.75),
+                (0.91, 1.12))
+#: Largest sideslip of a flight in the envelope, deg: beyond it the aircraft has departed (an
+#: injected effect that reverses the dihedral effect at high alpha can do that).
+MAX_BETA_DEG = 20.0
+SWEEP_RAMP_S = 8.0       # duration of each speed change (cosine ramp), s
+SWEEP_MAX_PITCH_FF = 0.15  # largest pitch-attitude feedforward of a speed change, rad
+SWEEP_SLIP_RUDDER = 0.5    # rudder of a steady-heading sideslip, share of the maneuver amplitude
 
 
 @dataclass(frozen=True)
@@ -68,6 +90,8 @@ class FlightConfig:
             maneuvers) through a first-order lag with a rate limit of ``servo_rate_deg_s`` (JSBSim's
             stock models move their surfaces instantly). 0 = ideal servos.
         servo_rate_deg_s: servo rate limit, deg/s of the project's deflection.
+        plan: ``"standard"`` (one trim airspeed) or ``"sweep"`` (:data:`PLANS`): the same
+            maneuvers plus a speed sweep and steady-heading sideslips that span alpha.
     """
 
     aircraft: str = "c172x"
@@ -81,8 +105,11 @@ class FlightConfig:
     amplitude_scale: float = 1.0
     servo_tau_s: float = 0.04
     servo_rate_deg_s: float = 300.0
+    plan: str = "standard"
 
     def __post_init__(self):
+        if self.plan not in PLANS:
+            raise ValueError(f"plan must be one of {', '.join(PLANS)}, got '{self.plan}'")
         if self.turbulence not in TURBULENCE:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}, got '{self.turbulence}'")
         if abs(self.sim_rate_hz / self.log_rate_hz - round(self.sim_rate_hz / self.log_rate_hz)) > 1e-9:
@@ -179,12 +206,75 @@ def _segments(spec: AircraftSpec, duration: float) -> list[tuple[str, int, float
     return out
 
 
-def maneuver_inputs(spec: AircraftSpec, t: np.ndarray, duration: float, scale: float = 1.0) -> np.ndarray:
+def speed_schedule(t: np.ndarray, duration: float, plan: str = "standard") -> tuple[np.ndarray, np.ndarray]:
+    """Airspeed reference of the plan as a multiple of the initial airspeed, and its rate.
+
+    ``"sweep"`` steps through :data:`SWEEP_LEVELS`, each change a cosine ramp of
+    :data:`SWEEP_RAMP_S` (a slow pull-up to slow down, a push-over to speed up: the autopilot adds
+    the pitch attitude ``-(dV_ref/dt)/g`` that the change of speed needs in a glide, limited to
+    :data:`SWEEP_MAX_PITCH_FF`). A speed sweep
+    is how a flight-test engineer spans alpha at 1 g (Morelli and Klein, sec. 9.1: data at several
+    flight conditions for nonlinear terms); ``"standard"`` holds 1.
+
+    Args:
+        t: log times, s, shape (T,), 0 at the end of the settling phase.
+        duration: logged duration, s. plan: one of :data:`PLANS`.
+
+    Returns:
+        (factor (T,), d factor / dt (T,) in 1/s).
+    """
+    t = np.asarray(t, float)
+    f, df = np.ones_like(t), np.zeros_like(t)
+    if plan != "sweep":
+        return f, df
+    for (_, prev), (frac, lev) in zip(SWEEP_LEVELS[:-1], SWEEP_LEVELS[1:]):
+        t0 = frac * duration
+        x = np.clip((t - t0) / SWEEP_RAMP_S, 0.0, 1.0)
+        f += (lev - prev) * 0.5 * (1 - np.cos(np.pi * x))
+        df += np.where((x > 0) & (x < 1), (lev - prev) * 0.5 * np.pi / SWEEP_RAMP_S * np.sin(np.pi * x), 0.0)
+    return f, df
+
+
+def sideslip_holds(spec: AircraftSpec, duration: float, plan: str = "standard") -> list[tuple[float, float]]:
+    """(start s, rudder deflection rad) of the plan's steady-heading sideslips (none for ``"standard"``).
+
+    One per speed level of :data:`SWEEP_LEVELS` (so at a different alpha each), starting when
+    60 % of the level's speed change is done, alternating in sign; each ramps in over 0.75 s,
+    holds 2.5 s and ramps out over 0.75 s, with the rudder at :data:`SWEEP_SLIP_RUDDER` of the
+    aircraft's maneuver amplitude.
+    The autopilot's roll and heading loops supply the opposite aileron and the bank, as a pilot
+    flying a steady-heading sideslip does. Levels too short to hold one are skipped.
+    """
+    if plan != "sweep":
+        return []
+    ar = SWEEP_SLIP_RUDDER * np.radians(spec.amplitude_deg[2])
+    starts = [frac * duration for frac, _ in SWEEP_LEVELS] + [duration]
+    out = []
+    for k in range(len(SWEEP_LEVELS)):
+        t0 = starts[k] + (0.6 * SWEEP_RAMP_S if k else 3.0)
+        if t0 + _SLIP_S <= starts[k + 1] - 0.3:
+            out.append((t0, ar * (1.0 if len(out) % 2 == 0 else -1.0)))
+    return out
+
+
+_SLIP_S = 4.0        # ramp in 0.75 s, hold 2.5 s, ramp out 0.75 s
+
+
+def _slip(t: np.ndarray, start: float, amp: float) -> np.ndarray:
+    x = t - start
+    up = np.clip(x / 0.75, 0.0, 1.0)
+    down = np.clip((_SLIP_S - x) / 0.75, 0.0, 1.0)
+    return amp * np.minimum(up, down) * ((x >= 0) & (x <= _SLIP_S))
+
+
+def maneuver_inputs(spec: AircraftSpec, t: np.ndarray, duration: float, scale: float = 1.0,
+                    plan: str = "standard") -> np.ndarray:
     """Maneuver deflections added to the autopilot's, rad, shape (T, 3): delta_e, delta_a, delta_r.
 
     3-2-1-1s and doublets on each axis in turn, then an orthogonal phase-optimised multisine on all
     three axes together (0.1-1.5 Hz, ``gcs_sysid.signals``), repeated with alternating signs; the last
-    20 % of the flight is one three-axis multisine (see :func:`_segments`).
+    20 % of the flight is one three-axis multisine (see :func:`_segments`). The ``"sweep"`` plan adds
+    the rudder of its steady-heading sideslips (:func:`sideslip_holds`).
     """
     u = np.zeros((len(t), 3))
     amps = np.radians(spec.amplitude_deg) * scale
@@ -196,6 +286,8 @@ def maneuver_inputs(spec: AircraftSpec, t: np.ndarray, duration: float, scale: f
             u[:, axis] += three_two_one_one(t, start, w, amp * scale)
         else:
             u[:, axis] += doublet(t, start, w, amp * scale)
+    for start, amp in sideslip_holds(spec, duration, plan):
+        u[:, 2] += _slip(t, start, amp * scale)
     return u
 
 
@@ -267,7 +359,7 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
         ValueError: unknown aircraft or bad configuration.
         RuntimeError: JSBSim failed to load or initialise the model, or the aircraft left the
             flight envelope (airspeed below half or above twice the initial value, bank beyond
-            70 deg), which means the autopilot or the maneuvers need retuning for it.
+            70 deg, sideslip beyond :data:`MAX_BETA_DEG`), which means the autopilot or the maneuvers need retuning for it.
     """
     spec = aircraft(config.aircraft)
     dt = 1.0 / config.sim_rate_hz
@@ -286,16 +378,21 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
     n_settle = int(round(config.settle_s * config.sim_rate_hz))
     n_log = int(round(config.duration_s * config.log_rate_hz))
     t_log = np.arange(n_log) / config.log_rate_hz
-    u_man = maneuver_inputs(spec, t_log, config.duration_s, config.amplitude_scale)
+    u_man = maneuver_inputs(spec, t_log, config.duration_s, config.amplitude_scale, config.plan)
+    v_fac, v_rate = speed_schedule(t_log, config.duration_s, config.plan)
     rec = {k: np.empty(n_log) for k in list(_PROPS) + ["delta_e", "delta_a", "delta_r", "delta_t"]}
     n_total = n_settle + n_log * dec
     for i in range(n_total):
         j = (i - n_settle) // dec
         man = u_man[j] if i >= n_settle else np.zeros(3)
+        v_cmd = v_ref * (v_fac[j] if i >= n_settle else 1.0)
+        # glide-path change for dV/dt (a pull-up to slow down, a push-over to speed up), limited
+        theta_ff = float(np.clip(-v_ref * (v_rate[j] if i >= n_settle else 0.0) / 9.80665,
+                                 -SWEEP_MAX_PITCH_FF, SWEEP_MAX_PITCH_FF))
         theta, q, V = fdm["attitude/theta-rad"], fdm["velocities/q-rad_sec"], fdm["velocities/vt-fps"] * FT
         phi, p, r = fdm["attitude/phi-rad"], fdm["velocities/p-rad_sec"], fdm["velocities/r-rad_sec"]
-        theta_ref0 += 0.2 * k_v * (V - v_ref) * dt            # slow trim of the pitch reference
-        theta_ref = theta_ref0 + k_v * (V - v_ref)
+        theta_ref0 += 0.2 * k_v * (V - v_cmd) * dt            # slow trim of the pitch reference
+        theta_ref = theta_ref0 + k_v * (V - v_cmd) + theta_ff
         e_th = theta - theta_ref
         de_int += 0.5 * k_th * e_th * dt
         de = de_int + k_th * e_th + k_q * q + man[0]
@@ -318,9 +415,11 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
                 rec[k][j] = fdm[prop] * scale
             rec["delta_e"][j], rec["delta_a"][j], rec["delta_r"][j] = _deflections(fdm, spec)
             rec["delta_t"][j] = 0.0
-            if not (0.5 * v_ref < rec["V"][j] < 2 * v_ref) or abs(rec["phi"][j]) > np.radians(70):
+            if not (0.5 * v_ref < rec["V"][j] < 2 * v_ref) or abs(rec["phi"][j]) > np.radians(70) \
+                    or abs(rec["beta"][j]) > np.radians(MAX_BETA_DEG):
                 raise RuntimeError(f"{spec.name}: left the envelope at t = {t_log[j]:.1f} s "
-                                   f"(V {rec['V'][j]:.1f} m/s, bank {np.degrees(rec['phi'][j]):.0f} deg)")
+                                   f"(V {rec['V'][j]:.1f} m/s, bank {np.degrees(rec['phi'][j]):.0f} deg, "
+                                   f"sideslip {np.degrees(rec['beta'][j]):.0f} deg)")
     left, right = spec.aileron_props
     const = {"mass": float(fdm["inertia/mass-slugs"] * SLUG),
              "Ixx": float(fdm["inertia/ixx-slugs_ft2"] * SLUG_FT2),

@@ -79,30 +79,55 @@ def _autocov(v: np.ndarray, max_lag: int) -> np.ndarray:
     return r
 
 
-def colored_covariance(X: np.ndarray, v: np.ndarray, max_lag: int | None = None) -> np.ndarray:
+def colored_covariance(X: np.ndarray, v: np.ndarray, max_lag: int | None = None,
+                       method: str = "bartlett") -> np.ndarray:
     """Parameter covariance of OLS for coloured residuals (Morelli and Klein sec. 5.3).
 
-    ``Cov = (X'X)^-1 X' R X (X'X)^-1`` with ``R`` the Toeplitz matrix of the residual
-    autocovariance, lags beyond ``max_lag`` set to zero and the rest weighted by
-    Bartlett's window (which keeps the middle factor positive semi-definite).
+    ``Cov = (X'X)^-1 X' R X (X'X)^-1`` with ``R`` the Toeplitz matrix of the biased residual
+    autocovariance ``R_vv(k) = (1/N) sum_i v(i) v(i+k)``.
+
+    Two forms:
+
+    * ``"bartlett"`` (default): lags beyond ``max_lag`` set to zero and the rest weighted by
+      Bartlett's window (Newey and West 1987), which keeps the middle factor positive
+      semi-definite; short lag windows under-state the variance when the residual is correlated
+      over seconds.
+    * ``"morelli"``: Morelli and Klein's own form (sec. 5.3; their SIDPAC ``r_colores``): every
+      lag ``|k| <= N - 1`` of the biased autocovariance, unweighted
+      (``sum_i sum_j x(i) R_vv(i - j) x(j)'``). It follows correlation over the whole record,
+      which is what 2-sigma intervals of equation-error estimates on turbulent flights need;
+      ``max_lag`` is ignored. The middle factor is symmetrised; it may be indefinite for
+      parameter combinations the data hardly excite, so take square roots of ``max(diag, 0)``.
 
     Args:
         X: design, shape (N, K).
         v: residuals, shape (N,).
-        max_lag: largest lag used; default ``min(N - 1, max(10, 4 * N**(1/3)), 250)``.
+        max_lag: largest lag of ``"bartlett"``; default ``min(N - 1, max(10, 4 * N**(1/3)), 250)``.
+        method: ``"bartlett"`` or ``"morelli"``.
 
     Returns:
-        covariance of shape (K, K). White residuals give ``~ s^2 (X'X)^-1``.
+        covariance of shape (K, K). White residuals give ``~ s^2 (X'X)^-1`` with either form.
+
+    Raises:
+        ValueError: unknown ``method``.
     """
     X = np.asarray(X, float)
+    v = np.asarray(v, float)
     n = X.shape[0]
-    if max_lag is None:
-        max_lag = int(min(n - 1, 250, max(10, 4 * n ** (1 / 3))))
-    max_lag = max(0, min(int(max_lag), n - 1))
-    r = _autocov(v, max_lag)
-    w = 1.0 - np.arange(max_lag + 1) / (max_lag + 1.0)
-    kern = np.concatenate([(r * w)[:0:-1], r * w])              # lags -L..L
-    RX = fftconvolve(X, kern[:, None], mode="same", axes=0) if max_lag > 0 else X * r[0]
+    if method == "morelli":
+        r = _autocov(v, n - 1)
+        kern = np.concatenate([r[:0:-1], r])                     # lags -(N-1)..N-1, unweighted
+        RX = fftconvolve(X, kern[:, None], mode="same", axes=0) if n > 1 else X * r[0]
+    elif method == "bartlett":
+        if max_lag is None:
+            max_lag = int(min(n - 1, 250, max(10, 4 * n ** (1 / 3))))
+        max_lag = max(0, min(int(max_lag), n - 1))
+        r = _autocov(v, max_lag)
+        w = 1.0 - np.arange(max_lag + 1) / (max_lag + 1.0)
+        kern = np.concatenate([(r * w)[:0:-1], r * w])          # lags -L..L
+        RX = fftconvolve(X, kern[:, None], mode="same", axes=0) if max_lag > 0 else X * r[0]
+    else:
+        raise ValueError(f"colored_covariance: method must be 'bartlett' or 'morelli', got '{method}'")
     mid = X.T @ RX
     mid = 0.5 * (mid + mid.T)
     xtx_inv = np.linalg.pinv(X.T @ X)
@@ -127,7 +152,8 @@ def effective_samples(v: np.ndarray, max_lag: int = 250) -> float:
     return float(np.clip(n / max(infl, 1e-9), 1.0, n))
 
 
-def ols(X: np.ndarray, z: np.ndarray, terms=None, colored: bool = True, max_lag: int | None = None) -> OLSResult:
+def ols(X: np.ndarray, z: np.ndarray, terms=None, colored: bool = True, max_lag: int | None = None,
+        cov_method: str = "bartlett") -> OLSResult:
     """Ordinary least squares with normalised regressors (Morelli and Klein sec. 5.2-5.4).
 
     Columns are centred (when an intercept column ``"1"`` is present) and scaled to
@@ -140,6 +166,7 @@ def ols(X: np.ndarray, z: np.ndarray, terms=None, colored: bool = True, max_lag:
         terms: K column names (default ``x0, x1, ...``; ``"1"`` for a constant column).
         colored: correct standard errors for coloured residuals (sec. 5.3).
         max_lag: lag limit of the residual autocovariance (see :func:`colored_covariance`).
+        cov_method: ``"bartlett"`` or ``"morelli"``, the form of :func:`colored_covariance`.
 
     Returns:
         :class:`OLSResult`.
@@ -180,7 +207,7 @@ def ols(X: np.ndarray, z: np.ndarray, terms=None, colored: bool = True, max_lag:
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
     cov_b_white = s2 * np.linalg.pinv(Xn.T @ Xn)
     cov_white = T @ cov_b_white @ T.T
-    cov = T @ colored_covariance(Xn, v, max_lag) @ T.T if colored else cov_white
+    cov = T @ colored_covariance(Xn, v, max_lag, cov_method) @ T.T if colored else cov_white
     se_w = np.sqrt(np.maximum(np.diag(cov_white), 0.0))
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     zbar = float(np.mean(z))

@@ -82,3 +82,30 @@ def test_stepwise_recovers_structure():
     assert th["alpha^2"] == pytest.approx(3.0, rel=0.03)
     assert [h["action"] for h in res.history][-1] == "stop"
     assert term_matrix(X, ["alpha*beta"])[:, 0] == pytest.approx(X[:, 0] * X[:, 1])
+
+
+def test_morelli_klein_covariance_covers_the_spread_of_coloured_estimates():
+    """Morelli and Klein's all-lags form (sec. 5.3, SIDPAC r_colores): right size under AR(1) residuals
+    that stay correlated for longer than the Bartlett window's default lags."""
+    rng = np.random.default_rng(3)
+    N, phi = 1500, 0.98
+    x = np.convolve(rng.normal(size=N + 200), np.ones(60) / 60, "same")[:N]
+    X = np.column_stack([np.ones(N), x / x.std()])
+    est, se_mk, se_b = [], [], []
+    for _ in range(120):
+        e = np.zeros(N)
+        w = rng.normal(size=N)
+        for i in range(1, N):
+            e[i] = phi * e[i - 1] + w[i]
+        z = X @ [1.0, 2.0] + 0.05 * e
+        est.append(ols(X, z, ["1", "x"], cov_method="morelli").theta[1])
+        se_mk.append(ols(X, z, ["1", "x"], cov_method="morelli").std_error[1])
+        se_b.append(ols(X, z, ["1", "x"]).std_error[1])
+    spread = np.std(est)
+    assert 0.6 < np.mean(se_mk) / spread < 1.4
+    assert np.mean(se_mk) > np.mean(se_b)                  # the short lag window under-states it here
+    v = rng.normal(size=N)                                  # white residuals: about s^2 (X'X)^-1
+    W = np.linalg.inv(X.T @ X) * np.var(v)
+    assert np.allclose(np.sqrt(np.diag(colored_covariance(X, v, method="morelli"))), np.sqrt(np.diag(W)), rtol=0.3)
+    with pytest.raises(ValueError, match="method"):
+        colored_covariance(X, v, method="hac")

@@ -92,3 +92,53 @@ def test_merge_keeps_the_simpler_catalogue_term():
     assert [f["cause"] for f in out] == ["Cm:alpha"] and out[0]["source"].startswith("catalogue")
     other = {"cause": "Cm:beta", "coefficient": "Cm", "evidence": {}}
     assert [f["cause"] for f in merge_findings([other], sparse)] == ["Cm:alpha*delta_t"]
+
+
+def test_side_force_scale_is_named_as_scale_of_cy(airframe):
+    """CY k times the model's: the residual is (k - 1) times the model's CY, the ``scale:CY`` candidate."""
+    ref = _ctx(airframe, seed=4)
+    cy = lambda t: 0.4 * (BASE["CY"]["beta"] * t.x("beta") + BASE["CY"]["delta_r"] * t.x("delta_r"))  # noqa: E731
+    ctx, R = _ctx(airframe, [(1, cy)], seed=5)
+    res = sparse_search(ctx, R, reference=ref)
+    assert res["findings"] and res["findings"][0]["cause"] == "scale:CY", \
+        [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
+    f = res["findings"][0]
+    assert f["estimate"] == pytest.approx(1.4, abs=0.1) and f["model_value"] == 1.0
+    # a scale of a moment is not in the library (it would stand in for term-level causes)
+    assert not any(t["term"].startswith("scale:") for e in res["coefficients"] if e["coefficient"] != "CY"
+                   for t in e["terms"])
+
+
+def _alpha_error_flight(airframe, seed, e2, cm_alpha2=0.0):
+    """A synthetic flight whose measured alpha carries ``e2 * alpha / V`` (a wind-estimate error of the
+    AHRS angle of attack), and optionally a Cm:alpha^2 change that acts on the true alpha."""
+    from diag_synthetic import measured
+
+    table, states = measured(BASE, seed=seed, hidden=None, duration=90.0)
+    a_true = table.X[:, 0].copy()
+    table.Y[:, 4] += cm_alpha2 * a_true**2
+    table.X[:, 0] = a_true + e2 * a_true / table.X[:, 9]
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    return ctx, ctx.Y - ctx.model_values()
+
+
+def test_angle_error_over_airspeed_is_removed_as_a_nuisance_not_named(airframe):
+    ref = _ctx(airframe, seed=4)
+    ctx, R = _alpha_error_flight(airframe, 6, e2=1.8)       # alpha reads 10 % high at 18 m/s
+    res = sparse_search(ctx, R, reference=ref)
+    assert res["findings"] == [], [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
+    assert res["angle_nuisance"]["alpha"][2] == pytest.approx(1.8, rel=0.2)
+    # without the nuisance the same flight gets a lift "change": the test can fail
+    off = sparse_search(ctx, R, reference=ref, thresholds={"angle_nuisance": False})
+    assert any(f["coefficient"] in ("CZ", "CX") for f in off["findings"]), off["findings"]
+
+
+def test_moment_term_survives_the_angle_nuisance(airframe):
+    """The nuisance is fitted on the forces only: a Cm:alpha^2 change is still named and sized."""
+    ref = _ctx(airframe, seed=4)
+    ctx, R = _alpha_error_flight(airframe, 7, e2=1.8, cm_alpha2=-3.0)
+    res = sparse_search(ctx, R, reference=ref)
+    assert res["findings"] and res["findings"][0]["cause"] == "Cm:alpha^2", res["findings"]
+    f = res["findings"][0]
+    assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
+    assert f["evidence"]["std_error_method"].startswith("Morelli and Klein")

@@ -4,7 +4,7 @@ generated airframe files, the .tlog as the pipeline decodes it."""
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import (AIRCRAFT, FlightConfig, fly, load_truth, truth_coefficients,
+from benchmarks.jsbsim_harness import (AIRCRAFT, FlightConfig, aircraft, fly, load_truth, truth_coefficients,
                                        truth_regressors)
 from benchmarks.jsbsim_harness.airframes import airframe_doc
 from gcs_sysid.airframe import load_airframe
@@ -83,3 +83,55 @@ def test_flights_are_reproducible_per_seed(tmp_path, monkeypatch):
     a, b, c = (fly(FlightConfig("sgs", duration_s=5.0, seed=s)) for s in (3, 3, 4))
     np.testing.assert_array_equal(a.truth["wn"], b.truth["wn"])
     assert np.abs(a.truth["wn"] - c.truth["wn"]).max() > 0.01
+
+
+def test_speed_schedule_levels_and_rate():
+    """The sweep's airspeed reference steps through its levels with cosine ramps; its rate is the
+    derivative of the factor; the standard plan holds 1 and adds no sideslip."""
+    from benchmarks.jsbsim_harness.flight import SWEEP_LEVELS, SWEEP_RAMP_S, sideslip_holds, speed_schedule
+
+    t = np.arange(0, 120, 0.02)
+    f, df = speed_schedule(t, 120.0, "sweep")
+    for (frac, lev), nxt in zip(SWEEP_LEVELS, [x[0] for x in SWEEP_LEVELS[1:]] + [1.0]):
+        if nxt * 120 - (frac * 120 + SWEEP_RAMP_S) > 0.5:          # levels that are held reach their value
+            k = np.searchsorted(t, frac * 120 + SWEEP_RAMP_S + 0.2)
+            assert f[k] == pytest.approx(lev, abs=1e-9)
+    np.testing.assert_allclose(np.gradient(f, t), df, atol=2e-3)
+    assert 0.7 <= f.min() and f.max() <= 1.15
+    spec = aircraft("c172x")
+    holds = sideslip_holds(spec, 120.0, "sweep")
+    assert len(holds) >= 5 and {np.sign(a) for _, a in holds} == {-1.0, 1.0}
+    f0, df0 = speed_schedule(t, 120.0, "standard")
+    assert np.all(f0 == 1.0) and not np.any(df0) and sideslip_holds(spec, 120.0, "standard") == []
+    with pytest.raises(ValueError, match="plan"):
+        FlightConfig("c172x", plan="loops")
+
+
+@pytest.mark.slow
+def test_sweep_plan_spans_alpha_and_sideslips_at_several_speeds():
+    """The sweep flies several trim speeds (a wider alpha range than the standard plan) and holds
+    sideslips at different alpha, inside the envelope (no stall, no departure)."""
+    std = fly(FlightConfig("c172x", duration_s=120.0, seed=1))
+    swp = fly(FlightConfig("c172x", duration_s=120.0, seed=1, plan="sweep"))
+
+    def spread(rec):          # alpha's standard deviation, all of it and its 2-s averages (trim alpha), deg
+        a = np.degrees(rec.truth["alpha"])
+        return a.std(), np.convolve(a, np.ones(100) / 100, "valid").std()
+
+    (s0, s0_trim), (s1, s1_trim) = spread(std), spread(swp)
+    assert s1 > 1.5 * s0 and s1_trim > 2.5 * s0_trim, (spread(std), spread(swp))
+    V = swp.truth["V"]
+    assert np.ptp(np.percentile(V, [1, 99])) > 0.3 * np.median(V)
+    a = np.degrees(swp.truth["alpha"])
+    assert a.max() < 12.0                                          # far below the c172x's stall
+    from benchmarks.jsbsim_harness.flight import sideslip_holds
+
+    b = np.degrees(swp.truth["beta"])
+    alphas, betas = [], []
+    for start, amp in sideslip_holds(aircraft("c172x"), 120.0, "sweep"):
+        m = (swp.t > start + 1.0) & (swp.t < start + 3.0)
+        betas.append(np.sign(amp) * b[m].mean())
+        alphas.append(a[m].mean())
+    # the c172x's holds (3 deg of rudder, on top of the other maneuvers) give about 1 deg of sideslip
+    assert np.median(betas) > 0.5, betas
+    assert np.ptp(alphas) > 1.0                                       # at different alpha
