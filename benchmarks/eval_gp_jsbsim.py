@@ -19,7 +19,9 @@ Variants (``--variants``): ``diag`` the GP with one noise variance per output (b
 ``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the shipped
 default is the input noise without ``full``, for the replay's speed), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
 of the least-squares model (LS as the prior mean), ``indep`` six
-independent one-output GPs (same settings, each its own hyperparameters), and ``ls`` (cached).
+independent one-output GPs (same settings, each its own hyperparameters), ``lmc`` = ``nigp`` with a
+linear model of coregionalisation of two latent kernels (``GPConfig.latent_kernels = 2``: per-output
+length-scales), ``lmc3`` with three, and ``ls`` (cached).
 
 Usage::
 
@@ -46,7 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 
-VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "ls")
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "ls")
 
 
 def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
@@ -91,6 +93,8 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True)
     if variant == "lsres":
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant in ("lmc", "lmc3"):
+        return replace(base, noise_correlation=True, input_noise=True, latent_kernels=2 if variant == "lmc" else 3)
     if variant == "global":
         return replace(base, noise_correlation=True, input_noise=True, local=False)
     raise ValueError(variant)
@@ -162,7 +166,8 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("full", "ls"), ("nigp", "ls"), ("full", "diag"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+                 ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]
         if pairs:
