@@ -23,7 +23,8 @@ default is the input noise without ``full``, for the replay's speed), ``global``
 of the least-squares model (LS as the prior mean), ``indep`` six
 independent one-output GPs (same settings, each its own hyperparameters), ``lmc`` = ``nigp`` with a
 linear model of coregionalisation of two latent kernels (``GPConfig.latent_kernels = 2``: per-output
-length-scales), ``lmc3`` with three, and ``ls`` (cached).
+length-scales), ``lmc3`` with three, ``nigpc`` = ``nigp`` with the coloured-residual variance factor
+(``GPConfig.residual_correlation``), and ``ls`` (cached).
 
 Usage::
 
@@ -50,7 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 
-VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "ls")
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "ls")
 
 
 def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
@@ -93,6 +94,8 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=variant == "full", input_noise=False)
     if variant == "nigp":
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "nigpc":
+        return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
         return replace(base, noise_correlation=True, input_noise=True)
     if variant in ("lmc", "lmc3"):

@@ -69,6 +69,10 @@ class GPConfig:
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
+        residual_correlation: multiply the global layer's explained predictive variance per output by
+            the long-run variance ratio of its time-ordered training residuals (coloured residuals:
+            consecutive rows share an error, so they are worth fewer independent rows;
+            :mod:`gcs_sysid.gp.colored`). Off by default (``docs/gp.md``, "Coloured residuals").
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -104,6 +108,7 @@ class GPConfig:
     hyper_every: int = 0
     noise_correlation: bool = False
     input_noise: bool = True
+    residual_correlation: bool = False
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:

@@ -376,6 +376,11 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
+    var_scale = None
+    if cfg.residual_correlation:
+        from .colored import variance_inflation
+
+        var_scale = variance_inflation(Ys - global_mean(params, post, Xs, cfg.batch_size))
     input_var = None
     if cfg.input_noise:
         t4 = time.perf_counter()
@@ -391,7 +396,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["total"] = time.perf_counter() - t0
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
-                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var)
+                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var,
+                          var_scale=var_scale)
     return model, history
 
 

@@ -27,7 +27,8 @@ VERSION = 4   # 2: the region-thinned row store (rows_*) replaces store_X / stor
 #                  stats_yy is (P, P), was its diagonal (P,)
 #               4: optional global_lmc_lengthscale (J-1, D) and global_lmc_A (J-1, P, P) (linear model
 #                  of coregionalisation); the statistics C, E, Rphi are then those of the J M stacked
-#                  features. Files of versions 1-3 (one kernel) read unchanged.
+#                  features. Files of versions 1-3 (one kernel) read unchanged. Optional var_scale (P,)
+#                  (coloured residuals).
 _GLOBAL = ("lengthscale", "A", "noise", "Z", "prior_std", "jitter")
 _STATS = ("C", "E", "F", "Rphi", "Rx", "yy", "n")
 _LOCAL = ("lengthscale", "beta", "amp", "noise")
@@ -54,6 +55,8 @@ def save_model(model: LocalGlobalGP, path) -> str:
     arrays.update({"global_" + k: np.asarray(getattr(model.params, k)) for k in _GLOBAL})
     if model.input_var is not None:
         arrays["input_var"] = np.asarray(model.input_var)
+    if model.var_scale is not None:
+        arrays["var_scale"] = np.asarray(model.var_scale)
     if model.params.noise_chol is not None:
         arrays["global_noise_chol"] = np.asarray(model.params.noise_chol)
     if model.params.lmc_lengthscale is not None:
@@ -148,4 +151,4 @@ def load_gp(path) -> LocalGlobalGP:
     return LocalGlobalGP(config, scaler, params, stats, post, local_params, store,
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
                          tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
-                         evicted=evicted, input_var=a.get("input_var"))
+                         evicted=evicted, input_var=a.get("input_var"), var_scale=a.get("var_scale"))

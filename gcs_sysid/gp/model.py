@@ -65,6 +65,9 @@ class LocalGlobalGP:
         since_refresh: rows conditioned on since the hyperparameters were last learned.
         input_var: ``(D,)`` input-noise variances of the regressors (standardised; NIGP,
             :mod:`gcs_sysid.gp.inputnoise`), None when not learned.
+        var_scale: ``(P,)`` factors on the global layer's explained variance for coloured residuals
+            (:mod:`gcs_sysid.gp.colored`; from the fit's time-ordered rows, kept through updates and
+            refreshes), None when not learned (``GPConfig.residual_correlation``).
         evicted: the part of ``stats`` from rows no longer stored (None: none). When the
             inducing inputs or length-scales change, the stored rows' statistics are computed
             again exactly and only this part is carried by the streaming projection.
@@ -85,6 +88,7 @@ class LocalGlobalGP:
     since_refresh: int = 0
     evicted: Stats | None = None
     input_var: np.ndarray | None = None
+    var_scale: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -151,7 +155,7 @@ class LocalGlobalGP:
         """
         enable_x64()
         Xs, ok = self._standardise_query(X)
-        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         noise = np.asarray(self.params.noise)
         if self.local_params is not None and self.store is not None:
             ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
@@ -180,7 +184,7 @@ class LocalGlobalGP:
         """Mean and variance ``(N, P)`` of the global layer alone (linear mean + sparse ICM GP)."""
         enable_x64()
         Xs, ok = self._standardise_query(X)
-        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         if include_noise:
             var = var + np.asarray(self.params.noise)[None, :]
         return self._finish(ok, mean, var)

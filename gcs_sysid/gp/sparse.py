@@ -353,12 +353,13 @@ def mean_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array
     return jnp.concatenate([phi, design(Xs).T], axis=0).T @ post.weights
 
 
-def predict_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array
+def predict_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array, scale: jax.Array | None = None
                          ) -> tuple[jax.Array, jax.Array]:
     """Latent mean and variance ``(N, P)`` of ``xa^T W_p + f_p`` at standardised ``Xs (N, D)``.
 
     ``var_p = sum_j B_j,pp (1 - |phi_j|^2) + u^T H_p u`` with ``u = [phi; xa]`` (Titsias 2009,
-    eq. 6, in whitened form). Noise is not included.
+    eq. 6, in whitened form). Noise is not included. ``scale`` ``(P,)``: multiplies the explained
+    part ``u^T H_p u`` (coloured residuals, :mod:`gcs_sysid.gp.colored`); None: 1.
     """
     phi = features(params, post.Lm, Xs)                          # (J M, N)
     u = jnp.concatenate([phi, design(Xs).T], axis=0)             # (J M + D1, N)
@@ -369,5 +370,7 @@ def predict_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Ar
     bdiag = jnp.sum(Bd, 0)
     prior_rest = rest.T @ Bd
     explained = jnp.sum(jnp.einsum("pij,jn->pin", post.H, u) * u[None], 1).T   # one batched matmul: ~3x faster
+    if scale is not None:
+        explained = explained * scale[None, :]
     var = jnp.maximum(prior_rest + explained, 1e-12 * bdiag[None, :])
     return mean, var
