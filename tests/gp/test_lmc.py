@@ -37,23 +37,21 @@ def test_lmc_sparse_at_the_data_equals_the_exact_gp():
     Xq = rng.uniform(-2.5, 2.5, (7, 2))
     p = _lmc_params(X)
     assert p.n_kernels == 3 and p.lengthscales.shape == (3, 2)
-    st = jax.jit(sparse.stats_of)(p, jnp.asarray(X), jnp.asarray(Y))
-    assert st.C.shape == (75, 75)                                     # stacked features of 3 kernels
-    ex = float(jax.jit(exact.exact_log_marginal)(p, jnp.asarray(X), jnp.asarray(Y)))
-    assert float(jax.jit(sparse.elbo)(p, st)) == pytest.approx(ex, rel=1e-7)
-    post = jax.jit(sparse.posterior)(p, st)
-    m, v = jax.jit(sparse.predict_global_chunk)(p, post, jnp.asarray(Xq))
-    me, ve = jax.jit(exact.exact_predict)(p, jnp.asarray(X), jnp.asarray(Y), jnp.asarray(Xq))
+
+    @jax.jit
+    def both(p, X, Y, Xq):        # one compiled program for the sparse and the exact sides
+        st = sparse.stats_of(p, X, Y)
+        post = sparse.posterior(p, st)
+        slope = jax.vmap(jax.jacfwd(lambda x: sparse.mean_global_chunk(p, post, x[None])[0]))(Xq)
+        return (st.C.shape[0], sparse.elbo(p, st), exact.exact_log_marginal(p, X, Y),
+                sparse.predict_global_chunk(p, post, Xq), exact.exact_predict(p, X, Y, Xq), post, slope)
+
+    nC, bound, ex, (m, v), (me, ve), post, slope = both(p, jnp.asarray(X), jnp.asarray(Y), jnp.asarray(Xq))
+    assert nC == 75                                                   # stacked features of 3 kernels
+    assert float(bound) == pytest.approx(float(ex), rel=1e-7)
     np.testing.assert_allclose(m, me, rtol=1e-6, atol=1e-7)
     np.testing.assert_allclose(v, ve, rtol=1e-6, atol=1e-8)
-    got = mean_gradient(p, post, Xq, batch=4)
-    ref = jax.vmap(jax.jacfwd(lambda x: sparse.mean_global_chunk(p, post, x[None])[0]))(jnp.asarray(Xq))
-    np.testing.assert_allclose(got, np.asarray(ref), rtol=1e-8, atol=1e-10)
-    # a one-kernel LMC is the ICM
-    icm = replace(p, lmc_lengthscale=None, lmc_A=None)
-    st1 = jax.jit(sparse.stats_of)(icm, jnp.asarray(X), jnp.asarray(Y))
-    assert float(jax.jit(sparse.elbo)(icm, st1)) == pytest.approx(
-        float(jax.jit(exact.exact_log_marginal)(icm, jnp.asarray(X), jnp.asarray(Y))), rel=1e-7)
+    np.testing.assert_allclose(mean_gradient(p, post, Xq, batch=8), np.asarray(slope), rtol=1e-8, atol=1e-10)
 
 
 def test_lmc_projection_is_exact_when_the_old_rows_are_the_old_inducing_inputs():
