@@ -245,10 +245,14 @@ def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tu
     J, P, R = F.shape
     M = st.C.shape[0] // J
     G = jnp.einsum("jpr,pq,kqs->jrks", F, N, F)          # (J, R, J, R): a_q^T N a_q'
-    C4 = st.C.reshape(J, M, J, M)
-    ww = jnp.einsum("jrks,jmkn->jrmksn", G, C4).reshape(J * R * M, J * R * M)   # ICM: kron(G, C)
     AN = jnp.einsum("jpr,pq->jrq", F, N)                 # (J, R, P)
-    wo = sv * jnp.einsum("jrq,jmx->jrmqx", AN, st.E.reshape(J, M, -1)).reshape(J * R * M, -1)  # kron(A^T N, E)
+    if J == 1:                                           # the ICM: Kronecker products
+        ww = jnp.kron(G[0, :, 0, :], st.C)
+        wo = sv * jnp.kron(AN[0], st.E)                  # rows (q, m), cols (p, i)
+    else:
+        C4 = st.C.reshape(J, M, J, M)
+        ww = jnp.einsum("jrks,jmkn->jrmksn", G, C4).reshape(J * R * M, J * R * M)
+        wo = sv * jnp.einsum("jrq,jmx->jrmqx", AN, st.E.reshape(J, M, -1)).reshape(J * R * M, -1)
     oo = sv * sv * jnp.kron(N, st.F)
     lam = jnp.block([[ww, wo], [wo.T, oo]])
     lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
@@ -322,7 +326,10 @@ def _selectors(params: GlobalParams, M: int) -> jax.Array:
 
     def one(p):
         # rows (j, r, m), cols (j', m'): A_j[p, r] delta_jj' delta_mm' (ICM: kron(A[p], I_M))
-        top = jnp.einsum("jr,jk,mn->jrmkn", F[:, p, :], eyeJ, eyeM).reshape(J * R * M, J * M)
+        if J == 1:
+            top = jnp.kron(F[0, p][:, None], eyeM)                           # (P*M, M), the ICM's
+        else:
+            top = jnp.einsum("jr,jk,mn->jrmkn", F[:, p, :], eyeJ, eyeM).reshape(J * R * M, J * M)
         bot = params.prior_std * jnp.kron(jax.nn.one_hot(p, P, dtype=dt)[:, None], eyeD)
         return jnp.block([[top, jnp.zeros((J * R * M, D1), dt)], [jnp.zeros((P * D1, J * M), dt), bot]])
 
