@@ -13,13 +13,18 @@ the held-out rows against the truth:
           has none), per coefficient, and the median over the six; ``cov_noise``: with the noise (the
           band the replay reports)
   corr    the largest |learned output correlation| of the global layer (``output_correlation``)
+  true    ``err_true``, ``cov_true``: the model at the true regressors (``predict(..., include_noise=False,
+          input_noise=False)``, as ``gcs-sysid predict`` at exact conditions), against the truth
 
 Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
 ``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),
 ``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the shipped
 default is the input noise without ``full``, for the replay's speed), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
 of the least-squares model (LS as the prior mean), ``indep`` six
-independent one-output GPs (same settings, each its own hyperparameters), and ``ls`` (cached).
+independent one-output GPs (same settings, each its own hyperparameters), ``lmc`` = ``nigp`` with a
+linear model of coregionalisation of two latent kernels (``GPConfig.latent_kernels = 2``: per-output
+length-scales), ``lmc3`` with three, ``nigpc`` = ``nigp`` with the coloured-residual variance factor
+(``GPConfig.residual_correlation``), and ``ls`` (cached).
 
 Usage::
 
@@ -46,7 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 
-VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "ls")
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "ls")
 
 
 def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
@@ -89,8 +94,12 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=variant == "full", input_noise=False)
     if variant == "nigp":
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "nigpc":
+        return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant in ("lmc", "lmc3"):
+        return replace(base, noise_correlation=True, input_noise=True, latent_kernels=2 if variant == "lmc" else 3)
     if variant == "global":
         return replace(base, noise_correlation=True, input_noise=True, local=False)
     raise ValueError(variant)
@@ -107,15 +116,18 @@ def score(path: Path, variants, base: GPConfig = GPConfig()):
     for v in variants:
         t0 = time.perf_counter()
         corr = float("nan")
+        true = None
         if v == "ls":
             mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
             sig_n = sig_g = sig
         elif v == "indep":
             cfg = _config(v, base)
-            parts = [fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0].predict(X[h], False)
-                     for p in range(Y.shape[1])]
+            models = [fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0] for p in range(Y.shape[1])]
+            parts = [m.predict(X[h], False) for m in models]
             mean = np.column_stack([m for m, _ in parts])
             sig = np.sqrt(np.column_stack([s for _, s in parts]))
+            tp = [m.predict(Xt[h], include_noise=False, input_noise=False) for m in models]
+            true = np.column_stack([m for m, _ in tp]), np.sqrt(np.column_stack([s for _, s in tp]))
             sig_n = sig_g = sig * np.nan
         else:
             prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
@@ -127,6 +139,8 @@ def score(path: Path, variants, base: GPConfig = GPConfig()):
             sig_g = np.sqrt(var + np.asarray(model.params.noise)[None, :] * model.scaler.y_std**2)
             c = model.output_correlation()
             corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
+            mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)     # exact regressors
+            true = mt + prior[h], np.sqrt(vt)
         e, cv, cvn = errors(mean, Yt[h]), coverage(mean, sig, Yt[h]), coverage(mean, sig_n, Yt[h])
         yield (dict(meta, variant=v, err=dict(zip(COEFFICIENTS, e.round(2).tolist())),
                          cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())),
@@ -134,6 +148,9 @@ def score(path: Path, variants, base: GPConfig = GPConfig()):
                          cov_gnoise=dict(zip(COEFFICIENTS, coverage(mean, sig_g, Yt[h]).round(1).tolist())),
                          max_corr=corr,
                          meas=dict(zip(COEFFICIENTS, errors(Y[h], Yt[h]).round(2).tolist())),
+                         **({} if true is None else {
+                             "err_true": dict(zip(COEFFICIENTS, errors(true[0], Yt[h]).round(2).tolist())),
+                             "cov_true": dict(zip(COEFFICIENTS, coverage(*true, Yt[h]).round(1).tolist()))}),
                          t_fit_s=round(time.perf_counter() - t0, 2)))
 
 
@@ -146,7 +163,7 @@ def summarize(paths) -> str:
     for r in rows:
         groups.setdefault((r["aircraft"], r["turbulence"], r["aoa"], r["variant"]), []).append(r)
     head = ("| aircraft | turb. | AOA_SSA | model | seeds | " + " | ".join(COEFFICIENTS)
-            + " | cov95 % latent (min-max) | with local noise | with global noise | max corr |")
+            + " | cov95 % latent (min-max) | with local noise | with global noise | at true regressors | max corr |")
     out = [head, "|" + "---|" * (head.count("|") - 1)]
     for (ac, turb, aoa, v), rs in sorted(groups.items()):
         med = lambda k, c: float(np.nanmedian([r[k][c] for r in rs]))   # noqa: E731
@@ -157,12 +174,14 @@ def summarize(paths) -> str:
         corr = float(np.nanmedian([r["max_corr"] for r in rs]))
         name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
         out.append(f"| {name} | {turb} | {aoa} | {v} | {len(rs)} | " + " | ".join(f"{med('err', c):.1f}" for c in COEFFICIENTS)
-                   + f" | {cov('cov')} | {cov('cov_noise')} | {cov('cov_gnoise')} | {'' if np.isnan(corr) else f'{corr:.2f}'} |")
+                   + f" | {cov('cov')} | {cov('cov_noise')} | {cov('cov_gnoise')} | {cov('cov_true')} | "
+                   + f"{'' if np.isnan(corr) else f'{corr:.2f}'} |")
     # pairwise: joint (full) vs independent, GP vs least squares, per flight and coefficient
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("full", "ls"), ("nigp", "ls"), ("full", "diag"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+                 ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]
         if pairs:

@@ -57,14 +57,15 @@ def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: in
     return total
 
 
-def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, batch: int
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Latent mean and variance ``(N, P)`` of the global layer at standardised ``Xs``."""
+def global_predict(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, batch: int,
+                   scale: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Latent mean and variance ``(N, P)`` of the global layer at standardised ``Xs``; ``scale (P,)``
+    multiplies the explained part of the variance (:func:`gcs_sysid.gp.sparse.predict_global_chunk`)."""
     P = params.A.shape[0]
     mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
     size = int(min(batch, _bucket(len(Xs))))
     for a, b in _chunks(len(Xs), size):
-        m, v = _predict_jit(params, post, _pad(Xs[a:b], size))
+        m, v = _predict_jit(params, post, _pad(Xs[a:b], size), scale)
         mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
     return mean, var
 

@@ -27,7 +27,15 @@ class GPConfig:
         tol: early stopping: an Adam run (global or local) stops when the mean loss (per data
             point and output) of the last 10 steps improved by less than this on the 10 before;
             0 runs every step.
-        rank: rank ``R`` of the shared part ``L L^T`` of the coregionalisation matrix.
+        rank: rank ``R`` of the shared part ``L L^T`` of the coregionalisation matrix (of each
+            kernel's ``B_j`` with ``latent_kernels > 1``).
+        latent_kernels: latent kernels ``J`` of the global layer: 1 is the intrinsic
+            coregionalisation model (one set of ARD length-scales for all outputs); ``J > 1`` a
+            linear model of coregionalisation, ``cov(f(x), f(x')) = sum_j B_j k_j(x, x')`` with
+            one length-scale vector per kernel, so each output weighs short and long
+            length-scales in its own proportions (``docs/gp.md``, "Per-output length-scales").
+            The feature space grows to ``J*P*M + P*(D+1)`` dimensions and the statistics to
+            ``(J M)^2``: keep ``J*P*M`` below ~1500.
         inducing: ``"mi"`` (greedy mutual information), ``"kmeans"`` or ``"random"``.
         mi_pool: candidates for the mutual-information selection.
         reselect: re-run the selection with the learned length-scales halfway.
@@ -61,6 +69,10 @@ class GPConfig:
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
+        residual_correlation: multiply the global layer's explained predictive variance per output by
+            the long-run variance ratio of its time-ordered training residuals (coloured residuals:
+            consecutive rows share an error, so they are worth fewer independent rows;
+            :mod:`gcs_sysid.gp.colored`). Off by default (``docs/gp.md``, "Coloured residuals").
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -73,6 +85,7 @@ class GPConfig:
     learning_rate: float = 0.05
     tol: float = 1e-3
     rank: int = 2
+    latent_kernels: int = 1
     inducing: str = "mi"
     mi_pool: int = 800
     reselect: bool = True
@@ -95,11 +108,13 @@ class GPConfig:
     hyper_every: int = 0
     noise_correlation: bool = False
     input_noise: bool = True
+    residual_correlation: bool = False
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
             raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, got {self.n_inducing_hyper!r}")
-        for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool"):
+        for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool",
+                     "latent_kernels"):
             if int(getattr(self, name)) < 1:
                 raise InputError(f"GPConfig.{name} must be a positive integer, got {getattr(self, name)!r}")
         if int(self.store_max) < 16:

@@ -4,6 +4,8 @@ Covariance of the stacked outputs (output-major, ``y = [y_1; ...; y_P]`` of leng
 
     K = B kron Kxx + v (I_P kron Xa Xa^T) + diag(sigma^2) kron I_N
 
+(for a linear model of coregionalisation ``sum_j B_j kron K_j`` in place of ``B kron Kxx``)
+
 O(N^3 P^3) time and O(N^2 P^2) memory; for tests and benchmark baselines only
 (Rasmussen and Williams 2006, eqs. 2.25-2.26 and 2.30).
 """
@@ -21,10 +23,12 @@ __all__ = ["exact_covariance", "exact_log_marginal", "exact_predict"]
 
 def exact_covariance(params: GlobalParams, X1: jnp.ndarray, X2: jnp.ndarray) -> jnp.ndarray:
     """Noise-free prior covariance ``(P*N1, P*N2)`` of ``xa^T W_p + f_p`` (output-major)."""
-    K = ARDSquaredExponential(params.lengthscale)(X1, X2)
     lin = params.prior_std**2 * design(X1) @ design(X2).T
     P = params.A.shape[0]
-    return jnp.kron(params.B, K) + jnp.kron(jnp.eye(P, dtype=K.dtype), lin)
+    out = jnp.kron(jnp.eye(P, dtype=lin.dtype), lin)
+    for Bj, ls in zip(params.B_parts, params.lengthscales):
+        out = out + jnp.kron(Bj, ARDSquaredExponential(ls)(X1, X2))
+    return out
 
 
 def _noisy(params: GlobalParams, Xs):

@@ -66,13 +66,23 @@ class FitHistory:
 
 
 def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
-    """Map unconstrained parameters to :class:`GlobalParams` (exp for scales, Cholesky of ``B``)."""
+    """Map unconstrained parameters to :class:`GlobalParams` (exp for scales, Cholesky of ``B``).
+
+    The further kernels of a linear model of coregionalisation (``lmc_log_ls (J-1, D)``,
+    ``lmc_L (J-1, P, R)``, ``lmc_log_kappa (J-1, P)``) are mapped the same way, one ``B_j`` each.
+    """
     ls = jnp.where(fixed["active"], jnp.exp(raw["log_ls"]), 1.0)
     B = coregionalisation(raw["L"], jnp.exp(raw["log_kappa"]) + _NOISE_FLOOR)
     Z = raw["Z"] if "Z" in raw else fixed["Z"]
+    lmc_ls = lmc_A = None
+    if "lmc_log_ls" in raw:
+        lmc_ls = jnp.where(fixed["active"][None, :], jnp.exp(raw["lmc_log_ls"]), 1.0)
+        Bj = jax.vmap(coregionalisation)(raw["lmc_L"], jnp.exp(raw["lmc_log_kappa"]) + _NOISE_FLOOR)
+        lmc_A = jnp.linalg.cholesky(Bj)
     return GlobalParams(lengthscale=ls, A=jnp.linalg.cholesky(B), noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR,
                         Z=Z, prior_std=fixed["prior_std"], jitter=fixed["jitter"],
-                        noise_chol=noise_correlation_factor(raw["noise_off"]) if "noise_off" in raw else None)
+                        noise_chol=noise_correlation_factor(raw["noise_off"]) if "noise_off" in raw else None,
+                        lmc_lengthscale=lmc_ls, lmc_A=lmc_A)
 
 
 def noise_correlation_factor(off: jax.Array) -> jax.Array:
@@ -147,8 +157,34 @@ def _adam(loss, raw, opt_state, lr, args, n_steps: int, tol: float = 0.0, window
     return raw, opt_state, np.asarray(jax.device_get(values))
 
 
+def _split_B(B: np.ndarray, rank: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(L (P, R), kappa (P,))`` with ``L L^T + diag(kappa) ~ B``: the leading ``rank`` eigenpairs in
+    ``L``, the rest of the diagonal (at least a tenth of it) in ``kappa``."""
+    P = len(B)
+    w, V = np.linalg.eigh(B)
+    r = int(min(rank, P))
+    L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((P, 0))
+    return np.asarray(L0, float), np.maximum(np.diag(B) - np.sum(L0**2, 1), 0.1 * np.diag(B))
+
+
+def lmc_start_factors(J: int) -> np.ndarray:
+    """Starting length-scale multipliers ``(J,)`` of the latent kernels: 1, 4, 1/4, 16, 1/16, ...
+
+    Distinct starts break the symmetry between the kernels (from equal starts they stay equal);
+    the bound then moves them. The second kernel starts longer: on a synthetic pair of outputs
+    with length-scales 0.33 and 1.4 a start at 1/3 collapsed the second kernel onto the first
+    (its variance went to ~0.01), a start at 4 separated them (``tests/gp/test_lmc.py``).
+    """
+    return np.array([4.0 ** ((-1) ** (j + 1) * ((j + 1) // 2)) for j in range(J)])
+
+
 def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
-    """Initial unconstrained parameters from a ridge fit of the linear mean."""
+    """Initial unconstrained parameters from a ridge fit of the linear mean.
+
+    With ``cfg.latent_kernels = J > 1`` the residual covariance is shared equally between the
+    kernels (``B_j = B0 / J``) and the length-scales start at :func:`lmc_start_factors` times the
+    ICM start.
+    """
     P = Ys.shape[1]
     R = Ys
     if cfg.linear_mean:
@@ -156,15 +192,20 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
         W = np.linalg.solve(Xa.T @ Xa + 1e-3 * np.eye(Xa.shape[1]), Xa.T @ Ys)
         R = Ys - Xa @ W
     Cr = np.cov(R.T).reshape(P, P) + 1e-6 * np.eye(P)
-    B0 = 0.7 * Cr
-    w, V = np.linalg.eigh(B0)
-    r = int(min(cfg.rank, P))
-    L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((P, 0))
-    kappa = np.maximum(np.diag(B0) - np.sum(L0**2, 1), 0.1 * np.diag(B0)) + 1e-4
+    J = int(cfg.latent_kernels)
+    B0 = 0.7 * Cr / J
+    L0, kappa = _split_B(B0, cfg.rank)
+    kappa = kappa + 1e-4
     n_active = max(int(active.sum()), 1)
+    ls0 = np.log(0.5 * np.sqrt(n_active))
     # host arrays moved once with device_put (jnp.asarray of a NumPy array compiles a program per shape)
-    raw = {"log_ls": np.full(Xs.shape[1], np.log(0.5 * np.sqrt(n_active))), "L": np.asarray(L0, float),
+    raw = {"log_ls": np.full(Xs.shape[1], ls0), "L": L0,
            "log_kappa": np.log(kappa), "log_noise": np.log(0.3 * np.diag(Cr) + 1e-4)}
+    if J > 1:
+        f = lmc_start_factors(J)[1:]
+        raw["lmc_log_ls"] = np.repeat((ls0 + np.log(f))[:, None], Xs.shape[1], axis=1)
+        raw["lmc_L"] = np.repeat(L0[None], J - 1, axis=0)
+        raw["lmc_log_kappa"] = np.repeat(np.log(kappa)[None], J - 1, axis=0)
     if cfg.noise_correlation:
         raw["noise_off"] = np.zeros((P, P))
     if cfg.train_inducing:
@@ -179,13 +220,15 @@ def _unconstrain(p: GlobalParams, cfg: GPConfig) -> dict:
     values are: its leading ``rank`` eigenpairs in ``L``, the rest of the diagonal in ``kappa``)."""
     A = np.asarray(p.A)
     B = A @ A.T
-    w, V = np.linalg.eigh(B)
-    r = int(min(cfg.rank, len(B)))
-    L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((len(B), 0))
-    kappa = np.maximum(np.diag(B) - np.sum(L0**2, 1), 0.1 * np.diag(B)) - _NOISE_FLOOR
-    out = {"log_ls": np.log(np.asarray(p.lengthscale)), "L": np.asarray(L0, float),
-           "log_kappa": np.log(np.maximum(kappa, 1e-8)),
+    L0, kappa = _split_B(B, cfg.rank)
+    out = {"log_ls": np.log(np.asarray(p.lengthscale)), "L": L0,
+           "log_kappa": np.log(np.maximum(kappa - _NOISE_FLOOR, 1e-8)),
            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
+    if p.lmc_A is not None and cfg.latent_kernels == p.n_kernels:
+        parts = [_split_B(Aj @ Aj.T, cfg.rank) for Aj in np.asarray(p.lmc_A)]
+        out["lmc_log_ls"] = np.log(np.asarray(p.lmc_lengthscale))
+        out["lmc_L"] = np.stack([L for L, _ in parts])
+        out["lmc_log_kappa"] = np.stack([np.log(np.maximum(k - _NOISE_FLOOR, 1e-8)) for _, k in parts])
     if cfg.noise_correlation:
         R = np.eye(len(B)) if p.noise_chol is None else np.asarray(p.noise_chol)
         out["noise_off"] = np.tril(R / np.diag(R)[:, None], -1)    # inverse of noise_correlation_factor
@@ -197,7 +240,7 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
 
     Returns ``(LocalParams, LocalStore)``; the loss history is appended to ``history``.
     """
-    metric = 1.0 / np.asarray(params.lengthscale)
+    metric = 1.0 / np.asarray(params.metric_lengthscale())
     store = build_store(Xs, resid, metric, cfg.local_neighbours)
     rng = np.random.default_rng(cfg.seed + 7)
     centres = rng.choice(len(Xs), min(cfg.local_batch, len(Xs)), replace=False)
@@ -212,7 +255,7 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
         noise0 = np.clip(nugget, 0.01 * v, 0.9 * v)
     else:
         noise0 = 0.5 * v
-    raw = jax.device_put({"log_ls": np.log(np.maximum(0.25 * np.asarray(params.lengthscale), 1e-3)),
+    raw = jax.device_put({"log_ls": np.log(np.maximum(0.25 * np.asarray(params.metric_lengthscale()), 1e-3)),
                           "beta": np.float64(0.0), "log_amp": np.log(np.maximum(v - noise0, 0.1 * v)),
                           "log_noise": np.log(noise0)})
     if cfg.local_steps > 0:
@@ -250,7 +293,8 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     Mh = M if cfg.train_inducing or cfg.n_inducing_hyper is None else int(min(cfg.n_inducing_hyper, M))
     if M == 0:
         Mh = int(min(cfg.n_inducing_hyper or cfg.n_inducing, len(Xs)))
-    ls0 = np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) if start is None else np.asarray(start.lengthscale)
+    ls0 = (np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) * min(lmc_start_factors(int(cfg.latent_kernels)))
+           if start is None else np.asarray(start.metric_lengthscale()))
     Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
     raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z)
     if start is not None:
@@ -259,10 +303,10 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
 
     def reselect(raw, fixed, m):
         p = _constrain_global_jit(raw, fixed)
-        bdiag = np.sum(np.asarray(p.A) ** 2, 1)
+        bdiag = np.diag(np.asarray(p.B))
         nugget = float(np.mean(np.asarray(p.noise) / (bdiag + np.asarray(p.noise))))
-        Z = select_inducing(Xs, m, np.asarray(p.lengthscale), cfg.inducing, cfg.mi_pool, nugget=max(nugget, 1e-4),
-                            seed=cfg.seed)
+        Z = select_inducing(Xs, m, np.asarray(p.metric_lengthscale()), cfg.inducing, cfg.mi_pool,
+                            nugget=max(nugget, 1e-4), seed=cfg.seed)
         return dict(fixed, Z=jax.device_put(Z))
 
     first = cfg.steps // 2 if cfg.reselect else cfg.steps
@@ -321,7 +365,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
     n_hyper = int(min(cfg.n_train_max, len(Xs)))
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
-    rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.lengthscale), cfg.store_cell, cfg.store_max,
+    rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.metric_lengthscale()), cfg.store_cell, cfg.store_max,
                                   cfg.seed).add_dropped(Xs, Ys)
     evicted = global_stats(params, Xd, Yd, cfg.batch_size) if len(Xd) else None
     if len(rows) < len(Xs):
@@ -332,6 +376,11 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
+    var_scale = None
+    if cfg.residual_correlation:
+        from .colored import variance_inflation
+
+        var_scale = variance_inflation(Ys - global_mean(params, post, Xs, cfg.batch_size))
     input_var = None
     if cfg.input_noise:
         t4 = time.perf_counter()
@@ -347,7 +396,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     history.timings["total"] = time.perf_counter() - t0
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
-                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var)
+                          n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var,
+                          var_scale=var_scale)
     return model, history
 
 

@@ -20,6 +20,9 @@ weights ``alpha = Lm^{-T} w_phi`` (``M x P``) and the linear-mean weights ``W``:
 
     m_p(x) = k(x, Z) alpha_p + xa(x)^T W_p
     d m_p / d x_d = sum_m k(x, z_m) (z_md - x_d) / l_d^2 alpha_mp + W_{1+d, p}
+
+(a sum of such terms, one per kernel with its own ``alpha_j``, for a linear model of
+coregionalisation).
 """
 
 from __future__ import annotations
@@ -38,15 +41,19 @@ __all__ = ["mean_gradient", "slope_variance", "fit_input_noise"]
 
 @jax.jit
 def _gradient_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array) -> jax.Array:
-    M = params.Z.shape[0]
-    alpha = solve_triangular(post.Lm.T, post.weights[:M], lower=False)          # (M, P)
-    K = ARDSquaredExponential(params.lengthscale)(Xs, params.Z)                 # (N, M)
-    KA = K @ alpha                                                              # (N, P)
-    M, D, P = params.Z.shape[0], params.Z.shape[1], alpha.shape[1]
-    ZA = (params.Z[:, :, None] * alpha[:, None, :]).reshape(M, D * P)             # one GEMM for all d, p
-    KZA = (K @ ZA).reshape(-1, D, P)                                            # (N, D, P)
-    g = (KZA - Xs[:, :, None] * KA[:, None, :]) / (params.lengthscale**2)[None, :, None]
-    return jnp.transpose(g + post.weights[M + 1:][None], (0, 2, 1))            # (N, P, D)
+    M, D = params.Z.shape
+    Lms = post.Lm[None] if post.Lm.ndim == 2 else post.Lm                       # (J, M, M)
+    g = 0.0
+    for j, ls in enumerate(params.lengthscales):                                 # one term per latent kernel
+        alpha = solve_triangular(Lms[j].T, post.weights[j * M:(j + 1) * M], lower=False)   # (M, P)
+        K = ARDSquaredExponential(ls)(Xs, params.Z)                             # (N, M)
+        KA = K @ alpha                                                          # (N, P)
+        P = alpha.shape[1]
+        ZA = (params.Z[:, :, None] * alpha[:, None, :]).reshape(M, D * P)         # one GEMM for all d, p
+        KZA = (K @ ZA).reshape(-1, D, P)                                        # (N, D, P)
+        g = g + (KZA - Xs[:, :, None] * KA[:, None, :]) / (ls**2)[None, :, None]
+    J = Lms.shape[0]
+    return jnp.transpose(g + post.weights[J * M + 1:][None], (0, 2, 1))        # (N, P, D)
 
 
 def mean_gradient(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, batch: int = 2048) -> np.ndarray:

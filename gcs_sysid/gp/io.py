@@ -22,9 +22,13 @@ from .sparse import GlobalParams, Stats
 __all__ = ["save_model", "load_gp"]
 
 FORMAT = "gcs-sysid-gp"
-VERSION = 3   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
+VERSION = 4   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
 #               3: optional global_noise_chol (cross-correlated noise) and input_var (NIGP);
 #                  stats_yy is (P, P), was its diagonal (P,)
+#               4: optional global_lmc_lengthscale (J-1, D) and global_lmc_A (J-1, P, P) (linear model
+#                  of coregionalisation); the statistics C, E, Rphi are then those of the J M stacked
+#                  features. Files of versions 1-3 (one kernel) read unchanged. Optional var_scale (P,)
+#                  (coloured residuals).
 _GLOBAL = ("lengthscale", "A", "noise", "Z", "prior_std", "jitter")
 _STATS = ("C", "E", "F", "Rphi", "Rx", "yy", "n")
 _LOCAL = ("lengthscale", "beta", "amp", "noise")
@@ -51,8 +55,13 @@ def save_model(model: LocalGlobalGP, path) -> str:
     arrays.update({"global_" + k: np.asarray(getattr(model.params, k)) for k in _GLOBAL})
     if model.input_var is not None:
         arrays["input_var"] = np.asarray(model.input_var)
+    if model.var_scale is not None:
+        arrays["var_scale"] = np.asarray(model.var_scale)
     if model.params.noise_chol is not None:
         arrays["global_noise_chol"] = np.asarray(model.params.noise_chol)
+    if model.params.lmc_lengthscale is not None:
+        arrays["global_lmc_lengthscale"] = np.asarray(model.params.lmc_lengthscale)
+        arrays["global_lmc_A"] = np.asarray(model.params.lmc_A)
     arrays.update({"stats_" + k: np.asarray(getattr(model.stats, k)) for k in _STATS})
     if model.local_params is not None:
         arrays.update({"local_" + k: np.asarray(getattr(model.local_params, k)) for k in _LOCAL})
@@ -110,8 +119,11 @@ def load_gp(path) -> LocalGlobalGP:
         with np.load(npz, allow_pickle=False) as f:
             a = {k: f[k] for k in f.files}
         scaler = Standardiser.from_arrays(a)
-        params = GlobalParams(**{k: jnp.asarray(a["global_" + k]) for k in _GLOBAL},
-                              noise_chol=jnp.asarray(a["global_noise_chol"]) if "global_noise_chol" in a else None)
+        opt = {k: jnp.asarray(a["global_" + k]) for k in ("noise_chol", "lmc_lengthscale", "lmc_A")
+               if "global_" + k in a}
+        params = GlobalParams(**{k: jnp.asarray(a["global_" + k]) for k in _GLOBAL}, **opt)
+        if (params.lmc_lengthscale is None) != (params.lmc_A is None):
+            raise ValueError("global_lmc_lengthscale and global_lmc_A must come together")
         stats = _stats(a, "stats_")
         evicted = _stats(a, "evicted_") if "evicted_C" in a else None
     except (KeyError, ValueError, OSError) as exc:
@@ -130,7 +142,7 @@ def load_gp(path) -> LocalGlobalGP:
         elif "store_X" in a:      # version 1: the local store's rows and residuals; targets = residual + global mean
             store = build_store(a["store_X"], a["store_resid"], a["store_metric"], int(meta["local_k"]))
             Y = a["store_resid"] + global_mean(params, post, a["store_X"], config.batch_size)
-            rows = RowStore.empty(len(a["scaler_x_mean"]), Y.shape[1], np.asarray(params.lengthscale),
+            rows = RowStore.empty(len(a["scaler_x_mean"]), Y.shape[1], np.asarray(params.metric_lengthscale()),
                                   config.store_cell, max(config.store_max, len(Y)), config.seed)
             rows = replace(rows, X=a["store_X"], Y=Y, priority=np.random.default_rng(config.seed).random(len(Y)),
                            seen=len(Y))
@@ -139,4 +151,4 @@ def load_gp(path) -> LocalGlobalGP:
     return LocalGlobalGP(config, scaler, params, stats, post, local_params, store,
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
                          tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
-                         evicted=evicted, input_var=a.get("input_var"))
+                         evicted=evicted, input_var=a.get("input_var"), var_scale=a.get("var_scale"))

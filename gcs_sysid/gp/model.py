@@ -7,7 +7,7 @@ from typing import Any
 
 import jax
 import numpy as np
-from scipy.linalg import cho_solve
+from scipy.linalg import block_diag, cho_solve
 
 from ..jaxconfig import enable_x64
 from .batching import global_mean, global_posterior, global_predict, global_stats, local_predict
@@ -22,6 +22,16 @@ __all__ = ["LocalGlobalGP"]
 
 _elbo_jit = jax.jit(elbo)
 _add_jit = jax.jit(add_stats)
+
+
+def _projection_all(old: GlobalParams, Z_new: np.ndarray, lengthscales_new: np.ndarray) -> np.ndarray:
+    """Streaming projection ``R`` of the stacked features of every latent kernel: block-diagonal,
+    one :func:`gcs_sysid.gp.streaming.projection` per kernel (each kernel's features move to the new
+    inducing inputs under its own new length-scales), ``(J M_old, J M_new)``."""
+    Z_old, jitter = np.asarray(old.Z), float(old.jitter)
+    blocks = [projection(chol_kmm(Z_old, ls_old, jitter), Z_old, Z_new, ls_new, jitter)
+              for ls_old, ls_new in zip(np.asarray(old.lengthscales), np.asarray(lengthscales_new))]
+    return blocks[0] if len(blocks) == 1 else block_diag(*blocks)
 
 
 @dataclass(frozen=True)
@@ -55,6 +65,9 @@ class LocalGlobalGP:
         since_refresh: rows conditioned on since the hyperparameters were last learned.
         input_var: ``(D,)`` input-noise variances of the regressors (standardised; NIGP,
             :mod:`gcs_sysid.gp.inputnoise`), None when not learned.
+        var_scale: ``(P,)`` factors on the global layer's explained variance for coloured residuals
+            (:mod:`gcs_sysid.gp.colored`; from the fit's time-ordered rows, kept through updates and
+            refreshes), None when not learned (``GPConfig.residual_correlation``).
         evicted: the part of ``stats`` from rows no longer stored (None: none). When the
             inducing inputs or length-scales change, the stored rows' statistics are computed
             again exactly and only this part is carried by the streaming projection.
@@ -75,6 +88,7 @@ class LocalGlobalGP:
     since_refresh: int = 0
     evicted: Stats | None = None
     input_var: np.ndarray | None = None
+    var_scale: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -89,7 +103,7 @@ class LocalGlobalGP:
         """The local layer's indexed rows with residuals of the global mean (computed on first use)."""
         if self._store is None and self.local_params is not None and self.rows is not None and len(self.rows):
             resid = self.rows.Y - self._global_mean_s(self.rows.X)
-            metric = 1.0 / np.asarray(self.params.lengthscale)
+            metric = 1.0 / np.asarray(self.params.metric_lengthscale())
             object.__setattr__(self, "_store", build_store(self.rows.X, resid, metric, self.config.local_neighbours))
         return self._store
 
@@ -141,7 +155,7 @@ class LocalGlobalGP:
         """
         enable_x64()
         Xs, ok = self._standardise_query(X)
-        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         noise = np.asarray(self.params.noise)
         if self.local_params is not None and self.store is not None:
             ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
@@ -170,7 +184,7 @@ class LocalGlobalGP:
         """Mean and variance ``(N, P)`` of the global layer alone (linear mean + sparse ICM GP)."""
         enable_x64()
         Xs, ok = self._standardise_query(X)
-        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         if include_noise:
             var = var + np.asarray(self.params.noise)[None, :]
         return self._finish(ok, mean, var)
@@ -181,7 +195,7 @@ class LocalGlobalGP:
 
     def _mi_nugget(self) -> float:
         """Relative noise of the mutual-information criterion (as in the fit's selection)."""
-        bdiag = np.sum(np.asarray(self.params.A) ** 2, 1)
+        bdiag = np.diag(np.asarray(self.params.B))
         noise = np.asarray(self.params.noise)
         return max(float(np.mean(noise / (bdiag + noise))), 1e-4)
 
@@ -221,12 +235,12 @@ class LocalGlobalGP:
         cfg = self.config
         params, stats, evicted = self.params, self.stats, self.evicted
         if exchange and cfg.swap_max > 0 and self.rows is not None:
-            Z_old, ls, jitter = np.asarray(params.Z), np.asarray(params.lengthscale), float(params.jitter)
+            Z_old, ls = np.asarray(params.Z), np.asarray(params.metric_lengthscale())
             pool = self.rows.X[self.rows.sample(cfg.swap_pool, seed=self.rows.seen)]
             Z_new, swaps = exchange_inducing(Z_old, ls, Xs, pool, self._mi_nugget(), cfg.swap_threshold,
                                              cfg.swap_max)
             if swaps:
-                R = projection(chol_kmm(Z_old, ls, jitter), Z_old, Z_new, ls, jitter)
+                R = _projection_all(params, Z_new, np.asarray(params.lengthscales))
                 stats = project_stats(stats, R)
                 evicted = None if evicted is None else project_stats(evicted, R)
                 params = replace(params, Z=jax.device_put(Z_new))
@@ -280,13 +294,12 @@ class LocalGlobalGP:
         hyper_cfg = replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M))   # the fit's compiled shapes
         new = learn_global(rows.X, rows.Y, self.scaler.active, hyper_cfg, M if reselect else 0, history,
                            start=self.params)
-        Z_old, jitter = np.asarray(self.params.Z), float(self.params.jitter)
+        Z_old = np.asarray(self.params.Z)
         Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
         params = replace(new, Z=jax.device_put(Z_new))
         stats, evicted = global_stats(params, rows.X, rows.Y, cfg.batch_size), None
         if self.evicted is not None:
-            R = projection(chol_kmm(Z_old, np.asarray(self.params.lengthscale), jitter), Z_old, Z_new,
-                           np.asarray(new.lengthscale), jitter)
+            R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))
             evicted = project_stats(self.evicted, R)
             stats = _add_jit(stats, evicted)
         model = replace(self, params=params, stats=stats, evicted=evicted, _post=None, _store=None,
@@ -358,6 +371,24 @@ class LocalGlobalGP:
         from .ranking import global_variance_after_many
 
         enable_x64()
+        if self.params.n_kernels > 1:
+            # the closed form of :mod:`gcs_sysid.gp.ranking` is written for one kernel; an LMC model
+            # takes the exact route, one update (refactorisation) per candidate
+            if len(X_extras) != len(X_queries):
+                raise ValueError("global_variance_after_many: one query set per candidate")
+            out = []
+            for Xe, Xq in zip(X_extras, X_queries):
+                v0 = self.predict_global(Xq, include_noise)[1]
+                Xe = check_inputs(Xe, self.n_inputs, "X_extra")
+                Xe = Xe[np.isfinite(Xe).all(1)]
+                if len(Xe) == 0:
+                    out.append((v0, v0.copy()))
+                    continue
+                zeros = np.zeros((len(Xe), self.n_outputs))
+                extra = self._with_stats(add_stats(self.stats, global_stats(self.params, self.scaler.x(Xe), zeros,
+                                                                            self.config.batch_size)))
+                out.append((v0, extra.predict_global(Xq, include_noise)[1]))
+            return out
         qs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         ext, qry, oks = [], [], []
         for Xe, Xq in zip(X_extras, X_queries):
@@ -377,9 +408,9 @@ class LocalGlobalGP:
 
     # ------------------------------------------------------------ reporting
     def output_correlation(self) -> np.ndarray:
-        """Correlation ``(P, P)`` between the outputs' global GP parts, from ``B``."""
-        A = np.asarray(self.params.A)
-        B = A @ A.T
+        """Correlation ``(P, P)`` between the outputs' global GP parts at one input, from ``B``
+        (``sum_j B_j`` for a linear model of coregionalisation)."""
+        B = np.asarray(self.params.B)
         s = np.sqrt(np.diag(B))
         return B / np.outer(s, s)
 
@@ -418,12 +449,14 @@ class LocalGlobalGP:
         def scales(values):
             return {n: (float(v * s) if a else None) for n, v, s, a in zip(names, values, sc.x_std, sc.active)}
 
-        A = np.asarray(self.params.A)
-        B = A @ A.T
+        B = np.asarray(self.params.B)
         intercept, slopes = self.linear_derivatives()
         out: dict[str, Any] = {
             "kind": "LocalGlobalGP",
-            "approximation": "VFE (Titsias 2009), intrinsic coregionalisation, linear mean",
+            "approximation": ("VFE (Titsias 2009), intrinsic coregionalisation, linear mean"
+                              if self.params.n_kernels == 1 else
+                              f"VFE (Titsias 2009), linear model of coregionalisation ({self.params.n_kernels} "
+                              "latent kernels), linear mean"),
             "inputs": list(names), "outputs": list(self.output_names),
             "inactive_inputs": [n for n, a in zip(names, sc.active) if not a],
             "n_inducing": int(self.params.Z.shape[0]), "n_used": self.n_used, "n_hyper": int(self.n_hyper),
@@ -440,6 +473,10 @@ class LocalGlobalGP:
                 "linear_intercept": dict(zip(self.output_names, intercept.tolist())),
                 "linear_derivatives": {o: dict(zip(names, row.tolist())) for o, row in zip(self.output_names, slopes)},
             },
+            "latent_kernels": None if self.params.n_kernels == 1 else [
+                {"lengthscales": scales(ls_j), "lengthscales_standardised": {n: float(v) for n, v in zip(names, ls_j)},
+                 "signal_std": dict(zip(self.output_names, (np.sqrt(np.diag(Bj)) * sc.y_std).tolist()))}
+                for ls_j, Bj in zip(np.asarray(self.params.lengthscales), np.asarray(self.params.B_parts))],
             "local": None,
             "streaming": None if self.rows is None else {
                 "rows_seen": int(self.rows.seen), "rows_stored": len(self.rows), "store_max": int(self.rows.capacity),

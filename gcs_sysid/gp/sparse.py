@@ -23,6 +23,19 @@ Titsias (2009), "Variational learning of inducing variables in sparse Gaussian
 processes", AISTATS, eq. 9 (collapsed bound); the multi-output form follows Alvarez,
 Luengo, Titsias and Lawrence (2010), "Efficient multioutput Gaussian processes through
 variational inducing kernels", AISTATS.
+
+Linear model of coregionalisation (LMC; Alvarez, Rosasco and Lawrence 2012, "Kernels for
+vector-valued functions: a review", sec. 4.2, eq. 19): with ``J > 1`` latent kernels
+(``GlobalParams.lmc_lengthscale``, ``lmc_A``) the latent part is
+
+    f(x) = sum_j A_j g_j(x),   g_j = (g_j1 .. g_jP) ~ GP(0, k_j) independent,   cov(f) = sum_j B_j k_j(x, x')
+
+with one ARD length-scale vector per kernel, so each output mixes short and long length-scales
+in its own proportions ``B_j[p, p]`` (per-output length-scales). The inducing inputs ``Z`` are
+shared; the features become ``phi = [phi_1; ...; phi_J]`` ``(J M,)`` with
+``phi_j = Lm_j^{-1} k_j(Z, x)``, the statistics ``C, E, Rphi`` are those of the stacked features
+(``C`` holds the cross-kernel blocks ``Phi_j Phi_j'^T``), and the latent ``q = (j, r)`` of the
+precision uses the block ``j`` of ``phi``. ``J = 1`` is the ICM above, unchanged.
 """
 
 from __future__ import annotations
@@ -37,7 +50,7 @@ from jax.scipy.linalg import cho_solve, solve_triangular
 from .kernels import ARDSquaredExponential
 
 __all__ = ["GlobalParams", "Stats", "GlobalPosterior", "stats_of", "add_stats", "elbo", "logdet_quad", "posterior",
-           "mean_global_chunk", "predict_global_chunk", "design"]
+           "mean_global_chunk", "predict_global_chunk", "design", "features"]
 
 _LOG2PI = math.log(2.0 * math.pi)
 
@@ -57,6 +70,9 @@ class GlobalParams:
         noise_chol: ``(P, P)`` lower Cholesky factor ``R`` of the noise *correlation* matrix
             (rows of unit norm): the noise covariance is ``Sigma = D^1/2 R R^T D^1/2`` with
             ``D = diag(noise)``. The identity (the default) is independent noise per output.
+        lmc_lengthscale: ``(J-1, D)`` length-scales of the further latent kernels of a linear
+            model of coregionalisation (module docstring); None: ICM (one kernel).
+        lmc_A: ``(J-1, P, P)`` lower Cholesky factors of their coregionalisation matrices ``B_j``.
     """
 
     lengthscale: jax.Array
@@ -66,11 +82,45 @@ class GlobalParams:
     prior_std: jax.Array
     jitter: jax.Array
     noise_chol: jax.Array | None = None
+    lmc_lengthscale: jax.Array | None = None
+    lmc_A: jax.Array | None = None
+
+    @property
+    def n_kernels(self) -> int:
+        """Number ``J`` of latent kernels (1: intrinsic coregionalisation)."""
+        return 1 if self.lmc_lengthscale is None else 1 + int(self.lmc_lengthscale.shape[0])
+
+    @property
+    def lengthscales(self) -> jax.Array:
+        """Length-scales of every latent kernel, ``(J, D)`` (row 0: ``lengthscale``)."""
+        if self.lmc_lengthscale is None:
+            return self.lengthscale[None, :]
+        return jnp.concatenate([self.lengthscale[None, :], self.lmc_lengthscale], axis=0)
+
+    @property
+    def factors(self) -> jax.Array:
+        """Coregionalisation factors of every latent kernel, ``(J, P, P)`` (``[0]``: ``A``)."""
+        if self.lmc_A is None:
+            return self.A[None]
+        return jnp.concatenate([self.A[None], self.lmc_A], axis=0)
 
     @property
     def B(self) -> jax.Array:
-        """Coregionalisation matrix ``(P, P)``."""
-        return self.A @ self.A.T
+        """Coregionalisation matrix ``(P, P)`` of the latent part at one input, ``sum_j B_j``
+        (``cov(f(x), f(x)) = sum_j B_j k_j(x, x)``, ``k_j(x, x) = 1``)."""
+        F = self.factors
+        return jnp.einsum("jpr,jqr->pq", F, F)
+
+    @property
+    def B_parts(self) -> jax.Array:
+        """Per-kernel coregionalisation matrices ``B_j = A_j A_j^T``, ``(J, P, P)``."""
+        F = self.factors
+        return jnp.einsum("jpr,jqr->jpq", F, F)
+
+    def metric_lengthscale(self) -> jax.Array:
+        """``(D,)`` the shortest length-scale of any kernel per input (for distances: inducing-point
+        selection, the row store's grid, the local layer's neighbours); ``lengthscale`` for ICM."""
+        return jnp.min(self.lengthscales, axis=0)
 
     def noise_cov(self) -> jax.Array:
         """Noise covariance ``Sigma (P, P)`` (diagonal ``noise`` when ``noise_chol`` is None)."""
@@ -113,11 +163,12 @@ class GlobalPosterior:
     """Posterior of the global layer, ready for prediction.
 
     Attributes:
-        Lm: ``(M, M)`` Cholesky factor of ``Kmm``.
-        L: ``(K, K)`` Cholesky factor of the posterior precision ``Lambda`` (K = P*M + P*(D+1)).
+        Lm: ``(M, M)`` Cholesky factor of ``Kmm``; ``(J, M, M)``, one per kernel, for an LMC with
+            ``J > 1`` kernels.
+        L: ``(K, K)`` Cholesky factor of the posterior precision ``Lambda`` (K = J*P*M + P*(D+1)).
         b: ``(K,)`` projection of the data.
-        weights: ``(M+D+1, P)`` predictive-mean weights on ``u = [phi(x); xa(x)]``.
-        H: ``(P, M+D+1, M+D+1)`` posterior covariance of ``S_p^T theta`` per output.
+        weights: ``(J*M+D+1, P)`` predictive-mean weights on ``u = [phi(x); xa(x)]``.
+        H: ``(P, J*M+D+1, J*M+D+1)`` posterior covariance of ``S_p^T theta`` per output.
     """
 
     Lm: jax.Array
@@ -132,16 +183,32 @@ def design(Xs: jax.Array) -> jax.Array:
     return jnp.concatenate([jnp.ones((Xs.shape[0], 1), Xs.dtype), Xs], axis=1)
 
 
-def _chol_kmm(params: GlobalParams) -> jax.Array:
+def _chol_kmm_all(params: GlobalParams) -> jax.Array:
+    """Cholesky factors ``(J, M, M)`` of ``k_j(Z, Z) + jitter I``, one per latent kernel."""
     Z = params.Z
-    Kmm = ARDSquaredExponential(params.lengthscale)(Z, Z)
-    return jnp.linalg.cholesky(Kmm + params.jitter * jnp.eye(Z.shape[0], dtype=Z.dtype))
+    eye = params.jitter * jnp.eye(Z.shape[0], dtype=Z.dtype)
+    return jnp.stack([jnp.linalg.cholesky(ARDSquaredExponential(ls)(Z, Z) + eye) for ls in params.lengthscales])
 
 
-def _features(params: GlobalParams, Lm: jax.Array, Xs: jax.Array) -> jax.Array:
-    """Whitened features ``phi = Lm^{-1} k(Z, X)`` of shape ``(M, N)``."""
-    Kzx = ARDSquaredExponential(params.lengthscale)(params.Z, Xs)
-    return solve_triangular(Lm, Kzx, lower=True)
+def _chol_kmm(params: GlobalParams) -> jax.Array:
+    """``GlobalPosterior.Lm``: ``(M, M)`` for one kernel, ``(J, M, M)`` for an LMC."""
+    Lm = _chol_kmm_all(params)
+    return Lm[0] if params.lmc_lengthscale is None else Lm
+
+
+def features(params: GlobalParams, Lm: jax.Array, Xs: jax.Array) -> jax.Array:
+    """Whitened features ``phi = [Lm_j^{-1} k_j(Z, X)]_j`` of shape ``(J M, N)``.
+
+    Args:
+        params: the global layer. Lm: ``GlobalPosterior.Lm`` (``(M, M)`` or ``(J, M, M)``).
+        Xs: ``(N, D)`` standardised inputs.
+    """
+    Lms = Lm[None] if Lm.ndim == 2 else Lm
+    return jnp.concatenate([solve_triangular(Lj, ARDSquaredExponential(ls)(params.Z, Xs), lower=True)
+                            for Lj, ls in zip(Lms, params.lengthscales)], axis=0)
+
+
+_features = features
 
 
 def stats_of(params: GlobalParams, Xs: jax.Array, Ys: jax.Array, weight: jax.Array | None = None) -> Stats:
@@ -150,7 +217,7 @@ def stats_of(params: GlobalParams, Xs: jax.Array, Ys: jax.Array, weight: jax.Arr
     ``weight`` ``(N,)`` of 0/1 lets padded batches keep one compiled shape.
     """
     Lm = _chol_kmm(params)
-    Phi = _features(params, Lm, Xs)
+    Phi = features(params, Lm, Xs)
     Xa = design(Xs)
     w = jnp.ones(Xs.shape[0], Xs.dtype) if weight is None else weight
     Phiw, Xaw = Phi * w[None, :], Xa * w[:, None]
@@ -171,18 +238,27 @@ def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tu
     ``(P, K)`` features of row ``n``; in blocks ``(A^T N A) kron C``, ``sqrt(v) (A^T N) kron E``,
     ``v N kron F`` (a cross-correlated noise only replaces ``diag(1/sigma^2)`` by ``N``).
     """
-    A, sv = params.A, params.prior_std
+    sv = params.prior_std
     if N is None:
         N = params.noise_precision()[0]
-    G = A.T @ N @ A                                      # (Q, Q): sum_pp' a_p N_pp' a_p'^T
-    ww = jnp.kron(G, st.C)
-    wo = sv * jnp.kron(A.T @ N, st.E)                   # rows (q, m), cols (p, j)
+    F = params.factors                                   # (J, P, R): latent q = (j, r) uses phi_j
+    J, P, R = F.shape
+    M = st.C.shape[0] // J
+    G = jnp.einsum("jpr,pq,kqs->jrks", F, N, F)          # (J, R, J, R): a_q^T N a_q'
+    AN = jnp.einsum("jpr,pq->jrq", F, N)                 # (J, R, P)
+    if J == 1:                                           # the ICM: Kronecker products
+        ww = jnp.kron(G[0, :, 0, :], st.C)
+        wo = sv * jnp.kron(AN[0], st.E)                  # rows (q, m), cols (p, i)
+    else:
+        C4 = st.C.reshape(J, M, J, M)
+        ww = jnp.einsum("jrks,jmkn->jrmksn", G, C4).reshape(J * R * M, J * R * M)
+        wo = sv * jnp.einsum("jrq,jmx->jrmqx", AN, st.E.reshape(J, M, -1)).reshape(J * R * M, -1)
     oo = sv * sv * jnp.kron(N, st.F)
     lam = jnp.block([[ww, wo], [wo.T, oo]])
     lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
-    RN = st.Rphi @ N                                     # (M, P): sum_n phi_n (N y_n)^T
-    bw = (RN @ A).T.reshape(-1)                          # b_{q,m} = sum_p A_pq (Rphi N)_mp
-    bo = sv * (st.Rx @ N).T.reshape(-1)                  # b_{p,j} = sqrt(v) (Rx N)_jp
+    RN = (st.Rphi @ N).reshape(J, M, P)                  # sum_n phi_j,n (N y_n)^T
+    bw = jnp.einsum("jmp,jpr->jrm", RN, F).reshape(-1)   # b_{(j,r),m} = sum_p A_j,pr (Rphi_j N)_mp
+    bo = sv * (st.Rx @ N).T.reshape(-1)                  # b_{p,i} = sqrt(v) (Rx N)_ip
     return lam, jnp.concatenate([bw, bo])
 
 
@@ -231,22 +307,31 @@ def elbo(params: GlobalParams, st: Stats) -> jax.Array:
     yy = st.yy if st.yy.ndim == 2 else jnp.diag(st.yy)
     quad = jnp.sum(N * yy) - bmb                        # sum_n y_n^T N y_n - b^T Lambda^{-1} b
     loglik = -0.5 * (st.n * P * _LOG2PI + st.n * logdet_noise + logdet + quad)
-    # residual covariance of f given u is B (k(x,x) - |phi(x)|^2): trace term tr(N B) (n - tr C)
-    trace = -0.5 * jnp.sum(N * params.B) * (st.n - jnp.trace(st.C))
+    # residual covariance of f given u is sum_j B_j (k_j(x,x) - |phi_j(x)|^2): trace term
+    # sum_j tr(N B_j) (n - tr C_jj)
+    Bj = params.B_parts
+    J, M = Bj.shape[0], st.C.shape[0] // Bj.shape[0]
+    trC = jnp.trace(st.C.reshape(J, M, J, M), axis1=1, axis2=3).diagonal()        # (J,): tr C_jj
+    trace = -0.5 * jnp.sum(jnp.einsum("pq,jpq->j", N, Bj) * (st.n - trC))
     return loglik + trace
 
 
 def _selectors(params: GlobalParams, M: int) -> jax.Array:
-    """``S_p`` of shape ``(P, K, M+D+1)``: ``psi_p(x) = S_p [phi(x); xa(x)]``."""
-    A = params.A
-    P = A.shape[0]
+    """``S_p`` of shape ``(P, K, J*M+D+1)``: ``psi_p(x) = S_p [phi(x); xa(x)]``."""
+    F = params.factors                                   # (J, P, R)
+    J, P, R = F.shape
     D1 = params.Z.shape[1] + 1
-    eyeM, eyeD = jnp.eye(M, dtype=A.dtype), jnp.eye(D1, dtype=A.dtype)
+    dt = F.dtype
+    eyeM, eyeD, eyeJ = jnp.eye(M, dtype=dt), jnp.eye(D1, dtype=dt), jnp.eye(J, dtype=dt)
 
     def one(p):
-        top = jnp.kron(A[p][:, None], eyeM)                                  # (P*M, M)
-        bot = params.prior_std * jnp.kron(jax.nn.one_hot(p, P, dtype=A.dtype)[:, None], eyeD)
-        return jnp.block([[top, jnp.zeros((P * M, D1), A.dtype)], [jnp.zeros((P * D1, M), A.dtype), bot]])
+        # rows (j, r, m), cols (j', m'): A_j[p, r] delta_jj' delta_mm' (ICM: kron(A[p], I_M))
+        if J == 1:
+            top = jnp.kron(F[0, p][:, None], eyeM)                           # (P*M, M), the ICM's
+        else:
+            top = jnp.einsum("jr,jk,mn->jrmkn", F[:, p, :], eyeJ, eyeM).reshape(J * R * M, J * M)
+        bot = params.prior_std * jnp.kron(jax.nn.one_hot(p, P, dtype=dt)[:, None], eyeD)
+        return jnp.block([[top, jnp.zeros((J * R * M, D1), dt)], [jnp.zeros((P * D1, J * M), dt), bot]])
 
     return jax.vmap(one)(jnp.arange(P))
 
@@ -271,24 +356,28 @@ def posterior(params: GlobalParams, st: Stats) -> GlobalPosterior:
 def mean_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array) -> jax.Array:
     """Latent mean ``(N, P)`` alone (as :func:`predict_global_chunk`, without the variance's
     ``N P (M+D1)^2`` quadratic forms): for residuals of the global layer."""
-    Kzx = ARDSquaredExponential(params.lengthscale)(params.Z, Xs)
-    phi = solve_triangular(post.Lm, Kzx, lower=True)             # (M, N)
+    phi = features(params, post.Lm, Xs)                          # (J M, N)
     return jnp.concatenate([phi, design(Xs).T], axis=0).T @ post.weights
 
 
-def predict_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array
+def predict_global_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array, scale: jax.Array | None = None
                          ) -> tuple[jax.Array, jax.Array]:
     """Latent mean and variance ``(N, P)`` of ``xa^T W_p + f_p`` at standardised ``Xs (N, D)``.
 
-    ``var_p = B_pp (1 - |phi|^2) + u^T H_p u`` with ``u = [phi; xa]`` (Titsias 2009, eq. 6,
-    in whitened form). Noise is not included.
+    ``var_p = sum_j B_j,pp (1 - |phi_j|^2) + u^T H_p u`` with ``u = [phi; xa]`` (Titsias 2009,
+    eq. 6, in whitened form). Noise is not included. ``scale`` ``(P,)``: multiplies the explained
+    part ``u^T H_p u`` (coloured residuals, :mod:`gcs_sysid.gp.colored`); None: 1.
     """
-    Kzx = ARDSquaredExponential(params.lengthscale)(params.Z, Xs)
-    phi = solve_triangular(post.Lm, Kzx, lower=True)             # (M, N)
-    u = jnp.concatenate([phi, design(Xs).T], axis=0)             # (M+D1, N)
+    phi = features(params, post.Lm, Xs)                          # (J M, N)
+    u = jnp.concatenate([phi, design(Xs).T], axis=0)             # (J M + D1, N)
     mean = u.T @ post.weights
-    bdiag = jnp.sum(params.A**2, 1)
-    prior_rest = bdiag[None, :] * jnp.maximum(1.0 - jnp.sum(phi * phi, 0), 0.0)[:, None]
+    Bd = jnp.sum(params.factors**2, 2)                           # (J, P): B_j,pp
+    J = Bd.shape[0]
+    rest = jnp.maximum(1.0 - jnp.sum((phi * phi).reshape(J, -1, phi.shape[1]), 1), 0.0)    # (J, N)
+    bdiag = jnp.sum(Bd, 0)
+    prior_rest = rest.T @ Bd
     explained = jnp.sum(jnp.einsum("pij,jn->pin", post.H, u) * u[None], 1).T   # one batched matmul: ~3x faster
+    if scale is not None:
+        explained = explained * scale[None, :]
     var = jnp.maximum(prior_rest + explained, 1e-12 * bdiag[None, :])
     return mean, var
