@@ -1,0 +1,69 @@
+"""Bounded-memory evaluation: chunked predictions equal one call on all rows (to 1e-9).
+
+The confidence map predicts in fixed-size chunks (``envelope.variance_in_chunks``) and the local
+layer in chunks of at most ``batching.LOCAL_CHUNK`` rows, so that the live learner's working arrays
+stay bounded (issue 10, soak memory). Rows are predicted independently, so neither may change a value
+beyond rounding.
+"""
+
+import numpy as np
+import pytest
+
+from gcs_sysid.aero.table import CoefficientTable
+from gcs_sysid.envelope import EnvelopeConfig, confidence_map, model_variance, variance_in_chunks
+from gcs_sysid.errors import InputError
+from gcs_sysid.gp import batching
+
+
+def _close(a, b, tol=1e-9):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    assert a.shape == b.shape
+    scale = np.maximum(np.abs(b), 1e-300)
+    assert np.all(np.abs(a - b) <= tol * scale), float(np.max(np.abs(a - b) / scale))
+
+
+def test_variance_in_chunks_equals_one_call(fitted, flight):
+    model, _ = fitted
+    X = flight[0][100:403]                        # 303 rows: 4 full chunks of 64 and a padded one
+    whole = model_variance(model.predict, X)
+    calls = []
+
+    def spy(Xq, include_noise=True, input_noise=True):
+        calls.append(len(Xq))
+        return model.predict(Xq, include_noise=include_noise, input_noise=input_noise)
+
+    chunked = variance_in_chunks(spy, X, chunk=64)
+    _close(chunked, whole)
+    assert calls == [64] * 5                      # one shape for every call, padding included
+    assert variance_in_chunks(model.predict, X[:0], chunk=64).shape[0] == 0
+    with pytest.raises(InputError):
+        variance_in_chunks(model.predict, X, chunk=0)
+
+
+def test_local_layer_chunk_cap_changes_nothing(fitted, flight, monkeypatch):
+    model, _ = fitted
+    Xs, _ = model._standardise_query(flight[0])   # 600 rows
+    capped = batching.local_predict(model.local_params, model.store, Xs, 1024)
+    monkeypatch.setattr(batching, "LOCAL_CHUNK", 1 << 20)
+    whole = batching.local_predict(model.local_params, model.store, Xs, 1024)
+    for a, b in zip(capped, whole):
+        _close(a, b)
+
+
+def test_confidence_map_chunked_equals_unchunked(fitted, flight):
+    model, _ = fitted
+    X, Y, _ = flight
+    n = 400
+    table = CoefficientTable(np.arange(n) * 0.05, X[:n], Y[:n], np.ones(n, bool), np.full(n, np.nan))
+    small = EnvelopeConfig(n_grid=12, chunk=100)              # 7 * 144 + 400 rows: 15 chunks
+    whole = EnvelopeConfig(n_grid=12, chunk=10**6)            # one call on all rows
+    a = confidence_map(model, table, table.valid, small)
+    b = confidence_map(model, table, table.valid, whole)
+    for sa, sb in zip(a.slices, b.slices):
+        for c in a.outputs:
+            _close(sa.sigma[c], sb.sigma[c])
+            assert np.array_equal(sa.labels[c], sb.labels[c])
+    assert [(r.coefficient, r.axes, r.n_cells) for r in a.regions] == \
+        [(r.coefficient, r.axes, r.n_cells) for r in b.regions]
+    for c in a.outputs:
+        assert abs(a.scores[c] - b.scores[c]) < 1e-9
