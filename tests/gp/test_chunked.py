@@ -67,3 +67,20 @@ def test_confidence_map_chunked_equals_unchunked(fitted, flight):
         [(r.coefficient, r.axes, r.n_cells) for r in b.regions]
     for c in a.outputs:
         assert abs(a.scores[c] - b.scores[c]) < 1e-9
+
+
+def test_cross_covariances_blockwise_equal_one_solve(fitted):
+    from scipy.linalg import solve_triangular
+
+    from gcs_sysid.gp import ranking
+
+    model, _ = fitted
+    Hc = ranking.cross_covariances(model)                   # solved one output's block at a time
+    V = solve_triangular(np.asarray(model.post.L), ranking._selectors(model), lower=True)
+    np.testing.assert_allclose(Hc, V.T @ V, rtol=0, atol=1e-9 * float(np.max(np.abs(Hc))))
+    P = model.n_outputs
+    J = Hc.shape[0] // P
+    H = np.asarray(model.post.H)
+    for p in range(P):
+        np.testing.assert_allclose(Hc[p * J:(p + 1) * J, p * J:(p + 1) * J], H[p], rtol=1e-8,
+                                   atol=1e-10 * float(np.max(np.abs(H[p]))))
