@@ -64,9 +64,9 @@ DEFAULT_SLICES = (
     ("r_hat", "delta_r"),
 )
 
-#: Rows per model call of the confidence map: every call gets exactly this many rows (the last chunk
-#: padded), so JAX compiles one shape and the working arrays stay bounded (``docs/benchmarks.md``,
-#: soak memory: one call on all ~4,400 map points held ~70 MiB of temporaries at once).
+#: Rows per model call of the confidence map (the last call padded to a multiple of a quarter of it),
+#: so JAX compiles few shapes and the working arrays stay bounded (``docs/benchmarks.md``, soak
+#: memory: one call on all ~4,400 map points held ~70 MiB of temporaries at once).
 MAP_CHUNK = 1024
 
 
@@ -315,9 +315,9 @@ def model_variance(fn: Any, *args: Any) -> np.ndarray:
 def variance_in_chunks(fn: Any, X: np.ndarray, chunk: int = MAP_CHUNK) -> np.ndarray:
     """:func:`model_variance` of ``fn`` at ``X (N, D)``, evaluated ``chunk`` rows at a time.
 
-    When ``N > chunk`` each call gets exactly ``chunk`` rows (the last chunk is padded by repeating
-    its last row, the padding's outputs dropped), so a compiled model sees one input shape, and
-    at most one chunk's temporaries are alive at once. Rows are predicted independently, so the
+    When ``N > chunk`` each call gets ``chunk`` rows, the last one a multiple of ``chunk / 4`` (padded
+    by repeating its last row, the padding's outputs dropped), so a compiled model sees at most four
+    input shapes (for a given ``N``, two), and at most one chunk's temporaries are alive at once. Rows are predicted independently, so the
     result equals one call on all rows (to rounding; a test checks 1e-9).
 
     Args:
@@ -341,8 +341,9 @@ def variance_in_chunks(fn: Any, X: np.ndarray, chunk: int = MAP_CHUNK) -> np.nda
     for a in range(0, n, chunk):
         block = X[a:a + chunk]
         m = len(block)
-        if m < chunk and n > chunk:   # keep the one shape (one short call needs no padding)
-            block = np.vstack([block, np.repeat(block[-1:], chunk - m, axis=0)])
+        if m < chunk and n > chunk:   # few shapes: the last chunk padded to a multiple of chunk / 4
+            q = max(chunk // 4, 1)
+            block = np.vstack([block, np.repeat(block[-1:], -m % q, axis=0)])
         parts.append(model_variance(fn, block)[:m])
     return np.concatenate(parts, axis=0)
 
