@@ -72,13 +72,11 @@ def _whitened_selectors(model) -> np.ndarray:
     copy of it) is never held beside ``V``: the same triangular solves, column block by block.
     """
     L = np.asarray(model.post.L)
-    V = None
-    for p in range(int(model.params.A.shape[0])):
-        Vp = solve_triangular(L, _selector_block(model, p), lower=True, check_finite=False)
-        if V is None:
-            J = Vp.shape[1]
-            V = np.empty((L.shape[0], int(model.params.A.shape[0]) * J))
-        V[:, p * J:(p + 1) * J] = Vp
+    P = int(model.params.A.shape[0])
+    J = int(model.params.Z.shape[0]) + int(model.params.Z.shape[1]) + 1
+    V = np.empty((L.shape[0], P * J))
+    for p in range(P):
+        V[:, p * J:(p + 1) * J] = solve_triangular(L, _selector_block(model, p), lower=True, check_finite=False)
     return V
 
 
