@@ -39,6 +39,8 @@ from .errors import DataError, InputError
 
 __all__ = [
     "model_variance",
+    "variance_in_chunks",
+    "MAP_CHUNK",
     "ENVELOPE_AXES",
     "DEFAULT_SLICES",
     "EnvelopeConfig",
@@ -61,6 +63,12 @@ DEFAULT_SLICES = (
     ("q_hat", "delta_e"),
     ("r_hat", "delta_r"),
 )
+
+#: Rows per model call of the confidence map (the last call padded to a multiple of a quarter of it),
+#: so JAX compiles few shapes and the working arrays stay bounded (``docs/benchmarks.md``, soak
+#: memory: one call on all ~4,400 map points held ~70 MiB of temporaries at once).
+MAP_CHUNK = 1024
+
 
 #: Smallest half-span of the grid around the median per axis (SI), used when the flight barely
 #: moved an axis (a rudder never deflected still gets a +-3 deg grid).
@@ -90,6 +98,7 @@ class EnvelopeConfig:
         min_points: a cell holding fewer training samples counts as "no data".
         min_region_cells: connected flagged areas smaller than this are ignored (None: 2 % of the
             slice's cells, at least 3).
+        chunk: grid and training points given to the model per call (:func:`variance_in_chunks`).
     """
 
     slices: tuple[tuple[str, str], ...] = DEFAULT_SLICES
@@ -101,6 +110,7 @@ class EnvelopeConfig:
     floor_factor: float = 2.0
     min_points: int = 1
     min_region_cells: int | None = None
+    chunk: int = MAP_CHUNK
 
 
 @dataclass
@@ -302,6 +312,41 @@ def model_variance(fn: Any, *args: Any) -> np.ndarray:
     return np.asarray(out[1] if isinstance(out, tuple) else out, float)
 
 
+def variance_in_chunks(fn: Any, X: np.ndarray, chunk: int = MAP_CHUNK) -> np.ndarray:
+    """:func:`model_variance` of ``fn`` at ``X (N, D)``, evaluated ``chunk`` rows at a time.
+
+    When ``N > chunk`` each call gets ``chunk`` rows, the last one a multiple of ``chunk / 4`` (padded
+    by repeating its last row, the padding's outputs dropped), so a compiled model sees at most four
+    input shapes (for a given ``N``, two), and at most one chunk's temporaries are alive at once. Rows are predicted independently, so the
+    result equals one call on all rows (to rounding; a test checks 1e-9).
+
+    Args:
+        fn: ``model.predict`` (or any callable accepted by :func:`model_variance`).
+        X: ``(N, D)`` query rows.
+        chunk: rows per call (>= 1).
+
+    Returns:
+        ``(N, P)`` variance (``(0, 0)`` for ``N = 0``).
+
+    Raises:
+        InputError: ``chunk`` < 1.
+    """
+    if int(chunk) < 1:
+        raise InputError(f"variance_in_chunks: chunk must be >= 1, got {chunk}")
+    X = np.asarray(X, float)
+    n, chunk = len(X), int(chunk)
+    if n == 0:
+        return np.zeros((0, 0))
+    parts = []
+    for a in range(0, n, chunk):
+        block = X[a:a + chunk]
+        m = len(block)
+        if m < chunk and n > chunk:   # few shapes: the last chunk padded to a multiple of chunk / 4
+            q = max(chunk // 4, 1)
+            block = np.vstack([block, np.repeat(block[-1:], -m % q, axis=0)])
+        parts.append(model_variance(fn, block)[:m])
+    return np.concatenate(parts, axis=0)
+
 
 def _f(v: float) -> float | None:
     v = float(v)
@@ -431,9 +476,9 @@ def confidence_map(model: Any, table: CoefficientTable, train_mask: np.ndarray,
         G[:, REGRESSORS.index(sy)] = gy.ravel()
         grids.append(G)
         edges.append((xe, ye))
-    # one predict call for all grid points and the training points (the sigma floor)
+    # all grid points and the training points (the sigma floor), in fixed-size chunks
     sub = Xt[np.linspace(0, len(Xt) - 1, min(len(Xt), 400)).astype(int)]
-    var = model_variance(model.predict, np.vstack(grids + [sub]))
+    var = variance_in_chunks(model.predict, np.vstack(grids + [sub]), cfg.chunk)
     sd = np.sqrt(np.maximum(var, 0.0))
     if sd.ndim != 2 or sd.shape[1] != len(outs):
         raise InputError(f"confidence_map: model variance has shape {sd.shape}, expected (N, {len(outs)})")

@@ -13,7 +13,12 @@ from .local import LocalParams, LocalStore, local_predict_chunk, neighbours
 from .sparse import (GlobalParams, GlobalPosterior, Stats, add_stats, mean_global_chunk, posterior,
                      predict_global_chunk, stats_of)
 
-__all__ = ["global_stats", "global_predict", "global_mean", "local_predict", "global_posterior"]
+__all__ = ["global_stats", "global_predict", "global_mean", "local_predict", "global_posterior", "LOCAL_CHUNK"]
+
+#: Most query rows per compiled chunk of the local layer. Its per-query Gibbs-kernel solves keep
+#: ``O(Q K^2 P)`` working arrays: ~66 MiB resident for a 2,048-row chunk against ~13 MiB for 512
+#: rows (``docs/benchmarks.md``, soak memory), and 512-row chunks are no slower.
+LOCAL_CHUNK = 512
 
 _stats_jit = jax.jit(stats_of)
 _predict_jit = jax.jit(predict_global_chunk)
@@ -81,10 +86,11 @@ def global_mean(params: GlobalParams, post: GlobalPosterior, Xs: np.ndarray, bat
 
 def local_predict(params: LocalParams, store: LocalStore, Xs: np.ndarray, batch: int
                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Latent mean and variance ``(N, P)`` of the local layer at standardised ``Xs``."""
+    """Latent mean and variance ``(N, P)`` of the local layer at standardised ``Xs``, in chunks of at
+    most ``min(batch, LOCAL_CHUNK)`` rows (bounded working memory)."""
     P = store.resid.shape[1]
     mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
-    size = int(min(batch, _bucket(len(Xs))))
+    size = int(min(batch, LOCAL_CHUNK, _bucket(len(Xs))))
     for a, b in _chunks(len(Xs), size):
         idx, zq = neighbours(store, Xs[a:b])
         args = (_pad(Xs[a:b], size), _pad(zq, size), _pad(store.X[idx], size), _pad(store.z[idx], size),

@@ -45,25 +45,39 @@ def _features(model, Xs: np.ndarray) -> np.ndarray:
     return np.vstack([phi, np.ones((1, len(Xs))), Xs.T])
 
 
-def _selectors(model) -> np.ndarray:
-    """``S_all (K, P J)``: column block ``p`` is ``S_p`` of :func:`gcs_sysid.gp.sparse._selectors`
-    (``psi_p(x) = S_p u(x)``), built in NumPy (no per-operation compilation)."""
+def _selector_block(model, p: int) -> np.ndarray:
+    """``S_p (K, J)`` of :func:`gcs_sysid.gp.sparse._selectors` (``psi_p(x) = S_p u(x)``), in NumPy
+    (no per-operation compilation): ``A[p, q] I_M`` in row block ``q`` of the inducing part, and
+    ``prior_std I_(D+1)`` in output ``p``'s rows of the linear-mean part."""
     A = np.asarray(model.params.A)
     P, M, D1 = A.shape[0], int(model.params.Z.shape[0]), int(model.params.Z.shape[1]) + 1
-    J = M + D1
-    S = np.zeros((P * M + P * D1, P * J))
+    S = np.zeros((P * M + P * D1, M + D1))
     eyeM = np.eye(M)
-    for p in range(P):
-        for q in range(P):
-            S[q * M:(q + 1) * M, p * J:p * J + M] = A[p, q] * eyeM
-        r0 = P * M + p * D1
-        S[r0:r0 + D1, p * J + M:(p + 1) * J] = float(model.params.prior_std) * np.eye(D1)
+    for q in range(P):
+        S[q * M:(q + 1) * M, :M] = A[p, q] * eyeM
+    r0 = P * M + p * D1
+    S[r0:r0 + D1, M:] = float(model.params.prior_std) * np.eye(D1)
     return S
 
 
+def _selectors(model) -> np.ndarray:
+    """``S_all (K, P J)``: column block ``p`` is ``S_p`` (:func:`_selector_block`)."""
+    return np.hstack([_selector_block(model, p) for p in range(int(model.params.A.shape[0]))])
+
+
 def _whitened_selectors(model) -> np.ndarray:
-    """``V = L^{-1} S_all (K, P J)`` with ``L`` the Cholesky factor of ``Lambda``."""
-    return solve_triangular(np.asarray(model.post.L), _selectors(model), lower=True, check_finite=False)
+    """``V = L^{-1} S_all (K, P J)`` with ``L`` the Cholesky factor of ``Lambda``.
+
+    Solved one output's column block ``S_p (K, J)`` at a time, so ``S_all`` (and a Fortran-ordered
+    copy of it) is never held beside ``V``: the same triangular solves, column block by block.
+    """
+    L = np.asarray(model.post.L)
+    P = int(model.params.A.shape[0])
+    J = int(model.params.Z.shape[0]) + int(model.params.Z.shape[1]) + 1
+    V = np.empty((L.shape[0], P * J))
+    for p in range(P):
+        V[:, p * J:(p + 1) * J] = solve_triangular(L, _selector_block(model, p), lower=True, check_finite=False)
+    return V
 
 
 def cross_covariances(model) -> np.ndarray:
@@ -124,11 +138,14 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
         # sum_p Wn_qp Ue^T H_{p,:}
         T0 = [Ue.T @ Hc[p * J:(p + 1) * J] for p in range(P)]
         T = np.vstack([sum(Wn[q, p] * T0[p] for p in range(P) if Wn[q, p] != 0.0) for q in range(P)])
+        # C = I + T Psi-features: column block q2 is sum_p Wn_q2p T_p Ue; each T_p Ue (P E, E) once
+        TU = [T[:, p * J:(p + 1) * J] @ Ue for p in range(P)]
         Cm = np.eye(P * E)
         for q2 in range(P):
             for p in range(P):
                 if Wn[q2, p] != 0.0:
-                    Cm[:, q2 * E:(q2 + 1) * E] += Wn[q2, p] * (T[:, p * J:(p + 1) * J] @ Ue)
+                    Cm[:, q2 * E:(q2 + 1) * E] += Wn[q2, p] * TU[p]
+        del T0, TU
         try:
             Lc = cho_factor(0.5 * (Cm + Cm.T), lower=True, check_finite=False)[0]
             R = solve_triangular(Lc, T, lower=True, check_finite=False)              # (P E, P J)
@@ -148,8 +165,8 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
             Uw, sv, _ = np.linalg.svd(W, full_matrices=False)
             R = (sv / np.sqrt(1.0 + sv**2))[:, None] * (Uw.T @ V)
         red = np.empty_like(v0)
-        for p in range(P):
-            W = R[:, p * J:(p + 1) * J] @ Uq
-            red[:, p] = np.sum(W * W, 0)
+        for p in range(P):   # |R_p u|^2 = u^T (R_p^T R_p) u: a (J, J) form, cheaper than R_p Uq for Q > J
+            Rp = R[:, p * J:(p + 1) * J]
+            red[:, p] = np.einsum("jq,jq->q", Uq, (Rp.T @ Rp) @ Uq)
         out.append((v0, np.maximum(v0 - red, 1e-12 * bdiag[None, :])))
     return out

@@ -50,8 +50,9 @@ def greedy_mutual_information(K: np.ndarray, m: int, nugget: float = 1e-2) -> np
     """
     n = K.shape[0]
     m = int(min(m, n))
-    Kn = K + nugget * np.eye(n)
-    prec0 = cho_solve(cho_factor(Kn, lower=True), np.eye(n))    # precision of all candidates
+    Kn = np.array(K, float)                                     # K + nugget I, without an (n, n) eye
+    Kn[np.diag_indices(n)] += nugget
+    prec0 = cho_solve(cho_factor(Kn, lower=True), np.eye(n), overwrite_b=True)   # precision of all candidates
     prec_diag = np.diag(prec0).copy()                           # diag of the unselected set's precision
     cond_var = np.diag(Kn).copy()                               # sigma^2_{y|A}, A empty
     factor = np.zeros((n, m))                                   # incremental Cholesky columns (chosen set)
@@ -110,6 +111,13 @@ def select_inducing(Xs: np.ndarray, m: int, lengthscale: np.ndarray, method: str
         raise ValueError(f"gp: unknown inducing-point selection {method!r} (expected 'mi', 'kmeans' or 'random')")
     cand = Xs[rng_pool]
     a = cand / lengthscale
-    d2 = np.sum(a * a, 1)[:, None] + np.sum(a * a, 1)[None, :] - 2.0 * a @ a.T
-    K = np.exp(-0.5 * np.maximum(d2, 0.0))
+    sq = np.sum(a * a, 1)
+    K = sq[:, None] + sq[None, :]                 # the (pool, pool) kernel built in place: the same
+    G = a @ a.T                                   # operations as exp(-0.5 max(|a|^2 + |b|^2 - 2 a.b, 0))
+    G *= 2.0                                      # with two arrays alive instead of five
+    K -= G
+    del G
+    np.maximum(K, 0.0, out=K)
+    K *= -0.5
+    np.exp(K, out=K)
     return cand[greedy_mutual_information(K, m, nugget)]

@@ -57,9 +57,11 @@ class LearnOptions:
             (:func:`gcs_sysid.gp.streaming.light_refresh`: warm start, 40 Adam steps on 1,000 stored
             rows; so the length-scales follow an envelope that grows); 0: never.
         max_window_s: longest window (stamp time) a step decodes when steps were coalesced (below).
-        trim_heap: after each step that decoded a window, give the C heap's free pages back to the
-            system (:func:`gcs_sysid.live.heap.release_free_heap`), so the resident size follows what
-            is held, not the high-water mark of the longest window or refresh so far.
+        trim_heap: after each step that decoded a window, and between the stages of a refresh (after
+            the hyperparameter refresh, between the confidence map and the suggestions), give the C
+            heap's free pages back to the system (:func:`gcs_sysid.live.heap.release_free_heap`), so
+            the resident size follows what is held, not the high-water mark of the longest window or
+            refresh so far, and one stage's freed temporaries do not stack under the next one's.
     """
 
     window_s: float = 30.0
@@ -314,6 +316,8 @@ class Learner:
             self.notes.append(f"step {self.steps}: GP hyperparameters refreshed (light) after {self.n_learned} rows")
         except SysidError as exc:
             self.notes.append(f"step {self.steps}: GP hyperparameters not refreshed ({exc})")
+        if self.options.trim_heap:   # its ~35-40 MiB of temporaries, before the map reuses the heap
+            release_free_heap()
 
     def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray) -> None:
         self.X = np.concatenate([self.X, X])
@@ -338,6 +342,8 @@ class Learner:
             return
         try:
             self.envelope = confidence_map(self.model, table, table.valid, outputs=self.outputs)
+            if self.options.trim_heap:   # the map's freed chunks back before the ranking's (no stacking)
+                release_free_heap()
             self.suggestions = list(suggest_maneuvers(self.envelope, self.model, table, self.airframe))
         except SysidError as exc:
             self.notes.append(f"step {self.steps}: confidence map not refreshed ({exc})")
