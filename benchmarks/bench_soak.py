@@ -17,8 +17,11 @@ time. A sender thread in this process sends the datagrams; it pauses while more 
 records wait for the learner (this only matters if the learner falls behind; the report says how
 long it paused), so a lagging learner cannot pass its backlog off as memory growth of the listener.
 
-RSS (VmRSS of this process: listener, learner, GP, sender) is sampled every 10 s of wall time and
-printed as a curve (messages received, vehicle time covered, RSS), with the growth from the end of the
+RSS is sampled every 10 s of wall time: VmRSS of this process (listener, sender, and the learner when
+it runs here) plus, when the learner runs in the spare worker process (the default where there are
+two CPUs, ``docs/live.md``), that worker's VmRSS read from ``/proc/PID/status``; the criterion is on
+the sum, so moving the learner out of the listening process cannot hide its memory. ``--in-process``
+runs the learner in this process instead. The curve is printed (messages received, vehicle time covered, RSS), with the growth from the end of the
 first tenth of the run (JAX programs compiled, first GP fit, store filling) to the end and the largest
 RSS after it.
 """
@@ -39,10 +42,14 @@ AIRFRAME = REPO / "data" / "airframes" / "sim-trainer.toml"
 RECORDED_RATE = 258.0   # messages/s of the sample flight
 
 
-def _rss_mib() -> float:
-    for line in Path("/proc/self/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1]) / 1024.0
+def _rss_mib(pid: int | str = "self") -> float:
+    """VmRSS (MiB) of process ``pid`` (this one by default); NaN when it cannot be read."""
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     return float("nan")
 
 
@@ -113,6 +120,7 @@ def main() -> int:
     ap.add_argument("--messages", type=int, default=1_800_000, help="messages to feed (default: 1 h at 500 msg/s)")
     ap.add_argument("--feed", type=float, default=1500.0, help="messages/s sent (default 1500 = 3x of 500 msg/s)")
     ap.add_argument("--queue-cap", type=int, default=30000, help="sender pauses while more records wait")
+    ap.add_argument("--in-process", action="store_true", help="run the learner in this process (no worker)")
     ap.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "soak"))
     a = ap.parse_args()
 
@@ -132,7 +140,8 @@ def main() -> int:
         port = s.getsockname()[1]
     lo = LearnOptions(window_s=30 / speed, step_s=10 / speed, lag_s=3.0, min_rows=500)
     opts = ListenOptions(connection=f"udpin:127.0.0.1:{port}", learn=lo, request=False, component=True,
-                         system_id=1, console=False, use_mavsdk=False)
+                         system_id=1, console=False, use_mavsdk=False,
+                         parallel=False if a.in_process else None)
     session = LiveSession(load_airframe(AIRFRAME), out, opts, link=open_link(opts.connection))
     curve: list[dict] = []
     result: dict = {}
@@ -149,11 +158,17 @@ def main() -> int:
         if not curve or time.perf_counter() - t0 - curve[-1]["wall_s"] >= 10.0:
             rec = session.receiver.stats.records
             lr = session.learner
-            curve.append({"wall_s": round(time.perf_counter() - t0, 1), "rss_mib": round(_rss_mib(), 1),
+            worker = getattr(lr, "worker_pid", None)
+            own = _rss_mib()
+            wrss = _rss_mib(worker) if worker else 0.0
+            if hasattr(lr, "rows_stored"):   # the learner in the worker: its status copy
+                stored = lr.rows_stored
+            else:
+                stored = len(lr.model.rows) if lr.model is not None and lr.model.rows is not None else 0
+            curve.append({"wall_s": round(time.perf_counter() - t0, 1), "rss_mib": round(own + wrss, 1),
+                          "rss_listener_mib": round(own, 1), "rss_worker_mib": round(wrss, 1),
                           "received": rec, "queue": session._q.qsize(), "steps": lr.steps,
-                          "rows_learned": lr.n_learned,
-                          "rows_stored": len(lr.model.rows) if lr.model is not None and lr.model.rows is not None
-                          else 0})
+                          "rows_learned": lr.n_learned, "rows_stored": stored})
             print(json.dumps(curve[-1]), file=sys.stderr, flush=True)
     time.sleep(1.0)
     session.stop()
@@ -166,6 +181,7 @@ def main() -> int:
            "speed_vs_500_msg_s": a.feed / 500.0, "passes_of_the_flight": stats.get("passes"),
            "vehicle_time_s": stats.get("sent", 0) / RECORDED_RATE, "send_wall_s": stats.get("send_s"),
            "sender_paused_s": stats.get("paused_s"), "learner_queue_max": qmax,
+           "learner_in_worker": any(c["rss_worker_mib"] > 0 for c in curve),
            "steps": snap.get("steps"), "samples_learned": snap.get("samples_learned"),
            "rss_start_mib": curve[0]["rss_mib"], "rss_ref_mib": ref["rss_mib"], "rss_ref_at_s": ref["wall_s"],
            "rss_end_mib": curve[-1]["rss_mib"], "rss_max_after_ref_mib": max(c["rss_mib"] for c in after),
