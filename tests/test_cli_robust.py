@@ -163,7 +163,7 @@ def _alive(pid: int) -> bool:
 
 @pytest.mark.parametrize("moment, sig", [
     ("summary.md", signal.SIGINT),   # while the report is written (figures, HTML; JAX's GC callbacks)
-    ("model.json", signal.SIGINT),   # just after the model is saved
+    pytest.param("model.json", signal.SIGINT, marks=pytest.mark.slow),   # just after the model is saved
     (None, signal.SIGTERM),          # while the log is decoded by the worker and this process
 ])
 def test_signal_at_any_stage(tmp_path, moment, sig):

@@ -79,8 +79,10 @@ def _model_value(coef, term):
 #: (hidden cause, value given to the simulation, true estimate); sizes realistic and clearly detectable
 E2E = [
     ("Cm:alpha", 0.3, _model_value("Cm", "alpha") + 0.3),              # static margin 40 % smaller
-    ("Cl:p_hat", -0.2, _model_value("Cl", "p_hat") - 0.2),             # roll damping 45 % larger
-    ("Cn:r_hat", -0.12, _model_value("Cn", "r_hat") - 0.12),           # yaw damping 80 % larger
+    pytest.param("Cl:p_hat", -0.2, _model_value("Cl", "p_hat") - 0.2,   # roll damping 45 % larger
+                 marks=pytest.mark.slow),
+    pytest.param("Cn:r_hat", -0.12, _model_value("Cn", "r_hat") - 0.12,  # yaw damping 80 % larger
+                 marks=pytest.mark.slow),
     ("delay:delta_e", 0.08, 0.08),                                     # 80 ms servo + link delay
     ("bias:alpha", 0.035, 0.035),                                      # 2 deg AOA estimate offset
     ("wind", (3.0, -4.0, 0.0), 5.0),                                   # 5 m/s steady wind, not modelled
