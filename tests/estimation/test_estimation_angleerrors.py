@@ -53,10 +53,11 @@ def _heave_record(seed=5, duration=300.0, wd_mean=0.0):
     return rec, alpha_true
 
 
-def _run(rec):
+def _run(rec, instrument_slopes=True):
     T = len(rec["V"])
     return aided_air_angles(DT, rec["alpha_kin"], rec["beta_kin"], rec["V"], rec["qbar"], rec["f_body"],
-                            rec["rates"], rec["controls"], MASS, S, B, C, np.ones(T, bool))
+                            rec["rates"], rec["controls"], MASS, S, B, C, np.ones(T, bool),
+                            instrument_slopes=instrument_slopes)
 
 
 def _scale(est, ref):
@@ -92,6 +93,8 @@ def test_instrumented_slope_recovers_cz_alpha_where_least_squares_is_attenuated(
     c_iv, *_ = iv_lstsq(Ah, yh, [0], _highpass(DT, lagged_instruments(DT, rec["controls"]["delta_e"]), segs))
     assert abs(c_iv[0] / CZ_ALPHA - 1.0) < 0.04
     assert "slopes by 2SLS" in describe(res)[0]
+    ols = _run(rec, instrument_slopes=False).axes[0]           # the switch off: least squares, attenuated
+    assert ols.slope_method == "OLS" and ols.coef[1] / CZ_ALPHA < 0.95, ols.coef
 
 
 def test_weak_instruments_fall_back_to_least_squares():
