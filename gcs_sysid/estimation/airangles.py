@@ -30,6 +30,12 @@ Circularity: the angles are then partly built from the same force measurements t
 learns ``CY(beta)`` and ``CZ(alpha)`` from. Judge it on held-out truth (``docs/benchmarks.md``),
 not on the angle error alone.
 
+Two errors stay (:mod:`gcs_sysid.estimation.angleerrors`): the least-squares ``CZ_alpha`` is attenuated
+because the aircraft heaves with the gust the kinematic angle misses (``instrument_slopes``: the
+elevator as instrument, two-stage least squares), and the flight-mean vertical wind puts an offset
+``mean(w_d) / V`` on alpha that no channel of the log sees (its 1-sigma, ``AxisFit.bias_sigma``, is
+added to alpha's sigma: an error common to the whole flight).
+
 References:
     Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5 (filter error
     method, process noise for turbulence) and ch. 7 (flight path reconstruction).

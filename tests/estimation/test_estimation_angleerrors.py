@@ -85,7 +85,8 @@ def test_instrumented_slope_recovers_cz_alpha_where_least_squares_is_attenuated(
     from gcs_sysid.estimation.nodes import segments
     T = len(alpha_true)
     segs = segments(np.ones(T, bool), 250)
-    A = np.column_stack([rec["alpha_kin"], (rec["alpha_kin"] - rec["alpha_kin"].mean()) ** 2, rec["controls"]["delta_e"]])
+    ak = rec["alpha_kin"]
+    A = np.column_stack([ak, (ak - ak.mean()) ** 2, rec["controls"]["delta_e"]])
     y = rec["f_body"][:, 2] * MASS / (rec["qbar"] * S)
     Ah, yh = _highpass(DT, A, segs), _highpass(DT, y[:, None], segs)[:, 0]
     c_ols, *_ = np.linalg.lstsq(Ah, yh, rcond=None)
