@@ -30,6 +30,12 @@ Circularity: the angles are then partly built from the same force measurements t
 learns ``CY(beta)`` and ``CZ(alpha)`` from. Judge it on held-out truth (``docs/benchmarks.md``),
 not on the angle error alone.
 
+Two errors stay (:mod:`gcs_sysid.estimation.angleerrors`): the least-squares ``CZ_alpha`` is attenuated
+because the aircraft heaves with the gust the kinematic angle misses (``instrument_slopes``: the
+elevator as instrument, two-stage least squares), and the flight-mean vertical wind puts an offset
+``mean(w_d) / V`` on alpha that no channel of the log sees (its 1-sigma, ``AxisFit.bias_sigma``, is
+added to alpha's sigma: an error common to the whole flight).
+
 References:
     Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5 (filter error
     method, process noise for turbulence) and ch. 7 (flight path reconstruction).
@@ -47,6 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import butter, lfilter, sosfiltfilt
 
+from .angleerrors import MIN_FIRST_STAGE_R2, iv_lstsq, lagged_instruments, mean_wind_sigma
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
 
@@ -63,6 +70,13 @@ SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero side
 SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
 MEAN_BLOCK_S = 5.0    #: block length for the standard error of the CY constant (correlated residuals), s
 MOMENT_MARGIN = 0.0   #: the aided angle is kept if its moment-fit residual is at most (1 + this) x the kinematic one
+#: Default of ``aided_air_angles(instrument_slopes=None)``: fit CZ_alpha by two-stage least squares with the
+#: elevator as instrument (:mod:`.angleerrors`). Off by default for now: measured better on JSBSim (c172x
+#: light: alpha scale error 8 -> 5 %, 7 -> 3 %) and on the project's sim trainer (alpha RMS 0.114 -> 0.047
+#: deg, CZ_alpha -4.3 -> -4.89 against -4.8), but with the sharper alpha the diagnosis finds small
+#: ``wind`` / ``CZ:V`` / ``Cm:V`` effects on clean sim flights (tests/diagnose), whose floors were set
+#: with the old alpha; switch on once those are re-measured (docs/estimation.md).
+INSTRUMENTED_SLOPES = False
 
 
 @dataclass
@@ -85,6 +99,12 @@ class AxisFit:
         shift_note: why the sideslip mean was or was not moved (beta only; empty for alpha).
         moment_rss: (kinematic, aided) residual variance of the moment cross-check, each as a share of
             the moment coefficients' variance (NaN: no moments given).
+        slope_method: how the slopes were fitted: ``"2SLS"`` (alpha: the elevator and its delayed copies
+            instrument the angle, :func:`gcs_sysid.estimation.angleerrors.iv_lstsq`) or ``"OLS"``.
+        first_stage_r2: the instruments' first-stage partial R^2 (NaN: no instruments).
+        bias_sigma: 1-sigma of the angle's flight-common offset, rad (alpha: the flight-mean vertical
+            wind over the airspeed, :func:`gcs_sysid.estimation.angleerrors.mean_wind_sigma`; NaN for beta,
+            whose mean the wind fit and the CY0 prior set). Included in the per-sample sigma.
     """
 
     name: str
@@ -101,6 +121,9 @@ class AxisFit:
     mean_shift: float = 0.0
     shift_note: str = ""
     moment_rss: tuple[float, float] = (float("nan"), float("nan"))
+    slope_method: str = "OLS"
+    first_stage_r2: float = float("nan")
+    bias_sigma: float = float("nan")
 
 
 @dataclass
@@ -206,14 +229,17 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
 
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
-          moments: list[np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
+          V: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
     ``symmetric`` takes the constant as ~0 (CY of a symmetric airframe) so that it measures the mean
     error of the kinematic angle (not with a varying throttle: a propeller side force); ``moments``: the
     moment coefficients that depend on this angle (Cm; Cl, Cn), for the cross-check against the kinematic
-    angle (None: none)."""
+    angle (None: none); ``instruments`` (T, Q): instruments of the angle for the slopes (two-stage least
+    squares, :mod:`.angleerrors`; None or too weak: ordinary least squares); ``V`` (T,) airspeed, m/s: with
+    it the alpha axis gets the 1-sigma of its flight-common offset (the mean vertical wind)."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -243,7 +269,17 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         # slopes from the band above HIGHPASS_HZ, where the kinematic angle is good (its gust errors are
         # slow: the turbulence scale over the airspeed); the constant from the full band with them fixed
         Ah, yh = _highpass(dt, A, segs), _highpass(dt, coeff[:, None], segs)[:, 0]
-        cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
+        method, fs_r2 = "OLS", float("nan")
+        if instruments is not None:
+            # errors in variables: the kinematic angle misses the gust, and the aircraft's answer to the gust
+            # correlates the two; instruments that move the angle but not the air give a consistent slope
+            Zh = _highpass(dt, instruments, segs)
+            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], [0], Zh[m])
+            method = "2SLS"
+            if not fs_r2 >= MIN_FIRST_STAGE_R2:
+                method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {MIN_FIRST_STAGE_R2:g})"
+        if not method.startswith("2SLS"):
+            cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
         r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
@@ -289,7 +325,15 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         sig = gs
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
             np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift,
-            shift_note if fit is None else fit.shift_note)
+            shift_note if fit is None else fit.shift_note, slope_method=method, first_stage_r2=fs_r2)
+    if fit is not None and V is not None:
+        # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
+        # the vertical gusts found, is a common error of all samples (angleerrors module docstring)
+        w = (V * (ang - kin0))[m]
+        w = w[np.isfinite(w)]
+        fit.bias_sigma = mean_wind_sigma(w, V[m][np.isfinite(V[m])], float(m.sum()) * dt)
+        if np.isfinite(fit.bias_sigma):
+            sig = np.sqrt(sig**2 + fit.bias_sigma**2)
     if moments is not None and fit is not None:
         # cross-check that does not use the forces: the moments depend on the angle too (Cm_alpha; Cl_beta,
         # Cn_beta) and are measured by the gyro, not by the accelerometers the aiding used. If the aided
@@ -310,7 +354,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
 def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: np.ndarray, qbar: np.ndarray,
                      f_body: np.ndarray, rates: np.ndarray, controls: dict[str, np.ndarray], mass: float,
                      S: float, b: float, c: float, use: np.ndarray, passes: int = 2,
-                     rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None) -> AidedAngles:
+                     rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None,
+                     instrument_slopes: bool | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -329,9 +374,13 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             the body inertia tensor, kg m^2: with both, the moment coefficients (Euler's equations)
             cross-check each aided axis (Cm for alpha; Cl, Cn for beta): an aided angle that explains
             them worse than the kinematic one is dropped (``AxisFit.moment_rss``). None: no check.
+        instrument_slopes: fit the alpha model's slopes by two-stage least squares with the elevator and
+            its delayed copies as instruments (errors in variables, :mod:`.angleerrors`), falling back to
+            least squares when they are weak; None: :data:`INSTRUMENTED_SLOPES`.
 
     Returns:
-        :class:`AidedAngles`; an axis whose slope is not identified (wrong sign or fewer than
+        :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
+        offset, common to all samples); an axis whose slope is not identified (wrong sign or fewer than
         :data:`MIN_T_STAT` standard errors), or with under :data:`MIN_VALID_S` s of usable data,
         or a grid slower than :data:`MIN_RATE_HZ`, or that fails the moment cross-check, keeps its
         kinematic angle (``AxisFit.used`` False, ``reason`` says why).
@@ -368,7 +417,10 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             qS = qbar * S
             mom_lon = [Mb[:, 1] / (qS * c)]
             mom_lat = [Mb[:, 0] / (qS * b), Mb[:, 2] / (qS * b)]
-    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon)
+    de = get("delta_e")
+    on = INSTRUMENTED_SLOPES if instrument_slopes is None else instrument_slopes
+    inst = lagged_instruments(dt, de) if on and np.nanstd(de[u]) > 1e-9 and np.isfinite(de[u]).all() else None
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V)
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
@@ -393,5 +445,9 @@ def describe(res: AidedAngles) -> list[str]:
                    f"{', '.join(ax.columns[1:])}: {terms}); gust state: tau {ax.tau_s:g} s, "
                    f"{np.degrees(ax.gust_sigma):.2f} deg; force-derived {ax.name} noise "
                    f"{np.degrees(ax.noise_sigma):.2f} deg per sample{check}"
-                   + (f"; {ax.shift_note}" if ax.shift_note else ""))
+                   + (f"; {ax.shift_note}" if ax.shift_note else "")
+                   + (f"; slopes by {ax.slope_method}" + (f" (first-stage R2 {ax.first_stage_r2:.2f})"
+                                                          if np.isfinite(ax.first_stage_r2) else ""))
+                   + (f"; offset common to the flight (mean vertical wind, not observable) 1-sigma "
+                      f"{np.degrees(ax.bias_sigma):.2f} deg, included in sigma" if np.isfinite(ax.bias_sigma) else ""))
     return out

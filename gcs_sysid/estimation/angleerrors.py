@@ -1,0 +1,140 @@
+"""What the air angles' reconstruction cannot see: the slope's errors in variables and the mean wind.
+
+Two errors of the specific-force aided angle of attack (:mod:`gcs_sysid.estimation.airangles`),
+measured against JSBSim's exact alpha (``docs/benchmarks.md``, "eval_jsbsim", 2026-11-22 subsection):
+
+1. **Scale** (the force model's slope). The kinematic alpha is the *inertial* angle
+   (``atan2`` of the ground velocity minus a slow wind, in body axes); the true, aerodynamic angle
+   adds the vertical gust ``g``: ``alpha = alpha_kin + g``. The aircraft answers a gust (it heaves
+   with it below the heave-mode corner, ``2 m / (rho S V CL_alpha)``, a fraction of a second), so
+   ``alpha_kin`` and ``g`` are negatively correlated even above the band edge where the slopes are
+   fitted, and the least-squares ``CZ_alpha`` on ``alpha_kin`` is attenuated (c172x, light: -8.9
+   against -9.9 per rad, the aided alpha then 8 % too steep; moderate: half). The remedy of
+   errors-in-variables regression is an instrument: a variable correlated with the true angle and
+   not with the gust. The elevator is one: its maneuver part moves alpha and ignores the air
+   (its feedback part answers the gust only through the attitude loop, slowly). Two-stage least
+   squares with the elevator and its delayed copies as instruments (the angle's response to the
+   elevator is spread over the short period) gives a consistent slope.
+   Sources: Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, sec. 5.4 (the
+   equation-error bias with noisy regressors) and ch. 10 (data compatibility); Jategaonkar,
+   *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 10 (flight path
+   reconstruction); Wooldridge, *Econometric Analysis of Cross Section and Panel Data*, 2nd ed.,
+   MIT Press 2010, sec. 5.2 (two-stage least squares, first-stage strength).
+
+2. **Mean** (the vertical wind over the flight). Body forces, rates and attitude do not see a
+   constant vertical wind (a Galilean shift of the air mass changes nothing in the air-relative
+   dynamics), and the force model's constant ``CZ0`` absorbs any constant in alpha; the pitot's
+   energy channel gives the pitch attitude, not alpha. So the flight-mean of the vertical wind
+   ``w_d`` stays out of reach, and with it an alpha offset ``mean(w_d) / V`` (measured: 0.07-0.17
+   deg in light turbulence, 0.7-1.7 deg moderate, equal to ``mean(w_d) / V`` to 0.01 deg). What
+   the log does give is the vertical wind's *fluctuation* (the aided gusts); with the turbulence's
+   scale length ``L_w`` (MIL-F-8785C sec. 3.7.2: 1750 ft above 2000 ft, ``h`` below) the standard
+   deviation of its mean over the record follows from the Dryden (first-order Gauss-Markov at zero
+   frequency) model, ``tau = L_w / V``:
+
+       var(mean over T) = 2 s^2 (tau / T) (1 - (tau / T) (1 - exp(-T / tau)))
+       s^2 = s_rec^2 / (1 - var(mean) / s^2)    (the record's own std misses its mean's share)
+
+   and the alpha offset's 1-sigma is ``sqrt(var(mean)) / V``. It is a *common* error of every
+   sample of the flight, not independent per sample.
+   Sources: MIL-F-8785C (1980) sec. 3.7; Papoulis, *Probability, Random Variables and Stochastic
+   Processes*, 1991, sec. 9-5 (variance of the time average of a stationary process).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["GUST_SCALE_M", "INSTRUMENT_LAGS_S", "MIN_FIRST_STAGE_R2", "lagged_instruments", "iv_lstsq",
+           "mean_wind_sigma"]
+
+GUST_SCALE_M = 533.4          #: vertical turbulence scale L_w, m (MIL-F-8785C: 1750 ft above 2000 ft AGL)
+INSTRUMENT_LAGS_S = (0.0, 0.1, 0.2, 0.4, 0.8, 1.6)   #: delays of the control instruments, s
+MIN_FIRST_STAGE_R2 = 0.3      #: the instruments must explain this share of the angle's in-band variance
+
+
+def lagged_instruments(dt: float, u: np.ndarray, lags_s: tuple[float, ...] = INSTRUMENT_LAGS_S) -> np.ndarray:
+    """Delayed copies of the control inputs, the first value held before the start.
+
+    Args:
+        dt: grid step, s.
+        u: (T, K) control inputs (e.g. the elevator, rad).
+        lags_s: delays, s (rounded to whole samples).
+
+    Returns:
+        (T, K * L) array, the K inputs at each of the L delays.
+    """
+    u = np.asarray(u, float).reshape(len(u), -1)
+    out = []
+    for lag in lags_s:
+        k = int(round(lag / dt))
+        out.append(np.vstack([np.repeat(u[:1], k, axis=0), u[:len(u) - k]]) if k else u)
+    return np.hstack(out)
+
+
+def iv_lstsq(A: np.ndarray, y: np.ndarray, endog: list[int], Z: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """Two-stage least squares ``y ~ A c`` with the columns ``endog`` of ``A`` instrumented by ``Z``.
+
+    The exogenous columns of ``A`` are their own instruments. First stage: each endogenous column on
+    ``[Z, A_exog]``; second stage: ``y`` on ``A`` with the endogenous columns replaced by their fitted
+    values. Residuals are ``y - A c`` (with the actual columns); covariance ``s^2 (Ah' Ah)^-1``.
+
+    Args:
+        A: (N, P) regressors. y: (N,) regressand. endog: indices of the noisy columns of ``A``.
+        Z: (N, Q) instruments, ``Q >= len(endog)``.
+
+    Returns:
+        ``(c (P,), standard errors (P,), residuals (N,), covariance (P, P), first-stage partial R^2)``:
+        the share of the endogenous columns' variance left by the exogenous columns that the
+        instruments explain (the smallest over ``endog``; weak instruments: near 0).
+
+    Source: Wooldridge (2010) sec. 5.2 (module docstring).
+    """
+    exog = [j for j in range(A.shape[1]) if j not in endog]
+    W = np.hstack([Z, A[:, exog]])
+    Ah = A.copy()
+    r2 = 1.0
+    for j in endog:
+        pi, *_ = np.linalg.lstsq(W, A[:, j], rcond=None)
+        Ah[:, j] = W @ pi
+        if exog:
+            pe, *_ = np.linalg.lstsq(A[:, exog], A[:, j], rcond=None)
+            left = A[:, j] - A[:, exog] @ pe
+        else:
+            left = A[:, j] - A[:, j].mean()
+        explained = Ah[:, j] - (A[:, exog] @ pe if exog else A[:, j].mean())
+        r2 = min(r2, float(explained @ explained) / max(float(left @ left), 1e-300))
+    c, *_ = np.linalg.lstsq(Ah, y, rcond=None)
+    e = y - A @ c
+    s2 = float(e @ e) / max(len(y) - A.shape[1], 1)
+    try:
+        cov = np.linalg.inv(Ah.T @ Ah) * s2
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(Ah.T @ Ah) * s2
+    return c, np.sqrt(np.maximum(np.diag(cov), 0.0)), e, cov, r2
+
+
+def mean_wind_sigma(w_gust: np.ndarray, V: np.ndarray, duration_s: float, scale_m: float = GUST_SCALE_M) -> float:
+    """1-sigma of the flight-mean of the vertical wind, as an angle-of-attack offset, rad.
+
+    Args:
+        w_gust: (N,) the vertical wind's fluctuation over the record, m/s (e.g. airspeed times the
+            aided minus the kinematic alpha), finite samples only.
+        V: (N,) true airspeed, m/s.
+        duration_s: record length T, s (the sum of the aided segments).
+        scale_m: turbulence scale length ``L_w``, m.
+
+    Returns:
+        ``sqrt(var(mean w_d over T)) / mean(V)`` (module docstring), rad; NaN without data.
+
+    Source: MIL-F-8785C sec. 3.7; Papoulis (1991) sec. 9-5 (module docstring).
+    """
+    w = np.asarray(w_gust, float)
+    if len(w) < 10 or not duration_s > 0:
+        return float("nan")
+    Vm = float(np.mean(V))
+    x = duration_s / (scale_m / max(Vm, 1.0))                      # T / tau
+    r = 2.0 / x * (1.0 - (1.0 - np.exp(-x)) / x)                  # var(mean) / s^2 of a Gauss-Markov process
+    s2 = float(np.var(w)) / max(1.0 - r, 1e-3)                     # the record's variance lacks its mean's share
+    return float(np.sqrt(r * s2) / max(Vm, 1.0))
