@@ -15,6 +15,8 @@ from ..outdir import StagedDir, StagedFiles
 
 #: What ``diagnose`` writes into its output folder.
 DIAGNOSE_OUTPUTS = ("diagnosis.json", "model_extended.toml", "report.html")
+#: Logs at least this large (a 10-minute 50 Hz flight is ~7 MB) are decoded with the spare worker process.
+SPLIT_MIN_BYTES = 4 << 20
 
 __all__ = ["Measurements", "load_measurements", "run_fit", "run_diagnose"]
 
@@ -63,23 +65,32 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
     from ..aero import compute_coefficients
     from ..estimation import estimate_states
     from ..options import check_window
+    from ..parallel import Helper
     from ..telemetry import cut_window, read_log
 
     tm: dict[str, float] = {}
     t0 = time.perf_counter()
     check_window(t_from, t_to)
     airframe = load_airframe(airframe_path)
-    flight = read_log(log)
-    tm["decode_s"] = time.perf_counter() - t0
-    if notify is not None:
-        for note in flight.damage:
-            notify(f"damaged log: {note}")
-    flight = cut_window(flight, t_from, t_to)
-    _check_airframe_matches(flight, airframe, str(log))
-    t1 = time.perf_counter()
-    states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
-                             if progress is not None else None)
-    tm["estimate_s"] = time.perf_counter() - t1
+    try:
+        big = Path(log).stat().st_size >= SPLIT_MIN_BYTES
+    except OSError:
+        big = False   # read_log says what is wrong with the path
+    # a long log is decoded in two parts at once and the specific force smoothed beside the other
+    # filters, as the replay does (gcs_sysid.parallel; the same results with and without the worker)
+    with Helper(enabled=None if big else False, warm=("gcs_sysid.telemetry.tlog_scan",)) as helper:
+        flight = read_log(log, helper=helper)
+        tm["decode_s"] = time.perf_counter() - t0
+        if notify is not None:
+            for note in flight.damage:
+                notify(f"damaged log: {note}")
+        flight = cut_window(flight, t_from, t_to)
+        _check_airframe_matches(flight, airframe, str(log))
+        t1 = time.perf_counter()
+        helper.preload(["gcs_sysid.estimation.rates"])
+        states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
+                                 if progress is not None else None, helper=helper)
+        tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe)
     tm["coefficients_s"] = time.perf_counter() - t2

@@ -121,10 +121,11 @@ class _EulerEKF(ExtendedKalmanFilter):
     def predict_x(self, u=0):
         """``u``: (n, 3) mean gyro rate of each grid step in the block (rad/s)."""
         x = self.x[:, 0].copy()
-        bp, bq, br = x[3], x[4], x[5]
+        bp, bq, br = float(x[3]), float(x[4]), float(x[5])
         ph, th, ps = float(x[0]), float(x[1]), float(x[2])
         dt = self.dt
-        for wp, wq, wr in u:                       # Euler steps: x += dt * E(phi, theta) (g - b)
+        # Python floats, not NumPy scalars: the same IEEE arithmetic, several times cheaper per operation
+        for wp, wq, wr in np.asarray(u, dtype=float).tolist():   # Euler steps: x += dt * E(phi, theta) (g - b)
             p, q, r = wp - bp, wq - bq, wr - br
             sf, cf, ct = math.sin(ph), math.cos(ph), math.cos(th)
             ct = math.copysign(max(abs(ct), _COS_MIN), ct)
@@ -223,23 +224,26 @@ def smooth_attitude(dt: float, gyro: np.ndarray, att: np.ndarray, sigma_gyro: fl
     Fs = np.empty((J, 6, 6))
     hj = lambda x: _H_ATT  # noqa: E731
     hx = lambda x: x[:3]   # noqa: E731
+    n_ok = np.concatenate([[0], np.cumsum(g_ok)])            # gyro samples present before each grid index
+    z_ok = np.isfinite(z).all(axis=1)
     for j in range(J):
         blk = slice(nodes[j - 1] + 1, nodes[j] + 1) if j else slice(0, 0)
         n = blk.stop - blk.start
+        nok = int(n_ok[blk.stop] - n_ok[blk.start])
         b = ekf.x[3:, 0]
         gb = gmid[blk]
-        okb = g_ok[blk]
-        w = np.where(okb[:, None], gb, b[None, :])          # missing gyro: hold the attitude (w - b = 0)
+        # missing gyro: hold the attitude (w - b = 0); a complete block is the gyro as it is
+        w = gb if nok == n else np.where(g_ok[blk][:, None], gb, b[None, :])
         x = ekf.x[:, 0]
         Fk = _euler_jacobian(x[0], x[1], (w.mean(0) - b) if n else np.zeros(3), n * dt)
-        qa = (sigma_gyro * dt) ** 2 * okb.sum() + (1.0 * dt) ** 2 * (n - okb.sum())
+        qa = (sigma_gyro * dt) ** 2 * nok + (1.0 * dt) ** 2 * (n - nok)
         ekf.F = Fk
         ekf.Q = np.diag([qa] * 3 + [sigma_bias_walk**2 * dt * n] * 3)
         ekf.predict(u=w)
         Fs[j] = Fk
         xp[j, 0] = ekf.x[:, 0]
         Pp[j, 0] = ekf.P
-        if np.isfinite(z[j]).all():
+        if z_ok[j]:
             zj = z[j].copy()
             zj[2] = _wrap(zj[2])
             ekf.update(zj[:, None], hj, hx, residual=_att_residual)

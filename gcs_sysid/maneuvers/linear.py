@@ -13,13 +13,16 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy.linalg import expm
 
 from ..aero.table import COEFFICIENTS, REGRESSORS, CoefficientTable
 from ..airframe import Airframe
 
-__all__ = ["G", "derivative_estimates", "linear_models", "mode_omega", "modes", "response", "zoh_simulate"]
+__all__ = ["G", "derivative_estimates", "linear_models", "mode_omega", "modes", "response", "zoh_simulate",
+           "zoh_simulate_stepwise"]
 
 G = 9.80665
 #: Typical values (Beard and McLain 2012, app. E, Aerosonde), signs per docs/conventions.md.
@@ -162,8 +165,98 @@ def modes(models: dict) -> dict[str, float]:
     return out
 
 
+#: Steps propagated per block by :func:`zoh_simulate` (one matrix product per block).
+ZOH_BLOCK = 64
+
+
+@lru_cache(maxsize=256)
+def _zoh_blocks(key: bytes, n: int, m: int, dt: float, L: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Exact zero-order-hold discretisation and the block operators of :func:`zoh_simulate` (cached).
+
+    Args:
+        key: ``A.tobytes() + B.tobytes()`` (float64, C order) of the continuous model, A (n, n), B (n, m).
+        n, m: state and input sizes. dt: step, s. L: steps per block.
+
+    Returns:
+        (Ad (n, n), Hp (L n, n), G (L n, L m)), or None when a power of ``Ad`` up to ``L`` is not finite
+        or exceeds 1e150 (a model that diverges that fast is simulated step by step): ``Hp`` stacks
+        ``Ad^1 .. Ad^L`` and ``G`` is the block lower-triangular Toeplitz matrix of
+        ``Ad^(i-j) Bd`` (row block i = step s+i+1, column block j = input at s+j, j <= i), so that a
+        block's states are ``Hp x_s + G u_block``.
+
+    Source: Franklin, Powell and Workman, *Digital Control of Dynamic Systems*, 3rd ed., 1998, sec. 4.3
+    (zero-order-hold equivalent by the matrix exponential of ``[[A, B], [0, 0]] dt``, and the
+    convolution sum of the discrete state equation).
+    """
+    A = np.frombuffer(key[:8 * n * n]).reshape(n, n)
+    B = np.frombuffer(key[8 * n * n:]).reshape(n, m)
+    M = expm(np.block([[A, B], [np.zeros((m, n + m))]]) * dt)
+    Ad, Bd = M[:n, :n], M[:n, n:]
+    P = np.empty((L + 1, n, n))
+    P[0] = np.eye(n)
+    for i in range(1, L + 1):
+        P[i] = Ad @ P[i - 1]
+    if not (np.all(np.isfinite(P)) and np.max(np.abs(P)) < 1e150):
+        return None
+    PB = P[:L] @ Bd                                # (L, n, m): Ad^j Bd
+    G = np.zeros((L, n, L, m))
+    for i in range(L):
+        G[i, :, :i + 1, :] = PB[i::-1].transpose(1, 0, 2)   # input j acts on step i through Ad^(i-j) Bd
+    return Ad, P[1:].reshape(L * n, n), G.reshape(L * n, L * m)
+
+
 def zoh_simulate(A: np.ndarray, B: np.ndarray, U: np.ndarray, dt: float) -> np.ndarray:
-    """Zero-order-hold response x (K, n) to inputs U (K, m) from x = 0; NaN after divergence."""
+    """Zero-order-hold response of ``x' = A x + B u`` from x = 0.
+
+    The discrete recursion ``x[k] = Ad x[k-1] + Bd u[k-1]`` is evaluated ``ZOH_BLOCK`` steps at a time
+    (one product with the block operators of :func:`_zoh_blocks`, cached per model and step) instead of
+    one small product per step; the result equals the step-by-step recursion
+    (:func:`zoh_simulate_stepwise`) to rounding (relative 1e-12 on the maneuver designs' models,
+    checked in ``tests/test_maneuver_zoh.py``).
+
+    Args:
+        A: (n, n) state matrix, 1/s. B: (n, m) input matrix. U: (K, m) inputs, held over each step.
+        dt: step, s.
+
+    Returns:
+        x (K, n), ``x[0] = 0``; rows from the first whose magnitude reaches 1e6 (divergence) are NaN.
+
+    Source: Franklin, Powell and Workman (1998) sec. 4.3.
+    """
+    A = np.ascontiguousarray(A, dtype=float)
+    B = np.ascontiguousarray(B, dtype=float)
+    n, m = B.shape
+    K = len(U)
+    ops = _zoh_blocks(A.tobytes() + B.tobytes(), n, m, float(dt), ZOH_BLOCK) if K > 1 else None
+    if ops is None:
+        return zoh_simulate_stepwise(A, B, U, dt)
+    _, Hp, G = ops
+    L = ZOH_BLOCK
+    nb = -(-(K - 1) // L)                          # blocks covering steps 1 .. K-1
+    Upad = np.zeros((nb * L, m))
+    Upad[:K - 1] = np.asarray(U, dtype=float)[:K - 1]
+    Ub = Upad.reshape(nb, L * m)
+    forced = Ub @ G.T                              # (nb, L n): every block's response from rest
+    out = np.empty((nb * L + 1, n))
+    out[0] = 0.0
+    xs = np.zeros(n)
+    with np.errstate(over="ignore", invalid="ignore"):   # a diverging model overflows; it is cut below
+        for j in range(nb):
+            blk = Hp @ xs + forced[j]
+            out[1 + j * L:1 + (j + 1) * L] = blk.reshape(L, n)
+            xs = out[(j + 1) * L]
+        x = out[:K]
+        bad = ~np.all(np.abs(x) < 1e6, axis=1)
+    if bad.any():
+        x[int(np.argmax(bad)):] = np.nan
+    return x
+
+
+def zoh_simulate_stepwise(A: np.ndarray, B: np.ndarray, U: np.ndarray, dt: float) -> np.ndarray:
+    """:func:`zoh_simulate` one step at a time (the reference the block form is checked against).
+
+    Args and returns as :func:`zoh_simulate`.
+    """
     n, m = B.shape
     M = expm(np.block([[A, B], [np.zeros((m, n + m))]]) * dt)
     Ad, Bd = M[:n, :n], M[:n, n:]
