@@ -62,6 +62,13 @@ for each candidate; then the delay ``l_c`` of each control (a servo or output
 delay, 0 ... ``max_delay_s``) by the same likelihood summed over the axes
 (coordinate ascent; a change must beat the BIC penalty of one parameter).
 
+One bandwidth per axis cannot follow what neither the inputs nor the nominal
+model explain (gust-driven moments at 2-5 Hz): it stays in the residual, gyro
+minus smoothed rate. :func:`smooth_rates` then adds the Wiener estimate of that
+residual's signal where its spectrum stands significantly above the gyro's
+white-noise floor (:mod:`.wiener`), zero phase, per axis and gap-free piece; a
+white residual is left alone.
+
 References:
     Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
     CUP 1989, sec. 3.4 (explanatory variables and interventions), ch. 3
