@@ -86,11 +86,14 @@ def residual_wiener(dt: float, residual: np.ndarray, window_s: float = WINDOW_S,
         window_s: Welch segment length, s.
         k_sigma: a frequency is corrected only where the residual's PSD exceeds the noise floor by
             ``k_sigma`` standard errors of the averaged periodogram.
-        f_max_hz: highest frequency corrected, Hz (also at most 0.6 x Nyquist: the floor is read above).
+        f_max_hz: highest frequency corrected, Hz.
 
     Returns:
         :class:`ResidualCorrection`, or None when the piece is shorter than four windows (too short to
-        tell signal from noise) or not finite.
+        tell signal from noise), not finite, or sampled too slowly to read the noise floor above the
+        flight dynamics (``0.6 x Nyquist < f_max_hz``: a grid below about 27 Hz for the default 8 Hz;
+        at 10 Hz the band above 3 Hz still holds roll motion, and the floor read there is not white
+        noise).
 
     Source: module docstring (Wiener gain ``1 - N / S`` from the measured spectrum: Bendat and Piersol
     2010 sec. 6.1; Morelli and Klein 2016 sec. 11.1).
@@ -98,14 +101,14 @@ def residual_wiener(dt: float, residual: np.ndarray, window_s: float = WINDOW_S,
     r = np.asarray(residual, float)
     n = len(r)
     nper = max(int(round(window_s / dt)), 8)
-    if n < 4 * nper or not np.isfinite(r).all():
+    nyq = 0.5 / dt
+    if n < 4 * nper or not np.isfinite(r).all() or 0.6 * nyq < f_max_hz:
         return None
     f, S = welch(r, 1.0 / dt, nperseg=nper)          # Hann, 50 % overlap, mean removed per segment
-    nyq = 0.5 / dt
     N = float(np.median(S[f > 0.6 * nyq]))             # white floor, read far above the flight dynamics
     n_avg = 2.0 * n / nper - 1.0                      # half-overlapping segments averaged
     thr = N * (1.0 + k_sigma / np.sqrt(n_avg))
-    band = (f > 0) & (f <= min(f_max_hz, 0.6 * nyq))
+    band = (f > 0) & (f <= f_max_hz)
     G = np.where(band & (S > thr), 1.0 - N / np.maximum(S, 1e-300), 0.0)
     if not (G > 0).any():
         z = np.zeros(n)

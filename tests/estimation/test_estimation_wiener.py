@@ -92,3 +92,11 @@ def test_short_or_gappy_pieces_are_left_alone():
     r = np.random.default_rng(0).normal(0.0, GYRO_NOISE, 2000)
     r[5] = np.nan
     assert residual_wiener(DT, r) is None
+
+
+def test_slow_grids_are_left_alone():
+    # at 10 Hz the band where the floor would be read (above 3 Hz) still holds flight dynamics
+    r = np.random.default_rng(0).normal(0.0, GYRO_NOISE, 1000)
+    assert residual_wiener(0.1, r) is None
+    assert residual_wiener(1 / 25.0, np.random.default_rng(0).normal(0.0, GYRO_NOISE, 2500)) is None
+    assert residual_wiener(1 / 30.0, np.random.default_rng(0).normal(0.0, GYRO_NOISE, 3000)) is not None
