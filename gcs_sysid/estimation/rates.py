@@ -62,6 +62,13 @@ for each candidate; then the delay ``l_c`` of each control (a servo or output
 delay, 0 ... ``max_delay_s``) by the same likelihood summed over the axes
 (coordinate ascent; a change must beat the BIC penalty of one parameter).
 
+One bandwidth per axis cannot follow what neither the inputs nor the nominal
+model explain (gust-driven moments at 2-5 Hz): it stays in the residual, gyro
+minus smoothed rate. :func:`smooth_rates` then adds the Wiener estimate of that
+residual's signal where its spectrum stands significantly above the gyro's
+white-noise floor (:mod:`.wiener`), zero phase, per axis and gap-free piece; a
+white residual is left alone.
+
 References:
     Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
     CUP 1989, sec. 3.4 (explanatory variables and interventions), ch. 3
@@ -90,6 +97,7 @@ from scipy.signal import lfilter, ss2tf
 from .inputs import aux_columns, control_columns, lagged, normal_force_input, prepare_inputs, shift
 from .kalman import SteadyState, lti_response, steady_state, steady_state_smoother
 from .nodes import segments
+from .wiener import residual_wiener
 
 __all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "ZOH_EVIDENCE", "RateEstimate", "normal_force_input", "smooth_rates",
            "smooth_specific_force", "control_columns"]
@@ -125,6 +133,9 @@ class RateEstimate:
             (:data:`HOLDS`): ``"zoh"`` steps at the samples (ideal or fast servos fed the logged
             commands), ``"foh"`` linear between them (logged surface positions, or servos slower
             than the log rate).
+        correction_band_hz: (3, 2) per axis the lowest and highest frequency (Hz) where the residual
+            correction (:mod:`.wiener`) found signal over the gyro's noise floor and added it; NaN
+            where it found none (or was switched off).
     """
 
     rate: np.ndarray
@@ -137,6 +148,7 @@ class RateEstimate:
     effectiveness_sigma: np.ndarray
     input_lag: np.ndarray
     hold: str = "zoh"
+    correction_band_hz: np.ndarray | None = None
 
 
 def _innovation_filter(F: np.ndarray, g: SteadyState, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -415,7 +427,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
                  input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
                  holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None,
-                 aux_axes: tuple[int, ...] | None = None) -> RateEstimate:
+                 aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -449,6 +461,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
             once, linear between samples, one coefficient per axis and signal, not delayed and not
             scaled (e.g. :func:`normal_force_input`); NaN rows are left out like gyro gaps.
         aux_axes: the axes (0 p, 1 q, 2 r) that take ``aux``; None: all.
+        residual_correction: add what the smoother left in the gyro where the residual's spectrum
+            shows signal over the white-noise floor (:func:`~.wiener.residual_wiener`, per axis and
+            gap-free piece, zero phase); False: the smoother alone.
 
     Returns:
         :class:`RateEstimate`.
@@ -474,8 +489,33 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         eff[:, ctl] = o["beta"][:, sel].sum(axis=1)
         eff_sig[:, ctl] = np.sqrt(np.maximum(o["cov"][:, sel][:, :, sel].sum(axis=(1, 2)), 0.0))
         lags[ctl] = o["lag"][k]
+    band = np.full((3, 2), np.nan)
+    if residual_correction:
+        band = _correct_residual(dt, np.asarray(rates, float), o)
     return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags,
-                        o.get("hold", "zoh"))
+                        o.get("hold", "zoh"), band)
+
+
+def _correct_residual(dt: float, Z: np.ndarray, o: dict) -> np.ndarray:
+    """Add the Wiener estimate of the residual's signal to the smoothed rates and accelerations in ``o``
+    (in place, per axis and gap-free piece) and its error variance to their sigmas; returns the
+    corrected band per axis (3, 2), Hz, NaN where none."""
+    band = np.full((Z.shape[1], 2), np.nan)
+    for i in range(Z.shape[1]):
+        res = Z[:, i] - o["x"][:, i]
+        lo, hi = np.inf, -np.inf
+        for sg in segments(np.isfinite(res), 10):
+            c = residual_wiener(dt, res[sg])
+            if c is None or c.accel_var == 0.0:
+                continue
+            o["x"][sg, i] += c.rate
+            o["xd"][sg, i] += c.accel
+            o["xds"][sg, i] = np.sqrt(o["xds"][sg, i] ** 2 + c.accel_var)
+            b = c.band_hz
+            lo, hi = min(lo, b[0]), max(hi, b[1])
+        if np.isfinite(lo):
+            band[i] = lo, hi
+    return band
 
 
 def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
