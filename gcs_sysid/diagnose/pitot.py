@@ -36,12 +36,16 @@ from .context import DiagContext
 from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
 
-__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "airspeed_cause", "wind_shift", "with_pitot"]
+__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "airspeed_cause", "wind_shift", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
 #: 1-sigma systematic error of an autopilot's wind estimate (m/s): its slow wander.
 WIND_SYSTEMATIC_MPS = 0.3
+#: |b_wind| / its standard error for the autopilot's wind estimate to *confirm* a pitot error on its own
+#: (then the coefficient offsets the bias makes count as its evidence, not as a between-flight allowance;
+#: :data:`gcs_sysid.diagnose.physical.OFFSETS_ALLOWED`).
+MIN_T_WIND = 3.0
 PITOT_CAUSES = ("bias:airspeed", "scale:airspeed")
 
 
@@ -134,7 +138,14 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         if not all(checks.values()):
             cand["accepted"] = False
             continue
-        gate = physical_gate(ctx, np.nan_to_num(R), f.delta, 1, proj, acc, gain_rows)
+        # the autopilot's own wind estimate independently confirms a pitot error along the heading: then the
+        # coefficient offsets the bias makes are part of its evidence, not a between-flight allowance
+        b_est = f.estimate if cause == "bias:airspeed" else (f.estimate - 1.0) * float(np.median(ctx.x("V")[ctx.valid]))
+        confirmed = wind is not None and abs(wind["bias_mps"]) >= MIN_T_WIND * wind["std_error"] and \
+            abs(wind["bias_mps"] - b_est) <= 3.0 * np.hypot(wind["std_error"], f.std_error) + 0.25 * abs(b_est)
+        gate = physical_gate(ctx, np.nan_to_num(R), f.delta, 1, proj, acc, gain_rows,
+                             offsets_allowed=False if confirmed else None)
+        cand["confirmed_by_wind_estimate"] = bool(confirmed)
         checks["signature"] = gate["signature"]["holds"]
         checks["beats_terms"] = bool(gate["versus_terms"]["beats"])
         cand["gate"] = gate
