@@ -29,6 +29,14 @@ errors, Morelli and Klein sec. 5.3; any other cause by its own fit in
   own correction; a step from about 0 to the full amplitude, accepted when it lowers the weighted
   squared error by at least ``min_step_chi2`` against "present from the start").
 
+Between-flight allowances (issue 9): an aero finding that is only an offset of its coefficient
+(:func:`offset_allowance`: the term refitted with a free constant is not significant or gains less
+than ``min_gain_pct`` beyond it on the held-out rows; ``C:1`` always) and, with two or more
+references, a correction within the references' own flight-to-flight spread, are not named; they are
+listed under ``allowance``. ``wind`` is the coefficient-domain correction to the wind the estimator
+reconstructed (a real wind is reconstructed and is no cause): the same correction in the references is
+a systematic air-data error (``model_inadequacy``); only a correction of this flight alone is named.
+
 Structure the residual GP (:mod:`gcs_sysid.diagnose.residual_gp`) finds in the new flight is
 compared the same way: structured in the same coefficient in a reference too means model
 inadequacy outside the library (with its region), structured only in the new flight means an

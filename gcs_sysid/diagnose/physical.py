@@ -25,8 +25,23 @@ are split in two by :func:`split_held_out`: alternate held-out blocks are the *a
 comparison and the reported untouched gain). With the training rows (the *selection*) that makes
 three disjoint sets.
 
+Between-flight allowance (:data:`OFFSETS_ALLOWED`, added 2026-11-22): both tests run on the residual
+and the correction with their per-coefficient mean over the selection rows removed, and each rival
+term has its coefficient's free constant, so a cause is named only for what it explains beyond the
+near-constant offsets by which flights of one aircraft differ (the reconstruction's angle-of-attack
+offset, weight and CG within tolerance, an engine's torque at one power setting). ``wind``, the
+coefficient-domain correction to the estimator's wind, is gated like the physical causes.
+
 The thresholds below were frozen on 2026-11-22 at 00:15 UTC, before the final evaluation
-(``benchmarks/eval_jsbsim_diagnose.py``); pa28 was kept out of their tuning.
+(``benchmarks/eval_jsbsim_diagnose.py``); pa28 was kept out of their tuning. The allowance and the
+wind gate were frozen again on 2026-11-22 (time and commit in ``docs/benchmarks.md``, "Between-flight
+allowances"), after tuning on c172x/sgs (seeds 1-2, clean 11-13) and the ALFA flights only.
+
+References:
+    Morelli and Klein, *Aircraft System Identification*, 2nd ed., sec. 5.3 (coloured residuals), 5.4
+    (model structure determination, PRESS) and ch. 10 (data compatibility); Jategaonkar, *Flight
+    Vehicle System Identification*, 2nd ed., ch. 10 (data compatibility check: biases and scale
+    factors of the air data and inertial sensors, estimated together with the wind).
 """
 
 from __future__ import annotations

@@ -16,6 +16,14 @@ Its signature is then:
 - **differential**: the same fit on the reference flight(s) must give a different value; a pitot
   bias the reference flight had too is a calibration note, not a change.
 
+The physical gate removes each coefficient's between-flight offset before it judges a cause
+(:data:`gcs_sysid.diagnose.physical.OFFSETS_ALLOWED`). A pitot bias at one trim speed is mostly such
+an offset, so when the autopilot's wind estimate confirms the bias on its own (the wind shift at least
+:data:`MIN_T_WIND` of its standard errors from 0 and in agreement with the fit), the offsets the bias
+makes are its evidence and the gate keeps them; without that confirmation they are an allowance,
+and the bias is named only for what it explains beyond them (its V-dependent size, rates, angles).
+Accepted, its symptoms (aero terms and ``scale:<coef>`` of the implied coefficients) leave the findings.
+
 Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:15 UTC):
 ``MIN_T`` on the fit's coloured-residual t statistic, and the systematic error of the autopilot's
 wind estimate ``WIND_SYSTEMATIC_MPS`` in the wind check.
@@ -222,7 +230,11 @@ def with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
     if f is None:
         return findings
     implied = set(f["evidence"]["signature"]["implied"])
-    symptoms = [g for g in findings if g["cause"].split(":")[0] in implied and g.get("kind") != "fault"
+    # its symptoms: aero terms of an implied coefficient, and a scale of one (the sparse search's
+    # ``scale:CY``: every coefficient is scaled by (V / (V + b))^2)
+    symptoms = [g for g in findings if (g["cause"].split(":")[0] in implied or
+                                        (g["cause"].startswith("scale:") and g["cause"][6:] in implied))
+                and g.get("kind") != "fault"
                 and g.get("evidence", {}).get("domain") not in ("data compatibility", "physical signature")]
     f["evidence"]["explains"] = [g["cause"] for g in symptoms]
     return [g for g in findings if g.get("kind") == "fault"] + [f] + \
