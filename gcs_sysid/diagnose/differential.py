@@ -421,8 +421,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         null = 0.0 if is_aero else _null_value(cause, airframe)
         # an aero finding's correction is its change from the model's value (catalogue: evidence.correction;
         # sparse search: estimate - model_value)
-        c_f = (f["evidence"].get("correction", f["estimate"] - f.get("model_value", f["evidence"].get("model_value", 0.0)))
-               if is_aero else f["estimate"] - null)
+        mv = f.get("model_value", f["evidence"].get("model_value", 0.0))
+        c_f = f["evidence"].get("correction", f["estimate"] - mv) if is_aero else f["estimate"] - null
         se_f = float(f["std_error"])
         comps = []
         for ref, ctx, R in refs:

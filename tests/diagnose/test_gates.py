@@ -5,11 +5,17 @@ reconstruction's angle-of-attack offset, weight and CG within tolerance, an engi
 fast tests hold the gates on synthetic coefficient tables (``diag_synthetic``) where the truth is set
 by the test:
 
-- a clean flight whose force and moment coefficients carry such an offset gets no ``mass``, ``wind``
-  or ``CZ`` term out of the gates (each fails when the allowance is removed: the offset alone passes
-  the old gates);
-- a real mass change (every force coefficient scaled, with the airspeed varying) still passes the
-  physical gate, so the allowance does not blind it.
+- on a clean flight whose coefficients carry the offsets of the reconstruction's angle offsets, ``mass``
+  and ``wind`` are fitted strongly enough to clear the diagnosis' thresholds, and the physical gate
+  rejects them;
+- the differential allowance drops a between-flight offset (``CZ:1``, an ``alpha`` term that only
+  rides on the offset) and keeps a real change of the lift slope;
+- slow: the whole diagnosis of a clean flight with CX/CZ offsets, differential against a clean
+  reference, names nothing (it fails when the allowance is removed: ``CZ:1`` and ``CX:1`` are named).
+
+The controls that the allowances do not blind the gates to real causes are the project's simulation
+cases: a 5 m/s wind (``test_diagnose_sim.py``, ``test_diagnose_e2e.py``) and a 2 m/s pitot bias
+(``test_physical.py``) are still named.
 """
 
 import numpy as np
@@ -50,13 +56,14 @@ def _ctx(table, states, airframe):
 
 
 def _fitted(ctx, R, cause):
-    got = fit_sensor_causes(ctx, R, Scorer(ctx, R, None), exclude=OTHERS + tuple(c for c in ("mass", "wind") if c != cause))
+    rest = OTHERS + tuple(c for c in ("mass", "wind") if c != cause)
+    got = fit_sensor_causes(ctx, R, Scorer(ctx, R, None), exclude=rest)
     assert got and got[0].cause == cause
     return got[0]
 
 
 @pytest.mark.parametrize("cause", ["mass", "wind"])
-def test_a_between_flight_offset_is_no_mass_or_wind(airframe, cause, monkeypatch):
+def test_a_between_flight_offset_is_no_mass_or_wind(airframe, cause):
     ctx = _ctx(*_offset_flight(), airframe)
     R = np.nan_to_num(ctx.Y - ctx.model_values())
     f = _fitted(ctx, R, cause)
@@ -66,8 +73,6 @@ def test_a_between_flight_offset_is_no_mass_or_wind(airframe, cause, monkeypatch
     # a strong candidate: it clears the diagnosis' own thresholds, so only the gate stands between the
     # offset and a named cause
     assert f.score >= 30.0 and f.gain_percent >= 10.0, (f.score, f.gain_percent)
-    loose = physical_gate(ctx, R, f.delta, len(f.params), offsets_allowed=False)
-    print(cause, loose["passed"], loose["why"])
 
 
 def test_an_offset_is_no_aero_term_and_a_slope_is():
