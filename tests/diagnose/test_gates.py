@@ -26,7 +26,7 @@ from gcs_sysid.diagnose import physical
 from gcs_sysid.diagnose.candidates import Scorer, fit_sensor_causes
 from gcs_sysid.diagnose.context import DiagContext
 from gcs_sysid.diagnose.core import diagnose
-from gcs_sysid.diagnose.differential import Reference, offset_allowance
+from gcs_sysid.diagnose.differential import Reference, _within_reference_variation, offset_allowance
 from gcs_sysid.diagnose.physical import physical_gate
 
 from diag_flights import AIRFRAME
@@ -108,3 +108,30 @@ def test_a_clean_flight_with_between_flight_offsets_gets_no_named_cause(airframe
     assert d.findings == [], [(f["cause"], f["estimate"], f["gain"]["percent"]) for f in d.findings]
     allowed = {a["cause"] for a in d.data["differential"]["allowance"]}
     assert "CZ:1" in allowed, d.data["differential"]
+
+
+def test_a_correction_within_the_references_spread_is_an_allowance():
+    refs = [{"correction": c, "std_error": 0.002} for c in (0.010, 0.030, 0.020)]
+    inside = _within_reference_variation(0.035, 0.003, refs)
+    assert inside is not None and inside["spread_between_references"] == pytest.approx(0.01)
+    assert _within_reference_variation(0.09, 0.003, refs) is None          # far outside: a change
+    assert _within_reference_variation(0.035, 0.003, refs[:1]) is None     # one reference: no spread to judge by
+
+
+def test_a_wind_correction_the_reference_needs_too_is_a_calibration(monkeypatch):
+    """The catalogue's wind is a correction to the estimator's wind: the same correction in the reference
+    flight is a systematic air-data error, not this flight's air; a different one is named."""
+    from types import SimpleNamespace
+
+    import gcs_sysid.diagnose.differential as differential
+
+    f = {"cause": "wind", "std_error": 0.1, "evidence": {"parameters": {"wn": 1.0, "we": -0.5}}}
+    fitted = SimpleNamespace(cov=np.eye(2) * 0.01)
+    ctx = SimpleNamespace(has=lambda *k: True)
+    refs = [(Reference(None, label="ref.tlog"), ctx, None)]
+    monkeypatch.setattr(differential, "_wind_fit", lambda c, R: (np.array([0.95, -0.45]), np.eye(2) * 0.01))
+    same = differential._wind_differential(f, fitted, refs)
+    assert same["verdict"] == "calibration" and same["references"][0]["same"]
+    monkeypatch.setattr(differential, "_wind_fit", lambda c, R: (np.array([0.0, 0.05]), np.eye(2) * 0.01))
+    changed = differential._wind_differential(f, fitted, refs)
+    assert changed["verdict"] == "changed" and "estimator" in changed["why"]
