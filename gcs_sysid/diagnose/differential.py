@@ -29,6 +29,14 @@ errors, Morelli and Klein sec. 5.3; any other cause by its own fit in
   own correction; a step from about 0 to the full amplitude, accepted when it lowers the weighted
   squared error by at least ``min_step_chi2`` against "present from the start").
 
+Between-flight allowances (issue 9): an aero finding that is only an offset of its coefficient
+(:func:`offset_allowance`: the term refitted with a free constant is not significant or gains less
+than ``min_gain_pct`` beyond it on the held-out rows; ``C:1`` always) and, with two or more
+references, a correction within the references' own flight-to-flight spread, are not named; they are
+listed under ``allowance``. ``wind`` is the coefficient-domain correction to the wind the estimator
+reconstructed (a real wind is reconstructed and is no cause): the same correction in the references is
+a systematic air-data error (``model_inadequacy``); only a correction of this flight alone is named.
+
 Structure the residual GP (:mod:`gcs_sysid.diagnose.residual_gp`) finds in the new flight is
 compared the same way: structured in the same coefficient in a reference too means model
 inadequacy outside the library (with its region), structured only in the new flight means an
@@ -48,7 +56,7 @@ from .regression import ols
 from .residual_gp import residual_structure
 from .terms import term_factors, term_matrix
 
-__all__ = ["Reference", "differential", "onset_of_change", "fit_record", "reference_logs"]
+__all__ = ["Reference", "differential", "offset_allowance", "onset_of_change", "fit_record", "reference_logs"]
 
 
 @dataclass
@@ -115,6 +123,139 @@ def _refit_other(ctx: DiagContext, R: np.ndarray, finding: dict, ref: Reference,
     if not hit or not np.isfinite(hit[0].std_error):
         return None
     return float(hit[0].estimate), float(hit[0].std_error)
+
+
+def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, coef: str, term: str,
+                     min_t: float = 3.0, min_gain_pct: float = 10.0) -> dict:
+    """Is an aero finding more than a between-flight offset of its coefficient?
+
+    Flights of one aircraft differ by near-constant coefficient offsets that are no cause (the
+    reconstruction's angle-of-attack offset, ``CZ_alpha d_alpha``; weight and CG within their tolerance
+    at one trim speed; an engine's torque at one power setting). The finding's term is refitted on the
+    selection rows together with a free constant, ``r_j ~ c + theta phi`` (coloured-residual standard
+    error, Morelli and Klein sec. 5.3), and scored on the held-out rows against the constant alone.
+    It is more than an offset when the term is not the constant, ``|theta| >= min_t se`` and the
+    held-out gain beyond the constant is at least ``min_gain_pct``.
+
+    Args:
+        X: (T, 10) regressors. R: (T, 6) residual without the finding (measured minus model).
+        train, test: (T,) selection and held-out rows. coef, term: the finding (``"CZ"``, ``"alpha"``).
+        min_t, min_gain_pct: the tests above.
+
+    Returns:
+        ``{"offset_only": bool, "estimate", "std_error", "t", "gain_beyond_offset_percent", "why"}``.
+    """
+    j = COEFFICIENTS.index(coef)
+    if term == "1":
+        return {"offset_only": True, "why": f"{coef}:1 is a between-flight offset of {coef}"}
+    try:
+        phi = term_matrix(X, [term])[:, 0]
+    except SysidError:                  # a term outside the vocabulary: the search fitted its own constant
+        return {"offset_only": False, "why": "term outside the vocabulary (the sparse search's own constant)"}
+    r = R[:, j]
+    ok = np.isfinite(r) & np.isfinite(phi)
+    tr, te = train & ok, test & ok
+    if tr.sum() < 50 or te.sum() < 20 or np.std(phi[tr]) == 0:
+        return {"offset_only": True, "why": f"{term} does not vary on these rows: an offset of {coef}"}
+    res = ols(np.column_stack([np.ones(tr.sum()), phi[tr]]), r[tr], terms=["1", term])
+    c, th, se = float(res.theta[0]), float(res.theta[1]), float(res.std_error[1])
+    b = float(np.sqrt(np.mean((r[te] - np.mean(r[tr])) ** 2)))
+    a = float(np.sqrt(np.mean((r[te] - c - th * phi[te]) ** 2)))
+    gain = 100.0 * (1.0 - a / b) if b > 0 else 0.0
+    t = th / se if se > 0 else 0.0
+    only = abs(t) < min_t or gain < min_gain_pct
+    why = (f"with {coef}'s between-flight offset free, {coef}:{term} is {th:+.4g} +- {se:.2g} (t {t:.1f}) and "
+           f"gains {gain:.0f} % on the held-out rows beyond the offset")
+    return {"offset_only": bool(only), "estimate": th, "std_error": se, "t": float(t),
+            "gain_beyond_offset_percent": float(gain), "why": why}
+
+
+def _within_reference_variation(c_f: float, se_f: float, compared: list[dict], k: float = 3.0) -> dict | None:
+    """With two or more reference flights: is the flight's correction within their flight-to-flight spread?
+
+    The references' own corrections ``c_r`` (each against the same model) scatter by ``s`` (sample standard
+    deviation) from flight to flight with nothing changed; the flight's ``c_f`` is an allowance when
+    ``|c_f - mean(c_r)| <= k sqrt(se_f^2 + s^2 + mean(se_r^2))``. None with fewer than two references or
+    outside the spread.
+    """
+    if len(compared) < 2:
+        return None
+    c = np.array([x["correction"] for x in compared], float)
+    se = np.array([x["std_error"] for x in compared], float)
+    s = float(np.std(c, ddof=1))
+    lim = k * float(np.sqrt(se_f**2 + s**2 + np.mean(se**2)))
+    if abs(c_f - float(np.mean(c))) > lim:
+        return None
+    return {"mean_reference": float(np.mean(c)), "spread_between_references": s, "limit": lim,
+            "why": f"{c_f:+.4g} against the references' {np.mean(c):+.4g} +- {s:.2g} (flight to flight): "
+                   "within the variation between the reference flights"}
+
+
+def _wind_fit(ctx: DiagContext, R: np.ndarray):
+    """The coefficient-domain wind correction (w_N, w_E) fitted on a residual: (params (2,), cov (2, 2)) or None."""
+    from .candidates import Scorer, fit_sensor_causes
+    from .causes import transforms
+
+    others = [c.cause for c in transforms(ctx) if c.cause != "wind"]
+    got = fit_sensor_causes(ctx, np.nan_to_num(R), Scorer(ctx, np.nan_to_num(R), None), exclude=others)
+    if not got or not np.all(np.isfinite(got[0].cov)):
+        return None
+    return np.asarray(got[0].params, float), np.asarray(got[0].cov, float)
+
+
+def _wind_differential(f: dict, fitted, refs, min_t: float = 3.0, consistent_rel: float = 0.25) -> dict:
+    """Is the flight's wind correction the same in the reference flight(s)?
+
+    The estimator already reconstructs the wind (GPS velocity minus the air-relative velocity), so the
+    catalogue's ``wind`` is a *correction* to that reconstruction: the true wind is the estimator's plus
+    ``(w_N, w_E)``. A real wind that differs between flights is reconstructed and is no cause; a
+    correction is news only when the reconstruction is wrong in this flight and not in the reference
+    flight(s). The same correction there (significant, ``|w_r| >= min_t`` standard errors, and
+    ``(w_f - w_r)^T (C_f + C_r)^-1 (w_f - w_r) <= 9`` or within ``consistent_rel |w_f|``) is a
+    systematic error of the air-data reconstruction (heading or sideslip offset): a calibration note,
+    not a named cause.
+
+    Args:
+        f: the finding (``evidence.parameters`` ``wn``, ``we``). fitted: its
+            :class:`~gcs_sysid.diagnose.candidates.Fitted` (for the covariance) or None.
+        refs: ``[(Reference, ctx, R)]`` against the same model.
+
+    Returns:
+        ``{"verdict": "changed" | "calibration" | "not compared", "why", "in_flight", "references"}``.
+    """
+    par = f.get("evidence", {}).get("parameters", {})
+    w_f = np.array([par.get("wn", np.nan), par.get("we", np.nan)], float)
+    C_f = np.asarray(fitted.cov, float) if fitted is not None and np.shape(fitted.cov) == (2, 2) \
+        else np.eye(2) * float(f.get("std_error", np.nan)) ** 2
+    comps = []
+    for ref, ctx, R in refs:
+        try:
+            got = _wind_fit(ctx, R) if ctx.has("phi", "theta", "psi") else None
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError, SysidError):
+            got = None
+        if got is None or not np.all(np.isfinite(w_f)):
+            comps.append({"label": ref.label, "compared": False})
+            continue
+        w_r, C_r = got
+        d = w_f - w_r
+        chi2 = float(d @ np.linalg.pinv(C_f + C_r) @ d)
+        sig_r = float(np.sqrt(max(w_r @ np.linalg.pinv(C_r) @ w_r, 0.0)))
+        same = sig_r >= min_t and (chi2 <= 9.0 or np.hypot(*d) <= consistent_rel * np.hypot(*w_f))
+        comps.append({"label": ref.label, "compared": True, "wn_mps": float(w_r[0]), "we_mps": float(w_r[1]),
+                      "t": sig_r, "chi2_difference": chi2, "same": bool(same)})
+    inflight = {"wn_mps": float(w_f[0]), "we_mps": float(w_f[1]), "speed_mps": float(np.hypot(*w_f))}
+    compared = [c for c in comps if c["compared"]]
+    if not compared:
+        return {"verdict": "not compared", "why": "no reference flight with attitude to compare the wind with",
+                "in_flight": inflight, "references": comps}
+    if all(c["same"] for c in compared):
+        return {"verdict": "calibration", "in_flight": inflight, "references": comps,
+                "why": (f"the reconstructed wind needs the same correction ({inflight['speed_mps']:.2g} m/s) in the "
+                        "reference flight(s): a systematic air-data error (heading or sideslip calibration), "
+                        "not this flight's air")}
+    return {"verdict": "changed", "in_flight": inflight, "references": comps,
+            "why": (f"the wind the estimator reconstructed is off by ({w_f[0]:+.2f}, {w_f[1]:+.2f}) m/s (N, E) in "
+                    "this flight and not in the reference flight(s): the true wind is the estimator's plus this")}
 
 
 def onset_of_change(t: np.ndarray, R_without: np.ndarray, delta: np.ndarray, valid: np.ndarray,
@@ -209,6 +350,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
         (list), ``changed`` (list of cause names with their reference comparison), ``not_compared``,
+        ``allowance`` (findings that are a between-flight offset of their coefficient,
+        :func:`offset_allowance`, or within the spread between two or more reference flights; not named),
         ``unexplained`` (per coefficient: ``"in the reference too"`` or ``"only in this flight"``).
 
     Raises:
@@ -221,17 +364,18 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
     doc: dict = {"references": [{"label": r.label, "n_valid": int(c.valid.sum()),
                                  "t_range_s": [float(c.t[c.valid][0]), float(c.t[c.valid][-1])]}
                                 for r, c, _ in refs],
-                 "model_inadequacy": [], "changed": [], "not_compared": [], "unexplained": {}}
+                 "model_inadequacy": [], "changed": [], "not_compared": [], "allowance": [], "unexplained": {}}
     fitted = {f.cause: f for f in diag.fitted}
     valid = np.isfinite(diag.residual_after).all(axis=1)
+    valid0 = np.isfinite(diag.residual_before).all(axis=1)
+    min_gain_pct = float(diag.data.get("thresholds", {}).get("min_gain_pct", 10.0))
     sig = np.nanstd(np.where(valid[:, None], diag.residual_after, np.nan), axis=0)
     sig = np.where(sig > 0, sig, 1.0)
     keep = []
     for f in diag.findings:
         cause = f["cause"]
-        if f.get("kind") == "fault" or cause.startswith("stuck:") or cause == "wind":
-            why = "an event in this flight (telemetry fault or stuck surface)" if cause != "wind" \
-                else "the air of this flight (wind is a flight condition)"
+        if f.get("kind") == "fault" or cause.startswith("stuck:"):
+            why = "an event in this flight (telemetry fault or stuck surface)"
             f["evidence"]["differential"] = {"verdict": "changed", "why": why}
             doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"), "why": why})
             keep.append(f)
@@ -246,9 +390,39 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 doc["not_compared"].append(cause)
             keep.append(f)
             continue
+        if cause == "wind":
+            verdict = _wind_differential(f, fitted.get(cause), refs)
+            f["evidence"]["differential"] = verdict
+            if verdict["verdict"] == "changed":
+                doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"), "why": verdict["why"]})
+                keep.append(f)
+            elif verdict["verdict"] == "not compared":
+                doc["not_compared"].append(cause)
+                keep.append(f)
+            else:
+                doc["model_inadequacy"].append({"cause": cause, "coefficient": f["coefficient"],
+                                                "in_flight": verdict["in_flight"],
+                                                "in_references": verdict["references"], "gain": f.get("gain", {}),
+                                                "summary": verdict["why"]})
+            continue
         is_aero = cause.split(":")[0] in COEFFICIENTS
+        if is_aero:                          # the between-flight allowance: an offset of the coefficient
+            coef, term = cause.split(":", 1)
+            R_wo = (diag.residual_after - fitted[cause].delta) if cause in fitted else diag.residual_before
+            allow = offset_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
+                                     min_t=min_t, min_gain_pct=min_gain_pct)
+            if allow["offset_only"]:
+                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": allow}
+                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
+                                         "gain": f.get("gain", {}), "why": allow["why"],
+                                         "summary": f"{cause}: a between-flight offset of {coef}, not a cause"})
+                continue
+            f["evidence"]["offset_allowance"] = allow
         null = 0.0 if is_aero else _null_value(cause, airframe)
-        c_f = (f["evidence"].get("correction", f["estimate"] - null) if is_aero else f["estimate"] - null)
+        # an aero finding's correction is its change from the model's value (catalogue: evidence.correction;
+        # sparse search: estimate - model_value)
+        mv = f.get("model_value", f["evidence"].get("model_value", 0.0))
+        c_f = f["evidence"].get("correction", f["estimate"] - mv) if is_aero else f["estimate"] - null
         se_f = float(f["std_error"])
         comps = []
         for ref, ctx, R in refs:
@@ -274,6 +448,13 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             f["evidence"]["differential"] = {"verdict": "not compared", "references": comps}
             doc["not_compared"].append(cause)
             keep.append(f)
+            continue
+        spread = _within_reference_variation(c_f, se_f, compared)
+        if spread is not None:
+            f["evidence"]["differential"] = {"verdict": "allowance", "references": comps, "allowance": spread}
+            doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
+                                     "gain": f.get("gain", {}), "why": spread["why"],
+                                     "summary": f"{cause}: within the variation between the reference flights"})
             continue
         if all(c["same"] for c in compared):
             w = np.array([1 / se_f**2] + [1 / c["std_error"] ** 2 for c in compared])

@@ -16,6 +16,14 @@ Its signature is then:
 - **differential**: the same fit on the reference flight(s) must give a different value; a pitot
   bias the reference flight had too is a calibration note, not a change.
 
+The physical gate removes each coefficient's between-flight offset before it judges a cause
+(:data:`gcs_sysid.diagnose.physical.OFFSETS_ALLOWED`). A pitot bias at one trim speed is mostly such
+an offset, so when the autopilot's wind estimate confirms the bias on its own (the wind shift at least
+:data:`MIN_T_WIND` of its standard errors from 0 and in agreement with the fit), the offsets the bias
+makes are its evidence and the gate keeps them; without that confirmation they are an allowance,
+and the bias is named only for what it explains beyond them (its V-dependent size, rates, angles).
+Accepted, its symptoms (aero terms and ``scale:<coef>`` of the implied coefficients) leave the findings.
+
 Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:15 UTC):
 ``MIN_T`` on the fit's coloured-residual t statistic, and the systematic error of the autopilot's
 wind estimate ``WIND_SYSTEMATIC_MPS`` in the wind check.
@@ -36,12 +44,16 @@ from .context import DiagContext
 from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
 
-__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "airspeed_cause", "wind_shift", "with_pitot"]
+__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "airspeed_cause", "wind_shift", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
 #: 1-sigma systematic error of an autopilot's wind estimate (m/s): its slow wander.
 WIND_SYSTEMATIC_MPS = 0.3
+#: |b_wind| / its standard error for the autopilot's wind estimate to *confirm* a pitot error on its own
+#: (then the coefficient offsets the bias makes count as its evidence, not as a between-flight allowance;
+#: :data:`gcs_sysid.diagnose.physical.OFFSETS_ALLOWED`).
+MIN_T_WIND = 3.0
 PITOT_CAUSES = ("bias:airspeed", "scale:airspeed")
 
 
@@ -134,7 +146,14 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         if not all(checks.values()):
             cand["accepted"] = False
             continue
-        gate = physical_gate(ctx, np.nan_to_num(R), f.delta, 1, proj, acc, gain_rows)
+        # the autopilot's own wind estimate independently confirms a pitot error along the heading: then the
+        # coefficient offsets the bias makes are part of its evidence, not a between-flight allowance
+        b_est = f.estimate if cause == "bias:airspeed" else (f.estimate - 1.0) * float(np.median(ctx.x("V")[ctx.valid]))
+        confirmed = wind is not None and abs(wind["bias_mps"]) >= MIN_T_WIND * wind["std_error"] and \
+            abs(wind["bias_mps"] - b_est) <= 3.0 * np.hypot(wind["std_error"], f.std_error) + 0.25 * abs(b_est)
+        gate = physical_gate(ctx, np.nan_to_num(R), f.delta, 1, proj, acc, gain_rows,
+                             offsets_allowed=False if confirmed else None)
+        cand["confirmed_by_wind_estimate"] = bool(confirmed)
         checks["signature"] = gate["signature"]["holds"]
         checks["beats_terms"] = bool(gate["versus_terms"]["beats"])
         cand["gate"] = gate
@@ -211,7 +230,11 @@ def with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
     if f is None:
         return findings
     implied = set(f["evidence"]["signature"]["implied"])
-    symptoms = [g for g in findings if g["cause"].split(":")[0] in implied and g.get("kind") != "fault"
+    # its symptoms: aero terms of an implied coefficient, and a scale of one (the sparse search's
+    # ``scale:CY``: every coefficient is scaled by (V / (V + b))^2)
+    symptoms = [g for g in findings if (g["cause"].split(":")[0] in implied or
+                                        (g["cause"].startswith("scale:") and g["cause"][6:] in implied))
+                and g.get("kind") != "fault"
                 and g.get("evidence", {}).get("domain") not in ("data compatibility", "physical signature")]
     f["evidence"]["explains"] = [g["cause"] for g in symptoms]
     return [g for g in findings if g.get("kind") == "fault"] + [f] + \
