@@ -424,6 +424,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             # determined (e0 trades with the constants): the library keeps the measured mean angle
             # rather than an arbitrary shift of it (which turns alpha^2 into alpha^3 or alpha^2*delta_e)
             err = err - err[tr].mean(axis=0)
+        info["library_shift_rad"] = [float(v) for v in err[tr].mean(axis=0)] if tr.size else [0.0, 0.0]
         Rd = Rd - N
         M0 = M0 + N
         result["angle_nuisance"] = info
