@@ -20,6 +20,11 @@ measurement equation). The corrected alpha feeds the candidate library and the m
 change ``M(X_c) - M(X)`` is removed from every coefficient, as for the parametric angle nuisance
 (:func:`gcs_sysid.diagnose.sparse.angle_nuisance`), which runs first.
 
+Off in the frozen thresholds of :data:`gcs_sysid.diagnose.sparse.THRESHOLDS` (``lift_alpha_hz`` 0,
+2026-11-22): on the SGS tuning flights it reduced the alpha error's standard deviation only from
+0.40-0.45 to 0.33-0.42 deg (the quadratic model's own lift error is of the same size) and hinges
+in alpha then won over ``alpha^2``; ``thresholds={"lift_alpha_hz": 0.2}`` switches it on.
+
 What it cannot tell apart: a slow true change of the normal force (a CZ term that varies only with
 the flight condition) from an alpha error; after it, CZ's residual holds only its faster part, so
 a CZ term is found from that part alone.
