@@ -171,7 +171,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
     p.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
-    p.add_argument("--clean-seeds", nargs="+", type=int, default=[11, 12, 13, 14, 15])
+    p.add_argument("--clean-seeds", nargs="*", type=int, default=[11, 12, 13, 14, 15])
     p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
     p.add_argument("--pairs", nargs="*", default=["Cm:alpha^2,Cn:delta_a", "Cl:alpha*beta,delay:delta_e"])
     p.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "diag-effects"))

@@ -36,7 +36,7 @@ from gcs_sysid.signals import doublet, multisine, three_two_one_one
 from .aircraft import AircraftSpec, aircraft
 
 __all__ = ["FlightConfig", "Recording", "fly", "load_model", "maneuver_inputs", "speed_schedule",
-           "sideslip_holds", "PLANS", "TURBULENCE", "LBF", "FT", "SLUG", "SLUG_FT2"]
+           "sideslip_holds", "slip_scale", "PLANS", "TURBULENCE", "LBF", "FT", "SLUG", "SLUG_FT2"]
 
 LBF = 4.4482216152605      # N per lbf
 FT = 0.3048                # m per ft
@@ -70,6 +70,24 @@ MAX_BETA_DEG = 20.0
 SWEEP_RAMP_S = 8.0       # duration of each speed change (cosine ramp), s
 SWEEP_MAX_PITCH_FF = 0.15  # largest pitch-attitude feedforward of a speed change, rad
 SWEEP_SLIP_RUDDER = 0.5    # rudder of a steady-heading sideslip, share of the maneuver amplitude
+#: Sideslip at the slow levels: the rudder of a steady-heading sideslip is scaled by
+#: ``clip((level - SLIP_SLOW_FROM) / (1 - SLIP_SLOW_FROM), SLIP_SLOW_MIN, 1)`` of the level's
+#: airspeed factor (full at the initial speed and above, half at 0.75), as a test pilot limits
+#: sideslip near the stall, where the dihedral effect can reverse (added 2026-11-22, issue 9).
+SLIP_SLOW_FROM = 0.5
+SLIP_SLOW_MIN = 0.5
+#: Knock-it-off limits of the maneuvers (the test pilot's abort): when the sideslip exceeds
+#: ``ABORT_BETA_DEG`` or the bank ``ABORT_BANK_DEG``, the maneuver inputs and the speed sweep's
+#: feedforward are faded out and the pilot recovers for ``RECOVER_S`` s: rudder against the
+#: sideslip (``RECOVER_K_BETA`` rad per rad), wings level, and the nose lowered to at least the
+#: initial airspeed (unloading restores the dihedral effect that high alpha took away); then the
+#: inputs fade back in over ``RECOVER_FADE_S`` s. Inside :data:`MAX_BETA_DEG`, so that a departing
+#: maneuver is stopped before the envelope check ends the flight; ``meta["aborts"]`` lists them.
+ABORT_BETA_DEG = 15.0
+ABORT_BANK_DEG = 45.0
+RECOVER_S = 6.0
+RECOVER_FADE_S = 1.5
+RECOVER_K_BETA = 0.5
 
 
 @dataclass(frozen=True)
@@ -241,7 +259,7 @@ def sideslip_holds(spec: AircraftSpec, duration: float, plan: str = "standard") 
     One per speed level of :data:`SWEEP_LEVELS` (so at a different alpha each), starting when
     60 % of the level's speed change is done, alternating in sign; each ramps in over 0.75 s,
     holds 2.5 s and ramps out over 0.75 s, with the rudder at :data:`SWEEP_SLIP_RUDDER` of the
-    aircraft's maneuver amplitude.
+    aircraft's maneuver amplitude times the slow-level limit (:func:`slip_scale`).
     The autopilot's roll and heading loops supply the opposite aileron and the bank, as a pilot
     flying a steady-heading sideslip does. Levels too short to hold one are skipped.
     """
@@ -253,8 +271,19 @@ def sideslip_holds(spec: AircraftSpec, duration: float, plan: str = "standard") 
     for k in range(len(SWEEP_LEVELS)):
         t0 = starts[k] + (0.6 * SWEEP_RAMP_S if k else 3.0)
         if t0 + _SLIP_S <= starts[k + 1] - 0.3:
-            out.append((t0, ar * (1.0 if len(out) % 2 == 0 else -1.0)))
+            out.append((t0, ar * slip_scale(SWEEP_LEVELS[k][1]) * (1.0 if len(out) % 2 == 0 else -1.0)))
     return out
+
+
+def slip_scale(level: float) -> float:
+    """Share of the full sideslip rudder flown at airspeed factor ``level`` (:data:`SLIP_SLOW_FROM`).
+
+    Near the stall a pilot flies smaller sideslips: the dihedral effect weakens or reverses at
+    high alpha and a large sideslip there can end in a departure (Morelli and Klein, sec. 9.1:
+    inputs sized to keep the aircraft near the condition being identified).
+    """
+    x = (float(level) - SLIP_SLOW_FROM) / (1.0 - SLIP_SLOW_FROM)
+    return float(np.clip(x, SLIP_SLOW_MIN, 1.0))
 
 
 _SLIP_S = 4.0        # ramp in 0.75 s, hold 2.5 s, ramp out 0.75 s
@@ -359,7 +388,9 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
         ValueError: unknown aircraft or bad configuration.
         RuntimeError: JSBSim failed to load or initialise the model, or the aircraft left the
             flight envelope (airspeed below half or above twice the initial value, bank beyond
-            70 deg, sideslip beyond :data:`MAX_BETA_DEG`), which means the autopilot or the maneuvers need retuning for it.
+            70 deg, sideslip beyond :data:`MAX_BETA_DEG`) even with the pilot's knock-it-off and
+            recovery (:data:`ABORT_BETA_DEG`; the aborts flown are listed in ``meta["aborts"]``),
+            which means the autopilot or the maneuvers need retuning for it.
     """
     spec = aircraft(config.aircraft)
     dt = 1.0 / config.sim_rate_hz
@@ -382,13 +413,25 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
     v_fac, v_rate = speed_schedule(t_log, config.duration_s, config.plan)
     rec = {k: np.empty(n_log) for k in list(_PROPS) + ["delta_e", "delta_a", "delta_r", "delta_t"]}
     n_total = n_settle + n_log * dec
+    aborts: list[dict] = []
+    t_abort = -np.inf            # time of the last knock-it-off, s of logged time
     for i in range(n_total):
         j = (i - n_settle) // dec
-        man = u_man[j] if i >= n_settle else np.zeros(3)
+        t_now = (i - n_settle) * dt
+        # knock-it-off: the maneuvers fade out, the autopilot recovers, then they fade back in
+        w_man = float(np.clip((t_now - t_abort - RECOVER_S) / RECOVER_FADE_S, 0.0, 1.0))
+        if i >= n_settle and (abs(fdm["aero/beta-rad"]) > np.radians(ABORT_BETA_DEG)
+                              or abs(fdm["attitude/phi-rad"]) > np.radians(ABORT_BANK_DEG)):
+            if t_now - t_abort > RECOVER_S:
+                aborts.append({"t_s": round(t_now, 3), "beta_deg": round(float(np.degrees(fdm["aero/beta-rad"])), 2),
+                               "bank_deg": round(float(np.degrees(fdm["attitude/phi-rad"])), 2)})
+            t_abort, w_man = t_now, 0.0
+        man = u_man[j] * w_man if i >= n_settle else np.zeros(3)
         v_cmd = v_ref * (v_fac[j] if i >= n_settle else 1.0)
+        v_cmd += (1.0 - w_man) * max(0.0, v_ref - v_cmd)          # recovery: unload to >= initial speed
         # glide-path change for dV/dt (a pull-up to slow down, a push-over to speed up), limited
-        theta_ff = float(np.clip(-v_ref * (v_rate[j] if i >= n_settle else 0.0) / 9.80665,
-                                 -SWEEP_MAX_PITCH_FF, SWEEP_MAX_PITCH_FF))
+        theta_ff = w_man * float(np.clip(-v_ref * (v_rate[j] if i >= n_settle else 0.0) / 9.80665,
+                                         -SWEEP_MAX_PITCH_FF, SWEEP_MAX_PITCH_FF))
         theta, q, V = fdm["attitude/theta-rad"], fdm["velocities/q-rad_sec"], fdm["velocities/vt-fps"] * FT
         phi, p, r = fdm["attitude/phi-rad"], fdm["velocities/p-rad_sec"], fdm["velocities/r-rad_sec"]
         theta_ref0 += 0.2 * k_v * (V - v_cmd) * dt            # slow trim of the pitch reference
@@ -399,7 +442,7 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
         psi_err = (fdm["attitude/psi-rad"] - psi_ref + np.pi) % (2 * np.pi) - np.pi
         phi_ref = float(np.clip(-0.5 * psi_err, -0.2, 0.2))     # weak heading hold
         da = k_phi * (phi - phi_ref) + k_p * p + man[1]
-        dr = k_r * r + man[2]
+        dr = k_r * r + man[2] - (1.0 - w_man) * RECOVER_K_BETA * fdm["aero/beta-rad"]   # + recovery rudder
         cmd = np.array([de, da, dr])
         if first:
             servo, first = cmd.copy(), False
@@ -432,6 +475,6 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
              "c": float(fdm["metrics/cbarw-ft"] * FT),
              "home_lat": float(rec["lat"][0]), "home_lon": float(rec["lon"][0]), "home_alt": 0.0}
     meta = {"config": asdict(config), "aircraft": asdict(spec) | {"airframe_path": str(spec.airframe_path)},
-            "jsbsim_version": jsbsim.__version__}
+            "jsbsim_version": jsbsim.__version__, "aborts": aborts}
     meta["aircraft"].pop("airframe_path", None)
     return Recording(t=t_log, truth=rec, constants=const, config=config, meta=meta)

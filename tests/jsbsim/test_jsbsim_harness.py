@@ -135,3 +135,40 @@ def test_sweep_plan_spans_alpha_and_sideslips_at_several_speeds():
     # the c172x's holds (3 deg of rudder, on top of the other maneuvers) give about 1 deg of sideslip
     assert np.median(betas) > 0.5, betas
     assert np.ptp(alphas) > 1.0                                       # at different alpha
+
+
+def test_sideslips_are_smaller_at_the_slow_levels():
+    """A test pilot limits sideslip near the stall: the rudder of a hold scales with the level's
+    speed, full at the initial speed and above, half at 0.75."""
+    from benchmarks.jsbsim_harness.flight import SWEEP_LEVELS, SWEEP_SLIP_RUDDER, sideslip_holds, slip_scale
+
+    assert slip_scale(0.75) == pytest.approx(0.5) and slip_scale(1.0) == 1.0 and slip_scale(1.12) == 1.0
+    assert slip_scale(0.82) == pytest.approx(0.64)
+    spec = aircraft("sgs")
+    full = SWEEP_SLIP_RUDDER * np.radians(spec.amplitude_deg[2])
+    holds = sideslip_holds(spec, 120.0, "sweep")
+    starts = [f * 120.0 for f, _ in SWEEP_LEVELS] + [120.0]
+    for t0, amp in holds:
+        k = max(i for i in range(len(SWEEP_LEVELS)) if starts[i] <= t0)
+        assert abs(amp) == pytest.approx(full * slip_scale(SWEEP_LEVELS[k][1]))
+    assert min(abs(a) for _, a in holds) < 0.6 * full < max(abs(a) for _, a in holds)
+
+
+@pytest.mark.slow
+def test_a_departing_maneuver_is_knocked_off_and_the_flight_survives(tmp_path):
+    """With Cl:alpha*beta = 3 the SGS's dihedral reverses at the slow level and a sideslip departs
+    (before the knock-it-off: beyond 20 deg, the flight ended). The pilot's abort stops the
+    maneuvers, recovers (rudder against the sideslip, unload) and resumes; the clean reference
+    flight never needs it."""
+    from benchmarks.jsbsim_harness.effects import Effect, _write_model
+    from benchmarks.jsbsim_harness.flight import ABORT_BETA_DEG, MAX_BETA_DEG
+
+    spec = aircraft("sgs")
+    cfg = FlightConfig("sgs", duration_s=120.0, seed=1, plan="sweep")
+    rec = fly(cfg, _write_model(spec, [Effect("Cl:alpha*beta", 3.0)], tmp_path))
+    aborts = rec.meta["aborts"]
+    assert aborts and all(abs(a["beta_deg"]) >= ABORT_BETA_DEG for a in aborts), aborts
+    assert np.degrees(np.abs(rec.truth["beta"])).max() < MAX_BETA_DEG
+    assert rec.t[-1] == pytest.approx(120.0 - 0.02)
+    ref = fly(FlightConfig("sgs", duration_s=120.0, seed=100, plan="sweep"))
+    assert ref.meta["aborts"] == []
