@@ -113,22 +113,25 @@ def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: 
     press = [float(rk.sum())]
     K = A.shape[1]
     while len(sel) < max_terms:
-        best, best_p = None, press[-1]
-        for c in range(K):
-            if c in sel:
-                continue
-            S = sel + [c]
-            p = 0.0
-            for k in range(F):
-                Gm = G[np.ix_(S, S)] - Gk[k][np.ix_(S, S)] + ridge * np.eye(len(S))
-                th = np.linalg.solve(Gm, b[S] - bk[k][S])
-                p += rk[k] - 2 * th @ bk[k][S] + th @ Gk[k][np.ix_(S, S)] @ th
-            if p < best_p:
-                best, best_p = c, p
-        if best is None or press[-1] - best_p < min_press_gain * press[-1]:
+        # every candidate c and fold k of this step at once: the fold-out normal equations of sel + [c]
+        # (Gm = G_S - Gk_S, stacked (F, C, s, s)) solved in one batched call, then the fold's PRESS term
+        # rk - 2 th.bk_S + th.Gk_S.th; the same arithmetic as one solve per (c, k), without the Python loop
+        cand = np.array([c for c in range(K) if c not in sel], dtype=int)
+        if cand.size == 0:
             break
-        sel.append(best)
-        press.append(float(best_p))
+        S = np.column_stack([np.tile(np.asarray(sel, dtype=int), (cand.size, 1)), cand])    # (C, s)
+        ii, jj = S[:, :, None], S[:, None, :]
+        Gks = Gk[:, ii, jj]                                                                 # (F, C, s, s)
+        bks = bk[:, S]                                                                      # (F, C, s)
+        Gm = G[ii, jj][None] - Gks + ridge * np.eye(S.shape[1])
+        th = np.linalg.solve(Gm, (b[S][None] - bks)[..., None])[..., 0]                     # (F, C, s)
+        p = (rk[:, None] - 2 * np.einsum("fcs,fcs->fc", th, bks)
+             + np.einsum("fcs,fcst,fct->fc", th, Gks, th)).sum(0)                           # (C,)
+        i = int(np.argmin(p))                                  # the first of equal minima, as the loop did
+        if not p[i] < press[-1] or press[-1] - p[i] < min_press_gain * press[-1]:
+            break
+        sel.append(int(cand[i]))
+        press.append(float(p[i]))
     return {"selected": sel, "press": press, "scale": scale}
 
 

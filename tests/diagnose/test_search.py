@@ -53,6 +53,53 @@ def test_press_stepwise_against_brute_force():
     assert res["press"][1] == pytest.approx(direct, rel=1e-6)
 
 
+def _press_stepwise_loop(Phi, r, fold, max_terms=6, min_press_gain=0.02):
+    """The straightforward form: one solve per candidate and fold (the batched code must agree)."""
+    scale = np.sqrt(np.mean(Phi**2, axis=0))
+    A = Phi / np.where(scale > 0, scale, 1.0)
+    F = int(fold.max()) + 1
+    Gk = np.stack([A[fold == k].T @ A[fold == k] for k in range(F)])
+    bk = np.stack([A[fold == k].T @ r[fold == k] for k in range(F)])
+    rk = np.array([r[fold == k] @ r[fold == k] for k in range(F)])
+    G, b = Gk.sum(0), bk.sum(0)
+    ridge = 1e-9 * np.trace(G) / G.shape[0]
+    sel, press = [], [float(rk.sum())]
+    while len(sel) < max_terms:
+        best, best_p = None, press[-1]
+        for c in range(A.shape[1]):
+            if c in sel:
+                continue
+            S = sel + [c]
+            p = 0.0
+            for k in range(F):
+                th = np.linalg.solve(G[np.ix_(S, S)] - Gk[k][np.ix_(S, S)] + ridge * np.eye(len(S)), b[S] - bk[k][S])
+                p += rk[k] - 2 * th @ bk[k][S] + th @ Gk[k][np.ix_(S, S)] @ th
+            if p < best_p:
+                best, best_p = c, p
+        if best is None or press[-1] - best_p < min_press_gain * press[-1]:
+            break
+        sel.append(best)
+        press.append(float(best_p))
+    return sel, press
+
+
+def test_press_stepwise_batched_equals_the_loop():
+    """Same terms, same PRESS path (1e-9) as one solve per candidate and fold, with a near-collinear pair."""
+    rng = np.random.default_rng(3)
+    for trial in range(3):
+        N, K = 1500, 60
+        Phi = rng.normal(size=(N, K)) * rng.uniform(0.1, 10.0, K)
+        Phi[:, 5] = 0.999 * Phi[:, 3] + 0.001 * rng.normal(size=N)
+        Phi[:, 7] = 0.0                                                      # an empty column
+        z = Phi / Phi.std(0).clip(1e-12)
+        r = z[:, [3, 17, 40]] @ np.array([0.5, -0.2, 0.05]) + 0.3 * np.sin(z[:, 50]) + 0.1 * rng.normal(size=N)
+        fold = np.minimum((np.arange(N) * 5) // N, 4)
+        res = press_stepwise(Phi, r, fold)
+        sel, press = _press_stepwise_loop(Phi, r, fold)
+        assert res["selected"] == sel and len(sel) >= 3
+        assert np.allclose(res["press"], press, rtol=1e-9, atol=0.0)
+
+
 def test_two_effects_outside_the_vocabulary_are_both_found(airframe):
     """A cubic in Cm and a break in the Cl slope at 5 deg alpha, at once; nothing found elsewhere."""
     ctx, R = _ctx(airframe, [(4, lambda t: -40.0 * t.x("alpha") ** 3),
