@@ -7,10 +7,10 @@ a gust, the air-angle estimate's lag or the angular-acceleration smoother's erro
 of consecutive 50 Hz rows together. To the likelihood such a coloured error looks like signal, so
 the latent GP and, above all, the local layer (whose neighbours are mostly the rows just before
 and after) learn it, and predict it where it is not: on rows of another time. Measured on the
-JSBSim flights (``docs/benchmarks.md``, "The GP earns its place"): without the local layer the
-held-out errors fell on 33 of 36 flight x coefficient pairs, and on the moments, whose truth is
-linear in the regressors plus the turbulence's rotational rates (which no regressor carries), the
-linear model alone beat the GP.
+JSBSim flights (``docs/benchmarks.md``, eval_gp_jsbsim, "The GP earns its place"): without the
+local layer the held-out errors fell on 30 of 36 flight x coefficient pairs (5 equal to 0.1 %, 1
+higher), and on the moments, whose truth is linear in the regressors plus the turbulence's
+rotational rates (which no regressor carries), a plain linear fit beat the GP.
 
 The check here asks the data the question the held-out segment asks: the training rows, in time
 order, are cut into ``k`` contiguous blocks; each block is predicted by the model conditioned on
@@ -22,8 +22,8 @@ rows, so "all rows minus block b" is exact and costs one posterior, not one fit)
   blocked squared error; ``s_p`` small leaves a Bayesian linear regression for that output (the
   smallest value is kept above 0 so that ``B`` stays positive definite);
 * local layer: kept for output ``p`` only when it lowers the blocked squared error of the global
-  residual; otherwise its signal variance ``amp_p`` is multiplied by :data:`LOCAL_OFF` (mean and
-  variance of that output's local part ~0).
+  residual by at least 1 % (:data:`LOCAL_MARGIN`); otherwise its signal variance ``amp_p`` is
+  multiplied by :data:`LOCAL_OFF` (mean and variance of that output's local part ~0).
 
 This is the k-fold cross-validation of Rasmussen and Williams (2006), *Gaussian Processes for
 Machine Learning*, sec. 5.3, with contiguous blocks as for dependent data (Roberts et al. 2017,
@@ -47,13 +47,18 @@ from .batching import global_stats, local_predict
 from .local import LocalParams, build_store
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
 
-__all__ = ["GLOBAL_GRID", "LOCAL_OFF", "block_folds", "scale_latent", "gate_global", "gate_local"]
+__all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "block_folds", "scale_latent", "gate_global", "gate_local"]
 
 #: Candidate scales ``s_p`` of the latent GP's prior std per output (1: as learned).
 GLOBAL_GRID: tuple[float, ...] = (0.05, 0.3, 1.0)
 
 #: Factor on a rejected output's local signal variance ``amp_p`` (its local mean and variance ~0).
 LOCAL_OFF = 1e-6
+
+#: The local layer is kept for an output when its blocked squared error is below this share of the
+#: error without it: it must earn its place by a margin, not by a rounding-level difference (on
+#: smooth synthetic data the ratio sits at 0.9996-1.0025 for outputs the layer has nothing to add).
+LOCAL_MARGIN = 0.99
 
 
 def block_folds(n: int, k: int) -> list[tuple[int, int]]:
@@ -153,8 +158,8 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
 
     Returns:
         ``(local_gated, keep, ratio)``: parameters with ``amp_p`` times :data:`LOCAL_OFF` where
-        rejected, ``keep (P,)`` bool, and ``ratio (P,)`` the blocked squared error with the local
-        layer over that without it (< 1: it helps).
+        rejected, ``keep (P,)`` bool (``ratio < LOCAL_MARGIN``), and ``ratio (P,)`` the blocked
+        squared error with the local layer over that without it (< 1: it helps).
     """
     n, P = resid.shape
     rng = np.random.default_rng(seed + 29)
@@ -171,6 +176,6 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
         with_l += np.sum((resid[rows] - m) ** 2, 0)
         without += np.sum(resid[rows] ** 2, 0)
     ratio = with_l / np.maximum(without, 1e-300)
-    keep = ratio < 1.0
+    keep = ratio < LOCAL_MARGIN
     amp = np.where(keep, np.asarray(local.amp), np.asarray(local.amp) * LOCAL_OFF)
     return replace(local, amp=jnp.asarray(amp)), keep, ratio
