@@ -116,7 +116,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
     ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
     tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
     if thin is not None:
-        tr &= (np.cumsum(tr) % int(thin)) == 1
+        tr &= (np.cumsum(tr) - 1) % int(thin) == 0
     h = d["held"] & ok
     meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
     if thin is not None:
