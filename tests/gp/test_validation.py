@@ -84,6 +84,19 @@ def coloured_fit():
     return X, Y, cfg, fit_gp(X, Y, cfg, input_names=["x"], output_names=["y0", "y1"])
 
 
+def test_fit_applies_the_gates_it_records(fitted):
+    """The shared fixture's fit (conftest, 400 time-ordered rows): the recorded choice is in the model."""
+    model, hist = fitted
+    v = hist.validation
+    assert len(v["latent_scale"]) == 6 and set(v["latent_scale"]) <= set(GLOBAL_GRID)
+    amp = np.asarray(model.local_params.amp)
+    off = ~np.asarray(v["local_kept"])
+    assert np.all((np.asarray(v["local_ratio"]) < 0.99) == ~off)
+    if off.any() and (~off).any():
+        assert amp[off].max() < 1e-3 * amp[~off].min()
+
+
+@pytest.mark.slow
 def test_fit_records_the_gates_and_the_model_round_trips(coloured_fit, tmp_path):
     X, Y, cfg, (model, hist) = coloured_fit
     v = hist.validation
