@@ -105,18 +105,27 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
     raise ValueError(variant)
 
 
-def score(path: Path, variants, base: GPConfig = GPConfig()):
-    """Every variant on one cached flight; yields one JSON-able dict per variant."""
+def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = None):
+    """Every variant on one cached flight; yields one JSON-able dict per variant.
+
+    ``thin``: fit on every ``thin``-th training row only (few samples over the whole flown envelope:
+    where pooling the outputs in one joint model should matter most); None: all of them.
+    """
     d = np.load(path)
     X, Y, Xt, Yt = d["X"], d["Y"], d["Xt"], d["Yt"]
     ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
     tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
+    if thin is not None:
+        tr &= (np.cumsum(tr) - 1) % int(thin) == 0
     h = d["held"] & ok
     meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
+    if thin is not None:
+        meta["aoa"] += f"/thin{int(thin)}"            # a separate group in --summarize
     for v in variants:
         t0 = time.perf_counter()
         corr = float("nan")
         true = None
+        validation = {}
         if v == "ls":
             mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
             sig_n = sig_g = sig
@@ -131,7 +140,8 @@ def score(path: Path, variants, base: GPConfig = GPConfig()):
             sig_n = sig_g = sig * np.nan
         else:
             prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
-            model, _ = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
+            model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
+            validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
             mean, sig = m + prior[h], np.sqrt(var)
             sig_n = np.sqrt(model.predict(X[h])[1])                         # with the observation noise (the replay's band)
@@ -146,7 +156,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig()):
                          cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())),
                          cov_noise=dict(zip(COEFFICIENTS, cvn.round(1).tolist())),
                          cov_gnoise=dict(zip(COEFFICIENTS, coverage(mean, sig_g, Yt[h]).round(1).tolist())),
-                         max_corr=corr,
+                         max_corr=corr, validation=validation,
                          meas=dict(zip(COEFFICIENTS, errors(Y[h], Yt[h]).round(2).tolist())),
                          **({} if true is None else {
                              "err_true": dict(zip(COEFFICIENTS, errors(true[0], Yt[h]).round(2).tolist())),
@@ -203,6 +213,8 @@ def main(argv=None) -> int:
     ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS)
     ap.add_argument("--json", default=None, help="append one JSON line per flight and variant")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
+    ap.add_argument("--thin", type=int, default=None,
+                    help="fit on every N-th training row only (joint vs independent with few samples)")
     a = ap.parse_args(argv)
     if a.summarize:
         print(summarize(a.summarize))
@@ -216,7 +228,7 @@ def main(argv=None) -> int:
                     path = cache / f"{ac}-{seed}-{turb}-{aoa}.npz"
                     if a.make or not path.is_file():
                         path = make(ac, seed, turb, aoa, a.duration, cache)
-                    for r in score(path, a.variants):
+                    for r in score(path, a.variants, thin=a.thin):
                         print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
                               + "  cov " + " ".join(f"{r['cov'][c]:5.1f}" for c in COEFFICIENTS)
                               + f"  corr {r['max_corr']:.2f}  {r['t_fit_s']:.1f} s", flush=True)

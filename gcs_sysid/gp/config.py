@@ -73,6 +73,10 @@ class GPConfig:
             the long-run variance ratio of its time-ordered training residuals (coloured residuals:
             consecutive rows share an error, so they are worth fewer independent rows;
             :mod:`gcs_sysid.gp.colored`). Off by default (``docs/gp.md``, "Coloured residuals").
+        validation_folds: contiguous blocks of the time-ordered training rows for the blocked
+            cross-validation that decides, per output, how much of the latent GP and whether the
+            local layer is kept (:mod:`gcs_sysid.gp.validation`; ``docs/gp.md``, "Earning its
+            place"); 0 or 1: keep both as learned (the model before this check).
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -109,6 +113,7 @@ class GPConfig:
     noise_correlation: bool = False
     input_noise: bool = True
     residual_correlation: bool = False
+    validation_folds: int = 5
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
@@ -121,7 +126,7 @@ class GPConfig:
             raise InputError(f"GPConfig.store_max must be at least 16 rows, got {self.store_max!r}")
         if not (self.store_cell > 0 and 0 <= self.swap_threshold <= 1):
             raise InputError("GPConfig: store_cell must be > 0 and swap_threshold within [0, 1]")
-        for name in ("steps", "local_steps", "rank", "swap_max", "swap_pool", "hyper_every"):
+        for name in ("steps", "local_steps", "rank", "swap_max", "swap_pool", "hyper_every", "validation_folds"):
             if int(getattr(self, name)) < 0:
                 raise InputError(f"GPConfig.{name} must be >= 0, got {getattr(self, name)!r}")
         if self.inducing not in ("mi", "kmeans", "random"):

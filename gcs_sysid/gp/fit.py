@@ -11,7 +11,10 @@ Steps (each one a plain function of arrays):
    re-select the inducing inputs with the learned length-scales and continue (``reselect``);
 5. the global posterior from the sufficient statistics of every row;
 6. the local layer: residuals of the global mean, k-d tree, Adam on the composite
-   local likelihood from a variogram start (nugget from nearest-neighbour differences).
+   local likelihood from a variogram start (nugget from nearest-neighbour differences);
+7. (between 4 and 5, and after 6) blocked cross-validation over contiguous blocks of the
+   time-ordered rows: per output, the latent GP's prior scale and whether the local layer is
+   kept (:mod:`gcs_sysid.gp.validation`, ``GPConfig.validation_folds``).
 """
 
 from __future__ import annotations
@@ -36,9 +39,10 @@ from .rowstore import RowStore
 from .scaling import Standardiser, check_training
 from .selection import random_points, select_inducing
 from .sparse import GlobalParams, design, elbo, stats_of
+from .validation import gate_global, gate_local
 
 __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local", "noise_correlation_factor",
-           "learn_input_noise"]
+           "learn_input_noise", "validated_global", "validated_local"]
 
 _NOISE_FLOOR = 1e-6
 
@@ -52,17 +56,21 @@ class FitHistory:
         local_loss: local composite negative log likelihood per point after each step.
         timings: stage -> seconds.
         notes: one-line remarks.
+        validation: what the blocked cross-validation chose (:mod:`gcs_sysid.gp.validation`):
+            ``latent_scale`` ``(P,)`` list, ``local_kept`` ``(P,)`` list, ``local_ratio`` ``(P,)``
+            list (blocked squared error with / without the local layer); empty when it did not run.
     """
 
     elbo: list[float] = field(default_factory=list)
     local_loss: list[float] = field(default_factory=list)
     timings: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    validation: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-able copy."""
         return {"elbo": list(self.elbo), "local_loss": list(self.local_loss), "timings": dict(self.timings),
-                "notes": list(self.notes)}
+                "notes": list(self.notes), "validation": dict(self.validation)}
 
 
 def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
@@ -372,7 +380,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         notes.append(f"gp: the local layer keeps {len(rows)} of {len(Xs)} rows (store_max), thinned by region")
 
     t2 = time.perf_counter()
-    stats = global_stats(params, Xs, Ys, cfg.batch_size)
+    params, stats = validated_global(params, Xs, Ys, cfg, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
@@ -392,13 +400,63 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         t3 = time.perf_counter()
         resid = rows.Y - global_mean(params, post, rows.X, cfg.batch_size)
         local_params, store = fit_local(cfg, params, rows.X, resid, history)
+        local_params = validated_local(local_params, params, rows.X, resid, cfg, history)
         history.timings["local"] = time.perf_counter() - t3
     history.timings["total"] = time.perf_counter() - t0
+    notes += [n for n in history.notes if n.startswith("gp: blocked validation")]
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
                           n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var,
                           var_scale=var_scale)
     return model, history
+
+
+def _validating(cfg: GPConfig, n: int) -> bool:
+    """Whether the blocked cross-validation runs: at least 2 blocks of at least 20 rows each."""
+    return int(cfg.validation_folds) >= 2 and n >= 20 * int(cfg.validation_folds)
+
+
+def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: GPConfig,
+                     history: FitHistory) -> tuple[GlobalParams, object]:
+    """The global statistics of ``Xs (N, D)``, ``Ys (N, P)`` (standardised, time order) and the
+    parameters with the latent GP's prior scale chosen per output by blocked cross-validation
+    (:func:`gcs_sysid.gp.validation.gate_global`; unchanged when ``cfg.validation_folds < 2`` or the
+    rows are too few). Appends a note with the scales to ``history.notes`` when one is below 1.
+
+    Returns:
+        ``(params, stats)``.
+    """
+    if not _validating(cfg, len(Xs)):
+        return params, global_stats(params, Xs, Ys, cfg.batch_size)
+    t0 = time.perf_counter()
+    params, stats, s, _ = gate_global(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max,
+                                      cfg.seed)
+    history.timings["validation_global"] = time.perf_counter() - t0
+    history.validation["latent_scale"] = [float(v) for v in s]
+    if np.any(s < 1.0):
+        history.notes.append("gp: blocked validation shrank the latent GP to " + ", ".join(
+            f"{v:g}" for v in s) + " of its learned prior std per output")
+    return params, stats
+
+
+def validated_local(local: LocalParams, params: GlobalParams, Xs: np.ndarray, resid: np.ndarray, cfg: GPConfig,
+                    history: FitHistory) -> LocalParams:
+    """The local layer switched off per output where it does not predict held-back time blocks of
+    the global residual ``resid (N, P)`` at ``Xs (N, D)`` (:func:`gcs_sysid.gp.validation.gate_local`;
+    unchanged when ``cfg.validation_folds < 2`` or the rows are too few)."""
+    if not _validating(cfg, len(Xs)):
+        return local
+    t0 = time.perf_counter()
+    metric = 1.0 / np.asarray(params.metric_lengthscale())
+    local, keep, ratio = gate_local(local, Xs, resid, metric, cfg.local_neighbours, int(cfg.validation_folds),
+                                    cfg.batch_size, cfg.n_train_max, cfg.seed)
+    history.timings["validation_local"] = time.perf_counter() - t0
+    history.validation["local_kept"] = [bool(k) for k in keep]
+    history.validation["local_ratio"] = [float(r) for r in ratio]
+    if not np.all(keep):
+        history.notes.append(f"gp: blocked validation switched the local layer off for {int(np.sum(~keep))} of "
+                             f"{len(keep)} outputs")
+    return local
 
 
 def learn_input_noise(params: GlobalParams, post, Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray,

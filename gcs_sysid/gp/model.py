@@ -269,7 +269,10 @@ class LocalGlobalGP:
         longer stored (``evicted``, thinned from dense regions) by the streaming projection to the
         new length-scales and inducing inputs (Bui et al. 2017,
         :func:`gcs_sysid.gp.streaming.projection`); exact for all rows while none was evicted.
-        The local layer is learned again on the stored rows' residuals. The cost does not depend
+        The local layer is learned again on the stored rows' residuals. The blocked
+        cross-validation of the fit (:mod:`gcs_sysid.gp.validation`) runs again on the stored rows
+        in arrival order, so the latent GP's per-output scales and the local layer's per-output
+        switch are chosen again for the new hyperparameters. The cost does not depend
         on the rows seen (``O(store_max M^2)`` plus a fit's hyperparameter stage).
 
         Args:
@@ -282,7 +285,7 @@ class LocalGlobalGP:
             DataError: fewer than 3 stored rows.
         """
         from ..errors import DataError
-        from .fit import FitHistory, fit_local, learn_global
+        from .fit import FitHistory, fit_local, learn_global, validated_global, validated_local
 
         enable_x64()
         rows = self.rows
@@ -297,7 +300,10 @@ class LocalGlobalGP:
         Z_old = np.asarray(self.params.Z)
         Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
         params = replace(new, Z=jax.device_put(Z_new))
-        stats, evicted = global_stats(params, rows.X, rows.Y, cfg.batch_size), None
+        # the blocked cross-validation of the fit, on the stored rows (arrival order; exact time order
+        # while none was thinned): a refresh must not bring back what the fit's check removed
+        params, stats = validated_global(params, rows.X, rows.Y, cfg, history)
+        evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))
             evicted = project_stats(self.evicted, R)
@@ -312,6 +318,7 @@ class LocalGlobalGP:
         if self.local_params is not None:
             resid = rows.Y - model._global_mean_s(rows.X)
             local_params, store = fit_local(cfg, params, rows.X, resid, history)
+            local_params = validated_local(local_params, params, rows.X, resid, cfg, history)
             model = replace(model, local_params=local_params, _store=store)
         return model
 

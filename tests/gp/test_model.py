@@ -66,7 +66,11 @@ def test_variance_after_shrinks_variance_near_new_points_only(flight, fitted):
     before = model.predict(np.vstack([far, X[:5]]), include_noise=False, input_noise=False)[1]
     after = model.variance_after(X_extra, np.vstack([far, X[:5]]), include_noise=False)
     assert np.all(after[:5] < 0.5 * before[:5])
-    np.testing.assert_allclose(after[5:], before[5:], rtol=0.05)
+    # near the data the variance hardly moves: by < 5 %, or, for outputs the blocked validation left
+    # (almost) linear (gcs_sysid.gp.validation), by < 1 % of the noise variance (far rows have
+    # leverage on a linear model's slopes, and its variance near the data is ~1e-3 of the noise's)
+    noise = np.asarray(model.params.noise) * model.scaler.y_std**2
+    np.testing.assert_array_less(np.abs(after[5:] - before[5:]), 0.05 * before[5:] + 0.01 * noise[None, :])
     # it is the variance of the model updated with any values at X_extra
     upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(np.vstack([far, X[:5]]), include_noise=False,
                                                                                       input_noise=False)[1]

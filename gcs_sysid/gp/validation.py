@@ -1,0 +1,181 @@
+"""Blocked cross-validation: each nonparametric part of the GP must earn its place, per output.
+
+The global layer is a Bayesian linear (stability-and-control-derivative) model plus a latent GP
+``f_p = a_p^T g``; the local layer adds nearest-neighbour GPs on its residual. Both are fitted by
+marginal likelihood with independent noise from row to row. Flight data break that assumption:
+a gust, the air-angle estimate's lag or the angular-acceleration smoother's error moves hundreds
+of consecutive 50 Hz rows together. To the likelihood such a coloured error looks like signal, so
+the latent GP and, above all, the local layer (whose neighbours are mostly the rows just before
+and after) learn it, and predict it where it is not: on rows of another time. Measured on the
+JSBSim flights (``docs/benchmarks.md``, eval_gp_jsbsim, "The GP earns its place"): without the
+local layer the held-out errors fell on 30 of 36 flight x coefficient pairs (5 equal to 0.1 %, 1
+higher), and on the moments, whose truth is linear in the regressors plus the turbulence's
+rotational rates (which no regressor carries), a plain linear fit beat the GP.
+
+The check here asks the data the question the held-out segment asks: the training rows, in time
+order, are cut into ``k`` contiguous blocks; each block is predicted by the model conditioned on
+the other blocks only (for fixed hyperparameters the global layer's statistics are sums over
+rows, so "all rows minus block b" is exact and costs one posterior, not one fit). Per output:
+
+* global layer: the latent GP's prior scale ``s_p`` (rows of the coregionalisation factor ``A``
+  multiplied by ``s_p``, so ``B -> S B S``) is chosen on the grid :data:`GLOBAL_GRID` by the
+  blocked squared error; ``s_p`` small leaves a Bayesian linear regression for that output (the
+  smallest value is kept above 0 so that ``B`` stays positive definite);
+* local layer: kept for output ``p`` only when it lowers the blocked squared error of the global
+  residual by at least 1 % (:data:`LOCAL_MARGIN`); otherwise its signal variance ``amp_p`` is
+  multiplied by :data:`LOCAL_OFF` (mean and variance of that output's local part ~0).
+
+This is the k-fold cross-validation of Rasmussen and Williams (2006), *Gaussian Processes for
+Machine Learning*, sec. 5.3, with contiguous blocks as for dependent data (Roberts et al. 2017,
+"Cross-validation strategies for data with temporal, spatial, hierarchical, or phylogenetic
+structure", Ecography 40(8):913-929, doi:10.1111/ecog.02881); the scales are selected, not
+optimised by gradient, to keep the cost to a few posteriors. The rows must be in time order (a
+flight's table is); shuffled rows make every block look like the training rows, and the check
+then keeps (almost) everything.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.scipy.linalg import cho_solve
+
+from .batching import global_stats, local_predict
+from .local import LocalParams, build_store
+from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
+
+__all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "block_folds", "scale_latent", "gate_global", "gate_local"]
+
+#: Candidate scales ``s_p`` of the latent GP's prior std per output (1: as learned).
+GLOBAL_GRID: tuple[float, ...] = (0.05, 0.3, 1.0)
+
+#: Factor on a rejected output's local signal variance ``amp_p`` (its local mean and variance ~0).
+LOCAL_OFF = 1e-6
+
+#: The local layer is kept for an output when its blocked squared error is below this share of the
+#: error without it: it must earn its place by a margin, not by a rounding-level difference (on
+#: smooth synthetic data the ratio sits at 0.9996-1.0025 for outputs the layer has nothing to add).
+LOCAL_MARGIN = 0.99
+
+
+def block_folds(n: int, k: int) -> list[tuple[int, int]]:
+    """``k`` contiguous ``(start, stop)`` blocks covering ``range(n)`` (sizes differ by at most 1)."""
+    edges = np.linspace(0, n, k + 1).round().astype(int)
+    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+
+
+def scale_latent(params: GlobalParams, s) -> GlobalParams:
+    """``params`` with the latent GP's prior std of output ``p`` multiplied by ``s[p]`` (``s (P,)``).
+
+    Rows of every coregionalisation factor are scaled (``A_j -> diag(s) A_j``, so
+    ``B_j -> S B_j S``); a lower-triangular factor stays lower-triangular.
+    """
+    s = jnp.asarray(s, params.A.dtype)
+    lmc = None if params.lmc_A is None else params.lmc_A * s[None, :, None]
+    return replace(params, A=params.A * s[:, None], lmc_A=lmc)
+
+
+@jax.jit
+def _mean_weights(params: GlobalParams, st: Stats) -> jax.Array:
+    """Predictive-mean weights ``(J*M+D+1, P)`` on ``u = [phi; xa]`` (as :func:`sparse.posterior`,
+    without the covariance)."""
+    lam, b = _assemble(params, st)
+    L = jnp.linalg.cholesky(lam)
+    mu = cho_solve((L, True), b)
+    return jnp.einsum("pkj,k->jp", _selectors(params, params.Z.shape[0]), mu)
+
+
+@jax.jit
+def _design_u(params: GlobalParams, Xs: jax.Array) -> jax.Array:
+    """``u = [phi(x); xa(x)]`` of shape ``(N, J*M+D+1)``; independent of ``A`` (the features use
+    only the length-scales and the inducing inputs)."""
+    Lm = _chol_kmm(params)
+    return jnp.concatenate([features(params, Lm, Xs), design(Xs).T], axis=0).T
+
+
+def _sub(a: Stats, b: Stats) -> Stats:
+    return jax.tree_util.tree_map(jnp.subtract, a, b)
+
+
+def _val_rows(a: int, b: int, most: int, rng: np.random.Generator) -> np.ndarray:
+    """Up to ``most`` rows of the block ``[a, b)`` (all of them when it is small), sorted."""
+    if b - a <= most:
+        return np.arange(a, b)
+    return np.sort(rng.choice(np.arange(a, b), most, replace=False))
+
+
+def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int, batch: int,
+                val_max: int = 1000, seed: int = 0) -> tuple[GlobalParams, Stats, np.ndarray, np.ndarray]:
+    """Choose the latent GP's prior scale per output by blocked cross-validation.
+
+    Args:
+        params: learned global hyperparameters.
+        Xs: ``(N, D)``, Ys: ``(N, P)`` standardised training rows in time order.
+        folds: contiguous blocks ``k`` (at least 2).
+        batch: rows per compiled chunk for the statistics.
+        val_max: most validation rows in all (spread evenly over the blocks).
+        seed: seed of the choice of validation rows.
+
+    Returns:
+        ``(params_scaled, stats, s, sse)``: the scaled parameters (:func:`scale_latent`), the
+        statistics of all rows (they do not depend on ``A``: the fit's posterior uses them),
+        the chosen scales ``s (P,)`` (from :data:`GLOBAL_GRID`) and the blocked squared errors
+        ``sse (G, P)`` per grid value (standardised units, summed over the validation rows).
+    """
+    n, P = Ys.shape
+    blocks = block_folds(n, folds)
+    parts = [global_stats(params, Xs[a:b], Ys[a:b], batch) for a, b in blocks]
+    total = parts[0]
+    for st in parts[1:]:
+        total = jax.tree_util.tree_map(jnp.add, total, st)
+    rng = np.random.default_rng(seed + 23)
+    per = max(1, val_max // len(blocks))
+    grid = [scale_latent(params, np.full(P, g)) for g in GLOBAL_GRID]
+    sse = np.zeros((len(GLOBAL_GRID), P))
+    for (a, b), st in zip(blocks, parts):
+        rest = _sub(total, st)
+        rows = _val_rows(a, b, per, rng)
+        U = np.asarray(_design_u(params, Xs[rows]))
+        for g, pg in enumerate(grid):
+            W = np.asarray(_mean_weights(pg, rest))
+            sse[g] += np.sum((Ys[rows] - U @ W) ** 2, 0)
+    s = np.asarray(GLOBAL_GRID)[np.argmin(sse, 0)]
+    return scale_latent(params, s), total, s, sse
+
+
+def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int, folds: int,
+               batch: int, val_max: int = 1000, seed: int = 0) -> tuple[LocalParams, np.ndarray, np.ndarray]:
+    """Keep the local layer per output only where it predicts held-back blocks of the global residual.
+
+    Args:
+        local: learned local hyperparameters.
+        Xs: ``(N, D)`` standardised rows in time order; resid: ``(N, P)`` their global residuals.
+        metric: ``(D,)`` the neighbour metric (1 / the global length-scales); k: neighbours.
+        folds, batch, val_max, seed: as :func:`gate_global`.
+
+    Returns:
+        ``(local_gated, keep, ratio)``: parameters with ``amp_p`` times :data:`LOCAL_OFF` where
+        rejected, ``keep (P,)`` bool (``ratio < LOCAL_MARGIN``), and ``ratio (P,)`` the blocked
+        squared error with the local layer over that without it (< 1: it helps).
+    """
+    n, P = resid.shape
+    rng = np.random.default_rng(seed + 29)
+    per = max(1, val_max // max(folds, 1))
+    with_l = np.zeros(P)
+    without = np.zeros(P)
+    for a, b in block_folds(n, folds):
+        keep_rows = np.r_[0:a, b:n]
+        if len(keep_rows) < 2:
+            continue
+        store = build_store(Xs[keep_rows], resid[keep_rows], metric, k)
+        rows = _val_rows(a, b, per, rng)
+        m, _ = local_predict(local, store, Xs[rows], batch)
+        with_l += np.sum((resid[rows] - m) ** 2, 0)
+        without += np.sum(resid[rows] ** 2, 0)
+    ratio = with_l / np.maximum(without, 1e-300)
+    keep = ratio < LOCAL_MARGIN
+    amp = np.where(keep, np.asarray(local.amp), np.asarray(local.amp) * LOCAL_OFF)
+    return replace(local, amp=jnp.asarray(amp)), keep, ratio
