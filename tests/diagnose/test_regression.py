@@ -42,6 +42,15 @@ def test_ols_matches_reference_and_statistics():
         ols(X[:2], z[:2], ["1", "a", "b"])
 
 
+def _ar1(rng, N, phi):
+    """AR(1) noise of length N, unit innovations, zero start."""
+    e = np.zeros(N)
+    w = rng.normal(size=N)
+    for i in range(1, N):
+        e[i] = phi * e[i - 1] + w[i]
+    return e
+
+
 def test_colored_covariance_against_monte_carlo():
     """AR(1) residuals: the corrected standard error matches the spread over repeated experiments."""
     rng = np.random.default_rng(1)
@@ -50,10 +59,7 @@ def test_colored_covariance_against_monte_carlo():
     X = np.column_stack([np.ones(N), x / x.std()])
     est, se_c, se_w = [], [], []
     for _ in range(150):
-        e = np.zeros(N)
-        w = rng.normal(size=N)
-        for i in range(1, N):
-            e[i] = phi * e[i - 1] + w[i]
+        e = _ar1(rng, N, phi)
         r = ols(X, X @ [1.0, 2.0] + 0.1 * e, ["1", "x"])
         est.append(r.theta[1])
         se_c.append(r.std_error[1])
@@ -93,10 +99,7 @@ def test_morelli_klein_covariance_covers_the_spread_of_coloured_estimates():
     X = np.column_stack([np.ones(N), x / x.std()])
     est, se_mk, se_b = [], [], []
     for _ in range(120):
-        e = np.zeros(N)
-        w = rng.normal(size=N)
-        for i in range(1, N):
-            e[i] = phi * e[i - 1] + w[i]
+        e = _ar1(rng, N, phi)
         z = X @ [1.0, 2.0] + 0.05 * e
         est.append(ols(X, z, ["1", "x"], cov_method="morelli").theta[1])
         se_mk.append(ols(X, z, ["1", "x"], cov_method="morelli").std_error[1])
