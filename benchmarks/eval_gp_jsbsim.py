@@ -72,7 +72,8 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut)
     out = cache / f"{name}.npz"
     np.savez(out, t=tab.t, X=tab.X, Y=tab.Y, valid=tab.valid, held=held, train=res.train, Xt=Xt, Yt=Yt,
-             gp_mean=res.pred_mean, gp_sigma=res.pred_sigma, ls=ls_model.evaluate(tab.X))
+             gp_mean=res.pred_mean, gp_sigma=res.pred_sigma, ls=ls_model.evaluate(tab.X),
+             x_offset_cov=np.full((tab.X.shape[1],) * 2, np.nan) if tab.x_offset_cov is None else tab.x_offset_cov)
     return out
 
 
@@ -111,8 +112,12 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
     ``thin``: fit on every ``thin``-th training row only (few samples over the whole flown envelope:
     where pooling the outputs in one joint model should matter most); None: all of them.
     """
+    from gcs_sysid.gp.discrepancy import with_offset_covariance
+
     d = np.load(path)
     X, Y, Xt, Yt = d["X"], d["Y"], d["Xt"], d["Yt"]
+    # the estimator's flight-common regressor offset (tables cached before it was carried have none)
+    off = d["x_offset_cov"] if "x_offset_cov" in d.files and np.isfinite(d["x_offset_cov"]).all() else None
     ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
     tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
     if thin is not None:
@@ -126,12 +131,14 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
         corr = float("nan")
         true = None
         validation = {}
+        true_latent = true_noise = None
         if v == "ls":
             mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
             sig_n = sig_g = sig
         elif v == "indep":
             cfg = _config(v, base)
-            models = [fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0] for p in range(Y.shape[1])]
+            models = [with_offset_covariance(fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0], off)
+                      for p in range(Y.shape[1])]
             parts = [m.predict(X[h], False) for m in models]
             mean = np.column_stack([m for m, _ in parts])
             sig = np.sqrt(np.column_stack([s for _, s in parts]))
@@ -141,6 +148,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
         else:
             prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
             model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
+            model = with_offset_covariance(model, off)
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
             mean, sig = m + prior[h], np.sqrt(var)
@@ -151,6 +159,11 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
             mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)     # exact regressors
             true = mt + prior[h], np.sqrt(vt)
+            # before the model-error term (docs/gp.md, "The band at exact conditions"): latent alone, and
+            # the latent band widened by the offset term alone / the discrepancy alone
+            _, vl = model.predict(Xt[h], include_noise=False, input_noise=False, model_error=False)
+            true_latent = coverage(mt + prior[h], np.sqrt(vl), Yt[h])
+            true_noise = coverage(mt + prior[h], np.sqrt(model.predict(Xt[h], input_noise=False)[1]), Yt[h])
         e, cv, cvn = errors(mean, Yt[h]), coverage(mean, sig, Yt[h]), coverage(mean, sig_n, Yt[h])
         yield (dict(meta, variant=v, err=dict(zip(COEFFICIENTS, e.round(2).tolist())),
                          cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())),
@@ -161,6 +174,12 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
                          **({} if true is None else {
                              "err_true": dict(zip(COEFFICIENTS, errors(true[0], Yt[h]).round(2).tolist())),
                              "cov_true": dict(zip(COEFFICIENTS, coverage(*true, Yt[h]).round(1).tolist()))}),
+                         **({} if true_latent is None else {
+                             "cov_true_latent": dict(zip(COEFFICIENTS, true_latent.round(1).tolist())),
+                             "cov_true_noise": dict(zip(COEFFICIENTS, true_noise.round(1).tolist())),
+                             "discrepancy_std": None if model.discrepancy is None else dict(zip(
+                                 COEFFICIENTS, (np.sqrt(model.discrepancy[0]) * model.scaler.y_std).tolist())),
+                             "offset_std_deg": None if off is None else float(np.degrees(np.sqrt(off[0, 0])))}),
                          t_fit_s=round(time.perf_counter() - t0, 2)))
 
 
@@ -232,6 +251,10 @@ def main(argv=None) -> int:
                         print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
                               + "  cov " + " ".join(f"{r['cov'][c]:5.1f}" for c in COEFFICIENTS)
                               + f"  corr {r['max_corr']:.2f}  {r['t_fit_s']:.1f} s", flush=True)
+                        for k in ("err_true", "cov_true", "cov_true_latent", "cov_true_noise", "cov_noise"):
+                            if r.get(k):
+                                print(f"{'':33s} {k:15s} " + " ".join(f"{r[k][c]:6.1f}" for c in COEFFICIENTS)
+                                      + f"   mean {np.nanmean(list(r[k].values())):5.1f}", flush=True)
                         if a.json:
                             with open(a.json, "a") as f:
                                 f.write(json.dumps(r) + "\n")

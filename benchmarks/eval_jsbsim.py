@@ -104,6 +104,12 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["true"] = _errs(np.asarray(mt), Yt[h])
     row["cov_true"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i])
                                         for i in range(6)]))
+    row["cov_true_each"] = [_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i]) for i in range(6)]
+    # the latent band alone (before the model-error term, docs/gp.md "The band at exact conditions")
+    _, vl = model.predict(Xt[h], include_noise=False, input_noise=False, model_error=False)
+    row["cov_true_latent"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vl)[:, i]), Yt[h, i])
+                                               for i in range(6)]))
+    row["cov_gp_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]
     t_cut = float(tab.t[h][0])
     ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
@@ -178,7 +184,9 @@ def main(argv=None) -> int:
                 print(f"{'':32s} gp    {_fmt(row['gp'])}   {row['cov_gp']:5.1f}  "
                       f"{row['alpha_deg']:.2f}/{row['beta_deg']:.2f} (signal {row['alpha_rms_deg']:.2f}/"
                       f"{row['beta_rms_deg']:.2f})")
-                print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}")
+                print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}  (latent alone "
+                      f"{row['cov_true_latent']:.1f}; per coefficient " + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
+                      + ")")
                 print(f"{'':32s} ls    {_fmt(row['ls'])}", flush=True)
                 if a.json:
                     with open(a.json, "a") as f:

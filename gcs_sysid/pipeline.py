@@ -241,6 +241,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         from .envelope import confidence_map
         from .estimation import estimate_states
         from .gp import GPConfig, fit_gp, load_gp
+        from .gp.discrepancy import with_offset_covariance
         from .jaxconfig import enable_compilation_cache
         from .maneuvers import ManeuverConfig, suggest_maneuvers
         from .report import write_report
@@ -288,12 +289,16 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     if model.n_outputs != len(fit_cols):
                         raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
                                          f"this flight identifies {len(fit_cols)}")
-                    model = model.update(X_train, Y_train)
+                    model = with_offset_covariance(model.update(X_train, Y_train), table.x_offset_cov,
+                                                   rows=len(X_train))
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
                     cfg = GPConfig() if options.n_inducing is None else GPConfig(n_inducing=options.n_inducing)
                     model, _history = fit_gp(X_train, Y_train, cfg)
+                    # the estimator's flight-common regressor offset (alpha: mean vertical wind / V): the
+                    # band at exact conditions (gcs-sysid predict) carries it through the slope
+                    model = with_offset_covariance(model, table.x_offset_cov)
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 if rows.any():

@@ -69,7 +69,7 @@ def compute_coefficients(states: FlightStates, airframe: Airframe) -> Coefficien
         :class:`~gcs_sysid.aero.table.CoefficientTable` with ``X`` (T, 10) in the
         order of :data:`REGRESSORS`, ``Y`` (T, 6) in the order of
         :data:`COEFFICIENTS`; ``valid`` = ``states.valid`` and every entry finite
-        and ``qbar > QBAR_MIN``.
+        and ``qbar > QBAR_MIN``; ``x_offset_cov`` from ``states.offsets`` (regressor units squared).
 
     Source: Klein and Morelli (2006) ch. 3; Stevens, Lewis and Johnson (2016) ch. 1.
     """
@@ -112,4 +112,9 @@ def compute_coefficients(states: FlightStates, airframe: Airframe) -> Coefficien
         ok, why = states.identifiability.get(key, (True, ""))
         if not ok:
             notes.append(f"{coeffs} not identifiable: {why}")
-    return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes)
+    offsets = getattr(states, "offsets", None) or {}
+    x_offset_cov = None
+    if any(k in offsets for k in REGRESSORS):
+        # errors common to the whole flight (alpha: the mean vertical wind over V): one draw, not per-row noise
+        x_offset_cov = np.diag([float(offsets.get(k, 0.0)) ** 2 for k in REGRESSORS])
+    return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes, x_offset_cov)

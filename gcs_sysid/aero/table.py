@@ -28,6 +28,10 @@ class CoefficientTable:
             The moment columns of Y may still be NaN there (rate derivatives not formed, e.g. 4 Hz data).
         qbar: dynamic pressure, Pa, shape (T,).
         notes: one-line remarks (e.g. "CX includes thrust: airframe has no thrust model").
+        x_offset_cov: ``(10, 10)`` covariance of the regressors' error common to all rows of the flight
+            (an offset, one draw per flight; units of the regressors squared, e.g. rad^2 for alpha), or
+            None when the estimator gave none (``FlightStates.offsets``; the GP's band at exact
+            conditions, ``docs/gp.md``).
     """
 
     t: np.ndarray
@@ -36,6 +40,7 @@ class CoefficientTable:
     valid: np.ndarray
     qbar: np.ndarray
     notes: list[str] = field(default_factory=list)
+    x_offset_cov: np.ndarray | None = None
 
     def x(self, name: str) -> np.ndarray:
         """Regressor column by name, shape (T,)."""
@@ -48,4 +53,4 @@ class CoefficientTable:
     def select(self, mask: np.ndarray) -> "CoefficientTable":
         """Rows where ``mask`` (T,) is True."""
         return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
-                                list(self.notes))
+                                list(self.notes), self.x_offset_cov)

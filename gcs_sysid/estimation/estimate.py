@@ -78,9 +78,10 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
 
 
 def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
-                Wd=None):
+                Wd=None, offsets=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
-    records sources, sigma and notes (and the gusts in the wind); returns ``(alpha, beta)``."""
+    records sources, sigma, notes and the flight-common offsets' 1-sigma (``offsets``, rad; and the
+    gusts in the wind); returns ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
         notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
                      "control outputs)")
@@ -96,6 +97,8 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
             sources[k] += src.format(c="CZ(alpha, q_hat, delta_e)" if k == "alpha" else
                                      "CY(beta, p_hat, r_hat, delta_a, delta_r)")
             sigma[k] = Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma     # NaN where not aided
+            if offsets is not None and np.isfinite(ax.bias_sigma):
+                offsets[k] = float(ax.bias_sigma)      # common to the flight: the GP's exact-condition band
     if any(ax.used for ax in Ai.axes):      # the gusts found belong to the wind: w = v_ground - C v_air
         ca, sa, cb, sb = np.cos(Ai.alpha), np.sin(Ai.alpha), np.cos(Ai.beta), np.sin(Ai.beta)
         vb = V[:, None] * np.stack([ca * cb, sb, sa * cb], axis=1)
@@ -149,6 +152,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         raise DataError(f"{src}: only {T} grid points at {rate:.1f} Hz; the log is too short to estimate states")
     data: dict[str, np.ndarray] = {}
     sigma: dict[str, np.ndarray] = {}
+    offsets: dict[str, float] = {}
     sources: dict[str, str] = {}
     missing: list[str] = []
     notes: list[str] = []
@@ -442,7 +446,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             alpha, beta = _take_vanes(vanes, sources, ident, notes)
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
-                                      fly, C, v_ned, sources, sigma, notes, Wd)
+                                      fly, C, v_ned, sources, sigma, notes, Wd, offsets)
     else:
         if have_tas:
             V = tas
@@ -512,4 +516,4 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     for c in ("Cl", "Cm", "Cn"):
         ident[c] = ident["moment_coefficients"]
     prog(1.0)
-    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident)
+    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident, offsets)

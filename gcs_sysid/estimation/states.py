@@ -45,6 +45,9 @@ class FlightStates:
             trust: keys ``"rate_derivatives"``, ``"moment_coefficients"``,
             ``"force_coefficients"``, ``"alpha"``, ``"beta"``, ``"controls"`` and
             one per coefficient ``"CX"`` ... ``"Cn"`` (e.g. ``(False, "gyro at 4.2 Hz: ...")``).
+        offsets: key -> 1-sigma of an error common to the whole flight (one offset, not per-sample
+            noise; also inside ``sigma[key]``): ``"alpha"``, rad, the flight-mean vertical wind over the
+            airspeed (:attr:`gcs_sysid.estimation.airangles.AxisFit.bias_sigma`). Empty when not estimated.
     """
 
     t: np.ndarray
@@ -56,6 +59,7 @@ class FlightStates:
     missing: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     identifiability: dict[str, tuple[bool, str]] = field(default_factory=dict)
+    offsets: dict[str, float] = field(default_factory=dict)
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self.data[key]

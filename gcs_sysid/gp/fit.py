@@ -14,7 +14,8 @@ Steps (each one a plain function of arrays):
    local likelihood from a variogram start (nugget from nearest-neighbour differences);
 7. (between 4 and 5, and after 6) blocked cross-validation over contiguous blocks of the
    time-ordered rows: per output, the latent GP's prior scale and whether the local layer is
-   kept (:mod:`gcs_sysid.gp.validation`, ``GPConfig.validation_folds``).
+   kept (:mod:`gcs_sysid.gp.validation`, ``GPConfig.validation_folds``);
+8. the model discrepancy from that validation's blocked error (:mod:`gcs_sysid.gp.discrepancy`).
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from .rowstore import RowStore
 from .scaling import Standardiser, check_training
 from .selection import random_points, select_inducing
 from .sparse import GlobalParams, design, elbo, stats_of
+from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local
 
 __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local", "noise_correlation_factor",
@@ -408,6 +410,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
                           n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var,
                           var_scale=var_scale)
+    model = calibrate(model, Xs, Ys, history.validation.get("cv_mse"))    # model error at exact conditions
     return model, history
 
 
@@ -429,10 +432,13 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
     if not _validating(cfg, len(Xs)):
         return params, global_stats(params, Xs, Ys, cfg.batch_size)
     t0 = time.perf_counter()
-    params, stats, s, _ = gate_global(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max,
-                                      cfg.seed)
+    params, stats, s, sse = gate_global(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max,
+                                        cfg.seed)
     history.timings["validation_global"] = time.perf_counter() - t0
     history.validation["latent_scale"] = [float(v) for v in s]
+    # the blocked squared error at the chosen scales, per validation row: the model discrepancy's source
+    n_val = validation_rows(len(Xs), int(cfg.validation_folds), cfg.n_train_max)
+    history.validation["cv_mse"] = (np.min(np.asarray(sse), 0) / max(n_val, 1)).tolist()
     if np.any(s < 1.0):
         history.notes.append("gp: blocked validation shrank the latent GP to " + ", ".join(
             f"{v:g}" for v in s) + " of its learned prior std per output")

@@ -28,7 +28,8 @@ VERSION = 4   # 2: the region-thinned row store (rows_*) replaces store_X / stor
 #               4: optional global_lmc_lengthscale (J-1, D) and global_lmc_A (J-1, P, P) (linear model
 #                  of coregionalisation); the statistics C, E, Rphi are then those of the J M stacked
 #                  features. Files of versions 1-3 (one kernel) read unchanged. Optional var_scale (P,)
-#                  (coloured residuals).
+#                  (coloured residuals). Optional offset_cov (D, D) and discrepancy (2, P) (the model's
+#                  error at exact conditions, gp/discrepancy.py); files without them read as before.
 _GLOBAL = ("lengthscale", "A", "noise", "Z", "prior_std", "jitter")
 _STATS = ("C", "E", "F", "Rphi", "Rx", "yy", "n")
 _LOCAL = ("lengthscale", "beta", "amp", "noise")
@@ -57,6 +58,9 @@ def save_model(model: LocalGlobalGP, path) -> str:
         arrays["input_var"] = np.asarray(model.input_var)
     if model.var_scale is not None:
         arrays["var_scale"] = np.asarray(model.var_scale)
+    for k in ("offset_cov", "discrepancy"):
+        if getattr(model, k) is not None:
+            arrays[k] = np.asarray(getattr(model, k))
     if model.params.noise_chol is not None:
         arrays["global_noise_chol"] = np.asarray(model.params.noise_chol)
     if model.params.lmc_lengthscale is not None:
@@ -151,4 +155,5 @@ def load_gp(path) -> LocalGlobalGP:
     return LocalGlobalGP(config, scaler, params, stats, post, local_params, store,
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
                          tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
-                         evicted=evicted, input_var=a.get("input_var"), var_scale=a.get("var_scale"))
+                         evicted=evicted, input_var=a.get("input_var"), var_scale=a.get("var_scale"),
+                         offset_cov=a.get("offset_cov"), discrepancy=a.get("discrepancy"))

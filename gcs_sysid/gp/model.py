@@ -68,6 +68,11 @@ class LocalGlobalGP:
         var_scale: ``(P,)`` factors on the global layer's explained variance for coloured residuals
             (:mod:`gcs_sysid.gp.colored`; from the fit's time-ordered rows, kept through updates and
             refreshes), None when not learned (``GPConfig.residual_correlation``).
+        offset_cov: ``(D, D)`` covariance of the training regressors' flight-common offset
+            (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
+        discrepancy: ``(2, P)``: the model discrepancy ``d`` and the white noise ``w`` per output from
+            the blocked cross-validation (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when the
+            check did not run.
         evicted: the part of ``stats`` from rows no longer stored (None: none). When the
             inducing inputs or length-scales change, the stored rows' statistics are computed
             again exactly and only this part is carried by the streaming projection.
@@ -89,6 +94,8 @@ class LocalGlobalGP:
     evicted: Stats | None = None
     input_var: np.ndarray | None = None
     var_scale: np.ndarray | None = None
+    offset_cov: np.ndarray | None = None
+    discrepancy: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -135,7 +142,8 @@ class LocalGlobalGP:
         mean[ok], var[ok] = self.scaler.y_back(mean_s, var_s)
         return mean, var
 
-    def predict(self, X, include_noise: bool = True, input_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    def predict(self, X, include_noise: bool = True, input_noise: bool = True,
+                model_error: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance of the coefficients.
 
         Args:
@@ -146,6 +154,11 @@ class LocalGlobalGP:
                 their errors carry through the mean's slope, ``grad m^T Sigma_x grad m``
                 (McHutchon and Rasmussen 2011, eq. 4; when ``input_var`` was learned). False for
                 exact conditions (a user's flight condition, the truth's regressors).
+            model_error: add the model's own error at exact conditions, the model discrepancy and
+                the training regressors' common offset carried through the slope
+                (:mod:`gcs_sysid.gp.discrepancy`; Kennedy and O'Hagan 2001); with ``include_noise``
+                the noise is then ``max(noise, d + w)``, not a sum. None: ``not input_noise`` (exact
+                conditions). False: the latent variance alone (what more data can reduce).
 
         Returns:
             ``(mean (N, P), var (N, P))`` in the outputs' units (variance in units squared).
@@ -165,7 +178,11 @@ class LocalGlobalGP:
             # white part of the noise; the global layer's likelihood noise also holds the coloured
             # part (docs/gp.md, "Noise"; measured on JSBSim flights, docs/benchmarks.md)
             noise = np.maximum(noise, np.asarray(self.local_params.noise))
-        if include_noise:
+        if (not input_noise) if model_error is None else model_error:
+            from .discrepancy import exact_condition_variance
+
+            var = var + exact_condition_variance(self, Xs, noise if include_noise else None)
+        elif include_noise:
             var = var + noise[None, :]
         if input_noise and self.input_var is not None and len(Xs):
             var = var + self.input_variance_s(Xs)
@@ -320,6 +337,10 @@ class LocalGlobalGP:
             local_params, store = fit_local(cfg, params, rows.X, resid, history)
             local_params = validated_local(local_params, params, rows.X, resid, cfg, history)
             model = replace(model, local_params=local_params, _store=store)
+        if self.discrepancy is not None:
+            from .discrepancy import calibrate
+
+            model = calibrate(model, rows.X, rows.Y, history.validation.get("cv_mse"))
         return model
 
     def _global_mean_s(self, Xs: np.ndarray) -> np.ndarray:
@@ -343,14 +364,14 @@ class LocalGlobalGP:
         enable_x64()
         Xe, _ = self._standardise_query(X_extra)
         if len(Xe) == 0:
-            return self.predict(X_query, include_noise, input_noise=False)[1]
+            return self.predict(X_query, include_noise, input_noise=False, model_error=False)[1]
         zeros = np.zeros((len(Xe), self.n_outputs))
         extra = self._with_stats(add_stats(self.stats, global_stats(self.params, Xe, zeros, self.config.batch_size)))
         if self.store is not None:
             X_all = np.vstack([self.store.X, Xe])
             store = build_store(X_all, np.vstack([self.store.resid, zeros]), self.store.metric, self.store.k)
             extra = replace(extra, _store=store)
-        return extra.predict(X_query, include_noise, input_noise=False)[1]
+        return extra.predict(X_query, include_noise, input_noise=False, model_error=False)[1]
 
     def global_variance_after_many(self, X_extras, X_queries, include_noise: bool = False
                                    ) -> list[tuple[np.ndarray, np.ndarray]]:

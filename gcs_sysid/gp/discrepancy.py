@@ -1,0 +1,192 @@
+"""The model's own error at exact flight conditions: model discrepancy and the inputs' common offset.
+
+``predict(X, include_noise=False)`` gives the GP's latent variance: how well the data pin down the
+function the model class can represent, *at the regressors as the estimator saw them*. Two errors
+are outside it, and both matter where the model is evaluated at exact conditions (a user's flight
+condition, ``gcs-sysid predict``; the truth's regressors in ``benchmarks/eval_jsbsim.py``):
+
+1. **A flight-common offset of the regressors.** The reconstructed alpha carries the flight-mean
+   vertical wind over the airspeed, ``mean(w_d) / V``, which no logged channel observes
+   (``docs/estimation.md``; its 1-sigma is ``AxisFit.bias_sigma``, carried to the table as
+   ``CoefficientTable.x_offset_cov``). The model learns ``m(x + delta) ~ C(x)`` with one ``delta``
+   for all rows, so at the exact ``x`` its error is ``m(x) - C(x) ~ grad m(x)^T delta``: not per-row
+   noise (it does not average out, and at the flight's own estimated regressors it cancels), but a
+   variance at exact conditions of
+
+       v_off,p(x) = grad m_p(x)^T Sigma_off grad m_p(x)
+
+   with ``Sigma_off`` the offset's covariance (the first-order propagation of McHutchon and
+   Rasmussen 2011, eq. 4, applied to a common error instead of a per-row one).
+
+2. **Model discrepancy.** The blocked cross-validation (:mod:`gcs_sysid.gp.validation`) shrinks the
+   latent GP per output when its nonparametric part does not predict held-back time blocks; the
+   latent variance shrinks with it, so the band then says "the linear mean is right", while the
+   truth also carries what none of the regressors explains (the turbulence's rotational rates,
+   ``alpha_dot``, a nonlinearity the shrunk GP no longer follows). Kennedy and O'Hagan (2001,
+   "Bayesian calibration of computer models", J. R. Stat. Soc. B 63(3):425-464, sec. 2.1 and 4.3)
+   write the truth as the model plus a discrepancy ``delta(x)``, separate from the observation
+   error. Its size is estimated here from the blocked cross-validation the fit already runs
+   (Rasmussen and Williams 2006, sec. 5.3): per output, the mean squared error of each held-back
+   block predicted from the other blocks, ``cv_p``, less the white measurement noise ``w_p``:
+
+       d_p = max(0, cv_p - w_p),        w_p = 1/2 mean_t (r_t+1,p - r_t,p)^2
+
+   ``w_p`` is the lag-1 semivariogram of the time-ordered training residuals ``r`` (the nugget of
+   the variogram, Cressie 1993, sec. 2.4; von Neumann's mean square successive difference): at
+   50 Hz a white error shows in full in successive differences, a gust's or a model error's, which
+   lasts hundreds of rows, hardly at all. What a held-back block shows beyond the white noise
+   persists in time; a truth at exact conditions carries it too. Coloured *measurement* errors (the
+   rate smoother's) are counted as well, which makes ``d_p`` conservative for the moments.
+
+   ``d_p`` is a constant per output (a homoscedastic discrepancy); the growth of the error away
+   from the data is the latent variance's (the GP and the linear mean's weights), which is kept.
+
+At exact conditions (``predict(..., input_noise=False)``, :meth:`LocalGlobalGP.predict`'s
+``model_error``) the variance is ``latent + v_off + d``; with the observation noise, ``latent +
+v_off + max(noise, d + w)``: the likelihood's noise already holds the misfit that the rows show, so
+the two are not added. At a flight's own estimated regressors nothing here is added (the offset
+cancels there, and the band with noise was measured to cover 94-98 % of the truth,
+``docs/benchmarks.md``). Everything is in the model's standardised units.
+
+References:
+    M. C. Kennedy and A. O'Hagan (2001), "Bayesian calibration of computer models", J. R. Stat.
+    Soc. B 63(3):425-464, doi:10.1111/1467-9868.00294.
+    C. E. Rasmussen and C. K. I. Williams (2006), *Gaussian Processes for Machine Learning*, MIT
+    Press, sec. 5.3 (cross-validation).
+    A. McHutchon and C. E. Rasmussen (2011), "Gaussian process training with input noise", NIPS 24.
+    N. Cressie (1993), *Statistics for Spatial Data*, revised ed., Wiley, sec. 2.4.
+    J. von Neumann (1941), "Distribution of the ratio of the mean square successive difference to
+    the variance", Ann. Math. Stat. 12(4):367-395.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import InputError
+from .validation import block_folds
+
+__all__ = ["validation_rows", "white_noise_variance", "discrepancy_variance", "calibrate", "offset_covariance_s",
+           "with_offset_covariance", "exact_condition_variance"]
+
+
+def validation_rows(n: int, folds: int, val_max: int) -> int:
+    """Number of validation rows :func:`gcs_sysid.gp.validation.gate_global` scores for ``n`` rows in
+    ``folds`` blocks with at most ``val_max`` in all (its ``sse`` divided by this is a mean)."""
+    blocks = block_folds(n, folds)
+    per = max(1, val_max // max(len(blocks), 1))
+    return int(sum(min(b - a, per) for a, b in blocks))
+
+
+def white_noise_variance(resid: np.ndarray) -> np.ndarray:
+    """White part of the residuals' variance, ``(P,)``: half the mean squared successive difference.
+
+    Args:
+        resid: ``(N, P)`` residuals in time order (N >= 2; NaN rows are dropped).
+
+    Returns:
+        ``(P,)`` the lag-1 semivariogram ``1/2 mean (r_t+1 - r_t)^2`` (Cressie 1993, sec. 2.4).
+    """
+    r = np.asarray(resid, float)
+    r = r[np.isfinite(r).all(1)]
+    if len(r) < 2:
+        return np.zeros(r.shape[1])
+    return 0.5 * np.mean(np.diff(r, axis=0) ** 2, axis=0)
+
+
+def discrepancy_variance(cv_mse: np.ndarray, white: np.ndarray) -> np.ndarray:
+    """``d_p = max(0, cv_p - w_p)`` ``(P,)`` from the blocked CV mean squared error and the white noise
+    (module docstring)."""
+    return np.maximum(np.asarray(cv_mse, float) - np.asarray(white, float), 0.0)
+
+
+def calibrate(model, Xs: np.ndarray, Ys: np.ndarray, cv_mse) -> object:
+    """``model`` with its discrepancy ``d`` and white noise ``w`` (module docstring) set.
+
+    Args:
+        model: a :class:`gcs_sysid.gp.LocalGlobalGP` (its global layer fitted).
+        Xs, Ys: ``(N, D)``, ``(N, P)`` standardised training rows in time order.
+        cv_mse: ``(P,)`` blocked cross-validation mean squared error of the global layer
+            (standardised; ``FitHistory.validation["cv_mse"]``), or None when the check did not run:
+            the model is returned without a discrepancy.
+
+    Returns:
+        A new model (``discrepancy = (d, w)`` stacked as ``(2, P)``), or ``model`` itself.
+    """
+    if cv_mse is None:
+        return replace(model, discrepancy=None)
+    from .batching import global_mean
+
+    resid = Ys - global_mean(model.params, model.post, Xs, model.config.batch_size)
+    w = white_noise_variance(resid)
+    return replace(model, discrepancy=np.stack([discrepancy_variance(cv_mse, w), w]))
+
+
+def offset_covariance_s(scaler, cov: np.ndarray) -> np.ndarray:
+    """The regressors' common-offset covariance ``(D, D)`` in the model's standardised units (inactive
+    inputs get 0: the model ignores them)."""
+    s = np.where(scaler.active, 1.0 / np.asarray(scaler.x_std, float), 0.0)
+    return np.asarray(cov, float) * s[:, None] * s[None, :]
+
+
+def with_offset_covariance(model, cov, rows: int | None = None):
+    """``model`` with the covariance of its training regressors' flight-common offset.
+
+    Args:
+        model: a :class:`gcs_sysid.gp.LocalGlobalGP`.
+        cov: ``(D, D)`` covariance in the regressors' units squared (``CoefficientTable.x_offset_cov``),
+            or None (no offset known: the model keeps what it has).
+        rows: rows of the flight ``cov`` belongs to, when ``model`` was *updated* with that flight
+            after learning others: offsets of different flights are independent, and the model's
+            mean follows the row-weighted mean of them, so the covariances combine as
+            ``(n_old^2 S_old + n^2 S) / (n_old + n)^2`` (``n_old = model.n_used - rows``; a model
+            without an offset counts as offset-free). None: the model learned this flight alone.
+
+    Returns:
+        A new model (``offset_cov`` standardised ``(D, D)``).
+
+    Raises:
+        InputError: ``cov`` is not ``(D, D)`` or not finite.
+    """
+    if cov is None:
+        return model
+    C = np.asarray(cov, float)
+    D = model.n_inputs
+    if C.shape != (D, D) or not np.isfinite(C).all():
+        raise InputError(f"gp: offset covariance must be a finite ({D}, {D}) matrix, got shape {C.shape}")
+    Cs = offset_covariance_s(model.scaler, C)
+    if rows is not None:
+        n_new = float(rows)
+        n_old = max(float(model.n_used) - n_new, 0.0)
+        old = model.offset_cov if model.offset_cov is not None else np.zeros((D, D))
+        Cs = (n_old**2 * old + n_new**2 * Cs) / max(n_old + n_new, 1.0) ** 2
+    return replace(model, offset_cov=Cs)
+
+
+def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = None) -> np.ndarray:
+    """What the model's error at exact conditions adds to its latent variance, ``(N, P)`` at standardised
+    ``Xs (N, D)`` (standardised units; module docstring).
+
+    Args:
+        model: a :class:`gcs_sysid.gp.LocalGlobalGP`.
+        Xs: ``(N, D)`` standardised exact regressors.
+        noise: ``(P,)`` the observation-noise variance to include (a new measurement at exact
+            conditions), or None (the coefficient itself).
+
+    Returns:
+        ``v_off(x) + d`` without noise; ``v_off(x) + max(noise, d + w)`` with it (the likelihood's noise
+        and the blocked residual both hold the misfit the rows show: the larger, not the sum). Zeros
+        (plus ``noise``) when neither an offset nor a discrepancy is known.
+    """
+    out = np.zeros((len(Xs), model.n_outputs))
+    if model.offset_cov is not None and len(Xs) and np.any(model.offset_cov):
+        from .inputnoise import mean_gradient
+
+        g = mean_gradient(model.params, model.post, Xs, model.config.batch_size)      # (N, P, D)
+        out += np.einsum("npd,de,npe->np", g, np.asarray(model.offset_cov), g)
+    if model.discrepancy is None:
+        return out if noise is None else out + np.asarray(noise)[None, :]
+    d, w = np.asarray(model.discrepancy)
+    return out + (d if noise is None else np.maximum(np.asarray(noise), d + w))[None, :]
