@@ -6,7 +6,8 @@ dimensionless, ``delta_e delta_a delta_r`` rad in the project's sign conventions
 ``V`` m/s true airspeed); degrees are not accepted (convert before). Other columns (a time, a case
 name) are copied to the output unchanged. Output: the input's columns, then for each coefficient
 the model's mean ``<C>_mean``, the standard deviation of the coefficient itself ``<C>_sigma`` (the
-model's uncertainty, without measurement noise: the band that should cover the true coefficient)
+model's uncertainty, without measurement noise: the band that should cover the true coefficient; with
+the model's error at exact conditions, :mod:`gcs_sysid.gp.discrepancy`)
 and ``<C>_sigma_obs`` (with the learned measurement noise: the band for a new measurement).
 
 The model is the one a replay saves (``OUT/model.npz`` + ``OUT/model.json``, :func:`gcs_sysid.gp.load_gp`).
@@ -125,7 +126,8 @@ def predict_conditions(model, X: np.ndarray, output_names=None) -> Predictions:
         X: regressors, (N, 10), SI.
         output_names: names of the model's outputs (default: the first P of :data:`COEFFICIENTS`).
     """
-    # the user's conditions are exact (no estimated regressors): no input-noise variance (docs/gp.md)
+    # the user's conditions are exact (no estimated regressors): no input-noise variance, but the model's
+    # own error there (the training flight's common regressor offset, model discrepancy; docs/gp.md)
     mean, var_obs = model.predict(X, include_noise=True, input_noise=False)
     _, var = model.predict(X, include_noise=False, input_noise=False)
     names = tuple(output_names or COEFFICIENTS[: model.n_outputs])

@@ -122,15 +122,15 @@ def test_nigp_inflates_the_variance_where_the_mean_is_steep_and_calibrates(noisy
     # the noisy input's std (0.15) found; the clean one gets a small share (measured 0.141 and 0.064 std)
     assert 0.12 < np.sqrt(iv[0]) < 0.18 and iv[1] < 0.3 * iv[0]
     steep, flat = np.array([[0.0, 0.0]]), np.array([[1.8, 0.0]])
-    _, v_steep0 = model.predict(steep, include_noise=False, input_noise=False)
+    _, v_steep0 = model.predict(steep, include_noise=False, input_noise=False, model_error=False)
     _, v_steep = model.predict(steep, include_noise=False)
-    _, v_flat0 = model.predict(flat, include_noise=False, input_noise=False)
+    _, v_flat0 = model.predict(flat, include_noise=False, input_noise=False, model_error=False)
     _, v_flat = model.predict(flat, include_noise=False)
     assert np.all(v_steep - v_steep0 > 10 * (v_flat - v_flat0))
     # calibration on held-out rows at measured (noisy) inputs against the noise-free truth
     m, v = model.predict(X_meas[400:], include_noise=False)
     cov = np.mean(np.abs(m - f(X_true[400:])) <= 1.96 * np.sqrt(v))
-    m0, v0 = model.predict(X_meas[400:], include_noise=False, input_noise=False)
+    m0, v0 = model.predict(X_meas[400:], include_noise=False, input_noise=False, model_error=False)
     cov0 = np.mean(np.abs(m0 - f(X_true[400:])) <= 1.96 * np.sqrt(v0))
     assert 0.90 <= cov <= 0.98 and cov0 < 0.85
 

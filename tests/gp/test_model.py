@@ -63,7 +63,7 @@ def test_variance_after_shrinks_variance_near_new_points_only(flight, fitted):
     model, _ = fitted
     far = X[:5] + 6 * X.std(0)          # outside the envelope: the model knows little there
     X_extra = np.repeat(far, 3, axis=0)
-    before = model.predict(np.vstack([far, X[:5]]), include_noise=False, input_noise=False)[1]
+    before = model.predict(np.vstack([far, X[:5]]), include_noise=False, input_noise=False, model_error=False)[1]
     after = model.variance_after(X_extra, np.vstack([far, X[:5]]), include_noise=False)
     assert np.all(after[:5] < 0.5 * before[:5])
     # near the data the variance hardly moves: by < 5 %, or, for outputs the blocked validation left
@@ -73,7 +73,7 @@ def test_variance_after_shrinks_variance_near_new_points_only(flight, fitted):
     np.testing.assert_array_less(np.abs(after[5:] - before[5:]), 0.05 * before[5:] + 0.01 * noise[None, :])
     # it is the variance of the model updated with any values at X_extra
     upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(np.vstack([far, X[:5]]), include_noise=False,
-                                                                                      input_noise=False)[1]
+                                                                                      input_noise=False, model_error=False)[1]
     np.testing.assert_allclose(after, upd, rtol=1e-7)
 
 
