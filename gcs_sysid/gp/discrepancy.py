@@ -69,7 +69,7 @@ from ..errors import InputError
 from .validation import block_folds
 
 __all__ = ["validation_rows", "white_noise_variance", "discrepancy_variance", "calibrate", "offset_covariance_s",
-           "with_offset_covariance", "exact_condition_variance"]
+           "with_offset_covariance", "exact_condition_variance", "model_error_summary"]
 
 
 def validation_rows(n: int, folds: int, val_max: int) -> int:
@@ -190,3 +190,21 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
         return out if noise is None else out + np.asarray(noise)[None, :]
     d, w = np.asarray(model.discrepancy)
     return out + (d if noise is None else np.maximum(np.asarray(noise), d + w))[None, :]
+
+
+def model_error_summary(model) -> dict | None:
+    """JSON-able ``{"discrepancy_std": {output: 1-sigma}, "white_noise_std": {...}, "offset_std": {input:
+    1-sigma}}`` in data units (None entries where not known; None when neither is), for
+    :meth:`LocalGlobalGP.summary`."""
+    if model.discrepancy is None and model.offset_cov is None:
+        return None
+    sc = model.scaler
+    out: dict = {"discrepancy_std": None, "white_noise_std": None, "offset_std": None}
+    if model.discrepancy is not None:
+        d, w = np.sqrt(np.asarray(model.discrepancy)) * sc.y_std[None, :]
+        out["discrepancy_std"] = dict(zip(model.output_names, d.tolist()))
+        out["white_noise_std"] = dict(zip(model.output_names, w.tolist()))
+    if model.offset_cov is not None:
+        s = np.sqrt(np.maximum(np.diag(np.asarray(model.offset_cov)), 0.0)) * sc.x_std
+        out["offset_std"] = {n: float(v) for n, v, a in zip(model.input_names, s, sc.active) if a and v > 0}
+    return out

@@ -512,6 +512,9 @@ class LocalGlobalGP:
                 "since_refresh": int(self.since_refresh)},
             "notes": list(self.notes),
         }
+        from .discrepancy import model_error_summary
+
+        out["model_error"] = model_error_summary(self)       # the band at exact conditions (docs/gp.md)
         if self.local_params is not None and self.store is not None:
             lp = self.local_params
             out["local"] = {
