@@ -14,7 +14,10 @@ the held-out rows against the truth:
           band the replay reports)
   corr    the largest |learned output correlation| of the global layer (``output_correlation``)
   true    ``err_true``, ``cov_true``: the model at the true regressors (``predict(..., include_noise=False,
-          input_noise=False)``, as ``gcs-sysid predict`` at exact conditions), against the truth
+          input_noise=False)``, as ``gcs-sysid predict`` at exact conditions: with the model's error there,
+          ``docs/gp.md``), against the truth; ``cov_true_latent``: the latent band alone
+          (``model_error=False``, the band before that term); ``cov_true_noise``: with the noise
+          (``<C>_sigma_obs``); ``discrepancy_std``, ``offset_std_deg``: the term's parts
 
 Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
 ``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),

@@ -15,7 +15,9 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
   cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
-         true: the model's sigma without noise), averaged over the six coefficients
+         true: the model's sigma without noise, at exact conditions, with the model's error there,
+         ``docs/gp.md``; ``cov_true_latent`` in the JSON: the latent band alone), averaged over the six
+         coefficients (``cov_true_each``, ``cov_gp_each``: per coefficient)
   air    alpha and beta RMS errors of the reconstructed air data, deg (all valid rows)
 
 Usage::
