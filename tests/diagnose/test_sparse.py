@@ -137,8 +137,14 @@ def test_moment_term_survives_the_angle_nuisance(airframe):
     """The nuisance is fitted on the forces only: a Cm:alpha^2 change is still named and sized."""
     ref = _ctx(airframe, seed=4)
     ctx, R = _alpha_error_flight(airframe, 7, e2=1.8, cm_alpha2=-3.0)
-    res = sparse_search(ctx, R, reference=ref)
+    res = sparse_search(ctx, R, reference=ref, keep_residual=True)
     assert res["findings"] and res["findings"][0]["cause"] == "Cm:alpha^2", res["findings"]
+    # keep_residual: what the search saw; its Cm part on the training rows follows the injected -3 alpha^2
+    tr, te = res["rows"]["train"], res["rows"]["untouched"]
+    assert res["residual"].shape == R.shape and tr.max() < te.min()
+    a2 = ctx.X[tr, 0] ** 2
+    slope = np.polyfit(a2 - a2.mean(), res["residual"][tr, 4], 1)[0]
+    assert slope == pytest.approx(-3.0, rel=0.3)
     f = res["findings"][0]
     assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
     assert f["evidence"]["std_error_method"].startswith("Morelli and Klein")
