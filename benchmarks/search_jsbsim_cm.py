@@ -161,7 +161,7 @@ def main(argv=None) -> int:
     reference = reference_context((rt, rs), raf, model)
     thr = json.loads(a.thresholds)
     print(f"reference alpha error: {_alpha_error(rt, dict(np.load(run / f'{a.aircraft}-ref-sweep-truth.npz')))}")
-    counts = {"cases": 0, "top": 0, "est": 0, "gain": 0, "clean": 0, "clean_ok": 0}
+    counts = {"cases": 0, "top": 0, "est": 0, "gain": 0, "all": 0, "clean": 0, "clean_ok": 0}
     for tlog in sorted(run.glob(f"{a.aircraft}-s*.tlog")):
         if a.glob not in tlog.name:
             continue
@@ -187,19 +187,25 @@ def main(argv=None) -> int:
             line += (f" | exact term's untouched gain {d['exact_gain_pct']:.0f}% ({d['exact_gain_no_gust_q_pct']:.0f}% "
                      f"without the gust pitch rate); Cm residual {d['residual_rms']:.5f}, measurement error "
                      f"{d['measurement_error_rms']:.5f}")
-        print(line + f" ({time.perf_counter() - t0:.0f} s)", flush=True)
+        mark = ""
         if not inj:
             counts["clean"] += 1
             counts["clean_ok"] += not res["findings"]
         elif len(inj) == 1:
             e, fs = inj[0], res["findings"]
             counts["cases"] += 1
-            if fs and fs[0]["cause"] == e["cause"]:
-                counts["top"] += 1
-                counts["est"] += abs(_change(fs[0]) - e["value"]) <= 0.25 * abs(e["value"])
-                counts["gain"] += fs[0]["gain"]["percent"] >= 50.0
+            ok = [bool(fs) and fs[0]["cause"] == e["cause"], False, False]
+            if ok[0]:
+                ok[1] = abs(_change(fs[0]) - e["value"]) <= 0.25 * abs(e["value"])
+                ok[2] = fs[0]["gain"]["percent"] >= 50.0
+            for key, v in zip(("top", "est", "gain"), ok):
+                counts[key] += v
+            counts["all"] += all(ok)
+            mark = " {" + "".join(c if v else "-" for c, v in zip("TEG", ok)) + "}"
+        print(line + mark + f" ({time.perf_counter() - t0:.0f} s)", flush=True)
     print(f"single effects: top {counts['top']}/{counts['cases']}, estimate within 25 % {counts['est']}/{counts['cases']}, "
-          f"gain >= 50 % {counts['gain']}/{counts['cases']}; clean flights with nothing named "
+          f"gain >= 50 % {counts['gain']}/{counts['cases']}, all three {counts['all']}/{counts['cases']}; "
+          f"clean flights with nothing named "
           f"{counts['clean_ok']}/{counts['clean']}")
     return 0
 
