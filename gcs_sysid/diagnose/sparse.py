@@ -39,9 +39,10 @@ Bartlett-window one the thresholds were frozen with.
 
 from __future__ import annotations
 
-import numpy as np
-
+import re
 from dataclasses import replace
+
+import numpy as np
 
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from .context import DiagContext
@@ -64,11 +65,15 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`sparse_search`); ``lift_alpha_hz`` 0 (the lift-equation alpha of :mod:`.lift_alpha` off:
 #: on the SGS it raised the gains but hinges in alpha then won over ``alpha^2``);
 #: ``angle_scale`` False (an ``e3 alpha`` nuisance term changed nothing on the c172x).
+#: Added 2026-11-22 (branch i9-cmalpha2), off: ``smooth_se`` (a selected hinge in a regressor is
+#: replaced by a polynomial in it when that stays within this many standard errors of the block
+#: PRESS, :func:`_prefer_smooth`); measured on the c172x/sgs tuning flights it only matters with
+#: ``lift_alpha_hz`` on, which costs as many cases as it wins (``docs/benchmarks.md``).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
               "angle_nuisance": True, "angle_error_centred": True, "lift_alpha_hz": 0.0,
-              "lift_alpha_offset": False, "angle_scale": False}
+              "lift_alpha_offset": False, "angle_scale": False, "smooth_se": 0.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -124,14 +129,19 @@ def select_terms(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: in
     return sel, res["press"]
 
 
+def _fold_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]) -> np.ndarray:
+    """Per-fold PRESS (F,) of least squares on columns ``cols`` of ``A`` (each fold predicted from the others)."""
+    out = np.zeros(int(fold.max()) + 1)
+    for k in range(out.size):
+        m = fold == k
+        th = np.linalg.lstsq(A[~m][:, cols], r[~m], rcond=None)[0] if cols else np.zeros(0)
+        out[k] = float(np.sum((r[m] - A[m][:, cols] @ th) ** 2))
+    return out
+
+
 def _block_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]) -> float:
     """Block PRESS of least squares on columns ``cols`` of ``A`` (each fold predicted from the others)."""
-    p = 0.0
-    for k in range(int(fold.max()) + 1):
-        m = fold == k
-        th = np.linalg.lstsq(A[~m][:, cols], r[~m], rcond=None)[0]
-        p += float(np.sum((r[m] - A[m][:, cols] @ th) ** 2))
-    return p
+    return float(_fold_press(A, r, fold, cols).sum())
 
 
 def _parents(name: str, index: dict[str, int]) -> list[int]:
@@ -176,6 +186,52 @@ def _prefer_lower_degree(A, r, fold, sel, names, tol):
                     break
             if changed:
                 break
+    return sel
+
+
+_HINGE = re.compile(r"^max\(0,([a-z_]+)-")
+
+
+def _prefer_smooth(A, r, fold, sel, names, n_se):
+    """Replace a selected hinge ``max(0,x-knot)`` by a polynomial in ``x`` alone by the one-standard-error rule.
+
+    A hinge carries a knot chosen among several, a polynomial in the same regressor (``x``, ``x^2``,
+    ``x^3``) none; when the polynomial's block PRESS (the other selected terms kept) lies within
+    ``n_se`` standard errors of the selected set's, the simpler, global term is taken (the
+    "one-standard-error rule" of cross-validation: Hastie, Tibshirani and Friedman, *The Elements
+    of Statistical Learning*, 2nd ed., sec. 7.10; Breiman et al., *Classification and Regression
+    Trees*, 1984, sec. 3.4.3). The standard error of the total block PRESS is ``sqrt(F)`` times the
+    standard deviation of the F fold terms. A curvature the hinges only approximate (``alpha^2``
+    under a slowly wrong alpha) is then named as the polynomial; a true break that the polynomial
+    fits worse by more than the folds' spread stays a hinge.
+
+    Args:
+        A: (N, K) candidates. r: (N,) residual. fold: (N,) block index. sel: selected columns.
+        names: the K candidate names. n_se: how many standard errors the polynomial may lose.
+
+    Returns:
+        The selected columns with hinges replaced where the rule says so.
+    """
+    index = {n: i for i, n in enumerate(names)}
+    sel = list(sel)
+    for i, k in enumerate(list(sel)):
+        m = _HINGE.match(names[k])
+        if not m:
+            continue
+        x = m.group(1)
+        p = _fold_press(A, r, fold, sel)
+        bound = p.sum() + n_se * np.sqrt(p.size) * np.std(p, ddof=1)
+        best = None
+        for cand in (x, f"{x}^2", f"{x}^3"):
+            c = index.get(cand)
+            if c is None or c in sel:
+                continue
+            trial = sel[:i] + [c] + sel[i + 1:]
+            pt = _block_press(A, r, fold, trial)
+            if pt <= bound and (best is None or pt < best[0]):
+                best = (pt, trial)
+        if best is not None:
+            sel = best[1]
     return sel
 
 
@@ -240,6 +296,8 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
     sel, press = select_terms(Pc, r[sub], fold, th["max_terms"], th["min_step_gain"], th["stlsq_threshold"])
     if sel and th.get("hierarchy_tol", 0.0) > 0:
         sel = _prefer_lower_degree(Pc, r[sub], fold, sel, names, th["hierarchy_tol"])
+    if sel and th.get("smooth_se", 0.0) > 0:
+        sel = _prefer_smooth(Pc, r[sub], fold, sel, names, th["smooth_se"])
     before = float(np.sqrt(np.mean(r[te] ** 2))) if te.size else 0.0
     out = {"terms": [], "press": press, "score": 0.0,
            "held_out": {"rms_before": before, "rms_after": before, "percent": 0.0}}
@@ -348,7 +406,7 @@ def angle_nuisance(ctx: DiagContext, R: np.ndarray, rows: np.ndarray, model: dic
 
 def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext, np.ndarray] | None = None,
                   folds: int = 5, segment_frac: float = 0.2, max_rows: int = 4000,
-                  thresholds: dict | None = None) -> dict:
+                  thresholds: dict | None = None, keep_residual: bool = False) -> dict:
     """Search each coefficient's residual for new terms; differential when a reference is given.
 
     Args:
@@ -359,6 +417,10 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         folds: contiguous training blocks for PRESS. segment_frac: untouched final share of the rows.
         max_rows: training rows are thinned evenly to at most this many for the selection.
         thresholds: overrides of :data:`THRESHOLDS`.
+        keep_residual: also return what the first round searches (for analysis,
+            ``benchmarks/search_jsbsim_cm.py``): ``"residual"`` (T, 6), the residual after the
+            reference's inadequacy and the angle nuisance, and ``"rows"``, ``{"train", "untouched"}``
+            row indices.
 
     Returns:
         ``{"coefficients": [...], "inadequacy": [...], "findings": [...], "segment": {...}}``:
@@ -452,6 +514,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["lift_alpha"] = info2
         if np.any(err):                    # the library on the corrected angles
             names, Phi = _library(replace(ctx, X=Xc), knots)
+    if keep_residual:
+        result["residual"], result["rows"] = Rd.copy(), {"train": tr, "untouched": te}
     named: list[dict] = []
     for rnd in range(th["rounds"]):
         entries, cands = [], []

@@ -137,8 +137,14 @@ def test_moment_term_survives_the_angle_nuisance(airframe):
     """The nuisance is fitted on the forces only: a Cm:alpha^2 change is still named and sized."""
     ref = _ctx(airframe, seed=4)
     ctx, R = _alpha_error_flight(airframe, 7, e2=1.8, cm_alpha2=-3.0)
-    res = sparse_search(ctx, R, reference=ref)
+    res = sparse_search(ctx, R, reference=ref, keep_residual=True)
     assert res["findings"] and res["findings"][0]["cause"] == "Cm:alpha^2", res["findings"]
+    # keep_residual: what the search saw; its Cm part on the training rows follows the injected -3 alpha^2
+    tr, te = res["rows"]["train"], res["rows"]["untouched"]
+    assert res["residual"].shape == R.shape and tr.max() < te.min()
+    a2 = ctx.X[tr, 0] ** 2
+    slope = np.polyfit(a2 - a2.mean(), res["residual"][tr, 4], 1)[0]
+    assert slope == pytest.approx(-3.0, rel=0.3)
     f = res["findings"][0]
     assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
     assert f["evidence"]["std_error_method"].startswith("Morelli and Klein")
@@ -207,3 +213,33 @@ def test_angle_nuisance_does_not_shift_the_mean_alpha_of_the_library(airframe):
     assert abs(off["angle_nuisance"]["library_shift_rad"][0]) > 1e-4, off["angle_nuisance"]
     f = on["findings"][0]
     assert f["cause"] == "Cm:alpha^2" and f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
+
+
+def _hinge_design(seed):
+    """Candidates in alpha (polynomials and hinges at four knots) over a slow sweep, five blocks."""
+    rng = np.random.default_rng(seed)
+    n = 2000
+    a = np.radians(2.0) + np.radians(2.5) * np.sin(np.linspace(0, 7 * np.pi, n)) + np.radians(0.3) * rng.normal(size=n)
+    knots = np.radians([-0.6, 0.1, 1.5, 3.5])
+    names = ["alpha", "alpha^2", "alpha^3"] + [f"max(0,alpha-{k:.1f}deg)" for k in np.degrees(knots)] + ["delta_e"]
+    A = np.column_stack([a, a**2, a**3] + [np.maximum(0.0, a - k) for k in knots] + [rng.normal(size=n)])
+    A = A - A.mean(axis=0)
+    fold = np.minimum((np.arange(n) * 5) // n, 4)
+    return names, A, a, fold, rng
+
+
+def test_one_standard_error_rule_prefers_the_polynomial_over_a_hinge():
+    """A curvature -4 alpha^2 that a hinge happens to fit as well is named alpha^2 (the smooth_se rule);
+    a true break at 1.5 deg stays a hinge (the polynomial loses by far more than the folds' spread)."""
+    from gcs_sysid.diagnose.sparse import _prefer_smooth
+
+    names, A, a, fold, rng = _hinge_design(3)
+    ih = names.index("max(0,alpha-1.5deg)")
+    r = -4.0 * a**2 + 0.002 * rng.normal(size=a.size)
+    r -= r.mean()
+    assert [names[k] for k in _prefer_smooth(A, r, fold, [ih], names, 1.0)] == ["alpha^2"]
+    # the other selected terms are kept in place
+    assert [names[k] for k in _prefer_smooth(A, r, fold, [ih, len(names) - 1], names, 1.0)] == ["alpha^2", "delta_e"]
+    brk = -0.6 * np.maximum(0.0, a - np.radians(1.5)) + 0.0005 * rng.normal(size=a.size)
+    brk -= brk.mean()
+    assert [names[k] for k in _prefer_smooth(A, brk, fold, [ih], names, 1.0)] == ["max(0,alpha-1.5deg)"]
