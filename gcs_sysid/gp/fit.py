@@ -436,6 +436,17 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
     if np.any(s < 1.0):
         history.notes.append("gp: blocked validation shrank the latent GP to " + ", ".join(
             f"{v:g}" for v in s) + " of its learned prior std per output")
+    if cfg.coupling_validation and Ys.shape[1] > 1:
+        from .joint import gate_coupling
+
+        t0 = time.perf_counter()
+        params, coupled, ratio = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
+        history.timings["validation_coupling"] = time.perf_counter() - t0
+        history.validation["coupled"] = [bool(c) for c in coupled]
+        history.validation["coupling_ratio"] = [float(r) for r in ratio]
+        if not np.all(coupled):
+            history.notes.append(f"gp: blocked validation decoupled {int(np.sum(~coupled))} of {len(coupled)} "
+                                 "outputs from the others (their coupling did not lower the blocked error)")
     return params, stats
 
 
