@@ -440,13 +440,13 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
         from .joint import gate_coupling
 
         t0 = time.perf_counter()
-        params, coupled, ratio = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
+        params, info = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
         history.timings["validation_coupling"] = time.perf_counter() - t0
-        history.validation["coupled"] = [bool(c) for c in coupled]
-        history.validation["coupling_ratio"] = [float(r) for r in ratio]
-        if not np.all(coupled):
-            history.notes.append(f"gp: blocked validation decoupled {int(np.sum(~coupled))} of {len(coupled)} "
-                                 "outputs from the others (their coupling did not lower the blocked error)")
+        history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
+        if not np.all(info["coupled"]):
+            history.notes.append(f"gp: blocked validation decoupled the signal of {int(np.sum(~info['coupled']))} of "
+                                 f"{len(info['coupled'])} outputs from the others (the coupling did not lower their "
+                                 "blocked error)")
     return params, stats
 
 

@@ -68,44 +68,54 @@ def decoupled(params: GlobalParams) -> GlobalParams:
 COUPLING_MARGIN = 0.99
 
 
-def couple_only(params: GlobalParams, coupled) -> GlobalParams:
-    """``params`` with the cross-output coupling kept only among the outputs where ``coupled (P,)``
-    is True: every ``B_j`` and ``Sigma`` keep their diagonal and the entries ``(p, q)`` with both
-    ``p`` and ``q`` coupled, the rest set to 0 (a principal block and a diagonal: positive definite).
-    All True returns ``params``; all False is :func:`decoupled`."""
+def couple_only(params: GlobalParams, coupled, noise_coupled=None) -> GlobalParams:
+    """``params`` with the cross-output coupling of the signal kept only among the outputs where
+    ``coupled (P,)`` is True, and that of the noise among those where ``noise_coupled (P,)`` is True
+    (default: ``coupled``). Each ``B_j`` (and ``Sigma``) keeps its diagonal and the entries
+    ``(p, q)`` with both ``p`` and ``q`` coupled; the rest is set to 0 (a principal block and a
+    diagonal: positive definite). All True returns ``params``; all False is :func:`decoupled`."""
     coupled = np.asarray(coupled, bool)
-    if coupled.all():
+    noise_coupled = coupled if noise_coupled is None else np.asarray(noise_coupled, bool)
+    if coupled.all() and noise_coupled.all():
         return params
-    if not coupled.any():
-        return decoupled(params)
-    mask = np.outer(coupled, coupled) | np.eye(len(coupled), dtype=bool)
+    eye = np.eye(len(coupled), dtype=bool)
     F = np.asarray(params.factors)
-    A = np.linalg.cholesky(np.einsum("jpr,jqr->jpq", F, F) * mask)
+    A = np.linalg.cholesky(np.einsum("jpr,jqr->jpq", F, F) * (np.outer(coupled, coupled) | eye))
     R = None
-    if params.noise_chol is not None:
+    if params.noise_chol is not None and noise_coupled.any():
         Rn = np.asarray(params.noise_chol)
-        R = jnp.asarray(np.linalg.cholesky((Rn @ Rn.T) * mask))
+        R = jnp.asarray(np.linalg.cholesky((Rn @ Rn.T) * (np.outer(noise_coupled, noise_coupled) | eye)))
     return replace(params, A=jnp.asarray(A[0]), lmc_A=None if params.lmc_A is None else jnp.asarray(A[1:]),
                    noise_chol=R)
 
 
 def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int, batch: int,
-                  margin: float = COUPLING_MARGIN) -> tuple[GlobalParams, np.ndarray, np.ndarray]:
-    """Keep the cross-output coupling (``B``'s and ``Sigma``'s off-diagonals) only for the outputs
-    whose blocked cross-validation error it lowers.
+                  margin: float = COUPLING_MARGIN) -> tuple[GlobalParams, dict]:
+    """Keep the cross-output coupling of the noise (``Sigma``) and of the signal (``B``) only among
+    the outputs that need it to lower their blocked cross-validation error.
 
     The time-ordered standardised rows ``Xs (N, D)``, ``Ys (N, P)`` are cut into ``folds``
     contiguous blocks; each block is predicted by the global posterior of the other blocks (exact
     for fixed hyperparameters; the statistics do not depend on ``B`` or ``Sigma``, so one set serves
-    both models) with the coupled ``params`` and with :func:`decoupled` ones. Output ``p`` stays
-    coupled when its squared error is below ``margin`` times the decoupled one. On isotopic data
-    with a shared kernel the coupling leaves the mean (nearly) unchanged (autokrigeability, module
-    docstring), and a learned correlation that does not change any prediction is not evidence of
-    a correlation; this gate reports coupling only where it earns its place on held-back time.
+    every candidate). Two gates, in turn:
+
+    1. noise: output ``p`` *benefits* when its squared error with the learned ``Sigma`` (and ``B``
+       diagonal) is below ``margin`` times that with both diagonal;
+    2. signal: output ``p`` benefits when its error with the learned ``B`` (and the gated
+       ``Sigma``) is below ``margin`` times that with ``B`` diagonal.
+
+    In each, the coupled group starts as the outputs that benefit; while one of those no longer
+    benefits within the group (its partner, e.g. the output whose noise it borrows, was left out)
+    the output most strongly correlated with the group in that component joins it (a partner need
+    not benefit itself). On isotopic data with a shared kernel the coupling leaves the mean
+    (nearly) unchanged (autokrigeability, module docstring), and a learned correlation that changes
+    no prediction is no evidence of a correlation: the gated model reports coupling only where it
+    earns its place on held-back time.
 
     Returns:
-        ``(params_gated, coupled (P,) bool, ratio (P,))`` with ``ratio`` the coupled over the
-        decoupled blocked squared error per output (< 1: the coupling helps).
+        ``(params_gated, info)``: ``info["noise_coupled"]``, ``info["coupled"]`` ``(P,)`` bool (signal),
+        ``info["noise_ratio"]``, ``info["ratio"]`` ``(P,)`` the coupled over the uncoupled blocked
+        squared error per output in each gate (< 1: the coupling helps).
     """
     n, P = Ys.shape
     blocks = block_folds(n, folds)
@@ -113,16 +123,45 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
     total = parts[0]
     for st in parts[1:]:
         total = jax.tree_util.tree_map(jnp.add, total, st)
-    dec = decoupled(params)
-    sse = np.zeros((2, P))
-    for (a, b), st in zip(blocks, parts):
-        rest = _sub(total, st)
-        U = np.asarray(_design_u(params, Xs[a:b]))
-        for k, pk in enumerate((params, dec)):
-            sse[k] += np.sum((Ys[a:b] - U @ np.asarray(_mean_weights(pk, rest))) ** 2, 0)
-    ratio = sse[0] / np.maximum(sse[1], 1e-300)
-    coupled = ratio < margin
-    return couple_only(params, coupled), coupled, ratio
+    rests = [_sub(total, st) for st in parts]
+    U = [np.asarray(_design_u(params, Xs[a:b])) for a, b in blocks]
+
+    def sse(pk: GlobalParams) -> np.ndarray:
+        out = np.zeros(P)
+        for (a, b), rest, u in zip(blocks, rests, U):
+            out += np.sum((Ys[a:b] - u @ np.asarray(_mean_weights(pk, rest))) ** 2, 0)
+        return out
+
+    none, every = np.zeros(P, bool), np.ones(P, bool)
+
+    def gate(make, strength):
+        """``make(group) -> params``; returns ``(group, ratio)``."""
+        base = sse(make(none))
+        ratio = sse(make(every)) / np.maximum(base, 1e-300)
+        seeds = ratio < margin
+        group = seeds.copy()
+        strength = np.abs(strength)
+        np.fill_diagonal(strength, 0.0)
+        while group.any() and not group.all():
+            within = sse(make(group)) / np.maximum(base, 1e-300)
+            if np.all(within[seeds] < margin):
+                break
+            group = group.copy()
+            group[int(np.argmax(np.where(group, -1.0, strength[group].max(0))))] = True
+        return group, ratio
+
+    if params.noise_chol is not None:
+        noise_group, noise_ratio = gate(lambda g: couple_only(params, none, g), _corr(np.asarray(params.noise_cov())))
+    else:
+        noise_group, noise_ratio = none, np.ones(P)
+    group, ratio = gate(lambda g: couple_only(params, g, noise_group), _corr(np.asarray(params.B)))
+    info = {"noise_coupled": noise_group, "coupled": group, "noise_ratio": noise_ratio, "ratio": ratio}
+    return couple_only(params, group, noise_group), info
+
+
+def _corr(S: np.ndarray) -> np.ndarray:
+    d = np.sqrt(np.clip(np.diag(S), 1e-300, None))
+    return S / np.outer(d, d)
 
 
 def decoupled_model(model: LocalGlobalGP) -> LocalGlobalGP:

@@ -117,3 +117,31 @@ def test_joint_beats_independent_gps_and_selection_takes_it(gust_case, gust_inde
         blocked_errors(joint, X[:3], Y[:3], folds=5)
     with pytest.raises(ValueError):
         select_outputs(joint, indep[:1], X[:n], Y[:n])
+
+
+def test_coupling_gate_keeps_the_gust_pair_and_drops_an_empty_correlation(gust_case):
+    """Blocked validation of the coupling: output 0 needs output 1's noise (kept together, the noise
+    correlation stays ~0.95); output 2 gains nothing from the others and is decoupled; no output
+    needs the signal's coupling, which removes the B correlation of 0.6 between outputs 1 and 2
+    (output 1 has no latent signal: an empty correlation). The held-out error of output 0 stays at
+    the coupled model's."""
+    from gcs_sysid.gp.joint import couple_only, gate_coupling
+
+    X, Y, F, n, joint = gust_case
+    Xs, Ys = joint.scaler.x(X[:n]), joint.scaler.y(Y[:n])
+    params, info = gate_coupling(joint.params, Xs, Ys, folds=5, batch=256)
+    print(info)
+    assert info["noise_coupled"].tolist() == [True, True, False]
+    assert info["noise_ratio"][0] < 0.95 and info["noise_ratio"][2] > 0.99
+    assert not info["coupled"].any()                      # the signals are unrelated
+    gated = replace(joint, params=params, _post=None, _store=None)       # the same model, gated coupling
+    c, r = gated.output_correlation(), gated.noise_correlation()
+    assert np.allclose(c, np.eye(3)) and r[0, 1] == pytest.approx(joint.noise_correlation()[0, 1])
+    assert r[0, 2] == 0 and r[1, 2] == 0
+    ej = _err(joint.predict(X[n:], include_noise=False)[0], F[n:])
+    eg = _err(gated.predict(X[n:], include_noise=False)[0], F[n:])
+    assert eg[0] < 1.05 * ej[0]
+    # all coupled is the identity; none is decoupled
+    assert couple_only(joint.params, [True] * 3) is joint.params
+    np.testing.assert_allclose(np.asarray(couple_only(joint.params, [False] * 3).B),
+                               np.diag(np.diag(np.asarray(joint.params.B))), atol=1e-12)
