@@ -145,3 +145,19 @@ def test_coupling_gate_keeps_the_gust_pair_and_drops_an_empty_correlation(gust_c
     assert couple_only(joint.params, [True] * 3) is joint.params
     np.testing.assert_allclose(np.asarray(couple_only(joint.params, [False] * 3).B),
                                np.diag(np.diag(np.asarray(joint.params.B))), atol=1e-12)
+
+
+@pytest.mark.slow
+def test_fit_with_coupling_validation_records_the_gate_and_keeps_the_gust_gain(gust_case):
+    """``GPConfig.coupling_validation`` runs the gate inside ``fit_gp`` (after the latent scales):
+    the history records it, the signal's correlations are gone, the gust pair's noise coupling and
+    output 0's held-out gain stay."""
+    X, Y, F, n, joint = gust_case
+    gated, hist = fit_gp(X[:n], Y[:n], replace(CFG, coupling_validation=True))
+    assert hist.validation["noise_coupled"] == [True, True, False]
+    assert "validation_coupling" in hist.timings
+    assert np.max(np.abs(gated.output_correlation() - np.eye(3))) < 0.5
+    assert gated.noise_correlation()[0, 1] == pytest.approx(0.95, abs=0.05)
+    ej = _err(joint.predict(X[n:], include_noise=False)[0], F[n:])
+    eg = _err(gated.predict(X[n:], include_noise=False)[0], F[n:])
+    assert eg[0] < 1.05 * ej[0]
