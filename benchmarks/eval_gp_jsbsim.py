@@ -27,7 +27,25 @@ of the least-squares model (LS as the prior mean), ``indep`` six
 independent one-output GPs (same settings, each its own hyperparameters), ``lmc`` = ``nigp`` with a
 linear model of coregionalisation of two latent kernels (``GPConfig.latent_kernels = 2``: per-output
 length-scales), ``lmc3`` with three, ``nigpc`` = ``nigp`` with the coloured-residual variance factor
-(``GPConfig.residual_correlation``), and ``ls`` (cached).
+(``GPConfig.residual_correlation``), ``dec`` = ``nigp`` with its cross-output coupling removed after the
+fit (``gp.joint.decoupled``: ``B`` and the noise covariance made diagonal, every other
+hyperparameter kept: what the coupling contributes to the mean), ``sel`` = per output ``nigp`` or
+that output's ``indep`` GP, whichever has the lower blocked cross-validation error on the training
+rows (``gp.joint.select_outputs``), ``nigpv`` = ``nigp`` with the coupling kept only for the outputs
+whose blocked cross-validation error it lowers (``GPConfig.coupling_validation``), and ``ls`` (cached).
+
+For the joint variants each line also carries the output correlations (issue 8, "no learned
+output correlation above 0.5 where the truth has none"): ``corr_learned`` (``output_correlation``),
+``latent_std`` (sqrt of ``B``'s diagonal, data units), ``noise_corr`` (``noise_correlation``),
+``corr_model_nl`` (the model's global mean over the training rows, its part not linear in the
+regressors, correlated across outputs) and the truth's counterparts ``truth`` from
+``gp.joint.truth_correlation`` on the exact regressors and coefficients of the training rows
+(``signal_corr``: the nonlinear part of a quadratic response surface; ``rest_corr``: what it
+leaves, the part no function of the regressors explains); matrices flattened row-major. ``flags``
+lists the pairs with a learned correlation above 0.5 where the truth's is below 0.2 (``TRUTH_NONE``),
+``flags_carrying`` those of them where both outputs' latent std is at least 0.1 of their noise std
+(``CARRIES``). ``--diagnose`` prints, per
+flight, least squares per output against seemingly-unrelated-regressions GLS (Zellner 1962).
 
 Usage::
 
@@ -53,8 +71,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
+from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
+                                truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "ls")
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "ls")
+
+#: |truth correlation| below which the truth "has none" (the flags of the joint variants)
+TRUTH_NONE = 0.2
+#: an output's latent GP "carries a signal" when its prior std is at least this share of its noise std
+#: (a correlation with a latent part of ~zero variance is scale-free but says nothing)
+CARRIES = 0.1
 
 
 def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
@@ -96,8 +122,10 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=False, input_noise=False)
     if variant in ("full", "indep"):
         return replace(base, noise_correlation=variant == "full", input_noise=False)
-    if variant == "nigp":
+    if variant in ("nigp", "dec", "sel"):
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "nigpv":
+        return replace(base, noise_correlation=True, input_noise=True, coupling_validation=True)
     if variant == "nigpc":
         return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
@@ -129,19 +157,43 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
     meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
     if thin is not None:
         meta["aoa"] += f"/thin{int(thin)}"            # a separate group in --summarize
+    memo: dict = {}
+
+    def joint_fit():          # nigp, shared by nigp, dec and sel (fitted once per flight)
+        if "joint" not in memo:
+            model, hist = fit_gp(X[tr], Y[tr], _config("nigp", base))
+            memo["joint"] = with_offset_covariance(model, off), hist
+        return memo["joint"]
+
+    def indep_fit():          # six one-output GPs, shared by indep and sel
+        if "indep" not in memo:
+            cfg = _config("indep", base)
+            memo["indep"] = [with_offset_covariance(fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0], off)
+                             for p in range(Y.shape[1])]
+        return memo["indep"]
+
     for v in variants:
         t0 = time.perf_counter()
         corr = float("nan")
         true = None
         validation = {}
         true_latent = true_noise = None
+        extra: dict = {}
         if v == "ls":
             mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
             sig_n = sig_g = sig
+        elif v == "sel":
+            sel = select_outputs(joint_fit()[0], indep_fit(), X[tr], Y[tr])
+            m, var = sel.predict(X[h], include_noise=False)
+            mean, sig = m, np.sqrt(var)
+            sig_n = np.sqrt(sel.predict(X[h])[1])
+            sig_g = sig * np.nan
+            mt, vt = sel.predict(Xt[h], include_noise=False, input_noise=False)
+            true = mt, np.sqrt(vt)
+            extra = {"use_joint": sel.use_joint.tolist(), "cv_joint": sel.err_joint.tolist(),
+                     "cv_indep": sel.err_indep.tolist()}
         elif v == "indep":
-            cfg = _config(v, base)
-            models = [with_offset_covariance(fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0], off)
-                      for p in range(Y.shape[1])]
+            models = indep_fit()
             parts = [m.predict(X[h], False) for m in models]
             mean = np.column_stack([m for m, _ in parts])
             sig = np.sqrt(np.column_stack([s for _, s in parts]))
@@ -150,8 +202,16 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             sig_n = sig_g = sig * np.nan
         else:
             prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
-            model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
-            model = with_offset_covariance(model, off)
+            if v in ("nigp", "dec"):
+                model, hist = joint_fit()
+                if v == "dec":
+                    model = decoupled_model(model)
+                extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
+            else:
+                model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
+                model = with_offset_covariance(model, off)
+                if v == "nigpv":
+                    extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
             mean, sig = m + prior[h], np.sqrt(var)
@@ -183,7 +243,67 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
                              "discrepancy_std": None if model.discrepancy is None else dict(zip(
                                  COEFFICIENTS, (np.sqrt(model.discrepancy[0]) * model.scaler.y_std).tolist())),
                              "offset_std_deg": None if off is None else float(np.degrees(np.sqrt(off[0, 0])))}),
-                         t_fit_s=round(time.perf_counter() - t0, 2)))
+                         **extra, t_fit_s=round(time.perf_counter() - t0, 2)))
+
+
+def _correlations(model, X, Xt, Yt) -> dict:
+    """Learned output correlations of ``model`` and the truth's on the training rows (JSON-able)."""
+    B = np.asarray(model.params.B)
+    gm, _ = model.predict_global(X, include_noise=False)
+    model_nl, _ = correlation(nonlinear_part(X, gm))
+    truth = truth_correlation(Xt, Yt)
+    learned = model.output_correlation()
+    P = learned.shape[0]
+    flags = [(i, j) for i in range(P) for j in range(i + 1, P)
+             if abs(learned[i, j]) > 0.5 and abs(truth["signal_corr"][i, j]) < TRUTH_NONE]
+    latent, noise = np.sqrt(np.diag(B)), np.sqrt(np.asarray(model.params.noise))     # standardised
+    carries = latent >= CARRIES * noise         # outputs whose latent GP carries a signal at all
+    name = lambda i, j: f"{COEFFICIENTS[i]}-{COEFFICIENTS[j]}"  # noqa: E731
+    r = lambda a: [float(f"{x:.4g}") for x in np.ravel(a)]  # noqa: E731   (flattened, 4 significant digits)
+    return {"corr_learned": r(learned), "latent_std": r(latent * model.scaler.y_std),
+            "noise_corr": r(model.noise_correlation()), "noise_std": r(noise * model.scaler.y_std),
+            "corr_model_nl": r(model_nl), "truth": {k: r(v) for k, v in truth.items()},
+            "flags": [name(i, j) for i, j in flags],
+            "flags_carrying": [name(i, j) for i, j in flags if carries[i] and carries[j]]}
+
+
+def diagnose(path: Path) -> str:
+    """Least squares per output against SUR/GLS on one cached flight (Zellner 1962), held-out error %.
+
+    ``ols``: each coefficient on all ten regressors; ``gls_all``: GLS with the residuals' 6 x 6
+    covariance and the same regressors for every output (equal to ``ols`` by Zellner's theorem);
+    ``ols_sub``/``sur_sub``: each coefficient on its own axis's regressors only (longitudinal CX CZ
+    Cm: alpha q_hat delta_e delta_t V; lateral CY Cl Cn: beta p_hat r_hat delta_a delta_r), least
+    squares and GLS: where the regressor sets differ, correlated noise can help a joint estimate.
+    """
+    d = np.load(path)
+    X, Y, Yt = d["X"], d["Y"], d["Yt"]
+    ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
+    tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
+    h = d["held"] & ok
+    sd = X[tr].std(0)
+    A = np.column_stack([np.ones(len(X)), (X - X[tr].mean(0)) / np.where(sd > 0, sd, 1.0)])
+    lon, lat = [1, 4, 6, 9, 10], [2, 3, 5, 7, 8]          # columns of A (1 + regressor index)
+    out = []
+    for name, cols in (("all", [list(range(11))] * 6), ("sub", [[0] + (lon if p in (0, 2, 4) else lat) for p in range(6)])):
+        Wo = [np.linalg.lstsq(A[tr][:, c], Y[tr][:, p], rcond=None)[0] for p, c in enumerate(cols)]
+        res = np.column_stack([Y[tr][:, p] - A[tr][:, c] @ w for p, (c, w) in enumerate(zip(cols, Wo))])
+        Si = np.linalg.inv(np.cov(res.T))
+        off = np.cumsum([0] + [len(c) for c in cols])
+        G, g = np.zeros((off[-1], off[-1])), np.zeros(off[-1])
+        for p, cp in enumerate(cols):
+            for q, cq in enumerate(cols):
+                G[off[p]:off[p + 1], off[q]:off[q + 1]] = Si[p, q] * A[tr][:, cp].T @ A[tr][:, cq]
+            g[off[p]:off[p + 1]] = A[tr][:, cp].T @ (Y[tr] @ Si[p])
+        b = np.linalg.lstsq(G, g, rcond=None)[0]
+        ols = np.column_stack([A[h][:, c] @ w for c, w in zip(cols, Wo)])
+        gls = np.column_stack([A[h][:, c] @ b[off[p]:off[p + 1]] for p, c in enumerate(cols)])
+        rc, _ = correlation(res)
+        big = max(abs(rc[i, j]) for i in range(6) for j in range(i + 1, 6))
+        out.append(f"{path.stem:26s} ols_{name} " + " ".join(f"{e:6.2f}" for e in errors(ols, Yt[h]))
+                   + f"   gls_{name} " + " ".join(f"{e:6.2f}" for e in errors(gls, Yt[h]))
+                   + f"   largest |residual corr| {big:.2f}")
+    return "\n".join(out)
 
 
 def summarize(paths) -> str:
@@ -212,7 +332,7 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]
@@ -237,6 +357,8 @@ def main(argv=None) -> int:
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
     ap.add_argument("--thin", type=int, default=None,
                     help="fit on every N-th training row only (joint vs independent with few samples)")
+    ap.add_argument("--diagnose", action="store_true",
+                    help="print least squares vs SUR/GLS per cached flight instead of fitting GPs")
     a = ap.parse_args(argv)
     if a.summarize:
         print(summarize(a.summarize))
@@ -250,6 +372,9 @@ def main(argv=None) -> int:
                     path = cache / f"{ac}-{seed}-{turb}-{aoa}.npz"
                     if a.make or not path.is_file():
                         path = make(ac, seed, turb, aoa, a.duration, cache)
+                    if a.diagnose:
+                        print(diagnose(path), flush=True)
+                        continue
                     for r in score(path, a.variants, thin=a.thin):
                         print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
                               + "  cov " + " ".join(f"{r['cov'][c]:5.1f}" for c in COEFFICIENTS)

@@ -77,6 +77,10 @@ class GPConfig:
             cross-validation that decides, per output, how much of the latent GP and whether the
             local layer is kept (:mod:`gcs_sysid.gp.validation`; ``docs/gp.md``, "Earning its
             place"); 0 or 1: keep both as learned (the model before this check).
+        coupling_validation: with the blocked validation, keep the cross-output coupling (the
+            off-diagonals of ``B`` and of the noise covariance) only for the outputs whose blocked
+            error it lowers by 1 % (:func:`gcs_sysid.gp.joint.gate_coupling`; ``docs/gp.md``,
+            "Joint vs independent outputs"). Off by default.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -114,6 +118,7 @@ class GPConfig:
     input_noise: bool = True
     residual_correlation: bool = False
     validation_folds: int = 5
+    coupling_validation: bool = False
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:

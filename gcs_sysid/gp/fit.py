@@ -442,6 +442,17 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
     if np.any(s < 1.0):
         history.notes.append("gp: blocked validation shrank the latent GP to " + ", ".join(
             f"{v:g}" for v in s) + " of its learned prior std per output")
+    if cfg.coupling_validation and Ys.shape[1] > 1:
+        from .joint import gate_coupling
+
+        t0 = time.perf_counter()
+        params, info = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
+        history.timings["validation_coupling"] = time.perf_counter() - t0
+        history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
+        if not np.all(info["coupled"]):
+            history.notes.append(f"gp: blocked validation decoupled the signal of {int(np.sum(~info['coupled']))} of "
+                                 f"{len(info['coupled'])} outputs from the others (the coupling did not lower their "
+                                 "blocked error)")
     return params, stats
 
 
