@@ -56,7 +56,8 @@ from .regression import ols
 from .residual_gp import residual_structure
 from .terms import term_factors, term_matrix
 
-__all__ = ["Reference", "differential", "offset_allowance", "onset_of_change", "fit_record", "reference_logs"]
+__all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "BETA_COEFFICIENTS",
+           "onset_of_change", "fit_record", "reference_logs"]
 
 
 @dataclass
@@ -168,6 +169,68 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
            f"gains {gain:.0f} % on the held-out rows beyond the offset")
     return {"offset_only": bool(only), "estimate": th, "std_error": se, "t": float(t),
             "gain_beyond_offset_percent": float(gain), "why": why}
+
+
+#: The lateral coefficients a sideslip-measurement scale acts on through the model's beta terms.
+BETA_COEFFICIENTS = ("CY", "Cl", "Cn")
+
+
+def beta_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
+                         term: str, min_t: float = 3.0, min_gain_pct: float = 10.0) -> dict | None:
+    """Is a sideslip finding more than a between-flight *scale* of the measured sideslip?
+
+    The log's sideslip is an estimate whose scale differs from flight to flight (the AHRS or the
+    reconstruction's: wind, airspeed and specific-force aiding). A scale ``1 + s`` of beta moves *every*
+    lateral coefficient by ``s`` times the model's own beta contribution ``n_j = beta dC_j/dbeta``;
+    a change of one coefficient's aerodynamics moves that coefficient alone. So ``s`` is fitted on the
+    *other* lateral coefficients (those with a beta contribution; offsets free, each weighted by its
+    residual variance on the selection rows), the finding's coefficient is corrected by ``s n_j``, and
+    :func:`offset_allowance` judges what is left: a finding that is only the common scale (plus an
+    offset) is an allowance, not a cause.
+
+    Args:
+        X: (T, 10) regressors. R: (T, 6) residual without the finding. train, test: (T,) rows.
+        model: the model under test (:data:`~gcs_sysid.diagnose.context.ModelDict`).
+        coef, term: the finding; only ``CY``/``Cl``/``Cn`` terms with beta among their factors are judged.
+        min_t, min_gain_pct: as :func:`offset_allowance`.
+
+    Returns:
+        None when the finding is not a sideslip term or no other coefficient has a beta contribution;
+        else ``{"scale_only": bool, "beta_scale", "std_error", "from": [coef...], "beyond_scale": {...}}``.
+    """
+    from .context import evaluate_model
+
+    if coef not in BETA_COEFFICIENTS or "beta" not in term.replace(" ", "").split("*"):
+        return None
+    ib = REGRESSORS.index("beta")
+    eps = 1e-3
+    X1 = np.array(X, float, copy=True)
+    X1[:, ib] *= 1.0 + eps
+    N = (evaluate_model(model, X1) - evaluate_model(model, X)) / eps        # (T, 6): beta dC/dbeta
+    ok = train & np.isfinite(R).all(axis=1) & np.isfinite(N).all(axis=1)
+    others = [c for c in BETA_COEFFICIENTS if c != coef and np.std(N[ok, COEFFICIENTS.index(c)]) > 0]
+    if ok.sum() < 50 or not others:
+        return None
+    num = den = 0.0
+    cols = []
+    for c in others:
+        j = COEFFICIENTS.index(c)
+        r, n = R[ok, j] - R[ok, j].mean(), N[ok, j] - N[ok, j].mean()
+        w = 1.0 / max(float(np.var(r)), 1e-30)
+        num, den = num + w * float(n @ r), den + w * float(n @ n)
+        cols.append((r * np.sqrt(w), n * np.sqrt(w)))
+    if den <= 0:
+        return None
+    s_hat = num / den
+    res = ols(np.concatenate([n for _, n in cols])[:, None], np.concatenate([r for r, _ in cols]), terms=["s"])
+    j = COEFFICIENTS.index(coef)
+    R_adj = np.array(R, float, copy=True)
+    R_adj[:, j] = R[:, j] - s_hat * N[:, j]
+    beyond = offset_allowance(X, R_adj, train, test, coef, term, min_t=min_t, min_gain_pct=min_gain_pct)
+    return {"scale_only": bool(beyond["offset_only"]), "beta_scale": float(s_hat),
+            "std_error": float(res.std_error[0]), "from": others, "beyond_scale": beyond,
+            "why": f"a common sideslip scale {1 + s_hat:.3f} (fitted on {', '.join(others)}) and {coef}'s offset "
+                   f"free: {beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
 
 
 def _within_reference_variation(c_f: float, se_f: float, compared: list[dict], k: float = 3.0) -> dict | None:
@@ -418,6 +481,17 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                                          "summary": f"{cause}: a between-flight offset of {coef}, not a cause"})
                 continue
             f["evidence"]["offset_allowance"] = allow
+            scale = beta_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model, coef,
+                                         term, min_t=min_t, min_gain_pct=min_gain_pct)
+            if scale is not None and scale["scale_only"]:
+                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scale}
+                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
+                                         "gain": f.get("gain", {}), "why": scale["why"],
+                                         "summary": f"{cause}: a between-flight scale of the measured sideslip, "
+                                                    "not a cause"})
+                continue
+            if scale is not None:
+                f["evidence"]["beta_scale_allowance"] = scale
         null = 0.0 if is_aero else _null_value(cause, airframe)
         # an aero finding's correction is its change from the model's value (catalogue: evidence.correction;
         # sparse search: estimate - model_value)

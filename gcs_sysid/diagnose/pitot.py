@@ -24,6 +24,15 @@ makes are its evidence and the gate keeps them; without that confirmation they a
 and the bias is named only for what it explains beyond them (its V-dependent size, rates, angles).
 Accepted, its symptoms (aero terms and ``scale:<coef>`` of the implied coefficients) leave the findings.
 
+**First, the wind triangle and the coefficients together** (added 2026-11-22, branch i9-pitot;
+``docs/diagnose.md``, "The pitot by the wind triangle and the coefficients together"): the pitot
+against GPS minus the autopilot's wind (:mod:`gcs_sysid.diagnose.wind_triangle`) and the bias fitted
+on the coefficients are independent measurements of one change since the reference flight; when they
+agree and their fused change is at least :data:`MIN_T_FUSED` standard errors, the coefficients are
+refitted with the bias's exact effect (the pipeline re-run with the pitot corrected, one estimate per
+coefficient, their median) and the bias is named if that correction gains on the untouched rows. Only
+when that path does not name it does the signature path below decide.
+
 Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:15 UTC):
 ``MIN_T`` on the fit's coloured-residual t statistic, and the systematic error of the autopilot's
 wind estimate ``WIND_SYSTEMATIC_MPS`` in the wind check.
@@ -44,7 +53,8 @@ from .context import DiagContext
 from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
 
-__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "airspeed_cause", "wind_shift", "with_pitot"]
+__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "MIN_T_SCREEN",
+           "MAX_SE_COEF_MPS", "airspeed_cause", "wind_shift", "fuse_pitot_evidence", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
@@ -55,6 +65,19 @@ WIND_SYSTEMATIC_MPS = 0.3
 #: :data:`gcs_sysid.diagnose.physical.OFFSETS_ALLOWED`).
 MIN_T_WIND = 3.0
 PITOT_CAUSES = ("bias:airspeed", "scale:airspeed")
+#: 1-sigma between-flight systematic error (m/s) of a pitot bias fitted on the coefficients: what the
+#: coloured standard error misses (the model's own flight-to-flight inadequacy). Set from the clean tuning
+#: flights (c172x/sgs seeds 11-12: fitted biases -0.02 to +0.20 m/s with coloured errors 0.03-0.07).
+COEF_SYSTEMATIC_MPS = 0.2
+#: |fused change| / its standard error for the wind triangle and the coefficients together to name a
+#: pitot bias (:func:`fuse_pitot_evidence`).
+MIN_T_FUSED = 3.0
+#: The cheap screen before the pipeline is re-run with the pitot corrected (:func:`_unit_delta_rereduced`):
+#: the wind triangle and the closed-form coefficient fit agree and their fused |t| reaches this.
+MIN_T_SCREEN = 2.0
+#: Largest coloured standard error (m/s) of one coefficient's estimate of the bias for it to take part in
+#: the coefficients' median (:func:`_fit_unit_delta`).
+MAX_SE_COEF_MPS = 0.5
 
 
 def wind_shift(ctx: DiagContext, flight) -> dict | None:
@@ -143,6 +166,8 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
                 "t_statistic": float(tstat), "score": float(f.score), "gain_percent": float(f.gain_percent),
                 "checks": checks}
         out["candidates"].append(cand)
+        if cause == "bias:airspeed":
+            cand["references"] = _reference_values(references, airframe, model, cause)
         if not all(checks.values()):
             cand["accepted"] = False
             continue
@@ -162,7 +187,7 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
             checks["wind_shift"] = bool(abs(wind["bias_mps"] - b) <= 3.0 * np.hypot(wind["std_error"], f.std_error)
                                         + 0.25 * abs(b))
             cand["wind_shift"] = wind
-        refs = _reference_values(references, airframe, model, cause)
+        refs = cand["references"] if "references" in cand else _reference_values(references, airframe, model, cause)
         cand["references"] = refs
         same = [r for r in refs if abs(f.estimate - r["estimate"]) < 3.0 * np.hypot(f.std_error, r["std_error"])]
         checks["changed_since_reference"] = not (refs and len(same) == len(refs))
@@ -174,6 +199,14 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         cand["gain_untouched"] = gate["versus_terms"].get("gain_cause", {})
         if cand["accepted"] and (best is None or f.score > best[0].score):
             best = (f, cand, gate)
+    fused = _fused_candidate(ctx, R, proj, flight, references, airframe, model, out["candidates"], gain_rows,
+                             min_gain_pct)
+    out["wind_triangle"] = fused
+    if fused is not None and fused["accepted"]:
+        out["finding"] = fused.pop("finding")
+        return out
+    if fused is not None:
+        fused.pop("finding", None)
     if best is not None:
         f, cand, gate = best
         main = max(cand["gain_untouched"], key=cand["gain_untouched"].get) if cand["gain_untouched"] else f.coefficient
@@ -190,6 +223,219 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
                          "gain_acceptance_by_coefficient": f.gains, "separable": True, "rivals": [],
                          "summary": f"{f.cause} {f.estimate:.3g} +- {f.std_error:.2g}: every implied coefficient "
                                     f"({', '.join(gate['signature']['implied'])}) sees it"}}
+    return out
+
+
+def fuse_pitot_evidence(triangle: dict | None, coef_change: float, coef_se: float) -> dict | None:
+    """Two independent measurements of one pitot bias change, combined when they agree.
+
+    The wind triangle (:func:`gcs_sysid.diagnose.wind_triangle.change_since_references`: the pitot
+    against GPS minus the wind, flight minus reference) and the coefficients' qbar signature (the
+    bias fitted on the coefficient residual, flight minus reference, its standard error with
+    :data:`COEF_SYSTEMATIC_MPS` in quadrature) see the same change through unrelated errors (the wind
+    estimate's wander; the model's between-flight inadequacy). They *agree* when they differ by at most
+    3 combined standard errors; then the inverse-variance mean is the estimate.
+
+    Args:
+        triangle: ``{"change_mps", "std_error"}`` or None. coef_change, coef_se: m/s.
+
+    Returns:
+        None without a usable triangle, else ``{"agree", "estimate", "std_error", "t_statistic",
+        "triangle_mps", "triangle_se", "coefficients_mps", "coefficients_se"}``.
+    """
+    if triangle is None or not (triangle["std_error"] > 0) or not (coef_se > 0) or not np.isfinite(coef_change):
+        return None
+    a, sa = triangle["change_mps"], triangle["std_error"]
+    wa, wc = 1.0 / sa ** 2, 1.0 / coef_se ** 2
+    est = (wa * a + wc * coef_change) / (wa + wc)
+    se = 1.0 / np.sqrt(wa + wc)
+    agree = abs(a - coef_change) <= 3.0 * np.hypot(sa, coef_se)
+    return {"agree": bool(agree), "estimate": float(est), "std_error": float(se), "t_statistic": float(est / se),
+            "triangle_mps": float(a), "triangle_se": float(sa), "coefficients_mps": float(coef_change),
+            "coefficients_se": float(coef_se)}
+
+
+def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidates, gain_rows, min_gain_pct):
+    """``bias:airspeed`` by the wind triangle and the coefficients together (:func:`fuse_pitot_evidence`).
+
+    Accepted when both measurements agree, their combined change since the reference flight(s) is at
+    least :data:`MIN_T_FUSED` standard errors from 0 and the correction at that size gains at least
+    ``min_gain_pct`` on a coefficient's untouched rows (never used by either fit). The offsets the
+    bias makes count as its evidence here (the triangle measures the bias without the coefficients).
+    """
+    from .wind_triangle import change_since_references, wind_triangle
+
+    cand = next((c for c in candidates if c["cause"] == "bias:airspeed"), None)
+    if cand is None:
+        return None
+    tri = wind_triangle(ctx.t, ctx.states, ctx.valid, flight)
+    ref_tri = _reference_triangles(references, airframe, model)
+    change = change_since_references(tri, ref_tri)
+    refs = cand.get("references") or []
+    if refs:
+        w = np.array([1.0 / max(r["std_error"], 1e-9) ** 2 for r in refs])
+        ref_b = float(np.sum(w * [r["estimate"] for r in refs]) / w.sum())
+        ref_se = float(1.0 / np.sqrt(w.sum()))
+    else:
+        ref_b, ref_se = 0.0, 0.0
+    coef_change = cand["estimate"] - ref_b
+    coef_se = float(np.sqrt(cand["std_error"] ** 2 + ref_se ** 2 + COEF_SYSTEMATIC_MPS ** 2))
+    fused = fuse_pitot_evidence(change, coef_change, coef_se)
+    out = {"flight": tri, "references": ref_tri, "change": change, "fused": fused, "accepted": False}
+    if fused is None:
+        out["why"] = "no wind triangle (no pitot, ground velocity or autopilot wind on this flight)"
+        return out
+    # the screen passed: the pipeline re-run on the flight with the pitot corrected gives the bias's
+    # exact effect on every regressor and coefficient (the estimation layer's aided angles move with the
+    # airspeed in ways the closed-form transform does not model); the coefficient fit is then redone with it
+    if not (fused["agree"] and abs(fused["t_statistic"]) >= MIN_T_SCREEN):
+        out["why"] = "the screen (wind triangle and closed-form coefficient fit) did not pass"
+        out["checks"] = {"measurements_agree": fused["agree"], "significant": False}
+        return out
+    D1 = _unit_delta_rereduced(ctx, flight, fused["estimate"])
+    if D1 is not None:
+        b_c, se_c, per_coef = _fit_unit_delta(ctx, R, D1)
+        coef_change = b_c - ref_b
+        coef_se = float(np.sqrt(se_c ** 2 + ref_se ** 2 + COEF_SYSTEMATIC_MPS ** 2))
+        fused = fuse_pitot_evidence(change, coef_change, coef_se)
+        out["fused"] = fused
+        out["coefficients_rereduced"] = {"estimate": float(b_c), "std_error": float(se_c), "by_coefficient": per_coef}
+        b = fused["estimate"]
+        delta = b * D1
+    else:
+        b = fused["estimate"]
+        delta = next(c for c in transforms(ctx) if c.cause == "bias:airspeed").delta(ctx, [b])
+    sc = Scorer(with_test(ctx, gain_rows), np.nan_to_num(R), proj)
+    score, gains = sc.score(np.nan_to_num(delta), 1)
+    gain_pct = {k: v["percent"] for k, v in gains.items()}
+    main = max(gain_pct, key=gain_pct.get) if gain_pct else ""
+    checks = {"measurements_agree": fused["agree"],
+              "significant": bool(abs(fused["t_statistic"]) >= MIN_T_FUSED),
+              "gain_on_untouched_rows": bool(main and gain_pct[main] >= min_gain_pct)}
+    out.update(checks=checks, gain_untouched=gain_pct, score_untouched=float(score),
+               accepted=all(checks.values()))
+    if not out["accepted"]:
+        out["why"] = ", ".join(k for k, v in checks.items() if not v) + " failed"
+        return out
+    ref_txt = (f"reference flight(s) {change['reference_mps']:+.2f} m/s" if change["reference_mps"] is not None
+               else "no reference flight")
+    out["finding"] = {
+        "cause": "bias:airspeed", "coefficient": main, "estimate": float(b), "std_error": float(fused["std_error"]),
+        "gain": {"percent": float(gain_pct[main]), "rows": "untouched (held out from selection and acceptance)"},
+        "evidence": {"domain": "data compatibility", "method": "wind triangle + coefficient signature",
+                     "score": float(score), "t_statistic": fused["t_statistic"], "checks": checks,
+                     "wind_triangle": {"flight": tri, "references": ref_tri, "change": change},
+                     "coefficients": {"estimate": cand["estimate"], "std_error": cand["std_error"],
+                                      "references": refs, "systematic_mps": COEF_SYSTEMATIC_MPS},
+                     "fused": fused, "gain_untouched_by_coefficient": gain_pct,
+                     "differential": {"verdict": "changed" if change["reference_mps"] is not None
+                                      else "no reference flight", "references": refs},
+                     "signature": {"implied": [c for c, g in gain_pct.items() if g > 0]},
+                     "separable": True, "rivals": [],
+                     "summary": f"the pitot reads {b:+.2f} +- {fused['std_error']:.2f} m/s more than before: "
+                                f"the wind triangle (pitot against GPS minus the autopilot's wind) "
+                                f"{change['flight_mps']:+.2f} m/s on this flight, {ref_txt}; the coefficients' "
+                                f"qbar signature {coef_change:+.2f} m/s"}}
+    return out
+
+
+def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float) -> np.ndarray | None:
+    """Change of the residual (T, 6) per m/s of pitot bias, from the pipeline re-run with the pitot reading
+    ``b0`` m/s (TAS) less (estimation and coefficients as :func:`gcs_sysid.diagnose.run.load_measurements`
+    computes them); None when the flight cannot be re-reduced (no pitot stream, another grid, ``b0`` ~ 0).
+    """
+    import dataclasses
+
+    from ..aero import compute_coefficients
+    from ..estimation import estimate_states
+    from ..telemetry.types import Stream
+
+    if flight is None or abs(b0) < 1e-3 or not ctx.has("rho"):
+        return None
+    streams = dict(flight.streams)
+    changed = False
+    for name, key in (("airspeed", "eas"), ("vfr_hud", "airspeed")):
+        if name in streams and key in streams[name].fields:
+            st = streams[name]
+            rho = np.interp(st.t, ctx.t, ctx.states["rho"])
+            f = dict(st.fields)
+            f[key] = np.asarray(st[key], float) - b0 * np.sqrt(rho / 1.225)      # TAS bias -> EAS
+            streams[name] = Stream(st.name, st.source, st.t, f)
+            changed = True
+    if not changed:
+        return None
+    try:
+        states = estimate_states(dataclasses.replace(flight, streams=streams), ctx.airframe)
+        table = compute_coefficients(states, ctx.airframe)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError, KeyError):
+        return None
+    X, Y = np.asarray(table.X, float), np.asarray(table.Y, float)
+    if X.shape != ctx.X.shape or not np.allclose(np.asarray(table.t, float), ctx.t):
+        return None
+    D = (Y - ctx.model_values(X)) - (ctx.Y - ctx.model_values())
+    return np.where(np.isfinite(D), D, 0.0) / b0
+
+
+def _fit_unit_delta(ctx: DiagContext, R: np.ndarray, D1: np.ndarray) -> tuple[float, float, dict]:
+    """Pitot bias from the coefficients with its exact per-m/s effect ``D1`` (T, 6): one estimate per
+    coefficient, combined by their median.
+
+    Each coefficient ``j`` gives ``b_j`` from ``R_j + b_j D1_j ~ 0`` on the selection rows with both
+    sides' means removed (the between-flight offset allowance of :mod:`gcs_sysid.diagnose.physical`: the
+    bias counts here only for what it explains beyond a constant per coefficient; the wind triangle
+    measures its level) and a coloured standard error. A coefficient takes part when it resolves the bias
+    (``se_j <= MAX_SE_COEF_MPS``). One bias acts on every coefficient, so their estimates agree where the
+    model is adequate; the median is robust to the minority where the model's own between-flight error
+    correlates with the bias's effect, and its standard error is the larger of the coefficients' scatter
+    (``1.2533 * 1.4826 * MAD / sqrt(k)``) and the smallest coloured error.
+
+    Returns:
+        ``(b, std_error, {coef: {"estimate", "std_error", "used"}})``; NaN when no coefficient resolves it.
+    """
+    from ..aero.table import COEFFICIENTS
+    from .regression import colored_covariance
+
+    tr = ctx.train & ctx.valid
+    per, est, ses = {}, [], []
+    for j, c in enumerate(COEFFICIENTS):
+        if not ctx.active[j]:
+            continue
+        r, d = np.nan_to_num(R[tr, j]), np.nan_to_num(D1[tr, j])
+        r, d = r - r.mean(), d - d.mean()
+        dd = float(d @ d)
+        if dd <= 0 or len(d) < 50:
+            continue
+        b = -float(r @ d) / dd
+        se = float(np.sqrt(max(colored_covariance(d[:, None], r + b * d)[0, 0], 0.0)))
+        used = bool(np.isfinite(b) and 0 < se <= MAX_SE_COEF_MPS)
+        per[c] = {"estimate": b, "std_error": se, "used": used}
+        if used:
+            est.append(b)
+            ses.append(se)
+    if not est:
+        return float("nan"), float("nan"), per
+    est = np.asarray(est)
+    b = float(np.median(est))
+    mad = float(np.median(np.abs(est - b)))
+    se = max(1.2533 * 1.4826 * mad / np.sqrt(len(est)), float(np.min(ses)))
+    return b, float(se), per
+
+
+def _reference_triangles(references, airframe, model) -> list[dict]:
+    """:func:`~gcs_sysid.diagnose.wind_triangle.wind_triangle` of each reference flight with a decoded log."""
+    from .wind_triangle import wind_triangle
+
+    out = []
+    for ref in references or ():
+        if getattr(ref, "flight", None) is None or getattr(ref, "states", None) is None:
+            continue
+        try:
+            rctx = DiagContext.build(ref.table, airframe, model, ref.states, None, None)
+            c = wind_triangle(rctx.t, rctx.states, rctx.valid, ref.flight)
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+            c = None
+        if c is not None:
+            out.append(c | {"label": getattr(ref, "label", "reference")})
     return out
 
 
@@ -224,6 +470,8 @@ def with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
     data["pitot"] = {"candidates": [{k: (v if k != "gate" else {"why": v["why"], "signature": v["signature"],
                                                                   "versus_terms": v["versus_terms"]})
                                      for k, v in c.items()} for c in pitot["candidates"]]}
+    if pitot.get("wind_triangle") is not None:
+        data["pitot"]["wind_triangle"] = pitot["wind_triangle"]
     if pitot["calibration"]:
         data.setdefault("calibration", []).extend(pitot["calibration"])
     f = pitot["finding"]

@@ -1,0 +1,61 @@
+"""The between-flight sideslip-scale allowance (gcs_sysid.diagnose.differential.beta_scale_allowance).
+
+A flight whose measured sideslip is 20 % too small moves CY, Cl and Cn together by their model beta
+terms: a `CY:beta` finding there is that scale, not a side-force change. A side-force change alone
+(CY's beta derivative 30 % larger, the others untouched) stays a finding. Fast (synthetic arrays)."""
+
+import numpy as np
+
+from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS
+from gcs_sysid.diagnose.context import evaluate_model
+from gcs_sysid.diagnose.differential import beta_scale_allowance, offset_allowance
+
+MODEL = {"CX": {"1": -0.03}, "CY": {"beta": -0.6, "delta_r": 0.15}, "CZ": {"1": -0.4, "alpha": -4.5},
+         "Cl": {"beta": -0.09, "p_hat": -0.45, "delta_a": -0.2}, "Cm": {"alpha": -0.9},
+         "Cn": {"beta": 0.07, "r_hat": -0.1, "delta_r": -0.07}}
+
+
+def _flight(seed=0, T=6000):
+    rng = np.random.default_rng(seed)
+    t = np.arange(T) * 0.02
+    X = np.zeros((T, len(REGRESSORS)))
+    X[:, REGRESSORS.index("alpha")] = 0.05 + 0.02 * np.sin(t / 3.0)
+    X[:, REGRESSORS.index("beta")] = 0.08 * np.sin(t / 1.7) + 0.03 * np.sin(t / 0.45)
+    X[:, REGRESSORS.index("p_hat")] = 0.02 * np.sin(t / 0.9)
+    X[:, REGRESSORS.index("r_hat")] = 0.01 * np.sin(t / 1.1 + 1)
+    X[:, REGRESSORS.index("delta_a")] = 0.05 * np.sign(np.sin(t / 2.3))
+    X[:, REGRESSORS.index("delta_r")] = 0.06 * np.sign(np.sin(t / 2.9 + 0.5))
+    X[:, REGRESSORS.index("V")] = 30.0
+    noise = rng.normal(0, 1, (T, 6)) * np.array([0.002, 0.002, 0.01, 0.0003, 0.001, 0.0003])
+    blocks = (t // 8).astype(int) % 3
+    return X, noise, blocks != 2, blocks == 2
+
+
+def test_a_sideslip_scale_is_an_allowance_but_a_side_force_change_is_not():
+    X, noise, train, test = _flight()
+    ib = REGRESSORS.index("beta")
+    # the measured beta 0.8 of the true one: the truth is the model on the true beta
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / 0.8
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    # the finding alone is more than an offset of CY ...
+    assert not offset_allowance(X, R, train, test, "CY", "beta")["offset_only"]
+    # ... but it is the common scale seen in Cl and Cn
+    a = beta_scale_allowance(X, R, train, test, MODEL, "CY", "beta")
+    assert a is not None and a["scale_only"], a
+    assert abs(a["beta_scale"] - 0.25) < 0.03 and set(a["from"]) == {"Cl", "Cn"}
+
+    # a side-force change alone (CY_beta 30 % larger): Cl and Cn see no scale, the finding stands
+    j = COEFFICIENTS.index("CY")
+    R2 = noise.copy()
+    R2[:, j] += 0.3 * MODEL["CY"]["beta"] * X[:, ib]
+    b = beta_scale_allowance(X, R2, train, test, MODEL, "CY", "beta")
+    assert b is not None and not b["scale_only"], b
+    assert abs(b["beta_scale"]) < 0.02
+
+
+def test_only_sideslip_terms_of_lateral_coefficients_are_judged():
+    X, noise, train, test = _flight(1)
+    assert beta_scale_allowance(X, noise, train, test, MODEL, "CZ", "alpha") is None
+    assert beta_scale_allowance(X, noise, train, test, MODEL, "Cl", "delta_a") is None
+    assert beta_scale_allowance(X, noise, train, test, MODEL, "CY", "alpha*beta") is not None

@@ -1,0 +1,104 @@
+"""The wind-triangle pitot calibration (gcs_sysid.diagnose.wind_triangle) and its fusion with the
+coefficients' qbar signature (gcs_sysid.diagnose.pitot.fuse_pitot_evidence).
+
+Synthetic flights with a known wind and pitot bias: the heading sweep ("cloverleaf") solves wind and
+bias without any wind estimate; a straight flight cannot, unless the autopilot's wind is given, and
+then only to within that estimate's systematic error. Fast (no pipeline run)."""
+
+import numpy as np
+import pytest
+
+from gcs_sysid.diagnose.pitot import COEF_SYSTEMATIC_MPS, fuse_pitot_evidence
+from gcs_sysid.diagnose.wind_triangle import WIND_SYSTEMATIC_MPS, change_since_references, wind_triangle
+from gcs_sysid.telemetry.types import Flight, Stream
+
+RHO = 1.1
+
+
+def _flight(bias: float, turn: bool, wind=(4.0, -3.0), ap_wind_error=(0.0, 0.0), seed: int = 0,
+            with_ap_wind: bool = True):
+    """A 200-s flight at 25 m/s TAS: (t grid, states, valid, Flight) with the pitot reading ``bias`` high."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 200.0, 0.02)
+    psi = 2 * np.pi * t / 100.0 if turn else np.full_like(t, 0.3)            # two full circles, or straight
+    V = 25.0 + 2.0 * np.sin(2 * np.pi * t / 37.0)
+    gust = np.convolve(rng.normal(0, 0.6, len(t)), np.ones(100) / 100, mode="same")   # slow along-track gusts
+    va = np.stack([(V + gust) * np.cos(psi), (V + gust) * np.sin(psi), 0.3 * np.sin(t / 5.0)], axis=1)
+    vg = va + np.array([wind[0], wind[1], 0.0])
+    vtas = np.linalg.norm(va, axis=1)
+    eas = (vtas + bias) * np.sqrt(RHO / 1.225) + rng.normal(0, 0.2, len(t))
+    states = {"vn": vg[:, 0] + rng.normal(0, 0.05, len(t)), "ve": vg[:, 1] + rng.normal(0, 0.05, len(t)),
+              "vd": vg[:, 2], "rho": np.full(len(t), RHO)}
+    streams = {"airspeed": Stream("airspeed", "SCALED_PRESSURE", t, {"eas": eas})}
+    if with_ap_wind:
+        tw = t[::25]
+        streams["wind"] = Stream("wind", "WIND", tw, {"wn": np.full(len(tw), wind[0] + ap_wind_error[0]),
+                                                      "we": np.full(len(tw), wind[1] + ap_wind_error[1])})
+    return t, states, np.ones(len(t), bool), Flight("synthetic", "tlog", streams)
+
+
+def test_cloverleaf_solves_bias_and_wind_without_a_wind_estimate():
+    t, st, valid, fl = _flight(1.5, turn=True, with_ap_wind=False)
+    c = wind_triangle(t, st, valid, fl)
+    assert c["wind"].startswith("solved")
+    assert c["heading_span_deg"] > 300
+    assert abs(c["bias_mps"] - 1.5) < 0.15 and c["std_error"] < 0.15
+    # the wind it solved: the correction from the zero start is the wind itself
+    assert np.allclose(c["wind_correction_mps"], [4.0, -3.0], atol=0.2)
+
+
+def test_straight_flight_without_a_wind_estimate_cannot_tell_bias_from_wind():
+    t, st, valid, fl = _flight(1.5, turn=False, with_ap_wind=False)
+    c = wind_triangle(t, st, valid, fl)
+    assert c["heading_span_deg"] < 5
+    assert c["std_error"] > 5.0               # bias and along-track wind are one unknown
+
+
+def test_straight_flight_with_the_autopilot_wind_is_limited_by_its_systematic_error():
+    t, st, valid, fl = _flight(1.5, turn=False, ap_wind_error=(0.0, 0.0))
+    c = wind_triangle(t, st, valid, fl)
+    assert abs(c["bias_mps"] - 1.5) < 0.2
+    # the prior's 0.3 m/s is the floor of the standard error on a straight flight
+    assert WIND_SYSTEMATIC_MPS * 0.8 < c["std_error"] < 0.5
+    # an autopilot wind 0.5 m/s off along the track moves the bias by about as much, inside 2 se
+    t, st, valid, fl = _flight(1.5, turn=False, ap_wind_error=(0.5 * np.cos(0.3), 0.5 * np.sin(0.3)))
+    c2 = wind_triangle(t, st, valid, fl)
+    assert abs(c2["bias_mps"] - 1.5) > 0.3 and abs(c2["bias_mps"] - 1.5) < 2 * c2["std_error"]
+
+
+def test_turns_beat_a_wrong_autopilot_wind():
+    """With the heading sweep the flight's own triangle overrides a wrong wind prior."""
+    t, st, valid, fl = _flight(1.0, turn=True, ap_wind_error=(0.8, -0.6))
+    c = wind_triangle(t, st, valid, fl)
+    assert abs(c["bias_mps"] - 1.0) < 0.15
+
+
+def test_change_since_reference_and_without_pitot():
+    t, st, valid, fl = _flight(1.0, turn=False, seed=1)
+    t0, st0, valid0, fl0 = _flight(0.0, turn=False, seed=2)
+    ch = change_since_references(wind_triangle(t, st, valid, fl), [wind_triangle(t0, st0, valid0, fl0)])
+    assert abs(ch["change_mps"] - 1.0) < 0.3
+    assert ch["std_error"] > np.sqrt(2) * WIND_SYSTEMATIC_MPS * 0.8     # both flights' wind errors
+    no_pitot = Flight("x", "tlog", {"wind": fl["wind"]})
+    assert wind_triangle(t, st, valid, no_pitot) is None
+    assert change_since_references(None, []) is None
+
+
+def test_fusion_needs_agreement():
+    tri = {"change_mps": 0.8, "std_error": 0.42}
+    f = fuse_pitot_evidence(tri, 0.85, float(np.hypot(0.05, COEF_SYSTEMATIC_MPS)))
+    assert f["agree"] and 0.8 < f["estimate"] < 0.85 and f["t_statistic"] > 3
+    # a clean flight: both near 0, not significant
+    f0 = fuse_pitot_evidence({"change_mps": -0.5, "std_error": 0.42}, 0.1, float(np.hypot(0.05, COEF_SYSTEMATIC_MPS)))
+    assert abs(f0["t_statistic"]) < 3
+    # contradicting measurements do not agree
+    fx = fuse_pitot_evidence({"change_mps": -1.5, "std_error": 0.3}, 1.5, 0.2)
+    assert not fx["agree"]
+    assert fuse_pitot_evidence(None, 1.0, 0.2) is None
+
+
+@pytest.mark.parametrize("bias", [0.0, 2.0])
+def test_bias_sign_and_size(bias):
+    t, st, valid, fl = _flight(bias, turn=True, with_ap_wind=False, seed=3)
+    c = wind_triangle(t, st, valid, fl)
+    assert abs(c["bias_mps"] - bias) < 0.15
