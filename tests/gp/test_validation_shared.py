@@ -15,7 +15,8 @@ import pytest
 from gcs_sysid.gp import validation
 from gcs_sysid.gp.batching import local_predict
 from gcs_sysid.gp.local import LocalParams, build_store
-from gcs_sysid.gp.validation import LOCAL_MARGIN, LOCAL_OFF, _val_rows, block_folds, block_stores, gate_local
+from gcs_sysid.gp.validation import (LOCAL_MARGIN, LOCAL_OFF, _val_rows, block_folds, block_stores, gate_local,
+                                      shared_search, store_without)
 
 
 def _rows(n, seed, dup=0):
@@ -62,6 +63,10 @@ def test_block_stores_equal_per_block_stores(n, k, folds, dup, seed):
         assert np.array_equal(s.z, ref.z) and s.z_mean == ref.z_mean and s.k == ref.k
         assert np.array_equal(s.X, ref.X) and np.array_equal(s.resid, ref.resid)
         assert np.array_equal(s.tree.data, ref.tree.data)
+    full = store_without(shared_search(X, metric, k), X, resid, 0, 0)     # the store of all rows
+    ref = build_store(X, resid, metric, k)
+    assert np.array_equal(full.z, ref.z) and full.z_mean == ref.z_mean and full.k == ref.k
+    assert np.array_equal(full.tree.data, ref.tree.data) and np.array_equal(full.X, X)
 
 
 def test_fallback_query_is_used_and_exact(monkeypatch):
@@ -86,3 +91,12 @@ def test_gate_local_decisions_and_predictions_unchanged():
     assert np.array_equal(ratio, ratio_ref)                 # the same predictions, summed the same way
     assert keep.tolist() == (ratio_ref < LOCAL_MARGIN).tolist() == [True, False]
     np.testing.assert_array_equal(np.asarray(gated.amp), [0.5, 0.5 * LOCAL_OFF])
+
+
+def test_fitted_model_store_equals_build_store(fitted):
+    """fit_gp builds the store of all rows from the validation's shared search: as build_store would."""
+    model, history = fitted
+    assert "local_kept" in history.validation                # the blocked validation ran (shared search)
+    st = model.store
+    ref = build_store(st.X, st.resid, st.metric, st.k)
+    assert np.array_equal(st.z, ref.z) and st.z_mean == ref.z_mean
