@@ -43,7 +43,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.scipy.linalg import cho_solve
 
-from .batching import global_stats, local_predict
+from .batching import _add_jit, global_stats, local_predict
 from .local import LocalParams, LocalStore
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
 
@@ -103,7 +103,9 @@ def _design_u(params: GlobalParams, Xs: jax.Array) -> jax.Array:
     return jnp.concatenate([features(params, Lm, Xs), design(Xs).T], axis=0).T
 
 
+@jax.jit
 def _sub(a: Stats, b: Stats) -> Stats:
+    """``a - b`` leaf by leaf, as one compiled program (eager, each leaf's shape compiles its own)."""
     return jax.tree_util.tree_map(jnp.subtract, a, b)
 
 
@@ -137,7 +139,7 @@ def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int
     parts = [global_stats(params, Xs[a:b], Ys[a:b], batch) for a, b in blocks]
     total = parts[0]
     for st in parts[1:]:
-        total = jax.tree_util.tree_map(jnp.add, total, st)
+        total = _add_jit(total, st)           # the chunks' sum program of global_stats: no new compilation
     rng = np.random.default_rng(seed + 23)
     per = max(1, val_max // len(blocks))
     grid = [scale_latent(params, np.full(P, g)) for g in GLOBAL_GRID]
