@@ -20,6 +20,7 @@ Steps (each one a plain function of arrays):
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -381,6 +382,15 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if len(rows) < len(Xs):
         notes.append(f"gp: the local layer keeps {len(rows)} of {len(Xs)} rows (store_max), thinned by region")
 
+    # the local layer's neighbour search (one for the store of all rows and the validation's blocks)
+    # needs only the rows and the length-scales: it runs in a thread (SciPy's k-d tree releases the
+    # GIL) while the global layer is validated and conditioned
+    search = None
+    if cfg.local and _validating(cfg, len(rows.X)):
+        pool = ThreadPoolExecutor(1, thread_name_prefix="gcs-sysid-neighbours")
+        search = pool.submit(shared_search, rows.X, 1.0 / np.asarray(params.metric_lengthscale()),
+                             cfg.local_neighbours)
+        pool.shutdown(wait=False)                 # the thread ends with its one job
     t2 = time.perf_counter()
     params, stats = validated_global(params, Xs, Ys, cfg, history)
     post = global_posterior(params, stats)
@@ -401,9 +411,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if cfg.local:
         t3 = time.perf_counter()
         resid = rows.Y - global_mean(params, post, rows.X, cfg.batch_size)
-        # one neighbour search for the store of all rows and those of the validation's blocks
-        search = (shared_search(rows.X, 1.0 / np.asarray(params.metric_lengthscale()), cfg.local_neighbours)
-                  if _validating(cfg, len(rows.X)) else None)
+        search = None if search is None else search.result()
         local_params, store = fit_local(cfg, params, rows.X, resid, history,
                                         None if search is None else store_without(search, rows.X, resid, 0, 0))
         local_params = validated_local(local_params, params, rows.X, resid, cfg, history, search)
