@@ -91,10 +91,21 @@ def local_predict(params: LocalParams, store: LocalStore, Xs: np.ndarray, batch:
     P = store.resid.shape[1]
     mean, var = np.empty((len(Xs), P)), np.empty((len(Xs), P))
     size = int(min(batch, LOCAL_CHUNK, _bucket(len(Xs))))
+    pending = None
     for a, b in _chunks(len(Xs), size):
+        # the neighbour search of this chunk runs while XLA solves the previous one (dispatched
+        # asynchronously; its results are read after): the same calls, overlapped
         idx, zq = neighbours(store, Xs[a:b])
         args = (_pad(Xs[a:b], size), _pad(zq, size), _pad(store.X[idx], size), _pad(store.z[idx], size),
                 _pad(store.resid[idx], size))
-        m, v = local_predict_chunk(params, *args)
-        mean[a:b], var[a:b] = np.asarray(m)[: b - a], np.asarray(v)[: b - a]
+        out = (a, b, local_predict_chunk(params, *args))
+        if pending is not None:
+            _store_rows(mean, var, *pending)
+        pending = out
+    if pending is not None:
+        _store_rows(mean, var, *pending)
     return mean, var
+
+
+def _store_rows(mean: np.ndarray, var: np.ndarray, a: int, b: int, mv) -> None:
+    mean[a:b], var[a:b] = np.asarray(mv[0])[: b - a], np.asarray(mv[1])[: b - a]

@@ -21,6 +21,7 @@ Steps (each one a plain function of arrays):
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -41,7 +42,7 @@ from .scaling import Standardiser, check_training
 from .selection import random_points, select_inducing
 from .sparse import GlobalParams, design, elbo, stats_of
 from .discrepancy import calibrate, validation_rows
-from .validation import gate_global, gate_local
+from .validation import gate_global, gate_local, shared_search, store_without
 
 __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local", "noise_correlation_factor",
            "learn_input_noise", "validated_global", "validated_local"]
@@ -245,13 +246,15 @@ def _unconstrain(p: GlobalParams, cfg: GPConfig) -> dict:
     return out
 
 
-def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory):
+def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistory, store=None):
     """Local layer on the rows ``Xs (N, D)`` with global residuals ``resid (N, P)`` (standardised).
 
-    Returns ``(LocalParams, LocalStore)``; the loss history is appended to ``history``.
+    ``store``: the :class:`~gcs_sysid.gp.local.LocalStore` of these rows when already built (as
+    ``build_store`` would), else built here. Returns ``(LocalParams, LocalStore)``; the loss history
+    is appended to ``history``.
     """
     metric = 1.0 / np.asarray(params.metric_lengthscale())
-    store = build_store(Xs, resid, metric, cfg.local_neighbours)
+    store = build_store(Xs, resid, metric, cfg.local_neighbours) if store is None else store
     rng = np.random.default_rng(cfg.seed + 7)
     centres = rng.choice(len(Xs), min(cfg.local_batch, len(Xs)), replace=False)
     idx, _ = neighbours(store, Xs[centres])
@@ -381,6 +384,15 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if len(rows) < len(Xs):
         notes.append(f"gp: the local layer keeps {len(rows)} of {len(Xs)} rows (store_max), thinned by region")
 
+    # the local layer's neighbour search (one for the store of all rows and the validation's blocks)
+    # needs only the rows and the length-scales: it runs in a thread (SciPy's k-d tree releases the
+    # GIL) while the global layer is validated and conditioned
+    search = None
+    if cfg.local and _validating(cfg, len(rows.X)):
+        pool = ThreadPoolExecutor(1, thread_name_prefix="gcs-sysid-neighbours")
+        search = pool.submit(shared_search, rows.X, 1.0 / np.asarray(params.metric_lengthscale()),
+                             cfg.local_neighbours)
+        pool.shutdown(wait=False)                 # the thread ends with its one job
     t2 = time.perf_counter()
     params, stats = validated_global(params, Xs, Ys, cfg, history)
     post = global_posterior(params, stats)
@@ -401,8 +413,10 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if cfg.local:
         t3 = time.perf_counter()
         resid = rows.Y - global_mean(params, post, rows.X, cfg.batch_size)
-        local_params, store = fit_local(cfg, params, rows.X, resid, history)
-        local_params = validated_local(local_params, params, rows.X, resid, cfg, history)
+        search = None if search is None else search.result()
+        local_params, store = fit_local(cfg, params, rows.X, resid, history,
+                                        None if search is None else store_without(search, rows.X, resid, 0, 0))
+        local_params = validated_local(local_params, params, rows.X, resid, cfg, history, search)
         history.timings["local"] = time.perf_counter() - t3
     history.timings["total"] = time.perf_counter() - t0
     notes += [n for n in history.notes if n.startswith("gp: blocked validation")]
@@ -457,16 +471,17 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
 
 
 def validated_local(local: LocalParams, params: GlobalParams, Xs: np.ndarray, resid: np.ndarray, cfg: GPConfig,
-                    history: FitHistory) -> LocalParams:
+                    history: FitHistory, search=None) -> LocalParams:
     """The local layer switched off per output where it does not predict held-back time blocks of
     the global residual ``resid (N, P)`` at ``Xs (N, D)`` (:func:`gcs_sysid.gp.validation.gate_local`;
-    unchanged when ``cfg.validation_folds < 2`` or the rows are too few)."""
+    unchanged when ``cfg.validation_folds < 2`` or the rows are too few). ``search``: a
+    :func:`gcs_sysid.gp.validation.shared_search` of ``Xs`` to reuse (made there when None)."""
     if not _validating(cfg, len(Xs)):
         return local
     t0 = time.perf_counter()
     metric = 1.0 / np.asarray(params.metric_lengthscale())
     local, keep, ratio = gate_local(local, Xs, resid, metric, cfg.local_neighbours, int(cfg.validation_folds),
-                                    cfg.batch_size, cfg.n_train_max, cfg.seed)
+                                    cfg.batch_size, cfg.n_train_max, cfg.seed, search)
     history.timings["validation_local"] = time.perf_counter() - t0
     history.validation["local_kept"] = [bool(k) for k in keep]
     history.validation["local_ratio"] = [float(r) for r in ratio]

@@ -36,18 +36,19 @@ then keeps (almost) everything.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jax.scipy.linalg import cho_solve
 
-from .batching import global_stats, local_predict
-from .local import LocalParams, build_store
+from .batching import _add_jit, global_stats, local_predict
+from .local import LocalParams, LocalStore
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
 
-__all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "block_folds", "scale_latent", "gate_global", "gate_local"]
+__all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "SHARED_NEIGHBOURS", "block_folds", "scale_latent",
+           "gate_global", "gate_local", "NeighbourSearch", "shared_search", "store_without", "block_stores"]
 
 #: Candidate scales ``s_p`` of the latent GP's prior std per output (1: as learned).
 GLOBAL_GRID: tuple[float, ...] = (0.05, 0.3, 1.0)
@@ -59,6 +60,12 @@ LOCAL_OFF = 1e-6
 #: error without it: it must earn its place by a margin, not by a rounding-level difference (on
 #: smooth synthetic data the ratio sits at 0.9996-1.0025 for outputs the layer has nothing to add).
 LOCAL_MARGIN = 0.99
+
+#: The stores of the held-back blocks share one neighbour search of all rows for this many times
+#: ``k`` neighbours each (plus the row itself); a row left with fewer than ``k + 1`` neighbours
+#: outside a block is searched again in that block's own tree (:func:`block_stores`). 3 leaves
+#: ~0.2 % of the rows to search again on the 10-minute benchmark flight (2: ~4 %, 1: ~30 %).
+SHARED_NEIGHBOURS = 3
 
 
 def block_folds(n: int, k: int) -> list[tuple[int, int]]:
@@ -96,7 +103,9 @@ def _design_u(params: GlobalParams, Xs: jax.Array) -> jax.Array:
     return jnp.concatenate([features(params, Lm, Xs), design(Xs).T], axis=0).T
 
 
+@jax.jit
 def _sub(a: Stats, b: Stats) -> Stats:
+    """``a - b`` leaf by leaf, as one compiled program (eager, each leaf's shape compiles its own)."""
     return jax.tree_util.tree_map(jnp.subtract, a, b)
 
 
@@ -130,7 +139,7 @@ def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int
     parts = [global_stats(params, Xs[a:b], Ys[a:b], batch) for a, b in blocks]
     total = parts[0]
     for st in parts[1:]:
-        total = jax.tree_util.tree_map(jnp.add, total, st)
+        total = _add_jit(total, st)           # the chunks' sum program of global_stats: no new compilation
     rng = np.random.default_rng(seed + 23)
     per = max(1, val_max // len(blocks))
     grid = [scale_latent(params, np.full(P, g)) for g in GLOBAL_GRID]
@@ -147,7 +156,8 @@ def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int
 
 
 def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int, folds: int,
-               batch: int, val_max: int = 1000, seed: int = 0) -> tuple[LocalParams, np.ndarray, np.ndarray]:
+               batch: int, val_max: int = 1000, seed: int = 0, search: NeighbourSearch | None = None
+               ) -> tuple[LocalParams, np.ndarray, np.ndarray]:
     """Keep the local layer per output only where it predicts held-back blocks of the global residual.
 
     Args:
@@ -155,6 +165,8 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
         Xs: ``(N, D)`` standardised rows in time order; resid: ``(N, P)`` their global residuals.
         metric: ``(D,)`` the neighbour metric (1 / the global length-scales); k: neighbours.
         folds, batch, val_max, seed: as :func:`gate_global`.
+        search: :func:`shared_search` of ``Xs`` with ``metric`` and ``k`` when the caller made one
+            (e.g. for the store of all rows); made here otherwise.
 
     Returns:
         ``(local_gated, keep, ratio)``: parameters with ``amp_p`` times :data:`LOCAL_OFF` where
@@ -166,11 +178,8 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
     per = max(1, val_max // max(folds, 1))
     with_l = np.zeros(P)
     without = np.zeros(P)
-    for a, b in block_folds(n, folds):
-        keep_rows = np.r_[0:a, b:n]
-        if len(keep_rows) < 2:
-            continue
-        store = build_store(Xs[keep_rows], resid[keep_rows], metric, k)
+    blocks = [(a, b) for a, b in block_folds(n, folds) if n - (b - a) >= 2]
+    for (a, b), store in zip(blocks, block_stores(Xs, resid, metric, k, blocks, search)):
         rows = _val_rows(a, b, per, rng)
         m, _ = local_predict(local, store, Xs[rows], batch)
         with_l += np.sum((resid[rows] - m) ** 2, 0)
@@ -179,3 +188,95 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
     keep = ratio < LOCAL_MARGIN
     amp = np.where(keep, np.asarray(local.amp), np.asarray(local.amp) * LOCAL_OFF)
     return replace(local, amp=jnp.asarray(amp)), keep, ratio
+
+
+@dataclass(frozen=True)
+class NeighbourSearch:
+    """One k-d tree query of all rows, shared by the local stores of all rows and of the rows outside
+    each held-back block (:func:`shared_search`).
+
+    Attributes:
+        pts: ``(N, D)`` the rows in the neighbour metric (``Xs * metric``). tree: the k-d tree on them.
+        dist, idx: ``(N, W)`` distances and indices of each row's ``W`` nearest rows (itself included).
+        metric: ``(D,)`` the metric. k: neighbours per local query.
+    """
+
+    pts: np.ndarray
+    tree: object
+    dist: np.ndarray
+    idx: np.ndarray
+    metric: np.ndarray
+    k: int
+
+
+def shared_search(Xs: np.ndarray, metric: np.ndarray, k: int) -> NeighbourSearch:
+    """The ``min(N, SHARED_NEIGHBOURS * k + 1)`` nearest rows of every row of ``Xs (N, D)`` in the
+    metric ``metric (D,)`` (one k-d tree query; :func:`store_without` builds stores from it)."""
+    from scipy.spatial import cKDTree
+
+    n = len(Xs)
+    pts = Xs * metric
+    tree = cKDTree(pts)
+    wide = min(n, SHARED_NEIGHBOURS * int(k) + 1)
+    dist, idx = tree.query(pts, k=wide, workers=-1)
+    return NeighbourSearch(pts, tree, np.asarray(dist).reshape(n, wide), np.asarray(idx).reshape(n, wide),
+                           np.asarray(metric), int(k))
+
+
+def store_without(search: NeighbourSearch, Xs: np.ndarray, resid: np.ndarray, a: int, b: int) -> LocalStore:
+    """The local store of the rows outside ``[a, b)`` (all rows when ``a == b``), equal to
+    :func:`gcs_sysid.gp.local.build_store` of those rows with ``search``'s metric and ``k``.
+
+    A store's log spacing ``z`` needs, for every stored row, the distances to its ``k + 1`` nearest
+    stored rows (itself included). Those are the first ``k + 1`` rows *outside the block* among the
+    row's shared neighbours, where at least ``k + 1`` of them lie outside; the other rows are queried
+    again in the store's own tree. Any stored row not among a row's shared neighbours is at least as
+    far as the last of them, so the kept distances are the ``k + 1`` smallest (ties give equal
+    values), and each pair's distance is computed from the same two points in either tree: ``z``
+    equals ``build_store``'s bit for bit (``tests/gp/test_validation_shared.py``).
+
+    Args:
+        search: :func:`shared_search` of ``Xs``. Xs: ``(N, D)`` standardised rows; resid: ``(N, P)``.
+        a, b: the held-back rows ``[a, b)``; at least 2 rows must lie outside.
+    """
+    from scipy.spatial import cKDTree
+
+    n = len(Xs)
+    keep_rows = np.r_[0:a, b:n]
+    m = len(keep_rows)
+    kb = int(max(1, min(search.k, m)))
+    kk = min(kb + 1, m)                                       # <= the shared width: m <= N, kb <= k
+    p_keep = search.pts[keep_rows]
+    tree = search.tree if m == n else cKDTree(p_keep)
+    ii = search.idx[keep_rows]
+    outside = (ii < a) | (ii >= b)
+    # the first kk neighbours outside the block, in distance order (stable: the query's order)
+    first = np.argsort(~outside, axis=1, kind="stable")[:, :kk]
+    dist = np.take_along_axis(search.dist[keep_rows], first, axis=1)
+    short = np.flatnonzero(outside.sum(1) < kk)
+    if len(short):
+        again, _ = tree.query(p_keep[short], k=kk, workers=-1)
+        dist[short] = np.asarray(again).reshape(len(short), kk)
+    logrho = np.log(np.maximum(dist[:, 1:].mean(1) if kk > 1 else np.ones(m), 1e-12))
+    z_mean = float(logrho.mean())
+    return LocalStore(Xs[keep_rows], resid[keep_rows], search.metric, logrho - z_mean, z_mean, kb, tree)
+
+
+def block_stores(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int, blocks: list[tuple[int, int]],
+                 search: NeighbourSearch | None = None):
+    """The local stores of all rows but each block, equal to ``build_store`` of those rows, from one
+    shared neighbour search (:func:`shared_search`, :func:`store_without`).
+
+    Args:
+        Xs: ``(N, D)`` standardised rows; resid: ``(N, P)`` their residuals.
+        metric: ``(D,)`` the neighbour metric; k: neighbours per query.
+        blocks: ``(start, stop)`` row ranges, each leaving at least 2 rows outside.
+        search: :func:`shared_search` of ``Xs`` with ``metric`` and ``k`` when already made.
+
+    Yields:
+        one :class:`~gcs_sysid.gp.local.LocalStore` per block, of the rows ``r_[0:start, stop:N]``
+        in that order.
+    """
+    search = shared_search(Xs, metric, k) if search is None else search
+    for a, b in blocks:
+        yield store_without(search, Xs, resid, a, b)
