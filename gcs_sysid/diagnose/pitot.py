@@ -52,14 +52,13 @@ from .causes import _air_velocity_body, _dcm_nb, transforms
 from .context import DiagContext
 from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
+from .wind_triangle import WIND_SYSTEMATIC_MPS, autopilot_wind  # noqa: F401  (WIND_SYSTEMATIC_MPS: re-exported)
 
 __all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "MIN_T_SCREEN",
            "MAX_SE_COEF_MPS", "airspeed_cause", "wind_shift", "fuse_pitot_evidence", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
-#: 1-sigma systematic error of an autopilot's wind estimate (m/s): its slow wander.
-WIND_SYSTEMATIC_MPS = 0.3
 #: |b_wind| / its standard error for the autopilot's wind estimate to *confirm* a pitot error on its own
 #: (then the coefficient offsets the bias makes count as its evidence, not as a between-flight allowance;
 #: :data:`gcs_sysid.diagnose.physical.OFFSETS_ALLOWED`).
@@ -94,19 +93,12 @@ def wind_shift(ctx: DiagContext, flight) -> dict | None:
         ``{"bias_mps", "std_error"}`` (the standard error: coloured scatter and
         :data:`WIND_SYSTEMATIC_MPS` in quadrature), or None without an autopilot wind estimate.
     """
-    if flight is None or not flight.has("wind") or not ctx.has("wn", "we", "phi", "theta", "psi"):
+    if not ctx.has("wn", "we", "phi", "theta", "psi"):
         return None
-    s = flight["wind"]
-    if not all(k in s.fields for k in ("wn", "we")):
+    w_ap = autopilot_wind(flight, ctx.t)
+    if w_ap is None:
         return None
-    ts = np.asarray(s.t, float)
-    ap = []
-    for k in ("wn", "we"):
-        x = np.asarray(s[k], float)
-        ok = np.isfinite(x)
-        if ok.sum() < 5:
-            return None
-        ap.append(np.interp(ctx.t, ts[ok], x[ok], left=np.nan, right=np.nan))
+    ap = (w_ap[:, 0], w_ap[:, 1])
     C = _dcm_nb(ctx.states["phi"], ctx.states["theta"], ctx.states["psi"])
     v_ned = np.einsum("tji,tj->ti", C, _air_velocity_body(ctx))
     hn = np.maximum(np.hypot(v_ned[:, 0], v_ned[:, 1]), 1e-3)

@@ -41,10 +41,10 @@ import numpy as np
 
 from .regression import effective_samples
 
-__all__ = ["WIND_SYSTEMATIC_MPS", "wind_triangle", "change_since_references"]
+__all__ = ["WIND_SYSTEMATIC_MPS", "autopilot_wind", "wind_triangle", "change_since_references"]
 
 #: 1-sigma systematic error (m/s, per horizontal component) of an autopilot's wind estimate over a flight:
-#: its slow wander. The same value as :data:`gcs_sysid.diagnose.pitot.WIND_SYSTEMATIC_MPS`.
+#: its slow wander (also the pitot cause's wind check, :func:`gcs_sysid.diagnose.pitot.wind_shift`).
 WIND_SYSTEMATIC_MPS = 0.3
 #: Pitot samples below this true airspeed (m/s), or below half the flight's 90th percentile, are not used
 #: (taxi, launch, landing).
@@ -64,8 +64,13 @@ def _pitot(flight) -> tuple[np.ndarray, np.ndarray] | None:
     return None
 
 
-def _autopilot_wind(flight, t: np.ndarray) -> np.ndarray | None:
-    """The autopilot's horizontal wind (N, 2) m/s at ``t``, NaN outside its samples; None without one."""
+def autopilot_wind(flight, t: np.ndarray) -> np.ndarray | None:
+    """The autopilot's horizontal wind estimate at the times ``t`` (N,) s.
+
+    Returns:
+        ``(N, 2)`` north and east wind, m/s (WIND message, linear interpolation, NaN outside its
+        samples); None without a ``wind`` stream with ``wn``/``we`` or with fewer than 5 finite samples.
+    """
     if flight is None or not flight.has("wind"):
         return None
     s = flight["wind"]
@@ -115,7 +120,7 @@ def wind_triangle(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight,
     if use.sum() < 100:
         return None
     use &= tas > max(MIN_TAS_MPS, 0.5 * float(np.percentile(tas[use], 90)))
-    w_ap = _autopilot_wind(flight, tp)
+    w_ap = autopilot_wind(flight, tp)
     if w_ap is not None:
         use &= np.isfinite(w_ap).all(axis=1)
     if use.sum() < 100:
