@@ -11,14 +11,15 @@ Typical use::
     # gcs-sysid replay files.tlog --airframe files.airframe ...; compare with load_truth(files.truth)
 """
 
-from .aircraft import AIRCRAFT, HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, AircraftSpec, aircraft
+from .aircraft import AIRCRAFT, HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, AircraftSpec, aircraft, canonical_name
 from .flight import TURBULENCE, FlightConfig, Recording, fly, maneuver_inputs
 from .logfile import FlightFiles, make_flight, write_log
 from .scoring import coefficient_errors, score_table
 from .sensors import AOA_VARIANTS, SENSOR_RATES_HZ, make_sensors
 from .truth import Truth, load_truth, save_truth, truth_coefficients, truth_regressors
 
-__all__ = ["AIRCRAFT", "HELD_OUT_AIRCRAFT", "TUNING_AIRCRAFT", "AircraftSpec", "aircraft", "TURBULENCE",
+__all__ = ["AIRCRAFT", "HELD_OUT_AIRCRAFT", "TUNING_AIRCRAFT", "UNTOUCHED_AIRCRAFT", "AircraftSpec", "aircraft",
+           "canonical_name", "TURBULENCE",
            "FlightConfig", "Recording", "fly", "maneuver_inputs", "FlightFiles", "make_flight", "write_log",
            "AOA_VARIANTS", "SENSOR_RATES_HZ", "make_sensors", "Truth", "load_truth", "save_truth",
            "truth_coefficients", "truth_regressors", "score_table", "coefficient_errors"]

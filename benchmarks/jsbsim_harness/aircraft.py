@@ -14,7 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["AircraftSpec", "AIRCRAFT", "TUNING_AIRCRAFT", "HELD_OUT_AIRCRAFT", "aircraft"]
+__all__ = ["AircraftSpec", "AIRCRAFT", "TUNING_AIRCRAFT", "HELD_OUT_AIRCRAFT", "UNTOUCHED_AIRCRAFT", "aircraft",
+           "canonical_name"]
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -66,7 +67,10 @@ class AircraftSpec:
 _DEG = 57.29577951308232
 
 #: Aircraft the harness knows. ``c172x`` and ``sgs`` were used to set up the harness and the test
-#: thresholds; ``pa28`` is kept out of all tuning (``HELD_OUT_AIRCRAFT``).
+#: thresholds; ``pa28`` is kept out of all tuning (``HELD_OUT_AIRCRAFT``), but has been evaluated
+#: after every session since 2026-11-21; ``j3cub`` (added 2026-11-22) is the untouched case
+#: (``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth), the method was
+#: never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -88,9 +92,29 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(_DEG / 23.0, _DEG / 22.5, _DEG / 27.0),
         amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0),
         notes="Piper PA-28 (JSBSim pa28), engine shut down, gliding; held out of all tuning"),
+    # J3Cub: Aeromatic model (Erik Hofman, 2015) with Du (2011) derivatives; surfaces from its
+    # "Systems/Conventional Controls.xml" (elevator +-0.14, ailerons +-0.31 with the right the
+    # mirror of the left, rudder +-0.52 rad). Signs read from its aerodynamics: Pitch_elevator
+    # -1.2004 * elevator-pos (positive = trailing edge down), Roll_aileron +0.3498 * left-aileron-pos
+    # (positive = left trailing edge down, roll right), Yaw_rudder -0.0565 * rudder-pos (positive =
+    # trailing edge left, nose left); checked on the truth by tests/jsbsim/test_jsbsim_j3cub.py.
+    # 50 kt CAS: 1.6 times the model's power-off stall (about 31 kt EAS at 967 lb, CL_max 1.62 at
+    # its lower Reynolds number); the sweep's slowest level, 37.5 kt, is 1.2 times the stall, as
+    # on the c172x. Its pitch damping is three times the c172x's (Cm_q c / (2V) at 30 m/s), so the
+    # elevator amplitude is 4 deg and the pitch-rate gain half the default; the elevator's +-8 deg
+    # leaves 3-4 deg below the slow level's trim. Set from the harness's truth only (alpha, beta,
+    # rates, excitation per axis; docs/jsbsim.md), never from a pipeline result.
+    "j3cub": AircraftSpec(
+        name="j3cub", model="J3Cub", airspeed_kts=50.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0,
+        aileron_props=("fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.14, 1.0 / 0.31, 1.0 / 0.52),
+        amplitude_deg=(4.0, 4.5, 5.0), pulse_s=(0.7, 0.8, 1.0), gains=(1.0, 0.15, 0.01, 0.4, 0.1, 0.4),
+        notes="Piper J-3 Cub (JSBSim J3Cub), engine shut down, gliding; untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs")
-HELD_OUT_AIRCRAFT = ("pa28",)
+HELD_OUT_AIRCRAFT = ("pa28", "j3cub")
+UNTOUCHED_AIRCRAFT = ("j3cub",)
 
 
 def aircraft(name: str) -> AircraftSpec:
@@ -103,3 +127,17 @@ def aircraft(name: str) -> AircraftSpec:
         return AIRCRAFT[name]
     except KeyError:
         raise KeyError(f"unknown aircraft '{name}' (known: {', '.join(AIRCRAFT)})") from None
+
+
+def canonical_name(name: str) -> str:
+    """The harness name of ``name``: a harness name (``j3cub``) or a JSBSim model name (``J3Cub``),
+    either in any case.
+
+    Raises:
+        KeyError: unknown name (the message lists the known ones).
+    """
+    key = str(name).strip().lower()
+    for spec in AIRCRAFT.values():
+        if key in (spec.name.lower(), spec.model.lower()):
+            return spec.name
+    raise KeyError(f"unknown aircraft '{name}' (known: {', '.join(AIRCRAFT)})")
