@@ -26,9 +26,14 @@ Usage::
     python benchmarks/eval_jsbsim.py --aircraft c172x sgs pa28 --seeds 1 2 3 --turbulence light moderate
     python benchmarks/eval_jsbsim.py --aoa vane             # AOA_SSA = exact vane angles
     python benchmarks/eval_jsbsim.py --summarize results.jsonl   # markdown table of --json results
+    python benchmarks/eval_jsbsim.py --aircraft j3cub --flights DIR --fly-only   # fly (or reuse) only
 
 ``pa28`` is the held-out aircraft: it was not used to set up the harness, the estimator or any
-threshold. Results are appended as JSON lines to ``--json`` when given.
+threshold. ``j3cub`` (the J-3 Cub, ``J3Cub`` also accepted) is the untouched one: never in the
+default list, evaluated once after the thresholds are frozen. ``--flights DIR`` keeps the flights
+in DIR and reuses those flown there by the same harness with the same configuration
+(``make_flight(reuse=True)``: ``<stem>-flight.json`` records the configuration and the harness
+fingerprint). Results are appended as JSON lines to ``--json`` when given.
 """
 
 from __future__ import annotations
@@ -44,7 +49,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.jsbsim_harness import FlightConfig, coefficient_errors, load_truth, make_flight  # noqa: E402
+from benchmarks.jsbsim_harness import (HELD_OUT_AIRCRAFT, FlightConfig, coefficient_errors, load_truth,  # noqa: E402
+                                       make_flight)
+from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
 
@@ -60,13 +67,18 @@ def _coverage(mean, sigma, ref) -> float:
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
 
 
-def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path) -> dict:
-    """One flight scored (see the module docstring); returns a JSON-able dict."""
+def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
+             flights: Path | None = None) -> dict:
+    """One flight scored (see the module docstring); returns a JSON-able dict.
+
+    ``flights``: fly into this folder, reusing a flight already there from the same harness and
+    configuration (default: fly into ``work``)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
     t0 = time.perf_counter()
-    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa)
+    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed),
+                        flights or work, aoa=aoa, reuse=flights is not None)
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
@@ -143,7 +155,7 @@ def summarize(paths: list[str]) -> str:
             cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}"}.get(k, "")
             air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
                    f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
-            name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
+            name = f"{ac}{' (held out)' if ac in HELD_OUT_AIRCRAFT else ''}"
             out.append(f"| {name} | {turb} | {aoa} | {len(rs)} | {label} | "
                        + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
     for turb in sorted({r["turbulence"] for r in rows}):
@@ -159,18 +171,35 @@ def summarize(paths: list[str]) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"])
+    ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
+                    help="harness names (c172x sgs pa28 j3cub) or JSBSim model names (J3Cub); default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
+    ap.add_argument("--flights", default=None, metavar="DIR",
+                    help="fly into DIR, reusing flights there from the same harness and configuration")
+    ap.add_argument("--fly-only", action="store_true", help="fly (or reuse) the flights into --flights and stop")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
                     help="only print the markdown table of earlier --json results (medians over seeds)")
     a = ap.parse_args(argv)
     if a.summarize:
         print(summarize(a.summarize))
+        return 0
+    flights = Path(a.flights) if a.flights else None
+    if a.fly_only:
+        if flights is None:
+            ap.error("--fly-only needs --flights DIR")
+        for ac in a.aircraft:
+            for turb in a.turbulence:
+                for seed in a.seeds:
+                    t0 = time.perf_counter()
+                    files = make_flight(FlightConfig(ac, duration_s=a.duration, turbulence=turb, seed=seed), flights,
+                                        aoa=a.aoa, reuse=True)
+                    print(f"{files.tlog}  {'reused' if files.recording is None else 'flown'} "
+                          f"[{time.perf_counter() - t0:.1f} s]", flush=True)
         return 0
     work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
     rows = []
@@ -178,7 +207,7 @@ def main(argv=None) -> int:
     for ac in a.aircraft:
         for turb in a.turbulence:
             for seed in a.seeds:
-                row = evaluate(ac, seed, turb, a.aoa, a.duration, work)
+                row = evaluate(ac, seed, turb, a.aoa, a.duration, work, flights)
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

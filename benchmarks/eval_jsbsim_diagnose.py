@@ -19,6 +19,13 @@ Usage::
 
     python -m benchmarks.eval_jsbsim_diagnose --aircraft c172x sgs --seeds 1 2 3 --out benchmarks/out/diag
     python -m benchmarks.eval_jsbsim_diagnose --aircraft pa28 --seeds 1 --out benchmarks/out/diag-pa28
+    python -m benchmarks.eval_jsbsim_diagnose --aircraft j3cub --out DIR --fly-only   # flights only
+
+``--aircraft`` takes the harness names (c172x sgs pa28 j3cub) or JSBSim's model names (J3Cub);
+``j3cub`` is the untouched aircraft, never in the defaults. The flights of ``--out`` are reused
+when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
+duration and plan; ``--fly-only`` flies (or finds) the reference and every case and stops,
+without fitting or diagnosing anything.
 
 Prints a table and writes one JSON line per case to ``<out>/results.jsonl``.
 """
@@ -36,9 +43,10 @@ if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
 from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
+from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "main"]
+__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "fly_only", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -51,7 +59,7 @@ PLAN = "sweep"
 def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | None = None):
     """:func:`make_effect_flight`, or the files already in ``out`` from an earlier run of the same case."""
     from benchmarks.jsbsim_harness.aircraft import aircraft
-    from benchmarks.jsbsim_harness.logfile import FlightFiles
+    from benchmarks.jsbsim_harness.logfile import FlightFiles, harness_fingerprint
 
     tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
     stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
@@ -59,9 +67,12 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
         stem += f"-{config.plan}"
     tlog = out / f"{stem}.tlog"
     done = tlog.with_name(stem + "-effects.json")
-    if tlog.exists() and done.exists() and json.loads(done.read_text())["config"]["duration_s"] == config.duration_s \
-            and json.loads(done.read_text())["config"].get("plan", "standard") == config.plan:
-        return FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None)
+    if tlog.exists() and done.exists():
+        doc = json.loads(done.read_text())
+        # files written before the fingerprint was recorded (2026-11-22) carry none and are reused as before
+        if doc["config"]["duration_s"] == config.duration_s and doc["config"].get("plan", "standard") == config.plan \
+                and doc.get("harness", harness_fingerprint(config.aircraft)) == harness_fingerprint(config.aircraft):
+            return FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None)
     return make_effect_flight(config, effects, out, stem=stem)
 
 
@@ -167,9 +178,33 @@ def summarize(paths: list[str]) -> str:
     return "\n".join(out)
 
 
+def fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, plan: str = PLAN) -> int:
+    """Fly (or find in ``out``) the reference flight and every case :func:`main` would diagnose, and
+    nothing else: a flight cache for a later run with the same ``--out``. Prints one line per flight
+    (flown / reused / left the envelope); returns 0."""
+    done = set()
+    for ac, seed, effs in _cases(aircraft_names, seeds, clean_seeds, pairs):
+        if effects and effs and not all(e.name in effects for e in effs):
+            continue
+        jobs = [] if ac in done else [(FlightConfig(ac, duration_s=DURATION_S, seed=REF_SEED, plan=plan), [], f"{ac}-ref")]
+        done.add(ac)
+        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan), effs, None))
+        for cfg, es, stem in jobs:
+            t0 = time.perf_counter()
+            tag = "+".join(f"{e.name}={e.value:g}" for e in es) or ("reference" if stem else "clean")
+            try:
+                files = _flight(cfg, es, out, stem=stem)
+                how = "reused" if files.recording is None else "flown"
+            except RuntimeError as exc:       # the aircraft left the envelope with that effect
+                how = f"FAILED: {exc}"
+            print(f"{cfg.aircraft:6s} s{cfg.seed:<3d} {tag:36s} {how} [{time.perf_counter() - t0:.1f} s]", flush=True)
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
+    p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"], type=aircraft_argument,
+                   help="harness names (c172x sgs pa28 j3cub) or JSBSim model names (J3Cub); default %(default)s")
     p.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
     p.add_argument("--clean-seeds", nargs="*", type=int, default=[11, 12, 13, 14, 15])
     p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
@@ -178,6 +213,8 @@ def main(argv=None) -> int:
     p.add_argument("--plan", default=PLAN, choices=("standard", "sweep"),
                    help="flight plan of every flight (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
+    p.add_argument("--fly-only", action="store_true",
+                   help="only fly (or find in --out) the reference and every case; no fit, no diagnosis")
     a = p.parse_args(argv)
     if a.summary:
         print(summarize(a.summary))
@@ -185,6 +222,8 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     pairs = [tuple(x.split(",")) for x in a.pairs]
+    if a.fly_only:
+        return fly_only(a.aircraft, a.seeds, a.clean_seeds, pairs, a.effects, out, a.plan)
     refs = {}
     lines = []
     with open(out / "results.jsonl", "a") as fh:

@@ -11,11 +11,12 @@ positive command (``docs/jsbsim.md``) and are checked against the truth in
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["AircraftSpec", "AIRCRAFT", "TUNING_AIRCRAFT", "HELD_OUT_AIRCRAFT", "UNTOUCHED_AIRCRAFT", "aircraft",
-           "canonical_name"]
+           "canonical_name", "aircraft_argument"]
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -141,3 +142,12 @@ def canonical_name(name: str) -> str:
         if key in (spec.name.lower(), spec.model.lower()):
             return spec.name
     raise KeyError(f"unknown aircraft '{name}' (known: {', '.join(AIRCRAFT)})")
+
+
+def aircraft_argument(name: str) -> str:
+    """``type=`` of the evaluation scripts' ``--aircraft``: :func:`canonical_name`, an unknown name
+    being argparse's one-line usage error (exit 2)."""
+    try:
+        return canonical_name(name)
+    except KeyError as e:
+        raise argparse.ArgumentTypeError(e.args[0]) from None

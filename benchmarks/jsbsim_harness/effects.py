@@ -39,7 +39,7 @@ import numpy as np
 
 from .aircraft import AircraftSpec, aircraft
 from .flight import FlightConfig, Recording, fly
-from .logfile import FlightFiles, write_log
+from .logfile import FlightFiles, harness_fingerprint, write_log
 from .sensors import make_sensors
 from .truth import save_truth, truth_coefficients, truth_regressors
 
@@ -213,6 +213,10 @@ def make_effect_flight(config: FlightConfig, effects: list[Effect], out_dir: str
                        stem: str | None = None) -> FlightFiles:
     """Fly ``config`` with ``effects`` injected; write ``<stem>.tlog``, ``-truth.npz`` and ``-effects.json``.
 
+    ``-effects.json`` also holds the flight's configuration and the harness fingerprint
+    (:func:`~benchmarks.jsbsim_harness.logfile.harness_fingerprint`), by which
+    ``benchmarks/eval_jsbsim_diagnose.py`` decides whether the files can be reused.
+
     Returns:
         the :class:`FlightFiles` (the airframe is the aircraft's checked-in file: the engineer's
         nominal data, unaware of the effect).
@@ -251,6 +255,7 @@ def make_effect_flight(config: FlightConfig, effects: list[Effect], out_dir: str
                     "delay:delta_e": "s", "bias:airspeed": "m/s"}[e.name]
             injected.append({"effect": e.name, "cause": e.name, "value": e.value, "unit": unit})
     doc = {"aircraft": spec.name, "config": asdict(config), "injected": injected,
-           "note": "change made to each term (aero terms: relative to the stock model)"}
+           "note": "change made to each term (aero terms: relative to the stock model)",
+           "harness": harness_fingerprint(spec.name)}
     (out / f"{stem}-effects.json").write_text(json.dumps(doc, indent=1))
     return FlightFiles(tlog, truth, spec.airframe_path, rec)

@@ -8,7 +8,11 @@ surface positions mapped to PWM through the aircraft's airframe file.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import ast
+import functools
+import hashlib
+import json
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -20,7 +24,15 @@ from .flight import FlightConfig, Recording, fly
 from .sensors import SENSOR_RATES_HZ, make_sensors
 from .truth import save_truth
 
-__all__ = ["write_log", "make_flight", "FlightFiles"]
+__all__ = ["write_log", "make_flight", "FlightFiles", "harness_fingerprint"]
+
+_REPO = Path(__file__).resolve().parents[2]
+#: The sources that decide what a flight's files hold (harness, the project's tlog writer and
+#: maneuver waveforms); with the aircraft's airframe file and the JSBSim version they make the
+#: fingerprint under which a flight may be reused.
+FINGERPRINT_SOURCES = tuple(f"benchmarks/jsbsim_harness/{m}.py" for m in
+                            ("aircraft", "flight", "sensors", "logfile", "truth", "effects")) + (
+    "gcs_sysid/signals.py", "gcs_sysid/sim/tlog.py")
 
 
 @dataclass(frozen=True)
@@ -30,7 +42,38 @@ class FlightFiles:
     tlog: Path
     truth: Path
     airframe: Path
-    recording: Recording
+    recording: Recording | None     # None when the files were reused (``make_flight(reuse=True)``)
+
+
+def _code(text: str) -> str:
+    """The code of a Python source without its comments, layout and docstrings (``ast.dump``)."""
+    tree = ast.parse(text)
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and node.body \
+                and isinstance(node.body[0], ast.Expr) and isinstance(node.body[0].value, ast.Constant) \
+                and isinstance(node.body[0].value.value, str):
+            node.body = node.body[1:] or [ast.Pass()]
+    return ast.dump(tree)
+
+
+@functools.lru_cache(maxsize=None)
+def harness_fingerprint(name: str) -> str:
+    """A 16-hex-digit SHA-256 of what makes aircraft ``name``'s flight files: the code of the
+    sources in :data:`FINGERPRINT_SOURCES` (comments and docstrings left out, so that a change of
+    wording keeps the flights), its airframe file and the JSBSim version. A flight written under
+    another fingerprint is flown again rather than reused."""
+    import jsbsim
+
+    h = hashlib.sha256(jsbsim.__version__.encode())
+    for rel in FINGERPRINT_SOURCES:
+        h.update(rel.encode() + b"\0" + _code((_REPO / rel).read_text()).encode())
+    h.update(aircraft(name).airframe_path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _stamp(config: FlightConfig, aoa: str) -> dict:
+    """What ``<stem>-flight.json`` holds, as read back from JSON (tuples as lists)."""
+    return json.loads(json.dumps({"config": asdict(config), "aoa": aoa, "harness": harness_fingerprint(config.aircraft)}))
 
 
 def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs", sensors: dict | None = None) -> int:
@@ -56,23 +99,39 @@ def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs", sensors: dict
     return write_tlog(result, path, af, rates_hz=SENSOR_RATES_HZ)
 
 
-def make_flight(config: FlightConfig, out_dir: str | Path, aoa: str = "ahrs", stem: str | None = None) -> FlightFiles:
+def make_flight(config: FlightConfig, out_dir: str | Path, aoa: str = "ahrs", stem: str | None = None,
+                reuse: bool = False) -> FlightFiles:
     """Fly ``config`` and write ``<stem>.tlog`` and ``<stem>-truth.npz`` into ``out_dir``.
 
     With ``aoa="vane"`` the airframe is the aircraft's file plus ``[air_data] angles = "vane"``
     (``docs/airframe.md``: the log's AOA_SSA are vane measurements), written as
     ``<stem>-airframe.toml``; otherwise the checked-in ``data/airframes/jsbsim-<name>.toml``.
+    Every flight also gets ``<stem>-flight.json``: its configuration, AOA variant and
+    :func:`harness_fingerprint`.
+
+    Args:
+        reuse: when the files are already in ``out_dir`` with the same ``<stem>-flight.json``
+            (same configuration, AOA variant and harness fingerprint), return them without flying
+            (``recording`` is then None); otherwise fly and overwrite.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     stem = stem or f"{config.aircraft}-{config.turbulence}-s{config.seed}-{aoa}"
-    rec = fly(config)
-    tlog, truth = out / f"{stem}.tlog", out / f"{stem}-truth.npz"
-    write_log(rec, tlog, aoa)
-    save_truth(rec, truth)
+    tlog, truth, stamp = out / f"{stem}.tlog", out / f"{stem}-truth.npz", out / f"{stem}-flight.json"
     airframe = aircraft(config.aircraft).airframe_path
     if aoa == "vane":
         vane = out / f"{stem}-airframe.toml"
-        vane.write_text(airframe.read_text() + '\n[air_data]\nangles = "vane"\n')
+        vane_text = airframe.read_text() + '\n[air_data]\nangles = "vane"\n'
+    want = _stamp(config, aoa)
+    if reuse and tlog.is_file() and truth.is_file() and stamp.is_file() and json.loads(stamp.read_text()) == want \
+            and (aoa != "vane" or (vane.is_file() and vane.read_text() == vane_text)):
+        return FlightFiles(tlog, truth, vane if aoa == "vane" else airframe, None)
+    stamp.unlink(missing_ok=True)
+    rec = fly(config)
+    write_log(rec, tlog, aoa)
+    save_truth(rec, truth)
+    if aoa == "vane":
+        vane.write_text(vane_text)
         airframe = vane
+    stamp.write_text(json.dumps(want, indent=1))
     return FlightFiles(tlog, truth, airframe, rec)

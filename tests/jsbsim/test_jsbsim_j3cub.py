@@ -167,3 +167,33 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
     held = rec.t >= 0.8 * cfg.duration_s                                        # the replay's held-out segment
     assert min(d(tr[k][held]).std() for k in ("p", "q", "r")) > 2.0
     assert tr["alt"][0] - tr["alt"][-1] > 100.0
+
+
+def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, monkeypatch):
+    """``--aircraft J3Cub`` resolves to ``j3cub``; ``--fly-only`` flies into ``--flights`` / ``--out``
+    and a second run reuses the files (same configuration and harness fingerprint), while a
+    file from another harness is flown again. No scoring is run."""
+    import json
+
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+
+    args = ["--aircraft", "J3Cub", "--seeds", "1", "--turbulence", "light", "--duration", "2",
+            "--flights", str(tmp_path / "f"), "--fly-only"]
+    assert eval_jsbsim.main(args) == 0 and eval_jsbsim.main(args) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert [ln.split()[1] for ln in out] == ["flown", "reused"] and "j3cub-light-s1-ahrs.tlog" in out[0]
+    assert read_log(tmp_path / "f" / "j3cub-light-s1-ahrs.tlog").streams["servo"].t.size > 50
+
+    monkeypatch.setattr(eval_jsbsim_diagnose, "DURATION_S", 2.0)
+    diag = ["--aircraft", "j3cub", "--seeds", "1", "--clean-seeds", "--pairs", "--effects", "bias:airspeed",
+            "--out", str(tmp_path / "d"), "--fly-only"]
+    assert eval_jsbsim_diagnose.main(diag) == 0
+    first = capsys.readouterr().out.splitlines()
+    assert len(first) == 3 and all(ln.split()[-3] == "flown" for ln in first), first    # reference + 2 sizes
+    doc = tmp_path / "d" / "j3cub-s1-bias_airspeed=1-sweep-effects.json"
+    stale = json.loads(doc.read_text()) | {"harness": "0" * 16}
+    doc.write_text(json.dumps(stale))
+    assert eval_jsbsim_diagnose.main(diag) == 0
+    second = capsys.readouterr().out.splitlines()
+    assert [ln.split()[-3] for ln in second] == ["reused", "reused", "flown"], second
+    assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
