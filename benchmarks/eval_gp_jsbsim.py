@@ -95,7 +95,9 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     name = f"{aircraft}-{seed}-{turbulence}-{aoa}"
     work = cache / ("work-" + name)
     work.mkdir(parents=True, exist_ok=True)
-    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa)
+    # a flight already in ``work`` from the same harness and configuration is reused (make_flight's stamp)
+    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa,
+                        reuse=True)
     truth = load_truth(files.truth)
     res = run_replay(files.tlog, files.airframe, work / "rep", ReplayOptions(progress=False))
     tab, held = res.table, res.held_out

@@ -197,3 +197,15 @@ def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, mon
     second = capsys.readouterr().out.splitlines()
     assert [ln.split()[-3] for ln in second] == ["reused", "reused", "flown"], second
     assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
+
+
+def test_flight_envelope_reads_the_truth_file(cub):
+    """The envelope summary of the fast flight agrees with its recording: ranges, excitation on
+    every axis, no knock-it-off, a glide that loses height."""
+    from benchmarks.jsbsim_harness.envelope import flight_envelope, format_envelope
+
+    e, tr = flight_envelope(cub.truth), cub.recording.truth
+    assert e["alpha"] == pytest.approx((np.degrees(tr["alpha"]).min(), np.degrees(tr["alpha"]).max()))
+    assert e["aborts"] == [] and e["sink_mps"] > 0.5 and min(e["rate_std"]) > 1.0 and min(e["surface_std"]) > 0.5
+    assert e["alpha_p"][0] >= e["alpha"][0] and e["V"][0] > 20.0
+    assert "aborts 0" in format_envelope("j3cub", e)
