@@ -71,7 +71,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, aircraft_argument  # noqa: E402
+from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, UNTOUCHED_AIRCRAFT, aircraft_argument  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
@@ -329,7 +329,7 @@ def summarize(paths) -> str:
                     if x is not None and np.isfinite(x)]
             return f"{np.median(vals):.0f} ({min(vals):.0f}-{max(vals):.0f})" if vals else ""
         corr = float(np.nanmedian([r["max_corr"] for r in rs]))
-        name = f"{ac}{' (held out)' if ac in HELD_OUT_AIRCRAFT else ''}"
+        name = ac + (" (untouched)" if ac in UNTOUCHED_AIRCRAFT else " (held out)" if ac in HELD_OUT_AIRCRAFT else "")
         out.append(f"| {name} | {turb} | {aoa} | {v} | {len(rs)} | " + " | ".join(f"{med('err', c):.1f}" for c in COEFFICIENTS)
                    + f" | {cov('cov')} | {cov('cov_noise')} | {cov('cov_gnoise')} | {cov('cov_true')} | "
                    + f"{'' if np.isnan(corr) else f'{corr:.2f}'} |")

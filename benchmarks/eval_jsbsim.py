@@ -49,8 +49,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.jsbsim_harness import (HELD_OUT_AIRCRAFT, FlightConfig, coefficient_errors, load_truth,  # noqa: E402
-                                       make_flight)
+from benchmarks.jsbsim_harness import (HELD_OUT_AIRCRAFT, UNTOUCHED_AIRCRAFT, FlightConfig,  # noqa: E402
+                                       coefficient_errors, load_truth, make_flight)
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
@@ -155,7 +155,7 @@ def summarize(paths: list[str]) -> str:
             cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}"}.get(k, "")
             air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
                    f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
-            name = f"{ac}{' (held out)' if ac in HELD_OUT_AIRCRAFT else ''}"
+            name = ac + (" (untouched)" if ac in UNTOUCHED_AIRCRAFT else " (held out)" if ac in HELD_OUT_AIRCRAFT else "")
             out.append(f"| {name} | {turb} | {aoa} | {len(rs)} | {label} | "
                        + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
     for turb in sorted({r["turbulence"] for r in rows}):

@@ -9,6 +9,7 @@ test suite: its first evaluation is the final one, after the merge.
 
 import tempfile
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -193,9 +194,13 @@ def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, mon
     doc = tmp_path / "d" / "j3cub-s1-bias_airspeed=1-sweep-effects.json"
     stale = json.loads(doc.read_text()) | {"harness": "0" * 16}
     doc.write_text(json.dumps(stale))
+    flown = []
+    monkeypatch.setattr(eval_jsbsim_diagnose, "make_effect_flight",
+                        lambda cfg, effs, out, stem=None: flown.append(stem) or SimpleNamespace(recording="flown"))
     assert eval_jsbsim_diagnose.main(diag) == 0
     second = capsys.readouterr().out.splitlines()
     assert [ln.split()[-3] for ln in second] == ["reused", "reused", "flown"], second
+    assert flown == ["j3cub-s1-bias_airspeed=1-sweep"]                    # only the stale one is flown again
     assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
 
 
@@ -209,3 +214,24 @@ def test_flight_envelope_reads_the_truth_file(cub):
     assert e["aborts"] == [] and e["sink_mps"] > 0.5 and min(e["rate_std"]) > 1.0 and min(e["surface_std"]) > 0.5
     assert e["alpha_p"][0] >= e["alpha"][0] and e["V"][0] > 20.0
     assert "aborts 0" in format_envelope("j3cub", e)
+
+
+def test_summaries_mark_the_untouched_and_the_held_out_aircraft(tmp_path):
+    """The markdown summaries label j3cub "(untouched)" and pa28 "(held out)" (synthetic rows: no
+    J3Cub result exists before the final evaluation)."""
+    import json
+
+    from benchmarks import eval_jsbsim
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in ("c172x", "pa28", "j3cub")))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| j3cub (untouched) |") for ln in lines)
+    assert any(ln.startswith("| pa28 (held out) |") for ln in lines)
+    assert any(ln.startswith("| c172x | light") for ln in lines)
