@@ -26,14 +26,14 @@ Usage::
     python benchmarks/eval_jsbsim.py --aircraft c172x sgs pa28 --seeds 1 2 3 --turbulence light moderate
     python benchmarks/eval_jsbsim.py --aoa vane             # AOA_SSA = exact vane angles
     python benchmarks/eval_jsbsim.py --summarize results.jsonl   # markdown table of --json results
-    python benchmarks/eval_jsbsim.py --aircraft j3cub --flights DIR --fly-only   # fly (or reuse) only
+    python benchmarks/eval_jsbsim.py --aircraft j3cub --work DIR --fly-only   # fly (or reuse) only
 
 ``pa28`` is the held-out aircraft: it was not used to set up the harness, the estimator or any
 threshold. ``j3cub`` (the J-3 Cub, ``J3Cub`` also accepted) is the untouched one: never in the
-default list, evaluated once after the thresholds are frozen. ``--flights DIR`` keeps the flights
-in DIR and reuses those flown there by the same harness with the same configuration
-(``make_flight(reuse=True)``: ``<stem>-flight.json`` records the configuration and the harness
-fingerprint). Results are appended as JSON lines to ``--json`` when given.
+default list, evaluated once after the thresholds are frozen. A flight already in ``--work``, flown
+by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
+``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
+(or finds) the flights there and stops. Results are appended as JSON lines to ``--json`` when given.
 """
 
 from __future__ import annotations
@@ -67,18 +67,14 @@ def _coverage(mean, sigma, ref) -> float:
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
 
 
-def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
-             flights: Path | None = None) -> dict:
-    """One flight scored (see the module docstring); returns a JSON-able dict.
-
-    ``flights``: fly into this folder, reusing a flight already there from the same harness and
-    configuration (default: fly into ``work``)."""
+def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path) -> dict:
+    """One flight scored (see the module docstring); returns a JSON-able dict."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
     t0 = time.perf_counter()
-    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed),
-                        flights or work, aoa=aoa, reuse=flights is not None)
+    files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa,
+                        reuse=True)     # a flight already in ``work`` from the same harness and configuration
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
@@ -179,25 +175,22 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
-    ap.add_argument("--flights", default=None, metavar="DIR",
-                    help="fly into DIR, reusing flights there from the same harness and configuration")
-    ap.add_argument("--fly-only", action="store_true", help="fly (or reuse) the flights into --flights and stop")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
                     help="only print the markdown table of earlier --json results (medians over seeds)")
+    ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     a = ap.parse_args(argv)
     if a.summarize:
         print(summarize(a.summarize))
         return 0
-    flights = Path(a.flights) if a.flights else None
     if a.fly_only:
-        if flights is None:
-            ap.error("--fly-only needs --flights DIR")
+        if not a.work:
+            ap.error("--fly-only needs --work DIR")
         for ac in a.aircraft:
             for turb in a.turbulence:
                 for seed in a.seeds:
                     t0 = time.perf_counter()
-                    files = make_flight(FlightConfig(ac, duration_s=a.duration, turbulence=turb, seed=seed), flights,
-                                        aoa=a.aoa, reuse=True)
+                    files = make_flight(FlightConfig(ac, duration_s=a.duration, turbulence=turb, seed=seed),
+                                        Path(a.work), aoa=a.aoa, reuse=True)
                     print(f"{files.tlog}  {'reused' if files.recording is None else 'flown'} "
                           f"[{time.perf_counter() - t0:.1f} s]", flush=True)
         return 0
@@ -207,7 +200,7 @@ def main(argv=None) -> int:
     for ac in a.aircraft:
         for turb in a.turbulence:
             for seed in a.seeds:
-                row = evaluate(ac, seed, turb, a.aoa, a.duration, work, flights)
+                row = evaluate(ac, seed, turb, a.aoa, a.duration, work)
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

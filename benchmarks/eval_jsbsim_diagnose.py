@@ -43,10 +43,9 @@ if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
 from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
-from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "fly_only", "main"]
+__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -74,6 +73,29 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
                 and doc.get("harness", harness_fingerprint(config.aircraft)) == harness_fingerprint(config.aircraft):
             return FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None)
     return make_effect_flight(config, effects, out, stem=stem)
+
+
+def _fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, plan: str = PLAN) -> int:
+    """Fly (or find in ``out``) the reference flight and every case :func:`main` would diagnose, and
+    nothing else: a flight cache for a later run with the same ``--out``. Prints one line per flight
+    (flown / reused / left the envelope); returns 0."""
+    done = set()
+    for ac, seed, effs in _cases(aircraft_names, seeds, clean_seeds, pairs):
+        if effects and effs and not all(e.name in effects for e in effs):
+            continue
+        jobs = [] if ac in done else [(FlightConfig(ac, duration_s=DURATION_S, seed=REF_SEED, plan=plan), [], f"{ac}-ref")]
+        done.add(ac)
+        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan), effs, None))
+        for cfg, es, stem in jobs:
+            t0 = time.perf_counter()
+            tag = "+".join(f"{e.name}={e.value:g}" for e in es) or ("reference" if stem else "clean")
+            try:
+                files = _flight(cfg, es, out, stem=stem)
+                how = "reused" if files.recording is None else "flown"
+            except RuntimeError as exc:       # the aircraft left the envelope with that effect
+                how = f"FAILED: {exc}"
+            print(f"{cfg.aircraft:6s} s{cfg.seed:<3d} {tag:36s} {how} [{time.perf_counter() - t0:.1f} s]", flush=True)
+    return 0
 
 
 def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: str = PLAN):
@@ -178,43 +200,19 @@ def summarize(paths: list[str]) -> str:
     return "\n".join(out)
 
 
-def fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, plan: str = PLAN) -> int:
-    """Fly (or find in ``out``) the reference flight and every case :func:`main` would diagnose, and
-    nothing else: a flight cache for a later run with the same ``--out``. Prints one line per flight
-    (flown / reused / left the envelope); returns 0."""
-    done = set()
-    for ac, seed, effs in _cases(aircraft_names, seeds, clean_seeds, pairs):
-        if effects and effs and not all(e.name in effects for e in effs):
-            continue
-        jobs = [] if ac in done else [(FlightConfig(ac, duration_s=DURATION_S, seed=REF_SEED, plan=plan), [], f"{ac}-ref")]
-        done.add(ac)
-        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan), effs, None))
-        for cfg, es, stem in jobs:
-            t0 = time.perf_counter()
-            tag = "+".join(f"{e.name}={e.value:g}" for e in es) or ("reference" if stem else "clean")
-            try:
-                files = _flight(cfg, es, out, stem=stem)
-                how = "reused" if files.recording is None else "flown"
-            except RuntimeError as exc:       # the aircraft left the envelope with that effect
-                how = f"FAILED: {exc}"
-            print(f"{cfg.aircraft:6s} s{cfg.seed:<3d} {tag:36s} {how} [{time.perf_counter() - t0:.1f} s]", flush=True)
-    return 0
-
-
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"], type=aircraft_argument,
-                   help="harness names (c172x sgs pa28 j3cub) or JSBSim model names (J3Cub); default %(default)s")
+    p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
     p.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
     p.add_argument("--clean-seeds", nargs="*", type=int, default=[11, 12, 13, 14, 15])
     p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
     p.add_argument("--pairs", nargs="*", default=["Cm:alpha^2,Cn:delta_a", "Cl:alpha*beta,delay:delta_e"])
+    p.add_argument("--fly-only", action="store_true",
+                   help="only fly (or find in --out) the reference and every case; no fit, no diagnosis")
     p.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "diag-effects"))
     p.add_argument("--plan", default=PLAN, choices=("standard", "sweep"),
                    help="flight plan of every flight (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
-    p.add_argument("--fly-only", action="store_true",
-                   help="only fly (or find in --out) the reference and every case; no fit, no diagnosis")
     a = p.parse_args(argv)
     if a.summary:
         print(summarize(a.summary))
@@ -222,8 +220,14 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     pairs = [tuple(x.split(",")) for x in a.pairs]
+    from benchmarks.jsbsim_harness.aircraft import canonical_name   # harness or JSBSim model names (J3Cub)
+
+    try:
+        a.aircraft = [canonical_name(x) for x in a.aircraft]
+    except KeyError as exc:
+        p.error(f"argument --aircraft: {exc.args[0]}")
     if a.fly_only:
-        return fly_only(a.aircraft, a.seeds, a.clean_seeds, pairs, a.effects, out, a.plan)
+        return _fly_only(a.aircraft, a.seeds, a.clean_seeds, pairs, a.effects, out, a.plan)
     refs = {}
     lines = []
     with open(out / "results.jsonl", "a") as fh:

@@ -179,7 +179,7 @@ def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, mon
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
 
     args = ["--aircraft", "J3Cub", "--seeds", "1", "--turbulence", "light", "--duration", "2",
-            "--flights", str(tmp_path / "f"), "--fly-only"]
+            "--work", str(tmp_path / "f"), "--fly-only"]
     assert eval_jsbsim.main(args) == 0 and eval_jsbsim.main(args) == 0
     out = capsys.readouterr().out.splitlines()
     assert [ln.split()[1] for ln in out] == ["flown", "reused"] and "j3cub-light-s1-ahrs.tlog" in out[0]
