@@ -171,7 +171,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
 
 
 def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, monkeypatch):
-    """``--aircraft J3Cub`` resolves to ``j3cub``; ``--fly-only`` flies into ``--flights`` / ``--out``
+    """``--aircraft J3Cub`` resolves to ``j3cub``; ``--fly-only`` flies into ``--work`` / ``--out``
     and a second run reuses the files (same configuration and harness fingerprint), while a
     file from another harness is flown again. No scoring is run."""
     import json
