@@ -182,6 +182,9 @@ def main(argv=None) -> int:
     if a.summarize:
         print(summarize(a.summarize))
         return 0
+    for ac in sorted(set(a.aircraft) & set(UNTOUCHED_AIRCRAFT)):
+        print(f"note: {ac} is the untouched aircraft (docs/jsbsim.md): score it only in the final evaluation",
+              file=sys.stderr)
     if a.fly_only:
         if not a.work:
             ap.error("--fly-only needs --work DIR")

@@ -220,12 +220,15 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     pairs = [tuple(x.split(",")) for x in a.pairs]
-    from benchmarks.jsbsim_harness.aircraft import canonical_name   # harness or JSBSim model names (J3Cub)
+    from benchmarks.jsbsim_harness.aircraft import UNTOUCHED_AIRCRAFT, canonical_name
 
     try:
-        a.aircraft = [canonical_name(x) for x in a.aircraft]
+        a.aircraft = [canonical_name(x) for x in a.aircraft]    # harness or JSBSim model names (J3Cub)
     except KeyError as exc:
         p.error(f"argument --aircraft: {exc.args[0]}")
+    for ac in sorted(set(a.aircraft) & set(UNTOUCHED_AIRCRAFT)):
+        print(f"note: {ac} is the untouched aircraft (docs/jsbsim.md): diagnose it only in the final evaluation",
+              file=sys.stderr)
     if a.fly_only:
         return _fly_only(a.aircraft, a.seeds, a.clean_seeds, pairs, a.effects, out, a.plan)
     refs = {}
