@@ -101,7 +101,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # trailing edge left, nose left); checked on the truth by tests/jsbsim/test_jsbsim_j3cub.py.
     # 50 kt CAS: 1.6 times the model's power-off stall (about 31 kt EAS at 967 lb, CL_max 1.62 at
     # its lower Reynolds number); the sweep's slowest level, 37.5 kt, is 1.2 times the stall, as
-    # on the c172x. Its pitch damping is three times the c172x's (Cm_q c / (2V) at 30 m/s), so the
+    # on the c172x. Its pitch damping is 2.6 times the c172x's (dimensional M_q at 30 m/s), so the
     # elevator amplitude is 4 deg and the pitch-rate gain half the default; the elevator's +-8 deg
     # leaves 3-4 deg below the slow level's trim. Set from the harness's truth only (alpha, beta,
     # rates, excitation per axis; docs/jsbsim.md), never from a pipeline result.
