@@ -25,8 +25,10 @@ __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_
 
 #: Share of the file this process scans; the worker starts about 0.1 s later and hands back its rows.
 HEAD_FRACTION = 0.55
-#: The same when the caller has its own work to do first (``meanwhile``: the replay's imports, ~1 s).
-HEAD_FRACTION_BUSY = 0.2
+#: The same when the caller has its own work to do first (``meanwhile``: the replay's imports, ~1.6 CPU s).
+#: The imports outlast the worker's scan of 90 % of the benchmark flight (~1.2 CPU s), so the head is kept
+#: small: 20 % cost this process 0.27-0.32 CPU s, 10 % about half that (``docs/benchmarks.md``).
+HEAD_FRACTION_BUSY = 0.1
 #: Files smaller than this are scanned in one piece (the hand-over would cost more than it saves).
 MIN_SPLIT_BYTES = 1 << 20
 

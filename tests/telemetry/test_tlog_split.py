@@ -35,7 +35,7 @@ def _same(a, b):
         assert (ca.seq, ca.stamp_us, ca.src, ca.rows) == (cb.seq, cb.stamp_us, cb.src, cb.rows), k
 
 
-@pytest.mark.parametrize("fraction", [0.3, 0.55, 0.8])
+@pytest.mark.parametrize("fraction", [0.1, 0.3, 0.55, 0.8])
 def test_split_equals_one_scan(data, helper, monkeypatch, fraction):
     assert len(data) > tlog_split.MIN_SPLIT_BYTES
     monkeypatch.setattr(tlog_split, "HEAD_FRACTION", fraction)
