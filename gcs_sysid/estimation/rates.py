@@ -51,7 +51,7 @@ smooth surface motion made the smoother overshoot JSBSim's angular accelerations
 (:data:`ZOH_EVIDENCE` per sample; they gain 0.43 per sample on the simulation).
 With the linear hold, measured signals ``aux`` may enter the acceleration too
 (one coefficient per axis that takes them, linear between samples, no delay): the
-replay passes the low-passed normal specific force (:func:`normal_force_input`) to
+replay passes the measured normal specific force (:func:`normal_force_input`) to
 the pitch axis only, where it shows
 the gust-driven angle of attack, and so ``Cm_alpha alpha``, at the instant it
 acts (Morelli and Klein 2016, ch. 5: measured accelerations as regressors).
@@ -68,6 +68,8 @@ minus smoothed rate. :func:`smooth_rates` then adds the Wiener estimate of that
 residual's signal where its spectrum stands significantly above the gyro's
 white-noise floor (:mod:`.wiener`), zero phase, per axis and gap-free piece; a
 white residual is left alone.
+:func:`smooth_specific_force` does the same with the accelerometer's residual
+(gust-driven forces above its bandwidth).
 
 References:
     Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
