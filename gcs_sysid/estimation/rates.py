@@ -68,7 +68,7 @@ minus smoothed rate. :func:`smooth_rates` then adds the Wiener estimate of that
 residual's signal where its spectrum stands significantly above the gyro's
 white-noise floor (:mod:`.wiener`), zero phase, per axis and gap-free piece; a
 white residual is left alone.
-:func:`smooth_specific_force` does the same with the accelerometer's residual
+:func:`smooth_specific_force` does the same with the accelerometer's residual on x and y
 (gust-driven forces above its bandwidth).
 
 References:
@@ -101,8 +101,8 @@ from .kalman import SteadyState, lti_response, steady_state, steady_state_smooth
 from .nodes import segments
 from .wiener import residual_wiener
 
-__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate", "normal_force_input", "smooth_rates",
-           "smooth_specific_force", "control_columns"]
+__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate",
+           "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
