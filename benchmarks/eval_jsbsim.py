@@ -60,8 +60,12 @@ def _coverage(mean, sigma, ref) -> float:
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
 
 
-def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path) -> dict:
-    """One flight scored (see the module docstring); returns a JSON-able dict."""
+def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
+             gust_rates: str | None = None) -> dict:
+    """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
+    replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``); the
+    model is then scored at the true regressors with JSBSim's air-relative rates ``p_aero q_aero r_aero``
+    (the same definition), and ``true_inertial`` keeps the score at the inertial ones."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -70,13 +74,21 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
-    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False))
+    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False, gust_rates=gust_rates))
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
+    Xt_inertial = Xt.copy()
+    if gust_rates is not None:   # the model's p_hat q_hat r_hat are air-relative: so are the true ones
+        c = truth.meta["constants"]
+        ip = lambda k: np.interp(tab.t, truth.t, truth.fields[k], left=np.nan, right=np.nan)  # noqa: E731
+        Vt = Xt[:, 9]
+        Xt[:, 2], Xt[:, 3], Xt[:, 4] = (ip("p_aero") * c["b"] / (2 * Vt), ip("q_aero") * c["c"] / (2 * Vt),
+                                        ip("r_aero") * c["b"] / (2 * Vt))
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
+                 "gust_rates": gust_rates,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
     row["meas_all"] = _errs(tab.Y[ok], Yt[ok])
@@ -104,6 +116,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     model = load_gp(Path(res.model_path))
     mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)   # exact regressors
     row["true"] = _errs(np.asarray(mt), Yt[h])
+    row["true_inertial"] = row["true"] if gust_rates is None else _errs(
+        np.asarray(model.predict(Xt_inertial[h], include_noise=False, input_noise=False)[0]), Yt[h])
     row["cov_true"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i])
                                         for i in range(6)]))
     row["cov_true_each"] = [_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i]) for i in range(6)]
@@ -113,7 +127,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
                                                for i in range(6)]))
     row["cov_gp_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]
     t_cut = float(tab.t[h][0])
-    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut)
+    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
+                          gust_rates=gust_rates)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     row["alpha_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 0] - Xt[ok, 0]) ** 2))))
     row["beta_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 1] - Xt[ok, 1]) ** 2))))
@@ -164,6 +179,8 @@ def main(argv=None) -> int:
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
+    ap.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+                    help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
@@ -178,7 +195,7 @@ def main(argv=None) -> int:
     for ac in a.aircraft:
         for turb in a.turbulence:
             for seed in a.seeds:
-                row = evaluate(ac, seed, turb, a.aoa, a.duration, work)
+                row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates)
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")
