@@ -13,6 +13,8 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
          ``estimate_states(earth="flat")``, what the velocity filter's Earth model changes)
   gp     the replay's model predictions at the measured regressors
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
+  tair   the same with JSBSim's air-relative rates ``p-aero q-aero r-aero`` in ``p_hat q_hat r_hat``
+         (the rates JSBSim's aerodynamics uses; ``true`` has the inertial rates a gyro measures)
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
   cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
          true: the model's sigma without noise, at exact conditions, with the model's error there,
@@ -63,9 +65,10 @@ def _coverage(mean, sigma, ref) -> float:
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
-    replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``); the
-    model is then scored at the true regressors with JSBSim's air-relative rates ``p_aero q_aero r_aero``
-    (the same definition), and ``true_inertial`` keeps the score at the inertial ones."""
+    replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
+    ``true`` scores the model at the true regressors with the inertial rates (as the truth file
+    keeps them), ``true_air`` with JSBSim's air-relative rates ``p_aero q_aero r_aero`` (the rates its
+    aerodynamics sees, what a simulator using the model would give it)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -78,13 +81,12 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
-    Xt_inertial = Xt.copy()
-    if gust_rates is not None:   # the model's p_hat q_hat r_hat are air-relative: so are the true ones
-        c = truth.meta["constants"]
-        ip = lambda k: np.interp(tab.t, truth.t, truth.fields[k], left=np.nan, right=np.nan)  # noqa: E731
-        Vt = Xt[:, 9]
-        Xt[:, 2], Xt[:, 3], Xt[:, 4] = (ip("p_aero") * c["b"] / (2 * Vt), ip("q_aero") * c["c"] / (2 * Vt),
-                                        ip("r_aero") * c["b"] / (2 * Vt))
+    Xt_air = Xt.copy()            # the true regressors with JSBSim's air-relative rates
+    cst = truth.meta["constants"]
+    ip = lambda k: np.interp(tab.t, truth.t, truth.fields[k], left=np.nan, right=np.nan)  # noqa: E731
+    Xt_air[:, 2], Xt_air[:, 3], Xt_air[:, 4] = (ip("p_aero") * cst["b"] / (2 * Xt[:, 9]),
+                                                ip("q_aero") * cst["c"] / (2 * Xt[:, 9]),
+                                                ip("r_aero") * cst["b"] / (2 * Xt[:, 9]))
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
@@ -116,8 +118,10 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     model = load_gp(Path(res.model_path))
     mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)   # exact regressors
     row["true"] = _errs(np.asarray(mt), Yt[h])
-    row["true_inertial"] = row["true"] if gust_rates is None else _errs(
-        np.asarray(model.predict(Xt_inertial[h], include_noise=False, input_noise=False)[0]), Yt[h])
+    ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
+    row["true_air"] = _errs(np.asarray(ma), Yt[h])
+    row["cov_true_air"] = float(np.nanmean([_coverage(np.asarray(ma)[:, i], np.sqrt(np.asarray(va)[:, i]), Yt[h, i])
+                                            for i in range(6)]))
     row["cov_true"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i])
                                         for i in range(6)]))
     row["cov_true_each"] = [_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i]) for i in range(6)]
@@ -206,6 +210,8 @@ def main(argv=None) -> int:
                 print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}  (latent alone "
                       f"{row['cov_true_latent']:.1f}; per coefficient " + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
                       + ")")
+                print(f"{'':32s} tair  {_fmt(row['true_air'])}   {row['cov_true_air']:5.1f}  (at the true regressors "
+                      "with JSBSim's air-relative rates)")
                 print(f"{'':32s} ls    {_fmt(row['ls'])}", flush=True)
                 if a.json:
                     with open(a.json, "a") as f:
