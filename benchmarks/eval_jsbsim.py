@@ -13,8 +13,9 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
          ``estimate_states(earth="flat")``, what the velocity filter's Earth model changes)
   gp     the replay's model predictions at the measured regressors
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
-  tair   the same with JSBSim's air-relative rates ``p-aero q-aero r-aero`` in ``p_hat q_hat r_hat``
-         (the rates JSBSim's aerodynamics uses; ``true`` has the inertial rates a gyro measures)
+  tair   the same with the rates the aircraft's JSBSim aerodynamics reads in ``p_hat q_hat r_hat``
+         (c172x, sgs: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
+         so ``tair`` = ``true``; ``true`` has the inertial rates a gyro measures)
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
   cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
          true: the model's sigma without noise, at exact conditions, with the model's error there,
@@ -62,13 +63,26 @@ def _coverage(mean, sigma, ref) -> float:
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
 
 
+def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
+    """Per body axis ``p q r``: does the stock model's XML read the air-relative rate
+    (``velocities/p-aero-rad_sec``...)? c172x and SGS do; pa28 reads ``velocities/p-rad_sec`` (the
+    body rates over the Earth; the truth's inertial rates differ from them by the Earth rate only)."""
+    from benchmarks.jsbsim_harness import aircraft as spec_of
+    from benchmarks.jsbsim_harness.effects import stock_model_dir
+
+    spec = spec_of(aircraft)
+    xml = (stock_model_dir(spec) / f"{spec.model}.xml").read_text()
+    return {ax: f"velocities/{ax}-aero-rad_sec" in xml for ax in "pqr"}
+
+
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
-    keeps them), ``true_air`` with JSBSim's air-relative rates ``p_aero q_aero r_aero`` (the rates its
-    aerodynamics sees, what a simulator using the model would give it)."""
+    keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
+    ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
+    what a simulator using the model would give it)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -81,12 +95,13 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
-    Xt_air = Xt.copy()            # the true regressors with JSBSim's air-relative rates
+    Xt_air = Xt.copy()            # the true regressors with the rates JSBSim's aerodynamics reads
     cst = truth.meta["constants"]
     ip = lambda k: np.interp(tab.t, truth.t, truth.fields[k], left=np.nan, right=np.nan)  # noqa: E731
-    Xt_air[:, 2], Xt_air[:, 3], Xt_air[:, 4] = (ip("p_aero") * cst["b"] / (2 * Xt[:, 9]),
-                                                ip("q_aero") * cst["c"] / (2 * Xt[:, 9]),
-                                                ip("r_aero") * cst["b"] / (2 * Xt[:, 9]))
+    air_axes = aero_reads_air_rates(aircraft)
+    for j, (ax, ref) in enumerate(zip("pqr", ("b", "c", "b"))):
+        if air_axes[ax]:
+            Xt_air[:, 2 + j] = ip(f"{ax}_aero") * cst[ref] / (2 * Xt[:, 9])
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
@@ -211,7 +226,7 @@ def main(argv=None) -> int:
                       f"{row['cov_true_latent']:.1f}; per coefficient " + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
                       + ")")
                 print(f"{'':32s} tair  {_fmt(row['true_air'])}   {row['cov_true_air']:5.1f}  (at the true regressors "
-                      "with JSBSim's air-relative rates)")
+                      "with the rates JSBSim's aerodynamics reads)")
                 print(f"{'':32s} ls    {_fmt(row['ls'])}", flush=True)
                 if a.json:
                     with open(a.json, "a") as f:
