@@ -172,9 +172,13 @@ def summarize(paths: list[str]) -> str:
     out = [head, "|" + "---|" * (head.count("|") - 1)]
     for (ac, turb, aoa), rs in groups.items():
         med = lambda k, c=None: float(np.nanmedian([r[k][c] if c else r[k] for r in rs]))   # noqa: E731
-        for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
-                         ("ls", "stepwise LS")):
-            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}"}.get(k, "")
+        scores = (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
+                  ("true_air", "GP at true regressors, aero rates"), ("ls", "stepwise LS"))
+        for k, label in scores:
+            if not all(k in r for r in rs):      # rows written before the score existed
+                continue
+            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}",
+                   "true_air": f"{med('cov_true_air'):.0f}" if all("cov_true_air" in r for r in rs) else ""}.get(k, "")
             air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
                    f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
             name = f"{ac}{' (held out)' if ac == 'pa28' else ''}"
@@ -182,8 +186,10 @@ def summarize(paths: list[str]) -> str:
                        + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
     for turb in sorted({r["turbulence"] for r in rows}):
         for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
-                         ("ls", "stepwise LS")):
+                         ("true_air", "GP at true regressors, aero rates"), ("ls", "stepwise LS")):
             rs = [r for r in rows if r["turbulence"] == turb]
+            if not all(k in r for r in rs):
+                continue
             f = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[:3]])
             m = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[3:]])
             out.append(f"\n{turb}, {label}: median over all flights and coefficients: forces {f:.1f} %, "
