@@ -4,9 +4,9 @@ The aerodynamic moments depend on the body's rotation relative to the air, ``p -
 ``q - q_g``, ``r - r_g``; a gyro measures ``p q r``. A turbulent air mass whose vertical gust
 ``w_g`` changes along the flight path pitches the air relative to the aircraft, one whose lateral
 gust ``v_g`` changes along the path yaws it (Etkin, *Dynamics of Atmospheric Flight*, Wiley 1972,
-sec. 13.5: ``q_g = -dw_g/dx``, ``r_g = dv_g/dx``, ``p_g = dw_g/dy``). With Taylor's frozen-field
+ch. 13, gust gradients: ``q_g = -dw_g/dx``, ``r_g = dv_g/dx``, ``p_g = dw_g/dy``). With Taylor's frozen-field
 hypothesis the along-path derivative is the time derivative over the airspeed, ``d/dx = (d/dt) / V``.
-MIL-F-8785C sec. 3.7.2.2 (Dryden form) gives the rates' spectra as those of filtered gust
+MIL-F-8785C sec. 3.7.2 (Dryden form) gives the rates' spectra as those of filtered gust
 velocities, which this module applies to the reconstructed gusts::
 
     q_g = s_q * (s / V) / (1 + (4 b / (pi V)) s) * w_g          (MIL-F-8785C eq. for q_g)
@@ -18,9 +18,11 @@ gradient averaged over the span and tail length. Two frames are offered (:data:`
 * ``"path"`` (physical; Etkin): body axes, ``w_g`` and ``v_g`` the gust's body z and y components,
   the derivative taken of the NED gust and rotated into body axes (a steady wind seen from a
   rotating body is no gradient), ``s_q = -1``, ``s_r = +1``.
-* ``"mean-wind"``: the low-altitude model's axes (MIL-F-8785C sec. 3.7.2.3 and MIL-HDBK-1797
-  appendix A: turbulence axes aligned with the mean wind), the form JSBSim's ``ttMilspec``
-  (``FGWinds::Turbulence``, eqs. 34-35 of its Yeager 1998 formulation) implements: ``w_g`` the
+* ``"mean-wind"``: the low-altitude model's axes (MIL-F-8785C sec. 3.7.2 and MIL-HDBK-1797
+  below 1000 ft: turbulence axes aligned with the mean wind), the form JSBSim's ``ttMilspec``
+  source describes (``FGWinds::Turbulence``, eqs. 34-35 of its Yeager 1998 formulation; the rates
+  measured from JSBSim 1.3.3 follow its filters and signs but not these axes, ``docs/benchmarks.md``,
+  "Gust rates"): ``w_g`` the
   vertical gust and ``v_g`` the gust across the mean wind, ``s_q = s_r = +1``, the rate vector
   ``(0, q_g, r_g)`` in the wind frame rotated to NED by the mean wind's azimuth and to body axes
   (a mean wind under :data:`MIN_MEAN_WIND` has no direction: north is taken, as JSBSim keeps its
@@ -29,7 +31,7 @@ gradient averaged over the span and tail length. Two frames are offered (:data:`
 ``p_g`` (the span-wise gradient ``dw_g/dy``, MIL-F-8785C's own filtered noise with
 ``sigma_p = 1.9 sigma_w / sqrt(L_w b)``) is not observable from one point's air data: it is left at 0
 and said so. In a filter-error method (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed.,
-AIAA 2015, ch. 7) it would be process noise of the roll equation, estimated through the measured
+AIAA 2015, ch. 5 and 7) it would be process noise of the roll equation, estimated through the measured
 roll moment itself.
 """
 
@@ -112,7 +114,7 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
     Raises:
         ValueError: unknown ``frame``, shapes that disagree, or ``b <= 0``.
 
-    Source: Etkin (1972) sec. 13.5; MIL-F-8785C sec. 3.7.2.2-3.7.2.3; MIL-HDBK-1797 app. A.
+    Source: Etkin (1972) ch. 13; MIL-F-8785C sec. 3.7.2 (Dryden form, low-altitude axes); MIL-HDBK-1797 (its turbulence models).
     """
     if frame not in FRAMES:
         raise ValueError(f"gust-rate frame must be one of {', '.join(FRAMES)}, got '{frame}'")
