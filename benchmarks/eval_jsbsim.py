@@ -13,6 +13,9 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
          ``estimate_states(earth="flat")``, what the velocity filter's Earth model changes)
   gp     the replay's model predictions at the measured regressors
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
+  tair   the same with the rates the aircraft's JSBSim aerodynamics reads in ``p_hat q_hat r_hat``
+         (c172x, sgs: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
+         so ``tair`` = ``true``; ``true`` has the inertial rates a gyro measures)
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
   cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
          true: the model's sigma without noise, at exact conditions, with the model's error there,
@@ -67,8 +70,26 @@ def _coverage(mean, sigma, ref) -> float:
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
 
 
-def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path) -> dict:
-    """One flight scored (see the module docstring); returns a JSON-able dict."""
+def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
+    """Per body axis ``p q r``: does the stock model's XML read the air-relative rate
+    (``velocities/p-aero-rad_sec``...)? c172x and SGS do; pa28 reads ``velocities/p-rad_sec`` (the
+    body rates over the Earth; the truth's inertial rates differ from them by the Earth rate only)."""
+    from benchmarks.jsbsim_harness import aircraft as spec_of
+    from benchmarks.jsbsim_harness.effects import stock_model_dir
+
+    spec = spec_of(aircraft)
+    xml = (stock_model_dir(spec) / f"{spec.model}.xml").read_text()
+    return {ax: f"velocities/{ax}-aero-rad_sec" in xml for ax in "pqr"}
+
+
+def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
+             gust_rates: str | None = None) -> dict:
+    """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
+    replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
+    ``true`` scores the model at the true regressors with the inertial rates (as the truth file
+    keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
+    ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
+    what a simulator using the model would give it)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -78,13 +99,21 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
-    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False))
+    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False, gust_rates=gust_rates))
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
+    Xt_air = Xt.copy()            # the true regressors with the rates JSBSim's aerodynamics reads
+    cst = truth.meta["constants"]
+    ip = lambda k: np.interp(tab.t, truth.t, truth.fields[k], left=np.nan, right=np.nan)  # noqa: E731
+    air_axes = aero_reads_air_rates(aircraft)
+    for j, (ax, ref) in enumerate(zip("pqr", ("b", "c", "b"))):
+        if air_axes[ax]:
+            Xt_air[:, 2 + j] = ip(f"{ax}_aero") * cst[ref] / (2 * Xt[:, 9])
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
+                 "gust_rates": gust_rates,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
     row["meas_all"] = _errs(tab.Y[ok], Yt[ok])
@@ -112,6 +141,10 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     model = load_gp(Path(res.model_path))
     mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)   # exact regressors
     row["true"] = _errs(np.asarray(mt), Yt[h])
+    ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
+    row["true_air"] = _errs(np.asarray(ma), Yt[h])
+    row["cov_true_air"] = float(np.nanmean([_coverage(np.asarray(ma)[:, i], np.sqrt(np.asarray(va)[:, i]), Yt[h, i])
+                                            for i in range(6)]))
     row["cov_true"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i])
                                         for i in range(6)]))
     row["cov_true_each"] = [_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i]) for i in range(6)]
@@ -121,7 +154,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
                                                for i in range(6)]))
     row["cov_gp_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]
     t_cut = float(tab.t[h][0])
-    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut)
+    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
+                          gust_rates=gust_rates)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     row["alpha_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 0] - Xt[ok, 0]) ** 2))))
     row["beta_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 1] - Xt[ok, 1]) ** 2))))
@@ -146,9 +180,13 @@ def summarize(paths: list[str]) -> str:
     out = [head, "|" + "---|" * (head.count("|") - 1)]
     for (ac, turb, aoa), rs in groups.items():
         med = lambda k, c=None: float(np.nanmedian([r[k][c] if c else r[k] for r in rs]))   # noqa: E731
-        for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
-                         ("ls", "stepwise LS")):
-            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}"}.get(k, "")
+        scores = (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
+                  ("true_air", "GP at true regressors, aero rates"), ("ls", "stepwise LS"))
+        for k, label in scores:
+            if not all(k in r for r in rs):      # rows written before the score existed
+                continue
+            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}",
+                   "true_air": f"{med('cov_true_air'):.0f}" if all("cov_true_air" in r for r in rs) else ""}.get(k, "")
             air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
                    f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
             name = ac + (" (untouched)" if ac in UNTOUCHED_AIRCRAFT else " (held out)" if ac in HELD_OUT_AIRCRAFT else "")
@@ -156,8 +194,10 @@ def summarize(paths: list[str]) -> str:
                        + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
     for turb in sorted({r["turbulence"] for r in rows}):
         for k, label in (("meas", "measured"), ("gp", "GP held-out"), ("true", "GP at true regressors"),
-                         ("ls", "stepwise LS")):
+                         ("true_air", "GP at true regressors, aero rates"), ("ls", "stepwise LS")):
             rs = [r for r in rows if r["turbulence"] == turb]
+            if not all(k in r for r in rs):
+                continue
             f = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[:3]])
             m = np.nanmedian([r[k][c] for r in rs for c in COEFFICIENTS[3:]])
             out.append(f"\n{turb}, {label}: median over all flights and coefficients: forces {f:.1f} %, "
@@ -173,6 +213,8 @@ def main(argv=None) -> int:
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
+    ap.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+                    help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
@@ -203,7 +245,7 @@ def main(argv=None) -> int:
     for ac in a.aircraft:
         for turb in a.turbulence:
             for seed in a.seeds:
-                row = evaluate(ac, seed, turb, a.aoa, a.duration, work)
+                row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates)
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")
@@ -214,6 +256,8 @@ def main(argv=None) -> int:
                 print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}  (latent alone "
                       f"{row['cov_true_latent']:.1f}; per coefficient " + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
                       + ")")
+                print(f"{'':32s} tair  {_fmt(row['true_air'])}   {row['cov_true_air']:5.1f}  (at the true regressors "
+                      "with the rates JSBSim's aerodynamics reads)")
                 print(f"{'':32s} ls    {_fmt(row['ls'])}", flush=True)
                 if a.json:
                     with open(a.json, "a") as f:

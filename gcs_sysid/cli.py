@@ -72,6 +72,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="recorded CAN log (.log/.asc/.blf/.csv): DroneCAN actuator positions and airspeed (docs/live.md)")
     r.add_argument("--can-offset", type=float, default=None, metavar="S",
                    help="seconds added to the CAN log's times (default 0 with a .tlog; required with a .bin)")
+    r.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+                   help="p_hat q_hat r_hat relative to the air: minus the gust rates estimated from the "
+                        "reconstructed gusts in this frame (default: the gyro's inertial rates; docs/estimation.md)")
     r.add_argument("--quiet", action="store_true", help="no progress display")
 
     s = sub.add_parser("simulate", help="simulate a flight with the project's 6-DOF model and write a tlog")
@@ -89,6 +92,8 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("log")
     f.add_argument("--airframe", required=True)
     f.add_argument("--out", required=True, help="output model TOML file")
+    f.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+                   help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates)")
     _window_args(f)
 
     d = sub.add_parser("diagnose", help="compare the simulation model with measured data, name the cause")
@@ -128,7 +133,7 @@ def _replay_options(a: argparse.Namespace):
     return ReplayOptions(rate_hz=a.rate, holdout=a.holdout, t_from=a.t_from, t_to=a.t_to,
                          model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say,
                          targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")),
-                         can_log=a.can_log, can_offset=a.can_offset)
+                         can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates)
 
 
 def _check_replay(a: argparse.Namespace) -> None:
@@ -207,7 +212,7 @@ def _check_fit(a: argparse.Namespace) -> None:
 def _cmd_fit(a: argparse.Namespace) -> int:
     from .diagnose import run_fit
 
-    run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say)
+    run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates)
     print(f"wrote {a.out}")
     return 0
 

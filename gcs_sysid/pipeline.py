@@ -60,6 +60,9 @@ class ReplayOptions:
         can_log: a recorded CAN log (DroneCAN actuator status, airspeed) merged on the vehicle time
             axis (:mod:`gcs_sysid.telemetry.can_merge`); None: none.
         can_offset: s added to the CAN log's times (None: 0 with a .tlog; required with a .bin).
+        gust_rates: None (inertial ``p_hat q_hat r_hat``) or a frame of
+            :data:`gcs_sysid.estimation.gustrates.FRAMES` (the hats relative to the air;
+            :func:`gcs_sysid.aero.compute_coefficients`).
     """
 
     rate_hz: float = 50.0
@@ -75,6 +78,7 @@ class ReplayOptions:
     targets: tuple[str, ...] | None = None
     can_log: str | None = None
     can_offset: float | None = None
+    gust_rates: str | None = None
 
 
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
@@ -260,7 +264,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper)
         helper.preload(["gcs_sysid.report.plots"])   # matplotlib for the figures, while the GP is fitted
         with _stage("coefficients", timings, bar):
-            table = compute_coefficients(states, airframe)
+            table = compute_coefficients(states, airframe, gust_rates=options.gust_rates)
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held

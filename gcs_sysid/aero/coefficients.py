@@ -57,13 +57,36 @@ def aero_moments(airframe: Airframe, p, q, r, p_dot, q_dot, r_dot) -> tuple[np.n
     return L, M, N
 
 
-def compute_coefficients(states: FlightStates, airframe: Airframe) -> CoefficientTable:
+def _air_relative(states, airframe, frame, p, q, r, V, notes):
+    """``(p, q, r)`` for the hats: inertial (``frame`` None) or minus the estimated gust rates."""
+    if frame is None:
+        return p, q, r
+    from ..estimation.ekf import dcm
+    from ..estimation.gustrates import gust_rates
+
+    need = [k for k in ("phi", "theta", "psi", "wn", "we", "wd") if k not in states.data]
+    if need or len(states.t) < 3:
+        notes.append(f"gust rates ({frame}) not removed from p_hat q_hat r_hat: no {' '.join(need) or 'grid'} in the states")
+        return p, q, r
+    d = states.data
+    G = gust_rates(float(np.median(np.diff(states.t))), dcm(d["phi"], d["theta"], d["psi"]),
+                   np.stack([d["wn"], d["we"], d["wd"]], axis=1), V, airframe.b, frame)
+    notes.append("p_hat q_hat r_hat relative to the air: " + "; ".join(G.notes))
+    return p - G.rates[:, 0], q - G.rates[:, 1], r - G.rates[:, 2]
+
+
+def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: str | None = None) -> CoefficientTable:
     """Measured coefficients CX CY CZ Cl Cm Cn and the regressors on the states' grid.
 
     Args:
         states: smoothed states (``ax ay az p q r p_dot q_dot r_dot V alpha beta
             qbar delta_*``); a missing key makes the columns that need it NaN.
         airframe: mass, inertia, S, b, c and the optional thrust model.
+        gust_rates: None (default: ``p_hat q_hat r_hat`` from the inertial rates a gyro measures) or a
+            frame of :data:`gcs_sysid.estimation.gustrates.FRAMES`: the hats from the rates relative
+            to the air, ``p - p_g`` etc., with the gust rates estimated from the states' wind
+            (:func:`gcs_sysid.estimation.gustrates.gust_rates`; needs ``phi theta psi wn we wd``).
+            The moment equations keep the inertial rates.
 
     Returns:
         :class:`~gcs_sysid.aero.table.CoefficientTable` with ``X`` (T, 10) in the
@@ -96,7 +119,8 @@ def compute_coefficients(states: FlightStates, airframe: Airframe) -> Coefficien
         p, q, r = get("p"), get("q"), get("r")
         L, M, N = aero_moments(airframe, p, q, r, get("p_dot"), get("q_dot"), get("r_dot"))
         Cl, Cm, Cn = L / (qS * b), M / (qS * c), N / (qS * b)
-        hat = {"p_hat": p * b / (2 * V), "q_hat": q * c / (2 * V), "r_hat": r * b / (2 * V)}
+        pa, qa, ra = _air_relative(states, airframe, gust_rates, p, q, r, V, notes)
+        hat = {"p_hat": pa * b / (2 * V), "q_hat": qa * c / (2 * V), "r_hat": ra * b / (2 * V)}
     cols = {**hat, **{k: get(k) for k in REGRESSORS if k not in hat}}
     X = np.stack([cols[k] for k in REGRESSORS], axis=1)
     Y = np.stack([CX, CY, CZ, Cl, Cm, Cn], axis=1)

@@ -49,7 +49,7 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
 
 
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
-                      progress=None, notify=None) -> Measurements:
+                      progress=None, notify=None, gust_rates: str | None = None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
@@ -92,13 +92,13 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
                                  if progress is not None else None, helper=helper)
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
-    table = compute_coefficients(states, airframe)
+    table = compute_coefficients(states, airframe, gust_rates=gust_rates)
     tm["coefficients_s"] = time.perf_counter() - t2
     return Measurements(flight, airframe, states, table, tm)
 
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
-            progress=None, notify=None):
+            progress=None, notify=None, gust_rates: str | None = None):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
     Also writes ``<out>.fit.json`` with the per-coefficient statistics (and the damage found in the
@@ -113,7 +113,7 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
 
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
-        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates)
         model, report = fit_model(meas.table, name=Path(out_path).stem)
         model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
         save_model(model, stage.path(out), header=report.header())

@@ -75,3 +75,29 @@ def test_invalid_rows_missing_keys_and_identifiability_notes():
     st2 = _states(HAND, valid=np.array([True, True, False]))
     st2.data["qbar"][1] = 1.0
     np.testing.assert_array_equal(compute_coefficients(st2, _airframe()).valid, [True, False, False])
+
+
+def test_gust_rates_make_the_hats_air_relative_and_leave_the_moments_alone():
+    n = 400
+    t = np.arange(n) * 0.02
+    vals = dict(HAND, phi=0.0, theta=0.0, psi=0.0, wn=0.0, we=0.0)
+    st = _states(vals, n)
+    st.data["wd"] = 0.8 * np.sin(2 * np.pi * 0.5 * t)         # a vertical gust
+    af = _airframe()
+    base = compute_coefficients(st, af)
+    air = compute_coefficients(st, af, gust_rates="path")
+    from gcs_sysid.estimation.ekf import dcm
+    from gcs_sysid.estimation.gustrates import gust_rates
+
+    G = gust_rates(0.02, dcm(t * 0, t * 0, t * 0), np.stack([t * 0, t * 0, st.data["wd"]], 1), np.full(n, 20.0),
+                   af.b, "path")
+    assert np.max(np.abs(G.rates[:, 1])) > 1e-3
+    np.testing.assert_allclose(air.x("q_hat"), (HAND["q"] - G.rates[:, 1]) * af.c / 40.0, rtol=1e-12)
+    np.testing.assert_allclose(air.x("p_hat"), base.x("p_hat"))       # p_g is not observable: 0
+    np.testing.assert_allclose(air.Y, base.Y)                         # moments use the inertial rates
+    assert any("relative to the air" in n for n in air.notes)
+    # without attitude or wind the hats stay inertial, and the table says why
+    st2 = _states(HAND, n)
+    tab = compute_coefficients(st2, af, gust_rates="path")
+    np.testing.assert_allclose(tab.X, compute_coefficients(st2, af).X)
+    assert any("not removed" in n and "phi" in n for n in tab.notes)

@@ -31,14 +31,28 @@ def test_summary_is_the_median_over_seeds(tmp_path):
     assert "0.20 / 0.20" in lines[0]
     assert any(ln.startswith("| pa28 (held out)") for ln in text.splitlines())
     assert "forces" in text and "19.8" in text
+    assert "aero rates" not in text                  # rows without the score: no row for it
+
+
+def test_summary_has_the_aero_rate_score_when_the_rows_have_it(tmp_path):
+    rows = [_row("sgs", s, 10.0) for s in (1, 2)]
+    for r in rows:
+        r["true_air"] = {c: 1.0 + r["seed"] for c in COEFFICIENTS}
+        r["cov_true_air"] = 97.0
+    p = tmp_path / "r.jsonl"
+    p.write_text("\n".join(json.dumps(r) for r in rows) + "\n")
+    line = [ln for ln in eval_jsbsim.summarize([str(p)]).splitlines() if "aero rates |" in ln]
+    assert len(line) == 1 and "| 2.5 |" in line[0] and "| 97 |" in line[0]
 
 
 @pytest.mark.slow
 def test_one_flight_is_scored(tmp_path):
     row = eval_jsbsim.evaluate("sgs", 4, "light", "vane", 40.0, tmp_path)
-    for k in KEYS + ("meas_all", "meas_true_accel", "meas_flat", "meas_offset"):
+    for k in KEYS + ("meas_all", "meas_true_accel", "meas_flat", "meas_offset", "true_air"):
         assert set(row[k]) == set(COEFFICIENTS)
         assert all(math.isfinite(v) for v in row[k].values()), (k, row[k])
     assert max(row["meas_true_accel"][c] for c in ("Cl", "Cm", "Cn")) < 2.0   # truth accelerations: exact moments
     assert row["alpha_deg"] < 0.2 and 0 <= row["cov_gp"] <= 100
     assert np.isfinite(row["beta_rms_deg"])
+    # JSBSim's Cl is linear in the air-relative rates: at them the model leaves less than at the gyro's
+    assert row["true_air"]["Cl"] < row["true"]["Cl"]

@@ -1,0 +1,158 @@
+"""Rotational gust components (gust rates) from the reconstructed gust velocities.
+
+The aerodynamic moments depend on the body's rotation relative to the air, ``p - p_g``,
+``q - q_g``, ``r - r_g``; a gyro measures ``p q r``. A turbulent air mass whose vertical gust
+``w_g`` changes along the flight path pitches the air relative to the aircraft, one whose lateral
+gust ``v_g`` changes along the path yaws it (Etkin, *Dynamics of Atmospheric Flight*, Wiley 1972,
+ch. 13, gust gradients: ``q_g = -dw_g/dx``, ``r_g = dv_g/dx``, ``p_g = dw_g/dy``). With Taylor's frozen-field
+hypothesis the along-path derivative is the time derivative over the airspeed, ``d/dx = (d/dt) / V``.
+MIL-F-8785C sec. 3.7.2 (Dryden form) gives the rates' spectra as those of filtered gust
+velocities, which this module applies to the reconstructed gusts::
+
+    q_g = s_q * (s / V) / (1 + (4 b / (pi V)) s) * w_g          (MIL-F-8785C eq. for q_g)
+    r_g = s_r * (s / V) / (1 + (3 b / (pi V)) s) * v_g          (MIL-F-8785C eq. for r_g)
+
+The standard leaves the signs open (``q_g = +-``, ``r_g = -+``); the first-order lag stands for the
+gradient averaged over the span and tail length. Two frames are offered (:data:`FRAMES`):
+
+* ``"path"`` (physical; Etkin): body axes, ``w_g`` and ``v_g`` the gust's body z and y components,
+  the derivative taken of the NED gust and rotated into body axes (a steady wind seen from a
+  rotating body is no gradient), ``s_q = -1``, ``s_r = +1``.
+* ``"mean-wind"``: the low-altitude model's axes (MIL-F-8785C sec. 3.7.2 and MIL-HDBK-1797
+  below 1000 ft: turbulence axes aligned with the mean wind), the form JSBSim's ``ttMilspec``
+  source describes (``FGWinds::Turbulence``, eqs. 34-35 of its Yeager 1998 formulation; the rates
+  measured from JSBSim 1.3.3 follow its filters and signs but not these axes, ``docs/benchmarks.md``,
+  "Gust rates"): ``w_g`` the
+  vertical gust and ``v_g`` the gust across the mean wind, ``s_q = s_r = +1``, the rate vector
+  ``(0, q_g, r_g)`` in the wind frame rotated to NED by the mean wind's azimuth and to body axes
+  (a mean wind under :data:`MIN_MEAN_WIND` has no direction: north is taken, as JSBSim keeps its
+  wind azimuth at 0 without a steady wind).
+
+``p_g`` (the span-wise gradient ``dw_g/dy``, MIL-F-8785C's own filtered noise with
+``sigma_p = 1.9 sigma_w / sqrt(L_w b)``) is not observable from one point's air data: it is left at 0
+and said so. In a filter-error method (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed.,
+AIAA 2015, ch. 5 and 7) it would be process noise of the roll equation, estimated through the measured
+roll moment itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["FRAMES", "MIN_MEAN_WIND", "GustRates", "gust_rates", "lag_filter"]
+
+FRAMES = ("path", "mean-wind")   #: frames of :func:`gust_rates`
+MIN_MEAN_WIND = 1.0              #: m/s; below it the mean wind has no direction and ``"mean-wind"`` takes north
+
+
+@dataclass(frozen=True)
+class GustRates:
+    """Estimated rotational gust components in body axes.
+
+    Attributes:
+        rates: ``(T, 3)`` ``p_g q_g r_g`` in rad/s (``p_g`` is 0: not observable); NaN where the
+            inputs are not finite.
+        frame: ``"path"`` or ``"mean-wind"``.
+        mean_wind: ``(2,)`` the mean horizontal wind (N, E) in m/s used by ``"mean-wind"``.
+        notes: one-line statements of what was done and what is missing.
+    """
+
+    rates: np.ndarray
+    frame: str
+    mean_wind: np.ndarray
+    notes: tuple[str, ...]
+
+
+def lag_filter(dt: float, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """First-order lag ``y = x / (1 + tau s)``, discretised exactly for a sample-and-hold input.
+
+    Args:
+        dt: sample interval, s.
+        x: input of shape ``(T,)``; non-finite samples are held at the last finite value.
+        tau: time constant of shape ``(T,)`` or scalar, s (> 0).
+
+    Returns:
+        ``(T,)`` output, started at ``x[0]`` (no start-up transient).
+
+    Source: zero-order-hold discretisation of ``tau y' + y = x`` (Franklin, Powell and Workman,
+    *Digital Control of Dynamic Systems*, 3rd ed., sec. 4.3).
+    """
+    x = np.asarray(x, float)
+    a = np.exp(-dt / np.broadcast_to(np.asarray(tau, float), x.shape))
+    y = np.empty_like(x)
+    prev = next((v for v in x if np.isfinite(v)), 0.0)
+    for k in range(len(x)):
+        xk = x[k] if np.isfinite(x[k]) else prev
+        prev = a[k] * prev + (1.0 - a[k]) * xk if k else xk
+        y[k] = prev
+    return y
+
+
+def _ddt(dt: float, x: np.ndarray) -> np.ndarray:
+    """Central difference along axis 0 (one-sided at the ends), per s."""
+    return np.gradient(x, dt, axis=0)
+
+
+def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b: float,
+               frame: str = "path") -> GustRates:
+    """Rotational gust components ``p_g q_g r_g`` from the reconstructed wind (mean + gusts).
+
+    Args:
+        dt: grid interval, s.
+        C: body-to-NED direction cosines of shape ``(T, 3, 3)``.
+        wind_ned: the air's velocity over the ground of shape ``(T, 3)``, m/s, gusts included
+            (``FlightStates`` ``wn we wd`` after the specific-force aiding).
+        V: true airspeed of shape ``(T,)``, m/s.
+        b: wing span, m (the lag's time constants ``4b/(pi V)``, ``3b/(pi V)``).
+        frame: ``"path"`` or ``"mean-wind"`` (module docstring).
+
+    Returns:
+        :class:`GustRates`.
+
+    Raises:
+        ValueError: unknown ``frame``, shapes that disagree, or ``b <= 0``.
+
+    Source: Etkin (1972) ch. 13; MIL-F-8785C sec. 3.7.2 (Dryden form, low-altitude axes); MIL-HDBK-1797 (its turbulence models).
+    """
+    if frame not in FRAMES:
+        raise ValueError(f"gust-rate frame must be one of {', '.join(FRAMES)}, got '{frame}'")
+    wind_ned, V, C = np.asarray(wind_ned, float), np.asarray(V, float), np.asarray(C, float)
+    T = len(V)
+    if wind_ned.shape != (T, 3) or C.shape != (T, 3, 3):
+        raise ValueError(f"gust_rates: wind_ned (T, 3) and C (T, 3, 3) with T = {T} expected, got "
+                         f"{wind_ned.shape} and {C.shape}")
+    if not b > 0:
+        raise ValueError(f"gust_rates: the wing span must be positive, got {b}")
+    good = np.isfinite(wind_ned).all(1) & np.isfinite(V) & (V > 1.0) & np.isfinite(C).all((1, 2))
+    Vs = np.where(good, V, np.nanmedian(V[good]) if good.any() else 1.0)
+    w = np.where(good[:, None], wind_ned, np.nan)
+    for i in range(3):                       # fill gaps so the derivative does not spread NaN
+        ok = np.isfinite(w[:, i])
+        w[:, i] = np.interp(np.arange(T), np.nonzero(ok)[0], w[ok, i]) if ok.any() else 0.0
+    mean = w[good, :2].mean(0) if good.any() else np.zeros(2)
+    wdot = _ddt(dt, w)                       # NED gust derivative, m/s^2 (the steady wind drops out)
+    tau_q, tau_r = 4.0 * b / (np.pi * Vs), 3.0 * b / (np.pi * Vs)
+    notes = ["p_g = 0: the span-wise gust gradient is not observable from one point's air data "
+             "(a filter-error method would estimate it from the roll moment)"]
+    rates = np.zeros((T, 3))
+    if frame == "path":
+        db = np.einsum("tji,tj->ti", np.where(np.isfinite(C), C, 0.0), wdot) / Vs[:, None]   # d/dx of the gust, body axes
+        rates[:, 1] = -lag_filter(dt, db[:, 2], tau_q)       # q_g = -dw_g/dx
+        rates[:, 2] = lag_filter(dt, db[:, 1], tau_r)        # r_g = +dv_g/dx
+        notes.append("q_g = -(s/V)/(1+4b s/(pi V)) w_g, r_g = +(s/V)/(1+3b s/(pi V)) v_g in body axes "
+                     "(MIL-F-8785C Dryden form, Etkin's signs)")
+    else:
+        psiw = float(np.arctan2(mean[1], mean[0])) if np.hypot(*mean) >= MIN_MEAN_WIND else 0.0
+        cw, sw = np.cos(psiw), np.sin(psiw)
+        v_across = (-sw * wdot[:, 0] + cw * wdot[:, 1]) / Vs          # d/dt of the gust across the mean wind / V
+        q_w = lag_filter(dt, wdot[:, 2] / Vs, tau_q)
+        r_w = lag_filter(dt, v_across, tau_r)
+        ned = np.stack([-sw * q_w, cw * q_w, r_w], axis=1)            # (0, q_w, r_w) rotated by psiw to NED
+        rates = np.einsum("tji,tj->ti", np.where(np.isfinite(C), C, 0.0), ned)
+        notes.append(f"q_g, r_g in the mean wind's axes (towards {np.degrees(psiw) % 360:.0f} deg): "
+                     "+(s/V)/(1+4b s/(pi V)) w_g, +(s/V)/(1+3b s/(pi V)) v_g, rotated to body axes "
+                     "(MIL-F-8785C low-altitude axes, JSBSim's ttMilspec form)")
+    rates[~good] = np.nan
+    return GustRates(rates, frame, mean, tuple(notes))

@@ -1,0 +1,22 @@
+"""`--gust-rates` on replay and fit: parsed into the options, a wrong frame is a user error."""
+
+import pytest
+
+from gcs_sysid.cli import _replay_options, build_parser, main
+
+
+def test_replay_gust_rates_reaches_the_options():
+    a = build_parser().parse_args(["replay", "x.tlog", "--airframe", "a.toml", "--out", "o", "--gust-rates", "path"])
+    assert _replay_options(a).gust_rates == "path"
+    a = build_parser().parse_args(["replay", "x.tlog", "--airframe", "a.toml", "--out", "o"])
+    assert _replay_options(a).gust_rates is None
+    a = build_parser().parse_args(["fit", "x.tlog", "--airframe", "a.toml", "--out", "m.toml", "--gust-rates",
+                                   "mean-wind"])
+    assert a.gust_rates == "mean-wind"
+
+
+def test_unknown_gust_rate_frame_is_a_user_error(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["replay", "x.tlog", "--airframe", "a.toml", "--out", "o", "--gust-rates", "body"], handle_signals=False)
+    assert e.value.code == 2
+    assert "--gust-rates" in capsys.readouterr().err
