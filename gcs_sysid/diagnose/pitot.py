@@ -72,7 +72,8 @@ COEF_SYSTEMATIC_MPS = 0.2
 #: pitot bias (:func:`fuse_pitot_evidence`).
 MIN_T_FUSED = 3.0
 #: The cheap screen before the pipeline is re-run with the pitot corrected (:func:`_unit_delta_rereduced`):
-#: the wind triangle and the closed-form coefficient fit agree and their fused |t| reaches this.
+#: the wind triangle and the closed-form coefficient fit agree and their fused |t| reaches this, or (added
+#: 2026-11-22, branch i9-top90) the wind triangle's change since the reference flight alone reaches it.
 MIN_T_SCREEN = 2.0
 #: Largest coloured standard error (m/s) of one coefficient's estimate of the bias for it to take part in
 #: the coefficients' median (:func:`_fit_unit_delta`).
@@ -280,11 +281,17 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     # the screen passed: the pipeline re-run on the flight with the pitot corrected gives the bias's
     # exact effect on every regressor and coefficient (the estimation layer's aided angles move with the
     # airspeed in ways the closed-form transform does not model); the coefficient fit is then redone with it
-    if not (fused["agree"] and abs(fused["t_statistic"]) >= MIN_T_SCREEN):
+    # the screen: the two agree and their fused change is significant, or the wind triangle alone is
+    # (then the closed-form coefficient fit, which the aided angles' response to the airspeed biases,
+    # must not keep the exact re-fit from being reached; the re-fit is then linearised at the triangle's value)
+    by_fused = bool(fused["agree"] and abs(fused["t_statistic"]) >= MIN_T_SCREEN)
+    by_triangle = bool(abs(change["t_statistic"]) >= MIN_T_SCREEN)
+    out["screen"] = {"fused": by_fused, "triangle_alone": by_triangle}
+    if not (by_fused or by_triangle):
         out["why"] = "the screen (wind triangle and closed-form coefficient fit) did not pass"
         out["checks"] = {"measurements_agree": fused["agree"], "significant": False}
         return out
-    D1 = _unit_delta_rereduced(ctx, flight, fused["estimate"])
+    D1 = _unit_delta_rereduced(ctx, flight, fused["estimate"] if by_fused else change["change_mps"])
     if D1 is not None:
         b_c, se_c, per_coef = _fit_unit_delta(ctx, R, D1)
         coef_change = b_c - ref_b
