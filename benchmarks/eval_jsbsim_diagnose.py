@@ -262,7 +262,13 @@ def main(argv=None) -> int:
                    help="with --summary: also the 2-se coverage with these scatter-<ac>.json files")
     p.add_argument("--scatter", action="store_true",
                    help="also fit each effect's term on the clean flights (flight-to-flight scatter, scatter-<ac>.json)")
+    p.add_argument("--sparse-thresholds", default="{}", metavar="JSON",
+                   help="overrides of gcs_sysid.diagnose.sparse.THRESHOLDS for this run (a variant, not the frozen set)")
     a = p.parse_args(argv)
+    if json.loads(a.sparse_thresholds):
+        from gcs_sysid.diagnose import sparse
+
+        sparse.THRESHOLDS.update(json.loads(a.sparse_thresholds))
     if a.summary:
         print(summarize(a.summary))
         if a.scatter_json:

@@ -77,14 +77,18 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: errors from 0 and inside ``confirm_slope``, :func:`untouched_confirmation`); ``name_control_parent``
 #: (a first term that is a product with a control whose control-free parent was selected beside it is
 #: named by that parent, :func:`_control_parent_first`); ``delay_time_resolution`` (a delay's standard
-#: error includes the time grid's resolution, ``dt / sqrt(12)``).
+#: error includes the time grid's resolution, ``dt / sqrt(12)``). Added after that freeze, *off*
+#: (not in the frozen evaluation): ``allowance_on_search_residual`` (``diagnose`` judges a searched
+#: term's between-flight allowances on the search's differential residual, not on the raw residual
+#: where the model's own inadequacy hides it; :func:`gcs_sysid.diagnose.differential.differential`).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
               "angle_nuisance": True, "angle_error_centred": True, "lift_alpha_hz": 0.0,
               "lift_alpha_offset": False, "angle_scale": False, "smooth_se": 2.0,
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
-              "name_control_parent": True, "delay_time_resolution": True}
+              "name_control_parent": True, "delay_time_resolution": True,
+              "allowance_on_search_residual": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
