@@ -125,7 +125,7 @@ def score_case(findings: list[dict], truth: dict) -> dict:
 
 #: the library term each injected aero cause is fitted as, by coefficient (``clean_scatter``)
 _FORCED = {"Cm:alpha^2": ("Cm", "alpha^2"), "Cl:alpha*beta": ("Cl", "alpha*beta"), "Cn:delta_a": ("Cn", "delta_a"),
-           "CY:scale": ("CY", "scale:CY")}
+           "scale:CY": ("CY", "scale:CY")}
 
 
 def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, plan: str = PLAN) -> dict:
