@@ -38,6 +38,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
@@ -45,7 +47,7 @@ if str(REPO) not in sys.path:
 from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "main"]
+__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -154,6 +156,50 @@ def score_case(findings: list[dict], truth: dict) -> dict:
             "named": causes}
 
 
+#: the library term each injected aero cause is fitted as, by coefficient (``clean_scatter``)
+_FORCED = {"Cm:alpha^2": ("Cm", "alpha^2"), "Cl:alpha*beta": ("Cl", "alpha*beta"), "Cn:delta_a": ("Cn", "delta_a"),
+           "scale:CY": ("CY", "scale:CY")}
+
+
+def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, plan: str = PLAN) -> dict:
+    """Flight-to-flight scatter of each injected term's estimate, from the clean flights.
+
+    On every clean flight the sparse search's residual (after the reference's inadequacy and the angle
+    nuisance, ``keep_residual``) is fitted with the constant and the one term each effect is named by
+    (``_FORCED``; ``scale:CY`` as the model's own CY), on the training rows. Nothing was injected, so the
+    spread of these estimates over the clean flights is what a flight changes a term by when nothing
+    changed: the between-flight error the test flight's coloured standard error does not hold.
+
+    Returns:
+        ``{cause: {"sd": float, "estimates": [...]}}`` (sample standard deviation over the clean flights;
+        ``delay:delta_e`` and ``bias:airspeed`` are not library terms and are left out).
+    """
+    from gcs_sysid.aero.table import COEFFICIENTS
+    from gcs_sysid.diagnose.context import DiagContext, model_as_dict
+    from gcs_sysid.diagnose.run import load_measurements
+    from gcs_sysid.diagnose.sparse import _library, alpha_quantile_knots, reference_context, sparse_search
+    from gcs_sysid.sim.model_file import load_model
+
+    model = model_as_dict(load_model(model_path))
+    reference = reference_context((ref_meas.table, ref_meas.states), ref_meas.airframe, model)
+    knots = alpha_quantile_knots(reference[0])
+    est: dict[str, list[float]] = {c: [] for c in _FORCED}
+    for cs in clean_seeds:
+        files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan), [], out)
+        m = load_measurements(files.tlog, files.airframe)
+        ctx = DiagContext.build(m.table, m.airframe, model, m.states)
+        res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, keep_residual=True)
+        names, Phi = _library(ctx, knots)
+        tr = res["rows"]["train"]
+        M = ctx.model_values()
+        for cause, (coef, term) in _FORCED.items():
+            j = COEFFICIENTS.index(coef)
+            x = M[:, j] if term.startswith("scale:") else Phi[:, names.index(term)]
+            A = np.c_[np.ones(tr.size), np.nan_to_num(x[tr])]
+            est[cause].append(float(np.linalg.lstsq(A, res["residual"][tr, j], rcond=None)[0][1]))
+    return {c: {"sd": float(np.std(v, ddof=1)) if len(v) > 1 else float("nan"), "estimates": v} for c, v in est.items()}
+
+
 def _cases(aircraft, seeds, clean_seeds, pairs):
     """Large sizes of the first seed, the clean flights and the pairs, then the small sizes, then the
     other seeds (a run cut short stays balanced over effects)."""
@@ -200,10 +246,44 @@ def summarize(paths: list[str]) -> str:
     return "\n".join(out)
 
 
+def coverage_with_scatter(results: list[str], scatter: list[str]) -> str:
+    """2-se coverage per injected cause, with the standard error alone and with the clean flights'
+    flight-to-flight scatter (:func:`clean_scatter`) added in quadrature.
+
+    Args:
+        results: ``results.jsonl`` files. scatter: ``scatter-<ac>.json`` files (the aircraft from the name).
+
+    Returns:
+        a markdown table: aircraft, cause, found, covered by 2 se, covered by 2 sqrt(se^2 + sd^2), sd.
+    """
+    sd = {Path(p).stem.split("-", 1)[1]: json.loads(Path(p).read_text()) for p in scatter}
+    rows: dict[tuple[str, str], list[int]] = {}
+    for p in results:
+        for ln in Path(p).read_text().splitlines():
+            r = json.loads(ln) if ln.strip() else None
+            if not r or not r["effects"]:
+                continue
+            for e in r["score"].get("effects", []):
+                if not e["found"]:
+                    continue
+                s = sd.get(r["aircraft"], {}).get(e["cause"], {}).get("sd", 0.0)
+                err = abs(e["estimate"] - e["value"])
+                k = rows.setdefault((r["aircraft"], e["cause"]), [0, 0, 0])
+                k[0] += 1
+                k[1] += bool(e.get("cover"))
+                k[2] += bool(err <= 2 * np.hypot(e.get("std_error") or 0.0, s))
+    out = ["| aircraft | injected | found | 2 se | 2 sqrt(se^2 + sd_clean^2) | sd_clean |", "|---|---|---|---|---|---|"]
+    for (ac, c), (n, c1, c2) in sorted(rows.items()):
+        s = sd.get(ac, {}).get(c, {}).get("sd")
+        out.append(f"| {ac} | {c} | {n} | {c1}/{n} | {c2}/{n} | {'-' if s is None else f'{s:.3g}'} |")
+    return "\n".join(out)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
-    p.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
+    p.add_argument("--seeds", nargs="*", type=int, default=[1, 2, 3],
+                   help="seeds of the effect flights (none with --scatter: only the clean flights' scatter)")
     p.add_argument("--clean-seeds", nargs="*", type=int, default=[11, 12, 13, 14, 15])
     p.add_argument("--effects", nargs="+", default=None, help="subset of effects (default all)")
     p.add_argument("--pairs", nargs="*", default=["Cm:alpha^2,Cn:delta_a", "Cl:alpha*beta,delay:delta_e"])
@@ -213,9 +293,22 @@ def main(argv=None) -> int:
     p.add_argument("--plan", default=PLAN, choices=("standard", "sweep"),
                    help="flight plan of every flight (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
+    p.add_argument("--scatter-json", nargs="+", metavar="JSON",
+                   help="with --summary: also the 2-se coverage with these scatter-<ac>.json files")
+    p.add_argument("--scatter", action="store_true",
+                   help="also fit each effect's term on the clean flights (flight-to-flight scatter, scatter-<ac>.json)")
+    p.add_argument("--sparse-thresholds", default="{}", metavar="JSON",
+                   help="overrides of gcs_sysid.diagnose.sparse.THRESHOLDS for this run (a variant, not the frozen set)")
     a = p.parse_args(argv)
+    if json.loads(a.sparse_thresholds):
+        from gcs_sysid.diagnose import sparse
+
+        sparse.THRESHOLDS.update(json.loads(a.sparse_thresholds))
     if a.summary:
         print(summarize(a.summary))
+        if a.scatter_json:
+            print()
+            print(coverage_with_scatter(a.summary, a.scatter_json))
         return 0
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -269,6 +362,15 @@ def main(argv=None) -> int:
               f"2-sigma coverage {sum(bool(r.get('cover')) for r in rows if r['found'])}/{sum(r['found'] for r in rows)}")
     if clean:
         print(f"clean flights: no named cause {sum(r['score']['ok'] for r in clean)}/{len(clean)}")
+    if a.scatter and len(a.clean_seeds) > 1:
+        for ac in a.aircraft:
+            if ac not in refs:
+                refs[ac] = reference_model(ac, out, plan=a.plan)
+            _, model_path, ref_meas = refs[ac]
+            sc = clean_scatter(ac, out, a.clean_seeds, ref_meas, model_path, plan=a.plan)
+            (out / f"scatter-{ac}.json").write_text(json.dumps(sc, indent=1))
+            print(f"{ac} flight-to-flight scatter on the clean flights: "
+                  + ", ".join(f"{c} {v['sd']:.3g}" for c, v in sc.items()))
     return 0
 
 

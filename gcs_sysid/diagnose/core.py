@@ -325,17 +325,25 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
     }
     if fault_summary is not None:
         data["faults"] = fault_summary
+    search_residual = None
     if search:
-        from .search import search_residual
+        from .search import search_residual as _search_wide
 
         say("diagnose: searching the wide candidate library")
         t1 = time.perf_counter()
-        data["search"] = search_residual(ctx, R)
+        data["search"] = _search_wide(ctx, R)
         from .sparse import merge_findings, reference_context, sparse_search
 
         if search_reference is None and references:   # the first reference flight makes the search differential
             search_reference = (references[0].table, references[0].states)
-        data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0))
+        from .sparse import THRESHOLDS as _SPARSE_TH
+
+        keep_rd = bool(_SPARSE_TH.get("allowance_on_search_residual", False))
+        data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0),
+                                       keep_residual=keep_rd)
+        search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
+        data["sparse"].pop("residual", None)
+        data["sparse"].pop("rows", None)
         findings[:] = merge_findings(findings, data["sparse"])
         data["timings"]["search_s"] = float(time.perf_counter() - t1)
     if calibration:
@@ -362,7 +370,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         say("diagnose: differential against the reference flight(s)")
         t1 = time.perf_counter()
         data["differential"] = differential(diag, list(references), airframe,
-                                            threshold_pct=unexplained_threshold_pct)
+                                            threshold_pct=unexplained_threshold_pct,
+                                            search_residual=search_residual if search else None)
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

@@ -397,7 +397,8 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 
 
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
-                 consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0) -> dict:
+                 consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
+                 search_residual: np.ndarray | None = None) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -409,6 +410,11 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         threshold_pct: structured share for the residual GP on the references.
         consistent_rel, min_t: the "same in the reference" test (see the module docstring).
         min_step_chi2: onset change-point acceptance.
+        search_residual: (T, 6) the differential sparse search's residual (after the reference flight's
+            inadequacy and the angle nuisance; ``sparse.THRESHOLDS["allowance_on_search_residual"]``):
+            given, a term the search named is judged for the between-flight allowances on it, not on
+            the raw residual against the model, where the model's own inadequacy (the reference flight
+            has it too, and the search took it out) can hide a change (the JSBSim c172x ``Cm:alpha^2``).
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -472,6 +478,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         if is_aero:                          # the between-flight allowance: an offset of the coefficient
             coef, term = cause.split(":", 1)
             R_wo = (diag.residual_after - fitted[cause].delta) if cause in fitted else diag.residual_before
+            if search_residual is not None and f.get("source") == "sparse search":
+                R_wo = np.where(valid0[:, None], search_residual, np.nan)
             allow = offset_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
                                      min_t=min_t, min_gain_pct=min_gain_pct)
             if allow["offset_only"]:

@@ -55,7 +55,7 @@ from .regression import effective_samples
 from .wind_triangle import WIND_SYSTEMATIC_MPS, autopilot_wind  # noqa: F401  (WIND_SYSTEMATIC_MPS: re-exported)
 
 __all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "MIN_T_SCREEN",
-           "MAX_SE_COEF_MPS", "airspeed_cause", "wind_shift", "fuse_pitot_evidence", "with_pitot"]
+           "MAX_SE_COEF_MPS", "airspeed_cause", "wind_shift", "fuse_pitot_evidence", "screen", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
@@ -72,7 +72,8 @@ COEF_SYSTEMATIC_MPS = 0.2
 #: pitot bias (:func:`fuse_pitot_evidence`).
 MIN_T_FUSED = 3.0
 #: The cheap screen before the pipeline is re-run with the pitot corrected (:func:`_unit_delta_rereduced`):
-#: the wind triangle and the closed-form coefficient fit agree and their fused |t| reaches this.
+#: the wind triangle and the closed-form coefficient fit agree and their fused |t| reaches this, or (added
+#: 2026-11-22, branch i9-top90) the wind triangle's change since the reference flight alone reaches it.
 MIN_T_SCREEN = 2.0
 #: Largest coloured standard error (m/s) of one coefficient's estimate of the bias for it to take part in
 #: the coefficients' median (:func:`_fit_unit_delta`).
@@ -247,6 +248,29 @@ def fuse_pitot_evidence(triangle: dict | None, coef_change: float, coef_se: floa
             "coefficients_se": float(coef_se)}
 
 
+def screen(fused: dict, change: dict) -> dict:
+    """The cheap screen before the exact re-fit of a pitot bias (:func:`_unit_delta_rereduced`).
+
+    It passes when the wind triangle and the closed-form coefficient fit agree and their fused change
+    is at least :data:`MIN_T_SCREEN` standard errors, *or* when the wind triangle's change since the
+    reference flight(s) alone is: the closed-form fit misses the aided angles' response to the
+    airspeed, so on some aircraft it comes out too low to agree, and it must not keep the exact re-fit
+    (which decides, with the same agreement test) from being reached.
+
+    Args:
+        fused: :func:`fuse_pitot_evidence` of the triangle and the closed-form fit.
+        change: :func:`gcs_sysid.diagnose.wind_triangle.change_since_references`.
+
+    Returns:
+        ``{"passes", "fused", "triangle_alone", "linearise_at_mps"}``: the two routes and the bias at
+        which the re-fit is linearised (the fused estimate, else the triangle's change), m/s.
+    """
+    by_fused = bool(fused["agree"] and abs(fused["t_statistic"]) >= MIN_T_SCREEN)
+    by_triangle = bool(change["std_error"] > 0 and abs(change["t_statistic"]) >= MIN_T_SCREEN)
+    return {"passes": by_fused or by_triangle, "fused": by_fused, "triangle_alone": by_triangle,
+            "linearise_at_mps": float(fused["estimate"] if by_fused else change["change_mps"])}
+
+
 def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidates, gain_rows, min_gain_pct):
     """``bias:airspeed`` by the wind triangle and the coefficients together (:func:`fuse_pitot_evidence`).
 
@@ -280,11 +304,15 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     # the screen passed: the pipeline re-run on the flight with the pitot corrected gives the bias's
     # exact effect on every regressor and coefficient (the estimation layer's aided angles move with the
     # airspeed in ways the closed-form transform does not model); the coefficient fit is then redone with it
-    if not (fused["agree"] and abs(fused["t_statistic"]) >= MIN_T_SCREEN):
+    # the screen: the two agree and their fused change is significant, or the wind triangle alone is
+    # (then the closed-form coefficient fit, which the aided angles' response to the airspeed biases,
+    # must not keep the exact re-fit from being reached; the re-fit is then linearised at the triangle's value)
+    out["screen"] = screen(fused, change)
+    if not out["screen"]["passes"]:
         out["why"] = "the screen (wind triangle and closed-form coefficient fit) did not pass"
         out["checks"] = {"measurements_agree": fused["agree"], "significant": False}
         return out
-    D1 = _unit_delta_rereduced(ctx, flight, fused["estimate"])
+    D1 = _unit_delta_rereduced(ctx, flight, out["screen"]["linearise_at_mps"])
     if D1 is not None:
         b_c, se_c, per_coef = _fit_unit_delta(ctx, R, D1)
         coef_change = b_c - ref_b
