@@ -13,6 +13,7 @@ O(N^3 P^3) time and O(N^2 P^2) memory; for tests and benchmark baselines only
 from __future__ import annotations
 
 import jax.numpy as jnp
+import numpy as np
 from jax.scipy.linalg import cho_solve, solve_triangular
 
 from .kernels import ARDSquaredExponential
@@ -31,24 +32,25 @@ def exact_covariance(params: GlobalParams, X1: jnp.ndarray, X2: jnp.ndarray) -> 
     return out
 
 
-def _observed(Ys: jnp.ndarray, mask) -> jnp.ndarray:
-    """Indices of the observed entries of the output-major stacked ``Ys (N, P)`` (all without ``mask``)."""
+def _observed(Ys: jnp.ndarray, mask) -> np.ndarray:
+    """Indices of the observed entries of the output-major stacked ``Ys (N, P)`` (all without ``mask``);
+    ``mask`` is a concrete (host) array, so the functions can be compiled with it closed over."""
     n_all = Ys.shape[0] * Ys.shape[1]
-    return jnp.arange(n_all) if mask is None else jnp.flatnonzero(jnp.asarray(mask, bool).T.reshape(-1))
+    return np.arange(n_all) if mask is None else np.flatnonzero(np.asarray(mask, bool).T.reshape(-1))
 
 
 def _noisy(params: GlobalParams, Xs, keep):
     N, P = Xs.shape[0], params.A.shape[0]
     K = exact_covariance(params, Xs, Xs) + jnp.kron(params.noise_cov(), jnp.eye(N, dtype=Xs.dtype))
-    return jnp.linalg.cholesky(K[jnp.ix_(keep, keep)]), N, P
+    return jnp.linalg.cholesky(K[np.ix_(keep, keep)]), N, P
 
 
 def exact_log_marginal(params: GlobalParams, Xs: jnp.ndarray, Ys: jnp.ndarray, mask=None) -> jnp.ndarray:
     """Log marginal likelihood ``log N(y | 0, K)`` of ``Ys (N, P)`` at ``Xs (N, D)``, a scalar.
 
     ``mask`` ``(N, P)`` bool (True: observed): the likelihood of the observed entries only
-    (heterotopic data: the stacked vector and ``K`` restricted to them); eager NumPy-style
-    indexing, not for ``jit``.
+    (heterotopic data: the stacked vector and ``K`` restricted to them); a host array, closed over
+    when compiled (``jax.jit(partial(exact_log_marginal, mask=mask))``).
     """
     keep = _observed(Ys, mask)
     L, N, P = _noisy(params, Xs, keep)
