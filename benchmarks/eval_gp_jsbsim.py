@@ -61,9 +61,13 @@ settings): ``hjoint`` one joint GP on every training row, moments missing where 
 per-output statistics, ``docs/gp.md``); ``hindep`` six independent GPs, each on the rows that carry
 its output; ``hdrop`` one joint GP on the complete rows only (what the pipeline did before: rows with
 a missing output dropped); ``hdec`` ``hjoint`` with its cross-output coupling removed after the fit
-(``gp.joint.decoupled_model``: what the coupling contributes). Each line carries ``err`` (all held-out
+(``gp.joint.decoupled_model``: what the coupling contributes); ``hjointv`` ``hjoint`` with the
+coupling gate (``GPConfig.coupling_validation``: the coupling kept only for the outputs whose
+blocked cross-validation error it lowers, on the rows that carry them). Each line carries ``err`` (all held-out
 rows) and ``err_region`` (for ``rates``: the held-out rows beyond the same threshold, where the
-training moments were missing; ``block``: all held-out rows again). ``--summarize`` prints the pairs.
+training moments were missing; ``block``: all held-out rows again) and ``err_gap`` (the training rows
+whose moments were removed, against the truth: the gap the replay fills, where the joint model has
+the forces of the same rows). ``--summarize`` prints the pairs.
 
 Usage::
 
@@ -288,7 +292,10 @@ def missing_rows(pattern: str, X: np.ndarray, tr: np.ndarray) -> tuple[np.ndarra
     raise ValueError(pattern)
 
 
-def score_missing(path: Path, patterns, base: GPConfig = GPConfig()):
+MISSING_MODELS = ("hjoint", "hindep", "hdrop", "hdec", "hjointv")
+
+
+def score_missing(path: Path, patterns, base: GPConfig = GPConfig(), which=MISSING_MODELS):
     """``hjoint``, ``hindep``, ``hdrop``, ``hdec`` on one cached flight for each missing-output pattern
     (module docstring); yields one JSON-able dict per pattern and model. The independent GPs of the
     forces see the same rows under every pattern and are fitted once."""
@@ -307,18 +314,23 @@ def score_missing(path: Path, patterns, base: GPConfig = GPConfig()):
         Ym = Y.copy()
         Ym[np.ix_(gone, MOMENTS)] = np.nan
         hr = h & region
-        models = {}
+        models, times, indep = {}, {}, []
+        if "hjoint" in which or "hdec" in which:
+            t0 = time.perf_counter()
+            models["hjoint"] = fit_gp(X[tr], Ym[tr], base)[0]
+            models["hdec"] = decoupled_model(models["hjoint"])
+            times.update(hjoint=time.perf_counter() - t0, hdec=0.0)
+        if "hjointv" in which:
+            t0 = time.perf_counter()
+            models["hjointv"] = fit_gp(X[tr], Ym[tr], replace(base, coupling_validation=True))[0]
+            times["hjointv"] = time.perf_counter() - t0
+        if "hdrop" in which:
+            t0 = time.perf_counter()
+            keep = tr & ~gone
+            models["hdrop"] = fit_gp(X[keep], Y[keep], base)[0]
+            times["hdrop"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        models["hjoint"] = fit_gp(X[tr], Ym[tr], base)[0]
-        models["hdec"] = decoupled_model(models["hjoint"])
-        times = {"hjoint": time.perf_counter() - t0, "hdec": 0.0}
-        t0 = time.perf_counter()
-        keep = tr & ~gone
-        models["hdrop"] = fit_gp(X[keep], Y[keep], base)[0]
-        times["hdrop"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        indep = []
-        for p in range(P):
+        for p in range(P if "hindep" in which else 0):
             rows = tr & np.isfinite(Ym[:, p])
             if p not in MOMENTS:
                 if p not in force_fits:
@@ -327,13 +339,15 @@ def score_missing(path: Path, patterns, base: GPConfig = GPConfig()):
             else:
                 indep.append(fit_gp(X[rows], Y[rows][:, [p]], base, output_names=[COEFFICIENTS[p]])[0])
         times["hindep"] = time.perf_counter() - t0
-        for v in ("hjoint", "hindep", "hdrop", "hdec"):
+        for v in [m for m in MISSING_MODELS if m in which]:
             if v == "hindep":
                 parts = [m.predict(X[h], include_noise=False) for m in indep]
                 mean, var = np.column_stack([a for a, _ in parts]), np.column_stack([b for _, b in parts])
+                gap = np.column_stack([m.predict(X[gone], include_noise=False)[0] for m in indep])
                 corr = float("nan")
             else:
                 mean, var = models[v].predict(X[h], include_noise=False)
+                gap = models[v].predict(X[gone], include_noise=False)[0]
                 c = models[v].output_correlation()
                 corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
             sig = np.sqrt(var)
@@ -342,6 +356,7 @@ def score_missing(path: Path, patterns, base: GPConfig = GPConfig()):
                        n_train=int(tr.sum()), n_missing=int(gone.sum()), n_held=int(h.sum()), n_region=int(hr.sum()),
                        err=dict(zip(COEFFICIENTS, errors(mean, Yt[h]).round(2).tolist())),
                        err_region=dict(zip(COEFFICIENTS, errors(mean[in_region], Yt[hr]).round(2).tolist())),
+                       err_gap=dict(zip(COEFFICIENTS, errors(gap, Yt[gone]).round(2).tolist())),
                        cov=dict(zip(COEFFICIENTS, coverage(mean, sig, Yt[h]).round(1).tolist())),
                        max_corr=corr, t_fit_s=round(times[v], 2),
                        notes=[] if v == "hindep" else [n for n in models[v].notes if "miss" in n])
@@ -354,9 +369,10 @@ def summarize_missing(rows: list[dict]) -> str:
     by: dict = {}
     for r in rows:
         by.setdefault((r.get("pattern"), r["aircraft"], r["seed"], r["turbulence"]), {})[r["variant"]] = r
-    for a, b in (("hjoint", "hindep"), ("hjoint", "hdrop"), ("hjoint", "hdec"), ("hindep", "hdrop")):
+    for a, b in (("hjoint", "hindep"), ("hjoint", "hdrop"), ("hjoint", "hdec"), ("hindep", "hdrop"),
+                 ("hjointv", "hindep"), ("hjointv", "hjoint")):
         for pattern in MISSING_PATTERNS:
-            for key in ("err", "err_region"):
+            for key in ("err", "err_region", "err_gap"):
                 for what, cols in (("all", COEFFICIENTS), ("moments", [COEFFICIENTS[i] for i in MOMENTS])):
                     pairs = [(f[a][key][c], f[b][key][c]) for (pt, *_), f in by.items() if pt == pattern
                              and a in f and b in f for c in cols]
@@ -486,7 +502,8 @@ def main(argv=None) -> int:
                     help="fit on every N-th training row only (joint vs independent with few samples)")
     ap.add_argument("--missing", nargs="+", default=None, choices=MISSING_PATTERNS,
                     help="remove the moments of part of the training rows by these patterns and score hjoint, "
-                         "hindep, hdrop, hdec instead of --variants")
+                         "hindep, hdrop, hdec, hjointv instead of --variants")
+    ap.add_argument("--missing-models", nargs="+", default=list(MISSING_MODELS), choices=MISSING_MODELS)
     ap.add_argument("--diagnose", action="store_true",
                     help="print least squares vs SUR/GLS per cached flight instead of fitting GPs")
     a = ap.parse_args(argv)
@@ -506,10 +523,11 @@ def main(argv=None) -> int:
                         print(diagnose(path), flush=True)
                         continue
                     if a.missing:
-                        for r in score_missing(path, a.missing):
+                        for r in score_missing(path, a.missing, which=a.missing_models):
                             print(f"{path.stem:26s} {r['pattern']:5s} {r['variant']:6s} err "
                                   + " ".join(f"{r['err'][c]:6.2f}" for c in COEFFICIENTS) + "  region "
-                                  + " ".join(f"{r['err_region'][c]:6.2f}" for c in COEFFICIENTS)
+                                  + " ".join(f"{r['err_region'][c]:6.2f}" for c in COEFFICIENTS) + "  gap "
+                                  + " ".join(f"{r['err_gap'][c]:6.2f}" for i, c in enumerate(COEFFICIENTS) if i in MOMENTS)
                                   + f"  ({r['n_missing']} of {r['n_train']} missing, {r['n_region']} held-out "
                                   f"rows in region)  {r['t_fit_s']:.1f} s", flush=True)
                             if a.json:

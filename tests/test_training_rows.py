@@ -19,3 +19,16 @@ def test_rows_with_missing_moments_are_kept_and_named():
 def test_complete_rows_give_no_note():
     X, Y = np.zeros((3, 2)), np.ones((3, 2))
     assert training_rows(X, Y, ["CX", "CY"])[2] == ""
+
+
+def test_fit_refuses_an_output_with_almost_no_values():
+    import pytest
+
+    from gcs_sysid.errors import DataError
+    from gcs_sysid.gp import fit_gp
+
+    X = np.random.default_rng(0).normal(size=(20, 2))
+    Y = np.column_stack([X[:, 0], X[:, 1]])
+    Y[2:, 1] = np.nan
+    with pytest.raises(DataError, match="y1: fewer than 3 finite values"):
+        fit_gp(X, Y)

@@ -382,7 +382,9 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     Args:
         X: ``(N, D)`` regressors (for the pipeline ``REGRESSORS``: alpha, beta, p_hat, q_hat,
             r_hat, delta_e, delta_a, delta_r, delta_t, V in rad, -, m/s).
-        Y: ``(N, P)`` coefficients (``COEFFICIENTS``: CX CY CZ Cl Cm Cn).
+        Y: ``(N, P)`` coefficients (``COEFFICIENTS``: CX CY CZ Cl Cm Cn). A NaN marks a missing
+            output of that row (heterotopic rows, e.g. moments rejected where the forces are kept):
+            each output is conditioned on the rows that carry it (``docs/gp.md``, "Missing outputs").
         config: :class:`GPConfig`.
         input_names, output_names: column names for the summary (default: the
             regressors and coefficients when the widths match, else ``x0..``, ``y0..``).
@@ -391,7 +393,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         ``(model, history)``.
 
     Raises:
-        InputError: wrong shapes. DataError: fewer than 3 finite rows.
+        InputError: wrong shapes. DataError: fewer than 3 finite rows, or an output with fewer
+        than 3 finite values.
 
     Sources: Titsias (2009) for the bound; Alvarez, Rosasco and Lawrence (2012) for the
     coregionalisation; Krause, Singh and Guestrin (2008) for the selection; Paciorek and
@@ -402,12 +405,15 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
 
     enable_x64()
     cfg, history, t0 = config, FitHistory(), time.perf_counter()
-    X, Y, notes = check_training(X, Y, min_rows=3, partial=True)
+    Y_names = None if output_names is None else list(output_names)
+    if np.ndim(Y) == 2 and (Y_names is None or len(Y_names) != np.shape(Y)[1]):     # the summary's default names
+        Y_names = list(COEFFICIENTS) if np.shape(Y)[1] == len(COEFFICIENTS) else [f"y{p}" for p in range(np.shape(Y)[1])]
+    X, Y, notes = check_training(X, Y, min_rows=3, partial=True, output_names=Y_names)
     D, P = X.shape[1], Y.shape[1]
     if not np.all(np.isfinite(Y)):
-        few = [p for p in range(P) if np.isfinite(Y[:, p]).sum() < 3]
+        few = [Y_names[p] for p in range(P) if np.isfinite(Y[:, p]).sum() < 3]
         if few:
-            raise DataError(f"gp: output(s) {few} have fewer than 3 finite values; fit only the outputs the data carry")
+            raise DataError(f"gp: {', '.join(few)}: fewer than 3 finite values; fit only the outputs the data carry")
         if cfg.noise_correlation:
             cfg = replace(cfg, noise_correlation=False)
             notes.append("gp: rows miss some outputs: the noise is taken as independent between outputs "

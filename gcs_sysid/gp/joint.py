@@ -129,7 +129,7 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
     def sse(pk: GlobalParams) -> np.ndarray:
         out = np.zeros(P)
         for (a, b), rest, u in zip(blocks, rests, U):
-            out += np.sum((Ys[a:b] - u @ np.asarray(_mean_weights(pk, rest))) ** 2, 0)
+            out += np.nansum((Ys[a:b] - u @ np.asarray(_mean_weights(pk, rest))) ** 2, 0)    # NaN: missing
         return out
 
     none, every = np.zeros(P, bool), np.ones(P, bool)

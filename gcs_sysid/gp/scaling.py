@@ -32,7 +32,8 @@ def check_inputs(X, n_inputs: int | None = None, what: str = "X") -> np.ndarray:
 
 
 def check_training(X, Y, n_inputs: int | None = None, n_outputs: int | None = None,
-                   min_rows: int = 1, partial: bool = False) -> tuple[np.ndarray, np.ndarray, list[str]]:
+                   min_rows: int = 1, partial: bool = False, output_names=None
+                   ) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Validate training data and drop rows with a non-finite value.
 
     Args:
@@ -42,6 +43,7 @@ def check_training(X, Y, n_inputs: int | None = None, n_outputs: int | None = No
         partial: keep rows that miss some outputs (NaN in ``Y``; heterotopic data): only rows with a
             non-finite regressor or with no finite output are dropped, and the missing entries are
             returned as NaN (infinite values become NaN), with a note per output that misses some.
+        output_names: names of the ``P`` outputs for that note (default ``output 0``, ...).
 
     Returns:
         ``(X, Y, notes)`` float64 finite rows and one-line notes (rows dropped).
@@ -65,7 +67,8 @@ def check_training(X, Y, n_inputs: int | None = None, n_outputs: int | None = No
         Y = np.where(np.isfinite(Y), Y, np.nan)
         miss = (~np.isfinite(Y)).sum(0)
         notes.append(f"gp: {int((~np.isfinite(Y)).any(1).sum())} of {len(Y)} rows miss some outputs (" + ", ".join(
-            f"output {p}: {int(m)}" for p, m in enumerate(miss) if m) + "); each output is conditioned on the rows "
+            f"{output_names[p] if output_names is not None else f'output {p}'}: {int(m)}" for p, m in enumerate(miss)
+            if m) + "); each output is conditioned on the rows "
             "that carry it, the others inform it through the coregionalisation")
     if X.shape[0] < min_rows:
         raise DataError(f"gp: need at least {min_rows} finite rows of (X, Y) to fit, got {X.shape[0]}")
