@@ -118,6 +118,28 @@ def test_joint_fit_predicts_a_missing_output_from_the_others_where_an_independen
     assert dec > 5 * joint
     # saved and loaded with its per-output statistics; updated with more partial rows
     loaded = load_gp(model.save(tmp_path / "m"))
+    import json
+
+    assert json.loads((tmp_path / "m.json").read_text())["version"] == 5 and loaded.stats.per_output
     np.testing.assert_allclose(loaded.predict(X[:50])[0], model.predict(X[:50])[0], rtol=1e-8, atol=1e-10)
     more = model.update(X[:40], Ym[:40])
     assert more.n_used == len(X) + 40 and np.isfinite(more.predict(X[miss][:20])[0]).all()
+
+
+def test_local_layer_skips_a_neighbours_missing_output():
+    from gcs_sysid.gp.local import LocalParams, local_predict_chunk
+
+    rng = np.random.default_rng(2)
+    lp = LocalParams(lengthscale=jnp.array([0.7, 1.1]), beta=jnp.asarray(0.3), amp=jnp.array([0.5, 0.2]),
+                     noise=jnp.array([0.01, 0.02]))
+    Xq, zq = rng.normal(size=(3, 2)), rng.normal(size=3) * 0.1
+    Xn, zn, rn = rng.normal(size=(3, 6, 2)), rng.normal(size=(3, 6)) * 0.1, rng.normal(size=(3, 6, 2))
+    rn_missing = rn.copy()
+    rn_missing[:, 2, 0] = np.nan                       # neighbour 2 misses output 0
+    m, v = local_predict_chunk(lp, Xq, zq, Xn, zn, rn_missing)
+    keep = [0, 1, 3, 4, 5]
+    m5, v5 = local_predict_chunk(lp, Xq, zq, Xn[:, keep], zn[:, keep], rn[:, keep])
+    m6, v6 = local_predict_chunk(lp, Xq, zq, Xn, zn, rn)
+    np.testing.assert_allclose(m[:, 0], m5[:, 0], rtol=1e-6, atol=1e-8)     # output 0: as without the neighbour
+    np.testing.assert_allclose(v[:, 0], v5[:, 0], rtol=1e-6, atol=1e-8)
+    np.testing.assert_allclose(m[:, 1], m6[:, 1], rtol=1e-12)                 # output 1: every neighbour
