@@ -369,6 +369,15 @@ def summarize_missing(rows: list[dict]) -> str:
     by: dict = {}
     for r in rows:
         by.setdefault((r.get("pattern"), r["aircraft"], r["seed"], r["turbulence"]), {})[r["variant"]] = r
+    models = [m for m in MISSING_MODELS if any(m in f for f in by.values())]
+    mom = [COEFFICIENTS[i] for i in MOMENTS]
+    for key, what in (("err", "held-out rows"), ("err_gap", "training rows whose moments were removed")):
+        out.append(f"\n{key}: Cl Cm Cn %, {what}\n\n| pattern | flight | " + " | ".join(models) + " |")
+        out.append("|" + "---|" * (len(models) + 2))
+        for (pt, ac, seed, turb), f in sorted(by.items()):
+            out.append(f"| {pt} | {ac} {turb} s{seed} | " + " | ".join(
+                " ".join(f"{f[m][key][c]:.1f}" for c in mom) if m in f else "" for m in models) + " |")
+    out.append("")
     for a, b in (("hjoint", "hindep"), ("hjoint", "hdrop"), ("hjoint", "hdec"), ("hindep", "hdrop"),
                  ("hjointv", "hindep"), ("hjointv", "hjoint")):
         for pattern in MISSING_PATTERNS:
