@@ -455,7 +455,9 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if cfg.residual_correlation:
         from .colored import variance_inflation
 
-        var_scale = variance_inflation(Ys - global_mean(params, post, Xs, cfg.batch_size))
+        R = Ys - global_mean(params, post, Xs, cfg.batch_size)
+        var_scale = variance_inflation(R) if np.isfinite(R).all() else np.array(      # missing outputs: own rows
+            [variance_inflation(R[np.isfinite(R[:, p]), p][:, None])[0] for p in range(P)])
     input_var = None
     if cfg.input_noise:
         t4 = time.perf_counter()
