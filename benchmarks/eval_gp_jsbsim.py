@@ -47,6 +47,28 @@ lists the pairs with a learned correlation above 0.5 where the truth's is below 
 (``CARRIES``). ``--diagnose`` prints, per
 flight, least squares per output against seemingly-unrelated-regressions GLS (Zellner 1962).
 
+Missing outputs (heterotopic data, ``--missing PATTERN ...``; issue 8 item 3, the case where the
+coupling of the outputs can move the predictions): the moment coefficients (Cl Cm Cn) of a share of
+the training rows are removed (NaN) by a pattern fixed before any run (:data:`MISSING_PATTERNS`):
+
+  rates   the rows whose largest standardised |p_hat|, |q_hat|, |r_hat| (distance from the training
+          median over the training std) is above its 70th percentile on the training rows: the
+          angular-acceleration estimate rejected in the fastest 30 % of the maneuvers
+  block   the rows in the 35-65 % stretch of the training time: a 30 % gyro dropout
+
+and four models are scored on the held-out rows against the truth (same ``GPConfig()``, the replay's
+settings): ``hjoint`` one joint GP on every training row, moments missing where removed (the
+per-output statistics, ``docs/gp.md``); ``hindep`` six independent GPs, each on the rows that carry
+its output; ``hdrop`` one joint GP on the complete rows only (what the pipeline did before: rows with
+a missing output dropped); ``hdec`` ``hjoint`` with its cross-output coupling removed after the fit
+(``gp.joint.decoupled_model``: what the coupling contributes); ``hjointv`` ``hjoint`` with the
+coupling gate (``GPConfig.coupling_validation``: the coupling kept only for the outputs whose
+blocked cross-validation error it lowers, on the rows that carry them). Each line carries ``err`` (all held-out
+rows) and ``err_region`` (for ``rates``: the held-out rows beyond the same threshold, where the
+training moments were missing; ``block``: all held-out rows again) and ``err_gap`` (the training rows
+whose moments were removed, against the truth: the gap the replay fills, where the joint model has
+the forces of the same rows). ``--summarize`` prints the pairs.
+
 Usage::
 
     python benchmarks/eval_gp_jsbsim.py --make --aircraft c172x sgs --seeds 1 2 --turbulence light moderate
@@ -251,6 +273,133 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
                          **extra, t_fit_s=round(time.perf_counter() - t0, 2)))
 
 
+#: Missing-output patterns of ``--missing`` (module docstring); the moments are removed.
+MISSING_PATTERNS = ("rates", "block")
+#: Share of the training rows whose moments a pattern removes.
+MISSING_SHARE = 0.3
+#: Columns of the moment coefficients (Cl Cm Cn) in ``COEFFICIENTS``; of the rate regressors in ``X``.
+MOMENTS, RATES = (3, 4, 5), (2, 3, 4)
+
+
+def missing_rows(pattern: str, X: np.ndarray, tr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows whose moments ``pattern`` removes ``(N,)`` (within ``tr``) and the rows of its region ``(N,)``
+    (``rates``: every row beyond the training threshold; ``block``: all rows)."""
+    if pattern == "rates":
+        med, sd = np.median(X[tr][:, RATES], 0), X[tr][:, RATES].std(0)
+        score = np.max(np.abs(X[:, RATES] - med) / np.where(sd > 0, sd, 1.0), 1)
+        thr = np.quantile(score[tr], 1.0 - MISSING_SHARE)
+        return tr & (score > thr), score > thr
+    if pattern == "block":
+        k = np.flatnonzero(tr)
+        lo, hi = k[int(round(0.35 * len(k)))], k[int(round(0.65 * len(k)))]
+        idx = np.arange(len(X))
+        return tr & (idx >= lo) & (idx < hi), np.ones(len(X), bool)
+    raise ValueError(pattern)
+
+
+MISSING_MODELS = ("hjoint", "hindep", "hdrop", "hdec", "hjointv")
+
+
+def score_missing(path: Path, patterns, base: GPConfig = GPConfig(), which=MISSING_MODELS):
+    """``hjoint``, ``hindep``, ``hdrop``, ``hdec`` on one cached flight for each missing-output pattern
+    (module docstring); yields one JSON-able dict per pattern and model. The independent GPs of the
+    forces see the same rows under every pattern and are fitted once."""
+    from gcs_sysid.gp.joint import decoupled_model
+
+    d = np.load(path)
+    X, Y, Xt, Yt = d["X"], d["Y"], d["Xt"], d["Yt"]
+    ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
+    tr = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
+    h = d["held"] & ok
+    meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
+    force_fits: dict = {}
+    P = Y.shape[1]
+    for pattern in patterns:
+        gone, region = missing_rows(pattern, X, tr)
+        Ym = Y.copy()
+        Ym[np.ix_(gone, MOMENTS)] = np.nan
+        hr = h & region
+        models, times, indep = {}, {}, []
+        if "hjoint" in which or "hdec" in which:
+            t0 = time.perf_counter()
+            models["hjoint"] = fit_gp(X[tr], Ym[tr], base)[0]
+            models["hdec"] = decoupled_model(models["hjoint"])
+            times.update(hjoint=time.perf_counter() - t0, hdec=0.0)
+        if "hjointv" in which:
+            t0 = time.perf_counter()
+            models["hjointv"] = fit_gp(X[tr], Ym[tr], replace(base, coupling_validation=True))[0]
+            times["hjointv"] = time.perf_counter() - t0
+        if "hdrop" in which:
+            t0 = time.perf_counter()
+            keep = tr & ~gone
+            models["hdrop"] = fit_gp(X[keep], Y[keep], base)[0]
+            times["hdrop"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        for p in range(P if "hindep" in which else 0):
+            rows = tr & np.isfinite(Ym[:, p])
+            if p not in MOMENTS:
+                if p not in force_fits:
+                    force_fits[p] = fit_gp(X[rows], Y[rows][:, [p]], base, output_names=[COEFFICIENTS[p]])[0]
+                indep.append(force_fits[p])
+            else:
+                indep.append(fit_gp(X[rows], Y[rows][:, [p]], base, output_names=[COEFFICIENTS[p]])[0])
+        times["hindep"] = time.perf_counter() - t0
+        for v in [m for m in MISSING_MODELS if m in which]:
+            if v == "hindep":
+                parts = [m.predict(X[h], include_noise=False) for m in indep]
+                mean, var = np.column_stack([a for a, _ in parts]), np.column_stack([b for _, b in parts])
+                gap = np.column_stack([m.predict(X[gone], include_noise=False)[0] for m in indep])
+                corr = float("nan")
+            else:
+                mean, var = models[v].predict(X[h], include_noise=False)
+                gap = models[v].predict(X[gone], include_noise=False)[0]
+                c = models[v].output_correlation()
+                corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
+            sig = np.sqrt(var)
+            in_region = region[h]
+            yield dict(meta, aoa=meta["aoa"] + f"/miss-{pattern}", variant=v, pattern=pattern,
+                       n_train=int(tr.sum()), n_missing=int(gone.sum()), n_held=int(h.sum()), n_region=int(hr.sum()),
+                       err=dict(zip(COEFFICIENTS, errors(mean, Yt[h]).round(2).tolist())),
+                       err_region=dict(zip(COEFFICIENTS, errors(mean[in_region], Yt[hr]).round(2).tolist())),
+                       err_gap=dict(zip(COEFFICIENTS, errors(gap, Yt[gone]).round(2).tolist())),
+                       cov=dict(zip(COEFFICIENTS, coverage(mean, sig, Yt[h]).round(1).tolist())),
+                       max_corr=corr, t_fit_s=round(times[v], 2),
+                       notes=[] if v == "hindep" else [n for n in models[v].notes if "miss" in n])
+
+
+def summarize_missing(rows: list[dict]) -> str:
+    """Pairs of the ``--missing`` models per pattern: all six coefficients and the moments alone, on all
+    held-out rows and in the pattern's region (better / worse by more than 0.05 points / within)."""
+    out = []
+    by: dict = {}
+    for r in rows:
+        by.setdefault((r.get("pattern"), r["aircraft"], r["seed"], r["turbulence"]), {})[r["variant"]] = r
+    models = [m for m in MISSING_MODELS if any(m in f for f in by.values())]
+    mom = [COEFFICIENTS[i] for i in MOMENTS]
+    for key, what in (("err", "held-out rows"), ("err_gap", "training rows whose moments were removed")):
+        out.append(f"\n{key}: Cl Cm Cn %, {what}\n\n| pattern | flight | " + " | ".join(models) + " |")
+        out.append("|" + "---|" * (len(models) + 2))
+        for (pt, ac, seed, turb), f in sorted(by.items()):
+            out.append(f"| {pt} | {ac} {turb} s{seed} | " + " | ".join(
+                " ".join(f"{f[m][key][c]:.1f}" for c in mom) if m in f else "" for m in models) + " |")
+    out.append("")
+    for a, b in (("hjoint", "hindep"), ("hjoint", "hdrop"), ("hjoint", "hdec"), ("hindep", "hdrop"),
+                 ("hjointv", "hindep"), ("hjointv", "hjoint")):
+        for pattern in MISSING_PATTERNS:
+            for key in ("err", "err_region", "err_gap"):
+                for what, cols in (("all", COEFFICIENTS), ("moments", [COEFFICIENTS[i] for i in MOMENTS])):
+                    pairs = [(f[a][key][c], f[b][key][c]) for (pt, *_), f in by.items() if pt == pattern
+                             and a in f and b in f for c in cols]
+                    if not pairs:
+                        continue
+                    better = sum(x < y - 0.05 for x, y in pairs)
+                    worse = sum(x > y + 0.05 for x, y in pairs)
+                    out.append(f"{pattern:6s} {key:10s} {what:7s} {a} vs {b}: {better} better / {worse} worse / "
+                               f"{len(pairs) - better - worse} within 0.05 of {len(pairs)} (median "
+                               f"{np.median([x for x, _ in pairs]):.2f} vs {np.median([y for _, y in pairs]):.2f} %)")
+    return "\n".join(out)
+
+
 def _correlations(model, X, Xt, Yt) -> dict:
     """Learned output correlations of ``model`` and the truth's on the training rows (JSON-able)."""
     B = np.asarray(model.params.B)
@@ -314,6 +463,9 @@ def diagnose(path: Path) -> str:
 def summarize(paths) -> str:
     """Markdown table (medians over seeds) of ``--json`` lines."""
     rows = [json.loads(line) for p in paths for line in open(p) if line.strip()]
+    missing = [r for r in rows if "pattern" in r]
+    if missing:
+        return summarize_missing(missing)
     last = {(r["aircraft"], r["seed"], r["turbulence"], r["aoa"], r["variant"]): r for r in rows}   # a rerun replaces
     rows = list(last.values())
     groups: dict[tuple, list[dict]] = {}
@@ -363,6 +515,10 @@ def main(argv=None) -> int:
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
     ap.add_argument("--thin", type=int, default=None,
                     help="fit on every N-th training row only (joint vs independent with few samples)")
+    ap.add_argument("--missing", nargs="+", default=None, choices=MISSING_PATTERNS,
+                    help="remove the moments of part of the training rows by these patterns and score hjoint, "
+                         "hindep, hdrop, hdec, hjointv instead of --variants")
+    ap.add_argument("--missing-models", nargs="+", default=list(MISSING_MODELS), choices=MISSING_MODELS)
     ap.add_argument("--diagnose", action="store_true",
                     help="print least squares vs SUR/GLS per cached flight instead of fitting GPs")
     a = ap.parse_args(argv)
@@ -380,6 +536,18 @@ def main(argv=None) -> int:
                         path = make(ac, seed, turb, aoa, a.duration, cache)
                     if a.diagnose:
                         print(diagnose(path), flush=True)
+                        continue
+                    if a.missing:
+                        for r in score_missing(path, a.missing, which=a.missing_models):
+                            print(f"{path.stem:26s} {r['pattern']:5s} {r['variant']:6s} err "
+                                  + " ".join(f"{r['err'][c]:6.2f}" for c in COEFFICIENTS) + "  region "
+                                  + " ".join(f"{r['err_region'][c]:6.2f}" for c in COEFFICIENTS) + "  gap "
+                                  + " ".join(f"{r['err_gap'][c]:6.2f}" for i, c in enumerate(COEFFICIENTS) if i in MOMENTS)
+                                  + f"  ({r['n_missing']} of {r['n_train']} missing, {r['n_region']} held-out "
+                                  f"rows in region)  {r['t_fit_s']:.1f} s", flush=True)
+                            if a.json:
+                                with open(a.json, "a") as f:
+                                    f.write(json.dumps(r) + "\n")
                         continue
                     for r in score(path, a.variants, thin=a.thin):
                         print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)

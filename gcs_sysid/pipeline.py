@@ -26,7 +26,7 @@ from .result import ReplayResult
 from .telemetry import cut_window, read_log
 
 __all__ = ["ReplayOptions", "REPLAY_OUTPUTS", "check_replay", "run_replay", "held_out_mask", "error_pct",
-           "identifiability"]
+           "identifiability", "training_rows"]
 
 #: What a replay writes into its output folder (an existing folder holding only these may be replaced).
 REPLAY_OUTPUTS = ("report.html", "summary.md", "coefficients.csv", "suggestions.json", "result", "model.npz",
@@ -139,6 +139,30 @@ def held_out_mask(t: np.ndarray, valid: np.ndarray, fraction: float) -> np.ndarr
     cut = tv[0] + (1.0 - fraction) * (tv[-1] - tv[0])
     mask[valid & (t >= cut)] = True
     return mask
+
+
+def training_rows(X: np.ndarray, Y: np.ndarray, names: list[str]) -> tuple[np.ndarray, np.ndarray, str]:
+    """The GP's training rows: finite regressors and at least one finite coefficient.
+
+    A row that misses some coefficients (NaN: e.g. an angular-acceleration estimate rejected, so its
+    moments are missing while its forces are kept) is kept: the joint GP conditions each coefficient
+    on the rows that carry it, and the coregionalisation lets the others inform it there
+    (``docs/gp.md``, "Missing outputs").
+
+    Args:
+        X: ``(N, D)`` regressors; Y: ``(N, P)`` coefficients; names: the ``P`` coefficient names.
+
+    Returns:
+        ``(X, Y, note)``: the kept rows and a one-line note saying what is missing ("" when nothing is).
+    """
+    ok = np.all(np.isfinite(X), axis=1) & np.any(np.isfinite(Y), axis=1)
+    X, Y = X[ok], Y[ok]
+    miss = (~np.isfinite(Y)).sum(0)
+    if not miss.any():
+        return X, Y, ""
+    return X, Y, ("training rows without some coefficients (each is learned from the rows that carry it, the "
+                  "joint GP's other coefficients inform it there): " + ", ".join(
+                      f"{n} missing on {int(m)} of {len(Y)}" for n, m in zip(names, miss) if m))
 
 
 def identifiability(states: FlightStates, table: CoefficientTable) -> dict[str, tuple[bool, str]]:
@@ -281,10 +305,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             notes.append(f"no model fitted: {int(train.sum())} valid training samples "
                          f"and {len(fit_cols)} identifiable coefficients")
         else:
-            X_train = table.X[train]
-            Y_train = table.Y[train][:, fit_cols]
-            ok_rows = np.all(np.isfinite(X_train), axis=1) & np.all(np.isfinite(Y_train), axis=1)
-            X_train, Y_train = X_train[ok_rows], Y_train[ok_rows]
+            X_train, Y_train, partial = training_rows(table.X[train], table.Y[train][:, fit_cols],
+                                                      [COEFFICIENTS[i] for i in fit_cols])
+            if partial:
+                notes.append(partial)
             with _stage("learn GP", timings, bar):
                 # compiled GP programs are cached on disk (only the first run on a machine compiles)
                 enable_compilation_cache()

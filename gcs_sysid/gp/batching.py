@@ -49,12 +49,19 @@ def global_stats(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, batch: in
                  weight: np.ndarray | None = None) -> Stats:
     """Sufficient statistics of all rows, accumulated over zero-padded chunks of ``batch`` rows
     (fewer rows: one chunk padded to the next power of two). ``weight (N,)``: each row counted
-    that many times (default 1)."""
+    that many times (default 1). A NaN in ``Ys`` marks a missing output of that row: the statistics
+    are then in the per-output form (:class:`gcs_sysid.gp.sparse.Stats`; heterotopic data)."""
     size = int(min(batch, _bucket(len(Xs))))
+    missing = not np.all(np.isfinite(Ys))
     total = None
     for a, b in _chunks(len(Xs), size):
         w = _pad(np.ones(b - a) if weight is None else np.asarray(weight[a:b], float), size)
-        st = _stats_jit(params, _pad(Xs[a:b], size), _pad(Ys[a:b], size), w)
+        if missing:
+            ok = np.isfinite(Ys[a:b])
+            st = _stats_jit(params, _pad(Xs[a:b], size), _pad(np.where(ok, Ys[a:b], 0.0), size), w,
+                            _pad(ok.astype(float), size))
+        else:
+            st = _stats_jit(params, _pad(Xs[a:b], size), _pad(Ys[a:b], size), w)
         total = st if total is None else _add_jit(total, st)
     if total is None:
         st = _stats_jit(params, np.zeros((1, Xs.shape[1])), np.zeros((1, Ys.shape[1])), np.zeros(1))

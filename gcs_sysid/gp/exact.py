@@ -13,6 +13,7 @@ O(N^3 P^3) time and O(N^2 P^2) memory; for tests and benchmark baselines only
 from __future__ import annotations
 
 import jax.numpy as jnp
+import numpy as np
 from jax.scipy.linalg import cho_solve, solve_triangular
 
 from .kernels import ARDSquaredExponential
@@ -31,27 +32,42 @@ def exact_covariance(params: GlobalParams, X1: jnp.ndarray, X2: jnp.ndarray) -> 
     return out
 
 
-def _noisy(params: GlobalParams, Xs):
+def _observed(Ys: jnp.ndarray, mask) -> np.ndarray:
+    """Indices of the observed entries of the output-major stacked ``Ys (N, P)`` (all without ``mask``);
+    ``mask`` is a concrete (host) array, so the functions can be compiled with it closed over."""
+    n_all = Ys.shape[0] * Ys.shape[1]
+    return np.arange(n_all) if mask is None else np.flatnonzero(np.asarray(mask, bool).T.reshape(-1))
+
+
+def _noisy(params: GlobalParams, Xs, keep):
     N, P = Xs.shape[0], params.A.shape[0]
     K = exact_covariance(params, Xs, Xs) + jnp.kron(params.noise_cov(), jnp.eye(N, dtype=Xs.dtype))
-    return jnp.linalg.cholesky(K), N, P
+    return jnp.linalg.cholesky(K[np.ix_(keep, keep)]), N, P
 
 
-def exact_log_marginal(params: GlobalParams, Xs: jnp.ndarray, Ys: jnp.ndarray) -> jnp.ndarray:
-    """Log marginal likelihood ``log N(y | 0, K)`` of ``Ys (N, P)`` at ``Xs (N, D)``, a scalar."""
-    L, N, P = _noisy(params, Xs)
-    y = Ys.T.reshape(-1)
+def exact_log_marginal(params: GlobalParams, Xs: jnp.ndarray, Ys: jnp.ndarray, mask=None) -> jnp.ndarray:
+    """Log marginal likelihood ``log N(y | 0, K)`` of ``Ys (N, P)`` at ``Xs (N, D)``, a scalar.
+
+    ``mask`` ``(N, P)`` bool (True: observed): the likelihood of the observed entries only
+    (heterotopic data: the stacked vector and ``K`` restricted to them); a host array, closed over
+    when compiled (``jax.jit(partial(exact_log_marginal, mask=mask))``).
+    """
+    keep = _observed(Ys, mask)
+    L, N, P = _noisy(params, Xs, keep)
+    y = Ys.T.reshape(-1)[keep]
     c = solve_triangular(L, y, lower=True)
-    return -0.5 * (c @ c) - jnp.sum(jnp.log(jnp.diag(L))) - 0.5 * N * P * jnp.log(2.0 * jnp.pi)
+    return -0.5 * (c @ c) - jnp.sum(jnp.log(jnp.diag(L))) - 0.5 * keep.shape[0] * jnp.log(2.0 * jnp.pi)
 
 
-def exact_predict(params: GlobalParams, Xs: jnp.ndarray, Ys: jnp.ndarray, Xq: jnp.ndarray
+def exact_predict(params: GlobalParams, Xs: jnp.ndarray, Ys: jnp.ndarray, Xq: jnp.ndarray, mask=None
                   ) -> tuple[jnp.ndarray, jnp.ndarray]:
-    """Latent predictive mean and variance ``(Q, P)`` at ``Xq (Q, D)`` (noise not included)."""
-    L, N, P = _noisy(params, Xs)
+    """Latent predictive mean and variance ``(Q, P)`` at ``Xq (Q, D)`` (noise not included);
+    ``mask`` as :func:`exact_log_marginal` (condition on the observed entries only)."""
+    keep = _observed(Ys, mask)
+    L, N, P = _noisy(params, Xs, keep)
     Q = Xq.shape[0]
-    Ks = exact_covariance(params, Xq, Xs)                       # (P Q, P N)
-    alpha = cho_solve((L, True), Ys.T.reshape(-1))
+    Ks = exact_covariance(params, Xq, Xs)[:, keep]              # (P Q, observed entries)
+    alpha = cho_solve((L, True), Ys.T.reshape(-1)[keep])
     mean = (Ks @ alpha).reshape(P, Q).T
     V = solve_triangular(L, Ks.T, lower=True)
     xa = design(Xq)

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import jax
@@ -116,9 +116,11 @@ _constrain_global_jit = jax.jit(constrain_global)
 _adam_init = jax.jit(optax.adam(1.0).init)
 
 
-def _global_loss(raw, fixed, Xs, Ys):
+def _global_loss(raw, fixed, Xs, Ys, mask=None):
+    """``-ELBO`` per observed entry; ``mask (N, P)`` of 0/1 marks the observed outputs (None: all)."""
     params = constrain_global(raw, fixed)
-    return -elbo(params, stats_of(params, Xs, Ys)) / (Xs.shape[0] * Ys.shape[1])
+    n_obs = Xs.shape[0] * Ys.shape[1] if mask is None else jnp.maximum(jnp.sum(mask), 1.0)
+    return -elbo(params, stats_of(params, Xs, Ys, None, mask)) / n_obs
 
 
 def _local_loss(raw, Xn, zn, rn):
@@ -189,6 +191,27 @@ def lmc_start_factors(J: int) -> np.ndarray:
     return np.array([4.0 ** ((-1) ** (j + 1) * ((j + 1) // 2)) for j in range(J)])
 
 
+def _residual_cov_missing(Xs, Ys, obs, linear_mean: bool) -> np.ndarray:
+    """Residual covariance ``(P, P)`` of the ridge linear mean with missing outputs (``obs (N, P)``):
+    each output fitted on its own rows; the covariance from the complete rows when there are more
+    than ``2 P`` of them, else its diagonal from each output's rows."""
+    P = Ys.shape[1]
+    Xa = np.concatenate([np.ones((len(Xs), 1)), Xs], axis=1)
+    R = np.where(obs, Ys, np.nan)
+    for p in range(P):
+        rows = obs[:, p]
+        if linear_mean and rows.sum() > 0:
+            Xp = Xa[rows]
+            W = np.linalg.solve(Xp.T @ Xp + 1e-3 * np.eye(Xa.shape[1]), Xp.T @ Ys[rows, p])
+            R[rows, p] = Ys[rows, p] - Xp @ W
+    complete = obs.all(1)
+    if complete.sum() > 2 * P:
+        Cr = np.cov(R[complete].T).reshape(P, P)
+    else:
+        Cr = np.diag(np.nan_to_num(np.nanvar(R, 0), nan=1.0))
+    return Cr + 1e-6 * np.eye(P)
+
+
 def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     """Initial unconstrained parameters from a ridge fit of the linear mean.
 
@@ -198,11 +221,15 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     """
     P = Ys.shape[1]
     R = Ys
-    if cfg.linear_mean:
-        Xa = np.concatenate([np.ones((len(Xs), 1)), Xs], axis=1)   # design(): [1, x]
-        W = np.linalg.solve(Xa.T @ Xa + 1e-3 * np.eye(Xa.shape[1]), Xa.T @ Ys)
-        R = Ys - Xa @ W
-    Cr = np.cov(R.T).reshape(P, P) + 1e-6 * np.eye(P)
+    obs = np.isfinite(Ys)
+    if obs.all():
+        if cfg.linear_mean:
+            Xa = np.concatenate([np.ones((len(Xs), 1)), Xs], axis=1)   # design(): [1, x]
+            W = np.linalg.solve(Xa.T @ Xa + 1e-3 * np.eye(Xa.shape[1]), Xa.T @ Ys)
+            R = Ys - Xa @ W
+        Cr = np.cov(R.T).reshape(P, P) + 1e-6 * np.eye(P)
+    else:
+        Cr = _residual_cov_missing(Xs, Ys, obs, cfg.linear_mean)
     J = int(cfg.latent_kernels)
     B0 = 0.7 * Cr / J
     L0, kappa = _split_B(B0, cfg.rank)
@@ -255,6 +282,14 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
     """
     metric = 1.0 / np.asarray(params.metric_lengthscale())
     store = build_store(Xs, resid, metric, cfg.local_neighbours) if store is None else store
+    full = store
+    complete = np.isfinite(resid).all(1)
+    if not complete.all() and complete.sum() >= 2:
+        # missing outputs: the composite likelihood shares one eigendecomposition between the outputs,
+        # so it is taken over the rows that carry all of them; the returned store keeps every row (a
+        # missing residual is skipped in prediction, gp.local._one_query)
+        Xs, resid = Xs[complete], resid[complete]
+        store = build_store(Xs, resid, metric, cfg.local_neighbours)
     rng = np.random.default_rng(cfg.seed + 7)
     centres = rng.choice(len(Xs), min(cfg.local_batch, len(Xs)), replace=False)
     idx, _ = neighbours(store, Xs[centres])
@@ -276,7 +311,7 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
         raw, _, values = _adam(_local_loss, raw, opt_state, cfg.local_learning_rate, args, int(cfg.local_steps),
                                cfg.tol)
         history.local_loss.extend(np.asarray(values).tolist())
-    return _constrain_local_jit(raw), store
+    return _constrain_local_jit(raw), full
 
 
 def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig, M: int,
@@ -300,7 +335,10 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     P = Ys.shape[1]
     t0 = time.perf_counter()
     sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
-    Xh, Yh = jax.device_put((Xs[sub], Ys[sub]))
+    obs = np.isfinite(Ys[sub])
+    # missing outputs (heterotopic rows): the bound over the observed entries (None: all observed)
+    mask_h = None if obs.all() else jax.device_put(obs.astype(float))
+    Xh, Yh = jax.device_put((Xs[sub], np.where(obs, Ys[sub], 0.0)))
 
     M = int(min(M, len(Xs)))
     Mh = M if cfg.train_inducing or cfg.n_inducing_hyper is None else int(min(cfg.n_inducing_hyper, M))
@@ -327,9 +365,9 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     for stage, n_steps in enumerate((first, cfg.steps - first)):
         if n_steps <= 0:
             continue
-        raw, opt_state, values = _adam(_global_loss, raw, opt_state, cfg.learning_rate, (fixed, Xh, Yh), int(n_steps),
-                                       cfg.tol)
-        history.elbo.extend((-np.asarray(values) * Xh.shape[0] * P).tolist())
+        raw, opt_state, values = _adam(_global_loss, raw, opt_state, cfg.learning_rate, (fixed, Xh, Yh, mask_h),
+                                       int(n_steps), cfg.tol)
+        history.elbo.extend((-np.asarray(values) * (Xh.shape[0] * P if mask_h is None else obs.sum())).tolist())
         if stage == 0 and cfg.reselect and cfg.steps > first and not cfg.train_inducing:
             fixed = reselect(raw, fixed, Mh)
     if Mh < M:
@@ -344,7 +382,9 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     Args:
         X: ``(N, D)`` regressors (for the pipeline ``REGRESSORS``: alpha, beta, p_hat, q_hat,
             r_hat, delta_e, delta_a, delta_r, delta_t, V in rad, -, m/s).
-        Y: ``(N, P)`` coefficients (``COEFFICIENTS``: CX CY CZ Cl Cm Cn).
+        Y: ``(N, P)`` coefficients (``COEFFICIENTS``: CX CY CZ Cl Cm Cn). A NaN marks a missing
+            output of that row (heterotopic rows, e.g. moments rejected where the forces are kept):
+            each output is conditioned on the rows that carry it (``docs/gp.md``, "Missing outputs").
         config: :class:`GPConfig`.
         input_names, output_names: column names for the summary (default: the
             regressors and coefficients when the widths match, else ``x0..``, ``y0..``).
@@ -353,18 +393,31 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         ``(model, history)``.
 
     Raises:
-        InputError: wrong shapes. DataError: fewer than 3 finite rows.
+        InputError: wrong shapes. DataError: fewer than 3 finite rows, or an output with fewer
+        than 3 finite values.
 
     Sources: Titsias (2009) for the bound; Alvarez, Rosasco and Lawrence (2012) for the
     coregionalisation; Krause, Singh and Guestrin (2008) for the selection; Paciorek and
     Schervish (2004) for the local covariance.
     """
     from ..aero.table import COEFFICIENTS, REGRESSORS
+    from ..errors import DataError
 
     enable_x64()
     cfg, history, t0 = config, FitHistory(), time.perf_counter()
-    X, Y, notes = check_training(X, Y, min_rows=3)
+    Y_names = None if output_names is None else list(output_names)
+    if np.ndim(Y) == 2 and (Y_names is None or len(Y_names) != np.shape(Y)[1]):     # the summary's default names
+        Y_names = list(COEFFICIENTS) if np.shape(Y)[1] == len(COEFFICIENTS) else [f"y{p}" for p in range(np.shape(Y)[1])]
+    X, Y, notes = check_training(X, Y, min_rows=3, partial=True, output_names=Y_names)
     D, P = X.shape[1], Y.shape[1]
+    if not np.all(np.isfinite(Y)):
+        few = [Y_names[p] for p in range(P) if np.isfinite(Y[:, p]).sum() < 3]
+        if few:
+            raise DataError(f"gp: {', '.join(few)}: fewer than 3 finite values; fit only the outputs the data carry")
+        if cfg.noise_correlation:
+            cfg = replace(cfg, noise_correlation=False)
+            notes.append("gp: rows miss some outputs: the noise is taken as independent between outputs "
+                         "(noise_correlation needs complete rows)")
     input_names = tuple(input_names or (REGRESSORS if D == len(REGRESSORS) else [f"x{d}" for d in range(D)]))
     output_names = tuple(output_names or (COEFFICIENTS if P == len(COEFFICIENTS) else [f"y{p}" for p in range(P)]))
     scaler, more = Standardiser.fit(X, Y, input_names)
@@ -402,7 +455,9 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if cfg.residual_correlation:
         from .colored import variance_inflation
 
-        var_scale = variance_inflation(Ys - global_mean(params, post, Xs, cfg.batch_size))
+        R = Ys - global_mean(params, post, Xs, cfg.batch_size)
+        var_scale = variance_inflation(R) if np.isfinite(R).all() else np.array(      # missing outputs: own rows
+            [variance_inflation(R[np.isfinite(R[:, p]), p][:, None])[0] for p in range(P)])
     input_var = None
     if cfg.input_noise:
         t4 = time.perf_counter()
@@ -496,6 +551,11 @@ def learn_input_noise(params: GlobalParams, post, Xs: np.ndarray, Ys: np.ndarray
     """Input-noise variances ``(D,)`` (standardised) on ``n_train_max`` random rows of ``Xs (N, D)``,
     ``Ys (N, P)``: the global layer's residuals, latent variances and slopes there, then
     :func:`gcs_sysid.gp.inputnoise.fit_input_noise` (McHutchon and Rasmussen 2011)."""
+    complete = np.flatnonzero(np.isfinite(Ys).all(1))
+    if len(complete) < len(Xs):                  # missing outputs: the rows that carry all of them
+        Xs, Ys = Xs[complete], Ys[complete]
+        if len(Xs) < 2:
+            return None
     sub = random_points(len(Xs), cfg.n_train_max, cfg.seed + 11)
     m, v = global_predict(params, post, Xs[sub], cfg.batch_size)
     grad = mean_gradient(params, post, Xs[sub], cfg.batch_size)

@@ -22,7 +22,7 @@ from .sparse import GlobalParams, Stats
 __all__ = ["save_model", "load_gp"]
 
 FORMAT = "gcs-sysid-gp"
-VERSION = 4   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
+VERSION = 5   # 2: the region-thinned row store (rows_*) replaces store_X / store_resid
 #               3: optional global_noise_chol (cross-correlated noise) and input_var (NIGP);
 #                  stats_yy is (P, P), was its diagonal (P,)
 #               4: optional global_lmc_lengthscale (J-1, D) and global_lmc_A (J-1, P, P) (linear model
@@ -30,6 +30,9 @@ VERSION = 4   # 2: the region-thinned row store (rows_*) replaces store_X / stor
 #                  features. Files of versions 1-3 (one kernel) read unchanged. Optional var_scale (P,)
 #                  (coloured residuals). Optional offset_cov (D, D) and discrepancy (2, P) (the model's
 #                  error at exact conditions, gp/discrepancy.py); files without them read as before.
+#               5: per-output statistics (rows with missing outputs, gp/sparse.py): stats_C (P, M, M),
+#                  stats_E (P, M, D+1), stats_F (P, D+1, D+1), stats_n (P,). Written only by such models;
+#                  a model with complete rows is still written as version 4.
 _GLOBAL = ("lengthscale", "A", "noise", "Z", "prior_std", "jitter")
 _STATS = ("C", "E", "F", "Rphi", "Rx", "yy", "n")
 _LOCAL = ("lengthscale", "beta", "amp", "noise")
@@ -77,7 +80,7 @@ def save_model(model: LocalGlobalGP, path) -> str:
                        "rows_cell_scale": rows.cell_scale})
     npz.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(npz, **arrays)
-    meta = {"format": FORMAT, "version": VERSION, "config": model.config.to_dict(),
+    meta = {"format": FORMAT, "version": VERSION if model.stats.per_output else 4, "config": model.config.to_dict(),
             "input_names": list(model.input_names), "output_names": list(model.output_names),
             "n_hyper": model.n_hyper, "notes": list(model.notes),
             "local_k": int(model.config.local_neighbours) if model.local_params is not None else None,

@@ -44,7 +44,7 @@ from .model import LocalGlobalGP
 from .sparse import GlobalParams
 from .validation import _design_u, _mean_weights, _sub, block_folds
 
-__all__ = ["COUPLING_MARGIN", "decoupled", "decoupled_model", "couple_only", "gate_coupling", "nonlinear_part", "correlation", "quadratic_features",
+__all__ = ["COUPLING_MARGIN", "decoupled", "decoupled_model", "couple_only", "gate_coupling", "gap_errors", "nonlinear_part", "correlation", "quadratic_features",
            "truth_correlation", "blocked_errors", "SelectedOutputs", "select_outputs"]
 
 
@@ -104,6 +104,12 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
     2. signal: output ``p`` benefits when its error with the learned ``B`` (and the gated
        ``Sigma``) is below ``margin`` times that with ``B`` diagonal.
 
+    With missing outputs (NaN in ``Ys``: heterotopic rows) the error of each output is its *gap*
+    error instead: in every block only that output's entries are held back, the other outputs of
+    the block stay in the statistics (the question a missing output poses: its value where the
+    others were measured; :func:`gap_errors`). There the coupling does move the prediction (the
+    observed outputs of the same rows inform the missing one through ``B``), for better or worse.
+
     In each, the coupled group starts as the outputs that benefit; while one of those no longer
     benefits within the group (its partner, e.g. the output whose noise it borrows, was left out)
     the output most strongly correlated with the group in that component joins it (a partner need
@@ -119,18 +125,21 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
     """
     n, P = Ys.shape
     blocks = block_folds(n, folds)
-    parts = [global_stats(params, Xs[a:b], Ys[a:b], batch) for a, b in blocks]
-    total = parts[0]
-    for st in parts[1:]:
-        total = jax.tree_util.tree_map(jnp.add, total, st)
-    rests = [_sub(total, st) for st in parts]
-    U = [np.asarray(_design_u(params, Xs[a:b])) for a, b in blocks]
+    if not np.all(np.isfinite(Ys)):
+        sse = gap_errors(params, Xs, Ys, blocks, batch)
+    else:
+        parts = [global_stats(params, Xs[a:b], Ys[a:b], batch) for a, b in blocks]
+        total = parts[0]
+        for st in parts[1:]:
+            total = jax.tree_util.tree_map(jnp.add, total, st)
+        rests = [_sub(total, st) for st in parts]
+        U = [np.asarray(_design_u(params, Xs[a:b])) for a, b in blocks]
 
-    def sse(pk: GlobalParams) -> np.ndarray:
-        out = np.zeros(P)
-        for (a, b), rest, u in zip(blocks, rests, U):
-            out += np.sum((Ys[a:b] - u @ np.asarray(_mean_weights(pk, rest))) ** 2, 0)
-        return out
+        def sse(pk: GlobalParams) -> np.ndarray:
+            out = np.zeros(P)
+            for (a, b), rest, u in zip(blocks, rests, U):
+                out += np.sum((Ys[a:b] - u @ np.asarray(_mean_weights(pk, rest))) ** 2, 0)
+            return out
 
     none, every = np.zeros(P, bool), np.ones(P, bool)
 
@@ -157,6 +166,45 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
     group, ratio = gate(lambda g: couple_only(params, g, noise_group), _corr(np.asarray(params.B)))
     info = {"noise_coupled": noise_group, "coupled": group, "noise_ratio": noise_ratio, "ratio": ratio}
     return couple_only(params, group, noise_group), info
+
+
+def gap_errors(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, blocks: list[tuple[int, int]], batch: int):
+    """The gap error of heterotopic rows: a function ``sse(params_k) -> (P,)``.
+
+    For every block ``[a, b)`` and output ``p`` the entries of output ``p`` in the block are held back
+    alone (the statistics of all rows minus that block's output-``p`` entries, per-output form; the
+    other outputs of the block stay), and output ``p`` is predicted there by the global posterior
+    mean; ``sse`` sums the squared errors over the observed entries (standardised units). The
+    statistics do not depend on ``B`` or ``Sigma``, so the candidates ``params_k`` (``B`` and
+    ``Sigma`` changed only) share them; each candidate costs ``k P`` posteriors.
+
+    Args:
+        params: learned global hyperparameters. Xs: ``(N, D)``, Ys: ``(N, P)`` standardised rows in
+            time order, NaN where an output is missing. blocks: ``(start, stop)`` row ranges.
+        batch: rows per compiled chunk of the statistics.
+    """
+    P = Ys.shape[1]
+    total = global_stats(params, Xs, Ys, batch)
+    U = [np.asarray(_design_u(params, Xs[a:b])) for a, b in blocks]
+    rests = []
+    for a, b in blocks:
+        row = []
+        for p in range(P):
+            only = np.full_like(Ys[a:b], np.nan)
+            only[:, p] = Ys[a:b, p]
+            obs = np.isfinite(only[:, p])
+            row.append(None if not obs.any() else _sub(total, global_stats(params, Xs[a:b], only, batch)))
+        rests.append(row)
+
+    def sse(pk: GlobalParams) -> np.ndarray:
+        out = np.zeros(P)
+        for (a, b), row, u in zip(blocks, rests, U):
+            for p, rest in enumerate(row):
+                if rest is not None:
+                    out[p] += np.nansum((Ys[a:b, p] - u @ np.asarray(_mean_weights(pk, rest))[:, p]) ** 2)
+        return out
+
+    return sse
 
 
 def _corr(S: np.ndarray) -> np.ndarray:

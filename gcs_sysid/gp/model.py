@@ -128,7 +128,7 @@ class LocalGlobalGP:
     @property
     def n_used(self) -> int:
         """Rows the posterior is conditioned on."""
-        return int(round(float(self.stats.n)))
+        return int(round(self.stats.rows()))
 
     # ------------------------------------------------------------ prediction
     def _standardise_query(self, X) -> tuple[np.ndarray, np.ndarray]:
@@ -247,7 +247,7 @@ class LocalGlobalGP:
             InputError: wrong shapes. DataError: no finite row.
         """
         enable_x64()
-        X_new, Y_new, notes = check_training(X_new, Y_new, self.n_inputs, self.n_outputs)
+        X_new, Y_new, notes = check_training(X_new, Y_new, self.n_inputs, self.n_outputs, partial=True)
         Xs, Ys = self.scaler.x(X_new), self.scaler.y(Y_new)
         cfg = self.config
         params, stats, evicted = self.params, self.stats, self.evicted
@@ -508,7 +508,7 @@ class LocalGlobalGP:
             "local": None,
             "streaming": None if self.rows is None else {
                 "rows_seen": int(self.rows.seen), "rows_stored": len(self.rows), "store_max": int(self.rows.capacity),
-                "rows_evicted": int(round(float(self.evicted.n))) if self.evicted is not None else 0,
+                "rows_evicted": int(round(self.evicted.rows())) if self.evicted is not None else 0,
                 "since_refresh": int(self.since_refresh)},
             "notes": list(self.notes),
         }

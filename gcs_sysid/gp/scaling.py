@@ -32,13 +32,18 @@ def check_inputs(X, n_inputs: int | None = None, what: str = "X") -> np.ndarray:
 
 
 def check_training(X, Y, n_inputs: int | None = None, n_outputs: int | None = None,
-                   min_rows: int = 1) -> tuple[np.ndarray, np.ndarray, list[str]]:
+                   min_rows: int = 1, partial: bool = False, output_names=None
+                   ) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Validate training data and drop rows with a non-finite value.
 
     Args:
         X: ``(N, D)`` regressors. Y: ``(N, P)`` coefficients.
         n_inputs, n_outputs: expected ``D`` and ``P`` (None: any).
         min_rows: fewest finite rows accepted.
+        partial: keep rows that miss some outputs (NaN in ``Y``; heterotopic data): only rows with a
+            non-finite regressor or with no finite output are dropped, and the missing entries are
+            returned as NaN (infinite values become NaN), with a note per output that misses some.
+        output_names: names of the ``P`` outputs for that note (default ``output 0``, ...).
 
     Returns:
         ``(X, Y, notes)`` float64 finite rows and one-line notes (rows dropped).
@@ -53,11 +58,18 @@ def check_training(X, Y, n_inputs: int | None = None, n_outputs: int | None = No
         raise InputError(f"gp: Y must have {n_outputs} columns (the model's outputs), got {Y.shape[1]}")
     if X.shape[0] != Y.shape[0]:
         raise InputError(f"gp: X and Y must have the same number of rows, got {X.shape[0]} and {Y.shape[0]}")
-    ok = np.isfinite(X).all(1) & np.isfinite(Y).all(1)
+    ok = np.isfinite(X).all(1) & (np.isfinite(Y).any(1) if partial else np.isfinite(Y).all(1))
     notes = []
     if not ok.all():
         notes.append(f"gp: dropped {int((~ok).sum())} of {len(ok)} rows with NaN or infinite values")
         X, Y = X[ok], Y[ok]
+    if partial and not np.isfinite(Y).all():
+        Y = np.where(np.isfinite(Y), Y, np.nan)
+        miss = (~np.isfinite(Y)).sum(0)
+        notes.append(f"gp: {int((~np.isfinite(Y)).any(1).sum())} of {len(Y)} rows miss some outputs (" + ", ".join(
+            f"{output_names[p] if output_names is not None else f'output {p}'}: {int(m)}" for p, m in enumerate(miss)
+            if m) + "); each output is conditioned on the rows "
+            "that carry it, the others inform it through the coregionalisation")
     if X.shape[0] < min_rows:
         raise DataError(f"gp: need at least {min_rows} finite rows of (X, Y) to fit, got {X.shape[0]}")
     return X, Y, notes
@@ -87,7 +99,10 @@ class Standardiser:
         """Scaler from training data ``X (N, D)``, ``Y (N, P)``; returns it and notes on constant columns."""
         x_mean, x_std = X.mean(0), X.std(0)
         active = x_std > _CONSTANT_REL * (1.0 + np.abs(x_mean))
-        y_mean, y_std = Y.mean(0), Y.std(0)
+        if np.all(np.isfinite(Y)):
+            y_mean, y_std = Y.mean(0), Y.std(0)
+        else:                                      # missing outputs (NaN): over the rows that carry each
+            y_mean, y_std = np.nanmean(Y, 0), np.nanstd(Y, 0)
         notes = []
         for d in np.flatnonzero(~active):
             name = names[d] if names is not None and d < len(names) else f"input {d}"

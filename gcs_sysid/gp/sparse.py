@@ -36,6 +36,19 @@ shared; the features become ``phi = [phi_1; ...; phi_J]`` ``(J M,)`` with
 ``phi_j = Lm_j^{-1} k_j(Z, x)``, the statistics ``C, E, Rphi`` are those of the stacked features
 (``C`` holds the cross-kernel blocks ``Phi_j Phi_j'^T``), and the latent ``q = (j, r)`` of the
 precision uses the block ``j`` of ``phi``. ``J = 1`` is the ICM above, unchanged.
+
+Heterotopic data (missing outputs; Alvarez, Rosasco and Lawrence 2012, sec. 4.2, where the
+coupling of the outputs is what lets an output borrow from the others): a row may carry only
+some outputs (an angular-acceleration estimate rejected: its moments missing, its forces kept).
+With a mask ``m_np`` (1 observed, 0 missing) and independent noise the sums run over the
+observed entries only, ``Lambda = I + sum_{n,p} m_np psi_p psi_p^T / sigma_p^2``, so the
+statistics whose sums involve the noise weight become per output (:class:`Stats`, "per-output
+form"): ``C_p = sum_n m_np phi_n phi_n^T (P, M, M)``, ``E_p (P, M, D+1)``, ``F_p (P, D+1, D+1)``,
+``n_p (P,)``; ``Rphi``, ``Rx`` and ``yy`` keep their shapes (missing entries enter as 0). The
+complete form is the special case ``m = 1`` and broadcasts against the per-output form (adding
+or subtracting the two is exact). Correlated noise needs the pattern of every row and is not
+supported with missing outputs (:func:`elbo` and :func:`posterior` use the diagonal of ``Sigma``
+for per-output statistics; the fit switches the noise correlation off, with a note).
 """
 
 from __future__ import annotations
@@ -146,6 +159,9 @@ class Stats:
     Attributes: C ``(M, M)``, E ``(M, D+1)``, F ``(D+1, D+1)``, Rphi ``(M, P)``, Rx ``(D+1, P)``,
     yy ``(P, P)`` (``sum_n y_n y_n^T``; files of version <= 2 held its diagonal ``(P,)`` only,
     enough for independent noise), n scalar (rows).
+    Per-output form (rows with missing outputs, module docstring): C ``(P, M, M)``, E
+    ``(P, M, D+1)``, F ``(P, D+1, D+1)``, n ``(P,)`` (observed entries per output); missing
+    entries count as 0 in Rphi, Rx and yy. :attr:`per_output` tells the forms apart.
     """
 
     C: jax.Array
@@ -155,6 +171,15 @@ class Stats:
     Rx: jax.Array
     yy: jax.Array
     n: jax.Array
+
+    @property
+    def per_output(self) -> bool:
+        """Whether these are per-output statistics (some rows miss some outputs)."""
+        return self.C.ndim == 3
+
+    def rows(self) -> float:
+        """Rows conditioned on (per-output form: the largest count of one output's entries)."""
+        return float(jnp.max(self.n))
 
 
 @jax.tree_util.register_dataclass
@@ -211,23 +236,57 @@ def features(params: GlobalParams, Lm: jax.Array, Xs: jax.Array) -> jax.Array:
 _features = features
 
 
-def stats_of(params: GlobalParams, Xs: jax.Array, Ys: jax.Array, weight: jax.Array | None = None) -> Stats:
+def stats_of(params: GlobalParams, Xs: jax.Array, Ys: jax.Array, weight: jax.Array | None = None,
+             mask: jax.Array | None = None) -> Stats:
     """Sufficient statistics of ``(Xs (N, D), Ys (N, P))``; rows with ``weight`` 0 count as absent.
 
-    ``weight`` ``(N,)`` of 0/1 lets padded batches keep one compiled shape.
+    ``weight`` ``(N,)`` of 0/1 lets padded batches keep one compiled shape. ``mask`` ``(N, P)`` of
+    0/1 (1: observed): the per-output form (module docstring); ``Ys`` entries where it is 0 are
+    ignored (they may be NaN). None: every entry observed, the complete form.
     """
     Lm = _chol_kmm(params)
     Phi = features(params, Lm, Xs)
     Xa = design(Xs)
     w = jnp.ones(Xs.shape[0], Xs.dtype) if weight is None else weight
+    if mask is not None:
+        wm = w[:, None] * mask                                     # (N, P)
+        Yz = jnp.where(mask > 0, Ys, 0.0)
+        return Stats(C=jnp.einsum("mn,np,kn->pmk", Phi, wm, Phi), E=jnp.einsum("mn,np,ni->pmi", Phi, wm, Xa),
+                     F=jnp.einsum("nj,np,ni->pji", Xa, wm, Xa), Rphi=Phi @ (wm * Yz), Rx=Xa.T @ (wm * Yz),
+                     yy=(wm * Yz).T @ Yz, n=jnp.sum(wm, 0))
     Phiw, Xaw = Phi * w[None, :], Xa * w[:, None]
     return Stats(C=Phiw @ Phi.T, E=Phiw @ Xa, F=Xaw.T @ Xa, Rphi=Phiw @ Ys, Rx=Xaw.T @ Ys,
                  yy=(w[:, None] * Ys).T @ Ys, n=jnp.sum(w))
 
 
 def add_stats(a: Stats, b: Stats) -> Stats:
-    """Statistics of the union of two data sets (they are sums over rows)."""
+    """Statistics of the union of two data sets (they are sums over rows); a complete and a
+    per-output form add to the per-output form (the complete one broadcasts: every output observed)."""
     return jax.tree_util.tree_map(jnp.add, a, b)
+
+
+def _assemble_per_output(params: GlobalParams, st: Stats) -> tuple[jax.Array, jax.Array]:
+    """:func:`_assemble` for per-output statistics (independent noise ``w_p = 1 / sigma_p^2``).
+
+    ``Lambda``'s blocks are sums over outputs: ``ww = sum_p w_p (a_p a_p^T) kron C_p``,
+    ``wo[(j,r,m),(q,i)] = sqrt(v) w_q A_j[q, r] E_q[(j,m), i]``, ``oo = v blockdiag_p(w_p F_p)``.
+    """
+    sv = params.prior_std
+    w = 1.0 / params.noise                               # (P,)
+    F = params.factors                                   # (J, P, R)
+    J, P, R = F.shape
+    M = st.C.shape[1] // J
+    D1 = st.F.shape[1]
+    C5 = st.C.reshape(P, J, M, J, M)
+    ww = jnp.einsum("p,jpr,kps,pjmkn->jrmksn", w, F, F, C5).reshape(J * R * M, J * R * M)
+    wo = sv * jnp.einsum("q,jqr,qjmi->jrmqi", w, F, st.E.reshape(P, J, M, D1)).reshape(J * R * M, P * D1)
+    oo = sv * sv * jnp.einsum("pq,pik->piqk", jnp.diag(w), st.F).reshape(P * D1, P * D1)
+    lam = jnp.block([[ww, wo], [wo.T, oo]])
+    lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
+    RN = (st.Rphi * w[None, :]).reshape(J, M, P)
+    bw = jnp.einsum("jmp,jpr->jrm", RN, F).reshape(-1)
+    bo = sv * (st.Rx * w[None, :]).T.reshape(-1)
+    return lam, jnp.concatenate([bw, bo])
 
 
 def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tuple[jax.Array, jax.Array]:
@@ -238,6 +297,8 @@ def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tu
     ``(P, K)`` features of row ``n``; in blocks ``(A^T N A) kron C``, ``sqrt(v) (A^T N) kron E``,
     ``v N kron F`` (a cross-correlated noise only replaces ``diag(1/sigma^2)`` by ``N``).
     """
+    if st.per_output:
+        return _assemble_per_output(params, st)
     sv = params.prior_std
     if N is None:
         N = params.noise_precision()[0]
@@ -298,8 +359,12 @@ def elbo(params: GlobalParams, st: Stats) -> jax.Array:
     (``Sigma`` the ``P x P`` noise covariance, :meth:`GlobalParams.noise_cov`; for independent
     noise the trace term is ``sum_p B_pp / sigma_p^2 (n - tr C)``),
     with the Gaussian term by the matrix determinant lemma and Woodbury identity in the
-    ``K``-dimensional feature space.
+    ``K``-dimensional feature space. Per-output statistics (missing outputs): the same bound over
+    the observed entries only, ``n P`` replaced by ``sum_p n_p`` and ``n log|Sigma|`` by
+    ``sum_p n_p log sigma_p^2`` (independent noise).
     """
+    if st.per_output:
+        return _elbo_per_output(params, st)
     N, logdet_noise = params.noise_precision()
     lam, b = _assemble(params, st, N)
     P = params.noise.shape[0]
@@ -313,6 +378,22 @@ def elbo(params: GlobalParams, st: Stats) -> jax.Array:
     J, M = Bj.shape[0], st.C.shape[0] // Bj.shape[0]
     trC = jnp.trace(st.C.reshape(J, M, J, M), axis1=1, axis2=3).diagonal()        # (J,): tr C_jj
     trace = -0.5 * jnp.sum(jnp.einsum("pq,jpq->j", N, Bj) * (st.n - trC))
+    return loglik + trace
+
+
+def _elbo_per_output(params: GlobalParams, st: Stats) -> jax.Array:
+    """:func:`elbo` for per-output statistics (independent noise, observed entries only)."""
+    w = 1.0 / params.noise
+    lam, b = _assemble_per_output(params, st)
+    logdet, bmb = logdet_quad(lam, b)
+    yy = st.yy if st.yy.ndim == 2 else jnp.diag(st.yy)
+    quad = jnp.sum(w * jnp.diag(yy)) - bmb
+    loglik = -0.5 * (jnp.sum(st.n) * _LOG2PI + jnp.sum(st.n * jnp.log(params.noise)) + logdet + quad)
+    Bd = jnp.sum(params.factors**2, 2)                                              # (J, P): B_j,pp
+    J = Bd.shape[0]
+    P, M = st.C.shape[0], st.C.shape[1] // J
+    trC = jnp.trace(st.C.reshape(P, J, M, J, M), axis1=2, axis2=4).diagonal(axis1=1, axis2=2)   # (P, J)
+    trace = -0.5 * jnp.sum(w[None, :] * Bd * (st.n[None, :] - trC.T))
     return loglik + trace
 
 

@@ -150,7 +150,7 @@ def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int
         U = np.asarray(_design_u(params, Xs[rows]))
         for g, pg in enumerate(grid):
             W = np.asarray(_mean_weights(pg, rest))
-            sse[g] += np.sum((Ys[rows] - U @ W) ** 2, 0)
+            sse[g] += np.nansum((Ys[rows] - U @ W) ** 2, 0)      # NaN: a missing output
     s = np.asarray(GLOBAL_GRID)[np.argmin(sse, 0)]
     return scale_latent(params, s), total, s, sse
 
@@ -182,8 +182,8 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
     for (a, b), store in zip(blocks, block_stores(Xs, resid, metric, k, blocks, search)):
         rows = _val_rows(a, b, per, rng)
         m, _ = local_predict(local, store, Xs[rows], batch)
-        with_l += np.sum((resid[rows] - m) ** 2, 0)
-        without += np.sum(resid[rows] ** 2, 0)
+        with_l += np.nansum((resid[rows] - m) ** 2, 0)            # NaN: a missing output
+        without += np.nansum(resid[rows] ** 2, 0)
     ratio = with_l / np.maximum(without, 1e-300)
     keep = ratio < LOCAL_MARGIN
     amp = np.where(keep, np.asarray(local.amp), np.asarray(local.amp) * LOCAL_OFF)
