@@ -12,6 +12,7 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # this directory's helpers (truth_fits)
 
 from benchmarks.jsbsim_harness import FlightConfig, make_flight  # noqa: E402
 

@@ -4,9 +4,9 @@ generated airframe files, the .tlog as the pipeline decodes it."""
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import (AIRCRAFT, FlightConfig, aircraft, fly, load_truth, truth_coefficients,
-                                       truth_regressors)
+from benchmarks.jsbsim_harness import AIRCRAFT, FlightConfig, aircraft, fly, load_truth
 from benchmarks.jsbsim_harness.airframes import airframe_doc
+from truth_fits import derivative_slopes
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
@@ -31,16 +31,7 @@ def test_truth_moments_are_about_the_cg_with_the_airframe_inertia(fast_flight):
 def test_truth_signs_follow_the_project_conventions(fast_flight):
     """Least squares on the exact truth: Cm_delta_e, Cl_delta_a, Cn_delta_r, Cm_alpha, Cl_p < 0 and
     Cn_beta > 0 in the project's conventions (docs/conventions.md)."""
-    rec = fast_flight.recording
-    X, Y = truth_regressors(rec), truth_coefficients(rec)
-
-    def slopes(y, cols):
-        A = np.c_[np.ones(len(y)), X[:, cols]]
-        return np.linalg.lstsq(A, y, rcond=None)[0][1:]
-
-    cm = slopes(Y[:, 4], [0, 3, 5])          # alpha, q_hat, delta_e
-    cl = slopes(Y[:, 3], [1, 2, 4, 6, 7])    # beta, p_hat, r_hat, delta_a, delta_r
-    cn = slopes(Y[:, 5], [1, 2, 4, 6, 7])
+    cm, cl, cn = derivative_slopes(fast_flight.recording)
     assert cm[0] < 0 and cm[2] < 0
     assert cl[1] < 0 and cl[3] < 0
     assert cn[0] > 0 and cn[4] < 0

@@ -14,9 +14,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import (FlightConfig, aircraft, canonical_name, fly, load_truth, make_flight,
-                                       truth_coefficients, truth_regressors)
+from benchmarks.jsbsim_harness import FlightConfig, aircraft, canonical_name, fly, load_truth, make_flight
 from benchmarks.jsbsim_harness.effects import EFFECTS, Effect, _write_model
+from truth_fits import derivative_slopes
 from benchmarks.jsbsim_harness.flight import _deflections, _set_ic, load_model
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
@@ -63,16 +63,7 @@ def test_sign_map_gives_the_project_conventions(cub):
     out at -0.96 to -1.0 against the table's -1.2004, also without turbulence: the model's
     Cm_alpha_dot term (-7.59) is no regressor here and moves with the elevator; with alpha_dot
     added it is -1.15. Only its sign is asserted.)"""
-    rec = cub.recording
-    X, Y = truth_regressors(rec), truth_coefficients(rec)
-
-    def slopes(y, cols):
-        A = np.c_[np.ones(len(y)), X[:, cols]]
-        return np.linalg.lstsq(A, y, rcond=None)[0][1:]
-
-    cm = slopes(Y[:, 4], [0, 3, 5])          # alpha, q_hat, delta_e
-    cl = slopes(Y[:, 3], [1, 2, 4, 6, 7])    # beta, p_hat, r_hat, delta_a, delta_r
-    cn = slopes(Y[:, 5], [1, 2, 4, 6, 7])
+    cm, cl, cn = derivative_slopes(cub.recording)
     assert cm[0] < 0 and cm[2] < 0 and cl[1] < 0 and cl[3] < 0 and cn[0] > 0 and cn[4] < 0, (cm, cl, cn)
     assert cl[3] == pytest.approx(-0.3498, rel=0.05) and cn[4] == pytest.approx(-0.0565, rel=0.05)
 
