@@ -320,6 +320,12 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
         fused = fuse_pitot_evidence(change, coef_change, coef_se)
         out["fused"] = fused
         out["coefficients_rereduced"] = {"estimate": float(b_c), "std_error": float(se_c), "by_coefficient": per_coef}
+        if fused is None:
+            # reached on the wind triangle alone (screen), the re-fit found no coefficient that carries
+            # the bias (no finite estimate): nothing to confirm it with, so no finding
+            out["why"] = "the exact re-fit gave no finite coefficient estimate of the bias to confirm the wind triangle"
+            out["checks"] = {"measurements_agree": False, "significant": False}
+            return out
         b = fused["estimate"]
         delta = b * D1
     else:

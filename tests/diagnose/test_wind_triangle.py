@@ -102,3 +102,23 @@ def test_bias_sign_and_size(bias):
     t, st, valid, fl = _flight(bias, turn=True, with_ap_wind=False, seed=3)
     c = wind_triangle(t, st, valid, fl)
     assert abs(c["bias_mps"] - bias) < 0.15
+
+
+def test_triangle_alone_screen_with_no_finite_refit_names_nothing(monkeypatch):
+    """The wind triangle alone passes the screen (i9-top90) but the exact re-fit finds no finite bias in
+    any coefficient (as on ALFA's Carbon-Z flights): no finding and a reason, not a crash."""
+    from types import SimpleNamespace
+
+    from gcs_sysid.diagnose import pitot, wind_triangle as wt
+
+    monkeypatch.setattr(wt, "wind_triangle", lambda *a, **k: {"bias_mps": 1.5})
+    monkeypatch.setattr(wt, "change_since_references",
+                        lambda tri, refs: {"change_mps": 1.5, "std_error": 0.3, "t_statistic": 5.0})
+    monkeypatch.setattr(pitot, "_reference_triangles", lambda *a: [])
+    monkeypatch.setattr(pitot, "_unit_delta_rereduced", lambda ctx, flight, b: np.zeros((10, 6)))
+    monkeypatch.setattr(pitot, "_fit_unit_delta", lambda ctx, R, D1: (np.nan, np.nan, {}))
+    ctx = SimpleNamespace(t=np.arange(10.0), states=None, valid=np.ones(10, bool))
+    out = pitot._fused_candidate(ctx, None, None, None, [], None, None,
+                                 [{"cause": "bias:airspeed", "estimate": 1.0, "std_error": 0.2}], None, 25.0)
+    assert out["screen"]["triangle_alone"] and out["fused"] is None and not out["accepted"]
+    assert "no finite coefficient estimate" in out["why"]
