@@ -4,9 +4,9 @@ generated airframe files, the .tlog as the pipeline decodes it."""
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import AIRCRAFT, FlightConfig, aircraft, fly, load_truth
+from benchmarks.jsbsim_harness import AIRCRAFT, FlightConfig, aircraft, fly
 from benchmarks.jsbsim_harness.airframes import airframe_doc
-from truth_fits import derivative_slopes
+from truth_fits import derivative_slopes, servo_against_truth
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
@@ -56,13 +56,8 @@ def test_tlog_carries_the_ardupilot_streams_and_the_surfaces(fast_flight):
                        ("airspeed", 25), ("wind", 2)):
         s = flight.streams[name]
         assert np.median(np.diff(s.t)) == pytest.approx(1.0 / rate, rel=0.05), name
-    af = load_airframe(fast_flight.airframe)
-    servo = flight.streams["servo"]
-    ctl = af.controls_from_pwm({c: servo.fields[f"pwm{c}"] for c in af.channels})
-    truth = load_truth(fast_flight.truth)
-    for k, i in (("delta_e", 5), ("delta_a", 6), ("delta_r", 7)):
-        ref = np.interp(servo.t, truth.t, truth.X[:, i])
-        assert np.max(np.abs(ctl[k] - ref)) < np.radians(0.1), k
+    for k, (from_pwm, ref) in servo_against_truth(flight, fast_flight).items():
+        assert np.max(np.abs(from_pwm - ref)) < np.radians(0.1), k
 
 
 def test_flights_are_reproducible_per_seed(tmp_path, monkeypatch):

@@ -14,9 +14,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import FlightConfig, aircraft, canonical_name, fly, load_truth, make_flight
+from benchmarks.jsbsim_harness import FlightConfig, aircraft, canonical_name, fly, make_flight
 from benchmarks.jsbsim_harness.effects import EFFECTS, Effect, _write_model
-from truth_fits import derivative_slopes
+from truth_fits import derivative_slopes, servo_against_truth
 from benchmarks.jsbsim_harness.flight import _deflections, _set_ic, load_model
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
@@ -75,13 +75,8 @@ def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(cub):
     flight = read_log(cub.tlog)
     for name in ("imu", "attitude", "servo", "aoa_ssa", "gps", "airspeed", "wind"):
         assert flight.streams[name].t.size > 0, name
-    af = load_airframe(cub.airframe)
-    servo = flight.streams["servo"]
-    ctl = af.controls_from_pwm({c: servo.fields[f"pwm{c}"] for c in af.channels})
-    truth = load_truth(cub.truth)
-    for k, i in (("delta_e", 5), ("delta_a", 6), ("delta_r", 7)):
-        ref = np.interp(servo.t, truth.t, truth.X[:, i])
-        assert np.max(np.abs(ctl[k] - ref)) < np.radians(0.1), k
+    for k, (from_pwm, ref) in servo_against_truth(flight, cub).items():
+        assert np.max(np.abs(from_pwm - ref)) < np.radians(0.1), k
         assert np.std(ref) > np.radians(0.5), k                  # every surface moves
 
 
