@@ -14,7 +14,7 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
   gp     the replay's model predictions at the measured regressors
   true   the saved model (``gcs-sysid predict``'s path) at the TRUE regressors
   tair   the same with the rates the aircraft's JSBSim aerodynamics reads in ``p_hat q_hat r_hat``
-         (c172x, sgs: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
+         (c172x, sgs, c182: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
          so ``tair`` = ``true``; ``true`` has the inertial rates a gyro measures)
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
   cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
@@ -29,10 +29,11 @@ Usage::
     python benchmarks/eval_jsbsim.py --aircraft c172x sgs pa28 --seeds 1 2 3 --turbulence light moderate
     python benchmarks/eval_jsbsim.py --aoa vane             # AOA_SSA = exact vane angles
     python benchmarks/eval_jsbsim.py --summarize results.jsonl   # markdown table of --json results
-    python benchmarks/eval_jsbsim.py --aircraft j3cub --work DIR --fly-only   # fly (or reuse) only
+    python benchmarks/eval_jsbsim.py --aircraft c182 --work DIR --fly-only   # fly (or reuse) only
 
-``pa28`` is the held-out aircraft: it was not used to set up the harness, the estimator or any
-threshold. ``j3cub`` (the J-3 Cub, ``J3Cub`` also accepted) is the untouched one: never in the
+``pa28`` (held out since 2026-11-21) and ``j3cub`` (the J-3 Cub, ``J3Cub`` also accepted; the
+sixth session's untouched aircraft) have been evaluated and their results read: they count as used.
+``c182`` (the Cessna 182, ``C182`` also accepted) is the held-out, untouched one: never in the
 default list, evaluated once after the thresholds are frozen. A flight already in ``--work``, flown
 by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
 ``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
@@ -52,9 +53,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.jsbsim_harness import (HELD_OUT_AIRCRAFT, UNTOUCHED_AIRCRAFT, FlightConfig,  # noqa: E402
-                                       coefficient_errors, load_truth, make_flight)
-from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
+from benchmarks.jsbsim_harness import (UNTOUCHED_AIRCRAFT, FlightConfig, coefficient_errors,  # noqa: E402
+                                       load_truth, make_flight)
+from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
 
@@ -189,7 +190,7 @@ def summarize(paths: list[str]) -> str:
                    "true_air": f"{med('cov_true_air'):.0f}" if all("cov_true_air" in r for r in rs) else ""}.get(k, "")
             air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
                    f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
-            name = ac + (" (untouched)" if ac in UNTOUCHED_AIRCRAFT else " (held out)" if ac in HELD_OUT_AIRCRAFT else "")
+            name = summary_label(ac)
             out.append(f"| {name} | {turb} | {aoa} | {len(rs)} | {label} | "
                        + " | ".join(f"{med(k, c):.1f}" for c in COEFFICIENTS) + f" | {cov} | {air} |")
     for turb in sorted({r["turbulence"] for r in rows}):
@@ -208,7 +209,7 @@ def summarize(paths: list[str]) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
-                    help="harness names (c172x sgs pa28 j3cub) or JSBSim model names (J3Cub); default %(default)s")
+                    help="harness names (c172x sgs pa28 j3cub c182) or JSBSim model names (J3Cub); default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))

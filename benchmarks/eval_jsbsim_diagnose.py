@@ -19,10 +19,11 @@ Usage::
 
     python -m benchmarks.eval_jsbsim_diagnose --aircraft c172x sgs --seeds 1 2 3 --out benchmarks/out/diag
     python -m benchmarks.eval_jsbsim_diagnose --aircraft pa28 --seeds 1 --out benchmarks/out/diag-pa28
-    python -m benchmarks.eval_jsbsim_diagnose --aircraft j3cub --out DIR --fly-only   # flights only
+    python -m benchmarks.eval_jsbsim_diagnose --aircraft c182 --out DIR --fly-only   # flights only
 
-``--aircraft`` takes the harness names (c172x sgs pa28 j3cub) or JSBSim's model names (J3Cub);
-``j3cub`` is the untouched aircraft, never in the defaults. The flights of ``--out`` are reused
+``--aircraft`` takes the harness names (c172x sgs pa28 j3cub c182) or JSBSim's model names (J3Cub);
+``c182`` is the untouched aircraft, never in the defaults (``j3cub``, untouched until the sixth
+session's final evaluation, now counts as used). The flights of ``--out`` are reused
 when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
 duration and plan; ``--fly-only`` flies (or finds) the reference and every case and stops,
 without fitting or diagnosing anything.
@@ -45,6 +46,7 @@ if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
 from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
+from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
 __all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
@@ -228,7 +230,7 @@ def summarize(paths: list[str]) -> str:
         if key == "clean":
             ok = sum(r["score"]["ok"] for r in rs)
             named = sorted({c for r in rs for c in r["score"].get("named", [])})
-            out.append(f"| {ac} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | {', '.join(named) or '-'} |")
+            out.append(f"| {summary_label(ac)} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | {', '.join(named) or '-'} |")
             continue
         rows = [e for r in rs for e in r["score"].get("effects", [])]
         n = len(rows)
@@ -239,7 +241,7 @@ def summarize(paths: list[str]) -> str:
                 f"[{', '.join(r['score'].get('named', [])[:2]) or 'nothing'}] ({e['value']:.3g})"
                 for e in r["score"].get("effects", []))
             for r in rs)
-        out.append(f"| {ac} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
+        out.append(f"| {summary_label(ac)} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
                    f"{sum(bool(e.get('est')) for e in rows)}/{n} | {sum(bool(e.get('gain')) for e in rows)}/{n} | "
                    f"{sum(bool(r['score']['ok']) for r in rs)}/{len(rs)} | "
                    f"{sum(bool(e.get('cover')) for e in found)}/{len(found)} | {desc} |")

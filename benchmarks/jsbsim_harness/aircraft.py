@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["AircraftSpec", "AIRCRAFT", "TUNING_AIRCRAFT", "HELD_OUT_AIRCRAFT", "UNTOUCHED_AIRCRAFT", "aircraft",
-           "canonical_name", "aircraft_argument"]
+           "canonical_name", "aircraft_argument", "summary_label"]
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -68,10 +68,12 @@ class AircraftSpec:
 _DEG = 57.29577951308232
 
 #: Aircraft the harness knows. ``c172x`` and ``sgs`` were used to set up the harness and the test
-#: thresholds; ``pa28`` is kept out of all tuning (``HELD_OUT_AIRCRAFT``), but has been evaluated
-#: after every session since 2026-11-21; ``j3cub`` (added 2026-11-22) is the untouched case
-#: (``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth), the method was
-#: never run on it before its final evaluation.
+#: thresholds; ``pa28`` (held out since 2026-11-21) and ``j3cub`` (untouched until the sixth
+#: session's final evaluation, 2026-11-22) have since been evaluated and their results read, so
+#: they count as used (``TUNING_AIRCRAFT``). ``c182`` (added in the seventh session, 2026-11-22)
+#: is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its
+#: harness was set up (from JSBSim's truth and its XML), the method was never run on it before
+#: its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -112,10 +114,32 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(1.0 / 0.14, 1.0 / 0.31, 1.0 / 0.52),
         amplitude_deg=(4.0, 4.5, 5.0), pulse_s=(0.7, 0.8, 1.0), gains=(1.0, 0.15, 0.01, 0.4, 0.1, 0.4),
         notes="Piper J-3 Cub (JSBSim J3Cub), engine shut down, gliding; untouched by any tuning of the method"),
+    # c182: JSBSim's stock Cessna 182 (c182.xml, jberndt 2012). Surfaces from its own
+    # <flight_control> (aerosurface_scale, zero-centred): elevator -28..+23 deg, left aileron
+    # -20..+15 deg (the only aileron property the aerodynamics read), rudder +-16 deg; the command
+    # scale is the mean of each surface's two ends (as the pa28's aileron). Signs read from its
+    # aerodynamics: CmDe -0.622 * elevator-pos (positive = trailing edge down), ClDa +0.15 *
+    # left-aileron-pos (positive = left trailing edge down, roll right), CnDr -0.0645 * rudder-pos
+    # (positive = trailing edge left, nose left); checked on the truth by tests/jsbsim/test_jsbsim_c182.py.
+    # 80 kt CAS as the c172x and pa28 (the same initial condition: 49 m/s TAS at 6000 ft); the
+    # sweep's slowest level, 36.5 m/s TAS, is 1.3 times the model's power-off stall (about 49 kt EAS:
+    # 2100 lb once the harness empties the pilot's off-centre point mass, CL_max 1.47 from its
+    # CLo + CLalpha tables). Its pitch stiffness and elevator power are a third and a half of the
+    # c172x's (Cm_alpha -0.61, CmDe -0.62 per rad), so the elevator amplitude is 5 deg (3 deg gave
+    # 1.5 deg/s of pitch-rate standard deviation); its rudder gives about 1 deg of sideslip per deg
+    # (Cn_beta 0.059, CnDr -0.065), so the rudder amplitude is 4 deg (6 deg gave 7.5 deg of
+    # sideslip and a knock-it-off with Cl:alpha*beta = 3). Default gains. Set from the harness's
+    # truth only (alpha, beta, rates, excitation per axis; docs/jsbsim.md), never from a method result.
+    "c182": AircraftSpec(
+        name="c182", model="c182", airspeed_kts=80.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(_DEG / 25.5, _DEG / 17.5, _DEG / 16.0),
+        amplitude_deg=(5.0, 5.0, 4.0), pulse_s=(0.7, 0.8, 1.0),
+        notes="Cessna 182 (JSBSim c182), engine shut down, gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs")
-HELD_OUT_AIRCRAFT = ("pa28", "j3cub")
-UNTOUCHED_AIRCRAFT = ("j3cub",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub")
+HELD_OUT_AIRCRAFT = ("c182",)
+UNTOUCHED_AIRCRAFT = ("c182",)
 
 
 def aircraft(name: str) -> AircraftSpec:
@@ -151,3 +175,10 @@ def aircraft_argument(name: str) -> str:
         return canonical_name(name)
     except KeyError as e:
         raise argparse.ArgumentTypeError(e.args[0]) from None
+
+
+def summary_label(name: str) -> str:
+    """``name`` as the evaluation summaries print it: ``"c182 (untouched)"`` for the
+    :data:`UNTOUCHED_AIRCRAFT`, ``"<name> (held out)"`` for the other :data:`HELD_OUT_AIRCRAFT`, the
+    name alone for the aircraft used in tuning."""
+    return name + (" (untouched)" if name in UNTOUCHED_AIRCRAFT else " (held out)" if name in HELD_OUT_AIRCRAFT else "")

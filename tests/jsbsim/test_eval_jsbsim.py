@@ -29,7 +29,7 @@ def test_summary_is_the_median_over_seeds(tmp_path):
     # median over seeds 1, 2, 6 of base + seed + i: base + 2 + i
     assert cells[6:12] == [f"{10.0 + 2 + i:.1f}" for i in range(6)]
     assert "0.20 / 0.20" in lines[0]
-    assert any(ln.startswith("| pa28 (held out)") for ln in text.splitlines())
+    assert any(ln.startswith("| pa28 | light") for ln in text.splitlines())     # used since 2026-11-22
     assert "forces" in text and "19.8" in text
     assert "aero rates" not in text                  # rows without the score: no row for it
 
