@@ -1,14 +1,13 @@
-"""The J3Cub in the JSBSim harness: the untouched aircraft of issues 8 and 9 (docs/jsbsim.md).
+"""The J3Cub in the JSBSim harness: the sixth session's untouched aircraft of issues 8 and 9
+(docs/jsbsim.md); evaluated since, it now counts as used (the c182 is the untouched one).
 
 Only the harness is checked here, on JSBSim's exact truth: the rigid-body consistency of the truth
 with the checked-in airframe file, the sign map, the .tlog as the pipeline decodes it, the XML
 edits of every hidden effect, and (slow) that the evaluation's flights stay in the envelope with
 enough excitation on every axis. No pipeline fit, GP or diagnosis is run on the J3Cub in the
-test suite: its first evaluation is the final one, after the merge.
+test suite. The shared checks are in ``truth_fits.py`` (also used by ``test_jsbsim_c182.py``).
 """
 
-import tempfile
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -16,8 +15,8 @@ import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft, canonical_name, fly, make_flight
 from benchmarks.jsbsim_harness.effects import EFFECTS, Effect, _write_model
-from truth_fits import derivative_slopes, servo_against_truth
-from benchmarks.jsbsim_harness.flight import _deflections, _set_ic, load_model
+from truth_fits import (delay_trace, derivative_slopes, effect_state, injected_moment, rigid_body_residual,
+                        servo_against_truth)
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
@@ -43,11 +42,7 @@ def test_truth_is_rigid_body_consistent_with_the_airframe_file(cub):
     (the stopped propeller makes no thrust)."""
     tr, af = cub.recording.truth, load_airframe(cub.airframe)
     assert af.inertia[0, 2] != 0.0
-    w = np.stack([tr["p"], tr["q"], tr["r"]], 1)
-    wd = np.stack([tr["p_dot"], tr["q_dot"], tr["r_dot"]], 1)
-    M = np.stack([tr["L_aero"], tr["M_aero"], tr["N_aero"]], 1)
-    rhs = wd @ af.inertia.T + np.cross(w, w @ af.inertia.T)
-    rel = np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
+    rel = rigid_body_residual(tr, af.inertia)
     assert (rel < 2e-3).all(), rel
     for a in "xyz":
         np.testing.assert_allclose(tr[f"F{a}_aero"], tr[f"F{a}_total"], atol=1e-9)
@@ -80,19 +75,6 @@ def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(cub):
         assert np.std(ref) > np.radians(0.5), k                  # every surface moves
 
 
-def _state(spec, effects, cmds=(0.3, -0.4, 0.2), n=40):
-    """JSBSim at the harness's initial condition with 4 deg of sideslip, ``n`` frames of fixed commands."""
-    with tempfile.TemporaryDirectory() as tmp:
-        fdm = load_model(spec, 1 / 200, 0, _write_model(spec, effects, Path(tmp)) if effects else None)
-        _set_ic(fdm, spec, FlightConfig(spec.name, turbulence="none"))
-        fdm["ic/beta-deg"] = 4.0
-        fdm.run_ic()
-        for _ in range(n):
-            fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
-            fdm.run()
-        return fdm
-
-
 def test_every_hidden_effect_edits_the_j3cub_as_specified():
     """The J3Cub's XML (Aeromatic layout: qbar and S as separate factors, one aileron property in the
     aerodynamics, its surfaces in a system file and an empty <flight_control>) takes every effect:
@@ -101,29 +83,13 @@ def test_every_hidden_effect_edits_the_j3cub_as_specified():
     aerodynamics' elevator 24 frames (0.12 s at 200 Hz) behind the surface."""
     assert set(EFFECTS) >= {"Cm:alpha^2", "Cl:alpha*beta", "Cn:delta_a", "CY:scale", "delay:delta_e"}
     spec = aircraft("j3cub")
-    for name, k, prop in (("Cm:alpha^2", -8.0, "injected_Cm_alpha2"), ("Cl:alpha*beta", 3.0, "injected_Cl_alpha_beta"),
-                          ("Cn:delta_a", -0.06, "injected_Cn_delta_a")):
-        fdm = _state(spec, [Effect(name, k)])
-        a, b = fdm["aero/alpha-rad"], fdm["aero/beta-rad"]
-        da = _deflections(fdm, spec)[1]
-        qS = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"]
-        want = {"Cm:alpha^2": k * a * a * fdm["metrics/cbarw-ft"], "Cl:alpha*beta": k * a * b * fdm["metrics/bw-ft"],
-                "Cn:delta_a": k * da * fdm["metrics/bw-ft"]}[name] * qS
+    for name, k in (("Cm:alpha^2", -8.0), ("Cl:alpha*beta", 3.0), ("Cn:delta_a", -0.06)):
+        got, want, _ = injected_moment(spec, name, k)
         assert abs(want) > 1e-3
-        assert fdm[f"aero/coefficient/{prop}"] == pytest.approx(want, rel=1e-9), name
-    stock, scaled = _state(spec, []), _state(spec, [Effect("CY:scale", 1.6)])
+        assert got == pytest.approx(want, rel=1e-9), name
+    stock, scaled = effect_state(spec, []), effect_state(spec, [Effect("CY:scale", 1.6)])
     assert scaled["forces/fwy-aero-lbs"] / stock["forces/fwy-aero-lbs"] == pytest.approx(1.6, rel=0.02)
-    with tempfile.TemporaryDirectory() as tmp:
-        fdm = load_model(spec, 1 / 200, 0, _write_model(spec, [Effect("delay:delta_e", 0.12)], Path(tmp)))
-        _set_ic(fdm, spec, FlightConfig("j3cub", turbulence="none"))
-        fdm.run()
-        fdm["fcs/elevator-cmd-norm"] = 0.5
-        pos, delayed = [], []
-        for _ in range(40):
-            fdm.run()
-            pos.append(fdm["fcs/elevator-pos-rad"])
-            delayed.append(fdm["fcs/elevator-pos-delayed-rad"])
-    pos, delayed = np.array(pos), np.array(delayed)
+    pos, delayed = delay_trace(spec, 0.12)
     assert pos[0] == pytest.approx(0.07) and np.all(delayed[:23] == 0.0) and delayed[23:] == pytest.approx(0.07)
 
 
@@ -201,23 +167,3 @@ def test_flight_envelope_reads_the_truth_file(cub):
     assert e["alpha_p"][0] >= e["alpha"][0] and e["V"][0] > 20.0
     assert "aborts 0" in format_envelope("j3cub", e)
 
-
-def test_summaries_mark_the_untouched_and_the_held_out_aircraft(tmp_path):
-    """The markdown summaries label j3cub "(untouched)" and pa28 "(held out)" (synthetic rows: no
-    J3Cub result exists before the final evaluation)."""
-    import json
-
-    from benchmarks import eval_jsbsim
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in ("c172x", "pa28", "j3cub")))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| j3cub (untouched) |") for ln in lines)
-    assert any(ln.startswith("| pa28 (held out) |") for ln in lines)
-    assert any(ln.startswith("| c172x | light") for ln in lines)

@@ -42,3 +42,107 @@ def servo_against_truth(flight, files) -> dict[str, tuple[np.ndarray, np.ndarray
     truth = load_truth(files.truth)
     return {k: (ctl[k], np.interp(servo.t, truth.t, truth.X[:, i]))
             for k, i in (("delta_e", 5), ("delta_a", 6), ("delta_r", 7))}
+
+
+def rigid_body_residual(truth: dict, inertia: np.ndarray) -> np.ndarray:
+    """How far JSBSim's aerodynamic moments are from the rigid body with the airframe file's inertia.
+
+    Args:
+        truth: a recording's truth arrays (``p q r`` rad/s, ``p_dot q_dot r_dot`` rad/s^2,
+            ``L_aero M_aero N_aero`` N m; each (T,)).
+        inertia: (3, 3) inertia tensor of the airframe file, kg m^2 (project convention).
+
+    Returns:
+        (3,) RMS of ``J w_dot + w x J w - M`` over the RMS of ``M``, per body axis (Euler's
+        equations about the CG, e.g. Stevens, Lewis and Johnson, *Aircraft Control and
+        Simulation*, 3rd ed., 2016, eq. 1.7-2).
+    """
+    w = np.stack([truth["p"], truth["q"], truth["r"]], 1)
+    wd = np.stack([truth["p_dot"], truth["q_dot"], truth["r_dot"]], 1)
+    M = np.stack([truth["L_aero"], truth["M_aero"], truth["N_aero"]], 1)
+    rhs = wd @ inertia.T + np.cross(w, w @ inertia.T)
+    return np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
+
+
+def effect_state(spec, effects, cmds=(0.3, -0.4, 0.2), n=40, alpha_deg=None):
+    """JSBSim (``FGFDMExec``) at the harness's initial condition with 4 deg of sideslip (and
+    ``alpha_deg`` of alpha when given) and the fixed normalised commands ``cmds`` (elevator,
+    aileron, rudder), after ``n`` frames at 200 Hz, with ``effects`` edited into a copy of the
+    model's XML (none: the stock model). ``n = 0``: the initial condition itself, where
+    ``run_ic`` has evaluated the models but nothing has been integrated, so that two models'
+    forces and moments there are at the same state (JSBSim integrates first in each later frame,
+    with the accelerations of the frame before)."""
+    import tempfile
+    from pathlib import Path
+
+    from benchmarks.jsbsim_harness import FlightConfig
+    from benchmarks.jsbsim_harness.effects import _write_model
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    with tempfile.TemporaryDirectory() as tmp:
+        fdm = load_model(spec, 1 / 200, 0, _write_model(spec, effects, Path(tmp)) if effects else None)
+        _set_ic(fdm, spec, FlightConfig(spec.name, turbulence="none"))
+        fdm["ic/beta-deg"] = 4.0
+        if alpha_deg is not None:
+            fdm["ic/alpha-deg"] = alpha_deg
+        fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
+        fdm.run_ic()
+        for _ in range(n):
+            fdm.run()
+        return fdm
+
+
+#: The injected moment effects: effect name -> (JSBSim function, moment property, reference length).
+MOMENT_EFFECTS = {"Cm:alpha^2": ("injected_Cm_alpha2", "moments/m-aero-lbsft", "metrics/cbarw-ft"),
+                  "Cl:alpha*beta": ("injected_Cl_alpha_beta", "moments/l-aero-lbsft", "metrics/bw-ft"),
+                  "Cn:delta_a": ("injected_Cn_delta_a", "moments/n-aero-lbsft", "metrics/bw-ft")}
+
+
+def injected_moment(spec, name, k, n=40, alpha_deg=None) -> tuple[float, float, float]:
+    """One moment effect of ``effects.py`` as JSBSim computes it (:func:`effect_state`).
+
+    Returns:
+        ``(function, specified, change)``, lbf ft: the injected function's value
+        (``aero/coefficient/injected_*``); ``k`` times its regressor (alpha^2, alpha beta, or the
+        harness's delta_a) times ``qbar S`` and c or b, from JSBSim's own state; and the change of
+        JSBSim's total aerodynamic moment on that axis against the stock model after the same
+        frames (equal to the function only while both states are the same: ``n = 0``).
+    """
+    from benchmarks.jsbsim_harness.effects import Effect
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    func, moment, ref = MOMENT_EFFECTS[name]
+    fdm, stock = effect_state(spec, [Effect(name, k)], n=n, alpha_deg=alpha_deg), \
+        effect_state(spec, [], n=n, alpha_deg=alpha_deg)
+    a, b, da = fdm["aero/alpha-rad"], fdm["aero/beta-rad"], _deflections(fdm, spec)[1]
+    x = {"Cm:alpha^2": a * a, "Cl:alpha*beta": a * b, "Cn:delta_a": da}[name]
+    want = k * x * fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm[ref]
+    return fdm[f"aero/coefficient/{func}"], want, fdm[moment] - stock[moment]
+
+
+def delay_trace(spec, delay_s: float, cmd: float = 0.5, n: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """The elevator and the delayed elevator the aerodynamics read with ``delay:delta_e`` = ``delay_s``,
+    frame by frame (200 Hz) after a step of the normalised elevator command to ``cmd``.
+
+    Returns:
+        ``(position, delayed)``, each (n,) rad (``fcs/elevator-pos-rad``,
+        ``fcs/elevator-pos-delayed-rad``).
+    """
+    import tempfile
+    from pathlib import Path
+
+    from benchmarks.jsbsim_harness import FlightConfig
+    from benchmarks.jsbsim_harness.effects import Effect, _write_model
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    with tempfile.TemporaryDirectory() as tmp:
+        fdm = load_model(spec, 1 / 200, 0, _write_model(spec, [Effect("delay:delta_e", delay_s)], Path(tmp)))
+        _set_ic(fdm, spec, FlightConfig(spec.name, turbulence="none"))
+        fdm.run()
+        fdm["fcs/elevator-cmd-norm"] = cmd
+        pos, delayed = [], []
+        for _ in range(n):
+            fdm.run()
+            pos.append(fdm["fcs/elevator-pos-rad"])
+            delayed.append(fdm["fcs/elevator-pos-delayed-rad"])
+    return np.array(pos), np.array(delayed)
