@@ -20,8 +20,8 @@ from benchmarks.jsbsim_harness.effects import EFFECTS, RHO0, Effect, _bias_airsp
     stock_model_dir
 from benchmarks.jsbsim_harness.envelope import flight_envelope
 from benchmarks.jsbsim_harness.sensors import make_sensors
-from truth_fits import (delay_trace, derivative_slopes, effect_state, injected_moment, rigid_body_residual,
-                        servo_against_truth)
+from truth_fits import (EVALUATION_FLIGHTS, decoded_servo_errors, delay_trace, derivative_slopes, effect_state, injected_moment,
+                        non_aero_residual, rigid_body_residual)
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
@@ -53,10 +53,7 @@ def test_truth_is_rigid_body_consistent_with_the_airframe_file(c182):
     tr, af, const = c182.recording.truth, load_airframe(c182.airframe), c182.recording.constants
     rel = rigid_body_residual(tr, af.inertia)
     assert (rel < 2e-3).all(), rel
-    for a in "xyz":
-        np.testing.assert_allclose(tr[f"F{a}_aero"], tr[f"F{a}_total"], atol=1e-9)
-    for k in ("L", "M", "N"):
-        np.testing.assert_allclose(tr[f"{k}_aero"], tr[f"{k}_total"], atol=1e-9)
+    assert non_aero_residual(tr) < 1e-9
     assert af.mass == pytest.approx(const["mass"], rel=1e-5) and const["mass"] == pytest.approx(2100 * LB, rel=1e-6)
     assert const["Ixy"] == 0.0 and const["Iyz"] == 0.0 and af.inertia[0, 2] != 0.0
 
@@ -76,12 +73,10 @@ def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(c182):
     """The pipeline's decoder reads the c182's .tlog; its SERVO_OUTPUT_RAW, through the checked-in
     airframe file, gives JSBSim's deflections within PWM quantisation (the elevator's 25.5-deg end
     makes 0.064 deg per microsecond)."""
-    flight = read_log(c182.tlog)
-    for name in ("imu", "attitude", "servo", "aoa_ssa", "gps", "airspeed", "wind"):
-        assert flight.streams[name].t.size > 0, name
-    for k, (from_pwm, ref) in servo_against_truth(flight, c182).items():
-        assert np.max(np.abs(from_pwm - ref)) < np.radians(0.1), k
-        assert np.std(ref) > np.radians(0.5), k                  # every surface moves
+    empty, errors = decoded_servo_errors(c182)
+    assert empty == []
+    for k, (err, std) in errors.items():
+        assert err < np.radians(0.1) and std > np.radians(0.5), k      # maps back; every surface moves
 
 
 def test_every_hidden_effect_shows_in_jsbsims_own_forces_and_moments():
@@ -155,13 +150,8 @@ def test_summaries_mark_the_c182_untouched_and_the_others_used(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed,turbulence,plan,effects", [
-    (100, "light", "sweep", []),                                 # the diagnosis's reference flight
-    (11, "light", "sweep", []),                                  # a clean diagnosis flight
-    (1, "light", "sweep", [("Cl:alpha*beta", 3.0)]),             # the effect most likely to depart
-    (1, "light", "sweep", [("delay:delta_e", 0.12)]),
+@pytest.mark.parametrize("seed,turbulence,plan,effects", EVALUATION_FLIGHTS + [
     (1, "light", "sweep", [("Cm:alpha^2", -8.0), ("Cn:delta_a", -0.06)]),   # the evaluation's pair
-    (2, "moderate", "standard", []),                             # eval_jsbsim, moderate turbulence
 ])
 def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_path, seed, turbulence, plan, effects):
     """The c182 flies the evaluation's plans as a test pilot would (``flight_envelope`` of the truth
@@ -190,17 +180,15 @@ def test_eval_scripts_fly_the_c182_without_scoring_it(tmp_path, capsys, monkeypa
     second run and score nothing."""
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
 
-    args = ["--aircraft", "C182", "--seeds", "1", "--turbulence", "light", "--duration", "2",
-            "--work", str(tmp_path / "f"), "--fly-only"]
-    assert eval_jsbsim.main(args) == 0 and eval_jsbsim.main(args) == 0
-    cap = capsys.readouterr()
-    assert [ln.split()[1] for ln in cap.out.splitlines()] == ["flown", "reused"]
-    assert "c182-light-s1-ahrs.tlog" in cap.out and "c182 is the untouched aircraft" in cap.err
     monkeypatch.setattr(eval_jsbsim_diagnose, "DURATION_S", 2.0)
-    diag = ["--aircraft", "C182", "--seeds", "1", "--clean-seeds", "--pairs", "--effects", "delay:delta_e",
-            "--out", str(tmp_path / "d"), "--fly-only"]
-    assert eval_jsbsim_diagnose.main(diag) == 0 and eval_jsbsim_diagnose.main(diag) == 0
-    cap = capsys.readouterr()
-    assert [ln.split()[-3] for ln in cap.out.splitlines()] == ["flown"] * 3 + ["reused"] * 3, cap.out
-    assert "c182 is the untouched aircraft" in cap.err
+    runs = ((eval_jsbsim.main, ["--turbulence", "light", "--duration", "2", "--work", str(tmp_path / "f")], 1, 1),
+            (eval_jsbsim_diagnose.main, ["--clean-seeds", "--pairs", "--effects", "delay:delta_e",
+                                         "--out", str(tmp_path / "d")], -3, 3))      # reference + 2 sizes
+    for main, extra, column, n in runs:
+        argv = ["--aircraft", "C182", "--seeds", "1", *extra, "--fly-only"]
+        assert main(argv) == 0 and main(argv) == 0
+        cap = capsys.readouterr()
+        assert [ln.split()[column] for ln in cap.out.splitlines()] == ["flown"] * n + ["reused"] * n, cap.out
+        assert "c182 is the untouched aircraft" in cap.err
+    assert read_log(tmp_path / "f" / "c182-light-s1-ahrs.tlog").streams["servo"].t.size > 50
     assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()

@@ -6,7 +6,7 @@ import pytest
 
 from benchmarks.jsbsim_harness import AIRCRAFT, FlightConfig, aircraft, fly
 from benchmarks.jsbsim_harness.airframes import airframe_doc
-from truth_fits import derivative_slopes, servo_against_truth
+from truth_fits import derivative_slopes, rigid_body_residual, servo_against_truth
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
@@ -16,12 +16,7 @@ def test_truth_moments_are_about_the_cg_with_the_airframe_inertia(fast_flight):
     the point masses and the moment reference point are right), and the specific force times the
     mass equals the aero force (a glide: no other non-gravity force)."""
     tr, af = fast_flight.recording.truth, load_airframe(fast_flight.airframe)
-    J = af.inertia
-    w = np.stack([tr["p"], tr["q"], tr["r"]], 1)
-    wd = np.stack([tr["p_dot"], tr["q_dot"], tr["r_dot"]], 1)
-    M = np.stack([tr["L_aero"], tr["M_aero"], tr["N_aero"]], 1)
-    rhs = wd @ J.T + np.cross(w, w @ J.T)
-    rel = np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
+    rel = rigid_body_residual(tr, af.inertia)
     assert (rel < 2e-3).all(), rel          # airframe values are rounded to 6 digits
     for a in "xyz":
         np.testing.assert_allclose(tr[f"F{a}_aero"], tr[f"F{a}_total"], atol=1e-9)

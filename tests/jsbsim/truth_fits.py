@@ -1,4 +1,5 @@
-"""Least-squares derivatives of a JSBSim flight's exact truth, shared by the harness tests."""
+"""Checks of a JSBSim flight's exact truth shared by the harness tests: least-squares derivatives,
+the rigid body, the decoded log, the hidden effects in JSBSim's own properties, the evaluation's flights."""
 
 import numpy as np
 
@@ -146,3 +147,45 @@ def delay_trace(spec, delay_s: float, cmd: float = 0.5, n: int = 40) -> tuple[np
             pos.append(fdm["fcs/elevator-pos-rad"])
             delayed.append(fdm["fcs/elevator-pos-delayed-rad"])
     return np.array(pos), np.array(delayed)
+
+
+#: The streams every harness .tlog carries (``docs/jsbsim.md``, "The log").
+LOG_STREAMS = ("imu", "attitude", "servo", "aoa_ssa", "gps", "airspeed", "wind")
+
+
+def decoded_servo_errors(files) -> tuple[list[str], dict[str, tuple[float, float]]]:
+    """Decode a harness flight's .tlog with the pipeline's reader and map its servos back.
+
+    Args:
+        files: the harness ``FlightFiles`` (tlog, airframe, truth).
+
+    Returns:
+        ``(empty, errors)``: the :data:`LOG_STREAMS` the log lacks or holds no sample of, and per
+        surface (``delta_e delta_a delta_r``) the largest absolute difference between the
+        deflection from SERVO_OUTPUT_RAW through the airframe file and JSBSim's, and the standard
+        deviation of JSBSim's, both rad (:func:`servo_against_truth`).
+    """
+    from gcs_sysid.telemetry import read_log
+
+    flight = read_log(files.tlog)
+    empty = [n for n in LOG_STREAMS if n not in flight.streams or flight.streams[n].t.size == 0]
+    return empty, {k: (float(np.max(np.abs(a - b))), float(np.std(b)))
+                   for k, (a, b) in servo_against_truth(flight, files).items()}
+
+
+def non_aero_residual(truth: dict) -> float:
+    """Largest absolute difference between JSBSim's total non-gravity forces and moments and the
+    aerodynamic ones (N, N m) over a recording's truth: zero in a glide with the engine stopped."""
+    return max(float(np.max(np.abs(truth[f"{k}_total"] - truth[f"{k}_aero"])))
+               for k in ("Fx", "Fy", "Fz", "L", "M", "N"))
+
+
+#: Flights of the final evaluation that a harness aircraft must fly inside its envelope:
+#: (seed, turbulence, plan, [(effect, size), ...]).
+EVALUATION_FLIGHTS = [
+    (100, "light", "sweep", []),                                 # the diagnosis's reference flight
+    (11, "light", "sweep", []),                                  # a clean diagnosis flight
+    (1, "light", "sweep", [("Cl:alpha*beta", 3.0)]),             # the effect most likely to depart
+    (1, "light", "sweep", [("delay:delta_e", 0.12)]),
+    (2, "moderate", "standard", []),                             # eval_jsbsim, moderate turbulence
+]
