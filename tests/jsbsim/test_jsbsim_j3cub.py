@@ -15,8 +15,8 @@ import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft, canonical_name, fly, make_flight
 from benchmarks.jsbsim_harness.effects import EFFECTS, Effect, _write_model
-from truth_fits import (EVALUATION_FLIGHTS, decoded_servo_errors, delay_trace, derivative_slopes, effect_state, injected_moment,
-                        non_aero_residual, rigid_body_residual)
+from truth_fits import (EVALUATION_FLIGHTS, decoded_servo_errors, delay_trace, derivative_slopes, effect_state,
+                        injected_moment, non_aero_residual, rigid_body_residual)
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
