@@ -4,7 +4,7 @@ rebuilt from the truth file, on the fast c172x flight. The derivative of the rec
 scored too: it carries the gusts' derivative and is the worse estimate of that rate.
 
 Thresholds FROZEN 2026-11-22 (branch i8-j3cub) from the first measurement on the J3Cub's flights (light,
-seeds 1-3: correlation 0.997-0.998, RMS error 7 % of the signal's RMS) with a margin; not measured on
+seeds 1-3: correlation 0.997-0.998, RMS error 7-7.5 % of the signal) with a margin; not measured on
 the c172x before they were set.
 """
 
