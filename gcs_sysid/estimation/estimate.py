@@ -21,6 +21,7 @@ from ..telemetry.types import Flight
 from .airangles import aided_air_angles, describe
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
+from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
 from .rates import HOLDS, normal_force_input, smooth_rates
 from .smoothers import normal_gravity, smooth_level, smooth_velocity
@@ -484,6 +485,12 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                 ", minus the KF accelerometer bias" if v_ned is not None and C is not None else "")
         notes.append("accelerometer noise (maximum likelihood) x y z = " + ", ".join(f"{x:.3f}" for x in f_noise)
                      + " m/s^2")
+        if alpha is not None and V is not None and W is not None and C is not None and v_ned is not None:
+            # from the force equations, not by differentiating alpha (module .alpharate): the alpha_dot that
+            # simulators' CL_alpha_dot and Cm_alpha_dot terms read; not a regressor of the GP (docs/estimation.md)
+            data["alpha_dot"] = kinematic_alpha_rate(C, v_ned, f_corr, W, V, alpha, beta)
+            sources["alpha_dot"] = ("force equations: (u_a w_dot - w_a u_dot) / (u_a^2 + w_a^2) with the smoothed "
+                                    "specific force, rates, attitude and GPS velocity (not differentiated)")
     prog(0.9)
 
     # --- validity --------------------------------------------------------------------------------
