@@ -88,7 +88,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "lift_alpha_offset": False, "angle_scale": False, "smooth_se": 2.0,
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
-              "allowance_on_search_residual": False}
+              "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
