@@ -46,7 +46,6 @@ VARIANTS = {
     "main": {"module": "main"},
     "default": {},
     "scale_se": {"angle_scale_se": True, "alpha_scale": False},
-    "alpha_only": {"angle_scale_se": False, "alpha_scale": True},
     "search_residual": {"search_residual": True},
     "main_search_residual": {"module": "main", "search_residual": True},
 }
@@ -58,7 +57,30 @@ def _load_differential(path: str):
     mod = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = mod
     spec.loader.exec_module(mod)
-    return mod.differential
+    return mod
+
+
+def _memo_structure(modules) -> None:
+    """Make each module's ``residual_structure`` (the residual GP on the reference flights, which every
+    variant computes on the same residual) compute once per residual and threshold."""
+    import hashlib
+
+    import numpy as np
+
+    from gcs_sysid.diagnose.residual_gp import residual_structure
+
+    cache: dict = {}
+
+    def memo(ctx, R, threshold_pct=20.0, **kw):
+        key = (hashlib.sha1(np.ascontiguousarray(np.nan_to_num(R)).tobytes()).hexdigest(), ctx.t.size,
+               float(threshold_pct), tuple(sorted(kw.items())))
+        if key not in cache:
+            cache.clear() if len(cache) > 8 else None
+            cache[key] = residual_structure(ctx, R, threshold_pct=threshold_pct, **kw)
+        return cache[key]
+
+    for m in modules:
+        m.residual_structure = memo
 
 
 def diagnose_held(ac: str, seed: int, effects, out: Path, model_path: Path, ref_meas):
@@ -108,14 +130,24 @@ def main(argv=None) -> int:
     p.add_argument("--out", required=True)
     p.add_argument("--variants", nargs="+", default=list(VARIANTS))
     p.add_argument("--main-differential", default=None, help="main's differential.py (for the 'main' variants)")
+    p.add_argument("--skip-done", action="store_true",
+                   help="skip the cases already in the first variant's results file (a run resumed)")
     a = p.parse_args(argv)
-    from gcs_sysid.diagnose.differential import differential
+    import gcs_sysid.diagnose.differential as dmod
 
-    fns = {"this": differential}
+    fns, mods = {"this": dmod.differential}, [dmod]
     if any(VARIANTS[v].get("module") == "main" for v in a.variants):
         if not a.main_differential:
             p.error("the 'main' variants need --main-differential")
-        fns["main"] = _load_differential(a.main_differential)
+        mm = _load_differential(a.main_differential)
+        fns["main"], mods = mm.differential, mods + [mm]
+    _memo_structure(mods)
+    done = set()
+    out_path = Path(a.out) / f"results-{a.variants[0]}.jsonl"
+    if a.skip_done and out_path.exists():
+        for ln in out_path.read_text().splitlines():
+            r = json.loads(ln)
+            done.add((r["aircraft"], r["seed"], tuple(tuple(e) for e in r["effects"])))
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     pairs = [tuple(x.split(",")) for x in a.pairs]
@@ -123,6 +155,8 @@ def main(argv=None) -> int:
     fhs = {v: open(out / f"results-{v}.jsonl", "a") for v in a.variants}
     for ac, seed, effects in _cases(a.aircraft, a.seeds, a.clean_seeds, pairs):
         if a.effects and effects and not all(e.name in a.effects for e in effects):
+            continue
+        if (ac, seed, tuple((e.name, e.value) for e in effects)) in done:
             continue
         if ac not in refs:
             refs[ac] = reference_model(ac, out)
