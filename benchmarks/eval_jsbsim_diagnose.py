@@ -14,7 +14,8 @@ Score per case:
     from the flight's exact truth by :func:`side_force_scale_truth`: the harness scales JSBSim's
     wind-axis side force by ``k``, the diagnosis's ``scale:CY`` scales the body-axis CY, whose
     ``-C_D sin(beta)`` part does not scale, so the body-axis change is ``(k - 1)`` times
-    ``CY_beta,wind / (CY_beta,wind - C_D)``: 0.93 (k - 1) on the SGS, 0.74 (k - 1) on the J3Cub;
+    ``CY_beta,wind / (CY_beta,wind - C_D)``: 0.86 (k - 1) on the c172x, 0.93 on the SGS, 0.90 on the
+    PA-28, 0.74 on the J3Cub (``docs/jsbsim.md``);
     before 2026-11-22 (branch i9-clean) it was scored against ``k - 1``);
   * ``gain``: held-out gain of that finding >= 50 %;
   * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);

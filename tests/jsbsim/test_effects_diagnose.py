@@ -160,3 +160,16 @@ def test_side_force_scale_is_scored_against_its_body_axis_equivalent(tmp_path):
     # scored against it: 0.43 is within 25 % of 0.514, not of 0.6
     f = [{"cause": "scale:CY", "estimate": 1.43, "std_error": 0.01, "model_value": 1.0, "gain": {"percent": 80}}]
     assert score_case(f, doc)["ok"] and not score_case(f, {"injected": [{"cause": "scale:CY", "value": 0.6}]})["ok"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ac,seed", [("sgs", 15), ("pa28", 14)])
+def test_windy_clean_flights_name_no_cause(tmp_path, ac, seed):
+    """The two clean windy flights that named a cause before the air-angle scale allowance carried its
+    uncertainty (sgs s15: ``CY:beta``, a 3.0 % small sideslip; pa28 s14: ``Cm:alpha``, a 5.6 % alpha
+    scale; docs/benchmarks.md, branch i9-clean) name nothing."""
+    from benchmarks.eval_jsbsim_diagnose import diagnose_case, reference_model
+
+    _, model_path, ref = reference_model(ac, tmp_path)
+    findings, truth, _ = diagnose_case(ac, seed, [], tmp_path, model_path, ref)
+    assert score_case(findings, truth)["ok"], [f["cause"] for f in findings]
