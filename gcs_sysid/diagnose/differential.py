@@ -194,8 +194,8 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
     (GPS velocity minus the wind estimate, aided by the specific force through a slope fitted on each
     flight, :mod:`gcs_sysid.estimation.airangles`) reads the JSBSim SGS's sideslip 0.6 % small on its
-    reference flight and 3.0 % small on clean seed 15, the PA-28's angle of attack 2.6 % large on its
-    reference and 2.9 % small on clean seed 14 (``docs/benchmarks.md``, branch i9-clean). A scale
+    reference flight and 3.0 % small on clean seed 15, the PA-28's angle of attack 3.1 % large on its
+    reference and 3.0 % small on clean seed 14 (``docs/benchmarks.md``, branch i9-clean). A scale
     ``1 + s`` of the angle moves *every* coefficient of :data:`ANGLE_COEFFICIENTS` by ``s`` times the
     model's own contribution of the angle, ``n_j = x dC_j/dx``; a change of one coefficient's
     aerodynamics moves that coefficient alone. So ``s`` is fitted on the *other* coefficients of the

@@ -166,7 +166,7 @@ def test_side_force_scale_is_scored_against_its_body_axis_equivalent(tmp_path):
 @pytest.mark.parametrize("ac,seed", [("sgs", 15), ("pa28", 14)])
 def test_windy_clean_flights_name_no_cause(tmp_path, ac, seed):
     """The two clean windy flights that named a cause before the air-angle scale allowance carried its
-    uncertainty (sgs s15: ``CY:beta``, a 3.0 % small sideslip; pa28 s14: ``Cm:alpha``, a 5.6 % alpha
+    uncertainty (sgs s15: ``CY:beta``, a 3.0 % small sideslip; pa28 s14: ``Cm:alpha``, a 6 % alpha
     scale; docs/benchmarks.md, branch i9-clean) name nothing."""
     from benchmarks.eval_jsbsim_diagnose import diagnose_case, reference_model
 
