@@ -10,7 +10,13 @@ Score per case:
   * ``top``: the injected cause is the top finding (for two effects: both among the findings);
   * ``est``: the estimate within 25 % of the injected value (aero terms: estimate minus the
     reference model's value of the term, i.e. the change; ``CY:scale``, named ``scale:CY``: the
-    estimated factor minus 1 against the injected factor minus 1);
+    estimated factor minus 1 against the *body-axis* equivalent of the injected factor, computed
+    from the flight's exact truth by :func:`side_force_scale_truth`: the harness scales JSBSim's
+    wind-axis side force by ``k``, the diagnosis's ``scale:CY`` scales the body-axis CY, whose
+    ``-C_D sin(beta)`` part does not scale, so the body-axis change is ``(k - 1)`` times
+    ``CY_beta,wind / (CY_beta,wind - C_D)``: 0.86 (k - 1) on the c172x, 0.93 on the SGS, 0.90 on the
+    PA-28, 0.74 on the J3Cub (``docs/jsbsim.md``);
+    before 2026-11-22 (branch i9-clean) it was scored against ``k - 1``);
   * ``gain``: held-out gain of that finding >= 50 %;
   * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);
   * clean flights: ``ok`` when no cause is named.
@@ -49,7 +55,7 @@ from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
+__all__ = ["reference_model", "diagnose_case", "score_case", "side_force_scale_truth", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -121,7 +127,8 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     from gcs_sysid.sim.model_file import load_model
 
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan), effects, out)
-    truth = json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text())
+    truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
+                          files.tlog.with_name(files.tlog.stem + "-truth.npz"))
     t0 = time.perf_counter()
     meas = load_measurements(files.tlog, files.airframe)
     from gcs_sysid.diagnose.differential import Reference
@@ -132,6 +139,69 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
                     flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states),
                     references=[Reference(ref_meas.table, ref_meas.states, ref_meas.flight, label=f"{ac}-ref")])
     return diag.findings, truth, time.perf_counter() - t0
+
+
+def side_force_scale_truth(truth_npz, k: float) -> float:
+    """The body-axis equivalent ``f - 1`` of a wind-axis side-force scale ``k``, from a flight's exact truth.
+
+    JSBSim sums its SIDE axis in wind axes; the effect multiplies that side force ``Y_w`` by ``k``. The
+    body-axis side force is ``Y_b = cos(beta) Y_w - sin(beta) D`` (JSBSim's ``Tw2b``: body from wind,
+    forces ``(-D, Y_w, -L)``; Stevens, Lewis and Johnson, *Aircraft Control and Simulation*, 3rd ed.,
+    sec. 2.3), so the effect adds ``(k - 1) cos(beta) Y_w`` to it and leaves the drag's part alone. Here
+    ``Y_w`` is taken from the flight's exact body-axis coefficients (``C_Yw = -cos(alpha) sin(beta) CX +
+    cos(beta) CY - sin(alpha) sin(beta) CZ``, already scaled by ``k``), the unscaled body-axis CY is
+    rebuilt (``CY - (k - 1)/k cos(beta) C_Yw``), and the change is regressed on it with a free constant,
+    as the diagnosis fits ``scale:CY`` on the model's CY. Exact to the truth file's precision; no
+    estimated quantity enters.
+
+    Args:
+        truth_npz: the flight's ``-truth.npz`` (``X`` (T, 10) with alpha, beta in rad, ``Y`` (T, 6)).
+        k: the injected wind-axis factor.
+
+    Returns:
+        ``f - 1`` (dimensionless): what a correct ``scale:CY`` estimates minus 1.
+    """
+    z = np.load(truth_npz)
+    X, Y = np.asarray(z["X"], float), np.asarray(z["Y"], float)
+    if X.shape[0] == 10 and X.shape[1] != 10:
+        X, Y = X.T, Y.T
+    a, b = X[:, 0], X[:, 1]
+    c_yw = -np.cos(a) * np.sin(b) * Y[:, 0] + np.cos(b) * Y[:, 1] - np.sin(a) * np.sin(b) * Y[:, 2]
+    clean = Y[:, 1] - (k - 1.0) / k * np.cos(b) * c_yw
+    d = Y[:, 1] - clean
+    ok = np.isfinite(d) & np.isfinite(clean)
+    return float(np.linalg.lstsq(np.column_stack([np.ones(ok.sum()), clean[ok]]), d[ok], rcond=None)[0][1])
+
+
+def scoring_truth(truth: dict, truth_npz) -> dict:
+    """The injected truth as scored: ``scale:CY``'s value replaced by its body-axis equivalent
+    (:func:`side_force_scale_truth`; the injected ``k - 1`` kept as ``wind_axis_value``)."""
+    out = dict(truth, injected=[dict(e) for e in truth["injected"]])
+    for e in out["injected"]:
+        if e["cause"] == "scale:CY" and "wind_axis_value" not in e:
+            e["wind_axis_value"] = e["value"]
+            e["value"] = side_force_scale_truth(truth_npz, e.get("scale", 1.0 + e["value"]))
+    return out
+
+
+def rescore(path: str) -> list[dict]:
+    """The records of a ``results.jsonl`` scored again by :func:`score_case` against :func:`scoring_truth`
+    (the flights' ``-effects.json`` and ``-truth.npz`` read from the file's folder)."""
+    out = []
+    folder = Path(path).parent
+    for ln in Path(path).read_text().splitlines():
+        if not ln.strip():
+            continue
+        r = json.loads(ln)
+        if r["effects"] and "error" not in r["score"]:
+            tag = "+".join(f"{n}={v:g}" for n, v in r["effects"])
+            stem = f"{r['aircraft']}-s{r['seed']}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
+            stem += f"-{r.get('plan', PLAN)}" if r.get("plan", PLAN) != "standard" else ""
+            truth = json.loads((folder / f"{stem}-effects.json").read_text())
+            findings = [dict(f, gain={"percent": f.get("gain_pct") or 0.0}) for f in r["findings"]]
+            r["score"] = score_case(findings, scoring_truth(truth, folder / f"{stem}-truth.npz"))
+        out.append(r)
+    return out
 
 
 def score_case(findings: list[dict], truth: dict) -> dict:
@@ -295,6 +365,9 @@ def main(argv=None) -> int:
     p.add_argument("--plan", default=PLAN, choices=("standard", "sweep"),
                    help="flight plan of every flight (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
+    p.add_argument("--rescore", action="store_true",
+                   help="with --summary: score the records again against today's scoring truth (scoring_truth: "
+                        "scale:CY against its body-axis equivalent), flights read from each file's folder")
     p.add_argument("--scatter-json", nargs="+", metavar="JSON",
                    help="with --summary: also the 2-se coverage with these scatter-<ac>.json files")
     p.add_argument("--scatter", action="store_true",
@@ -307,6 +380,16 @@ def main(argv=None) -> int:
 
         sparse.THRESHOLDS.update(json.loads(a.sparse_thresholds))
     if a.summary:
+        if a.rescore:
+            import tempfile
+
+            tmp = Path(tempfile.mkdtemp(prefix="rescored-"))
+            paths = []
+            for i, pth in enumerate(a.summary):
+                q = tmp / f"{i}-{Path(pth).name}"
+                q.write_text("".join(json.dumps(r, default=float) + "\n" for r in rescore(pth)))
+                paths.append(str(q))
+            a.summary = paths
         print(summarize(a.summary))
         if a.scatter_json:
             print()

@@ -56,7 +56,8 @@ from .regression import ols
 from .residual_gp import residual_structure
 from .terms import term_factors, term_matrix
 
-__all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "BETA_COEFFICIENTS",
+__all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "angle_scale_allowance",
+           "BETA_COEFFICIENTS", "ANGLE_COEFFICIENTS",
            "onset_of_change", "fit_record", "reference_logs"]
 
 
@@ -173,42 +174,72 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
 
 #: The lateral coefficients a sideslip-measurement scale acts on through the model's beta terms.
 BETA_COEFFICIENTS = ("CY", "Cl", "Cn")
+#: The coefficients a scale error of each measured air angle acts on through the model's terms in it:
+#: the sideslip's lateral ones, and the angle of attack's longitudinal ones (lift, drag, pitch).
+ANGLE_COEFFICIENTS = {"beta": BETA_COEFFICIENTS, "alpha": ("CX", "CZ", "Cm")}
 
 
-def beta_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
-                         term: str, min_t: float = 3.0, min_gain_pct: float = 10.0) -> dict | None:
-    """Is a sideslip finding more than a between-flight *scale* of the measured sideslip?
+def _angle_factors(term: str) -> list[str]:
+    """Regressor names among a monomial's factors (``alpha^2*delta_e`` -> alpha, delta_e; others: [])."""
+    if "(" in term or ":" in term:
+        return []
+    return [part.partition("^")[0] for part in term.replace(" ", "").split("*")]
 
-    The log's sideslip is an estimate whose scale differs from flight to flight (the AHRS or the
-    reconstruction's: wind, airspeed and specific-force aiding). A scale ``1 + s`` of beta moves *every*
-    lateral coefficient by ``s`` times the model's own beta contribution ``n_j = beta dC_j/dbeta``;
-    a change of one coefficient's aerodynamics moves that coefficient alone. So ``s`` is fitted on the
-    *other* lateral coefficients (those with a beta contribution; offsets free, each weighted by its
-    residual variance on the selection rows), the finding's coefficient is corrected by ``s n_j``, and
-    :func:`offset_allowance` judges what is left: a finding that is only the common scale (plus an
-    offset) is an allowance, not a cause.
+
+def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
+                          term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
+                          scale_se: bool = True) -> dict | None:
+    """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
+
+    The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
+    (GPS velocity minus the wind estimate, aided by the specific force through a slope fitted on each
+    flight, :mod:`gcs_sysid.estimation.airangles`) reads the JSBSim SGS's sideslip 0.6 % small on its
+    reference flight and 3.0 % small on clean seed 15, the PA-28's angle of attack 3.1 % large on its
+    reference and 3.0 % small on clean seed 14 (``docs/benchmarks.md``, branch i9-clean). A scale
+    ``1 + s`` of the angle moves *every* coefficient of :data:`ANGLE_COEFFICIENTS` by ``s`` times the
+    model's own contribution of the angle, ``n_j = x dC_j/dx``; a change of one coefficient's
+    aerodynamics moves that coefficient alone. So ``s`` is fitted on the *other* coefficients of the
+    group (those with a contribution; offsets free, each weighted by its residual variance on the
+    selection rows; coloured-residual standard error, Morelli and Klein sec. 5.3), the finding's
+    coefficient is corrected by ``s n_j``, and :func:`offset_allowance` judges what is left.
+
+    With ``scale_se`` the scale's own uncertainty is carried into that judgement (added 2026-11-22,
+    branch i9-clean): the term's estimate beyond the scale moves by ``k ds`` for an error ``ds`` of
+    ``s``, ``k`` the slope of ``n_j`` on the term (a free constant beside it, selection rows), so its
+    standard error is ``sqrt(se^2 + (k se_s)^2)`` (first-order propagation of independent errors;
+    the other coefficients' residuals are not the finding's). Without it a scale known to +- 1.2 %
+    from the moments left a 2.4 % CY:beta "change" at 7 standard errors.
 
     Args:
         X: (T, 10) regressors. R: (T, 6) residual without the finding. train, test: (T,) rows.
         model: the model under test (:data:`~gcs_sysid.diagnose.context.ModelDict`).
-        coef, term: the finding; only ``CY``/``Cl``/``Cn`` terms with beta among their factors are judged.
+        coef, term: the finding; judged only when ``coef`` is in ``ANGLE_COEFFICIENTS[angle]`` and
+            ``angle`` is among the term's factors.
+        angle: ``"beta"`` or ``"alpha"``.
         min_t, min_gain_pct: as :func:`offset_allowance`.
+        scale_se: carry the scale's standard error into the term's (see above).
 
     Returns:
-        None when the finding is not a sideslip term or no other coefficient has a beta contribution;
-        else ``{"scale_only": bool, "beta_scale", "std_error", "from": [coef...], "beyond_scale": {...}}``.
+        None when the finding is not such a term or no other coefficient has a contribution of the
+        angle; else ``{"scale_only": bool, "angle", "scale", "std_error", "from": [coef...],
+        "beyond_scale": {...}, "why"}`` (``beyond_scale`` is :func:`offset_allowance`'s document, with
+        ``std_error_scale_share`` and the propagated ``std_error``/``t`` when ``scale_se``).
+
+    Raises:
+        KeyError: ``angle`` other than ``"alpha"`` or ``"beta"``.
     """
     from .context import evaluate_model
 
-    if coef not in BETA_COEFFICIENTS or "beta" not in term.replace(" ", "").split("*"):
+    group = ANGLE_COEFFICIENTS[angle]
+    if coef not in group or angle not in _angle_factors(term):
         return None
-    ib = REGRESSORS.index("beta")
+    ia = REGRESSORS.index(angle)
     eps = 1e-3
     X1 = np.array(X, float, copy=True)
-    X1[:, ib] *= 1.0 + eps
-    N = (evaluate_model(model, X1) - evaluate_model(model, X)) / eps        # (T, 6): beta dC/dbeta
+    X1[:, ia] *= 1.0 + eps
+    N = (evaluate_model(model, X1) - evaluate_model(model, X)) / eps        # (T, 6): x dC/dx
     ok = train & np.isfinite(R).all(axis=1) & np.isfinite(N).all(axis=1)
-    others = [c for c in BETA_COEFFICIENTS if c != coef and np.std(N[ok, COEFFICIENTS.index(c)]) > 0]
+    others = [c for c in group if c != coef and np.std(N[ok, COEFFICIENTS.index(c)]) > 0]
     if ok.sum() < 50 or not others:
         return None
     num = den = 0.0
@@ -223,14 +254,42 @@ def beta_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: 
         return None
     s_hat = num / den
     res = ols(np.concatenate([n for _, n in cols])[:, None], np.concatenate([r for r, _ in cols]), terms=["s"])
+    se_s = float(res.std_error[0])
     j = COEFFICIENTS.index(coef)
     R_adj = np.array(R, float, copy=True)
     R_adj[:, j] = R[:, j] - s_hat * N[:, j]
     beyond = offset_allowance(X, R_adj, train, test, coef, term, min_t=min_t, min_gain_pct=min_gain_pct)
-    return {"scale_only": bool(beyond["offset_only"]), "beta_scale": float(s_hat),
-            "std_error": float(res.std_error[0]), "from": others, "beyond_scale": beyond,
-            "why": f"a common sideslip scale {1 + s_hat:.3f} (fitted on {', '.join(others)}) and {coef}'s offset "
-                   f"free: {beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
+    if scale_se and "std_error" in beyond and np.isfinite(se_s):
+        try:
+            phi = term_matrix(X, [term])[:, 0]
+        except SysidError:
+            phi = None
+        m = ok & np.isfinite(phi) if phi is not None else ok[:0]
+        if phi is not None and m.sum() >= 50 and np.std(phi[m]) > 0:
+            k = float(np.linalg.lstsq(np.column_stack([np.ones(m.sum()), phi[m]]), N[m, j], rcond=None)[0][1])
+            share = abs(k) * se_s
+            se = float(np.hypot(beyond["std_error"], share))
+            t = beyond["estimate"] / se if se > 0 else 0.0
+            beyond = dict(beyond, std_error=se, std_error_fit=beyond["std_error"], std_error_scale_share=share,
+                          t=float(t), offset_only=bool(beyond["offset_only"] or abs(t) < min_t),
+                          why=(f"with {coef}'s between-flight offset free, {coef}:{term} is {beyond['estimate']:+.4g} "
+                               f"+- {se:.2g} (the scale's uncertainty {share:.2g} included; t {t:.1f}) and gains "
+                               f"{beyond['gain_beyond_offset_percent']:.0f} % on the held-out rows beyond the offset"))
+    return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
+            "beta_scale" if angle == "beta" else "alpha_scale": float(s_hat),
+            "std_error": se_s, "from": others, "beyond_scale": beyond,
+            "why": f"a common {angle} scale {1 + s_hat:.3f} +- {se_s:.2g} (fitted on {', '.join(others)}) and {coef}'s "
+                   f"offset free: {beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
+
+
+def beta_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
+                         term: str, min_t: float = 3.0, min_gain_pct: float = 10.0, scale_se: bool = True) -> dict | None:
+    """Is a sideslip finding more than a between-flight scale of the measured sideslip?
+
+    :func:`angle_scale_allowance` with ``angle="beta"`` (the sideslip's lateral coefficients CY, Cl, Cn);
+    the result also carries ``beta_scale``. Args, returns: as there.
+    """
+    return angle_scale_allowance(X, R, train, test, model, coef, term, "beta", min_t, min_gain_pct, scale_se)
 
 
 def _within_reference_variation(c_f: float, se_f: float, compared: list[dict], k: float = 3.0) -> dict | None:
@@ -398,7 +457,8 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
-                 search_residual: np.ndarray | None = None) -> dict:
+                 search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
+                 alpha_scale: bool = True) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -415,6 +475,11 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             given, a term the search named is judged for the between-flight allowances on it, not on
             the raw residual against the model, where the model's own inadequacy (the reference flight
             has it too, and the search took it out) can hide a change (the JSBSim c172x ``Cm:alpha^2``).
+        angle_scale_se: carry the fitted angle scale's standard error into the scale allowances
+            (:func:`angle_scale_allowance`; ``sparse.THRESHOLDS["angle_scale_se"]``).
+        alpha_scale: also judge a finding in alpha against a between-flight scale of the measured angle of
+            attack seen in the other longitudinal coefficients (``sparse.THRESHOLDS["alpha_scale_allowance"]``;
+            the sideslip's is always judged).
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -489,17 +554,24 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                                          "summary": f"{cause}: a between-flight offset of {coef}, not a cause"})
                 continue
             f["evidence"]["offset_allowance"] = allow
-            scale = beta_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model, coef,
-                                         term, min_t=min_t, min_gain_pct=min_gain_pct)
-            if scale is not None and scale["scale_only"]:
-                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scale}
+            scaled = None
+            for angle in ("beta", "alpha") if alpha_scale else ("beta",):
+                scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
+                                              coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
+                                              scale_se=angle_scale_se)
+                if scale is not None and scale["scale_only"]:
+                    scaled = scale
+                    break
+                if scale is not None:
+                    f["evidence"][f"{angle}_scale_allowance"] = scale
+            if scaled is not None:
+                what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
+                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}
                 doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
-                                         "gain": f.get("gain", {}), "why": scale["why"],
-                                         "summary": f"{cause}: a between-flight scale of the measured sideslip, "
+                                         "gain": f.get("gain", {}), "why": scaled["why"],
+                                         "summary": f"{cause}: a between-flight scale of the measured {what}, "
                                                     "not a cause"})
                 continue
-            if scale is not None:
-                f["evidence"]["beta_scale_allowance"] = scale
         null = 0.0 if is_aero else _null_value(cause, airframe)
         # an aero finding's correction is its change from the model's value (catalogue: evidence.correction;
         # sparse search: estimate - model_value)

@@ -81,6 +81,13 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: (not in the frozen evaluation): ``allowance_on_search_residual`` (``diagnose`` judges a searched
 #: term's between-flight allowances on the search's differential residual, not on the raw residual
 #: where the model's own inadequacy hides it; :func:`gcs_sysid.diagnose.differential.differential`).
+#: Added and frozen 2026-11-22 10:16 UTC (branch i9-clean, tuned on the windy sgs clean s15 and pa28 clean
+#: s14 and 20 sgs cases; ``docs/benchmarks.md``), both read by ``diagnose`` for the differential step:
+#: ``angle_scale_se`` (the between-flight air-angle scale's own standard error is carried into the judgement
+#: of the term beyond it) and ``alpha_scale_allowance`` (a finding in alpha is judged against a common alpha
+#: scale seen in CX and CZ, as one in beta is against the sideslip's;
+#: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance`). ``allowance_on_search_residual`` measured
+#: on the windy sgs/pa28 flights: no better than without it, left off.
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -88,7 +95,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "lift_alpha_offset": False, "angle_scale": False, "smooth_se": 2.0,
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
-              "allowance_on_search_residual": False}
+              "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

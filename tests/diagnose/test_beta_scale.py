@@ -1,4 +1,4 @@
-"""The between-flight sideslip-scale allowance (gcs_sysid.diagnose.differential.beta_scale_allowance).
+"""The between-flight air-angle scale allowances (gcs_sysid.diagnose.differential.angle_scale_allowance).
 
 A flight whose measured sideslip is 20 % too small moves CY, Cl and Cn together by their model beta
 terms: a `CY:beta` finding there is that scale, not a side-force change. A side-force change alone
@@ -59,3 +59,50 @@ def test_only_sideslip_terms_of_lateral_coefficients_are_judged():
     assert beta_scale_allowance(X, noise, train, test, MODEL, "CZ", "alpha") is None
     assert beta_scale_allowance(X, noise, train, test, MODEL, "Cl", "delta_a") is None
     assert beta_scale_allowance(X, noise, train, test, MODEL, "CY", "alpha*beta") is not None
+
+
+def test_the_scale_uncertainty_is_carried_into_the_finding():
+    """A sideslip 3 % small on a flight whose moments see the scale only to +- a few %: CY, whose beta term
+    is large and quiet, reads it as a significant ``CY:beta`` "change" unless the scale's own standard
+    error is carried into the term's (the JSBSim SGS clean seed 15, docs/benchmarks.md, branch i9-clean)."""
+    X, noise, train, test = _flight(2)
+    noise[:, COEFFICIENTS.index("CY")] *= 0.1           # a quiet side force ...
+    noise[:, COEFFICIENTS.index("Cl")] *= 20.0          # ... and moments too noisy to pin the scale
+    noise[:, COEFFICIENTS.index("Cn")] *= 20.0
+    ib = REGRESSORS.index("beta")
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / 0.97
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    old = beta_scale_allowance(X, R, train, test, MODEL, "CY", "beta", scale_se=False)
+    new = beta_scale_allowance(X, R, train, test, MODEL, "CY", "beta")
+    assert old is not None and not old["scale_only"], old          # the invention without the scale's error
+    assert new is not None and new["scale_only"], new
+    share = new["beyond_scale"]["std_error_scale_share"]
+    assert abs(share - 0.6 * new["std_error"]) < 0.1 * share       # k = CY_beta = -0.6: |k| se_s
+    # a real side-force change of 30 % stays a finding with the scale's error included
+    R2 = noise.copy()
+    R2[:, COEFFICIENTS.index("CY")] += 0.3 * MODEL["CY"]["beta"] * X[:, ib]
+    assert not beta_scale_allowance(X, R2, train, test, MODEL, "CY", "beta")["scale_only"]
+
+
+def test_an_angle_of_attack_scale_is_an_allowance_but_a_pitching_moment_term_is_not():
+    """The angle of attack 5 % large moves CX, CZ and Cm together (the JSBSim PA-28 clean seed 14's
+    ``Cm:alpha``); a pitching-moment term alone (``Cm:alpha^2``) moves Cm alone and stays a finding."""
+    from gcs_sysid.diagnose.differential import angle_scale_allowance
+
+    X, noise, train, test = _flight(3)
+    ia = REGRESSORS.index("alpha")
+    model = dict(MODEL, CX={"1": -0.03, "alpha": 0.2, "alpha^2": 2.0})
+    X_true = X.copy()
+    X_true[:, ia] = X[:, ia] / 1.05
+    R = evaluate_model(model, X_true) - evaluate_model(model, X) + noise
+    assert not offset_allowance(X, R, train, test, "Cm", "alpha")["offset_only"]
+    a = angle_scale_allowance(X, R, train, test, model, "Cm", "alpha", "alpha")
+    assert a is not None and a["scale_only"], a
+    assert abs(a["alpha_scale"] + 0.048) < 0.01 and set(a["from"]) == {"CX", "CZ"}
+    R2 = noise.copy()
+    R2[:, COEFFICIENTS.index("Cm")] += -8.0 * X[:, ia] ** 2
+    b = angle_scale_allowance(X, R2, train, test, model, "Cm", "alpha^2", "alpha")
+    assert b is not None and not b["scale_only"], b
+    assert angle_scale_allowance(X, R2, train, test, model, "Cm", "delta_e", "alpha") is None
+    assert angle_scale_allowance(X, R2, train, test, model, "Cl", "alpha", "alpha") is None

@@ -129,3 +129,47 @@ def test_summary_table_counts_each_score(tmp_path):
     assert "| 2 | 1/2 | 1/2 | 1/2 | 1/2 | 1/1 |" in row and "[CX:alpha]" in row
     clean = next(ln for ln in lines if "| clean |" in ln)
     assert "no named cause 0/1" in clean and "CX:alpha" in clean
+
+
+def test_side_force_scale_is_scored_against_its_body_axis_equivalent(tmp_path):
+    """``CY:scale`` multiplies JSBSim's wind-axis side force by k; the body-axis CY keeps its drag part
+    ``-C_D sin(beta)``, so a correct ``scale:CY`` is ``(k - 1) CY_beta,w / (CY_beta,w - C_D)``, not k - 1
+    (synthetic exact truth: wind-axis side force ``-0.3 beta``, drag 0.05)."""
+    from benchmarks.eval_jsbsim_diagnose import scoring_truth, side_force_scale_truth
+
+    rng = np.random.default_rng(0)
+    T, k = 3000, 1.6
+    a = np.radians(2.0 + rng.normal(0, 1.5, T))
+    b = np.radians(rng.normal(0, 3.0, T))
+    D, Yw, L = 0.05 + 0 * a, k * (-0.3 * b), 0.4 + 5 * a          # wind-axis drag, side (scaled), lift
+    # body from wind (JSBSim Tw2b), forces (-D, Y_w, -L)
+    ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+    CX = ca * cb * -D - ca * sb * Yw - sa * -L
+    CY = sb * -D + cb * Yw
+    CZ = sa * cb * -D - sa * sb * Yw + ca * -L
+    X = np.zeros((T, 10))
+    X[:, 0], X[:, 1] = a, b
+    Y = np.zeros((T, 6))
+    Y[:, 0], Y[:, 1], Y[:, 2] = CX, CY, CZ
+    np.savez(tmp_path / "t.npz", X=X, Y=Y)
+    want = (k - 1) * -0.3 / (-0.3 - 0.05)
+    assert abs(side_force_scale_truth(tmp_path / "t.npz", k) - want) < 0.01 * want
+    doc = scoring_truth({"injected": [{"cause": "scale:CY", "value": k - 1, "scale": k}]}, tmp_path / "t.npz")
+    assert doc["injected"][0]["wind_axis_value"] == pytest.approx(0.6)
+    assert doc["injected"][0]["value"] == pytest.approx(want, rel=0.01)
+    # scored against it: 0.43 is within 25 % of 0.514, not of 0.6
+    f = [{"cause": "scale:CY", "estimate": 1.43, "std_error": 0.01, "model_value": 1.0, "gain": {"percent": 80}}]
+    assert score_case(f, doc)["ok"] and not score_case(f, {"injected": [{"cause": "scale:CY", "value": 0.6}]})["ok"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ac,seed", [("sgs", 15), ("pa28", 14)])
+def test_windy_clean_flights_name_no_cause(tmp_path, ac, seed):
+    """The two clean windy flights that named a cause before the air-angle scale allowance carried its
+    uncertainty (sgs s15: ``CY:beta``, a 3.0 % small sideslip; pa28 s14: ``Cm:alpha``, a 6 % alpha
+    scale; docs/benchmarks.md, branch i9-clean) name nothing."""
+    from benchmarks.eval_jsbsim_diagnose import diagnose_case, reference_model
+
+    _, model_path, ref = reference_model(ac, tmp_path)
+    findings, truth, _ = diagnose_case(ac, seed, [], tmp_path, model_path, ref)
+    assert score_case(findings, truth)["ok"], [f["cause"] for f in findings]
