@@ -96,6 +96,12 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True}
+#: Added 2026-11-22 (branch i9-j3bias; set on the J3Cub's delay flights, checked on c172x/sgs/pa28, time of
+#: the freeze in ``docs/benchmarks.md``): ``delay_differential`` (a named delay's size is this flight's delay
+#: minus the reference flight's, each fitted through the model's response on its own residual, without the
+#: reference's ridge inadequacy, :func:`_differential_delay`; off: refined on the search's differential
+#: residual, which read the J3Cub's 0.12 s as 0.085 s).
+THRESHOLDS["delay_differential"] = True
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -572,6 +578,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             base_mean[j] = base[tr, j].mean() if tr.size else 0.0
             base[:, j] -= base_mean[j]
     Rd = R - base
+    # the residual without the reference's ridge inadequacy (same nuisances and named delays taken out):
+    # a delay is refined on it, as a parameter against the reference's own (_differential_delay)
+    Rn = R.copy()
     M0 = np.nan_to_num(ctx.Y) - R          # the model's own prediction (R is measured minus model)
     if th.get("angle_nuisance", True):
         model0 = reference[0].model if reference is not None else ctx.model
@@ -585,7 +594,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             # rather than an arbitrary shift of it (which turns alpha^2 into alpha^3 or alpha^2*delta_e)
             err = err - err[tr].mean(axis=0)
         info["library_shift_rad"] = [float(v) for v in err[tr].mean(axis=0)] if tr.size else [0.0, 0.0]
-        Rd = Rd - N
+        Rd, Rn = Rd - N, Rn - N
         M0 = M0 + N
         result["angle_nuisance"] = info
         Xc = ctx.X.copy()
@@ -609,6 +618,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                     * ctx.active[None, :]
                 N2 -= N2[tr].mean(axis=0)
                 Rd, M0, Xc, err = Rd - N2, M0 + N2, X2, err + np.c_[e2, np.zeros_like(e2)]
+                Rn = Rn - N2
                 result["lift_alpha"] = info2
         if np.any(err):                    # the library on the corrected angles
             names, Phi = _library(replace(ctx, X=Xc), knots)
@@ -640,7 +650,12 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         delays = [f for f in new if f["cause"].startswith("delay:")]
         if delays:                 # a delay shows in every coefficient of its surface: name it alone,
             f = delays[0]          # take its (model-based) effect out of all of them, search again
-            tau, D, se = _refine_delay(ctx, Rd, f["cause"].split(":")[1], tr, COEFFICIENTS.index(f["coefficient"]))
+            surf, jf = f["cause"].split(":")[1], COEFFICIENTS.index(f["coefficient"])
+            if th.get("delay_differential", False):
+                tau, D, se, parts = _differential_delay(ctx, Rn, surf, tr, jf, reference)
+                f["evidence"]["delay_differential"] = parts
+            else:
+                tau, D, se = _refine_delay(ctx, Rd, surf, tr, jf)
             if th.get("delay_time_resolution", False) and ctx.t.size > 1:
                 # the log's time grid: a delay is known to no better than a uniform step of one sample
                 dt = float(np.median(np.diff(ctx.t)))
@@ -648,7 +663,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 se = float(np.hypot(se, dt / np.sqrt(12.0)))
             f["estimate"], f["std_error"] = tau, se
             f["evidence"]["refined_on"] = "model response to the delayed surface, all coefficients"
-            Rd = Rd - D
+            Rd, Rn = Rd - D, Rn - D
             named.append(f)
             continue
         named += new
@@ -696,6 +711,50 @@ def _with_reference_error(f: dict, ref_after) -> None:
         return
     f["evidence"]["std_error_parts"] = {"flight": float(f["std_error"]), "reference": se_ref}
     f["std_error"] = float(np.hypot(f["std_error"], se_ref))
+
+
+def _differential_delay(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarray, j: int,
+                        reference: tuple[DiagContext, np.ndarray] | None,
+                        taus=np.arange(-0.1, 0.4001, 0.005)) -> tuple[float, np.ndarray, float, dict]:
+    """A delay of ``surf`` as the change of a parameter: this flight's minus the reference flight's.
+
+    Each flight's delay is fitted through the model's own response to the delayed surface
+    (:func:`_refine_delay`) on its *own* residual against the model: this flight's ``Rn`` (after the
+    angle nuisance, without the reference's ridge inadequacy) and the reference's raw residual. The
+    ridge inadequacy is left out because it is a shrunken fit over many collinear columns: on the
+    reference flight (no delay) its lagged-surface columns take a share of the dynamic misfit that
+    belongs to ``alpha_dot_hat`` and ``q_hat`` (a pitching moment due to alpha rate, an angle of
+    attack whose fast error follows the elevator), and on a flight whose surface is delayed the same
+    weights, applied to its lagged columns, cancel part of the delay's own signature (measured on the
+    JSBSim J3Cub: 0.12 s read as 0.085 s, 0.06 s as 0.04 s; without the ridge 0.105-0.11 and 0.045-0.05,
+    the reference's own delay -0.005 s; ``docs/benchmarks.md``). A lag common to both flights (a servo
+    lag the log does not show) is no change and cancels in the difference, as the differential
+    search's inadequacy does for terms. The grid ``taus`` reaches below zero so that a reference whose
+    surface leads its log is measured without clipping.
+
+    Args:
+        ctx: this flight. Rn: (T, 6) its residual (measured minus model, nuisances and earlier named
+            delays removed). surf: the surface (``delta_e``). tr: training rows. j: the coefficient
+            whose lag terms named the delay. reference: ``(ctx_ref, R_ref)`` or None (no difference).
+
+    Returns:
+        (change of the delay s, this flight's (T, 6) part of the residual at that change, its standard
+        error s (both flights' linearised standard errors in quadrature), ``{"flight_s", "reference_s",
+        "std_error_flight_s", "std_error_reference_s"}``).
+    """
+    tau, _, se = _refine_delay(ctx, Rn, surf, tr, j, taus=taus)
+    tau_ref, se_ref = 0.0, 0.0
+    if reference is not None:
+        rctx, Rr = reference
+        rows = np.nonzero(rctx.valid)[0]
+        if rows.size >= 50:
+            tau_ref, _, se_ref = _refine_delay(rctx, np.nan_to_num(np.asarray(Rr, float)), surf, rows, j, taus=taus)
+            se_ref = se_ref if np.isfinite(se_ref) else 0.0
+    change = float(tau - tau_ref)
+    _, D, _ = _refine_delay(ctx, Rn, surf, tr, j, taus=np.array([max(change, 0.0)]))
+    parts = {"flight_s": float(tau), "reference_s": float(tau_ref), "std_error_flight_s": float(se),
+             "std_error_reference_s": float(se_ref)}
+    return change, D, float(np.hypot(se, se_ref)), parts
 
 
 def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j: int,
