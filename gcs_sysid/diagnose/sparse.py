@@ -88,6 +88,11 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: scale seen in CX and CZ, as one in beta is against the sideslip's;
 #: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance`). ``allowance_on_search_residual`` measured
 #: on the windy sgs/pa28 flights: no better than without it, left off.
+#: Added 2026-11-22 (branch i9-j3bias; set on the J3Cub's delay flights, checked on c172x/sgs/pa28, time of
+#: the freeze in ``docs/benchmarks.md``): ``delay_differential`` (a named delay's size is this flight's delay
+#: minus the reference flight's, each fitted through the model's response on its own residual, without the
+#: reference's ridge inadequacy, :func:`_differential_delay`; off: refined on the search's differential
+#: residual, which read the J3Cub's 0.12 s as 0.085 s).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -95,13 +100,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "lift_alpha_offset": False, "angle_scale": False, "smooth_se": 2.0,
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
-              "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True}
-#: Added 2026-11-22 (branch i9-j3bias; set on the J3Cub's delay flights, checked on c172x/sgs/pa28, time of
-#: the freeze in ``docs/benchmarks.md``): ``delay_differential`` (a named delay's size is this flight's delay
-#: minus the reference flight's, each fitted through the model's response on its own residual, without the
-#: reference's ridge inadequacy, :func:`_differential_delay`; off: refined on the search's differential
-#: residual, which read the J3Cub's 0.12 s as 0.085 s).
-THRESHOLDS["delay_differential"] = True
+              "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
+              "delay_differential": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
