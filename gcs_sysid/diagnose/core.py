@@ -366,15 +366,15 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
     if references:
         from .differential import differential
-        from .sparse import THRESHOLDS as _SPARSE_TH2
+        from .sparse import THRESHOLDS as _SPARSE_TH
 
         say("diagnose: differential against the reference flight(s)")
         t1 = time.perf_counter()
         data["differential"] = differential(diag, list(references), airframe,
                                             threshold_pct=unexplained_threshold_pct,
                                             search_residual=search_residual if search else None,
-                                            angle_scale_se=bool(_SPARSE_TH2.get("angle_scale_se", False)),
-                                            alpha_scale=bool(_SPARSE_TH2.get("alpha_scale_allowance", False)))
+                                            angle_scale_se=bool(_SPARSE_TH.get("angle_scale_se", False)),
+                                            alpha_scale=bool(_SPARSE_TH.get("alpha_scale_allowance", False)))
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)
