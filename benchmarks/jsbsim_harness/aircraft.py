@@ -42,6 +42,9 @@ class AircraftSpec:
         amplitude_deg: (delta_e, delta_a, delta_r) maneuver amplitudes, deg.
         pulse_s: (pitch, roll, yaw) pulse width of doublets and 3-2-1-1s, s.
         gains: autopilot gains (k_theta, k_q, k_v, k_phi, k_p, k_r), rad/rad, rad/(rad/s), rad/(m/s).
+        gear_up: retract the landing gear (``gear/gear-cmd-norm`` = 0 at the initial condition;
+            the model's gear channel moves it up during the settling phase) for a model whose
+            retractable gear adds drag while down; False leaves a fixed gear as the model has it.
         notes: provenance.
     """
 
@@ -57,6 +60,7 @@ class AircraftSpec:
     amplitude_deg: tuple[float, float, float]
     pulse_s: tuple[float, float, float]
     gains: tuple[float, float, float, float, float, float] = (1.0, 0.3, 0.01, 0.4, 0.1, 0.4)
+    gear_up: bool = False
     notes: str = ""
 
     @property
@@ -68,12 +72,12 @@ class AircraftSpec:
 _DEG = 57.29577951308232
 
 #: Aircraft the harness knows. ``c172x`` and ``sgs`` were used to set up the harness and the test
-#: thresholds; ``pa28`` (held out since 2026-11-21) and ``j3cub`` (untouched until the sixth
-#: session's final evaluation, 2026-11-22) have since been evaluated and their results read, so
-#: they count as used (``TUNING_AIRCRAFT``). ``c182`` (added in the seventh session, 2026-11-22)
-#: is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its
-#: harness was set up (from JSBSim's truth and its XML), the method was never run on it before
-#: its final evaluation.
+#: thresholds; ``pa28`` (held out since 2026-11-21), ``j3cub`` (untouched until the sixth
+#: session's final evaluation, 2026-11-22) and ``c182`` (untouched until the seventh session's)
+#: have since been evaluated and their results read, so they count as used (``TUNING_AIRCRAFT``).
+#: ``t37`` (added in the eighth session, 2026-11-22) is the held-out, untouched case
+#: (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's
+#: truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -136,10 +140,37 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(_DEG / 25.5, _DEG / 17.5, _DEG / 16.0),
         amplitude_deg=(5.0, 5.0, 4.0), pulse_s=(0.7, 0.8, 1.0),
         notes="Cessna 182 (JSBSim c182), engine shut down, gliding; untouched by any tuning of the method"),
+    # t37: JSBSim's stock Cessna T-37 (T37.xml, Erik Hofman 2001), a twin-jet side-by-side trainer.
+    # Chosen after the c310 (its inertia, Ixx + Iyy < Izz, is not a physical tensor: the airframe
+    # file refuses it), the pc7 (its propwash terms read the windmilling propeller's thrust
+    # coefficient, -0.30 engine off, and cancel most of its pitch stiffness), the DHC6 (Cl_beta an
+    # even table in beta, Cn_beta negative below zero alpha, CmT on the windmilling thrust) and
+    # the L17 (its FCS reads fcs/flaps-pos-deg, which does not exist: JSBSim 1.3.3 cannot
+    # initialise it). Surfaces from its <flight_control> (aerosurface_scale, zero-centred):
+    # elevator -0.35..+0.30 rad, left aileron +-0.35 rad (the only aileron property the
+    # aerodynamics read), rudder +-0.35 rad; the elevator's command scale is the mean of its two
+    # ends (as the c182's). Signs read from its aerodynamics: Cmde -1.12 (Mach 0) * elevator-pos
+    # (positive = trailing edge down), Clda +0.181 (Mach 0) * left-aileron-pos (positive = left trailing edge
+    # down, roll right), Cndr -0.0365 * rudder-pos (positive = trailing edge left, nose left);
+    # checked on the truth by tests/jsbsim/test_jsbsim_t37.py. Gear up (retractable; its gear-down
+    # terms, CDgear, DCYbdf, DClrDg and the |beta| term DCnbDg, vanish with it). Engines off: the
+    # "direct" thrusters give no force. 130 kt CAS at 10000 ft: the sweep's slowest level, 97.5 kt,
+    # is 1.28 times the model's power-off stall (about 76 kt EAS: 4756 lb, CL_max 1.34 at 0.26 rad
+    # from its CLalpha table); the glide sinks about 12 m/s (L/D about 6), so it starts at 10000 ft
+    # to end a 120-s flight well above the ground. Elevator 3 deg (Cmde/Cm_alpha 1.6, Cmq -50),
+    # aileron 5 deg, rudder 6 deg (Cndr -0.0365 against Cn_beta 0.11: a third of a degree of
+    # sideslip per degree). Default gains. Set from the harness's truth only (alpha, beta, rates,
+    # excitation per axis; docs/jsbsim.md), never from a method result.
+    "t37": AircraftSpec(
+        name="t37", model="T37", airspeed_kts=150.0, altitude_ft=12000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.325, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
+        notes="Cessna T-37 (JSBSim T37), engines shut down, gear up, gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub")
-HELD_OUT_AIRCRAFT = ("c182",)
-UNTOUCHED_AIRCRAFT = ("c182",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182")
+HELD_OUT_AIRCRAFT = ("t37",)
+UNTOUCHED_AIRCRAFT = ("t37",)
 
 
 def aircraft(name: str) -> AircraftSpec:
@@ -178,7 +209,7 @@ def aircraft_argument(name: str) -> str:
 
 
 def summary_label(name: str) -> str:
-    """``name`` as the evaluation summaries print it: ``"c182 (untouched)"`` for the
+    """``name`` as the evaluation summaries print it: ``"t37 (untouched)"`` for the
     :data:`UNTOUCHED_AIRCRAFT`, ``"<name> (held out)"`` for the other :data:`HELD_OUT_AIRCRAFT`, the
     name alone for the aircraft used in tuning."""
     return name + (" (untouched)" if name in UNTOUCHED_AIRCRAFT else " (held out)" if name in HELD_OUT_AIRCRAFT else "")

@@ -380,6 +380,8 @@ def _set_ic(fdm: jsbsim.FGFDMExec, spec: AircraftSpec, cfg: FlightConfig) -> Non
         fdm[f"propulsion/engine[{i}]/set-running"] = 0
     fdm["fcs/throttle-cmd-norm"] = 0.0
     fdm["fcs/mixture-cmd-norm"] = 0.0
+    if spec.gear_up:
+        fdm["gear/gear-cmd-norm"] = 0.0
 
 
 def _deflections(fdm: jsbsim.FGFDMExec, spec: AircraftSpec) -> tuple[float, float, float]:
