@@ -5,6 +5,78 @@ import numpy as np
 
 from benchmarks.jsbsim_harness.truth import truth_coefficients, truth_regressors
 
+LB = 0.45359237          # kg per lb
+
+
+def short_flight_fixture(name: str):
+    """A module-scoped pytest fixture called ``name``: the fast tests' flight of aircraft ``name``
+    (30 s, light turbulence, seed 1, AHRS AOA_SSA, in a new temporary folder), one per test module;
+    its value is the harness ``FlightFiles``."""
+    import pytest
+
+    from benchmarks.jsbsim_harness import FlightConfig, make_flight
+
+    @pytest.fixture(scope="module", name=name)
+    def flight(tmp_path_factory):
+        config = FlightConfig(name, duration_s=30.0, turbulence="light", seed=1)
+        return make_flight(config, tmp_path_factory.mktemp(name))
+
+    return flight
+
+
+def assert_names_resolve(name: str, model: str, typo: str) -> None:
+    """The harness name ``name`` and the JSBSim model name ``model`` resolve to ``name`` in any case
+    and with spaces (``canonical_name``); the unknown ``typo`` raises a KeyError listing ``name``.
+
+    Raises:
+        AssertionError: one of these fails.
+    """
+    import re
+
+    import pytest
+
+    from benchmarks.jsbsim_harness import canonical_name
+
+    assert canonical_name(model) == canonical_name(f" {name.upper()} ") == canonical_name(name) == name
+    with pytest.raises(KeyError, match=f"unknown aircraft '{re.escape(typo)}' .*{re.escape(name)}"):
+        canonical_name(typo)
+
+
+def assert_rigid_body_glide(files, mass_lb: float) -> None:
+    """A harness flight's truth is a rigid body with the checked-in airframe file, gliding.
+
+    JSBSim's aerodynamic moments equal ``J w_dot + w x J w`` with the airframe file's J to 2e-3 of
+    their RMS (:func:`rigid_body_residual`), every non-gravity force and moment is aerodynamic
+    (:func:`non_aero_residual` under 1e-9: engines stopped), and the airframe file's mass is
+    JSBSim's, ``mass_lb`` lb.
+
+    Raises:
+        AssertionError: one of these fails.
+    """
+    import pytest
+
+    from gcs_sysid.airframe import load_airframe
+
+    tr, af, const = files.recording.truth, load_airframe(files.airframe), files.recording.constants
+    rel = rigid_body_residual(tr, af.inertia)
+    assert (rel < 2e-3).all(), rel
+    assert non_aero_residual(tr) < 1e-9
+    assert af.mass == pytest.approx(const["mass"], rel=1e-5) and const["mass"] == pytest.approx(mass_lb * LB, rel=1e-6)
+
+
+def assert_servos_map_back(files) -> None:
+    """The pipeline decodes every stream of a harness flight's .tlog, and its SERVO_OUTPUT_RAW maps
+    back through the airframe file to JSBSim's deflections within 0.1 deg, each surface moving
+    (standard deviation over 0.5 deg; :func:`decoded_servo_errors`).
+
+    Raises:
+        AssertionError: a stream is missing or a surface does not map back.
+    """
+    empty, errors = decoded_servo_errors(files)
+    assert empty == [], empty
+    for k, (err, std) in errors.items():
+        assert err < np.radians(0.1) and std > np.radians(0.5), k      # maps back; every surface moves
+
 
 def derivative_slopes(rec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Slopes of the exact Cm, Cl, Cn on their leading regressors (intercept fitted, not returned).
@@ -189,3 +261,123 @@ EVALUATION_FLIGHTS = [
     (1, "light", "sweep", [("delay:delta_e", 0.12)]),
     (2, "moderate", "standard", []),                             # eval_jsbsim, moderate turbulence
 ]
+
+#: The evaluation flights an untouched aircraft's envelope test flies: :data:`EVALUATION_FLIGHTS`
+#: and the evaluation's pair of effects.
+ENVELOPE_FLIGHTS = EVALUATION_FLIGHTS + [(1, "light", "sweep", [("Cm:alpha^2", -8.0), ("Cn:delta_a", -0.06)])]
+
+
+def assert_hidden_effects_in_jsbsim(spec, elevator_down_end_rad: float, n_side: int = 5,
+                                    n_elevator_reads: int = 2) -> None:
+    """Every hidden effect of ``effects.py`` as JSBSim computes it on ``spec``'s XML (the aircraft
+    tests' shared check).
+
+    At the harness's initial condition with alpha 4 deg and sideslip 4 deg (:func:`effect_state`,
+    ``n = 0``: the stock and the edited model at the same state) each injected moment
+    (``Cm:alpha^2`` = -8, ``Cl:alpha*beta`` = 3, ``Cn:delta_a`` = -0.06) is more than 10 lbf ft and
+    equals k times its regressor times qbar S c|b and the change of JSBSim's total aerodynamic
+    moment, to 1e-9 (:func:`injected_moment`); ``CY:scale`` = 1.6 multiplies the sum of the model's
+    ``n_side`` SIDE functions and the wind-axis side force ``forces/fwy-aero-lbs`` by 1.6;
+    ``delay:delta_e`` = 0.12 s holds the elevator the aerodynamics read 24 frames (200 Hz) behind
+    the surface, whose step to half the command reaches ``elevator_down_end_rad / 2`` (rad, the
+    trailing-edge-down end), and redirects all ``n_elevator_reads`` aerodynamic reads of
+    ``fcs/elevator-pos-rad``.
+
+    Raises:
+        AssertionError: one of these fails.
+    """
+    import copy
+    import xml.etree.ElementTree as ET
+
+    import pytest
+
+    from benchmarks.jsbsim_harness.effects import EFFECTS, Effect, inject_xml, stock_model_dir
+
+    assert set(EFFECTS) >= {"Cm:alpha^2", "Cl:alpha*beta", "Cn:delta_a", "CY:scale", "delay:delta_e"}
+    for name, k in (("Cm:alpha^2", -8.0), ("Cl:alpha*beta", 3.0), ("Cn:delta_a", -0.06)):
+        got, want, change = injected_moment(spec, name, k, n=0, alpha_deg=4.0)
+        assert abs(want) > 10.0, (name, want)                     # lbf ft
+        assert got == pytest.approx(want, rel=1e-9) and change == pytest.approx(got, rel=1e-9), (name, got, change)
+    root = ET.parse(stock_model_dir(spec) / f"{spec.model}.xml").getroot()
+    side = [f.get("name") for ax in root.iter("axis") if ax.get("name") == "SIDE" for f in ax.findall("function")]
+    assert len(side) == n_side, side
+    stock, scaled = (effect_state(spec, e, n=0, alpha_deg=4.0) for e in ([], [Effect("CY:scale", 1.6)]))
+    total = lambda fdm: sum(fdm[n] for n in side)   # noqa: E731
+    assert total(scaled) == pytest.approx(1.6 * total(stock), rel=1e-9) and abs(total(stock)) > 10.0
+    assert scaled["forces/fwy-aero-lbs"] / stock["forces/fwy-aero-lbs"] == pytest.approx(1.6, rel=1e-9)
+    pos, delayed = delay_trace(spec, 0.12)
+    assert pos[0] == pytest.approx(0.5 * elevator_down_end_rad, rel=1e-3)
+    assert np.all(delayed[:23] == 0.0) and delayed[23:] == pytest.approx(pos[0])
+    edited = inject_xml(copy.deepcopy(root), spec, [Effect("delay:delta_e", 0.12)])
+    reads = lambda r, p: sum((e.text or "").strip() == p for e in r.find("aerodynamics").iter("property"))  # noqa: E731
+    assert reads(root, "fcs/elevator-pos-rad") == n_elevator_reads and reads(edited, "fcs/elevator-pos-rad") == 0
+    assert reads(edited, "fcs/elevator-pos-delayed-rad") == n_elevator_reads
+
+
+def assert_airspeed_bias_in_log(files, out_dir, bias: float = 2.0) -> None:
+    """``bias:airspeed`` = ``bias`` m/s of TAS written into a second log of a harness flight.
+
+    Args:
+        files: the harness ``FlightFiles`` of a flight flown here (``recording`` set).
+        out_dir: folder for the biased .tlog.
+
+    Raises:
+        AssertionError: the decoded airspeed (EAS, from SCALED_PRESSURE) of the biased log minus
+            the clean log's (same seed, same sensor noise) differs from ``bias sqrt(rho / rho0)``
+            by more than 0.01 m/s at a sample.
+    """
+    from pathlib import Path
+
+    from benchmarks.jsbsim_harness import write_log
+    from benchmarks.jsbsim_harness.effects import RHO0, _bias_airspeed
+    from benchmarks.jsbsim_harness.sensors import make_sensors
+    from gcs_sysid.telemetry import read_log
+
+    rec, biased = files.recording, Path(out_dir) / "biased.tlog"
+    write_log(rec, biased, sensors=_bias_airspeed(make_sensors(rec, "ahrs"), rec, bias))
+    a, b = (read_log(p).streams["airspeed"] for p in (files.tlog, biased))
+    want = bias * np.sqrt(np.interp(a.t, rec.t, rec.truth["rho"]) / RHO0)
+    np.testing.assert_allclose(b.fields["eas"] - a.fields["eas"], want, atol=0.01)
+
+
+def evaluation_envelope(name: str, seed: int, turbulence: str, plan: str, effects, out_dir) -> dict:
+    """Fly one of the :data:`EVALUATION_FLIGHTS` (120 s) of aircraft ``name`` into ``out_dir``.
+
+    Returns:
+        ``flight_envelope`` of its truth file plus ``wild`` (True when ``Cl:alpha*beta`` is
+        injected: the effect that reverses the dihedral effect) and ``alt_min`` (lowest altitude
+        above sea level, m).
+    """
+    from benchmarks.jsbsim_harness import FlightConfig, make_flight
+    from benchmarks.jsbsim_harness.effects import Effect, make_effect_flight
+    from benchmarks.jsbsim_harness.envelope import flight_envelope
+
+    cfg = FlightConfig(name, duration_s=120.0, turbulence=turbulence, seed=seed, plan=plan)
+    files = (make_effect_flight(cfg, [Effect(n, v) for n, v in effects], out_dir) if effects
+             else make_flight(cfg, out_dir))
+    with np.load(files.truth) as z:
+        alt_min = float(z["alt"].min())
+    return flight_envelope(files.truth) | {"wild": any(n == "Cl:alpha*beta" for n, _ in effects), "alt_min": alt_min}
+
+
+def assert_in_envelope(e: dict, alpha, beta, bank, speed, rate_std: float, rate_std_held: float,
+                       alt_min: float = 0.0) -> None:
+    """An :func:`evaluation_envelope` inside the aircraft's limits, with every axis excited.
+
+    Args:
+        alpha: (lowest, highest) alpha, deg. beta, bank: (clean, ``wild``) largest abs(beta) and
+            bank, deg. speed: (lowest, highest) TAS, m/s. rate_std, rate_std_held: least standard
+            deviation of each body rate on the whole flight and the held-out last 20 %, deg/s.
+        alt_min: lowest altitude above sea level, m.
+
+    Raises:
+        AssertionError: a knock-it-off was flown, or a limit is exceeded; every surface moves by
+            more than 1 deg (standard deviation) and the glide sinks more than 3 m/s.
+    """
+    w = int(e["wild"])
+    assert e["aborts"] == [], e["aborts"]
+    assert alpha[0] < e["alpha"][0] and e["alpha"][1] < alpha[1], e["alpha"]
+    assert max(map(abs, e["beta"])) < beta[w] and e["bank_max"] < bank[w], e
+    assert speed[0] < e["V"][0] and e["V"][1] < speed[1], e["V"]
+    assert min(e["rate_std"]) > rate_std and min(e["rate_std_held"]) > rate_std_held, e      # deg/s
+    assert min(e["surface_std"]) > 1.0 and e["sink_mps"] > 3.0 and e["alt_min"] > alt_min, e
