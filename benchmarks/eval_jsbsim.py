@@ -34,8 +34,9 @@ Usage::
 ``pa28`` (held out since 2026-11-21), ``j3cub`` (the J-3 Cub, ``J3Cub`` also accepted; the
 sixth session's untouched aircraft) and ``c182`` (the seventh session's) have been evaluated and
 their results read: they count as used. ``t37`` (the Cessna T-37, ``T37`` also accepted) is the
-held-out, untouched one: never in the default list, evaluated once after the thresholds are frozen. A flight already in ``--work``, flown
-by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
+held-out, untouched one: never in the default list, evaluated once after the thresholds are
+frozen. A flight already in ``--work``, flown by the same harness with the same configuration, is
+reused (``make_flight(reuse=True)``:
 ``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
 (or finds) the flights there and stops. Results are appended as JSON lines to ``--json`` when given.
 """
