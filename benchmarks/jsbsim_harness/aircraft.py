@@ -157,15 +157,17 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # "direct" thrusters give no force. 130 kt CAS at 10000 ft: the sweep's slowest level, 97.5 kt,
     # is 1.28 times the model's power-off stall (about 76 kt EAS: 4756 lb, CL_max 1.34 at 0.26 rad
     # from its CLalpha table); the glide sinks about 12 m/s (L/D about 6), so it starts at 10000 ft
-    # to end a 120-s flight well above the ground. Elevator 3 deg (Cmde/Cm_alpha 1.6, Cmq -50),
-    # aileron 5 deg, rudder 6 deg (Cndr -0.0365 against Cn_beta 0.11: a third of a degree of
-    # sideslip per degree). Default gains. Set from the harness's truth only (alpha, beta, rates,
+    # to end a 120-s flight well above the ground. Elevator 4.5 deg (the c172x's 3 deg gave 1.7
+    # deg/s of pitch-rate standard deviation and 1.0 deg of elevator in the standard light
+    # flights: Cmq -50 and Iyy 8135 kg m^2 damp it; 4.5 deg gave 2.6 deg/s), aileron 5 deg, rudder
+    # 6 deg (Cndr -0.0365 against Cn_beta 0.11: a third of a degree of sideslip per degree).
+    # Default gains. Set from the harness's truth only (alpha, beta, rates,
     # excitation per axis; docs/jsbsim.md), never from a method result.
     "t37": AircraftSpec(
         name="t37", model="T37", airspeed_kts=150.0, altitude_ft=12000.0,
         elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
         cmd_per_rad=(1.0 / 0.325, 1.0 / 0.35, 1.0 / 0.35),
-        amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
+        amplitude_deg=(4.5, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
         notes="Cessna T-37 (JSBSim T37), engines shut down, gear up, gliding; untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182")
