@@ -32,7 +32,8 @@ set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag ter
 Added 2026-11-22 (issue 9): before step 2 an angle-of-attack error of the autopilot's AOA_SSA
 (``e0 + e1/V + e2 alpha/V``, from its wind estimate) is fitted on CX and CZ through the model's
 own derivatives and removed from every coefficient (:func:`angle_nuisance`); CY's library holds
-the model's own CY, a ``scale:CY`` candidate named with the factor as its estimate; reported
+the model's own side force (since branch i9-scale its wind-axis side force, :func:`scale_columns`), a
+``scale:CY`` candidate named with the factor as its estimate; reported
 standard errors are Morelli and Klein's all-lags form (sec. 5.3), the naming test keeps the
 Bartlett-window one the thresholds were frozen with.
 """
