@@ -10,13 +10,13 @@ Score per case:
   * ``top``: the injected cause is the top finding (for two effects: both among the findings);
   * ``est``: the estimate within 25 % of the injected value (aero terms: estimate minus the
     reference model's value of the term, i.e. the change; ``CY:scale``, named ``scale:CY``: the
-    estimated factor minus 1 against the *body-axis* equivalent of the injected factor, computed
-    from the flight's exact truth by :func:`side_force_scale_truth`: the harness scales JSBSim's
-    wind-axis side force by ``k``, the diagnosis's ``scale:CY`` scales the body-axis CY, whose
-    ``-C_D sin(beta)`` part does not scale, so the body-axis change is ``(k - 1)`` times
-    ``CY_beta,wind / (CY_beta,wind - C_D)``: 0.86 (k - 1) on the c172x, 0.93 on the SGS, 0.90 on the
-    PA-28, 0.74 on the J3Cub (``docs/jsbsim.md``);
-    before 2026-11-22 (branch i9-clean) it was scored against ``k - 1``);
+    estimated factor minus 1 against the injected ``k - 1``: the harness scales JSBSim's wind-axis
+    side force by ``k``, and the diagnosis's ``scale:CY`` candidate is the model's wind-axis side force
+    (:func:`gcs_sysid.diagnose.sparse.scale_columns`, since 2026-11-22, branch i9-scale). From branch
+    i9-clean until then it was scored against the body-axis equivalent of a single factor on the
+    model's body-axis CY, :func:`side_force_scale_truth` (0.74-0.93 (k - 1)), which is not what the
+    search's estimate is: the search fitted the factor with the drag's part beside it as a ``beta``
+    term whenever it selected one (``docs/jsbsim.md``); that value is kept as ``body_axis_value``);
   * ``gain``: held-out gain of that finding >= 50 %;
   * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);
   * clean flights: ``ok`` when no cause is named.
@@ -144,6 +144,9 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
 def side_force_scale_truth(truth_npz, k: float) -> float:
     """The body-axis equivalent ``f - 1`` of a wind-axis side-force scale ``k``, from a flight's exact truth.
 
+    Not the scored truth since 2026-11-22 (branch i9-scale; :func:`scoring_truth` scores ``k - 1``): it is
+    what a *single* factor on the body-axis CY reads, kept as ``body_axis_value`` for comparison.
+
     JSBSim sums its SIDE axis in wind axes; the effect multiplies that side force ``Y_w`` by ``k``. The
     body-axis side force is ``Y_b = cos(beta) Y_w - sin(beta) D`` (JSBSim's ``Tw2b``: body from wind,
     forces ``(-D, Y_w, -L)``; Stevens, Lewis and Johnson, *Aircraft Control and Simulation*, 3rd ed.,
@@ -174,13 +177,17 @@ def side_force_scale_truth(truth_npz, k: float) -> float:
 
 
 def scoring_truth(truth: dict, truth_npz) -> dict:
-    """The injected truth as scored: ``scale:CY``'s value replaced by its body-axis equivalent
-    (:func:`side_force_scale_truth`; the injected ``k - 1`` kept as ``wind_axis_value``)."""
+    """The injected truth as scored: ``scale:CY`` against the injected wind-axis ``k - 1`` (the
+    diagnosis's candidate is the model's wind-axis side force, :func:`gcs_sysid.diagnose.sparse.scale_columns`);
+    its body-axis single-factor equivalent (:func:`side_force_scale_truth`) is added as ``body_axis_value``
+    for comparison, never scored. Before 2026-11-22 (branch i9-scale) the body-axis value was scored."""
     out = dict(truth, injected=[dict(e) for e in truth["injected"]])
     for e in out["injected"]:
-        if e["cause"] == "scale:CY" and "wind_axis_value" not in e:
-            e["wind_axis_value"] = e["value"]
-            e["value"] = side_force_scale_truth(truth_npz, e.get("scale", 1.0 + e["value"]))
+        if e["cause"] == "scale:CY":
+            k = e.get("scale", 1.0 + e.get("wind_axis_value", e["value"]))
+            e["value"] = e["wind_axis_value"] = k - 1.0
+            if "body_axis_value" not in e:
+                e["body_axis_value"] = side_force_scale_truth(truth_npz, k)
     return out
 
 
@@ -238,7 +245,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
 
     On every clean flight the sparse search's residual (after the reference's inadequacy and the angle
     nuisance, ``keep_residual``) is fitted with the constant and the one term each effect is named by
-    (``_FORCED``; ``scale:CY`` as the model's own CY), on the training rows. Nothing was injected, so the
+    (``_FORCED``; ``scale:CY`` as the search's own candidate, the model's wind-axis side force), on the training rows. Nothing was injected, so the
     spread of these estimates over the clean flights is what a flight changes a term by when nothing
     changed: the between-flight error the test flight's coloured standard error does not hold.
 
@@ -263,7 +270,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
         res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, keep_residual=True)
         names, Phi = _library(ctx, knots)
         tr = res["rows"]["train"]
-        M = ctx.model_values()
+        M = res["scale_columns"]          # the candidates the search fits scale:<coef> with
         for cause, (coef, term) in _FORCED.items():
             j = COEFFICIENTS.index(coef)
             x = M[:, j] if term.startswith("scale:") else Phi[:, names.index(term)]
@@ -367,7 +374,7 @@ def main(argv=None) -> int:
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
     p.add_argument("--rescore", action="store_true",
                    help="with --summary: score the records again against today's scoring truth (scoring_truth: "
-                        "scale:CY against its body-axis equivalent), flights read from each file's folder")
+                        "scale:CY against the injected wind-axis k - 1), flights read from each file's folder")
     p.add_argument("--scatter-json", nargs="+", metavar="JSON",
                    help="with --summary: also the 2-se coverage with these scatter-<ac>.json files")
     p.add_argument("--scatter", action="store_true",

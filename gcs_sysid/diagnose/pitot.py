@@ -78,6 +78,10 @@ MIN_T_SCREEN = 2.0
 #: Largest coloured standard error (m/s) of one coefficient's estimate of the bias for it to take part in
 #: the coefficients' median (:func:`_fit_unit_delta`).
 MAX_SE_COEF_MPS = 0.5
+#: The exact re-fit's coefficient estimates are changes since the reference flight(s) re-fitted the same way
+#: (:func:`_rereduced_baseline`), not minus the closed-form fit's reference value (added 2026-11-22, branch
+#: i9-scale; freeze time in ``docs/benchmarks.md``).
+DIFFERENTIAL_REREDUCED = True
 
 
 def wind_shift(ctx: DiagContext, flight) -> dict | None:
@@ -314,12 +318,19 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
         return out
     D1 = _unit_delta_rereduced(ctx, flight, out["screen"]["linearise_at_mps"])
     if D1 is not None:
-        b_c, se_c, per_coef = _fit_unit_delta(ctx, R, D1)
-        coef_change = b_c - ref_b
-        coef_se = float(np.sqrt(se_c ** 2 + ref_se ** 2 + COEF_SYSTEMATIC_MPS ** 2))
+        # the same exact re-fit on the reference flight(s), coefficient by coefficient: the differential
+        # baseline of each coefficient's estimate (_rereduced_baseline); without one, the closed-form
+        # reference value as before
+        base = _rereduced_baseline(references, airframe, model, out["screen"]["linearise_at_mps"]) \
+            if DIFFERENTIAL_REREDUCED else None
+        b_c, se_c, per_coef = _fit_unit_delta(ctx, R, D1, base)
+        coef_change = b_c - (0.0 if base else ref_b)
+        coef_se = float(np.sqrt(se_c ** 2 + (0.0 if base else ref_se ** 2) + COEF_SYSTEMATIC_MPS ** 2))
         fused = fuse_pitot_evidence(change, coef_change, coef_se)
         out["fused"] = fused
-        out["coefficients_rereduced"] = {"estimate": float(b_c), "std_error": float(se_c), "by_coefficient": per_coef}
+        out["coefficients_rereduced"] = {"estimate": float(b_c), "std_error": float(se_c), "by_coefficient": per_coef,
+                                         "baseline": "re-reduced reference flight(s), per coefficient" if base
+                                         else "closed-form reference value"}
         if fused is None:
             # reached on the wind triangle alone (screen), the re-fit found no coefficient that carries
             # the bias (no finite estimate): nothing to confirm it with, so no finding
@@ -402,9 +413,15 @@ def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float) -> np.ndarray | N
     return np.where(np.isfinite(D), D, 0.0) / b0
 
 
-def _fit_unit_delta(ctx: DiagContext, R: np.ndarray, D1: np.ndarray) -> tuple[float, float, dict]:
+def _fit_unit_delta(ctx: DiagContext, R: np.ndarray, D1: np.ndarray,
+                    baseline: dict | None = None) -> tuple[float, float, dict]:
     """Pitot bias from the coefficients with its exact per-m/s effect ``D1`` (T, 6): one estimate per
     coefficient, combined by their median.
+
+    With ``baseline`` (``{coef: {"estimate", "std_error"}}``, the same fit on the reference flight(s),
+    :func:`_rereduced_baseline`) each coefficient's estimate is its *change* since the reference: the
+    reference's value is subtracted and its standard error added in quadrature before the median, and
+    a coefficient takes part only when it resolves the bias on both flights.
 
     Each coefficient ``j`` gives ``b_j`` from ``R_j + b_j D1_j ~ 0`` on the selection rows with both
     sides' means removed (the between-flight offset allowance of :mod:`gcs_sysid.diagnose.physical`: the
@@ -435,6 +452,13 @@ def _fit_unit_delta(ctx: DiagContext, R: np.ndarray, D1: np.ndarray) -> tuple[fl
         se = float(np.sqrt(max(colored_covariance(d[:, None], r + b * d)[0, 0], 0.0)))
         used = bool(np.isfinite(b) and 0 < se <= MAX_SE_COEF_MPS)
         per[c] = {"estimate": b, "std_error": se, "used": used}
+        if baseline is not None:
+            ref = baseline.get(c)
+            used = bool(used and ref is not None and ref["used"])
+            if ref is not None and np.isfinite(ref["estimate"]):
+                b, se = b - ref["estimate"], float(np.hypot(se, ref["std_error"]))
+            per[c] = {"estimate": b, "std_error": se, "used": used, "flight": per[c]["estimate"],
+                      "reference": None if ref is None else ref["estimate"]}
         if used:
             est.append(b)
             ses.append(se)
@@ -445,6 +469,53 @@ def _fit_unit_delta(ctx: DiagContext, R: np.ndarray, D1: np.ndarray) -> tuple[fl
     mad = float(np.median(np.abs(est - b)))
     se = max(1.2533 * 1.4826 * mad / np.sqrt(len(est)), float(np.min(ses)))
     return b, float(se), per
+
+
+def _rereduced_baseline(references, airframe, model, b0: float) -> dict | None:
+    """Each coefficient's exact re-fit of the pitot bias (:func:`_fit_unit_delta`) on the reference flight(s).
+
+    Why: the re-fit removes each coefficient's mean (the between-flight offset allowance), and what is left
+    of the model's own inadequacy correlates with the bias's per-m/s effect (which scales every coefficient by
+    ``(V / (V + b))^2``, so it follows the speed sweep). On the C182 the re-fit reads -0.18 m/s on the
+    clean reference and -0.23 on a clean test flight, and a 1 m/s bias read 0.66, then 0.65 after fusion
+    with the wind triangle, because the baseline subtracted was the closed-form fit's (+0.01), a different
+    estimator. The change of the *same* estimator since the reference, coefficient by coefficient, is
+    the differential measurement (as ``b - b_ref`` is for the wind triangle). Costs one more re-reduction
+    of each reference flight, only when the screen passed.
+
+    Args:
+        references: :class:`~gcs_sysid.diagnose.differential.Reference` flights (decoded flight and states).
+        airframe, model: those of the diagnosis. b0: the bias (m/s) the flight's re-fit is linearised at.
+
+    Returns:
+        ``{coef: {"estimate", "std_error", "used"}}`` (inverse-variance mean over the references of the
+        coefficients each resolves), or None when no reference can be re-reduced.
+    """
+    acc: dict[str, list] = {}
+    for ref in references or ():
+        if getattr(ref, "flight", None) is None or getattr(ref, "states", None) is None:
+            continue
+        try:
+            rctx = DiagContext.build(ref.table, airframe, model, ref.states, None, None)
+            D1 = _unit_delta_rereduced(rctx, ref.flight, b0)
+            if D1 is None:
+                continue
+            _, _, per = _fit_unit_delta(rctx, np.nan_to_num(rctx.Y - rctx.model_values()), D1)
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+            continue
+        for c, v in per.items():
+            acc.setdefault(c, []).append(v)
+    if not acc:
+        return None
+    out = {}
+    for c, vs in acc.items():
+        ok = [v for v in vs if np.isfinite(v["estimate"]) and v["std_error"] > 0]
+        if not ok:
+            continue
+        w = np.array([1.0 / v["std_error"] ** 2 for v in ok])
+        out[c] = {"estimate": float(np.sum(w * [v["estimate"] for v in ok]) / w.sum()),
+                  "std_error": float(1.0 / np.sqrt(w.sum())), "used": all(v["used"] for v in ok)}
+    return out or None
 
 
 def _reference_triangles(references, airframe, model) -> list[dict]:

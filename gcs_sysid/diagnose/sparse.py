@@ -32,7 +32,8 @@ set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag ter
 Added 2026-11-22 (issue 9): before step 2 an angle-of-attack error of the autopilot's AOA_SSA
 (``e0 + e1/V + e2 alpha/V``, from its wind estimate) is fitted on CX and CZ through the model's
 own derivatives and removed from every coefficient (:func:`angle_nuisance`); CY's library holds
-the model's own CY, a ``scale:CY`` candidate named with the factor as its estimate; reported
+the model's own side force (since branch i9-scale its wind-axis side force, :func:`scale_columns`), a
+``scale:CY`` candidate named with the factor as its estimate; reported
 standard errors are Morelli and Klein's all-lags form (sec. 5.3), the naming test keeps the
 Bartlett-window one the thresholds were frozen with.
 """
@@ -51,7 +52,7 @@ from .regression import ols
 from .search import alpha_quantile_knots, candidate_library, press_stepwise
 
 __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
-           "angle_nuisance", "untouched_confirmation"]
+           "angle_nuisance", "untouched_confirmation", "scale_columns"]
 
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out). Added and
@@ -93,6 +94,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: minus the reference flight's, each fitted through the model's response on its own residual, without the
 #: reference's ridge inadequacy, :func:`_differential_delay`; off: refined on the search's differential
 #: residual, which read the J3Cub's 0.12 s as 0.085 s).
+#: Added 2026-11-22 (branch i9-scale; set on the J3Cub's and checked on the PA-28's and C182's ``CY:scale``
+#: flights, freeze time in ``docs/benchmarks.md``): ``side_force_wind_axis`` (the ``scale:CY`` candidate is
+#: the model's *wind-axis* side force in body axes, :func:`scale_columns`, not the body-axis CY: a scaled
+#: side force leaves the drag's ``-sin(beta) C_D`` part of the body-axis CY alone).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -101,7 +106,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
-              "delay_differential": True}
+              "delay_differential": True, "side_force_wind_axis": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -504,6 +509,42 @@ def angle_nuisance(ctx: DiagContext, R: np.ndarray, rows: np.ndarray, model: dic
     return out * act[None, :], info, err
 
 
+def scale_columns(M: np.ndarray, X: np.ndarray, wind_axis: bool = True) -> np.ndarray:
+    """The candidate column of each ``scale:<coef>``: what a scale of that coefficient adds per unit of ``k - 1``.
+
+    For every coefficient but CY it is the model's own value. A side force is an aerodynamic force
+    normal to the air velocity: the side-force coefficient of wind axes, ``C_Yw`` (JSBSim's SIDE axis;
+    Stevens, Lewis and Johnson, *Aircraft Control and Simulation*, 3rd ed., sec. 2.3, the wind-to-body
+    rotation). The body-axis CY the project measures is ``CY = cos(beta) C_Yw - sin(beta) C_D`` (body
+    forces ``(-D, Y_w, -L)`` rotated by ``beta`` and ``alpha``), and the drag's part does not scale with the
+    side force. With ``C_D = -cos(alpha) CX - sin(alpha) CZ`` and ``C_Yw = cos(beta) CY + sin(beta) C_D``
+    (the same rotation, inverted), a side force ``k`` times the model's adds ``(k - 1) cos(beta) C_Yw`` to
+    the body-axis CY: that is the CY column here (``wind_axis``). Fitted on the body-axis CY alone, the
+    factor is a mix of the rate and control terms' true ``k - 1`` and the sideslip slope's smaller
+    ``(k - 1) C_Yw,beta / (C_Yw,beta - C_D)`` (0.74 (k - 1) on the gliding J3Cub, ``C_D`` about a quarter of
+    ``|C_Yw,beta|``), and which one it reads depends on whether the search also selects a ``beta`` term
+    (which then takes the drag's ``(k - 1) C_D beta``; measured on the J3Cub: +0.032 for 0.029).
+
+    Without a thrust model the model's CX holds the thrust too, and ``C_D`` here is then drag minus thrust;
+    the correction is ``sin(beta)`` small, so the column degrades towards the body-axis CY, not worse.
+
+    Args:
+        M: (T, 6) the model's coefficients (columns :data:`~gcs_sysid.aero.table.COEFFICIENTS`).
+        X: (T, 10) the regressors the model was evaluated at (alpha, beta in rad).
+        wind_axis: False: CY's column is the model's CY (the rule before 2026-11-22, branch i9-scale).
+
+    Returns:
+        (T, 6) the columns (NaN where ``M`` or the angles are).
+    """
+    out = np.array(M, float, copy=True)
+    if wind_axis:
+        a, b = X[:, REGRESSORS.index("alpha")], X[:, REGRESSORS.index("beta")]
+        jx, jy, jz = (COEFFICIENTS.index(c) for c in ("CX", "CY", "CZ"))
+        c_d = -np.cos(a) * M[:, jx] - np.sin(a) * M[:, jz]
+        out[:, jy] = np.cos(b) * (np.cos(b) * M[:, jy] + np.sin(b) * c_d)
+    return out
+
+
 def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext, np.ndarray] | None = None,
                   folds: int = 5, segment_frac: float = 0.2, max_rows: int = 4000,
                   thresholds: dict | None = None, keep_residual: bool = False) -> dict:
@@ -564,7 +605,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 e = Rr[rows, j] - ((rPhi[rows] - mu) / sc) @ W[:, j]
                 ref_ms[j] = float(np.mean((e - e.mean()) ** 2))
                 if ref_after is None:
-                    ref_after = (rnames, rPhi, np.zeros_like(Rr), rows, np.nan_to_num(rctx.Y) - Rr)
+                    ref_after = (rnames, rPhi, np.zeros_like(Rr), rows,
+                                 np.nan_to_num(scale_columns(np.nan_to_num(rctx.Y) - Rr, np.nan_to_num(rctx.X),
+                                                             bool(th.get("side_force_wind_axis", False)))))
                 ref_after[2][rows, j] = e
                 result["inadequacy"].append({"coefficient": coef, "model": "ridge", "lambda": float(lam[j]),
                                              "rms_explained": float(np.std(((rPhi[rows] - mu) / sc) @ W[:, j]))})
@@ -622,8 +665,12 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["lift_alpha"] = info2
         if np.any(err):                    # the library on the corrected angles
             names, Phi = _library(replace(ctx, X=Xc), knots)
+    # the scale candidates on the angles the library uses (corrected by the nuisance when it ran)
+    S0 = np.nan_to_num(scale_columns(M0, np.nan_to_num(Xc if th.get("angle_nuisance", True) else ctx.X),
+                                     bool(th.get("side_force_wind_axis", False))))
     if keep_residual:
         result["residual"], result["rows"] = Rd.copy(), {"train": tr, "untouched": te}
+        result["scale_columns"] = S0
     named: list[dict] = []
     for rnd in range(th["rounds"]):
         entries, cands = [], []
@@ -632,7 +679,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 continue
             # the coefficient's own model prediction: a scale of the whole coefficient ("scale:CY",
             # a side force k times the model's: its residual is (k - 1) times the model's CY)
-            cnames, cPhi = (names + [f"scale:{coef}"], np.column_stack([Phi, M0[:, j]])) \
+            # (CY: the model's wind-axis side force, scale_columns)
+            cnames, cPhi = (names + [f"scale:{coef}"], np.column_stack([Phi, S0[:, j]])) \
                 if coef in th.get("scale_coefficients", ()) else (names, Phi)
             entry, _ = _fit_coefficient(cnames, cPhi, Rd[:, j], tr, te, folds, th, max_rows)
             entry["coefficient"] = coef
@@ -687,13 +735,13 @@ def _with_reference_error(f: dict, ref_after) -> None:
     """
     if f["cause"].startswith("delay:") or not np.isfinite(f.get("std_error", np.nan)):
         return
-    rnames, rPhi, Rr, rows, M0r = ref_after
+    rnames, rPhi, Rr, rows, S0r = ref_after
     j = COEFFICIENTS.index(f["coefficient"])
     idx = {n: i for i, n in enumerate(rnames)}
     cols = []
     for t in f["evidence"].get("terms", []):
         if t["term"] == f"scale:{f['coefficient']}":
-            cols.append(M0r[:, j])
+            cols.append(S0r[:, j])
         elif t["term"] in idx:
             cols.append(rPhi[:, idx[t["term"]]])
         else:

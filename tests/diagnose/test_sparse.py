@@ -243,3 +243,54 @@ def test_one_standard_error_rule_prefers_the_polynomial_over_a_hinge():
     brk = -0.6 * np.maximum(0.0, a - np.radians(1.5)) + 0.0005 * rng.normal(size=a.size)
     brk -= brk.mean()
     assert [names[k] for k in _prefer_smooth(A, brk, fold, [ih], names, 1.0)] == ["max(0,alpha-1.5deg)"]
+
+
+def _wind_axes_to_body(a, b, D, Yw, L):
+    """Body-axis (CX, CY, CZ) of wind-axis drag, side force and lift (JSBSim's ``Tw2b``, forces
+    ``(-D, Y_w, -L)``; Stevens, Lewis and Johnson 3rd ed. sec. 2.3)."""
+    ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+    return (ca * cb * -D - ca * sb * Yw - sa * -L, sb * -D + cb * Yw, sa * cb * -D - sa * sb * Yw + ca * -L)
+
+
+def test_scale_columns_hold_the_wind_axis_side_force():
+    """A side force k times the model's adds ``(k - 1) cos(beta) C_Yw`` to the body-axis CY, not ``(k - 1) CY``:
+    the drag's ``-sin(beta) C_D`` part does not scale. The CY column is exactly that; fitted on it, the change
+    reads k - 1, fitted on the body-axis CY it reads ``(k - 1) C_Yw,beta / (C_Yw,beta - C_D)``."""
+    from gcs_sysid.diagnose.sparse import scale_columns
+
+    rng = np.random.default_rng(3)
+    T, k = 4000, 1.6
+    a, b = np.radians(3.0 + rng.normal(0, 2.0, T)), np.radians(rng.normal(0, 4.0, T))
+    D, Yw, L = 0.08 + 0.5 * a ** 2, -0.2 * b, 0.4 + 5.0 * a
+    CX, CY, CZ = _wind_axes_to_body(a, b, D, Yw, L)
+    M = np.zeros((T, 6))
+    M[:, 0], M[:, 1], M[:, 2], M[:, 4] = CX, CY, CZ, 0.3
+    X = np.zeros((T, 10))
+    X[:, 0], X[:, 1] = a, b
+    S = scale_columns(M, X)
+    assert S[:, 1] == pytest.approx(np.cos(b) * Yw, abs=1e-12)
+    assert np.array_equal(np.delete(S, 1, axis=1), np.delete(M, 1, axis=1))
+    assert np.array_equal(scale_columns(M, X, wind_axis=False), M)
+    dCY = _wind_axes_to_body(a, b, D, k * Yw, L)[1] - CY
+    fit = lambda x: np.linalg.lstsq(np.c_[np.ones(T), x], dCY, rcond=None)[0][1]  # noqa: E731
+    assert fit(S[:, 1]) == pytest.approx(k - 1, rel=1e-6)
+    assert fit(CY) == pytest.approx((k - 1) * -0.2 / (-0.2 - 0.08), rel=0.03)      # 0.43, not 0.6
+
+
+@pytest.mark.slow
+def test_a_wind_axis_side_force_scale_reads_k_minus_1(airframe):
+    """The synthetic flight's wind-axis side force (the model's, rotated with its drag) scaled by 1.6: the
+    search's ``scale:CY`` reads 0.6 on the wind-axis column and less on the body-axis CY (the rule before)."""
+    from gcs_sysid.diagnose.sparse import scale_columns
+
+    ref = _ctx(airframe, seed=4)
+    ctx, _ = _ctx(airframe, seed=5)
+    extra = 0.6 * scale_columns(ctx.model_values(), ctx.X)[:, 1]
+    got = {}
+    for wind in (True, False):
+        c2, R = _ctx(airframe, [(1, lambda t: extra)], seed=5)
+        res = sparse_search(c2, R, reference=ref, thresholds={"side_force_wind_axis": wind})
+        f = [f for f in res["findings"] if f["cause"] == "scale:CY"]
+        got[wind] = f[0]["estimate"] if f else None
+    assert got[True] == pytest.approx(1.6, abs=0.02), got
+    assert got[False] is None or got[False] < got[True] - 0.02, got
