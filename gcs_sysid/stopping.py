@@ -13,18 +13,27 @@ output folder, stop the worker process), prints one line and ends the process wi
 Before the clean-ups run, the main thread is stopped at its next Python instruction: the watcher
 raises :class:`Stopped` in it (CPython's asynchronous exception), and the command's entry point
 catches it and :func:`park` s, so that no writer puts back a folder the clean-up just removed; from
-then on only the one line reaches stderr (the rest goes to the null device). Clean-ups are
+then on only the one line reaches stderr (the rest goes to the null device). The one place the
+main thread is not interrupted is an import: an exception raised in the Python code that an extension
+module's initialisation calls (jaxlib's ``xla_extension``, imported while the worker decodes) crashed
+the process with SIGSEGV or SIGABRT instead of ending it with 143 (16 of 30 SIGTERMs sent 0.1-0.5 s
+into a replay, measured 2026-11-22). So the watcher first takes the interpreter's import lock, which
+it keeps until the process ends (no import can start in another thread), and raises :class:`Stopped`
+only if the main thread is not inside one; a main thread inside an import writes no output and
+ends with the process. Clean-ups are
 registered by what creates something to clean (:mod:`gcs_sysid.outdir`,
 :mod:`gcs_sysid.parallel`); :func:`critical` marks a short section that must not be cut in half
 (moving finished outputs into place): a stop waits for it to end.
 
 References:
     Python documentation, ``signal.set_wakeup_fd`` and "Note on Signal Handlers and Exceptions",
-    https://docs.python.org/3/library/signal.html
+    https://docs.python.org/3/library/signal.html; C API ``PyThreadState_SetAsyncExc``; ``_imp.acquire_lock``
+    (the global import lock that ``importlib._bootstrap`` takes before every module lock).
 """
 
 from __future__ import annotations
 
+import _imp
 import itertools
 import os
 import signal
@@ -67,14 +76,33 @@ def park() -> None:
         threading.Event().wait(3600.0)
 
 
-def _interrupt_main() -> None:
-    """Raise :class:`Stopped` in the main thread at its next bytecode (CPython's asynchronous exception)."""
+def _importing(ident: int) -> bool:
+    """Whether the thread ``ident`` is inside an import (a frame of ``importlib._bootstrap`` on its stack)."""
+    frame = sys._current_frames().get(ident)
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _interrupt_main() -> bool:
+    """Raise :class:`Stopped` in the main thread at its next bytecode (CPython's asynchronous exception),
+    unless it is inside an import; returns whether it was raised.
+
+    Takes the interpreter's import lock first and never releases it (the process is ending), so the main
+    thread cannot enter an import between the check and the exception.
+    """
     import ctypes
 
     main = threading.main_thread()
     if threading.current_thread() is main or main.ident is None:
-        return
+        return False
+    _imp.acquire_lock()
+    if _importing(main.ident):
+        return False
     ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(main.ident), ctypes.py_object(Stopped))
+    return True
 
 
 def register(cleanup: Callable[[], str | None]) -> int:
@@ -123,8 +151,8 @@ def _stop(signum: int) -> None:
     with _critical:   # a commit in progress finishes first (it takes milliseconds)
         # the main thread stops writing before its staging outputs are removed: otherwise a writer that
         # creates its folder (mkdir(parents=True)) puts the staging folder back after the clean-up
-        _interrupt_main()
-        _parked.wait(PARK_WAIT_S)
+        if _interrupt_main():
+            _parked.wait(PARK_WAIT_S)
         with _lock:
             todo = list(_cleanups.values())[::-1]
             _cleanups.clear()

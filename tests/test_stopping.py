@@ -1,0 +1,51 @@
+"""gcs_sysid.stopping: a signal during an import ends the process cleanly, without raising inside it.
+
+An exception raised into Python code that an extension module's initialisation calls (jaxlib's
+``xla_extension``, imported while a replay's worker decodes) crashed the replay with SIGSEGV/SIGABRT
+instead of 143. The watcher now leaves a main thread that is inside an import alone. This test puts the
+main thread in a slow pure-Python import (a busy loop at module level, which would take the
+asynchronous exception at once) and checks that nothing is raised inside it and that the process still
+ends with 143 and its one line.
+"""
+
+import signal
+import subprocess
+import sys
+import time
+
+SCRIPT = r'''
+import pathlib, sys, time
+from gcs_sysid import stopping
+tmp = pathlib.Path(sys.argv[1])
+(tmp / "slowmod.py").write_text(
+    "import pathlib, sys, time\n"
+    "try:\n"
+    "    t_end = time.monotonic() + 20.0\n"
+    "    while time.monotonic() < t_end:\n"
+    "        pass\n"
+    "except BaseException as e:\n"
+    "    pathlib.Path(sys.argv[1], 'raised-inside-import').write_text(type(e).__name__)\n"
+    "    raise\n")
+sys.path.insert(0, str(tmp))
+stopping.install()
+print("importing", flush=True)
+try:
+    import slowmod
+except stopping.Stopped:
+    stopping.park()
+'''
+
+
+def test_signal_inside_an_import_is_not_raised_into_it(tmp_path):
+    proc = subprocess.Popen([sys.executable, "-c", SCRIPT, str(tmp_path)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "importing"
+    time.sleep(0.3)   # well inside the 20-s import
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=30)
+    took = time.monotonic() - t0
+    assert not (tmp_path / "raised-inside-import").exists(), "Stopped was raised inside the import"
+    assert proc.returncode == 128 + signal.SIGTERM, (proc.returncode, stderr)
+    assert stderr.strip() == "gcs-sysid: stopped by SIGTERM", stderr
+    assert took < 3.0, took
