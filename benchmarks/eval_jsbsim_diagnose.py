@@ -130,7 +130,8 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
     t0 = time.perf_counter()
-    meas = load_measurements(files.tlog, files.airframe)
+    # as run_diagnose does: the test flight's alpha aided with the reference's force model (one alpha scale)
+    meas = load_measurements(files.tlog, files.airframe, angle_models=ref_meas.states.angle_fits)
     from gcs_sysid.diagnose.differential import Reference
 
     # as the CLI does with the flight recorded in <model>.fit.json: the reference carries its decoded
@@ -258,7 +259,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     est: dict[str, list[float]] = {c: [] for c in _FORCED}
     for cs in clean_seeds:
         files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan), [], out)
-        m = load_measurements(files.tlog, files.airframe)
+        m = load_measurements(files.tlog, files.airframe, angle_models=ref_meas.states.angle_fits)
         ctx = DiagContext.build(m.table, m.airframe, model, m.states)
         res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, keep_residual=True)
         names, Phi = _library(ctx, knots)

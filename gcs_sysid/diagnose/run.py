@@ -49,7 +49,8 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
 
 
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
-                      progress=None, notify=None, gust_rates: str | None = None) -> Measurements:
+                      progress=None, notify=None, gust_rates: str | None = None,
+                      angle_models: dict | None = None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
@@ -57,6 +58,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         airframe_path: airframe TOML.
         t_from, t_to: vehicle-time window, s (None = open).
         notify: called with one line per damage found in the log (None: not shown).
+        angle_models: a reference flight's ``states.angle_fits``: this flight's alpha is aided with its
+            force model (one alpha scale for both; :func:`gcs_sysid.estimation.estimate_states`). None: own.
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
@@ -89,7 +92,7 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         t1 = time.perf_counter()
         helper.preload(["gcs_sysid.estimation.rates"])
         states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
-                                 if progress is not None else None, helper=helper)
+                                 if progress is not None else None, helper=helper, angle_models=angle_models)
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
@@ -151,8 +154,12 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     t0 = time.perf_counter()
     model = load_model(model_path)
     with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
-        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
+        # the references first: this flight's alpha is aided with the first reference's force model, so that
+        # the two flights' alpha share one scale (a per-flight fitted CZ_alpha scales it by a few per cent)
         kw = {**kw, **_references(model_path, airframe_path, references, progress)}
+        refs = kw.get("references") or []
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify,
+                                 angle_models=getattr(refs[0].states, "angle_fits", None) if refs else None)
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag
