@@ -48,6 +48,14 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
                          f"{airframe.source or 'the airframe file'}")
 
 
+#: Aid the flight's alpha with the first reference flight's CZ slopes, so that the two flights' alpha share
+#: one scale (``estimate_states(angle_models=...)``, docs/estimation.md). Off: on the JSBSim ``Cm:alpha^2``
+#: cases it moved one J3Cub and one c182 estimate into 25 % and lost one c182 top finding, and on the
+#: project's own sim it turned the CLI test's delay into ``Cm:delta_e`` (docs/benchmarks.md, "Eighth
+#: session, i8-alpha").
+SHARE_ALPHA_MODEL = False
+
+
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
                       progress=None, notify=None, gust_rates: str | None = None,
                       angle_models: dict | None = None) -> Measurements:
@@ -154,12 +162,10 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     t0 = time.perf_counter()
     model = load_model(model_path)
     with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
-        # the references first: this flight's alpha is aided with the first reference's force model, so that
-        # the two flights' alpha share one scale (a per-flight fitted CZ_alpha scales it by a few per cent)
         kw = {**kw, **_references(model_path, airframe_path, references, progress)}
         refs = kw.get("references") or []
-        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify,
-                                 angle_models=getattr(refs[0].states, "angle_fits", None) if refs else None)
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=getattr(
+            refs[0].states, "angle_fits", None) if SHARE_ALPHA_MODEL and refs else None)
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag
