@@ -130,7 +130,12 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
     t0 = time.perf_counter()
-    meas = load_measurements(files.tlog, files.airframe)
+    # as run_diagnose does: with SHARE_ALPHA_MODEL the test flight's alpha is aided with the reference's
+    # force model (one alpha scale for both)
+    from gcs_sysid.diagnose import run as diagnose_run
+
+    meas = load_measurements(files.tlog, files.airframe, angle_models=ref_meas.states.angle_fits
+                             if diagnose_run.SHARE_ALPHA_MODEL else None)
     from gcs_sysid.diagnose.differential import Reference
 
     # as the CLI does with the flight recorded in <model>.fit.json: the reference carries its decoded
@@ -381,7 +386,14 @@ def main(argv=None) -> int:
                    help="also fit each effect's term on the clean flights (flight-to-flight scatter, scatter-<ac>.json)")
     p.add_argument("--sparse-thresholds", default="{}", metavar="JSON",
                    help="overrides of gcs_sysid.diagnose.sparse.THRESHOLDS for this run (a variant, not the frozen set)")
+    p.add_argument("--share-alpha-model", action="store_true",
+                   help="aid each flight's alpha with the reference flight's CZ slopes "
+                        "(gcs_sysid.diagnose.run.SHARE_ALPHA_MODEL; off by default)")
     a = p.parse_args(argv)
+    if a.share_alpha_model:
+        from gcs_sysid.diagnose import run as diagnose_run
+
+        diagnose_run.SHARE_ALPHA_MODEL = True
     if json.loads(a.sparse_thresholds):
         from gcs_sysid.diagnose import sparse
 

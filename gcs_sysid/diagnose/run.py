@@ -48,8 +48,17 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
                          f"{airframe.source or 'the airframe file'}")
 
 
+#: Aid the flight's alpha with the first reference flight's CZ slopes, so that the two flights' alpha share
+#: one scale (``estimate_states(angle_models=...)``, docs/estimation.md). Off: on the JSBSim ``Cm:alpha^2``
+#: cases it moved one J3Cub and one c182 estimate into 25 % and lost one c182 top finding, and on the
+#: project's own sim it turned the CLI test's delay into ``Cm:delta_e`` (docs/benchmarks.md, "Eighth
+#: session, i8-alpha").
+SHARE_ALPHA_MODEL = False
+
+
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
-                      progress=None, notify=None, gust_rates: str | None = None) -> Measurements:
+                      progress=None, notify=None, gust_rates: str | None = None,
+                      angle_models: dict | None = None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
@@ -57,6 +66,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         airframe_path: airframe TOML.
         t_from, t_to: vehicle-time window, s (None = open).
         notify: called with one line per damage found in the log (None: not shown).
+        angle_models: a reference flight's ``states.angle_fits``: this flight's alpha is aided with its
+            force model (one alpha scale for both; :func:`gcs_sysid.estimation.estimate_states`). None: own.
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
@@ -89,7 +100,7 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         t1 = time.perf_counter()
         helper.preload(["gcs_sysid.estimation.rates"])
         states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
-                                 if progress is not None else None, helper=helper)
+                                 if progress is not None else None, helper=helper, angle_models=angle_models)
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
@@ -151,8 +162,10 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     t0 = time.perf_counter()
     model = load_model(model_path)
     with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
-        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify)
         kw = {**kw, **_references(model_path, airframe_path, references, progress)}
+        refs = kw.get("references") or []
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=getattr(
+            refs[0].states, "angle_fits", None) if SHARE_ALPHA_MODEL and refs else None)
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag

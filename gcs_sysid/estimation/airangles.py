@@ -100,7 +100,8 @@ class AxisFit:
         moment_rss: (kinematic, aided) residual variance of the moment cross-check, each as a share of
             the moment coefficients' variance (NaN: no moments given).
         slope_method: how the slopes were fitted: ``"2SLS"`` (alpha: the elevator and its delayed copies
-            instrument the angle, :func:`gcs_sysid.estimation.angleerrors.iv_lstsq`) or ``"OLS"``.
+            instrument the angle, :func:`gcs_sysid.estimation.angleerrors.iv_lstsq`), ``"OLS"`` or ``"given"``
+            (another flight's slopes, :func:`aided_air_angles` ``models``), followed by a note when a model was given.
         first_stage_r2: the instruments' first-stage partial R^2 (NaN: no instruments).
         bias_sigma: 1-sigma of the angle's flight-common offset, rad (alpha: the flight-mean vertical
             wind over the airspeed, :func:`gcs_sysid.estimation.angleerrors.mean_wind_sigma`; NaN for beta,
@@ -230,7 +231,7 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
-          V: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          V: np.ndarray | None = None, given: AxisFit | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -239,7 +240,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     moment coefficients that depend on this angle (Cm; Cl, Cn), for the cross-check against the kinematic
     angle (None: none); ``instruments`` (T, Q): instruments of the angle for the slopes (two-stage least
     squares, :mod:`.angleerrors`; None or too weak: ordinary least squares); ``V`` (T,) airspeed, m/s: with
-    it the alpha axis gets the 1-sigma of its flight-common offset (the mean vertical wind)."""
+    it the alpha axis gets the 1-sigma of its flight-common offset (the mean vertical wind); ``given``: another
+    flight's fit of this axis whose slopes are used instead of fitting them here (the constant is still this
+    flight's), when its columns are this flight's (:func:`aided_air_angles`, ``models``)."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -260,6 +263,14 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     sig = np.full(len(kin), np.nan)
     shift_note = ""
     names = ("1", name) + ((f"({name} - {name}0)^2",) if quadratic else ()) + tuple(cols)
+    fixed, given_note = None, ""
+    if given is not None and given.used:
+        if tuple(given.columns) == names and len(given.coef) == len(names) and np.isfinite(given.coef[1:]).all():
+            fixed = np.asarray(given.coef[1:], float)
+            given_note = "slopes of the given model (another flight's fit of the same aircraft), constant fitted here"
+        else:
+            given_note = (f"the given model's terms ({', '.join(given.columns[1:])}) are not this flight's "
+                          f"({', '.join(names[1:])}): slopes fitted here")
     nq = 2 if quadratic else 1
     fit = None
     ctr = float(np.mean(kin[m]))
@@ -270,7 +281,10 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         # slow: the turbulence scale over the airspeed); the constant from the full band with them fixed
         Ah, yh = _highpass(dt, A, segs), _highpass(dt, coeff[:, None], segs)[:, 0]
         method, fs_r2 = "OLS", float("nan")
-        if instruments is not None:
+        if fixed is not None:
+            cr, csr, method = fixed, np.full(len(fixed), np.nan), "given"
+            res, cov_r = yh[m] - Ah[m] @ cr, np.zeros((len(fixed), len(fixed)))
+        elif instruments is not None:
             # errors in variables: the kinematic angle misses the gust, and the aircraft's answer to the gust
             # correlates the two; instruments that move the angle but not the air give a consistent slope
             Zh = _highpass(dt, instruments, segs)
@@ -278,12 +292,12 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             method = "2SLS"
             if not fs_r2 >= MIN_FIRST_STAGE_R2:
                 method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {MIN_FIRST_STAGE_R2:g})"
-        if not method.startswith("2SLS"):
+        if not method.startswith(("2SLS", "given")):
             cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
         r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
-        a1, t_stat = c[1], abs(c[1]) / max(cs[1], 1e-300)
+        a1, t_stat = c[1], (abs(c[1]) / max(cs[1], 1e-300) if fixed is None else np.inf)
         if sign * a1 <= 0 or t_stat < MIN_T_STAT:
             if fit is None:
                 return kin, sig, AxisFit(name, False, f"{'CZ_alpha' if name == 'alpha' else 'CY_beta'} not "
@@ -326,6 +340,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
             np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift,
             shift_note if fit is None else fit.shift_note, slope_method=method, first_stage_r2=fs_r2)
+    if fit is not None and given_note:
+        fit.slope_method = f"{fit.slope_method}: {given_note}"
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
         # the vertical gusts found, is a common error of all samples (angleerrors module docstring)
@@ -355,7 +371,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      f_body: np.ndarray, rates: np.ndarray, controls: dict[str, np.ndarray], mass: float,
                      S: float, b: float, c: float, use: np.ndarray, passes: int = 2,
                      rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None,
-                     instrument_slopes: bool | None = None) -> AidedAngles:
+                     instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None
+                     ) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -377,6 +394,12 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         instrument_slopes: fit the alpha model's slopes by two-stage least squares with the elevator and
             its delayed copies as instruments (errors in variables, :mod:`.angleerrors`), falling back to
             least squares when they are weak; None: :data:`INSTRUMENTED_SLOPES`.
+        models: the axes of another flight's :class:`AidedAngles` by name (``{"alpha": AxisFit}``), e.g. the
+            reference flight of a differential diagnosis: the alpha axis then uses that flight's CZ slopes
+            (``CZ_alpha``, the curvature, ``CZ_q_hat``, ``CZ_delta_e``; its constant is fitted here) instead of
+            fitting them on this flight, so that both flights' aided alpha share one scale (a fitted slope's
+            error scales the aided alpha at manoeuvre frequencies: ``docs/estimation.md``). Used only when its
+            terms are this flight's (else fitted here, said in ``AxisFit.slope_method``). None: fitted here.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -420,7 +443,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     de = get("delta_e")
     on = INSTRUMENTED_SLOPES if instrument_slopes is None else instrument_slopes
     inst = lagged_instruments(dt, de) if on and np.nanstd(de[u]) > 1e-9 and np.isfinite(de[u]).all() else None
-    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V)
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
+                         (models or {}).get("alpha"))
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "

@@ -79,18 +79,22 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
 
 
 def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
-                Wd=None, offsets=None):
+                Wd=None, offsets=None, models=None, fits=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
     records sources, sigma, notes and the flight-common offsets' 1-sigma (``offsets``, rad; and the
-    gusts in the wind); returns ``(alpha, beta)``."""
+    gusts in the wind) and the axes' fits (``fits``); ``models``: another flight's fits to take the alpha
+    model's slopes from; returns ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
         notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
                      "control outputs)")
         return alpha, beta
     ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
     Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
-                          airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia)
+                          airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia,
+                          models=models)
     notes.extend(describe(Ai))
+    if fits is not None:
+        fits.update({ax.name: ax for ax in Ai.axes})
     src = ("; gusts from the specific force: {c} model fitted on this flight, gust angle a Gauss-Markov state, "
            "Kalman + RTS smoother")
     for ax, k in zip(Ai.axes, ("alpha", "beta")):
@@ -114,7 +118,8 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
 
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     progress: Callable[[float], None] | None = None, helper: Helper | None = None,
-                    aid_air_angles: bool = True, earth: str = "wgs84") -> FlightStates:
+                    aid_air_angles: bool = True, earth: str = "wgs84", angle_models: dict | None = None
+                    ) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -129,6 +134,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         earth: the velocity filter's Earth: ``"wgs84"`` (WGS-84 normal gravity, Coriolis and transport
             rate at the GPS latitude and height; a flat Earth where the log has no GPS latitude) or
             ``"flat"`` (non-rotating, standard gravity: the project's own simulation's world).
+        angle_models: another flight's :attr:`FlightStates.angle_fits` (the same aircraft, e.g. the reference
+            of a differential diagnosis): the alpha aiding then uses that flight's CZ slopes, so that both
+            flights' alpha share one scale (:func:`gcs_sysid.estimation.airangles.aided_air_angles`, ``models``).
+            None: fitted on this flight.
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -154,6 +163,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     data: dict[str, np.ndarray] = {}
     sigma: dict[str, np.ndarray] = {}
     offsets: dict[str, float] = {}
+    fits: dict = {}
     sources: dict[str, str] = {}
     missing: list[str] = []
     notes: list[str] = []
@@ -447,7 +457,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             alpha, beta = _take_vanes(vanes, sources, ident, notes)
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
-                                      fly, C, v_ned, sources, sigma, notes, Wd, offsets)
+                                      fly, C, v_ned, sources, sigma, notes, Wd, offsets, angle_models, fits)
     else:
         if have_tas:
             V = tas
@@ -523,4 +533,4 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     for c in ("Cl", "Cm", "Cn"):
         ident[c] = ident["moment_coefficients"]
     prog(1.0)
-    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident, offsets)
+    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident, offsets, fits)

@@ -48,6 +48,9 @@ class FlightStates:
         offsets: key -> 1-sigma of an error common to the whole flight (one offset, not per-sample
             noise; also inside ``sigma[key]``): ``"alpha"``, rad, the flight-mean vertical wind over the
             airspeed (:attr:`gcs_sysid.estimation.airangles.AxisFit.bias_sigma`). Empty when not estimated.
+        angle_fits: ``"alpha"`` / ``"beta"`` -> the :class:`gcs_sysid.estimation.airangles.AxisFit` of the
+            specific-force aiding (its force model and gust parameters); empty when the angles were not aided.
+            Another flight of the same aircraft can be aided with them (``estimate_states(angle_models=...)``).
     """
 
     t: np.ndarray
@@ -60,6 +63,7 @@ class FlightStates:
     notes: list[str] = field(default_factory=list)
     identifiability: dict[str, tuple[bool, str]] = field(default_factory=dict)
     offsets: dict[str, float] = field(default_factory=dict)
+    angle_fits: dict = field(default_factory=dict)
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self.data[key]

@@ -2,6 +2,7 @@
 gusts, the gust smoother against filterpy's Kalman filter + RTS smoother, and the fallbacks."""
 
 import numpy as np
+import pytest
 from filterpy.kalman import KalmanFilter, rts_smoother
 
 from gcs_sysid.estimation.airangles import _gust_smoother, aided_air_angles, describe
@@ -180,3 +181,44 @@ def test_varying_throttle_keeps_the_sideslip_mean_and_stays_out_of_the_force_mod
     assert fb.mean_shift == 0.0 and "sideslip mean kept: the throttle varies" in fb.shift_note
     assert abs(np.degrees(np.mean(res.beta - beta)) - 1.0) < 0.3          # the 1 deg error stays
     assert "delta_t" not in fa.columns and "delta_t" not in fb.columns
+
+
+def _hp_slope(est, true):
+    """Regression slope of ``est`` on ``true`` above 0.2 Hz (the manoeuvre band)."""
+    from scipy.signal import butter, sosfiltfilt
+
+    sos = butter(2, 0.2, "highpass", fs=1.0 / DT, output="sos")
+    x, y = sosfiltfilt(sos, true - true.mean()), sosfiltfilt(sos, est - est.mean())
+    return float(np.polyfit(x[500:-500], y[500:-500], 1)[0])
+
+
+@pytest.mark.slow
+def test_another_flights_force_model_sets_the_alpha_scale():
+    """``models``: the alpha axis takes another flight's CZ slopes (its constant fitted here); the aided alpha's
+    manoeuvre-band scale is then ``true slope / given slope`` on both flights alike (the differential
+    diagnosis's shared scale, docs/estimation.md)."""
+    rec_a, _, _ = _record(seed=3)
+    rec_b, alpha_b, _ = _record(seed=8)
+    fa = _run(rec_a).axes[0]
+    own = _run(rec_b).axes[0]
+    T = len(rec_b["V"])
+    run_b = lambda models: aided_air_angles(DT, rec_b["alpha_kin"], rec_b["beta_kin"], rec_b["V"],  # noqa: E731
+                                            rec_b["qbar"], rec_b["f_body"], rec_b["rates"], rec_b["controls"],
+                                            MASS, S, B, C, np.ones(T, bool), models=models)
+    res = run_b({"alpha": fa})
+    fb = res.axes[0]
+    assert fb.used and fb.slope_method.startswith("given"), fb.slope_method
+    np.testing.assert_array_equal(fb.coef[1:], fa.coef[1:])           # the slopes are flight A's
+    assert fb.coef[0] != fa.coef[0]                                     # the constant is this flight's
+    assert not np.array_equal(own.coef[1:], fa.coef[1:])
+    assert abs(_hp_slope(res.alpha, alpha_b) - 1.0) < 0.03
+    # a given CZ_alpha 10 % too flat makes the aided alpha 10 % too steep in the manoeuvre band (1 / 0.9)
+    flat = type(fa)(**{**fa.__dict__, "coef": np.r_[fa.coef[0], 0.9 * fa.coef[1], fa.coef[2:]]})
+    k = _hp_slope(run_b({"alpha": flat}).alpha, alpha_b)
+    assert abs(k - 1.0 / 0.9) < 0.03, k
+    # a model with other terms is not used: the slopes are fitted here, and the note says why
+    other = type(fa)(**{**fa.__dict__, "columns": fa.columns[:-1] + ("delta_t",)})
+    fo = run_b({"alpha": other}).axes[0]
+    np.testing.assert_allclose(fo.coef, own.coef)
+    assert "not this flight's" in fo.slope_method
+    assert "slopes by given: slopes of the given model" in describe(res)[0]
