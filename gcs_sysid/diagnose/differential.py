@@ -451,6 +451,30 @@ def _where(ctx_X: np.ndarray, valid: np.ndarray, term: str, contribution: np.nda
     return out
 
 
+def _reference_delay(ctx: DiagContext, R: np.ndarray, surf: str, coef: str) -> tuple[float, float] | None:
+    """A reference flight's own delay of ``surf`` by the fit that sized the flight's (``sparse._refine_delay``).
+
+    The model's response to the delayed surface in ``coef`` is scanned on a grid that reaches below zero
+    (a reference without a delay reads about 0, not the grid's first step), on all the reference's valid
+    rows. The standard error is the linearised fit's with the log's time resolution ``dt / sqrt(12)`` in
+    quadrature, as the flight's (``sparse.THRESHOLDS["delay_time_resolution"]``).
+
+    Returns:
+        (delay s, standard error s), or None with fewer than 50 valid rows or a surface that never moves.
+    """
+    from .sparse import _refine_delay
+
+    rows = np.nonzero(ctx.valid)[0]
+    if rows.size < 50 or surf not in REGRESSORS:
+        return None
+    tau, _, se = _refine_delay(ctx, np.nan_to_num(np.asarray(R, float)), surf, rows, COEFFICIENTS.index(coef),
+                               taus=np.arange(-0.1, 0.4001, 0.005))
+    if not np.isfinite(se):
+        return None
+    dt = float(np.median(np.diff(ctx.t))) if ctx.t.size > 1 else 0.0
+    return float(tau), float(np.hypot(se, dt / np.sqrt(12.0)))
+
+
 def _residual_of(ctx: DiagContext) -> np.ndarray:
     return np.where(ctx.valid[:, None], ctx.Y - ctx.model_values(), np.nan)
 
@@ -458,7 +482,7 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
-                 alpha_scale: bool = True) -> dict:
+                 alpha_scale: bool = True, delay_same_fit: bool = True) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -480,6 +504,13 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         alpha_scale: also judge a finding in alpha against a between-flight scale of the measured angle of
             attack seen in the other longitudinal coefficients (``sparse.THRESHOLDS["alpha_scale_allowance"]``;
             the sideslip's is always judged).
+        delay_same_fit: a delay the sparse search sized as a difference (``evidence.delay_differential``) is
+            compared with each reference by the same fit (:func:`_reference_delay`): the flight's own delay
+            against the reference's (``sparse.THRESHOLDS["delay_reference_same_fit"]``; added 2026-11-22,
+            branch i9-delay). Off: the reference's delay by the catalogue's scan
+            (:func:`gcs_sysid.diagnose.candidates.fit_delays`), whose grid starts at one sample, so a
+            reference without a delay reads one sample (0.02 s at 50 Hz) with a standard error of a
+            minimum on the grid's edge, and the flight's *change* was held against it.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -578,11 +609,18 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         mv = f.get("model_value", f["evidence"].get("model_value", 0.0))
         c_f = f["evidence"].get("correction", f["estimate"] - mv) if is_aero else f["estimate"] - null
         se_f = float(f["std_error"])
+        # a delay sized as a difference (sparse._differential_delay): compare the flight's own delay with each
+        # reference's, both by that one fit
+        same_fit = delay_same_fit and cause.startswith("delay:") and "delay_differential" in f.get("evidence", {})
+        if same_fit:
+            c_f = float(f["evidence"]["delay_differential"]["flight_s"])
         comps = []
         for ref, ctx, R in refs:
             if is_aero:
                 coef, term = cause.split(":", 1)
                 got = _refit_aero(ctx, R, coef, term)
+            elif same_fit:
+                got = _reference_delay(ctx, R, cause.split(":", 1)[1], f["coefficient"])
             else:
                 try:                                   # a fit that fails on the reference compares nothing
                     got = _refit_other(ctx, ctx.Y - ctx.model_values(), f, ref, airframe)

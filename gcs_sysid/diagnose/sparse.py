@@ -93,6 +93,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: minus the reference flight's, each fitted through the model's response on its own residual, without the
 #: reference's ridge inadequacy, :func:`_differential_delay`; off: refined on the search's differential
 #: residual, which read the J3Cub's 0.12 s as 0.085 s).
+#: Added 2026-11-22 (branch i9-delay; set on the PA-28's 0.06-s delays, time of the freeze in
+#: ``docs/benchmarks.md``), read by ``diagnose`` for the differential step: ``delay_reference_same_fit`` (a delay
+#: sized by ``delay_differential`` is held against each reference flight's delay by the same fit,
+#: :func:`gcs_sysid.diagnose.differential._reference_delay`; off: by the catalogue's scan, whose grid starts at
+#: one sample and read the PA-28's delay-free reference as 0.02 s, so a 0.045-s change was called "in the
+#: reference too").
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -101,7 +107,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
-              "delay_differential": True}
+              "delay_differential": True, "delay_reference_same_fit": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
