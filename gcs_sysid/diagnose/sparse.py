@@ -107,7 +107,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
-              "delay_differential": True, "delay_reference_same_fit": True}
+              "delay_differential": True, "delay_reference_same_fit": True,
+              "alpha_jackknife_s": 15.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
