@@ -556,7 +556,7 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
-                 alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 0.0) -> dict:
+                 alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
