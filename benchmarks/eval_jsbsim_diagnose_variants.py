@@ -50,10 +50,11 @@ VARIANTS = {
     "search_residual": {"search_residual": True},
     "main_search_residual": {"module": "main", "search_residual": True},
     # branch i9-delay (2026-11-22): the two rules of the differential step added there, each off and both
-    "i9delay_before": {"delay_same_fit": False, "alpha_jackknife_s": 0.0},
-    "i9delay_after": {"delay_same_fit": True, "alpha_jackknife_s": 15.0},
-    "i9delay_no_jackknife": {"delay_same_fit": True, "alpha_jackknife_s": 0.0},
-    "i9delay_no_same_fit": {"delay_same_fit": False, "alpha_jackknife_s": 15.0},
+    "i9delay_before": {"delay_same_fit": False, "alpha_jackknife_s": 0.0, "delay_change_min_t": 0.0},
+    "i9delay_after": {"delay_same_fit": True, "alpha_jackknife_s": 15.0, "delay_change_min_t": 0.0},
+    "i9delay_no_jackknife": {"delay_same_fit": True, "alpha_jackknife_s": 0.0, "delay_change_min_t": 0.0},
+    "i9delay_no_same_fit": {"delay_same_fit": False, "alpha_jackknife_s": 15.0, "delay_change_min_t": 0.0},
+    "i9delay_after2": {"delay_same_fit": True, "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0},
 }
 
 

@@ -556,7 +556,8 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
-                 alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0) -> dict:
+                 alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
+                 delay_change_min_t: float = 3.0) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -585,6 +586,10 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             (:func:`gcs_sysid.diagnose.candidates.fit_delays`), whose grid starts at one sample, so a
             reference without a delay reads one sample (0.02 s at 50 Hz) with a standard error of a
             minimum on the grid's edge, and the flight's *change* was held against it.
+        delay_change_min_t: with ``delay_same_fit``, a delay whose change against the reference (its estimate) is
+            below this many of its standard errors (time resolution included) is an allowance, not a change
+            (``sparse.THRESHOLDS["delay_change_min_t"]``; added 2026-11-22 13:20 UTC, branch i9-delay, after the
+            first freeze: the PA-28 s1 2-m/s pitot bias got a 0.010 +- 0.006 s delay beside it); 0: off.
         alpha_jackknife_s: block length, s, of the block-jackknife standard error with which a finding in alpha
             is also judged beyond the alpha scale (:func:`angle_scale_allowance` ``jackknife``, the first
             reference's slope included); 0: off (``sparse.THRESHOLDS["alpha_jackknife_s"]``).
@@ -695,6 +700,14 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         # a delay sized as a difference (sparse._differential_delay): compare the flight's own delay with each
         # reference's, both by that one fit
         same_fit = delay_same_fit and cause.startswith("delay:") and "delay_differential" in f.get("evidence", {})
+        if same_fit and delay_change_min_t > 0 and not abs(c_f) >= delay_change_min_t * se_f:
+            # the change of the delay is within its standard error (time resolution included) of none
+            why = (f"{cause}: a change of {c_f:+.3f} +- {se_f:.2g} s against the reference (t {c_f / se_f:.1f} "
+                   f"< {delay_change_min_t:g}): no change beyond the fit and the log's time resolution")
+            f["evidence"]["differential"] = {"verdict": "allowance", "why": why}
+            doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
+                                     "gain": f.get("gain", {}), "why": why, "summary": why})
+            continue
         if same_fit:
             c_f = float(f["evidence"]["delay_differential"]["flight_s"])
         comps = []

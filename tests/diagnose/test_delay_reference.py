@@ -69,3 +69,13 @@ def test_a_delay_change_is_not_called_the_references_own_delay():
     old = differential(d_old, [Reference(rtab, rst, label="ref")], af, delay_same_fit=False)
     assert d_old.findings == [] and old["model_inadequacy"][0]["cause"] == "delay:delta_e", old
     assert old["model_inadequacy"][0]["in_references"][0]["correction"] == pytest.approx(0.02, abs=0.005)
+    # a "change" within its standard error of none (the PA-28 s1 pitot-bias flight's 0.010 +- 0.006 s beside
+    # the bias) is an allowance with delay_change_min_t, a change without it
+    small = dict(finding(), estimate=0.010, std_error=0.006,
+                 evidence={"delay_differential": dict(parts, flight_s=parts["reference_s"] + 0.010)})
+    d_small = _diag(ctx, small)
+    doc_small = differential(d_small, [Reference(rtab, rst, label="ref")], af, delay_same_fit=True)
+    assert d_small.findings == [] and doc_small["allowance"][0]["cause"] == "delay:delta_e", doc_small
+    d_kept = _diag(ctx, dict(small, evidence={"delay_differential": small["evidence"]["delay_differential"]}))
+    differential(d_kept, [Reference(rtab, rst, label="ref")], af, delay_same_fit=True, delay_change_min_t=0.0)
+    assert [f["cause"] for f in d_kept.findings] == ["delay:delta_e"]
