@@ -9,7 +9,8 @@ per variant on a deep copy of the diagnosis. Scores and ``results-<variant>.json
 reads them).
 
 Variants (``VARIANTS``): the differential step's switches (``angle_scale_se``, ``alpha_scale``,
-``search_residual``: :func:`~gcs_sysid.diagnose.differential.differential`), and optionally
+``search_residual``, ``delay_same_fit``, ``alpha_jackknife_s``:
+:func:`~gcs_sysid.diagnose.differential.differential`), and optionally
 ``module``: the path of another ``differential.py`` (e.g. main's, from ``git archive``) whose
 ``differential`` is run instead, loaded into the ``gcs_sysid.diagnose`` package so its relative
 imports take this tree's modules (valid only when those are the same as that tree's).
@@ -48,6 +49,12 @@ VARIANTS = {
     "scale_se": {"angle_scale_se": True, "alpha_scale": False},
     "search_residual": {"search_residual": True},
     "main_search_residual": {"module": "main", "search_residual": True},
+    # branch i9-delay (2026-11-22): the two rules of the differential step added there, each off and both
+    "i9delay_before": {"delay_same_fit": False, "alpha_jackknife_s": 0.0, "delay_change_min_t": 0.0},
+    "i9delay_after": {"delay_same_fit": True, "alpha_jackknife_s": 15.0, "delay_change_min_t": 0.0},
+    "i9delay_no_jackknife": {"delay_same_fit": True, "alpha_jackknife_s": 0.0, "delay_change_min_t": 0.0},
+    "i9delay_no_same_fit": {"delay_same_fit": False, "alpha_jackknife_s": 15.0, "delay_change_min_t": 0.0},
+    "i9delay_after2": {"delay_same_fit": True, "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0},
 }
 
 

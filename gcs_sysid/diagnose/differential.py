@@ -57,6 +57,7 @@ from .residual_gp import residual_structure
 from .terms import term_factors, term_matrix
 
 __all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "angle_scale_allowance",
+           "block_jackknife_se",
            "BETA_COEFFICIENTS", "ANGLE_COEFFICIENTS",
            "onset_of_change", "fit_record", "reference_logs"]
 
@@ -186,9 +187,48 @@ def _angle_factors(term: str) -> list[str]:
     return [part.partition("^")[0] for part in term.replace(" ", "").split("*")]
 
 
+def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.ndarray, block_s: float) -> float:
+    """Block-jackknife standard error of the slope of ``r`` on ``phi`` (a free constant beside it).
+
+    The rows are cut into contiguous blocks of ``block_s`` seconds; the slope is refitted with each block
+    left out, ``theta_i``, and ``se^2 = (B - 1)/B sum (theta_i - mean theta)^2`` (the delete-a-block
+    jackknife for dependent observations: Kuensch, *Ann. Statist.* 17 (1989) 1217-1241; Efron and
+    Tibshirani, *An Introduction to the Bootstrap*, 1993, ch. 11). Unlike the coloured-residual standard
+    error (Morelli and Klein sec. 5.3), which holds the regressor fixed, it also carries a slowly varying
+    error of the *regressor* (a measured air angle that misses slow gusts) whose chance alignment with the
+    flight's manoeuvres moves the slope.
+
+    Args:
+        t: (T,) time, s. phi: (T,) regressor. r: (T,) response. rows: (T,) bool rows to use.
+        block_s: block length, s.
+
+    Returns:
+        the standard error (same units as the slope); NaN with fewer than 3 blocks of 50 rows or more.
+    """
+    rows = np.asarray(rows, bool) & np.isfinite(phi) & np.isfinite(r)
+    if rows.sum() < 150 or block_s <= 0:
+        return float("nan")
+    tt, x, y = t[rows], phi[rows], r[rows]
+    k = np.floor((tt - tt[0]) / block_s).astype(int)
+    labels = [b for b in np.unique(k) if np.sum(k == b) >= 50]
+    if len(labels) < 3:
+        return float("nan")
+    th = []
+    for b in labels:
+        m = k != b
+        xm, ym = x[m] - x[m].mean(), y[m] - y[m].mean()
+        d = float(xm @ xm)
+        if d <= 0:
+            return float("nan")
+        th.append(float(xm @ ym) / d)
+    th = np.asarray(th)
+    B = th.size
+    return float(np.sqrt((B - 1) / B * np.sum((th - th.mean()) ** 2)))
+
+
 def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
-                          scale_se: bool = True) -> dict | None:
+                          scale_se: bool = True, jackknife: dict | None = None) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -218,6 +258,12 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
         angle: ``"beta"`` or ``"alpha"``.
         min_t, min_gain_pct: as :func:`offset_allowance`.
         scale_se: carry the scale's standard error into the term's (see above).
+        jackknife: ``{"t": (T,) s, "block_s": s, "reference": (t_r, X_r, R_r, rows_r) or None}``: the term
+            beyond the scale is also judged with the block-jackknife standard error
+            (:func:`block_jackknife_se`) of this flight's slope and of the reference flight's (the model's
+            value is the reference's estimate, so a change carries both), in quadrature; the larger of that
+            and the standard error above is used (added 2026-11-22, branch i9-delay:
+            ``sparse.THRESHOLDS["alpha_jackknife_s"]``).
 
     Returns:
         None when the finding is not such a term or no other coefficient has a contribution of the
@@ -275,11 +321,39 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                           why=(f"with {coef}'s between-flight offset free, {coef}:{term} is {beyond['estimate']:+.4g} "
                                f"+- {se:.2g} (the scale's uncertainty {share:.2g} included; t {t:.1f}) and gains "
                                f"{beyond['gain_beyond_offset_percent']:.0f} % on the held-out rows beyond the offset"))
+    if jackknife and "std_error" in beyond:
+        beyond = _with_jackknife(beyond, X, R_adj[:, j], ok, term, jackknife, min_t)
     return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
             "beta_scale" if angle == "beta" else "alpha_scale": float(s_hat),
             "std_error": se_s, "from": others, "beyond_scale": beyond,
             "why": f"a common {angle} scale {1 + s_hat:.3f} +- {se_s:.2g} (fitted on {', '.join(others)}) and {coef}'s "
                    f"offset free: {beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
+
+
+def _with_jackknife(beyond: dict, X: np.ndarray, r: np.ndarray, rows: np.ndarray, term: str, jk: dict,
+                    min_t: float) -> dict:
+    """``beyond`` (an :func:`offset_allowance` document) judged with the block-jackknife standard error too."""
+    try:
+        phi = term_matrix(X, [term])[:, 0]
+    except SysidError:
+        return beyond
+    se_f = block_jackknife_se(np.asarray(jk["t"], float), phi, r, rows, float(jk["block_s"]))
+    se_r = 0.0
+    if jk.get("reference") is not None:
+        t_r, X_r, r_r, rows_r = jk["reference"]
+        try:
+            se_r = block_jackknife_se(np.asarray(t_r, float), term_matrix(X_r, [term])[:, 0], r_r, rows_r,
+                                      float(jk["block_s"]))
+        except SysidError:
+            se_r = float("nan")
+    if not (np.isfinite(se_f) and np.isfinite(se_r)):
+        return beyond
+    se_jk = float(np.hypot(se_f, se_r))
+    se = max(float(beyond["std_error"]), se_jk)
+    t = beyond["estimate"] / se if se > 0 else 0.0
+    return dict(beyond, std_error=se, std_error_jackknife={"flight": se_f, "reference": se_r}, t=float(t),
+                offset_only=bool(beyond["offset_only"] or abs(t) < min_t),
+                why=beyond["why"] + f"; block jackknife (flight {se_f:.2g}, reference {se_r:.2g}): t {t:.1f}")
 
 
 def beta_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
@@ -451,6 +525,30 @@ def _where(ctx_X: np.ndarray, valid: np.ndarray, term: str, contribution: np.nda
     return out
 
 
+def _reference_delay(ctx: DiagContext, R: np.ndarray, surf: str, coef: str) -> tuple[float, float] | None:
+    """A reference flight's own delay of ``surf`` by the fit that sized the flight's (``sparse._refine_delay``).
+
+    The model's response to the delayed surface in ``coef`` is scanned on a grid that reaches below zero
+    (a reference without a delay reads about 0, not the grid's first step), on all the reference's valid
+    rows. The standard error is the linearised fit's with the log's time resolution ``dt / sqrt(12)`` in
+    quadrature, as the flight's (``sparse.THRESHOLDS["delay_time_resolution"]``).
+
+    Returns:
+        (delay s, standard error s), or None with fewer than 50 valid rows or a surface that never moves.
+    """
+    from .sparse import _refine_delay
+
+    rows = np.nonzero(ctx.valid)[0]
+    if rows.size < 50 or surf not in REGRESSORS:
+        return None
+    tau, _, se = _refine_delay(ctx, np.nan_to_num(np.asarray(R, float)), surf, rows, COEFFICIENTS.index(coef),
+                               taus=np.arange(-0.1, 0.4001, 0.005))
+    if not np.isfinite(se):
+        return None
+    dt = float(np.median(np.diff(ctx.t))) if ctx.t.size > 1 else 0.0
+    return float(tau), float(np.hypot(se, dt / np.sqrt(12.0)))
+
+
 def _residual_of(ctx: DiagContext) -> np.ndarray:
     return np.where(ctx.valid[:, None], ctx.Y - ctx.model_values(), np.nan)
 
@@ -458,7 +556,8 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
-                 alpha_scale: bool = True) -> dict:
+                 alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
+                 delay_change_min_t: float = 3.0) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -480,6 +579,20 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         alpha_scale: also judge a finding in alpha against a between-flight scale of the measured angle of
             attack seen in the other longitudinal coefficients (``sparse.THRESHOLDS["alpha_scale_allowance"]``;
             the sideslip's is always judged).
+        delay_same_fit: a delay the sparse search sized as a difference (``evidence.delay_differential``) is
+            compared with each reference by the same fit (:func:`_reference_delay`): the flight's own delay
+            against the reference's (``sparse.THRESHOLDS["delay_reference_same_fit"]``; added 2026-11-22,
+            branch i9-delay). Off: the reference's delay by the catalogue's scan
+            (:func:`gcs_sysid.diagnose.candidates.fit_delays`), whose grid starts at one sample, so a
+            reference without a delay reads one sample (0.02 s at 50 Hz) with a standard error of a
+            minimum on the grid's edge, and the flight's *change* was held against it.
+        delay_change_min_t: with ``delay_same_fit``, a delay whose change against the reference (its estimate) is
+            below this many of its standard errors (time resolution included) is an allowance, not a change
+            (``sparse.THRESHOLDS["delay_change_min_t"]``; added 2026-11-22 13:20 UTC, branch i9-delay, after the
+            first freeze: the PA-28 s1 2-m/s pitot bias got a 0.010 +- 0.006 s delay beside it); 0: off.
+        alpha_jackknife_s: block length, s, of the block-jackknife standard error with which a finding in alpha
+            is also judged beyond the alpha scale (:func:`angle_scale_allowance` ``jackknife``, the first
+            reference's slope included); 0: off (``sparse.THRESHOLDS["alpha_jackknife_s"]``).
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -556,9 +669,15 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             f["evidence"]["offset_allowance"] = allow
             scaled = None
             for angle in ("beta", "alpha") if alpha_scale else ("beta",):
+                jk = None
+                if angle == "alpha" and alpha_jackknife_s > 0:
+                    r_ctx, r_R = (refs[0][1], refs[0][2]) if refs else (None, None)
+                    jk = {"t": diag.t, "block_s": alpha_jackknife_s,
+                          "reference": None if r_ctx is None else
+                          (r_ctx.t, r_ctx.X, r_R[:, COEFFICIENTS.index(coef)], r_ctx.valid)}
                 scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                               coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                              scale_se=angle_scale_se)
+                                              scale_se=angle_scale_se, jackknife=jk)
                 if scale is not None and scale["scale_only"]:
                     scaled = scale
                     break
@@ -578,11 +697,26 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         mv = f.get("model_value", f["evidence"].get("model_value", 0.0))
         c_f = f["evidence"].get("correction", f["estimate"] - mv) if is_aero else f["estimate"] - null
         se_f = float(f["std_error"])
+        # a delay sized as a difference (sparse._differential_delay): compare the flight's own delay with each
+        # reference's, both by that one fit
+        same_fit = delay_same_fit and cause.startswith("delay:") and "delay_differential" in f.get("evidence", {})
+        if same_fit and delay_change_min_t > 0 and not abs(c_f) >= delay_change_min_t * se_f:
+            # the change of the delay is within its standard error (time resolution included) of none
+            why = (f"{cause}: a change of {c_f:+.3f} +- {se_f:.2g} s against the reference (t {c_f / se_f:.1f} "
+                   f"< {delay_change_min_t:g}): no change beyond the fit and the log's time resolution")
+            f["evidence"]["differential"] = {"verdict": "allowance", "why": why}
+            doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
+                                     "gain": f.get("gain", {}), "why": why, "summary": why})
+            continue
+        if same_fit:
+            c_f = float(f["evidence"]["delay_differential"]["flight_s"])
         comps = []
         for ref, ctx, R in refs:
             if is_aero:
                 coef, term = cause.split(":", 1)
                 got = _refit_aero(ctx, R, coef, term)
+            elif same_fit:
+                got = _reference_delay(ctx, R, cause.split(":", 1)[1], f["coefficient"])
             else:
                 try:                                   # a fit that fails on the reference compares nothing
                     got = _refit_other(ctx, ctx.Y - ctx.model_values(), f, ref, airframe)

@@ -98,6 +98,16 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: flights, freeze time in ``docs/benchmarks.md``): ``side_force_wind_axis`` (the ``scale:CY`` candidate is
 #: the model's *wind-axis* side force in body axes, :func:`scale_columns`, not the body-axis CY: a scaled
 #: side force leaves the drag's ``-sin(beta) C_D`` part of the body-axis CY alone).
+#: Added 2026-11-22 (branch i9-delay; set on the PA-28's 0.06-s delays, time of the freeze in
+#: ``docs/benchmarks.md``), read by ``diagnose`` for the differential step: ``delay_reference_same_fit`` (a delay
+#: sized by ``delay_differential`` is held against each reference flight's delay by the same fit,
+#: :func:`gcs_sysid.diagnose.differential._reference_delay`; off: by the catalogue's scan, whose grid starts at
+#: one sample and read the PA-28's delay-free reference as 0.02 s, so a 0.045-s change was called "in the
+#: reference too"); ``alpha_jackknife_s`` (a finding in alpha is also judged beyond the alpha scale with the
+#: block-jackknife standard error of its slope, this flight's and the reference's, blocks of this many seconds,
+#: :func:`gcs_sysid.diagnose.differential.block_jackknife_se`; 0 off). Added 13:20 UTC after that freeze (seen on
+#: the PA-28 s1 2-m/s pitot bias of the final run): ``delay_change_min_t`` (with ``delay_reference_same_fit``, a
+#: delay change below this many standard errors is an allowance).
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -106,7 +116,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "confirm_min_gain_pct": 10.0, "confirm_min_t": 3.0, "confirm_slope": (0.5, 1.5),
               "name_control_parent": True, "delay_time_resolution": True,
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
-              "delay_differential": True, "side_force_wind_axis": True}
+              "delay_differential": True, "side_force_wind_axis": True, "delay_reference_same_fit": True,
+              "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
