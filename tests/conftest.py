@@ -30,20 +30,3 @@ DATA = REPO / "data"
 def data_dir() -> Path:
     """The repository's data/ directory."""
     return DATA
-
-
-TESTS = Path(__file__).resolve().parent
-
-
-def pytest_collection_modifyitems(config, items):
-    """Group the tests for pytest-xdist's ``--dist loadgroup`` (pyproject.toml): a test directory's tests
-    run in one worker, so that its session fixtures (a JSBSim flight, a fitted GP, a simulated flight) are
-    built once; a test file at the top level is its own group."""
-    for item in items:
-        try:
-            rel = item.path.resolve().relative_to(TESTS)
-        except ValueError:
-            continue
-        group = rel.parts[0] if len(rel.parts) > 1 else rel.stem
-        item.add_marker(pytest.mark.xdist_group(group))
-
