@@ -73,9 +73,10 @@ _DEG = 57.29577951308232
 
 #: Aircraft the harness knows. ``c172x`` and ``sgs`` were used to set up the harness and the test
 #: thresholds; ``pa28`` (held out since 2026-11-21), ``j3cub`` (untouched until the sixth
-#: session's final evaluation, 2026-11-22) and ``c182`` (untouched until the seventh session's)
+#: session's final evaluation, 2026-11-22), ``c182`` (untouched until the seventh session's)
 #: have since been evaluated and their results read, so they count as used (``TUNING_AIRCRAFT``).
-#: ``t37`` (added in the eighth session, 2026-11-22) is the held-out, untouched case
+#: ``t37`` (untouched until the eighth session's final evaluation) is used since as well.
+#: ``t6`` (added in the ninth session, 2026-11-22) is the held-out, untouched case
 #: (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's
 #: truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
@@ -152,7 +153,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # ends (as the c182's). Signs read from its aerodynamics: Cmde -1.12 (Mach 0) * elevator-pos
     # (positive = trailing edge down), Clda +0.181 (Mach 0) * left-aileron-pos (positive = left trailing edge
     # down, roll right), Cndr -0.0365 * rudder-pos (positive = trailing edge left, nose left);
-    # checked on the truth by tests/jsbsim/test_jsbsim_t37.py. Gear up (retractable; its gear-down
+    # checked on the truth by tests/jsbsim/test_jsbsim_t37.py (used since the eighth session's final evaluation). Gear up (retractable; its gear-down
     # terms, CDgear, DCYbdf, DClrDg and the |beta| term DCnbDg, vanish with it). Engines off: the
     # "direct" thrusters give no force. 130 kt CAS at 10000 ft: the sweep's slowest level, 97.5 kt,
     # is 1.28 times the model's power-off stall (about 76 kt EAS: 4756 lb, CL_max 1.34 at 0.26 rad
@@ -169,10 +170,42 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(1.0 / 0.325, 1.0 / 0.35, 1.0 / 0.35),
         amplitude_deg=(4.5, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
         notes="Cessna T-37 (JSBSim T37), engines shut down, gear up, gliding; untouched by any tuning of the method"),
+    # t6: JSBSim's stock Raytheon T-6A Texan II (t6texan2.xml, "Aeromatic / David Culp"), a
+    # single-turboprop tandem trainer. Chosen after the candidates in docs/jsbsim.md ("The t6"):
+    # T38 (its aerodynamics read the normalised surfaces, its FCS has a yaw damper, no aileron yaw),
+    # A4 (Ixx + Izz < Iyy: not a physical tensor), f104, dr1, fokker50 (JSBSim 1.3.3 cannot
+    # initialise them), p51d and Camel (propwash / induced-velocity and gyroscopic terms of the
+    # propeller), OV10 (its windmilling-propeller drag, 0.07 at idle, makes a 30-deg dive of the
+    # glide at the speeds the sweep needs), f15 (Cl_beta -0.057 at alpha 0 and tables with kinks at
+    # alpha 0). Its engine drives a "direct" thruster: no force once stopped, no propeller.
+    # Surfaces from its <flight_control> (aerosurface_scale, gain 0.017 / 0.01745 rad per deg):
+    # elevator +-30 x 0.017 = +-0.51 rad, left aileron -20..+15 x 0.017 = -0.34..+0.255 rad (the only
+    # aileron property the aerodynamics read; the right the mirror), rudder +-25 x 0.01745 =
+    # +-0.436 rad; the aileron's command scale is the mean of its two ends (as the c182's). Signs
+    # read from its aerodynamics: CmDe -1.2 x elevator-pos (positive = trailing edge down), Clda
+    # +0.29 x left-aileron-pos (positive = left trailing edge down, roll right), Cndr -0.06 x
+    # rudder-pos (positive = trailing edge left, nose left); checked on the truth by
+    # tests/jsbsim/test_jsbsim_t6.py. Gear up (retractable; CDgear 0.03 vanishes with it). 160 kt
+    # (ic/vc-kts) at 10000 ft: about 190 kt EAS, 2.3 x the model's power-off stall (83 kt EAS: 6000
+    # lb, CL_max 1.47 at 0.28 rad), as the t37's 2.35: the sweep's slowest level flies 133 kt EAS
+    # (1.6 x) and alpha stays under 4 deg, so Cl:alpha*beta = 3 (which reverses the stock Cl_beta
+    # -0.086 above 1.7 deg of alpha) flies without a knock-it-off. It sinks 13 m/s (L/D about 8).
+    # Amplitudes: elevator 4 deg (pitch-rate standard deviation 3.1 deg/s, standard plan, light),
+    # aileron 4 deg (its roll is lively: Clda 0.29, Clp -0.5, Ixx 6483 kg m^2; roll-rate standard
+    # deviation 8.2 deg/s), rudder 3.5 deg (its weathercock stability is weak, Cn_beta 0.04 against
+    # Cndr -0.06: 1.5 deg of sideslip per degree; 3 deg gave 1.0 deg of rudder standard deviation).
+    # Default gains. Set from the harness's truth only (alpha, beta, rates, excitation per axis;
+    # docs/jsbsim.md), never from a method result.
+    "t6": AircraftSpec(
+        name="t6", model="t6texan2", airspeed_kts=160.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.51, 1.0 / 0.2975, 1.0 / 0.43625),
+        amplitude_deg=(4.0, 4.0, 3.5), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
+        notes="Raytheon T-6A Texan II (JSBSim t6texan2), engine shut down, gear up, gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182")
-HELD_OUT_AIRCRAFT = ("t37",)
-UNTOUCHED_AIRCRAFT = ("t37",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37")
+HELD_OUT_AIRCRAFT = ("t6",)
+UNTOUCHED_AIRCRAFT = ("t6",)
 
 
 def aircraft(name: str) -> AircraftSpec:
@@ -211,7 +244,7 @@ def aircraft_argument(name: str) -> str:
 
 
 def summary_label(name: str) -> str:
-    """``name`` as the evaluation summaries print it: ``"t37 (untouched)"`` for the
+    """``name`` as the evaluation summaries print it: ``"t6 (untouched)"`` for the
     :data:`UNTOUCHED_AIRCRAFT`, ``"<name> (held out)"`` for the other :data:`HELD_OUT_AIRCRAFT`, the
     name alone for the aircraft used in tuning."""
     return name + (" (untouched)" if name in UNTOUCHED_AIRCRAFT else " (held out)" if name in HELD_OUT_AIRCRAFT else "")
