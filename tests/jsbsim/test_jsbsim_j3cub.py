@@ -1,5 +1,5 @@
 """The J3Cub in the JSBSim harness: the sixth session's untouched aircraft of issues 8 and 9
-(docs/jsbsim.md); evaluated since, it now counts as used (the t37 is the untouched one).
+(docs/jsbsim.md); evaluated since, it now counts as used (the t6 is the untouched one).
 
 Only the harness is checked here, on JSBSim's exact truth: the rigid-body consistency of the truth
 with the checked-in airframe file, the sign map, the .tlog as the pipeline decodes it, the XML

@@ -1,15 +1,15 @@
-"""The t37 in the JSBSim harness: the untouched aircraft of issues 8 and 9 (docs/jsbsim.md, "The t37").
+"""The t37 in the JSBSim harness: the eighth session's untouched aircraft (docs/jsbsim.md, "The t37"),
+evaluated in its final evaluation and used since (the ninth session's untouched aircraft is the t6,
+``test_jsbsim_t6.py``). Its checks below are slow tests now, but for the names' test.
 
 Only the harness is checked here, on JSBSim's exact truth and its own properties: the rigid-body
 consistency of the truth with the checked-in airframe file, the sign map against the model's XML
 constants, the gear retracted by the harness, the .tlog as the pipeline decodes it, every hidden
 effect as JSBSim computes it (the injected moments reach JSBSim's total aerodynamic moments), the
-summaries' label, and (slow) the airspeed bias in the log and that the evaluation's flights stay in
+airspeed bias in the log and that the evaluation's flights stay in
 the envelope with every axis excited. No pipeline fit, GP, diagnosis or scoring is run on the t37
-here: its first evaluation is the final one, after the merge. One 30-s flight serves every fast test.
+here. One 30-s flight serves the module's tests.
 """
-
-import json
 
 import numpy as np
 import pytest
@@ -25,14 +25,14 @@ from gcs_sysid.telemetry import read_log
 t37_flight = short_flight_fixture("t37")      # fixture "t37": 30 s, light, seed 1
 
 
-def test_names_resolve_and_only_the_t37_is_untouched():
-    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT
+def test_names_resolve_and_the_t37_is_used():
+    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, summary_label
 
     assert_names_resolve("t37", "T37", "t3")
-    assert UNTOUCHED_AIRCRAFT == HELD_OUT_AIRCRAFT == ("t37",)
-    assert {"pa28", "j3cub", "c182"} <= set(TUNING_AIRCRAFT) and "t37" not in TUNING_AIRCRAFT
+    assert "t37" in TUNING_AIRCRAFT and "t37" not in HELD_OUT_AIRCRAFT and summary_label("t37") == "t37"
 
 
+@pytest.mark.slow
 def test_truth_is_rigid_body_consistent_with_the_airframe_file(t37):
     """JSBSim's aero moments equal J w_dot + w x J w with the checked-in airframe's J; in the glide
     every non-gravity force and moment is aerodynamic (both jets stopped, "direct" thrusters); the
@@ -43,6 +43,7 @@ def test_truth_is_rigid_body_consistent_with_the_airframe_file(t37):
     assert const["Ixy"] == const["Iyz"] == const["Ixz"] == 0.0 and af.inertia[0, 2] == 0.0
 
 
+@pytest.mark.slow
 def test_sign_map_gives_the_project_conventions(t37):
     """Least squares on the exact truth: Cm_delta_e, Cl_delta_a, Cn_delta_r, Cm_alpha, Cl_p < 0,
     Cn_beta > 0, and the lateral control derivatives at the model's constants (T37.xml: Clda
@@ -54,6 +55,7 @@ def test_sign_map_gives_the_project_conventions(t37):
     assert cn[3] == pytest.approx(0.0254, rel=0.1) and cn[4] == pytest.approx(-0.0365, rel=0.05), cn
 
 
+@pytest.mark.slow
 def test_the_harness_flies_the_t37_with_its_gear_up():
     """``gear_up``: the retractable gear (5 s from down to up) is up before the log starts (the 15-s
     settling phase), so its drag and its gear-down stability terms (DCYbdf, DClrDg, DCnbDg) are zero."""
@@ -69,6 +71,7 @@ def test_the_harness_flies_the_t37_with_its_gear_up():
     assert all(fdm[f"aero/coefficient/{n}"] == 0.0 for n in ("CDgear", "DCYbdf", "DClrDg", "DCnbDg"))
 
 
+@pytest.mark.slow
 def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(t37):
     """The pipeline's decoder reads the t37's .tlog; its SERVO_OUTPUT_RAW, through the checked-in
     airframe file, gives JSBSim's deflections within PWM quantisation (the elevator's 18.6-deg end,
@@ -76,6 +79,7 @@ def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(t37):
     assert_servos_map_back(t37)
 
 
+@pytest.mark.slow
 def test_every_hidden_effect_shows_in_jsbsims_own_forces_and_moments():
     """On the t37's XML (LIFT/DRAG/SIDE and ROLL/PITCH/YAW axes, one aileron property in the
     aerodynamics) every effect does what ``effects.py`` specifies, in JSBSim's own properties at
@@ -95,34 +99,6 @@ def test_airspeed_bias_reaches_the_logged_airspeed(t37, tmp_path):
     assert_airspeed_bias_in_log(t37, tmp_path)
 
 
-def test_summaries_mark_the_t37_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label t37 "(untouched)" and
-    no other aircraft, the c182 included (synthetic rows: no t37 result exists before the final
-    evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| t37 (untouched) | light") for ln in lines)
-    for ac in acs[:4]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| t37 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| c182 | clean |") for ln in lines)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("seed,turbulence,plan,effects", ENVELOPE_FLIGHTS)    # with the evaluation's pair
 def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_path, seed, turbulence, plan, effects):
@@ -135,24 +111,3 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
     limits = dict(alpha=(-5.0, 7.0), beta=(6.0, 9.0), bank=(18.0, 30.0), speed=(1.3 * 46.9, 150.0), alt_min=500.0)
     assert_in_envelope(evaluation_envelope("t37", seed, turbulence, plan, effects, tmp_path), **limits,
                        rate_std=1.8, rate_std_held=1.8)     # deg/s; least measured 2.2, 2.4
-
-
-@pytest.mark.slow
-def test_eval_scripts_fly_the_t37_without_scoring_it(tmp_path, capsys, monkeypatch):
-    """``--aircraft T37`` resolves to ``t37`` in both scripts; with ``--fly-only`` they fly into
-    ``--work`` / ``--out``, say that the t37 is the untouched aircraft, reuse the flights on a
-    second run and score nothing."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-
-    monkeypatch.setattr(eval_jsbsim_diagnose, "DURATION_S", 2.0)
-    runs = ((eval_jsbsim.main, ["--turbulence", "light", "--duration", "2", "--work", str(tmp_path / "f")], 1, 1),
-            (eval_jsbsim_diagnose.main, ["--clean-seeds", "--pairs", "--effects", "delay:delta_e",
-                                         "--out", str(tmp_path / "d")], -3, 3))      # reference + 2 sizes
-    for main, extra, column, n in runs:
-        argv = ["--aircraft", "T37", "--seeds", "1", *extra, "--fly-only"]
-        assert main(argv) == 0 and main(argv) == 0
-        cap = capsys.readouterr()
-        assert [ln.split()[column] for ln in cap.out.splitlines()] == ["flown"] * n + ["reused"] * n, cap.out
-        assert "t37 is the untouched aircraft" in cap.err
-    assert read_log(tmp_path / "f" / "t37-light-s1-ahrs.tlog").streams["servo"].t.size > 50
-    assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
