@@ -24,7 +24,7 @@ from .flight import FlightConfig, Recording, fly
 from .sensors import SENSOR_RATES_HZ, make_sensors
 from .truth import save_truth
 
-__all__ = ["write_log", "make_flight", "FlightFiles", "harness_fingerprint"]
+__all__ = ["write_log", "make_flight", "FlightFiles", "harness_fingerprint", "fingerprint"]
 
 _REPO = Path(__file__).resolve().parents[2]
 #: The sources that decide what a flight's files hold (harness, the project's tlog writer and
@@ -45,9 +45,26 @@ class FlightFiles:
     recording: Recording | None     # None when the files were reused (``make_flight(reuse=True)``)
 
 
-def _code(text: str) -> str:
-    """The code of a Python source without its comments, layout and docstrings (``ast.dump``)."""
+#: Module-level names of ``aircraft.py`` that list the aircraft and their roles. The fingerprint
+#: leaves them out of that file's code and takes the flown aircraft's own spec instead
+#: (:func:`fingerprint`), so that adding an aircraft, or making one tuning or untouched, keeps the
+#: other aircraft's flights (since the ninth session, 2026-11-22; before, any edit of
+#: ``aircraft.py`` changed every aircraft's fingerprint).
+ROSTER_NAMES = ("AIRCRAFT", "TUNING_AIRCRAFT", "HELD_OUT_AIRCRAFT", "UNTOUCHED_AIRCRAFT")
+
+
+def _assigned(node: ast.stmt) -> set[str]:
+    """The plain names a module-level (annotated) assignment binds; empty for any other statement."""
+    targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) else []
+    return {t.id for t in targets if isinstance(t, ast.Name)}
+
+
+@functools.lru_cache(maxsize=64)
+def _code(text: str, drop: tuple[str, ...] = ()) -> str:
+    """The code of a Python source without its comments, layout and docstrings (``ast.dump``), and
+    without the module-level assignments to the names in ``drop``."""
     tree = ast.parse(text)
+    tree.body = [n for n in tree.body if not _assigned(n) & set(drop)]
     for node in ast.walk(tree):
         if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and node.body \
                 and isinstance(node.body[0], ast.Expr) and isinstance(node.body[0].value, ast.Constant) \
@@ -56,19 +73,38 @@ def _code(text: str) -> str:
     return ast.dump(tree)
 
 
+def fingerprint(spec, sources: dict[str, str], airframe: bytes, version: str) -> str:
+    """A 16-hex-digit SHA-256 of what makes one aircraft's flight files.
+
+    Args:
+        spec: the aircraft's ``AircraftSpec`` (its ``repr``: every field).
+        sources: path (as in :data:`FINGERPRINT_SOURCES`) -> source text; their code, comments and
+            docstrings left out, ``aircraft.py`` also without the :data:`ROSTER_NAMES` (the other
+            aircraft's specs and everyone's roles).
+        airframe: the bytes of the aircraft's airframe file.
+        version: the JSBSim version.
+    """
+    h = hashlib.sha256(version.encode())
+    for rel, text in sources.items():
+        drop = ROSTER_NAMES if rel.endswith("jsbsim_harness/aircraft.py") else ()
+        h.update(rel.encode() + b"\0" + _code(text, drop).encode())
+    h.update(b"spec\0" + repr(spec).encode())
+    h.update(airframe)
+    return h.hexdigest()[:16]
+
+
 @functools.lru_cache(maxsize=None)
 def harness_fingerprint(name: str) -> str:
-    """A 16-hex-digit SHA-256 of what makes aircraft ``name``'s flight files: the code of the
+    """The fingerprint (:func:`fingerprint`) of aircraft ``name``'s flight files: the code of the
     sources in :data:`FINGERPRINT_SOURCES` (comments and docstrings left out, so that a change of
-    wording keeps the flights), its airframe file and the JSBSim version. A flight written under
-    another fingerprint is flown again rather than reused."""
+    wording keeps the flights; the aircraft list and roles left out of ``aircraft.py``, its own spec
+    put in), its airframe file and the JSBSim version. A flight written under another fingerprint is
+    flown again rather than reused."""
     import jsbsim
 
-    h = hashlib.sha256(jsbsim.__version__.encode())
-    for rel in FINGERPRINT_SOURCES:
-        h.update(rel.encode() + b"\0" + _code((_REPO / rel).read_text()).encode())
-    h.update(aircraft(name).airframe_path.read_bytes())
-    return h.hexdigest()[:16]
+    spec = aircraft(name)
+    return fingerprint(spec, {rel: (_REPO / rel).read_text() for rel in FINGERPRINT_SOURCES},
+                       spec.airframe_path.read_bytes(), jsbsim.__version__)
 
 
 def _stamp(config: FlightConfig, aoa: str) -> dict:

@@ -153,3 +153,32 @@ def test_a_departing_maneuver_is_knocked_off_and_the_flight_survives(tmp_path):
     assert rec.t[-1] == pytest.approx(120.0 - 0.02)
     ref = fly(FlightConfig("sgs", duration_s=120.0, seed=100, plan="sweep"))
     assert ref.meta["aborts"] == []
+
+
+def test_fingerprint_is_per_aircraft():
+    """The flight fingerprint of an aircraft holds its own spec and the harness's code, not the
+    other aircraft or the roles: adding an aircraft or moving one between tuning and untouched
+    keeps it; a change of its spec, of another fingerprinted source's code or of its airframe file
+    changes it; comments and docstrings do not."""
+    import dataclasses
+
+    from benchmarks.jsbsim_harness.logfile import _REPO, FINGERPRINT_SOURCES, fingerprint, harness_fingerprint
+
+    rel_ac = "benchmarks/jsbsim_harness/aircraft.py"
+    src = {rel: (_REPO / rel).read_text() for rel in FINGERPRINT_SOURCES}
+    spec = aircraft("c172x")
+    fp = lambda s=spec, texts=src, af=b"airframe": fingerprint(s, texts, af, "1.3.3")   # noqa: E731
+    assert harness_fingerprint("c172x") == fingerprint(spec, src, spec.airframe_path.read_bytes(),
+                                                       __import__("jsbsim").__version__)
+    text = src[rel_ac]
+    assert '"t6": AircraftSpec(' in text and 'UNTOUCHED_AIRCRAFT = ("t6",)' in text
+    roster = (text.replace('"t6": AircraftSpec(', '"t6b": AircraftSpec(name="t6b", model="x", airspeed_kts=1.0, '
+                           'altitude_ft=1.0, elevator_sign=1.0, aileron_sign=1.0, aileron_props=("a", None), '
+                           'rudder_sign=1.0, cmd_per_rad=(1, 1, 1), amplitude_deg=(1, 1, 1), pulse_s=(1, 1, 1)),\n'
+                           '    "t6": AircraftSpec(')
+              .replace('UNTOUCHED_AIRCRAFT = ("t6",)', 'UNTOUCHED_AIRCRAFT = ("t6b",)') + "\n# a comment\n")
+    assert fp(texts=src | {rel_ac: roster}) == fp()
+    assert fp(s=dataclasses.replace(spec, amplitude_deg=(3.0, 5.0, 6.5))) != fp()
+    assert fp(texts=src | {rel_ac: text + "\n_DEG = 1.0\n"}) != fp()
+    rel_fl = "benchmarks/jsbsim_harness/flight.py"
+    assert fp(texts=src | {rel_fl: src[rel_fl] + "\nX = 1\n"}) != fp() and fp(af=b"other") != fp()
