@@ -39,8 +39,8 @@ def test_truth_is_rigid_body_consistent_with_the_airframe_file(t6):
     """JSBSim's aero moments equal J w_dot + w x J w with the checked-in airframe's J, its Ixz
     included; in the glide every non-gravity force and moment is aerodynamic (the turboprop drives a
     "direct" thruster: no force once stopped, no propeller to windmill); the mass is the model's
-    5000 lb empty plus 2 x 500 lb of fuel on the centre line, no point mass; the model's product of
-    inertia is Ixz alone (``<ixz>`` -1000 slug ft^2 with ``negated_crossproduct_inertia``: JSBSim's
+    5000 lb empty plus 2 x 500 lb of fuel in two wing tanks at y = +-50 in (a symmetric pair), no
+    point mass; the model's product of inertia is Ixz alone (``<ixz>`` -1000 slug ft^2 with ``negated_crossproduct_inertia``: JSBSim's
     -997.4 with the tanks, the project's Ixz = +997.4 slug ft^2)."""
     assert_rigid_body_glide(t6, mass_lb=6000)
     const, af = t6.recording.constants, load_airframe(t6.airframe)
@@ -53,8 +53,9 @@ def test_sign_map_gives_the_project_conventions(t6):
     """Least squares on the exact truth: Cm_delta_e, Cl_delta_a, Cn_delta_r, Cm_alpha, Cl_p < 0,
     Cn_beta > 0, and the control derivatives at the model's constants (t6texan2.xml: CmDe -1.2 x
     elevator-pos, Clda 0.29 x left-aileron-pos, so Cl_delta_a = -0.29 in the project's sign; Cldr
-    0.012, Cndr -0.06; the model has no aileron yaw term, so Cn_delta_a = 0: the aerodynamic reference
-    point is the CG, nothing transfers)."""
+    0.012, Cndr -0.06; the model has no aileron yaw term and no side force from a surface, so
+    Cn_delta_a = 0: the aerodynamic reference point, 0.2 in aft of and 2 in above the CG, transfers
+    nothing measurable)."""
     cm, cl, cn = derivative_slopes(t6.recording)
     assert cm[0] < 0 and cm[2] < 0 and cl[1] < 0 and cl[3] < 0 and cn[0] > 0 and cn[4] < 0, (cm, cl, cn)
     assert cm[2] == pytest.approx(-1.2, rel=0.02) and cl[3] == pytest.approx(-0.29, rel=0.02), (cm, cl)
