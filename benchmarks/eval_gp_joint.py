@@ -139,6 +139,8 @@ def score(path: Path, lengths, patterns, lmc: bool = False):
                     if p in MOMENTS or hind[p] is None:
                         rows = tr & np.isfinite(Ym[:, p])
                         hind[p] = fit_gp(X[rows], Y[rows][:, [p]], base, output_names=[COEFFICIENTS[p]])[0]
+                if not indep:          # the forces' GPs see the same rows under every pattern: fitted once
+                    indep = [m if p not in MOMENTS else None for p, m in enumerate(hind)]
                 times["hindep"] = time.perf_counter() - t0
                 preds = {v: _pred(m, X[h]) for v, m in models.items()}
                 preds["hindep"] = np.column_stack([_pred(m, X[h])[:, 0] for m in hind])
@@ -195,6 +197,16 @@ def summarize(paths) -> str:
             if lines:
                 out += [f"\n{a} vs {b}, pattern {pattern}, {what} (better / worse by > 0.05 points / within; medians)\n",
                         "| training | turbulence | pairs |", "|---|---|---|"] + lines
+    # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
+    out += ["\njoint vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
+            "| aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|"]
+    for ac in sorted({r["aircraft"] for r in rows}):
+        for L in lengths:
+            g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
+            f = _count(_pairs(rows, "joint", "indep", "none", "err", COEFFICIENTS[:3], g))
+            m = _count(_pairs(rows, "joint", "indep", "none", "err", mom, g))
+            if f or m:
+                out.append(f"| {ac} | {'all' if L <= 0 else f'{L:g} s'} | {f} | {m} |")
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
