@@ -2,9 +2,9 @@
 its forces, in the first fit and in the updates, as the replay does (``pipeline.training_rows``).
 
 Why (docs/benchmarks.md, "Ninth session, i8-joint"): the learner's first fit is a short log. With the
-moments removed from 30 % of 20 s of JSBSim rows (c172x, pa28, t37, seed 1, light and moderate), the
-joint GP on every row beat the same GP on the complete rows on 47 of 72 held-out flight x coefficient
-pairs and was worse on 12 (forces 23 / 3, moments 24 / 9)."""
+moments removed from 30 % of 20 s of JSBSim rows (c172x, pa28, t37, seeds 1-2, light and moderate), the
+joint GP on every row beat the same GP on the complete rows on 88 of 144 held-out flight x coefficient
+pairs and was worse on 35 (forces 46 / 13, moments 42 / 22)."""
 
 from __future__ import annotations
 
