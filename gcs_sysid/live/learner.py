@@ -289,7 +289,9 @@ class Learner:
                 self._pending = [(Xa[-self.options.min_rows:], Ya[-self.options.min_rows:])]
                 return
             self._pending = []
-            ok = np.all(np.isfinite(Ya[:, cols]), axis=1)
+            # a row that misses some coefficients (an angular-acceleration estimate rejected) is kept for the
+            # others: the joint GP conditions each on the rows that carry it (docs/gp.md, "Missing outputs")
+            ok = np.any(np.isfinite(Ya[:, cols]), axis=1)
             self.outputs = tuple(COEFFICIENTS[i] for i in cols)
             cfg = GPConfig() if self.options.n_inducing is None else GPConfig(n_inducing=self.options.n_inducing)
             self.model, _ = fit_gp(Xa[ok], Ya[ok][:, cols], cfg)
@@ -298,7 +300,7 @@ class Learner:
                               f"({', '.join(self.outputs)})")
             return
         cols = [COEFFICIENTS.index(c) for c in self.outputs]
-        ok = np.all(np.isfinite(Y[:, cols]), axis=1)
+        ok = np.any(np.isfinite(Y[:, cols]), axis=1)        # partial rows kept, as in the first fit
         if ok.any():
             self.model = self.model.update(X[ok], Y[ok][:, cols])
             self.n_learned += int(ok.sum())

@@ -1,0 +1,263 @@
+"""When does the joint (coregionalised) GP beat six independent GPs? Learning curve, heterotopic rows,
+correlated gust noise, against JSBSim's exact truth (issue 8 item 3).
+
+Uses the cached flights of ``benchmarks/eval_gp_jsbsim.py`` (``--make`` there, or here: the same
+``.npz`` files, same harness, same replay). For each flight the training rows (the first 80 % of the
+flight, as the replay takes them) are cut to their first ``L`` seconds (``--lengths``; ``0`` means all,
+72 s of a 90-s flight): a shorter log, contiguous in time as a log gives it. On those rows:
+
+  pattern ``none`` (isotopic: every coefficient on every row)
+    ``joint``    ``fit_gp(X, Y, GPConfig())``: the replay's model (ICM, one noise variance per output,
+                 input noise, blocked validation)
+    ``jointn``   the same with the full 6 x 6 noise covariance in the likelihood
+                 (``GPConfig.noise_correlation``: the gusts' correlated error between outputs)
+    ``dec``      ``joint`` with its cross-output coupling removed after the fit (``gp.joint.decoupled_model``:
+                 ``B`` diagonal, every other hyperparameter kept): ``joint - dec`` is what the coupling does
+    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal)
+    ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
+    ``lmc``      (``--lmc``) ``GPConfig(latent_kernels=2)``: two latent kernels, per-output length-scales
+  pattern ``rates`` / ``block`` (heterotopic: the moments Cl Cm Cn removed on 30 % of those rows,
+  ``eval_gp_jsbsim.missing_rows``: the fastest rates, as a rejected angular-acceleration estimate;
+  or the 35-65 % stretch of the time, a dropout of the gyro stream)
+    ``hjoint``   the joint GP on every row, moments missing where removed (what the pipeline does,
+                 ``pipeline.training_rows``)
+    ``hdec``     ``hjoint`` decoupled after the fit
+    ``hdrop``    the joint GP on the complete rows only (a row with a missing coefficient dropped)
+    ``hindep``   six one-output GPs, each on the rows that carry its coefficient (the forces' GPs are
+                 those of ``indep``: the same rows)
+
+Scores (one JSON line per flight, length, pattern and model): ``err`` the held-out error
+``100 RMS(mean - truth) / RMS(truth)`` per coefficient on the held-out last 20 % (never trained on),
+``err_gap`` on the training rows whose moments were removed (the gap the joint model fills from the
+forces of the same rows); for the joint models ``corr_learned`` and the truth's output correlation with
+the flags of ``eval_gp_jsbsim._correlations`` (learned ``|corr| > 0.5`` where the truth's nonlinear
+parts correlate below 0.2). ``--summarize`` prints the pair counts (better / worse by more than 0.05
+points / within) and medians per length, turbulence and pattern.
+
+Usage::
+
+    python benchmarks/eval_gp_joint.py --cache DIR --aircraft c172x pa28 t37 --seeds 1 2 \\
+        --turbulence light moderate --lengths 10 20 40 0 --json J.jsonl
+    python benchmarks/eval_gp_joint.py --summarize J.jsonl
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.eval_gp_jsbsim import MOMENTS, _correlations, errors, make, missing_rows  # noqa: E402
+from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
+from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
+from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
+from gcs_sysid.gp.joint import decoupled_model  # noqa: E402
+
+PATTERNS = ("none", "rates", "block")
+ISO_MODELS = ("joint", "jointn", "dec", "decn", "indep", "lmc")
+HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
+#: the comparisons ``--summarize`` counts: (model, against, pattern)
+PAIRS = (("joint", "indep", "none"), ("jointn", "indep", "none"), ("lmc", "indep", "none"),
+         ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
+         ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
+         ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
+
+
+def first_seconds(t: np.ndarray, tr: np.ndarray, length: float) -> np.ndarray:
+    """The training rows ``tr`` ``(N,)`` within ``length`` s of the first one (``length <= 0``: all)."""
+    if length <= 0:
+        return tr.copy()
+    t0 = t[tr][0]
+    return tr & (t <= t0 + length)
+
+
+def _pred(model, X):
+    return model.predict(X, include_noise=False)[0]
+
+
+def score(path: Path, lengths, patterns, lmc: bool = False):
+    """Every model on one cached flight; yields one JSON-able dict per length, pattern and model."""
+    d = np.load(path)
+    t, X, Y, Xt, Yt = d["t"], d["X"], d["Y"], d["Xt"], d["Yt"]
+    ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
+    tr_all = d["train"] & np.isfinite(Y).all(1) & np.isfinite(X).all(1)
+    h = d["held"] & ok
+    meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
+    base = GPConfig()
+    P = Y.shape[1]
+    for length in lengths:
+        tr = first_seconds(t, tr_all, length)
+        info = dict(meta, length=float(length), n_train=int(tr.sum()),
+                    span_s=round(float(t[tr][-1] - t[tr][0]), 2))
+        indep: list = []
+        for pattern in patterns:
+            models: dict = {}
+            times: dict = {}
+            corr: dict = {}
+            gone = np.zeros(len(X), bool)
+            if pattern == "none":
+                for v, cfg in (("joint", base), ("jointn", replace(base, noise_correlation=True)),
+                               ("lmc", replace(base, latent_kernels=2))):
+                    if v == "lmc" and not lmc:
+                        continue
+                    t0 = time.perf_counter()
+                    models[v] = fit_gp(X[tr], Y[tr], cfg)[0]
+                    times[v] = time.perf_counter() - t0
+                    corr[v] = _correlations(models[v], X[tr], Xt[tr], Yt[tr])
+                models["dec"], models["decn"] = decoupled_model(models["joint"]), decoupled_model(models["jointn"])
+                times["dec"] = times["decn"] = 0.0
+                t0 = time.perf_counter()
+                indep = [fit_gp(X[tr], Y[tr][:, [p]], base, output_names=[COEFFICIENTS[p]])[0] for p in range(P)]
+                times["indep"] = time.perf_counter() - t0
+                preds = {v: _pred(m, X[h]) for v, m in models.items()}
+                preds["indep"] = np.column_stack([_pred(m, X[h])[:, 0] for m in indep])
+                gaps = {}
+            else:
+                gone, _ = missing_rows(pattern, X, tr)
+                Ym = Y.copy()
+                Ym[np.ix_(gone, MOMENTS)] = np.nan
+                t0 = time.perf_counter()
+                models["hjoint"] = fit_gp(X[tr], Ym[tr], base)[0]
+                times["hjoint"] = time.perf_counter() - t0
+                corr["hjoint"] = _correlations(models["hjoint"], X[tr], Xt[tr], Yt[tr])
+                models["hdec"] = decoupled_model(models["hjoint"])
+                times["hdec"] = 0.0
+                keep = tr & ~gone
+                t0 = time.perf_counter()
+                models["hdrop"] = fit_gp(X[keep], Y[keep], base)[0]
+                times["hdrop"] = time.perf_counter() - t0
+                t0 = time.perf_counter()
+                hind = list(indep) if indep else [None] * P
+                for p in range(P):
+                    if p in MOMENTS or hind[p] is None:
+                        rows = tr & np.isfinite(Ym[:, p])
+                        hind[p] = fit_gp(X[rows], Y[rows][:, [p]], base, output_names=[COEFFICIENTS[p]])[0]
+                if not indep:          # the forces' GPs see the same rows under every pattern: fitted once
+                    indep = [m if p not in MOMENTS else None for p, m in enumerate(hind)]
+                times["hindep"] = time.perf_counter() - t0
+                preds = {v: _pred(m, X[h]) for v, m in models.items()}
+                preds["hindep"] = np.column_stack([_pred(m, X[h])[:, 0] for m in hind])
+                gaps = {v: _pred(m, X[gone]) for v, m in models.items()}
+                gaps["hindep"] = np.column_stack([_pred(m, X[gone])[:, 0] for m in hind])
+            for v, mean in preds.items():
+                row = dict(info, pattern=pattern, variant=v, n_missing=int(gone.sum()),
+                           err=dict(zip(COEFFICIENTS, errors(mean, Yt[h]).round(3).tolist())),
+                           t_fit_s=round(times[v], 2))
+                if v in gaps:
+                    row["err_gap"] = dict(zip(COEFFICIENTS, errors(gaps[v], Yt[gone]).round(3).tolist()))
+                if v in corr:
+                    row.update(corr[v])
+                yield row
+
+
+def _pairs(rows, a, b, pattern, key="err", cols=COEFFICIENTS, group=lambda r: True):
+    by: dict = {}
+    for r in rows:
+        if r["pattern"] == pattern and group(r):
+            by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["length"]), {})[r["variant"]] = r
+    return [(f[a][key][c], f[b][key][c]) for f in by.values() if a in f and b in f and key in f[a] for c in cols]
+
+
+def _count(pairs) -> str:
+    if not pairs:
+        return ""
+    x, y = np.array(pairs).T
+    better, worse = int(np.sum(x < y - 0.05)), int(np.sum(x > y + 0.05))
+    return (f"{better} / {worse} / {len(x) - better - worse}, {np.median(x):.2f} vs {np.median(y):.2f} %, "
+            f"ratio of medians {np.median(x) / np.median(y):.3f}")
+
+
+def summarize(paths) -> str:
+    """Pair counts per comparison, length and turbulence (markdown)."""
+    rows = [json.loads(line) for p in paths for line in open(p) if line.strip()]
+    last = {(r["aircraft"], r["seed"], r["turbulence"], r["length"], r["pattern"], r["variant"]): r for r in rows}
+    rows = list(last.values())
+    lengths = sorted({r["length"] for r in rows}, key=lambda v: (v <= 0, v))
+    turbs = sorted({r["turbulence"] for r in rows})
+    flights = sorted({(r["aircraft"], r["seed"], r["turbulence"]) for r in rows})
+    out = [f"{len(flights)} flights: " + ", ".join(f"{a} s{s} {t}" for a, s, t in flights), ""]
+    mom = [COEFFICIENTS[i] for i in MOMENTS]
+    for a, b, pattern in PAIRS:
+        for key, cols, what in (("err", COEFFICIENTS, "held-out, all six"),) if pattern == "none" else (
+                ("err", mom, "held-out, moments"), ("err_gap", mom, "gap, moments")):
+            lines = []
+            for L in lengths:
+                for tb in turbs + ["both"]:
+                    g = (lambda r, L=L, tb=tb: r["length"] == L and (tb == "both" or r["turbulence"] == tb))
+                    s = _count(_pairs(rows, a, b, pattern, key, cols, g))
+                    if s:
+                        lines.append(f"| {'all' if L <= 0 else f'{L:g} s'} | {tb} | {s} |")
+            if lines:
+                out += [f"\n{a} vs {b}, pattern {pattern}, {what} (better / worse by > 0.05 points / within; medians)\n",
+                        "| training | turbulence | pairs |", "|---|---|---|"] + lines
+    # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
+    out += ["\njoint vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
+            "| aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|"]
+    for ac in sorted({r["aircraft"] for r in rows}):
+        for L in lengths:
+            g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
+            f = _count(_pairs(rows, "joint", "indep", "none", "err", COEFFICIENTS[:3], g))
+            m = _count(_pairs(rows, "joint", "indep", "none", "err", mom, g))
+            if f or m:
+                out.append(f"| {ac} | {'all' if L <= 0 else f'{L:g} s'} | {f} | {m} |")
+    # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
+    out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
+    out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
+    for v in ("joint", "jointn", "lmc", "hjoint"):
+        for L in lengths:
+            rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
+            if rs:
+                out.append(f"| {v} | {'all' if L <= 0 else f'{L:g} s'} | {sum(len(r['flags']) for r in rs)} | "
+                           f"{sum(len(r['flags_carrying']) for r in rs)} | {15 * len(rs)} |")
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
+    ap.add_argument("--make", action="store_true", help="fly, replay and cache the flights that are missing")
+    ap.add_argument("--aircraft", nargs="+", default=["c172x"], type=aircraft_argument)
+    ap.add_argument("--seeds", nargs="+", type=int, default=[1])
+    ap.add_argument("--turbulence", nargs="+", default=["light"])
+    ap.add_argument("--lengths", nargs="+", type=float, default=[10.0, 20.0, 40.0, 0.0],
+                    help="training lengths in s from the first training row (0: all)")
+    ap.add_argument("--patterns", nargs="+", default=list(PATTERNS), choices=PATTERNS)
+    ap.add_argument("--lmc", action="store_true", help="also fit the two-kernel LMC (isotopic rows)")
+    ap.add_argument("--json", default=None, help="append one JSON line per flight, length, pattern and model")
+    ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
+    a = ap.parse_args(argv)
+    if a.summarize:
+        print(summarize(a.summarize))
+        return 0
+    cache = Path(a.cache)
+    cache.mkdir(parents=True, exist_ok=True)
+    for ac in a.aircraft:
+        for turb in a.turbulence:
+            for seed in a.seeds:
+                path = cache / f"{ac}-{seed}-{turb}-ahrs.npz"
+                if not path.is_file():
+                    if not a.make:
+                        print(f"no cached flight {path} (run with --make)", file=sys.stderr)
+                        return 2
+                    path = make(ac, seed, turb, "ahrs", 90.0, cache)
+                for r in score(path, a.lengths, a.patterns, a.lmc):
+                    print(f"{path.stem:26s} {r['length']:4.0f} s {r['pattern']:5s} {r['variant']:6s} err "
+                          + " ".join(f"{r['err'][c]:6.2f}" for c in COEFFICIENTS)
+                          + ("" if "err_gap" not in r else "  gap " + " ".join(
+                              f"{r['err_gap'][COEFFICIENTS[i]]:6.2f}" for i in MOMENTS))
+                          + f"  ({r['n_train']} rows, {r['t_fit_s']:.1f} s)", flush=True)
+                    if a.json:
+                        with open(a.json, "a") as f:
+                            f.write(json.dumps(r) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
