@@ -810,7 +810,7 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             the scale columns were built from. model0: the model (``{coef: {term: value}}``).
         wind_axis: ``scale:CY`` on the wind-axis side force. angle_u: see above. block_s: jackknife block, s.
     """
-    from .uncertainty import angle_sensitivity, combine, fit_standard_errors
+    from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
     coef = f["coefficient"]
     j = COEFFICIENTS.index(coef)
@@ -857,9 +857,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         sens = angle_sensitivity(columns, X, rr, tr, i, REGRESSORS.index(angle), float(u.get("scale", 0.0)),
                                  float(u.get("offset_rad", 0.0)))
         typeb.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
-    flight = np.nanmax([parts["flight_coloured"], parts["flight_jackknife"]])
-    reference = np.nanmax([parts.get("reference_coloured", np.nan), parts.get("reference_jackknife", np.nan)]) \
-        if "reference_coloured" in parts else None
+    flight = float(type_a(own)[i])
+    reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
     u_c = combine({"flight": flight, "reference": reference, **typeb})
     if not np.isfinite(u_c) or u_c <= 0:
         return

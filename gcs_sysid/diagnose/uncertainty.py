@@ -37,7 +37,7 @@ import numpy as np
 
 from .regression import ols
 
-__all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "air_data_uncertainty",
+__all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "air_data_uncertainty",
            "angle_sensitivity", "combine"]
 
 #: block length of the delete-a-block jackknife, s (the diagnosis's ``alpha_jackknife_s``: longer than the
@@ -107,6 +107,13 @@ def fit_standard_errors(t: np.ndarray, A: np.ndarray, r: np.ndarray, labels: lis
     jk = np.sqrt(np.maximum(np.diag(cov), 0.0)) if cov is not None else np.full(A.shape[1], np.nan)
     return {"theta": np.asarray(fit.theta, float), "coloured": np.asarray(fit.std_error, float), "jackknife": jk,
             "blocks": int(np.floor((np.nanmax(t) - np.nanmin(t)) / block_s) + 1) if cov is not None else 0}
+
+
+def type_a(res: dict) -> np.ndarray:
+    """The type-A standard error of each coefficient of a :func:`fit_standard_errors` result: the larger of
+    the coloured-residual and the block-jackknife standard error ((P,); the jackknife where the analytic
+    form is NaN and the other way round)."""
+    return np.fmax(np.asarray(res["coloured"], float), np.asarray(res["jackknife"], float))
 
 
 def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = None) -> dict:
