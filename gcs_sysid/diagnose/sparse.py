@@ -598,6 +598,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         result["note"] = "too few rows for the sparse search"
         return result
     base = np.zeros_like(R)
+    base_jk: list[np.ndarray] = []         # the inadequacy's delete-a-block refits on this flight
     base_mean = np.zeros(R.shape[1])       # the inadequacy's level on this flight (kept for the lift alpha)
     ref_ms = None
     ref_after = None                       # the reference's residual after its inadequacy: (names, Phi, R, rows, M0)
@@ -636,6 +637,15 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["inadequacy"].append({"coefficient": coef, "terms": entry["terms"], "score": entry["score"]})
             base_mean[j] = base[tr, j].mean() if tr.size else 0.0
             base[:, j] -= base_mean[j]
+        if ridge is not None and th.get("honest_std_error", True):
+            # the inadequacy is itself fitted on the reference flight: its delete-a-block refits, as this
+            # flight sees them (the same centring), for the standard uncertainty of a named term
+            # (_with_uncertainty)
+            Wb = _ridge_jackknife(rPhi[rows], Rr[rows], rctx.t[rows], ridge, max_rows,
+                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0)
+            Ps = (Phi - ridge[1]) / ridge[2]
+            base_jk = [(Ps @ W_b) * (base != 0).any(axis=0) for W_b in Wb]
+            base_jk = [b - b[tr].mean(axis=0) for b in base_jk]
     Rd = R - base
     # the residual without the reference's ridge inadequacy (same nuisances and named delays taken out):
     # a delay is refined on it, as a parameter against the reference's own (_differential_delay)
@@ -746,7 +756,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             if f["cause"] in at_naming:
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
-                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0)
+                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk])
     result["findings"] = named
     return result
 
@@ -789,8 +799,41 @@ def _with_reference_error(f: dict, ref_after) -> None:
     f["std_error"] = float(np.hypot(f["std_error"], se_ref))
 
 
+def _ridge_jackknife(Phi: np.ndarray, Y: np.ndarray, t: np.ndarray, ridge, max_rows: int,
+                     block_s: float) -> list[np.ndarray]:
+    """The reference's ridge inadequacy (:func:`_ridge_cv`) refitted with each ``block_s``-second block left out.
+
+    Same thinned rows, column means and scales and per-column ridges as the fit it repeats; the blocks are
+    contiguous in time (delete-a-block jackknife, Kuensch 1989).
+
+    Args:
+        Phi: (N, K) the reference's library on its valid rows. Y: (N, 6) its residual. t: (N,) time, s.
+        ridge: ``(W, mu, sc, lam)`` of :func:`_ridge_cv`. max_rows, block_s: as there; block length, s.
+
+    Returns:
+        ``[W_b (K, 6)]`` one per block with at least 50 thinned rows (empty with fewer than 3 such blocks).
+    """
+    _, mu, sc, lam = ridge
+    rows = np.arange(len(Y))[:: max(1, int(np.ceil(len(Y) / max_rows)))]
+    A = (Phi[rows] - mu) / sc
+    Yc = Y[rows] - Y[rows].mean(axis=0)
+    n = A.shape[0]
+    k = np.floor((t[rows] - t[rows][0]) / block_s).astype(int)
+    labels = [b for b in np.unique(k) if np.sum(k == b) >= 50]
+    if len(labels) < 3:
+        return []
+    out = []
+    for b in labels:
+        m = k != b
+        ev, U = np.linalg.eigh(A[m].T @ A[m])
+        bU = U.T @ (A[m].T @ (Yc[m] - Yc[m].mean(axis=0)))
+        out.append(U @ (bU / (np.maximum(ev, 0.0)[:, None] + lam[None, :] * n)))
+    return out
+
+
 def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
-                      M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float) -> None:
+                      M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
+                      inadequacy_jk: list[np.ndarray] | None = None) -> None:
     """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
 
     The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
@@ -809,6 +852,10 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             ``(names, Phi, R, rows, S0, t)`` after its inadequacy, or None. M0: (T, 6) the model's prediction
             the scale columns were built from. model0: the model (``{coef: {term: value}}``).
         wind_axis: ``scale:CY`` on the wind-axis side force. angle_u: see above. block_s: jackknife block, s.
+        inadequacy_jk: the reference's ridge inadequacy refitted with each ``block_s`` block of the reference
+            left out, minus the one subtracted, on this flight ((T, 6) each; :func:`_ridge_jackknife`): the
+            term refitted on the residual each would leave gives the inadequacy's share (delete-a-block
+            jackknife), a further type-A component of the reference.
     """
     from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
@@ -850,6 +897,11 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                 parts.update(reference_coloured=float(ref["coloured"][i]), reference_jackknife=float(ref["jackknife"][i]))
             except (ValueError, np.linalg.LinAlgError):
                 pass
+    if inadequacy_jk and len(inadequacy_jk) >= 3:
+        Af = columns(X)[tr]
+        th_b = np.array([np.linalg.lstsq(Af, -d[tr, j], rcond=None)[0][i] for d in inadequacy_jk])
+        B = th_b.size
+        parts["inadequacy_jackknife"] = float(np.sqrt((B - 1) / B * np.sum((th_b - th_b.mean()) ** 2)))
     typeb = {}
     for angle, u in (angle_u or {}).items():
         if not (u.get("scale", 0) > 0 or u.get("offset_rad", 0) > 0):
@@ -859,7 +911,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         typeb.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
-    u_c = combine({"flight": flight, "reference": reference, **typeb})
+    u_c = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
+                   **typeb})
     if not np.isfinite(u_c) or u_c <= 0:
         return
     f["evidence"]["std_error_decision"] = float(f["std_error"])
