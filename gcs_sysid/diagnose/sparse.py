@@ -822,10 +822,11 @@ def _ridge_jackknife(Phi: np.ndarray, Y: np.ndarray, t: np.ndarray, ridge, max_r
     labels = [b for b in np.unique(k) if np.sum(k == b) >= 50]
     if len(labels) < 3:
         return []
+    G = A.T @ A
     out = []
     for b in labels:
-        m = k != b
-        ev, U = np.linalg.eigh(A[m].T @ A[m])
+        m, o = k != b, k == b
+        ev, U = np.linalg.eigh(G - A[o].T @ A[o])            # the Gram matrix without the block (downdated)
         bU = U.T @ (A[m].T @ (Yc[m] - Yc[m].mean(axis=0)))
         out.append(U @ (bU / (np.maximum(ev, 0.0)[:, None] + lam[None, :] * n)))
     return out
@@ -868,15 +869,21 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
     i = 1 + terms.index(named)
 
     def columns(Xp: np.ndarray) -> np.ndarray:
-        nm, P = _library(replace(ctx, X=Xp), knots)
-        idx = {n: k for k, n in enumerate(nm)}
+        lib = None
         cols = [np.ones(len(Xp))]
+        Xn = np.nan_to_num(Xp)
         for t in terms:
+            fac = _factors(t)
             if t == f"scale:{coef}":
                 Mp = M0 + np.nan_to_num(ctx.model_values(Xp, model0) - ctx.model_values(X, model0))
-                cols.append(scale_columns(Mp, np.nan_to_num(Xp), wind_axis)[:, j])
-            else:
-                cols.append(P[:, idx[t]])
+                cols.append(scale_columns(Mp, Xn, wind_axis)[:, j])
+            elif fac and all(x in REGRESSORS for x in fac):     # a monomial, as the library forms it
+                cols.append(np.prod([Xn[:, REGRESSORS.index(x)] for x in fac], axis=0))
+            else:                                               # hinges, lags, alpha_dot_hat: the library
+                if lib is None:
+                    nm, P = _library(replace(ctx, X=Xp), knots)
+                    lib = ({n: k for k, n in enumerate(nm)}, P)
+                cols.append(lib[1][:, lib[0][t]])
         return np.nan_to_num(np.column_stack(cols))
 
     rr = np.nan_to_num(r - r[tr].mean())
