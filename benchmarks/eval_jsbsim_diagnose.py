@@ -18,7 +18,10 @@ Score per case:
     search's estimate is: the search fitted the factor with the drag's part beside it as a ``beta``
     term whenever it selected one (``docs/jsbsim.md``); that value is kept as ``body_axis_value``);
   * ``gain``: held-out gain of that finding >= 50 %;
-  * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);
+  * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors; a term the
+    sparse search names reports its combined standard uncertainty since the ninth session, branch i9-se);
+    ``cover_decision``: the same with ``evidence.std_error_decision``, the standard error the diagnosis's
+    decisions read (the reported one before; the summary shows it in brackets);
   * clean flights: ``ok`` when no cause is named.
 
 Usage::
