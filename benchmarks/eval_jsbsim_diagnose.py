@@ -18,7 +18,10 @@ Score per case:
     search's estimate is: the search fitted the factor with the drag's part beside it as a ``beta``
     term whenever it selected one (``docs/jsbsim.md``); that value is kept as ``body_axis_value``);
   * ``gain``: held-out gain of that finding >= 50 %;
-  * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors);
+  * ``cover``: |estimate - truth| <= 2 standard errors (coverage of the reported standard errors; a term the
+    sparse search names reports its combined standard uncertainty since the ninth session, branch i9-se);
+    ``cover_decision``: the same with ``evidence.std_error_decision``, the standard error the diagnosis's
+    decisions read (the reported one before; the summary shows it in brackets);
   * clean flights: ``ok`` when no cause is named.
 
 Usage::
@@ -231,10 +234,14 @@ def score_case(findings: list[dict], truth: dict) -> dict:
             est = f["estimate"] - (f.get("model_value", 0.0) if ":" in e["cause"] and not
                                    e["cause"].startswith(("delay:", "bias:")) else 0.0)
             se = float(f.get("std_error") or 0.0)
+            # the standard error the diagnosis's decisions read (before the ninth session's combined
+            # uncertainty, sparse._with_uncertainty, it was the reported one)
+            se_d = float(f.get("std_error_decision") or f.get("evidence", {}).get("std_error_decision") or se)
             row.update(estimate=est, std_error=se, est=abs(est - e["value"]) <= 0.25 * abs(e["value"]),
                        gain_pct=float(f["gain"].get("percent", 0.0)),
                        gain=float(f["gain"].get("percent", 0.0)) >= 50.0,
-                       cover=se > 0 and abs(est - e["value"]) <= 2 * se)
+                       cover=se > 0 and abs(est - e["value"]) <= 2 * se,
+                       std_error_decision=se_d, cover_decision=se_d > 0 and abs(est - e["value"]) <= 2 * se_d)
         rows.append(row)
     return {"ok": all(r["top"] and r.get("est") and r.get("gain") for r in rows), "effects": rows,
             "named": causes}
@@ -326,7 +333,9 @@ def summarize(paths: list[str]) -> str:
         out.append(f"| {summary_label(ac)} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
                    f"{sum(bool(e.get('est')) for e in rows)}/{n} | {sum(bool(e.get('gain')) for e in rows)}/{n} | "
                    f"{sum(bool(r['score']['ok']) for r in rs)}/{len(rs)} | "
-                   f"{sum(bool(e.get('cover')) for e in found)}/{len(found)} | {desc} |")
+                   f"{sum(bool(e.get('cover')) for e in found)}/{len(found)}"
+                   + (f" ({sum(bool(e.get('cover_decision')) for e in found)}/{len(found)} with the decision se)"
+                      if any('cover_decision' in e for e in found) else "") + f" | {desc} |")
     return "\n".join(out)
 
 
@@ -445,7 +454,9 @@ def main(argv=None) -> int:
             rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs,
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
-                                | {"gain_pct": f.get("gain", {}).get("percent")} for f in findings]}
+                                | {"gain_pct": f.get("gain", {}).get("percent"),
+                                   "std_error_decision": f.get("evidence", {}).get("std_error_decision"),
+                                   "uncertainty": f.get("evidence", {}).get("uncertainty")} for f in findings]}
             fh.write(json.dumps(rec, default=float) + "\n")
             fh.flush()
             lines.append(rec)

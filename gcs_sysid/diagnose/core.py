@@ -339,8 +339,14 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         from .sparse import THRESHOLDS as _SPARSE_TH
 
         keep_rd = bool(_SPARSE_TH.get("allowance_on_search_residual", False))
+        from .uncertainty import air_data_uncertainty
+
         data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0),
-                                       keep_residual=keep_rd)
+                                       keep_residual=keep_rd,
+                                       angle_uncertainty=air_data_uncertainty(
+                                           getattr(states, "angle_fits", None),
+                                           getattr(search_reference[1], "angle_fits", None)
+                                           if isinstance(search_reference, tuple) else None))
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)
         data["sparse"].pop("rows", None)

@@ -696,7 +696,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         # sparse search: estimate - model_value)
         mv = f.get("model_value", f["evidence"].get("model_value", 0.0))
         c_f = f["evidence"].get("correction", f["estimate"] - mv) if is_aero else f["estimate"] - null
-        se_f = float(f["std_error"])
+        # the standard error the rules below were frozen with: a named term's reported std_error is its combined
+        # standard uncertainty since the ninth session (sparse._with_uncertainty), which no decision reads
+        se_f = float(f["evidence"].get("std_error_decision", f["std_error"]))
         # a delay sized as a difference (sparse._differential_delay): compare the flight's own delay with each
         # reference's, both by that one fit
         same_fit = delay_same_fit and cause.startswith("delay:") and "delay_differential" in f.get("evidence", {})

@@ -558,7 +558,8 @@ def scale_columns(M: np.ndarray, X: np.ndarray, wind_axis: bool = True) -> np.nd
 
 def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext, np.ndarray] | None = None,
                   folds: int = 5, segment_frac: float = 0.2, max_rows: int = 4000,
-                  thresholds: dict | None = None, keep_residual: bool = False) -> dict:
+                  thresholds: dict | None = None, keep_residual: bool = False,
+                  angle_uncertainty: dict | None = None) -> dict:
     """Search each coefficient's residual for new terms; differential when a reference is given.
 
     Args:
@@ -573,6 +574,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             ``benchmarks/search_jsbsim_cm.py``): ``"residual"`` (T, 6), the residual after the
             reference's inadequacy and the angle nuisance, and ``"rows"``, ``{"train", "untouched"}``
             row indices.
+        angle_uncertainty: the reconstruction's own standard uncertainty of the air angles' scale and
+            offset (:func:`gcs_sysid.diagnose.uncertainty.air_data_uncertainty`), carried into each named
+            term's ``std_error`` as a type-B component (:func:`_with_uncertainty`); None: left out.
 
     Returns:
         ``{"coefficients": [...], "inadequacy": [...], "findings": [...], "segment": {...}}``:
@@ -594,6 +598,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         result["note"] = "too few rows for the sparse search"
         return result
     base = np.zeros_like(R)
+    base_jk: list[np.ndarray] = []         # the inadequacy's delete-a-block refits on this flight
     base_mean = np.zeros(R.shape[1])       # the inadequacy's level on this flight (kept for the lift alpha)
     ref_ms = None
     ref_after = None                       # the reference's residual after its inadequacy: (names, Phi, R, rows, M0)
@@ -618,7 +623,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 if ref_after is None:
                     ref_after = (rnames, rPhi, np.zeros_like(Rr), rows,
                                  np.nan_to_num(scale_columns(np.nan_to_num(rctx.Y) - Rr, np.nan_to_num(rctx.X),
-                                                             bool(th.get("side_force_wind_axis", False)))))
+                                                             bool(th.get("side_force_wind_axis", False)))),
+                                 rctx.t)
                 ref_after[2][rows, j] = e
                 result["inadequacy"].append({"coefficient": coef, "model": "ridge", "lambda": float(lam[j]),
                                              "rms_explained": float(np.std(((rPhi[rows] - mu) / sc) @ W[:, j]))})
@@ -631,11 +637,21 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["inadequacy"].append({"coefficient": coef, "terms": entry["terms"], "score": entry["score"]})
             base_mean[j] = base[tr, j].mean() if tr.size else 0.0
             base[:, j] -= base_mean[j]
+        if ridge is not None and th.get("honest_std_error", True):
+            # the inadequacy is itself fitted on the reference flight: its delete-a-block refits, as this
+            # flight sees them (the same centring), for the standard uncertainty of a named term
+            # (_with_uncertainty)
+            Wb = _ridge_jackknife(rPhi[rows], Rr[rows], rctx.t[rows], ridge, max_rows,
+                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0)
+            Ps = (Phi - ridge[1]) / ridge[2]
+            base_jk = [(Ps @ W_b) * (base != 0).any(axis=0) for W_b in Wb]
+            base_jk = [b - b[tr].mean(axis=0) for b in base_jk]
     Rd = R - base
     # the residual without the reference's ridge inadequacy (same nuisances and named delays taken out):
     # a delay is refined on it, as a parameter against the reference's own (_differential_delay)
     Rn = R.copy()
     M0 = np.nan_to_num(ctx.Y) - R          # the model's own prediction (R is measured minus model)
+    Xc = ctx.X
     if th.get("angle_nuisance", True):
         model0 = reference[0].model if reference is not None else ctx.model
         # weights from the reference flight's residual (after its inadequacy): the same for every
@@ -683,6 +699,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         result["residual"], result["rows"] = Rd.copy(), {"train": tr, "untouched": te}
         result["scale_columns"] = S0
     named: list[dict] = []
+    at_naming: dict[str, np.ndarray] = {}
     for rnd in range(th["rounds"]):
         entries, cands = [], []
         for j, coef in enumerate(COEFFICIENTS):
@@ -725,11 +742,21 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             Rd, Rn = Rd - D, Rn - D
             named.append(f)
             continue
+        for f in new:                      # what each term was fitted on, for its standard uncertainty
+            at_naming[f["cause"]] = Rd[:, COEFFICIENTS.index(f["coefficient"])].copy()
         named += new
         break
     if ref_after is not None:
         for f in named:
             _with_reference_error(f, ref_after)
+    if th.get("honest_std_error", True):
+        Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
+        model0 = reference[0].model if reference is not None else ctx.model
+        for f in named:
+            if f["cause"] in at_naming:
+                _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
+                                  bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
+                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk])
     result["findings"] = named
     return result
 
@@ -746,7 +773,7 @@ def _with_reference_error(f: dict, ref_after) -> None:
     """
     if f["cause"].startswith("delay:") or not np.isfinite(f.get("std_error", np.nan)):
         return
-    rnames, rPhi, Rr, rows, S0r = ref_after
+    rnames, rPhi, Rr, rows, S0r = ref_after[:5]
     j = COEFFICIENTS.index(f["coefficient"])
     idx = {n: i for i, n in enumerate(rnames)}
     cols = []
@@ -770,6 +797,139 @@ def _with_reference_error(f: dict, ref_after) -> None:
         return
     f["evidence"]["std_error_parts"] = {"flight": float(f["std_error"]), "reference": se_ref}
     f["std_error"] = float(np.hypot(f["std_error"], se_ref))
+
+
+def _ridge_jackknife(Phi: np.ndarray, Y: np.ndarray, t: np.ndarray, ridge, max_rows: int,
+                     block_s: float) -> list[np.ndarray]:
+    """The reference's ridge inadequacy (:func:`_ridge_cv`) refitted with each ``block_s``-second block left out.
+
+    Same thinned rows, column means and scales and per-column ridges as the fit it repeats; the blocks are
+    contiguous in time (delete-a-block jackknife, Kuensch 1989).
+
+    Args:
+        Phi: (N, K) the reference's library on its valid rows. Y: (N, 6) its residual. t: (N,) time, s.
+        ridge: ``(W, mu, sc, lam)`` of :func:`_ridge_cv`. max_rows, block_s: as there; block length, s.
+
+    Returns:
+        ``[W_b (K, 6)]`` one per block with at least 50 thinned rows (empty with fewer than 3 such blocks).
+    """
+    _, mu, sc, lam = ridge
+    rows = np.arange(len(Y))[:: max(1, int(np.ceil(len(Y) / max_rows)))]
+    A = (Phi[rows] - mu) / sc
+    Yc = Y[rows] - Y[rows].mean(axis=0)
+    n = A.shape[0]
+    k = np.floor((t[rows] - t[rows][0]) / block_s).astype(int)
+    labels = [b for b in np.unique(k) if np.sum(k == b) >= 50]
+    if len(labels) < 3:
+        return []
+    G = A.T @ A
+    out = []
+    for b in labels:
+        m, o = k != b, k == b
+        ev, U = np.linalg.eigh(G - A[o].T @ A[o])            # the Gram matrix without the block (downdated)
+        bU = U.T @ (A[m].T @ (Yc[m] - Yc[m].mean(axis=0)))
+        out.append(U @ (bU / (np.maximum(ev, 0.0)[:, None] + lam[None, :] * n)))
+    return out
+
+
+def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
+                      M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
+                      inadequacy_jk: list[np.ndarray] | None = None) -> None:
+    """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
+
+    The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
+    the larger of Morelli and Klein's coloured-residual standard error (sec. 5.3) and the delete-a-block
+    jackknife over ``block_s``-second blocks of the training rows (Kuensch 1989); the reference flight's
+    fit of the same terms on its residual after its inadequacy, the same two forms; and, as type B, the
+    air angles' scale and offset uncertainty the reconstruction itself reports (``angle_u``,
+    :func:`gcs_sysid.diagnose.uncertainty.air_data_uncertainty`) propagated through the fit by central
+    differences. ``evidence.uncertainty`` holds every component; ``evidence.std_error_decision`` keeps the
+    standard error the diagnosis's decisions read (:mod:`gcs_sysid.diagnose.differential`), unchanged.
+
+    Args:
+        f: the finding (a library term or ``scale:<coef>``). ctx: this flight. X: (T, 10) the regressors the
+            library was built on (angles corrected by the nuisance). knots: the library's alpha hinges.
+        r: (T,) the residual the term was fitted on. tr: training rows. ref_after: the reference's
+            ``(names, Phi, R, rows, S0, t)`` after its inadequacy, or None. M0: (T, 6) the model's prediction
+            the scale columns were built from. model0: the model (``{coef: {term: value}}``).
+        wind_axis: ``scale:CY`` on the wind-axis side force. angle_u: see above. block_s: jackknife block, s.
+        inadequacy_jk: the reference's ridge inadequacy refitted with each ``block_s`` block of the reference
+            left out, minus the one subtracted, on this flight ((T, 6) each; :func:`_ridge_jackknife`): the
+            term refitted on the residual each would leave gives the inadequacy's share (delete-a-block
+            jackknife), a further type-A component of the reference.
+    """
+    from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
+
+    coef = f["coefficient"]
+    j = COEFFICIENTS.index(coef)
+    terms = [t["term"] for t in f["evidence"].get("terms", [])]
+    named = f"scale:{coef}" if f["cause"].startswith("scale:") else f["cause"].split(":", 1)[1]
+    if named not in terms:
+        return
+    i = 1 + terms.index(named)
+
+    def columns(Xp: np.ndarray) -> np.ndarray:
+        lib = None
+        cols = [np.ones(len(Xp))]
+        Xn = np.nan_to_num(Xp)
+        for t in terms:
+            fac = _factors(t)
+            if t == f"scale:{coef}":
+                Mp = M0 + np.nan_to_num(ctx.model_values(Xp, model0) - ctx.model_values(X, model0))
+                cols.append(scale_columns(Mp, Xn, wind_axis)[:, j])
+            elif fac and all(x in REGRESSORS for x in fac):     # a monomial, as the library forms it
+                cols.append(np.prod([Xn[:, REGRESSORS.index(x)] for x in fac], axis=0))
+            else:                                               # hinges, lags, alpha_dot_hat: the library
+                if lib is None:
+                    nm, P = _library(replace(ctx, X=Xp), knots)
+                    lib = ({n: k for k, n in enumerate(nm)}, P)
+                cols.append(lib[1][:, lib[0][t]])
+        return np.nan_to_num(np.column_stack(cols))
+
+    rr = np.nan_to_num(r - r[tr].mean())
+    try:
+        own = fit_standard_errors(ctx.t[tr], columns(X)[tr], rr[tr], ["1"] + terms, block_s)
+    except (ValueError, KeyError, np.linalg.LinAlgError):
+        return
+    parts = {"flight_coloured": float(own["coloured"][i]), "flight_jackknife": float(own["jackknife"][i])}
+    if ref_after is not None and len(ref_after) > 5:
+        rnames, rPhi, Rr, rows, S0r, tref = ref_after
+        ridx = {n: k for k, n in enumerate(rnames)}
+        if all(t == f"scale:{coef}" or t in ridx for t in terms) and rows.size >= 50:
+            A = np.column_stack([np.ones(rows.size)] + [S0r[rows, j] if t == f"scale:{coef}" else rPhi[rows, ridx[t]]
+                                                         for t in terms])
+            try:
+                ref = fit_standard_errors(tref[rows], np.nan_to_num(A), Rr[rows, j] - Rr[rows, j].mean(),
+                                          ["1"] + terms, block_s)
+                parts.update(reference_coloured=float(ref["coloured"][i]), reference_jackknife=float(ref["jackknife"][i]))
+            except (ValueError, np.linalg.LinAlgError):
+                pass
+    if inadequacy_jk and len(inadequacy_jk) >= 3:
+        Af = columns(X)[tr]
+        th_b = np.array([np.linalg.lstsq(Af, -d[tr, j], rcond=None)[0][i] for d in inadequacy_jk])
+        B = th_b.size
+        parts["inadequacy_jackknife"] = float(np.sqrt((B - 1) / B * np.sum((th_b - th_b.mean()) ** 2)))
+    typeb = {}
+    for angle, u in (angle_u or {}).items():
+        if not (u.get("scale", 0) > 0 or u.get("offset_rad", 0) > 0):
+            continue
+        sens = angle_sensitivity(columns, X, rr, tr, i, REGRESSORS.index(angle), float(u.get("scale", 0.0)),
+                                 float(u.get("offset_rad", 0.0)))
+        typeb.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
+    flight = float(type_a(own)[i])
+    reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
+    u_c = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
+                   **typeb})
+    if not np.isfinite(u_c) or u_c <= 0:
+        return
+    f["evidence"]["std_error_decision"] = float(f["std_error"])
+    f["evidence"]["uncertainty"] = {
+        "method": "GUM (JCGM 100:2008) eq. 10: type A = max(Morelli-Klein coloured, Kuensch 1989 block "
+                  f"jackknife over {block_s:g}-s blocks) for this flight and the reference; type B = the air "
+                  "angles' scale and offset uncertainty the reconstruction reports, propagated by central differences",
+        "type_a": {k: float(v) for k, v in parts.items()}, "type_b": typeb, "air_data": angle_u or {},
+        "combined": u_c}
+    f["std_error"] = u_c
 
 
 def _differential_delay(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarray, j: int,

@@ -103,6 +103,12 @@ class AxisFit:
             instrument the angle, :func:`gcs_sysid.estimation.angleerrors.iv_lstsq`), ``"OLS"`` or ``"given"``
             (another flight's slopes, :func:`aided_air_angles` ``models``), followed by a note when a model was given.
         first_stage_r2: the instruments' first-stage partial R^2 (NaN: no instruments).
+        scale_sigma: standard uncertainty of the aided angle's relative scale: the aided and the kinematic
+            angle's disagreement in scale, ``sqrt(d^2 + se_d^2)`` with ``d`` the slope of (aided - kinematic)
+            on the centred aided angle and ``se_d`` its block-jackknife standard error (15-s blocks, Kuensch
+            1989). The kinematic angle's scale is set by geometry (GPS velocity, attitude), the aided one's
+            by the force slope, which errors in variables attenuate; NaN where not aided. Read by the
+            diagnosis as a type-B uncertainty (:func:`gcs_sysid.diagnose.uncertainty.air_data_uncertainty`).
         bias_sigma: 1-sigma of the angle's flight-common offset, rad (alpha: the flight-mean vertical
             wind over the airspeed, :func:`gcs_sysid.estimation.angleerrors.mean_wind_sigma`; NaN for beta,
             whose mean the wind fit and the CY0 prior set). Included in the per-sample sigma.
@@ -125,6 +131,7 @@ class AxisFit:
     slope_method: str = "OLS"
     first_stage_r2: float = float("nan")
     bias_sigma: float = float("nan")
+    scale_sigma: float = float("nan")
 
 
 @dataclass
@@ -350,6 +357,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         fit.bias_sigma = mean_wind_sigma(w, V[m][np.isfinite(V[m])], float(m.sum()) * dt)
         if np.isfinite(fit.bias_sigma):
             sig = np.sqrt(sig**2 + fit.bias_sigma**2)
+    if fit is not None:
+        fit.scale_sigma = _scale_disagreement(dt, ang, kin0, m)
     if moments is not None and fit is not None:
         # cross-check that does not use the forces: the moments depend on the angle too (Cm_alpha; Cl_beta,
         # Cn_beta) and are measured by the gyro, not by the accelerometers the aiding used. If the aided
@@ -365,6 +374,36 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                           f"vs {100 * rk:.1f} % of the variance): the force model is not trusted")
             return kin0, np.full(len(kin0), np.nan), fit
     return ang, sig, fit
+
+
+def _scale_disagreement(dt: float, ang: np.ndarray, kin: np.ndarray, m: np.ndarray, block_s: float = 15.0) -> float:
+    """``sqrt(d^2 + se_d^2)``: the aided angle's scale against the kinematic one (:attr:`AxisFit.scale_sigma`).
+
+    Args:
+        dt: sample interval, s. ang, kin: (T,) aided and kinematic angle, rad. m: (T,) bool rows aided.
+
+    Returns:
+        dimensionless (0.05 = 5 %); NaN with too few rows or no excitation.
+    """
+    ok = np.asarray(m, bool) & np.isfinite(ang) & np.isfinite(kin)
+    if ok.sum() < 150:
+        return float("nan")
+    x, y = ang[ok], (ang - kin)[ok]
+
+    def slope(k: np.ndarray) -> float:
+        xc = x[k] - x[k].mean()
+        return float(xc @ (y[k] - y[k].mean())) / float(xc @ xc) if float(xc @ xc) > 0 else float("nan")
+
+    d = slope(np.ones(x.size, bool))
+    if not np.isfinite(d):
+        return float("nan")
+    # delete-a-block jackknife over contiguous blocks of block_s (Kuensch 1989): the gusts are slow
+    blk = np.floor(np.nonzero(ok)[0] * dt / block_s).astype(int)
+    labels = [b for b in np.unique(blk) if np.sum(blk == b) >= 50]
+    th = np.array([slope(blk != b) for b in labels]) if len(labels) >= 3 else np.zeros(0)
+    se = float(np.sqrt((th.size - 1) / th.size * np.sum((th - th.mean()) ** 2))) \
+        if th.size and np.all(np.isfinite(th)) else 0.0
+    return float(np.hypot(d, se))
 
 
 def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: np.ndarray, qbar: np.ndarray,

@@ -93,7 +93,12 @@ def test_a_differential_standard_error_counts_the_reference_flight():
     f = next(f for f in res["findings"] if f["cause"] == "Cn:delta_a")
     parts = f["evidence"]["std_error_parts"]
     assert parts["reference"] > 0 and parts["flight"] > 0
-    assert f["std_error"] == pytest.approx(np.hypot(parts["flight"], parts["reference"]))
+    # the standard error the decisions read (item 12 of docs/diagnose.md's sparse search); the reported one is
+    # the combined standard uncertainty (item 14), which holds both flights' coloured standard errors and more
+    assert f["evidence"]["std_error_decision"] == pytest.approx(np.hypot(parts["flight"], parts["reference"]))
+    u = f["evidence"]["uncertainty"]
+    assert u["type_a"]["reference_coloured"] > 0 and f["std_error"] == pytest.approx(u["combined"])
+    assert f["std_error"] >= np.hypot(u["type_a"]["flight_coloured"], u["type_a"]["reference_coloured"]) * (1 - 1e-9)
     assert f["estimate"] - f["model_value"] == pytest.approx(-0.08, rel=0.25)
 
 

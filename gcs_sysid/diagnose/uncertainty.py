@@ -1,0 +1,203 @@
+"""Standard uncertainty of a named term's estimate: coloured residuals, the reference fit, the air angles.
+
+A term the sparse search names (``Cm:alpha^2``, ``Cl:alpha*beta``, ``scale:CY`` ...) is a *change*: this
+flight's least-squares fit minus what the reference flight's fit holds. Its standard uncertainty is
+combined from uncorrelated components in quadrature (GUM, JCGM 100:2008, sec. 5.1, eq. 10):
+
+* **type A, this flight**: the larger of Morelli and Klein's coloured-residual standard error
+  (*Aircraft System Identification*, 2nd ed., sec. 5.3: ``(X'X)^-1 X' R_vv X (X'X)^-1``, the LS covariance
+  corrected for the residual autocorrelation) and the delete-a-block jackknife over contiguous blocks of
+  ``block_s`` seconds (Kuensch, *Ann. Statist.* 17 (1989) 1217-1241; Efron and Tibshirani 1993, ch. 11).
+  Gust-driven residuals are coloured on the scale of seconds, so a 90-s flight holds few independent
+  samples; the jackknife also carries a slowly varying error of the *regressor* (an air angle that misses
+  slow gusts) aligned by chance with the manoeuvres, which the LS covariance (regressor held fixed) does
+  not. The jackknife has only ``B - 1`` degrees of freedom (5-6 blocks in a 90-s training segment), so
+  the analytic form is kept as a floor;
+* **type A, the reference flight**: the same two forms of the same terms on the reference flight's
+  residual after its inadequacy (the change is a difference of two fits);
+* **type B, the air angles** (GUM sec. 4.3): the reconstructed angle of attack (and sideslip) has a
+  per-flight scale error (the aiding's force slope) and an offset (the flight-mean vertical wind, which
+  no sensor observes). A term in those angles is biased by them. The pipeline's *own* assessment of
+  its air-data uncertainty (:func:`air_data_uncertainty`: the estimator's standard errors of the aiding
+  slope and its 1-sigma of the mean vertical wind over the airspeed), never the truth, gives a standard
+  uncertainty ``u_s`` of the relative scale and ``u_o`` of the offset; each is propagated through the
+  fit by a central difference (GUM sec. 5.1.3, sensitivity coefficients found numerically): the selected
+  terms' columns are rebuilt on the angle scaled about its flight mean by ``1 +- u_s`` (shifted by
+  ``+- u_o``) and refitted on the same residual, ``u = |theta(+) - theta(-)| / 2``.
+
+Nothing here changes which cause is named, its estimate or its gain: the diagnosis's decisions keep the
+standard errors they were frozen with (``evidence.std_error_decision``).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from .regression import ols
+
+__all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "air_data_uncertainty",
+           "angle_sensitivity", "combine"]
+
+#: block length of the delete-a-block jackknife, s (the diagnosis's ``alpha_jackknife_s``: longer than the
+#: gusts' correlation times of 1-5 s at light aircraft speeds, short enough to give 5-8 blocks per flight)
+BLOCK_S = 15.0
+
+
+def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: float = BLOCK_S,
+                        min_rows: int = 50) -> np.ndarray | None:
+    """Delete-a-block jackknife covariance of least-squares coefficients on dependent data.
+
+    The rows (in time order) are cut into contiguous blocks of ``block_s`` seconds; the least-squares
+    solution ``theta_i`` is recomputed with block ``i`` left out, and
+    ``Cov = (B - 1)/B sum (theta_i - mean theta)(theta_i - mean theta)'`` (Kuensch 1989; Efron and
+    Tibshirani, *An Introduction to the Bootstrap*, 1993, sec. 11.5 for the delete-one form).
+
+    Args:
+        t: (N,) time of the rows, s. A: (N, P) regressors (a constant column included by the caller).
+        r: (N,) response. block_s: block length, s. min_rows: a block with fewer rows is left with its
+            neighbours (it is never left out on its own).
+
+    Returns:
+        (P, P) covariance, or None with fewer than 3 blocks or a singular fit.
+    """
+    t, A, r = np.asarray(t, float), np.asarray(A, float), np.asarray(r, float)
+    ok = np.isfinite(t) & np.all(np.isfinite(A), axis=1) & np.isfinite(r)
+    t, A, r = t[ok], A[ok], r[ok]
+    if t.size < 3 * min_rows or block_s <= 0:
+        return None
+    k = np.floor((t - t[0]) / block_s).astype(int)
+    labels = [b for b in np.unique(k) if np.sum(k == b) >= min_rows]
+    if len(labels) < 3:
+        return None
+    G, g = A.T @ A, A.T @ r
+    th = []
+    for b in labels:
+        m = k == b
+        try:
+            th.append(np.linalg.solve(G - A[m].T @ A[m], g - A[m].T @ r[m]))
+        except np.linalg.LinAlgError:
+            return None
+    th = np.asarray(th)
+    B = th.shape[0]
+    d = th - th.mean(axis=0)
+    return (B - 1) / B * (d.T @ d)
+
+
+def fit_standard_errors(t: np.ndarray, A: np.ndarray, r: np.ndarray, labels: list[str],
+                        block_s: float = BLOCK_S) -> dict:
+    """Coloured-residual and block-jackknife standard errors of one least-squares fit.
+
+    Args:
+        t: (N,) time, s. A: (N, P) regressors, the first column the constant. r: (N,) response.
+        labels: (P,) names of the columns.
+
+    Returns:
+        ``{"theta": (P,), "coloured": (P,), "jackknife": (P,) (NaN where the jackknife is not
+        possible), "blocks": int}``: Morelli and Klein's all-lags form (sec. 5.3,
+        :func:`gcs_sysid.diagnose.regression.colored_covariance` ``method="morelli"``) and
+        :func:`block_jackknife_cov`.
+
+    Raises:
+        ValueError: from :func:`gcs_sysid.diagnose.regression.ols` (too few rows, singular).
+    """
+    fit = ols(A, r, labels, cov_method="morelli")
+    cov = block_jackknife_cov(t, A, r, block_s)
+    jk = np.sqrt(np.maximum(np.diag(cov), 0.0)) if cov is not None else np.full(A.shape[1], np.nan)
+    return {"theta": np.asarray(fit.theta, float), "coloured": np.asarray(fit.std_error, float), "jackknife": jk,
+            "blocks": int(np.floor((np.nanmax(t) - np.nanmin(t)) / block_s) + 1) if cov is not None else 0}
+
+
+def type_a(res: dict) -> np.ndarray:
+    """The type-A standard error of each coefficient of a :func:`fit_standard_errors` result: the larger of
+    the coloured-residual and the block-jackknife standard error ((P,); the jackknife where the analytic
+    form is NaN and the other way round)."""
+    return np.fmax(np.asarray(res["coloured"], float), np.asarray(res["jackknife"], float))
+
+
+def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = None) -> dict:
+    """The reconstruction's own standard uncertainty of each air angle's scale and offset.
+
+    From the estimator's fits of the specific-force aiding
+    (:class:`gcs_sysid.estimation.airangles.AxisFit`, ``FlightStates.angle_fits``): the aided angle's
+    excursions are the force coefficient's divided by the aiding slope (``CZ_alpha``, ``CY_beta``), so a
+    relative error of that slope is a relative scale error of the angle: ``u_s = coef_sigma[1] /
+    |coef[1]|`` (the slope's own standard error, instrumental-variable or OLS as fitted). The offset:
+    alpha's ``bias_sigma`` (the flight-mean vertical wind, which no sensor observes, over the airspeed:
+    :func:`gcs_sysid.estimation.angleerrors.mean_wind_sigma`); beta's mean is set by the wind fit and a
+    symmetric airframe's ``CY0 ~ 0``, whose spread the estimator does not report, so its offset
+    uncertainty is left out (0). An axis the aiding did not use (kinematic angle kept) or a slope given
+    from another flight carries no scale uncertainty of its own here (0). The scale also takes the aided
+    and the kinematic angle's disagreement in scale (``AxisFit.scale_sigma``) in quadrature: the kinematic
+    angle's scale is set by geometry, the aided one's by a force slope that errors in variables attenuate.
+
+    The change is this flight's fit minus the reference's, and the reference's angle errors stay in the
+    model (the angle nuisance brings this flight's angle to the reference's scale; a term of degree ``k``
+    comes out ``(1 + s_ref)^-k`` of its size), so with ``reference_fits`` each component is the two
+    flights' in quadrature (independent flights).
+
+    Args:
+        angle_fits: ``{"alpha": AxisFit, "beta": AxisFit}`` of this flight, or None.
+        reference_fits: the same of the reference flight, or None.
+
+    Returns:
+        ``{"alpha": {"scale": u_s, "offset_rad": u_o}, "beta": {...}}`` (dimensionless, rad; 0 where unknown).
+    """
+    if reference_fits is not None:
+        a, b = air_data_uncertainty(angle_fits), air_data_uncertainty(reference_fits)
+        return {n: {k: float(np.hypot(a[n][k], b[n][k])) for k in a[n]} for n in a}
+    out = {}
+    for name in ("alpha", "beta"):
+        fit = (angle_fits or {}).get(name)
+        us, uo = 0.0, 0.0
+        if fit is not None and getattr(fit, "used", False):
+            c, s = np.asarray(fit.coef, float), np.asarray(fit.coef_sigma, float)
+            if c.size > 1 and s.size > 1 and np.isfinite(s[1]) and abs(c[1]) > 0:
+                us = float(abs(s[1] / c[1]))
+            d = float(getattr(fit, "scale_sigma", float("nan")))
+            us = float(np.hypot(us, d)) if np.isfinite(d) else us
+            b = float(getattr(fit, "bias_sigma", float("nan")))
+            uo = b if np.isfinite(b) else 0.0
+        out[name] = {"scale": us, "offset_rad": uo}
+    return out
+
+
+def angle_sensitivity(columns: Callable[[np.ndarray], np.ndarray], X: np.ndarray, r: np.ndarray,
+                      rows: np.ndarray, index: int, k_angle: int, scale: float, offset: float) -> dict:
+    """Standard uncertainty of one fitted coefficient from an air angle's scale and offset (type B).
+
+    Args:
+        columns: ``X -> (T, P)`` the fit's regressors (constant first) built from regressors ``X``.
+        X: (T, 10) the regressors the fit used. r: (T,) the response. rows: (N,) row indices of the fit.
+        index: column of the coefficient in ``columns``' output. k_angle: column of the angle in ``X``.
+        scale: standard uncertainty of the angle's relative scale (about its mean over ``rows``).
+        offset: standard uncertainty of its offset, rad.
+
+    Returns:
+        ``{"scale": u, "offset": u}``: ``|theta(+u) - theta(-u)| / 2`` for each (0 when its input is 0).
+    """
+    mean = float(np.nanmean(X[rows, k_angle]))
+    out = {}
+    for what, u in (("scale", scale), ("offset", offset)):
+        if not u > 0:
+            out[what] = 0.0
+            continue
+        th = []
+        for sgn in (1.0, -1.0):
+            Xp = X.copy()
+            if what == "scale":
+                Xp[:, k_angle] = mean + (1.0 + sgn * u) * (X[:, k_angle] - mean)
+            else:
+                Xp[:, k_angle] = X[:, k_angle] + sgn * u
+            A = np.nan_to_num(np.asarray(columns(Xp), float)[rows])
+            th.append(np.linalg.lstsq(A, r[rows], rcond=None)[0][index])
+        out[what] = float(abs(th[0] - th[1]) / 2.0)
+    return out
+
+
+def combine(parts: dict) -> float:
+    """Root sum of squares of uncorrelated standard uncertainties (GUM eq. 10 with unit sensitivities);
+    NaN and missing parts count as 0."""
+    v = np.array([p for p in parts.values() if p is not None and np.isfinite(p)], float)
+    return float(np.sqrt(np.sum(v**2))) if v.size else float("nan")
