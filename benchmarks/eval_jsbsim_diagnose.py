@@ -445,7 +445,13 @@ def main(argv=None) -> int:
             rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs,
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
-                                | {"gain_pct": f.get("gain", {}).get("percent")} for f in findings]}
+                                | {"gain_pct": f.get("gain", {}).get("percent"),
+                                   # the gain on the residual against the model, where diagnose now reports the
+                                   # differential one (core.DIFFERENTIAL_GAIN; None where nothing was replaced)
+                                   "gain_against_model_pct": f.get("evidence", {}).get("gain_against_model",
+                                                                                       {}).get("percent"),
+                                   "source": f.get("source") or f.get("evidence", {}).get("domain")}
+                                for f in findings]}
             fh.write(json.dumps(rec, default=float) + "\n")
             fh.flush()
             lines.append(rec)

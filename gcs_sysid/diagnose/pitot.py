@@ -141,7 +141,9 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         min_score, min_gain_pct: the usual acceptance on the acceptance rows.
 
     Returns:
-        ``{"candidates": [...], "finding": dict | None, "calibration": [str]}``; each candidate
+        ``{"candidates": [...], "finding": dict | None, "calibration": [str], "delta"}``; ``delta`` (T, 6)
+        the accepted cause's correction (``R + delta`` the residual after it; not JSON, for
+        :func:`gcs_sysid.diagnose.core._differential_gains`); each candidate
         ``{"cause", "estimate", "std_error", "t_statistic", "score", "gain_percent", "checks": {...},
         "accepted"}``; ``finding`` the accepted one as a diagnosis finding (evidence domain
         ``"physical signature"``), ``gain`` on the untouched rows.
@@ -199,13 +201,16 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
     fused = _fused_candidate(ctx, R, proj, flight, references, airframe, model, out["candidates"], gain_rows,
                              min_gain_pct)
     out["wind_triangle"] = fused
+    delta = fused.pop("_delta", None) if fused is not None else None
     if fused is not None and fused["accepted"]:
         out["finding"] = fused.pop("finding")
+        out["delta"] = delta
         return out
     if fused is not None:
         fused.pop("finding", None)
     if best is not None:
         f, cand, gate = best
+        out["delta"], out["delta_offsets_removed"] = f.delta, bool(gate.get("offsets_allowed"))
         main = max(cand["gain_untouched"], key=cand["gain_untouched"].get) if cand["gain_untouched"] else f.coefficient
         gu = gate["versus_terms"]["gain_cause"].get(main, 0.0)
         out["finding"] = {
@@ -350,7 +355,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
               "significant": bool(abs(fused["t_statistic"]) >= MIN_T_FUSED),
               "gain_on_untouched_rows": bool(main and gain_pct[main] >= min_gain_pct)}
     out.update(checks=checks, gain_untouched=gain_pct, score_untouched=float(score),
-               accepted=all(checks.values()))
+               accepted=all(checks.values()), _delta=np.nan_to_num(delta))
     if not out["accepted"]:
         out["why"] = ", ".join(k for k, v in checks.items() if not v) + " failed"
         return out
