@@ -79,7 +79,7 @@ MIN_T_SCREEN = 2.0
 #: screen only decides whether the exact re-fit is spent; naming stays with MIN_T_FUSED on both measurements. The
 #: closed-form route is biased low by the aided angles (0.16, -0.08, 0.08 m/s for 1 m/s on pa28 s3, j3cub s1,
 #: c182 s1), so a triangle of 1.6-1.9 standard errors stopped three 1 m/s biases before the measurement that
-#: decides; on the 74 tuning flights without a pitot change the triangle's t lies in [-1.27, +0.30]
+#: decides; on 76 recorded tuning flights without a pitot change the triangle's t lies in [-1.27, +0.30]
 #: (``docs/benchmarks.md``, *Ninth session, i9-pitot*).
 MIN_T_SCREEN_TRIANGLE = 1.5
 #: Largest coloured standard error (m/s) of one coefficient's estimate of the bias for it to take part in

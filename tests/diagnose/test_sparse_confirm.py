@@ -116,7 +116,7 @@ def test_pitot_screen_reaches_the_refit_on_the_triangle_alone():
 
 def test_pitot_screen_passes_a_one_mps_triangle_and_not_a_clean_one():
     """The triangle-alone route at MIN_T_SCREEN_TRIANGLE (1.5): a 1 m/s bias's triangle (0.73 +- 0.42, the
-    JSBSim c182 s1, closed-form fit 0.08) reaches the exact re-fit; the largest |t| of the 74 tuning flights
+    JSBSim c182 s1, closed-form fit 0.08) reaches the exact re-fit; the largest |t| of the 76 recorded tuning flights
     without a pitot change (-0.54 +- 0.43, j3cub s11) does not."""
     one = {"change_mps": 0.73, "std_error": 0.42, "t_statistic": 0.73 / 0.42}
     assert MIN_T_SCREEN_TRIANGLE <= abs(one["t_statistic"]) < MIN_T_SCREEN
