@@ -129,6 +129,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     from gcs_sysid.diagnose.run import load_measurements
     from gcs_sysid.sim.model_file import load_model
 
+    _LAST_PITOT.clear()
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan), effects, out)
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
@@ -146,7 +147,28 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     diag = diagnose(meas.table, meas.airframe, load_model(model_path), meas.states, output_error=False,
                     flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states),
                     references=[Reference(ref_meas.table, ref_meas.states, ref_meas.flight, label=f"{ac}-ref")])
+    _LAST_PITOT.update(_pitot_summary(diag.data))
     return diag.findings, truth, time.perf_counter() - t0
+
+
+#: the last diagnosed case's pitot evidence (:func:`_pitot_summary`), recorded with it in ``results.jsonl``
+_LAST_PITOT: dict = {}
+
+
+def _pitot_summary(data: dict) -> dict:
+    """The wind triangle's and the coefficients' pitot-bias changes, fused, and why it was or was not named
+    (``data["pitot"]["wind_triangle"]``), for the record of a case; {} when the pitot was not judged."""
+    wt = (data.get("pitot") or {}).get("wind_triangle") or {}
+    if not wt:
+        return {}
+    fused = wt.get("fused") or {}
+    ch = wt.get("change") or {}
+    re = wt.get("coefficients_rereduced") or {}
+    return {"triangle_mps": ch.get("change_mps"), "triangle_se": ch.get("std_error"),
+            "coefficients_mps": fused.get("coefficients_mps"), "coefficients_se": fused.get("coefficients_se"),
+            "fused_mps": fused.get("estimate"), "fused_t": fused.get("t_statistic"), "agree": fused.get("agree"),
+            "screen": (wt.get("screen") or {}).get("passes"), "rereduced_mps": re.get("estimate"),
+            "checks": wt.get("checks"), "why": wt.get("why")}
 
 
 def side_force_scale_truth(truth_npz, k: float) -> float:
@@ -452,11 +474,17 @@ def main(argv=None) -> int:
             except RuntimeError as exc:       # the aircraft left the envelope with that effect
                 sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
             rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
-                   "score": sc, "diagnose_s": secs,
+                   "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT),
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
                                 | {"gain_pct": f.get("gain", {}).get("percent"),
                                    "std_error_decision": f.get("evidence", {}).get("std_error_decision"),
-                                   "uncertainty": f.get("evidence", {}).get("uncertainty")} for f in findings]}
+                                   "uncertainty": f.get("evidence", {}).get("uncertainty"),
+                                   # the gain on the residual against the model, where diagnose now reports the
+                                   # differential one (core.DIFFERENTIAL_GAIN; None where nothing was replaced)
+                                   "gain_against_model_pct": f.get("evidence", {}).get("gain_against_model",
+                                                                                       {}).get("percent"),
+                                   "source": f.get("source") or f.get("evidence", {}).get("domain")}
+                                for f in findings]}
             fh.write(json.dumps(rec, default=float) + "\n")
             fh.flush()
             lines.append(rec)

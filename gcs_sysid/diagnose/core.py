@@ -123,6 +123,72 @@ def _reestimate(ctx: DiagContext, R_final: np.ndarray, accepted: list[Fitted], p
             f.delta = new_delta
 
 
+#: With a reference flight and the search, every coefficient-domain finding's reported held-out gain is
+#: measured on the *differential* residual: the residual against the model minus the reference flight's own
+#: inadequacy predicted on this flight (the search's ridge, :func:`gcs_sysid.diagnose.sparse.sparse_search`),
+#: the residual on which the search's own terms have always been measured. Added 2026-11-22, branch i9-pitot;
+#: ``docs/diagnose.md`` step 7. Naming is unchanged (every threshold is judged as before).
+DIFFERENTIAL_GAIN = True
+
+
+def _differential_gains(ctx: DiagContext, R0: np.ndarray, proj, inadequacy: np.ndarray, accepted: list[Fitted],
+                        pitot: dict | None, findings: list[dict]) -> None:
+    """Measure the held-out gain of the catalogue and pitot findings on the change since the reference flight.
+
+    The catalogue's causes and the pitot were scored on the residual against the model, ``R0`` (T, 6),
+    which also holds what the model never captured: present in the reference flight too, that part is no
+    change and no cause can take it up (on the JSBSim T-37 the reference's inadequacy is 0.0096 of CZ's
+    0.0148 held-out RMS, the 2-m/s pitot bias's exact effect 0.0106). The differential diagnosis names
+    changes, and the search's terms are measured on ``R0 - inadequacy``; so is every other finding here,
+    with its own rows and correction: a catalogue cause on ``ctx.test`` after the causes accepted before it,
+    the pitot on its untouched rows (offsets removed where its gate removed them). Each such finding's
+    ``gain`` is replaced by the largest per-coefficient gain there (``gain.coefficient``, ``gain.residual``
+    = ``"differential"``), the former one kept as ``evidence.gain_against_model``. Sensor causes judged by
+    data compatibility (gains in the sensor's own units), telemetry faults and the search's terms keep theirs.
+
+    Args:
+        ctx: the context. R0: (T, 6) residual against the model. proj: the gust projector or None.
+        inadequacy: (T, 6) the reference's inadequacy on this flight (``sparse_search``'s
+            ``inadequacy_prediction``). accepted: the catalogue's accepted causes, in order.
+        pitot: :func:`gcs_sysid.diagnose.pitot.airspeed_cause` or None. findings: edited in place.
+    """
+    from .physical import remove_offsets, split_held_out, with_test
+
+    Rb = np.nan_to_num(R0) - np.nan_to_num(inadequacy)
+
+    def gain_of(c, R, delta, k):
+        _, g = Scorer(c, R, proj).score(np.nan_to_num(delta), k)
+        if not g:
+            return None
+        main = max(g, key=lambda m: g[m]["percent"])
+        return dict(g[main], coefficient=main, residual="differential (against the model minus the reference "
+                                                          "flight's inadequacy)")
+
+    new = {}
+    R = Rb.copy()
+    for f in accepted:
+        new[f.cause] = gain_of(ctx, R, f.delta, len(f.params))
+        R = R + f.delta
+    pf = pitot.get("finding") if pitot is not None else None
+    if pf is not None and pitot.get("delta") is not None:
+        _, gain_rows = split_held_out(ctx.t, ctx.test)
+        Rp, dp = Rb, pitot["delta"]
+        if pitot.get("delta_offsets_removed"):
+            Rp, dp = remove_offsets(ctx, Rp), remove_offsets(ctx, dp)
+        g = gain_of(with_test(ctx, gain_rows), Rp, dp, 1)
+        if g is not None:
+            pf.setdefault("evidence", {})["gain_against_model"] = dict(pf.get("gain", {}))
+            pf["gain"] = dict(g, rows=pf.get("gain", {}).get("rows", "untouched"))
+    for fd in findings:
+        if fd is pf or fd.get("source") == "sparse search" or fd.get("kind") == "fault" \
+                or str(fd.get("evidence", {}).get("domain", "")).startswith(
+                    ("data compatibility", "physical signature", "output error", "telemetry", "sparse search")) \
+                or new.get(fd["cause"]) is None:
+            continue
+        fd.setdefault("evidence", {})["gain_against_model"] = dict(fd.get("gain", {}))
+        fd["gain"] = dict(new[fd["cause"]], rows=fd.get("gain", {}).get("rows", "held out"))
+
+
 def _finding(f: Fitted, rivals: list[Fitted]) -> dict:
     main = f.coefficient
     ev = {"score": float(f.score), "t_statistic": float(f.estimate / f.std_error) if f.std_error > 0 else None,
@@ -350,12 +416,17 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)
         data["sparse"].pop("rows", None)
+        inadequacy = data["sparse"].pop("inadequacy_prediction", None)
         findings[:] = merge_findings(findings, data["sparse"])
         data["timings"]["search_s"] = float(time.perf_counter() - t1)
+    else:
+        inadequacy = None
     if calibration:
         data["calibration"] = calibration
     if pitot is not None:
         findings[:] = with_pitot(findings, pitot, data)
+    if inadequacy is not None and DIFFERENTIAL_GAIN:
+        _differential_gains(ctx, R0, proj, inadequacy, accepted, pitot, findings)
     if compat:
         data["sensor_candidates"] = [{"cause": c["cause"], "estimate": c["estimate"], "score": c["score"],
                                       "gain_percent": c["gain"]["percent"]} for c in compat]

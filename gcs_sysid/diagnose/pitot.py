@@ -54,7 +54,7 @@ from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
 from .wind_triangle import WIND_SYSTEMATIC_MPS, autopilot_wind  # noqa: F401  (WIND_SYSTEMATIC_MPS: re-exported)
 
-__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "MIN_T_SCREEN",
+__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "MIN_T_SCREEN", "MIN_T_SCREEN_TRIANGLE",
            "MAX_SE_COEF_MPS", "airspeed_cause", "wind_shift", "fuse_pitot_evidence", "screen", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
@@ -75,6 +75,13 @@ MIN_T_FUSED = 3.0
 #: the wind triangle and the closed-form coefficient fit agree and their fused |t| reaches this, or (added
 #: 2026-11-22, branch i9-top90) the wind triangle's change since the reference flight alone reaches it.
 MIN_T_SCREEN = 2.0
+#: The screen's wind-triangle-alone route (added 2026-11-22 15:55 UTC, branch i9-pitot; before: MIN_T_SCREEN). The
+#: screen only decides whether the exact re-fit is spent; naming stays with MIN_T_FUSED on both measurements. The
+#: closed-form route is biased low by the aided angles (0.16, -0.08, 0.08 m/s for 1 m/s on pa28 s3, j3cub s1,
+#: c182 s1), so a triangle of 1.6-1.9 standard errors stopped three 1 m/s biases before the measurement that
+#: decides; on 76 recorded tuning flights without a pitot change the triangle's t lies in [-1.27, +0.30]
+#: (``docs/benchmarks.md``, *Ninth session, i9-pitot*).
+MIN_T_SCREEN_TRIANGLE = 1.5
 #: Largest coloured standard error (m/s) of one coefficient's estimate of the bias for it to take part in
 #: the coefficients' median (:func:`_fit_unit_delta`).
 MAX_SE_COEF_MPS = 0.5
@@ -141,7 +148,9 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         min_score, min_gain_pct: the usual acceptance on the acceptance rows.
 
     Returns:
-        ``{"candidates": [...], "finding": dict | None, "calibration": [str]}``; each candidate
+        ``{"candidates": [...], "finding": dict | None, "calibration": [str], "delta"}``; ``delta`` (T, 6)
+        the accepted cause's correction (``R + delta`` the residual after it; not JSON, for
+        :func:`gcs_sysid.diagnose.core._differential_gains`); each candidate
         ``{"cause", "estimate", "std_error", "t_statistic", "score", "gain_percent", "checks": {...},
         "accepted"}``; ``finding`` the accepted one as a diagnosis finding (evidence domain
         ``"physical signature"``), ``gain`` on the untouched rows.
@@ -199,13 +208,16 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
     fused = _fused_candidate(ctx, R, proj, flight, references, airframe, model, out["candidates"], gain_rows,
                              min_gain_pct)
     out["wind_triangle"] = fused
+    delta = fused.pop("_delta", None) if fused is not None else None
     if fused is not None and fused["accepted"]:
         out["finding"] = fused.pop("finding")
+        out["delta"] = delta
         return out
     if fused is not None:
         fused.pop("finding", None)
     if best is not None:
         f, cand, gate = best
+        out["delta"], out["delta_offsets_removed"] = f.delta, bool(gate.get("offsets_allowed"))
         main = max(cand["gain_untouched"], key=cand["gain_untouched"].get) if cand["gain_untouched"] else f.coefficient
         gu = gate["versus_terms"]["gain_cause"].get(main, 0.0)
         out["finding"] = {
@@ -257,7 +269,7 @@ def screen(fused: dict, change: dict) -> dict:
 
     It passes when the wind triangle and the closed-form coefficient fit agree and their fused change
     is at least :data:`MIN_T_SCREEN` standard errors, *or* when the wind triangle's change since the
-    reference flight(s) alone is: the closed-form fit misses the aided angles' response to the
+    reference flight(s) alone is at least :data:`MIN_T_SCREEN_TRIANGLE`: the closed-form fit misses the aided angles' response to the
     airspeed, so on some aircraft it comes out too low to agree, and it must not keep the exact re-fit
     (which decides, with the same agreement test) from being reached.
 
@@ -270,7 +282,7 @@ def screen(fused: dict, change: dict) -> dict:
         which the re-fit is linearised (the fused estimate, else the triangle's change), m/s.
     """
     by_fused = bool(fused["agree"] and abs(fused["t_statistic"]) >= MIN_T_SCREEN)
-    by_triangle = bool(change["std_error"] > 0 and abs(change["t_statistic"]) >= MIN_T_SCREEN)
+    by_triangle = bool(change["std_error"] > 0 and abs(change["t_statistic"]) >= MIN_T_SCREEN_TRIANGLE)
     return {"passes": by_fused or by_triangle, "fused": by_fused, "triangle_alone": by_triangle,
             "linearise_at_mps": float(fused["estimate"] if by_fused else change["change_mps"])}
 
@@ -350,7 +362,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
               "significant": bool(abs(fused["t_statistic"]) >= MIN_T_FUSED),
               "gain_on_untouched_rows": bool(main and gain_pct[main] >= min_gain_pct)}
     out.update(checks=checks, gain_untouched=gain_pct, score_untouched=float(score),
-               accepted=all(checks.values()))
+               accepted=all(checks.values()), _delta=np.nan_to_num(delta))
     if not out["accepted"]:
         out["why"] = ", ".join(k for k, v in checks.items() if not v) + " failed"
         return out

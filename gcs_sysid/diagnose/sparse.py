@@ -583,6 +583,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         per coefficient the selected terms (estimate, std_error), PRESS path, score and the
         untouched-segment gain; ``findings`` the named terms, best first, each
         ``{"cause", "coefficient", "estimate", "std_error", "gain": {"percent", ...}, "evidence"}``.
+        With a reference also ``"inadequacy_prediction"``, (T, 6): the reference flight's inadequacy (its
+        ridge) predicted on this flight, centred on the training rows (an array, not JSON).
     """
     th = dict(THRESHOLDS, **(thresholds or {}))
     # one library for both flights: the hinges in alpha sit at the reference flight's quantiles
@@ -647,6 +649,11 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             base_jk = [(Ps @ W_b) * (base != 0).any(axis=0) for W_b in Wb]
             base_jk = [b - b[tr].mean(axis=0) for b in base_jk]
     Rd = R - base
+    if reference is not None:
+        # the reference's inadequacy predicted on this flight (T, 6; centred on the training rows): the
+        # diagnosis measures every coefficient-domain finding's held-out gain on ``R - base`` (the change
+        # since the reference), as the search's own terms' (core._differential_gains); not JSON, popped there
+        result["inadequacy_prediction"] = base.copy()
     # the residual without the reference's ridge inadequacy (same nuisances and named delays taken out):
     # a delay is refined on it, as a parameter against the reference's own (_differential_delay)
     Rn = R.copy()

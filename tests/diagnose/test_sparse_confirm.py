@@ -7,7 +7,7 @@ import pytest
 
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.diagnose.context import DiagContext
-from gcs_sysid.diagnose.pitot import MIN_T_SCREEN, fuse_pitot_evidence, screen
+from gcs_sysid.diagnose.pitot import MIN_T_SCREEN, MIN_T_SCREEN_TRIANGLE, fuse_pitot_evidence, screen
 from gcs_sysid.diagnose.sparse import (THRESHOLDS, _control_parent_first, _held_out_passes, sparse_search,
                                        untouched_confirmation)
 
@@ -117,3 +117,15 @@ def test_pitot_screen_reaches_the_refit_on_the_triangle_alone():
     clean = {"change_mps": -0.52, "std_error": 0.43, "t_statistic": -0.52 / 0.43}
     assert abs(clean["t_statistic"]) < MIN_T_SCREEN
     assert not screen(fuse_pitot_evidence(clean, 0.0, 0.2), clean)["passes"]
+
+
+def test_pitot_screen_passes_a_one_mps_triangle_and_not_a_clean_one():
+    """The triangle-alone route at MIN_T_SCREEN_TRIANGLE (1.5): a 1 m/s bias's triangle (0.73 +- 0.42, the
+    JSBSim c182 s1, closed-form fit 0.08) reaches the exact re-fit; the largest |t| of the 76 recorded tuning flights
+    without a pitot change (-0.54 +- 0.43, j3cub s11) does not."""
+    one = {"change_mps": 0.73, "std_error": 0.42, "t_statistic": 0.73 / 0.42}
+    assert MIN_T_SCREEN_TRIANGLE <= abs(one["t_statistic"]) < MIN_T_SCREEN
+    s = screen(fuse_pitot_evidence(one, 0.08, 0.23), one)
+    assert s["passes"] and s["triangle_alone"] and s["linearise_at_mps"] == 0.73
+    worst = {"change_mps": -0.54, "std_error": 0.43, "t_statistic": -0.54 / 0.43}
+    assert not screen(fuse_pitot_evidence(worst, 0.0, 0.2), worst)["passes"]
