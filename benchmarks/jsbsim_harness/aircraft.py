@@ -202,10 +202,54 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(1.0 / 0.51, 1.0 / 0.2975, 1.0 / 0.43625),
         amplitude_deg=(4.0, 4.0, 3.5), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
         notes="Raytheon T-6A Texan II (JSBSim t6texan2), engine shut down, gear up, gliding; untouched by any tuning of the method"),
+    # b747: JSBSim's stock Boeing 747 (B747.xml, author "Unknown", 2002; an Aeromatic-style model of
+    # constant derivatives and a few tables), four turbofans on "direct" thrusters (no force once
+    # stopped). Chosen in the tenth session after the candidates in docs/jsbsim.md ("The b747"):
+    # f22, L410, 787-8, Concorde (Ixx + Iyy < Izz or Ixx + Izz < Iyy: not a physical tensor), f16
+    # (fly-by-wire: PID g and roll-rate laws between the commands and the surfaces), X15 and x24b
+    # (pitch, roll and yaw stability augmentation in their FCS; the x24b's Cl_beta is zero at
+    # alpha 0), f15 (flown: a lift-to-drag ratio of at most 6.5 and Mach tables with columns at 0.5
+    # and 1.4 only; the glide dived to 60 deg of pitch), XB-70 (the same aerodynamics as this
+    # model, with the reference point 54 ft ahead of the CG: Cm_alpha +2.6 per rad at the CG),
+    # F4N, F80C, A320 (each also without aileron yaw or a second side-force term, and weaker: Cl_beta
+    # -0.05, -0.1 and -0.03 per rad, Cm_alpha -0.22, -0.29 per rad at the CG, the F80C's rudder a
+    # fifth of this one's, and yaw dampers as well), B17, C130,
+    # Boeing314, Short_S23 (propellers that windmill once the engines stop; seaplanes), J246 (a
+    # launch vehicle). Surfaces from its <flight_control> (aerosurface_scale, zero-centred):
+    # elevator -0.35..+0.175 rad, left aileron +-0.35 rad (the only aileron property the
+    # aerodynamics read; the right the mirror), rudder +-0.35 rad. The elevator's command scale is
+    # its larger end (0.35 rad), so that the airframe file's servo ends (+-20.05 deg) cover every
+    # deflection flown (the sweep reaches -18 deg, trailing edge up; the mean end, 15 deg, would
+    # clip the logged PWM); a positive command then moves it half as far as a negative one. Signs
+    # read from its aerodynamics: Cmde -1.3 + 0.4875 Mach x elevator-pos (positive = trailing edge
+    # down), Clda +0.1 - 0.0335 Mach x left-aileron-pos (positive = left trailing edge down, roll
+    # right), Cndr -0.1 x rudder-pos (positive = trailing edge left, nose left); checked on the
+    # truth by tests/jsbsim/test_jsbsim_b747.py. Gear up (retractable; CDgear 0.011 vanishes with
+    # it). Its FCS has a yaw damper (2 x r-aero in normalised rudder per rad/s, clipped to +-0.2,
+    # i.e. 0.7 rad of rudder per rad/s up to 4 deg) that the harness cannot switch off, so the
+    # harness's own yaw damper is off (k_r = 0): the model's replaces it. 260 kt (ic/vc-kts) at
+    # 10000 ft: about 315 kt EAS, Mach 0.53, 2 x the model's power-off stall (about 155 kt EAS at
+    # 551098 lb, CL_max 1.2 at 0.23 rad); alpha stays under 7 deg in the sweep, so Cl:alpha*beta = 3
+    # (which reverses the stock Cl_beta -0.1 above 1.9 deg) flies without a knock-it-off. It sinks
+    # about 18 m/s (L/D about 10). Gains: the pitch loop of a 250-t aircraft at 180 m/s (k_theta
+    # 0.8, k_q 0.8: with the default 1.0 / 0.3 the sweep's first level put it into a pitch
+    # oscillation of +-30 deg with the elevator on its stops) and a speed gain k_v of 0.004 rad per
+    # m/s (the default 0.01 turns the sweep's 45-m/s speed steps into 0.45 rad of pitch); roll
+    # k_phi 1.0, k_p 0.4 (its aileron rolls it 5 x slower than the t6's; with the defaults the
+    # sweep banked past 70 deg). Amplitudes: elevator 4 deg (+2 / -4 deg of surface: pitch-rate
+    # standard deviation 0.9 deg/s, standard plan, light), aileron 8 deg (roll rate 1.9 deg/s),
+    # rudder 5 deg (yaw rate 0.8 deg/s, sideslip under 4.2 deg). Set from the harness's truth only
+    # (alpha, beta, rates, excitation per axis; docs/jsbsim.md), never from a method result.
+    "b747": AircraftSpec(
+        name="b747", model="B747", airspeed_kts=260.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(4.0, 8.0, 5.0), pulse_s=(0.7, 0.8, 1.0), gains=(0.8, 0.8, 0.004, 1.0, 0.4, 0.0), gear_up=True,
+        notes="Boeing 747 (JSBSim B747), engines shut down, gear up, gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37")
-HELD_OUT_AIRCRAFT = ("t6",)
-UNTOUCHED_AIRCRAFT = ("t6",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6")
+HELD_OUT_AIRCRAFT = ("b747",)
+UNTOUCHED_AIRCRAFT = ("b747",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -1,6 +1,6 @@
 """The c182 in the JSBSim harness: the seventh session's untouched aircraft of issues 8 and 9
-(docs/jsbsim.md, "The c182"); evaluated since, it now counts as used (the t6 is the untouched one:
-``test_jsbsim_t6.py`` checks the summaries' label and the eval scripts' ``--fly-only`` on it).
+(docs/jsbsim.md, "The c182"); evaluated since, it now counts as used (the b747 is the untouched one:
+``test_jsbsim_b747.py`` checks the summaries' label and the eval scripts' ``--fly-only`` on it).
 
 Only the harness is checked here, on JSBSim's exact truth and its own properties: the rigid-body
 consistency of the truth with the checked-in airframe file, the sign map against the model's XML

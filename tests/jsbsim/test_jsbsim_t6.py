@@ -1,16 +1,15 @@
-"""The t6 in the JSBSim harness: the untouched aircraft of issues 8 and 9 (docs/jsbsim.md, "The t6").
+"""The t6 in the JSBSim harness: the ninth session's untouched aircraft (docs/jsbsim.md, "The t6"),
+evaluated in its final evaluation and used since (the tenth session's untouched aircraft is the b747,
+``test_jsbsim_b747.py``). Its checks below are slow tests now, but for the names' test.
 
 Only the harness is checked here, on JSBSim's exact truth and its own properties: the rigid-body
 consistency of the truth with the checked-in airframe file (the model's product of inertia Ixz
 included), the sign map against the model's XML constants, the gear retracted by the harness, the
 .tlog as the pipeline decodes it, every hidden effect as JSBSim computes it (the injected moments
-reach JSBSim's total aerodynamic moments), the summaries' label, and (slow) the airspeed bias in the
-log and that the evaluation's flights stay in the envelope with every axis excited. No pipeline fit,
-GP, diagnosis or scoring is run on the t6 here: its first evaluation is the final one, after the
-merge. One 30-s flight serves every fast test.
+reach JSBSim's total aerodynamic moments), the airspeed bias in the log and that the evaluation's
+flights stay in the envelope with every axis excited. No pipeline fit, GP, diagnosis or scoring is
+run on the t6 here. One 30-s flight serves the module's tests.
 """
-
-import json
 
 import pytest
 
@@ -19,7 +18,6 @@ from truth_fits import (ENVELOPE_FLIGHTS, assert_airspeed_bias_in_log, assert_hi
                         assert_in_envelope, assert_names_resolve, assert_rigid_body_glide, assert_servos_map_back,
                         derivative_slopes, evaluation_envelope, short_flight_fixture)
 from gcs_sysid.airframe import load_airframe
-from gcs_sysid.telemetry import read_log
 
 
 t6_flight = short_flight_fixture("t6")      # fixture "t6": 30 s, light, seed 1
@@ -27,14 +25,14 @@ t6_flight = short_flight_fixture("t6")      # fixture "t6": 30 s, light, seed 1
 SLUG_FT2 = 1.3558179483314004     # kg m^2 per slug ft^2
 
 
-def test_names_resolve_and_only_the_t6_is_untouched():
-    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT
+def test_names_resolve_and_the_t6_is_used():
+    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, summary_label
 
     assert_names_resolve("t6", "t6texan2", "t66")
-    assert UNTOUCHED_AIRCRAFT == HELD_OUT_AIRCRAFT == ("t6",)
-    assert {"pa28", "j3cub", "c182", "t37"} <= set(TUNING_AIRCRAFT) and "t6" not in TUNING_AIRCRAFT
+    assert "t6" in TUNING_AIRCRAFT and "t6" not in HELD_OUT_AIRCRAFT and summary_label("t6") == "t6"
 
 
+@pytest.mark.slow
 def test_truth_is_rigid_body_consistent_with_the_airframe_file(t6):
     """JSBSim's aero moments equal J w_dot + w x J w with the checked-in airframe's J, its Ixz
     included; in the glide every non-gravity force and moment is aerodynamic (the turboprop drives a
@@ -49,6 +47,7 @@ def test_truth_is_rigid_body_consistent_with_the_airframe_file(t6):
         const["Ixz"], rel=1e-5)
 
 
+@pytest.mark.slow
 def test_sign_map_gives_the_project_conventions(t6):
     """Least squares on the exact truth: Cm_delta_e, Cl_delta_a, Cn_delta_r, Cm_alpha, Cl_p < 0,
     Cn_beta > 0, and the control derivatives at the model's constants (t6texan2.xml: CmDe -1.2 x
@@ -63,6 +62,7 @@ def test_sign_map_gives_the_project_conventions(t6):
     assert abs(cn[3]) < 1e-3, cn
 
 
+@pytest.mark.slow
 def test_the_harness_flies_the_t6_with_its_gear_up():
     """``gear_up``: the retractable gear (5 s from down to up) is up before the log starts (the 15-s
     settling phase), so its drag (CDgear 0.03) is zero."""
@@ -77,6 +77,7 @@ def test_the_harness_flies_the_t6_with_its_gear_up():
     assert fdm["gear/gear-pos-norm"] == 0.0 and fdm["aero/coefficient/CDgear"] == 0.0
 
 
+@pytest.mark.slow
 def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(t6):
     """The pipeline's decoder reads the t6's .tlog; its SERVO_OUTPUT_RAW, through the checked-in
     airframe file, gives JSBSim's deflections within PWM quantisation (the elevator's 29.2-deg end
@@ -84,6 +85,7 @@ def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(t6):
     assert_servos_map_back(t6)
 
 
+@pytest.mark.slow
 def test_every_hidden_effect_shows_in_jsbsims_own_forces_and_moments():
     """On the t6's XML (LIFT/DRAG/SIDE and ROLL/PITCH/YAW axes, one aileron property in the
     aerodynamics) every effect does what ``effects.py`` specifies, in JSBSim's own properties at
@@ -103,34 +105,6 @@ def test_airspeed_bias_reaches_the_logged_airspeed(t6, tmp_path):
     assert_airspeed_bias_in_log(t6, tmp_path)
 
 
-def test_summaries_mark_the_t6_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label t6 "(untouched)" and
-    no other aircraft, the t37 included (synthetic rows: no t6 result exists before the final
-    evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| t6 (untouched) | light") for ln in lines)
-    for ac in acs[:5]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| t6 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| t37 | clean |") for ln in lines)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("seed,turbulence,plan,effects", ENVELOPE_FLIGHTS)    # with the evaluation's pair
 def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_path, seed, turbulence, plan, effects):
@@ -143,24 +117,3 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
     limits = dict(alpha=(-6.0, 7.0), beta=(6.0, 8.0), bank=(20.0, 25.0), speed=(1.3 * 50.0, 140.0), alt_min=500.0)
     assert_in_envelope(evaluation_envelope("t6", seed, turbulence, plan, effects, tmp_path), **limits,
                        rate_std=1.5, rate_std_held=1.5)     # deg/s
-
-
-@pytest.mark.slow
-def test_eval_scripts_fly_the_t6_without_scoring_it(tmp_path, capsys, monkeypatch):
-    """``--aircraft t6texan2`` resolves to ``t6`` in both scripts; with ``--fly-only`` they fly into
-    ``--work`` / ``--out``, say that the t6 is the untouched aircraft, reuse the flights on a
-    second run and score nothing."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-
-    monkeypatch.setattr(eval_jsbsim_diagnose, "DURATION_S", 2.0)
-    runs = ((eval_jsbsim.main, ["--turbulence", "light", "--duration", "2", "--work", str(tmp_path / "f")], 1, 1),
-            (eval_jsbsim_diagnose.main, ["--clean-seeds", "--pairs", "--effects", "delay:delta_e",
-                                         "--out", str(tmp_path / "d")], -3, 3))      # reference + 2 sizes
-    for main, extra, column, n in runs:
-        argv = ["--aircraft", "t6texan2", "--seeds", "1", *extra, "--fly-only"]
-        assert main(argv) == 0 and main(argv) == 0
-        cap = capsys.readouterr()
-        assert [ln.split()[column] for ln in cap.out.splitlines()] == ["flown"] * n + ["reused"] * n, cap.out
-        assert "t6 is the untouched aircraft" in cap.err
-    assert read_log(tmp_path / "f" / "t6-light-s1-ahrs.tlog").streams["servo"].t.size > 50
-    assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
