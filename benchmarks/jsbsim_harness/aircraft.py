@@ -228,17 +228,18 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # it). Its FCS has a yaw damper (2 x r-aero in normalised rudder per rad/s, clipped to +-0.2,
     # i.e. 0.7 rad of rudder per rad/s up to 4 deg) that the harness cannot switch off, so the
     # harness's own yaw damper is off (k_r = 0): the model's replaces it. 260 kt (ic/vc-kts) at
-    # 10000 ft: about 315 kt EAS, Mach 0.53, 2 x the model's power-off stall (about 155 kt EAS at
-    # 551098 lb, CL_max 1.2 at 0.23 rad); alpha stays under 7 deg in the sweep, so Cl:alpha*beta = 3
+    # 10000 ft: 305-325 kt EAS, Mach 0.53-0.54, 2 x the model's power-off stall (about 155 kt EAS at
+    # 551098 lb, CL_max 1.2 at 0.23 rad); alpha stays within -5..7 deg in the sweep, so Cl:alpha*beta = 3
     # (which reverses the stock Cl_beta -0.1 above 1.9 deg) flies without a knock-it-off. It sinks
-    # about 18 m/s (L/D about 10). Gains: the pitch loop of a 250-t aircraft at 180 m/s (k_theta
+    # 15-17 m/s (L/D about 11). Gains: the pitch loop of a 250-t aircraft at 180 m/s (k_theta
     # 0.8, k_q 0.8: with the default 1.0 / 0.3 the sweep's first level put it into a pitch
     # oscillation of +-30 deg with the elevator on its stops) and a speed gain k_v of 0.004 rad per
     # m/s (the default 0.01 turns the sweep's 45-m/s speed steps into 0.45 rad of pitch); roll
-    # k_phi 1.0, k_p 0.4 (its aileron rolls it 5 x slower than the t6's; with the defaults the
+    # k_phi 1.0, k_p 0.4 (its aileron rolls it far more slowly than the t6's: 1.9 deg/s of roll-rate
+    # standard deviation with 8 deg of aileron, the t6 8.3 with 4; with the default roll gains the
     # sweep banked past 70 deg). Amplitudes: elevator 4 deg (+2 / -4 deg of surface: pitch-rate
     # standard deviation 0.9 deg/s, standard plan, light), aileron 8 deg (roll rate 1.9 deg/s),
-    # rudder 5 deg (yaw rate 0.8 deg/s, sideslip under 4.2 deg). Set from the harness's truth only
+    # rudder 5 deg (yaw rate 0.8 deg/s, sideslip under 4.4 deg). Set from the harness's truth only
     # (alpha, beta, rates, excitation per axis; docs/jsbsim.md), never from a method result.
     "b747": AircraftSpec(
         name="b747", model="B747", airspeed_kts=260.0, altitude_ft=10000.0,
