@@ -233,7 +233,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # (which reverses the stock Cl_beta -0.1 above 1.9 deg) flies without a knock-it-off. It sinks
     # 15-17 m/s (L/D about 11). Gains: the pitch loop of a 250-t aircraft at 180 m/s (k_theta
     # 0.8, k_q 0.8: with the default 1.0 / 0.3 the sweep's first level put it into a pitch
-    # oscillation of +-30 deg with the elevator on its stops) and a speed gain k_v of 0.004 rad per
+    # oscillation of +30..-80 deg with the elevator on its stops) and a speed gain k_v of 0.004 rad per
     # m/s (the default 0.01 turns the sweep's 45-m/s speed steps into 0.45 rad of pitch); roll
     # k_phi 1.0, k_p 0.4 (its aileron rolls it far more slowly than the t6's: 1.9 deg/s of roll-rate
     # standard deviation with 8 deg of aileron, the t6 8.3 with 4; with the default roll gains the

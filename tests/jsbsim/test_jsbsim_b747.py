@@ -13,7 +13,6 @@ fast test.
 
 import json
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft
