@@ -129,3 +129,17 @@ def test_side_force_error_is_accelerometer_noise(measured, fast_flight):
     assert _side_force_check(table, truth, log, raw)["floors"] > SIDE_FORCE_LIMITS["floors"]
     scaled = table.Y * 1.03
     assert abs(_side_force_check(table, truth, log, scaled)["scale"]) > SIDE_FORCE_LIMITS["scale"]
+
+
+def test_wiener_floor_of_white_signal_in_white_noise():
+    """Flat spectra: the floor is ``sqrt(S N / (S + N) * fs / 2)``, and the noise level reads back."""
+    from benchmarks.jsbsim_harness.scoring import white_noise_psd, wiener_floor
+
+    rng = np.random.default_rng(0)
+    dt, s_sig, s_noise = 0.02, 0.2, 0.05
+    x = rng.normal(0.0, s_sig, 20000)
+    N = white_noise_psd(rng.normal(0.0, s_noise, 20000), dt)
+    assert abs(N / (2 * s_noise**2 * dt) - 1) < 0.1
+    S = 2 * s_sig**2 * dt
+    expect = np.sqrt(S * N / (S + N) * 0.5 / dt)
+    assert abs(wiener_floor(x, N, dt) / expect - 1) < 0.05
