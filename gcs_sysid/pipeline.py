@@ -330,7 +330,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 if rows.any():
-                    mean, var = model.predict(table.X[rows])
+                    # the estimator's stated per-row air-angle variance: errors the residuals cannot show
+                    mean, var = model.predict(table.X[rows], x_var=None if table.x_var is None else table.x_var[rows])
                     pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
                     pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
             gp_summary = model.summary()
