@@ -37,6 +37,10 @@ class CoefficientTable:
             The air angles' smoothed 1-sigma less ``bias_sigma`` (``coefficients.STATED_INPUT_NOISE``); the
             GP's band at a flight's own regressors takes the larger of it and its learned input noise
             (``docs/gp.md``, "Noisy inputs: the estimator's stated variance").
+        x_scale_var: ``(10,)`` variance of the regressors' relative scale error common to the flight
+            (dimensionless; 0 where none is stated), or None: the aided air angles' ``AxisFit.scale_sigma``
+            squared. The GP's band at exact conditions carries it (``docs/gp.md``, "The band at exact
+            conditions").
     """
 
     t: np.ndarray
@@ -47,6 +51,7 @@ class CoefficientTable:
     notes: list[str] = field(default_factory=list)
     x_offset_cov: np.ndarray | None = None
     x_var: np.ndarray | None = None
+    x_scale_var: np.ndarray | None = None
 
     def x(self, name: str) -> np.ndarray:
         """Regressor column by name, shape (T,)."""
@@ -59,4 +64,5 @@ class CoefficientTable:
     def select(self, mask: np.ndarray) -> "CoefficientTable":
         """Rows where ``mask`` (T,) is True."""
         return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
-                                list(self.notes), self.x_offset_cov, None if self.x_var is None else self.x_var[mask])
+                                list(self.notes), self.x_offset_cov, None if self.x_var is None else self.x_var[mask],
+                                self.x_scale_var)

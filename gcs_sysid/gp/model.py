@@ -71,6 +71,8 @@ class LocalGlobalGP:
             refreshes), None when not learned (``GPConfig.residual_correlation``).
         offset_cov: ``(D, D)`` covariance of the training regressors' flight-common offset
             (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
+        scale_var: ``(D,)`` variance of the training regressors' relative scale error common to the flight
+            (dimensionless; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
         discrepancy: ``(2, P)``: the model discrepancy ``d`` and the white noise ``w`` per output from
             the blocked cross-validation (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when the
             check did not run.
@@ -97,6 +99,7 @@ class LocalGlobalGP:
     var_scale: np.ndarray | None = None
     offset_cov: np.ndarray | None = None
     discrepancy: np.ndarray | None = None
+    scale_var: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property

@@ -106,3 +106,34 @@ def test_band_covers_the_truth_when_the_angle_is_built_from_the_measured_force()
     cov1 = 100 * np.mean(np.abs(m1[:, 2] - truth[te, 2]) <= 1.96 * np.sqrt(v1[:, 2]))
     assert cov0 < 80.0, cov0
     assert 90.0 <= cov1 <= 99.5, cov1
+
+
+def test_exact_condition_band_carries_a_common_scale_error(fitted, flight, tmp_path):
+    """``scale_var`` (the aided angles' ``AxisFit.scale_sigma^2``): at exact conditions the variance gains
+    ``(dm/dx)^2 s^2 (x - mean x)^2``; nothing at the flight's own regressors; saved and loaded."""
+    from gcs_sysid.gp import load_gp
+    from gcs_sysid.gp.discrepancy import with_offset_covariance
+    from gcs_sysid.gp.inputnoise import mean_gradient
+    from gcs_sysid.gp.io import save_model
+
+    model, _ = fitted
+    X = flight[0][400:]
+    _, v0 = model.predict(X, include_noise=False, input_noise=False)
+    sv = np.zeros(10)
+    sv[0] = 0.1**2                                                           # alpha's scale known to 10 %
+    scaled = with_offset_covariance(model, None, scale_var=sv)
+    _, v1 = scaled.predict(X, include_noise=False, input_noise=False)
+    Xs = model.scaler.x(X)
+    g = mean_gradient(model.params, model.post, Xs)[:, :, 0] * model.scaler.y_std
+    np.testing.assert_allclose(v1, v0 + g**2 * sv[0] * Xs[:, [0]] ** 2, rtol=1e-6, atol=1e-14)
+    np.testing.assert_allclose(scaled.predict(X)[1], model.predict(X)[1])    # the flight's own regressors
+    back = load_gp(save_model(scaled, tmp_path / "m"))
+    np.testing.assert_allclose(back.predict(X, include_noise=False, input_noise=False)[1], v1, rtol=1e-9)
+    from gcs_sysid.gp.discrepancy import model_error_summary
+
+    assert model_error_summary(scaled)["scale_std"] == {"alpha": pytest.approx(0.1)}
+    # combined as independent across flights when the model was updated with this one
+    again = with_offset_covariance(scaled, None, rows=model.n_used // 2, scale_var=sv)
+    np.testing.assert_allclose(again.scale_var[0], 0.01 * 0.5, rtol=0.02)
+    with pytest.raises(InputError, match="scale variance"):
+        with_offset_covariance(model, None, scale_var=np.zeros(3))
