@@ -196,9 +196,9 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
             conditions), or None (the coefficient itself).
 
     Returns:
-        ``v_off(x) + v_scale(x) + d`` without noise; ``v_off(x) + v_scale(x) + max(noise, d + w)`` with it (the likelihood's noise
-        and the blocked residual both hold the misfit the rows show: the larger, not the sum). Zeros
-        (plus ``noise``) when neither an offset nor a discrepancy is known.
+        ``v_off(x) + v_scale(x) + d`` without noise; ``v_off(x) + v_scale(x) + max(noise, d + w)`` with
+        it (the likelihood's noise and the blocked residual both hold the misfit the rows show: the
+        larger, not the sum). Zeros (plus ``noise``) when no offset, scale error or discrepancy is known.
     """
     out = np.zeros((len(Xs), model.n_outputs))
     off = model.offset_cov is not None and np.any(model.offset_cov)
@@ -219,8 +219,8 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
 
 def model_error_summary(model) -> dict | None:
     """JSON-able ``{"discrepancy_std": {output: 1-sigma}, "white_noise_std": {...}, "offset_std": {input:
-    1-sigma}, "scale_std": {input: relative 1-sigma}}`` in data units (None entries where not known; None when neither is), for
-    :meth:`LocalGlobalGP.summary`."""
+    1-sigma}, "scale_std": {input: relative 1-sigma}}`` in data units (None entries where not known; None
+    when none is), for :meth:`LocalGlobalGP.summary`."""
     scale = getattr(model, "scale_var", None)
     if model.discrepancy is None and model.offset_cov is None and scale is None:
         return None

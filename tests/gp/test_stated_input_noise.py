@@ -69,7 +69,8 @@ def test_predict_takes_the_larger_of_stated_and_learned_input_variance(fitted, f
     np.testing.assert_allclose(var1, expect, rtol=1e-6, atol=1e-14)
     assert np.median(var1[:, 2] / var0[:, 2]) > 2.0                          # CZ (CZ_alpha -4.5) gains most
     # exact conditions: no input noise, so no statement either
-    np.testing.assert_allclose(model.predict(X, input_noise=False, x_var=stated)[1], model.predict(X, input_noise=False)[1])
+    np.testing.assert_allclose(model.predict(X, input_noise=False, x_var=stated)[1],
+                               model.predict(X, input_noise=False)[1])
     with pytest.raises(InputError, match="x_var"):
         model.predict(X, x_var=stated[:, :3])
 
