@@ -318,7 +318,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                         raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
                                          f"this flight identifies {len(fit_cols)}")
                     model = with_offset_covariance(model.update(X_train, Y_train), table.x_offset_cov,
-                                                   rows=len(X_train))
+                                                   rows=len(X_train), scale_var=table.x_scale_var)
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
@@ -326,11 +326,12 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     model, _history = fit_gp(X_train, Y_train, cfg)
                     # the estimator's flight-common regressor offset (alpha: mean vertical wind / V): the
                     # band at exact conditions (gcs-sysid predict) carries it through the slope
-                    model = with_offset_covariance(model, table.x_offset_cov)
+                    model = with_offset_covariance(model, table.x_offset_cov, scale_var=table.x_scale_var)
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 if rows.any():
-                    mean, var = model.predict(table.X[rows])
+                    # the estimator's stated per-row air-angle variance: errors the residuals cannot show
+                    mean, var = model.predict(table.X[rows], x_var=None if table.x_var is None else table.x_var[rows])
                     pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
                     pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
             gp_summary = model.summary()

@@ -32,9 +32,66 @@ from ..airframe import Airframe
 from ..estimation.states import FlightStates
 from .table import REGRESSORS, CoefficientTable
 
-__all__ = ["compute_coefficients", "aero_moments", "QBAR_MIN"]
+__all__ = ["compute_coefficients", "aero_moments", "stated_input_variance", "stated_scale_variance", "QBAR_MIN",
+           "STATED_INPUT_NOISE"]
 
 QBAR_MIN = 5.0  #: Pa; rows with a smaller dynamic pressure are not valid (coefficients blow up)
+#: Regressors whose per-row error variance the estimator states for the GP's band (``CoefficientTable.x_var``):
+#: the air angles, the only regressors built partly from the measured coefficients themselves (the
+#: specific-force aiding), so that their errors hide in the GP's residuals (``docs/gp.md``).
+STATED_INPUT_NOISE = ("alpha", "beta")
+
+
+def stated_input_variance(states: FlightStates) -> np.ndarray | None:
+    """Per-row variance of the regressors' errors that the estimator states, beyond their flight-common offset.
+
+    For each regressor in :data:`STATED_INPUT_NOISE` with a smoothed 1-sigma in ``states.sigma`` (rad):
+    ``sigma^2 - offset^2`` (``states.offsets``, rad; ``sigma`` holds the offset in quadrature, and a common
+    offset cancels at the flight's own regressors, so it belongs to the band at exact conditions instead),
+    floored at 0. Other columns, and rows where no sigma is stated (the angle was not aided), are NaN.
+
+    Args:
+        states: smoothed states with ``sigma`` and ``offsets``.
+
+    Returns:
+        ``(T, 10)`` in the regressors' units squared (columns :data:`~gcs_sysid.aero.table.REGRESSORS`), or
+        None when no such sigma is stated.
+    """
+    sig = getattr(states, "sigma", None) or {}
+    keys = [k for k in STATED_INPUT_NOISE if k in sig]
+    if not keys:
+        return None
+    offsets = getattr(states, "offsets", None) or {}
+    out = np.full((len(states), len(REGRESSORS)), np.nan)
+    for k in keys:
+        s = np.asarray(sig[k], float)
+        with np.errstate(invalid="ignore"):
+            out[:, REGRESSORS.index(k)] = np.maximum(s**2 - float(offsets.get(k, 0.0)) ** 2, 0.0)
+    return out
+
+
+def stated_scale_variance(states: FlightStates) -> np.ndarray | None:
+    """Variance of the aided air angles' relative scale error, common to the flight, ``(10,)``.
+
+    The aided angle's scale is set by the force slope (``CZ_alpha``, ``CY_beta``) fitted on this flight,
+    which errors in variables bias; the estimator states its standard uncertainty as the aided and the
+    kinematic angle's disagreement in scale (:attr:`gcs_sysid.estimation.airangles.AxisFit.scale_sigma`).
+    A model learned on angles scaled by ``1 + s`` is off by ``-dm/dx s (x - mean x)`` at exact conditions.
+
+    Args:
+        states: smoothed states with ``angle_fits``.
+
+    Returns:
+        ``(10,)`` ``scale_sigma^2`` in the alpha / beta columns of an aided axis, 0 elsewhere; None when no
+        axis was aided.
+    """
+    fits = getattr(states, "angle_fits", None) or {}
+    out = np.zeros(len(REGRESSORS))
+    for k, fit in fits.items():
+        s = float(getattr(fit, "scale_sigma", np.nan))
+        if k in REGRESSORS and getattr(fit, "used", False) and np.isfinite(s):
+            out[REGRESSORS.index(k)] = s**2
+    return out if np.any(out) else None
 
 
 def aero_moments(airframe: Airframe, p, q, r, p_dot, q_dot, r_dot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -92,7 +149,8 @@ def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: s
         :class:`~gcs_sysid.aero.table.CoefficientTable` with ``X`` (T, 10) in the
         order of :data:`REGRESSORS`, ``Y`` (T, 6) in the order of
         :data:`COEFFICIENTS`; ``valid`` = ``states.valid`` and every entry finite
-        and ``qbar > QBAR_MIN``; ``x_offset_cov`` from ``states.offsets`` (regressor units squared).
+        and ``qbar > QBAR_MIN``; ``x_offset_cov`` from ``states.offsets`` (regressor units squared);
+        ``x_var`` from :func:`stated_input_variance`, ``x_scale_var`` from :func:`stated_scale_variance`.
 
     Source: Klein and Morelli (2006) ch. 3; Stevens, Lewis and Johnson (2016) ch. 1.
     """
@@ -141,4 +199,5 @@ def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: s
     if any(k in offsets for k in REGRESSORS):
         # errors common to the whole flight (alpha: the mean vertical wind over V): one draw, not per-row noise
         x_offset_cov = np.diag([float(offsets.get(k, 0.0)) ** 2 for k in REGRESSORS])
-    return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes, x_offset_cov)
+    return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes, x_offset_cov,
+                            stated_input_variance(states), stated_scale_variance(states))

@@ -32,6 +32,15 @@ class CoefficientTable:
             (an offset, one draw per flight; units of the regressors squared, e.g. rad^2 for alpha), or
             None when the estimator gave none (``FlightStates.offsets``; the GP's band at exact
             conditions, ``docs/gp.md``).
+        x_var: ``(T, 10)`` per-row variance of the regressors' errors that the estimator states, beyond
+            the flight-common offset (units of the regressors squared; NaN where it states none), or None.
+            The air angles' smoothed 1-sigma less ``bias_sigma`` (``coefficients.STATED_INPUT_NOISE``); the
+            GP's band at a flight's own regressors takes the larger of it and its learned input noise
+            (``docs/gp.md``, "Noisy inputs: the estimator's stated variance").
+        x_scale_var: ``(10,)`` variance of the regressors' relative scale error common to the flight
+            (dimensionless; 0 where none is stated), or None: the aided air angles' ``AxisFit.scale_sigma``
+            squared. The GP's band at exact conditions carries it (``docs/gp.md``, "The band at exact
+            conditions").
     """
 
     t: np.ndarray
@@ -41,6 +50,8 @@ class CoefficientTable:
     qbar: np.ndarray
     notes: list[str] = field(default_factory=list)
     x_offset_cov: np.ndarray | None = None
+    x_var: np.ndarray | None = None
+    x_scale_var: np.ndarray | None = None
 
     def x(self, name: str) -> np.ndarray:
         """Regressor column by name, shape (T,)."""
@@ -53,4 +64,5 @@ class CoefficientTable:
     def select(self, mask: np.ndarray) -> "CoefficientTable":
         """Rows where ``mask`` (T,) is True."""
         return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
-                                list(self.notes), self.x_offset_cov)
+                                list(self.notes), self.x_offset_cov, None if self.x_var is None else self.x_var[mask],
+                                self.x_scale_var)

@@ -16,7 +16,15 @@ condition, ``gcs-sysid predict``; the truth's regressors in ``benchmarks/eval_js
        v_off,p(x) = grad m_p(x)^T Sigma_off grad m_p(x)
 
    with ``Sigma_off`` the offset's covariance (the first-order propagation of McHutchon and
-   Rasmussen 2011, eq. 4, applied to a common error instead of a per-row one).
+   Rasmussen 2011, eq. 4, applied to a common error instead of a per-row one). Likewise a
+   flight-common *scale* error of an aided angle (its force slope, fitted on the flight, is biased by
+   errors in variables; the estimator's 1-sigma is ``AxisFit.scale_sigma``, carried as
+   ``CoefficientTable.x_scale_var`` -> ``scale_var``): the model learned ``m(xbar + (1 + s)(x - xbar))
+   ~ C(x)``, so at exact conditions it is off by ``-dm/dx s (x - xbar)``, variance
+
+       v_scale,p(x) = sum_d (d m_p / d x_d)^2 scale_var_d (x_d - xbar_d)^2
+
+   with ``xbar`` the training mean (the standardiser's), zero at the centre of the data.
 
 2. **Model discrepancy.** The blocked cross-validation (:mod:`gcs_sysid.gp.validation`) shrinks the
    latent GP per output when its nonparametric part does not predict held-back time blocks; the
@@ -131,8 +139,8 @@ def offset_covariance_s(scaler, cov: np.ndarray) -> np.ndarray:
     return np.asarray(cov, float) * s[:, None] * s[None, :]
 
 
-def with_offset_covariance(model, cov, rows: int | None = None):
-    """``model`` with the covariance of its training regressors' flight-common offset.
+def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None):
+    """``model`` with the covariance of its training regressors' flight-common offset (and scale error).
 
     Args:
         model: a :class:`gcs_sysid.gp.LocalGlobalGP`.
@@ -143,26 +151,38 @@ def with_offset_covariance(model, cov, rows: int | None = None):
             mean follows the row-weighted mean of them, so the covariances combine as
             ``(n_old^2 S_old + n^2 S) / (n_old + n)^2`` (``n_old = model.n_used - rows``; a model
             without an offset counts as offset-free). None: the model learned this flight alone.
+        scale_var: ``(D,)`` variance of the regressors' relative scale error common to the flight
+            (dimensionless; ``CoefficientTable.x_scale_var``), or None (the model keeps what it has);
+            combined across flights as ``cov`` is. At exact conditions it adds
+            ``sum_d (dm/dx_d)^2 scale_var_d (x_d - mean x_d)^2`` (module docstring, item 1).
 
     Returns:
-        A new model (``offset_cov`` standardised ``(D, D)``).
+        A new model (``offset_cov`` standardised ``(D, D)``, ``scale_var`` ``(D,)``).
 
     Raises:
-        InputError: ``cov`` is not ``(D, D)`` or not finite.
+        InputError: ``cov`` is not ``(D, D)`` or ``scale_var`` not ``(D,)``, or either is not finite.
     """
+    D = model.n_inputs
+
+    def combine(old, new):
+        if rows is None:
+            return new
+        n_new = float(rows)
+        n_old = max(float(model.n_used) - n_new, 0.0)
+        old = np.zeros_like(new) if old is None else old
+        return (n_old**2 * old + n_new**2 * new) / max(n_old + n_new, 1.0) ** 2
+
+    if scale_var is not None:
+        S = np.asarray(scale_var, float)
+        if S.shape != (D,) or not np.isfinite(S).all():
+            raise InputError(f"gp: scale variance must be a finite ({D},) vector, got shape {S.shape}")
+        model = replace(model, scale_var=combine(model.scale_var, np.where(model.scaler.active, S, 0.0)))
     if cov is None:
         return model
     C = np.asarray(cov, float)
-    D = model.n_inputs
     if C.shape != (D, D) or not np.isfinite(C).all():
         raise InputError(f"gp: offset covariance must be a finite ({D}, {D}) matrix, got shape {C.shape}")
-    Cs = offset_covariance_s(model.scaler, C)
-    if rows is not None:
-        n_new = float(rows)
-        n_old = max(float(model.n_used) - n_new, 0.0)
-        old = model.offset_cov if model.offset_cov is not None else np.zeros((D, D))
-        Cs = (n_old**2 * old + n_new**2 * Cs) / max(n_old + n_new, 1.0) ** 2
-    return replace(model, offset_cov=Cs)
+    return replace(model, offset_cov=combine(model.offset_cov, offset_covariance_s(model.scaler, C)))
 
 
 def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = None) -> np.ndarray:
@@ -176,16 +196,21 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
             conditions), or None (the coefficient itself).
 
     Returns:
-        ``v_off(x) + d`` without noise; ``v_off(x) + max(noise, d + w)`` with it (the likelihood's noise
-        and the blocked residual both hold the misfit the rows show: the larger, not the sum). Zeros
-        (plus ``noise``) when neither an offset nor a discrepancy is known.
+        ``v_off(x) + v_scale(x) + d`` without noise; ``v_off(x) + v_scale(x) + max(noise, d + w)`` with
+        it (the likelihood's noise and the blocked residual both hold the misfit the rows show: the
+        larger, not the sum). Zeros (plus ``noise``) when no offset, scale error or discrepancy is known.
     """
     out = np.zeros((len(Xs), model.n_outputs))
-    if model.offset_cov is not None and len(Xs) and np.any(model.offset_cov):
+    off = model.offset_cov is not None and np.any(model.offset_cov)
+    scale = getattr(model, "scale_var", None) is not None and np.any(model.scale_var)
+    if (off or scale) and len(Xs):
         from .inputnoise import mean_gradient
 
         g = mean_gradient(model.params, model.post, Xs, model.config.batch_size)      # (N, P, D)
-        out += np.einsum("npd,de,npe->np", g, np.asarray(model.offset_cov), g)
+        if off:
+            out += np.einsum("npd,de,npe->np", g, np.asarray(model.offset_cov), g)
+        if scale:       # a scale error s_d of x_d about the training mean: standardised x_d is x_d - mean
+            out += np.einsum("npd,d,nd->np", g**2, np.asarray(model.scale_var), np.asarray(Xs) ** 2)
     if model.discrepancy is None:
         return out if noise is None else out + np.asarray(noise)[None, :]
     d, w = np.asarray(model.discrepancy)
@@ -194,12 +219,15 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
 
 def model_error_summary(model) -> dict | None:
     """JSON-able ``{"discrepancy_std": {output: 1-sigma}, "white_noise_std": {...}, "offset_std": {input:
-    1-sigma}}`` in data units (None entries where not known; None when neither is), for
-    :meth:`LocalGlobalGP.summary`."""
-    if model.discrepancy is None and model.offset_cov is None:
+    1-sigma}, "scale_std": {input: relative 1-sigma}}`` in data units (None entries where not known; None
+    when none is), for :meth:`LocalGlobalGP.summary`."""
+    scale = getattr(model, "scale_var", None)
+    if model.discrepancy is None and model.offset_cov is None and scale is None:
         return None
     sc = model.scaler
-    out: dict = {"discrepancy_std": None, "white_noise_std": None, "offset_std": None}
+    out: dict = {"discrepancy_std": None, "white_noise_std": None, "offset_std": None, "scale_std": None}
+    if scale is not None:
+        out["scale_std"] = {n: float(np.sqrt(v)) for n, v in zip(model.input_names, np.asarray(scale)) if v > 0}
     if model.discrepancy is not None:
         d, w = np.sqrt(np.asarray(model.discrepancy)) * sc.y_std[None, :]
         out["discrepancy_std"] = dict(zip(model.output_names, d.tolist()))

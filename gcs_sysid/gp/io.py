@@ -30,6 +30,7 @@ VERSION = 5   # 2: the region-thinned row store (rows_*) replaces store_X / stor
 #                  features. Files of versions 1-3 (one kernel) read unchanged. Optional var_scale (P,)
 #                  (coloured residuals). Optional offset_cov (D, D) and discrepancy (2, P) (the model's
 #                  error at exact conditions, gp/discrepancy.py); files without them read as before.
+#                  Optional scale_var (D,) (the same, a common scale error; tenth session).
 #               5: per-output statistics (rows with missing outputs, gp/sparse.py): stats_C (P, M, M),
 #                  stats_E (P, M, D+1), stats_F (P, D+1, D+1), stats_n (P,). Written only by such models;
 #                  a model with complete rows is still written as version 4.
@@ -61,7 +62,7 @@ def save_model(model: LocalGlobalGP, path) -> str:
         arrays["input_var"] = np.asarray(model.input_var)
     if model.var_scale is not None:
         arrays["var_scale"] = np.asarray(model.var_scale)
-    for k in ("offset_cov", "discrepancy"):
+    for k in ("offset_cov", "discrepancy", "scale_var"):
         if getattr(model, k) is not None:
             arrays[k] = np.asarray(getattr(model, k))
     if model.params.noise_chol is not None:
@@ -159,4 +160,5 @@ def load_gp(path) -> LocalGlobalGP:
                          tuple(meta["input_names"]), tuple(meta["output_names"]), int(meta.get("n_hyper", 0)),
                          tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
                          evicted=evicted, input_var=a.get("input_var"), var_scale=a.get("var_scale"),
-                         offset_cov=a.get("offset_cov"), discrepancy=a.get("discrepancy"))
+                         offset_cov=a.get("offset_cov"), discrepancy=a.get("discrepancy"),
+                         scale_var=a.get("scale_var"))

@@ -9,6 +9,7 @@ import jax
 import numpy as np
 from scipy.linalg import block_diag, cho_solve
 
+from ..errors import InputError
 from ..jaxconfig import enable_x64
 from .batching import global_mean, global_posterior, global_predict, global_stats, local_predict
 from .config import GPConfig
@@ -70,6 +71,8 @@ class LocalGlobalGP:
             refreshes), None when not learned (``GPConfig.residual_correlation``).
         offset_cov: ``(D, D)`` covariance of the training regressors' flight-common offset
             (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
+        scale_var: ``(D,)`` variance of the training regressors' relative scale error common to the flight
+            (dimensionless; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
         discrepancy: ``(2, P)``: the model discrepancy ``d`` and the white noise ``w`` per output from
             the blocked cross-validation (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when the
             check did not run.
@@ -96,6 +99,7 @@ class LocalGlobalGP:
     var_scale: np.ndarray | None = None
     offset_cov: np.ndarray | None = None
     discrepancy: np.ndarray | None = None
+    scale_var: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -143,7 +147,7 @@ class LocalGlobalGP:
         return mean, var
 
     def predict(self, X, include_noise: bool = True, input_noise: bool = True,
-                model_error: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
+                model_error: bool | None = None, x_var=None) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance of the coefficients.
 
         Args:
@@ -159,15 +163,28 @@ class LocalGlobalGP:
                 (:mod:`gcs_sysid.gp.discrepancy`; Kennedy and O'Hagan 2001); with ``include_noise``
                 the noise is then ``max(noise, d + w)``, not a sum. None: ``not input_noise`` (exact
                 conditions). False: the latent variance alone (what more data can reduce).
+            x_var: ``(N, D)`` per-row variances of the regressors' errors that the estimator states
+                (data units squared; NaN: none stated; ``CoefficientTable.x_var``), or None. With
+                ``input_noise`` the slope term then uses, per row and regressor, the larger of this and
+                the learned ``input_var``: the learned one sees only the input errors that show in the
+                residuals, and an air angle built from the measured coefficient itself (the
+                specific-force aiding) carries errors that move the coefficient with it and do not
+                (``docs/gp.md``, "Noisy inputs: the estimator's stated variance").
 
         Returns:
             ``(mean (N, P), var (N, P))`` in the outputs' units (variance in units squared).
 
         Raises:
-            InputError: ``X`` is not ``(N, D)``.
+            InputError: ``X`` is not ``(N, D)``, or ``x_var`` is not ``X``'s shape.
         """
         enable_x64()
         Xs, ok = self._standardise_query(X)
+        xv_s = None
+        if x_var is not None and input_noise:
+            xv = np.asarray(x_var, float)
+            if xv.shape != (len(ok), self.n_inputs):
+                raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
+            xv_s = np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
         mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         noise = np.asarray(self.params.noise)
         if self.local_params is not None and self.store is not None:
@@ -184,18 +201,25 @@ class LocalGlobalGP:
             var = var + exact_condition_variance(self, Xs, noise if include_noise else None)
         elif include_noise:
             var = var + noise[None, :]
-        if input_noise and self.input_var is not None and len(Xs):
-            var = var + self.input_variance_s(Xs)
+        if input_noise and (self.input_var is not None or xv_s is not None) and len(Xs):
+            var = var + self.input_variance_s(Xs, xv_s)
         return self._finish(ok, mean, var)
 
-    def input_variance_s(self, Xs: np.ndarray) -> np.ndarray:
+    def input_variance_s(self, Xs: np.ndarray, x_var_s: np.ndarray | None = None) -> np.ndarray:
         """``grad m_p^T Sigma_x grad m_p`` ``(N, P)`` at standardised ``Xs (N, D)`` (standardised units;
-        zeros when no input noise was learned). Source: McHutchon and Rasmussen (2011), eq. 4."""
+        zeros when no input noise was learned or stated). ``x_var_s``: ``(N, D)`` stated per-row input
+        variances (standardised; NaN: none), taken where larger than the learned ``input_var``.
+        Source: McHutchon and Rasmussen (2011), eq. 4."""
         from .inputnoise import mean_gradient, slope_variance
 
-        if self.input_var is None:
+        if self.input_var is None and x_var_s is None:
             return np.zeros((len(Xs), self.n_outputs))
-        return slope_variance(mean_gradient(self.params, self.post, Xs, self.config.batch_size), self.input_var)
+        grad = mean_gradient(self.params, self.post, Xs, self.config.batch_size)
+        learned = np.zeros(self.n_inputs) if self.input_var is None else np.asarray(self.input_var, float)
+        if x_var_s is None:
+            return slope_variance(grad, learned)
+        per_row = np.fmax(learned[None, :], np.asarray(x_var_s, float))     # NaN (not stated): the learned one
+        return np.einsum("npd,nd->np", grad**2, per_row)
 
     def predict_global(self, X, include_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance ``(N, P)`` of the global layer alone (linear mean + sparse ICM GP)."""
