@@ -24,6 +24,17 @@ Score per case:
     decisions read (the reported one before; the summary shows it in brackets);
   * clean flights: ``ok`` when no cause is named.
 
+Since the tenth session (branch i9-alias) every score is also given *with aliases* (``top_alias``,
+``est_alias``, ``gain_alias``, ``ok_alias``; the strict ones above are kept and reported beside them): the
+top finding also counts when the injected cause is one of the candidates the diagnosis reports it cannot
+be told apart from on this flight (``aliases``: partial-column condition index >= 30,
+:mod:`gcs_sysid.diagnose.aliases`), and the estimate and gain are then that alias's own (its fit in place
+of the named term; ``scale:CY`` reads ``factor - 1``, a term ``estimate - model_value``). With two effects,
+each injected cause must be named or an alias of some finding. Why: when two candidates are one regressor
+on the flight (the t6's ``scale:CY`` and ``CY:beta``, partial correlation 0.99997), no data from that
+flight can rank them, and the diagnosis reports both readings; scoring only the first would score a coin
+the data never tossed. A clean flight is still ``ok`` only when nothing is named (aliases name nothing).
+
 Usage::
 
     python -m benchmarks.eval_jsbsim_diagnose --aircraft c172x sgs --seeds 1 2 3 --out benchmarks/out/diag

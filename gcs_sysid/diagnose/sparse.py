@@ -109,6 +109,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`gcs_sysid.diagnose.differential.block_jackknife_se`; 0 off). Added 13:20 UTC after that freeze (seen on
 #: the PA-28 s1 2-m/s pitot bias of the final run): ``delay_change_min_t`` (with ``delay_reference_same_fit``, a
 #: delay change below this many standard errors is an allowance).
+#: Added 2026-11-22 (tenth session, branch i9-alias; frozen before the 19:00 UTC freeze): ``alias_condition_index``
+#: (a named term's candidates whose partial column has a condition index of at least this with the named one are
+#: reported as its ``aliases``, :mod:`gcs_sysid.diagnose.aliases`; Belsley, Kuh and Welsch's 30; 0 off). It names,
+#: drops and re-sizes nothing.
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
