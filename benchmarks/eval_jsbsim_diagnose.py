@@ -24,6 +24,17 @@ Score per case:
     decisions read (the reported one before; the summary shows it in brackets);
   * clean flights: ``ok`` when no cause is named.
 
+Since the tenth session (branch i9-alias) every score is also given *with aliases* (``top_alias``,
+``est_alias``, ``gain_alias``, ``ok_alias``; the strict ones above are kept and reported beside them): the
+top finding also counts when the injected cause is one of the candidates the diagnosis reports it cannot
+be told apart from on this flight (``aliases``: partial-column condition index >= 30,
+:mod:`gcs_sysid.diagnose.aliases`), and the estimate and gain are then that alias's own (its fit in place
+of the named term; ``scale:CY`` reads ``factor - 1``, a term ``estimate - model_value``). With two effects,
+each injected cause must be named or an alias of some finding. Why: when two candidates are one regressor
+on the flight (the t6's ``scale:CY`` and ``CY:beta``, partial correlation 0.99997), no data from that
+flight can rank them, and the diagnosis reports both readings; scoring only the first would score a coin
+the data never tossed. A clean flight is still ``ok`` only when nothing is named (aliases name nothing).
+
 Usage::
 
     python -m benchmarks.eval_jsbsim_diagnose --aircraft c172x sgs --seeds 1 2 3 --out benchmarks/out/diag
@@ -241,32 +252,64 @@ def rescore(path: str) -> list[dict]:
     return out
 
 
+def _estimate_scores(f: dict, e: dict) -> dict:
+    """Estimate, gain and coverage of finding (or alias) ``f`` against injected effect ``e``."""
+    est = f["estimate"] - (f.get("model_value", 0.0) if ":" in e["cause"] and not
+                           e["cause"].startswith(("delay:", "bias:")) else 0.0)
+    se = float(f.get("std_error") or 0.0)
+    # the standard error the diagnosis's decisions read (before the ninth session's combined
+    # uncertainty, sparse._with_uncertainty, it was the reported one)
+    se_d = float(f.get("std_error_decision") or f.get("evidence", {}).get("std_error_decision") or se)
+    gain = float((f.get("gain") or {}).get("percent", f.get("gain_pct")) or 0.0)
+    return dict(estimate=est, std_error=se, est=abs(est - e["value"]) <= 0.25 * abs(e["value"]),
+                gain_pct=gain, gain=gain >= 50.0, cover=se > 0 and abs(est - e["value"]) <= 2 * se,
+                std_error_decision=se_d, cover_decision=se_d > 0 and abs(est - e["value"]) <= 2 * se_d)
+
+
+def _with_alias(findings: list[dict], cause: str) -> tuple[dict | None, dict | None]:
+    """``(finding, alias)``: the first finding whose reported aliases include ``cause`` and that alias."""
+    for f in findings:
+        for a in f.get("aliases") or []:
+            if a["cause"] == cause:
+                return f, a
+    return None, None
+
+
 def score_case(findings: list[dict], truth: dict) -> dict:
-    """Scores of one case against its injected truth (see the module docstring)."""
+    """Scores of one case against its injected truth (see the module docstring).
+
+    Strict (``top``, ``est``, ``gain``, ``ok``): the injected cause is the finding's named cause, as before the
+    tenth session. With aliases (``top_alias``, ``est_alias``, ``gain_alias``, ``ok_alias``; branch i9-alias): a
+    finding also counts when the injected cause is one of the candidates it reports it cannot be told apart from
+    on this flight (``aliases``, :mod:`gcs_sysid.diagnose.aliases`), scored on that alias's own estimate and
+    held-out gain; ``via_alias`` names the finding it came through. A named cause is always tried first.
+    """
     inj = truth["injected"]
     causes = [f["cause"] for f in findings]
     if not inj:
-        return {"ok": not causes, "named": causes}
+        return {"ok": not causes, "ok_alias": not causes, "named": causes}
     rows = []
     for k, e in enumerate(inj):
         f = next((f for f in findings if f["cause"] == e["cause"]), None)
         row = {"cause": e["cause"], "value": e["value"], "found": f is not None,
                "top": (causes[:1] == [e["cause"]]) if len(inj) == 1 else f is not None}
         if f is not None:
-            est = f["estimate"] - (f.get("model_value", 0.0) if ":" in e["cause"] and not
-                                   e["cause"].startswith(("delay:", "bias:")) else 0.0)
-            se = float(f.get("std_error") or 0.0)
-            # the standard error the diagnosis's decisions read (before the ninth session's combined
-            # uncertainty, sparse._with_uncertainty, it was the reported one)
-            se_d = float(f.get("std_error_decision") or f.get("evidence", {}).get("std_error_decision") or se)
-            row.update(estimate=est, std_error=se, est=abs(est - e["value"]) <= 0.25 * abs(e["value"]),
-                       gain_pct=float(f["gain"].get("percent", 0.0)),
-                       gain=float(f["gain"].get("percent", 0.0)) >= 50.0,
-                       cover=se > 0 and abs(est - e["value"]) <= 2 * se,
-                       std_error_decision=se_d, cover_decision=se_d > 0 and abs(est - e["value"]) <= 2 * se_d)
+            row.update(_estimate_scores(f, e))
+        # with aliases: the named cause first, else an alias of the top finding (one effect) or of any finding (two)
+        g, a = (None, None) if row["top"] else _with_alias(findings[:1] if len(inj) == 1 else findings, e["cause"])
+        if row["top"]:
+            row.update(top_alias=True, est_alias=row.get("est"), gain_alias=row.get("gain"))
+        elif a is not None:
+            sa = _estimate_scores(a, e)
+            row.update(top_alias=True, via_alias=g["cause"], estimate_alias=sa["estimate"],
+                       gain_pct_alias=sa["gain_pct"], est_alias=sa["est"], gain_alias=sa["gain"],
+                       cover_alias=sa["cover"])
+        else:
+            row.update(top_alias=False, est_alias=False, gain_alias=False)
         rows.append(row)
-    return {"ok": all(r["top"] and r.get("est") and r.get("gain") for r in rows), "effects": rows,
-            "named": causes}
+    return {"ok": all(r["top"] and r.get("est") and r.get("gain") for r in rows),
+            "ok_alias": all(r["top_alias"] and r.get("est_alias") and r.get("gain_alias") for r in rows),
+            "effects": rows, "named": causes}
 
 
 #: the library term each injected aero cause is fitted as, by coefficient (``clean_scatter``)
@@ -335,13 +378,14 @@ def summarize(paths: list[str]) -> str:
     for r in recs:
         key = "clean" if not r["effects"] else " + ".join(e[0] for e in r["effects"])
         groups.setdefault((r["aircraft"], key), []).append(r)
-    out = ["| aircraft | injected | cases | top | estimate within 25 % | gain >= 50 % | all three | 2-se coverage | what was named (estimate - model, truth) |",
-           "|---|---|---|---|---|---|---|---|---|"]
+    out = ["| aircraft | injected | cases | top | estimate within 25 % | gain >= 50 % | all three "
+           "| with aliases: top, estimate, gain, all three | 2-se coverage | what was named (estimate - model, truth) |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
     for (ac, key), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "clean", kv[0][1])):
         if key == "clean":
             ok = sum(r["score"]["ok"] for r in rs)
             named = sorted({c for r in rs for c in r["score"].get("named", [])})
-            out.append(f"| {summary_label(ac)} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | {', '.join(named) or '-'} |")
+            out.append(f"| {summary_label(ac)} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | | {', '.join(named) or '-'} |")
             continue
         rows = [e for r in rs for e in r["score"].get("effects", [])]
         n = len(rows)
@@ -349,13 +393,18 @@ def summarize(paths: list[str]) -> str:
         desc = "; ".join(
             f"s{r['seed']} " + ", ".join(
                 f"{e['cause']} {e['estimate']:.3g} ({e['value']:.3g})" if e["found"] else
+                f"[{e['via_alias']} ~ {e['cause']} {e['estimate_alias']:.3g}] ({e['value']:.3g})" if e.get("via_alias") else
                 f"[{', '.join(r['score'].get('named', [])[:2]) or 'nothing'}] ({e['value']:.3g})"
                 for e in r["score"].get("effects", []))
             for r in rs)
         out.append(f"| {summary_label(ac)} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
                    f"{sum(bool(e.get('est')) for e in rows)}/{n} | {sum(bool(e.get('gain')) for e in rows)}/{n} | "
                    f"{sum(bool(r['score']['ok']) for r in rs)}/{len(rs)} | "
-                   f"{sum(bool(e.get('cover')) for e in found)}/{len(found)}"
+                   + (f"{sum(bool(e.get('top_alias')) for e in rows)}/{n}, {sum(bool(e.get('est_alias')) for e in rows)}/{n}, "
+                      f"{sum(bool(e.get('gain_alias')) for e in rows)}/{n}, "
+                      f"{sum(bool(r['score'].get('ok_alias')) for r in rs)}/{len(rs)} | "
+                      if any('top_alias' in e for e in rows) else "| ")
+                   + f"{sum(bool(e.get('cover')) for e in found)}/{len(found)}"
                    + (f" ({sum(bool(e.get('cover_decision')) for e in found)}/{len(found)} with the decision se)"
                       if any('cover_decision' in e for e in found) else "") + f" | {desc} |")
     return "\n".join(out)
@@ -483,7 +532,15 @@ def main(argv=None) -> int:
                                    # differential one (core.DIFFERENTIAL_GAIN; None where nothing was replaced)
                                    "gain_against_model_pct": f.get("evidence", {}).get("gain_against_model",
                                                                                        {}).get("percent"),
-                                   "source": f.get("source") or f.get("evidence", {}).get("domain")}
+                                   "source": f.get("source") or f.get("evidence", {}).get("domain"),
+                                   # the candidates this finding cannot be told apart from on this flight
+                                   # (gcs_sysid.diagnose.aliases), each with its own estimate and gain
+                                   "aliases": [{k: a.get(k) for k in ("cause", "estimate", "std_error", "model_value",
+                                                                       "partial_correlation", "condition_index",
+                                                                       "per_unit_of_named", "cannot_tell_apart",
+                                                                       "separate_with")}
+                                               | {"gain_pct": a.get("gain", {}).get("percent")}
+                                               for a in f.get("aliases") or []]}
                                 for f in findings]}
             fh.write(json.dumps(rec, default=float) + "\n")
             fh.flush()
@@ -501,7 +558,10 @@ def main(argv=None) -> int:
         n = len(rows)
         print(f"\neffect cases {len(eff)}: top {sum(r['top'] for r in rows)}/{n}, est within 25 % "
               f"{sum(bool(r.get('est')) for r in rows)}/{n}, gain >= 50 % {sum(bool(r.get('gain')) for r in rows)}/{n}, "
-              f"all three {sum(bool(r['ok']) for r in (x['score'] for x in eff))}/{len(eff)}, "
+              f"all three {sum(bool(r['ok']) for r in (x['score'] for x in eff))}/{len(eff)}; with aliases: top "
+              f"{sum(bool(r.get('top_alias')) for r in rows)}/{n}, est {sum(bool(r.get('est_alias')) for r in rows)}/{n}, "
+              f"gain {sum(bool(r.get('gain_alias')) for r in rows)}/{n}, "
+              f"all three {sum(bool(r.get('ok_alias')) for r in (x['score'] for x in eff))}/{len(eff)}; "
               f"2-sigma coverage {sum(bool(r.get('cover')) for r in rows if r['found'])}/{sum(r['found'] for r in rows)}")
     if clean:
         print(f"clean flights: no named cause {sum(r['score']['ok'] for r in clean)}/{len(clean)}")

@@ -412,7 +412,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                        angle_uncertainty=air_data_uncertainty(
                                            getattr(states, "angle_fits", None),
                                            getattr(search_reference[1], "angle_fits", None)
-                                           if isinstance(search_reference, tuple) else None))
+                                           if isinstance(search_reference, tuple) else None),
+                                       model=model0)
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)
         data["sparse"].pop("rows", None)

@@ -185,12 +185,19 @@ def render_html(d) -> str:
         parts.append(_table([[f["cause"], f["coefficient"], _f(f["estimate"]), _f(f["std_error"]),
                               f.get("onset_s", ""), _f(f["gain"].get("rms_before")), _f(f["gain"].get("rms_after")),
                               _f(f["gain"].get("percent"), "{:.0f} %"),
-                              "yes" if f["evidence"].get("separable", True) else "NO"] for f in d.findings],
+                              "NO" if not f["evidence"].get("separable", True)
+                              else "aliased" if f.get("aliases") else "yes"] for f in d.findings],
                             ["cause", "coefficient", "estimate", "std error", "onset (s)", "held-out RMS before",
                              "after", "gain", "separable"]))
     else:
         parts.append("<p class='ok'>No cause from the catalogue explains the residual better than noise on held-out "
                      "data: no finding.</p>")
+    for f in d.findings:                  # candidates the flight cannot tell apart from the named one (aliases.py)
+        for a in f.get("aliases") or []:
+            parts.append(f"<p class='warn'>{html.escape(a['cannot_tell_apart'])}; read as {html.escape(a['cause'])}: "
+                         f"estimate {_f(a['estimate'])} (model {_f(a['model_value'])}), held-out gain "
+                         f"{_f(a['gain'].get('percent'), '{:.0f} %')}. To separate them: "
+                         f"{html.escape(a['separate_with'])}.</p>")
     for s in data.get("separation", []):
         parts.append(f"<p class='warn'>{html.escape(s)}</p>")
     parts.append(_faults_section(d.findings, data.get("faults")))

@@ -46,6 +46,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..aero.table import COEFFICIENTS, REGRESSORS
+from .aliases import ALIAS_CONDITION_INDEX, find_aliases, separation_advice
 from .context import DiagContext
 from .lift_alpha import lift_alpha_error
 from .regression import ols
@@ -108,6 +109,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`gcs_sysid.diagnose.differential.block_jackknife_se`; 0 off). Added 13:20 UTC after that freeze (seen on
 #: the PA-28 s1 2-m/s pitot bias of the final run): ``delay_change_min_t`` (with ``delay_reference_same_fit``, a
 #: delay change below this many standard errors is an allowance).
+#: Added 2026-11-22 (tenth session, branch i9-alias; frozen before the 19:00 UTC freeze): ``alias_condition_index``
+#: (a named term's candidates whose partial column has a condition index of at least this with the named one are
+#: reported as its ``aliases``, :mod:`gcs_sysid.diagnose.aliases`; Belsley, Kuh and Welsch's 30; 0 off). It names,
+#: drops and re-sizes nothing.
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -117,7 +122,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "name_control_parent": True, "delay_time_resolution": True,
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
               "delay_differential": True, "side_force_wind_axis": True, "delay_reference_same_fit": True,
-              "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0}
+              "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
+              "alias_condition_index": ALIAS_CONDITION_INDEX}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -365,7 +371,51 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
                        "confirmation": untouched_confirmation(r[te], pred[te])}
     if th.get("name_control_parent", False):
         out["terms"] = _control_parent_first(out["terms"], th["min_abs_t"])
+    if th.get("alias_condition_index", 0) > 0:
+        k0 = names.index(out["terms"][0]["term"])
+        out["aliases"] = _aliases(names, Phi, r, tr, te, Pc, k0, [k for k in sel if k != k0], before, th)
     return out, pred
+
+
+def _aliases(names, Phi, r, tr, te, Pc, k0: int, others: list[int], before: float, th: dict) -> list[dict]:
+    """The candidates aliased with the named column ``k0`` (:func:`gcs_sysid.diagnose.aliases.find_aliases`,
+    on the thinned, centred training columns ``Pc`` the selection saw), each refitted in its place.
+
+    Each alias is fitted as the named term was (constant, the other selected terms, training rows ``tr``;
+    Bartlett standard error for the t statistic, Morelli and Klein's all-lags one reported), and its gain
+    measured on the untouched rows ``te`` against the same RMS ``before``.
+
+    Returns:
+        ``[{"term", "estimate" (the change), "std_error", "std_error_naming", "partial_correlation",
+        "condition_index", "per_unit_of_named", "held_out": {"rms_before", "rms_after", "percent"}}, ...]``.
+    """
+    out = []
+    x0 = Pc[:, k0]
+    for k, rho, eta in find_aliases(Pc, k0, others, float(th["alias_condition_index"])):
+        cols = [k] + list(others)
+        A = np.column_stack([np.ones(tr.size), Phi[tr][:, cols]])
+        labels = ["1"] + [names[c] for c in cols]
+        try:
+            fit = ols(A, r[tr], labels, cov_method="bartlett")
+            fit_mk = ols(A, r[tr], labels, cov_method="morelli")
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+        pred = np.column_stack([np.ones(len(r)), Phi[:, cols]]) @ fit.theta
+        after = float(np.sqrt(np.mean((r[te] - pred[te]) ** 2))) if te.size else before
+        xk = Pc[:, k]
+        if others:                          # the other selected terms projected out of both columns
+            O = Pc[:, others]
+            x0 = Pc[:, k0] - O @ np.linalg.lstsq(O, Pc[:, k0], rcond=None)[0]
+            xk = xk - O @ np.linalg.lstsq(O, xk, rcond=None)[0]
+        out.append({"term": names[k], "estimate": float(fit.theta[1]), "std_error": float(fit_mk.std_error[1]),
+                    "std_error_naming": float(fit.std_error[1]), "partial_correlation": rho,
+                    "condition_index": eta,
+                    # how much of this alias one unit of the named term is (least squares of the named
+                    # column on this one, the other terms projected out): alias change ~ this x named change
+                    "per_unit_of_named": float((x0 @ xk) / (xk @ xk)) if xk @ xk > 0 else float("nan"),
+                    "held_out": {"rms_before": before, "rms_after": after,
+                                 "percent": float(100 * (1 - after / before)) if before > 0 else 0.0}})
+    return out
 
 
 def untouched_confirmation(r: np.ndarray, p: np.ndarray) -> dict:
@@ -559,7 +609,7 @@ def scale_columns(M: np.ndarray, X: np.ndarray, wind_axis: bool = True) -> np.nd
 def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext, np.ndarray] | None = None,
                   folds: int = 5, segment_frac: float = 0.2, max_rows: int = 4000,
                   thresholds: dict | None = None, keep_residual: bool = False,
-                  angle_uncertainty: dict | None = None) -> dict:
+                  angle_uncertainty: dict | None = None, model: dict | None = None) -> dict:
     """Search each coefficient's residual for new terms; differential when a reference is given.
 
     Args:
@@ -577,6 +627,11 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         angle_uncertainty: the reconstruction's own standard uncertainty of the air angles' scale and
             offset (:func:`gcs_sysid.diagnose.uncertainty.air_data_uncertainty`), carried into each named
             term's ``std_error`` as a type-B component (:func:`_with_uncertainty`); None: left out.
+        model: the model under test (``{coef: {term: value}}``) whose values a named term's ``model_value`` and
+            ``estimate = model_value + change`` read; None: ``ctx.model``. ``diagnose`` passes the model as given:
+            its ``ctx.model`` already holds the catalogue's accepted corrections, which made a term the catalogue
+            had also accepted read ``model value + 2 x change`` (e.g. the t6's ``CY:beta`` -3.14 for -2.30) before
+            the tenth session (branch i9-alias); the change itself, which every decision reads, was right.
 
     Returns:
         ``{"coefficients": [...], "inadequacy": [...], "findings": [...], "segment": {...}}``:
@@ -728,7 +783,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         if rnd == 0:
             result["coefficients"] = entries
         cands.sort(key=lambda c: c[0], reverse=True)
-        new = [f for f in (_name(coef, entry, ctx) for _, coef, entry in cands)
+        new = [f for f in (_name(coef, entry, ctx, model) for _, coef, entry in cands)
                if f["cause"] not in {n["cause"] for n in named}]
         delays = [f for f in new if f["cause"].startswith("delay:")]
         if delays:                 # a delay shows in every coefficient of its surface: name it alone,
@@ -1026,8 +1081,46 @@ def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j:
     return best, best_D, se
 
 
-def _name(coef: str, entry: dict, ctx: DiagContext) -> dict:
-    """The finding for a coefficient's first selected term."""
+def _name(coef: str, entry: dict, ctx: DiagContext, model: dict | None = None) -> dict:
+    """The finding for a coefficient's first selected term, with the candidates aliased with it (``aliases``).
+    ``model``: the model under test whose values ``model_value`` reads (None: ``ctx.model``)."""
+    model = ctx.model if model is None else model
+    f = _name_term(coef, entry, model)
+    f["aliases"] = _alias_findings(coef, entry, model, f)
+    return f
+
+
+def _alias_findings(coef: str, entry: dict, model: dict, named: dict) -> list[dict]:
+    """The entry's aliases (:func:`_aliases`) as causes the finding cannot be told apart from.
+
+    Each is converted the way :func:`_name_term` converts a term: a ``scale:<coef>`` reads the factor ``1 +
+    change`` (``model_value`` 1), a library term ``model value + change``, a lag term ``delay:<surface>`` with the
+    lag as its estimate. An alias naming the same cause as the finding (another lag of the same surface) is left
+    out. The named term stays first (the selection's choice: the data cannot rank aliased candidates, so the rule
+    of :func:`_fit_coefficient` is kept; docs/diagnose.md, "Aliased explanations").
+    """
+    out = []
+    model_terms = [t for t in model.get(coef, {})]
+    named_term = entry["terms"][0]["term"]
+    for a in entry.get("aliases", []):
+        g = _name_term(coef, dict(entry, terms=[a], held_out=a["held_out"]), model)
+        if g["cause"] == named["cause"] or any(g["cause"] == o["cause"] for o in out):
+            continue
+        out.append({"cause": g["cause"], "coefficient": coef, "estimate": g["estimate"],
+                    "std_error": g["std_error"], "model_value": g["model_value"], "gain": g["gain"],
+                    "term": a["term"], "change": a["estimate"],
+                    "partial_correlation": a["partial_correlation"], "condition_index": a["condition_index"],
+                    "per_unit_of_named": a["per_unit_of_named"],
+                    "t_statistic": a["estimate"] / a["std_error_naming"] if a["std_error_naming"] > 0 else None,
+                    "cannot_tell_apart": f"{named['cause']} cannot be told apart from {g['cause']} on this flight "
+                                         f"(partial correlation {a['partial_correlation']:+.5f}, condition index "
+                                         f"{a['condition_index']:.0f} >= {ALIAS_CONDITION_INDEX:.0f})",
+                    "separate_with": separation_advice(coef, named_term, a["term"], model_terms)})
+    return out
+
+
+def _name_term(coef: str, entry: dict, model: dict) -> dict:
+    """The finding for a coefficient's first selected term (no aliases)."""
     t = entry["terms"][0]
     term = t["term"]
     ev = {"domain": "sparse search", "score": entry["score"], "terms": entry["terms"],
@@ -1045,7 +1138,7 @@ def _name(coef: str, entry: dict, ctx: DiagContext) -> dict:
     if term.startswith("scale:"):           # estimate: the factor on the model's coefficient
         return {"cause": term, "coefficient": coef, "estimate": 1.0 + t["estimate"], "std_error": t["std_error"],
                 "model_value": 1.0, "gain": dict(entry["held_out"]), "evidence": ev}
-    mv = float(ctx.model.get(coef, {}).get(term, 0.0))
+    mv = float(model.get(coef, {}).get(term, 0.0))
     return {"cause": f"{coef}:{term}", "coefficient": coef, "estimate": mv + t["estimate"],
             "std_error": t["std_error"], "model_value": mv, "gain": dict(entry["held_out"]), "evidence": ev}
 

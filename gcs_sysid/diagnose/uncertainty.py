@@ -35,6 +35,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..jackknife import block_jackknife_cov
 from .regression import ols
 
 __all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "air_data_uncertainty",
@@ -43,46 +44,6 @@ __all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "a
 #: block length of the delete-a-block jackknife, s (the diagnosis's ``alpha_jackknife_s``: longer than the
 #: gusts' correlation times of 1-5 s at light aircraft speeds, short enough to give 5-8 blocks per flight)
 BLOCK_S = 15.0
-
-
-def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: float = BLOCK_S,
-                        min_rows: int = 50) -> np.ndarray | None:
-    """Delete-a-block jackknife covariance of least-squares coefficients on dependent data.
-
-    The rows (in time order) are cut into contiguous blocks of ``block_s`` seconds; the least-squares
-    solution ``theta_i`` is recomputed with block ``i`` left out, and
-    ``Cov = (B - 1)/B sum (theta_i - mean theta)(theta_i - mean theta)'`` (Kuensch 1989; Efron and
-    Tibshirani, *An Introduction to the Bootstrap*, 1993, sec. 11.5 for the delete-one form).
-
-    Args:
-        t: (N,) time of the rows, s. A: (N, P) regressors (a constant column included by the caller).
-        r: (N,) response. block_s: block length, s. min_rows: a block with fewer rows is left with its
-            neighbours (it is never left out on its own).
-
-    Returns:
-        (P, P) covariance, or None with fewer than 3 blocks or a singular fit.
-    """
-    t, A, r = np.asarray(t, float), np.asarray(A, float), np.asarray(r, float)
-    ok = np.isfinite(t) & np.all(np.isfinite(A), axis=1) & np.isfinite(r)
-    t, A, r = t[ok], A[ok], r[ok]
-    if t.size < 3 * min_rows or block_s <= 0:
-        return None
-    k = np.floor((t - t[0]) / block_s).astype(int)
-    labels = [b for b in np.unique(k) if np.sum(k == b) >= min_rows]
-    if len(labels) < 3:
-        return None
-    G, g = A.T @ A, A.T @ r
-    th = []
-    for b in labels:
-        m = k == b
-        try:
-            th.append(np.linalg.solve(G - A[m].T @ A[m], g - A[m].T @ r[m]))
-        except np.linalg.LinAlgError:
-            return None
-    th = np.asarray(th)
-    B = th.shape[0]
-    d = th - th.mean(axis=0)
-    return (B - 1) / B * (d.T @ d)
 
 
 def fit_standard_errors(t: np.ndarray, A: np.ndarray, r: np.ndarray, labels: list[str],

@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import butter, lfilter, sosfiltfilt
 
+from ..jackknife import block_jackknife_cov
 from .angleerrors import MIN_FIRST_STAGE_R2, iv_lstsq, lagged_instruments, mean_wind_sigma
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
@@ -389,20 +390,15 @@ def _scale_disagreement(dt: float, ang: np.ndarray, kin: np.ndarray, m: np.ndarr
     if ok.sum() < 150:
         return float("nan")
     x, y = ang[ok], (ang - kin)[ok]
-
-    def slope(k: np.ndarray) -> float:
-        xc = x[k] - x[k].mean()
-        return float(xc @ (y[k] - y[k].mean())) / float(xc @ xc) if float(xc @ xc) > 0 else float("nan")
-
-    d = slope(np.ones(x.size, bool))
-    if not np.isfinite(d):
+    xc = x - x.mean()
+    if not float(xc @ xc) > 0:
         return float("nan")
-    # delete-a-block jackknife over contiguous blocks of block_s (Kuensch 1989): the gusts are slow
-    blk = np.floor(np.nonzero(ok)[0] * dt / block_s).astype(int)
-    labels = [b for b in np.unique(blk) if np.sum(blk == b) >= 50]
-    th = np.array([slope(blk != b) for b in labels]) if len(labels) >= 3 else np.zeros(0)
-    se = float(np.sqrt((th.size - 1) / th.size * np.sum((th - th.mean()) ** 2))) \
-        if th.size and np.all(np.isfinite(th)) else 0.0
+    d = float(xc @ (y - y.mean())) / float(xc @ xc)
+    # delete-a-block jackknife over contiguous blocks of block_s (Kuensch 1989): the gusts are slow. The
+    # shared estimator (gcs_sysid.jackknife, also the diagnosis's); its blocks start at the first aided row
+    # (before the tenth session this loop's started at sample 0 of the log)
+    cov = block_jackknife_cov(np.nonzero(ok)[0] * dt, np.column_stack([np.ones(x.size), x]), y, block_s)
+    se = float(np.sqrt(max(cov[1, 1], 0.0))) if cov is not None and np.isfinite(cov[1, 1]) else 0.0
     return float(np.hypot(d, se))
 
 

@@ -1,0 +1,43 @@
+"""Scoring of eval_jsbsim_diagnose through a finding's reported aliases (tenth session, branch i9-alias).
+
+The findings are the shape ``diagnose`` returns (the t6's seed-1 ``CY:scale`` = 1.6 case of the ninth
+session's final evaluation, the alias as ``gcs_sysid.diagnose.sparse`` reports it); no flight is flown.
+"""
+
+from benchmarks.eval_jsbsim_diagnose import score_case
+
+
+def _finding(cause, est, mv, gain, aliases=()):
+    return {"cause": cause, "estimate": est, "model_value": mv, "std_error": 0.01, "gain": {"percent": gain},
+            "aliases": list(aliases)}
+
+
+_ALIAS = {"cause": "scale:CY", "estimate": 1.588, "model_value": 1.0, "std_error": 0.0005,
+          "gain": {"percent": 97.0}}
+_SCALE = {"injected": [{"cause": "scale:CY", "value": 0.6}]}
+
+
+def test_an_injected_cause_reported_as_the_top_findings_alias_counts_with_its_own_estimate():
+    sc = score_case([_finding("CY:beta", -2.302, -1.467, 97.0, [_ALIAS])], _SCALE)
+    e = sc["effects"][0]
+    assert not e["top"] and not sc["ok"]                      # the strict count is kept
+    assert e["top_alias"] and e["via_alias"] == "CY:beta" and sc["ok_alias"]
+    assert abs(e["estimate_alias"] - 0.588) < 1e-9 and e["est_alias"] and e["gain_alias"]
+
+
+def test_no_alias_no_credit_and_a_wrong_alias_estimate_fails():
+    assert not score_case([_finding("CY:beta", -2.302, -1.467, 97.0)], _SCALE)["effects"][0]["top_alias"]
+    # an alias of a finding that is not the top one does not count for a single effect
+    sc = score_case([_finding("Cn:beta", 0.1, 0.08, 60.0), _finding("CY:beta", -2.3, -1.467, 97.0, [_ALIAS])], _SCALE)
+    assert not sc["effects"][0]["top_alias"]
+    bad = dict(_ALIAS, estimate=1.3)                          # reads 0.3 for 0.6
+    e = score_case([_finding("CY:beta", -2.302, -1.467, 97.0, [bad])], _SCALE)["effects"][0]
+    assert e["top_alias"] and not e["est_alias"]
+
+
+def test_a_named_cause_is_scored_first_and_clean_flights_stay_strict():
+    sc = score_case([_finding("scale:CY", 1.6, 1.0, 93.0, [{"cause": "CY:beta", "estimate": -9.0, "model_value": -1.0,
+                                                            "gain": {"percent": 10.0}}])], _SCALE)
+    assert sc["effects"][0]["top"] and sc["effects"][0]["top_alias"] and sc["ok"] and sc["ok_alias"]
+    sc = score_case([_finding("CY:beta", -2.3, -1.467, 97.0, [_ALIAS])], {"injected": []})
+    assert sc["ok"] is False and sc["ok_alias"] is False
