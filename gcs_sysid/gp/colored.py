@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["variance_inflation"]
+__all__ = ["variance_inflation", "ols_coloured_t", "significant_inputs", "T_KEEP"]
 
 
 def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float = 0.25) -> np.ndarray:
@@ -61,3 +61,102 @@ def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float 
         w = 1.0 - np.arange(1, K + 1) / (K + 1.0)
         out[p] = max(1.0, 1.0 + 2.0 * float(np.sum(w * rho[:K])))
     return out
+
+
+def ols_coloured_t(X: np.ndarray, y: np.ndarray, max_lag: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Least squares ``y ~ theta_0 + X theta`` and the ``|t|`` of each slope with coloured residuals.
+
+    The slopes' covariance is the sandwich ``(X^T X)^{-1} X^T R X (X^T X)^{-1}`` with ``R`` the
+    Toeplitz matrix of the residuals' biased autocovariance, weighted by Bartlett's window up to
+    ``max_lag`` (Morelli and Klein 2016, sec. 5.3; Newey and West 1987): the form and default lag of
+    ``gcs_sysid.diagnose.regression.colored_covariance`` (``"bartlett"``), which the project's
+    stepwise regression uses for its partial F (``tests/gp/test_linear_terms.py`` checks that the two
+    agree). Columns are centred (the intercept is estimated, not tested).
+
+    Args:
+        X: ``(N, K)`` regressors in time order (K >= 1), finite.
+        y: ``(N,)`` output, finite.
+        max_lag: largest lag; default ``min(N - 1, 250, max(10, 4 N^(1/3)))``.
+
+    Returns:
+        ``(theta (K,), t (K,))``: the slopes and ``|theta| / se`` (``inf`` where the standard error is 0).
+    """
+    from scipy.signal import fftconvolve
+
+    X = np.asarray(X, float)
+    y = np.asarray(y, float)
+    n = len(y)
+    Xc = X - X.mean(0)
+    scale = np.sqrt(np.sum(Xc**2, 0))
+    scale[scale == 0] = 1.0
+    Xn = Xc / scale
+    b, *_ = np.linalg.lstsq(Xn, y - y.mean(), rcond=None)
+    v = (y - y.mean()) - Xn @ b
+    if max_lag is None:
+        max_lag = int(min(n - 1, 250, max(10, 4 * n ** (1 / 3))))
+    max_lag = max(0, min(int(max_lag), n - 1))
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    f = np.fft.rfft(v, nfft)
+    r = np.fft.irfft(f * np.conj(f), nfft)[: max_lag + 1] / n
+    w = 1.0 - np.arange(max_lag + 1) / (max_lag + 1.0)
+    kern = np.concatenate([(r * w)[:0:-1], r * w])
+    RX = fftconvolve(Xn, kern[:, None], mode="same", axes=0) if max_lag > 0 else Xn * r[0]
+    mid = Xn.T @ RX
+    xtx_inv = np.linalg.pinv(Xn.T @ Xn)
+    cov = xtx_inv @ (0.5 * (mid + mid.T)) @ xtx_inv
+    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(se > 0, np.abs(b) / se, np.inf)
+    return b / scale, t
+
+
+#: A regressor stays in an output's linear mean while its slope's ``|t|`` with coloured residuals is at
+#: least this: partial F >= 4, the stepwise regression's rule to keep a term (``f_out``; Morelli and
+#: Klein 2016, sec. 5.4.3).
+T_KEEP = 2.0
+
+
+def significant_inputs(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, t_keep: float = T_KEEP) -> np.ndarray:
+    """Per output, the regressors whose linear term the data support with coloured residuals.
+
+    Backward elimination (Morelli and Klein 2016, sec. 5.4.3; Draper and Smith, *Applied Regression
+    Analysis*, 3rd ed., ch. 15): start from every active regressor, fit least squares, drop the
+    regressor with the smallest ``|t|`` (:func:`ols_coloured_t`) while it is below ``t_keep``.
+
+    Why (``docs/gp.md``, "Linear terms that earn their place"): the measured moment coefficients carry
+    the angular-acceleration estimate's error, which is largest at control steps and so correlated with
+    the controls over a whole flight. A linear mean with every regressor turns it into small apparent
+    derivatives (on the JSBSim T-6, ``Cn_delta_a`` and ``Cn_q_hat``, which its aerodynamics does not
+    have) that do not hold on a differently excited segment. With white-noise standard errors those
+    terms look significant; with the residuals' autocorrelation most of them do not.
+
+    Args:
+        Xs: ``(N, D)`` regressors in time order (standardised or not: ``t`` does not depend on scale).
+        Ys: ``(N, P)`` outputs; NaN marks a missing entry (each output uses its own finite rows).
+        active: ``(D,)`` bool, the regressors that vary (the others are never kept).
+        t_keep: the least ``|t|`` a kept term has.
+
+    Returns:
+        ``(P, D)`` bool: True where output ``p``'s linear mean keeps regressor ``d``. An output with
+        fewer rows than ``2 (D + 2)`` keeps every active regressor.
+    """
+    Xs = np.asarray(Xs, float)
+    Ys = np.asarray(Ys, float)
+    active = np.asarray(active, bool)
+    P, D = Ys.shape[1], Xs.shape[1]
+    keep = np.tile(active, (P, 1))
+    for p in range(P):
+        rows = np.isfinite(Ys[:, p]) & np.all(np.isfinite(Xs), 1)
+        if rows.sum() < 2 * (D + 2):
+            continue
+        X, y = Xs[rows], Ys[rows, p]
+        cols = [d for d in range(D) if active[d]]
+        while cols:
+            _, t = ols_coloured_t(X[:, cols], y)
+            j = int(np.argmin(t))
+            if t[j] >= t_keep:
+                break
+            cols.pop(j)
+        keep[p] = False
+        keep[p, cols] = True
+    return keep

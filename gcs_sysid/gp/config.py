@@ -42,6 +42,11 @@ class GPConfig:
         train_inducing: also optimise the inducing inputs ``Z``.
         linear_mean: include the linear (stability-and-control-derivative) mean.
         prior_std: prior std of the linear-mean weights, standardised units.
+        linear_terms: which regressors enter each output's linear mean: ``"significant"`` (the
+            default) those whose slope keeps ``|t| >= 2`` with coloured-residual standard errors in a
+            backward elimination on the training rows (:func:`gcs_sysid.gp.colored.significant_inputs`;
+            ``docs/gp.md``, "Linear terms that earn their place"); ``"all"``: every active regressor
+            (the model before the tenth session).
         jitter: added to the diagonal of ``Kmm``.
         local: add the local non-stationary layer.
         local_neighbours: neighbours ``K`` per local prediction.
@@ -100,6 +105,7 @@ class GPConfig:
     train_inducing: bool = False
     linear_mean: bool = True
     prior_std: float = 3.0
+    linear_terms: str = "significant"
     jitter: float = 1e-6
     local: bool = True
     local_neighbours: int = 16
@@ -134,6 +140,8 @@ class GPConfig:
         for name in ("steps", "local_steps", "rank", "swap_max", "swap_pool", "hyper_every", "validation_folds"):
             if int(getattr(self, name)) < 0:
                 raise InputError(f"GPConfig.{name} must be >= 0, got {getattr(self, name)!r}")
+        if self.linear_terms not in ("significant", "all"):
+            raise InputError(f"GPConfig.linear_terms must be 'significant' or 'all', got {self.linear_terms!r}")
         if self.inducing not in ("mi", "kmeans", "random"):
             raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
         if not (self.learning_rate > 0 and self.local_learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0
