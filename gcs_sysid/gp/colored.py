@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["variance_inflation", "ols_coloured_t", "significant_inputs", "T_KEEP"]
+__all__ = ["variance_inflation", "ols_coloured_t", "significant_inputs", "T_KEEP", "lagged_products", "default_lag"]
 
 
 def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float = 0.25) -> np.ndarray:
@@ -63,51 +63,72 @@ def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float 
     return out
 
 
-def ols_coloured_t(X: np.ndarray, y: np.ndarray, max_lag: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def default_lag(n: int) -> int:
+    """The Bartlett window's largest lag for ``n`` rows: ``min(n - 1, 250, max(10, 4 n^(1/3)))`` (as
+    ``gcs_sysid.diagnose.regression.colored_covariance``)."""
+    return max(0, int(min(n - 1, 250, max(10, 4 * n ** (1 / 3)))))
+
+
+def _autocov(v: np.ndarray, max_lag: int) -> np.ndarray:
+    """Biased autocovariance ``(max_lag + 1,)``: ``r_k = (1/N) sum_i v_i v_(i+k)`` (by FFT)."""
+    n = len(v)
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    f = np.fft.rfft(v, nfft)
+    return np.fft.irfft(f * np.conj(f), nfft)[: max_lag + 1] / n
+
+
+def lagged_products(X: np.ndarray, max_lag: int) -> np.ndarray:
+    """``G_k = sum_i x_i x_(i+k)^T`` for ``k = 0..max_lag``, ``(max_lag + 1, K, K)``, of the columns of
+    ``X (N, K)`` (by FFT: one cross-spectrum per pair of columns)."""
+    X = np.asarray(X, float)
+    n = len(X)
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    F = np.fft.rfft(X, nfft, axis=0)                                   # (nfft/2+1, K)
+    cross = np.fft.irfft(np.conj(F)[:, :, None] * F[:, None, :], nfft, axis=0)   # [k, a, b] = sum_i x_ia x_(i+k)b
+    return cross[: max_lag + 1]
+
+
+def ols_coloured_t(X: np.ndarray, y: np.ndarray, max_lag: int | None = None, lagged: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """Least squares ``y ~ theta_0 + X theta`` and the ``|t|`` of each slope with coloured residuals.
 
     The slopes' covariance is the sandwich ``(X^T X)^{-1} X^T R X (X^T X)^{-1}`` with ``R`` the
-    Toeplitz matrix of the residuals' biased autocovariance, weighted by Bartlett's window up to
-    ``max_lag`` (Morelli and Klein 2016, sec. 5.3; Newey and West 1987): the form and default lag of
+    Toeplitz matrix of the residuals' biased autocovariance ``r_k``, weighted by Bartlett's window
+    ``w_k = 1 - k / (L + 1)`` up to ``L = max_lag`` (Morelli and Klein 2016, sec. 5.3; Newey and West
+    1987), so ``X^T R X = w_0 r_0 G_0 + sum_(k=1..L) w_k r_k (G_k + G_k^T)`` with the lagged products
+    ``G_k`` of the centred columns (:func:`lagged_products`). It is the form and default lag of
     ``gcs_sysid.diagnose.regression.colored_covariance`` (``"bartlett"``), which the project's
     stepwise regression uses for its partial F (``tests/gp/test_linear_terms.py`` checks that the two
-    agree). Columns are centred (the intercept is estimated, not tested).
+    agree). The intercept is estimated (columns centred), not tested.
 
     Args:
         X: ``(N, K)`` regressors in time order (K >= 1), finite.
         y: ``(N,)`` output, finite.
-        max_lag: largest lag; default ``min(N - 1, 250, max(10, 4 N^(1/3)))``.
+        max_lag: ``L``; default :func:`default_lag`.
+        lagged: ``lagged_products(X - X.mean(0), L)`` when the caller has it (a backward elimination
+            reuses the products of all columns: pass the rows and columns of the kept ones).
 
     Returns:
         ``(theta (K,), t (K,))``: the slopes and ``|theta| / se`` (``inf`` where the standard error is 0).
     """
-    from scipy.signal import fftconvolve
-
     X = np.asarray(X, float)
     y = np.asarray(y, float)
     n = len(y)
+    L = default_lag(n) if max_lag is None else max(0, min(int(max_lag), n - 1))
     Xc = X - X.mean(0)
-    scale = np.sqrt(np.sum(Xc**2, 0))
-    scale[scale == 0] = 1.0
-    Xn = Xc / scale
-    b, *_ = np.linalg.lstsq(Xn, y - y.mean(), rcond=None)
-    v = (y - y.mean()) - Xn @ b
-    if max_lag is None:
-        max_lag = int(min(n - 1, 250, max(10, 4 * n ** (1 / 3))))
-    max_lag = max(0, min(int(max_lag), n - 1))
-    nfft = 1 << int(np.ceil(np.log2(2 * n)))
-    f = np.fft.rfft(v, nfft)
-    r = np.fft.irfft(f * np.conj(f), nfft)[: max_lag + 1] / n
-    w = 1.0 - np.arange(max_lag + 1) / (max_lag + 1.0)
-    kern = np.concatenate([(r * w)[:0:-1], r * w])
-    RX = fftconvolve(Xn, kern[:, None], mode="same", axes=0) if max_lag > 0 else Xn * r[0]
-    mid = Xn.T @ RX
-    xtx_inv = np.linalg.pinv(Xn.T @ Xn)
-    cov = xtx_inv @ (0.5 * (mid + mid.T)) @ xtx_inv
-    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    G = lagged_products(Xc, L) if lagged is None else np.asarray(lagged)[: L + 1]
+    xtx = G[0]
+    yc = y - y.mean()
+    theta = np.linalg.lstsq(xtx, Xc.T @ yc, rcond=None)[0]          # normal equations (K x K): columns centred
+    r = _autocov(yc - Xc @ theta, L)
+    w = 1.0 - np.arange(L + 1) / (L + 1.0)
+    S = np.einsum("k,kab->ab", w[1:] * r[1:], G[1:]) if L > 0 else np.zeros_like(xtx)
+    mid = r[0] * xtx + S + S.T
+    xtx_inv = np.linalg.pinv(xtx)
+    se = np.sqrt(np.maximum(np.diag(xtx_inv @ mid @ xtx_inv), 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.where(se > 0, np.abs(b) / se, np.inf)
-    return b / scale, t
+        t = np.where(se > 0, np.abs(theta) / se, np.inf)
+    return theta, t
 
 
 #: A regressor stays in an output's linear mean while its slope's ``|t|`` with coloured residuals is at
@@ -145,14 +166,18 @@ def significant_inputs(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, t_kee
     active = np.asarray(active, bool)
     P, D = Ys.shape[1], Xs.shape[1]
     keep = np.tile(active, (P, 1))
+    G = None
     for p in range(P):
         rows = np.isfinite(Ys[:, p]) & np.all(np.isfinite(Xs), 1)
         if rows.sum() < 2 * (D + 2):
             continue
         X, y = Xs[rows], Ys[rows, p]
         cols = [d for d in range(D) if active[d]]
+        L = default_lag(len(y))
+        if G is None or G[0] != rows.tobytes():         # the lagged products of these rows, once
+            G = (rows.tobytes(), lagged_products(X - X.mean(0), L))
         while cols:
-            _, t = ols_coloured_t(X[:, cols], y)
+            _, t = ols_coloured_t(X[:, cols], y, L, G[1][:, cols][:, :, cols])
             j = int(np.argmin(t))
             if t[j] >= t_keep:
                 break
