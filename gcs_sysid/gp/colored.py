@@ -145,7 +145,7 @@ def significant_inputs(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, t_kee
     regressor with the smallest ``|t|`` (:func:`ols_coloured_t`) while it is below ``t_keep``.
 
     Why (``docs/gp.md``, "Linear terms that earn their place"): the measured moment coefficients carry
-    the angular-acceleration estimate's error, which is largest at control steps and so correlated with
+    the angular-acceleration estimate's error, which grows with the control rate and so is correlated with
     the controls over a whole flight. A linear mean with every regressor turns it into small apparent
     derivatives (on the JSBSim T-6, ``Cn_delta_a`` and ``Cn_q_hat``, which its aerodynamics does not
     have) that do not hold on a differently excited segment. With white-noise standard errors those
