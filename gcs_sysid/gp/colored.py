@@ -151,6 +151,10 @@ def significant_inputs(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, t_kee
     have) that do not hold on a differently excited segment. With white-noise standard errors those
     terms look significant; with the residuals' autocorrelation most of them do not.
 
+    The test treats the linear fit's residual as noise. For an output with a large smooth nonlinear
+    part that residual is signal, and a true linear term can be dropped. That is why
+    ``GPConfig.linear_terms`` defaults to ``"all"`` (``docs/gp.md``).
+
     Args:
         Xs: ``(N, D)`` regressors in time order (standardised or not: ``t`` does not depend on scale).
         Ys: ``(N, P)`` outputs; NaN marks a missing entry (each output uses its own finite rows).
