@@ -1,5 +1,6 @@
-"""Linear terms that earn their place: each output's linear mean keeps only the regressors whose slope
-is significant with coloured-residual standard errors (``gp.colored.significant_inputs``; docs/gp.md).
+"""Linear terms that earn their place (``GPConfig.linear_terms="significant"``, opt-in): each output's
+linear mean keeps only the regressors whose slope is significant with coloured-residual standard errors
+(``gp.colored.significant_inputs``; docs/gp.md).
 
 The weakness these tests guard: a linear mean with every regressor, fitted by a likelihood that counts
 each 50 Hz row as independent, turns a slowly varying measurement error into a derivative of any
@@ -73,9 +74,9 @@ def test_missing_entries_inactive_inputs_and_the_prior_std():
 
 @pytest.mark.slow
 def test_gp_mean_leaves_the_spurious_slope_out_and_predicts_better():
-    """The fitted GP: slope of ``x2`` exactly 0 in the default mean (``linear_terms="significant"``),
-    not with every regressor (``"all"``); on a later segment where ``x2`` moves 3x as far, the default
-    model's error against the noise-free truth is lower."""
+    """The fitted GP: slope of ``x2`` exactly 0 with ``linear_terms="significant"`` (opt-in), not with
+    every regressor (``"all"``, the default); on a later segment where ``x2`` moves 3x as far, the
+    ``"significant"`` model's error against the noise-free truth is lower."""
     X, y = _case(9, 2400)
     seen = 0
     cfg = dict(n_inducing=32, n_inducing_hyper=16, steps=60, local=False)
