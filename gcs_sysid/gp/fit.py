@@ -226,7 +226,7 @@ def linear_prior_std(cfg: GPConfig, terms: np.ndarray | None, P: int, D: int) ->
 def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> np.ndarray | None:
     """The regressors of each output's linear mean ``(P, D)`` bool for ``cfg.linear_terms`` (None: every
     regressor, ``"all"``): :func:`gcs_sysid.gp.colored.significant_inputs` on the rows in time order."""
-    if cfg.linear_terms == "all" or not cfg.linear_mean:
+    if cfg.linear_terms in ("all", "validated") or not cfg.linear_mean:
         return None
     from .colored import significant_inputs
 
@@ -481,6 +481,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         pool.shutdown(wait=False)                 # the thread ends with its one job
     t2 = time.perf_counter()
     params, stats = validated_global(params, Xs, Ys, cfg, history)
+    if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
+        params = _validated_terms(params, Xs, Ys, scaler.active, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
@@ -514,6 +516,28 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
                           var_scale=var_scale)
     model = calibrate(model, Xs, Ys, history.validation.get("cv_mse"))    # model error at exact conditions
     return model, history
+
+
+def _validated_terms(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray,
+                     history: FitHistory) -> GlobalParams:
+    """``GPConfig.linear_terms = "validated"``: for the outputs whose latent GP the blocked validation
+    shrank to the smallest scale (:data:`gcs_sysid.gp.validation.GLOBAL_GRID`), where the linear fit's
+    residual is noise, the linear mean keeps only the regressors significant with coloured residuals
+    (:func:`gcs_sysid.gp.colored.significant_inputs`); the prior std of the others becomes 0. The
+    statistics do not depend on it: only the posterior changes."""
+    from .colored import significant_inputs
+    from .validation import GLOBAL_GRID
+
+    lin = [p for p, v in enumerate(history.validation["latent_scale"]) if v <= GLOBAL_GRID[0]]
+    if not lin:
+        return params
+    P, D = Ys.shape[1], Xs.shape[1]
+    S = np.array(np.broadcast_to(np.asarray(params.prior_std, float), (P, D + 1)))
+    keep = significant_inputs(Xs, Ys[:, lin], active)
+    for k, p in enumerate(lin):
+        S[p, 1:] *= keep[k]
+    history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(S[p, 1:])] for p in range(P)]
+    return replace(params, prior_std=jax.device_put(S))
 
 
 def _validating(cfg: GPConfig, n: int) -> bool:

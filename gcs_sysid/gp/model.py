@@ -302,7 +302,7 @@ class LocalGlobalGP:
             DataError: fewer than 3 stored rows.
         """
         from ..errors import DataError
-        from .fit import FitHistory, fit_local, learn_global, validated_global, validated_local
+        from .fit import FitHistory, _validated_terms, fit_local, learn_global, validated_global, validated_local
 
         enable_x64()
         rows = self.rows
@@ -320,6 +320,8 @@ class LocalGlobalGP:
         # the blocked cross-validation of the fit, on the stored rows (arrival order; exact time order
         # while none was thinned): a refresh must not bring back what the fit's check removed
         params, stats = validated_global(params, rows.X, rows.Y, cfg, history)
+        if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
+            params = _validated_terms(params, rows.X, rows.Y, self.scaler.active, history)
         evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))
