@@ -152,8 +152,9 @@ def significant_inputs(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, t_kee
     terms look significant; with the residuals' autocorrelation most of them do not.
 
     The test treats the linear fit's residual as noise. For an output with a large smooth nonlinear
-    part that residual is signal, and a true linear term can be dropped. That is why
-    ``GPConfig.linear_terms`` defaults to ``"all"`` (``docs/gp.md``).
+    part that residual is signal, and a true linear term can be dropped. That is why the default
+    ``GPConfig.linear_terms = "validated"`` applies it only to the outputs whose latent GP the blocked
+    validation shrank (``gcs_sysid.gp.fit._validated_terms``; ``docs/gp.md``).
 
     Args:
         Xs: ``(N, D)`` regressors in time order (standardised or not: ``t`` does not depend on scale).
