@@ -131,3 +131,25 @@ def test_per_output_prior_std_equals_the_exact_gp(missing):
     me, ve = jax.jit(lambda q: exact.exact_predict(q, jnp.asarray(X), jnp.asarray(Y), jnp.asarray(Xq), mask=mask))(p)
     np.testing.assert_allclose(m, me, rtol=1e-6, atol=1e-7)
     np.testing.assert_allclose(v, ve, rtol=1e-5, atol=1e-8)
+
+
+def test_validated_terms_only_for_outputs_the_validation_found_linear():
+    """``linear_terms="validated"`` (the default): the elimination runs only for the outputs whose latent
+    GP the blocked validation shrank to the smallest scale; the others keep every regressor."""
+    import jax.numpy as jnp
+
+    from gcs_sysid.gp.fit import FitHistory, _validated_terms
+    from gcs_sysid.gp.sparse import GlobalParams
+    from gcs_sysid.gp.validation import GLOBAL_GRID
+
+    X, y = _case(0)
+    Y = np.column_stack([y, y])
+    p = GlobalParams(lengthscale=jnp.ones(3), A=jnp.eye(2), noise=jnp.ones(2), Z=jnp.zeros((4, 3)),
+                     prior_std=jnp.asarray(3.0), jitter=jnp.asarray(1e-6))
+    hist = FitHistory()
+    hist.validation["latent_scale"] = [GLOBAL_GRID[0], 1.0]
+    S = np.asarray(_validated_terms(p, X, Y, np.ones(3, bool), hist).prior_std)
+    np.testing.assert_array_equal(S, [[3, 3, 3, 0], [3, 3, 3, 3]])
+    assert hist.validation["linear_terms"] == [[0, 1], [0, 1, 2]]
+    hist.validation["latent_scale"] = [1.0, 0.3]                      # nothing found linear: unchanged
+    assert _validated_terms(p, X, Y, np.ones(3, bool), hist) is p
