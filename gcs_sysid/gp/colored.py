@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["variance_inflation"]
+__all__ = ["variance_inflation", "ols_coloured_t", "significant_inputs", "T_KEEP", "lagged_products", "default_lag"]
 
 
 def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float = 0.25) -> np.ndarray:
@@ -61,3 +61,132 @@ def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float 
         w = 1.0 - np.arange(1, K + 1) / (K + 1.0)
         out[p] = max(1.0, 1.0 + 2.0 * float(np.sum(w * rho[:K])))
     return out
+
+
+def default_lag(n: int) -> int:
+    """The Bartlett window's largest lag for ``n`` rows: ``min(n - 1, 250, max(10, 4 n^(1/3)))`` (as
+    ``gcs_sysid.diagnose.regression.colored_covariance``)."""
+    return max(0, int(min(n - 1, 250, max(10, 4 * n ** (1 / 3)))))
+
+
+def _autocov(v: np.ndarray, max_lag: int) -> np.ndarray:
+    """Biased autocovariance ``(max_lag + 1,)``: ``r_k = (1/N) sum_i v_i v_(i+k)`` (by FFT)."""
+    n = len(v)
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    f = np.fft.rfft(v, nfft)
+    return np.fft.irfft(f * np.conj(f), nfft)[: max_lag + 1] / n
+
+
+def lagged_products(X: np.ndarray, max_lag: int) -> np.ndarray:
+    """``G_k = sum_i x_i x_(i+k)^T`` for ``k = 0..max_lag``, ``(max_lag + 1, K, K)``, of the columns of
+    ``X (N, K)`` (by FFT: one cross-spectrum per pair of columns)."""
+    X = np.asarray(X, float)
+    n = len(X)
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    F = np.fft.rfft(X, nfft, axis=0)                                   # (nfft/2+1, K)
+    cross = np.fft.irfft(np.conj(F)[:, :, None] * F[:, None, :], nfft, axis=0)   # [k, a, b] = sum_i x_ia x_(i+k)b
+    return cross[: max_lag + 1]
+
+
+def ols_coloured_t(X: np.ndarray, y: np.ndarray, max_lag: int | None = None, lagged: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Least squares ``y ~ theta_0 + X theta`` and the ``|t|`` of each slope with coloured residuals.
+
+    The slopes' covariance is the sandwich ``(X^T X)^{-1} X^T R X (X^T X)^{-1}`` with ``R`` the
+    Toeplitz matrix of the residuals' biased autocovariance ``r_k``, weighted by Bartlett's window
+    ``w_k = 1 - k / (L + 1)`` up to ``L = max_lag`` (Morelli and Klein 2016, sec. 5.3; Newey and West
+    1987), so ``X^T R X = w_0 r_0 G_0 + sum_(k=1..L) w_k r_k (G_k + G_k^T)`` with the lagged products
+    ``G_k`` of the centred columns (:func:`lagged_products`). It is the form and default lag of
+    ``gcs_sysid.diagnose.regression.colored_covariance`` (``"bartlett"``), which the project's
+    stepwise regression uses for its partial F (``tests/gp/test_linear_terms.py`` checks that the two
+    agree). The intercept is estimated (columns centred), not tested.
+
+    Args:
+        X: ``(N, K)`` regressors in time order (K >= 1), finite.
+        y: ``(N,)`` output, finite.
+        max_lag: ``L``; default :func:`default_lag`.
+        lagged: ``lagged_products(X - X.mean(0), L)`` when the caller has it (a backward elimination
+            reuses the products of all columns: pass the rows and columns of the kept ones).
+
+    Returns:
+        ``(theta (K,), t (K,))``: the slopes and ``|theta| / se`` (``inf`` where the standard error is 0).
+    """
+    X = np.asarray(X, float)
+    y = np.asarray(y, float)
+    n = len(y)
+    L = default_lag(n) if max_lag is None else max(0, min(int(max_lag), n - 1))
+    Xc = X - X.mean(0)
+    G = lagged_products(Xc, L) if lagged is None else np.asarray(lagged)[: L + 1]
+    xtx = G[0]
+    yc = y - y.mean()
+    theta = np.linalg.lstsq(xtx, Xc.T @ yc, rcond=None)[0]          # normal equations (K x K): columns centred
+    r = _autocov(yc - Xc @ theta, L)
+    w = 1.0 - np.arange(L + 1) / (L + 1.0)
+    S = np.einsum("k,kab->ab", w[1:] * r[1:], G[1:]) if L > 0 else np.zeros_like(xtx)
+    mid = r[0] * xtx + S + S.T
+    xtx_inv = np.linalg.pinv(xtx)
+    se = np.sqrt(np.maximum(np.diag(xtx_inv @ mid @ xtx_inv), 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(se > 0, np.abs(theta) / se, np.inf)
+    return theta, t
+
+
+#: A regressor stays in an output's linear mean while its slope's ``|t|`` with coloured residuals is at
+#: least this: partial F >= 4, the stepwise regression's rule to keep a term (``f_out``; Morelli and
+#: Klein 2016, sec. 5.4.3).
+T_KEEP = 2.0
+
+
+def significant_inputs(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, t_keep: float = T_KEEP) -> np.ndarray:
+    """Per output, the regressors whose linear term the data support with coloured residuals.
+
+    Backward elimination (Morelli and Klein 2016, sec. 5.4.3; Draper and Smith, *Applied Regression
+    Analysis*, 3rd ed., ch. 15): start from every active regressor, fit least squares, drop the
+    regressor with the smallest ``|t|`` (:func:`ols_coloured_t`) while it is below ``t_keep``.
+
+    Why (``docs/gp.md``, "Linear terms that earn their place"): the measured moment coefficients carry
+    the angular-acceleration estimate's error, which grows with the control rate and so is correlated with
+    the controls over a whole flight. A linear mean with every regressor turns it into small apparent
+    derivatives (on the JSBSim T-6, ``Cn_delta_a`` and ``Cn_q_hat``, which its aerodynamics does not
+    have) that do not hold on a differently excited segment. With white-noise standard errors those
+    terms look significant; with the residuals' autocorrelation most of them do not.
+
+    The test treats the linear fit's residual as noise. For an output with a large smooth nonlinear
+    part that residual is signal, and a true linear term can be dropped. That is why the default
+    ``GPConfig.linear_terms = "validated"`` applies it only to the outputs whose latent GP the blocked
+    validation shrank (``gcs_sysid.gp.fit._validated_terms``; ``docs/gp.md``).
+
+    Args:
+        Xs: ``(N, D)`` regressors in time order (standardised or not: ``t`` does not depend on scale).
+        Ys: ``(N, P)`` outputs; NaN marks a missing entry (each output uses its own finite rows).
+        active: ``(D,)`` bool, the regressors that vary (the others are never kept).
+        t_keep: the least ``|t|`` a kept term has.
+
+    Returns:
+        ``(P, D)`` bool: True where output ``p``'s linear mean keeps regressor ``d``. An output with
+        fewer rows than ``2 (D + 2)`` keeps every active regressor.
+    """
+    Xs = np.asarray(Xs, float)
+    Ys = np.asarray(Ys, float)
+    active = np.asarray(active, bool)
+    P, D = Ys.shape[1], Xs.shape[1]
+    keep = np.tile(active, (P, 1))
+    G = None
+    for p in range(P):
+        rows = np.isfinite(Ys[:, p]) & np.all(np.isfinite(Xs), 1)
+        if rows.sum() < 2 * (D + 2):
+            continue
+        X, y = Xs[rows], Ys[rows, p]
+        cols = [d for d in range(D) if active[d]]
+        L = default_lag(len(y))
+        if G is None or G[0] != rows.tobytes():         # the lagged products of these rows, once
+            G = (rows.tobytes(), lagged_products(X - X.mean(0), L))
+        while cols:
+            _, t = ols_coloured_t(X[:, cols], y, L, G[1][:, cols][:, :, cols])
+            j = int(np.argmin(t))
+            if t[j] >= t_keep:
+                break
+            cols.pop(j)
+        keep[p] = False
+        keep[p, cols] = True
+    return keep

@@ -45,6 +45,7 @@ from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local, shared_search, store_without
 
 __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local", "noise_correlation_factor",
+           "linear_prior_std", "linear_terms_of",
            "learn_input_noise", "validated_global", "validated_local"]
 
 _NOISE_FLOOR = 1e-6
@@ -212,8 +213,31 @@ def _residual_cov_missing(Xs, Ys, obs, linear_mean: bool) -> np.ndarray:
     return Cr + 1e-6 * np.eye(P)
 
 
-def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
+def linear_prior_std(cfg: GPConfig, terms: np.ndarray | None, P: int, D: int) -> np.ndarray:
+    """Prior std of the linear-mean weights ``(P, D+1)`` (intercept first): ``cfg.prior_std`` on the
+    intercept and on the regressors ``terms (P, D)`` keeps (None: all), 0 on the others (the term is
+    not in that output's mean); all 0 without a linear mean."""
+    if not cfg.linear_mean:
+        return np.zeros((P, D + 1))
+    keep = np.ones((P, D), bool) if terms is None else np.asarray(terms, bool)
+    return float(cfg.prior_std) * np.concatenate([np.ones((P, 1)), keep.astype(float)], axis=1)
+
+
+def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> np.ndarray | None:
+    """The regressors of each output's linear mean ``(P, D)`` bool for ``cfg.linear_terms`` (None: every
+    regressor, ``"all"``): :func:`gcs_sysid.gp.colored.significant_inputs` on the rows in time order."""
+    if cfg.linear_terms in ("all", "validated") or not cfg.linear_mean:
+        return None
+    from .colored import significant_inputs
+
+    return significant_inputs(Xs, Ys, active)
+
+
+def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = None):
     """Initial unconstrained parameters from a ridge fit of the linear mean.
+
+    ``terms`` ``(P, D)`` bool: the regressors of each output's linear mean (None: all); the ridge fit
+    of output ``p`` uses its own, and the prior std of the others' weights is 0.
 
     With ``cfg.latent_kernels = J > 1`` the residual covariance is shared equally between the
     kernels (``B_j = B0 / J``) and the length-scales start at :func:`lmc_start_factors` times the
@@ -225,8 +249,14 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     if obs.all():
         if cfg.linear_mean:
             Xa = np.concatenate([np.ones((len(Xs), 1)), Xs], axis=1)   # design(): [1, x]
-            W = np.linalg.solve(Xa.T @ Xa + 1e-3 * np.eye(Xa.shape[1]), Xa.T @ Ys)
-            R = Ys - Xa @ W
+            if terms is None:
+                W = np.linalg.solve(Xa.T @ Xa + 1e-3 * np.eye(Xa.shape[1]), Xa.T @ Ys)
+                R = Ys - Xa @ W
+            else:                                                    # each output its own terms
+                R = np.empty_like(Ys)
+                for p in range(P):
+                    Xp = Xa[:, np.r_[True, np.asarray(terms[p], bool)]]
+                    R[:, p] = Ys[:, p] - Xp @ np.linalg.solve(Xp.T @ Xp + 1e-3 * np.eye(Xp.shape[1]), Xp.T @ Ys[:, p])
         Cr = np.cov(R.T).reshape(P, P) + 1e-6 * np.eye(P)
     else:
         Cr = _residual_cov_missing(Xs, Ys, obs, cfg.linear_mean)
@@ -249,7 +279,7 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z):
     if cfg.train_inducing:
         raw["Z"] = np.asarray(Z, float)
     fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
-             "prior_std": np.float64(cfg.prior_std if cfg.linear_mean else 0.0), "jitter": np.float64(cfg.jitter)}
+             "prior_std": linear_prior_std(cfg, terms, P, Xs.shape[1]), "jitter": np.float64(cfg.jitter)}
     return jax.device_put(raw), jax.device_put(fixed)
 
 
@@ -334,6 +364,9 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     D = Xs.shape[1]
     P = Ys.shape[1]
     t0 = time.perf_counter()
+    terms = linear_terms_of(Xs, Ys, active, cfg)          # on every row, in time order (coloured residuals)
+    if terms is not None:
+        history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(k)] for k in terms]
     sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
     obs = np.isfinite(Ys[sub])
     # missing outputs (heterotopic rows): the bound over the observed entries (None: all observed)
@@ -347,7 +380,7 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     ls0 = (np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) * min(lmc_start_factors(int(cfg.latent_kernels)))
            if start is None else np.asarray(start.metric_lengthscale()))
     Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
-    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z)
+    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z, terms)
     if start is not None:
         raw = jax.device_put(dict(jax.device_get(raw), **_unconstrain(start, cfg)))
     history.timings["init"] = time.perf_counter() - t0
@@ -448,6 +481,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         pool.shutdown(wait=False)                 # the thread ends with its one job
     t2 = time.perf_counter()
     params, stats = validated_global(params, Xs, Ys, cfg, history)
+    if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
+        params = _validated_terms(params, Xs, Ys, scaler.active, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
@@ -481,6 +516,28 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
                           var_scale=var_scale)
     model = calibrate(model, Xs, Ys, history.validation.get("cv_mse"))    # model error at exact conditions
     return model, history
+
+
+def _validated_terms(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray,
+                     history: FitHistory) -> GlobalParams:
+    """``GPConfig.linear_terms = "validated"``: for the outputs whose latent GP the blocked validation
+    shrank to the smallest scale (:data:`gcs_sysid.gp.validation.GLOBAL_GRID`), where the linear fit's
+    residual is noise, the linear mean keeps only the regressors significant with coloured residuals
+    (:func:`gcs_sysid.gp.colored.significant_inputs`); the prior std of the others becomes 0. The
+    statistics do not depend on it: only the posterior changes."""
+    from .colored import significant_inputs
+    from .validation import GLOBAL_GRID
+
+    lin = [p for p, v in enumerate(history.validation["latent_scale"]) if v <= GLOBAL_GRID[0]]
+    if not lin:
+        return params
+    P, D = Ys.shape[1], Xs.shape[1]
+    S = np.array(np.broadcast_to(np.asarray(params.prior_std, float), (P, D + 1)))
+    keep = significant_inputs(Xs, Ys[:, lin], active)
+    for k, p in enumerate(lin):
+        S[p, 1:] *= keep[k]
+    history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(S[p, 1:])] for p in range(P)]
+    return replace(params, prior_std=jax.device_put(S))
 
 
 def _validating(cfg: GPConfig, n: int) -> bool:

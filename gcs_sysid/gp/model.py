@@ -326,7 +326,7 @@ class LocalGlobalGP:
             DataError: fewer than 3 stored rows.
         """
         from ..errors import DataError
-        from .fit import FitHistory, fit_local, learn_global, validated_global, validated_local
+        from .fit import FitHistory, _validated_terms, fit_local, learn_global, validated_global, validated_local
 
         enable_x64()
         rows = self.rows
@@ -344,6 +344,8 @@ class LocalGlobalGP:
         # the blocked cross-validation of the fit, on the stored rows (arrival order; exact time order
         # while none was thinned): a refresh must not bring back what the fit's check removed
         params, stats = validated_global(params, rows.X, rows.Y, cfg, history)
+        if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
+            params = _validated_terms(params, rows.X, rows.Y, self.scaler.active, history)
         evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))
@@ -482,7 +484,7 @@ class LocalGlobalGP:
         P, D = self.n_outputs, self.n_inputs
         K = self.post.b.shape[0]
         mu = cho_solve((np.asarray(self.post.L), True), np.asarray(self.post.b))
-        W = float(self.params.prior_std) * mu[K - P * (D + 1):].reshape(P, D + 1)
+        W = np.broadcast_to(np.asarray(self.params.prior_std, float), (P, D + 1)) * mu[K - P * (D + 1):].reshape(P, D + 1)
         sc = self.scaler
         slopes = sc.y_std[:, None] * W[:, 1:] / sc.x_std[None, :] * sc.active[None, :]
         intercept = sc.y_mean + sc.y_std * W[:, 0] - slopes @ sc.x_mean

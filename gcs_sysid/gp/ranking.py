@@ -48,7 +48,7 @@ def _features(model, Xs: np.ndarray) -> np.ndarray:
 def _selector_block(model, p: int) -> np.ndarray:
     """``S_p (K, J)`` of :func:`gcs_sysid.gp.sparse._selectors` (``psi_p(x) = S_p u(x)``), in NumPy
     (no per-operation compilation): ``A[p, q] I_M`` in row block ``q`` of the inducing part, and
-    ``prior_std I_(D+1)`` in output ``p``'s rows of the linear-mean part."""
+    ``diag(prior std of output p's weights)`` in output ``p``'s rows of the linear-mean part."""
     A = np.asarray(model.params.A)
     P, M, D1 = A.shape[0], int(model.params.Z.shape[0]), int(model.params.Z.shape[1]) + 1
     S = np.zeros((P * M + P * D1, M + D1))
@@ -56,7 +56,7 @@ def _selector_block(model, p: int) -> np.ndarray:
     for q in range(P):
         S[q * M:(q + 1) * M, :M] = A[p, q] * eyeM
     r0 = P * M + p * D1
-    S[r0:r0 + D1, M:] = float(model.params.prior_std) * np.eye(D1)
+    S[r0:r0 + D1, M:] = np.diag(np.broadcast_to(np.asarray(model.params.prior_std, float), (P, D1))[p])
     return S
 
 

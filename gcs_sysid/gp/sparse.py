@@ -63,7 +63,7 @@ from jax.scipy.linalg import cho_solve, solve_triangular
 from .kernels import ARDSquaredExponential
 
 __all__ = ["GlobalParams", "Stats", "GlobalPosterior", "stats_of", "add_stats", "elbo", "logdet_quad", "posterior",
-           "mean_global_chunk", "predict_global_chunk", "design", "features"]
+           "mean_global_chunk", "predict_global_chunk", "design", "features", "prior_scales"]
 
 _LOG2PI = math.log(2.0 * math.pi)
 
@@ -78,7 +78,9 @@ class GlobalParams:
         A: ``(P, P)`` lower Cholesky factor of the coregionalisation matrix ``B``.
         noise: ``(P,)`` noise variances ``sigma_p^2``.
         Z: ``(M, D)`` inducing inputs.
-        prior_std: scalar ``sqrt(v)``, prior std of the linear-mean weights.
+        prior_std: prior std of the linear-mean weights: a scalar ``sqrt(v)`` (every output, every
+            term), or ``(P, D+1)`` per output and term (0: the term is not in that output's mean;
+            ``GPConfig.linear_terms``). :func:`prior_scales` broadcasts either form.
         jitter: scalar added to the diagonal of ``Kmm``.
         noise_chol: ``(P, P)`` lower Cholesky factor ``R`` of the noise *correlation* matrix
             (rows of unit norm): the noise covariance is ``Sigma = D^1/2 R R^T D^1/2`` with
@@ -208,6 +210,13 @@ def design(Xs: jax.Array) -> jax.Array:
     return jnp.concatenate([jnp.ones((Xs.shape[0], 1), Xs.dtype), Xs], axis=1)
 
 
+def prior_scales(params: GlobalParams) -> jax.Array:
+    """Prior std of every linear-mean weight, ``(P, D+1)`` (``GlobalParams.prior_std`` broadcast: a
+    scalar for models fitted before per-output terms, or already per output and term)."""
+    P, D1 = params.A.shape[0], params.Z.shape[1] + 1
+    return jnp.broadcast_to(jnp.asarray(params.prior_std, params.A.dtype), (P, D1))
+
+
 def _chol_kmm_all(params: GlobalParams) -> jax.Array:
     """Cholesky factors ``(J, M, M)`` of ``k_j(Z, Z) + jitter I``, one per latent kernel."""
     Z = params.Z
@@ -271,7 +280,7 @@ def _assemble_per_output(params: GlobalParams, st: Stats) -> tuple[jax.Array, ja
     ``Lambda``'s blocks are sums over outputs: ``ww = sum_p w_p (a_p a_p^T) kron C_p``,
     ``wo[(j,r,m),(q,i)] = sqrt(v) w_q A_j[q, r] E_q[(j,m), i]``, ``oo = v blockdiag_p(w_p F_p)``.
     """
-    sv = params.prior_std
+    sv = prior_scales(params).reshape(-1)               # (P D1,): rows/columns (p, i) of the linear part
     w = 1.0 / params.noise                               # (P,)
     F = params.factors                                   # (J, P, R)
     J, P, R = F.shape
@@ -279,8 +288,8 @@ def _assemble_per_output(params: GlobalParams, st: Stats) -> tuple[jax.Array, ja
     D1 = st.F.shape[1]
     C5 = st.C.reshape(P, J, M, J, M)
     ww = jnp.einsum("p,jpr,kps,pjmkn->jrmksn", w, F, F, C5).reshape(J * R * M, J * R * M)
-    wo = sv * jnp.einsum("q,jqr,qjmi->jrmqi", w, F, st.E.reshape(P, J, M, D1)).reshape(J * R * M, P * D1)
-    oo = sv * sv * jnp.einsum("pq,pik->piqk", jnp.diag(w), st.F).reshape(P * D1, P * D1)
+    wo = sv[None, :] * jnp.einsum("q,jqr,qjmi->jrmqi", w, F, st.E.reshape(P, J, M, D1)).reshape(J * R * M, P * D1)
+    oo = sv[:, None] * jnp.einsum("pq,pik->piqk", jnp.diag(w), st.F).reshape(P * D1, P * D1) * sv[None, :]
     lam = jnp.block([[ww, wo], [wo.T, oo]])
     lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
     RN = (st.Rphi * w[None, :]).reshape(J, M, P)
@@ -299,7 +308,7 @@ def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tu
     """
     if st.per_output:
         return _assemble_per_output(params, st)
-    sv = params.prior_std
+    sv = prior_scales(params).reshape(-1)               # (P D1,): rows/columns (p, i) of the linear part
     if N is None:
         N = params.noise_precision()[0]
     F = params.factors                                   # (J, P, R): latent q = (j, r) uses phi_j
@@ -309,17 +318,17 @@ def _assemble(params: GlobalParams, st: Stats, N: jax.Array | None = None) -> tu
     AN = jnp.einsum("jpr,pq->jrq", F, N)                 # (J, R, P)
     if J == 1:                                           # the ICM: Kronecker products
         ww = jnp.kron(G[0, :, 0, :], st.C)
-        wo = sv * jnp.kron(AN[0], st.E)                  # rows (q, m), cols (p, i)
+        wo = jnp.kron(AN[0], st.E) * sv[None, :]         # rows (q, m), cols (p, i)
     else:
         C4 = st.C.reshape(J, M, J, M)
         ww = jnp.einsum("jrks,jmkn->jrmksn", G, C4).reshape(J * R * M, J * R * M)
-        wo = sv * jnp.einsum("jrq,jmx->jrmqx", AN, st.E.reshape(J, M, -1)).reshape(J * R * M, -1)
-    oo = sv * sv * jnp.kron(N, st.F)
+        wo = jnp.einsum("jrq,jmx->jrmqx", AN, st.E.reshape(J, M, -1)).reshape(J * R * M, -1) * sv[None, :]
+    oo = sv[:, None] * jnp.kron(N, st.F) * sv[None, :]
     lam = jnp.block([[ww, wo], [wo.T, oo]])
     lam = lam + jnp.eye(lam.shape[0], dtype=lam.dtype)
     RN = (st.Rphi @ N).reshape(J, M, P)                  # sum_n phi_j,n (N y_n)^T
     bw = jnp.einsum("jmp,jpr->jrm", RN, F).reshape(-1)   # b_{(j,r),m} = sum_p A_j,pr (Rphi_j N)_mp
-    bo = sv * (st.Rx @ N).T.reshape(-1)                  # b_{p,i} = sqrt(v) (Rx N)_ip
+    bo = sv * (st.Rx @ N).T.reshape(-1)                  # b_{p,i} = sqrt(v_pi) (Rx N)_ip
     return lam, jnp.concatenate([bw, bo])
 
 
@@ -403,6 +412,7 @@ def _selectors(params: GlobalParams, M: int) -> jax.Array:
     J, P, R = F.shape
     D1 = params.Z.shape[1] + 1
     dt = F.dtype
+    sv = prior_scales(params).reshape(-1)               # (P D1,)
     eyeM, eyeD, eyeJ = jnp.eye(M, dtype=dt), jnp.eye(D1, dtype=dt), jnp.eye(J, dtype=dt)
 
     def one(p):
@@ -411,7 +421,7 @@ def _selectors(params: GlobalParams, M: int) -> jax.Array:
             top = jnp.kron(F[0, p][:, None], eyeM)                           # (P*M, M), the ICM's
         else:
             top = jnp.einsum("jr,jk,mn->jrmkn", F[:, p, :], eyeJ, eyeM).reshape(J * R * M, J * M)
-        bot = params.prior_std * jnp.kron(jax.nn.one_hot(p, P, dtype=dt)[:, None], eyeD)
+        bot = jnp.kron(jax.nn.one_hot(p, P, dtype=dt)[:, None], eyeD) * sv[:, None]
         return jnp.block([[top, jnp.zeros((J * R * M, D1), dt)], [jnp.zeros((P * D1, J * M), dt), bot]])
 
     return jax.vmap(one)(jnp.arange(P))

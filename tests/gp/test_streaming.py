@@ -5,6 +5,7 @@ from dataclasses import replace
 
 import jax
 import numpy as np
+from scipy.linalg import block_diag
 
 from gp_data import FAST, envelope_expansion_case, error_pct, flight_regressors, nonlinear_truth
 from gcs_sysid.gp import fit_gp, load_gp
@@ -22,7 +23,8 @@ def dense_vfe_predict(params, Xs, Ys, Xq):
     the Nystrom covariance ``Q = K_xz K_zz^{-1} K_zx`` on the training rows (ICM ``B kron Q`` plus the
     linear mean's ``v Xa Xa^T`` plus noise), and the prior rest ``B_pp (k - Q)`` added at the query."""
     p = jax.tree_util.tree_map(np.asarray, params)
-    ls, Z, B, v = p.lengthscale, p.Z, p.A @ p.A.T, float(p.prior_std) ** 2
+    ls, Z, B = p.lengthscale, p.Z, p.A @ p.A.T
+    S2 = np.broadcast_to(np.asarray(p.prior_std, float), (B.shape[0], Z.shape[1] + 1)) ** 2   # per output and term
     Kzz = se_kernel(Z, Z, ls) + float(p.jitter) * np.eye(len(Z))
 
     def Q(X1, X2):
@@ -31,12 +33,15 @@ def dense_vfe_predict(params, Xs, Ys, Xq):
     def xa(X):
         return np.column_stack([np.ones(len(X)), X])
 
+    def lin(X1, X2):                      # blockdiag_p(Xa V_p Xa^T), V_p = diag(prior std of output p)^2
+        return block_diag(*[(xa(X1) * S2[q]) @ xa(X2).T for q in range(len(S2))])
+
     N, P = len(Xs), B.shape[0]
-    K = np.kron(B, Q(Xs, Xs)) + v * np.kron(np.eye(P), xa(Xs) @ xa(Xs).T) + np.kron(np.asarray(params.noise_cov()), np.eye(N))   # Sigma kron I (full noise)
-    Kq = np.kron(B, Q(Xq, Xs)) + v * np.kron(np.eye(P), xa(Xq) @ xa(Xs).T)
+    K = np.kron(B, Q(Xs, Xs)) + lin(Xs, Xs) + np.kron(np.asarray(params.noise_cov()), np.eye(N))   # Sigma kron I (full noise)
+    Kq = np.kron(B, Q(Xq, Xs)) + lin(Xq, Xs)
     mean = (Kq @ np.linalg.solve(K, Ys.T.reshape(-1))).reshape(P, -1).T
     qq = np.sum(se_kernel(Xq, Z, ls) * np.linalg.solve(Kzz, se_kernel(Z, Xq, ls)).T, 1)
-    prior_q = np.kron(np.diag(B), qq) + v * np.tile(np.sum(xa(Xq) ** 2, 1), P)
+    prior_q = np.kron(np.diag(B), qq) + ((xa(Xq) ** 2) @ S2.T).T.reshape(-1)
     var = prior_q - np.sum(Kq * np.linalg.solve(K, Kq.T).T, 1)
     var = var.reshape(P, -1).T + np.diag(B)[None, :] * (1.0 - qq)[:, None]
     return mean, var
