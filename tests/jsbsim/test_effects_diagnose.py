@@ -126,7 +126,15 @@ def test_summary_table_counts_each_score(tmp_path):
     p.write_text("\n".join(json.dumps(r) for r in recs) + "\n")
     lines = summarize([str(p)]).splitlines()
     row = next(ln for ln in lines if "| Cn:delta_a |" in ln)
-    assert "| 2 | 1/2 | 1/2 | 1/2 | 1/2 | 1/1 |" in row and "[CX:alpha]" in row
+    # records scored before the aliases (no ``*_alias`` keys) leave the with-aliases column empty
+    assert "| 2 | 1/2 | 1/2 | 1/2 | 1/2 | | 1/1 |" in row and "[CX:alpha]" in row
+    # scored with aliases (i9-alias): the column counts top, estimate, gain and all three
+    hit.update(top_alias=True, est_alias=True, gain_alias=True)
+    miss.update(top_alias=False, est_alias=False, gain_alias=False)
+    recs[0]["score"]["ok_alias"], recs[1]["score"]["ok_alias"] = True, False
+    p.write_text("\n".join(json.dumps(r) for r in recs) + "\n")
+    row = next(ln for ln in summarize([str(p)]).splitlines() if "| Cn:delta_a |" in ln)
+    assert "| 2 | 1/2 | 1/2 | 1/2 | 1/2 | 1/2, 1/2, 1/2, 1/2 | 1/1 |" in row
     clean = next(ln for ln in lines if "| clean |" in ln)
     assert "no named cause 0/1" in clean and "CX:alpha" in clean
 
