@@ -247,10 +247,49 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
         amplitude_deg=(4.0, 8.0, 5.0), pulse_s=(0.7, 0.8, 1.0), gains=(0.8, 0.8, 0.004, 1.0, 0.4, 0.0), gear_up=True,
         notes="Boeing 747 (JSBSim B747), engines shut down, gear up, gliding; untouched by any tuning of the method"),
+    # f16: JSBSim's stock F-16A (f16.xml, Erik Hofman 2001, tables from Nguyen et al., NASA TP-1538,
+    # 1979), flown as a derived model, ``f16_direct`` (benchmarks/jsbsim_harness/derived.py): the
+    # only aircraft whose flight control was replaced. Its fly-by-wire (roll-rate and g-command PID
+    # laws, alpha limiter, yaw PID, leading-edge flaps switched on alpha, flaperons) is replaced by a
+    # direct map of the commands to the surfaces the aerodynamics read: elevator +-0.436 rad
+    # (``fcs/elevator-pos-rad``, the tables' horizontal-tail deflection), aileron +-0.375 rad
+    # (``fcs/aileron-pos-rad``, the only aileron property the aerodynamics read), rudder +-0.524 rad;
+    # leading-edge flap and flaperon-mix fixed at 0 (the log has no flap channel); aerodynamics,
+    # mass, inertia and propulsion are the wheel's. Chosen in the eleventh session after the stock
+    # fixed-wing list was used up (docs/jsbsim.md, "The f16"): relaxing the rule "no FCS law between
+    # the commands and the surfaces" once. Signs read from its aerodynamics: CmDh decreases with
+    # elevator-pos (positive = trailing edge down), Clda +0.05 x aileron-pos (positive = right roll,
+    # left trailing edge down: delta_a = -aileron-pos), Cndr -0.045 x rudder-pos (positive = trailing
+    # edge left, nose left). Static stability about the CG, in JSBSim (fixed surfaces, run_ic, 260 kt):
+    # Cm_alpha -0.026 per rad between alpha 0 and 4 deg and -0.079 between 4 and 8 (the pilot and
+    # 3000 lb of wing fuel put the CG 2.4 in ahead of the reference point): relaxed, but stable.
+    # Gear up (CDgear 0.027 vanishes). Engine off ("direct" thruster: no force once stopped).
+    # 212 kt (ic/vc-kts) at 15000 ft: 168 m/s TAS, Mach 0.52; the sweep flies 124-190 m/s, Mach
+    # 0.38-0.57, under the Mach tables' first breakpoint (0.6, where Cma_M, Clb_M, Cnb_M, Clda_M
+    # start), alpha -4..10 deg (the tables' rows every 5 deg from -10). It sinks 19-22 m/s (a
+    # lift-to-drag ratio of about 7-8), so it starts at 15000 ft. Gains: k_q 0.6 (the pitch damping
+    # of a relaxed-stability airframe; with 0.3 `Cm:alpha^2` = -8 pitched it down past -26 deg of
+    # alpha with the elevator on its stop), k_v 0.003 (the default 0.01 turned the sweep's 60-m/s
+    # speed steps into 0.5-0.8 rad of pitch reference: the first trial dived to -84 deg). Amplitudes:
+    # elevator 4 deg (pitch-rate standard deviation 2.7 deg/s in the standard plan, light; 3 deg gave
+    # 2.0 and 1.04 deg of elevator standard deviation; with k_q 0.3, 4 deg gave 5.1 deg/s and alpha
+    # -5..10 in the sweep), aileron 5 deg (roll rate 6.5 deg/s: Clda 0.05 against Ixx 9496 slug
+    # ft^2), rudder 6 deg (yaw rate 1.7 deg/s, sideslip under 3.5 deg: Cndr -0.045 against Cnb 0.21).
+    # Set from the harness's truth only (alpha, beta, rates, excitation per axis), never from a
+    # method result. The notes carry the derived XML's SHA-256 (16 hex digits), so that the
+    # derivation is part of this aircraft's fingerprint.
+    "f16": AircraftSpec(
+        name="f16", model="f16_direct", airspeed_kts=212.0, altitude_ft=15000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.436, 1.0 / 0.375, 1.0 / 0.524),
+        amplitude_deg=(4.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0), gains=(1.0, 0.6, 0.003, 0.4, 0.1, 0.4), gear_up=True,
+        notes="General Dynamics F-16A (JSBSim f16) with its fly-by-wire replaced by direct surfaces, flaps fixed "
+              "(derived model f16_direct, XML sha256 c58370508ab7d631), engine shut down, gear up, gliding; "
+              "untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6")
-HELD_OUT_AIRCRAFT = ("b747",)
-UNTOUCHED_AIRCRAFT = ("b747",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747")
+HELD_OUT_AIRCRAFT = ("f16",)
+UNTOUCHED_AIRCRAFT = ("f16",)
 
 
 def aircraft(name: str) -> AircraftSpec:

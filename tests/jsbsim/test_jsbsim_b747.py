@@ -1,17 +1,17 @@
-"""The b747 in the JSBSim harness: the untouched aircraft of issues 8 and 9 (docs/jsbsim.md, "The b747").
+"""The b747 in the JSBSim harness: the tenth session's untouched aircraft (docs/jsbsim.md, "The b747"),
+evaluated in its final evaluation and used since (the eleventh session's untouched aircraft is the f16,
+``test_jsbsim_f16.py``, which also checks the summaries' labels). Its checks below are slow tests now,
+but for the names' test.
 
 Only the harness is checked here, on JSBSim's exact truth and its own properties: the rigid-body
 consistency of the truth with the checked-in airframe file (the model's product of inertia Ixz
 included), the sign map against the model's XML constants, the gear retracted by the harness, the
 model's own yaw damper standing in for the harness's, the .tlog as the pipeline decodes it, every
 hidden effect as JSBSim computes it (the injected moments reach JSBSim's total aerodynamic moments),
-the summaries' label, and (slow) the airspeed bias in the log and that the evaluation's flights stay
+and (slow) the airspeed bias in the log and that the evaluation's flights stay
 in the envelope with every axis excited. No pipeline fit, GP, diagnosis or scoring is run on the
-b747 here: its first evaluation is the final one, after the merge. One 30-s flight serves every
-fast test.
+b747 here (it was set up before its final evaluation). One 30-s flight serves the module's tests.
 """
-
-import json
 
 import pytest
 
@@ -28,14 +28,14 @@ b747_flight = short_flight_fixture("b747")      # fixture "b747": 30 s, light, s
 SLUG_FT2 = 1.3558179483314004     # kg m^2 per slug ft^2
 
 
-def test_names_resolve_and_only_the_b747_is_untouched():
-    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT
+def test_names_resolve_and_the_b747_is_used():
+    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, summary_label
 
     assert_names_resolve("b747", "B747", "b74")
-    assert UNTOUCHED_AIRCRAFT == HELD_OUT_AIRCRAFT == ("b747",)
-    assert {"pa28", "j3cub", "c182", "t37", "t6"} <= set(TUNING_AIRCRAFT) and "b747" not in TUNING_AIRCRAFT
+    assert "b747" in TUNING_AIRCRAFT and "b747" not in HELD_OUT_AIRCRAFT and summary_label("b747") == "b747"
 
 
+@pytest.mark.slow
 def test_truth_is_rigid_body_consistent_with_the_airframe_file(b747):
     """JSBSim's aero moments equal J w_dot + w x J w with the checked-in airframe's J, its Ixz
     included; in the glide every non-gravity force and moment is aerodynamic (four turbofans on
@@ -50,6 +50,7 @@ def test_truth_is_rigid_body_consistent_with_the_airframe_file(b747):
         const["Ixz"], rel=1e-5)
 
 
+@pytest.mark.slow
 def test_sign_map_gives_the_project_conventions(b747):
     """Least squares on the exact truth (Mach 0.53-0.54): Cm_delta_e, Cl_delta_a, Cn_delta_r,
     Cm_alpha, Cl_p < 0, Cn_beta > 0, and the derivatives at the model's constants (B747.xml: Cmde
@@ -67,6 +68,7 @@ def test_sign_map_gives_the_project_conventions(b747):
     assert abs(cn[3]) < 1e-3, cn
 
 
+@pytest.mark.slow
 def test_the_harness_flies_the_b747_with_its_gear_up_and_its_own_yaw_damper():
     """``gear_up``: the retractable gear is up before the log starts (the 15-s settling phase), so
     its drag (CDgear 0.011) is zero. The model's FCS adds 2 x ``velocities/r-aero-rad_sec`` to the
@@ -89,6 +91,7 @@ def test_the_harness_flies_the_b747_with_its_gear_up_and_its_own_yaw_damper():
     assert fdm["fcs/rudder-pos-rad"] > 0.03
 
 
+@pytest.mark.slow
 def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(b747):
     """The pipeline's decoder reads the b747's .tlog; its SERVO_OUTPUT_RAW, through the checked-in
     airframe file, gives JSBSim's deflections within PWM quantisation (the 20.05-deg ends make 0.05
@@ -96,6 +99,7 @@ def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(b747):
     assert_servos_map_back(b747)
 
 
+@pytest.mark.slow
 def test_every_hidden_effect_shows_in_jsbsims_own_forces_and_moments():
     """On the b747's XML (LIFT/DRAG/SIDE and ROLL/PITCH/YAW axes, one aileron property in the
     aerodynamics) every effect does what ``effects.py`` specifies, in JSBSim's own properties at
@@ -115,34 +119,6 @@ def test_airspeed_bias_reaches_the_logged_airspeed(b747, tmp_path):
     assert_airspeed_bias_in_log(b747, tmp_path)
 
 
-def test_summaries_mark_the_b747_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label b747 "(untouched)" and
-    no other aircraft, the t6 included (synthetic rows: no b747 result exists before the final
-    evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| b747 (untouched) | light") for ln in lines)
-    for ac in acs[:6]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| b747 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| t6 | clean |") for ln in lines)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("seed,turbulence,plan,effects", ENVELOPE_FLIGHTS)    # with the evaluation's pair
 def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_path, seed, turbulence, plan, effects):
@@ -160,8 +136,8 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
 @pytest.mark.slow
 def test_eval_scripts_fly_the_b747_without_scoring_it(tmp_path, capsys, monkeypatch):
     """``--aircraft B747`` resolves to ``b747`` in both scripts; with ``--fly-only`` they fly into
-    ``--work`` / ``--out``, say that the b747 is the untouched aircraft, reuse the flights on a
-    second run and score nothing."""
+    ``--work`` / ``--out``, reuse the flights on a second run and score nothing (the b747 is used
+    now: no untouched-aircraft note)."""
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
 
     monkeypatch.setattr(eval_jsbsim_diagnose, "DURATION_S", 2.0)
@@ -173,6 +149,6 @@ def test_eval_scripts_fly_the_b747_without_scoring_it(tmp_path, capsys, monkeypa
         assert main(argv) == 0 and main(argv) == 0
         cap = capsys.readouterr()
         assert [ln.split()[column] for ln in cap.out.splitlines()] == ["flown"] * n + ["reused"] * n, cap.out
-        assert "b747 is the untouched aircraft" in cap.err
+        assert "b747 is the untouched aircraft" not in cap.err
     assert read_log(tmp_path / "f" / "b747-light-s1-ahrs.tlog").streams["servo"].t.size > 50
     assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()

@@ -1,0 +1,199 @@
+"""Derived JSBSim models: a stock model of the installed ``jsbsim`` wheel with its flight-control
+system replaced by a direct mapping from the harness's commands to the surfaces.
+
+The harness flies stock models whose surfaces follow the normalised commands
+(``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
+fly-by-wire system between them: a roll-rate PID law, a g-command PID law with an alpha limiter,
+a yaw PID on yaw rate and lateral load, leading-edge flaps switched on alpha, trailing-edge flaps
+on airspeed and flaperons. This module writes a variant, ``f16_direct``, whose aerodynamics,
+metrics, mass and inertia, ground reactions, propulsion and systems are the wheel's, with:
+
+* ``<flight_control>`` replaced: ``fcs/elevator-pos-rad`` = 0.436 x ``fcs/elevator-cmd-norm``,
+  ``fcs/aileron-pos-rad`` = 0.375 x ``fcs/aileron-cmd-norm`` (the property the aerodynamics read;
+  ``fcs/left-aileron-pos-rad`` and ``fcs/right-aileron-pos-rad`` are written as +- that, for
+  display), ``fcs/rudder-pos-rad`` = 0.524 x ``fcs/rudder-cmd-norm`` (the stock surface ranges,
+  ``aerosurface_scale``, no actuator dynamics: the harness's servos are the actuators);
+  ``fcs/lef-pos-rad``, ``fcs/flaperon-mix-rad`` (the stock model drives it from the ailerons, so
+  its CLDflaps / CDDflaps terms made lift and drag follow the aileron) fixed at 0 (the speed
+  brake, no longer commanded by an FCS channel, stays at JSBSim's 0), because the harness's log carries no flap channel; the stock ``Landing Gear`` and
+  ``Throttle`` channels kept as they are (they drive no surface).
+* one identity function added to ``<aerodynamics>``: ``aero/function/elevator-pos-rad`` =
+  ``fcs/elevator-pos-rad``, and the tables that looked the elevator up as an ``independentVar``
+  (CDdHT, CLDh, CmDh) look it up there. The numbers are unchanged (a test checks JSBSim's
+  forces and moments against the stock tables read with the elevator directly); the alias gives
+  the aerodynamics one ``<property>`` read of the elevator, which ``effects.py``'s
+  ``delay:delta_e`` redirects.
+
+The derived folder is generated from the installed wheel (LGPL-2.1; nothing of JSBSim is copied
+into this repository) into the wheel's own ``aircraft/`` folder, beside the stock models, because
+the harness's loader (``flight.load_model``) loads models from there by name and must not change
+(its code is part of every aircraft's harness fingerprint, ``logfile.harness_fingerprint``).
+:func:`install_derived_models` runs when ``benchmarks.jsbsim_harness`` is imported; it rewrites the
+folder only when its XML differs from the derivation. The derived XML's SHA-256 (first 16 hex
+digits) is written in the aircraft's ``AircraftSpec.notes``, so it is part of that aircraft's
+fingerprint; a test checks that it matches.
+
+References:
+    JSBSim Reference Manual, "Flight control and systems" (aerosurface_scale, switch) and
+    "Aerodynamics" (functions evaluated before the axes). Nguyen et al., NASA TP-1538 (1979),
+    the F-16 wind-tunnel data the model's tables come from.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import os
+import shutil
+import tempfile
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+__all__ = ["DERIVED", "derive_f16_direct", "derived_xml", "derived_sha", "install_derived_models",
+           "ELEVATOR_ALIAS"]
+
+#: The elevator alias the derived F-16's tables read (see the module docstring).
+ELEVATOR_ALIAS = "aero/function/elevator-pos-rad"
+
+
+def _wheel_root() -> Path:
+    import jsbsim
+
+    return Path(jsbsim.get_default_root_dir())
+
+
+def _el(parent: ET.Element, tag: str, text: str | None = None, **attrib) -> ET.Element:
+    e = ET.SubElement(parent, tag, attrib)
+    if text is not None:
+        e.text = text
+    return e
+
+
+def _scale(channel: ET.Element, name: str, cmd: str, half_range: float, out: str) -> None:
+    c = _el(channel, "aerosurface_scale", name=name)
+    _el(c, "input", cmd)
+    r = _el(c, "range")
+    _el(r, "min", repr(-half_range))
+    _el(r, "max", repr(half_range))
+    _el(c, "output", out)
+
+
+def derive_f16_direct(root: ET.Element) -> ET.Element:
+    """The F-16's XML ``root`` with its FCS replaced by the direct mapping (module docstring).
+
+    Args:
+        root: the parsed stock ``f16.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the stock XML lacks the elements the derivation expects (another jsbsim
+            version): the ``flight_control``, its ``Landing Gear`` or ``Throttle`` channel, the
+            aerodynamics, or a table reading ``fcs/elevator-pos-rad``.
+    """
+    root = copy.deepcopy(root)
+    fc = root.find("flight_control")
+    if fc is None:
+        raise ValueError("f16.xml: no <flight_control>")
+    keep = {ch.get("name"): ch for ch in fc.findall("channel") if ch.get("name") in ("Landing Gear", "Throttle")}
+    if set(keep) != {"Landing Gear", "Throttle"}:
+        raise ValueError("f16.xml: the <flight_control> lacks its 'Landing Gear' or 'Throttle' channel")
+    new = ET.Element("flight_control", name="F-16 direct surfaces (gcs-sysid harness, benchmarks/jsbsim_harness/derived.py)")
+    pitch = _el(new, "channel", name="Pitch")
+    _scale(pitch, "fcs/elevator-control", "fcs/elevator-cmd-norm", 0.436, "fcs/elevator-pos-rad")
+    roll = _el(new, "channel", name="Roll")
+    _scale(roll, "fcs/aileron-control", "fcs/aileron-cmd-norm", 0.375, "fcs/aileron-pos-rad")
+    _scale(roll, "fcs/left-aileron-control", "fcs/aileron-cmd-norm", 0.375, "fcs/left-aileron-pos-rad")
+    _scale(roll, "fcs/right-aileron-control", "-fcs/aileron-cmd-norm", 0.375, "fcs/right-aileron-pos-rad")
+    yaw = _el(new, "channel", name="Yaw")
+    _scale(yaw, "fcs/rudder-control", "fcs/rudder-cmd-norm", 0.524, "fcs/rudder-pos-rad")
+    fixed = _el(new, "channel", name="Fixed flaps")
+    for name in ("fcs/lef-pos-rad", "fcs/flaperon-mix-rad"):
+        _el(_el(fixed, "switch", name=name), "default", value="0.0")
+    new.append(keep["Landing Gear"])
+    new.append(keep["Throttle"])
+    index = list(root).index(fc)
+    root.remove(fc)
+    root.insert(index, new)
+
+    aero = root.find("aerodynamics")
+    if aero is None:
+        raise ValueError("f16.xml: no <aerodynamics>")
+    n = 0
+    for iv in aero.iter("independentVar"):
+        if iv.text and iv.text.strip() == "fcs/elevator-pos-rad":
+            iv.text = ELEVATOR_ALIAS
+            n += 1
+    if n == 0:
+        raise ValueError("f16.xml: no aerodynamic table looks up fcs/elevator-pos-rad")
+    alias = ET.Element("function", name=ELEVATOR_ALIAS)
+    _el(alias, "description", "elevator position the tables read (identity; added by the harness's derivation)")
+    _el(alias, "property", "fcs/elevator-pos-rad")
+    aero.insert(0, alias)
+    return root
+
+
+#: Derived model name -> (stock model it comes from, derivation).
+DERIVED = {"f16_direct": ("f16", derive_f16_direct)}
+
+
+def derived_xml(name: str, stock_dir: Path | None = None) -> bytes:
+    """The derived model ``name``'s XML as bytes, from the installed wheel's stock model.
+
+    Raises:
+        KeyError: ``name`` is not in :data:`DERIVED`.
+        ValueError: the stock XML does not take the derivation.
+    """
+    stock, derive = DERIVED[name]
+    src = (stock_dir or _wheel_root() / "aircraft" / stock) / f"{stock}.xml"
+    root = derive(ET.parse(src).getroot())
+    ET.indent(root, space=" ")
+    header = (f"<?xml version=\"1.0\"?>\n<!-- Derived from the jsbsim wheel's aircraft/{stock}/{stock}.xml (LGPL-2.1) by "
+              f"gcs-sysid's benchmarks/jsbsim_harness/derived.py: flight control replaced by a direct mapping of the "
+              f"commands to the surfaces, flaps fixed at 0; aerodynamics, mass and propulsion unchanged. -->\n")
+    return header.encode() + ET.tostring(root, encoding="unicode").encode() + b"\n"
+
+
+def derived_sha(name: str) -> str:
+    """First 16 hex digits of the SHA-256 of :func:`derived_xml` (recorded in the spec's notes)."""
+    return hashlib.sha256(derived_xml(name)).hexdigest()[:16]
+
+
+def install_derived_models(aircraft_dir: Path | None = None) -> list[Path]:
+    """Write every model of :data:`DERIVED` into the wheel's ``aircraft/`` folder (or ``aircraft_dir``)
+    where it is missing or differs; returns the folders written.
+
+    Each is the stock folder copied (its ``Systems/`` included) with the XML replaced by
+    :func:`derived_xml` as ``<name>/<name>.xml``; written in a temporary folder beside it and
+    renamed into place, so that a concurrent reader sees the old folder or the new one.
+
+    A folder that cannot be written (a read-only installation) gives a ``UserWarning`` naming it;
+    flying that model then fails in JSBSim's loader.
+    """
+    base = Path(aircraft_dir) if aircraft_dir else _wheel_root() / "aircraft"
+    written = []
+    for name, (stock, _) in DERIVED.items():
+        try:
+            want = derived_xml(name, base / stock)
+            dest = base / name
+            if (dest / f"{name}.xml").is_file() and (dest / f"{name}.xml").read_bytes() == want:
+                continue
+            tmp = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=base))
+            shutil.copytree(base / stock, tmp / name)
+            (tmp / name / f"{stock}.xml").unlink()
+            (tmp / name / f"{name}.xml").write_bytes(want)
+            old = None
+            if dest.exists():
+                old = base / f".{name}-old-{os.getpid()}"
+                dest.rename(old)
+            (tmp / name).rename(dest)
+            shutil.rmtree(tmp, ignore_errors=True)
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+            written.append(dest)
+        except OSError as e:
+            warnings.warn(f"could not write the derived JSBSim model '{name}' into {base}: {e}; "
+                          f"the harness cannot fly it from this installation", stacklevel=2)
+    return written
