@@ -75,9 +75,9 @@ Usage::
     python benchmarks/eval_gp_jsbsim.py --variants diag full nigp indep ls --json /tmp/gp.jsonl
     python benchmarks/eval_gp_jsbsim.py --summarize /tmp/gp.jsonl
 
-``pa28``, ``j3cub`` (``J3Cub``), ``c182``, ``t37`` and ``t6`` (``t6texan2``) were held out in earlier
-sessions and have been evaluated: they count as used. ``b747`` (``--aircraft b747`` or ``B747``) is the
-held-out, untouched one: never in the defaults, made and scored only in the final evaluation.
+``pa28``, ``j3cub`` (``J3Cub``), ``c182``, ``t37``, ``t6`` (``t6texan2``) and ``b747`` (``B747``) were held
+out in earlier sessions and have been evaluated: they count as used. ``f16`` (``--aircraft f16`` or
+``f16_direct``) is the held-out, untouched one: never in the defaults, made and scored only in the final evaluation.
 """
 
 from __future__ import annotations
@@ -505,8 +505,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
     ap.add_argument("--make", action="store_true", help="fly, replay and cache the flights first")
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"], type=aircraft_argument,
-                    help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747) or JSBSim model names (J3Cub, T37, t6texan2, "
-                         "B747); b747 is the untouched aircraft; default %(default)s")
+                    help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16) or JSBSim model names (J3Cub, T37, "
+                         "t6texan2, B747, f16_direct); f16 is the untouched aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
     ap.add_argument("--aoa", nargs="+", default=["ahrs"], choices=("ahrs", "vane"))

@@ -125,7 +125,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # scale is the mean of each surface's two ends (as the pa28's aileron). Signs read from its
     # aerodynamics: CmDe -0.622 * elevator-pos (positive = trailing edge down), ClDa +0.15 *
     # left-aileron-pos (positive = left trailing edge down, roll right), CnDr -0.0645 * rudder-pos
-    # (positive = trailing edge left, nose left); checked on the truth by tests/jsbsim/test_jsbsim_c182.py.
+    # (positive = trailing edge left, nose left); checked on the truth by tests/jsbsim/test_jsbsim_roster.py.
     # 80 kt CAS as the c172x and pa28 (the same initial condition: 49 m/s TAS at 6000 ft); the
     # sweep's slowest level, 36.5 m/s TAS, is 1.3 times the model's power-off stall (about 49 kt EAS:
     # 2100 lb once the harness empties the pilot's off-centre point mass, CL_max 1.47 from its
@@ -153,7 +153,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # ends (as the c182's). Signs read from its aerodynamics: Cmde -1.12 (Mach 0) * elevator-pos
     # (positive = trailing edge down), Clda +0.181 (Mach 0) * left-aileron-pos (positive = left trailing edge
     # down, roll right), Cndr -0.0365 * rudder-pos (positive = trailing edge left, nose left);
-    # checked on the truth by tests/jsbsim/test_jsbsim_t37.py (used since the eighth session's final evaluation). Gear up (retractable; its gear-down
+    # checked on the truth by tests/jsbsim/test_jsbsim_roster.py (used since the eighth session's final evaluation). Gear up (retractable; its gear-down
     # terms, CDgear, DCYbdf, DClrDg and the |beta| term DCnbDg, vanish with it). Engines off: the
     # "direct" thrusters give no force. 130 kt CAS at 10000 ft: the sweep's slowest level, 97.5 kt,
     # is 1.28 times the model's power-off stall (about 76 kt EAS: 4756 lb, CL_max 1.34 at 0.26 rad
@@ -185,7 +185,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # read from its aerodynamics: CmDe -1.2 x elevator-pos (positive = trailing edge down), Clda
     # +0.29 x left-aileron-pos (positive = left trailing edge down, roll right), Cndr -0.06 x
     # rudder-pos (positive = trailing edge left, nose left); checked on the truth by
-    # tests/jsbsim/test_jsbsim_t6.py. Gear up (retractable; CDgear 0.03 vanishes with it). 160 kt
+    # tests/jsbsim/test_jsbsim_roster.py. Gear up (retractable; CDgear 0.03 vanishes with it). 160 kt
     # (ic/vc-kts) at 10000 ft: about 190 kt EAS, 2.3 x the model's power-off stall (83 kt EAS: 6000
     # lb, CL_max 1.47 at 0.28 rad), as the t37's 2.35: the sweep's slowest level flies 133 kt EAS
     # (1.6 x) and alpha stays under 4 deg, so Cl:alpha*beta = 3 (which reverses the stock Cl_beta
@@ -224,7 +224,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # read from its aerodynamics: Cmde -1.3 + 0.4875 Mach x elevator-pos (positive = trailing edge
     # down), Clda +0.1 - 0.0335 Mach x left-aileron-pos (positive = left trailing edge down, roll
     # right), Cndr -0.1 x rudder-pos (positive = trailing edge left, nose left); checked on the
-    # truth by tests/jsbsim/test_jsbsim_b747.py. Gear up (retractable; CDgear 0.011 vanishes with
+    # truth by tests/jsbsim/test_jsbsim_roster.py. Gear up (retractable; CDgear 0.011 vanishes with
     # it). Its FCS has a yaw damper (2 x r-aero in normalised rudder per rad/s, clipped to +-0.2,
     # i.e. 0.7 rad of rudder per rad/s up to 4 deg) that the harness cannot switch off, so the
     # harness's own yaw damper is off (k_r = 0): the model's replaces it. 260 kt (ic/vc-kts) at

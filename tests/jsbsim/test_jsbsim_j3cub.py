@@ -5,7 +5,7 @@ Only the harness is checked here, on JSBSim's exact truth: the rigid-body consis
 with the checked-in airframe file, the sign map, the .tlog as the pipeline decodes it, the XML
 edits of every hidden effect, and (slow) that the evaluation's flights stay in the envelope with
 enough excitation on every axis. No pipeline fit, GP or diagnosis is run on the J3Cub in the
-test suite. The shared checks are in ``truth_fits.py`` (also used by ``test_jsbsim_c182.py``).
+test suite. The shared checks are in ``truth_fits.py`` (also used by ``test_jsbsim_roster.py``).
 """
 
 from types import SimpleNamespace

@@ -8,22 +8,6 @@ from benchmarks.jsbsim_harness.truth import truth_coefficients, truth_regressors
 LB = 0.45359237          # kg per lb
 
 
-def short_flight_fixture(name: str):
-    """A module-scoped pytest fixture called ``name``: the fast tests' flight of aircraft ``name``
-    (30 s, light turbulence, seed 1, AHRS AOA_SSA, in a new temporary folder), one per test module;
-    its value is the harness ``FlightFiles``."""
-    import pytest
-
-    from benchmarks.jsbsim_harness import FlightConfig, make_flight
-
-    @pytest.fixture(scope="module", name=name)
-    def flight(tmp_path_factory):
-        config = FlightConfig(name, duration_s=30.0, turbulence="light", seed=1)
-        return make_flight(config, tmp_path_factory.mktemp(name))
-
-    return flight
-
-
 def assert_names_resolve(name: str, model: str, typo: str) -> None:
     """The harness name ``name`` and the JSBSim model name ``model`` resolve to ``name`` in any case
     and with spaces (``canonical_name``); the unknown ``typo`` raises a KeyError listing ``name``.

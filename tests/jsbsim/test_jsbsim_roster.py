@@ -1,0 +1,276 @@
+"""The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
+t37, t6, b747 and the untouched f16; docs/jsbsim.md, one section each), parametrised over the roster.
+
+Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
+the rigid-body consistency of the truth with the checked-in airframe file (mass, product of inertia),
+the sign map against each model's XML, the gear retracted by the harness, the .tlog as the pipeline
+decodes it, every hidden effect as JSBSim computes it, the airspeed bias in the log, the evaluation's
+flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pipeline fit, GP,
+diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
+
+Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
+default suite, as before the fold); the untouched f16's are slow too but its names', and its own
+default checks (the derived model, static stability, the summaries' label) are in
+``test_jsbsim_f16.py``. Folded in the eleventh session from ``test_jsbsim_{c182,t37,t6,b747}.py``
+(same checks, same numbers; the Ixz checks now pin each model's value).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import FlightConfig, aircraft, make_flight
+from truth_fits import (ENVELOPE_FLIGHTS, assert_airspeed_bias_in_log, assert_hidden_effects_in_jsbsim,
+                        assert_in_envelope, assert_names_resolve, assert_rigid_body_glide, assert_servos_map_back,
+                        derivative_slopes, evaluation_envelope)
+from gcs_sysid.airframe import load_airframe
+from gcs_sysid.telemetry import read_log
+
+SLUG_FT2 = 1.3558179483314004     # kg m^2 per slug ft^2
+
+
+@dataclass(frozen=True)
+class Case:
+    """What one aircraft's harness is checked against (each number from its XML or JSBSim; sources in
+    its docs/jsbsim.md section).
+
+    Attributes:
+        name, model, typo: harness name, JSBSim model name, an unknown name close to it.
+        mass_lb: JSBSim's mass in the glide (empty + fuel + kept point masses), lb.
+        ixz: the project's Ixz, kg m^2 (JSBSim's with the sign flipped; 0: no product of inertia).
+        slopes: sign-map checks on ``derivative_slopes`` (cm: alpha, q_hat, delta_e; cl, cn: beta,
+            p_hat, r_hat, delta_a, delta_r): (coefficient, index, target, tolerance), the tolerance
+            ``("rel", x)``, ``("abs", x)`` or ``("in", lo, hi)`` (target unused).
+        gear_zero: the gear-down aerodynamic functions that must read 0 after the settling phase
+            (empty: fixed gear, not retracted).
+        elevator_end: the elevator's trailing-edge-down end, rad; n_side: its SIDE functions;
+            n_elevator_reads: its aerodynamics' ``<property>`` reads of ``fcs/elevator-pos-rad``.
+        envelope: ``assert_in_envelope`` limits of the evaluation's flights.
+        default: the flight checks run in the default suite (else slow).
+        untouched: the untouched aircraft of the next final evaluation.
+    """
+
+    name: str
+    model: str
+    typo: str
+    mass_lb: float
+    ixz: float
+    slopes: tuple
+    gear_zero: tuple
+    elevator_end: float
+    n_side: int
+    envelope: dict
+    n_elevator_reads: int = 2
+    default: bool = False
+    untouched: bool = False
+
+
+CASES = (
+    # c182: 1700 lb empty + 400 lb fuel; its 180-lb pilot at y = -14 in emptied by the harness.
+    # ClDa +0.15 x left-aileron-pos (Cl_delta_a = -0.15); CnDr -0.0645 at alpha 0 to -0.0805 at 5.4 deg.
+    Case("c182", "c182", "c18", 2100, 32.5499,
+         (("cl", 3, -0.15, ("rel", 0.03)), ("cn", 4, None, ("in", -0.0805, -0.0645))), (), np.radians(23.0), 5,
+         dict(alpha=(-4.0, 8.0), beta=(8.0, 13.0), bank=(15.0, 25.0), speed=(1.15 * 27.8, 70.0), rate_std=1.8,
+              rate_std_held=1.5), default=True),
+    # t37: 4056 lb empty + 2 x 350 lb on the centre line, no product of inertia. Clda (0.181 - 0.0705
+    # Mach) x left-aileron-pos: -0.157 at Mach 0.34; Cnda -0.0254 x left (+0.0254); Cndr -0.0365.
+    Case("t37", "T37", "t3", 4756, 0.0,
+         (("cl", 3, -0.157, ("rel", 0.03)), ("cn", 3, 0.0254, ("rel", 0.1)), ("cn", 4, -0.0365, ("rel", 0.05))),
+         ("CDgear", "DCYbdf", "DClrDg", "DCnbDg"), 0.30, 5,
+         dict(alpha=(-5.0, 7.0), beta=(6.0, 9.0), bank=(18.0, 30.0), speed=(1.3 * 46.9, 150.0), alt_min=500.0,
+              rate_std=1.8, rate_std_held=1.8)),
+    # t6: 5000 lb empty + 2 x 500 lb in wing tanks at y = +-50 in; <ixz> -1000 (997.41 slug ft^2 with the
+    # tanks). CmDe -1.2, Clda 0.29 x left (Cl_delta_a -0.29), Cldr 0.012, Cndr -0.06, no aileron yaw.
+    Case("t6", "t6texan2", "t66", 6000, 997.41 * SLUG_FT2,
+         (("cm", 2, -1.2, ("rel", 0.02)), ("cl", 3, -0.29, ("rel", 0.02)), ("cl", 4, 0.012, ("rel", 0.05)),
+          ("cn", 4, -0.06, ("rel", 0.02)), ("cn", 3, 0.0, ("abs", 1e-3))), ("CDgear",), 0.51, 1,
+         dict(alpha=(-6.0, 7.0), beta=(6.0, 8.0), bank=(20.0, 25.0), speed=(1.3 * 50.0, 140.0), alt_min=500.0,
+              rate_std=1.5, rate_std_held=1.5)),
+    # b747: 523816 lb empty + 5 x 5456.4 lb on the centre line; <ixz> -970000. Cmde (-1.3 + 0.4875 Mach)
+    # with CLde's arm: -1.068 at the CG; Clda (0.1 - 0.0335 Mach): -0.082; Clb -0.1, Clp -0.4, Cldr 0.01;
+    # Cnb 0.12 + the side force's arm: 0.140; Cnr -0.15, Cndr -0.1; no Cnda.
+    Case("b747", "B747", "b74", 551098, 970000 * SLUG_FT2,
+         (("cm", 2, -1.068, ("rel", 0.02)), ("cl", 3, -0.082, ("rel", 0.02)), ("cl", 0, -0.1, ("rel", 0.02)),
+          ("cl", 1, -0.4, ("rel", 0.02)), ("cl", 4, 0.01, ("rel", 0.05)), ("cn", 4, -0.1, ("rel", 0.02)),
+          ("cn", 0, 0.140, ("rel", 0.02)), ("cn", 2, -0.15, ("rel", 0.02)), ("cn", 3, 0.0, ("abs", 1e-3))),
+         ("CDgear",), 0.175, 1,
+         dict(alpha=(-7.0, 8.0), beta=(6.0, 6.0), bank=(15.0, 15.0), speed=(1.3 * 95.0, 230.0), alt_min=500.0,
+              rate_std=0.5, rate_std_held=0.4)),
+    # f16 (derived f16_direct): 17400 lb empty + the 230-lb pilot on the centre line + 2 x 1500 lb in
+    # wing tanks at y = +-65 in; <ixz> -982 (1059.9 slug ft^2 with the tanks). Clda 0.051-0.052 x
+    # aileron-pos at these alphas (-0.052); Cnda +0.009..0.011 (-0.010); Cndr -0.045; CmDh about -0.53
+    # per rad of elevator near 0. Six SIDE functions; the elevator read once, through the alias.
+    Case("f16", "f16_direct", "f15x", 20630, 1436.98,
+         (("cl", 3, -0.052, ("rel", 0.1)), ("cn", 4, -0.045, ("rel", 0.1)), ("cn", 3, -0.010, ("abs", 0.004)),
+          ("cm", 2, -0.53, ("rel", 0.1))), ("CDgear",), 0.436, 6,
+         dict(alpha=(-6.0, 11.0), beta=(6.0, 6.0), bank=(20.0, 25.0), speed=(110.0, 200.0), alt_min=1000.0,
+              rate_std=1.0, rate_std_held=1.0), n_elevator_reads=1, untouched=True),
+)
+BY_NAME = {c.name: c for c in CASES}
+
+
+def _params(cases=CASES, flight=True):
+    """``cases`` as pytest params: slow unless the case's flight checks are default (or ``flight``
+    is False: the names' check, always default)."""
+    return [pytest.param(c, id=c.name, marks=() if (c.default or not flight) else pytest.mark.slow) for c in cases]
+
+
+_FLIGHTS: dict = {}
+
+
+@pytest.fixture(scope="module")
+def short_flight(tmp_path_factory):
+    """``short_flight(name)``: the aircraft's 30-s flight (light, seed 1, AHRS AOA_SSA), flown once per
+    module: the harness ``FlightFiles``."""
+    def get(name):
+        if name not in _FLIGHTS:
+            cfg = FlightConfig(name, duration_s=30.0, turbulence="light", seed=1)
+            _FLIGHTS[name] = make_flight(cfg, tmp_path_factory.mktemp(name))
+        return _FLIGHTS[name]
+    return get
+
+
+@pytest.mark.parametrize("case", _params(flight=False))
+def test_names_resolve_and_roles(case):
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the f16
+    alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
+    from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
+
+    assert_names_resolve(case.name, case.model, case.typo)
+    if case.untouched:
+        assert UNTOUCHED_AIRCRAFT == HELD_OUT_AIRCRAFT == (case.name,) and case.name not in TUNING_AIRCRAFT
+        assert summary_label(case.name) == f"{case.name} (untouched)"
+    else:
+        assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
+        assert summary_label(case.name) == case.name
+    assert {"pa28", "j3cub", "c182", "t37", "t6", "b747"} <= set(TUNING_AIRCRAFT)
+
+
+@pytest.mark.parametrize("case", _params())
+def test_truth_is_rigid_body_consistent_with_the_airframe_file(case, short_flight):
+    """JSBSim's aero moments equal J w_dot + w x J w with the checked-in airframe's J, its Ixz
+    included; in the glide every non-gravity force and moment is aerodynamic (engines stopped: no
+    propeller windmills; "direct" thrusters give no force once stopped); the mass is the model's
+    (off-centre point masses emptied by the harness); the product of inertia is Ixz alone, the
+    model's (``negated_crossproduct_inertia``: the project's Ixz is JSBSim's with the sign flipped)."""
+    files = short_flight(case.name)
+    assert_rigid_body_glide(files, mass_lb=case.mass_lb)
+    const, af = files.recording.constants, load_airframe(files.airframe)
+    assert const["Ixy"] == const["Iyz"] == 0.0
+    assert const["Ixz"] == pytest.approx(case.ixz, rel=1e-4, abs=1e-9)
+    assert -af.inertia[0, 2] == pytest.approx(const["Ixz"], rel=1e-5, abs=1e-9)
+
+
+@pytest.mark.parametrize("case", _params())
+def test_sign_map_gives_the_project_conventions(case, short_flight):
+    """Least squares on the exact truth: Cm_delta_e, Cl_delta_a, Cn_delta_r, Cm_alpha, Cl_p < 0,
+    Cn_beta > 0, and the derivatives the case lists at its model's numbers."""
+    cm, cl, cn = derivative_slopes(short_flight(case.name).recording)
+    assert cm[0] < 0 and cm[2] < 0 and cl[1] < 0 and cl[3] < 0 and cn[0] > 0 and cn[4] < 0, (cm, cl, cn)
+    got = {"cm": cm, "cl": cl, "cn": cn}
+    for coef, i, target, tol in case.slopes:
+        v = got[coef][i]
+        if tol[0] == "in":
+            assert tol[1] < v < tol[2], (coef, i, v)
+        else:
+            assert v == pytest.approx(target, **{tol[0]: tol[1]}), (coef, i, v)
+
+
+@pytest.mark.parametrize("case", [p for p in _params() if p.values[0].gear_zero])
+def test_the_harness_flies_it_with_its_gear_up(case):
+    """``gear_up``: the retractable gear (5 s from down to up) is up before the log starts (the 15-s
+    settling phase), so its drag and any gear-down stability term read 0 (the c182's gear is fixed)."""
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    spec = aircraft(case.name)
+    assert spec.gear_up and not aircraft("c182").gear_up
+    fdm = load_model(spec, 1 / 200)
+    _set_ic(fdm, spec, FlightConfig(case.name, turbulence="none"))
+    for _ in range(int(FlightConfig(case.name).settle_s * 200)):
+        fdm.run()
+    assert fdm["gear/gear-pos-norm"] == 0.0
+    assert all(fdm[f"aero/coefficient/{n}"] == 0.0 for n in case.gear_zero)
+
+
+@pytest.mark.slow
+def test_the_b747_keeps_its_own_yaw_damper():
+    """The B747's FCS adds 2 x ``velocities/r-aero-rad_sec`` to the normalised rudder (clipped to
+    +-0.2), which the harness cannot switch off: the harness's own yaw damper is off (k_r = 0) and the
+    model's moves the rudder the aerodynamics read against a yaw rate."""
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    spec = aircraft("b747")
+    assert spec.gains[5] == 0.0
+    fdm = load_model(spec, 1 / 200)
+    _set_ic(fdm, spec, FlightConfig("b747", turbulence="none"))
+    for _ in range(int(FlightConfig("b747").settle_s * 200)):
+        fdm.run()
+    fdm["ic/r-rad_sec"] = 0.05
+    fdm.run_ic()
+    fdm.run()
+    assert fdm["fcs/yaw-damper-final"] == pytest.approx(2 * fdm["velocities/r-aero-rad_sec"], rel=0.02)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.35 * fdm["fcs/yaw-damper-final"], rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] > 0.03
+
+
+@pytest.mark.parametrize("case", _params())
+def test_tlog_decodes_and_the_servos_map_back_to_the_surfaces(case, short_flight):
+    """The pipeline's decoder reads the aircraft's .tlog; its SERVO_OUTPUT_RAW, through the checked-in
+    airframe file, gives JSBSim's deflections within PWM quantisation (0.1 deg), every surface moving."""
+    assert_servos_map_back(short_flight(case.name))
+
+
+@pytest.mark.parametrize("case", _params())
+def test_every_hidden_effect_shows_in_jsbsims_own_forces_and_moments(case):
+    """On the aircraft's XML every effect does what ``effects.py`` specifies, in JSBSim's own
+    properties at one initial condition (alpha 4 deg, sideslip 4 deg, fixed surfaces): each injected
+    moment is k alpha^2, k alpha beta or k delta_a times qbar S c|b and exactly the change of JSBSim's
+    total aerodynamic moment; CY:scale multiplies the sum of its SIDE functions (and the wind-axis
+    side force) by k; the delay holds the elevator the aerodynamics read 24 frames (0.12 s at 200 Hz)
+    behind the surface (``truth_fits.assert_hidden_effects_in_jsbsim``)."""
+    assert_hidden_effects_in_jsbsim(aircraft(case.name), case.elevator_end, n_side=case.n_side,
+                                    n_elevator_reads=case.n_elevator_reads)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", _params())
+def test_airspeed_bias_reaches_the_logged_airspeed(case, short_flight, tmp_path):
+    """``bias:airspeed`` = 2 m/s of TAS in a second log of the aircraft's flight: 2 sqrt(rho / rho0)
+    m/s more decoded airspeed, sample by sample."""
+    assert_airspeed_bias_in_log(short_flight(case.name), tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", _params())
+@pytest.mark.parametrize("seed,turbulence,plan,effects", ENVELOPE_FLIGHTS)    # with the evaluation's pair
+def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_path, case, seed, turbulence, plan,
+                                                                         effects):
+    """Each flight the final evaluation flies (120 s) keeps inside the aircraft's envelope, read from
+    ``flight_envelope`` of the truth file: no knock-it-off, alpha, sideslip, bank and TAS within the
+    case's limits (sideslip and bank wider with Cl:alpha*beta = 3, whose reversed dihedral rolls it),
+    every rate and surface moving (also in the held-out 20 %), the glide still above the case's
+    lowest altitude. The limits' sources are in each aircraft's docs/jsbsim.md section."""
+    assert_in_envelope(evaluation_envelope(case.name, seed, turbulence, plan, effects, tmp_path), **case.envelope)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", [p for p in _params() if p.values[0].name in ("b747", "f16")])
+def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
+    """The JSBSim model name in capitals resolves to the harness name in both scripts; with
+    ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
+    the flights on a second run and score nothing."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+
+    monkeypatch.setattr(eval_jsbsim_diagnose, "DURATION_S", 2.0)
+    runs = ((eval_jsbsim.main, ["--turbulence", "light", "--duration", "2", "--work", str(tmp_path / "f")], 1, 1),
+            (eval_jsbsim_diagnose.main, ["--clean-seeds", "--pairs", "--effects", "delay:delta_e",
+                                         "--out", str(tmp_path / "d")], -3, 3))      # reference + 2 sizes
+    for main, extra, column, n in runs:
+        argv = ["--aircraft", case.model.upper(), "--seeds", "1", *extra, "--fly-only"]
+        assert main(argv) == 0 and main(argv) == 0
+        cap = capsys.readouterr()
+        assert [ln.split()[column] for ln in cap.out.splitlines()] == ["flown"] * n + ["reused"] * n, cap.out
+        assert (f"{case.name} is the untouched aircraft" in cap.err) == case.untouched
+    assert read_log(tmp_path / "f" / f"{case.name}-light-s1-ahrs.tlog").streams["servo"].t.size > 50
+    assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
