@@ -75,8 +75,9 @@ _DEG = 57.29577951308232
 #: thresholds; ``pa28`` (held out since 2026-11-21), ``j3cub`` (untouched until the sixth
 #: session's final evaluation, 2026-11-22), ``c182`` (untouched until the seventh session's)
 #: have since been evaluated and their results read, so they count as used (``TUNING_AIRCRAFT``).
-#: ``t37`` (untouched until the eighth session's final evaluation) is used since as well.
-#: ``t6`` (added in the ninth session, 2026-11-22) is the held-out, untouched case
+#: ``t37``, ``t6`` and ``b747`` (untouched until the eighth, ninth and tenth sessions' final
+#: evaluations) are used since as well. ``f16`` (added in the eleventh session, 2026-11-22, as the
+#: derived model ``f16_direct``, ``derived.py``) is the held-out, untouched case
 #: (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's
 #: truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
