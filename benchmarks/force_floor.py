@@ -39,8 +39,12 @@ from gcs_sysid.telemetry import read_log  # noqa: E402
 AXES = {"CX": ("x", "ax"), "CY": ("y", "ay"), "CZ": ("z", "az")}
 
 
-def attribute(stem: Path, coef: str = "CY") -> dict:
+def attribute(stem: Path, coef: str = "CY", noise_sigma: float | None = None) -> dict:
     """Error attribution of one flight (module docstring); ``stem`` is the path without ``-truth.npz``.
+
+    ``noise_sigma`` (m/s^2 per sample at the log's rate), if given, replaces the noise level read from
+    the log in ``floor`` (white noise: PSD ``2 sigma^2 dt``): the floor another accelerometer would
+    set on the same flight (``benchmarks/imu_noise.py --floor``).
 
     Raises:
         FileNotFoundError: the truth, log or replay table is missing.
@@ -61,7 +65,7 @@ def attribute(stem: Path, coef: str = "CY") -> dict:
     err = (est - aero) * qS / m
     imu = read_log(f"{stem}.tlog")["imu"]
     dt = float(np.median(np.diff(imu.t)))
-    N = white_noise_psd(imu[field], dt)
+    N = white_noise_psd(imu[field], dt) if noise_sigma is None else 2.0 * noise_sigma ** 2 * dt
     sel = tr.t >= t[h][0]
     sig = F[f"F{ax}_aero"][sel] / m
     floor = wiener_floor(sig, N, float(np.median(np.diff(tr.t))))
