@@ -22,8 +22,9 @@ from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64
 
 enable_x64()
 # Each test process reads and fills that cache from its start (before, only after its first replay):
-# a program one xdist worker compiled is loaded by the other, and by later CLI subprocesses
-# (tests/gp/test_honest.py in a fresh process: 68.7 s CPU without the cache, 14.3 s with it warm).
+# a program one xdist worker compiled is loaded by the other, and by later CLI subprocesses. Measured:
+# tests/gp/test_honest.py 68.7 s CPU without the cache, 14.3 s with it warm; but -n 2 on four GP
+# files only -2.3 % (the workers mostly compile different programs; docs/benchmarks.md, ci-cut).
 enable_compilation_cache()
 
 REPO = Path(__file__).resolve().parents[1]
