@@ -54,8 +54,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.eval_gp_jsbsim import MOMENTS, _correlations, errors, make, missing_rows  # noqa: E402
-from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
+from benchmarks.eval_gp_jsbsim import MOMENTS, _correlations, add_flight_args, errors, make, missing_rows  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import decoupled_model  # noqa: E402
@@ -221,11 +220,7 @@ def summarize(paths) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
-    ap.add_argument("--make", action="store_true", help="fly, replay and cache the flights that are missing")
-    ap.add_argument("--aircraft", nargs="+", default=["c172x"], type=aircraft_argument)
-    ap.add_argument("--seeds", nargs="+", type=int, default=[1])
-    ap.add_argument("--turbulence", nargs="+", default=["light"])
+    add_flight_args(ap, ["c172x"], make_help="fly, replay and cache the flights that are missing")
     ap.add_argument("--lengths", nargs="+", type=float, default=[10.0, 20.0, 40.0, 0.0],
                     help="training lengths in s from the first training row (0: all)")
     ap.add_argument("--patterns", nargs="+", default=list(PATTERNS), choices=PATTERNS)

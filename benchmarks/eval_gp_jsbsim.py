@@ -500,15 +500,28 @@ def summarize(paths) -> str:
     return "\n".join(out)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
+                    make_help: str = "fly, replay and cache the flights first") -> None:
+    """Add the options that pick the cached flights (``--cache --make --aircraft --seeds --turbulence``)
+    to ``ap``; shared by this script and ``eval_gp_joint.py``.
+
+    Args:
+        ap: the script's parser (changed in place).
+        aircraft: the default of ``--aircraft`` (harness names).
+        make_help: the help of ``--make`` (what the script does with missing flights).
+    """
     ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
-    ap.add_argument("--make", action="store_true", help="fly, replay and cache the flights first")
-    ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"], type=aircraft_argument,
+    ap.add_argument("--make", action="store_true", help=make_help)
+    ap.add_argument("--aircraft", nargs="+", default=aircraft, type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16) or JSBSim model names (J3Cub, T37, "
                          "t6texan2, B747, f16_direct); f16 is the untouched aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_flight_args(ap, ["c172x", "sgs"])
     ap.add_argument("--aoa", nargs="+", default=["ahrs"], choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=90.0)
     ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS)

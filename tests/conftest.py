@@ -18,9 +18,14 @@ from pathlib import Path
 
 import pytest
 
-from gcs_sysid.jaxconfig import enable_x64
+from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64
 
 enable_x64()
+# Each test process reads and fills that cache from its start (before, only after its first replay):
+# a program one xdist worker compiled is loaded by the other, and by later CLI subprocesses. Measured:
+# tests/gp/test_honest.py 68.7 s CPU without the cache, 14.3 s with it warm; but -n 2 on four GP
+# files only -2.3 % (the workers mostly compile different programs; docs/benchmarks.md, ci-cut).
+enable_compilation_cache()
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -30,3 +35,42 @@ DATA = REPO / "data"
 def data_dir() -> Path:
     """The repository's data/ directory."""
     return DATA
+
+
+#: Seconds per test file in the default run on CI's 2-core machine (the tenth session's fresh-clone
+#: runs' ``--durations``, less what the eleventh session's ci-cut moved to slow; files under ~9 s are
+#: left out). ``--dist loadfile`` hands whole files to the two workers in xdist's order, most tests
+#: first, which left the long one-test files (a live session, the parallel replay) to the end, where one
+#: worker finished them while the other idled. The files named here go first, longest first (longest
+#: processing time first); the others follow in xdist's order. A stale or missing entry changes only
+#: the order, never which tests run.
+FILE_SECONDS = {
+    "tests/diagnose/test_diagnose_e2e.py": 62, "tests/test_cli_robust.py": 57, "tests/test_cli.py": 54,
+    "tests/gp/test_honest.py": 42, "tests/test_roundtrip.py": 41, "tests/jsbsim/test_effects_diagnose.py": 38,
+    "tests/diagnose/test_faults.py": 35, "tests/live/test_listen_can_learner.py": 30,
+    "tests/test_data_files.py": 25, "tests/test_pipeline_parallel.py": 23, "tests/gp/test_lmc.py": 22,
+    "tests/gp/test_streaming.py": 21, "tests/diagnose/test_physical.py": 20, "tests/gp/test_model.py": 20,
+    "tests/report/test_report.py": 19, "tests/test_maneuvers.py": 16, "tests/live/test_mavproxy.py": 16,
+    "tests/test_campaign.py": 16, "tests/diagnose/test_diagnose_sim.py": 14, "tests/sim/test_sim_effects.py": 13,
+    "tests/gp/test_joint.py": 12, "tests/live/test_learner_catch_up.py": 10, "tests/jsbsim/test_predict.py": 10,
+    "tests/estimation/test_estimation_sim_roundtrip.py": 9,
+}
+
+
+@pytest.hookimpl(optionalhook=True)   # pytest-xdist's hook; without xdist nothing is distributed
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` with the files of :data:`FILE_SECONDS` first, longest first."""
+    if config.getoption("dist", None) != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class LongestFirst(LoadFileScheduling):
+        def _assign_work_unit(self, node):
+            if not getattr(self, "_ordered", False):   # the queue is complete at the first assignment
+                self._ordered = True
+                units = sorted(self.workqueue.items(), key=lambda u: -FILE_SECONDS.get(u[0], 0))   # stable
+                self.workqueue.clear()
+                self.workqueue.update(units)
+            super()._assign_work_unit(node)
+
+    return LongestFirst(config, log)

@@ -140,14 +140,15 @@ def test_truncated_log_still_decodes_or_says_so(tmp_path):
         assert (out / "report.html").exists()
 
 
-def test_simulate_fit_diagnose_chain(tmp_path):
-    """The issue-3 commands end to end as a user runs them: simulate a short flight, fit a model
-    from it, then diagnose the shipped model against the flight."""
-    import json
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    """A short flight made by ``gcs-sysid simulate`` (75 s of the sample plan, in its steady 4 m/s wind);
+    (log, model it was made from)."""
     import tomllib
 
     import tomli_w
 
+    tmp_path = tmp_path_factory.mktemp("chain")
     doc = tomllib.loads((DATA / "plans" / "sysid-trainer.toml").read_text())
     doc["duration_s"] = 75.0
     doc["maneuver"] = [m for m in doc["maneuver"] if m["start_s"] < 95.0]
@@ -160,13 +161,33 @@ def test_simulate_fit_diagnose_chain(tmp_path):
                 "--seed", "3")
     assert p.returncode == 0, p.stderr
     assert log.stat().st_size > 100_000
+    return log, model
 
+
+def test_simulate_fit_chain(simulated, tmp_path):
+    """The issue-3 commands end to end as a user runs them: simulate a short flight (the fixture), fit a
+    model from it; diagnose refuses a model with an unknown coefficient in one line."""
+    import tomllib
+
+    log, model = simulated
     fitted = tmp_path / "fitted.toml"
     p = run_cli("fit", log, "--airframe", AIRFRAME, "--out", fitted)
     assert p.returncode == 0, p.stderr
     fit = tomllib.loads(fitted.read_text())
     assert fit["Cm"]["delta_e"] < 0 and fit["Cl"]["p_hat"] < 0  # the damping and control signs survive
 
+    bad = tmp_path / "bad_model.toml"
+    bad.write_text(model.read_text() + '\n[Cq]\nalpha = 1.0\n')
+    p = run_cli("diagnose", log, "--airframe", AIRFRAME, "--model", bad, "--out", tmp_path / "d2")
+    assert_one_line_error(p, "bad_model.toml")
+
+
+@pytest.mark.slow   # the same cause through a written log: tests/diagnose/test_diagnose_e2e.py, wind case
+def test_simulate_diagnose_chain(simulated, tmp_path):
+    """Then diagnose the shipped model against the simulated flight as a user runs it."""
+    import json
+
+    log, model = simulated
     out = tmp_path / "diag"
     p = run_cli("diagnose", log, "--airframe", AIRFRAME, "--model", model, "--out", out)
     assert p.returncode == 0, p.stderr
@@ -176,8 +197,3 @@ def test_simulate_fit_diagnose_chain(tmp_path):
     assert [f["cause"] for f in diag["findings"]] == ["wind"], diag["findings"]
     assert 3.0 < diag["findings"][0]["estimate"] < 5.0
     assert (out / "model_extended.toml").exists() and (out / "report.html").exists()
-
-    bad = tmp_path / "bad_model.toml"
-    bad.write_text(model.read_text() + '\n[Cq]\nalpha = 1.0\n')
-    p = run_cli("diagnose", log, "--airframe", AIRFRAME, "--model", bad, "--out", tmp_path / "d2")
-    assert_one_line_error(p, "bad_model.toml")

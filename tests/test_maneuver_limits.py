@@ -206,6 +206,7 @@ def test_plan_file_flies_the_suggestions_exactly(full):
         plan_document(sug[:2], duration_s=5.0)
 
 
+@pytest.mark.slow   # tests/test_pipeline_parallel.py replays the sample flight with targets=("Cn",) too
 def test_replay_targets_only_the_coefficients_asked_for(tmp_path):
     """``replay --target Cn`` (ReplayOptions.targets): every suggestion of the sample flight aims at Cn."""
     from gcs_sysid.pipeline import ReplayOptions, run_replay

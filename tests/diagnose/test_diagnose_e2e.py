@@ -78,7 +78,8 @@ def _model_value(coef, term):
 
 #: (hidden cause, value given to the simulation, true estimate); sizes realistic and clearly detectable
 E2E = [
-    ("Cm:alpha", 0.3, _model_value("Cm", "alpha") + 0.3),              # static margin 40 % smaller
+    pytest.param("Cm:alpha", 0.3, _model_value("Cm", "alpha") + 0.3,   # static margin 40 % smaller; slow:
+                 marks=pytest.mark.slow),   # test_diagnose_sim[Cm:alpha] (sim path), a term through a log in jsbsim/
     pytest.param("Cl:p_hat", -0.2, _model_value("Cl", "p_hat") - 0.2,   # roll damping 45 % larger
                  marks=pytest.mark.slow),
     pytest.param("Cn:r_hat", -0.12, _model_value("Cn", "r_hat") - 0.12,  # yaw damping 80 % larger
