@@ -68,9 +68,11 @@ def pytest_xdist_make_scheduler(config, log):
         def _assign_work_unit(self, node):
             if not getattr(self, "_ordered", False):   # the queue is complete at the first assignment
                 self._ordered = True
-                units = sorted(self.workqueue.items(), key=lambda u: -FILE_SECONDS.get(u[0], 0))   # stable
-                self.workqueue.clear()
-                self.workqueue.update(units)
+                queue = getattr(self, "workqueue", None)   # xdist 3.x's internal queue of files
+                if isinstance(queue, dict):                # any other shape keeps xdist's own order
+                    units = sorted(queue.items(), key=lambda u: -FILE_SECONDS.get(u[0], 0))   # stable
+                    queue.clear()
+                    queue.update(units)
             super()._assign_work_unit(node)
 
     return LongestFirst(config, log)
