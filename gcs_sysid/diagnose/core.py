@@ -181,10 +181,11 @@ def _differential_gains(ctx: DiagContext, R0: np.ndarray, proj, inadequacy: np.n
         gs = pf.get("evidence", {}).get("gain_sensor")
         if g is not None and gs is not None and gs["percent"] > g["percent"]:
             g = dict(gs, coefficient="V", residual="the pitot's airspeed against the wind triangle (m/s)")
-            pf["coefficient"] = "V"
         if g is not None:
             pf.setdefault("evidence", {})["gain_against_model"] = dict(pf.get("gain", {}))
             pf["gain"] = dict(g, rows=pf.get("gain", {}).get("rows", "untouched"))
+            if gs is not None:             # the finding's quantity is the one its reported gain is on
+                pf["coefficient"] = g["coefficient"]
     for fd in findings:
         if fd is pf or fd.get("source") == "sparse search" or fd.get("kind") == "fault" \
                 or str(fd.get("evidence", {}).get("domain", "")).startswith(
