@@ -94,10 +94,10 @@ DIFFERENTIAL_REREDUCED = True
 #: (:func:`gcs_sysid.diagnose.wind_triangle.triangle_gain`), as every other data-compatibility sensor cause's gain is
 #: in its own units (:mod:`gcs_sysid.diagnose.compat`). Read by the naming check ``gain_on_untouched_rows`` and by
 #: the reported ``gain``. Why (eleventh session, branch i9-b747, ``docs/benchmarks.md``): on the JSBSim b747 at 134
-#: m/s even the *exact* effect of the bias (the same flight logged with the pitot 1 m/s apart) gains at most 15-17 %
-#: of a coefficient's held-out residual at 2 m/s and 7.5 % at 1 m/s, so a coefficient gain measures the flight's
-#: turbulence floor, not the finding; on the wind triangle the same biases gain 82-84 % and 66-71 % (residual
-#: 0.37 m/s). False: coefficients only (the tenth session's rule).
+#: m/s even the *exact* effect of the bias (the same flight logged with the pitot 1 m/s apart) gains at most 12-17 %
+#: of a coefficient's held-out residual at 2 m/s and 5-7.5 % at 1 m/s, so a coefficient gain measures the flight's
+#: turbulence floor, not the finding; on the wind triangle the same biases gain 81-86 % and 60-73 % (residual
+#: 0.29-0.36 m/s). False: coefficients only (the tenth session's rule).
 SENSOR_GAIN = True
 
 
