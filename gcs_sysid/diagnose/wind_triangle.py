@@ -136,13 +136,13 @@ def triangle_gain(t_grid: np.ndarray, states: dict, rows: np.ndarray, flight, ca
         before_mps, after_mps: the pitot bias without and with the correction, m/s TAS.
 
     Returns:
-        ``{"rms_before", "rms_after" (m/s), "percent", "n"}``, or None (no samples, fewer than 20 in ``rows``,
-        no calibration).
+        ``{"rms_before", "rms_after" (m/s), "percent", "n", "unit"}``, or None (no pitot, ground velocity or
+        density, fewer than 100 usable pitot samples in ``rows``, or no calibration ``cal``).
     """
     if cal is None:
         return None
     smp = _samples(t_grid, states, rows, flight)
-    if smp is None or len(smp[0]) < 20:
+    if smp is None:
         return None
     tas, vg, w0, _ = smp
     a = vg.copy()
