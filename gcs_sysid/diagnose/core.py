@@ -176,9 +176,16 @@ def _differential_gains(ctx: DiagContext, R0: np.ndarray, proj, inadequacy: np.n
         if pitot.get("delta_offsets_removed"):
             Rp, dp = remove_offsets(ctx, Rp), remove_offsets(ctx, dp)
         g = gain_of(with_test(ctx, gain_rows), Rp, dp, 1)
+        # the wind-triangle finding's gain in the pitot's own units (pitot.SENSOR_GAIN) needs no reference
+        # inadequacy: it stays one of the quantities the largest gain is taken over
+        gs = pf.get("evidence", {}).get("gain_sensor")
+        if g is not None and gs is not None and gs["percent"] > g["percent"]:
+            g = dict(gs, coefficient="V", residual="the pitot's airspeed against the wind triangle (m/s)")
         if g is not None:
             pf.setdefault("evidence", {})["gain_against_model"] = dict(pf.get("gain", {}))
             pf["gain"] = dict(g, rows=pf.get("gain", {}).get("rows", "untouched"))
+            if gs is not None:             # the finding's quantity is the one its reported gain is on
+                pf["coefficient"] = g["coefficient"]
     for fd in findings:
         if fd is pf or fd.get("source") == "sparse search" or fd.get("kind") == "fault" \
                 or str(fd.get("evidence", {}).get("domain", "")).startswith(
@@ -455,7 +462,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                             alpha_scale=bool(_SPARSE_TH.get("alpha_scale_allowance", False)),
                                             delay_same_fit=bool(_SPARSE_TH.get("delay_reference_same_fit", False)),
                                             alpha_jackknife_s=float(_SPARSE_TH.get("alpha_jackknife_s", 0.0)),
-                                            delay_change_min_t=float(_SPARSE_TH.get("delay_change_min_t", 0.0)))
+                                            delay_change_min_t=float(_SPARSE_TH.get("delay_change_min_t", 0.0)),
+                                            angle_error_along=tuple(_SPARSE_TH.get("angle_error_along_term", ())))
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

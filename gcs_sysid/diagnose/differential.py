@@ -58,6 +58,7 @@ from .terms import term_factors, term_matrix
 from .uncertainty import block_jackknife_cov
 
 __all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "angle_scale_allowance",
+           "angle_error_allowance",
            "block_jackknife_se",
            "BETA_COEFFICIENTS", "ANGLE_COEFFICIENTS",
            "onset_of_change", "fit_record", "reference_logs"]
@@ -216,7 +217,8 @@ def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.n
 
 def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
-                          scale_se: bool = True, jackknife: dict | None = None) -> dict | None:
+                          scale_se: bool = True, jackknife: dict | None = None,
+                          along_term: bool = False) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -246,6 +248,11 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
         angle: ``"beta"`` or ``"alpha"``.
         min_t, min_gain_pct: as :func:`offset_allowance`.
         scale_se: carry the scale's standard error into the term's (see above).
+        along_term: the angle's error is ``s phi`` along the finding's own term ``phi`` instead of ``s x``
+            (a scale): :func:`angle_error_allowance` (eleventh session, branch i9-b747). Then ``angle``
+            need not be among the term's factors, ``n_j = phi dC_j/dx`` and the document's keys read
+            ``error_along_term`` (``scale`` is ``s``, in radians per unit of the term: the true angle is the
+            measured one plus ``s phi``, as the scale's ``1 + s`` multiplies the measured angle).
         jackknife: ``{"t": (T,) s, "block_s": s, "reference": (t_r, X_r, R_r, rows_r) or None}``: the term
             beyond the scale is also judged with the block-jackknife standard error
             (:func:`block_jackknife_se`) of this flight's slope and of the reference flight's (the model's
@@ -265,13 +272,24 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     from .context import evaluate_model
 
     group = ANGLE_COEFFICIENTS[angle]
-    if coef not in group or angle not in _angle_factors(term):
+    if coef not in group or (not along_term and angle not in _angle_factors(term)):
         return None
     ia = REGRESSORS.index(angle)
     eps = 1e-3
     X1 = np.array(X, float, copy=True)
-    X1[:, ia] *= 1.0 + eps
-    N = (evaluate_model(model, X1) - evaluate_model(model, X)) / eps        # (T, 6): x dC/dx
+    if along_term:
+        try:
+            phi_e = term_matrix(X, [term])[:, 0]
+        except SysidError:              # a term outside the vocabulary (lag, hinge): nothing to align with
+            return None
+        if not np.isfinite(phi_e).any() or np.nanstd(phi_e) == 0:
+            return None
+        d = eps / float(np.nanstd(phi_e))       # an angle error of 1e-3 rad at one standard deviation of phi
+        X1[:, ia] += d * np.nan_to_num(phi_e)
+        N = (evaluate_model(model, X1) - evaluate_model(model, X)) / d      # (T, 6): phi dC/dx
+    else:
+        X1[:, ia] *= 1.0 + eps
+        N = (evaluate_model(model, X1) - evaluate_model(model, X)) / eps    # (T, 6): x dC/dx
     ok = train & np.isfinite(R).all(axis=1) & np.isfinite(N).all(axis=1)
     others = [c for c in group if c != coef and np.std(N[ok, COEFFICIENTS.index(c)]) > 0]
     if ok.sum() < 50 or not others:
@@ -311,11 +329,44 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                                f"{beyond['gain_beyond_offset_percent']:.0f} % on the held-out rows beyond the offset"))
     if jackknife and "std_error" in beyond:
         beyond = _with_jackknife(beyond, X, R_adj[:, j], ok, term, jackknife, min_t)
+    if along_term:
+        return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
+                "error_along_term": float(s_hat), "term": term,
+                "std_error": se_s, "from": others, "beyond_scale": beyond,
+                "why": f"a common {angle} error {s_hat:+.3g} +- {se_s:.2g} rad per unit of {term} (fitted on "
+                       f"{', '.join(others)}) and {coef}'s offset free: "
+                       f"{beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
     return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
             "beta_scale" if angle == "beta" else "alpha_scale": float(s_hat),
             "std_error": se_s, "from": others, "beyond_scale": beyond,
             "why": f"a common {angle} scale {1 + s_hat:.3f} +- {se_s:.2g} (fitted on {', '.join(others)}) and {coef}'s "
                    f"offset free: {beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
+
+
+def angle_error_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
+                          term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
+                          scale_se: bool = True) -> dict | None:
+    """Is a finding more than an error of the measured air angle that moves with the finding's own term?
+
+    The scale allowance (:func:`angle_scale_allowance`) covers an angle error proportional to the angle.
+    The reconstructed sideslip also carries errors that follow the flight's other states, differently on
+    each flight: on the JSBSim b747 (clean seed 15, measured against the truth, ``docs/benchmarks.md``,
+    *Eleventh session, i9-b747*) the aided sideslip's error has a slope of +0.136 rad per unit of
+    ``r_hat`` (correlation 0.48; -0.005 on the reference flight, -0.050 on clean seed 11), and through
+    ``CY_beta`` = -1.06 it reads as a ``CY:r_hat`` "change" of +0.096 at 15 standard errors; Cl and Cn
+    see the same error through their own ``beta`` derivatives (their residual slopes on ``r_hat``,
+    +0.017 and -0.016, are the +0.014 and -0.019 the sideslip error predicts). An error ``e = s phi`` of
+    the angle along the finding's term ``phi`` moves *every* coefficient of the angle's group by
+    ``-s phi dC_j/dx`` (the model's own derivatives, so in the model's ratios), while a change of one
+    coefficient's aerodynamics moves that coefficient alone. So ``s`` is fitted on the *other*
+    coefficients of the group and the finding judged beyond it, with ``s``'s standard error carried, exactly
+    as for the scale (the scale is the case ``phi = x``).
+
+    Args, returns: as :func:`angle_scale_allowance` (``along_term=True``); None when ``coef`` is not in the
+    angle's group, the term is not a vocabulary monomial, or no other coefficient depends on the angle.
+    """
+    return angle_scale_allowance(X, R, train, test, model, coef, term, angle, min_t, min_gain_pct, scale_se,
+                                 along_term=True)
 
 
 def _with_jackknife(beyond: dict, X: np.ndarray, r: np.ndarray, rows: np.ndarray, term: str, jk: dict,
@@ -545,7 +596,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
                  alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
-                 delay_change_min_t: float = 3.0) -> dict:
+                 delay_change_min_t: float = 3.0, angle_error_along: tuple = ()) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -581,6 +632,10 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         alpha_jackknife_s: block length, s, of the block-jackknife standard error with which a finding in alpha
             is also judged beyond the alpha scale (:func:`angle_scale_allowance` ``jackknife``, the first
             reference's slope included); 0: off (``sparse.THRESHOLDS["alpha_jackknife_s"]``).
+        angle_error_along: the air angles (``"beta"``) against whose error along a finding's own term each aero
+            finding of that angle's coefficients is also judged (:func:`angle_error_allowance`;
+            ``sparse.THRESHOLDS["angle_error_along_term"]``; added in the eleventh session, branch i9-b747); ():
+            off.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -671,6 +726,24 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                     break
                 if scale is not None:
                     f["evidence"][f"{angle}_scale_allowance"] = scale
+            for angle in angle_error_along if scaled is None else ():
+                # an error of the measured angle along the finding's own term (angle_error_allowance)
+                err = angle_error_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
+                                            coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
+                                            scale_se=angle_scale_se)
+                if err is not None and err["scale_only"]:
+                    scaled = err
+                    break
+                if err is not None:
+                    f["evidence"][f"{angle}_error_allowance"] = err
+            if scaled is not None and "error_along_term" in scaled:
+                what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
+                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}
+                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
+                                         "gain": f.get("gain", {}), "why": scaled["why"],
+                                         "summary": f"{cause}: an error of the measured {what} that moves with "
+                                                    f"{term}, not a cause"})
+                continue
             if scaled is not None:
                 what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
                 f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}

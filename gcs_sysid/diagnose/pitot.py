@@ -54,7 +54,7 @@ from .physical import physical_gate, split_held_out, with_test
 from .regression import effective_samples
 from .wind_triangle import WIND_SYSTEMATIC_MPS, autopilot_wind  # noqa: F401  (WIND_SYSTEMATIC_MPS: re-exported)
 
-__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "MIN_T_SCREEN", "MIN_T_SCREEN_TRIANGLE",
+__all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", "MIN_T_FUSED", "SENSOR_GAIN", "MIN_T_SCREEN", "MIN_T_SCREEN_TRIANGLE",
            "MAX_SE_COEF_MPS", "airspeed_cause", "wind_shift", "fuse_pitot_evidence", "screen", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
@@ -89,6 +89,16 @@ MAX_SE_COEF_MPS = 0.5
 #: (:func:`_rereduced_baseline`), not minus the closed-form fit's reference value (added 2026-11-22, branch
 #: i9-scale; freeze time in ``docs/benchmarks.md``).
 DIFFERENTIAL_REREDUCED = True
+#: The wind-triangle pitot finding's gain is the largest over the quantities the bias acts on: each coefficient (as
+#: before) *and the pitot's own airspeed*, on the wind triangle's residual in m/s over the same untouched rows
+#: (:func:`gcs_sysid.diagnose.wind_triangle.triangle_gain`), as every other data-compatibility sensor cause's gain is
+#: in its own units (:mod:`gcs_sysid.diagnose.compat`). Read by the naming check ``gain_on_untouched_rows`` and by
+#: the reported ``gain``. Why (eleventh session, branch i9-b747, ``docs/benchmarks.md``): on the JSBSim b747 at 134
+#: m/s even the *exact* effect of the bias (the same flight logged with the pitot 1 m/s apart) gains at most 12-17 %
+#: of a coefficient's held-out residual at 2 m/s and 5-7.5 % at 1 m/s, so a coefficient gain measures the flight's
+#: turbulence floor, not the finding; on the wind triangle the same biases gain 81-86 % and 60-73 % (residual
+#: 0.29-0.36 m/s). False: coefficients only (the tenth session's rule).
+SENSOR_GAIN = True
 
 
 def wind_shift(ctx: DiagContext, flight) -> dict | None:
@@ -295,7 +305,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     ``min_gain_pct`` on a coefficient's untouched rows (never used by either fit). The offsets the
     bias makes count as its evidence here (the triangle measures the bias without the coefficients).
     """
-    from .wind_triangle import change_since_references, wind_triangle
+    from .wind_triangle import change_since_references, triangle_gain, wind_triangle
 
     cand = next((c for c in candidates if c["cause"] == "bias:airspeed"), None)
     if cand is None:
@@ -357,6 +367,15 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     sc = Scorer(with_test(ctx, gain_rows), np.nan_to_num(R), proj)
     score, gains = sc.score(np.nan_to_num(delta), 1)
     gain_pct = {k: v["percent"] for k, v in gains.items()}
+    if SENSOR_GAIN:
+        # the bias acts first on the pitot's own reading: its gain there, in m/s on the wind triangle's
+        # residual over the same untouched rows (wind_triangle.triangle_gain), is one of the quantities
+        # the largest gain is taken over, as each coefficient is
+        ref_b = change["reference_mps"] if change["reference_mps"] is not None else 0.0
+        g_v = triangle_gain(ctx.t, ctx.states, gain_rows & ctx.valid, flight, tri, ref_b, ref_b + float(b))
+        if g_v is not None:
+            out["gain_sensor"] = g_v
+            gain_pct["V"] = g_v["percent"]
     main = max(gain_pct, key=gain_pct.get) if gain_pct else ""
     checks = {"measurements_agree": fused["agree"],
               "significant": bool(abs(fused["t_statistic"]) >= MIN_T_FUSED),
@@ -377,9 +396,10 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
                      "coefficients": {"estimate": cand["estimate"], "std_error": cand["std_error"],
                                       "references": refs, "systematic_mps": COEF_SYSTEMATIC_MPS},
                      "fused": fused, "gain_untouched_by_coefficient": gain_pct,
+                     "gain_sensor": out.get("gain_sensor"),
                      "differential": {"verdict": "changed" if change["reference_mps"] is not None
                                       else "no reference flight", "references": refs},
-                     "signature": {"implied": [c for c, g in gain_pct.items() if g > 0]},
+                     "signature": {"implied": [c for c, g in gain_pct.items() if g > 0 and c != "V"]},
                      "separable": True, "rivals": [],
                      "summary": f"the pitot reads {b:+.2f} +- {fused['std_error']:.2f} m/s more than before: "
                                 f"the wind triangle (pitot against GPS minus the autopilot's wind) "

@@ -113,6 +113,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: (a named term's candidates whose partial column has a condition index of at least this with the named one are
 #: reported as its ``aliases``, :mod:`gcs_sysid.diagnose.aliases`; Belsley, Kuh and Welsch's 30; 0 off). It names,
 #: drops and re-sizes nothing.
+#: Added 2026-11-22 (eleventh session, branch i9-b747; committed before the 21:45 UTC freeze), read by ``diagnose``
+#: for the differential step: ``angle_error_along_term`` (the air angles, ``("beta",)``, against whose error along a
+#: lateral finding's own term the finding is judged, as against the sideslip's scale: the error fitted on the other
+#: coefficients of the angle through the model's own derivatives, :func:`gcs_sysid.diagnose.differential.
+#: angle_error_allowance`; the JSBSim b747's clean seed 15 ``CY:r_hat`` was the aided sideslip's error following
+#: r_hat, measured against the truth; ``()`` off). No new threshold: ``min_t`` 3 and ``min_gain_pct`` as the scale's.
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -123,7 +129,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
               "delay_differential": True, "side_force_wind_axis": True, "delay_reference_same_fit": True,
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
-              "alias_condition_index": ALIAS_CONDITION_INDEX}
+              "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",)}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

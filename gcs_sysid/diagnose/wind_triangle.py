@@ -41,7 +41,7 @@ import numpy as np
 
 from .regression import effective_samples
 
-__all__ = ["WIND_SYSTEMATIC_MPS", "autopilot_wind", "wind_triangle", "change_since_references"]
+__all__ = ["WIND_SYSTEMATIC_MPS", "autopilot_wind", "wind_triangle", "triangle_gain", "change_since_references"]
 
 #: 1-sigma systematic error (m/s, per horizontal component) of an autopilot's wind estimate over a flight:
 #: its slow wander (also the pitot cause's wind check, :func:`gcs_sysid.diagnose.pitot.wind_shift`).
@@ -87,24 +87,10 @@ def autopilot_wind(flight, t: np.ndarray) -> np.ndarray | None:
     return np.stack(out, axis=1)
 
 
-def wind_triangle(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight,
-                  wind_systematic: float = WIND_SYSTEMATIC_MPS) -> dict | None:
-    """Pitot bias from the wind triangle on one flight (see the module docstring).
-
-    Args:
-        t_grid: (T,) times of the state grid, s.
-        states: the pipeline's states on that grid: ``vn ve vd`` (smoothed GPS ground velocity, m/s) and
-            ``rho`` (air density, kg/m^3), each (T,).
-        valid: (T,) rows to use (the diagnosis' valid rows).
-        flight: the decoded flight: the pitot (``airspeed`` EAS or ``vfr_hud`` airspeed, m/s EAS) and,
-            when present, the autopilot's wind (``wind`` ``wn we``, m/s).
-        wind_systematic: 1-sigma prior of the constant correction to the autopilot's wind, m/s.
-
-    Returns:
-        None without a pitot, ground velocity or density, or with fewer than 100 usable samples; else
-        ``{"bias_mps", "std_error", "wind_correction_mps" (north, east), "heading_span_deg", "n",
-        "n_eff", "residual_rms_mps", "wind": "autopilot prior" | "solved (no autopilot wind)"}``.
-    """
+def _samples(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight):
+    """The pitot's usable samples on ``valid`` rows: ``(tas (N,), v_gps (N, 3), w_ap (N, 2), has_prior)``, or None
+    (no pitot, ground velocity or density; fewer than 100 usable samples). ``w_ap`` is zeros without an autopilot
+    wind."""
     if not all(k in states for k in ("vn", "ve", "vd", "rho")):
         return None
     p = _pitot(flight)
@@ -128,6 +114,68 @@ def wind_triangle(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight,
     tas, vg = tas[use], vg[use]
     prior = w_ap is not None
     w0 = w_ap[use] if prior else np.zeros((len(tas), 2))
+    return tas, vg, w0, prior
+
+
+def triangle_gain(t_grid: np.ndarray, states: dict, rows: np.ndarray, flight, cal: dict, before_mps: float,
+                  after_mps: float) -> dict | None:
+    """Gain of a pitot correction in the sensor's own units: the wind triangle's residual on ``rows``.
+
+    The residual is ``V_pitot - |v_gps - w_ap - dw| - b`` (m/s TAS) on the pitot's samples that fall in
+    ``rows`` (rows no fit has used: the diagnosis' untouched rows), with the flight's wind correction
+    ``dw`` (``cal["wind_correction_mps"]``, fitted with the bias, :func:`wind_triangle`) and the pitot
+    bias ``b`` = ``before_mps`` (what the reference flight(s) read: nothing changed) and then
+    ``after_mps`` (the named bias added). Not centred: a bias *is* the residual's level. The gain in the
+    sensor's own units, as for the other data-compatibility sensor causes
+    (:mod:`gcs_sysid.diagnose.compat`: every sensor against the kinematics; Morelli and Klein, *Aircraft
+    System Identification*, 2nd ed., ch. 10).
+
+    Args:
+        t_grid: (T,) times of the state grid, s. states, flight: as :func:`wind_triangle`.
+        rows: (T,) rows of the grid to score on. cal: :func:`wind_triangle` of this flight.
+        before_mps, after_mps: the pitot bias without and with the correction, m/s TAS.
+
+    Returns:
+        ``{"rms_before", "rms_after" (m/s), "percent", "n", "unit"}``, or None (no pitot, ground velocity or
+        density, fewer than 100 usable pitot samples in ``rows``, or no calibration ``cal``).
+    """
+    if cal is None:
+        return None
+    smp = _samples(t_grid, states, rows, flight)
+    if smp is None:
+        return None
+    tas, vg, w0, _ = smp
+    a = vg.copy()
+    a[:, :2] -= w0 + np.asarray(cal.get("wind_correction_mps", [0.0, 0.0]), float)[None, :]
+    r = tas - np.linalg.norm(a, axis=1)
+    b = float(np.sqrt(np.mean((r - before_mps) ** 2)))
+    f = float(np.sqrt(np.mean((r - after_mps) ** 2)))
+    return {"rms_before": b, "rms_after": f, "percent": float(100.0 * (1.0 - f / b)) if b > 0 else 0.0,
+            "n": int(len(r)), "unit": "m/s"}
+
+
+def wind_triangle(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight,
+                  wind_systematic: float = WIND_SYSTEMATIC_MPS) -> dict | None:
+    """Pitot bias from the wind triangle on one flight (see the module docstring).
+
+    Args:
+        t_grid: (T,) times of the state grid, s.
+        states: the pipeline's states on that grid: ``vn ve vd`` (smoothed GPS ground velocity, m/s) and
+            ``rho`` (air density, kg/m^3), each (T,).
+        valid: (T,) rows to use (the diagnosis' valid rows).
+        flight: the decoded flight: the pitot (``airspeed`` EAS or ``vfr_hud`` airspeed, m/s EAS) and,
+            when present, the autopilot's wind (``wind`` ``wn we``, m/s).
+        wind_systematic: 1-sigma prior of the constant correction to the autopilot's wind, m/s.
+
+    Returns:
+        None without a pitot, ground velocity or density, or with fewer than 100 usable samples; else
+        ``{"bias_mps", "std_error", "wind_correction_mps" (north, east), "heading_span_deg", "n",
+        "n_eff", "residual_rms_mps", "wind": "autopilot prior" | "solved (no autopilot wind)"}``.
+    """
+    smp = _samples(t_grid, states, valid, flight)
+    if smp is None:
+        return None
+    tas, vg, w0, prior = smp
     dw_total = np.zeros(2)
     theta, cov, r, A = np.zeros(3), np.eye(3), np.zeros(len(tas)), np.zeros((len(tas), 3))
     for _ in range(8 if not prior else 3):       # Gauss-Newton on the wind; linear in b

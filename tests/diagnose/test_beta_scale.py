@@ -8,7 +8,7 @@ import numpy as np
 
 from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS
 from gcs_sysid.diagnose.context import evaluate_model
-from gcs_sysid.diagnose.differential import beta_scale_allowance, offset_allowance
+from gcs_sysid.diagnose.differential import angle_error_allowance, beta_scale_allowance, offset_allowance
 
 MODEL = {"CX": {"1": -0.03}, "CY": {"beta": -0.6, "delta_r": 0.15}, "CZ": {"1": -0.4, "alpha": -4.5},
          "Cl": {"beta": -0.09, "p_hat": -0.45, "delta_a": -0.2}, "Cm": {"alpha": -0.9},
@@ -142,3 +142,35 @@ def test_an_alpha_error_aligned_with_part_of_the_flight_is_carried_by_the_block_
     # the jackknife of a slope that is the same in every block is about its sampling error
     se = block_jackknife_se(t, X[:, ia], R2[:, jm], np.ones(T, bool), 15.0)
     assert 0 < se < 0.01
+
+
+def test_a_sideslip_error_that_follows_the_yaw_rate_is_an_allowance_but_a_side_force_term_is_not():
+    """Eleventh session (branch i9-b747): the JSBSim b747's clean seed 15 read a ``CY:r_hat`` of +0.096 at 15
+    standard errors; against the truth it was the aided sideslip's error, +0.136 rad per unit of r_hat,
+    seen through CY_beta, and Cl and Cn showed the same error through their beta derivatives."""
+    X, noise, train, test = _flight(2)
+    ib, ir = REGRESSORS.index("beta"), REGRESSORS.index("r_hat")
+    # the measured sideslip carries 2 rad per unit of r_hat (0.02 rad RMS at this flight's 0.01 r_hat):
+    # the truth is the model on the true sideslip
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] - 2.0 * X[:, ir]
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    # r_hat is no sideslip term: the scale rule does not judge it, and alone the finding is more than an offset
+    assert beta_scale_allowance(X, R, train, test, MODEL, "CY", "r_hat") is None
+    assert not offset_allowance(X, R, train, test, "CY", "r_hat")["offset_only"]
+    # the error along r_hat, fitted on Cl and Cn, takes all of it
+    a = angle_error_allowance(X, R, train, test, MODEL, "CY", "r_hat")
+    assert a is not None and a["scale_only"], a
+    # the correction of the measured angle: true = measured + s r_hat, s = -2
+    assert abs(a["error_along_term"] + 2.0) < 0.3 and set(a["from"]) == {"Cl", "Cn"}
+
+    # a side-force change in r_hat alone (CY:r_hat +0.5): Cl and Cn see no sideslip error, the finding stands
+    j = COEFFICIENTS.index("CY")
+    R2 = noise.copy()
+    R2[:, j] += 0.5 * X[:, ir]
+    b = angle_error_allowance(X, R2, train, test, MODEL, "CY", "r_hat")
+    assert b is not None and not b["scale_only"], b
+    assert abs(b["error_along_term"]) < 0.3
+    # outside the sideslip's coefficients, or a term outside the vocabulary: not judged
+    assert angle_error_allowance(X, R, train, test, MODEL, "CZ", "r_hat") is None
+    assert angle_error_allowance(X, R, train, test, MODEL, "CY", "delta_r(t-0.1)-delta_r") is None

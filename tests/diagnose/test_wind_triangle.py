@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from gcs_sysid.diagnose.pitot import COEF_SYSTEMATIC_MPS, fuse_pitot_evidence
-from gcs_sysid.diagnose.wind_triangle import WIND_SYSTEMATIC_MPS, change_since_references, wind_triangle
+from gcs_sysid.diagnose.wind_triangle import (WIND_SYSTEMATIC_MPS, change_since_references, triangle_gain,
+                                              wind_triangle)
 from gcs_sysid.telemetry.types import Flight, Stream
 
 RHO = 1.1
@@ -122,3 +123,21 @@ def test_triangle_alone_screen_with_no_finite_refit_names_nothing(monkeypatch):
                                  [{"cause": "bias:airspeed", "estimate": 1.0, "std_error": 0.2}], None, 25.0)
     assert out["screen"]["triangle_alone"] and out["fused"] is None and not out["accepted"]
     assert "no finite coefficient estimate" in out["why"]
+
+
+def test_a_pitot_bias_gains_in_the_sensors_own_units_on_rows_no_fit_used():
+    """Eleventh session (branch i9-b747, ``pitot.SENSOR_GAIN``): a pitot bias's gain on the wind triangle's residual
+    (m/s), on untouched rows, against the reference's calibration. The gusts the wind estimate cannot follow are
+    the floor (here about 0.25 m/s RMS along track, the JSBSim b747's 0.37 m/s), so a 1 m/s bias gains well over
+    half of that residual while a coefficient gain at 134 m/s is limited by the turbulence."""
+    t, st, valid, fl = _flight(1.0, turn=False, seed=3)
+    rows = (np.floor(t / 8.0).astype(int) % 3) == 2             # every third 8-s block
+    fit = wind_triangle(t, st, valid & ~rows, fl)                 # fitted on the other rows only
+    g = triangle_gain(t, st, rows, fl, fit, 0.0, fit["bias_mps"])
+    assert g["unit"] == "m/s" and g["n"] > 1000
+    assert g["rms_before"] > 0.9 and g["rms_after"] < 0.45 and g["percent"] > 55.0, g
+    # no bias: the same correction explains nothing
+    t, st, valid, fl = _flight(0.0, turn=False, seed=3)
+    g0 = triangle_gain(t, st, rows, fl, wind_triangle(t, st, valid & ~rows, fl), 0.0, 1.0)
+    assert g0["percent"] < -50.0, g0
+    assert triangle_gain(t, st, rows, fl, None, 0.0, 1.0) is None
