@@ -119,8 +119,8 @@ class AxisFit:
         map_cov: ``(K, K)`` over ``map_columns``: second moment of the aided angle's flight-common *linear*
             error ``e(x) = sum_k M_k (x_k - mean x_k)`` (rad per unit of each regressor; the first entry is the
             scale). The force model's slopes, biased by errors in variables, make the aided angle's error
-            follow the manoeuvre: in moderate turbulence it is 2.5-10 times the per-sample sigma, while what
-            is left after this map is 0.5-1.5 times it (``docs/estimation.md``, "The aided angles' common
+            follow the manoeuvre: in moderate turbulence it is 2-10 times the per-sample sigma, while what
+            is left after this map is 0.5-1.7 times it (``docs/estimation.md``, "The aided angles' common
             linear error"). Stated as ``M M^T + Cov_jk(M)``: ``M`` the least-squares slopes of (aided -
             kinematic) on the centred columns, ``Cov_jk`` their block-jackknife covariance (15-s blocks,
             Kuensch 1989): :attr:`scale_sigma`'s rule on every column. Common to the flight, so it cancels

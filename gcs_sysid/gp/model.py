@@ -181,7 +181,7 @@ class LocalGlobalGP:
                 coefficient itself does not, and keep the coloured rest of the noise (what the regressors
                 do not explain and the coefficient does carry: gust rates, unsteady terms): the band for the
                 coefficient, noise floored at 0 (at exact conditions at ``d``). Rasmussen and Williams
-                (2006), eqs. 2.24-2.26: the latent ``f*`` against the noisy ``y* = f* + eps``, with only the
+                (2006), eqs. 2.22-2.26: the latent ``f*`` against the noisy ``y* = f* + eps``, with only the
                 white ``eps`` as measurement noise. Without a known ``w`` (no blocked validation) the whole
                 noise is kept (conservative). ``docs/gp.md``, "Two bands: the coefficient and a new
                 measurement".
