@@ -17,10 +17,14 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
          (c172x, sgs, c182, t37, t6, b747: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
          so ``tair`` = ``true``; ``true`` has the inertial rates a gyro measures)
   ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
-  cov    share of the truth inside the model's 95 % band (gp: the replay's sigma with noise;
-         true: the model's sigma without noise, at exact conditions, with the model's error there,
-         ``docs/gp.md``; ``cov_true_latent`` in the JSON: the latent band alone), averaged over the six
-         coefficients (``cov_true_each``, ``cov_gp_each``: per coefficient)
+  cov    share of the truth inside the model's 95 % band, averaged over the six coefficients
+         (``cov_gp_each`` etc. in the JSON: per coefficient). The truth is noise-free, so both scored bands
+         are bands for the coefficient itself (``docs/gp.md``, "Two bands"; ``docs/jsbsim.md``, "What the
+         coverage criterion scores"): gp: the replay's ``<C>_sigma`` at the flight's estimated
+         regressors, without the white measurement noise (since the eleventh session; before, the band
+         with it, now ``cov_gp_obs``: the replay's ``<C>_sigma_obs``, a band for a new measurement);
+         true: the model's sigma without noise at exact conditions, with the model's error there
+         (``cov_true_latent`` in the JSON: the latent band alone)
   air    alpha and beta RMS errors of the reconstructed air data, deg (all valid rows)
 
 Usage::
@@ -140,8 +144,19 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     tab_flat = compute_coefficients(estimate_states(read_log(files.tlog), af, earth="flat"), af)
     row["meas_flat"] = _errs(tab_flat.Y[h], Yt[h])
     row["gp"] = _errs(res.pred_mean[h], Yt[h])
+    # the coefficient's band (no white measurement noise; the truth carries none) and a measurement's band
     row["cov_gp"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]))
+    row["cov_gp_obs"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma_obs[h, i], Yt[h, i])
+                                          for i in range(6)]))
+    row["cov_gp_obs_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma_obs[h, i], Yt[h, i]) for i in range(6)]
     model = load_gp(Path(res.model_path))
+    if model.discrepancy is not None and model.n_outputs == 6:
+        # a diagnosis, not a criterion: the coefficient band with its coloured noise share floored at the
+        # blocked validation's discrepancy d (as at exact conditions)
+        d = np.asarray(model.discrepancy)[0] * model.scaler.y_std**2
+        col = model.noise_var(white_noise=False)
+        sd = np.sqrt(res.pred_sigma[h] ** 2 + np.maximum(d - col, 0.0)[None, :])
+        row["cov_gp_dfloor"] = float(np.nanmean([_coverage(res.pred_mean[h, i], sd[:, i], Yt[h, i]) for i in range(6)]))
     mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)   # exact regressors
     row["true"] = _errs(np.asarray(mt), Yt[h])
     ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
@@ -188,7 +203,8 @@ def summarize(paths: list[str]) -> str:
         for k, label in scores:
             if not all(k in r for r in rs):      # rows written before the score existed
                 continue
-            cov = {"gp": f"{med('cov_gp'):.0f}", "true": f"{med('cov_true'):.0f}",
+            obs = f" (measurement {med('cov_gp_obs'):.0f})" if all("cov_gp_obs" in r for r in rs) else ""
+            cov = {"gp": f"{med('cov_gp'):.0f}{obs}", "true": f"{med('cov_true'):.0f}",
                    "true_air": f"{med('cov_true_air'):.0f}" if all("cov_true_air" in r for r in rs) else ""}.get(k, "")
             air = (f"{med('alpha_deg'):.2f} / {med('beta_deg'):.2f} ({med('alpha_rms_deg'):.2f} / "
                    f"{med('beta_rms_deg'):.2f})") if k == "meas" else ""
@@ -256,7 +272,7 @@ def main(argv=None) -> int:
                 print(f"{'':32s} flat  {_fmt(row['meas_flat'])}   (measured, flat-Earth velocity filter)")
                 print(f"{'':32s} gp    {_fmt(row['gp'])}   {row['cov_gp']:5.1f}  "
                       f"{row['alpha_deg']:.2f}/{row['beta_deg']:.2f} (signal {row['alpha_rms_deg']:.2f}/"
-                      f"{row['beta_rms_deg']:.2f})")
+                      f"{row['beta_rms_deg']:.2f}); band for a measurement {row['cov_gp_obs']:.1f}")
                 print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}  (latent alone "
                       f"{row['cov_true_latent']:.1f}; per coefficient " + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
                       + ")")

@@ -296,7 +296,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
         pred_mean = np.full(table.Y.shape, np.nan)
-        pred_sigma = np.full(table.Y.shape, np.nan)
+        pred_sigma = np.full(table.Y.shape, np.nan)        # the coefficient itself (no white measurement noise)
+        pred_sigma_obs = np.full(table.Y.shape, np.nan)    # a new measurement of it (with that noise)
         model = None
         envelope = None
         suggestions = []
@@ -318,7 +319,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                         raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
                                          f"this flight identifies {len(fit_cols)}")
                     model = with_offset_covariance(model.update(X_train, Y_train), table.x_offset_cov,
-                                                   rows=len(X_train), scale_var=table.x_scale_var)
+                                                   rows=len(X_train), scale_var=table.x_scale_var,
+                                                   map_cov=table.x_map_cov)
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
@@ -326,17 +328,23 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     model, _history = fit_gp(X_train, Y_train, cfg)
                     # the estimator's flight-common regressor offset (alpha: mean vertical wind / V): the
                     # band at exact conditions (gcs-sysid predict) carries it through the slope
-                    model = with_offset_covariance(model, table.x_offset_cov, scale_var=table.x_scale_var)
+                    # and the aided angles' common scale and linear error (docs/gp.md, "The band at exact conditions")
+                    model = with_offset_covariance(model, table.x_offset_cov, scale_var=table.x_scale_var,
+                                                   map_cov=table.x_map_cov)
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 if rows.any():
                     # the estimator's stated per-row air-angle variance: errors the residuals cannot show
                     mean, var = model.predict(table.X[rows], x_var=None if table.x_var is None else table.x_var[rows])
                     pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
-                    pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
+                    pred_sigma_obs[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
+                    # the coefficient's band: the same less the white measurement noise (docs/gp.md, "Two bands")
+                    white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
+                    pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.maximum(np.asarray(var) - white[None, :], 0.0))
             gp_summary = model.summary()
             gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
-            draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma, held, ident)
+            # the measurements are drawn against the band for a measurement
+            draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma_obs, held, ident)
             corr = correlation_of(gp_summary, gp_summary["outputs"])
             if corr is not None:
                 draw("correlation", "correlation_figure", *corr)
@@ -378,7 +386,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             log_path=str(log), airframe_name=airframe.name, airframe_path=str(airframe_path),
             vehicle=dict(flight.vehicle), window=(options.t_from, options.t_to),
             summaries=dict(flight.summaries), messages=dict(flight.messages), states=states, table=table,
-            held_out=held, train=train, pred_mean=pred_mean, pred_sigma=pred_sigma, metrics=metrics,
+            held_out=held, train=train, pred_mean=pred_mean, pred_sigma=pred_sigma, pred_sigma_obs=pred_sigma_obs,
+            metrics=metrics,
             identifiable=ident, envelope=envelope, suggestions=suggestions, gp_summary=gp_summary,
             model_path=model_path, missing=list(states.missing),
             notes=list(flight.warnings) + list(states.notes) + list(table.notes) + notes, timings=timings,

@@ -29,7 +29,13 @@ class ReplayResult:
         table: regressors and measured coefficients on the grid.
         held_out: (T,) bool, the held-out time segment (never used for fitting).
         train: (T,) bool, rows the GP was fitted on (valid and not held out).
-        pred_mean, pred_sigma: (T, 6) model mean and 1-sigma (predictive, incl. noise) on every row; NaN where invalid.
+        pred_mean: (T, 6) model mean on every row; NaN where invalid.
+        pred_sigma: (T, 6) 1-sigma of the coefficient itself at the row's estimated regressors: latent variance,
+            the regressors' errors through the slope and the coloured part of the observation noise, without
+            the white measurement noise (``docs/gp.md``, "Two bands"); NaN where invalid.
+        pred_sigma_obs: (T, 6) 1-sigma of a new measurement of it (``pred_sigma`` plus the white measurement
+            noise); NaN where invalid or not known (a result saved before the eleventh session: there
+            ``pred_sigma`` held this band, and :func:`gcs_sysid.report.load_result` moves it here).
         metrics: coefficient -> {"error_pct_heldout", "error_pct_train", "rms_measured", "n_heldout", ...}.
         identifiable: coefficient -> (bool, reason) whether the data support an estimate.
         envelope: the confidence map (``gcs_sysid.envelope.EnvelopeMap``) or None.
@@ -63,3 +69,8 @@ class ReplayResult:
     missing: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     timings: dict[str, float] = field(default_factory=dict)
+    pred_sigma_obs: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.pred_sigma_obs is None:
+            self.pred_sigma_obs = np.full(np.shape(self.pred_sigma), np.nan)

@@ -64,6 +64,22 @@ def test_report_files_written(roundtrip):
         assert (rep / name).stat().st_size > 0, name
     header = (rep / "coefficients.csv").read_text().splitlines()[0].split(",")
     assert header[0] == "time_s" and "Cm_pred" in header and "Cn_sigma" in header and header[-1] == "held_out"
+    assert "Cn_sigma_obs" in header
+
+
+def test_replay_bands_coefficient_and_measurement(roundtrip):
+    """``pred_sigma`` (the coefficient) is ``pred_sigma_obs`` (a new measurement) less the model's white
+    measurement noise, row by row (docs/gp.md, "Two bands")."""
+    from gcs_sysid.gp import load_gp
+
+    _, result, _ = roundtrip
+    model = load_gp(Path(result.model_path))
+    ok = np.isfinite(result.pred_sigma_obs).all(axis=1)
+    assert ok.sum() > 500
+    white = model.noise_var() - model.noise_var(white_noise=False)
+    assert (white > 0).all()
+    np.testing.assert_allclose(result.pred_sigma_obs[ok] ** 2 - result.pred_sigma[ok] ** 2,
+                               np.broadcast_to(white, (int(ok.sum()), 6)), rtol=1e-6, atol=1e-14)
     assert result.model_path and Path(result.model_path + ".npz").exists() and Path(result.model_path + ".json").exists()
 
 

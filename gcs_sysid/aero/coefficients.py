@@ -32,7 +32,8 @@ from ..airframe import Airframe
 from ..estimation.states import FlightStates
 from .table import REGRESSORS, CoefficientTable
 
-__all__ = ["compute_coefficients", "aero_moments", "stated_input_variance", "stated_scale_variance", "QBAR_MIN",
+__all__ = ["compute_coefficients", "aero_moments", "stated_input_variance", "stated_scale_variance",
+           "stated_map_covariance", "QBAR_MIN",
            "STATED_INPUT_NOISE"]
 
 QBAR_MIN = 5.0  #: Pa; rows with a smaller dynamic pressure are not valid (coefficients blow up)
@@ -94,6 +95,36 @@ def stated_scale_variance(states: FlightStates) -> np.ndarray | None:
     return out if np.any(out) else None
 
 
+def stated_map_covariance(states: FlightStates) -> np.ndarray | None:
+    """Second moment of the aided air angles' flight-common linear error, ``(10, 10, 10)``.
+
+    An aided angle's error that follows the manoeuvre, ``e_j(x) = sum_d M_jd (x_d - mean x_d)`` (the force
+    model's slopes biased by errors in variables: the scale, and e.g. alpha's error along ``q_hat`` and
+    ``delta_e``), as the estimator states it (:attr:`gcs_sysid.estimation.airangles.AxisFit.map_cov`). A model
+    learned on such angles is off by ``-dm/dx_j e_j(x)`` at exact conditions; at the flight's own
+    regressors it cancels (``docs/estimation.md``, "The aided angles' common linear error").
+
+    Args:
+        states: smoothed states with ``angle_fits``.
+
+    Returns:
+        ``(10, 10, 10)``: ``[j]`` the ``(10, 10)`` second moment of ``M_j.`` for aided angle ``j`` (units of
+        ``x_j^2 / (x_d x_e)``; columns :data:`~gcs_sysid.aero.table.REGRESSORS`), zeros for the other
+        regressors and terms; None when no axis stated one.
+    """
+    fits = getattr(states, "angle_fits", None) or {}
+    D = len(REGRESSORS)
+    out = np.zeros((D, D, D))
+    for k, fit in fits.items():
+        cols, C = tuple(getattr(fit, "map_columns", ())), np.asarray(getattr(fit, "map_cov", np.zeros((0, 0))), float)
+        if (k not in REGRESSORS or not getattr(fit, "used", False) or not cols or C.shape != (len(cols),) * 2
+                or not np.isfinite(C).all() or any(c not in REGRESSORS for c in cols)):
+            continue
+        idx = [REGRESSORS.index(c) for c in cols]
+        out[REGRESSORS.index(k)][np.ix_(idx, idx)] = C
+    return out if np.any(out) else None
+
+
 def aero_moments(airframe: Airframe, p, q, r, p_dot, q_dot, r_dot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Aerodynamic (plus propulsive) moments L, M, N in N m from rates and accelerations.
 
@@ -150,7 +181,8 @@ def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: s
         order of :data:`REGRESSORS`, ``Y`` (T, 6) in the order of
         :data:`COEFFICIENTS`; ``valid`` = ``states.valid`` and every entry finite
         and ``qbar > QBAR_MIN``; ``x_offset_cov`` from ``states.offsets`` (regressor units squared);
-        ``x_var`` from :func:`stated_input_variance`, ``x_scale_var`` from :func:`stated_scale_variance`.
+        ``x_var`` from :func:`stated_input_variance`, ``x_scale_var`` from :func:`stated_scale_variance`,
+        ``x_map_cov`` from :func:`stated_map_covariance`.
 
     Source: Klein and Morelli (2006) ch. 3; Stevens, Lewis and Johnson (2016) ch. 1.
     """
@@ -200,4 +232,5 @@ def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: s
         # errors common to the whole flight (alpha: the mean vertical wind over V): one draw, not per-row noise
         x_offset_cov = np.diag([float(offsets.get(k, 0.0)) ** 2 for k in REGRESSORS])
     return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes, x_offset_cov,
-                            stated_input_variance(states), stated_scale_variance(states))
+                            stated_input_variance(states), stated_scale_variance(states),
+                            stated_map_covariance(states))

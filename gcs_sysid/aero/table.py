@@ -41,6 +41,10 @@ class CoefficientTable:
             (dimensionless; 0 where none is stated), or None: the aided air angles' ``AxisFit.scale_sigma``
             squared. The GP's band at exact conditions carries it (``docs/gp.md``, "The band at exact
             conditions").
+        x_map_cov: ``(10, 10, 10)`` second moment of the aided angles' flight-common linear error (``[j]``:
+            regressor ``j``'s error along the regressors, ``coefficients.stated_map_covariance``), or None.
+            Where stated for an angle, the GP's band at exact conditions carries it in place of that
+            angle's ``x_scale_var`` (``docs/gp.md``, "The band at exact conditions").
     """
 
     t: np.ndarray
@@ -52,6 +56,7 @@ class CoefficientTable:
     x_offset_cov: np.ndarray | None = None
     x_var: np.ndarray | None = None
     x_scale_var: np.ndarray | None = None
+    x_map_cov: np.ndarray | None = None
 
     def x(self, name: str) -> np.ndarray:
         """Regressor column by name, shape (T,)."""
@@ -65,4 +70,4 @@ class CoefficientTable:
         """Rows where ``mask`` (T,) is True."""
         return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
                                 list(self.notes), self.x_offset_cov, None if self.x_var is None else self.x_var[mask],
-                                self.x_scale_var)
+                                self.x_scale_var, self.x_map_cov)

@@ -113,6 +113,19 @@ class AxisFit:
         bias_sigma: 1-sigma of the angle's flight-common offset, rad (alpha: the flight-mean vertical
             wind over the airspeed, :func:`gcs_sysid.estimation.angleerrors.mean_wind_sigma`; NaN for beta,
             whose mean the wind fit and the CY0 prior set). Included in the per-sample sigma.
+        map_columns: regressors of the force model the aided angle is built from: the angle itself, then
+            the others (alpha: ``alpha q_hat delta_e``; beta: ``beta p_hat r_hat delta_a delta_r``), those that
+            vary; empty where not aided.
+        map_cov: ``(K, K)`` over ``map_columns``: second moment of the aided angle's flight-common *linear*
+            error ``e(x) = sum_k M_k (x_k - mean x_k)`` (rad per unit of each regressor; the first entry is the
+            scale). The force model's slopes, biased by errors in variables, make the aided angle's error
+            follow the manoeuvre: in moderate turbulence it is 2-10 times the per-sample sigma, while what
+            is left after this map is 0.5-1.7 times it (``docs/estimation.md``, "The aided angles' common
+            linear error"). Stated as ``M M^T + Cov_jk(M)``: ``M`` the least-squares slopes of (aided -
+            kinematic) on the centred columns, ``Cov_jk`` their block-jackknife covariance (15-s blocks,
+            Kuensch 1989): :attr:`scale_sigma`'s rule on every column. Common to the flight, so it cancels
+            at the flight's own regressors and belongs to the band at exact conditions only. Empty where
+            not aided.
     """
 
     name: str
@@ -133,6 +146,8 @@ class AxisFit:
     first_stage_r2: float = float("nan")
     bias_sigma: float = float("nan")
     scale_sigma: float = float("nan")
+    map_columns: tuple[str, ...] = ()
+    map_cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
 
 @dataclass
@@ -360,6 +375,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             sig = np.sqrt(sig**2 + fit.bias_sigma**2)
     if fit is not None:
         fit.scale_sigma = _scale_disagreement(dt, ang, kin0, m)
+        fit.map_columns, fit.map_cov = _map_disagreement(dt, name, ang, kin0, cols, X_other, m)
     if moments is not None and fit is not None:
         # cross-check that does not use the forces: the moments depend on the angle too (Cm_alpha; Cl_beta,
         # Cn_beta) and are measured by the gyro, not by the accelerometers the aiding used. If the aided
@@ -400,6 +416,41 @@ def _scale_disagreement(dt: float, ang: np.ndarray, kin: np.ndarray, m: np.ndarr
     cov = block_jackknife_cov(np.nonzero(ok)[0] * dt, np.column_stack([np.ones(x.size), x]), y, block_s)
     se = float(np.sqrt(max(cov[1, 1], 0.0))) if cov is not None and np.isfinite(cov[1, 1]) else 0.0
     return float(np.hypot(d, se))
+
+
+def _map_disagreement(dt: float, name: str, ang: np.ndarray, kin: np.ndarray, cols: list[str], X_other: np.ndarray,
+                      m: np.ndarray, block_s: float = 15.0) -> tuple[tuple[str, ...], np.ndarray]:
+    """The aided angle's flight-common linear error along the force model's regressors (:attr:`AxisFit.map_cov`).
+
+    The slopes ``M`` of (aided - kinematic) on the centred columns ``[angle, others]`` (least squares on the
+    aided rows) and their delete-a-block jackknife covariance (:func:`gcs_sysid.jackknife.block_jackknife_cov`);
+    :func:`_scale_disagreement` is the one-column case. Conservative where the true gust correlates with a
+    column (the gust is part of the true angle and the aircraft answers it with its rates): that share
+    counts as possible error too.
+
+    Args:
+        dt: sample interval, s. name: ``"alpha"`` or ``"beta"``. ang, kin: (T,) aided and kinematic angle, rad.
+        cols: names of ``X_other``'s columns (T, Q). m: (T,) bool rows aided.
+
+    Returns:
+        ``(columns, (K, K) M M^T + Cov_jk)``, rad^2 per unit of the regressors; ``((), (0, 0))`` with too few
+        rows or a singular fit.
+    """
+    ok = np.asarray(m, bool) & np.isfinite(ang) & np.isfinite(kin) & np.all(np.isfinite(X_other), axis=1)
+    if ok.sum() < 150:
+        return (), np.zeros((0, 0))
+    A = np.column_stack([ang[ok], X_other[ok]])
+    keep = A.std(axis=0) > 1e-12
+    keep[0] = True
+    names = tuple(n for n, k in zip((name, *cols), keep) if k)
+    A = A[:, keep] - A[:, keep].mean(axis=0)
+    y = (ang - kin)[ok]
+    M, _, rank, _ = np.linalg.lstsq(A, y - y.mean(), rcond=None)
+    if rank < A.shape[1]:
+        return (), np.zeros((0, 0))
+    cov = block_jackknife_cov(np.nonzero(ok)[0] * dt, np.column_stack([np.ones(len(y)), A]), y, block_s)
+    jk = cov[1:, 1:] if cov is not None and np.isfinite(cov).all() else np.zeros((len(M), len(M)))
+    return names, np.outer(M, M) + jk
 
 
 def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: np.ndarray, qbar: np.ndarray,

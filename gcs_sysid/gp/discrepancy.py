@@ -139,7 +139,16 @@ def offset_covariance_s(scaler, cov: np.ndarray) -> np.ndarray:
     return np.asarray(cov, float) * s[:, None] * s[None, :]
 
 
-def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None):
+def map_covariance_s(scaler, cov: np.ndarray) -> np.ndarray:
+    """``(D, D, D)`` second moment of the regressors' common linear error in standardised units: ``[j]`` maps
+    standardised ``x`` to standardised ``x_j``, so ``C_s[j] = C[j] * s s^T / s_j^2`` (``s`` the regressors'
+    scales); inactive regressors zero."""
+    s = np.where(scaler.active, scaler.x_std, 0.0)
+    sj = np.where(scaler.active, scaler.x_std, np.inf)
+    return np.asarray(cov, float) * (s[:, None] * s[None, :])[None, :, :] / sj[:, None, None] ** 2
+
+
+def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None, map_cov=None):
     """``model`` with the covariance of its training regressors' flight-common offset (and scale error).
 
     Args:
@@ -155,12 +164,18 @@ def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None):
             (dimensionless; ``CoefficientTable.x_scale_var``), or None (the model keeps what it has);
             combined across flights as ``cov`` is. At exact conditions it adds
             ``sum_d (dm/dx_d)^2 scale_var_d (x_d - mean x_d)^2`` (module docstring, item 1).
+        map_cov: ``(D, D, D)`` second moment of the regressors' flight-common linear error
+            (``CoefficientTable.x_map_cov``: ``[j]`` of regressor ``j``'s error along the regressors, in
+            ``x_j^2 / (x_d x_e)``), or None (the model keeps what it has); combined across flights as ``cov``
+            is. At exact conditions it adds ``sum_j (dm/dx_j)^2 (x - mean x)^T C_j (x - mean x)``, in place of
+            ``scale_var_j`` for every ``j`` with a nonzero ``C_j`` (module docstring, item 1).
 
     Returns:
-        A new model (``offset_cov`` standardised ``(D, D)``, ``scale_var`` ``(D,)``).
+        A new model (``offset_cov`` standardised ``(D, D)``, ``scale_var`` ``(D,)``, ``map_cov`` ``(D, D, D)``).
 
     Raises:
-        InputError: ``cov`` is not ``(D, D)`` or ``scale_var`` not ``(D,)``, or either is not finite.
+        InputError: ``cov`` is not ``(D, D)``, ``scale_var`` not ``(D,)`` or ``map_cov`` not ``(D, D, D)``, or
+            one is not finite.
     """
     D = model.n_inputs
 
@@ -177,6 +192,12 @@ def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None):
         if S.shape != (D,) or not np.isfinite(S).all():
             raise InputError(f"gp: scale variance must be a finite ({D},) vector, got shape {S.shape}")
         model = replace(model, scale_var=combine(model.scale_var, np.where(model.scaler.active, S, 0.0)))
+    if map_cov is not None:
+        Mc = np.asarray(map_cov, float)
+        if Mc.shape != (D, D, D) or not np.isfinite(Mc).all():
+            raise InputError(f"gp: linear-error map covariance must be a finite ({D}, {D}, {D}) array, got shape "
+                             f"{Mc.shape}")
+        model = replace(model, map_cov=combine(getattr(model, "map_cov", None), map_covariance_s(model.scaler, Mc)))
     if cov is None:
         return model
     C = np.asarray(cov, float)
@@ -185,7 +206,8 @@ def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None):
     return replace(model, offset_cov=combine(model.offset_cov, offset_covariance_s(model.scaler, C)))
 
 
-def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = None) -> np.ndarray:
+def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = None,
+                             white_noise: bool = True) -> np.ndarray:
     """What the model's error at exact conditions adds to its latent variance, ``(N, P)`` at standardised
     ``Xs (N, D)`` (standardised units; module docstring).
 
@@ -194,6 +216,9 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
         Xs: ``(N, D)`` standardised exact regressors.
         noise: ``(P,)`` the observation-noise variance to include (a new measurement at exact
             conditions), or None (the coefficient itself).
+        white_noise: with ``noise``, False leaves the white part ``w`` out of the noise term (what the
+            coefficient carries of it: ``max(noise, d + w) - w = max(noise - w, d)``; ``docs/gp.md``, "Two
+            bands"); ignored without a discrepancy (``w`` unknown: the noise is kept).
 
     Returns:
         ``v_off(x) + v_scale(x) + d`` without noise; ``v_off(x) + v_scale(x) + max(noise, d + w)`` with
@@ -202,19 +227,28 @@ def exact_condition_variance(model, Xs: np.ndarray, noise: np.ndarray | None = N
     """
     out = np.zeros((len(Xs), model.n_outputs))
     off = model.offset_cov is not None and np.any(model.offset_cov)
-    scale = getattr(model, "scale_var", None) is not None and np.any(model.scale_var)
-    if (off or scale) and len(Xs):
+    Mc = getattr(model, "map_cov", None)
+    mapped = np.zeros(model.n_inputs, bool) if Mc is None else np.any(np.asarray(Mc) != 0, axis=(1, 2))
+    sv = getattr(model, "scale_var", None)
+    sv = None if sv is None else np.where(mapped, 0.0, np.asarray(sv))     # the map holds those angles' scale
+    scale = sv is not None and np.any(sv)
+    if (off or scale or mapped.any()) and len(Xs):
         from .inputnoise import mean_gradient
 
         g = mean_gradient(model.params, model.post, Xs, model.config.batch_size)      # (N, P, D)
         if off:
             out += np.einsum("npd,de,npe->np", g, np.asarray(model.offset_cov), g)
         if scale:       # a scale error s_d of x_d about the training mean: standardised x_d is x_d - mean
-            out += np.einsum("npd,d,nd->np", g**2, np.asarray(model.scale_var), np.asarray(Xs) ** 2)
+            out += np.einsum("npd,d,nd->np", g**2, sv, np.asarray(Xs) ** 2)
+        for j in np.nonzero(mapped)[0]:     # x_j's error along all regressors, e_j = M_j (x - mean x)
+            ve = np.einsum("nd,de,ne->n", np.asarray(Xs), np.asarray(Mc)[j], np.asarray(Xs))
+            out += g[:, :, j] ** 2 * ve[:, None]
     if model.discrepancy is None:
         return out if noise is None else out + np.asarray(noise)[None, :]
     d, w = np.asarray(model.discrepancy)
-    return out + (d if noise is None else np.maximum(np.asarray(noise), d + w))[None, :]
+    if noise is None:
+        return out + d[None, :]
+    return out + (np.maximum(np.asarray(noise), d + w) - (0.0 if white_noise else w))[None, :]
 
 
 def model_error_summary(model) -> dict | None:

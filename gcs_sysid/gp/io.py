@@ -31,6 +31,8 @@ VERSION = 5   # 2: the region-thinned row store (rows_*) replaces store_X / stor
 #                  (coloured residuals). Optional offset_cov (D, D) and discrepancy (2, P) (the model's
 #                  error at exact conditions, gp/discrepancy.py); files without them read as before.
 #                  Optional scale_var (D,) (the same, a common scale error; tenth session).
+#                  Optional map_cov (D, D, D) (the same, the aided angles' common linear error; eleventh
+#                  session); files without it read as before.
 #               5: per-output statistics (rows with missing outputs, gp/sparse.py): stats_C (P, M, M),
 #                  stats_E (P, M, D+1), stats_F (P, D+1, D+1), stats_n (P,). Written only by such models;
 #                  a model with complete rows is still written as version 4.
@@ -62,7 +64,7 @@ def save_model(model: LocalGlobalGP, path) -> str:
         arrays["input_var"] = np.asarray(model.input_var)
     if model.var_scale is not None:
         arrays["var_scale"] = np.asarray(model.var_scale)
-    for k in ("offset_cov", "discrepancy", "scale_var"):
+    for k in ("offset_cov", "discrepancy", "scale_var", "map_cov"):
         if getattr(model, k) is not None:
             arrays[k] = np.asarray(getattr(model, k))
     if model.params.noise_chol is not None:
@@ -161,4 +163,4 @@ def load_gp(path) -> LocalGlobalGP:
                          tuple(meta.get("notes", [])), rows=rows, since_refresh=int(meta.get("since_refresh", 0)),
                          evicted=evicted, input_var=a.get("input_var"), var_scale=a.get("var_scale"),
                          offset_cov=a.get("offset_cov"), discrepancy=a.get("discrepancy"),
-                         scale_var=a.get("scale_var"))
+                         scale_var=a.get("scale_var"), map_cov=a.get("map_cov"))

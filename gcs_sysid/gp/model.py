@@ -73,6 +73,9 @@ class LocalGlobalGP:
             (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
         scale_var: ``(D,)`` variance of the training regressors' relative scale error common to the flight
             (dimensionless; :mod:`gcs_sysid.gp.discrepancy`), None when not known.
+        map_cov: ``(D, D, D)`` second moment of the training regressors' flight-common linear error, ``[j]`` for
+            regressor ``j`` along all regressors (standardised; :mod:`gcs_sysid.gp.discrepancy`; in place of
+            ``scale_var_j`` where ``[j]`` is not zero), None when not known.
         discrepancy: ``(2, P)``: the model discrepancy ``d`` and the white noise ``w`` per output from
             the blocked cross-validation (standardised; :mod:`gcs_sysid.gp.discrepancy`), None when the
             check did not run.
@@ -100,6 +103,7 @@ class LocalGlobalGP:
     offset_cov: np.ndarray | None = None
     discrepancy: np.ndarray | None = None
     scale_var: np.ndarray | None = None
+    map_cov: np.ndarray | None = None
 
     # ------------------------------------------------------------ derived
     @property
@@ -147,7 +151,8 @@ class LocalGlobalGP:
         return mean, var
 
     def predict(self, X, include_noise: bool = True, input_noise: bool = True,
-                model_error: bool | None = None, x_var=None) -> tuple[np.ndarray, np.ndarray]:
+                model_error: bool | None = None, x_var=None,
+                white_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance of the coefficients.
 
         Args:
@@ -170,6 +175,16 @@ class LocalGlobalGP:
                 residuals, and an air angle built from the measured coefficient itself (the
                 specific-force aiding) carries errors that move the coefficient with it and do not
                 (``docs/gp.md``, "Noisy inputs: the estimator's stated variance").
+            white_noise: with ``include_noise``, keep the white part of the observation noise. False: leave
+                out the white measurement noise ``w_p`` (the lag-1 semivariogram of the time-ordered training
+                residuals, :mod:`gcs_sysid.gp.discrepancy`), which a new *measurement* carries and the
+                coefficient itself does not, and keep the coloured rest of the noise (what the regressors
+                do not explain and the coefficient does carry: gust rates, unsteady terms): the band for the
+                coefficient, noise floored at 0 (at exact conditions at ``d``). Rasmussen and Williams
+                (2006), eqs. 2.22-2.26: the latent ``f*`` against the noisy ``y* = f* + eps``, with only the
+                white ``eps`` as measurement noise. Without a known ``w`` (no blocked validation) the whole
+                noise is kept (conservative). ``docs/gp.md``, "Two bands: the coefficient and a new
+                measurement".
 
         Returns:
             ``(mean (N, P), var (N, P))`` in the outputs' units (variance in units squared).
@@ -186,24 +201,51 @@ class LocalGlobalGP:
                 raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
             xv_s = np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
         mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
-        noise = np.asarray(self.params.noise)
+        noise = self._noise_s()
         if self.local_params is not None and self.store is not None:
             ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
             mean, var = mean + ml, var + vl
-            # the larger of the two layers' noise variances: the local nugget, learned from
-            # nearest-neighbour differences of 50 Hz rows that share a gust's error, sees only the
-            # white part of the noise; the global layer's likelihood noise also holds the coloured
-            # part (docs/gp.md, "Noise"; measured on JSBSim flights, docs/benchmarks.md)
-            noise = np.maximum(noise, np.asarray(self.local_params.noise))
+        white = None if white_noise or not include_noise else self.white_noise_var()
         if (not input_noise) if model_error is None else model_error:
             from .discrepancy import exact_condition_variance
 
-            var = var + exact_condition_variance(self, Xs, noise if include_noise else None)
+            var = var + exact_condition_variance(self, Xs, noise if include_noise else None,
+                                                 white_noise=white is None)
         elif include_noise:
-            var = var + noise[None, :]
+            var = var + (noise if white is None else np.maximum(noise - white, 0.0))[None, :]
         if input_noise and (self.input_var is not None or xv_s is not None) and len(Xs):
             var = var + self.input_variance_s(Xs, xv_s)
         return self._finish(ok, mean, var)
+
+    def _noise_s(self) -> np.ndarray:
+        """``(P,)`` observation-noise variance (standardised): the larger of the global likelihood's and the
+        local nugget. The local nugget, learned from nearest-neighbour differences of 50 Hz rows that share a
+        gust's error, sees only the white part of the noise; the global layer's likelihood noise also holds
+        the coloured part (docs/gp.md, "Noise"; measured on JSBSim flights, docs/benchmarks.md)."""
+        noise = np.asarray(self.params.noise)
+        if self.local_params is not None and self.store is not None:
+            noise = np.maximum(noise, np.asarray(self.local_params.noise))
+        return noise
+
+    def noise_var(self, white_noise: bool = True) -> np.ndarray:
+        """``(P,)`` the observation-noise variance that :meth:`predict` adds at a flight's own regressors
+        (``include_noise=True, input_noise=True``), in the outputs' units squared: ``max(sigma_p^2, tau_p^2)``,
+        or with ``white_noise=False`` that less the white part ``w_p``, floored at 0 (:meth:`white_noise_var`;
+        the whole noise when ``w`` is not known). The two bands' variances at a flight's regressors differ by
+        exactly ``noise_var(True) - noise_var(False)`` (``docs/gp.md``, "Two bands")."""
+        noise = self._noise_s()
+        w = None if white_noise else self.white_noise_var()
+        if w is not None:
+            noise = np.maximum(noise - w, 0.0)
+        return noise * self.scaler.y_std**2
+
+    def white_noise_var(self) -> np.ndarray | None:
+        """``(P,)`` the white measurement-noise variance ``w`` of the outputs (standardised units): the lag-1
+        semivariogram of the time-ordered training residuals that the blocked validation stored
+        (:func:`gcs_sysid.gp.discrepancy.white_noise_variance`; Cressie 1993 sec. 2.4); None when not known."""
+        if self.discrepancy is None:
+            return None
+        return np.asarray(self.discrepancy, float)[1]
 
     def input_variance_s(self, Xs: np.ndarray, x_var_s: np.ndarray | None = None) -> np.ndarray:
         """``grad m_p^T Sigma_x grad m_p`` ``(N, P)`` at standardised ``Xs (N, D)`` (standardised units;

@@ -125,7 +125,8 @@ def coefficients_figure(table: CoefficientTable, pred_mean: np.ndarray, pred_sig
     """Measured coefficients vs model mean with 2-sigma bands; held-out segment shaded.
 
     Args:
-        table: measured coefficients. pred_mean, pred_sigma: ``(T, 6)`` model mean and 1-sigma.
+        table: measured coefficients. pred_mean, pred_sigma: ``(T, 6)`` model mean and 1-sigma (the report
+            passes the band for a new measurement, ``ReplayResult.pred_sigma_obs``: the points are measurements).
         held_out: ``(T,)`` bool. identifiable: coefficient -> (bool, reason), shown where there is no model.
     """
     tb = table
@@ -310,7 +311,7 @@ def figure(r: ReplayResult, name: str) -> bytes | list[bytes] | None:
     if name == "states":
         return states_figure(r.states, r.held_out)
     if name == "coefficients":
-        return coefficients_figure(r.table, r.pred_mean, r.pred_sigma, r.held_out, r.identifiable)
+        return coefficients_figure(r.table, r.pred_mean, r.pred_sigma_obs, r.held_out, r.identifiable)   # measurements
     if name == "correlation":
         corr = correlation_of(r.gp_summary, list(r.envelope.outputs) if r.envelope is not None else [])
         return correlation_figure(*corr) if corr is not None else None

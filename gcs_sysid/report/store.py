@@ -76,7 +76,7 @@ def save_result(result: ReplayResult, path: str | Path) -> dict[str, Path]:
     arrays: dict[str, np.ndarray] = {
         "states_t": st.t, "table_t": tb.t, "table_X": tb.X, "table_Y": tb.Y, "table_valid": tb.valid,
         "table_qbar": tb.qbar, "held_out": result.held_out, "train": result.train,
-        "pred_mean": result.pred_mean, "pred_sigma": result.pred_sigma,
+        "pred_mean": result.pred_mean, "pred_sigma": result.pred_sigma, "pred_sigma_obs": result.pred_sigma_obs,
     }
     if st.valid is not None:
         arrays["states_valid"] = st.valid
@@ -141,11 +141,15 @@ def load_result(path: str | Path) -> ReplayResult:
                    for k, v in m.items()} for c, m in doc["metrics"].items()}
     env = EnvelopeMap.from_dict(doc["envelope"]) if doc.get("envelope") else None
     window = tuple(None if v is None else float(v) for v in doc["window"])
+    if "pred_sigma_obs" in a:
+        sigma, sigma_obs = a["pred_sigma"], a["pred_sigma_obs"]
+    else:       # saved before the eleventh session: its pred_sigma was the band for a new measurement
+        sigma, sigma_obs = np.full(a["pred_sigma"].shape, np.nan), a["pred_sigma"]
     return ReplayResult(
         log_path=doc["log_path"], airframe_name=doc["airframe_name"], airframe_path=doc["airframe_path"],
         vehicle=dict(doc["vehicle"]), window=window, summaries=summaries, messages=dict(doc["messages"]),
         states=states, table=table, held_out=a["held_out"].astype(bool), train=a["train"].astype(bool),
-        pred_mean=a["pred_mean"], pred_sigma=a["pred_sigma"], metrics=metrics,
+        pred_mean=a["pred_mean"], pred_sigma=sigma, pred_sigma_obs=sigma_obs, metrics=metrics,
         identifiable={k: (bool(v[0]), str(v[1])) for k, v in doc["identifiable"].items()}, envelope=env,
         suggestions=SuggestionList([Suggestion.from_dict(s) for s in doc["suggestions"]],
                                    doc.get("suggestion_context") or {}), gp_summary=dict(doc["gp_summary"]),

@@ -22,7 +22,10 @@ __all__ = ["THESIS_FLOOR_PCT", "CSV_COLUMNS", "fmt", "fmt_axis", "facts", "strea
 THESIS_FLOOR_PCT = {"forces": 19.8, "moments": 23.8}
 #: Columns of coefficients.csv.
 CSV_COLUMNS = (["time_s", *REGRESSORS, *COEFFICIENTS] + [f"{c}_pred" for c in COEFFICIENTS]
-               + [f"{c}_sigma" for c in COEFFICIENTS] + ["held_out"])
+               + [f"{c}_sigma" for c in COEFFICIENTS] + [f"{c}_sigma_obs" for c in COEFFICIENTS] + ["held_out"])
+#: ``<C>_sigma``: 1-sigma of the coefficient itself at the row's estimated regressors (no white measurement
+#: noise); ``<C>_sigma_obs``: of a new measurement (with it). Before the eleventh session ``<C>_sigma`` was the
+#: latter and there was no ``<C>_sigma_obs``. docs/gp.md, "Two bands".
 #: Regressors shown in degrees.
 ANGLES = ("alpha", "beta", "delta_e", "delta_a", "delta_r")
 
@@ -181,7 +184,7 @@ def lengthscale_rows(r: ReplayResult) -> list[dict[str, str]]:
 def write_csv(r: ReplayResult, path: Path) -> Path:
     """coefficients.csv: one row per grid time (columns :data:`CSV_COLUMNS`; NaN written as ``nan``)."""
     tb = r.table
-    data = np.column_stack([tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.held_out.astype(float)])
+    data = np.column_stack([tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.pred_sigma_obs, r.held_out.astype(float)])
     # one %-format per row (as numpy.savetxt does) is several times faster than csv.writer with
     # per-value f-strings; same text, same "\r\n" line ends as csv.writer
     fmt = ",".join(["%.4f"] + ["%.7g"] * (data.shape[1] - 2) + ["%d"])

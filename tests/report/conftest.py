@@ -68,7 +68,8 @@ def build_result(seed: int = 3, n: int = 400, drop_moments: bool = False, n_slic
         log_path="synthetic/flight.tlog", airframe_name=af.name, airframe_path=str(af.source),
         vehicle={"mav_type": 1, "autopilot": 3}, window=(None, None), summaries=summaries,
         messages={"ATTITUDE": 200, "RAW_IMU": 400, "SERVO_OUTPUT_RAW": 190}, states=states, table=tab,
-        held_out=held, train=train, pred_mean=pm, pred_sigma=ps, metrics=metrics, identifiable=ident,
+        held_out=held, train=train, pred_mean=pm, pred_sigma=ps, pred_sigma_obs=np.sqrt(ps**2 + (0.1 * ps) ** 2),
+        metrics=metrics, identifiable=ident,
         envelope=env, suggestions=sug, gp_summary=model.summary() | {"outputs": outs}, model_path="",
         missing=["wind: no WIND message"] if drop_moments else [], notes=notes, timings={"learn GP": 1.0},
     )

@@ -32,13 +32,16 @@ def test_csv_columns_and_values(written):
     with open(files["csv"]) as f:
         rows = list(csv.reader(f))
     expected = ["time_s", *REGRESSORS, *COEFFICIENTS, *(c + "_pred" for c in COEFFICIENTS),
-                *(c + "_sigma" for c in COEFFICIENTS), "held_out"]
+                *(c + "_sigma" for c in COEFFICIENTS), *(c + "_sigma_obs" for c in COEFFICIENTS), "held_out"]
     assert rows[0] == expected == list(CSV_COLUMNS)
     assert len(rows) == len(r.table.t) + 1
     data = np.array([[float(v) for v in row] for row in rows[1:]])
     np.testing.assert_allclose(data[:, 0], r.table.t, atol=1e-4)
     np.testing.assert_allclose(data[:, 1 + REGRESSORS.index("V")], r.table.x("V"), rtol=1e-6)
     np.testing.assert_allclose(data[:, expected.index("Cm_pred")], r.pred_mean[:, 4], rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(data[:, expected.index("Cm_sigma")], r.pred_sigma[:, 4], rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(data[:, expected.index("Cm_sigma_obs")], r.pred_sigma_obs[:, 4], rtol=1e-6,
+                               atol=1e-12)
     assert set(np.unique(data[:, -1])) == {0.0, 1.0}
     assert data[:, -1].sum() == r.held_out.sum()
 
@@ -88,6 +91,7 @@ def test_save_load_rerender(partial_result, tmp_path):
     back = load_result(tmp_path / "first" / "result")
     np.testing.assert_array_equal(back.table.X, partial_result.table.X)
     np.testing.assert_array_equal(back.pred_sigma, partial_result.pred_sigma)
+    np.testing.assert_array_equal(back.pred_sigma_obs, partial_result.pred_sigma_obs)
     np.testing.assert_array_equal(back.held_out, partial_result.held_out)
     assert back.states.data.keys() == partial_result.states.data.keys()
     assert [s.reason for s in back.suggestions] == [s.reason for s in partial_result.suggestions]
@@ -135,7 +139,7 @@ def test_figures_from_the_worker_make_the_same_page(replay_result, tmp_path):
             "streams": h.submit("gcs_sysid.report.plots:streams_figure", r.summaries),
             "states": h.submit("gcs_sysid.report.plots:states_figure", r.states, r.held_out),
             "coefficients": h.submit("gcs_sysid.report.plots:coefficients_figure", r.table, r.pred_mean,
-                                     r.pred_sigma, r.held_out, r.identifiable),
+                                     r.pred_sigma_obs, r.held_out, r.identifiable),   # the measurements' band
             "envelope": h.submit("gcs_sysid.report.plots:envelope_figures", r.envelope, r.table.X[r.train]),
             "suggestions": h.submit("gcs_sysid.report.plots:suggestions_figure", r.suggestions),
         }
@@ -145,3 +149,20 @@ def test_figures_from_the_worker_make_the_same_page(replay_result, tmp_path):
     assert all(j.ran_in_worker for j in jobs.values())
     b = write_report(r, tmp_path / "here", save=False)["html"].read_text()
     assert a == b
+
+
+def test_result_saved_before_the_two_bands_loads_its_sigma_as_the_measurement_band(partial_result, tmp_path):
+    """A result saved before the eleventh session has one ``pred_sigma``, the band for a new measurement:
+    it loads as ``pred_sigma_obs``, and the coefficient's band is unknown (NaN), not mislabelled."""
+    import zipfile
+
+    from gcs_sysid.report.store import save_result
+
+    files = save_result(partial_result, tmp_path / "old")
+    with zipfile.ZipFile(files["result_npz"]) as z:
+        arrays = {n[:-4]: np.load(z.open(n)) for n in z.namelist() if n != "pred_sigma_obs.npy"}
+    arrays["pred_sigma"] = partial_result.pred_sigma_obs
+    np.savez(files["result_npz"], **arrays)
+    back = load_result(tmp_path / "old")
+    np.testing.assert_array_equal(back.pred_sigma_obs, partial_result.pred_sigma_obs)
+    assert np.isnan(back.pred_sigma).all()
