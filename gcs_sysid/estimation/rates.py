@@ -101,7 +101,7 @@ from .kalman import SteadyState, lti_response, steady_state, steady_state_smooth
 from .nodes import segments
 from .wiener import residual_wiener
 
-__all__ = ["BANDWIDTHS_HZ", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate",
+__all__ = ["BANDWIDTHS_HZ", "CONTROL_AXES", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate",
            "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
@@ -115,6 +115,13 @@ DECAYS = (2.0, 5.0, 12.0, 30.0)
 #: than :data:`DECAYS` spans; on the small aircraft the extra columns only add noise, and the test leaves them
 #: out (docs/estimation.md, "Slow transients").
 SLOW_DECAYS = (1.0,)
+#: The axes (0 p, 1 q, 2 r) each control may accelerate, for delta_e delta_a delta_r delta_t: the moment
+#: equations' control terms of a laterally symmetric aircraft (Morelli and Klein 2016, ch. 3; Etkin 1972,
+#: ch. 5): the symmetric elevator moves Cm alone, the antisymmetric aileron and rudder Cl and Cn alone (and
+#: through Ixz both p_dot and r_dot); the throttle all three (engine torque, slipstream, thrust line).
+#: A free elevator column on the yaw axis only carried the gyro's noise onto r_dot, where it followed q and
+#: appeared as a Cn_q_hat in the fits (docs/estimation.md, "Slow transients and the control terms").
+CONTROL_AXES = {"delta_e": (1,), "delta_a": (0, 2), "delta_r": (0, 2), "delta_t": None}
 #: How a logged control may move between its samples; the likelihood picks one per record (module docstring).
 HOLDS = ("zoh", "foh")
 #: Log-likelihood gain per sample that steps ("zoh") must show over linear motion ("foh") to be chosen.
@@ -252,7 +259,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         bandwidths_hz: tuple[float, ...], order: int,
                         hold: tuple[str, ...] = ("zoh", "foh"), aux: np.ndarray | None = None,
                         aux_axes: tuple[int, ...] | None = None,
-                        slow_decays: tuple[float, ...] = ()) -> dict[str, np.ndarray]:
+                        slow_decays: tuple[float, ...] = (),
+                        control_axes: list[tuple[int, ...] | None] | None = None) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -267,6 +275,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     ``slow_decays``: further transient decay rates whose columns are left out of the bandwidth and
     delay choices and then taken per axis only if the likelihood-ratio test with the BIC penalty
     (``n log(RSS_without / RSS_with) > k log n``, ``k`` the axis' extra columns) asks for them.
+    ``control_axes``: per control of ``U`` the axes whose signal it may move (None: all); its columns
+    are left out on the others.
     """
     T, d = Z.shape
     F = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
@@ -282,7 +292,13 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     all_decays = (0.0,) + tuple(decays) + tuple(slow_decays)
     nd, nc = len(all_decays), U.shape[1]
     # the optional (slow) transients' columns: out of the bandwidth and delay choices, tested per axis at the end
-    opt = np.array([c * nd + j for c in range(nc) for j in range(nd - len(slow_decays), nd)], int)
+    ctl_axes = [None] * nc if control_axes is None else list(control_axes)
+    on = lambda c, i: ctl_axes[c] is None or i in ctl_axes[c]       # noqa: E731
+    n_base = nd - len(slow_decays)
+
+    def opt_of(i):
+        """The optional slow transients' columns of axis ``i``."""
+        return np.array([c * nd + j for c in range(nc) if on(c, i) for j in range(n_base, nd)], int)
     lag = np.zeros(nc, int) if lag is None else np.asarray(lag, int)
     out = {k: np.full((T, d), np.nan) for k in ("x", "xs", "xd", "xds")}
     out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), lag=lag)
@@ -292,13 +308,12 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     m_of = {h: nc * nd + (aux.shape[1] if h == "foh" else 0) for h in holds}
 
     def sel_of(i, m):
-        """Columns of axis ``i``: the controls' (without the optional slow transients), and the measured
-        signals' if the axis takes them."""
-        if not len(opt):
-            return None if m == nc * nd or aux_axes is None or i in aux_axes else np.arange(nc * nd)
-        base = np.setdiff1d(np.arange(nc * nd), opt)
-        return base if m == nc * nd or (aux_axes is not None and i not in aux_axes) else np.concatenate(
-            [base, np.arange(nc * nd, m)])
+        """Columns of axis ``i`` (None: all): its controls' (without the optional slow transients), and
+        the measured signals' if the axis takes them."""
+        cols = [c * nd + j for c in range(nc) if on(c, i) for j in range(n_base)]
+        if m > nc * nd and (aux_axes is None or i in aux_axes):
+            cols += list(range(nc * nd, m))
+        return None if len(cols) == m else np.array(cols, int)
     per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
     ll_hold = dict.fromkeys(holds, 0.0)
     colcache: dict = {}
@@ -422,6 +437,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             Ge += Gl.T @ e
             ee += float(e @ e)
         sel = sel_of(i, m)
+        opt = opt_of(i)
         if len(opt):   # the slow transients: taken on this axis only if the likelihood-ratio test asks for them
             sel1 = np.union1d(sel, opt)
             rss = [max(ee - float(Ge[q] @ _solve(GG[np.ix_(q, q)], Ge[q])[0]), 1e-300) for q in (sel, sel1)]
@@ -462,7 +478,8 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
                  holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None,
                  aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True,
-                 slow_decays: tuple[float, ...] = SLOW_DECAYS) -> RateEstimate:
+                 slow_decays: tuple[float, ...] = SLOW_DECAYS,
+                 control_axes: list[tuple[int, ...] | None] | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -491,6 +508,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         decays: decay rates of the control transients, 1/s.
         slow_decays: slower transient decay rates, 1/s, taken per axis only where the likelihood-ratio
             test with the BIC penalty asks for them (:data:`SLOW_DECAYS`; ``()``: none offered).
+        control_axes: optional, per column of ``controls``, the axes (0 p, 1 q, 2 r) that control may
+            accelerate (None: all; :data:`CONTROL_AXES` for delta_e delta_a delta_r delta_t, the
+            moment equations' control terms); its columns are left out on the other axes.
         holds: the candidate motions of the controls between their samples (:data:`HOLDS`), one
             chosen for all axes by the likelihood (steps only with decisive evidence,
             :data:`ZOH_EVIDENCE`).
@@ -515,7 +535,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
                             tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds),
-                            aux=aux, aux_axes=aux_axes, slow_decays=tuple(slow_decays))
+                            aux=aux, aux_axes=aux_axes, slow_decays=tuple(slow_decays),
+                            control_axes=None if control_axes is None else
+                            [a for a, mv in zip(control_axes, moving) if mv])
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
