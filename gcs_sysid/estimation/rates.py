@@ -56,6 +56,12 @@ the pitch axis only, where it shows
 the gust-driven angle of attack, and so ``Cm_alpha alpha``, at the instant it
 acts (Morelli and Klein 2016, ch. 5: measured accelerations as regressors).
 
+Each control enters the axes its moment equation gives it (:data:`CONTROL_AXES`: the elevator pitch,
+the aileron and rudder roll and yaw, the throttle all three; Morelli and Klein 2016, ch. 3): a free
+column on another axis only carries the gyro's noise there, in a shape that follows the controls. A
+slower transient per control (:data:`SLOW_DECAYS`) is added on an axis only where a likelihood-ratio
+test with the BIC penalty asks for it (a large aircraft's yaw damping).
+
 The bandwidth of the nominal model is chosen per axis by the diffuse profile
 likelihood (de Jong 1991) over a ladder of candidates, with ``b`` re-estimated
 for each candidate; then the delay ``l_c`` of each control (a servo or output
@@ -101,8 +107,8 @@ from .kalman import SteadyState, lti_response, steady_state, steady_state_smooth
 from .nodes import segments
 from .wiener import residual_wiener
 
-__all__ = ["BANDWIDTHS_HZ", "CONTROL_AXES", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate",
-           "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
+__all__ = ["BANDWIDTHS_HZ", "CONTROL_AXES", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES",
+           "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
@@ -111,9 +117,10 @@ BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
 DECAYS = (2.0, 5.0, 12.0, 30.0)
 #: Slower transients (1/s) taken per axis only where the likelihood asks for them (a likelihood-ratio test
 #: with the BIC penalty, ``n log(RSS_without / RSS_with) > k log n`` for the axis' ``k`` extra columns): the
-#: damping of a large or slow aircraft (the B747's yaw and roll, the T-6's yaw) decays at about 1/s, slower
-#: than :data:`DECAYS` spans; on the small aircraft the extra columns only add noise, and the test leaves them
-#: out (docs/estimation.md, "Slow transients").
+#: B747's yaw response (its own yaw damper in the loop) decays at about 1/s, slower than :data:`DECAYS` spans;
+#: where the extra columns would only carry the gyro's noise (a fixed 1/s transient on every axis cost the
+#: light aircraft up to a point of q_dot / r_dot error), the test leaves them out (docs/estimation.md,
+#: "Slow transients and the control terms").
 SLOW_DECAYS = (1.0,)
 #: The axes (0 p, 1 q, 2 r) each control may accelerate, for delta_e delta_a delta_r delta_t: the moment
 #: equations' control terms of a laterally symmetric aircraft (Morelli and Klein 2016, ch. 3; Etkin 1972,
@@ -144,7 +151,8 @@ class RateEstimate:
         effectiveness: (3, m) acceleration jump per unit scaled control step (rad/s^2 per unit
             of ``scale * control``: the step and transient coefficients summed over the lags;
             with ``scale`` = qbar in Pa and the controls in rad, times ``I / (S b)`` it is a
-            control derivative), per control given; NaN for a control that never moves.
+            control derivative), per control given; NaN for a control that never moves, 0 on an
+            axis the control is not given (``control_axes``).
         effectiveness_sigma: (3, m) 1-sigma of ``effectiveness``.
         input_lag: (m,) delay of each given control's effect, grid steps (maximum likelihood
             or as given); NaN for a control that never moves.
@@ -291,7 +299,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     ok_u = np.isfinite(U).all(axis=1) & np.isfinite(aux).all(axis=1)
     all_decays = (0.0,) + tuple(decays) + tuple(slow_decays)
     nd, nc = len(all_decays), U.shape[1]
-    # the optional (slow) transients' columns: out of the bandwidth and delay choices, tested per axis at the end
+    # each control's axes (control_axes); the optional slow transients' columns are out of the bandwidth and
+    # delay choices and tested per axis at the end
     ctl_axes = [None] * nc if control_axes is None else list(control_axes)
     on = lambda c, i: ctl_axes[c] is None or i in ctl_axes[c]       # noqa: E731
     n_base = nd - len(slow_decays)
@@ -526,12 +535,17 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         :class:`RateEstimate`.
 
     Raises:
-        ValueError: ``controls`` or ``scale`` of the wrong length.
+        ValueError: ``controls`` or ``scale`` of the wrong length, or ``control_axes`` not one entry per
+            column of ``controls``.
 
-    Source: module docstring; Harvey (1989) sec. 3.4; de Jong (1991).
+    Source: module docstring; Harvey (1989) sec. 3.4; de Jong (1991); the control terms: Morelli and
+    Klein (2016) ch. 3; the slow transients' test: Schwarz, "Estimating the dimension of a model", Annals
+    of Statistics 6(2), 1978 (BIC).
     """
     T = len(rates)
     U, moving, s = prepare_inputs(T, controls, scale)
+    if control_axes is not None and len(control_axes) != len(moving):
+        raise ValueError(f"control_axes has {len(control_axes)} entries, controls {len(moving)} columns")
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
                             tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds),
