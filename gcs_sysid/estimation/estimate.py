@@ -23,7 +23,7 @@ from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude,
 from .align import Aligned, align_flight, events
 from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
-from .rates import HOLDS, normal_force_input, smooth_rates
+from .rates import CONTROL_AXES, HOLDS, normal_force_input, smooth_rates
 from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
@@ -256,7 +256,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     if gyro is not None:
         acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
         Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
-                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,))
+                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,),
+                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None)
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):
@@ -278,7 +279,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                          + "; delay of their effect (maximum likelihood) = "
                          + ", ".join(f"{lg * dt:.2f}" for lg in Rr.input_lag) + " s; between samples the controls "
                          + ("step (ideal servos)" if Rr.hold == "zoh" else "move linearly (servo motion)")
-                         + " (likelihood)")
+                         + " (likelihood); slow transients (1/s, likelihood-ratio test) on "
+                         + (" ".join(a for a, on in zip("pqr", Rr.slow_transient) if on) or "no axis"))
     else:
         missing.append("p q r p_dot q_dot r_dot: no gyro (IMU) and no rates in ATTITUDE")
     if gyro_rate < 0.95 * RATE_MIN_HZ:  # 5 % margin: a nominal 10 Hz stream logs 9.9-10.1 Hz

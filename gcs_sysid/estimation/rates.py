@@ -56,6 +56,12 @@ the pitch axis only, where it shows
 the gust-driven angle of attack, and so ``Cm_alpha alpha``, at the instant it
 acts (Morelli and Klein 2016, ch. 5: measured accelerations as regressors).
 
+Each control enters the axes its moment equation gives it (:data:`CONTROL_AXES`: the elevator pitch,
+the aileron and rudder roll and yaw, the throttle all three; Morelli and Klein 2016, ch. 3): a free
+column on another axis only carries the gyro's noise there, in a shape that follows the controls. A
+slower transient per control (:data:`SLOW_DECAYS`) is added on an axis only where a likelihood-ratio
+test with the BIC penalty asks for it (a large aircraft's yaw damping).
+
 The bandwidth of the nominal model is chosen per axis by the diffuse profile
 likelihood (de Jong 1991) over a ladder of candidates, with ``b`` re-estimated
 for each candidate; then the delay ``l_c`` of each control (a servo or output
@@ -101,14 +107,28 @@ from .kalman import SteadyState, lti_response, steady_state, steady_state_smooth
 from .nodes import segments
 from .wiener import residual_wiener
 
-__all__ = ["BANDWIDTHS_HZ", "DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate",
-           "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
+__all__ = ["BANDWIDTHS_HZ", "CONTROL_AXES", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES",
+           "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
 #: Decay rates (1/s) of the control transients: a basis for the response shape after a step (the roll,
 #: pitch and yaw damping of small aircraft lie within it); measured on the simulation in docs/estimation.md.
 DECAYS = (2.0, 5.0, 12.0, 30.0)
+#: Slower transients (1/s) taken per axis only where the likelihood asks for them (a likelihood-ratio test
+#: with the BIC penalty, ``n log(RSS_without / RSS_with) > k log n`` for the axis' ``k`` extra columns): the
+#: B747's yaw response (its own yaw damper in the loop) decays at about 1/s, slower than :data:`DECAYS` spans;
+#: where the extra columns would only carry the gyro's noise (a fixed 1/s transient on every axis cost the
+#: light aircraft up to a point of q_dot / r_dot error), the test leaves them out (docs/estimation.md,
+#: "Slow transients and the control terms").
+SLOW_DECAYS = (1.0,)
+#: The axes (0 p, 1 q, 2 r) each control may accelerate, for delta_e delta_a delta_r delta_t: the moment
+#: equations' control terms of a laterally symmetric aircraft (Morelli and Klein 2016, ch. 3; Etkin 1972,
+#: ch. 5): the symmetric elevator moves Cm alone, the antisymmetric aileron and rudder Cl and Cn alone (and
+#: through Ixz both p_dot and r_dot); the throttle all three (engine torque, slipstream, thrust line).
+#: A free elevator column on the yaw axis only carried the gyro's noise onto r_dot, where it followed q and
+#: appeared as a Cn_q_hat in the fits (docs/estimation.md, "Slow transients and the control terms").
+CONTROL_AXES = {"delta_e": (1,), "delta_a": (0, 2), "delta_r": (0, 2), "delta_t": None}
 #: How a logged control may move between its samples; the likelihood picks one per record (module docstring).
 HOLDS = ("zoh", "foh")
 #: Log-likelihood gain per sample that steps ("zoh") must show over linear motion ("foh") to be chosen.
@@ -131,7 +151,8 @@ class RateEstimate:
         effectiveness: (3, m) acceleration jump per unit scaled control step (rad/s^2 per unit
             of ``scale * control``: the step and transient coefficients summed over the lags;
             with ``scale`` = qbar in Pa and the controls in rad, times ``I / (S b)`` it is a
-            control derivative), per control given; NaN for a control that never moves.
+            control derivative), per control given; NaN for a control that never moves, 0 on an
+            axis the control is not given (``control_axes``).
         effectiveness_sigma: (3, m) 1-sigma of ``effectiveness``.
         input_lag: (m,) delay of each given control's effect, grid steps (maximum likelihood
             or as given); NaN for a control that never moves.
@@ -142,6 +163,8 @@ class RateEstimate:
         correction_band_hz: (3, 2) per axis the lowest and highest frequency (Hz) where the residual
             correction (:mod:`.wiener`) found signal over the gyro's noise floor and added it; NaN
             where it found none (or was switched off).
+        slow_transient: (3,) per axis whether the slow transients (:data:`SLOW_DECAYS`) were taken
+            (likelihood-ratio test); all False when none were offered.
     """
 
     rate: np.ndarray
@@ -155,6 +178,7 @@ class RateEstimate:
     input_lag: np.ndarray
     hold: str = "zoh"
     correction_band_hz: np.ndarray | None = None
+    slow_transient: np.ndarray | None = None
 
 
 def _innovation_filter(F: np.ndarray, g: SteadyState, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -242,7 +266,9 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         max_lag: int, decays: tuple[float, ...], noise_floor: float,
                         bandwidths_hz: tuple[float, ...], order: int,
                         hold: tuple[str, ...] = ("zoh", "foh"), aux: np.ndarray | None = None,
-                        aux_axes: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:
+                        aux_axes: tuple[int, ...] | None = None,
+                        slow_decays: tuple[float, ...] = (),
+                        control_axes: list[tuple[int, ...] | None] | None = None) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -253,6 +279,12 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     axis' bandwidth; a change must raise the log-likelihood by more than the BIC
     penalty of one parameter, ``0.5 log(n)``, so a control with little effect
     keeps its delay.
+
+    ``slow_decays``: further transient decay rates whose columns are left out of the bandwidth and
+    delay choices and then taken per axis only if the likelihood-ratio test with the BIC penalty
+    (``n log(RSS_without / RSS_with) > k log n``, ``k`` the axis' extra columns) asks for them.
+    ``control_axes``: per control of ``U`` the axes whose signal it may move (None: all); its columns
+    are left out on the others.
     """
     T, d = Z.shape
     F = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
@@ -265,8 +297,17 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     S = np.array([g.S[0, 0] for g in gains])
     aux = np.zeros((T, 0)) if aux is None else np.asarray(aux, float).reshape(T, -1)
     ok_u = np.isfinite(U).all(axis=1) & np.isfinite(aux).all(axis=1)
-    all_decays = (0.0,) + tuple(decays)
+    all_decays = (0.0,) + tuple(decays) + tuple(slow_decays)
     nd, nc = len(all_decays), U.shape[1]
+    # each control's axes (control_axes); the optional slow transients' columns are out of the bandwidth and
+    # delay choices and tested per axis at the end
+    ctl_axes = [None] * nc if control_axes is None else list(control_axes)
+    on = lambda c, i: ctl_axes[c] is None or i in ctl_axes[c]       # noqa: E731
+    n_base = nd - len(slow_decays)
+
+    def opt_of(i):
+        """The optional slow transients' columns of axis ``i``."""
+        return np.array([c * nd + j for c in range(nc) if on(c, i) for j in range(n_base, nd)], int)
     lag = np.zeros(nc, int) if lag is None else np.asarray(lag, int)
     out = {k: np.full((T, d), np.nan) for k in ("x", "xs", "xd", "xds")}
     out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), lag=lag)
@@ -276,8 +317,12 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     m_of = {h: nc * nd + (aux.shape[1] if h == "foh" else 0) for h in holds}
 
     def sel_of(i, m):
-        """Columns of axis ``i``: the controls', and the measured signals' if the axis takes them."""
-        return None if m == nc * nd or aux_axes is None or i in aux_axes else np.arange(nc * nd)
+        """Columns of axis ``i`` (None: all): its controls' (without the optional slow transients), and
+        the measured signals' if the axis takes them."""
+        cols = [c * nd + j for c in range(nc) if on(c, i) for j in range(n_base)]
+        if m > nc * nd and (aux_axes is None or i in aux_axes):
+            cols += list(range(nc * nd, m))
+        return None if len(cols) == m else np.array(cols, int)
     per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
     ll_hold = dict.fromkeys(holds, 0.0)
     colcache: dict = {}
@@ -339,7 +384,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     axes = per_hold[best_hold]
     out["hold"] = best_hold
     m = m_of[best_hold]
-    out.update(beta=np.full((d, m), np.nan), cov=np.full((d, m, m), np.nan))
+    out.update(beta=np.full((d, m), np.nan), cov=np.full((d, m, m), np.nan), slow=np.zeros(d, bool))
 
     def grams(lagv):
         """Per axis: the lagged column innovations per segment and their Gram matrices (the Gram
@@ -400,7 +445,15 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             GG += Gl.T @ Gl
             Ge += Gl.T @ e
             ee += float(e @ e)
-        _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor, sel_of(i, m))
+        sel = sel_of(i, m)
+        opt = opt_of(i)
+        if len(opt):   # the slow transients: taken on this axis only if the likelihood-ratio test asks for them
+            sel1 = np.union1d(sel, opt)
+            rss = [max(ee - float(Ge[q] @ _solve(GG[np.ix_(q, q)], Ge[q])[0]), 1e-300) for q in (sel, sel1)]
+            if n * math.log(rss[0] / rss[1]) > len(opt) * math.log(n):
+                sel = None if len(sel1) == m else sel1
+                out["slow"][i] = True
+        _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor, sel)
         out["bw"][i], out["sig"][i] = bws[c], math.sqrt(s2)
         out["beta"][i], out["cov"][i] = beta, s2 * Minv
         g = gains[c]
@@ -433,7 +486,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
                  input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
                  holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None,
-                 aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True) -> RateEstimate:
+                 aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True,
+                 slow_decays: tuple[float, ...] = SLOW_DECAYS,
+                 control_axes: list[tuple[int, ...] | None] | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -460,6 +515,11 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         input_lag: optional delay per given control, grid steps: fixed if ``max_delay_s`` is 0,
             else the start of the search.
         decays: decay rates of the control transients, 1/s.
+        slow_decays: slower transient decay rates, 1/s, taken per axis only where the likelihood-ratio
+            test with the BIC penalty asks for them (:data:`SLOW_DECAYS`; ``()``: none offered).
+        control_axes: optional, per column of ``controls``, the axes (0 p, 1 q, 2 r) that control may
+            accelerate (None: all; :data:`CONTROL_AXES` for delta_e delta_a delta_r delta_t, the
+            moment equations' control terms); its columns are left out on the other axes.
         holds: the candidate motions of the controls between their samples (:data:`HOLDS`), one
             chosen for all axes by the likelihood (steps only with decisive evidence,
             :data:`ZOH_EVIDENCE`).
@@ -475,21 +535,28 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         :class:`RateEstimate`.
 
     Raises:
-        ValueError: ``controls`` or ``scale`` of the wrong length.
+        ValueError: ``controls`` or ``scale`` of the wrong length, or ``control_axes`` not one entry per
+            column of ``controls``.
 
-    Source: module docstring; Harvey (1989) sec. 3.4; de Jong (1991).
+    Source: module docstring; Harvey (1989) sec. 3.4; de Jong (1991); the control terms: Morelli and
+    Klein (2016) ch. 3; the slow transients' test: Schwarz, "Estimating the dimension of a model", Annals
+    of Statistics 6(2), 1978 (BIC).
     """
     T = len(rates)
     U, moving, s = prepare_inputs(T, controls, scale)
+    if control_axes is not None and len(control_axes) != len(moving):
+        raise ValueError(f"control_axes has {len(control_axes)} entries, controls {len(moving)} columns")
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     o = _smooth_with_inputs(dt, np.asarray(rates, float), U, s, lag, int(round(max_delay_s / dt)),
                             tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds),
-                            aux=aux, aux_axes=aux_axes)
+                            aux=aux, aux_axes=aux_axes, slow_decays=tuple(slow_decays),
+                            control_axes=None if control_axes is None else
+                            [a for a, mv in zip(control_axes, moving) if mv])
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
     lags = np.full(nctl, np.nan)
-    nd = 1 + len(decays)
+    nd = 1 + len(decays) + len(slow_decays)
     for k, ctl in enumerate(np.nonzero(moving)[0]):   # the jump: step + transients at the (delayed) step
         sel = np.arange(k * nd, (k + 1) * nd)
         eff[:, ctl] = o["beta"][:, sel].sum(axis=1)
@@ -499,7 +566,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
     if residual_correction:
         band = _correct_residual(dt, np.asarray(rates, float), o)
     return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags,
-                        o.get("hold", "zoh"), band)
+                        o.get("hold", "zoh"), band, o["slow"])
 
 
 def _correct_residual(dt: float, Z: np.ndarray, o: dict, order: int = 1,
