@@ -98,7 +98,13 @@ DIFFERENTIAL_REREDUCED = True
 #: of a coefficient's held-out residual at 2 m/s and 5-7.5 % at 1 m/s, so a coefficient gain measures the flight's
 #: turbulence floor, not the finding; on the wind triangle the same biases gain 81-86 % and 60-73 % (residual
 #: 0.29-0.36 m/s). False: coefficients only (the tenth session's rule).
-SENSOR_GAIN = True
+#: **Off** (set False at the eleventh session's merge, after its final evaluation): with it on, the project's own
+#: simulated flights name a pitot bias that is not there (``tests/diagnose/test_diagnose_e2e.py``: the clean
+#: flight and three single-effect flights name ``bias:airspeed`` with 37-45 % triangle gains;
+#: ``tests/diagnose/test_physical.py::test_imu_turn_on_biases_below_the_reconstruction_error_are_not_named``):
+#: a gain on the triangle's residual is also earned by anything else that offsets that residual, so it is not
+#: yet evidence of the pitot alone (docs/diagnose.md).
+SENSOR_GAIN = False
 
 
 def wind_shift(ctx: DiagContext, flight) -> dict | None:
