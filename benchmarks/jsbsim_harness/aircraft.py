@@ -287,10 +287,17 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="General Dynamics F-16A (JSBSim f16) with its fly-by-wire replaced by direct surfaces, flaps fixed "
               "(derived model f16_direct, XML sha256 c58370508ab7d631), engine shut down, gear up, gliding; "
               "untouched by any tuning of the method"),
+    "f4n": AircraftSpec(
+        name="f4n", model="F4N", airspeed_kts=250.0, altitude_ft=15000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.25),
+        amplitude_deg=(4.0, 5.0, 3.0), pulse_s=(0.7, 0.8, 1.0), gains=(1.0, 0.6, 0.003, 1.0, 0.3, 0.0), gear_up=True,
+        notes="McDonnell F-4N Phantom II (JSBSim F4N), its own yaw damper in the loop, engines shut down, gear up, "
+              "gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747")
-HELD_OUT_AIRCRAFT = ("f16",)
-UNTOUCHED_AIRCRAFT = ("f16",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16")
+HELD_OUT_AIRCRAFT = ("f4n",)
+UNTOUCHED_AIRCRAFT = ("f4n",)
 
 
 def aircraft(name: str) -> AircraftSpec:
