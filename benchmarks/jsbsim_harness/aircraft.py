@@ -75,11 +75,12 @@ _DEG = 57.29577951308232
 #: thresholds; ``pa28`` (held out since 2026-11-21), ``j3cub`` (untouched until the sixth
 #: session's final evaluation, 2026-11-22), ``c182`` (untouched until the seventh session's)
 #: have since been evaluated and their results read, so they count as used (``TUNING_AIRCRAFT``).
-#: ``t37``, ``t6`` and ``b747`` (untouched until the eighth, ninth and tenth sessions' final
-#: evaluations) are used since as well. ``f16`` (added in the eleventh session, 2026-11-22, as the
-#: derived model ``f16_direct``, ``derived.py``) is the held-out, untouched case
-#: (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's
-#: truth and its XML), the method was never run on it before its final evaluation.
+#: ``t37``, ``t6``, ``b747`` and ``f16`` (untouched until the eighth to eleventh sessions' final
+#: evaluations; the f16 flown as the derived model ``f16_direct``, ``derived.py``) are used since as
+#: well. ``f4n`` (added in the twelfth session, 2026-11-22, the stock F4N with its own yaw damper in
+#: the loop) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its
+#: harness was set up (from JSBSim's truth and its XML), the method was never run on it before its
+#: final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -287,13 +288,41 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="General Dynamics F-16A (JSBSim f16) with its fly-by-wire replaced by direct surfaces, flaps fixed "
               "(derived model f16_direct, XML sha256 c58370508ab7d631), engine shut down, gear up, gliding; "
               "untouched by any tuning of the method"),
+    # f4n: JSBSim's stock McDonnell F-4N Phantom II (F4N.xml, Aeromatic v0.9 / David Culp, 2007: a
+    # model of constant derivatives and a few tables, as the b747's), two J79 turbojets on "direct"
+    # thrusters (no force once stopped), one fuel tank of 13000 lb on the centre line, no point mass,
+    # no product of inertia. Chosen in the twelfth session (docs/jsbsim.md, "The f4n") with the rule
+    # "no FCS law between the commands and the surfaces" relaxed as for the b747: its FCS
+    # (systems/FCS-pitch.xml, FCS-roll.xml, FCS-yaw.xml) maps the commands straight to the surfaces
+    # (aerosurface_scale, zero-centred: elevator -0.35..+0.30 rad, left aileron +-0.35 rad, the only
+    # aileron property the aerodynamics read, rudder +-0.25 rad) and adds a yaw damper, 2 x r-aero in
+    # normalised rudder per rad/s (above 60 kt EAS), clipped to +-0.1 (0.025 rad of rudder), that the
+    # harness cannot switch off: the harness's own yaw damper is off (k_r = 0), the model's replaces
+    # it, and the logged rudder (fcs/rudder-pos-rad, what Cndr and Cldr read) includes it. The
+    # elevator's command scale is its larger end (0.35 rad, the b747's rule). Signs read from its
+    # aerodynamics: Cmde (-0.70 + 0.25 Mach) x elevator-pos (positive = trailing edge down), Clda
+    # (0.12 - 0.04 Mach) x left-aileron-pos (positive = left trailing edge down, roll right), Cndr
+    # -0.08 x rudder-pos (positive = trailing edge left, nose left). Static stability about the CG
+    # (JSBSim, fixed surfaces, run_ic): Cm_alpha -0.23 per rad. Gear up (CDgear 0.028 vanishes).
+    # 250 kt (ic/vc-kts) at 15000 ft: about 196 m/s TAS, Mach 0.62 at the start; the sweep flies
+    # 147-214 m/s, alpha -5..7 deg. It sinks 28-32 m/s (lift-to-drag about 6-7: CD0 0.021 and
+    # CDi 0.14 CL^2 at CL 0.2-0.3). Trial sets on the truth (docs/jsbsim.md): at 230 kt the pair
+    # (Cm:alpha^2 = -8 with Cn:delta_a) took the elevator to -19.9 deg of its -20 at the slow level,
+    # hence 250 kt (-16.4 deg); at 18000 ft the speed steps took alpha to -9 deg with the pair, hence
+    # 15000 ft. Gains: k_q 0.6, k_v 0.003 (the f16's: gentle push-overs of the speed steps); roll
+    # k_phi 1.0, k_p 0.3 (with the default 0.4 / 0.1 the sweep with Cl:alpha*beta = 3, which reverses
+    # its Cl_beta -0.05 above 1 deg of alpha, banked past 45 deg: a knock-it-off). Amplitudes:
+    # elevator 4 deg, aileron 5 deg, rudder 3 deg (5 deg flew 8 deg of sideslip and 4.3 deg/s of
+    # yaw-rate standard deviation in the standard plan: Cnb 0.12 against Cndr -0.08). Set from the
+    # harness's truth only (alpha, beta, rates, excitation per axis), never from a method result.
     "f4n": AircraftSpec(
-        name="f4n", model="F4N", airspeed_kts=250.0, altitude_ft=15000.0,
+        name="f4n", model="F4N_fcs", airspeed_kts=250.0, altitude_ft=15000.0,
         elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
         cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.25),
         amplitude_deg=(4.0, 5.0, 3.0), pulse_s=(0.7, 0.8, 1.0), gains=(1.0, 0.6, 0.003, 1.0, 0.3, 0.0), gear_up=True,
-        notes="McDonnell F-4N Phantom II (JSBSim F4N), its own yaw damper in the loop, engines shut down, gear up, "
-              "gliding; untouched by any tuning of the method"),
+        notes="McDonnell F-4N Phantom II (JSBSim F4N), its own yaw damper in the loop, flown as the derived model "
+              "F4N_fcs (the stock XML with an empty flight_control added, XML sha256 546ac6c12a62200c), engines shut "
+              "down, gear up, gliding; untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16")
 HELD_OUT_AIRCRAFT = ("f4n",)

@@ -50,7 +50,7 @@ import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-__all__ = ["DERIVED", "derive_f16_direct", "derived_xml", "derived_sha", "install_derived_models",
+__all__ = ["DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derived_xml", "derived_sha", "install_derived_models",
            "ELEVATOR_ALIAS"]
 
 #: The elevator alias the derived F-16's tables read (see the module docstring).
@@ -135,8 +135,48 @@ def derive_f16_direct(root: ET.Element) -> ET.Element:
     return root
 
 
-#: Derived model name -> (stock model it comes from, derivation).
-DERIVED = {"f16_direct": ("f16", derive_f16_direct)}
+def derive_f4n_fcs(root: ET.Element) -> ET.Element:
+    """The F-4N's XML ``root`` with an empty ``<flight_control>`` element added (twelfth session).
+
+    The stock ``F4N.xml`` flies its surfaces through ``<system>`` files (``FCS-pitch``, ``FCS-roll``,
+    ``FCS-yaw``: the commands straight to the surfaces plus a yaw damper) and has its
+    ``<flight_control name="FCS">`` commented out, so ``effects.py``'s ``delay:delta_e``, which adds
+    its delay channel to the model's ``<flight_control>``, had nowhere to go. The derivation adds that
+    element, empty, where the stock comment stands (after the last ``<system>``, before
+    ``<aerodynamics>``); nothing else changes. JSBSim runs the ``<system>`` channels before the
+    ``<flight_control>`` ones (it loads them first), so an injected delay reads the elevator the
+    systems wrote in the same frame, as on the other aircraft. An empty ``<flight_control>`` computes
+    nothing: a test checks every force and moment against the stock model's to 1e-12.
+
+    Args:
+        root: the parsed stock ``F4N.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the stock XML already has a ``<flight_control>`` or lacks ``<aerodynamics>``
+            (another jsbsim version).
+    """
+    root = copy.deepcopy(root)
+    if root.find("flight_control") is not None:
+        raise ValueError("F4N.xml: already has a <flight_control>")
+    aero = root.find("aerodynamics")
+    if aero is None:
+        raise ValueError("F4N.xml: no <aerodynamics>")
+    fc = ET.Element("flight_control", name="FCS (empty; added by gcs-sysid's benchmarks/jsbsim_harness/derived.py)")
+    root.insert(list(root).index(aero), fc)
+    return root
+
+
+#: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
+#: derived XML's header comment).
+DERIVED = {
+    "f16_direct": ("f16", derive_f16_direct, "flight control replaced by a direct mapping of the commands to the "
+                                             "surfaces, flaps fixed at 0; aerodynamics, mass and propulsion unchanged."),
+    "F4N_fcs": ("F4N", derive_f4n_fcs, "an empty <flight_control> added (the stock one is commented out), for the "
+                                       "harness's injected elevator delay; everything else unchanged."),
+}
 
 
 def derived_xml(name: str, stock_dir: Path | None = None) -> bytes:
@@ -146,13 +186,12 @@ def derived_xml(name: str, stock_dir: Path | None = None) -> bytes:
         KeyError: ``name`` is not in :data:`DERIVED`.
         ValueError: the stock XML does not take the derivation.
     """
-    stock, derive = DERIVED[name]
+    stock, derive, what = DERIVED[name]
     src = (stock_dir or _wheel_root() / "aircraft" / stock) / f"{stock}.xml"
     root = derive(ET.parse(src).getroot())
     ET.indent(root, space=" ")
     header = (f"<?xml version=\"1.0\"?>\n<!-- Derived from the jsbsim wheel's aircraft/{stock}/{stock}.xml (LGPL-2.1) by "
-              f"gcs-sysid's benchmarks/jsbsim_harness/derived.py: flight control replaced by a direct mapping of the "
-              f"commands to the surfaces, flaps fixed at 0; aerodynamics, mass and propulsion unchanged. -->\n")
+              f"gcs-sysid's benchmarks/jsbsim_harness/derived.py: {what} -->\n")
     return header.encode() + ET.tostring(root, encoding="unicode").encode() + b"\n"
 
 
@@ -174,7 +213,7 @@ def install_derived_models(aircraft_dir: Path | None = None) -> list[Path]:
     """
     base = Path(aircraft_dir) if aircraft_dir else _wheel_root() / "aircraft"
     written = []
-    for name, (stock, _) in DERIVED.items():
+    for name, (stock, _, _) in DERIVED.items():
         try:
             want = derived_xml(name, base / stock)
             dest = base / name
