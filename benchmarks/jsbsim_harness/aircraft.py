@@ -291,7 +291,10 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # f4n: JSBSim's stock McDonnell F-4N Phantom II (F4N.xml, Aeromatic v0.9 / David Culp, 2007: a
     # model of constant derivatives and a few tables, as the b747's), two J79 turbojets on "direct"
     # thrusters (no force once stopped), one fuel tank of 13000 lb on the centre line, no point mass,
-    # no product of inertia. Chosen in the twelfth session (docs/jsbsim.md, "The f4n") with the rule
+    # no product of inertia. Loaded as the derived model ``F4N_fcs`` (derived.py): the stock XML with an
+    # empty <flight_control> added where its own is commented out, because effects.py's delay:delta_e
+    # adds its channel to that element (the first pre-fly failed there); JSBSim computes the same
+    # forces and moments (test). Chosen in the twelfth session (docs/jsbsim.md, "The f4n") with the rule
     # "no FCS law between the commands and the surfaces" relaxed as for the b747: its FCS
     # (systems/FCS-pitch.xml, FCS-roll.xml, FCS-yaw.xml) maps the commands straight to the surfaces
     # (aerosurface_scale, zero-centred: elevator -0.35..+0.30 rad, left aileron +-0.35 rad, the only

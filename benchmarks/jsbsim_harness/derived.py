@@ -1,5 +1,7 @@
 """Derived JSBSim models: a stock model of the installed ``jsbsim`` wheel with its flight-control
-system replaced by a direct mapping from the harness's commands to the surfaces.
+system replaced by a direct mapping from the harness's commands to the surfaces (``f16_direct``), or
+given the empty ``<flight_control>`` element the harness's injected elevator delay needs
+(``F4N_fcs``, :func:`derive_f4n_fcs`; twelfth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a

@@ -1,5 +1,5 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747 and the untouched f16; docs/jsbsim.md, one section each), parametrised over the roster.
+t37, t6, b747, f16 and the untouched f4n; docs/jsbsim.md, one section each), parametrised over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
 the rigid-body consistency of the truth with the checked-in airframe file (mass, product of inertia),
@@ -9,10 +9,12 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched f16's are slow too but its names', and its own
-default checks (the derived model, static stability, the summaries' label) are in
-``test_jsbsim_f16.py``. Folded in the eleventh session from ``test_jsbsim_{c182,t37,t6,b747}.py``
-(same checks, same numbers; the Ixz checks now pin each model's value).
+default suite, as before the fold); the untouched f4n's are slow too but its names', and its own
+default checks (its yaw damper in the loop, static stability, the summaries' label) are in
+``test_jsbsim_f4n.py`` (the f16's, the derived model and static stability, in ``test_jsbsim_f16.py``;
+the f16 is a tuning aircraft since the twelfth session). Folded in the eleventh session from
+``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
+value); the f4n added in the twelfth.
 """
 
 from dataclasses import dataclass
@@ -105,7 +107,19 @@ CASES = (
          (("cl", 3, -0.052, ("rel", 0.1)), ("cn", 4, -0.045, ("rel", 0.1)), ("cn", 3, -0.010, ("abs", 0.004)),
           ("cm", 2, -0.53, ("rel", 0.1))), ("CDgear",), 0.436, 6,
          dict(alpha=(-6.0, 11.0), beta=(6.0, 6.0), bank=(20.0, 25.0), speed=(110.0, 200.0), alt_min=1000.0,
-              rate_std=1.0, rate_std_held=1.0), n_elevator_reads=1, untouched=True),
+              rate_std=1.0, rate_std_held=1.0), n_elevator_reads=1),
+    # f4n (stock F4N as F4N_fcs, its own yaw damper in the loop): 28000 lb empty + 13000 lb of fuel on the centre
+    # line, no product of inertia. Cmde (-0.70 + 0.25 Mach) x elevator-pos; Clda (0.12 - 0.04 Mach) x
+    # left-aileron-pos: -0.547 and -0.0956 at the standard flight's Mach 0.61 (the reference point 4 in
+    # above the CG adds no arm); Clb -0.05, Clp -0.4, Cldr 0.005; Cnb 0.12 (no side-force arm), Cnr -0.15,
+    # Cndr -0.08; Cnda 0 (a function of value 0). One SIDE function (CYb); the elevator read by CLde, Cmde.
+    Case("f4n", "F4N_fcs", "f4", 41000, 0.0,
+         (("cm", 2, -0.547, ("rel", 0.03)), ("cl", 3, -0.0956, ("rel", 0.03)), ("cl", 0, -0.05, ("rel", 0.05)),
+          ("cl", 1, -0.4, ("rel", 0.02)), ("cl", 4, 0.005, ("rel", 0.1)), ("cn", 4, -0.08, ("rel", 0.02)),
+          ("cn", 0, 0.12, ("rel", 0.02)), ("cn", 2, -0.15, ("rel", 0.02)), ("cn", 3, 0.0, ("abs", 1e-3))),
+         ("CDgear",), 0.30, 1,
+         dict(alpha=(-7.0, 9.0), beta=(6.0, 6.0), bank=(10.0, 15.0), speed=(130.0, 230.0), alt_min=200.0,
+              rate_std=1.0, rate_std_held=1.0), untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -133,7 +147,7 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the f16
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the f4n
     alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
@@ -144,7 +158,7 @@ def test_names_resolve_and_roles(case):
     else:
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
-    assert {"pa28", "j3cub", "c182", "t37", "t6", "b747"} <= set(TUNING_AIRCRAFT)
+    assert {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16"} <= set(TUNING_AIRCRAFT)
 
 
 @pytest.mark.parametrize("case", _params())
@@ -255,7 +269,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", [p for p in _params() if p.values[0].name in ("b747", "f16")])
+@pytest.mark.parametrize("case", [p for p in _params() if p.values[0].name in ("b747", "f4n")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
