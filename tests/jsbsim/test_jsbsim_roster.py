@@ -111,10 +111,14 @@ CASES = (
     # f4n (stock F4N as F4N_fcs, its own yaw damper in the loop): 28000 lb empty + 13000 lb of fuel on the centre
     # line, no product of inertia. Cmde (-0.70 + 0.25 Mach) x elevator-pos; Clda (0.12 - 0.04 Mach) x
     # left-aileron-pos: -0.547 and -0.0956 at the standard flight's Mach 0.61 (the reference point 4 in
-    # above the CG adds no arm); Clb -0.05, Clp -0.4, Cldr 0.005; Cnb 0.12 (no side-force arm), Cnr -0.15,
-    # Cndr -0.08; Cnda 0 (a function of value 0). One SIDE function (CYb); the elevator read by CLde, Cmde.
+    # above the CG adds no pitch arm); Cmalpha -0.3 with the lift 4 in above the CG: -0.228 (JSBSim, as
+    # run_ic gives -0.229); Cmq -18 + Cmadot -9: -27; Clb -0.05 plus the side force (CYb -1) acting 4 in
+    # above the CG: -0.05 + 4 / (12 x 38.4) = -0.041; Clp -0.4, Cldr 0.005; Cnb 0.12 (no side-force arm
+    # fore or aft), Cnr -0.15, Cndr -0.08; Cnda 0 (a function of value 0). One SIDE function (CYb); the
+    # elevator read by CLde and Cmde.
     Case("f4n", "F4N_fcs", "f4", 41000, 0.0,
-         (("cm", 2, -0.547, ("rel", 0.03)), ("cl", 3, -0.0956, ("rel", 0.03)), ("cl", 0, -0.05, ("rel", 0.05)),
+         (("cm", 0, -0.228, ("rel", 0.03)), ("cm", 1, -27.0, ("rel", 0.02)), ("cm", 2, -0.547, ("rel", 0.03)),
+          ("cl", 3, -0.0956, ("rel", 0.03)), ("cl", 0, -0.041, ("rel", 0.02)),
           ("cl", 1, -0.4, ("rel", 0.02)), ("cl", 4, 0.005, ("rel", 0.1)), ("cn", 4, -0.08, ("rel", 0.02)),
           ("cn", 0, 0.12, ("rel", 0.02)), ("cn", 2, -0.15, ("rel", 0.02)), ("cn", 3, 0.0, ("abs", 1e-3))),
          ("CDgear",), 0.30, 1,
