@@ -307,8 +307,8 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # (0.12 - 0.04 Mach) x left-aileron-pos (positive = left trailing edge down, roll right), Cndr
     # -0.08 x rudder-pos (positive = trailing edge left, nose left). Static stability about the CG
     # (JSBSim, fixed surfaces, run_ic): Cm_alpha -0.23 per rad. Gear up (CDgear 0.028 vanishes).
-    # 250 kt (ic/vc-kts) at 15000 ft: about 196 m/s TAS, Mach 0.62 at the start; the sweep flies
-    # 147-214 m/s, alpha -5..7 deg. It sinks 28-32 m/s (lift-to-drag about 6-7: CD0 0.021 and
+    # 250 kt (ic/vc-kts) at 15000 ft: 305 kt EAS, 198 m/s TAS, Mach 0.61 at the start; the sweep flies
+    # 147-214 m/s, alpha -5.3..6.9 deg. It sinks 28-31 m/s (lift-to-drag about 6-7: CD0 0.021 and
     # CDi 0.14 CL^2 at CL 0.2-0.3). Trial sets on the truth (docs/jsbsim.md): at 230 kt the pair
     # (Cm:alpha^2 = -8 with Cn:delta_a) took the elevator to -19.9 deg of its -20 at the slow level,
     # hence 250 kt (-16.4 deg); at 18000 ft the speed steps took alpha to -9 deg with the pair, hence
