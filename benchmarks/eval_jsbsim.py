@@ -103,7 +103,9 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     Returns:
         ``{"gp": {term: [6 floats]}, "true": {term: [6 floats]}}``, % of the truth's RMS per coefficient.
     """
-    from gcs_sysid.gp.inputnoise import mean_gradient
+    from dataclasses import replace
+
+    from gcs_sysid.gp.discrepancy import exact_condition_variance
 
     ys2 = model.scaler.y_std ** 2
     scale = 100.0 / np.sqrt(np.mean(np.asarray(ref) ** 2, axis=0))
@@ -117,16 +119,13 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     gp = {"latent": pct(lat), "input_learned": pct(learned), "input": pct(inp), "coloured": pct(col),
           "white": pct(model.noise_var() - col), "sigma": pct(lat + inp + col[None, :])}
     _, lat_t = model.predict(X_true, include_noise=False, input_noise=False, model_error=False)
-    g = mean_gradient(model.params, model.post, Xts, model.config.batch_size)          # (N, P, D) standardised
-    zero = np.zeros_like(lat_t)
-    off = zero if model.offset_cov is None else np.einsum("npd,de,npe->np", g, np.asarray(model.offset_cov), g) * ys2
-    Mc = None if model.map_cov is None else np.asarray(model.map_cov)
-    mapped = np.zeros(model.n_inputs, bool) if Mc is None else np.any(Mc != 0, axis=(1, 2))
-    vmap = zero.copy()
-    for j in np.nonzero(mapped)[0]:
-        vmap += g[:, :, j] ** 2 * np.einsum("nd,de,ne->n", Xts, Mc[j], Xts)[:, None] * ys2
-    sv = None if model.scale_var is None else np.where(mapped, 0.0, np.asarray(model.scale_var))
-    vsc = zero if sv is None else np.einsum("npd,d,nd->np", g ** 2, sv, Xts ** 2) * ys2
+    # each term alone, by the model's own formula (gcs_sysid.gp.discrepancy.exact_condition_variance)
+    Mc = model.map_cov
+    mapped = np.zeros(model.n_inputs, bool) if Mc is None else np.any(np.asarray(Mc) != 0, axis=(1, 2))
+    sv = None if model.scale_var is None else np.where(mapped, 0.0, np.asarray(model.scale_var))   # the map holds those
+    bare = replace(model, offset_cov=None, scale_var=None, map_cov=None, discrepancy=None)
+    alone = lambda **kw: exact_condition_variance(replace(bare, **kw), Xts) * ys2                 # noqa: E731
+    off, vsc, vmap = alone(offset_cov=model.offset_cov), alone(scale_var=sv), alone(map_cov=Mc)
     d = np.zeros(model.n_outputs) if model.discrepancy is None else np.asarray(model.discrepancy)[0] * ys2
     true = {"latent": pct(lat_t), "offset": pct(off), "scale": pct(vsc), "map": pct(vmap), "discrepancy": pct(d),
             "sigma": pct(lat_t + off + vsc + vmap + d[None, :])}
