@@ -13,7 +13,7 @@ from benchmarks.eval_jsbsim import band_terms
 from gcs_sysid.gp.discrepancy import with_offset_covariance
 
 
-@pytest.mark.slow          # 14 s of compiling on a loaded machine: a benchmark's diagnosis, not the suite's
+@pytest.mark.slow          # 6-14 s (load 8-11), most of it compiling: a benchmark's diagnosis, not the suite's
 def test_band_terms_add_up_to_the_two_scored_bands(fitted, flight):
     model, _ = fitted
     X, _, Yt = flight
