@@ -25,6 +25,8 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
          with it, now ``cov_gp_obs``: the replay's ``<C>_sigma_obs``, a band for a new measurement);
          true: the model's sigma without noise at exact conditions, with the model's error there
          (``cov_true_latent`` in the JSON: the latent band alone)
+  terms  (JSON only, ``band_terms``) each variance term of the two bands per coefficient, as the RMS of
+         its sigma in % of the truth's RMS (:func:`band_terms`; read against ``gp`` and ``true``)
   air    alpha and beta RMS errors of the reconstructed air data, deg (all valid rows)
 
 Usage::
@@ -76,6 +78,59 @@ def _errs(est: np.ndarray, ref: np.ndarray) -> dict[str, float]:
 def _coverage(mean, sigma, ref) -> float:
     m = np.isfinite(mean) & np.isfinite(sigma) & np.isfinite(ref)
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
+
+
+def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]]:
+    """The two scored bands taken apart: each variance term's size per coefficient (a diagnosis).
+
+    ``gp`` (the replay's ``<C>_sigma`` at the flight's estimated regressors ``X``, ``docs/gp.md``, "Two
+    bands"): ``latent`` (what more data can reduce), ``input_learned`` (NIGP's learned input noise through
+    the slope, McHutchon and Rasmussen 2011, eq. 4), ``input`` (the term as used: per row and regressor the
+    larger of the learned and the estimator's stated variance ``x_var``), ``coloured`` (the observation noise
+    less its white part, ``noise_var(white_noise=False)``), ``white`` (the white part, left out of the band)
+    and ``sigma`` (the band: ``latent + input + coloured``). ``true`` (the band at exact conditions
+    ``X_true``, ``docs/gp.md``, "The band at exact conditions"): ``latent``, ``offset`` (``v_off``), ``scale``
+    (``v_scale``, angles without a map), ``map`` (``v_map``, the aided angles' common linear error),
+    ``discrepancy`` (``d``) and ``sigma`` (their sum). Each entry is the RMS over the rows of the term's
+    standard deviation, ``100 sqrt(mean(var)) / RMS(ref)``: the coefficient errors' unit (``row["gp"]``,
+    ``row["true"]``), so a band whose ``sigma`` is well above the error over-covers.
+
+    Args:
+        model: the replay's saved :class:`gcs_sysid.gp.LocalGlobalGP` (six outputs).
+        X, X_true: ``(N, 10)`` the estimated and the true regressors of the scored rows (finite).
+        x_var: ``(N, 10)`` the estimator's stated per-row regressor variances (``CoefficientTable.x_var``) or None.
+        ref: ``(N, 6)`` the true coefficients.
+
+    Returns:
+        ``{"gp": {term: [6 floats]}, "true": {term: [6 floats]}}``, % of the truth's RMS per coefficient.
+    """
+    from dataclasses import replace
+
+    from gcs_sysid.gp.discrepancy import exact_condition_variance
+
+    ys2 = model.scaler.y_std ** 2
+    scale = 100.0 / np.sqrt(np.mean(np.asarray(ref) ** 2, axis=0))
+    pct = lambda v: (scale * np.sqrt(np.nanmean(np.broadcast_to(v, np.shape(ref)), axis=0))).round(3).tolist()  # noqa: E731
+    Xs, Xts = model.scaler.x(np.asarray(X)), model.scaler.x(np.asarray(X_true))
+    xv_s = None if x_var is None else np.where(model.scaler.active, np.asarray(x_var) / model.scaler.x_std ** 2, np.nan)
+    _, lat = model.predict(X, include_noise=False, input_noise=False, model_error=False)
+    learned = model.input_variance_s(Xs) * ys2
+    inp = model.input_variance_s(Xs, xv_s) * ys2
+    col = model.noise_var(white_noise=False)
+    gp = {"latent": pct(lat), "input_learned": pct(learned), "input": pct(inp), "coloured": pct(col),
+          "white": pct(model.noise_var() - col), "sigma": pct(lat + inp + col[None, :])}
+    _, lat_t = model.predict(X_true, include_noise=False, input_noise=False, model_error=False)
+    # each term alone, by the model's own formula (gcs_sysid.gp.discrepancy.exact_condition_variance)
+    Mc = model.map_cov
+    mapped = np.zeros(model.n_inputs, bool) if Mc is None else np.any(np.asarray(Mc) != 0, axis=(1, 2))
+    sv = None if model.scale_var is None else np.where(mapped, 0.0, np.asarray(model.scale_var))   # the map holds those
+    bare = replace(model, offset_cov=None, scale_var=None, map_cov=None, discrepancy=None)
+    alone = lambda **kw: exact_condition_variance(replace(bare, **kw), Xts) * ys2                 # noqa: E731
+    off, vsc, vmap = alone(offset_cov=model.offset_cov), alone(scale_var=sv), alone(map_cov=Mc)
+    d = np.zeros(model.n_outputs) if model.discrepancy is None else np.asarray(model.discrepancy)[0] * ys2
+    true = {"latent": pct(lat_t), "offset": pct(off), "scale": pct(vsc), "map": pct(vmap), "discrepancy": pct(d),
+            "sigma": pct(lat_t + off + vsc + vmap + d[None, :])}
+    return {"gp": gp, "true": true}
 
 
 def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
@@ -172,6 +227,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["cov_true_latent"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vl)[:, i]), Yt[h, i])
                                                for i in range(6)]))
     row["cov_gp_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]
+    if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
+        row["band_terms"] = band_terms(model, tab.X[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
     t_cut = float(tab.t[h][0])
     ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates)
