@@ -59,10 +59,11 @@ acts (Morelli and Klein 2016, ch. 5: measured accelerations as regressors).
 Each control enters the axes its moment equation gives it (:data:`CONTROL_AXES`: the elevator pitch,
 the aileron and rudder roll and yaw, the throttle all three; Morelli and Klein 2016, ch. 3): a free
 column on another axis only carries the gyro's noise there, in a shape that follows the controls. A
-slower transient per control (:data:`SLOW_DECAYS`) is added on an axis only where a Wald test with
-coloured innovations (a Bartlett long-run covariance of the scores, Newey and West 1987) beats the BIC
-penalty (a large aircraft's yaw damping): with white innovations it is the likelihood-ratio test, and
-where the innovations stay correlated over the transient's second (model error, gusts) it asks for more.
+slower transient per control (:data:`SLOW_DECAYS`) is added on an axis only where both the
+likelihood-ratio statistic and a Wald statistic with coloured innovations (a Bartlett long-run covariance
+of the scores, Newey and West 1987) beat the BIC penalty (a large aircraft's yaw damping): with white
+innovations the two agree, and where the innovations stay correlated over the transient's second (model
+error, gusts) the second asks for more.
 
 The bandwidth of the nominal model is chosen per axis by the diffuse profile
 likelihood (de Jong 1991) over a ladder of candidates, with ``b`` re-estimated
@@ -117,8 +118,9 @@ BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
 #: Decay rates (1/s) of the control transients: a basis for the response shape after a step (the roll,
 #: pitch and yaw damping of small aircraft lie within it); measured on the simulation in docs/estimation.md.
 DECAYS = (2.0, 5.0, 12.0, 30.0)
-#: Slower transients (1/s) taken per axis only where the data carry them (a Wald test with coloured
-#: innovations against the BIC penalty, ``W > k log n`` for the axis' ``k`` extra columns, :func:`_coloured_wald`;
+#: Slower transients (1/s) taken per axis only where the data carry them (the likelihood-ratio statistic and
+#: a Wald statistic with coloured innovations, :func:`_coloured_wald`, both above the BIC penalty ``k log n``
+#: for the axis' ``k`` extra columns;
 #: the plain likelihood-ratio test took them on the project's own simulation's yaw axis, where the
 #: innovations stay correlated for seconds, and cost its Cn 2.66 -> 3.21 %): the
 #: B747's yaw response (its own yaw damper in the loop) decays at about 1/s, slower than :data:`DECAYS` spans;
@@ -168,7 +170,7 @@ class RateEstimate:
             correction (:mod:`.wiener`) found signal over the gyro's noise floor and added it; NaN
             where it found none (or was switched off).
         slow_transient: (3,) per axis whether the slow transients (:data:`SLOW_DECAYS`) were taken
-            (Wald test with coloured innovations); all False when none were offered.
+            (likelihood-ratio and coloured Wald tests); all False when none were offered.
     """
 
     rate: np.ndarray
@@ -327,8 +329,9 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     keeps its delay.
 
     ``slow_decays``: further transient decay rates whose columns are left out of the bandwidth and
-    delay choices and then taken per axis only if the Wald statistic with coloured innovations
-    (:func:`_coloured_wald`) beats the BIC penalty ``k log n`` (``k`` the axis' extra columns).
+    delay choices and then taken per axis only if the likelihood-ratio statistic ``n log(RSS_0 / RSS_1)``
+    and the Wald statistic with coloured innovations (:func:`_coloured_wald`) both beat the BIC penalty
+    ``k log n`` (``k`` the axis' extra columns).
     ``control_axes``: per control of ``U`` the axes whose signal it may move (None: all); its columns
     are left out on the others.
     """
@@ -499,7 +502,9 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             wald = _coloured_wald([(lagged(G, nd, lag), e) for G, e in inn], GG, Ge, sel, opt)
             # kept for diagnosis: rows, extra columns, the white likelihood-ratio statistic, the Wald statistic
             out.setdefault("slow_test", {})[i] = (n, len(opt), n * float(math.log(rss[0] / rss[1])), wald)
-            if wald > len(opt) * math.log(n):
+            # stricter than the white test, never looser: anti-correlated innovations (a long-run variance
+            # below the white one) do not lower the bar (as gcs_sysid.gp.colored.variance_inflation, >= 1)
+            if min(wald, n * math.log(rss[0] / rss[1])) > len(opt) * math.log(n):
                 sel = None if len(sel1) == m else sel1
                 out["slow"][i] = True
         _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor, sel)
@@ -564,8 +569,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         input_lag: optional delay per given control, grid steps: fixed if ``max_delay_s`` is 0,
             else the start of the search.
         decays: decay rates of the control transients, 1/s.
-        slow_decays: slower transient decay rates, 1/s, taken per axis only where the Wald test with
-            coloured innovations beats the BIC penalty (:data:`SLOW_DECAYS`; ``()``: none offered).
+        slow_decays: slower transient decay rates, 1/s, taken per axis only where the likelihood-ratio
+            and the coloured-innovation Wald statistics both beat the BIC penalty (:data:`SLOW_DECAYS`;
+            ``()``: none offered).
         control_axes: optional, per column of ``controls``, the axes (0 p, 1 q, 2 r) that control may
             accelerate (None: all; :data:`CONTROL_AXES` for delta_e delta_a delta_r delta_t, the
             moment equations' control terms); its columns are left out on the other axes.
