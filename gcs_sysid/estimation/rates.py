@@ -271,7 +271,8 @@ def _coloured_wald(inn: list[tuple[np.ndarray, np.ndarray]], GG: np.ndarray, Ge:
     ``gcs_sysid.diagnose.regression.colored_covariance``): ``W = b^T A S^{-1} A b``. With white innovations
     ``W`` is the likelihood-ratio statistic ``n log(RSS_0 / RSS_1)`` to first order; when the innovations
     stay correlated over the transients' time scale (model error, gusts) it is smaller by their long-run
-    variance ratio (Newey and West 1987; Morelli and Klein 2016, sec. 5.3).
+    variance ratio, and larger where the scores are anti-correlated (Newey and West 1987; Morelli and
+    Klein 2016, sec. 5.3). Returns 0 when ``S`` is singular.
     """
     sel1 = np.union1d(sel, opt)
     b1 = _solve(GG[np.ix_(sel1, sel1)], Ge[sel1])[0]
@@ -496,7 +497,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             ee += float(e @ e)
         sel = sel_of(i, m)
         opt = opt_of(i)
-        if len(opt):   # the slow transients: taken on this axis only if the coloured-innovation test asks for them
+        if len(opt):   # the slow transients: taken on this axis only if the white and the coloured test both ask for them
             sel1 = np.union1d(sel, opt)
             rss = [max(ee - float(Ge[q] @ _solve(GG[np.ix_(q, q)], Ge[q])[0]), 1e-300) for q in (sel, sel1)]
             wald = _coloured_wald([(lagged(G, nd, lag), e) for G, e in inn], GG, Ge, sel, opt)
