@@ -279,7 +279,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                          + "; delay of their effect (maximum likelihood) = "
                          + ", ".join(f"{lg * dt:.2f}" for lg in Rr.input_lag) + " s; between samples the controls "
                          + ("step (ideal servos)" if Rr.hold == "zoh" else "move linearly (servo motion)")
-                         + " (likelihood); slow transients (1/s, likelihood-ratio test) on "
+                         + " (likelihood); slow transients (1/s, likelihood-ratio and coloured Wald tests) on "
                          + (" ".join(a for a, on in zip("pqr", Rr.slow_transient) if on) or "no axis"))
     else:
         missing.append("p q r p_dot q_dot r_dot: no gyro (IMU) and no rates in ATTITUDE")
