@@ -75,7 +75,11 @@ residual's signal where its spectrum stands significantly above the gyro's
 white-noise floor (:mod:`.wiener`), zero phase, per axis and gap-free piece; a
 white residual is left alone.
 :func:`smooth_specific_force` does the same with the accelerometer's residual on x and y
-(gust-driven forces above its bandwidth).
+(gust-driven forces above its bandwidth). On z (the lift's answer to vertical gusts, with the Dryden ``1/f^2``
+tail up to the Nyquist frequency in moderate turbulence) the turbulence is a state of the model instead: a
+first-order Gauss-Markov gust added to the measured force, its level chosen by the likelihood and kept only
+past a BIC penalty (:data:`GUST_HZ`, :func:`_nominal_model`; the filter-error method's process noise,
+Jategaonkar 2015 ch. 5).
 
 References:
     Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
@@ -147,7 +151,7 @@ GUST_TAU_S = 2.0
 #: attack and the lift at once (``CZ_alpha w_g / V``), the largest gust force, with the Dryden ``1/f^2`` tail up
 #: to the Nyquist frequency in moderate turbulence (f16: 26-260 x the accelerometer's noise at 4-24 Hz). On y the
 #: likelihood took the state and made CY worse (f16 moderate 7.8 -> 9.0 %): the side force's spectrum is not of
-#: that form; x and y keep the residual's Wiener correction (docs/estimation.md, "Turbulence in the specific force").
+#: that form; x and y keep the residual's Wiener correction (docs/estimation.md, section 5, "Moderate turbulence").
 GUST_FORCE_AXES = (2,)
 
 
@@ -346,6 +350,12 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     (``n log(RSS_without / RSS_with) > k log n``, ``k`` the axis' extra columns) asks for them.
     ``control_axes``: per control of ``U`` the axes whose signal it may move (None: all); its columns
     are left out on the others.
+    ``gust_hz``, ``gust_tau_s``, ``gust_axes``: the turbulence state (:func:`_nominal_model`) offered on the
+    axes ``gust_axes`` (None: none) at the levels ``gust_hz``: after the nominal bandwidths, coordinate ascent
+    over the level and the bandwidth; taken only if the log-likelihood gains more than ``0.5 log n`` over the
+    nominal model's best. The smoothed signal is then the nominal part plus the gust; ``xd`` stays the nominal
+    part's derivative (order 0 only: the forces need no derivative). ``out["gust"]``: the level taken per axis
+    (0: none).
     """
     T, d = Z.shape
     bw_ok = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
@@ -739,6 +749,11 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
             spectrum shows signal over the white-noise floor (per axis and gap-free piece, zero
             phase; its error variance ``sum G N df`` goes into ``f_sigma``); False: the smoother alone.
         residual_axes: the axes (0 x, 1 y, 2 z) corrected (:data:`RESIDUAL_FORCE_AXES`).
+        gust_hz: levels of the turbulence state (Hz where its ``1/f^2`` spectrum meets the white noise) offered
+            by the likelihood (:data:`GUST_HZ`; ``()``: none, the plain smoother).
+        gust_axes: the axes offered it (:data:`GUST_FORCE_AXES`, z: the gust-driven lift); the state is a
+            first-order Gauss-Markov gust added to the measured force (:func:`_nominal_model`), taken on an
+            axis only if it gains more than the BIC penalty over the plain smoother's best bandwidth.
 
     Returns:
         ``(f_smooth, f_sigma, noise_std)``: (T, 3), (T, 3) in m/s^2 and (3,) the
@@ -748,7 +763,9 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
         ValueError: ``controls`` or ``scale`` of the wrong length.
 
     Source: module docstring; Klein and Morelli (2006) ch. 10; Morelli and Klein (2016) sec. 11.1
-    (smoothing from the measured signal and noise spectra).
+    (smoothing from the measured signal and noise spectra); the turbulence state: Jategaonkar, *Flight Vehicle
+    System Identification*, 2nd ed., AIAA 2015, ch. 5 and 7 (process noise, the filter-error method);
+    MIL-F-8785C sec. 3.7.2 (the Dryden spectra); Schwarz (1978) (the BIC penalty).
     """
     U, moving, s = prepare_inputs(len(f), controls, scale)
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)

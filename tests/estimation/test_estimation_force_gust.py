@@ -54,8 +54,9 @@ def test_signal_of_the_nominal_form_gets_the_plain_smoother():
     rng = np.random.default_rng(11)
     T = 2500
     x = np.zeros((T, 3))
+    step = np.array([[1.0, 0.0, 0.0], [DT, 1.0, 0.0], [0.5 * DT**2, DT, 1.0]])   # x = [f, f_dot, f_ddot]
     for k in range(1, T):
-        x[k] = x[k - 1] @ np.array([[1.0, 0.0, 0.0], [DT, 1.0, 0.0], [0.5 * DT**2, DT, 1.0]]) + [0, 0, 4.0 * rng.normal()]
+        x[k] = x[k - 1] @ step + [0.0, 0.0, 4.0 * rng.normal()]
     f = x[:, 0] - 9.81
     z = f + rng.normal(0.0, ACC_NOISE, T)
     Z = np.stack([z, z, z], 1)
