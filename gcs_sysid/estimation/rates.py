@@ -411,21 +411,18 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             return c0, lls
         levels = [0.0] + [fg for fg in gust_hz if fg > 0]
         idx = lambda f, fg: bw_index[f] + (0 if fg == 0 else n_nominal * levels.index(fg))   # noqa: E731
+
+        def visit(cs):
+            """Evaluate the candidates ``cs`` not yet seen; the best so far."""
+            for c in cs:
+                if c not in lls:
+                    lls[c] = ll_of(c)
+            return max(lls, key=lls.get)
         best = c0
-        for _ in range(3):
+        for _ in range(3):      # levels at the best bandwidth, then bandwidths at the best level
             before = best
-            f_b = cands[best][0]
-            for fg in levels:
-                lls.setdefault(idx(f_b, fg), None)
-            for c in [c for c in lls if lls[c] is None]:
-                lls[c] = ll_of(c)
-            best = max(lls, key=lls.get)
-            fg_b = cands[best][1]
-            for f in bw_ok:
-                lls.setdefault(idx(f, fg_b), None)
-            for c in [c for c in lls if lls[c] is None]:
-                lls[c] = ll_of(c)
-            best = max(lls, key=lls.get)
+            best = visit([idx(cands[best][0], fg) for fg in levels])
+            best = visit([idx(f, cands[best][1]) for f in bw_ok])
             if best == before:
                 break
         # the gust state is one more parameter: taken only if it beats the nominal model's best by the
