@@ -440,7 +440,8 @@ def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float) -> np.ndarray | N
     if not changed:
         return None
     try:
-        states = estimate_states(dataclasses.replace(flight, streams=streams), ctx.airframe)
+        states = estimate_states(dataclasses.replace(flight, streams=streams), ctx.airframe,
+                                 turbulence_state=False)      # as load_measurements
         table = compute_coefficients(states, ctx.airframe)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError, KeyError):
         return None

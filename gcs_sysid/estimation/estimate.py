@@ -23,7 +23,7 @@ from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude,
 from .align import Aligned, align_flight, events
 from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
-from .rates import CONTROL_AXES, HOLDS, normal_force_input, smooth_rates
+from .rates import CONTROL_AXES, GUST_HZ, HOLDS, normal_force_input, smooth_rates
 from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
@@ -118,8 +118,8 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
 
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     progress: Callable[[float], None] | None = None, helper: Helper | None = None,
-                    aid_air_angles: bool = True, earth: str = "wgs84", angle_models: dict | None = None
-                    ) -> FlightStates:
+                    aid_air_angles: bool = True, earth: str = "wgs84", angle_models: dict | None = None,
+                    turbulence_state: bool = True) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -138,6 +138,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             of a differential diagnosis): the alpha aiding then uses that flight's CZ slopes, so that both
             flights' alpha share one scale (:func:`gcs_sysid.estimation.airangles.aided_air_angles`, ``models``).
             None: fitted on this flight.
+        turbulence_state: offer the specific-force smoother's z axis the turbulence state
+            (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default). False: the plain smoother, as the
+            diagnosis and ``fit`` load their flights (:func:`gcs_sysid.diagnose.run.load_measurements`: on a
+            clean JSBSim c172x flight the retained high-frequency CZ was named a zero-size elevator delay).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -313,7 +317,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         # worker (when there is one) while this process runs them; collected at the end
         sf_job = (helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
                                                           f_cg, controls=U, scale=qbar_eas, input_lag=in_lag,
-                                                          holds=(Rr.hold,) if in_lag is not None else HOLDS)
+                                                          holds=(Rr.hold,) if in_lag is not None else HOLDS,
+                                                          gust_hz=GUST_HZ if turbulence_state else ())
     vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
         "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
     vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")

@@ -306,6 +306,10 @@ def steady_state(F: np.ndarray, Q: np.ndarray, H: np.ndarray, R: np.ndarray) -> 
     return SteadyState(K, Pp, Pf, C, 0.5 * (Ps + Ps.T), S)
 
 
+#: Steps of the zero-input response of :func:`lti_response` taken one by one before the rest is filtered.
+_ZERO_INPUT_STEPS = 200
+
+
 def lti_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, u: np.ndarray,
                  x0: np.ndarray) -> np.ndarray:
     """Output of ``x_{k+1} = A x_k + B u_k, y_k = C x_k + D u_k`` from state ``x0``, in compiled code.
@@ -330,6 +334,15 @@ def lti_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, u: 
     scale = max(float(np.abs(v).max()), 1e-300)
     for k in range(T):
         if not np.abs(v).max() > 1e-15 * scale:
+            break
+        if k == _ZERO_INPUT_STEPS:
+            # a slowly decaying mode (a Gauss-Markov state near 1): the rest of C A^j v at once, as the
+            # impulse response of (A, A v, C, C v) through lfilter, instead of one Python step per sample
+            imp = np.zeros(T - k)
+            imp[0] = 1.0
+            for j in range(C.shape[0]):
+                num, den = ss2tf(A, (A @ v)[:, None], C[j:j + 1], np.array([[C[j] @ v]]))
+                y[k:, j] += lfilter(num[0], den, imp)
             break
         y[k] += C @ v
         v = A @ v

@@ -78,7 +78,11 @@ residual's signal where its spectrum stands significantly above the gyro's
 white-noise floor (:mod:`.wiener`), zero phase, per axis and gap-free piece; a
 white residual is left alone.
 :func:`smooth_specific_force` does the same with the accelerometer's residual on x and y
-(gust-driven forces above its bandwidth).
+(gust-driven forces above its bandwidth). On z (the lift's answer to vertical gusts, with the Dryden ``1/f^2``
+tail up to the Nyquist frequency in moderate turbulence) the turbulence is a state of the model instead: a
+first-order Gauss-Markov gust added to the measured force, its level chosen by the likelihood and kept only
+past a BIC penalty (:data:`GUST_HZ`, :func:`_nominal_model`; the filter-error method's process noise,
+Jategaonkar 2015 ch. 5).
 
 References:
     Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*,
@@ -143,6 +147,18 @@ ZOH_EVIDENCE = 0.01
 #: already 0.4-1.4 % off the truth in light turbulence (JSBSim), and there the correction (1.4 -> 1.1 % on
 #: the c172x) narrowed the GP's CZ band with noise to 62-77 % coverage of the truth on the sgs (88-94 % without).
 RESIDUAL_FORCE_AXES = (0, 1)
+#: Levels of the turbulence state offered to the specific-force smoother (Hz: where the gust's ``1/f^2``
+#: spectrum meets the accelerometer's white noise), by the likelihood with a BIC penalty (:func:`_nominal_model`).
+GUST_HZ = (2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
+#: Correlation time of the turbulence state, s (its spectrum is flat below ``1/(2 pi tau)``, where the nominal
+#: part already follows the signal; 0.5 and 2 s gave the same CZ on the f16, 0.66 / 0.67 %).
+GUST_TAU_S = 2.0
+#: Axes of the specific force that are offered the turbulence state: z. A vertical gust changes the angle of
+#: attack and the lift at once (``CZ_alpha w_g / V``), the largest gust force, with the Dryden ``1/f^2`` tail up
+#: to the Nyquist frequency in moderate turbulence (f16: 26-260 x the accelerometer's noise at 4-24 Hz). On y the
+#: likelihood took the state and made CY worse (f16 moderate 7.8 -> 9.0 %): the side force's spectrum is not of
+#: that form; x and y keep the residual's Wiener correction (docs/estimation.md, section 5, "Moderate turbulence").
+GUST_FORCE_AXES = (2,)
 
 
 @dataclass
@@ -185,6 +201,48 @@ class RateEstimate:
     hold: str = "zoh"
     correction_band_hz: np.ndarray | None = None
     slow_transient: np.ndarray | None = None
+
+
+def _nominal_model(dt: float, bandwidth_hz: float, gust_hz: float = 0.0,
+                   gust_tau_s: float = 2.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(F, Q, H)`` of the nominal model for unit measurement noise.
+
+    ``[s, s_dot, s_ddot]`` with white snap, ``q = dt omega_c^6`` (``omega_c = 2 pi bandwidth_hz``). With
+    ``gust_hz > 0`` a fourth state ``g``, first-order Gauss-Markov (``g_{k+1} = exp(-dt/tau) g_k + w_k``), is
+    added to the measurement (``z = s + g + v``): the turbulence-driven part of the signal, whose spectrum
+    falls as ``1/f^2`` above ``1/(2 pi tau)`` (the Dryden form's high-frequency tail, MIL-F-8785C sec.
+    3.7.2) where the white-snap part falls as ``1/f^6``. ``var(w) = (2 pi gust_hz dt)^2``: above ``1/tau``
+    the gust's spectrum equals the white noise's at ``gust_hz``. Jategaonkar, *Flight Vehicle System
+    Identification*, 2nd ed., AIAA 2015, ch. 5 (process noise for turbulence, the filter-error model).
+    """
+    F = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+    Q = dt * (2 * np.pi * bandwidth_hz) ** 6 * Q_continuous_white_noise(dim=3, dt=dt, spectral_density=1.0)
+    H = np.array([[1.0, 0.0, 0.0]])
+    if gust_hz <= 0:
+        return F, Q, H
+    F4, Q4 = np.zeros((4, 4)), np.zeros((4, 4))
+    F4[:3, :3], Q4[:3, :3] = F, Q
+    F4[3, 3], Q4[3, 3] = math.exp(-dt / gust_tau_s), (2 * np.pi * gust_hz * dt) ** 2
+    return F4, Q4, np.array([[1.0, 0.0, 0.0, 1.0]])
+
+
+class _Lazy(dict):
+    """``lazy[c]`` computes ``fn(c)`` once, on first use (the candidates a search never visits cost nothing)."""
+
+    def __init__(self, fn):
+        super().__init__()
+        self.fn = fn
+
+    def __missing__(self, c):
+        self[c] = v = self.fn(c)
+        return v
+
+
+def _x0(z0: float, nx: int) -> np.ndarray:
+    """Prior mean of the nominal state: the first measurement as the signal, rates and gust 0."""
+    x = np.zeros(nx)
+    x[0] = z0
+    return x
 
 
 def _innovation_filter(F: np.ndarray, g: SteadyState, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -241,11 +299,16 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray)
             xs[:, j] += _lfilter_columns(num[0], den, xr[:, i])
     v = F @ x[-1]            # zero-input response of the end condition, until it has decayed
     scale = max(float(np.abs(v).max()), 1e-300)
-    for k in range(n):
-        if not np.abs(v).max() > 1e-15 * scale:
+    # the powers C^(k+1) until they have decayed (small matrices), then all rows at once
+    pw, Ck = [], Cg.copy()
+    norm_c = max(float(np.abs(Cg).max()), 1e-300)
+    for _ in range(n):
+        if not np.abs(Ck).max() * float(np.abs(v).max()) > 1e-15 * scale * min(norm_c, 1.0):
             break
-        xs[k] += Cg @ v
-        v = Cg @ v
+        pw.append(Ck)
+        Ck = Cg @ Ck
+    if pw:
+        xs[:len(pw)] += np.einsum("kij,jm->kim", np.array(pw), v)
     return xs[::-1]
 
 
@@ -317,7 +380,9 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         hold: tuple[str, ...] = ("zoh", "foh"), aux: np.ndarray | None = None,
                         aux_axes: tuple[int, ...] | None = None,
                         slow_decays: tuple[float, ...] = (),
-                        control_axes: list[tuple[int, ...] | None] | None = None) -> dict[str, np.ndarray]:
+                        control_axes: list[tuple[int, ...] | None] | None = None,
+                        gust_hz: tuple[float, ...] = (), gust_tau_s: float = 2.0,
+                        gust_axes: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -335,16 +400,25 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     ``k log n`` (``k`` the axis' extra columns).
     ``control_axes``: per control of ``U`` the axes whose signal it may move (None: all); its columns
     are left out on the others.
+    ``gust_hz``, ``gust_tau_s``, ``gust_axes``: the turbulence state (:func:`_nominal_model`) offered on the
+    axes ``gust_axes`` (None: none) at the levels ``gust_hz``: after the nominal bandwidths, coordinate ascent
+    over the level and the bandwidth; taken only if the log-likelihood gains more than ``0.5 log n`` over the
+    nominal model's best. The smoothed signal is then the nominal part plus the gust; ``xd`` stays the nominal
+    part's derivative (order 0 only: the forces need no derivative). ``out["gust"]``: the level taken per axis
+    (0: none).
     """
     T, d = Z.shape
-    F = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
-    H = np.array([[1.0, 0.0, 0.0]])
-    bws = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
-    q0 = Q_continuous_white_noise(dim=3, dt=dt, spectral_density=1.0)
-    # unit measurement noise; q = dt * omega_c^6 sets the ratio
-    gains = [steady_state(F, dt * (2 * np.pi * f) ** 6 * q0, H, np.eye(1)) for f in bws]
-    tfs = [_innovation_filter(F, g, H) for g in gains]
-    S = np.array([g.S[0, 0] for g in gains])
+    bw_ok = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
+    # candidates (bandwidth, gust level): the nominal model alone (gust 0) and, for each level in
+    # gust_hz, with the turbulence-driven part as a Gauss-Markov state of the measured signal
+    cands = [(f, 0.0) for f in bw_ok] + [(f, fg) for fg in gust_hz if fg > 0 for f in bw_ok]
+    models = [_nominal_model(dt, f, fg, gust_tau_s) for f, fg in cands]
+    Fs, Hs = [mo[0] for mo in models], [mo[2] for mo in models]
+    gains = _Lazy(lambda c: steady_state(*models[c], np.eye(1)))
+    tfs = _Lazy(lambda c: _innovation_filter(Fs[c], gains[c], Hs[c]))
+    S = _Lazy(lambda c: gains[c].S[0, 0])
+    bws = np.array([c[0] for c in cands])
+    n_nominal = len(bw_ok)          # the first n_nominal candidates have no gust state
     aux = np.zeros((T, 0)) if aux is None else np.asarray(aux, float).reshape(T, -1)
     ok_u = np.isfinite(U).all(axis=1) & np.isfinite(aux).all(axis=1)
     all_decays = (0.0,) + tuple(decays) + tuple(slow_decays)
@@ -360,7 +434,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
         return np.array([c * nd + j for c in range(nc) if on(c, i) for j in range(n_base, nd)], int)
     lag = np.zeros(nc, int) if lag is None else np.asarray(lag, int)
     out = {k: np.full((T, d), np.nan) for k in ("x", "xs", "xd", "xds")}
-    out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), lag=lag)
+    out.update(bw=np.full(d, np.nan), sig=np.full(d, np.nan), gust=np.full(d, np.nan), lag=lag)
     holds = tuple(hold) if nc else ("foh",)
     # the measured signals (aux) only with smooth controls: low-passed, they would smear the jumps that
     # ideal actuators (zoh) make in them (the project's simulation: q_dot 2.7 -> 5.0 % with them)
@@ -376,24 +450,56 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     per_hold = {h: [] for h in holds}   # per hold, per axis: segments, columns, innovations at its bandwidth
     ll_hold = dict.fromkeys(holds, 0.0)
     colcache: dict = {}
+    bw_index = {f: j for j, f in enumerate(bw_ok)}
+
+    def candidates_of(i, ll_of):
+        """Candidates to evaluate on axis ``i`` and the best: every nominal bandwidth; on a gust axis then
+        coordinate ascent over the gust level (at the best bandwidth) and the bandwidth (at the best level)."""
+        lls = {c: ll_of(c) for c in range(n_nominal)}
+        c0 = max(lls, key=lls.get)
+        if gust_axes is None or i not in gust_axes or len(cands) == n_nominal:
+            return c0, lls
+        levels = [0.0] + [fg for fg in gust_hz if fg > 0]
+        idx = lambda f, fg: bw_index[f] + (0 if fg == 0 else n_nominal * levels.index(fg))   # noqa: E731
+
+        def visit(cs):
+            """Evaluate the candidates ``cs`` not yet seen; the best so far."""
+            for c in cs:
+                if c not in lls:
+                    lls[c] = ll_of(c)
+            return max(lls, key=lls.get)
+        best = c0
+        for _ in range(3):      # levels at the best bandwidth, then bandwidths at the best level
+            before = best
+            best = visit([idx(cands[best][0], fg) for fg in levels])
+            best = visit([idx(f, cands[best][1]) for f in bw_ok])
+            if best == before:
+                break
+        # the gust state is one more parameter: taken only if it beats the nominal model's best by the
+        # BIC penalty 0.5 log n (Schwarz 1978); else the nominal choice, exactly as without it
+        n_i = ll_of.n
+        return (best if lls[best] - lls[c0] > 0.5 * math.log(max(n_i, 2)) else c0), lls
+
     for i in range(d):
         segs = segments(np.isfinite(Z[:, i]) & ok_u, 10)
         if not segs:
             continue
-        ez = []            # the measurement's innovations per segment and candidate (the same for every hold)
-        for sg in segs:
-            z = Z[sg, i][:, None]
-            x0 = np.array([z[0, 0], 0.0, 0.0])
-            # innovations only: one transfer function, not the filter's three states as well
-            ez.append([lti_response((np.eye(3) - g.K @ H) @ F, g.K, -H @ F, np.eye(1), z, x0)[:, 0] / math.sqrt(S[c])
-                       for c, g in enumerate(gains)])
-        n = sum(len(e[0]) for e in ez)
+        ezc: dict = {}      # the measurement's innovations per candidate and segment (the same for every hold)
+
+        def ez_of(c, segs=segs, i=i, ezc=ezc):
+            if c not in ezc:
+                F_, H_, g = Fs[c], Hs[c], gains[c]
+                # innovations only: one transfer function, not the filter's states as well
+                ezc[c] = [lti_response((np.eye(len(F_)) - g.K @ H_) @ F_, g.K, -H_ @ F_, np.eye(1),
+                                       Z[sg, i][:, None], _x0(Z[sg.start, i], len(F_)))[:, 0] / math.sqrt(S[c])
+                          for sg in segs]
+            return ezc[c]
+        n = sum(sg.stop - sg.start for sg in segs)
         for h in holds:
             key = (_segkey(segs), h)
             m = m_of[h]
             if key not in colcache:     # the columns and their Gram matrices are the same for every axis
-                cols, Gs = [], []       # with the same segments (the usual case): filtered once, not per axis
-                GG = np.zeros((len(bws), m, m))
+                cols = []               # with the same segments (the usual case): filtered once, not per axis
                 for sg in segs:
                     A, W = control_columns(dt, U[sg], s[sg], (0,), all_decays, h)
                     if m > nc * nd:             # measured signals: continuous, linear between samples
@@ -401,26 +507,29 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         A, W = np.concatenate([A, Ax], 1), np.concatenate([W, Wx], 1)
                     # measured part, and the parts of the signal and of its derivative (undelayed)
                     cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
-                    Gs.append([])
-                    for c, (num, den) in enumerate(tfs):   # all candidates
-                        G = (_lfilter_columns(num, den, cols[-1][0]) if m else cols[-1][0]) / math.sqrt(S[c])
-                        Gs[-1].append(G)
-                        Gl = lagged(G, nd, lag)
-                        GG[c] += Gl.T @ Gl
-                colcache[key] = (cols, Gs, GG)
+                colcache[key] = (cols, {}, {})
             cols, Gs, GG = colcache[key]
-            Ge, ee = np.zeros((len(bws), m)), np.zeros(len(bws))
-            inn = []
-            for Gseg, es in zip(Gs, ez):
-                inn.append(list(zip(Gseg, es)))
-                for c in range(len(bws)):
-                    Ge[c] += lagged(Gseg[c], nd, lag).T @ es[c]
-                    ee[c] += float(es[c] @ es[c])
-            lls = [_profile(GG[c], Ge[c], ee[c], n, m, S[c], noise_floor, sel_of(i, m))[0]
-                   for c in range(len(bws))]
-            c = int(np.argmax(lls))
+
+            def gram(c, cols=cols, Gs=Gs, GG=GG, m=m):
+                """Per segment the column innovations of candidate ``c`` and their lagged Gram matrix
+                (computed once per candidate, shared by the axes)."""
+                if c not in Gs:
+                    num, den = tfs[c]
+                    Gs[c] = [(_lfilter_columns(num, den, X[0]) if m else X[0]) / math.sqrt(S[c]) for X in cols]
+                    GG[c] = sum(lagged(G, nd, lag).T @ lagged(G, nd, lag) for G in Gs[c]) if Gs[c] else \
+                        np.zeros((m, m))
+                return Gs[c], GG[c]
+
+            def ll_of(c, i=i, m=m):
+                Gc, GGc = gram(c)
+                es = ez_of(c)
+                Ge = sum(lagged(G, nd, lag).T @ e for G, e in zip(Gc, es))
+                ee = sum(float(e @ e) for e in es)
+                return _profile(GGc, Ge, ee, n, m, S[c], noise_floor, sel_of(i, m))[0]
+            ll_of.n = n
+            c, lls = candidates_of(i, ll_of)
             ll_hold[h] += lls[c]
-            per_hold[h].append((i, segs, cols, [per[c] for per in inn], c, n))
+            per_hold[h].append((i, segs, cols, list(zip(gram(c)[0], ez_of(c))), c, n))
     # the same hold for every axis (it is how the servos move). Steps need decisive evidence: no servo
     # moves within one sample, so "zoh" (ideal actuators fed the logged commands, as in the project's own
     # simulation, where it gains about 0.4 per sample) is taken only when it beats "foh" by more than
@@ -509,16 +618,17 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                 sel = None if len(sel1) == m else sel1
                 out["slow"][i] = True
         _, beta, Minv, s2 = _profile(GG, Ge, ee, n, m, S[c], noise_floor, sel)
-        out["bw"][i], out["sig"][i] = bws[c], math.sqrt(s2)
+        out["bw"][i], out["sig"][i], out["gust"][i] = bws[c], math.sqrt(s2), cands[c][1]
         out["beta"][i], out["cov"][i] = beta, s2 * Minv
-        g = gains[c]
+        g, F, H = gains[c], Fs[c], Hs[c]
         for sg, (Mz, X0, X1) in zip(segs, cols):
             Mz, X0, X1 = (lagged(X, nd, lag) for X in (Mz, X0, X1))
             z = Z[sg, i][:, None] - (Mz @ beta)[:, None]
-            xs, _ = steady_state_smoother(F, g, H, z, np.array([z[0, 0], 0.0, 0.0]))
-            out["x"][sg, i] = xs[:, 0] + X0 @ beta
+            xs, _ = steady_state_smoother(F, g, H, z, _x0(z[0, 0], len(F)))
+            # the signal is what the sensor measures without its noise: the nominal part plus the gust
+            out["x"][sg, i] = xs @ H[0] + X0 @ beta
             out["xd"][sg, i] = xs[:, 1] + X1 @ beta
-            var0 = np.full(len(z), s2 * g.Ps[0, 0])
+            var0 = np.full(len(z), s2 * float(H[0] @ g.Ps @ H[0]))
             var1 = np.full(len(z), s2 * g.Ps[1, 1])
             if m:
                 # the coefficients' own uncertainty: x = x~(z - Mz b) + X b, so an error db moves the
@@ -527,7 +637,7 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                 if kk not in xjcache:
                     xjcache[kk] = _smooth_columns(F, g, H, Mz)
                 xj = xjcache[kk]
-                D0, D1 = X0 - xj[:, 0], X1 - xj[:, 1]
+                D0, D1 = X0 - np.einsum("j,njm->nm", H[0], xj), X1 - xj[:, 1]
                 C = s2 * Minv
                 var0 += ((D0 @ C) * D0).sum(axis=1)
                 var1 += ((D1 @ C) * D1).sum(axis=1)
@@ -663,7 +773,8 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
                           scale: np.ndarray | None = None, max_delay_s: float = 0.2,
                           input_lag: np.ndarray | None = None, decays: tuple[float, ...] = DECAYS,
                           holds: tuple[str, ...] = HOLDS, residual_correction: bool = True,
-                          residual_axes: tuple[int, ...] = RESIDUAL_FORCE_AXES
+                          residual_axes: tuple[int, ...] = RESIDUAL_FORCE_AXES,
+                          gust_hz: tuple[float, ...] = GUST_HZ, gust_axes: tuple[int, ...] = GUST_FORCE_AXES
                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Zero-phase smoothing of the specific force, jumping where the controls step.
 
@@ -692,6 +803,11 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
             spectrum shows signal over the white-noise floor (per axis and gap-free piece, zero
             phase; its error variance ``sum G N df`` goes into ``f_sigma``); False: the smoother alone.
         residual_axes: the axes (0 x, 1 y, 2 z) corrected (:data:`RESIDUAL_FORCE_AXES`).
+        gust_hz: levels of the turbulence state (Hz where its ``1/f^2`` spectrum meets the white noise) offered
+            by the likelihood (:data:`GUST_HZ`; ``()``: none, the plain smoother).
+        gust_axes: the axes offered it (:data:`GUST_FORCE_AXES`, z: the gust-driven lift); the state is a
+            first-order Gauss-Markov gust added to the measured force (:func:`_nominal_model`), taken on an
+            axis only if it gains more than the BIC penalty over the plain smoother's best bandwidth.
 
     Returns:
         ``(f_smooth, f_sigma, noise_std)``: (T, 3), (T, 3) in m/s^2 and (3,) the
@@ -701,13 +817,16 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
         ValueError: ``controls`` or ``scale`` of the wrong length.
 
     Source: module docstring; Klein and Morelli (2006) ch. 10; Morelli and Klein (2016) sec. 11.1
-    (smoothing from the measured signal and noise spectra).
+    (smoothing from the measured signal and noise spectra); the turbulence state: Jategaonkar, *Flight Vehicle
+    System Identification*, 2nd ed., AIAA 2015, ch. 5 and 7 (process noise, the filter-error method);
+    MIL-F-8785C sec. 3.7.2 (the Dryden spectra); Schwarz (1978) (the BIC penalty).
     """
     U, moving, s = prepare_inputs(len(f), controls, scale)
     lag = None if input_lag is None else np.nan_to_num(np.asarray(input_lag, float)[moving]).astype(int)
     f = np.asarray(f, float)
     o = _smooth_with_inputs(dt, f, U, s, lag, int(round(max_delay_s / dt)),
-                            tuple(decays), noise_floor, bandwidths_hz, order=0, hold=tuple(holds))
+                            tuple(decays), noise_floor, bandwidths_hz, order=0, hold=tuple(holds),
+                            gust_hz=tuple(gust_hz), gust_tau_s=GUST_TAU_S, gust_axes=tuple(gust_axes))
     if residual_correction:
         _correct_residual(dt, f, o, order=0, axes=tuple(residual_axes))
     return o["x"], o["xs"], o["sig"]

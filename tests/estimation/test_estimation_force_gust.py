@@ -1,0 +1,65 @@
+"""The turbulence state of the specific-force smoother's z axis (estimation/rates.py, issue 8, branch i8-turb):
+a gust-driven normal force with the Dryden form's 1/f^2 tail is followed up to the Nyquist frequency where the
+plain smoother took it for noise, and a flight without it gets exactly the plain smoother."""
+
+import numpy as np
+from scipy.signal import butter, lfilter
+
+from gcs_sysid.estimation.rates import GUST_FORCE_AXES, smooth_specific_force
+
+DT = 0.02          # 50 Hz SCALED_IMU
+ACC_NOISE = 0.05   # m/s^2 white per sample, the JSBSim harness's accelerometer
+
+
+def _normal_force(T: int = 2500, seed: int = 3, gust_rms: float = 0.4):
+    """A slow manoeuvre force (white noise through a 0.4 Hz low-pass, 1 m/s^2 RMS) plus a gust-driven part
+    (first-order Gauss-Markov, 0.5 s, so 1/f^2 above 0.3 Hz: the vertical gust through the lift slope),
+    measured with white noise. Returns (f, z)."""
+    rng = np.random.default_rng(seed)
+    b, a = butter(2, 0.4 * 2 * DT)
+    lf = lfilter(b, a, rng.normal(size=T))
+    lf *= 1.0 / lf.std()
+    phi = np.exp(-DT / 0.5)
+    g = lfilter([1.0], [1.0, -phi], rng.normal(size=T))
+    g *= gust_rms / g.std() if gust_rms > 0 else 0.0
+    f = lf + g - 9.81
+    return f, f + rng.normal(0.0, ACC_NOISE, T)
+
+
+def _err(x, ref):
+    m = slice(100, -100)
+    return float(np.sqrt(np.mean((x[m] - ref[m]) ** 2)))
+
+
+def test_gust_driven_normal_force_is_followed():
+    assert GUST_FORCE_AXES == (2,)
+    f, z = _normal_force()
+    Z = np.stack([z, z, z], 1)
+    with_gust, sig, _ = smooth_specific_force(DT, Z, residual_correction=False)
+    plain, _, noise0 = smooth_specific_force(DT, Z, residual_correction=False, gust_hz=())
+    e0, e1, e_raw = _err(plain[:, 2], f), _err(with_gust[:, 2], f), _err(z, f)
+    assert e1 < 0.6 * e0, (e0, e1)                 # measured 0.097 -> 0.049 m/s^2
+    assert e1 <= e_raw                             # at least as good as the raw samples (0.051)
+    assert noise0[2] > 2 * ACC_NOISE               # the plain smoother took the gust for noise (0.116)
+    # x and y are not offered the state: the plain smoother there
+    np.testing.assert_array_equal(with_gust[:, :2], plain[:, :2])
+    # the stated sigma is finite; it is optimistic here (0.019 against 0.049 m/s^2): with the gust's spectrum
+    # above the noise up to the Nyquist frequency the white noise's share is not identified (docs/estimation.md)
+    assert np.isfinite(sig[:, 2]).all() and (sig[:, 2] > 0).all()
+
+
+def test_signal_of_the_nominal_form_gets_the_plain_smoother():
+    # a force whose spectrum is the nominal model's own (white snap, 1/f^6): the gust state gains less than
+    # the BIC penalty and the smoother is exactly the plain one
+    rng = np.random.default_rng(11)
+    T = 2500
+    x = np.zeros((T, 3))
+    step = np.array([[1.0, 0.0, 0.0], [DT, 1.0, 0.0], [0.5 * DT**2, DT, 1.0]])   # x = [f, f_dot, f_ddot]
+    for k in range(1, T):
+        x[k] = x[k - 1] @ step + [0.0, 0.0, 4.0 * rng.normal()]
+    f = x[:, 0] - 9.81
+    z = f + rng.normal(0.0, ACC_NOISE, T)
+    Z = np.stack([z, z, z], 1)
+    with_gust, _, _ = smooth_specific_force(DT, Z, residual_correction=False)
+    plain, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_hz=())
+    np.testing.assert_array_equal(with_gust, plain)
