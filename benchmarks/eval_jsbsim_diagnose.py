@@ -179,7 +179,8 @@ def _pitot_summary(data: dict) -> dict:
             "coefficients_mps": fused.get("coefficients_mps"), "coefficients_se": fused.get("coefficients_se"),
             "fused_mps": fused.get("estimate"), "fused_t": fused.get("t_statistic"), "agree": fused.get("agree"),
             "screen": (wt.get("screen") or {}).get("passes"), "rereduced_mps": re.get("estimate"),
-            "checks": wt.get("checks"), "why": wt.get("why")}
+            "checks": wt.get("checks"), "why": wt.get("why"),
+            "gain_untouched": wt.get("gain_untouched"), "gain_sensor": wt.get("gain_sensor")}
 
 
 def side_force_scale_truth(truth_npz, k: float) -> float:

@@ -117,41 +117,49 @@ def _samples(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight):
     return tas, vg, w0, prior
 
 
-def triangle_gain(t_grid: np.ndarray, states: dict, rows: np.ndarray, flight, cal: dict, before_mps: float,
+def triangle_gain(t_grid: np.ndarray, states: dict, rows: np.ndarray, flight, before_mps: float,
                   after_mps: float) -> dict | None:
-    """Gain of a pitot correction in the sensor's own units: the wind triangle's residual on ``rows``.
+    """Gain of a pitot correction in the sensor's own units: the residual against the logged wind on ``rows``.
 
-    The residual is ``V_pitot - |v_gps - w_ap - dw| - b`` (m/s TAS) on the pitot's samples that fall in
-    ``rows`` (rows no fit has used: the diagnosis' untouched rows), with the flight's wind correction
-    ``dw`` (``cal["wind_correction_mps"]``, fitted with the bias, :func:`wind_triangle`) and the pitot
-    bias ``b`` = ``before_mps`` (what the reference flight(s) read: nothing changed) and then
+    The residual is ``V_pitot - |v_gps - w_ap| - b`` (m/s TAS) on the pitot's samples that fall in ``rows``
+    (rows no fit has used: the diagnosis' untouched rows), with the autopilot's wind ``w_ap`` *as logged*
+    and the pitot bias ``b`` = ``before_mps`` (what the reference flight(s) read: nothing changed) and then
     ``after_mps`` (the named bias added). Not centred: a bias *is* the residual's level. The gain in the
-    sensor's own units, as for the other data-compatibility sensor causes
-    (:mod:`gcs_sysid.diagnose.compat`: every sensor against the kinematics; Morelli and Klein, *Aircraft
-    System Identification*, 2nd ed., ch. 10).
+    sensor's own units, as for the other data-compatibility sensor causes (:mod:`gcs_sysid.diagnose.compat`:
+    every sensor against the kinematics; Morelli and Klein, *Aircraft System Identification*, 2nd ed., ch. 10).
+
+    Why the logged wind and not the wind correction :func:`wind_triangle` fits (twelfth session, branch
+    i9-pitot; ``docs/diagnose.md``): that correction is fitted *together with* the bias, so keeping it while
+    the bias is set back to ``before_mps`` scores a "before" the data never supported, and the bias earns a
+    gain for whatever the correction traded against it. On the project's own simulated flights (two headings,
+    the autopilot's wind wandering 0.3 m/s with a 20-s time constant) the joint fit reads a pitot bias of
+    +0.50 +- 0.13 m/s where there is none, with a wind correction of (0.78, 0.54) m/s, 3 of its prior's standard
+    errors; the residual against the logged wind has a level of -0.004 m/s there. A pitot bias is a constant
+    offset of the pitot against GPS minus the wind whatever the heading, so it shows in that residual itself;
+    an offset made by a fitted wind correction does not.
 
     Args:
         t_grid: (T,) times of the state grid, s. states, flight: as :func:`wind_triangle`.
-        rows: (T,) rows of the grid to score on. cal: :func:`wind_triangle` of this flight.
+        rows: (T,) rows of the grid to score on.
         before_mps, after_mps: the pitot bias without and with the correction, m/s TAS.
 
     Returns:
-        ``{"rms_before", "rms_after" (m/s), "percent", "n", "unit"}``, or None (no pitot, ground velocity or
-        density, fewer than 100 usable pitot samples in ``rows``, or no calibration ``cal``).
+        ``{"rms_before", "rms_after", "level" (m/s), "percent", "n", "unit", "wind"}`` (``level``: the residual's
+        mean on ``rows``), or None (no pitot, ground velocity, density or autopilot wind, or fewer than 100
+        usable pitot samples in ``rows``).
     """
-    if cal is None:
-        return None
     smp = _samples(t_grid, states, rows, flight)
-    if smp is None:
+    if smp is None or not smp[3]:
         return None
     tas, vg, w0, _ = smp
     a = vg.copy()
-    a[:, :2] -= w0 + np.asarray(cal.get("wind_correction_mps", [0.0, 0.0]), float)[None, :]
+    a[:, :2] -= w0
     r = tas - np.linalg.norm(a, axis=1)
     b = float(np.sqrt(np.mean((r - before_mps) ** 2)))
     f = float(np.sqrt(np.mean((r - after_mps) ** 2)))
-    return {"rms_before": b, "rms_after": f, "percent": float(100.0 * (1.0 - f / b)) if b > 0 else 0.0,
-            "n": int(len(r)), "unit": "m/s"}
+    return {"rms_before": b, "rms_after": f, "level": float(np.mean(r)),
+            "percent": float(100.0 * (1.0 - f / b)) if b > 0 else 0.0,
+            "n": int(len(r)), "unit": "m/s", "wind": "autopilot's, as logged"}
 
 
 def wind_triangle(t_grid: np.ndarray, states: dict, valid: np.ndarray, flight,
