@@ -9,9 +9,8 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
   pattern ``none`` (isotopic: every coefficient on every row)
     ``joint``    ``fit_gp(X, Y, GPConfig())``: the replay's model (ICM, one noise variance per output,
                  input noise, blocked validation)
-    ``jointf``   ``joint`` with ``GPConfig(output_groups="none")``: every shared factor of ``B`` on every
-                 output (the model before the twelfth session; ``joint`` splits them between the
-                 longitudinal and the lateral-directional outputs)
+    ``jointa``   ``joint`` with ``GPConfig(output_groups="axes")``: each shared factor of ``B`` on the
+                 longitudinal (CX CZ Cm) or the lateral-directional (CY Cl Cn) outputs only
     ``jointn``   the same with the full 6 x 6 noise covariance in the likelihood
                  (``GPConfig.noise_correlation``: the gusts' correlated error between outputs)
     ``dec``      ``joint`` with its cross-output coupling removed after the fit (``gp.joint.decoupled_model``:
@@ -63,10 +62,10 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import decoupled_model  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "jointf", "jointn", "dec", "decn", "indep", "lmc")
+ISO_MODELS = ("joint", "jointa", "jointn", "dec", "decn", "indep", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
-PAIRS = (("joint", "indep", "none"), ("jointf", "indep", "none"), ("joint", "jointf", "none"), ("jointn", "indep", "none"), ("lmc", "indep", "none"),
+PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"), ("jointn", "indep", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
@@ -107,7 +106,7 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
             corr: dict = {}
             gone = np.zeros(len(X), bool)
             if pattern == "none":
-                for v, cfg in (("joint", base), ("jointf", replace(base, output_groups="none")),
+                for v, cfg in (("joint", base), ("jointa", replace(base, output_groups="axes")),
                                ("jointn", replace(base, noise_correlation=True)),
                                ("lmc", replace(base, latent_kernels=2))):
                     if (v == "lmc" and not lmc) or v not in models_wanted:
@@ -205,19 +204,20 @@ def summarize(paths) -> str:
                 out += [f"\n{a} vs {b}, pattern {pattern}, {what} (better / worse by > 0.05 points / within; medians)\n",
                         "| training | turbulence | pairs |", "|---|---|---|"] + lines
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
-    out += ["\njoint vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
-            "| aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|"]
-    for ac in sorted({r["aircraft"] for r in rows}):
-        for L in lengths:
-            g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
-            f = _count(_pairs(rows, "joint", "indep", "none", "err", COEFFICIENTS[:3], g))
-            m = _count(_pairs(rows, "joint", "indep", "none", "err", mom, g))
-            if f or m:
-                out.append(f"| {ac} | {'all' if L <= 0 else f'{L:g} s'} | {f} | {m} |")
+    out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
+            "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
+    for v in ("joint", "jointa"):
+        for ac in sorted({r["aircraft"] for r in rows}):
+            for L in lengths:
+                g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
+                f = _count(_pairs(rows, v, "indep", "none", "err", COEFFICIENTS[:3], g))
+                m = _count(_pairs(rows, v, "indep", "none", "err", mom, g))
+                if f or m:
+                    out.append(f"| {v} | {ac} | {'all' if L <= 0 else f'{L:g} s'} | {f} | {m} |")
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointf", "jointn", "lmc", "hjoint"):
+    for v in ("joint", "jointa", "jointn", "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:

@@ -41,8 +41,8 @@ def test_coregionalisation_learns_the_coupling_of_two_outputs():
     rest = 0.05 * rng.standard_normal((300, 4)) + X[:, 6:] * [1.0, 10.0, 1.0, 0.1]
 
     def fitted_corr(second):
-        # the pair as outputs 0 and 2 (CX and CZ by the default names: one axis; GPConfig.output_groups
-        # keeps the longitudinal and lateral outputs' factors apart)
+        # the pair as outputs 0 and 2 (CX and CZ by the default names: one axis, so the test holds with
+        # GPConfig.output_groups="axes" too)
         Y = np.column_stack([g, rest[:, 0], second, rest[:, 1:]]) + 0.05 * rng.standard_normal((300, 6))
         return fit_gp(X, Y, FAST)[0].output_correlation()[0, 2]
 
