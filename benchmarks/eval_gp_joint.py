@@ -65,7 +65,8 @@ PATTERNS = ("none", "rates", "block")
 ISO_MODELS = ("joint", "jointa", "jointn", "dec", "decn", "indep", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
-PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"), ("jointn", "indep", "none"), ("lmc", "indep", "none"),
+PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
+         ("jointn", "indep", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))

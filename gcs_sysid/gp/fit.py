@@ -44,7 +44,8 @@ from .sparse import GlobalParams, design, elbo, stats_of
 from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local, shared_search, store_without
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "fit_local", "noise_correlation_factor",
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "fit_local",
+           "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
            "learn_input_noise", "validated_global", "validated_local"]
 
