@@ -9,6 +9,8 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
   pattern ``none`` (isotopic: every coefficient on every row)
     ``joint``    ``fit_gp(X, Y, GPConfig())``: the replay's model (ICM, one noise variance per output,
                  input noise, blocked validation)
+    ``jointa``   ``joint`` with ``GPConfig(output_groups="axes")``: each shared factor of ``B`` on the
+                 longitudinal (CX CZ Cm) or the lateral-directional (CY Cl Cn) outputs only
     ``jointn``   the same with the full 6 x 6 noise covariance in the likelihood
                  (``GPConfig.noise_correlation``: the gusts' correlated error between outputs)
     ``dec``      ``joint`` with its cross-output coupling removed after the fit (``gp.joint.decoupled_model``:
@@ -60,10 +62,11 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import decoupled_model  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "jointn", "dec", "decn", "indep", "lmc")
+ISO_MODELS = ("joint", "jointa", "jointn", "dec", "decn", "indep", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
-PAIRS = (("joint", "indep", "none"), ("jointn", "indep", "none"), ("lmc", "indep", "none"),
+PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
+         ("jointn", "indep", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
@@ -81,8 +84,9 @@ def _pred(model, X):
     return model.predict(X, include_noise=False)[0]
 
 
-def score(path: Path, lengths, patterns, lmc: bool = False):
-    """Every model on one cached flight; yields one JSON-able dict per length, pattern and model."""
+def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
+    """Every model on one cached flight; yields one JSON-able dict per length, pattern and model
+    (isotopic rows: those of ``models`` only; ``dec``/``decn`` need ``joint``/``jointn``)."""
     d = np.load(path)
     t, X, Y, Xt, Yt = d["t"], d["X"], d["Y"], d["Xt"], d["Yt"]
     ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
@@ -91,6 +95,7 @@ def score(path: Path, lengths, patterns, lmc: bool = False):
     meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
     base = GPConfig()
     P = Y.shape[1]
+    models_wanted = set(models)
     for length in lengths:
         tr = first_seconds(t, tr_all, length)
         info = dict(meta, length=float(length), n_train=int(tr.sum()),
@@ -102,21 +107,24 @@ def score(path: Path, lengths, patterns, lmc: bool = False):
             corr: dict = {}
             gone = np.zeros(len(X), bool)
             if pattern == "none":
-                for v, cfg in (("joint", base), ("jointn", replace(base, noise_correlation=True)),
+                for v, cfg in (("joint", base), ("jointa", replace(base, output_groups="axes")),
+                               ("jointn", replace(base, noise_correlation=True)),
                                ("lmc", replace(base, latent_kernels=2))):
-                    if v == "lmc" and not lmc:
+                    if (v == "lmc" and not lmc) or v not in models_wanted:
                         continue
                     t0 = time.perf_counter()
                     models[v] = fit_gp(X[tr], Y[tr], cfg)[0]
                     times[v] = time.perf_counter() - t0
                     corr[v] = _correlations(models[v], X[tr], Xt[tr], Yt[tr])
-                models["dec"], models["decn"] = decoupled_model(models["joint"]), decoupled_model(models["jointn"])
-                times["dec"] = times["decn"] = 0.0
-                t0 = time.perf_counter()
-                indep = [fit_gp(X[tr], Y[tr][:, [p]], base, output_names=[COEFFICIENTS[p]])[0] for p in range(P)]
-                times["indep"] = time.perf_counter() - t0
+                for v, src in (("dec", "joint"), ("decn", "jointn")):
+                    if v in models_wanted and src in models:
+                        models[v], times[v] = decoupled_model(models[src]), 0.0
                 preds = {v: _pred(m, X[h]) for v, m in models.items()}
-                preds["indep"] = np.column_stack([_pred(m, X[h])[:, 0] for m in indep])
+                if "indep" in models_wanted:
+                    t0 = time.perf_counter()
+                    indep = [fit_gp(X[tr], Y[tr][:, [p]], base, output_names=[COEFFICIENTS[p]])[0] for p in range(P)]
+                    times["indep"] = time.perf_counter() - t0
+                    preds["indep"] = np.column_stack([_pred(m, X[h])[:, 0] for m in indep])
                 gaps = {}
             else:
                 gone, _ = missing_rows(pattern, X, tr)
@@ -197,19 +205,20 @@ def summarize(paths) -> str:
                 out += [f"\n{a} vs {b}, pattern {pattern}, {what} (better / worse by > 0.05 points / within; medians)\n",
                         "| training | turbulence | pairs |", "|---|---|---|"] + lines
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
-    out += ["\njoint vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
-            "| aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|"]
-    for ac in sorted({r["aircraft"] for r in rows}):
-        for L in lengths:
-            g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
-            f = _count(_pairs(rows, "joint", "indep", "none", "err", COEFFICIENTS[:3], g))
-            m = _count(_pairs(rows, "joint", "indep", "none", "err", mom, g))
-            if f or m:
-                out.append(f"| {ac} | {'all' if L <= 0 else f'{L:g} s'} | {f} | {m} |")
+    out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
+            "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
+    for v in ("joint", "jointa"):
+        for ac in sorted({r["aircraft"] for r in rows}):
+            for L in lengths:
+                g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
+                f = _count(_pairs(rows, v, "indep", "none", "err", COEFFICIENTS[:3], g))
+                m = _count(_pairs(rows, v, "indep", "none", "err", mom, g))
+                if f or m:
+                    out.append(f"| {v} | {ac} | {'all' if L <= 0 else f'{L:g} s'} | {f} | {m} |")
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointn", "lmc", "hjoint"):
+    for v in ("joint", "jointa", "jointn", "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:
@@ -225,6 +234,8 @@ def main(argv=None) -> int:
                     help="training lengths in s from the first training row (0: all)")
     ap.add_argument("--patterns", nargs="+", default=list(PATTERNS), choices=PATTERNS)
     ap.add_argument("--lmc", action="store_true", help="also fit the two-kernel LMC (isotopic rows)")
+    ap.add_argument("--models", nargs="+", default=[m for m in ISO_MODELS if m != "lmc"], choices=ISO_MODELS,
+                    help="the isotopic models to fit (default: all but lmc; dec/decn come with joint/jointn)")
     ap.add_argument("--json", default=None, help="append one JSON line per flight, length, pattern and model")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
     a = ap.parse_args(argv)
@@ -242,7 +253,7 @@ def main(argv=None) -> int:
                         print(f"no cached flight {path} (run with --make)", file=sys.stderr)
                         return 2
                     path = make(ac, seed, turb, "ahrs", 90.0, cache)
-                for r in score(path, a.lengths, a.patterns, a.lmc):
+                for r in score(path, a.lengths, a.patterns, a.lmc, tuple(a.models) + (("lmc",) if a.lmc else ())):
                     print(f"{path.stem:26s} {r['length']:4.0f} s {r['pattern']:5s} {r['variant']:6s} err "
                           + " ".join(f"{r['err'][c]:6.2f}" for c in COEFFICIENTS)
                           + ("" if "err_gap" not in r else "  gap " + " ".join(

@@ -92,6 +92,19 @@ class GPConfig:
             off-diagonals of ``B`` and of the noise covariance) only for the outputs whose blocked
             error it lowers by 1 % (:func:`gcs_sysid.gp.joint.gate_coupling`; ``docs/gp.md``,
             "Joint vs independent outputs"). Off by default.
+        output_groups: ``"axes"``: when the outputs are the body-axis coefficients (named
+            ``CX CY CZ Cl Cm Cn``, the pipeline's), the shared factors ``L`` of every
+            coregionalisation matrix are split between the longitudinal outputs (CX, CZ, Cm) and the
+            lateral-directional ones (CY, Cl, Cn): factor ``r`` loads only on group ``r mod 2``, so
+            the signal's cross-axis covariance is 0 and each output keeps its own independent part
+            ``kappa``. A symmetric aircraft's longitudinal coefficients are even functions of the
+            lateral variables (beta, p, r, delta_a, delta_r) and its lateral ones odd (the symmetric-
+            flight decoupling; Etkin and Reid 1996, *Dynamics of Flight*), so over an envelope flown
+            both ways their nonlinear parts do not correlate; the learned cross-axis correlations
+            were what the rank-2 factors shared, not the truth's. ``"none"`` (the default): every
+            factor loads on every output. Off by default: on the replay's JSBSim flights it moved the
+            errors by 0.0-0.4 points both ways and lost 3 GP-vs-LS pairs of 72 by 0.00-0.18 points
+            (``docs/gp.md``, "Joint vs independent outputs", twelfth session).
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -131,6 +144,7 @@ class GPConfig:
     residual_correlation: bool = False
     validation_folds: int = 5
     coupling_validation: bool = False
+    output_groups: str = "none"
 
     def __post_init__(self):
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
@@ -149,6 +163,8 @@ class GPConfig:
         if self.linear_terms not in ("significant", "validated", "all"):
             raise InputError("GPConfig.linear_terms must be 'significant', 'validated' or 'all', got "
                              f"{self.linear_terms!r}")
+        if self.output_groups not in ("axes", "none"):
+            raise InputError(f"GPConfig.output_groups must be 'axes' or 'none', got {self.output_groups!r}")
         if self.inducing not in ("mi", "kmeans", "random"):
             raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
         if not (self.learning_rate > 0 and self.local_learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0

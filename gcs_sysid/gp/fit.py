@@ -44,7 +44,8 @@ from .sparse import GlobalParams, design, elbo, stats_of
 from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local, shared_search, store_without
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "fit_local", "noise_correlation_factor",
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "fit_local",
+           "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
            "learn_input_noise", "validated_global", "validated_local"]
 
@@ -82,14 +83,19 @@ def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
 
     The further kernels of a linear model of coregionalisation (``lmc_log_ls (J-1, D)``,
     ``lmc_L (J-1, P, R)``, ``lmc_log_kappa (J-1, P)``) are mapped the same way, one ``B_j`` each.
+    ``fixed["L_mask"]`` ``(P, R)`` (optional, :func:`factor_mask`) zeroes the loadings of each shared
+    factor outside its output group (``GPConfig.output_groups``).
     """
     ls = jnp.where(fixed["active"], jnp.exp(raw["log_ls"]), 1.0)
-    B = coregionalisation(raw["L"], jnp.exp(raw["log_kappa"]) + _NOISE_FLOOR)
+    mask = fixed.get("L_mask")                   # (P, R) 0/1: which outputs each shared factor loads on
+    L = raw["L"] if mask is None else raw["L"] * mask
+    B = coregionalisation(L, jnp.exp(raw["log_kappa"]) + _NOISE_FLOOR)
     Z = raw["Z"] if "Z" in raw else fixed["Z"]
     lmc_ls = lmc_A = None
     if "lmc_log_ls" in raw:
         lmc_ls = jnp.where(fixed["active"][None, :], jnp.exp(raw["lmc_log_ls"]), 1.0)
-        Bj = jax.vmap(coregionalisation)(raw["lmc_L"], jnp.exp(raw["lmc_log_kappa"]) + _NOISE_FLOOR)
+        Lj = raw["lmc_L"] if mask is None else raw["lmc_L"] * mask[None]
+        Bj = jax.vmap(coregionalisation)(Lj, jnp.exp(raw["lmc_log_kappa"]) + _NOISE_FLOOR)
         lmc_A = jnp.linalg.cholesky(Bj)
     return GlobalParams(lengthscale=ls, A=jnp.linalg.cholesky(B), noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR,
                         Z=Z, prior_std=fixed["prior_std"], jitter=fixed["jitter"],
@@ -171,10 +177,49 @@ def _adam(loss, raw, opt_state, lr, args, n_steps: int, tol: float = 0.0, window
     return raw, opt_state, np.asarray(jax.device_get(values))
 
 
-def _split_B(B: np.ndarray, rank: int) -> tuple[np.ndarray, np.ndarray]:
+#: The body-axis output groups of ``GPConfig.output_groups = "axes"``: longitudinal and lateral-directional.
+AXIS_GROUPS = (("CX", "CZ", "Cm"), ("CY", "Cl", "Cn"))
+
+
+def output_groups(names, cfg: GPConfig) -> np.ndarray | None:
+    """Group label per output ``(P,)`` int for ``cfg.output_groups``, or None (no split).
+
+    ``"axes"``: 0 for CX CZ Cm, 1 for CY Cl Cn, when every name is one of the six coefficients and
+    both groups occur; otherwise (other outputs, one axis only, ``"none"``) None.
+    """
+    if cfg.output_groups != "axes" or names is None:
+        return None
+    label = {n: g for g, group in enumerate(AXIS_GROUPS) for n in group}
+    if any(n not in label for n in names):
+        return None
+    g = np.array([label[n] for n in names], int)
+    return g if len(set(g.tolist())) > 1 else None
+
+
+def factor_mask(groups: np.ndarray | None, rank: int) -> np.ndarray | None:
+    """``(P, R)`` 0/1 loadings allowed for the shared factors: factor ``r`` loads only on the outputs of
+    group ``r mod G`` (``groups (P,)`` labels ``0..G-1``; None: no mask). With ``R >= G`` each group
+    has its own factors and ``B`` is block diagonal between the groups."""
+    if groups is None or rank < 1:
+        return None
+    G = int(groups.max()) + 1
+    return (groups[:, None] == (np.arange(rank) % G)[None, :]).astype(float)
+
+
+def _split_B(B: np.ndarray, rank: int, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(L (P, R), kappa (P,))`` with ``L L^T + diag(kappa) ~ B``: the leading ``rank`` eigenpairs in
-    ``L``, the rest of the diagonal (at least a tenth of it) in ``kappa``."""
+    ``L``, the rest of the diagonal (at least a tenth of it) in ``kappa``. With ``mask (P, R)``
+    (:func:`factor_mask`) each group's factors are the leading eigenpairs of its own block of ``B``."""
     P = len(B)
+    if mask is not None:
+        L0 = np.zeros((P, rank))
+        for cols in {tuple(np.flatnonzero(mask[p])) for p in range(P)}:
+            if not cols:
+                continue
+            rows = np.flatnonzero(mask[:, cols[0]] > 0)
+            Lg, _ = _split_B(B[np.ix_(rows, rows)], len(cols))
+            L0[np.ix_(rows, list(cols[:Lg.shape[1]]))] = Lg
+        return L0, np.maximum(np.diag(B) - np.sum(L0**2, 1), 0.1 * np.diag(B))
     w, V = np.linalg.eigh(B)
     r = int(min(rank, P))
     L0 = V[:, ::-1][:, :r] * np.sqrt(np.maximum(w[::-1][:r], 0.0)) if r > 0 else np.zeros((P, 0))
@@ -233,11 +278,14 @@ def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPC
     return significant_inputs(Xs, Ys, active)
 
 
-def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = None):
+def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = None,
+                 groups: np.ndarray | None = None):
     """Initial unconstrained parameters from a ridge fit of the linear mean.
 
     ``terms`` ``(P, D)`` bool: the regressors of each output's linear mean (None: all); the ridge fit
-    of output ``p`` uses its own, and the prior std of the others' weights is 0.
+    of output ``p`` uses its own, and the prior std of the others' weights is 0. ``groups`` ``(P,)``
+    (:func:`output_groups`): each shared factor starts on its own group's block of the residual
+    covariance and stays there (``fixed["L_mask"]``).
 
     With ``cfg.latent_kernels = J > 1`` the residual covariance is shared equally between the
     kernels (``B_j = B0 / J``) and the length-scales start at :func:`lmc_start_factors` times the
@@ -262,7 +310,8 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         Cr = _residual_cov_missing(Xs, Ys, obs, cfg.linear_mean)
     J = int(cfg.latent_kernels)
     B0 = 0.7 * Cr / J
-    L0, kappa = _split_B(B0, cfg.rank)
+    mask = factor_mask(groups, int(cfg.rank))
+    L0, kappa = _split_B(B0, cfg.rank, mask)
     kappa = kappa + 1e-4
     n_active = max(int(active.sum()), 1)
     ls0 = np.log(0.5 * np.sqrt(n_active))
@@ -280,20 +329,24 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         raw["Z"] = np.asarray(Z, float)
     fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
              "prior_std": linear_prior_std(cfg, terms, P, Xs.shape[1]), "jitter": np.float64(cfg.jitter)}
+    if mask is not None:
+        fixed["L_mask"] = mask
     return jax.device_put(raw), jax.device_put(fixed)
 
 
-def _unconstrain(p: GlobalParams, cfg: GPConfig) -> dict:
+def _unconstrain(p: GlobalParams, cfg: GPConfig, groups: np.ndarray | None = None) -> dict:
     """Unconstrained values near ``p`` (inverse of :func:`constrain_global`; ``B`` split as the initial
-    values are: its leading ``rank`` eigenpairs in ``L``, the rest of the diagonal in ``kappa``)."""
+    values are: its leading ``rank`` eigenpairs in ``L``, per output group with ``groups``, the rest
+    of the diagonal in ``kappa``)."""
     A = np.asarray(p.A)
     B = A @ A.T
-    L0, kappa = _split_B(B, cfg.rank)
+    mask = factor_mask(groups, int(cfg.rank))
+    L0, kappa = _split_B(B, cfg.rank, mask)
     out = {"log_ls": np.log(np.asarray(p.lengthscale)), "L": L0,
            "log_kappa": np.log(np.maximum(kappa - _NOISE_FLOOR, 1e-8)),
            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
     if p.lmc_A is not None and cfg.latent_kernels == p.n_kernels:
-        parts = [_split_B(Aj @ Aj.T, cfg.rank) for Aj in np.asarray(p.lmc_A)]
+        parts = [_split_B(Aj @ Aj.T, cfg.rank, mask) for Aj in np.asarray(p.lmc_A)]
         out["lmc_log_ls"] = np.log(np.asarray(p.lmc_lengthscale))
         out["lmc_L"] = np.stack([L for L, _ in parts])
         out["lmc_log_kappa"] = np.stack([np.log(np.maximum(k - _NOISE_FLOOR, 1e-8)) for _, k in parts])
@@ -345,7 +398,8 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
 
 
 def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig, M: int,
-                 history: FitHistory, start: GlobalParams | None = None) -> GlobalParams:
+                 history: FitHistory, start: GlobalParams | None = None,
+                 groups: np.ndarray | None = None) -> GlobalParams:
     """Global hyperparameters by Adam on the VFE bound over a random subset of ``n_train_max`` rows.
 
     Args:
@@ -357,6 +411,7 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         history: receives the bound after each step and the timings of the stage.
         start: warm start (a refresh): the length-scales, noise and coregionalisation to start
             from instead of the ridge-regression initial values.
+        groups: ``(P,)`` output group labels (:func:`output_groups`; None: every factor on every output).
 
     Returns:
         :class:`GlobalParams` (constrained).
@@ -380,9 +435,9 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     ls0 = (np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) * min(lmc_start_factors(int(cfg.latent_kernels)))
            if start is None else np.asarray(start.metric_lengthscale()))
     Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
-    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z, terms)
+    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z, terms, groups)
     if start is not None:
-        raw = jax.device_put(dict(jax.device_get(raw), **_unconstrain(start, cfg)))
+        raw = jax.device_put(dict(jax.device_get(raw), **_unconstrain(start, cfg, groups)))
     history.timings["init"] = time.perf_counter() - t0
 
     def reselect(raw, fixed, m):
@@ -460,7 +515,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if M < cfg.n_inducing:
         notes.append(f"gp: only {len(Xs)} rows; using {M} inducing points instead of {cfg.n_inducing}")
     t1 = time.perf_counter()
-    params = learn_global(Xs, Ys, scaler.active, cfg, M, history)
+    params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg))
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
     n_hyper = int(min(cfg.n_train_max, len(Xs)))
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region

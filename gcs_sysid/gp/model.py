@@ -368,7 +368,8 @@ class LocalGlobalGP:
             DataError: fewer than 3 stored rows.
         """
         from ..errors import DataError
-        from .fit import FitHistory, _validated_terms, fit_local, learn_global, validated_global, validated_local
+        from .fit import (FitHistory, _validated_terms, fit_local, learn_global, output_groups, validated_global,
+                          validated_local)
 
         enable_x64()
         rows = self.rows
@@ -379,7 +380,7 @@ class LocalGlobalGP:
         M = int(self.params.Z.shape[0])
         hyper_cfg = replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M))   # the fit's compiled shapes
         new = learn_global(rows.X, rows.Y, self.scaler.active, hyper_cfg, M if reselect else 0, history,
-                           start=self.params)
+                           start=self.params, groups=output_groups(self.output_names, cfg))
         Z_old = np.asarray(self.params.Z)
         Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
         params = replace(new, Z=jax.device_put(Z_new))

@@ -144,7 +144,9 @@ def test_joint_model_beats_independent_gps_on_shared_structure():
     g = np.sin(2 * X[:, 0]) * np.cos(X[:, 1])
     F = np.outer(g, [1.0, -0.8, 0.6, 1.2, -0.5, 0.9])
     Y = F + 0.4 * rng.standard_normal(F.shape)
-    cfg = replace(FAST, local=False, input_noise=False, n_inducing=24)
+    # one latent function shared by all six outputs, across both axes (not an aircraft's coefficients,
+    # whose axes GPConfig.output_groups keeps apart): every factor on every output
+    cfg = replace(FAST, local=False, input_noise=False, n_inducing=24, output_groups="none")
     joint, _ = fit_gp(X[:n], Y[:n], cfg)
     mj = joint.predict(X[n:], include_noise=False)[0]
     mi = np.column_stack([fit_gp(X[:n], Y[:n, [p]], cfg)[0].predict(X[n:], include_noise=False)[0][:, 0]

@@ -185,3 +185,37 @@ def test_pooled_hyperparameters_beat_independent_gps_with_few_rows():
     print("decoupled joint", ed, "independent", ei, ed.mean() / ei.mean())
     # measured: better on 6 of 6, mean 0.145 vs 0.176 (0.82); seeds 1-3 of the same draw: 5-6 of 6, 0.82-0.90
     assert np.sum(ed < ei) >= 5 and ed.mean() < 0.9 * ei.mean()
+
+
+def test_axis_groups_split_the_shared_factors_between_longitudinal_and_lateral_outputs():
+    """``GPConfig.output_groups = "axes"`` with the six coefficients: every factor of ``B``
+    loads on one axis only (so the cross-axis coregionalisation is 0); other outputs are not grouped."""
+    from gcs_sysid.gp.fit import _split_B, factor_mask, output_groups
+
+    names = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
+    axes = replace(FAST, output_groups="axes")
+    g = output_groups(names, axes)
+    assert g.tolist() == [0, 1, 0, 1, 0, 1]
+    assert output_groups(("y0", "y1"), axes) is None and output_groups(("CX", "CZ", "Cm"), axes) is None
+    assert output_groups(names, FAST) is None                       # the default: "none"
+    mask = factor_mask(g, 2)
+    assert mask.tolist() == [[1, 0], [0, 1], [1, 0], [0, 1], [1, 0], [0, 1]]
+    B = np.full((6, 6), 0.5) + 0.5 * np.eye(6)
+    L0, kappa = _split_B(B, 2, mask)
+    assert np.all(L0[mask == 0] == 0) and np.all(kappa > 0)
+
+
+@pytest.mark.slow
+def test_axis_groups_learn_no_cross_axis_correlation_and_keep_the_within_axis_one():
+    """A fit with the six coefficients' names: cross-axis correlation exactly 0, within an axis learned."""
+    rng = np.random.default_rng(3)
+    n = 200
+    X = rng.uniform(-2, 2, (n, 2))
+    lon, lat = np.sin(2 * X[:, 0]), np.cos(X[:, 1]) * X[:, 0]
+    F = np.column_stack([lon, lat, -0.8 * lon, 1.2 * lat, 0.6 * lon, -0.9 * lat])
+    Y = F + 0.1 * rng.standard_normal(F.shape)
+    model, _ = fit_gp(X, Y, replace(FAST, local=False, input_noise=False, validation_folds=0, steps=60,
+                                    output_groups="axes"))
+    c = model.output_correlation()
+    assert np.all(c[np.ix_([0, 2, 4], [1, 3, 5])] == 0.0)
+    assert abs(c[0, 2]) > 0.5 and abs(c[1, 3]) > 0.5
