@@ -489,6 +489,14 @@ def _force_changes(diag, fitted: dict, cause: str) -> dict:
     return out
 
 
+def _note_allowance(doc: dict, f: dict, allowance: dict, summary: str) -> None:
+    """Record an aero finding judged an allowance: its ``evidence.differential`` and an entry of ``doc["allowance"]``
+    (``cause coefficient estimate gain why summary``; ``why`` is the allowance document's)."""
+    f["evidence"]["differential"] = {"verdict": "allowance", "allowance": allowance}
+    doc["allowance"].append({"cause": f["cause"], "coefficient": f["coefficient"], "estimate": f["estimate"],
+                             "gain": f.get("gain", {}), "why": allowance["why"], "summary": summary})
+
+
 def _with_jackknife(beyond: dict, X: np.ndarray, r: np.ndarray, rows: np.ndarray, term: str, jk: dict,
                     min_t: float) -> dict:
     """``beyond`` (an :func:`offset_allowance` document) judged with the block-jackknife standard error too."""
@@ -863,30 +871,20 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                     f["evidence"][f"{angle}_error_allowance"] = err
             if scaled is not None and "error_along_term" in scaled:
                 what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
-                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}
-                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
-                                         "gain": f.get("gain", {}), "why": scaled["why"],
-                                         "summary": f"{cause}: an error of the measured {what} that moves with "
-                                                    f"{term}, not a cause"})
+                _note_allowance(doc, f, scaled, f"{cause}: an error of the measured {what} that moves with {term}, "
+                                                "not a cause")
                 continue
             if scaled is not None:
                 what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
-                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}
-                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
-                                         "gain": f.get("gain", {}), "why": scaled["why"],
-                                         "summary": f"{cause}: a between-flight scale of the measured {what}, "
-                                                    "not a cause"})
+                _note_allowance(doc, f, scaled, f"{cause}: a between-flight scale of the measured {what}, not a cause")
                 continue
             forces = _force_changes(diag, fitted, cause) if force_moment_arm_max > 0 else {}
             moment = force_moment_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
                                             forces, arm_max=force_moment_arm_max, min_t=min_t,
                                             min_gain_pct=min_gain_pct) if forces else None
             if moment is not None and moment["moment_only"]:
-                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": moment}
-                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
-                                         "gain": f.get("gain", {}), "why": moment["why"],
-                                         "summary": f"{cause}: the moment about the CG of the named force change "
-                                                    f"({', '.join(sorted(moment['arms']))}), not a cause"})
+                _note_allowance(doc, f, moment, f"{cause}: the moment about the CG of the named force change "
+                                                f"({', '.join(sorted(moment['arms']))}), not a cause")
                 continue
             if moment is not None:
                 f["evidence"]["force_moment_allowance"] = moment
