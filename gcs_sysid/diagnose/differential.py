@@ -58,7 +58,7 @@ from .terms import term_factors, term_matrix
 from .uncertainty import block_jackknife_cov
 
 __all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "angle_scale_allowance",
-           "angle_error_allowance",
+           "angle_error_allowance", "force_moment_allowance", "FORCE_MOMENT_ARMS",
            "block_jackknife_se",
            "BETA_COEFFICIENTS", "ANGLE_COEFFICIENTS",
            "onset_of_change", "fit_record", "reference_logs"]
@@ -369,6 +369,134 @@ def angle_error_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                                  along_term=True)
 
 
+#: The force coefficients whose moment about the CG each moment coefficient carries when the aerodynamic force
+#: acts at a point off the CG, for an airframe symmetric about its x-z plane (the lateral offset of the force's
+#: point of action is zero): ``L = y Z - z Y``, ``M = z X - x Z``, ``N = x Y - y X`` (body axes; Etkin and
+#: Reid, *Dynamics of Flight*, 3rd ed., sec. 4.2; JSBSim transfers its aerodynamic forces from the
+#: aerodynamic reference point ``AERORP`` to the CG so, ``FGAerodynamics::GetMoments``).
+FORCE_MOMENT_ARMS = {"Cl": ("CY",), "Cm": ("CX", "CZ"), "Cn": ("CY",)}
+
+
+def force_moment_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, coef: str,
+                           term: str, force_change: dict, arm_max: float = 0.1, min_t: float = 3.0,
+                           min_gain_pct: float = 10.0) -> dict | None:
+    """Is a moment finding only the moment about the CG of a force change named beside it?
+
+    A model fitted at the CG holds a force change and the change of that force's moment about the CG
+    as separate numbers, but a real change of an aerodynamic force acts at a point of the airframe (for
+    JSBSim, ``AERORP``; for a real aircraft, wherever the changed surface's load acts): a side force
+    scaled by ``k`` moves ``Cl`` by ``-(z_a/b) dCY`` and ``Cn`` by ``(x_a/b) dCY`` along *every* term of
+    the side force, ``z_a, x_a`` the point's offset from the CG (:data:`FORCE_MOMENT_ARMS`). On the
+    JSBSim f16 (``AERORP`` 9 in above the CG: 0.025 b) a ``CY:scale`` of 1.6 moves the exact
+    ``Cl_beta`` from -0.1133 to -0.1268 and ``Cl_r`` from 0.114 to 0.130 (ratio to the CY changes
+    0.020-0.023), which the diagnosis named as a second cause ``Cl:beta`` (twelfth session, branch
+    i9-second, ``docs/benchmarks.md``). So the finding's coefficient is fitted jointly on a free
+    constant, the named force changes ``dF_k(t)`` (one free arm ``a_k`` each, in the moment's reference
+    length per unit force coefficient) and the finding's term ``phi``; the finding is the force's moment
+    when its term is not significant beyond them (``|theta| < min_t se``, coloured-residual standard
+    error of the joint fit, Morelli and Klein sec. 5.3) or gains less than ``min_gain_pct`` on the held-out
+    rows beyond the offset and the arms (:func:`offset_allowance` on the residual less ``sum a_k dF_k``),
+    and every arm is within ``arm_max`` reference lengths of the CG (a point of action inside the airframe).
+
+    Args:
+        X: (T, 10) regressors. R: (T, 6) residual without the finding (measured minus model).
+        train, test: (T,) selection and held-out rows. coef, term: the finding (``"Cl"``, ``"beta"``).
+        force_change: force coefficient -> (T,) the change of that force the other named findings make
+            (measured minus model: minus their summed ``delta``); forces outside ``FORCE_MOMENT_ARMS[coef]``
+            are ignored.
+        arm_max: the largest arm, in the moment's reference length (``b`` for Cl and Cn, ``c`` for Cm).
+        min_t, min_gain_pct: as :func:`offset_allowance`.
+
+    Returns:
+        None when ``coef`` is not a moment, no named finding changes a force with an arm to it, or the rows
+        are too few; else ``{"moment_only": bool, "arms": {force: a}, "arms_std_error": {...}, "estimate",
+        "std_error", "t", "gain_beyond_arm_percent", "why"}``.
+    """
+    forces = [k for k in FORCE_MOMENT_ARMS.get(coef, ())
+              if k in force_change and np.nanstd(force_change[k]) > 0]
+    if not forces:
+        return None
+    try:
+        phi = term_matrix(X, [term])[:, 0]
+    except SysidError:
+        return None
+    j = COEFFICIENTS.index(coef)
+    F = np.column_stack([np.asarray(force_change[k], float) for k in forces])
+    ok = np.isfinite(R[:, j]) & np.isfinite(phi) & np.isfinite(F).all(axis=1)
+    tr = train & ok
+    if tr.sum() < 50 or (test & ok).sum() < 20 or np.std(phi[tr]) == 0:
+        return None
+    res = ols(np.column_stack([np.ones(tr.sum()), F[tr], phi[tr]]), R[tr, j], terms=["1", *forces, term])
+    arms = {k: float(res.theta[1 + i]) for i, k in enumerate(forces)}
+    arms_se = {k: float(res.std_error[1 + i]) for i, k in enumerate(forces)}
+    th, se = float(res.theta[-1]), float(res.std_error[-1])
+    t = th / se if se > 0 else 0.0
+    R_adj = np.array(R, float, copy=True)
+    R_adj[:, j] = R[:, j] - np.nan_to_num(F) @ np.array([arms[k] for k in forces])
+    beyond = offset_allowance(X, R_adj, train & ok, test & ok, coef, term, min_t=min_t, min_gain_pct=min_gain_pct)
+    gain = float(beyond.get("gain_beyond_offset_percent", 0.0))
+    inside = all(abs(a) <= arm_max for a in arms.values())
+    only = inside and (abs(t) < min_t or gain < min_gain_pct)
+    arm_txt = ", ".join(f"{k} {a:+.4f} +- {arms_se[k]:.2g}" for k, a in arms.items())
+    why = (f"with the named force change's moment free (arm per reference length: {arm_txt}; largest allowed "
+           f"{arm_max:g}) and {coef}'s offset free, {coef}:{term} is {th:+.4g} +- {se:.2g} (t {t:.1f}) and gains "
+           f"{gain:.0f} % on the held-out rows beyond them")
+    return {"moment_only": bool(only), "arms": arms, "arms_std_error": arms_se, "arm_max": float(arm_max),
+            "estimate": th, "std_error": se, "t": float(t), "gain_beyond_arm_percent": gain, "why": why}
+
+
+def _force_changes(diag, fitted: dict, cause: str) -> dict:
+    """Force coefficient -> (T,) change (measured minus model) of the *other* named aero findings of a force.
+
+    A finding of CX, CY or CZ (an aero term or ``scale:<force>``) changes that force only, as the diagnosis
+    names it: its change is the sum of its terms' estimates times their columns (``evidence.terms`` of the
+    sparse search; ``scale:C`` is :func:`gcs_sysid.diagnose.sparse.scale_columns`'s column), or minus its fitted
+    ``delta`` (a catalogue term). Findings of other kinds (delays, sensors, faults) move the moments through
+    their own paths and are left out. Returns {} when there is none.
+    """
+    from .context import evaluate_model
+    from .sparse import THRESHOLDS as SPARSE_TH, scale_columns
+
+    out: dict = {}
+    cols = None
+    for f in diag.findings:
+        c = f.get("coefficient")
+        if f["cause"] == cause or c not in ("CX", "CY", "CZ") or f.get("kind") == "fault":
+            continue
+        if f["cause"].split(":")[0] not in COEFFICIENTS and not f["cause"].startswith("scale:"):
+            continue
+        terms = f.get("evidence", {}).get("terms")
+        d = None
+        if terms:
+            d = np.zeros(len(diag.X))
+            for tm in terms:
+                if tm["term"].startswith("scale:"):
+                    if cols is None:
+                        cols = scale_columns(evaluate_model(diag.model, diag.X), diag.X,
+                                             wind_axis=bool(SPARSE_TH.get("side_force_wind_axis", True)))
+                    phi = cols[:, COEFFICIENTS.index(tm["term"].split(":", 1)[1])]
+                else:
+                    try:
+                        phi = term_matrix(diag.X, [tm["term"]])[:, 0]
+                    except SysidError:      # a lag or hinge term: the finding's change is not rebuilt
+                        d = None
+                        break
+                d = d + float(tm["estimate"]) * phi
+        elif f["cause"] in fitted and getattr(fitted[f["cause"]], "delta", None) is not None:
+            d = -np.asarray(fitted[f["cause"]].delta, float)[:, COEFFICIENTS.index(c)]
+        if d is not None and np.isfinite(d).any():
+            out[c] = out.get(c, 0.0) + d
+    return out
+
+
+def _note_allowance(doc: dict, f: dict, allowance: dict, summary: str) -> None:
+    """Record an aero finding judged an allowance: its ``evidence.differential`` and an entry of ``doc["allowance"]``
+    (``cause coefficient estimate gain why summary``; ``why`` is the allowance document's)."""
+    f["evidence"]["differential"] = {"verdict": "allowance", "allowance": allowance}
+    doc["allowance"].append({"cause": f["cause"], "coefficient": f["coefficient"], "estimate": f["estimate"],
+                             "gain": f.get("gain", {}), "why": allowance["why"], "summary": summary})
+
+
 def _with_jackknife(beyond: dict, X: np.ndarray, r: np.ndarray, rows: np.ndarray, term: str, jk: dict,
                     min_t: float) -> dict:
     """``beyond`` (an :func:`offset_allowance` document) judged with the block-jackknife standard error too."""
@@ -596,7 +724,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
                  alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
-                 delay_change_min_t: float = 3.0, angle_error_along: tuple = ()) -> dict:
+                 delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
+                 force_moment_arm_max: float = 0.0) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -636,6 +765,10 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             finding of that angle's coefficients is also judged (:func:`angle_error_allowance`;
             ``sparse.THRESHOLDS["angle_error_along_term"]``; added in the eleventh session, branch i9-b747); ():
             off.
+        force_moment_arm_max: a moment finding (Cl, Cm, Cn) beside named findings that change forces only is
+            also judged beyond those force changes' moment about the CG, each with a free arm of at most this
+            many reference lengths (:func:`force_moment_allowance`; ``sparse.THRESHOLDS["force_moment_arm_max"]``;
+            added in the twelfth session, branch i9-second); 0: off.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -738,20 +871,23 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                     f["evidence"][f"{angle}_error_allowance"] = err
             if scaled is not None and "error_along_term" in scaled:
                 what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
-                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}
-                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
-                                         "gain": f.get("gain", {}), "why": scaled["why"],
-                                         "summary": f"{cause}: an error of the measured {what} that moves with "
-                                                    f"{term}, not a cause"})
+                _note_allowance(doc, f, scaled, f"{cause}: an error of the measured {what} that moves with {term}, "
+                                                "not a cause")
                 continue
             if scaled is not None:
                 what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
-                f["evidence"]["differential"] = {"verdict": "allowance", "allowance": scaled}
-                doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
-                                         "gain": f.get("gain", {}), "why": scaled["why"],
-                                         "summary": f"{cause}: a between-flight scale of the measured {what}, "
-                                                    "not a cause"})
+                _note_allowance(doc, f, scaled, f"{cause}: a between-flight scale of the measured {what}, not a cause")
                 continue
+            forces = _force_changes(diag, fitted, cause) if force_moment_arm_max > 0 else {}
+            moment = force_moment_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
+                                            forces, arm_max=force_moment_arm_max, min_t=min_t,
+                                            min_gain_pct=min_gain_pct) if forces else None
+            if moment is not None and moment["moment_only"]:
+                _note_allowance(doc, f, moment, f"{cause}: the moment about the CG of the named force change "
+                                                f"({', '.join(sorted(moment['arms']))}), not a cause")
+                continue
+            if moment is not None:
+                f["evidence"]["force_moment_allowance"] = moment
         null = 0.0 if is_aero else _null_value(cause, airframe)
         # an aero finding's correction is its change from the model's value (catalogue: evidence.correction;
         # sparse search: estimate - model_value)

@@ -119,6 +119,13 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: coefficients of the angle through the model's own derivatives, :func:`gcs_sysid.diagnose.differential.
 #: angle_error_allowance`; the JSBSim b747's clean seed 15 ``CY:r_hat`` was the aided sideslip's error following
 #: r_hat, measured against the truth; ``()`` off). No new threshold: ``min_t`` 3 and ``min_gain_pct`` as the scale's.
+#: Added 2026-11-23 (twelfth session, branch i9-second; committed before the 00:30 UTC freeze), read by ``diagnose``
+#: for the differential step: ``force_moment_arm_max`` (a moment finding beside named findings that change forces
+#: only is judged beyond those force changes' moment about the CG, one free arm per force, each at most this many
+#: reference lengths, b for Cl and Cn, c for Cm: :func:`gcs_sysid.diagnose.differential.force_moment_allowance`; the
+#: JSBSim f16's ``CY:scale`` 1.6 flights named ``Cl:beta`` beside ``scale:CY``, and the exact truth's Cl_beta moves
+#: by the side force's moment about the CG, AERORP 0.025 b above it; 0 off). ``min_t`` and ``min_gain_pct`` as the
+#: scale's.
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -129,7 +136,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "allowance_on_search_residual": False, "angle_scale_se": True, "alpha_scale_allowance": True,
               "delay_differential": True, "side_force_wind_axis": True, "delay_reference_same_fit": True,
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
-              "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",)}
+              "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
+              "force_moment_arm_max": 0.1}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

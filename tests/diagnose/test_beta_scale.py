@@ -174,3 +174,35 @@ def test_a_sideslip_error_that_follows_the_yaw_rate_is_an_allowance_but_a_side_f
     # outside the sideslip's coefficients, or a term outside the vocabulary: not judged
     assert angle_error_allowance(X, R, train, test, MODEL, "CZ", "r_hat") is None
     assert angle_error_allowance(X, R, train, test, MODEL, "CY", "delta_r(t-0.1)-delta_r") is None
+
+
+def test_a_moment_that_is_a_named_side_force_change_about_an_offset_point_is_an_allowance_but_a_roll_change_is_not():
+    """Twelfth session (branch i9-second): on the JSBSim f16, whose aerodynamic reference point is 0.025 b above
+    the CG, a side force scaled by 1.6 moves the exact Cl_beta from -0.113 to -0.127 (the side force's moment
+    about the CG), and the diagnosis named ``Cl:beta`` beside ``scale:CY``."""
+    from gcs_sysid.diagnose.differential import force_moment_allowance
+
+    X, noise, train, test = _flight(3)
+    ib, ir, idr = (REGRESSORS.index(n) for n in ("beta", "r_hat", "delta_r"))
+    jl = COEFFICIENTS.index("Cl")
+    # the named side-force change: 0.6 times a side force with sideslip, yaw-rate and rudder parts
+    dF = 0.6 * (-0.6 * X[:, ib] + 1.0 * X[:, ir] + 0.15 * X[:, idr])
+    R = noise.copy()
+    R[:, jl] += 0.025 * dF                     # its moment about the CG: a point 0.025 b above it
+    assert not offset_allowance(X, R, train, test, "Cl", "beta")["offset_only"]   # alone, Cl:beta stands
+    a = force_moment_allowance(X, R, train, test, "Cl", "beta", {"CY": dF})
+    assert a is not None and a["moment_only"], a
+    assert abs(a["arms"]["CY"] - 0.025) < 0.005
+    # a roll change of its own (Cl_beta 12 % larger) beside the same side-force change: not the force's moment
+    R2 = noise.copy()
+    R2[:, jl] += -0.011 * X[:, ib]
+    b = force_moment_allowance(X, R2, train, test, "Cl", "beta", {"CY": dF})
+    assert b is not None and not b["moment_only"], b
+    # the same moment from a point farther than the largest arm (0.1 b): not an allowance
+    R3 = noise.copy()
+    R3[:, jl] += 0.3 * dF
+    c = force_moment_allowance(X, R3, train, test, "Cl", "beta", {"CY": dF})
+    assert c is not None and not c["moment_only"] and abs(c["arms"]["CY"] - 0.3) < 0.03, c
+    # no arm from CZ to Cl on a symmetric airframe; a force coefficient is no moment
+    assert force_moment_allowance(X, R, train, test, "Cl", "beta", {"CZ": dF}) is None
+    assert force_moment_allowance(X, R, train, test, "CY", "beta", {"CY": dF}) is None
