@@ -27,7 +27,7 @@ class AircraftSpec:
 
     Attributes:
         name: harness name (also the airframe file ``data/airframes/jsbsim-<name>.toml``).
-        model: JSBSim model directory name shipped by the ``jsbsim`` wheel.
+        model: JSBSim model directory name shipped by the ``jsbsim`` wheel (or written there by ``derived.py``).
         airspeed_kts: calibrated airspeed of the glide, kt (JSBSim's ``ic/vc-kts``).
         altitude_ft: initial altitude above sea level, ft.
         elevator_sign: delta_e = sign * ``fcs/elevator-pos-rad``.
@@ -75,12 +75,13 @@ _DEG = 57.29577951308232
 #: thresholds; ``pa28`` (held out since 2026-11-21), ``j3cub`` (untouched until the sixth
 #: session's final evaluation, 2026-11-22), ``c182`` (untouched until the seventh session's)
 #: have since been evaluated and their results read, so they count as used (``TUNING_AIRCRAFT``).
-#: ``t37``, ``t6``, ``b747`` and ``f16`` (untouched until the eighth to eleventh sessions' final
-#: evaluations; the f16 flown as the derived model ``f16_direct``, ``derived.py``) are used since as
-#: well. ``f4n`` (added in the twelfth session, 2026-11-22, the stock F4N with its own yaw damper in
-#: the loop) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its
-#: harness was set up (from JSBSim's truth and its XML), the method was never run on it before its
-#: final evaluation.
+#: ``t37``, ``t6``, ``b747``, ``f16`` and ``f4n`` (untouched until the eighth to twelfth sessions'
+#: final evaluations; the f16 flown as the derived model ``f16_direct``, the f4n as ``F4N_fcs``,
+#: ``derived.py``) are used since as well. ``rascal`` (added in the thirteenth session, 2026-11-23:
+#: ArduPilot's SITL Rascal 110, a model from outside the wheel checked into ``data/jsbsim_models``,
+#: flown without its propeller) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
+#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method
+#: was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -326,10 +327,47 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="McDonnell F-4N Phantom II (JSBSim F4N), its own yaw damper in the loop, flown as the derived model "
               "F4N_fcs (the stock XML with an empty flight_control added, XML sha256 546ac6c12a62200c), engines shut "
               "down, gear up, gliding; untouched by any tuning of the method"),
+    # rascal: ArduPilot's SITL Rascal 110 (Tools/autotest/aircraft/Rascal/Rascal110-JSBSim.xml, based on
+    # FlightGear's Rascal110; GPL-3.0 as ArduPilot), a 14.5-lb, 2.8-m-span radio-controlled trainer: the
+    # first aircraft from outside the jsbsim wheel and the first of a UAV's size. Its XML is checked in
+    # (data/jsbsim_models/rascal/, provenance and licence in its README.md) and flown as the derived
+    # model ``Rascal110_glide`` (derived.py): the engine and its 18x8 propeller removed, so that the glide
+    # has no windmilling propeller (the rule that rejected the p51d, B17 and C130); everything else is
+    # the file's. Chosen in the thirteenth session (docs/jsbsim.md, "The rascal") after the 737 (the
+    # wheel's last unscreened model: the b747's term set with a yaw damper in the loop) and the F80C
+    # (a rudder a quarter of the F4N's). A direct FCS (aerosurface_scale, no damper or augmentation):
+    # elevator -0.35..+0.30 rad, left aileron +-0.35 rad (the only aileron property the aerodynamics
+    # read; the right the mirror), rudder +-0.35 rad; the elevator's command scale is its larger end
+    # (0.35 rad, the b747's rule). Signs read from its aerodynamics: Cmde (-0.5 + 0.1125 Mach) x
+    # elevator-pos (positive = trailing edge down), Clda (0.13 - 0.0365 Mach) x left-aileron-pos
+    # (positive = left trailing edge down, roll right), Cndr -0.05 x rudder-pos (positive = trailing edge
+    # left, nose left); Cnda -0.03 x left-aileron-pos (adverse yaw: Cn_delta_a +0.03 in the project's
+    # sign), Cndi 0.0007 (a constant yawing moment). Fixed gear (no gear terms). 34 kt (ic/vc-kts) at
+    # 6000 ft: 20.3-21.3 m/s TAS in the standard flights, 2.2 x the power-off stall (about 8.8 m/s EAS:
+    # 14.5 lb, CL_max 1.4 at 0.23 rad); the sweep flies 16.5-23 m/s and alpha -1..4.5 deg. It sinks
+    # 1.6-2.2 m/s (lift-to-drag about 10). Pulses 0.4 / 0.5 / 0.5 s: its modes are about twice as fast
+    # as the light aircraft's (short period and Dutch roll near 6 rad/s from its Cm_alpha about -0.8,
+    # Cnb 0.12 and inertia; roll mode 6.6 per s), and a doublet's best pulse is about 2.3 / omega_n.
+    # Amplitudes: elevator 4 deg (3 deg gave 0.84 deg of elevator standard deviation at 40 kt, under the
+    # envelope test's 1-deg floor), aileron 5 deg, rudder 6 deg (Cndr -0.05 against Cnb 0.12: 0.4 deg of
+    # sideslip per degree). Trial speeds (truth only): 40 kt flew alpha -1.4..2.2 deg in the sweep
+    # (too little span for alpha^2 and alpha*beta), 36 kt -1.1..3.4; 34 kt keeps the elevator at -17.1
+    # deg at worst (delay:delta_e = 0.12) of its -20.05. Default gains. Set from the harness's truth only
+    # (alpha, beta, rates, excitation per axis), never from a method result. The notes carry the derived
+    # XML's SHA-256 (16 hex digits), so that the checked-in XML and the derivation are part of this
+    # aircraft's fingerprint.
+    "rascal": AircraftSpec(
+        name="rascal", model="Rascal110_glide", airspeed_kts=34.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(4.0, 5.0, 6.0), pulse_s=(0.4, 0.5, 0.5),
+        notes="ArduPilot SITL Rascal 110 (JSBSim Rascal110-JSBSim.xml, checked in under data/jsbsim_models/rascal) "
+              "with its engine and propeller removed (derived model Rascal110_glide, XML sha256 7bc358774d2412a5), "
+              "gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16")
-HELD_OUT_AIRCRAFT = ("f4n",)
-UNTOUCHED_AIRCRAFT = ("f4n",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n")
+HELD_OUT_AIRCRAFT = ("rascal",)
+UNTOUCHED_AIRCRAFT = ("rascal",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -17,6 +17,7 @@ import sys
 import tomli_w
 
 from .aircraft import AIRCRAFT, AircraftSpec
+from .derived import REPO_DERIVED
 from .flight import FT, SLUG, SLUG_FT2, load_model
 
 __all__ = ["airframe_doc", "write_airframes"]
@@ -40,7 +41,10 @@ def airframe_doc(spec: AircraftSpec) -> dict:
         "name": f"jsbsim-{spec.name}",
         "mass": r(fdm["inertia/mass-slugs"] * SLUG),
         "imu_lever_arm": [0.0, 0.0, 0.0],
-        "notes": (f"Generated from JSBSim {spec.model} (jsbsim wheel) by benchmarks/jsbsim_harness/airframes.py: "
+        "notes": (f"Generated from JSBSim {spec.model} ("
+                  + ("derived from the repository's " + REPO_DERIVED[spec.model][0] if spec.model in REPO_DERIVED
+                     else "jsbsim wheel")
+                  + f") by benchmarks/jsbsim_harness/airframes.py: "
                   f"{spec.notes}. Surfaces: full command = the end deflections; aileron = "
                   f"0.5 * (left - right) trailing edge down, as the harness defines delta_a."),
         "inertia": {"Ixx": r(fdm["inertia/ixx-slugs_ft2"] * SLUG_FT2), "Iyy": r(fdm["inertia/iyy-slugs_ft2"] * SLUG_FT2),

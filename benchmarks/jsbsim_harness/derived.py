@@ -1,7 +1,9 @@
 """Derived JSBSim models: a stock model of the installed ``jsbsim`` wheel with its flight-control
 system replaced by a direct mapping from the harness's commands to the surfaces (``f16_direct``), or
 given the empty ``<flight_control>`` element the harness's injected elevator delay needs
-(``F4N_fcs``, :func:`derive_f4n_fcs`; twelfth session).
+(``F4N_fcs``, :func:`derive_f4n_fcs`; twelfth session), or a model from outside the wheel, checked into
+this repository, with its engine removed (``Rascal110_glide``, :func:`derive_rascal_glide`: ArduPilot's
+SITL Rascal 110; thirteenth session, :data:`REPO_DERIVED`).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -52,8 +54,8 @@ import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-__all__ = ["DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derived_xml", "derived_sha", "install_derived_models",
-           "ELEVATOR_ALIAS"]
+__all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide", "derived_xml",
+           "derived_sha", "install_derived_models", "ELEVATOR_ALIAS"]
 
 #: The elevator alias the derived F-16's tables read (see the module docstring).
 ELEVATOR_ALIAS = "aero/function/elevator-pos-rad"
@@ -171,6 +173,37 @@ def derive_f4n_fcs(root: ET.Element) -> ET.Element:
     return root
 
 
+def derive_rascal_glide(root: ET.Element) -> ET.Element:
+    """The Rascal 110's XML ``root`` with its engine and propeller removed (thirteenth session).
+
+    ArduPilot's SITL Rascal 110 (``data/jsbsim_models/rascal/Rascal110-JSBSim.xml``) drives an 18x8
+    propeller with a Zenoah G-26A piston engine, whose files are not in the jsbsim wheel. The harness
+    glides every aircraft with its engines stopped, so that every non-gravity force is aerodynamic;
+    a stopped engine would still leave JSBSim's windmilling propeller (the rule that rejected the
+    p51d, B17 and C130). The derivation removes the ``<engine>`` element (engine and thruster): the
+    glide of a UAV with its propeller folded or stopped and no propeller force. Its fuel tank (1.5 lb
+    on the centre line) stays as mass; the aerodynamics, metrics, mass balance, ground reactions and
+    flight control are unchanged (a test checks every other element).
+
+    Args:
+        root: the parsed ``Rascal110-JSBSim.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML has no ``<propulsion>`` with an ``<engine>`` or no ``<aerodynamics>``.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    if not engines or root.find("aerodynamics") is None:
+        raise ValueError("Rascal110-JSBSim.xml: no <propulsion><engine> to remove or no <aerodynamics>")
+    for e in engines:
+        prop.remove(e)
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -180,19 +213,40 @@ DERIVED = {
                                        "harness's injected elevator delay; everything else unchanged."),
 }
 
+_REPO = Path(__file__).resolve().parents[2]
+
+#: Derived models whose source XML is checked into this repository (a model from outside the wheel;
+#: provenance and licence in the folder's README.md): name -> (source XML relative to the
+#: repository root, where it comes from, derivation, what the derivation did).
+REPO_DERIVED = {
+    "Rascal110_glide": ("data/jsbsim_models/rascal/Rascal110-JSBSim.xml",
+                        "ArduPilot's Tools/autotest/aircraft/Rascal/Rascal110-JSBSim.xml (GPL-3.0), copied into "
+                        "gcs-sysid's data/jsbsim_models/rascal/",
+                        derive_rascal_glide, "engine and propeller removed (a glide with no propeller force); "
+                                             "everything else unchanged."),
+}
+
 
 def derived_xml(name: str, stock_dir: Path | None = None) -> bytes:
     """The derived model ``name``'s XML as bytes, from the installed wheel's stock model.
 
+    ``stock_dir`` is ignored for the :data:`REPO_DERIVED` models (their source is in the repository).
+
     Raises:
-        KeyError: ``name`` is not in :data:`DERIVED`.
+        KeyError: ``name`` is in neither :data:`DERIVED` nor :data:`REPO_DERIVED`.
         ValueError: the stock XML does not take the derivation.
     """
-    stock, derive, what = DERIVED[name]
-    src = (stock_dir or _wheel_root() / "aircraft" / stock) / f"{stock}.xml"
+    if name in REPO_DERIVED:
+        rel, origin, derive, what = REPO_DERIVED[name]
+        src = _REPO / rel
+        source = origin
+    else:
+        stock, derive, what = DERIVED[name]
+        src = (stock_dir or _wheel_root() / "aircraft" / stock) / f"{stock}.xml"
+        source = f"the jsbsim wheel's aircraft/{stock}/{stock}.xml (LGPL-2.1)"
     root = derive(ET.parse(src).getroot())
     ET.indent(root, space=" ")
-    header = (f"<?xml version=\"1.0\"?>\n<!-- Derived from the jsbsim wheel's aircraft/{stock}/{stock}.xml (LGPL-2.1) by "
+    header = (f"<?xml version=\"1.0\"?>\n<!-- Derived from {source} by "
               f"gcs-sysid's benchmarks/jsbsim_harness/derived.py: {what} -->\n")
     return header.encode() + ET.tostring(root, encoding="unicode").encode() + b"\n"
 
@@ -207,23 +261,28 @@ def install_derived_models(aircraft_dir: Path | None = None) -> list[Path]:
     where it is missing or differs; returns the folders written.
 
     Each is the stock folder copied (its ``Systems/`` included) with the XML replaced by
-    :func:`derived_xml` as ``<name>/<name>.xml``; written in a temporary folder beside it and
-    renamed into place, so that a concurrent reader sees the old folder or the new one.
+    :func:`derived_xml` as ``<name>/<name>.xml`` (a :data:`REPO_DERIVED` model: a folder with that
+    XML alone); written in a temporary folder beside it and renamed into place, so that a concurrent
+    reader sees the old folder or the new one.
 
     A folder that cannot be written (a read-only installation) gives a ``UserWarning`` naming it;
     flying that model then fails in JSBSim's loader.
     """
     base = Path(aircraft_dir) if aircraft_dir else _wheel_root() / "aircraft"
     written = []
-    for name, (stock, _, _) in DERIVED.items():
+    for name in list(DERIVED) + list(REPO_DERIVED):
+        stock = DERIVED[name][0] if name in DERIVED else None
         try:
-            want = derived_xml(name, base / stock)
+            want = derived_xml(name, base / stock if stock else None)
             dest = base / name
             if (dest / f"{name}.xml").is_file() and (dest / f"{name}.xml").read_bytes() == want:
                 continue
             tmp = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=base))
-            shutil.copytree(base / stock, tmp / name)
-            (tmp / name / f"{stock}.xml").unlink()
+            if stock:
+                shutil.copytree(base / stock, tmp / name)
+                (tmp / name / f"{stock}.xml").unlink()
+            else:
+                (tmp / name).mkdir()
             (tmp / name / f"{name}.xml").write_bytes(want)
             old = None
             if dest.exists():
