@@ -1,4 +1,6 @@
-"""The f4n in the JSBSim harness: the twelfth session's untouched aircraft (docs/jsbsim.md, "The f4n").
+"""The f4n in the JSBSim harness: the twelfth session's untouched aircraft (docs/jsbsim.md, "The f4n"),
+a tuning aircraft since its final evaluation was read (the thirteenth session's untouched one is the
+rascal, ``test_jsbsim_rascal.py``, where the summaries-label test moved).
 
 JSBSim's stock F-4N Phantom II (``F4N.xml``, Aeromatic v0.9 / David Culp, 2007), flown with its own
 flight control as the wheel ships it: direct surfaces (``systems/FCS-pitch.xml``, ``FCS-roll.xml``)
@@ -9,15 +11,14 @@ Its own checks are here, on the XML and JSBSim's own properties, no flight: the 
 stock one plus that empty element (hash in the spec, so in the fingerprint) and JSBSim computes the
 same forces and moments with it; the yaw damper moves the rudder the aerodynamics read (so the logged
 rudder includes it) and nothing else stands between the commands and the surfaces; it is statically
-stable about the CG; the summaries' label. The checks it
+stable about the CG. The checks it
 shares with the other aircraft (names, rigid body, sign map, gear, .tlog, hidden effects, airspeed
 bias, the evaluation's flights in the envelope, ``--fly-only``; slow but the names') are in
-``test_jsbsim_roster.py``. No pipeline fit, GP, diagnosis or scoring is run on the f4n: its first
-evaluation is the final one, after the merge.
+``test_jsbsim_roster.py``. No pipeline fit, GP, diagnosis or scoring ran on the f4n before its final
+evaluation (twelfth session).
 """
 
 import dataclasses
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -108,31 +109,3 @@ def test_the_f4n_is_statically_stable_about_its_cg():
     slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
     assert slope(c0, c4) == pytest.approx(-0.23, abs=0.01) and slope(c4, c8) == pytest.approx(-0.23, abs=0.01)
     assert (cm(4.0, -0.5) - c4) / (-0.5 * 0.35) == pytest.approx(-0.54, abs=0.02)
-
-
-def test_summaries_mark_the_f4n_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label f4n "(untouched)" and
-    no other aircraft, the f16 included (synthetic rows: no f4n result exists before the final
-    evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| f4n (untouched) | light") for ln in lines)
-    for ac in acs[:8]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| f4n (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| f16 | clean |") for ln in lines)

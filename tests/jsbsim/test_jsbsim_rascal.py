@@ -1,0 +1,165 @@
+"""The rascal in the JSBSim harness: the thirteenth session's untouched aircraft (docs/jsbsim.md, "The rascal").
+
+The model is ArduPilot's SITL Rascal 110 (``Rascal110-JSBSim.xml``, based on FlightGear's Rascal110). It
+is the first model from outside the jsbsim wheel: the XML is checked in under
+``data/jsbsim_models/rascal/`` (GPL-3.0; provenance in its README.md). The harness flies it as the
+derived model ``Rascal110_glide`` (``benchmarks/jsbsim_harness/derived.py``), the XML with its engine
+and propeller removed.
+
+The checks here use the XML and JSBSim's own properties; none of them flies:
+
+- the checked-in file is the one the README names (its SHA-256);
+- the derived XML is that file without its ``<engine>``, and its hash is in the spec (so in the
+  fingerprint);
+- JSBSim then has no propulsion, and every non-gravity force is aerodynamic;
+- the FCS maps the commands straight to the surfaces the aerodynamics read, with no damper;
+- it is statically stable about the CG, and its aileron yaws it the way its ``Cnda`` says;
+- the summaries label it "(untouched)" and nothing else.
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
+map, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
+All of them but the names are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the rascal: its first evaluation is the final one,
+after the merge.
+"""
+
+import hashlib
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import FlightConfig, aircraft
+from benchmarks.jsbsim_harness.logfile import _REPO
+
+SOURCE = _REPO / "data" / "jsbsim_models" / "rascal" / "Rascal110-JSBSim.xml"
+SOURCE_SHA256 = "d5b9e7435e3a04d7f8c4d3e37b6ecb9ca4865f98e17d38a50177e5a86d41dd20"   # README.md's
+
+
+def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+    """JSBSim at the harness's initial condition for the rascal with the given alpha, sideslip, yaw
+    rate (rad/s) and fixed normalised commands, after ``run_ic`` (the FCS evaluated once, nothing
+    integrated)."""
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    spec = aircraft("rascal")
+    fdm = load_model(spec, 1 / 200)
+    _set_ic(fdm, spec, FlightConfig("rascal", turbulence="none"))
+    fdm["ic/alpha-deg"], fdm["ic/beta-deg"], fdm["ic/r-rad_sec"] = alpha_deg, beta_deg, r_rad_s
+    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
+    fdm.run_ic()
+    return fdm
+
+
+def test_the_derived_model_is_ardupilots_rascal_without_its_engine():
+    """The checked-in XML is the file the README names (SHA-256). ``Rascal110_glide`` (hash in the
+    spec's notes, so in the rascal's fingerprint; the installed copy is it) is that XML with the
+    ``<engine>`` element (engine and 18x8 propeller) removed: its propulsion holds the 1.5-lb fuel tank
+    alone, and every other element is equal."""
+    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
+    from benchmarks.jsbsim_harness.effects import stock_model_dir
+
+    assert hashlib.sha256(SOURCE.read_bytes()).hexdigest() == SOURCE_SHA256
+    spec = aircraft("rascal")
+    xml = derived_xml("Rascal110_glide")
+    assert spec.model == "Rascal110_glide" and _REPO / REPO_DERIVED[spec.model][0] == SOURCE
+    assert f"XML sha256 {derived_sha('Rascal110_glide')}" in spec.notes
+    assert (stock_model_dir(spec) / "Rascal110_glide.xml").read_bytes() == xml
+    derived, source = ET.fromstring(xml), ET.parse(SOURCE).getroot()
+    assert [c.tag for c in derived] == [c.tag for c in source]
+    assert source.find("propulsion/engine") is not None and derived.find("propulsion/engine") is None
+    assert [t.tag for t in derived.find("propulsion")] == ["tank"]
+    canon = lambda e: ET.tostring(e, encoding="unicode").replace(" ", "").replace("\n", "")   # noqa: E731
+    for a, b in zip(derived, source):
+        if a.tag == "propulsion":
+            assert canon(a.find("tank")) == canon(b.find("tank"))
+        else:
+            assert canon(a) == canon(b), a.tag
+
+
+def test_the_rascal_flies_its_own_surfaces_and_no_propulsion():
+    """No engine, so every non-gravity force and moment is aerodynamic, 50 frames on. The FCS maps the
+    commands straight to the surfaces the aerodynamics read:
+
+    - elevator -0.35..+0.30 rad, zero-centred;
+    - left aileron +-0.35 rad, the right its mirror;
+    - rudder +-0.35 rad.
+
+    A yaw rate does not move the rudder (no yaw damper), so the harness's own damper flies it (k_r 0.4)."""
+    spec = aircraft("rascal")
+    assert spec.gains[5] == 0.4
+    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.30, rel=1e-9)
+    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
+    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
+    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
+    for _ in range(50):
+        fdm.run()
+    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
+        for ax in ("xyz" if f.startswith("forces") else "lmn"):
+            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
+    assert abs(fdm["forces/fbz-aero-lbs"]) > 5.0
+
+
+def test_the_rascal_is_statically_stable_and_yaws_adversely():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic``, the harness's initial condition).
+
+    - **Pitch:** without its ``Cmadot`` term, Cm falls with alpha: -0.79 per rad between 0 and 4 deg,
+      -0.65 between 4 and 8 deg. ``run_ic`` gives this light aircraft an alpha-dot, which the term reads.
+      The stiffness is its Cmalpha -0.5, plus the lift acting 1.0 in aft of the CG, less the axial force
+      acting 3.4 in below it.
+    - **Elevator:** Cm per rad of elevator -0.53: Cmde -0.5 + 0.1125 Mach (-0.493 at Mach 0.063), plus
+      CLde's lift acting aft of the CG (-0.015) and CDde's drag (0.03 per unit of
+      ``fcs/elevator-pos-norm``, i.e. 0.1 per rad) acting below it (-0.025).
+    - **Yaw:** Cn per rad of left aileron -0.030 (its Cnda: adverse yaw, Cn_delta_a +0.03 in the
+      project's sign). Cn at rest is its Cndi, +0.0007.
+    """
+    def cm(alpha, de=0.0):
+        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
+        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
+        return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc
+
+    c0, c4, c8 = cm(0.0), cm(4.0), cm(8.0)
+    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
+    assert slope(c0, c4) == pytest.approx(-0.79, abs=0.02) and slope(c4, c8) == pytest.approx(-0.65, abs=0.02)
+    assert (cm(4.0, -0.5) - c4) / (-0.5 * 0.35) == pytest.approx(-0.53, abs=0.01)
+
+    def cn(cmd):
+        fdm = _state(alpha_deg=2.0, cmds=(0.0, cmd, 0.0))
+        return fdm["moments/n-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]), \
+            fdm["fcs/left-aileron-pos-rad"]
+
+    (n0, l0), (n1, l1) = cn(0.0), cn(0.4)
+    assert (n1 - n0) / (l1 - l0) == pytest.approx(-0.03, rel=1e-6) and n0 == pytest.approx(0.0007, rel=1e-6)
+
+
+def test_summaries_mark_the_rascal_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the rascal "(untouched)" and
+    no other aircraft, the f4n and f16 included (synthetic rows: no rascal result exists before the
+    final evaluation)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| rascal (untouched) | light") for ln in lines)
+    for ac in acs[:9]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| rascal (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| f4n | clean |") for ln in lines)
