@@ -29,7 +29,9 @@ metrics, mass and inertia, ground reactions, propulsion and systems are the whee
   ``delay:delta_e`` redirects.
 
 The derived folder is generated from the installed wheel (LGPL-2.1; nothing of JSBSim is copied
-into this repository) into the wheel's own ``aircraft/`` folder, beside the stock models, because
+into this repository; the one exception is ArduPilot's Rascal 110, a model from outside the wheel, whose
+XML is checked in under ``data/jsbsim_models/rascal/`` with its GPL-3.0 provenance) into the wheel's own
+``aircraft/`` folder, beside the stock models, because
 the harness's loader (``flight.load_model``) loads models from there by name and must not change
 (its code is part of every aircraft's harness fingerprint, ``logfile.harness_fingerprint``).
 :func:`install_derived_models` runs when ``benchmarks.jsbsim_harness`` is imported; it rewrites the
