@@ -24,22 +24,13 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import FlightConfig, aircraft
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import ic_state
 
 
 def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0, spec=None):
-    """JSBSim at the harness's initial condition for the f4n (or ``spec``) with the given alpha,
-    sideslip, yaw rate (rad/s) and fixed commands, after ``run_ic`` (the FCS evaluated once, nothing
-    integrated)."""
-    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
-
-    spec = spec or aircraft("f4n")
-    fdm = load_model(spec, 1 / 200)
-    _set_ic(fdm, spec, FlightConfig("f4n", turbulence="none"))
-    fdm["ic/alpha-deg"], fdm["ic/beta-deg"], fdm["ic/r-rad_sec"] = alpha_deg, beta_deg, r_rad_s
-    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
-    fdm.run_ic()
-    return fdm
+    """:func:`truth_fits.ic_state` for the f4n (or ``spec``)."""
+    return ic_state(spec or aircraft("f4n"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 
 def test_the_derived_model_is_the_stock_f4n_with_an_empty_flight_control():

@@ -31,26 +31,17 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from benchmarks.jsbsim_harness import FlightConfig, aircraft
+from benchmarks.jsbsim_harness import aircraft
 from benchmarks.jsbsim_harness.logfile import _REPO
+from truth_fits import ic_state
 
 SOURCE = _REPO / "data" / "jsbsim_models" / "rascal" / "Rascal110-JSBSim.xml"
 SOURCE_SHA256 = "d5b9e7435e3a04d7f8c4d3e37b6ecb9ca4865f98e17d38a50177e5a86d41dd20"   # README.md's
 
 
 def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """JSBSim at the harness's initial condition for the rascal with the given alpha, sideslip, yaw
-    rate (rad/s) and fixed normalised commands, after ``run_ic`` (the FCS evaluated once, nothing
-    integrated)."""
-    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
-
-    spec = aircraft("rascal")
-    fdm = load_model(spec, 1 / 200)
-    _set_ic(fdm, spec, FlightConfig("rascal", turbulence="none"))
-    fdm["ic/alpha-deg"], fdm["ic/beta-deg"], fdm["ic/r-rad_sec"] = alpha_deg, beta_deg, r_rad_s
-    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
-    fdm.run_ic()
-    return fdm
+    """:func:`truth_fits.ic_state` for the rascal."""
+    return ic_state(aircraft("rascal"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 
 def test_the_derived_model_is_ardupilots_rascal_without_its_engine():

@@ -121,6 +121,22 @@ def rigid_body_residual(truth: dict, inertia: np.ndarray) -> np.ndarray:
     return np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
 
 
+def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+    """JSBSim (``FGFDMExec``) at the harness's initial condition for ``spec`` with the given alpha and
+    sideslip (deg), yaw rate (rad/s) and fixed normalised commands ``cmds`` (elevator, aileron,
+    rudder), after ``run_ic``: the FCS evaluated once, nothing integrated (the f4n's and rascal's
+    checks of their FCS and static stability)."""
+    from benchmarks.jsbsim_harness import FlightConfig
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    fdm = load_model(spec, 1 / 200)
+    _set_ic(fdm, spec, FlightConfig(spec.name, turbulence="none"))
+    fdm["ic/alpha-deg"], fdm["ic/beta-deg"], fdm["ic/r-rad_sec"] = alpha_deg, beta_deg, r_rad_s
+    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
+    fdm.run_ic()
+    return fdm
+
+
 def effect_state(spec, effects, cmds=(0.3, -0.4, 0.2), n=40, alpha_deg=None):
     """JSBSim (``FGFDMExec``) at the harness's initial condition with 4 deg of sideslip (and
     ``alpha_deg`` of alpha when given) and the fixed normalised commands ``cmds`` (elevator,
