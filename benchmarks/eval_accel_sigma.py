@@ -108,20 +108,25 @@ def measure(work: Path, ac: str, turb: str, seed: int, cap: dict) -> dict:
 def summarize(path: Path) -> str:
     """Markdown table of a ``--json`` file: per aircraft and level, the ratio per axis over the seeds."""
     rows = [json.loads(line) for line in open(path) if line.strip()]
-    lines = ["| aircraft | turb. | p_dot ratio | q_dot ratio | r_dot ratio | true err p q r (rad/s^2) | true noise-driven / rest (RMS, seed mean) p; q; r | stated/true: noise-driven p q r | stated prior/true: rest p q r | >3 Hz share p q r |",
+    axes = ("p_dot", "q_dot", "r_dot")
+    lines = ["| aircraft | turb. | p_dot ratio | q_dot ratio | r_dot ratio | true err p q r (rad/s^2) "
+             "| true noise-driven / rest (RMS, seed mean) p; q; r | stated/true: noise-driven p q r "
+             "| stated prior/true: rest p q r | >3 Hz share p q r |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     keys = sorted({(r["ac"], r["turb"]) for r in rows}, key=lambda k: (k[0], k[1] != "light"))
     for ac, turb in keys:
         rs = [r for r in rows if r["ac"] == ac and r["turb"] == turb]
-        cell = lambda a, f: "/".join(f"{r[a][f]:.2f}" for r in rs)                 # noqa: E731
-        mean = lambda a, f: float(np.mean([r[a].get(f, np.nan) for r in rs]))       # noqa: E731
-        lines.append(f"| {ac} | {turb} | {cell('p_dot', 'ratio')} | {cell('q_dot', 'ratio')} | {cell('r_dot', 'ratio')} | "
-                     + " ".join(f"{mean(a, 'err'):.4f}" for a in ("p_dot", "q_dot", "r_dot")) + " | "
-                     + "; ".join(f"{mean(a, 'noise'):.4f} / {mean(a, 'rest'):.4f}" for a in ("p_dot", "q_dot", "r_dot")) + " | "
-                     + " ".join(f"{mean(a, 'st_noise') / mean(a, 'noise'):.2f}" for a in ("p_dot", "q_dot", "r_dot")) + " | "
-                     + " ".join(f"{mean(a, 'st_dist') / mean(a, 'rest'):.2f}" for a in ("p_dot", "q_dot", "r_dot")) + " | "
-                     + " ".join(f"{mean(a, 'above3'):.2f}" for a in ("p_dot", "q_dot", "r_dot")) + " |")
-    allr = np.array([r[a]["ratio"] for r in rows for a in ("p_dot", "q_dot", "r_dot")])
+
+        def mean(a, f):
+            return float(np.mean([r[a].get(f, np.nan) for r in rs]))
+        cells = ["/".join(f"{r[a]['ratio']:.2f}" for r in rs) for a in axes]
+        cells.append(" ".join(f"{mean(a, 'err'):.4f}" for a in axes))
+        cells.append("; ".join(f"{mean(a, 'noise'):.4f} / {mean(a, 'rest'):.4f}" for a in axes))
+        cells.append(" ".join(f"{mean(a, 'st_noise') / mean(a, 'noise'):.2f}" for a in axes))
+        cells.append(" ".join(f"{mean(a, 'st_dist') / mean(a, 'rest'):.2f}" for a in axes))
+        cells.append(" ".join(f"{mean(a, 'above3'):.2f}" for a in axes))
+        lines.append(f"| {ac} | {turb} | " + " | ".join(cells) + " |")
+    allr = np.array([r[a]["ratio"] for r in rows for a in axes])
     lines.append("")
     lines.append(f"{len(allr)} axis-flights: median ratio {np.median(allr):.2f}, within 0.8-1.25: "
                  f"{int(np.sum((allr >= 0.8) & (allr <= 1.25)))}, range {allr.min():.2f}-{allr.max():.2f}")
