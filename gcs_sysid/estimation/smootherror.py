@@ -13,9 +13,10 @@ with ``D`` the smoother's transfer function from the gyro to the angular acceler
 and ``S_model`` the white-snap model's rate spectrum at the chosen bandwidth. The first part depends only
 on the smoother and the measured gyro noise: it is the flight's own, and it is what the smoothed
 residuals of a later fit can show. The second is the model's *prior* for the signal the smoother cuts
-off: the angular acceleration above the bandwidth, which on the flights measured (JSBSim, 9 aircraft,
-docs/benchmarks.md "Thirteenth session, i8-sigma") holds 10-90 % of the true error variance, most of it
-above 3 Hz where the rate signal is 1-2 % of the gyro noise's power: no gyro-based statistic reads it.
+off: the angular acceleration above the bandwidth. On the flights measured (JSBSim, 9 aircraft,
+docs/benchmarks.md "Thirteenth session, i8-sigma") the prior is 0.15-2.6x the true cut-off part (RMS), and
+4-94 % of the true error's variance lies above 3 Hz, where the rate signal is a few % of the gyro noise's
+power or less: no gyro-based statistic reads it.
 
 :func:`accel_error_split` returns both parts for a smoother (bandwidth, gyro noise), so a caller can tell
 the stated error the residuals can show from the part they cannot.
@@ -33,7 +34,7 @@ import numpy as np
 
 __all__ = ["N_FREQ", "model_response", "accel_error_split"]
 
-#: Frequencies of the midpoint rule over (0, pi) rad/sample (the parts agree with ``Ps[1, 1]`` to 1e-6).
+#: Frequencies of the midpoint rule over (0, pi) rad/sample (the parts sum to ``Ps[1, 1]`` within 1e-5).
 N_FREQ = 4096
 
 
