@@ -274,7 +274,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         notes.append("rate smoother bandwidth p q r = " + ", ".join(f"{b:g}" for b in Rr.bandwidth_hz)
                      + " Hz; gyro noise = " + ", ".join(f"{s:.4f}" for s in Rr.noise_std) + " rad/s; signal "
                      "above it recovered from the residual's spectrum (Wiener) p q r: " + ", ".join(
-                         "none" if not np.isfinite(b[0]) else f"{b[0]:.1f}-{b[1]:.1f} Hz" for b in Rr.correction_band_hz))
+                         "none" if not np.isfinite(b[0]) else f"{b[0]:.1f}-{b[1]:.1f} Hz" for b in Rr.correction_band_hz)
+                     + ("" if Rr.local_bandwidth_hz is None else "; narrower where the motion is weaker (5-s windows, "
+                        "likelihood) p q r: " + ", ".join("no" if not np.isfinite(b[0]) else f"down to {b[0]:.2g} Hz"
+                                                          for b in Rr.local_bandwidth_hz)))
         if cnames:
             unit = "rad/s^2 per Pa rad" if qbar_eas is not None else "rad/s^2 per rad"
             notes.append("control steps taken as known inputs (" + ", ".join(cnames) + "); step effectiveness "

@@ -192,7 +192,8 @@ class RateEstimate:
         slow_transient: (3,) per axis whether the slow transients (:data:`SLOW_DECAYS`) were taken
             (likelihood-ratio and coloured Wald tests); all False when none were offered.
         local_bandwidth_hz: (3, 2) per axis the lowest and highest local (weighted-mean) bandwidth, Hz, where
-            the bandwidth was let change along the record (:func:`_local_blend`); None where not.
+            the bandwidth was let change along the record (:func:`_local_blend`), NaN on an axis where it was not
+            (its whole-record choice the narrowest candidate); None where on no axis.
     """
 
     rate: np.ndarray
