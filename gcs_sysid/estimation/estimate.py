@@ -23,7 +23,7 @@ from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude,
 from .align import Aligned, align_flight, events
 from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
-from .rates import CONTROL_AXES, GUST_HZ, HOLDS, normal_force_input, smooth_rates
+from .rates import CONTROL_AXES, GUST_HZ, HOLDS, LOCAL_WINDOW_S, normal_force_input, smooth_rates
 from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
@@ -139,9 +139,11 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             flights' alpha share one scale (:func:`gcs_sysid.estimation.airangles.aided_air_angles`, ``models``).
             None: fitted on this flight.
         turbulence_state: offer the specific-force smoother's z axis the turbulence state
-            (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default). False: the plain smoother, as the
-            diagnosis and ``fit`` load their flights (:func:`gcs_sysid.diagnose.run.load_measurements`: on a
-            clean JSBSim c172x flight the retained high-frequency CZ was named a zero-size elevator delay).
+            (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default) and let the rate smoother's
+            bandwidth narrow where the motion is weaker (:data:`gcs_sysid.estimation.rates.LOCAL_WINDOW_S`).
+            False: the plain smoothers, as the diagnosis and ``fit`` load their flights
+            (:func:`gcs_sysid.diagnose.run.load_measurements`: on a clean JSBSim c172x flight the retained
+            high-frequency CZ was named a zero-size elevator delay; the local bandwidth was not measured there).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -261,7 +263,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
         Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
                           aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,),
-                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None)
+                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None,
+                          local_window_s=LOCAL_WINDOW_S if turbulence_state else None)
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):
