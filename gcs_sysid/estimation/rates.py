@@ -159,9 +159,10 @@ GUST_TAU_S = 2.0
 #: likelihood took the state and made CY worse (f16 moderate 7.8 -> 9.0 %): the side force's spectrum is not of
 #: that form; x and y keep the residual's Wiener correction (docs/estimation.md, section 5, "Moderate turbulence").
 GUST_FORCE_AXES = (2,)
-#: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the turbulence's strength
-#: changes along a flight (with altitude, MIL-F-8785C sec. 3.7.2, and in patches), a whole-record bandwidth
-#: cannot follow it.
+#: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the motion's strength changes
+#: along a flight (manoeuvres and quiet legs; turbulence with altitude, MIL-F-8785C sec. 3.7, and in patches), a
+#: whole-record bandwidth cannot follow it; only the whole-record choice and narrower candidates are offered
+#: (offered wider ones too, it cost the f4n's held-out q_dot 7.60 -> 8.00 %, docs/estimation.md).
 LOCAL_WINDOW_S = 5.0
 
 
@@ -415,11 +416,12 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     nominal model's best. The smoothed signal is then the nominal part plus the gust; ``xd`` stays the nominal
     part's derivative (order 0 only: the forces need no derivative). ``out["gust"]``: the level taken per axis
     (0: none).
-    ``local_window_s``: where given, the nominal bandwidth may change along the record (:func:`_local_blend`):
-    per window of about this length each nominal candidate's posterior weight from its innovations (the input
-    coefficients and the noise level of the whole-record choice), the smoothed means blended with the weights
-    interpolated between window centres. Not on an axis that took the turbulence state. ``out["local_bw"]``:
-    per axis the lowest and highest weighted-mean bandwidth over the record, Hz (NaN where not used).
+    ``local_window_s``: where given, the nominal bandwidth may narrow along the record (:func:`_local_blend`):
+    per window of about this length the posterior weight of the whole-record choice and of each narrower nominal
+    candidate from its innovations (the input coefficients and the noise level of the whole-record fit), the
+    smoothed means blended with the weights interpolated between window centres. Not on an axis that took the
+    turbulence state or whose choice is the narrowest. ``out["local_bw"]``: per axis the lowest and highest
+    weighted-mean bandwidth over the record, Hz (NaN where not used).
     """
     T, d = Z.shape
     bw_ok = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
@@ -675,15 +677,16 @@ def _local_blend(z: np.ndarray, models: list, c0: int, s2: float, window: int
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The nominal part smoothed with a bandwidth that may change along the record (a multiple-model smoother).
 
-    One bandwidth per axis is a compromise over the whole record: where the turbulence is stronger than on
-    average (it varies with altitude, MIL-F-8785C sec. 3.7.2, and comes in patches) the signal outruns it, and
-    where the air is calm a wider one only lets the sensor's noise through. Each candidate ``j`` (a nominal
-    model, unit measurement noise) runs its constant-gain filter and smoother over ``z`` (the measurement less
-    the input columns of the whole-record fit); per window of ``window`` samples its log-likelihood is the
-    Gaussian density of its own innovations with the whole-record noise variance ``s2`` (the prediction-error
-    decomposition: the innovations' density given the past, exactly as a multiple-model filter weighs its
-    modes; Bar-Shalom, Li and Kirubarajan 2001, sec. 11.6, the interacting multiple model; Jazwinski 1970,
-    ch. 7, adaptive noise), with prior 1/2 on the whole-record choice ``c0`` and the rest shared by the others.
+    One bandwidth per axis is a compromise over the whole record, set where the signal is strongest
+    (manoeuvres, turbulence; its strength varies with altitude, MIL-F-8785C sec. 3.7, and comes in patches);
+    where the motion is weaker it lets more of the sensor's noise through than the signal needs. Each candidate
+    ``j`` (a nominal model, unit measurement noise; the caller passes the whole-record choice and the narrower
+    ones) runs its constant-gain filter and smoother over ``z`` (the measurement less the input columns of the
+    whole-record fit); per window of ``window`` samples its log-likelihood is the Gaussian density of its own
+    innovations with the whole-record noise variance ``s2`` (the prediction-error decomposition: the
+    innovations' density given the past, as a multiple-model filter weighs its modes; Bar-Shalom, Li and
+    Kirubarajan, *Estimation with Applications to Tracking and Navigation*, Wiley 2001, ch. 11, the
+    multiple-model approach), with prior 1/2 on the whole-record choice ``c0`` and the rest shared by the others.
     The posterior weights at the window centres are interpolated linearly in time and the smoothed means
     blended with them (model averaging, zero phase as each smoother). On a record of one window or less the
     weights are those of the whole record.
@@ -776,9 +779,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         residual_correction: add what the smoother left in the gyro where the residual's spectrum
             shows signal over the white-noise floor (:func:`~.wiener.residual_wiener`, per axis and
             gap-free piece, zero phase); False: the smoother alone.
-        local_window_s: let the nominal bandwidth change along the record, chosen per window of about this
-            length by the candidates' innovations (:func:`_local_blend`, :data:`LOCAL_WINDOW_S`); None: one
-            bandwidth per axis for the whole record.
+        local_window_s: let the nominal bandwidth narrow along the record where the motion is weaker, chosen
+            per window of about this length by the candidates' innovations (:func:`_local_blend`,
+            :data:`LOCAL_WINDOW_S`); None: one bandwidth per axis for the whole record.
 
     Returns:
         :class:`RateEstimate`.
