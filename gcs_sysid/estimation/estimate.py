@@ -23,7 +23,7 @@ from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude,
 from .align import Aligned, align_flight, events
 from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
-from .rates import CONTROL_AXES, GUST_HZ, HOLDS, LOCAL_WINDOW_S, normal_force_input, smooth_rates
+from .rates import CONTROL_AXES, GUST_HZ, HOLDS, normal_force_input, smooth_rates
 from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
@@ -139,11 +139,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             flights' alpha share one scale (:func:`gcs_sysid.estimation.airangles.aided_air_angles`, ``models``).
             None: fitted on this flight.
         turbulence_state: offer the specific-force smoother's z axis the turbulence state
-            (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default) and let the rate smoother's
-            bandwidth narrow where the motion is weaker (:data:`gcs_sysid.estimation.rates.LOCAL_WINDOW_S`).
-            False: the plain smoothers, as the diagnosis and ``fit`` load their flights
-            (:func:`gcs_sysid.diagnose.run.load_measurements`: on a clean JSBSim c172x flight the retained
-            high-frequency CZ was named a zero-size elevator delay; the local bandwidth was not measured there).
+            (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default). False: the plain smoother, as the
+            diagnosis and ``fit`` load their flights (:func:`gcs_sysid.diagnose.run.load_measurements`: on a
+            clean JSBSim c172x flight the retained high-frequency CZ was named a zero-size elevator delay).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -263,8 +261,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
         Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
                           aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,),
-                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None,
-                          local_window_s=LOCAL_WINDOW_S if turbulence_state else None)
+                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None)
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):
@@ -277,10 +274,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         notes.append("rate smoother bandwidth p q r = " + ", ".join(f"{b:g}" for b in Rr.bandwidth_hz)
                      + " Hz; gyro noise = " + ", ".join(f"{s:.4f}" for s in Rr.noise_std) + " rad/s; signal "
                      "above it recovered from the residual's spectrum (Wiener) p q r: " + ", ".join(
-                         "none" if not np.isfinite(b[0]) else f"{b[0]:.1f}-{b[1]:.1f} Hz" for b in Rr.correction_band_hz)
-                     + ("" if Rr.local_bandwidth_hz is None else "; narrower where the motion is weaker (5-s windows, "
-                        "likelihood) p q r: " + ", ".join("no" if not np.isfinite(b[0]) else f"down to {b[0]:.2g} Hz"
-                                                          for b in Rr.local_bandwidth_hz)))
+                         "none" if not np.isfinite(b[0]) else f"{b[0]:.1f}-{b[1]:.1f} Hz" for b in Rr.correction_band_hz))
         if cnames:
             unit = "rad/s^2 per Pa rad" if qbar_eas is not None else "rad/s^2 per rad"
             notes.append("control steps taken as known inputs (" + ", ".join(cnames) + "); step effectiveness "

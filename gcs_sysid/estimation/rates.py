@@ -162,7 +162,8 @@ GUST_FORCE_AXES = (2,)
 #: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the motion's strength changes
 #: along a flight (manoeuvres and quiet legs; turbulence with altitude, MIL-F-8785C sec. 3.7, and in patches), a
 #: whole-record bandwidth cannot follow it; only the whole-record choice and narrower candidates are offered
-#: (offered wider ones too, it cost the f4n's held-out q_dot 7.60 -> 8.00 %, docs/estimation.md).
+#: (offered wider ones too, it cost the f4n's held-out q_dot 7.60 -> 8.00 %, docs/estimation.md). Opt-in
+#: (``smooth_rates(local_window_s=LOCAL_WINDOW_S)``); the pipeline does not use it (docs/benchmarks.md).
 LOCAL_WINDOW_S = 5.0
 
 
@@ -736,7 +737,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True,
                  slow_decays: tuple[float, ...] = SLOW_DECAYS,
                  control_axes: list[tuple[int, ...] | None] | None = None,
-                 local_window_s: float | None = LOCAL_WINDOW_S) -> RateEstimate:
+                 local_window_s: float | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -780,8 +781,11 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
             shows signal over the white-noise floor (:func:`~.wiener.residual_wiener`, per axis and
             gap-free piece, zero phase); False: the smoother alone.
         local_window_s: let the nominal bandwidth narrow along the record where the motion is weaker, chosen
-            per window of about this length by the candidates' innovations (:func:`_local_blend`,
-            :data:`LOCAL_WINDOW_S`); None: one bandwidth per axis for the whole record.
+            per window of about this length by the candidates' innovations (:func:`_local_blend`; e.g.
+            :data:`LOCAL_WINDOW_S`); None (the default, and what :func:`~.estimate.estimate_states` uses): one
+            bandwidth per axis for the whole record. Opt-in: on the JSBSim flights it improved the measured Cn
+            but cost the GP's held-out Cl on pa28 light s3 (9.37 -> 10.82 %) and two GP-vs-LS ties on the t6
+            (docs/benchmarks.md, "Thirteenth session, i8-meas").
 
     Returns:
         :class:`RateEstimate`.

@@ -1,4 +1,4 @@
-"""The rate smoother's local bandwidth (estimation/rates.py ``_local_blend``, issue 8, branch i8-meas): where the
+"""The rate smoother's opt-in local bandwidth (estimation/rates.py ``_local_blend``, issue 8, branch i8-meas): where the
 motion is weaker than over the whole record (calm air after turbulence, a quiet leg between manoeuvres) a
 narrower bandwidth, chosen per window by the candidates' own innovations, lets less of the gyro's noise into the
 angular acceleration; where the whole-record bandwidth is already the narrowest the smoother is unchanged."""
@@ -33,8 +33,8 @@ def test_calm_part_gets_a_narrower_bandwidth():
     T, half = 2000, 1000
     w, acc, z = _rate(T, 5, half)
     Z = np.stack([z, z, z], 1)
-    loc = smooth_rates(DT, Z, residual_correction=False)
-    one = smooth_rates(DT, Z, residual_correction=False, local_window_s=None)
+    loc = smooth_rates(DT, Z, residual_correction=False, local_window_s=LOCAL_WINDOW_S)
+    one = smooth_rates(DT, Z, residual_correction=False)          # the default: one bandwidth per axis
     assert LOCAL_WINDOW_S == 5.0
     calm, active = slice(half + 300, T - 100), slice(100, half - 300)
     e_one, e_loc = _err(one.accel[:, 0], acc, calm), _err(loc.accel[:, 0], acc, calm)
@@ -53,8 +53,8 @@ def test_narrowest_whole_record_bandwidth_is_the_plain_smoother():
     w, acc, z = _rate(T, 7, 0)
     Z = np.stack([z, z, z], 1)
     ladder = (1.0, 2.5, 4.0)
-    loc = smooth_rates(DT, Z, residual_correction=False, bandwidths_hz=ladder)
-    one = smooth_rates(DT, Z, residual_correction=False, bandwidths_hz=ladder, local_window_s=None)
+    loc = smooth_rates(DT, Z, residual_correction=False, bandwidths_hz=ladder, local_window_s=LOCAL_WINDOW_S)
+    one = smooth_rates(DT, Z, residual_correction=False, bandwidths_hz=ladder)
     assert (one.bandwidth_hz == 1.0).all() and loc.local_bandwidth_hz is None
     np.testing.assert_array_equal(loc.accel, one.accel)
     np.testing.assert_array_equal(loc.accel_sigma, one.accel_sigma)
