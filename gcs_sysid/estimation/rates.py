@@ -159,6 +159,12 @@ GUST_TAU_S = 2.0
 #: likelihood took the state and made CY worse (f16 moderate 7.8 -> 9.0 %): the side force's spectrum is not of
 #: that form; x and y keep the residual's Wiener correction (docs/estimation.md, section 5, "Moderate turbulence").
 GUST_FORCE_AXES = (2,)
+#: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the motion's strength changes
+#: along a flight (manoeuvres and quiet legs; turbulence with altitude, MIL-F-8785C sec. 3.7, and in patches), a
+#: whole-record bandwidth cannot follow it; only the whole-record choice and narrower candidates are offered
+#: (offered wider ones too, it cost the f4n's held-out q_dot 7.60 -> 8.00 %, docs/estimation.md). Opt-in
+#: (``smooth_rates(local_window_s=LOCAL_WINDOW_S)``); the pipeline does not use it (docs/benchmarks.md).
+LOCAL_WINDOW_S = 5.0
 
 
 @dataclass
@@ -187,6 +193,9 @@ class RateEstimate:
             where it found none (or was switched off).
         slow_transient: (3,) per axis whether the slow transients (:data:`SLOW_DECAYS`) were taken
             (likelihood-ratio and coloured Wald tests); all False when none were offered.
+        local_bandwidth_hz: (3, 2) per axis the lowest and highest local (weighted-mean) bandwidth, Hz, where
+            the bandwidth was let change along the record (:func:`_local_blend`), NaN on an axis where it was not
+            (its whole-record choice the narrowest candidate); None where on no axis.
     """
 
     rate: np.ndarray
@@ -201,6 +210,7 @@ class RateEstimate:
     hold: str = "zoh"
     correction_band_hz: np.ndarray | None = None
     slow_transient: np.ndarray | None = None
+    local_bandwidth_hz: np.ndarray | None = None
 
 
 def _nominal_model(dt: float, bandwidth_hz: float, gust_hz: float = 0.0,
@@ -382,7 +392,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         slow_decays: tuple[float, ...] = (),
                         control_axes: list[tuple[int, ...] | None] | None = None,
                         gust_hz: tuple[float, ...] = (), gust_tau_s: float = 2.0,
-                        gust_axes: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:
+                        gust_axes: tuple[int, ...] | None = None,
+                        local_window_s: float | None = None) -> dict[str, np.ndarray]:
     """The shared engine of :func:`smooth_rates` (``order`` 1) and :func:`smooth_specific_force` (``order`` 0).
 
     ``order`` is the derivative of the measured signal that the control columns
@@ -406,6 +417,12 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     nominal model's best. The smoothed signal is then the nominal part plus the gust; ``xd`` stays the nominal
     part's derivative (order 0 only: the forces need no derivative). ``out["gust"]``: the level taken per axis
     (0: none).
+    ``local_window_s``: where given, the nominal bandwidth may narrow along the record (:func:`_local_blend`):
+    per window of about this length the posterior weight of the whole-record choice and of each narrower nominal
+    candidate from its innovations (the input coefficients and the noise level of the whole-record fit), the
+    smoothed means blended with the weights interpolated between window centres. Not on an axis that took the
+    turbulence state or whose choice is the narrowest. ``out["local_bw"]``: per axis the lowest and highest
+    weighted-mean bandwidth over the record, Hz (NaN where not used).
     """
     T, d = Z.shape
     bw_ok = np.array([f for f in bandwidths_hz if f < 0.35 / dt] or [min(bandwidths_hz)])
@@ -621,15 +638,26 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
         out["bw"][i], out["sig"][i], out["gust"][i] = bws[c], math.sqrt(s2), cands[c][1]
         out["beta"][i], out["cov"][i] = beta, s2 * Minv
         g, F, H = gains[c], Fs[c], Hs[c]
+        local = local_window_s is not None and cands[c][1] == 0 and 0 < c < n_nominal
         for sg, (Mz, X0, X1) in zip(segs, cols):
             Mz, X0, X1 = (lagged(X, nd, lag) for X in (Mz, X0, X1))
             z = Z[sg, i][:, None] - (Mz @ beta)[:, None]
-            xs, _ = steady_state_smoother(F, g, H, z, _x0(z[0, 0], len(F)))
+            if local:
+                js = list(range(c + 1))      # the whole-record choice and the narrower candidates
+                x0n, x1n, var0, var1, bw_t = _local_blend(
+                    z[:, 0], [(Fs[j], gains[j], Hs[j]) for j in js], js.index(c), s2,
+                    max(int(round(local_window_s / dt)), 10))
+                bw_mean = bws[js] @ bw_t
+                lo_hi = out.setdefault("local_bw", np.full((d, 2), np.nan))
+                lo_hi[i] = np.fmin(lo_hi[i, 0], bw_mean.min()), np.fmax(lo_hi[i, 1], bw_mean.max())
+            else:
+                xs, _ = steady_state_smoother(F, g, H, z, _x0(z[0, 0], len(F)))
+                x0n, x1n = xs @ H[0], xs[:, 1]
+                var0 = np.full(len(z), s2 * float(H[0] @ g.Ps @ H[0]))
+                var1 = np.full(len(z), s2 * g.Ps[1, 1])
             # the signal is what the sensor measures without its noise: the nominal part plus the gust
-            out["x"][sg, i] = xs @ H[0] + X0 @ beta
-            out["xd"][sg, i] = xs[:, 1] + X1 @ beta
-            var0 = np.full(len(z), s2 * float(H[0] @ g.Ps @ H[0]))
-            var1 = np.full(len(z), s2 * g.Ps[1, 1])
+            out["x"][sg, i] = x0n + X0 @ beta
+            out["xd"][sg, i] = x1n + X1 @ beta
             if m:
                 # the coefficients' own uncertainty: x = x~(z - Mz b) + X b, so an error db moves the
                 # states by (X - smoother(Mz)) db
@@ -646,6 +674,61 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
     return out
 
 
+def _local_blend(z: np.ndarray, models: list, c0: int, s2: float, window: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The nominal part smoothed with a bandwidth that may change along the record (a multiple-model smoother).
+
+    One bandwidth per axis is a compromise over the whole record, set where the signal is strongest
+    (manoeuvres, turbulence; its strength varies with altitude, MIL-F-8785C sec. 3.7, and comes in patches);
+    where the motion is weaker it lets more of the sensor's noise through than the signal needs. Each candidate
+    ``j`` (a nominal model, unit measurement noise; the caller passes the whole-record choice and the narrower
+    ones) runs its constant-gain filter and smoother over ``z`` (the measurement less the input columns of the
+    whole-record fit); per window of ``window`` samples its log-likelihood is the Gaussian density of its own
+    innovations with the whole-record noise variance ``s2`` (the prediction-error decomposition: the
+    innovations' density given the past, as a multiple-model filter weighs its modes; Bar-Shalom, Li and
+    Kirubarajan, *Estimation with Applications to Tracking and Navigation*, Wiley 2001, ch. 11, the
+    multiple-model approach), with prior 1/2 on the whole-record choice ``c0`` and the rest shared by the others.
+    The posterior weights at the window centres are interpolated linearly in time and the smoothed means
+    blended with them (model averaging, zero phase as each smoother). On a record of one window or less the
+    weights are those of the whole record.
+
+    Args:
+        z: (n,) measurement less the input columns' part, finite.
+        models: per candidate ``(F, SteadyState, H)`` of the nominal model (:func:`_nominal_model`), the
+            bandwidth ladder's order.
+        c0: index of the whole-record choice.
+        s2: measurement-noise variance of the whole-record fit.
+        window: window length, samples.
+
+    Returns:
+        ``(x, x_dot, var_x, var_x_dot, w)``: the blended signal and derivative (n,), their variances (n,)
+        (each candidate's steady-state smoothed variance and the candidates' spread, weighted), and the
+        weights ``w`` (K, n).
+    """
+    n, K = len(z), len(models)
+    xs, xd, v0, v1, ll = np.empty((K, n)), np.empty((K, n)), np.empty(K), np.empty(K), []
+    nw = max(int(round(n / window)), 1)
+    edges = np.linspace(0, n, nw + 1).round().astype(int)
+    for j, (F, g, H) in enumerate(models):
+        x, inn = steady_state_smoother(F, g, H, z[:, None], _x0(z[0], len(F)))
+        xs[j], xd[j] = x @ H[0], x[:, 1]
+        v0[j], v1[j] = s2 * float(H[0] @ g.Ps @ H[0]), s2 * g.Ps[1, 1]
+        S = s2 * float(g.S[0, 0])
+        nll = 0.5 * (math.log(2 * math.pi * S) + inn[:, 0] ** 2 / S)
+        ll.append([-float(nll[a:b].sum()) for a, b in zip(edges[:-1], edges[1:])])
+    logp = np.array(ll) + np.log(np.where(np.arange(K) == c0, 0.5, 0.5 / max(K - 1, 1)))[:, None]
+    wc = np.exp(logp - logp.max(axis=0))
+    wc /= wc.sum(axis=0)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    k = np.arange(n)
+    w = np.array([np.interp(k, centres, wc[j]) for j in range(K)])
+    w /= w.sum(axis=0)
+    xm, xdm = (w * xs).sum(axis=0), (w * xd).sum(axis=0)
+    var0 = (w * (v0[:, None] + (xs - xm) ** 2)).sum(axis=0)
+    var1 = (w * (v1[:, None] + (xd - xdm) ** 2)).sum(axis=0)
+    return xm, xdm, var0, var1, w
+
+
 def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
@@ -653,7 +736,8 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  holds: tuple[str, ...] = HOLDS, aux: np.ndarray | None = None,
                  aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True,
                  slow_decays: tuple[float, ...] = SLOW_DECAYS,
-                 control_axes: list[tuple[int, ...] | None] | None = None) -> RateEstimate:
+                 control_axes: list[tuple[int, ...] | None] | None = None,
+                 local_window_s: float | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -696,6 +780,12 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         residual_correction: add what the smoother left in the gyro where the residual's spectrum
             shows signal over the white-noise floor (:func:`~.wiener.residual_wiener`, per axis and
             gap-free piece, zero phase); False: the smoother alone.
+        local_window_s: let the nominal bandwidth narrow along the record where the motion is weaker, chosen
+            per window of about this length by the candidates' innovations (:func:`_local_blend`; e.g.
+            :data:`LOCAL_WINDOW_S`); None (the default, and what :func:`~.estimate.estimate_states` uses): one
+            bandwidth per axis for the whole record. Opt-in: on the JSBSim flights it improved the measured Cn
+            but cost the GP's held-out Cl on pa28 light s3 (9.37 -> 10.82 %) and two GP-vs-LS ties on the t6
+            (docs/benchmarks.md, "Thirteenth session, i8-meas").
 
     Returns:
         :class:`RateEstimate`.
@@ -718,7 +808,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                             tuple(decays), noise_floor, bandwidths_hz, order=1, hold=tuple(holds),
                             aux=aux, aux_axes=aux_axes, slow_decays=tuple(slow_decays),
                             control_axes=None if control_axes is None else
-                            [a for a, mv in zip(control_axes, moving) if mv])
+                            [a for a, mv in zip(control_axes, moving) if mv], local_window_s=local_window_s)
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
@@ -733,7 +823,7 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
     if residual_correction:
         band = _correct_residual(dt, np.asarray(rates, float), o)
     return RateEstimate(o["x"], o["xs"], o["xd"], o["xds"], o["bw"], o["sig"], eff, eff_sig, lags,
-                        o.get("hold", "zoh"), band, o["slow"])
+                        o.get("hold", "zoh"), band, o["slow"], o.get("local_bw"))
 
 
 def _correct_residual(dt: float, Z: np.ndarray, o: dict, order: int = 1,
