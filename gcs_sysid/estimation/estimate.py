@@ -23,7 +23,7 @@ from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude,
 from .align import Aligned, align_flight, events
 from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
-from .rates import CONTROL_AXES, GUST_HZ, HOLDS, normal_force_input, smooth_rates
+from .rates import CONTROL_AXES, COUPLED, GUST_HZ, HOLDS, normal_force_input, smooth_rates
 from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
@@ -261,7 +261,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
         Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
                           aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,),
-                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None)
+                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None,
+                          coupled={cnames.index(k): v for k, v in COUPLED.items() if k in cnames})
         in_lag = Rr.input_lag if cnames else None
         W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):

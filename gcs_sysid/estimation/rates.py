@@ -114,8 +114,9 @@ from .kalman import SteadyState, lti_response, steady_state, steady_state_smooth
 from .nodes import segments
 from .wiener import residual_wiener
 
-__all__ = ["BANDWIDTHS_HZ", "CONTROL_AXES", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES",
-           "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force", "control_columns"]
+__all__ = ["AILERON_YAW_TIE", "BANDWIDTHS_HZ", "CONTROL_AXES", "COUPLED", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE",
+           "RESIDUAL_FORCE_AXES", "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force",
+           "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
@@ -139,6 +140,18 @@ SLOW_DECAYS = (1.0,)
 #: A free elevator column on the yaw axis only carried the gyro's noise onto r_dot, where it followed q and
 #: appeared as a Cn_q_hat in the fits (docs/estimation.md, "Slow transients and the control terms").
 CONTROL_AXES = {"delta_e": (1,), "delta_a": (0, 2), "delta_r": (0, 2), "delta_t": None}
+#: Controls whose response on a second axis is tied to their response on the first (primary, secondary axis).
+#: The aileron: ``I_z r_dot = N + I_xz p_dot``, so its yaw response is its fitted roll response times
+#: ``I_xz / I_z``, a part shaped like the roll rate it starts (``N_p p``) and its own step (``N_da``): three
+#: coefficients instead of its five or six free columns on the yaw axis, kept unless those beat them by the BIC
+#: penalty (:func:`_coupled_axis`; docs/estimation.md, "The aileron's yaw response").
+AILERON_YAW_TIE = {"delta_a": (0, 2)}
+#: The ties the pipeline applies: none by default (thirteenth session, i8-cnda, decided at the merge). The
+#: aileron tie above mends the b747's apparent ``Cn_delta_a`` (GP better than LS 10 -> 12 of 18) but over nine
+#: aircraft the count stays 134 of 162 (t6 17 -> 15 on two 0.02-point ties, f16 16 -> 15 on a gate flip), and
+#: the diagnosis was not evaluated with it. Opt in with ``COUPLED.update(AILERON_YAW_TIE)`` or
+#: ``smooth_rates(coupled=...)`` (docs/estimation.md, "The aileron's yaw response").
+COUPLED: dict[str, tuple[int, int]] = {}
 #: How a logged control may move between its samples; the likelihood picks one per record (module docstring).
 HOLDS = ("zoh", "foh")
 #: Log-likelihood gain per sample that steps ("zoh") must show over linear motion ("foh") to be chosen.
@@ -729,6 +742,74 @@ def _local_blend(z: np.ndarray, models: list, c0: int, s2: float, window: int
     return xm, xdm, var0, var1, w
 
 
+def _coupled_axis(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, o: dict, k: int, pa: int, sa: int,
+                  decays: tuple[float, ...], slow_decays: tuple[float, ...], noise_floor: float,
+                  bandwidths_hz: tuple[float, ...], control_axes: list[tuple[int, ...] | None] | None
+                  ) -> tuple[int, int, float, float] | None:
+    """Re-smooth axis ``sa`` of ``o`` (in place) with control ``k``'s response tied to axis ``pa``'s.
+
+    From ``J w_dot = M`` with the product of inertia ``I_xz``: ``I_z r_dot = N + I_xz p_dot``. The aileron's
+    part of ``r_dot`` is then its part of ``p_dot`` (the rolling moment ``L_da`` and the roll damping that
+    follows, as the roll axis' control columns fitted them) times ``I_xz / I_z``, plus the yawing moment it
+    brings: ``N_da`` at once (a step) and, through the roll it starts, a part shaped like that roll rate
+    (``N_p p``, and the sideslip the roll makes) (Etkin, *Dynamics of Atmospheric Flight*, 1972, ch. 5;
+    Morelli and Klein 2016, ch. 3). So on axis ``sa`` the control's free step and transients (five or six
+    columns) are replaced by three inputs with one coefficient each: the primary axis' fitted response to
+    the control (acceleration ``A b``, and its rate ``W b`` taken as an acceleration) and the control's
+    step. The free columns fitted the secondary axis' gyro noise in a shape that follows the control: on
+    the JSBSim B747 an apparent ``Cn_delta_a`` with ``t`` 2-6 in the measured Cn, which its aerodynamics
+    does not have (docs/estimation.md, "The aileron's yaw response").
+
+    The three enter as measured signals (linear between samples, :func:`~.inputs.aux_columns`) on axis
+    ``sa`` alone, with the other controls' columns, lags and the slow transients' test as in ``o`` (linear
+    hold only). The tied form is kept unless the free columns lower the axis' profiled noise variance by
+    more than the BIC penalty of their extra parameters, ``n log(s2_tied / s2_free) > (m_free - 3) log n``
+    (Schwarz 1978; as the slow transients' test); then ``o`` is left as it was and None is returned.
+
+    Returns:
+        ``(pa, sa, effectiveness, sigma)``: control ``k``'s acceleration jump on ``sa`` (the tied
+        acceleration's coefficient times the primary axis' jump, plus the step's) and its 1-sigma; or None.
+    """
+    nc = U.shape[1]
+    all_decays = (0.0,) + tuple(decays) + tuple(slow_decays)
+    nd = len(all_decays)
+    lag = np.asarray(o["lag"], int)
+    kb = slice(k * nd, (k + 1) * nd)
+    b = o["beta"][pa, kb]
+    T = len(Z)
+    acc, rate, step = np.full(T, np.nan), np.full(T, np.nan), np.full(T, np.nan)
+    ok = np.isfinite(U).all(axis=1) & np.isfinite(Z[:, pa])
+    for sg in segments(ok, 10):
+        A, W = control_columns(dt, U[sg][:, [k]], s[sg], (0,), all_decays, "foh")
+        A, W = shift(A, int(lag[k])), shift(W, int(lag[k]))
+        acc[sg], rate[sg], step[sg] = A @ b, W @ b, A[:, 0]
+    aux = np.column_stack([acc, rate, step])
+    ax = [() if c == k else ((0,) if control_axes is None or control_axes[c] is None or sa in control_axes[c]
+                              else ()) for c in range(nc)]
+    o2 = _smooth_with_inputs(dt, Z[:, [sa]], U, s, lag, 0, decays, noise_floor, bandwidths_hz, order=1,
+                             hold=("foh",), aux=aux, aux_axes=None, slow_decays=slow_decays, control_axes=ax)
+    # BIC between the free columns (pass 1) and the tied inputs on this axis
+    n = int(np.isfinite(o2["x"][:, 0]).sum())
+    m_free = int(np.count_nonzero(o["cov"][sa, kb, kb].diagonal()))
+    if not (np.isfinite(o2["sig"][0]) and np.isfinite(o["sig"][sa])) or n < 2 or \
+            2 * n * math.log(o2["sig"][0] / o["sig"][sa]) > (m_free - 3) * math.log(n):
+        return None
+    for key in ("x", "xs", "xd", "xds"):
+        o[key][:, sa] = o2[key][:, 0]
+    for key in ("bw", "sig", "gust", "slow"):
+        o[key][sa] = o2[key][0]
+    j = nc * nd
+    o["beta"][sa], o["cov"][sa] = 0.0, 0.0
+    o["beta"][sa, :j] = o2["beta"][0, :j]
+    o["cov"][sa, :j, :j] = o2["cov"][0, :j, :j]
+    if "slow_test" in o2:
+        o.setdefault("slow_test", {})[sa] = o2["slow_test"][0]
+    g = np.array([float(b.sum()), 0.0, 1.0])
+    o.setdefault("coupled", {})[k] = o2["beta"][0, j:j + 3]
+    var = float(g @ o2["cov"][0, j:j + 3, j:j + 3] @ g)
+    return pa, sa, float(g @ o2["beta"][0, j:j + 3]), math.sqrt(max(var, 0.0))
+
+
 def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  bandwidths_hz: tuple[float, ...] = BANDWIDTHS_HZ, controls: np.ndarray | None = None,
                  scale: np.ndarray | None = None, max_delay_s: float = 0.2,
@@ -737,7 +818,8 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                  aux_axes: tuple[int, ...] | None = None, residual_correction: bool = True,
                  slow_decays: tuple[float, ...] = SLOW_DECAYS,
                  control_axes: list[tuple[int, ...] | None] | None = None,
-                 local_window_s: float | None = None) -> RateEstimate:
+                 local_window_s: float | None = None,
+                 coupled: dict[int, tuple[int, int]] | None = None) -> RateEstimate:
     """Body rates and their derivatives from bias-corrected gyro samples and the control commands.
 
     Per axis the nominal state is ``[w, w_dot, w_ddot]`` with white snap of
@@ -770,6 +852,12 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         control_axes: optional, per column of ``controls``, the axes (0 p, 1 q, 2 r) that control may
             accelerate (None: all; :data:`CONTROL_AXES` for delta_e delta_a delta_r delta_t, the
             moment equations' control terms); its columns are left out on the other axes.
+        coupled: optional ``{control column: (primary axis, secondary axis)}``: on the secondary axis that
+            control's free columns are replaced by three (:func:`_coupled_axis`): the primary axis' fitted
+            response to it (acceleration, and rate taken as an acceleration) and its step, unless the free
+            columns beat them by the BIC penalty. For the aileron ``(0, 2)`` (:data:`AILERON_YAW_TIE`): its yaw
+            response is its roll response times ``I_xz / I_z`` plus ``N_p p`` and ``N_da`` (Etkin 1972,
+            ch. 5). Only with the linear hold (``"foh"``); with steps the free columns stay.
         holds: the candidate motions of the controls between their samples (:data:`HOLDS`), one
             chosen for all axes by the likelihood (steps only with decisive evidence,
             :data:`ZOH_EVIDENCE`).
@@ -809,6 +897,16 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
                             aux=aux, aux_axes=aux_axes, slow_decays=tuple(slow_decays),
                             control_axes=None if control_axes is None else
                             [a for a, mv in zip(control_axes, moving) if mv], local_window_s=local_window_s)
+    tied = {}
+    if coupled and o.get("hold") == "foh":
+        idx = np.cumsum(moving) - 1           # column of ``controls`` -> column of the moving ones
+        for ctl, (pa, sa) in coupled.items():
+            if 0 <= ctl < len(moving) and moving[ctl] and (control_axes is None or control_axes[ctl] is None
+                                                            or {pa, sa} <= set(control_axes[ctl])):
+                tied[ctl] = _coupled_axis(dt, np.asarray(rates, float), U, s, o, int(idx[ctl]), pa, sa,
+                                          tuple(decays), tuple(slow_decays), noise_floor, bandwidths_hz,
+                                          None if control_axes is None else
+                                          [a for a, mv in zip(control_axes, moving) if mv])
     nctl = len(moving)
     eff = np.full((3, nctl), np.nan)
     eff_sig = np.full((3, nctl), np.nan)
@@ -819,6 +917,9 @@ def smooth_rates(dt: float, rates: np.ndarray, noise_floor: float = 2e-4,
         eff[:, ctl] = o["beta"][:, sel].sum(axis=1)
         eff_sig[:, ctl] = np.sqrt(np.maximum(o["cov"][:, sel][:, :, sel].sum(axis=(1, 2)), 0.0))
         lags[ctl] = o["lag"][k]
+    for ctl, res in tied.items():
+        if res is not None:
+            eff[res[1], ctl], eff_sig[res[1], ctl] = res[2], res[3]
     band = np.full((3, 2), np.nan)
     if residual_correction:
         band = _correct_residual(dt, np.asarray(rates, float), o)
