@@ -115,7 +115,11 @@ class GPConfig:
             ``"kernels-free"``: the same kernels, started the same way, but each kernel's factor
             ``A_g (P, |g|)`` is free to load on every output (an output mixes both kernels' length-
             scales; cross-axis couplings are learnable again).
-            Both need ``latent_kernels = 1`` and no ``coupling_validation``; outputs that are not the six
+            ``"output-kernels"``: one kernel (own length-scales) and one latent process per output,
+            the latent loading on the outputs of its own axis (free loadings there, 0 elsewhere): the
+            semiparametric latent factor model (Teh, Seeger and Jordan 2005) with ``Q = P``; its
+            statistics cost ``(P M)^2`` per row.
+            All three need ``latent_kernels = 1`` and no ``coupling_validation``; outputs that are not the six
             coefficients (or one axis only) fall back to the ICM.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
@@ -175,10 +179,10 @@ class GPConfig:
         if self.linear_terms not in ("significant", "validated", "all"):
             raise InputError("GPConfig.linear_terms must be 'significant', 'validated' or 'all', got "
                              f"{self.linear_terms!r}")
-        if self.output_groups not in ("axes", "kernels", "kernels-free", "none"):
-            raise InputError("GPConfig.output_groups must be 'axes', 'kernels', 'kernels-free' or 'none', got "
-                             f"{self.output_groups!r}")
-        if self.output_groups in ("kernels", "kernels-free") and (int(self.latent_kernels) != 1 or self.coupling_validation):
+        if self.output_groups not in ("axes", "kernels", "kernels-free", "output-kernels", "none"):
+            raise InputError("GPConfig.output_groups must be 'axes', 'kernels', 'kernels-free', 'output-kernels' or "
+                             f"'none', got {self.output_groups!r}")
+        if self.output_groups in ("kernels", "kernels-free", "output-kernels") and (int(self.latent_kernels) != 1 or self.coupling_validation):
             raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
                              "latent_kernels=1 and coupling_validation=False")
         if self.inducing not in ("mi", "kmeans", "random"):

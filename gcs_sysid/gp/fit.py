@@ -44,7 +44,7 @@ from .sparse import GlobalParams, design, elbo, stats_of
 from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local, shared_search, store_without
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "group_embedding", "group_factors", "fit_local",
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
            "learn_input_noise", "validated_global", "validated_local"]
@@ -95,8 +95,10 @@ def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
     lmc_ls = lmc_A = None
     if "lmc_log_ls" in raw:
         lmc_ls = jnp.where(fixed["active"][None, :], jnp.exp(raw["lmc_log_ls"]), 1.0)
-    if "group_A" in raw:                         # per-group kernels, loadings free ("kernels-free")
-        A, lmc_A = raw["group_A"][0], raw["group_A"][1:]
+    if "group_A" in raw:                         # per-group kernels, loadings free ("kernels-free"), or one
+        Ag = raw["group_A"]                      # kernel per output loading on its own group ("output-kernels")
+        Ag = Ag * fixed["A_mask"] if "A_mask" in fixed else Ag
+        A, lmc_A = Ag[0], Ag[1:]
     else:
         mask = fixed.get("L_mask")               # (P, R) 0/1: which outputs each shared factor loads on
         L = raw["L"] if mask is None else raw["L"] * mask
@@ -198,10 +200,10 @@ AXIS_GROUPS = (("CX", "CZ", "Cm"), ("CY", "Cl", "Cn"))
 def output_groups(names, cfg: GPConfig) -> np.ndarray | None:
     """Group label per output ``(P,)`` int for ``cfg.output_groups``, or None (no split).
 
-    ``"axes"``, ``"kernels"`` and ``"kernels-free"``: 0 for CX CZ Cm, 1 for CY Cl Cn, when every name is one of the six coefficients and
+    ``"axes"``, ``"kernels"``, ``"kernels-free"`` and ``"output-kernels"``: 0 for CX CZ Cm, 1 for CY Cl Cn, when every name is one of the six coefficients and
     both groups occur; otherwise (other outputs, one axis only, ``"none"``) None.
     """
-    if cfg.output_groups not in ("axes", "kernels", "kernels-free") or names is None:
+    if cfg.output_groups not in ("axes", "kernels", "kernels-free", "output-kernels") or names is None:
         return None
     label = {n: g for g, group in enumerate(AXIS_GROUPS) for n in group}
     if any(n not in label for n in names):
@@ -395,9 +397,26 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         fixed["L_mask"] = mask
     if per_group and cfg.output_groups == "kernels-free":        # the same start, loadings then free
         raw = _free_factors(raw, group_embedding(groups))
+    elif per_group and cfg.output_groups == "output-kernels":    # column k of group g's factor: output (g, k)'s kernel
+        raw = _free_factors(raw, group_embedding(groups))
+        E = group_embedding(groups)
+        A1 = np.zeros((P, P, 1))
+        for p in range(P):
+            g = int(groups[p])
+            A1[p, :, 0] = raw["group_A"][g][:, int(np.flatnonzero(E[g, p])[0])]
+        raw["group_A"] = A1
+        raw["lmc_log_ls"] = np.full((P - 1, Xs.shape[1]), ls0)
+        fixed["A_mask"] = output_kernel_mask(groups)
     elif per_group:
         fixed["G_embed"] = group_embedding(groups)
     return jax.device_put(raw), jax.device_put(fixed)
+
+
+def output_kernel_mask(groups: np.ndarray) -> np.ndarray:
+    """``(P, P, 1)`` 0/1 loadings of ``output_groups = "output-kernels"``: the latent of output ``j``'s
+    kernel loads on the outputs of ``j``'s group only."""
+    groups = np.asarray(groups, int)
+    return (groups[:, None] == groups[None, :]).astype(float)[:, :, None]
 
 
 def _free_factors(raw: dict, E: np.ndarray) -> dict:
@@ -419,7 +438,7 @@ def _free_factors(raw: dict, E: np.ndarray) -> dict:
 def _per_group(cfg: GPConfig, groups: np.ndarray | None) -> bool:
     """Whether the global layer has one latent kernel per output group (``output_groups = "kernels"``
     and the outputs split into groups)."""
-    return cfg.output_groups in ("kernels", "kernels-free") and groups is not None
+    return cfg.output_groups in ("kernels", "kernels-free", "output-kernels") and groups is not None
 
 
 def _unconstrain(p: GlobalParams, cfg: GPConfig, groups: np.ndarray | None = None) -> dict:
@@ -434,7 +453,11 @@ def _unconstrain(p: GlobalParams, cfg: GPConfig, groups: np.ndarray | None = Non
            "log_kappa": np.log(np.maximum(kappa - _NOISE_FLOOR, 1e-8)),
            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
     G = 0 if groups is None else int(np.max(groups)) + 1
-    if _per_group(cfg, groups) and p.n_kernels == G and cfg.output_groups == "kernels-free":
+    if _per_group(cfg, groups) and p.n_kernels == len(groups) and cfg.output_groups == "output-kernels":
+        for k in ("L", "log_kappa"):
+            out.pop(k)
+        out.update(lmc_log_ls=np.log(np.asarray(p.lmc_lengthscale)), group_A=np.asarray(p.factors))
+    elif _per_group(cfg, groups) and p.n_kernels == G and cfg.output_groups == "kernels-free":
         for k in ("L", "log_kappa"):
             out.pop(k)
         out.update(lmc_log_ls=np.log(np.asarray(p.lmc_lengthscale)), group_A=np.asarray(p.factors))
