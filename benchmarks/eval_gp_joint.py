@@ -71,7 +71,8 @@ ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", 
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
 PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
-         ("jointk", "indep", "none"), ("jointk", "joint", "none"), ("jointf", "indep", "none"), ("jointf", "joint", "none"),
+         ("jointk", "indep", "none"), ("jointk", "joint", "none"),
+         ("jointf", "indep", "none"), ("jointf", "joint", "none"),
          ("jointo", "indep", "none"), ("jointo", "joint", "none"),
          ("jointn", "indep", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),

@@ -182,7 +182,8 @@ class GPConfig:
         if self.output_groups not in ("axes", "kernels", "kernels-free", "output-kernels", "none"):
             raise InputError("GPConfig.output_groups must be 'axes', 'kernels', 'kernels-free', 'output-kernels' or "
                              f"'none', got {self.output_groups!r}")
-        if self.output_groups in ("kernels", "kernels-free", "output-kernels") and (int(self.latent_kernels) != 1 or self.coupling_validation):
+        if self.output_groups in ("kernels", "kernels-free", "output-kernels") and (
+                int(self.latent_kernels) != 1 or self.coupling_validation):
             raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
                              "latent_kernels=1 and coupling_validation=False")
         if self.inducing not in ("mi", "kmeans", "random"):

@@ -44,7 +44,8 @@ from .sparse import GlobalParams, design, elbo, stats_of
 from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local, shared_search, store_without
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask",
+           "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
            "learn_input_noise", "validated_global", "validated_local"]
@@ -200,7 +201,8 @@ AXIS_GROUPS = (("CX", "CZ", "Cm"), ("CY", "Cl", "Cn"))
 def output_groups(names, cfg: GPConfig) -> np.ndarray | None:
     """Group label per output ``(P,)`` int for ``cfg.output_groups``, or None (no split).
 
-    ``"axes"``, ``"kernels"``, ``"kernels-free"`` and ``"output-kernels"``: 0 for CX CZ Cm, 1 for CY Cl Cn, when every name is one of the six coefficients and
+    ``"axes"``, ``"kernels"``, ``"kernels-free"`` and ``"output-kernels"``: 0 for CX CZ Cm, 1 for CY Cl
+    Cn, when every name is one of the six coefficients and
     both groups occur; otherwise (other outputs, one axis only, ``"none"``) None.
     """
     if cfg.output_groups not in ("axes", "kernels", "kernels-free", "output-kernels") or names is None:
@@ -367,7 +369,8 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
     n_active = max(int(active.sum()), 1)
     ls0 = np.log(0.5 * np.sqrt(n_active))
     if per_group:                      # kernel g on group g's block of the residual covariance, whole
-        parts = [_group_split(0.7 * Cr, np.flatnonzero(groups == g), int(cfg.rank)) for g in range(int(groups.max()) + 1)]
+        parts = [_group_split(0.7 * Cr, np.flatnonzero(groups == g), int(cfg.rank))
+                 for g in range(int(groups.max()) + 1)]
         L0, kappa = parts[0][0], parts[0][1] + 1e-4
         mask = None
     else:
