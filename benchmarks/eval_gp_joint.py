@@ -11,6 +11,11 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  input noise, blocked validation)
     ``jointa``   ``joint`` with ``GPConfig(output_groups="axes")``: each shared factor of ``B`` on the
                  longitudinal (CX CZ Cm) or the lateral-directional (CY Cl Cn) outputs only
+    ``jointk``   ``joint`` with ``GPConfig(output_groups="kernels")``: one latent kernel (own length-scales)
+                 per axis, loading on that axis's outputs only
+    ``jointf``   ``joint`` with ``GPConfig(output_groups="kernels-free")``: the same kernels, loadings free
+    ``jointo``   ``joint`` with ``GPConfig(output_groups="output-kernels")``: one kernel per output, its latent
+                 loading on that output's axis
     ``jointn``   the same with the full 6 x 6 noise covariance in the likelihood
                  (``GPConfig.noise_correlation``: the gusts' correlated error between outputs)
     ``dec``      ``joint`` with its cross-output coupling removed after the fit (``gp.joint.decoupled_model``:
@@ -62,10 +67,13 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import decoupled_model  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "jointa", "jointn", "dec", "decn", "indep", "lmc")
+ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
 PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
+         ("jointk", "indep", "none"), ("jointk", "joint", "none"),
+         ("jointf", "indep", "none"), ("jointf", "joint", "none"),
+         ("jointo", "indep", "none"), ("jointo", "joint", "none"),
          ("jointn", "indep", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
@@ -108,6 +116,9 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
             gone = np.zeros(len(X), bool)
             if pattern == "none":
                 for v, cfg in (("joint", base), ("jointa", replace(base, output_groups="axes")),
+                               ("jointk", replace(base, output_groups="kernels")),
+                               ("jointf", replace(base, output_groups="kernels-free")),
+                               ("jointo", replace(base, output_groups="output-kernels")),
                                ("jointn", replace(base, noise_correlation=True)),
                                ("lmc", replace(base, latent_kernels=2))):
                     if (v == "lmc" and not lmc) or v not in models_wanted:
@@ -207,7 +218,7 @@ def summarize(paths) -> str:
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
     out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
             "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointa"):
+    for v in ("joint", "jointa", "jointk", "jointf", "jointo"):
         for ac in sorted({r["aircraft"] for r in rows}):
             for L in lengths:
                 g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
@@ -218,7 +229,7 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointa", "jointn", "lmc", "hjoint"):
+    for v in ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:

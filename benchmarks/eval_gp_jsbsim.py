@@ -34,7 +34,9 @@ that output's ``indep`` GP, whichever has the lower blocked cross-validation err
 rows (``gp.joint.select_outputs``), ``nigpv`` = ``nigp`` with the coupling kept only for the outputs
 whose blocked cross-validation error it lowers (``GPConfig.coupling_validation``), ``nigpa`` = ``nigp``
 with each shared factor of ``B`` on the longitudinal or the lateral outputs only
-(``GPConfig(output_groups="axes")``), and ``ls`` (cached).
+(``GPConfig(output_groups="axes")``), ``nigpk`` = ``nigp`` with one latent kernel (own length-scales) per
+axis (``GPConfig(output_groups="kernels")``), ``nigpf`` = the same with free loadings
+(``"kernels-free"``), ``nigpo`` = one kernel per output (``"output-kernels"``), and ``ls`` (cached).
 
 For the joint variants each line also carries the output correlations (issue 8, "no learned
 output correlation above 0.5 where the truth has none"): ``corr_learned`` (``output_correlation``),
@@ -102,7 +104,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
                                 truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "ls")
+VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "ls")
 
 #: |truth correlation| below which the truth "has none" (the flags of the joint variants)
 TRUTH_NONE = 0.2
@@ -158,6 +160,12 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True, coupling_validation=True)
     if variant == "nigpa":        # the longitudinal and lateral outputs' factors of B kept apart (GPConfig.output_groups)
         return replace(base, noise_correlation=True, input_noise=True, output_groups="axes")
+    if variant == "nigpk":        # one latent kernel per output group (GPConfig.output_groups="kernels")
+        return replace(base, noise_correlation=True, input_noise=True, output_groups="kernels")
+    if variant == "nigpf":        # the same kernels, loadings free (GPConfig.output_groups="kernels-free")
+        return replace(base, noise_correlation=True, input_noise=True, output_groups="kernels-free")
+    if variant == "nigpo":        # one kernel per output, loading on its axis (GPConfig.output_groups="output-kernels")
+        return replace(base, noise_correlation=True, input_noise=True, output_groups="output-kernels")
     if variant == "nigpc":
         return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
@@ -242,7 +250,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             else:
                 model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
                 model = with_offset_covariance(model, off)
-                if v in ("nigpv", "nigpa"):
+                if v in ("nigpv", "nigpa", "nigpk", "nigpf", "nigpo"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
@@ -494,7 +502,7 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]

@@ -105,6 +105,22 @@ class GPConfig:
             factor loads on every output. Off by default: on the replay's JSBSim flights it moved the
             errors by 0.0-0.4 points both ways and lost 3 GP-vs-LS pairs of 72 by 0.00-0.18 points
             (``docs/gp.md``, "Joint vs independent outputs", twelfth session).
+            ``"kernels"`` (thirteenth session): the same two groups, each with its own latent kernel
+            (its own ARD length-scales) and its own coregionalisation ``B_g = L_g L_g^T +
+            diag(kappa_g)`` over its outputs only: a linear model of coregionalisation whose kernel
+            ``g`` loads on group ``g`` alone, so the longitudinal outputs no longer share the lateral
+            outputs' input relevance, the couplings within an axis stay learnable and the cross-axis
+            ones are 0 (``docs/gp.md``, "Per-group kernels"). Each kernel has ``|g|`` latent
+            processes, so the posterior's feature space keeps the ICM's size ``P M + P (D+1)``.
+            ``"kernels-free"``: the same kernels, started the same way, but each kernel's factor
+            ``A_g (P, |g|)`` is free to load on every output (an output mixes both kernels' length-
+            scales; cross-axis couplings are learnable again).
+            ``"output-kernels"``: one kernel (own length-scales) and one latent process per output,
+            the latent loading on the outputs of its own axis (free loadings there, 0 elsewhere): the
+            semiparametric latent factor model (Teh, Seeger and Jordan 2005) with ``Q = P``; its
+            statistics cost ``(P M)^2`` per row.
+            All three need ``latent_kernels = 1`` and no ``coupling_validation``; outputs that are not the six
+            coefficients (or one axis only) fall back to the ICM.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -163,8 +179,13 @@ class GPConfig:
         if self.linear_terms not in ("significant", "validated", "all"):
             raise InputError("GPConfig.linear_terms must be 'significant', 'validated' or 'all', got "
                              f"{self.linear_terms!r}")
-        if self.output_groups not in ("axes", "none"):
-            raise InputError(f"GPConfig.output_groups must be 'axes' or 'none', got {self.output_groups!r}")
+        if self.output_groups not in ("axes", "kernels", "kernels-free", "output-kernels", "none"):
+            raise InputError("GPConfig.output_groups must be 'axes', 'kernels', 'kernels-free', 'output-kernels' or "
+                             f"'none', got {self.output_groups!r}")
+        if self.output_groups in ("kernels", "kernels-free", "output-kernels") and (
+                int(self.latent_kernels) != 1 or self.coupling_validation):
+            raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
+                             "latent_kernels=1 and coupling_validation=False")
         if self.inducing not in ("mi", "kmeans", "random"):
             raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
         if not (self.learning_rate > 0 and self.local_learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0

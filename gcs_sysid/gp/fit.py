@@ -44,7 +44,8 @@ from .sparse import GlobalParams, design, elbo, stats_of
 from .discrepancy import calibrate, validation_rows
 from .validation import gate_global, gate_local, shared_search, store_without
 
-__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask", "fit_local",
+__all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_groups", "factor_mask",
+           "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
            "learn_input_noise", "validated_global", "validated_local"]
@@ -84,20 +85,36 @@ def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
     The further kernels of a linear model of coregionalisation (``lmc_log_ls (J-1, D)``,
     ``lmc_L (J-1, P, R)``, ``lmc_log_kappa (J-1, P)``) are mapped the same way, one ``B_j`` each.
     ``fixed["L_mask"]`` ``(P, R)`` (optional, :func:`factor_mask`) zeroes the loadings of each shared
-    factor outside its output group (``GPConfig.output_groups``).
+    factor outside its output group (``GPConfig.output_groups = "axes"``). ``fixed["G_embed"]``
+    ``(G, P, Rg)`` (optional, :func:`group_embedding`; ``output_groups = "kernels"``): kernel ``g`` (the
+    ICM's parameters for ``g = 0``, ``lmc_*[g-1]`` for the others) loads on group ``g``'s outputs only,
+    its factor ``(P, Rg)`` from :func:`group_factors`. ``raw["group_A"]`` ``(G, P, Rg)`` (``output_groups =
+    "kernels-free"``): the factors themselves, unconstrained (started per group, free to load on any output).
     """
     ls = jnp.where(fixed["active"], jnp.exp(raw["log_ls"]), 1.0)
-    mask = fixed.get("L_mask")                   # (P, R) 0/1: which outputs each shared factor loads on
-    L = raw["L"] if mask is None else raw["L"] * mask
-    B = coregionalisation(L, jnp.exp(raw["log_kappa"]) + _NOISE_FLOOR)
     Z = raw["Z"] if "Z" in raw else fixed["Z"]
     lmc_ls = lmc_A = None
     if "lmc_log_ls" in raw:
         lmc_ls = jnp.where(fixed["active"][None, :], jnp.exp(raw["lmc_log_ls"]), 1.0)
-        Lj = raw["lmc_L"] if mask is None else raw["lmc_L"] * mask[None]
-        Bj = jax.vmap(coregionalisation)(Lj, jnp.exp(raw["lmc_log_kappa"]) + _NOISE_FLOOR)
-        lmc_A = jnp.linalg.cholesky(Bj)
-    return GlobalParams(lengthscale=ls, A=jnp.linalg.cholesky(B), noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR,
+    if "group_A" in raw:                         # per-group kernels, loadings free ("kernels-free"), or one
+        Ag = raw["group_A"]                      # kernel per output loading on its own group ("output-kernels")
+        Ag = Ag * fixed["A_mask"] if "A_mask" in fixed else Ag
+        A, lmc_A = Ag[0], Ag[1:]
+    else:
+        mask = fixed.get("L_mask")               # (P, R) 0/1: which outputs each shared factor loads on
+        L = raw["L"] if mask is None else raw["L"] * mask
+        B = coregionalisation(L, jnp.exp(raw["log_kappa"]) + _NOISE_FLOOR)
+        if "lmc_L" in raw:
+            Lj = raw["lmc_L"] if mask is None else raw["lmc_L"] * mask[None]
+            Bj = jax.vmap(coregionalisation)(Lj, jnp.exp(raw["lmc_log_kappa"]) + _NOISE_FLOOR)
+            if "G_embed" not in fixed:
+                lmc_A = jnp.linalg.cholesky(Bj)
+        if "G_embed" in fixed:                   # per-group kernels: kernel g loads on group g's outputs only
+            Ag = group_factors(fixed["G_embed"], jnp.concatenate([B[None], Bj], axis=0))
+            A, lmc_A = Ag[0], Ag[1:]
+        else:
+            A = jnp.linalg.cholesky(B)
+    return GlobalParams(lengthscale=ls, A=A, noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR,
                         Z=Z, prior_std=fixed["prior_std"], jitter=fixed["jitter"],
                         noise_chol=noise_correlation_factor(raw["noise_off"]) if "noise_off" in raw else None,
                         lmc_lengthscale=lmc_ls, lmc_A=lmc_A)
@@ -184,10 +201,11 @@ AXIS_GROUPS = (("CX", "CZ", "Cm"), ("CY", "Cl", "Cn"))
 def output_groups(names, cfg: GPConfig) -> np.ndarray | None:
     """Group label per output ``(P,)`` int for ``cfg.output_groups``, or None (no split).
 
-    ``"axes"``: 0 for CX CZ Cm, 1 for CY Cl Cn, when every name is one of the six coefficients and
+    ``"axes"``, ``"kernels"``, ``"kernels-free"`` and ``"output-kernels"``: 0 for CX CZ Cm, 1 for CY Cl
+    Cn, when every name is one of the six coefficients and
     both groups occur; otherwise (other outputs, one axis only, ``"none"``) None.
     """
-    if cfg.output_groups != "axes" or names is None:
+    if cfg.output_groups not in ("axes", "kernels", "kernels-free", "output-kernels") or names is None:
         return None
     label = {n: g for g, group in enumerate(AXIS_GROUPS) for n in group}
     if any(n not in label for n in names):
@@ -204,6 +222,44 @@ def factor_mask(groups: np.ndarray | None, rank: int) -> np.ndarray | None:
         return None
     G = int(groups.max()) + 1
     return (groups[:, None] == (np.arange(rank) % G)[None, :]).astype(float)
+
+
+def group_embedding(groups: np.ndarray) -> np.ndarray:
+    """``(G, P, Rg)`` 0/1 embedding of each output group's outputs (``GPConfig.output_groups =
+    "kernels"``): ``E[g, p, k] = 1`` when output ``p`` is the ``k``-th output of group ``g``;
+    ``Rg`` the largest group's size (a smaller group's extra columns are 0)."""
+    groups = np.asarray(groups, int)
+    G, P = int(groups.max()) + 1, len(groups)
+    Rg = max(int(np.sum(groups == g)) for g in range(G))
+    E = np.zeros((G, P, Rg))
+    for g in range(G):
+        for k, p in enumerate(np.flatnonzero(groups == g)):
+            E[g, p, k] = 1.0
+    return E
+
+
+def group_factors(E: jax.Array, B: jax.Array) -> jax.Array:
+    """Coregionalisation factors ``(G, P, Rg)`` of per-group kernels: ``A_g = E_g chol(E_g^T B_g E_g)``.
+
+    ``E`` ``(G, P, Rg)`` (:func:`group_embedding`), ``B`` ``(G, P, P)`` each kernel's coregionalisation
+    matrix over all outputs, of which only group ``g``'s block is used: ``A_g A_g^T`` is that block,
+    0 outside it, so kernel ``g``'s ``Rg`` latent processes load on group ``g`` alone (a padded
+    column of a smaller group is 0)."""
+    pad = 1.0 - jnp.sum(E, axis=1)                                          # (G, Rg): 1 on padded columns
+    Bg = jnp.einsum("gpk,gpq,gql->gkl", E, B, E) + jax.vmap(jnp.diag)(pad)
+    return jnp.einsum("gpk,gkl->gpl", E, jnp.linalg.cholesky(Bg))
+
+
+def _group_split(Bfull: np.ndarray, rows: np.ndarray, rank: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(L (P, rank), kappa (P,))`` of one per-group kernel: :func:`_split_B` of the block
+    ``Bfull[rows, rows]`` placed in those rows (the other rows' ``L`` 0, ``kappa`` 1: not used)."""
+    P = len(Bfull)
+    Lg, kg = _split_B(Bfull[np.ix_(rows, rows)], rank)
+    L = np.zeros((P, rank))
+    L[np.ix_(rows, np.arange(Lg.shape[1]))] = Lg
+    kappa = np.ones(P)
+    kappa[rows] = kg
+    return L, kappa
 
 
 def _split_B(B: np.ndarray, rank: int, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -308,17 +364,28 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         Cr = np.cov(R.T).reshape(P, P) + 1e-6 * np.eye(P)
     else:
         Cr = _residual_cov_missing(Xs, Ys, obs, cfg.linear_mean)
+    per_group = _per_group(cfg, groups)
     J = int(cfg.latent_kernels)
-    B0 = 0.7 * Cr / J
-    mask = factor_mask(groups, int(cfg.rank))
-    L0, kappa = _split_B(B0, cfg.rank, mask)
-    kappa = kappa + 1e-4
     n_active = max(int(active.sum()), 1)
     ls0 = np.log(0.5 * np.sqrt(n_active))
+    if per_group:                      # kernel g on group g's block of the residual covariance, whole
+        parts = [_group_split(0.7 * Cr, np.flatnonzero(groups == g), int(cfg.rank))
+                 for g in range(int(groups.max()) + 1)]
+        L0, kappa = parts[0][0], parts[0][1] + 1e-4
+        mask = None
+    else:
+        B0 = 0.7 * Cr / J
+        mask = factor_mask(groups, int(cfg.rank))
+        L0, kappa = _split_B(B0, cfg.rank, mask)
+        kappa = kappa + 1e-4
     # host arrays moved once with device_put (jnp.asarray of a NumPy array compiles a program per shape)
     raw = {"log_ls": np.full(Xs.shape[1], ls0), "L": L0,
            "log_kappa": np.log(kappa), "log_noise": np.log(0.3 * np.diag(Cr) + 1e-4)}
-    if J > 1:
+    if per_group:                      # every kernel starts at the ICM's length-scales: their outputs differ
+        raw["lmc_log_ls"] = np.full((len(parts) - 1, Xs.shape[1]), ls0)
+        raw["lmc_L"] = np.stack([L for L, _ in parts[1:]])
+        raw["lmc_log_kappa"] = np.stack([np.log(k + 1e-4) for _, k in parts[1:]])
+    elif J > 1:
         f = lmc_start_factors(J)[1:]
         raw["lmc_log_ls"] = np.repeat((ls0 + np.log(f))[:, None], Xs.shape[1], axis=1)
         raw["lmc_L"] = np.repeat(L0[None], J - 1, axis=0)
@@ -331,7 +398,50 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
              "prior_std": linear_prior_std(cfg, terms, P, Xs.shape[1]), "jitter": np.float64(cfg.jitter)}
     if mask is not None:
         fixed["L_mask"] = mask
+    if per_group and cfg.output_groups == "kernels-free":        # the same start, loadings then free
+        raw = _free_factors(raw, group_embedding(groups))
+    elif per_group and cfg.output_groups == "output-kernels":    # column k of group g's factor: output (g, k)'s kernel
+        raw = _free_factors(raw, group_embedding(groups))
+        E = group_embedding(groups)
+        A1 = np.zeros((P, P, 1))
+        for p in range(P):
+            g = int(groups[p])
+            A1[p, :, 0] = raw["group_A"][g][:, int(np.flatnonzero(E[g, p])[0])]
+        raw["group_A"] = A1
+        raw["lmc_log_ls"] = np.full((P - 1, Xs.shape[1]), ls0)
+        fixed["A_mask"] = output_kernel_mask(groups)
+    elif per_group:
+        fixed["G_embed"] = group_embedding(groups)
     return jax.device_put(raw), jax.device_put(fixed)
+
+
+def output_kernel_mask(groups: np.ndarray) -> np.ndarray:
+    """``(P, P, 1)`` 0/1 loadings of ``output_groups = "output-kernels"``: the latent of output ``j``'s
+    kernel loads on the outputs of ``j``'s group only."""
+    groups = np.asarray(groups, int)
+    return (groups[:, None] == groups[None, :]).astype(float)[:, :, None]
+
+
+def _free_factors(raw: dict, E: np.ndarray) -> dict:
+    """``raw`` with the per-group kernels' ``L``/``kappa`` entries replaced by their factors
+    ``group_A (G, P, Rg)`` (:func:`group_factors` of the same ``B_g``, in NumPy), for
+    ``output_groups = "kernels-free"``."""
+    raw = dict(raw)
+    Ls = [np.asarray(raw.pop("L"))] + list(np.asarray(raw.pop("lmc_L")))
+    ks = [np.asarray(raw.pop("log_kappa"))] + list(np.asarray(raw.pop("lmc_log_kappa")))
+    out = []
+    for Eg, L, lk in zip(E, Ls, ks):
+        B = L @ L.T + np.diag(np.exp(lk) + _NOISE_FLOOR)
+        Bg = Eg.T @ B @ Eg + np.diag(1.0 - Eg.sum(0))
+        out.append(Eg @ np.linalg.cholesky(Bg))
+    raw["group_A"] = np.stack(out)
+    return raw
+
+
+def _per_group(cfg: GPConfig, groups: np.ndarray | None) -> bool:
+    """Whether the global layer has one latent kernel per output group (``output_groups = "kernels"``
+    and the outputs split into groups)."""
+    return cfg.output_groups in ("kernels", "kernels-free", "output-kernels") and groups is not None
 
 
 def _unconstrain(p: GlobalParams, cfg: GPConfig, groups: np.ndarray | None = None) -> dict:
@@ -345,7 +455,22 @@ def _unconstrain(p: GlobalParams, cfg: GPConfig, groups: np.ndarray | None = Non
     out = {"log_ls": np.log(np.asarray(p.lengthscale)), "L": L0,
            "log_kappa": np.log(np.maximum(kappa - _NOISE_FLOOR, 1e-8)),
            "log_noise": np.log(np.maximum(np.asarray(p.noise) - _NOISE_FLOOR, 1e-8))}
-    if p.lmc_A is not None and cfg.latent_kernels == p.n_kernels:
+    G = 0 if groups is None else int(np.max(groups)) + 1
+    if _per_group(cfg, groups) and p.n_kernels == len(groups) and cfg.output_groups == "output-kernels":
+        for k in ("L", "log_kappa"):
+            out.pop(k)
+        out.update(lmc_log_ls=np.log(np.asarray(p.lmc_lengthscale)), group_A=np.asarray(p.factors))
+    elif _per_group(cfg, groups) and p.n_kernels == G and cfg.output_groups == "kernels-free":
+        for k in ("L", "log_kappa"):
+            out.pop(k)
+        out.update(lmc_log_ls=np.log(np.asarray(p.lmc_lengthscale)), group_A=np.asarray(p.factors))
+    elif _per_group(cfg, groups) and p.n_kernels == G:
+        Bp = np.asarray(p.B_parts)
+        parts = [_group_split(Bp[g], np.flatnonzero(groups == g), int(cfg.rank)) for g in range(G)]
+        logk = [np.log(np.maximum(k - _NOISE_FLOOR, 1e-8)) for _, k in parts]
+        out.update(L=parts[0][0], log_kappa=logk[0], lmc_log_ls=np.log(np.asarray(p.lmc_lengthscale)),
+                   lmc_L=np.stack([L for L, _ in parts[1:]]), lmc_log_kappa=np.stack(logk[1:]))
+    elif p.lmc_A is not None and cfg.latent_kernels == p.n_kernels:
         parts = [_split_B(Aj @ Aj.T, cfg.rank, mask) for Aj in np.asarray(p.lmc_A)]
         out["lmc_log_ls"] = np.log(np.asarray(p.lmc_lengthscale))
         out["lmc_L"] = np.stack([L for L, _ in parts])

@@ -56,7 +56,19 @@ def decoupled(params: GlobalParams) -> GlobalParams:
     scales, inducing inputs and the linear mean's prior are unchanged.
     """
     def diag_factor(A):
-        return jnp.sqrt(jnp.sum(A * A, axis=-1))[..., :, None] * jnp.eye(A.shape[-1], dtype=A.dtype)
+        if A.shape[-1] == A.shape[-2]:
+            return jnp.sqrt(jnp.sum(A * A, axis=-1))[..., :, None] * jnp.eye(A.shape[-1], dtype=A.dtype)
+        # per-group kernels (``(P, Rg)`` factors, GPConfig.output_groups="kernels"): output p's latent
+        # variance on the column of its own diagonal entry, the last non-zero of its row
+        A = np.asarray(A)
+        col = np.where(A != 0.0, np.arange(A.shape[-1]), 0).max(-1)
+        for Ak, ck in zip(A.reshape(-1, *A.shape[-2:]), col.reshape(-1, A.shape[-2])):
+            used = ck[np.any(Ak != 0.0, -1)]
+            if len(set(used.tolist())) < len(used):
+                raise ValueError("decoupled: factors with free loadings (output_groups='kernels-free') have no "
+                                 "one latent per output to keep")
+        out = np.sqrt(np.sum(A * A, -1))[..., None] * (col[..., None] == np.arange(A.shape[-1]))
+        return jnp.asarray(out)
 
     return replace(params, A=diag_factor(params.A),
                    lmc_A=None if params.lmc_A is None else diag_factor(params.lmc_A),

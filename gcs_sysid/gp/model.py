@@ -468,24 +468,6 @@ class LocalGlobalGP:
         from .ranking import global_variance_after_many
 
         enable_x64()
-        if self.params.n_kernels > 1:
-            # the closed form of :mod:`gcs_sysid.gp.ranking` is written for one kernel; an LMC model
-            # takes the exact route, one update (refactorisation) per candidate
-            if len(X_extras) != len(X_queries):
-                raise ValueError("global_variance_after_many: one query set per candidate")
-            out = []
-            for Xe, Xq in zip(X_extras, X_queries):
-                v0 = self.predict_global(Xq, include_noise)[1]
-                Xe = check_inputs(Xe, self.n_inputs, "X_extra")
-                Xe = Xe[np.isfinite(Xe).all(1)]
-                if len(Xe) == 0:
-                    out.append((v0, v0.copy()))
-                    continue
-                zeros = np.zeros((len(Xe), self.n_outputs))
-                extra = self._with_stats(add_stats(self.stats, global_stats(self.params, self.scaler.x(Xe), zeros,
-                                                                            self.config.batch_size)))
-                out.append((v0, extra.predict_global(Xq, include_noise)[1]))
-            return out
         qs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         ext, qry, oks = [], [], []
         for Xe, Xq in zip(X_extras, X_queries):

@@ -16,7 +16,8 @@ In the feature space of :mod:`gcs_sysid.gp.sparse` the extra rows add
 
 and both ``T_p`` and ``Psi^T Lambda^{-1} Psi`` are products of the candidate's features
 ``u_e = [phi(x_e); xa(x_e)]`` with the cross-covariances ``H_pq = S_p^T Lambda^{-1} S_q``
-``(J, J)``, ``J = M + D + 1``, computed once per model. A candidate then costs
+``(J, J)``, ``J = K M + D + 1`` for ``K`` latent kernels (1 for the ICM; a linear model of
+coregionalisation stacks each kernel's features), computed once per model. A candidate then costs
 ``O(P^2 E J^2 + (P E)^2 P J + (P E)^3)`` instead of ``O((P M)^3)``: the query variance is
 ``var_p(x) - |R_p u(x)|^2`` with ``R_p = chol(C)^{-1} T_p``.
 
@@ -34,29 +35,36 @@ __all__ = ["cross_covariances", "global_variance_after_many"]
 
 
 def _features(model, Xs: np.ndarray) -> np.ndarray:
-    """``u = [phi(x); xa(x)]`` of shape ``(J, N)`` at standardised ``Xs (N, D)`` (numpy)."""
+    """``u = [phi_1(x); ..; phi_K(x); xa(x)]`` of shape ``(J, N)`` at standardised ``Xs (N, D)`` (numpy):
+    the whitened features of each of the ``K`` latent kernels (one for the ICM), then the design."""
     p = model.params
-    ls = np.asarray(p.lengthscale)
-    Z = np.asarray(p.Z) / ls
-    A = Xs / ls
-    d2 = np.sum(Z * Z, 1)[:, None] + np.sum(A * A, 1)[None, :] - 2.0 * Z @ A.T
-    Kzx = np.exp(-0.5 * np.maximum(d2, 0.0))
-    phi = solve_triangular(np.asarray(model.post.Lm), Kzx, lower=True, check_finite=False)
-    return np.vstack([phi, np.ones((1, len(Xs))), Xs.T])
+    Lm = np.asarray(model.post.Lm)
+    phis = []
+    for Lj, ls in zip(Lm[None] if Lm.ndim == 2 else Lm, np.asarray(p.lengthscales)):
+        Z = np.asarray(p.Z) / ls
+        A = Xs / ls
+        d2 = np.sum(Z * Z, 1)[:, None] + np.sum(A * A, 1)[None, :] - 2.0 * Z @ A.T
+        Kzx = np.exp(-0.5 * np.maximum(d2, 0.0))
+        phis.append(solve_triangular(Lj, Kzx, lower=True, check_finite=False))
+    return np.vstack(phis + [np.ones((1, len(Xs))), Xs.T])
 
 
 def _selector_block(model, p: int) -> np.ndarray:
     """``S_p (K, J)`` of :func:`gcs_sysid.gp.sparse._selectors` (``psi_p(x) = S_p u(x)``), in NumPy
-    (no per-operation compilation): ``A[p, q] I_M`` in row block ``q`` of the inducing part, and
+    (no per-operation compilation): ``A_k[p, r] I_M`` in row block ``(k, r)`` of the inducing part and
+    column block ``k`` (kernel ``k``'s features; the ICM has one kernel and ``A`` square), and
     ``diag(prior std of output p's weights)`` in output ``p``'s rows of the linear-mean part."""
-    A = np.asarray(model.params.A)
-    P, M, D1 = A.shape[0], int(model.params.Z.shape[0]), int(model.params.Z.shape[1]) + 1
-    S = np.zeros((P * M + P * D1, M + D1))
+    F = np.asarray(model.params.factors)                  # (K, P, R)
+    Kk, P, R = F.shape
+    M, D1 = int(model.params.Z.shape[0]), int(model.params.Z.shape[1]) + 1
+    S = np.zeros((Kk * R * M + P * D1, Kk * M + D1))
     eyeM = np.eye(M)
-    for q in range(P):
-        S[q * M:(q + 1) * M, :M] = A[p, q] * eyeM
-    r0 = P * M + p * D1
-    S[r0:r0 + D1, M:] = np.diag(np.broadcast_to(np.asarray(model.params.prior_std, float), (P, D1))[p])
+    for k in range(Kk):
+        for q in range(R):
+            row = (k * R + q) * M
+            S[row:row + M, k * M:(k + 1) * M] = F[k, p, q] * eyeM
+    r0 = Kk * R * M + p * D1
+    S[r0:r0 + D1, Kk * M:] = np.diag(np.broadcast_to(np.asarray(model.params.prior_std, float), (P, D1))[p])
     return S
 
 
@@ -73,7 +81,7 @@ def _whitened_selectors(model) -> np.ndarray:
     """
     L = np.asarray(model.post.L)
     P = int(model.params.A.shape[0])
-    J = int(model.params.Z.shape[0]) + int(model.params.Z.shape[1]) + 1
+    J = model.params.n_kernels * int(model.params.Z.shape[0]) + int(model.params.Z.shape[1]) + 1
     V = np.empty((L.shape[0], P * J))
     for p in range(P):
         V[:, p * J:(p + 1) * J] = solve_triangular(L, _selector_block(model, p), lower=True, check_finite=False)
@@ -111,7 +119,8 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
     J = Hc.shape[0] // P
     Ls = np.linalg.cholesky(np.asarray(model.params.noise_cov()))
     Wn = solve_triangular(Ls, np.eye(len(Ls)), lower=True)            # (P, P) whitening Ls^{-1}, lower
-    bdiag = np.sum(np.asarray(model.params.A) ** 2, 1)
+    Bd = np.sum(np.asarray(model.params.factors) ** 2, 2)              # (K, P): B_k,pp per latent kernel
+    bdiag = np.sum(Bd, 0)
     M = int(model.params.Z.shape[0])
     out = []
     V = None
@@ -124,7 +133,8 @@ def global_variance_after_many(model, X_extras: Sequence[np.ndarray], X_queries:
             for p in range(P):
                 Hp = Hc[p * J:(p + 1) * J, p * J:(p + 1) * J]
                 before[:, p] = np.einsum("iq,iq->q", Uq, Hp @ Uq)
-            rest = bdiag[None, :] * np.maximum(1.0 - np.sum(Uq[:M] ** 2, 0), 0.0)[:, None]
+            rest = sum(Bd[k][None, :] * np.maximum(1.0 - np.sum(Uq[k * M:(k + 1) * M] ** 2, 0), 0.0)[:, None]
+                       for k in range(len(Bd)))
             cache[key] = (Uq, np.maximum(rest + before, 1e-12 * bdiag[None, :]))
         Uq, v0 = cache[key]
         Xe = np.asarray(Xe, float)

@@ -75,7 +75,9 @@ class GlobalParams:
 
     Attributes:
         lengthscale: ``(D,)`` ARD length-scales (standardised inputs).
-        A: ``(P, P)`` lower Cholesky factor of the coregionalisation matrix ``B``.
+        A: ``(P, R)`` factor of the coregionalisation matrix ``B = A A^T``: its lower Cholesky factor
+            (``R = P``), or, for per-group kernels (``GPConfig.output_groups``), ``R = |g|`` columns
+            loading on the group's outputs (each column one latent process).
         noise: ``(P,)`` noise variances ``sigma_p^2``.
         Z: ``(M, D)`` inducing inputs.
         prior_std: prior std of the linear-mean weights: a scalar ``sqrt(v)`` (every output, every
@@ -87,7 +89,7 @@ class GlobalParams:
             ``D = diag(noise)``. The identity (the default) is independent noise per output.
         lmc_lengthscale: ``(J-1, D)`` length-scales of the further latent kernels of a linear
             model of coregionalisation (module docstring); None: ICM (one kernel).
-        lmc_A: ``(J-1, P, P)`` lower Cholesky factors of their coregionalisation matrices ``B_j``.
+        lmc_A: ``(J-1, P, R)`` factors of their coregionalisation matrices ``B_j`` (as ``A``).
     """
 
     lengthscale: jax.Array
@@ -114,7 +116,7 @@ class GlobalParams:
 
     @property
     def factors(self) -> jax.Array:
-        """Coregionalisation factors of every latent kernel, ``(J, P, P)`` (``[0]``: ``A``)."""
+        """Coregionalisation factors of every latent kernel, ``(J, P, R)`` (``[0]``: ``A``)."""
         if self.lmc_A is None:
             return self.A[None]
         return jnp.concatenate([self.A[None], self.lmc_A], axis=0)
