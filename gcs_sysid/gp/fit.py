@@ -502,7 +502,12 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     D = Xs.shape[1]
     P = Ys.shape[1]
     t0 = time.perf_counter()
-    terms = linear_terms_of(Xs, Ys, active, cfg)          # on every row, in time order (coloured residuals)
+    # on every row, in time order (coloured residuals); mean-only inputs are no candidates here (their own gate
+    # is mean_only_masks), so they cannot take a collinear regressor's t
+    kern = None if masks is None or masks[0] is None else np.asarray(masks[0], bool)
+    terms = linear_terms_of(Xs, Ys, active if kern is None else np.asarray(active, bool) & kern, cfg)
+    if terms is not None and kern is not None:
+        terms[:, ~kern] = np.asarray(masks[1], bool)[:, ~kern]
     if terms is not None:
         history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(k)] for k in terms]
     sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
@@ -678,9 +683,16 @@ def _validated_terms(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, activ
         return params
     P, D = Ys.shape[1], Xs.shape[1]
     S = np.array(np.broadcast_to(np.asarray(params.prior_std, float), (P, D + 1)))
-    keep = significant_inputs(Xs, Ys[:, lin], active)
-    for k, p in enumerate(lin):
-        S[p, 1:] *= keep[k]
+    # each output's elimination runs over the regressors its mean may carry: a mean-only input that is not in
+    # an output's mean (prior std 0) is no candidate there (near-collinear with q_hat, it would take q_hat's t)
+    may = np.asarray(active, bool)[None, :] & (S[:, 1:] > 0)
+    groups: dict[bytes, list[int]] = {}
+    for p in lin:
+        groups.setdefault(may[p].tobytes(), []).append(p)
+    for ps in groups.values():
+        keep = significant_inputs(Xs, Ys[:, ps], may[ps[0]])
+        for k, p in enumerate(ps):
+            S[p, 1:] *= keep[k]
     history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(S[p, 1:])] for p in range(P)]
     return replace(params, prior_std=jax.device_put(S))
 
