@@ -357,6 +357,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
                     model, _history = fit_gp(X_train, Y_train, cfg, input_names=names,
                                              output_names=[COEFFICIENTS[i] for i in fit_cols])
+                    use_adot = use_adot and model.n_inputs == len(REGRESSORS) + 1   # kept by the gates
                     # the estimator's flight-common regressor offset (alpha: mean vertical wind / V): the
                     # band at exact conditions (gcs-sysid predict) carries it through the slope
                     # and the aided angles' common scale and linear error (docs/gp.md, "The band at exact conditions")

@@ -606,6 +606,16 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         notes.append(f"gp: only {len(Xs)} rows; using {M} inducing points instead of {cfg.n_inducing}")
     t1 = time.perf_counter()
     kernel, allowed, info = mean_only_masks(cfg, input_names, output_names, Xs, Ys, scaler.active)
+    if info and not any(info["outputs"].values()):
+        # no output's mean may carry them: the model is fitted without the columns, exactly as it would be
+        # without them (a query with them is refused: the caller checks n_inputs)
+        k = len(info["inputs"])
+        notes.append(f"gp: {', '.join(info['inputs'])} in no output's linear mean (the gates on the training rows): "
+                     "fitted without")
+        X, input_names, D = X[:, :-k], input_names[:-k], D - k
+        scaler, _ = Standardiser.fit(X, Y, input_names)
+        Xs = scaler.x(X)
+        kernel = allowed = None
     if info:
         history.validation["mean_only"] = info
     params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg),
