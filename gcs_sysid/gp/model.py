@@ -391,8 +391,8 @@ class LocalGlobalGP:
             DataError: fewer than 3 stored rows.
         """
         from ..errors import DataError
-        from .fit import (FitHistory, _validated_mean_only, _validated_terms, fit_local, learn_global, mean_only_masks, output_groups,
-                          validated_global, validated_local)
+        from .fit import (FitHistory, _validated_mean_only, _validated_terms, fit_local, learn_global, mean_only_masks,
+                          output_groups, validated_global, validated_local)
 
         enable_x64()
         rows = self.rows

@@ -48,7 +48,8 @@ from .local import LocalParams, LocalStore
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
 
 __all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "SHARED_NEIGHBOURS", "block_folds", "scale_latent",
-           "gate_global", "gate_local", "gate_mean_only", "NeighbourSearch", "shared_search", "store_without", "block_stores"]
+           "gate_global", "gate_local", "gate_mean_only",
+           "NeighbourSearch", "shared_search", "store_without", "block_stores"]
 
 #: Candidate scales ``s_p`` of the latent GP's prior std per output (1: as learned).
 GLOBAL_GRID: tuple[float, ...] = (0.05, 0.3, 1.0)
