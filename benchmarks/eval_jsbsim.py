@@ -99,7 +99,8 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
 
     Args:
         model: the replay's saved :class:`gcs_sysid.gp.LocalGlobalGP` (six outputs).
-        X, X_true: ``(N, 10)`` the estimated and the true regressors of the scored rows (finite).
+        X, X_true: ``(N, D)`` the estimated and the true regressors of the scored rows (finite; ``D`` the model's
+            inputs: 11 with ``alpha_dot_hat``).
         x_var: ``(N, 10)`` the estimator's stated per-row regressor variances (``CoefficientTable.x_var``) or None.
         ref: ``(N, 6)`` the true coefficients.
 
@@ -114,6 +115,8 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     scale = 100.0 / np.sqrt(np.mean(np.asarray(ref) ** 2, axis=0))
     pct = lambda v: (scale * np.sqrt(np.nanmean(np.broadcast_to(v, np.shape(ref)), axis=0))).round(3).tolist()  # noqa: E731
     Xs, Xts = model.scaler.x(np.asarray(X)), model.scaler.x(np.asarray(X_true))
+    if x_var is not None and model.n_mean_only:          # nothing stated for the mean-only inputs
+        x_var = model.full_inputs(x_var, "x_var", np.nan)
     xv_s = None if x_var is None else np.where(model.scaler.active, np.asarray(x_var) / model.scaler.x_std ** 2, np.nan)
     _, lat = model.predict(X, include_noise=False, input_noise=False, model_error=False)
     learned = model.input_variance_s(Xs) * ys2
@@ -133,6 +136,18 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     true = {"latent": pct(lat_t), "offset": pct(off), "scale": pct(vsc), "map": pct(vmap), "discrepancy": pct(d),
             "sigma": pct(lat_t + off + vsc + vmap + d[None, :])}
     return {"gp": gp, "true": true}
+
+
+def true_alpha_dot(truth) -> np.ndarray:
+    """JSBSim's ``aero/alphadot-rad_sec`` rebuilt from the truth file, ``(T,)`` rad/s on ``truth.t``:
+    ``(u_a w_dot - w_a u_dot) / (u_a^2 + w_a^2)`` with ``u_dot w_dot`` the time derivative of the body-axis
+    ground velocity (``velocities/u-fps``, ``w-fps``; FGAuxiliary's ``vUVWdot``) and ``u_a w_a`` from the
+    true airspeed and air angles (central differences at the truth's rate)."""
+    f = truth.fields
+    ud, wd = np.gradient(f["u"], truth.t), np.gradient(f["w"], truth.t)
+    ua = f["V"] * np.cos(f["alpha"]) * np.cos(f["beta"])
+    wa = f["V"] * np.sin(f["alpha"]) * np.cos(f["beta"])
+    return (ua * wd - wa * ud) / (ua**2 + wa**2)
 
 
 def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
@@ -215,6 +230,16 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         col = model.noise_var(white_noise=False)
         sd = np.sqrt(res.pred_sigma[h] ** 2 + np.maximum(d - col, 0.0)[None, :])
         row["cov_gp_dfloor"] = float(np.nanmean([_coverage(res.pred_mean[h, i], sd[:, i], Yt[h, i]) for i in range(6)]))
+    Xg = tab.X
+    if model.n_mean_only:      # alpha_dot_hat, a mean-only input of Cm: the truth's own and the estimate
+        adt = np.interp(tab.t, truth.t, true_alpha_dot(truth)) * cst["c"] / (2 * Xt[:, 9])
+        Xt, Xt_air = np.c_[Xt, adt], np.c_[Xt_air, adt]
+        ade = np.nan_to_num(np.asarray(tab.alpha_dot_hat, float))
+        Xg = np.c_[tab.X, ade]
+        ok_a = ok & np.isfinite(adt)
+        row["alpha_dot_hat"] = {"rms": float(np.std(adt[ok_a])),
+                                "err_pct": float(100 * np.sqrt(np.mean((ade[ok_a] - adt[ok_a]) ** 2)) / np.std(adt[ok_a])),
+                                "corr": float(np.corrcoef(ade[ok_a], adt[ok_a])[0, 1])}
     mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)   # exact regressors
     row["true"] = _errs(np.asarray(mt), Yt[h])
     ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
@@ -230,7 +255,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
                                                for i in range(6)]))
     row["cov_gp_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]
     if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
-        row["band_terms"] = band_terms(model, tab.X[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
+        row["band_terms"] = band_terms(model, Xg[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
     t_cut = float(tab.t[h][0])
     ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates)

@@ -15,7 +15,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from .aero import compute_coefficients
-from .aero.table import COEFFICIENTS, MOMENT_COEFFICIENTS, CoefficientTable
+from .aero.table import COEFFICIENTS, MOMENT_COEFFICIENTS, REGRESSORS, CoefficientTable
 from .airframe import load_airframe
 from .errors import InputError
 from .estimation.states import FlightStates
@@ -63,6 +63,11 @@ class ReplayOptions:
         gust_rates: None (inertial ``p_hat q_hat r_hat``) or a frame of
             :data:`gcs_sysid.estimation.gustrates.FRAMES` (the hats relative to the air;
             :func:`gcs_sysid.aero.compute_coefficients`).
+        alpha_dot_hat: give the GP ``alpha_dot_hat`` (``CoefficientTable.alpha_dot_hat``) as a mean-only input
+            of Cm (:data:`ALPHA_DOT_GP`; ``docs/gp.md``, "Mean-only inputs"): a linear ``Cm_alpha_dot`` term,
+            kept when its slope is significant with coloured residuals, negative, and lowers Cm's blocked
+            cross-validation error; when the first two fail the model is fitted without the column. False: the
+            ten regressors alone.
     """
 
     rate_hz: float = 50.0
@@ -79,6 +84,25 @@ class ReplayOptions:
     can_log: str | None = None
     can_offset: float | None = None
     gust_rates: str | None = None
+    alpha_dot_hat: bool = True
+
+
+#: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
+#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md).
+ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("Cm",), "mean_only_sign": -1.0}
+
+
+def gp_inputs(table, rows: np.ndarray, with_alpha_dot: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """The GP's inputs of ``rows`` (``(T,)`` bool) of a :class:`~gcs_sysid.aero.table.CoefficientTable`:
+    ``(X (n, 10), x_var (n, 10) or None)``, or with ``with_alpha_dot`` and a table that carries
+    ``alpha_dot_hat``, ``X (n, 11)`` with it as the last column (NaN there: 0, steady flight, as a query that
+    leaves it out). ``x_var`` stays ``(n, 10)``: the model pads it (nothing stated for ``alpha_dot_hat``)."""
+    X = table.X[rows]
+    xv = None if table.x_var is None else table.x_var[rows]
+    if with_alpha_dot and table.alpha_dot_hat is not None:
+        a = np.asarray(table.alpha_dot_hat, float)[rows]
+        X = np.concatenate([X, np.where(np.isfinite(a), a, 0.0)[:, None]], axis=1)
+    return X, xv
 
 
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
@@ -306,7 +330,13 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             notes.append(f"no model fitted: {int(train.sum())} valid training samples "
                          f"and {len(fit_cols)} identifiable coefficients")
         else:
-            X_train, Y_train, partial = training_rows(table.X[train], table.Y[train][:, fit_cols],
+            use_adot = options.alpha_dot_hat and table.alpha_dot_hat is not None
+            if options.model_in:                 # a saved model takes what it was fitted with
+                use_adot = use_adot and load_gp(check_model_state(options.model_in)).n_inputs == len(REGRESSORS) + 1
+            X_all = gp_inputs(table, np.ones(len(table.t), bool), use_adot)[0]
+            if use_adot:                         # training rows need a finite alpha_dot_hat
+                X_all[~np.isfinite(table.alpha_dot_hat), -1] = np.nan
+            X_train, Y_train, partial = training_rows(X_all[train], table.Y[train][:, fit_cols],
                                                       [COEFFICIENTS[i] for i in fit_cols])
             if partial:
                 notes.append(partial)
@@ -324,8 +354,12 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
-                    cfg = GPConfig() if options.n_inducing is None else GPConfig(n_inducing=options.n_inducing)
-                    model, _history = fit_gp(X_train, Y_train, cfg)
+                    cfg = GPConfig(**(ALPHA_DOT_GP if use_adot else {}),
+                                   **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
+                    names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
+                    model, _history = fit_gp(X_train, Y_train, cfg, input_names=names,
+                                             output_names=[COEFFICIENTS[i] for i in fit_cols])
+                    use_adot = use_adot and model.n_inputs == len(REGRESSORS) + 1   # kept by the gates
                     # the estimator's flight-common regressor offset (alpha: mean vertical wind / V): the
                     # band at exact conditions (gcs-sysid predict) carries it through the slope
                     # and the aided angles' common scale and linear error (docs/gp.md, "The band at exact conditions")
@@ -335,7 +369,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 if rows.any():
                     # the estimator's stated per-row air-angle variance: errors the residuals cannot show
-                    mean, var = model.predict(table.X[rows], x_var=None if table.x_var is None else table.x_var[rows])
+                    Xq, xv = gp_inputs(table, rows, use_adot)
+                    mean, var = model.predict(Xq, x_var=xv)
                     pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
                     pred_sigma_obs[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
                     # the coefficient's band: the same less the white measurement noise (docs/gp.md, "Two bands")

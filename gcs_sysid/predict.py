@@ -165,14 +165,29 @@ def run_predict(model_dir: str | Path, inputs: str | Path, out: str | Path) -> P
 
     Raises:
         InputError: missing model, bad conditions file, or a model that does not take the 10 regressors.
+
+    A model fitted with mean-only inputs (the replay's ``alpha_dot_hat``, ``docs/gp.md``, "Mean-only inputs")
+    reads them from columns of the same names when all are present; without them they are 0 (steady flight).
     """
     from .gp import load_gp
 
     prefix = model_prefix(model_dir)
     X, header, rows = read_conditions(inputs)
     model = load_gp(prefix)
-    if model.n_inputs != len(REGRESSORS):
+    if model.n_inputs - model.n_mean_only != len(REGRESSORS):
         raise InputError(f"{prefix}.npz: model takes {model.n_inputs} regressors, expected {len(REGRESSORS)}")
+    extra = list(model.input_names[len(REGRESSORS):])        # mean-only inputs (alpha_dot_hat): optional columns
+    if extra and all(c in header for c in extra):
+        cols = []
+        for c in extra:
+            try:
+                v = np.array([float(r[header.index(c)]) for r in rows])
+            except ValueError:
+                v = np.array([math.nan])
+            if not np.isfinite(v).all():
+                raise InputError(f"{inputs}: column {c}: expected finite numbers")
+            cols.append(v)
+        X = np.concatenate([X, np.stack(cols, 1)], axis=1)
     pred = predict_conditions(model, X, _output_names(prefix, model.n_outputs))
     out_p = Path(out)
     try:

@@ -91,3 +91,23 @@ def test_model_state_continues(roundtrip, tmp_path):
                                      write=False))
     assert any("continued" in n for n in again.notes)
     assert np.isfinite(again.pred_mean[again.table.valid]).any()
+
+
+def test_replay_model_takes_alpha_dot_hat_for_cm_only(roundtrip):
+    """The replay's GP takes the table's ``alpha_dot_hat`` as its last, mean-only input (``docs/gp.md``,
+    "Mean-only inputs"): no kernel sees it (pinned length-scale) and no output but Cm may carry it. The
+    simulated aircraft has no ``Cm_alpha_dot``; whether Cm keeps it is the gates' choice (when none passes the model
+    is fitted without the column and says so)."""
+    from gcs_sysid.gp import load_gp
+    from gcs_sysid.gp.fit import MEAN_ONLY_LENGTHSCALE
+
+    _, result, _ = roundtrip
+    assert result.table.alpha_dot_hat is not None and np.isfinite(result.table.alpha_dot_hat[result.table.valid]).all()
+    model = load_gp(result.model_path)
+    if model.n_inputs == 10:            # no gate passed on the training rows: fitted without it, and said so
+        assert any("alpha_dot_hat in no output's linear mean" in n for n in model.notes), model.notes
+        return
+    assert model.input_names[-1] == "alpha_dot_hat" and model.n_mean_only == 1
+    assert float(np.asarray(model.params.lengthscale)[-1]) == MEAN_ONLY_LENGTHSCALE
+    prior = np.broadcast_to(np.asarray(model.params.prior_std), (model.n_outputs, model.n_inputs + 1))
+    assert np.all(prior[np.arange(6) != COEFFICIENTS.index("Cm"), -1] == 0.0)

@@ -211,6 +211,8 @@ def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: s
         Cl, Cm, Cn = L / (qS * b), M / (qS * c), N / (qS * b)
         pa, qa, ra = _air_relative(states, airframe, gust_rates, p, q, r, V, notes)
         hat = {"p_hat": pa * b / (2 * V), "q_hat": qa * c / (2 * V), "r_hat": ra * b / (2 * V)}
+        # the unsteady pitch regressor (Etkin 1972 ch. 5): alpha_dot from the force equations, not a column of X
+        alpha_dot_hat = get("alpha_dot") * c / (2 * V) if "alpha_dot" in states.data else None
     cols = {**hat, **{k: get(k) for k in REGRESSORS if k not in hat}}
     X = np.stack([cols[k] for k in REGRESSORS], axis=1)
     Y = np.stack([CX, CY, CZ, Cl, Cm, Cn], axis=1)
@@ -233,4 +235,4 @@ def compute_coefficients(states: FlightStates, airframe: Airframe, gust_rates: s
         x_offset_cov = np.diag([float(offsets.get(k, 0.0)) ** 2 for k in REGRESSORS])
     return CoefficientTable(np.asarray(states.t, float), X, Y, valid, qbar.copy(), notes, x_offset_cov,
                             stated_input_variance(states), stated_scale_variance(states),
-                            stated_map_covariance(states))
+                            stated_map_covariance(states), alpha_dot_hat)

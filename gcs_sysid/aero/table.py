@@ -45,6 +45,9 @@ class CoefficientTable:
             regressor ``j``'s error along the regressors, ``coefficients.stated_map_covariance``), or None.
             Where stated for an angle, the GP's band at exact conditions carries it in place of that
             angle's ``x_scale_var`` (``docs/gp.md``, "The band at exact conditions").
+        alpha_dot_hat: ``(T,)`` ``alpha_dot c / (2 V)`` (dimensionless; ``alpha_dot`` the estimator's state from the
+            force equations, ``gcs_sysid.estimation.alpharate``), or None. Not a column of ``X``: the pipeline's GP
+            takes it as a mean-only input of Cm (``docs/gp.md``, "Mean-only inputs").
     """
 
     t: np.ndarray
@@ -57,6 +60,7 @@ class CoefficientTable:
     x_var: np.ndarray | None = None
     x_scale_var: np.ndarray | None = None
     x_map_cov: np.ndarray | None = None
+    alpha_dot_hat: np.ndarray | None = None
 
     def x(self, name: str) -> np.ndarray:
         """Regressor column by name, shape (T,)."""
@@ -70,4 +74,5 @@ class CoefficientTable:
         """Rows where ``mask`` (T,) is True."""
         return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
                                 list(self.notes), self.x_offset_cov, None if self.x_var is None else self.x_var[mask],
-                                self.x_scale_var, self.x_map_cov)
+                                self.x_scale_var, self.x_map_cov,
+                                None if self.alpha_dot_hat is None else self.alpha_dot_hat[mask])

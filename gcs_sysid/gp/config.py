@@ -121,6 +121,21 @@ class GPConfig:
             statistics cost ``(P M)^2`` per row.
             All three need ``latent_kernels = 1`` and no ``coupling_validation``; outputs that are not the six
             coefficients (or one axis only) fall back to the ICM.
+        mean_only_inputs: names of inputs (``fit_gp``'s ``input_names``; the trailing columns of ``X``) that
+            enter only the linear mean, never a kernel: their length-scales are pinned at
+            :data:`gcs_sysid.gp.fit.MEAN_ONLY_LENGTHSCALE` (standardised) in both layers, so the latent GP,
+            the local layer and the neighbour search do not see them. A query may leave them out (``X`` with
+            ``D - len(mean_only_inputs)`` columns): they are then 0 in data units (the pipeline's
+            ``alpha_dot_hat``: steady flight). ``docs/gp.md``, "Mean-only inputs".
+        mean_only_outputs: the outputs whose linear mean may carry the ``mean_only_inputs`` (others: prior std
+            0), and then only where the slope is significant with coloured residuals on the training rows
+            (:func:`gcs_sysid.gp.colored.significant_inputs`, the data's own test). The pipeline: ``("Cm",)``.
+        mean_only_sign: 0 (any sign), or -1 / +1: a mean-only input enters an output's mean only when its slope
+            in that test's least-squares fit has this sign. The pipeline: -1, ``Cm_alpha_dot < 0`` (the lag of the
+            wing's downwash at an aft tail: ``Cm_alpha_dot = -2 a_t V_H (l_t / c) d(epsilon)/d(alpha)``, Etkin
+            and Reid 1996, *Dynamics of Flight*, 3rd ed., sec. 5.5). A positive slope is what the pitch gust rate
+            gives through its correlation with ``alpha_dot`` (measured on the f4n in moderate turbulence,
+            +12 to +15 against JSBSim's -9; ``docs/gp.md``, "Mean-only inputs").
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -161,8 +176,16 @@ class GPConfig:
     validation_folds: int = 5
     coupling_validation: bool = False
     output_groups: str = "none"
+    mean_only_inputs: tuple[str, ...] = ()
+    mean_only_outputs: tuple[str, ...] = ()
+    mean_only_sign: float = 0.0
 
     def __post_init__(self):
+        for name in ("mean_only_inputs", "mean_only_outputs"):      # JSON gives lists: kept hashable
+            v = getattr(self, name)
+            if isinstance(v, str) or not all(isinstance(x, str) for x in v):
+                raise InputError(f"GPConfig.{name} must be a sequence of names, got {v!r}")
+            object.__setattr__(self, name, tuple(v))
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
             raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, got {self.n_inducing_hyper!r}")
         for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool",

@@ -154,7 +154,8 @@ def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None, 
     Args:
         model: a :class:`gcs_sysid.gp.LocalGlobalGP`.
         cov: ``(D, D)`` covariance in the regressors' units squared (``CoefficientTable.x_offset_cov``),
-            or None (no offset known: the model keeps what it has).
+            or None (each of ``cov``, ``scale_var`` and ``map_cov`` may leave out the model's trailing mean-only
+            inputs, ``GPConfig.mean_only_inputs``: zero there) (no offset known: the model keeps what it has).
         rows: rows of the flight ``cov`` belongs to, when ``model`` was *updated* with that flight
             after learning others: offsets of different flights are independent, and the model's
             mean follows the row-weighted mean of them, so the covariances combine as
@@ -178,6 +179,21 @@ def with_offset_covariance(model, cov, rows: int | None = None, scale_var=None, 
             one is not finite.
     """
     D = model.n_inputs
+    k = getattr(model, "n_mean_only", 0)
+    if k:                 # the estimator states nothing for the mean-only inputs (GPConfig.mean_only_inputs): 0
+        d0 = D - k
+
+        def pad(a, nd):
+            a = np.asarray(a, float)
+            if a.shape != (d0,) * nd:
+                return a
+            out = np.zeros((D,) * nd)
+            out[(slice(0, d0),) * nd] = a
+            return out
+
+        cov = None if cov is None else pad(cov, 2)
+        scale_var = None if scale_var is None else pad(scale_var, 1)
+        map_cov = None if map_cov is None else pad(map_cov, 3)
 
     def combine(old, new):
         if rows is None:

@@ -48,9 +48,13 @@ __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_g
            "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
-           "learn_input_noise", "validated_global", "validated_local"]
+           "learn_input_noise", "validated_global", "validated_local", "mean_only_masks", "MEAN_ONLY_LENGTHSCALE"]
 
 _NOISE_FLOOR = 1e-6
+#: Length-scale (standardised units) pinned on a mean-only input (``GPConfig.mean_only_inputs``): the
+#: squared-exponential and Gibbs kernels then differ from 1 along it by ``(dx / l)^2 / 2 < 1e-10`` over
+#: any standardised spread below 10, so no kernel, neighbour search or inducing choice sees it.
+MEAN_ONLY_LENGTHSCALE = 1.0e6
 
 
 @dataclass
@@ -92,10 +96,15 @@ def constrain_global(raw: dict, fixed: dict) -> GlobalParams:
     "kernels-free"``): the factors themselves, unconstrained (started per group, free to load on any output).
     """
     ls = jnp.where(fixed["active"], jnp.exp(raw["log_ls"]), 1.0)
+    kernel = fixed.get("kernel")                 # (D,) False: a mean-only input (GPConfig.mean_only_inputs)
+    if kernel is not None:
+        ls = jnp.where(kernel, ls, MEAN_ONLY_LENGTHSCALE)
     Z = raw["Z"] if "Z" in raw else fixed["Z"]
     lmc_ls = lmc_A = None
     if "lmc_log_ls" in raw:
         lmc_ls = jnp.where(fixed["active"][None, :], jnp.exp(raw["lmc_log_ls"]), 1.0)
+        if kernel is not None:
+            lmc_ls = jnp.where(kernel[None, :], lmc_ls, MEAN_ONLY_LENGTHSCALE)
     if "group_A" in raw:                         # per-group kernels, loadings free ("kernels-free"), or one
         Ag = raw["group_A"]                      # kernel per output loading on its own group ("output-kernels")
         Ag = Ag * fixed["A_mask"] if "A_mask" in fixed else Ag
@@ -314,14 +323,77 @@ def _residual_cov_missing(Xs, Ys, obs, linear_mean: bool) -> np.ndarray:
     return Cr + 1e-6 * np.eye(P)
 
 
-def linear_prior_std(cfg: GPConfig, terms: np.ndarray | None, P: int, D: int) -> np.ndarray:
+def linear_prior_std(cfg: GPConfig, terms: np.ndarray | None, P: int, D: int,
+                     allowed: np.ndarray | None = None) -> np.ndarray:
     """Prior std of the linear-mean weights ``(P, D+1)`` (intercept first): ``cfg.prior_std`` on the
-    intercept and on the regressors ``terms (P, D)`` keeps (None: all), 0 on the others (the term is
-    not in that output's mean); all 0 without a linear mean."""
+    intercept and on the regressors ``terms (P, D)`` keeps (None: all) and ``allowed (P, D)`` allows
+    (None: all; :func:`mean_only_masks`), 0 on the others (the term is not in that output's mean); all 0
+    without a linear mean."""
     if not cfg.linear_mean:
         return np.zeros((P, D + 1))
     keep = np.ones((P, D), bool) if terms is None else np.asarray(terms, bool)
+    if allowed is not None:
+        keep = keep & np.asarray(allowed, bool)
     return float(cfg.prior_std) * np.concatenate([np.ones((P, 1)), keep.astype(float)], axis=1)
+
+
+def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys: np.ndarray,
+                    active: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
+    """Which inputs the kernels see and which linear-mean terms each output may carry
+    (``GPConfig.mean_only_inputs``, ``mean_only_outputs``; ``docs/gp.md``, "Mean-only inputs").
+
+    A mean-only input is left out of every kernel. It may enter the linear mean of the
+    ``mean_only_outputs`` only, and there only when its slope keeps ``|t| >= 2`` with coloured-residual
+    standard errors in the backward elimination on these rows, in time order
+    (:func:`gcs_sysid.gp.colored.significant_inputs`: the data's own test, the one the ``"validated"``
+    linear terms use; its other choices are not used here) and, with ``GPConfig.mean_only_sign``, when that fit's
+    slope has the sign physics gives it (the pipeline: ``Cm_alpha_dot < 0``).
+
+    Args:
+        cfg: settings. input_names ``(D,)``, output_names ``(P,)``: the model's column names.
+        Xs: ``(N, D)``, Ys: ``(N, P)`` standardised training rows in time order (NaN: a missing output).
+        active: ``(D,)`` inputs that vary.
+
+    Returns:
+        ``(kernel (D,) bool, allowed (P, D) bool, info)``, ``(None, None, {})`` when no named mean-only
+        input is among ``input_names``; ``info``: ``{"inputs": [names], "outputs": {output: [kept inputs]}}``
+        (and ``"wrong_sign": ["output:input", ...]`` for the significant slopes of the wrong sign).
+
+    Raises:
+        InputError: a mean-only input that is not among the trailing columns (a query may leave out only
+            trailing columns).
+    """
+    from ..errors import InputError
+    from .colored import significant_inputs
+
+    names = list(input_names)
+    only = [d for d, n in enumerate(names) if n in cfg.mean_only_inputs]
+    if not only:
+        return None, None, {}
+    D, P = len(names), Ys.shape[1]
+    if only != list(range(D - len(only), D)):
+        raise InputError(f"gp: mean-only inputs {[names[d] for d in only]} must be the last columns of X")
+    kernel = np.ones(D, bool)
+    kernel[only] = False
+    allowed = np.ones((P, D), bool)
+    allowed[:, only] = False
+    info = {"inputs": [names[d] for d in only], "outputs": {}}
+    for p, name in enumerate(output_names):
+        if name not in cfg.mean_only_outputs or not cfg.linear_mean:
+            continue
+        keep = significant_inputs(Xs, Ys[:, [p]], active)[0]
+        if cfg.mean_only_sign and keep[only].any():          # the slope's sign in that least-squares fit
+            rows = np.isfinite(Ys[:, p])
+            cols = np.flatnonzero(keep)
+            A = np.concatenate([np.ones((int(rows.sum()), 1)), Xs[rows][:, cols]], axis=1)
+            w = np.linalg.lstsq(A, Ys[rows, p], rcond=None)[0][1:]
+            for d in only:
+                if keep[d] and np.sign(w[list(cols).index(d)]) != np.sign(cfg.mean_only_sign):
+                    keep[d] = False
+                    info.setdefault("wrong_sign", []).append(f"{name}:{names[d]}")
+        allowed[p, only] = keep[only]
+        info["outputs"][name] = [names[d] for d in only if keep[d]]
+    return kernel, allowed, info
 
 
 def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> np.ndarray | None:
@@ -335,13 +407,14 @@ def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPC
 
 
 def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = None,
-                 groups: np.ndarray | None = None):
+                 groups: np.ndarray | None = None, masks=None):
     """Initial unconstrained parameters from a ridge fit of the linear mean.
 
     ``terms`` ``(P, D)`` bool: the regressors of each output's linear mean (None: all); the ridge fit
     of output ``p`` uses its own, and the prior std of the others' weights is 0. ``groups`` ``(P,)``
     (:func:`output_groups`): each shared factor starts on its own group's block of the residual
-    covariance and stays there (``fixed["L_mask"]``).
+    covariance and stays there (``fixed["L_mask"]``). ``masks``: ``(kernel (D,), allowed (P, D))`` from
+    :func:`mean_only_masks` (None: every input in the kernels and every mean).
 
     With ``cfg.latent_kernels = J > 1`` the residual covariance is shared equally between the
     kernels (``B_j = B0 / J``) and the length-scales start at :func:`lmc_start_factors` times the
@@ -350,6 +423,9 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
     P = Ys.shape[1]
     R = Ys
     obs = np.isfinite(Ys)
+    kernel, allowed = (None, None) if masks is None else masks
+    if allowed is not None and cfg.linear_mean:
+        terms = np.asarray(allowed, bool) if terms is None else np.asarray(terms, bool) & allowed
     if obs.all():
         if cfg.linear_mean:
             Xa = np.concatenate([np.ones((len(Xs), 1)), Xs], axis=1)   # design(): [1, x]
@@ -395,7 +471,9 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
     if cfg.train_inducing:
         raw["Z"] = np.asarray(Z, float)
     fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
-             "prior_std": linear_prior_std(cfg, terms, P, Xs.shape[1]), "jitter": np.float64(cfg.jitter)}
+             "prior_std": linear_prior_std(cfg, terms, P, Xs.shape[1], allowed), "jitter": np.float64(cfg.jitter)}
+    if kernel is not None:
+        fixed["kernel"] = np.asarray(kernel, bool)
     if mask is not None:
         fixed["L_mask"] = mask
     if per_group and cfg.output_groups == "kernels-free":        # the same start, loadings then free
@@ -519,12 +597,16 @@ def fit_local(cfg: GPConfig, params: GlobalParams, Xs, resid, history: FitHistor
         raw, _, values = _adam(_local_loss, raw, opt_state, cfg.local_learning_rate, args, int(cfg.local_steps),
                                cfg.tol)
         history.local_loss.extend(np.asarray(values).tolist())
-    return _constrain_local_jit(raw), full
+    local = _constrain_local_jit(raw)
+    pinned = np.asarray(params.metric_lengthscale()) >= MEAN_ONLY_LENGTHSCALE
+    if pinned.any():                             # a mean-only input: no local kernel along it either
+        local = replace(local, lengthscale=jnp.where(pinned, MEAN_ONLY_LENGTHSCALE, local.lengthscale))
+    return local, full
 
 
 def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig, M: int,
                  history: FitHistory, start: GlobalParams | None = None,
-                 groups: np.ndarray | None = None) -> GlobalParams:
+                 groups: np.ndarray | None = None, masks=None) -> GlobalParams:
     """Global hyperparameters by Adam on the VFE bound over a random subset of ``n_train_max`` rows.
 
     Args:
@@ -537,6 +619,7 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         start: warm start (a refresh): the length-scales, noise and coregionalisation to start
             from instead of the ridge-regression initial values.
         groups: ``(P,)`` output group labels (:func:`output_groups`; None: every factor on every output).
+        masks: ``(kernel (D,), allowed (P, D))`` from :func:`mean_only_masks`, or None.
 
     Returns:
         :class:`GlobalParams` (constrained).
@@ -544,7 +627,12 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
     D = Xs.shape[1]
     P = Ys.shape[1]
     t0 = time.perf_counter()
-    terms = linear_terms_of(Xs, Ys, active, cfg)          # on every row, in time order (coloured residuals)
+    # on every row, in time order (coloured residuals); mean-only inputs are no candidates here (their own gate
+    # is mean_only_masks), so they cannot take a collinear regressor's t
+    kern = None if masks is None or masks[0] is None else np.asarray(masks[0], bool)
+    terms = linear_terms_of(Xs, Ys, active if kern is None else np.asarray(active, bool) & kern, cfg)
+    if terms is not None and kern is not None:
+        terms[:, ~kern] = np.asarray(masks[1], bool)[:, ~kern]
     if terms is not None:
         history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(k)] for k in terms]
     sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
@@ -559,8 +647,10 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         Mh = int(min(cfg.n_inducing_hyper or cfg.n_inducing, len(Xs)))
     ls0 = (np.full(D, 0.5 * np.sqrt(max(int(active.sum()), 1))) * min(lmc_start_factors(int(cfg.latent_kernels)))
            if start is None else np.asarray(start.metric_lengthscale()))
+    if masks is not None and masks[0] is not None:
+        ls0 = np.where(masks[0], ls0, MEAN_ONLY_LENGTHSCALE)
     Z = select_inducing(Xs, Mh, ls0, cfg.inducing, cfg.mi_pool, seed=cfg.seed)
-    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z, terms, groups)
+    raw, fixed = _init_global(Xs[sub], Ys[sub], active, cfg, Z, terms, groups, masks)
     if start is not None:
         raw = jax.device_put(dict(jax.device_get(raw), **_unconstrain(start, cfg, groups)))
     history.timings["init"] = time.perf_counter() - t0
@@ -640,7 +730,21 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if M < cfg.n_inducing:
         notes.append(f"gp: only {len(Xs)} rows; using {M} inducing points instead of {cfg.n_inducing}")
     t1 = time.perf_counter()
-    params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg))
+    kernel, allowed, info = mean_only_masks(cfg, input_names, output_names, Xs, Ys, scaler.active)
+    if info and not any(info["outputs"].values()):
+        # no output's mean may carry them: the model is fitted without the columns, exactly as it would be
+        # without them (a query with them is refused: the caller checks n_inputs)
+        k = len(info["inputs"])
+        notes.append(f"gp: {', '.join(info['inputs'])} in no output's linear mean (the gates on the training rows): "
+                     "fitted without")
+        X, input_names, D = X[:, :-k], input_names[:-k], D - k
+        scaler, _ = Standardiser.fit(X, Y, input_names)
+        Xs = scaler.x(X)
+        kernel = allowed = None
+    if info:
+        history.validation["mean_only"] = info
+    params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg),
+                          masks=(kernel, allowed))
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
     n_hyper = int(min(cfg.n_train_max, len(Xs)))
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
@@ -663,6 +767,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     params, stats = validated_global(params, Xs, Ys, cfg, history)
     if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
         params = _validated_terms(params, Xs, Ys, scaler.active, history)
+    params = _validated_mean_only(params, Xs, Ys, cfg, kernel, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
@@ -713,11 +818,40 @@ def _validated_terms(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, activ
         return params
     P, D = Ys.shape[1], Xs.shape[1]
     S = np.array(np.broadcast_to(np.asarray(params.prior_std, float), (P, D + 1)))
-    keep = significant_inputs(Xs, Ys[:, lin], active)
-    for k, p in enumerate(lin):
-        S[p, 1:] *= keep[k]
+    # each output's elimination runs over the regressors its mean may carry: a mean-only input that is not in
+    # an output's mean (prior std 0) is no candidate there (near-collinear with q_hat, it would take q_hat's t)
+    may = np.asarray(active, bool)[None, :] & (S[:, 1:] > 0)
+    groups: dict[bytes, list[int]] = {}
+    for p in lin:
+        groups.setdefault(may[p].tobytes(), []).append(p)
+    for ps in groups.values():
+        keep = significant_inputs(Xs, Ys[:, ps], may[ps[0]])
+        for k, p in enumerate(ps):
+            S[p, 1:] *= keep[k]
     history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(S[p, 1:])] for p in range(P)]
     return replace(params, prior_std=jax.device_put(S))
+
+
+def _validated_mean_only(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: GPConfig,
+                         kernel: np.ndarray | None, history: FitHistory) -> GlobalParams:
+    """The mean-only inputs (``kernel`` False) kept in an output's mean only where they lower its blocked
+    cross-validation error (:func:`gcs_sysid.gp.validation.gate_mean_only`); unchanged without mean-only inputs
+    or when the blocked validation does not run. Recorded in ``history.validation["mean_only"]``."""
+    from .validation import gate_mean_only
+
+    if kernel is None or np.all(kernel) or not _validating(cfg, len(Xs)):
+        return params
+    t0 = time.perf_counter()
+    params, keep, ratio = gate_mean_only(params, Xs, Ys, np.flatnonzero(~np.asarray(kernel, bool)),
+                                         int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max, cfg.seed)
+    history.timings["validation_mean_only"] = time.perf_counter() - t0
+    info = history.validation.setdefault("mean_only", {})
+    info["blocked_ratio"] = [None if not np.isfinite(r) else float(r) for r in ratio]
+    info["blocked_kept"] = [bool(k) for k in keep]
+    if not np.all(keep):
+        history.notes.append(f"gp: blocked validation took the mean-only inputs out of {int(np.sum(~keep))} "
+                             "output(s) (they did not lower the blocked error)")
+    return params
 
 
 def _validating(cfg: GPConfig, n: int) -> bool:

@@ -129,6 +129,27 @@ class LocalGlobalGP:
         return int(self.scaler.x_mean.shape[0])
 
     @property
+    def n_mean_only(self) -> int:
+        """Trailing inputs that enter only the linear mean (``GPConfig.mean_only_inputs``), which a query may
+        leave out."""
+        return sum(1 for n in self.input_names if n in self.config.mean_only_inputs)
+
+    def full_inputs(self, X, what: str = "X", fill: float = 0.0) -> np.ndarray:
+        """``X`` with the trailing mean-only inputs appended as ``fill`` (0: in data units, the pipeline's
+        ``alpha_dot_hat`` of steady flight) when a query leaves them out: ``(N, D - n_mean_only)`` ->
+        ``(N, D)``; an ``(N, D)`` array is returned checked and unchanged.
+
+        Raises:
+            InputError: ``X`` has neither ``D`` nor ``D - n_mean_only`` columns.
+        """
+        k = self.n_mean_only
+        if k:
+            X = check_inputs(X, None, what)
+            if X.shape[1] == self.n_inputs - k:
+                return np.concatenate([X, np.full((len(X), k), fill)], axis=1)
+        return check_inputs(X, self.n_inputs, what)
+
+    @property
     def n_outputs(self) -> int:
         """Number of outputs ``P``."""
         return int(self.scaler.y_mean.shape[0])
@@ -140,7 +161,7 @@ class LocalGlobalGP:
 
     # ------------------------------------------------------------ prediction
     def _standardise_query(self, X) -> tuple[np.ndarray, np.ndarray]:
-        X = check_inputs(X, self.n_inputs, "X")
+        X = self.full_inputs(X)
         ok = np.isfinite(X).all(1)
         return self.scaler.x(X[ok]), ok
 
@@ -197,6 +218,8 @@ class LocalGlobalGP:
         xv_s = None
         if x_var is not None and input_noise:
             xv = np.asarray(x_var, float)
+            if self.n_mean_only and xv.ndim == 2 and xv.shape[1] == self.n_inputs - self.n_mean_only:
+                xv = self.full_inputs(xv, "x_var", np.nan)      # none stated for the mean-only inputs
             if xv.shape != (len(ok), self.n_inputs):
                 raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
             xv_s = np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
@@ -368,8 +391,8 @@ class LocalGlobalGP:
             DataError: fewer than 3 stored rows.
         """
         from ..errors import DataError
-        from .fit import (FitHistory, _validated_terms, fit_local, learn_global, output_groups, validated_global,
-                          validated_local)
+        from .fit import (FitHistory, _validated_mean_only, _validated_terms, fit_local, learn_global, mean_only_masks,
+                          output_groups, validated_global, validated_local)
 
         enable_x64()
         rows = self.rows
@@ -379,8 +402,10 @@ class LocalGlobalGP:
         history = FitHistory()
         M = int(self.params.Z.shape[0])
         hyper_cfg = replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M))   # the fit's compiled shapes
+        kernel, allowed, _ = mean_only_masks(cfg, self.input_names, self.output_names, rows.X, rows.Y,
+                                             self.scaler.active)
         new = learn_global(rows.X, rows.Y, self.scaler.active, hyper_cfg, M if reselect else 0, history,
-                           start=self.params, groups=output_groups(self.output_names, cfg))
+                           start=self.params, groups=output_groups(self.output_names, cfg), masks=(kernel, allowed))
         Z_old = np.asarray(self.params.Z)
         Z_new = np.asarray(new.Z) if reselect and new.Z.shape[0] == M else Z_old
         params = replace(new, Z=jax.device_put(Z_new))
@@ -389,6 +414,7 @@ class LocalGlobalGP:
         params, stats = validated_global(params, rows.X, rows.Y, cfg, history)
         if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
             params = _validated_terms(params, rows.X, rows.Y, self.scaler.active, history)
+        params = _validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history)
         evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))

@@ -48,7 +48,8 @@ from .local import LocalParams, LocalStore
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
 
 __all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "SHARED_NEIGHBOURS", "block_folds", "scale_latent",
-           "gate_global", "gate_local", "NeighbourSearch", "shared_search", "store_without", "block_stores"]
+           "gate_global", "gate_local", "gate_mean_only",
+           "NeighbourSearch", "shared_search", "store_without", "block_stores"]
 
 #: Candidate scales ``s_p`` of the latent GP's prior std per output (1: as learned).
 GLOBAL_GRID: tuple[float, ...] = (0.05, 0.3, 1.0)
@@ -153,6 +154,61 @@ def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int
             sse[g] += np.nansum((Ys[rows] - U @ W) ** 2, 0)      # NaN: a missing output
     s = np.asarray(GLOBAL_GRID)[np.argmin(sse, 0)]
     return scale_latent(params, s), total, s, sse
+
+
+def gate_mean_only(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cols, folds: int, batch: int,
+                   val_max: int = 1000, seed: int = 0) -> tuple[GlobalParams, np.ndarray, np.ndarray]:
+    """Keep the mean-only inputs ``cols`` (``GPConfig.mean_only_inputs``) in an output's linear mean only where
+    they lower its blocked cross-validation error (``docs/gp.md``, "Mean-only inputs").
+
+    The same blocks and validation rows as :func:`gate_global` (same ``seed``): for each held-back block the
+    posterior mean of the other blocks with those weights' prior std as it is, and with it set to 0 (the
+    statistics do not depend on it: a posterior-only change, as ``linear_terms = "validated"``). A term that
+    is significant in a least-squares fit on every row can still be a proxy that does not predict held-back
+    time: on the f16 (no ``Cm_alpha_dot`` in its aerodynamics) ``alpha_dot_hat`` took 3.4-3.8 per rad of Cm's
+    ``q_hat`` slope and raised the held-out Cm error by 0.2-0.4 points.
+
+    Args:
+        params: the global hyperparameters after :func:`gate_global` (``prior_std`` ``(P, D+1)`` or scalar).
+        Xs: ``(N, D)``, Ys: ``(N, P)`` standardised training rows in time order.
+        cols: indices ``d`` (into ``D``) of the mean-only inputs.
+        folds, batch, val_max, seed: as :func:`gate_global`.
+
+    Returns:
+        ``(params, keep (P,) bool, ratio (P,))``: ``prior_std`` with those weights at 0 for the outputs where the
+        blocked squared error with them is not below that without (``keep`` False; outputs that carry none of
+        them keep ``True``), and ``ratio`` the error with over without (NaN where they carry none).
+    """
+    n, P = Ys.shape
+    D = Xs.shape[1]
+    S = np.array(np.broadcast_to(np.asarray(params.prior_std, float), (P, D + 1)))
+    idx = 1 + np.asarray(list(cols), int)
+    carry = np.any(S[:, idx] > 0, axis=1)
+    keep, ratio = np.ones(P, bool), np.full(P, np.nan)
+    if not carry.any():
+        return params, keep, ratio
+    S0 = S.copy()
+    S0[:, idx] = 0.0
+    with_p = replace(params, prior_std=jax.device_put(S))
+    without = replace(params, prior_std=jax.device_put(S0))
+    blocks = block_folds(n, folds)
+    parts = [global_stats(params, Xs[a:b], Ys[a:b], batch) for a, b in blocks]
+    total = parts[0]
+    for st in parts[1:]:
+        total = _add_jit(total, st)
+    rng = np.random.default_rng(seed + 23)
+    per = max(1, val_max // len(blocks))
+    sse1, sse0 = np.zeros(P), np.zeros(P)
+    for (a, b), st in zip(blocks, parts):
+        rest = _sub(total, st)
+        rows = _val_rows(a, b, per, rng)
+        U = np.asarray(_design_u(params, Xs[rows]))
+        sse1 += np.nansum((Ys[rows] - U @ np.asarray(_mean_weights(with_p, rest))) ** 2, 0)
+        sse0 += np.nansum((Ys[rows] - U @ np.asarray(_mean_weights(without, rest))) ** 2, 0)
+    ratio[carry] = sse1[carry] / np.maximum(sse0[carry], 1e-300)
+    keep[carry] = sse1[carry] < sse0[carry]
+    S[~keep] = S0[~keep]
+    return replace(params, prior_std=jax.device_put(S)), keep, ratio
 
 
 def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int, folds: int,
