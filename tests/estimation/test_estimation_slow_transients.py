@@ -27,18 +27,24 @@ def _yaw_moment_error(accel: np.ndarray, p_dot: np.ndarray, r_dot: np.ndarray, r
     return float(100 * np.sqrt(np.mean((Ne[rows] - N[rows]) ** 2) / np.mean(N[rows] ** 2)))
 
 
+def _b747_flight():
+    """The B747 fixture (light, seed 3): gyro ``(T, 3)`` with q NaN, ``dt`` s, controls ``(T, 3)`` rad,
+    ``qbar`` Pa, the truth's ``p_dot`` and ``r_dot`` ``(T,)`` rad/s^2 and the held-out mask (the last 20 %)."""
+    d = np.load(DATA / "flights" / "jsbsim-b747-light-s3-rates.npz")
+    z = np.full((len(d["gyro_pr"]), 3), np.nan)
+    z[:, [0, 2]] = d["gyro_pr"]
+    dt, U, qbar = float(d["dt"]), d["controls"].astype(float), d["qbar_eas"].astype(float)
+    p_dot, r_dot = d["p_dot"].astype(float), d["r_dot"].astype(float)
+    return z, dt, U, qbar, p_dot, r_dot, np.arange(len(z)) >= int(0.8 * len(z))
+
+
 def test_slow_transients_and_control_terms_bring_the_b747_yaw_moment_within_8_percent():
     """The smoother as ``estimate_states`` runs it (slow transients offered, each control on the axes of
     :data:`~gcs_sysid.estimation.rates.CONTROL_AXES`) on the B747 flight: the yaw axis takes the slow
     transients, the elevator moves neither p nor r, and the held-out yaw moment is within the issue's
     8 % (measured 6.57 %; whole flight 8.15 %). Main's smoother (neither) gives 9.45 / 13.0 % on the
     same data (eval_jsbsim's measured Cn: 9.43 %). Only p and r are given (q NaN: no pitch column)."""
-    d = np.load(DATA / "flights" / "jsbsim-b747-light-s3-rates.npz")
-    z = np.full((len(d["gyro_pr"]), 3), np.nan)
-    z[:, [0, 2]] = d["gyro_pr"]
-    dt, U, qbar = float(d["dt"]), d["controls"].astype(float), d["qbar_eas"].astype(float)
-    p_dot, r_dot = d["p_dot"].astype(float), d["r_dot"].astype(float)
-    held = np.arange(len(z)) >= int(0.8 * len(z))
+    z, dt, U, qbar, p_dot, r_dot, held = _b747_flight()
     R = smooth_rates(dt, z, controls=U, scale=qbar,
                      control_axes=[CONTROL_AXES[k] for k in ("delta_e", "delta_a", "delta_r")])
     assert R.slow_transient.tolist() == [False, False, True]
@@ -78,12 +84,7 @@ def test_aileron_yaw_response_through_the_roll_axis_b747():
     flight's 8.15 -> 5.34 % (measured 2026-11-23; the free columns' numbers are the test above's). The B747
     has no ``Cn_delta_a``: the aileron's jump on the yaw axis is at most the ``I_xz / I_z`` share (0.020) of
     the roll axis' (here 1.7 % of it) within 3 sigma."""
-    d = np.load(DATA / "flights" / "jsbsim-b747-light-s3-rates.npz")
-    z = np.full((len(d["gyro_pr"]), 3), np.nan)
-    z[:, [0, 2]] = d["gyro_pr"]
-    dt, U, qbar = float(d["dt"]), d["controls"].astype(float), d["qbar_eas"].astype(float)
-    p_dot, r_dot = d["p_dot"].astype(float), d["r_dot"].astype(float)
-    held = np.arange(len(z)) >= int(0.8 * len(z))
+    z, dt, U, qbar, p_dot, r_dot, held = _b747_flight()
     names = ("delta_e", "delta_a", "delta_r")
     R = smooth_rates(dt, z, controls=U, scale=qbar, control_axes=[CONTROL_AXES[k] for k in names],
                      coupled={names.index(k): v for k, v in AILERON_YAW_TIE.items()})
