@@ -75,13 +75,13 @@ _DEG = 57.29577951308232
 #: thresholds; ``pa28`` (held out since 2026-11-21), ``j3cub`` (untouched until the sixth
 #: session's final evaluation, 2026-11-22), ``c182`` (untouched until the seventh session's)
 #: have since been evaluated and their results read, so they count as used (``TUNING_AIRCRAFT``).
-#: ``t37``, ``t6``, ``b747``, ``f16`` and ``f4n`` (untouched until the eighth to twelfth sessions'
-#: final evaluations; the f16 flown as the derived model ``f16_direct``, the f4n as ``F4N_fcs``,
-#: ``derived.py``) are used since as well. ``rascal`` (added in the thirteenth session, 2026-11-23:
-#: ArduPilot's SITL Rascal 110, a model from outside the wheel checked into ``data/jsbsim_models``,
-#: flown without its propeller) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
-#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method
-#: was never run on it before its final evaluation.
+#: ``t37``, ``t6``, ``b747``, ``f16``, ``f4n`` and ``rascal`` (untouched until the eighth to thirteenth
+#: sessions' final evaluations; the f16 flown as the derived model ``f16_direct``, the f4n as ``F4N_fcs``,
+#: the rascal, ArduPilot's SITL Rascal 110 checked into ``data/jsbsim_models``, as ``Rascal110_glide``:
+#: ``derived.py``) are used since as well. ``sgs126`` (added in the fourteenth session, 2026-11-23: the
+#: wheel's Schweizer SGS 1-26 glider, flown at 3000 ft where JSBSim's light turbulence is active) is the
+#: held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up
+#: (from JSBSim's truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -364,10 +364,52 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="ArduPilot SITL Rascal 110 (JSBSim Rascal110-JSBSim.xml, checked in under data/jsbsim_models/rascal) "
               "with its engine and propeller removed (derived model Rascal110_glide, XML sha256 7bc358774d2412a5), "
               "gliding; untouched by any tuning of the method"),
+    # sgs126: JSBSim's stock Schweizer SGS 1-26 (sgs126.xml, author "Unknown"; an Aeromatic-style model of
+    # constant derivatives and a few tables), a single-seat glider: 445 lb (no pilot or point mass), 40-ft
+    # span, 160 ft^2 (wing loading 2.8 lb/ft^2, the lightest of the roster but the rascal's), no propulsion
+    # at all (no engine, no propeller, nothing to stop). Chosen in the fourteenth session
+    # (docs/jsbsim.md, "The sgs126") after the wheel's three jets no session had screened: fokker100
+    # (JSBSim 1.3.3 cannot initialise it: its pushback system reads FlightGear's
+    # /sim/model/pushback/position-norm; else the b747's term set with a yaw damper in the loop and its
+    # rudder command clipped at 0.35), global5000 and MD11 (Ixx + Iyy < Izz in JSBSim: not a physical
+    # tensor); a jet's 10-15 m/s of sink cannot glide 135 s below 4000 ft anyway, and a glider can fly
+    # where JSBSim's light turbulence
+    # is active: MIL-F-8785C's light curve (JSBSim's Milspec table) falls to zero at 7500 ft, so the
+    # f16's light flights at 15000 ft were calm and the rascal's at 6000 ft had 0.2 m/s of vertical gust;
+    # at 3000 ft the sgs126's light flights have 0.5 m/s (truth: total wind less the steady wind).
+    # A direct FCS (aerosurface_scale, zero-centred, no damper): elevator -0.35..+0.30 rad, left
+    # aileron +-0.35 rad (the only aileron property the aerodynamics read; the right the mirror),
+    # rudder +-0.35 rad; the elevator's command scale is its larger end (0.35 rad, the b747's rule).
+    # Signs read from its aerodynamics: Cmde (-0.8 + 0.3 Mach) x elevator-pos (positive = trailing edge
+    # down), Clda (0.06 - 0.02 Mach) x left-aileron-pos (positive = left trailing edge down, roll
+    # right), Cndr -0.03 x rudder-pos (positive = trailing edge left, nose left); Cnda -0.02 x
+    # left-aileron-pos (adverse yaw: Cn_delta_a +0.02 in the project's sign, two thirds of its rudder's
+    # power). Its gear is left down as the model has it (its one gear term, CDgear 0.001 x
+    # gear-pos-norm, is then a constant). 45 kt (ic/vc-kts) at 3000 ft: 24.6-26.8 m/s TAS in the standard light
+    # flights, 2 x the stall (about 12.5 m/s EAS: CL_max 1.4 at 0.21 rad); the sweep flies 19.3-28 m/s
+    # (1.55 x the stall at its slowest) and alpha -0.7..4.7 deg. It sinks 0.8-1.5 m/s (lift-to-drag
+    # about 25: CD0 0.01, CDi 0.023 CL^2), so a 135-s flight from 3000 ft ends above 700 m.
+    # Pulses 0.7 / 0.8 / 1.3 s: its short period is fast and well damped (about 4 rad/s: Cmalpha
+    # -0.5, Cmq -9, Cmadot -12 with a heavy lift slope per unit mass), its Dutch roll slow (about
+    # 1.7 rad/s: Cnb 0.12 against Izz 2309 kg m^2), and a doublet's best pulse is about 2.3 / omega_n.
+    # Amplitudes: elevator 4 deg (Cmde -0.8 against Cmalpha -0.5: a degree of elevator holds 1.6 deg
+    # of alpha; 3 deg gave 1.23-1.28 deg of elevator standard deviation and alpha 0.3..2.2 deg, 1st-99th
+    # percentile, in the standard light flight; 4 deg -0.1..2.4), aileron 8 deg (Clda 0.06, a weak
+    # aileron: 10 deg took it to 19.5 deg of its 20 with Cl:alpha*beta = 3, which reverses its Clb -0.1
+    # above 1.9 deg of alpha; 8 deg to 17.5), rudder 8 deg (Cndr -0.03 against Cnb 0.12: a quarter of a
+    # degree of sideslip per degree). Default gains. Set from the harness's truth only (alpha, beta,
+    # rates, excitation per axis, gusts), never from a method result.
+    "sgs126": AircraftSpec(
+        name="sgs126", model="sgs126", airspeed_kts=45.0, altitude_ft=3000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(4.0, 8.0, 8.0), pulse_s=(0.7, 0.8, 1.3),
+        notes="Schweizer SGS 1-26 glider (JSBSim sgs126), flown at 3000 ft in JSBSim's light turbulence; "
+              "untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n")
-HELD_OUT_AIRCRAFT = ("rascal",)
-UNTOUCHED_AIRCRAFT = ("rascal",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal")
+HELD_OUT_AIRCRAFT = ("sgs126",)
+UNTOUCHED_AIRCRAFT = ("sgs126",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -1,6 +1,6 @@
 """The f4n in the JSBSim harness: the twelfth session's untouched aircraft (docs/jsbsim.md, "The f4n"),
 a tuning aircraft since its final evaluation was read (the thirteenth session's untouched one is the
-rascal, ``test_jsbsim_rascal.py``, where the summaries-label test moved).
+rascal, the fourteenth's the sgs126, ``test_jsbsim_sgs126.py``, where the summaries-label test moved).
 
 JSBSim's stock F-4N Phantom II (``F4N.xml``, Aeromatic v0.9 / David Culp, 2007), flown with its own
 flight control as the wheel ships it: direct surfaces (``systems/FCS-pitch.xml``, ``FCS-roll.xml``)

@@ -1,4 +1,5 @@
-"""The rascal in the JSBSim harness: the thirteenth session's untouched aircraft (docs/jsbsim.md, "The rascal").
+"""The rascal in the JSBSim harness: the thirteenth session's untouched aircraft, a tuning aircraft since its
+final evaluation (docs/jsbsim.md, "The rascal").
 
 The model is ArduPilot's SITL Rascal 110 (``Rascal110-JSBSim.xml``, based on FlightGear's Rascal110). It
 is the first model from outside the jsbsim wheel: the XML is checked in under
@@ -13,19 +14,18 @@ The checks here use the XML and JSBSim's own properties; none of them flies:
   fingerprint);
 - JSBSim then has no propulsion, and every non-gravity force is aerodynamic;
 - the FCS maps the commands straight to the surfaces the aerodynamics read, with no damper;
-- it is statically stable about the CG, and its aileron yaws it the way its ``Cnda`` says;
-- the summaries label it "(untouched)" and nothing else.
+- it is statically stable about the CG, and its aileron yaws it the way its ``Cnda`` says.
+
+The summaries' label test moved to ``test_jsbsim_sgs126.py`` (the fourteenth session's untouched aircraft).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
 map, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
 All of them but the names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the rascal: its first evaluation is the final one,
-after the merge.
+No pipeline fit, GP, diagnosis or scoring runs here.
 """
 
 import hashlib
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -127,30 +127,3 @@ def test_the_rascal_is_statically_stable_and_yaws_adversely():
     (n0, l0), (n1, l1) = cn(0.0), cn(0.4)
     assert (n1 - n0) / (l1 - l0) == pytest.approx(-0.03, rel=1e-6) and n0 == pytest.approx(0.0007, rel=1e-6)
 
-
-def test_summaries_mark_the_rascal_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the rascal "(untouched)" and
-    no other aircraft, the f4n and f16 included (synthetic rows: no rascal result exists before the
-    final evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| rascal (untouched) | light") for ln in lines)
-    for ac in acs[:9]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| rascal (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| f4n | clean |") for ln in lines)

@@ -81,6 +81,38 @@ def derivative_slopes(rec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return (slopes(Y[:, 4], [0, 3, 5]), slopes(Y[:, 3], [1, 2, 4, 6, 7]), slopes(Y[:, 5], [1, 2, 4, 6, 7]))
 
 
+def closure_slopes(rec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Slopes of the exact Cm, Cl, Cn on the regressors JSBSim's terms read (intercept fitted, not returned):
+    the body rates relative to the turbulent air (``p_aero q_aero r_aero``, what ``Clp Cmq Cnr`` read) made
+    dimensionless, and JSBSim's ``aero/alphadot-rad_sec`` rebuilt from the truth as JSBSim's
+    ``FGAuxiliary`` computes it: ``(u_a w_dot - w_a u_dot) / (u_a^2 + w_a^2)`` with the air-relative
+    ``u_a w_a`` and the time derivatives of the body velocity over the ground (so without the gusts' own
+    rate). :func:`derivative_slopes` uses the inertial rates and no alpha-dot; in light turbulence at
+    3000 ft the sgs126's alpha-dot term (Cmadot -12, larger than its Cmq -9) and the gusts' rotation turn
+    the sign of its Cm_alpha and halve its Cl_beta on a 30-s flight, while this fit closes on JSBSim's
+    numbers (Cl and Cn to 1e-6).
+
+    Args:
+        rec: a harness ``Recording``.
+
+    Returns:
+        ``(cm, cl, cn)``: Cm on (alpha, q_aero_hat, delta_e, alpha_dot_hat); Cl and Cn each on (beta,
+        p_aero_hat, r_aero_hat, delta_a, delta_r); 1/rad.
+    """
+    tr, c, b = rec.truth, rec.constants["c"], rec.constants["b"]
+    V, al, be = tr["V"], tr["alpha"], tr["beta"]
+    ua, wa = V * np.cos(al) * np.cos(be), V * np.sin(al) * np.cos(be)
+    adot = (ua * np.gradient(tr["w"], rec.t) - wa * np.gradient(tr["u"], rec.t)) / (ua**2 + wa**2)
+    Y = truth_coefficients(rec)
+
+    def slopes(y, *cols):
+        return np.linalg.lstsq(np.column_stack((np.ones(len(y)),) + cols), y, rcond=None)[0][1:]
+
+    lat = (be, tr["p_aero"] * b / (2 * V), tr["r_aero"] * b / (2 * V), tr["delta_a"], tr["delta_r"])
+    return (slopes(Y[:, 4], al, tr["q_aero"] * c / (2 * V), tr["delta_e"], adot * c / (2 * V)),
+            slopes(Y[:, 3], *lat), slopes(Y[:, 5], *lat))
+
+
 def servo_against_truth(flight, files) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The logged servo PWM mapped back to deflections, next to the truth's, per surface.
 
