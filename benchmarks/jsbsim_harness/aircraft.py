@@ -388,7 +388,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # gear-pos-norm, is then a constant). 45 kt (ic/vc-kts) at 3000 ft: 24.6-26.8 m/s TAS in the standard light
     # flights, 2 x the stall (about 12.5 m/s EAS: CL_max 1.4 at 0.21 rad); the sweep flies 19.3-28 m/s
     # (1.55 x the stall at its slowest) and alpha -0.7..4.7 deg. It sinks 0.8-1.5 m/s (lift-to-drag
-    # about 25: CD0 0.01, CDi 0.023 CL^2), so a 135-s flight from 3000 ft ends above 700 m.
+    # about 28: CD0 0.01, CDi 0.023 CL^2), so a 135-s flight from 3000 ft ends above 700 m.
     # Pulses 0.7 / 0.8 / 1.3 s: its short period is fast and well damped (about 4 rad/s: Cmalpha
     # -0.5, Cmq -9, Cmadot -12 with a heavy lift slope per unit mass), its Dutch roll slow (about
     # 1.7 rad/s: Cnb 0.12 against Izz 2309 kg m^2), and a doublet's best pulse is about 2.3 / omega_n.
