@@ -84,7 +84,10 @@ def search_flight(tlog: Path, model: dict, reference, airframe: Path, cache: Pat
     if true_alpha:
         table.X[:, 0] = np.interp(table.t, truth["t"], truth["alpha"])
     ctx = DiagContext.build(table, af, model, states)
-    res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, thresholds=thresholds, keep_residual=True)
+    from gcs_sysid.diagnose.core import _angle_sigma
+
+    res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, thresholds=thresholds, keep_residual=True,
+                        angle_sigma=_angle_sigma(states, ctx.t))
     res["alpha_error"] = _alpha_error(table, truth)
     return res, ctx, truth, injected
 

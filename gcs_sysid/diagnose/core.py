@@ -196,6 +196,17 @@ def _differential_gains(ctx: DiagContext, R0: np.ndarray, proj, inadequacy: np.n
         fd["gain"] = dict(new[fd["cause"]], rows=fd.get("gain", {}).get("rows", "held out"))
 
 
+def _angle_sigma(states, t: np.ndarray) -> dict | None:
+    """The estimator's stated per-sample 1-sigma of alpha and beta (``FlightStates.sigma``, rad) on the grid ``t``
+    (T,), ``{"alpha": (T,), "beta": (T,)}`` (NaN where not stated); None without states or sigma. Read by the sparse
+    search's errors-in-variables correction (``sparse.THRESHOLDS["errors_in_variables"]``)."""
+    sig = getattr(states, "sigma", None) if states is not None else None
+    if not sig or not any(k in sig for k in ("alpha", "beta")):
+        return None
+    st = np.asarray(states.t, float)
+    return {k: np.interp(t, st, np.asarray(sig[k], float)) for k in ("alpha", "beta") if k in sig}
+
+
 def _finding(f: Fitted, rivals: list[Fitted]) -> dict:
     main = f.coefficient
     ev = {"score": float(f.score), "t_statistic": float(f.estimate / f.std_error) if f.std_error > 0 else None,
@@ -420,7 +431,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                            getattr(states, "angle_fits", None),
                                            getattr(search_reference[1], "angle_fits", None)
                                            if isinstance(search_reference, tuple) else None),
-                                       model=model0)
+                                       model=model0, angle_sigma=_angle_sigma(states, ctx.t))
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)
         data["sparse"].pop("rows", None)

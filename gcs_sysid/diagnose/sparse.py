@@ -137,7 +137,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "delay_differential": True, "side_force_wind_axis": True, "delay_reference_same_fit": True,
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
-              "force_moment_arm_max": 0.1}
+              "force_moment_arm_max": 0.1, "errors_in_variables": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -623,7 +623,8 @@ def scale_columns(M: np.ndarray, X: np.ndarray, wind_axis: bool = True) -> np.nd
 def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext, np.ndarray] | None = None,
                   folds: int = 5, segment_frac: float = 0.2, max_rows: int = 4000,
                   thresholds: dict | None = None, keep_residual: bool = False,
-                  angle_uncertainty: dict | None = None, model: dict | None = None) -> dict:
+                  angle_uncertainty: dict | None = None, model: dict | None = None,
+                  angle_sigma: dict | None = None) -> dict:
     """Search each coefficient's residual for new terms; differential when a reference is given.
 
     Args:
@@ -833,8 +834,66 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk])
+    if th.get("errors_in_variables", False) and angle_sigma:
+        Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
+        for f in named:
+            if f["cause"] in at_naming:
+                _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
     result["findings"] = named
     return result
+
+
+def _with_errors_in_variables(f: dict, names: list[str], Phi: np.ndarray, X: np.ndarray, r: np.ndarray,
+                              tr: np.ndarray, angle_sigma: dict) -> None:
+    """Re-estimate a named library term with moments corrected for the air angles' stated error (in place).
+
+    :func:`gcs_sysid.diagnose.eiv.corrected_fit` on the same selected terms, residual and training rows as the
+    search's fit. The finding's ``estimate`` becomes ``model_value + corrected change`` and its reported
+    ``std_error`` is scaled by ``|corrected / least-squares change|`` (first order: the corrected estimate is the
+    least-squares one through ``G``, every component of the uncertainty scales alike). What the diagnosis
+    *decides* is left as it was: ``evidence.correction`` keeps the least-squares change and
+    ``evidence.std_error_decision`` its standard error, which the differential step compares with the same
+    uncorrected fit on the reference flight; the gain stays the least-squares fit's (the least-squares
+    coefficient is the best linear predictor from the measured angles, which is what a gain on this flight
+    measures). ``evidence.errors_in_variables`` holds the least-squares and corrected changes, the factor and
+    the reliabilities.
+
+    Args:
+        f: the finding. names, Phi: (K,), (T, K) the library the search fitted. X: (T, 10) its regressors.
+        r: (T,) the residual the term was fitted on. tr: training rows. angle_sigma: see :func:`sparse_search`.
+    """
+    from .eiv import corrected_fit
+
+    if f["cause"].startswith(("scale:", "delay:")):
+        return
+    terms = [t["term"] for t in f["evidence"].get("terms", [])]
+    named = f["cause"].split(":", 1)[1]
+    idx = {n: k for k, n in enumerate(names)}
+    if named not in terms or not all(t in idx for t in terms) or tr.size < 50:
+        return
+    i = 1 + terms.index(named)
+    y = np.nan_to_num(r[tr] - r[tr].mean())
+    var = {k: np.nan_to_num(np.asarray(v, float)[tr]) ** 2 for k, v in angle_sigma.items() if v is not None}
+    try:
+        res = corrected_fit(terms, Phi[tr][:, [idx[t] for t in terms]], y, np.nan_to_num(X[tr]), var)
+    except (ValueError, np.linalg.LinAlgError):
+        return
+    ls, ce = float(res["theta_ls"][i]), float(res["theta"][i])
+    info = {"applied": bool(res["applied"]), "change_least_squares": ls, "change_corrected": ce,
+            "reliability": [float(x) for x in res["reliability"]], "why": res["why"],
+            "stated_sigma_rad": {k: float(np.sqrt(np.mean(v))) for k, v in var.items()},
+            "method": "Fuller 1987 ch. 2 corrected normal equations, Hermite corrected scores for powers "
+                      "and products (Cheng and Schneeweiss 1998), the estimator's stated angle variance"}
+    f["evidence"]["errors_in_variables"] = info
+    if not res["applied"] or ls == 0 or not np.isfinite(ce):
+        return
+    factor = ce / ls
+    info["factor"] = float(factor)
+    mv = float(f.get("model_value", 0.0))
+    f["evidence"].setdefault("correction", float(f["estimate"]) - mv)
+    f["evidence"].setdefault("std_error_decision", float(f["std_error"]))
+    f["estimate"] = float(f["estimate"]) + (ce - ls)
+    f["std_error"] = float(f["std_error"]) * abs(factor)
 
 
 def _with_reference_error(f: dict, ref_after) -> None:
