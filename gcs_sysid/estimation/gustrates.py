@@ -23,13 +23,14 @@ gradient averaged over the span and tail length. Three frames are offered (:data
   ``ttMilspec``, its eq. 35: ``xi_r`` the ``3b`` filter of ``+d xi_v/dt / V``) agree in sign; on the pitch
   axis JSBSim steps ``xi_q`` with ``+d xi_w/dt / V`` (its eq. 34, ``xi_w`` the gust down), the opposite
   of Etkin's ``q_g = -dw_g/dx``, and the estimate from the reconstructed vertical gust (a derivative of
-  an alpha-limited ``w_g``) carries as much error as signal on the JSBSim flights
-  (``docs/benchmarks.md``, "Fourteenth session, i8-rotgust").
+  an alpha-limited ``w_g``) carries as much error as signal on the rascal's JSBSim flights (0.96-2.45
+  of it even with JSBSim's sign; ``docs/benchmarks.md``, "Fourteenth session, i8-rotgust").
 * ``"mean-wind"``: the low-altitude model's axes (MIL-F-8785C sec. 3.7.2 and MIL-HDBK-1797
   below 1000 ft: turbulence axes aligned with the mean wind), the form JSBSim's ``ttMilspec``
   source describes (``FGWinds::Turbulence``, eqs. 34-35 of its Yeager 1998 formulation; the rates
   measured from JSBSim 1.3.3 follow its filters and signs but not these axes, ``docs/benchmarks.md``,
-  "Gust rates"): ``w_g`` the
+  "Gust rates"; JSBSim turns its turbulence by the mirror of the wind azimuth, ``xi_u`` along ``-psiw``,
+  ``docs/benchmarks.md``, "Fourteenth session, i8-rotgust"): ``w_g`` the
   vertical gust and ``v_g`` the gust across the mean wind, ``s_q = s_r = +1``, the rate vector
   ``(0, q_g, r_g)`` in the wind frame rotated to NED by the mean wind's azimuth and to body axes
   (a mean wind under :data:`MIN_MEAN_WIND` has no direction: north is taken, as JSBSim keeps its
@@ -153,7 +154,7 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
                          "(MIL-F-8785C Dryden form, Etkin's signs)")
         else:
             notes.append("q_g = 0: the pitch gust rate is not removed (its sign differs between Etkin and "
-                         "JSBSim, and the vertical gust's derivative is too noisy)")
+                         "JSBSim, and the vertical gust's derivative, from alpha, is as noisy as its signal on a slow UAV)")
             notes.append("r_g = +(s/V)/(1+3b s/(pi V)) v_g in body axes (MIL-F-8785C Dryden form; Etkin's "
                          "sign, which JSBSim's shares)")
     else:
