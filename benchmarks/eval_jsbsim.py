@@ -319,7 +319,7 @@ def main(argv=None) -> int:
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
-    ap.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+    ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")

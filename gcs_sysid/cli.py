@@ -72,7 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="recorded CAN log (.log/.asc/.blf/.csv): DroneCAN actuator positions and airspeed (docs/live.md)")
     r.add_argument("--can-offset", type=float, default=None, metavar="S",
                    help="seconds added to the CAN log's times (default 0 with a .tlog; required with a .bin)")
-    r.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+    r.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                    help="p_hat q_hat r_hat relative to the air: minus the gust rates estimated from the "
                         "reconstructed gusts in this frame (default: the gyro's inertial rates; docs/estimation.md)")
     r.add_argument("--quiet", action="store_true", help="no progress display")
@@ -92,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("log")
     f.add_argument("--airframe", required=True)
     f.add_argument("--out", required=True, help="output model TOML file")
-    f.add_argument("--gust-rates", default=None, choices=("path", "mean-wind"),
+    f.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                    help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates)")
     _window_args(f)
 

@@ -13,16 +13,24 @@ velocities, which this module applies to the reconstructed gusts::
     r_g = s_r * (s / V) / (1 + (3 b / (pi V)) s) * v_g          (MIL-F-8785C eq. for r_g)
 
 The standard leaves the signs open (``q_g = +-``, ``r_g = -+``); the first-order lag stands for the
-gradient averaged over the span and tail length. Two frames are offered (:data:`FRAMES`):
+gradient averaged over the span and tail length. Three frames are offered (:data:`FRAMES`):
 
 * ``"path"`` (physical; Etkin): body axes, ``w_g`` and ``v_g`` the gust's body z and y components,
   the derivative taken of the NED gust and rotated into body axes (a steady wind seen from a
   rotating body is no gradient), ``s_q = -1``, ``s_r = +1``.
+* ``"path-yaw"``: ``"path"`` on the yaw axis only, ``q_g = p_g = 0``. The yaw axis is the one where
+  the physical relation (Etkin: ``r_g = +dv_g/dx``) and JSBSim's turbulence model (``FGWinds::Turbulence``,
+  ``ttMilspec``, its eq. 35: ``xi_r`` the ``3b`` filter of ``+d xi_v/dt / V``) agree in sign; on the pitch
+  axis JSBSim steps ``xi_q`` with ``+d xi_w/dt / V`` (its eq. 34, ``xi_w`` the gust down), the opposite
+  of Etkin's ``q_g = -dw_g/dx``, and the estimate from the reconstructed vertical gust (a derivative of
+  an alpha-limited ``w_g``) carries as much error as signal on the rascal's JSBSim flights (0.96-2.45
+  of it even with JSBSim's sign; ``docs/benchmarks.md``, "Fourteenth session, i8-rotgust").
 * ``"mean-wind"``: the low-altitude model's axes (MIL-F-8785C sec. 3.7.2 and MIL-HDBK-1797
   below 1000 ft: turbulence axes aligned with the mean wind), the form JSBSim's ``ttMilspec``
   source describes (``FGWinds::Turbulence``, eqs. 34-35 of its Yeager 1998 formulation; the rates
   measured from JSBSim 1.3.3 follow its filters and signs but not these axes, ``docs/benchmarks.md``,
-  "Gust rates"): ``w_g`` the
+  "Gust rates"; JSBSim turns its turbulence by the mirror of the wind azimuth, ``xi_u`` along ``-psiw``,
+  ``docs/benchmarks.md``, "Fourteenth session, i8-rotgust"): ``w_g`` the
   vertical gust and ``v_g`` the gust across the mean wind, ``s_q = s_r = +1``, the rate vector
   ``(0, q_g, r_g)`` in the wind frame rotated to NED by the mean wind's azimuth and to body axes
   (a mean wind under :data:`MIN_MEAN_WIND` has no direction: north is taken, as JSBSim keeps its
@@ -43,7 +51,7 @@ import numpy as np
 
 __all__ = ["FRAMES", "MIN_MEAN_WIND", "GustRates", "gust_rates", "lag_filter"]
 
-FRAMES = ("path", "mean-wind")   #: frames of :func:`gust_rates`
+FRAMES = ("path", "path-yaw", "mean-wind")   #: frames of :func:`gust_rates`
 MIN_MEAN_WIND = 1.0              #: m/s; below it the mean wind has no direction and ``"mean-wind"`` takes north
 
 
@@ -54,7 +62,7 @@ class GustRates:
     Attributes:
         rates: ``(T, 3)`` ``p_g q_g r_g`` in rad/s (``p_g`` is 0: not observable); NaN where the
             inputs are not finite.
-        frame: ``"path"`` or ``"mean-wind"``.
+        frame: one of :data:`FRAMES`.
         mean_wind: ``(2,)`` the mean horizontal wind (N, E) in m/s used by ``"mean-wind"``.
         notes: one-line statements of what was done and what is missing.
     """
@@ -106,7 +114,7 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
             (``FlightStates`` ``wn we wd`` after the specific-force aiding).
         V: true airspeed of shape ``(T,)``, m/s.
         b: wing span, m (the lag's time constants ``4b/(pi V)``, ``3b/(pi V)``).
-        frame: ``"path"`` or ``"mean-wind"`` (module docstring).
+        frame: ``"path"``, ``"path-yaw"`` (``r_g`` alone) or ``"mean-wind"`` (module docstring).
 
     Returns:
         :class:`GustRates`.
@@ -137,12 +145,18 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
     notes = ["p_g = 0: the span-wise gust gradient is not observable from one point's air data "
              "(a filter-error method would estimate it from the roll moment)"]
     rates = np.zeros((T, 3))
-    if frame == "path":
+    if frame in ("path", "path-yaw"):
         db = np.einsum("tji,tj->ti", np.where(np.isfinite(C), C, 0.0), wdot) / Vs[:, None]   # d/dx of the gust, body axes
-        rates[:, 1] = -lag_filter(dt, db[:, 2], tau_q)       # q_g = -dw_g/dx
         rates[:, 2] = lag_filter(dt, db[:, 1], tau_r)        # r_g = +dv_g/dx
-        notes.append("q_g = -(s/V)/(1+4b s/(pi V)) w_g, r_g = +(s/V)/(1+3b s/(pi V)) v_g in body axes "
-                     "(MIL-F-8785C Dryden form, Etkin's signs)")
+        if frame == "path":
+            rates[:, 1] = -lag_filter(dt, db[:, 2], tau_q)   # q_g = -dw_g/dx
+            notes.append("q_g = -(s/V)/(1+4b s/(pi V)) w_g, r_g = +(s/V)/(1+3b s/(pi V)) v_g in body axes "
+                         "(MIL-F-8785C Dryden form, Etkin's signs)")
+        else:
+            notes.append("q_g = 0: the pitch gust rate is not removed (its sign differs between Etkin and "
+                         "JSBSim, and the vertical gust's derivative, from alpha, is as noisy as its signal on a slow UAV)")
+            notes.append("r_g = +(s/V)/(1+3b s/(pi V)) v_g in body axes (MIL-F-8785C Dryden form; Etkin's "
+                         "sign, which JSBSim's shares)")
     else:
         psiw = float(np.arctan2(mean[1], mean[0])) if np.hypot(*mean) >= MIN_MEAN_WIND else 0.0
         cw, sw = np.cos(psiw), np.sin(psiw)

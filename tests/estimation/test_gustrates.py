@@ -98,3 +98,17 @@ def test_rows_without_airspeed_are_nan():
     V_[50:60] = np.nan
     G = gust_rates(DT, dcm(t * 0, t * 0, t * 0), np.zeros((200, 3)), V_, B)
     assert np.isnan(G.rates[50:60]).all() and np.isfinite(G.rates[:50]).all() and np.isfinite(G.rates[60:]).all()
+
+
+def test_path_yaw_frame_keeps_r_g_and_leaves_q_g_at_zero():
+    t = _grid()
+    wind = np.zeros((len(t), 3))
+    wind[:, 1] = np.sin(2 * np.pi * 0.2 * t)          # a lateral gust (east = body y heading north)
+    wind[:, 2] = 1.5 * np.sin(2 * np.pi * 0.3 * t)    # and a vertical one
+    C = dcm(np.zeros_like(t), np.zeros_like(t), np.zeros_like(t))
+    full = gust_rates(DT, C, wind, np.full(len(t), V), B, "path")
+    yaw = gust_rates(DT, C, wind, np.full(len(t), V), B, "path-yaw")
+    np.testing.assert_array_equal(yaw.rates[:, 2], full.rates[:, 2])
+    assert np.max(np.abs(full.rates[:, 1])) > 0.01
+    assert np.all(yaw.rates[:, :2] == 0.0)
+    assert any("q_g = 0" in n for n in yaw.notes)
