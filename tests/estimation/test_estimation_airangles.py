@@ -264,6 +264,7 @@ def test_alpha_slopes_are_fitted_above_the_heave_corner(monkeypatch):
     import gcs_sysid.estimation.airangles as aa
 
     args, alpha, f_h = _riding_record(1)
+    monkeypatch.setattr(aa, "HEAVE_EDGE", 1.0)         # opt-in
     res = aided_air_angles(*args)
     fa = res.axes[0]
     assert fa.used, describe(res)
@@ -280,15 +281,18 @@ def test_alpha_slopes_are_fitted_above_the_heave_corner(monkeypatch):
 
 
 def test_heavy_aircraft_keep_the_fixed_band(monkeypatch):
-    """A corner below HIGHPASS_HZ (the 1000-kg record: 0.27 Hz) leaves the aiding exactly as before."""
+    """A corner below HIGHPASS_HZ (the 1000-kg record: 0.27 Hz) leaves the aiding exactly as without the heave edge,
+    and the default (``HEAVE_EDGE = None``) is the fixed band."""
     import gcs_sysid.estimation.airangles as aa
 
     assert abs(aa.lift_slope(8.0) - 4.90) < 0.01 and abs(aa.lift_slope(1e6) / (2 * np.pi) - 1) < 1e-3
     assert np.isnan(aa.lift_slope(0.0))
-    assert aa.heave_edge_hz(5.0, 0.1) == aa.HIGHPASS_HZ and aa.heave_edge_hz(5.0, 100.0) == aa.MAX_EDGE_HZ
+    assert aa.heave_edge_hz(5.0, 0.1, 1.0) == aa.HIGHPASS_HZ and aa.heave_edge_hz(5.0, 100.0, 1.0) == aa.MAX_EDGE_HZ
+    assert aa.HEAVE_EDGE is None and aa.heave_edge_hz(5.0, 100.0) == aa.HIGHPASS_HZ
     rec, _, _ = _record()
+    monkeypatch.setattr(aa, "HEAVE_EDGE", 1.0)         # opt-in
     new = _run(rec)
-    monkeypatch.setattr(aa, "HEAVE_EDGE", None)
+    monkeypatch.setattr(aa, "HEAVE_EDGE", None)        # the default
     old = _run(rec)
     assert new.axes[0].band_hz == aa.HIGHPASS_HZ
     np.testing.assert_array_equal(new.alpha, old.alpha)
