@@ -67,8 +67,8 @@ MIN_SEGMENT_S = 5.0   #: shortest contiguous record that is aided, s
 MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
 MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, Hz
 HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz (at least; see HEAVE_EDGE)
-#: alpha's slopes are fitted above ``max(HIGHPASS_HZ, HEAVE_EDGE x f_heave)``, ``f_heave = qbar S |CZ_alpha| /
-#: (2 pi m V)`` the heave (plunge) mode's corner, below which the aircraft rides the vertical gust and the
+#: alpha's slopes are fitted above ``max(HIGHPASS_HZ, HEAVE_EDGE x f_heave)``, ``f_heave = qbar S CL_alpha /
+#: (2 pi m V)`` (``CL_alpha`` the wing's, :func:`lift_slope`) the heave (plunge) mode's corner, below which the aircraft rides the vertical gust and the
 #: kinematic alpha's gust error correlates with the kinematic alpha (errors in variables; ``docs/estimation.md``,
 #: "The slopes' band and the heave mode"). None (the default): the fixed :data:`HIGHPASS_HZ`. Opt-in (1.0: the
 #: corner itself): measured better on the rascal (aided alpha's error SD 0.11-0.14 -> 0.035-0.046 deg in light
