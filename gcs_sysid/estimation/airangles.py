@@ -66,7 +66,17 @@ MIN_T_STAT = 8.0      #: |CY_beta|, |CZ_alpha| must exceed this many standard er
 MIN_SEGMENT_S = 5.0   #: shortest contiguous record that is aided, s
 MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
 MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, Hz
-HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz
+HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz (at least; see HEAVE_EDGE)
+#: alpha's slopes are fitted above ``max(HIGHPASS_HZ, HEAVE_EDGE x f_heave)``, ``f_heave = qbar S CL_alpha /
+#: (2 pi m V)`` (``CL_alpha`` the wing's, :func:`lift_slope`) the heave (plunge) mode's corner, below which the aircraft rides the vertical gust and the
+#: kinematic alpha's gust error correlates with the kinematic alpha (errors in variables; ``docs/estimation.md``,
+#: "The slopes' band and the heave mode"). None (the default): the fixed :data:`HIGHPASS_HZ`. Opt-in (1.0: the
+#: corner itself): measured better on the rascal (aided alpha's error SD 0.11-0.14 -> 0.035-0.046 deg in light
+#: turbulence; issue 9's ``Cm:alpha^2`` named 0/6 -> 4/6), but on the project's sim trainer (corner 1.5 Hz) the
+#: diagnosis then names ``bias:airspeed`` before ``wind`` in tests/diagnose/test_diagnose_e2e.py: its ranking was
+#: set with the old alpha (as for :data:`INSTRUMENTED_SLOPES`).
+HEAVE_EDGE: float | None = None
+MAX_EDGE_HZ = 2.0     #: the heave edge is capped here (the manoeuvres' band, 0.1-1.5 Hz, must stay in reach), Hz
 SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
 SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
 MEAN_BLOCK_S = 5.0    #: block length for the standard error of the CY constant (correlated residuals), s
@@ -126,6 +136,8 @@ class AxisFit:
             Kuensch 1989): :attr:`scale_sigma`'s rule on every column. Common to the flight, so it cancels
             at the flight's own regressors and belongs to the band at exact conditions only. Empty where
             not aided.
+        band_hz: the edge, Hz, above which the slopes were fitted (:data:`HIGHPASS_HZ`, or for alpha the heave
+            mode's corner where higher: :func:`heave_edge_hz`).
     """
 
     name: str
@@ -148,6 +160,7 @@ class AxisFit:
     scale_sigma: float = float("nan")
     map_columns: tuple[str, ...] = ()
     map_cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    band_hz: float = HIGHPASS_HZ
 
 
 @dataclass
@@ -199,15 +212,59 @@ def _moment_rss(angle: np.ndarray, X_other: np.ndarray, moments: list[np.ndarray
     return float(np.mean(out))
 
 
-def _highpass(dt: float, X: np.ndarray, segs: list[slice]) -> np.ndarray:
-    """Zero-phase second-order Butterworth high-pass at :data:`HIGHPASS_HZ` of the columns of ``X``
-    (T, P) on each segment (NaN elsewhere)."""
-    sos = butter(2, HIGHPASS_HZ, btype="highpass", fs=1.0 / dt, output="sos")
+def _highpass(dt: float, X: np.ndarray, segs: list[slice], edge_hz: float | None = None) -> np.ndarray:
+    """Zero-phase second-order Butterworth high-pass at ``edge_hz`` (None: :data:`HIGHPASS_HZ`) of the
+    columns of ``X`` (T, P) on each segment (NaN elsewhere)."""
+    edge = HIGHPASS_HZ if edge_hz is None else float(edge_hz)
+    sos = butter(2, edge, btype="highpass", fs=1.0 / dt, output="sos")
     out = np.full(X.shape, np.nan)
     for sg in segs:
         out[sg] = sosfiltfilt(sos, X[sg] - X[sg].mean(axis=0), axis=0, padtype="odd",
-                              padlen=min(3 * int(1.0 / (HIGHPASS_HZ * dt)), sg.stop - sg.start - 1))
+                              padlen=min(3 * int(1.0 / (edge * dt)), sg.stop - sg.start - 1))
     return out
+
+
+def lift_slope(aspect_ratio: float) -> float:
+    """The finite wing's lift-curve slope, 1/rad: Helmbold's formula for an unswept wing,
+    ``2 pi A / (2 + sqrt(A^2 + 4))`` (USAF DATCOM sec. 4.1.3.2 with no sweep, section slope ``2 pi``, Mach 0;
+    Anderson, *Fundamentals of Aerodynamics*, 5th ed., 2011, sec. 5.3). 4.9 for ``A`` = 8 (the rascal), 3.6 for 3.3
+    (the f16). Used only for the heave mode's corner (:func:`heave_edge_hz`), where a 20 % error moves the edge
+    by 20 %. NaN for a non-positive or non-finite ``A``."""
+    if not np.isfinite(aspect_ratio) or aspect_ratio <= 0:
+        return float("nan")
+    return float(2.0 * np.pi * aspect_ratio / (2.0 + np.sqrt(aspect_ratio**2 + 4.0)))
+
+
+def heave_edge_hz(slope: float, heave_gain: float, factor: float | None = None) -> float:
+    """The band edge above which the alpha model's slopes are fitted: ``max(HIGHPASS_HZ, factor x f_heave)``.
+
+    The heave (plunge) mode of an aircraft hit by a vertical gust is first order with the rate
+    ``|Z_w| = qbar S |CZ_alpha| / (m V)`` (Etkin, *Dynamics of Atmospheric Flight*, 1972, sec. 13.6, the
+    response to a vertical gust; the CD term neglected). Below its corner ``f_heave = |Z_w| / (2 pi)`` the
+    aircraft rides the gust: the true alpha barely moves, while the kinematic alpha (the inertial angle)
+    takes the whole gust with the opposite sign, so in that band its error is correlated with the
+    kinematic alpha itself, and least squares on it attenuates ``CZ_alpha`` and hands the rest to the
+    correlated columns (``q_hat``). Above the corner the gust is an uncorrelated error with a falling
+    spectrum. 0.3-0.4 Hz for the light aircraft at 50 m/s, 0.1-0.25 Hz for the fast and heavy ones, 1.3 Hz
+    for the 6.6-kg rascal at 21 m/s.
+
+    The slope is the wing's, from its aspect ratio (:func:`lift_slope`), not the flight's fitted ``CZ_alpha``:
+    that is the attenuated one (on the rascal -2.3..-2.7 in light and -1.0..-1.1 per rad in moderate turbulence
+    against JSBSim's -5.0), and an edge set from it stays below the corner.
+
+    Args:
+        slope: the lift-curve slope, 1/rad (its magnitude is used). heave_gain: ``qbar S / (m V)``, 1/s (the
+            flight's median). factor: multiple of ``f_heave`` (None: :data:`HEAVE_EDGE`; None there too: the
+            fixed edge).
+
+    Returns:
+        The edge, Hz, in ``[HIGHPASS_HZ, max(HIGHPASS_HZ, MAX_EDGE_HZ)]``.
+    """
+    k = HEAVE_EDGE if factor is None else factor
+    if k is None or not np.isfinite(slope) or not np.isfinite(heave_gain) or heave_gain <= 0:
+        return HIGHPASS_HZ
+    f_h = k * abs(slope) * heave_gain / (2.0 * np.pi)
+    return float(min(max(HIGHPASS_HZ, f_h), max(HIGHPASS_HZ, MAX_EDGE_HZ)))
 
 
 def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, ...],
@@ -254,7 +311,8 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
-          V: np.ndarray | None = None, given: AxisFit | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None
+          ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -265,7 +323,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     squares, :mod:`.angleerrors`; None or too weak: ordinary least squares); ``V`` (T,) airspeed, m/s: with
     it the alpha axis gets the 1-sigma of its flight-common offset (the mean vertical wind); ``given``: another
     flight's fit of this axis whose slopes are used instead of fitting them here (the constant is still this
-    flight's), when its columns are this flight's (:func:`aided_air_angles`, ``models``)."""
+    flight's), when its columns are this flight's (:func:`aided_air_angles`, ``models``); ``band_hz``: the edge
+    above which the slopes are fitted, Hz (at least :data:`HIGHPASS_HZ`; alpha: :func:`heave_edge_hz`), None:
+    :data:`HIGHPASS_HZ`."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -296,13 +356,16 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                           f"({', '.join(names[1:])}): slopes fitted here")
     nq = 2 if quadratic else 1
     fit = None
+    edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
     X_other = np.column_stack([others[k] for k in cols]) if cols else np.zeros((len(kin), 0))
     for _ in range(passes):
         A = np.column_stack([ang] + ([(ang - ctr) ** 2] if quadratic else []) + [X_other])
-        # slopes from the band above HIGHPASS_HZ, where the kinematic angle is good (its gust errors are
-        # slow: the turbulence scale over the airspeed); the constant from the full band with them fixed
-        Ah, yh = _highpass(dt, A, segs), _highpass(dt, coeff[:, None], segs)[:, 0]
+        # slopes from the band above the edge (HIGHPASS_HZ, or for alpha the heave mode's corner where that is
+        # higher: heave_edge_hz), where the kinematic angle is good (its gust errors are slow: the turbulence
+        # scale over the airspeed; and below the heave corner the aircraft rides the gust); the constant from
+        # the full band with them fixed
+        Ah, yh = _highpass(dt, A, segs, edge), _highpass(dt, coeff[:, None], segs, edge)[:, 0]
         method, fs_r2 = "OLS", float("nan")
         if fixed is not None:
             cr, csr, method = fixed, np.full(len(fixed), np.nan), "given"
@@ -310,7 +373,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         elif instruments is not None:
             # errors in variables: the kinematic angle misses the gust, and the aircraft's answer to the gust
             # correlates the two; instruments that move the angle but not the air give a consistent slope
-            Zh = _highpass(dt, instruments, segs)
+            Zh = _highpass(dt, instruments, segs, edge)
             cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], [0], Zh[m])
             method = "2SLS"
             if not fs_r2 >= MIN_FIRST_STAGE_R2:
@@ -362,7 +425,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         sig = gs
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
             np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift,
-            shift_note if fit is None else fit.shift_note, slope_method=method, first_stage_r2=fs_r2)
+            shift_note if fit is None else fit.shift_note, slope_method=method, first_stage_r2=fs_r2,
+            band_hz=edge)
     if fit is not None and given_note:
         fit.slope_method = f"{fit.slope_method}: {given_note}"
     if fit is not None and V is not None:
@@ -529,8 +593,12 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     de = get("delta_e")
     on = INSTRUMENTED_SLOPES if instrument_slopes is None else instrument_slopes
     inst = lagged_instruments(dt, de) if on and np.nanstd(de[u]) > 1e-9 and np.isfinite(de[u]).all() else None
+    with np.errstate(invalid="ignore", divide="ignore"):
+        hg = qbar * S / (mass * Vs)          # heave mode's rate per unit |CZ_alpha|, 1/s (heave_edge_hz)
+    hg = float(np.nanmedian(hg[u])) if np.isfinite(hg[u]).any() else float("nan")
+    edge = heave_edge_hz(lift_slope(b * b / S), hg)
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
-                         (models or {}).get("alpha"))
+                         (models or {}).get("alpha"), band_hz=edge)
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
@@ -558,6 +626,7 @@ def describe(res: AidedAngles) -> list[str]:
                    + (f"; {ax.shift_note}" if ax.shift_note else "")
                    + (f"; slopes by {ax.slope_method}" + (f" (first-stage R2 {ax.first_stage_r2:.2f})"
                                                           if np.isfinite(ax.first_stage_r2) else ""))
+                   + f" above {ax.band_hz:.2f} Hz"
                    + (f"; offset common to the flight (mean vertical wind, not observable) 1-sigma "
                       f"{np.degrees(ax.bias_sigma):.2f} deg, included in sigma" if np.isfinite(ax.bias_sigma) else ""))
     return out

@@ -222,3 +222,77 @@ def test_another_flights_force_model_sets_the_alpha_scale():
     np.testing.assert_allclose(fo.coef, own.coef)
     assert "not this flight's" in fo.slope_method
     assert "slopes by given: slopes of the given model" in describe(res)[0]
+
+
+def _riding_record(seed: int, duration: float = 120.0):
+    """A 3-kg, 2-m UAV at 18 m/s (the heave mode's corner at 1.5 Hz) in a slow vertical gust (Dryden scale
+    533 m, 3 deg): below the corner it rides the gust (the kinematic alpha takes the low-passed gust with the
+    opposite sign), the true alpha keeps the rest; the manoeuvre's alpha is a 2-Hz short period's answer to a
+    square-wave elevator. Returns the arguments of ``aided_air_angles``, the true alpha and the corner, Hz."""
+    from scipy.signal import bilinear, lfilter
+
+    rng = np.random.default_rng(seed)
+    T = int(duration / DT)
+    t = np.arange(T) * DT
+    mass, S_, b_, c_, V0, rho, cla = 3.0, 0.55, 2.0, 0.28, 18.0, 1.2, 4.8
+    V = np.full(T, V0)
+    qbar = 0.5 * rho * V**2
+    w_h = qbar[0] * S_ * cla / (mass * V0)                 # heave rate, rad/s
+    phi = np.exp(-DT * V0 / 533.4)
+    g = lfilter([np.sqrt(1 - phi**2)], [1, -phi], rng.normal(0, np.radians(3.0), T))
+    a = np.exp(-w_h * DT)
+    g_lp = lfilter([1 - a], [1, -a], g)                     # the part of the gust the aircraft rides
+    d_e = np.radians(2.0) * np.sign(np.sin(2 * np.pi * 0.4 * t)) + np.radians(1.0) * np.sin(2 * np.pi * 1.7 * t)
+    bz, az = bilinear([14.0**2], [1, 2 * 0.5 * 14.0, 14.0**2], fs=1 / DT)
+    man = lfilter(bz, az, -0.2 * d_e) + np.radians(0.3) * np.sin(2 * np.pi * 0.9 * t)
+    alpha_true = 0.05 + man + (g - g_lp)
+    alpha_kin = 0.05 + man - g_lp + rng.normal(0, np.radians(0.01), T)
+    beta_kin = np.radians(1.0) * np.sin(2 * np.pi * 0.5 * t)
+    k = qbar * S_ / mass
+    f = np.zeros((T, 3))
+    f[:, 1] = k * (-0.3 * beta_kin) + rng.normal(0, 0.05, T)
+    f[:, 2] = k * (-0.4 - cla * alpha_true - 0.4 * d_e) + rng.normal(0, 0.05, T)
+    ctrl = {"delta_e": d_e, "delta_a": np.zeros(T), "delta_r": np.radians(2.0) * np.sin(2 * np.pi * 0.5 * t)}
+    args = (DT, alpha_kin, beta_kin, V, qbar, f, np.zeros((T, 3)), ctrl, mass, S_, b_, c_, np.ones(T, bool))
+    return args, alpha_true, w_h / (2 * np.pi)
+
+
+def test_alpha_slopes_are_fitted_above_the_heave_corner(monkeypatch):
+    """Below the heave mode's corner the aircraft rides the gust and the kinematic alpha's error correlates
+    with it: the slopes fitted above 0.3 Hz are attenuated, above the corner (from the wing's Helmbold slope)
+    much less, and the aided alpha is better."""
+    import gcs_sysid.estimation.airangles as aa
+
+    args, alpha, f_h = _riding_record(1)
+    monkeypatch.setattr(aa, "HEAVE_EDGE", 1.0)         # opt-in
+    res = aided_air_angles(*args)
+    fa = res.axes[0]
+    assert fa.used, describe(res)
+    # the edge is the corner from the geometry (Helmbold 4.71 per rad for A = 7.3 against the record's 4.8)
+    assert abs(fa.band_hz / f_h - 4.71 / 4.8) < 0.03, (fa.band_hz, f_h)
+    assert any(f"above {fa.band_hz:.2f} Hz" in n for n in describe(res))
+    monkeypatch.setattr(aa, "HEAVE_EDGE", None)
+    old = aided_air_angles(*args)
+    monkeypatch.undo()
+    assert old.axes[0].band_hz == aa.HIGHPASS_HZ
+    # measured (seeds 1-3): -3.9..-4.0 above the corner, -2.9..-3.1 above 0.3 Hz; alpha error 0.11 vs 0.19-0.24 deg
+    assert abs(fa.coef[1] / -4.8 - 1) < 0.25 < abs(old.axes[0].coef[1] / -4.8 - 1), (fa.coef, old.axes[0].coef)
+    assert np.std(res.alpha - alpha) < 0.7 * np.std(old.alpha - alpha)
+
+
+def test_heavy_aircraft_keep_the_fixed_band(monkeypatch):
+    """A corner below HIGHPASS_HZ (the 1000-kg record: 0.27 Hz) leaves the aiding exactly as without the heave edge,
+    and the default (``HEAVE_EDGE = None``) is the fixed band."""
+    import gcs_sysid.estimation.airangles as aa
+
+    assert abs(aa.lift_slope(8.0) - 4.90) < 0.01 and abs(aa.lift_slope(1e6) / (2 * np.pi) - 1) < 1e-3
+    assert np.isnan(aa.lift_slope(0.0))
+    assert aa.heave_edge_hz(5.0, 0.1, 1.0) == aa.HIGHPASS_HZ and aa.heave_edge_hz(5.0, 100.0, 1.0) == aa.MAX_EDGE_HZ
+    assert aa.HEAVE_EDGE is None and aa.heave_edge_hz(5.0, 100.0) == aa.HIGHPASS_HZ
+    rec, _, _ = _record()
+    monkeypatch.setattr(aa, "HEAVE_EDGE", 1.0)         # opt-in
+    new = _run(rec)
+    monkeypatch.setattr(aa, "HEAVE_EDGE", None)        # the default
+    old = _run(rec)
+    assert new.axes[0].band_hz == aa.HIGHPASS_HZ
+    np.testing.assert_array_equal(new.alpha, old.alpha)
