@@ -156,7 +156,8 @@ class AidedAngles:
 
     Attributes:
         alpha, beta: (T,) air angles, rad (the kinematic ones where an axis was not aided).
-        alpha_sigma, beta_sigma: (T,) 1-sigma, rad (NaN where not aided).
+        alpha_sigma, beta_sigma: (T,) 1-sigma, rad (NaN where not aided; where the moment cross-check rejected
+            the aiding, the kept kinematic angle's error from the gust found, :func:`kinematic_sigma`).
         axes: the two :class:`AxisFit` (alpha, beta).
     """
 
@@ -365,6 +366,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             shift_note if fit is None else fit.shift_note, slope_method=method, first_stage_r2=fs_r2)
     if fit is not None and given_note:
         fit.slope_method = f"{fit.slope_method}: {given_note}"
+    gust_sig = sig          # the gust smoother's posterior 1-sigma, before the flight-common offset is added
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
         # the vertical gusts found, is a common error of all samples (angleerrors module docstring)
@@ -389,8 +391,38 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             fit.used = False
             fit.reason = (f"the aided {name} fits {mname} worse than the kinematic one (residual {100 * ra:.1f} % "
                           f"vs {100 * rk:.1f} % of the variance): the force model is not trusted")
-            return kin0, np.full(len(kin0), np.nan), fit
+            return kin0, kinematic_sigma(ang, kin0, gust_sig, m), fit
     return ang, sig, fit
+
+
+def kinematic_sigma(ang: np.ndarray, kin: np.ndarray, gust_sig: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Per-row 1-sigma of a kinematic air angle kept where the aiding was rejected (the moment cross-check).
+
+    The kinematic angle misses the gust angle ``g`` (the unmeasured gust over the airspeed) that the aiding
+    estimated before its cross-check, ``g_hat = ang - kin`` with the Gauss-Markov smoother's posterior variance
+    ``P`` (Rauch, Tung and Striebel 1965). Given the data ``g ~ N(g_hat, P)``, so the kinematic angle's mean
+    squared error is ``E[(kin - true)^2] = E[g^2] = g_hat^2 + P`` (bias squared plus variance). The part of
+    ``g_hat`` common to the flight (its mean over the aided rows) is left out: a flight-common offset cancels at
+    the flight's own regressors (as ``AxisFit.bias_sigma`` is left out of the per-row variance,
+    :func:`gcs_sysid.aero.coefficients.stated_input_variance`). Before the fourteenth session such a fallback
+    stated no sigma at all, and the GP's band carried no air-angle error there (f4n, light, seeds 1 and 3:
+    the held-out alpha error 0.07-0.11 deg moved CZ by 2.5-3.7 % of its RMS against a band of 0.9-1.1 %).
+
+    Args:
+        ang: (T,) the rejected aided angle, rad. kin: (T,) the kinematic angle, rad.
+        gust_sig: (T,) the gust smoother's posterior 1-sigma, rad (without the flight-common offset).
+        m: (T,) bool, the aided rows.
+
+    Returns:
+        (T,) 1-sigma, rad; NaN outside ``m`` or where an input is not finite.
+    """
+    out = np.full(len(kin), np.nan)
+    g = np.where(m, np.asarray(ang, float) - np.asarray(kin, float), np.nan)
+    ok = m & np.isfinite(g) & np.isfinite(gust_sig)
+    if ok.any():
+        gc = g[ok] - float(np.mean(g[ok]))
+        out[ok] = np.sqrt(gc**2 + np.asarray(gust_sig, float)[ok] ** 2)
+    return out
 
 
 def _scale_disagreement(dt: float, ang: np.ndarray, kin: np.ndarray, m: np.ndarray, block_s: float = 15.0) -> float:
