@@ -38,7 +38,7 @@ def rows_of(paths: list[str], turbulence: str | None) -> list[dict]:
             if line.strip():
                 r = json.loads(line)
                 if "cov_gp_each" not in r:
-                    raise SystemExit(f"{p}: a row without cov_gp_each (an eval_jsbsim.py older than the twelfth session)")
+                    raise SystemExit(f"{p}: a row without cov_gp_each (eval_jsbsim.py before the twelfth session)")
                 if turbulence is None or r["turbulence"] == turbulence:
                     out.append(r)
     return out
