@@ -80,6 +80,10 @@ MAX_EDGE_HZ = 2.0     #: the heave edge is capped here (the manoeuvres' band, 0.
 SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
 SIGMA_BETA_MEAN = np.radians(1.0)   #: prior 1-sigma of the kinematic sideslip's mean error, rad
 MEAN_BLOCK_S = 5.0    #: block length for the standard error of the CY constant (correlated residuals), s
+#: gust correlation times in the moving window of :func:`kinematic_sigma`'s local gust variance (5: the variance
+#: of a Gauss-Markov gust averaged over 5 tau has a relative standard error of about sqrt(2 / 5) ~ 0.6 in
+#: variance, 0.3 in sigma, and follows a turbulent stretch of a flight that is calm elsewhere)
+MOMENT_WINDOW_TAUS = 5.0
 MOMENT_MARGIN = 0.0   #: the aided angle is kept if its moment-fit residual is at most (1 + this) x the kinematic one
 #: Default of ``aided_air_angles(instrument_slopes=None)``: fit CZ_alpha by two-stage least squares with the
 #: elevator as instrument (:mod:`.angleerrors`). Off by default for now: measured better on JSBSim (c172x
@@ -169,7 +173,8 @@ class AidedAngles:
 
     Attributes:
         alpha, beta: (T,) air angles, rad (the kinematic ones where an axis was not aided).
-        alpha_sigma, beta_sigma: (T,) 1-sigma, rad (NaN where not aided).
+        alpha_sigma, beta_sigma: (T,) 1-sigma, rad (NaN where not aided; where the moment cross-check rejected
+            the aiding, the kept kinematic angle's error from the gust found, :func:`kinematic_sigma`).
         axes: the two :class:`AxisFit` (alpha, beta).
     """
 
@@ -429,6 +434,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             band_hz=edge)
     if fit is not None and given_note:
         fit.slope_method = f"{fit.slope_method}: {given_note}"
+    gust_sig = sig          # the gust smoother's posterior 1-sigma, before the flight-common offset is added
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
         # the vertical gusts found, is a common error of all samples (angleerrors module docstring)
@@ -453,8 +459,48 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             fit.used = False
             fit.reason = (f"the aided {name} fits {mname} worse than the kinematic one (residual {100 * ra:.1f} % "
                           f"vs {100 * rk:.1f} % of the variance): the force model is not trusted")
-            return kin0, np.full(len(kin0), np.nan), fit
+            return kin0, kinematic_sigma(ang, kin0, gust_sig, m, int(round(MOMENT_WINDOW_TAUS * fit.tau_s / dt))), fit
     return ang, sig, fit
+
+
+def kinematic_sigma(ang: np.ndarray, kin: np.ndarray, gust_sig: np.ndarray, m: np.ndarray,
+                    window: int = 1) -> np.ndarray:
+    """Per-row 1-sigma of a kinematic air angle kept where the aiding was rejected (the moment cross-check).
+
+    The kinematic angle misses the gust angle ``g`` (the unmeasured gust over the airspeed) that the aiding
+    estimated before its cross-check: ``g_hat = ang - kin``, with the Gauss-Markov smoother's posterior variance
+    ``P`` (Rauch, Tung and Striebel 1965). Given the data ``g ~ N(g_hat, P)``, so the kinematic angle's mean
+    squared error at a row is ``g_hat^2 + P`` (bias squared plus variance). A band centred on the kinematic
+    angle needs the error's spread, not its value at the row (``g_hat^2`` is near 0 where the gust crosses
+    zero and the 1.96-sigma band at its peaks covers ~100 %): the gust is taken as locally stationary,
+    zero-mean with the local second moment, the centred moving mean of ``g_hat^2`` over ``window`` rows (the
+    caller passes ``MOMENT_WINDOW_TAUS`` gust correlation times, a method-of-moments variance), plus ``P``. The
+    part of ``g_hat`` common to the flight (its mean over the aided rows) is left out: a flight-common offset
+    cancels at the flight's own regressors (as ``AxisFit.bias_sigma`` is left out of the per-row variance,
+    :func:`gcs_sysid.aero.coefficients.stated_input_variance`). Before the fourteenth session such a fallback
+    stated no sigma, and the GP's band carried no air-angle error there (f4n, light, seeds 1 and 3: the held-out
+    alpha error 0.07-0.11 deg moved CZ by 2.5-3.7 % of its RMS against a band of 0.9-1.1 %).
+
+    Args:
+        ang: (T,) the rejected aided angle, rad. kin: (T,) the kinematic angle, rad.
+        gust_sig: (T,) the gust smoother's posterior 1-sigma, rad (without the flight-common offset).
+        m: (T,) bool, the aided rows.
+        window: rows of the moving mean (1: ``g_hat^2`` of the row itself).
+
+    Returns:
+        (T,) 1-sigma, rad; NaN outside ``m`` or where an input is not finite.
+    """
+    out = np.full(len(kin), np.nan)
+    g = np.where(m, np.asarray(ang, float) - np.asarray(kin, float), np.nan)
+    ok = m & np.isfinite(g) & np.isfinite(gust_sig)
+    if ok.any():
+        g2 = np.where(ok, (g - float(np.mean(g[ok]))) ** 2, 0.0)
+        w = max(int(window), 1)
+        if w > 1:                      # gaps and ends: the mean over the aided rows inside the window
+            k = np.ones(w)
+            g2 = np.convolve(g2, k, mode="same") / np.maximum(np.convolve(ok.astype(float), k, mode="same"), 1.0)
+        out[ok] = np.sqrt(g2[ok] + np.asarray(gust_sig, float)[ok] ** 2)
+    return out
 
 
 def _scale_disagreement(dt: float, ang: np.ndarray, kin: np.ndarray, m: np.ndarray, block_s: float = 15.0) -> float:

@@ -104,6 +104,13 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
             sigma[k] = Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma     # NaN where not aided
             if offsets is not None and np.isfinite(ax.bias_sigma):
                 offsets[k] = float(ax.bias_sigma)      # common to the flight: the GP's exact-condition band
+        else:
+            # a fallback after the moment cross-check keeps the kinematic angle and states its error: the gust
+            # the rejected aiding found (airangles.kinematic_sigma); NaN (nothing stated) otherwise
+            s = Ai.alpha_sigma if k == "alpha" else Ai.beta_sigma
+            if np.isfinite(s).any():
+                sigma[k] = s
+                sources[k] += "; 1-sigma: the gust angle the rejected specific-force aiding found"
     if any(ax.used for ax in Ai.axes):      # the gusts found belong to the wind: w = v_ground - C v_air
         ca, sa, cb, sb = np.cos(Ai.alpha), np.sin(Ai.alpha), np.cos(Ai.beta), np.sin(Ai.beta)
         vb = V[:, None] * np.stack([ca * cb, sb, sa * cb], axis=1)

@@ -1,11 +1,13 @@
 """Air angles aided by the specific force (estimation/airangles.py) on a synthetic record with known
-gusts, the gust smoother against filterpy's Kalman filter + RTS smoother, and the fallbacks."""
+gusts, the gust smoother against filterpy's Kalman filter + RTS smoother, the fallbacks and the kept
+kinematic angle's stated error."""
 
 import numpy as np
 import pytest
 from filterpy.kalman import KalmanFilter, rts_smoother
 
-from gcs_sysid.estimation.airangles import _gust_smoother, aided_air_angles, describe
+from gcs_sysid.estimation.airangles import (MOMENT_WINDOW_TAUS, _gust_smoother, aided_air_angles, describe,
+                                            kinematic_sigma)
 from gcs_sysid.estimation.kalman import steady_state
 
 DT = 0.02
@@ -164,7 +166,44 @@ def test_moment_cross_check_keeps_good_aiding_and_drops_misled_aiding():
     assert fb.used and not fa.used, describe(bad)
     assert "fits Cm worse than the kinematic one" in fa.reason
     np.testing.assert_array_equal(bad.alpha, rec["alpha_kin"])
-    assert np.isnan(bad.alpha_sigma).all()
+    # the kept kinematic alpha states its error (the gust the rejected aiding found, kinematic_sigma): here the
+    # misleading force inflates that gust, so the statement is conservative, never blind
+    err = rec["alpha_kin"] - alpha
+    err = err - err.mean()                               # a flight-common offset cancels at the flight's regressors
+    s = bad.alpha_sigma
+    assert np.isfinite(s).all()
+    assert np.sqrt(np.mean(s**2)) >= 0.8 * np.sqrt(np.mean(err**2))
+    assert np.mean(np.abs(err) <= 1.96 * s) >= 0.9
+
+
+def test_kinematic_sigma_states_the_kinematic_angles_gust_error():
+    """``kinematic_sigma``: ``sqrt((g_hat - mean g_hat)^2 + P)`` on the aided rows, NaN elsewhere; with a right
+    force model (the gust found is the true one) its RMS is the kinematic alpha's true error RMS within 20 %,
+    and with the caller's moving window it covers 90-99 % of that error at 1.96 sigma."""
+    rec, alpha, beta = _record()
+    T = len(alpha)
+    good = aided_air_angles(DT, rec["alpha_kin"], rec["beta_kin"], rec["V"], rec["qbar"], rec["f_body"],
+                            rec["rates"], rec["controls"], MASS, S, B, C, np.ones(T, bool))
+    assert good.axes[0].used
+    m = np.isfinite(good.alpha_sigma)
+    m[: T // 10] = False                                 # a stretch not aided: NaN there
+    # the smoother's posterior sigma alone (the offset's share left out): alpha_sigma^2 - bias_sigma^2
+    P = np.sqrt(np.maximum(good.alpha_sigma**2 - good.axes[0].bias_sigma**2, 0.0))
+    s = kinematic_sigma(good.alpha, rec["alpha_kin"], P, m)
+    assert np.isnan(s[~m]).all() and np.isfinite(s[m]).all()
+    g = (good.alpha - rec["alpha_kin"])[m]
+    np.testing.assert_allclose(s[m], np.sqrt((g - g.mean()) ** 2 + P[m] ** 2))
+    err = (rec["alpha_kin"] - alpha)[m]
+    err = err - err.mean()
+    # the local second moment over MOMENT_WINDOW_TAUS gust correlation times (the caller's window): the band
+    # covers the error near its nominal 95 % (the row's own g_hat^2 covers ~99 %)
+    w = int(round(MOMENT_WINDOW_TAUS * good.axes[0].tau_s / DT))
+    s_w = kinematic_sigma(good.alpha, rec["alpha_kin"], P, m, w)
+    assert np.isnan(s_w[~m]).all()
+    for sig in (s[m], s_w[m]):
+        ratio = np.sqrt(np.mean(sig**2) / np.mean(err**2))
+        assert 0.8 <= ratio <= 1.2, ratio
+    assert 0.9 <= np.mean(np.abs(err) <= 1.96 * s_w[m]) <= 0.99
 
 
 def test_varying_throttle_keeps_the_sideslip_mean_and_stays_out_of_the_force_model():
