@@ -145,9 +145,9 @@ class GPConfig:
             pitch rate and angle of attack rate dependencies", NASA NTRS 20170001231: separating them takes
             dedicated maneuvers) and the split follows whatever else the residual carries; for an aft tail
             ``Cm_alpha_dot / Cm_q(tail) = d(epsilon)/d(alpha) < 1`` (Etkin and Reid 1996, sec. 5.5; Nelson 1998,
-            *Flight Stability and Automatic Control*, 2nd ed., ch. 3), and ``Cm_q < 0``. On the JSBSim F-16 (no alpha-dot term) ``alpha_dot_hat`` pushed
-            ``q_hat`` out of Cm's mean (the nonlinear ``CmDh(alpha, delta_e)`` table left in the linear residual,
-            carried by ``alpha_dot_hat``'s small part not collinear with the regressors); ``docs/gp.md``,
+            *Flight Stability and Automatic Control*, 2nd ed., ch. 3), and ``Cm_q < 0``. On the JSBSim F-16 (no
+            alpha-dot term) ``alpha_dot_hat`` pushed ``q_hat`` out of Cm's mean (the nonlinear
+            ``CmDh(alpha, delta_e)`` table left in the linear residual, carried by ``alpha_dot_hat``'s small part not collinear with the regressors); ``docs/gp.md``,
             "Mean-only inputs".
         mean_only_ratio: the largest ``|slope(input)| / |slope(partner)|`` (data units), see
             ``mean_only_partners``.
@@ -203,6 +203,11 @@ class GPConfig:
             if isinstance(v, str) or not all(isinstance(x, str) for x in v):
                 raise InputError(f"GPConfig.{name} must be a sequence of names, got {v!r}")
             object.__setattr__(self, name, tuple(v))
+        if self.mean_only_partners and len(self.mean_only_partners) != len(self.mean_only_inputs):
+            raise InputError("GPConfig.mean_only_partners must name one partner (or '') per mean-only input, got "
+                             f"{self.mean_only_partners!r} for {self.mean_only_inputs!r}")
+        if not float(self.mean_only_ratio) > 0:
+            raise InputError(f"GPConfig.mean_only_ratio must be > 0, got {self.mean_only_ratio!r}")
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
             raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, got {self.n_inducing_hyper!r}")
         for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool",

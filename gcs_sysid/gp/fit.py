@@ -48,7 +48,8 @@ __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_g
            "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
-           "learn_input_noise", "validated_global", "validated_local", "mean_only_masks", "rows_without_mean_only", "MEAN_ONLY_LENGTHSCALE"]
+           "learn_input_noise", "validated_global", "validated_local", "mean_only_masks",
+           "rows_without_mean_only", "MEAN_ONLY_LENGTHSCALE"]
 
 _NOISE_FLOOR = 1e-6
 #: Length-scale (standardised units) pinned on a mean-only input (``GPConfig.mean_only_inputs``): the
@@ -430,7 +431,8 @@ def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys
     return kernel, allowed, info
 
 
-def rows_without_mean_only(X, Y, cfg: GPConfig, input_names, output_names) -> tuple[np.ndarray, tuple | None, list[str]]:
+def rows_without_mean_only(X, Y, cfg: GPConfig, input_names, output_names
+                           ) -> tuple[np.ndarray, tuple | None, list[str]]:
     """Rows that lack only their mean-only inputs (``GPConfig.mean_only_inputs``: NaN there, every other
     input finite): they stay training rows when the pre-fit gates (:func:`mean_only_masks`, run on the rows
     that carry the inputs) put the inputs in no output's mean, as the model is then fitted without those
@@ -469,8 +471,9 @@ def rows_without_mean_only(X, Y, cfg: GPConfig, input_names, output_names) -> tu
     if any(info.get("outputs", {}).values()):
         return X, input_names, [f"gp: {int(lack.sum())} of {int(head.sum())} rows without {which} left out "
                                 "(the gates keep it in a mean)"]
-    return X[:, :-k], names[:-k], [f"gp: {which} in no output's linear mean (the gates on the {int((head & tail).sum())} "
-                                    f"rows that carry it): fitted without, on all {int(head.sum())} rows"]
+    n_carry = int((head & tail).sum())
+    return X[:, :-k], names[:-k], [f"gp: {which} in no output's linear mean (the gates on the {n_carry} rows that "
+                                    f"carry it): fitted without, on all {int(head.sum())} rows"]
 
 
 def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> np.ndarray | None:

@@ -98,6 +98,10 @@ def test_mean_only_inputs_must_be_trailing():
         mean_only_masks(cfg, ("a", "b"), ("y",), Xs, Xs[:, :1], np.ones(2, bool))
     with pytest.raises(InputError, match="sequence of names"):
         GPConfig(mean_only_inputs="alpha_dot_hat")
+    with pytest.raises(InputError, match="one partner"):
+        GPConfig(mean_only_inputs=("a", "b"), mean_only_partners=("q_hat",))
+    with pytest.raises(InputError, match="mean_only_ratio"):
+        GPConfig(mean_only_ratio=0.0)
 
 
 @pytest.mark.slow
