@@ -147,8 +147,8 @@ class GPConfig:
             ``Cm_alpha_dot / Cm_q(tail) = d(epsilon)/d(alpha) < 1`` (Etkin and Reid 1996, sec. 5.5; Nelson 1998,
             *Flight Stability and Automatic Control*, 2nd ed., ch. 3), and ``Cm_q < 0``. On the JSBSim F-16 (no
             alpha-dot term) ``alpha_dot_hat`` pushed ``q_hat`` out of Cm's mean (the nonlinear
-            ``CmDh(alpha, delta_e)`` table left in the linear residual, carried by ``alpha_dot_hat``'s small part not collinear with the regressors); ``docs/gp.md``,
-            "Mean-only inputs".
+            ``CmDh(alpha, delta_e)`` table left in the linear residual, carried by ``alpha_dot_hat``'s small part
+            not collinear with the regressors); ``docs/gp.md``, "The partner rule".
         mean_only_ratio: the largest ``|slope(input)| / |slope(partner)|`` (data units), see
             ``mean_only_partners``.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
