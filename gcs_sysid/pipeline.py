@@ -88,8 +88,10 @@ class ReplayOptions:
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
-#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md).
-ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("Cm",), "mean_only_sign": -1.0}
+#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md), with ``q_hat`` as its partner:
+#: only where ``Cm_q < 0`` stays in the same fit and ``|Cm_alpha_dot| <= |Cm_q|`` (``GPConfig.mean_only_partners``).
+ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("Cm",), "mean_only_sign": -1.0,
+                "mean_only_partners": ("q_hat",), "mean_only_ratio": 1.0}
 
 
 def gp_inputs(table, rows: np.ndarray, with_alpha_dot: bool) -> tuple[np.ndarray, np.ndarray | None]:
@@ -165,8 +167,13 @@ def held_out_mask(t: np.ndarray, valid: np.ndarray, fraction: float) -> np.ndarr
     return mask
 
 
-def training_rows(X: np.ndarray, Y: np.ndarray, names: list[str]) -> tuple[np.ndarray, np.ndarray, str]:
+def training_rows(X: np.ndarray, Y: np.ndarray, names: list[str], optional: int = 0
+                  ) -> tuple[np.ndarray, np.ndarray, str]:
     """The GP's training rows: finite regressors and at least one finite coefficient.
+
+    The last ``optional`` columns of ``X`` may be NaN (the mean-only ``alpha_dot_hat``): ``fit_gp`` keeps
+    such rows when its gates leave the column out and drops them otherwise
+    (:func:`gcs_sysid.gp.fit.rows_without_mean_only`).
 
     A row that misses some coefficients (NaN: e.g. an angular-acceleration estimate rejected, so its
     moments are missing while its forces are kept) is kept: the joint GP conditions each coefficient
@@ -179,7 +186,7 @@ def training_rows(X: np.ndarray, Y: np.ndarray, names: list[str]) -> tuple[np.nd
     Returns:
         ``(X, Y, note)``: the kept rows and a one-line note saying what is missing ("" when nothing is).
     """
-    ok = np.all(np.isfinite(X), axis=1) & np.any(np.isfinite(Y), axis=1)
+    ok = np.all(np.isfinite(X[:, :X.shape[1] - int(optional)]), axis=1) & np.any(np.isfinite(Y), axis=1)
     X, Y = X[ok], Y[ok]
     miss = (~np.isfinite(Y)).sum(0)
     if not miss.any():
@@ -334,10 +341,13 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             if options.model_in:                 # a saved model takes what it was fitted with
                 use_adot = use_adot and load_gp(check_model_state(options.model_in)).n_inputs == len(REGRESSORS) + 1
             X_all = gp_inputs(table, np.ones(len(table.t), bool), use_adot)[0]
-            if use_adot:                         # training rows need a finite alpha_dot_hat
+            if use_adot:                         # NaN: fit_gp keeps the row only if the gates drop the column
                 X_all[~np.isfinite(table.alpha_dot_hat), -1] = np.nan
+                if options.model_in:             # a saved model's update needs every value
+                    X_all[~np.isfinite(X_all[:, -1])] = np.nan
             X_train, Y_train, partial = training_rows(X_all[train], table.Y[train][:, fit_cols],
-                                                      [COEFFICIENTS[i] for i in fit_cols])
+                                                      [COEFFICIENTS[i] for i in fit_cols],
+                                                      optional=int(use_adot and not options.model_in))
             if partial:
                 notes.append(partial)
             with _stage("learn GP", timings, bar):

@@ -136,6 +136,21 @@ class GPConfig:
             and Reid 1996, *Dynamics of Flight*, 3rd ed., sec. 5.5). A positive slope is what the pitch gust rate
             gives through its correlation with ``alpha_dot`` (measured on the f4n in moderate turbulence,
             +12 to +15 against JSBSim's -9; ``docs/gp.md``, "Mean-only inputs").
+        mean_only_partners: per mean-only input (same order; ``""``: none), the kernel regressor whose slope it
+            splits with: the input then enters an output's mean only when that same least-squares fit keeps the
+            partner too, with the sign ``mean_only_sign``, and the input's slope is at most ``mean_only_ratio``
+            times the partner's in data units. The pipeline: ``("q_hat",)`` and 1: ``Cm_q < 0`` and
+            ``|Cm_alpha_dot| <= |Cm_q|``. Why: in the short period ``alpha_dot ~ q``, so only their sum is well
+            determined from ordinary maneuvers (Grauer, Morelli and Murri 2017, "Flight test techniques for quantifying
+            pitch rate and angle of attack rate dependencies", NASA NTRS 20170001231: separating them takes
+            dedicated maneuvers) and the split follows whatever else the residual carries; for an aft tail
+            ``Cm_alpha_dot / Cm_q(tail) = d(epsilon)/d(alpha) < 1`` (Etkin and Reid 1996, sec. 5.5; Nelson 1998,
+            *Flight Stability and Automatic Control*, 2nd ed., ch. 3), and ``Cm_q < 0``. On the JSBSim F-16 (no
+            alpha-dot term) ``alpha_dot_hat`` pushed ``q_hat`` out of Cm's mean (the nonlinear
+            ``CmDh(alpha, delta_e)`` table left in the linear residual, carried by ``alpha_dot_hat``'s small part
+            not collinear with the regressors); ``docs/gp.md``, "The partner rule".
+        mean_only_ratio: the largest ``|slope(input)| / |slope(partner)|`` (data units), see
+            ``mean_only_partners``.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -179,13 +194,20 @@ class GPConfig:
     mean_only_inputs: tuple[str, ...] = ()
     mean_only_outputs: tuple[str, ...] = ()
     mean_only_sign: float = 0.0
+    mean_only_partners: tuple[str, ...] = ()
+    mean_only_ratio: float = 1.0
 
     def __post_init__(self):
-        for name in ("mean_only_inputs", "mean_only_outputs"):      # JSON gives lists: kept hashable
+        for name in ("mean_only_inputs", "mean_only_outputs", "mean_only_partners"):   # JSON gives lists: kept hashable
             v = getattr(self, name)
             if isinstance(v, str) or not all(isinstance(x, str) for x in v):
                 raise InputError(f"GPConfig.{name} must be a sequence of names, got {v!r}")
             object.__setattr__(self, name, tuple(v))
+        if self.mean_only_partners and len(self.mean_only_partners) != len(self.mean_only_inputs):
+            raise InputError("GPConfig.mean_only_partners must name one partner (or '') per mean-only input, got "
+                             f"{self.mean_only_partners!r} for {self.mean_only_inputs!r}")
+        if not float(self.mean_only_ratio) > 0:
+            raise InputError(f"GPConfig.mean_only_ratio must be > 0, got {self.mean_only_ratio!r}")
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
             raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, got {self.n_inducing_hyper!r}")
         for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool",

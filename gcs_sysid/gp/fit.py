@@ -48,7 +48,8 @@ __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_g
            "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
-           "learn_input_noise", "validated_global", "validated_local", "mean_only_masks", "MEAN_ONLY_LENGTHSCALE"]
+           "learn_input_noise", "validated_global", "validated_local", "mean_only_masks",
+           "rows_without_mean_only", "MEAN_ONLY_LENGTHSCALE"]
 
 _NOISE_FLOOR = 1e-6
 #: Length-scale (standardised units) pinned on a mean-only input (``GPConfig.mean_only_inputs``): the
@@ -338,7 +339,8 @@ def linear_prior_std(cfg: GPConfig, terms: np.ndarray | None, P: int, D: int,
 
 
 def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys: np.ndarray,
-                    active: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
+                    active: np.ndarray, x_std: np.ndarray | None = None
+                    ) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
     """Which inputs the kernels see and which linear-mean terms each output may carry
     (``GPConfig.mean_only_inputs``, ``mean_only_outputs``; ``docs/gp.md``, "Mean-only inputs").
 
@@ -347,17 +349,26 @@ def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys
     standard errors in the backward elimination on these rows, in time order
     (:func:`gcs_sysid.gp.colored.significant_inputs`: the data's own test, the one the ``"validated"``
     linear terms use; its other choices are not used here) and, with ``GPConfig.mean_only_sign``, when that fit's
-    slope has the sign physics gives it (the pipeline: ``Cm_alpha_dot < 0``).
+    slope has the sign physics gives it (the pipeline: ``Cm_alpha_dot < 0``). With
+    ``GPConfig.mean_only_partners`` (the pipeline: ``q_hat`` for ``alpha_dot_hat``), that fit must also keep the
+    partner, with the sign ``mean_only_sign``, and the input's slope may be at most ``GPConfig.mean_only_ratio``
+    times the partner's in data units (``|Cm_alpha_dot| <= |Cm_q|``, both ``< 0``): a term that pushes its
+    partner out of the mean or takes more than it has split a sum the data determine only as a sum.
 
     Args:
         cfg: settings. input_names ``(D,)``, output_names ``(P,)``: the model's column names.
         Xs: ``(N, D)``, Ys: ``(N, P)`` standardised training rows in time order (NaN: a missing output).
         active: ``(D,)`` inputs that vary.
+        x_std: ``(D,)`` the standardisation's input scales (data units per standardised unit), for the
+            partner ratio; None: the ratio is taken in standardised units.
 
     Returns:
         ``(kernel (D,) bool, allowed (P, D) bool, info)``, ``(None, None, {})`` when no named mean-only
         input is among ``input_names``; ``info``: ``{"inputs": [names], "outputs": {output: [kept inputs]}}``
-        (and ``"wrong_sign": ["output:input", ...]`` for the significant slopes of the wrong sign).
+        (and ``"wrong_sign": ["output:input", ...]`` for the significant slopes of the wrong sign,
+        ``"partner": ["output:input: why", ...]`` for those the partner rule took out, and
+        ``"slopes": {"output:name": slope}`` of the input and its partner in that fit, per data unit of the
+        input and standardised unit of the output).
 
     Raises:
         InputError: a mean-only input that is not among the trailing columns (a query may leave out only
@@ -378,22 +389,91 @@ def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys
     allowed = np.ones((P, D), bool)
     allowed[:, only] = False
     info = {"inputs": [names[d] for d in only], "outputs": {}}
+    partners = dict(zip([names[d] for d in only], cfg.mean_only_partners))
+    scale = np.ones(D) if x_std is None else np.asarray(x_std, float)
     for p, name in enumerate(output_names):
         if name not in cfg.mean_only_outputs or not cfg.linear_mean:
             continue
         keep = significant_inputs(Xs, Ys[:, [p]], active)[0]
-        if cfg.mean_only_sign and keep[only].any():          # the slope's sign in that least-squares fit
+        if (cfg.mean_only_sign or partners) and keep[only].any():   # the slopes in that least-squares fit
             rows = np.isfinite(Ys[:, p])
-            cols = np.flatnonzero(keep)
+            cols = list(np.flatnonzero(keep))
             A = np.concatenate([np.ones((int(rows.sum()), 1)), Xs[rows][:, cols]], axis=1)
-            w = np.linalg.lstsq(A, Ys[rows, p], rcond=None)[0][1:]
+            w = np.linalg.lstsq(A, Ys[rows, p], rcond=None)[0][1:] / scale[cols]     # data units (x Y's scale)
+            slope = dict(zip(cols, w))
             for d in only:
-                if keep[d] and np.sign(w[list(cols).index(d)]) != np.sign(cfg.mean_only_sign):
+                if not keep[d]:
+                    continue
+                info.setdefault("slopes", {})[f"{name}:{names[d]}"] = float(slope[d])
+                if cfg.mean_only_sign and np.sign(slope[d]) != np.sign(cfg.mean_only_sign):
                     keep[d] = False
                     info.setdefault("wrong_sign", []).append(f"{name}:{names[d]}")
+                    continue
+                partner = partners.get(names[d], "")
+                if not partner:
+                    continue
+                e = names.index(partner) if partner in names else -1
+                sign = cfg.mean_only_sign or np.sign(slope[d])
+                why = ""
+                if e < 0 or not keep[e]:
+                    why = f"{partner} not in the fit"
+                else:
+                    info["slopes"][f"{name}:{partner}"] = float(slope[e])
+                    if np.sign(slope[e]) != np.sign(sign):
+                        why = f"{partner} slope of the wrong sign"
+                    elif abs(slope[d]) > float(cfg.mean_only_ratio) * abs(slope[e]):
+                        why = f"|slope| above {float(cfg.mean_only_ratio):g} x {partner}'s"
+                if why:
+                    keep[d] = False
+                    info.setdefault("partner", []).append(f"{name}:{names[d]}: {why}")
         allowed[p, only] = keep[only]
         info["outputs"][name] = [names[d] for d in only if keep[d]]
     return kernel, allowed, info
+
+
+def rows_without_mean_only(X, Y, cfg: GPConfig, input_names, output_names
+                           ) -> tuple[np.ndarray, tuple | None, list[str]]:
+    """Rows that lack only their mean-only inputs (``GPConfig.mean_only_inputs``: NaN there, every other
+    input finite): they stay training rows when the pre-fit gates (:func:`mean_only_masks`, run on the rows
+    that carry the inputs) put the inputs in no output's mean, as the model is then fitted without those
+    columns; otherwise :func:`gcs_sysid.gp.scaling.check_training` drops them (a kept term needs its value).
+
+    Args:
+        X: ``(N, D)`` regressors, the mean-only inputs the trailing columns (NaN allowed there).
+        Y: ``(N, P)`` outputs (NaN: missing). cfg: settings. input_names ``(D,)`` (None: nothing to do),
+        output_names ``(P,)``.
+
+    Returns:
+        ``(X, input_names, notes)``: ``X`` ``(N, D)`` unchanged, or ``(N, D - k)`` without the ``k`` mean-only
+        columns when the gates keep them nowhere and some rows lack them; one-line notes.
+    """
+    from .scaling import Standardiser, check_training
+
+    if input_names is None or not cfg.mean_only_inputs or np.ndim(X) != 2 or np.ndim(Y) != 2:
+        return X, input_names, []
+    names = tuple(input_names)
+    k = 0
+    while k < len(names) and names[len(names) - 1 - k] in cfg.mean_only_inputs:
+        k += 1
+    X = np.asarray(X, float)
+    if not k or k == len(names) or X.shape[1] != len(names) or np.shape(Y)[0] != X.shape[0]:
+        return X, input_names, []
+    Y = np.asarray(Y, float)
+    head = np.isfinite(X[:, :-k]).all(1) & np.isfinite(Y).any(1)
+    tail = np.isfinite(X[:, -k:]).all(1)
+    lack = head & ~tail
+    if not lack.any() or (head & tail).sum() < 3:
+        return X, input_names, []
+    Xf, Yf, _ = check_training(X[head & tail], Y[head & tail], min_rows=3, partial=True)
+    scaler, _ = Standardiser.fit(Xf, Yf, names)
+    _, _, info = mean_only_masks(cfg, names, output_names, scaler.x(Xf), scaler.y(Yf), scaler.active, scaler.x_std)
+    which = ", ".join(names[-k:])
+    if any(info.get("outputs", {}).values()):
+        return X, input_names, [f"gp: {int(lack.sum())} of {int(head.sum())} rows without {which} left out "
+                                "(the gates keep it in a mean)"]
+    n_carry = int((head & tail).sum())
+    return X[:, :-k], names[:-k], [f"gp: {which} in no output's linear mean (the gates on the {n_carry} rows that "
+                                    f"carry it): fitted without, on all {int(head.sum())} rows"]
 
 
 def linear_terms_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> np.ndarray | None:
@@ -711,7 +791,9 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     Y_names = None if output_names is None else list(output_names)
     if np.ndim(Y) == 2 and (Y_names is None or len(Y_names) != np.shape(Y)[1]):     # the summary's default names
         Y_names = list(COEFFICIENTS) if np.shape(Y)[1] == len(COEFFICIENTS) else [f"y{p}" for p in range(np.shape(Y)[1])]
-    X, Y, notes = check_training(X, Y, min_rows=3, partial=True, output_names=Y_names)
+    X, input_names, notes = rows_without_mean_only(X, Y, cfg, input_names, Y_names)
+    X, Y, more = check_training(X, Y, min_rows=3, partial=True, output_names=Y_names)
+    notes += more
     D, P = X.shape[1], Y.shape[1]
     if not np.all(np.isfinite(Y)):
         few = [Y_names[p] for p in range(P) if np.isfinite(Y[:, p]).sum() < 3]
@@ -730,7 +812,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if M < cfg.n_inducing:
         notes.append(f"gp: only {len(Xs)} rows; using {M} inducing points instead of {cfg.n_inducing}")
     t1 = time.perf_counter()
-    kernel, allowed, info = mean_only_masks(cfg, input_names, output_names, Xs, Ys, scaler.active)
+    kernel, allowed, info = mean_only_masks(cfg, input_names, output_names, Xs, Ys, scaler.active, scaler.x_std)
     if info and not any(info["outputs"].values()):
         # no output's mean may carry them: the model is fitted without the columns, exactly as it would be
         # without them (a query with them is refused: the caller checks n_inputs)

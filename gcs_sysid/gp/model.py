@@ -403,7 +403,7 @@ class LocalGlobalGP:
         M = int(self.params.Z.shape[0])
         hyper_cfg = replace(cfg, n_inducing_hyper=min(cfg.n_inducing_hyper or M, M))   # the fit's compiled shapes
         kernel, allowed, _ = mean_only_masks(cfg, self.input_names, self.output_names, rows.X, rows.Y,
-                                             self.scaler.active)
+                                             self.scaler.active, self.scaler.x_std)
         new = learn_global(rows.X, rows.Y, self.scaler.active, hyper_cfg, M if reselect else 0, history,
                            start=self.params, groups=output_groups(self.output_names, cfg), masks=(kernel, allowed))
         Z_old = np.asarray(self.params.Z)
