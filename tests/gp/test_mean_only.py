@@ -8,7 +8,7 @@ from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS, CoefficientTable
 from gcs_sysid.errors import InputError
 from gcs_sysid.gp import GPConfig, fit_gp
 from gcs_sysid.gp.fit import MEAN_ONLY_LENGTHSCALE, mean_only_masks, rows_without_mean_only
-from gcs_sysid.pipeline import ALPHA_DOT_GP, gp_inputs
+from gcs_sysid.pipeline import ALPHA_DOT_GP, ALPHA_DOT_PARTNER_RULE, gp_inputs
 
 from gp_data import FAST, flight_regressors, linear_truth
 
@@ -67,7 +67,7 @@ def test_partner_rule_and_rows_without_alpha_dot_hat():
     more than q_hat's slope (|Cm_alpha_dot| > |Cm_q|) or pushes q_hat out of the fit (no pitch damping left:
     what the F-16's nonlinear Cm did); rows that lack only alpha_dot_hat are training rows when the gates leave
     the column out, and left out when it is kept."""
-    cfg = GPConfig(**ALPHA_DOT_GP)
+    cfg = GPConfig(**ALPHA_DOT_GP, **ALPHA_DOT_PARTNER_RULE)
     names = REGRESSORS + ("alpha_dot_hat",)
     for cm_q, why in ((-6.0, "|slope| above 1 x q_hat's"), (0.0, "q_hat not in the fit")):
         table, _ = _flight(cm_q=cm_q)
