@@ -26,6 +26,8 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  cross-validation error on the training rows (``gp.joint.select_outputs``, 5 time blocks,
                  margin 1, hyperparameters those of the fits on all training rows: ``fit_selected``'s
                  ``hyper="fixed"``); needs ``joint`` and ``indep``
+    ``jointself`` ``jointsel`` with only the forces (CX CY CZ) free to leave the joint model; the moments keep it
+                 (``select_outputs(outputs=(0, 1, 2))``)
     ``jointse``  the same blocked errors, the one-standard-error rule: ``joint`` unless the output's own GP
                  is better by more than one standard error of the five blocks' differences
                  (``select_outputs(rule="1se")``)
@@ -78,10 +80,10 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "jointsel", "jointse", "jointfwd", "lmc")
+ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
-PAIRS = (("joint", "indep", "none"), ("jointse", "indep", "none"), ("jointse", "joint", "none"), ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
+PAIRS = (("joint", "indep", "none"), ("jointself", "indep", "none"), ("jointself", "joint", "none"), ("jointse", "indep", "none"), ("jointse", "joint", "none"), ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
          ("jointsel", "indep", "none"), ("jointsel", "joint", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
          ("jointk", "indep", "none"), ("jointk", "joint", "none"),
          ("jointf", "indep", "none"), ("jointf", "joint", "none"),
@@ -172,6 +174,12 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                     times["jointsel"] = times["joint"] + times["indep"] + time.perf_counter() - t0
                     preds["jointsel"] = sel.predict(X[h], include_noise=False)[0]
                     corr["jointsel"] = _selected_correlations(sel, corr["joint"])
+                if "jointself" in models_wanted and "joint" in models and indep:
+                    t0 = time.perf_counter()
+                    sel = select_outputs(models["joint"], indep, X[tr], Y[tr], outputs=(0, 1, 2))
+                    times["jointself"] = times["joint"] + times["indep"] + time.perf_counter() - t0
+                    preds["jointself"] = sel.predict(X[h], include_noise=False)[0]
+                    corr["jointself"] = _selected_correlations(sel, corr["joint"])
                 if "jointse" in models_wanted and "joint" in models and indep:
                     t0 = time.perf_counter()
                     sel = select_outputs(models["joint"], indep, X[tr], Y[tr], rule="1se")
@@ -267,7 +275,7 @@ def summarize(paths) -> str:
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
     out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
             "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo"):
+    for v in ("joint", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo"):
         for ac in sorted({r["aircraft"] for r in rows}):
             for L in lengths:
                 g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
@@ -278,7 +286,7 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "lmc", "hjoint"):
+    for v in ("joint", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:

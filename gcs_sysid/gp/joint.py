@@ -385,7 +385,7 @@ class SelectedOutputs:
 
 
 def select_outputs(joint: LocalGlobalGP, independent, X: np.ndarray, Y: np.ndarray, folds: int = 5,
-                   margin: float = 1.0, rule: str = "min") -> SelectedOutputs:
+                   margin: float = 1.0, rule: str = "min", outputs=None) -> SelectedOutputs:
     """Choose per output between the joint model and its independent GP by blocked cross-validation.
 
     Args:
@@ -399,6 +399,10 @@ def select_outputs(joint: LocalGlobalGP, independent, X: np.ndarray, Y: np.ndarr
             one-standard-error rule, Breiman et al. 1984, *Classification and Regression Trees*, sec. 3.4.3;
             Hastie, Tibshirani and Friedman 2009, *The Elements of Statistical Learning*, 2nd ed., sec. 7.10:
             the default structure stays unless the data show the other better beyond the validation's noise).
+        outputs: indices of the outputs that may leave the joint model (default all); the others keep it.
+            For outputs whose measured values are a poor proxy of the truth on other maneuvers (the moments
+            through the angular-acceleration estimate, whose error grows with the control rate:
+            ``docs/gp.md``, "Per-output choice") the validation on the training rows is not evidence.
 
     Returns:
         :class:`SelectedOutputs`.
@@ -423,6 +427,10 @@ def select_outputs(joint: LocalGlobalGP, independent, X: np.ndarray, Y: np.ndarr
         d = bi - bj                                         # (folds, P): > 0 where the joint model is better
         se = d.std(0, ddof=1) / np.sqrt(len(d))
         use = ~(d.mean(0) + se < 0.0)
+    if outputs is not None:
+        may = np.zeros(P, bool)
+        may[np.asarray(list(outputs), int)] = True
+        use = use | ~may
     return SelectedOutputs(joint, independent, use, ej, ei)
 
 
@@ -474,7 +482,7 @@ def forward_errors(X, Y, config=None, output_names=None, folds: int = 5) -> tupl
 
 
 def fit_selected(X, Y, config=None, output_names=None, folds: int | None = None, margin: float = 1.0,
-                 hyper: str = "refit") -> SelectedOutputs:
+                 hyper: str = "fixed", outputs=None) -> SelectedOutputs:
     """Fit the joint model and one GP per output on the same training rows, and choose per output on those
     rows: model selection inside the fit, on training data only, so an output is predicted by the joint
     model only where pooling (the shared kernel's length-scales, the coregionalisation, the noise coupling)
@@ -495,10 +503,13 @@ def fit_selected(X, Y, config=None, output_names=None, folds: int | None = None,
         output_names: names of the ``P`` outputs (default as :func:`fit_gp`).
         folds: time blocks (default ``config.validation_folds``, at least 2).
         margin: the joint model is used for an output when its error is below ``margin`` times the own GP's.
-        hyper: ``"refit"`` (default): :func:`forward_errors` (every hyperparameter learned again without the
-            last block; ``2 (P + 1)`` fits in all); ``"fixed"``: :func:`blocked_errors` with the
-            hyperparameters of the fits on all rows (``P + 1`` fits; measured to prefer the own GPs of the
-            moments where the joint model predicts them better, ``docs/benchmarks.md``).
+        hyper: ``"fixed"`` (default): :func:`blocked_errors` with the hyperparameters of the fits on all rows
+            (``P + 1`` fits); ``"refit"``: :func:`forward_errors` (every hyperparameter learned again without
+            the last block; ``2 (P + 1)`` fits in all). Both were measured to prefer the own GPs of the
+            moments where the joint model predicts them better on a held-out multisine (``docs/benchmarks.md``,
+            "Fourteenth session, i8-jointcx").
+        outputs: indices of the outputs that may leave the joint model (default all; ``(0, 1, 2)``: the forces
+            CX CY CZ, the choice that won there); the others keep it.
 
     Returns:
         :class:`SelectedOutputs` (the ``P + 1`` models fitted on all rows and the choice).
@@ -523,6 +534,11 @@ def fit_selected(X, Y, config=None, output_names=None, folds: int | None = None,
         own.append(fit_gp(X[rows], Y[rows][:, [p]], cfg, output_names=[names[p]])[0])
     k = max(int(cfg.validation_folds if folds is None else folds), 2)
     if hyper == "fixed":
-        return select_outputs(joint, own, X, Y, k, margin)
+        return select_outputs(joint, own, X, Y, k, margin, outputs=outputs)
     ej, ei = forward_errors(X, Y, cfg, names, k)
-    return SelectedOutputs(joint, tuple(own), ej < margin * ei, ej, ei)
+    use = ej < margin * ei
+    if outputs is not None:
+        may = np.zeros(P, bool)
+        may[np.asarray(list(outputs), int)] = True
+        use = use | ~may
+    return SelectedOutputs(joint, tuple(own), use, ej, ei)

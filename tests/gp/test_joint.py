@@ -239,22 +239,25 @@ def test_selected_outputs_correlation_is_zero_for_an_output_on_its_own_gp(gust_c
 @pytest.mark.slow
 def test_fit_selected_fits_the_joint_model_and_own_gps_and_chooses_on_training_rows(gust_case):
     """``fit_selected`` on the gust case's training rows: its joint model is the module's (same settings and
-    seed); with ``hyper="fixed"`` the choice is the blocked errors' (``select_outputs``) and output 0 takes
-    the joint model (its noise is read from output 1's); with ``"refit"`` (the default) the choice is the
-    forward errors' (``forward_errors``); each output's prediction is its chosen model's."""
+    seed); with ``hyper="fixed"`` (the default) the choice is the blocked errors' (``select_outputs``) and
+    output 0 takes the joint model (its noise is read from output 1's); with ``"refit"`` the choice is the
+    forward errors' (``forward_errors``), and an output not in ``outputs`` keeps the joint model; each
+    output's prediction is its chosen model's."""
     from gcs_sysid.gp.joint import fit_selected, forward_errors
 
     X, Y, F, n, joint = gust_case
-    fixed = fit_selected(X[:n], Y[:n], CFG, hyper="fixed")
+    fixed = fit_selected(X[:n], Y[:n], CFG)
     assert len(fixed.independent) == 3 and all(m.n_outputs == 1 for m in fixed.independent)
     np.testing.assert_allclose(fixed.joint.predict(X[n:n + 20])[0], joint.predict(X[n:n + 20])[0])
     np.testing.assert_array_equal(fixed.use_joint, fixed.err_joint < fixed.err_indep)
     assert fixed.use_joint[0]
-    sel = fit_selected(X[:n], Y[:n], CFG)
+    kept = select_outputs(fixed.joint, fixed.independent, X[:n], Y[:n], outputs=(1,))      # only output 1 may leave
+    np.testing.assert_array_equal(kept.use_joint, [True, fixed.use_joint[1], True])
+    sel = fit_selected(X[:n], Y[:n], CFG, hyper="refit", outputs=(0, 1))
     ej, ei = forward_errors(X[:n], Y[:n], CFG)
     np.testing.assert_allclose(sel.err_joint, ej)
     np.testing.assert_allclose(sel.err_indep, ei)
-    np.testing.assert_array_equal(sel.use_joint, ej < ei)
+    np.testing.assert_array_equal(sel.use_joint, (ej < ei) | np.array([False, False, True]))
     print("forward errors joint / own", ej, ei)
     m, _ = sel.predict(X[n:], include_noise=False)
     for p in range(3):
