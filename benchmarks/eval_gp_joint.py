@@ -22,6 +22,18 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  ``B`` diagonal, every other hyperparameter kept): ``joint - dec`` is what the coupling does
     ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal)
     ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
+    ``jointsel`` per output ``joint`` or that output's ``indep`` GP, whichever has the lower blocked
+                 cross-validation error on the training rows (``gp.joint.select_outputs``, 5 time blocks,
+                 margin 1, hyperparameters those of the fits on all training rows: ``fit_selected``'s
+                 ``hyper="fixed"``); needs ``joint`` and ``indep``
+    ``jointself`` ``jointsel`` with only the forces (CX CY CZ) free to leave the joint model; the moments keep it
+                 (``select_outputs(outputs=(0, 1, 2))``)
+    ``jointse``  the same blocked errors, the one-standard-error rule: ``joint`` unless the output's own GP
+                 is better by more than one standard error of the five blocks' differences
+                 (``select_outputs(rule="1se")``)
+    ``jointfwd`` the same choice by the forward error with every hyperparameter learned again
+                 (``gp.joint.forward_errors``: ``joint`` and each ``indep`` GP refitted on the first 80 % of
+                 the training rows, scored on the last 20 %; ``fit_selected``'s default); needs ``joint``, ``indep``
     ``lmc``      (``--lmc``) ``GPConfig(latent_kernels=2)``: two latent kernels, per-output length-scales
   pattern ``rates`` / ``block`` (heterotopic: the moments Cl Cm Cn removed on 30 % of those rows,
   ``eval_gp_jsbsim.missing_rows``: the fastest rates, as a rejected angular-acceleration estimate;
@@ -61,16 +73,18 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.eval_gp_jsbsim import MOMENTS, _correlations, add_flight_args, errors, make, missing_rows  # noqa: E402
+from benchmarks.eval_gp_jsbsim import (CARRIES, MOMENTS, TRUTH_NONE, _correlations, add_flight_args, errors,  # noqa: E402
+                                       make, missing_rows)
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
-from gcs_sysid.gp.joint import decoupled_model  # noqa: E402
+from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "lmc")
+ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
-PAIRS = (("joint", "indep", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
+PAIRS = (("joint", "indep", "none"), ("jointself", "indep", "none"), ("jointself", "joint", "none"), ("jointse", "indep", "none"), ("jointse", "joint", "none"), ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
+         ("jointsel", "indep", "none"), ("jointsel", "joint", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
          ("jointk", "indep", "none"), ("jointk", "joint", "none"),
          ("jointf", "indep", "none"), ("jointf", "joint", "none"),
          ("jointo", "indep", "none"), ("jointo", "joint", "none"),
@@ -86,6 +100,24 @@ def first_seconds(t: np.ndarray, tr: np.ndarray, length: float) -> np.ndarray:
         return tr.copy()
     t0 = t[tr][0]
     return tr & (t <= t0 + length)
+
+
+def _selected_correlations(sel, joint_corr: dict) -> dict:
+    """``joint_corr`` (:func:`_correlations` of the joint model) with the learned correlation of the selected
+    model (``SelectedOutputs.output_correlation``: 0 for an output predicted by its own GP) and its flags."""
+    learned = sel.output_correlation()
+    P = learned.shape[0]
+    truth = np.asarray(joint_corr["truth"]["signal_corr"]).reshape(P, P)
+    latent, noise = np.asarray(joint_corr["latent_std"]), np.asarray(joint_corr["noise_std"])
+    carries = latent >= CARRIES * noise
+    flags = [(i, j) for i in range(P) for j in range(i + 1, P)
+             if abs(learned[i, j]) > 0.5 and abs(truth[i, j]) < TRUTH_NONE]
+    name = lambda i, j: f"{COEFFICIENTS[i]}-{COEFFICIENTS[j]}"  # noqa: E731
+    return dict(joint_corr, corr_learned=[float(f"{x:.4g}") for x in learned.ravel()],
+                flags=[name(i, j) for i, j in flags],
+                flags_carrying=[name(i, j) for i, j in flags if carries[i] and carries[j]],
+                use_joint=[bool(u) for u in sel.use_joint],
+                cv_ratio=[float(f"{x:.4g}") for x in sel.err_joint / sel.err_indep])
 
 
 def _pred(model, X):
@@ -136,6 +168,31 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                     indep = [fit_gp(X[tr], Y[tr][:, [p]], base, output_names=[COEFFICIENTS[p]])[0] for p in range(P)]
                     times["indep"] = time.perf_counter() - t0
                     preds["indep"] = np.column_stack([_pred(m, X[h])[:, 0] for m in indep])
+                if "jointsel" in models_wanted and "joint" in models and indep:
+                    t0 = time.perf_counter()
+                    sel = select_outputs(models["joint"], indep, X[tr], Y[tr])
+                    times["jointsel"] = times["joint"] + times["indep"] + time.perf_counter() - t0
+                    preds["jointsel"] = sel.predict(X[h], include_noise=False)[0]
+                    corr["jointsel"] = _selected_correlations(sel, corr["joint"])
+                if "jointself" in models_wanted and "joint" in models and indep:
+                    t0 = time.perf_counter()
+                    sel = select_outputs(models["joint"], indep, X[tr], Y[tr], outputs=(0, 1, 2))
+                    times["jointself"] = times["joint"] + times["indep"] + time.perf_counter() - t0
+                    preds["jointself"] = sel.predict(X[h], include_noise=False)[0]
+                    corr["jointself"] = _selected_correlations(sel, corr["joint"])
+                if "jointse" in models_wanted and "joint" in models and indep:
+                    t0 = time.perf_counter()
+                    sel = select_outputs(models["joint"], indep, X[tr], Y[tr], rule="1se")
+                    times["jointse"] = times["joint"] + times["indep"] + time.perf_counter() - t0
+                    preds["jointse"] = sel.predict(X[h], include_noise=False)[0]
+                    corr["jointse"] = _selected_correlations(sel, corr["joint"])
+                if "jointfwd" in models_wanted and "joint" in models and indep:
+                    t0 = time.perf_counter()
+                    ej, ei = forward_errors(X[tr], Y[tr], base, COEFFICIENTS, 5)
+                    sel = SelectedOutputs(models["joint"], tuple(indep), ej < ei, ej, ei)
+                    times["jointfwd"] = times["joint"] + times["indep"] + time.perf_counter() - t0
+                    preds["jointfwd"] = sel.predict(X[h], include_noise=False)[0]
+                    corr["jointfwd"] = _selected_correlations(sel, corr["joint"])
                 gaps = {}
             else:
                 gone, _ = missing_rows(pattern, X, tr)
@@ -218,7 +275,7 @@ def summarize(paths) -> str:
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
     out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
             "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointa", "jointk", "jointf", "jointo"):
+    for v in ("joint", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo"):
         for ac in sorted({r["aircraft"] for r in rows}):
             for L in lengths:
                 g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
@@ -229,7 +286,7 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "lmc", "hjoint"):
+    for v in ("joint", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:

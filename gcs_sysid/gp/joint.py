@@ -45,7 +45,7 @@ from .sparse import GlobalParams
 from .validation import _design_u, _mean_weights, _sub, block_folds
 
 __all__ = ["COUPLING_MARGIN", "decoupled", "decoupled_model", "couple_only", "gate_coupling", "gap_errors", "nonlinear_part", "correlation", "quadratic_features",
-           "truth_correlation", "blocked_errors", "SelectedOutputs", "select_outputs"]
+           "truth_correlation", "blocked_errors", "SelectedOutputs", "select_outputs", "forward_errors", "fit_selected"]
 
 
 def decoupled(params: GlobalParams) -> GlobalParams:
@@ -303,7 +303,8 @@ def truth_correlation(X_true: np.ndarray, Y_true: np.ndarray) -> dict[str, np.nd
     return {"signal_corr": sc, "signal_std": ss, "rest_corr": rc, "rest_std": rs, "linear_std": ls}
 
 
-def blocked_errors(model: LocalGlobalGP, X: np.ndarray, Y: np.ndarray, folds: int = 5) -> np.ndarray:
+def blocked_errors(model: LocalGlobalGP, X: np.ndarray, Y: np.ndarray, folds: int = 5,
+                   per_block: bool = False) -> np.ndarray:
     """Blocked cross-validation squared error per output of the model's global layer, data units.
 
     The time-ordered rows are cut into ``folds`` contiguous blocks; each block is predicted by the
@@ -315,9 +316,11 @@ def blocked_errors(model: LocalGlobalGP, X: np.ndarray, Y: np.ndarray, folds: in
         model: a fitted model; X: ``(N, D)``, Y: ``(N, P_model)`` its training rows in time order
             (rows with a non-finite value are dropped).
         folds: number of blocks (at least 2).
+        per_block: return each block's mean squared error, ``(folds, P_model)``.
 
     Returns:
-        ``(P_model,)`` mean squared error per output over all rows, in the outputs' units squared.
+        ``(P_model,)`` mean squared error per output over all rows, in the outputs' units squared
+        (``(folds, P_model)`` with ``per_block``).
 
     Raises:
         ValueError: fewer than 2 folds or fewer rows than folds.
@@ -333,12 +336,14 @@ def blocked_errors(model: LocalGlobalGP, X: np.ndarray, Y: np.ndarray, folds: in
     total = parts[0]
     for st in parts[1:]:
         total = jax.tree_util.tree_map(jnp.add, total, st)
-    sse = np.zeros(Ys.shape[1])
-    for (a, b), st in zip(blocks, parts):
+    sse = np.zeros((len(blocks), Ys.shape[1]))
+    for k, ((a, b), st) in enumerate(zip(blocks, parts)):
         W = np.asarray(_mean_weights(params, _sub(total, st)))
         U = np.asarray(_design_u(params, Xs[a:b]))
-        sse += np.sum((Ys[a:b] - U @ W) ** 2, 0)
-    return sse / n * model.scaler.y_std**2
+        sse[k] = np.sum((Ys[a:b] - U @ W) ** 2, 0)
+    if per_block:
+        return sse / np.array([b - a for a, b in blocks], float)[:, None] * model.scaler.y_std**2
+    return sse.sum(0) / n * model.scaler.y_std**2
 
 
 @dataclass(frozen=True)
@@ -367,9 +372,20 @@ class SelectedOutputs:
                 mean[:, p], var[:, p] = mp[:, 0], vp[:, 0]
         return mean, var
 
+    def output_correlation(self) -> np.ndarray:
+        """Correlation ``(P, P)`` of the outputs' latent parts as the selected model predicts them: the joint
+        model's (``LocalGlobalGP.output_correlation``) between outputs that both use it, 0 between an output
+        predicted by its own GP and any other (that output's prediction does not depend on the others)."""
+        C = np.array(self.joint.output_correlation(), float)
+        own = ~np.asarray(self.use_joint, bool)
+        C[own, :] = 0.0
+        C[:, own] = 0.0
+        np.fill_diagonal(C, 1.0)
+        return C
+
 
 def select_outputs(joint: LocalGlobalGP, independent, X: np.ndarray, Y: np.ndarray, folds: int = 5,
-                   margin: float = 1.0) -> SelectedOutputs:
+                   margin: float = 1.0, rule: str = "min", outputs=None) -> SelectedOutputs:
     """Choose per output between the joint model and its independent GP by blocked cross-validation.
 
     Args:
@@ -377,18 +393,153 @@ def select_outputs(joint: LocalGlobalGP, independent, X: np.ndarray, Y: np.ndarr
             of ``Y`` each), all on the rows ``X (N, D)``, ``Y (N, P)`` in time order.
         folds: contiguous blocks (:func:`blocked_errors`).
         margin: the joint model is used for output ``p`` when its blocked error is below ``margin``
-            times the independent one's (1: whichever is lower).
+            times the independent one's (1: whichever is lower); rule ``"min"``.
+        rule: ``"min"``: the lower blocked error (with ``margin``); ``"1se"``: the joint model unless the own
+            GP's blocked error is lower by more than one standard error of the per-block differences (the
+            one-standard-error rule, Breiman et al. 1984, *Classification and Regression Trees*, sec. 3.4.3;
+            Hastie, Tibshirani and Friedman 2009, *The Elements of Statistical Learning*, 2nd ed., sec. 7.10:
+            the default structure stays unless the data show the other better beyond the validation's noise).
+        outputs: indices of the outputs that may leave the joint model (default all); the others keep it.
+            On the JSBSim flights the blocked errors on the training maneuvers picked the better model for
+            CX and not for the moments, which the joint model's pooled length-scales predict better on a
+            held-out multisine (``docs/gp.md``, "Why the joint model loses CX"): ``(0, 1, 2)`` there.
 
     Returns:
         :class:`SelectedOutputs`.
 
     Raises:
-        ValueError: ``independent`` does not hold one model per output of ``joint``.
+        ValueError: ``independent`` does not hold one model per output of ``joint``; an unknown ``rule``.
     """
     independent = tuple(independent)
     P = joint.n_outputs
     if len(independent) != P or any(m.n_outputs != 1 for m in independent):
         raise ValueError(f"select_outputs: need {P} one-output models, got {len(independent)}")
+    if rule not in ("min", "1se"):
+        raise ValueError(f"select_outputs: rule must be 'min' or '1se', got {rule!r}")
     ej = blocked_errors(joint, X, Y, folds)
     ei = np.array([blocked_errors(m, X, np.asarray(Y)[:, [p]], folds)[0] for p, m in enumerate(independent)])
-    return SelectedOutputs(joint, independent, ej < margin * ei, ej, ei)
+    if rule == "min":
+        use = ej < margin * ei
+    else:
+        bj = blocked_errors(joint, X, Y, folds, per_block=True)
+        bi = np.column_stack([blocked_errors(m, X, np.asarray(Y)[:, [p]], folds, per_block=True)[:, 0]
+                              for p, m in enumerate(independent)])
+        d = bi - bj                                         # (folds, P): > 0 where the joint model is better
+        se = d.std(0, ddof=1) / np.sqrt(len(d))
+        use = ~(d.mean(0) + se < 0.0)
+    if outputs is not None:
+        may = np.zeros(P, bool)
+        may[np.asarray(list(outputs), int)] = True
+        use = use | ~may
+    return SelectedOutputs(joint, independent, use, ej, ei)
+
+
+def forward_errors(X, Y, config=None, output_names=None, folds: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    """Held-forward error of the joint model and of each output's own GP, every hyperparameter learned again
+    without the held-back rows: both are fitted on the first ``(folds - 1) / folds`` of the time-ordered rows
+    and predict the last block (``LocalGlobalGP.predict``, the local layer included, noise-free mean).
+
+    The blocked errors of :func:`blocked_errors` keep the hyperparameters learned on every row, so they cannot
+    see hyperparameters that fit the maneuvers they were learned on and nothing else (an own GP of a moment
+    learned from a few maneuvers: ``docs/gp.md``, "Why the joint model loses CX"); a forward split with the
+    hyperparameters learned again is meant to (Bergmeir and Benitez 2012, "On the use of cross-validation for
+    time series predictor evaluation", Inf. Sci. 191:192-213; Roberts et al. 2017). Measured on one JSBSim
+    flight it did not pick the moments' better model either.
+
+    Args:
+        X: ``(N, D)``, Y: ``(N, P)`` training rows in time order (rows with a missing output are left out of
+            that output's scores).
+        config: :class:`GPConfig` (default ``GPConfig()``); output_names: as :func:`fit_gp`.
+        folds: the last ``N // folds`` rows are held back (at least 2).
+
+    Returns:
+        ``(err_joint, err_own)``, each ``(P,)``: mean squared error on the held-back rows, data units squared.
+
+    Raises:
+        ValueError: fewer than 2 folds, or fewer than ``3 folds`` rows.
+    """
+    from .config import GPConfig
+    from .fit import fit_gp
+
+    cfg = GPConfig() if config is None else config
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
+    n, P = Y.shape
+    if folds < 2 or n < 3 * folds:
+        raise ValueError(f"forward_errors: need at least 2 folds and 3 rows per fold, got {folds} folds, {n} rows")
+    cut = n - n // folds
+    names = None if output_names is None else list(output_names)
+    joint, _ = fit_gp(X[:cut], Y[:cut], cfg, output_names=names)
+    names = list(joint.output_names)
+    mj = joint.predict(X[cut:], include_noise=False)[0]
+    ej, ei = np.zeros(P), np.zeros(P)
+    for p in range(P):
+        rows = np.isfinite(Y[:cut, p])
+        own = fit_gp(X[:cut][rows], Y[:cut][rows][:, [p]], cfg, output_names=[names[p]])[0]
+        mi = own.predict(X[cut:], include_noise=False)[0][:, 0]
+        ok = np.isfinite(Y[cut:, p]) & np.isfinite(mj[:, p]) & np.isfinite(mi)
+        ej[p] = np.mean((mj[ok, p] - Y[cut:][ok, p]) ** 2)
+        ei[p] = np.mean((mi[ok] - Y[cut:][ok, p]) ** 2)
+    return ej, ei
+
+
+def fit_selected(X, Y, config=None, output_names=None, folds: int | None = None, margin: float = 1.0,
+                 hyper: str = "fixed", outputs=None) -> SelectedOutputs:
+    """Fit the joint model and one GP per output on the same training rows, and choose per output on those
+    rows: model selection inside the fit, on training data only, so an output is predicted by the joint
+    model only where pooling (the shared kernel's length-scales, the coregionalisation, the noise coupling)
+    lowers its error on held-back time blocks.
+
+    Why (``docs/gp.md``, "Why the joint model loses CX, and a per-output choice"): on isotopic flight
+    tables the coupling contributes nothing to the mean (autokrigeability; Alvarez, Rosasco and Lawrence
+    2012, sec. 4.2; Bonilla, Chai and Williams 2008), and the one kernel all outputs share is what moves
+    an output: it helps the moments of a short log (hyperparameters pooled across tasks; Lawrence and Platt
+    2004) and costs an output whose own length-scales differ from the pooled ones (CX's along the lateral
+    controls, where the shared kernel follows Cm's along the elevator and pitch rate). Choosing by
+    validation keeps the first and not the second (Rasmussen and Williams 2006, sec. 5.3).
+
+    Args:
+        X: ``(N, D)`` regressors, Y: ``(N, P)`` coefficients, rows in time order (as :func:`fit_gp`; rows
+            with a missing output are left out of that output's own GP and of its score).
+        config: :class:`GPConfig` for every fit (default ``GPConfig()``).
+        output_names: names of the ``P`` outputs (default as :func:`fit_gp`).
+        folds: time blocks (default ``config.validation_folds``, at least 2).
+        margin: the joint model is used for an output when its error is below ``margin`` times the own GP's.
+        hyper: ``"fixed"`` (default): :func:`blocked_errors` with the hyperparameters of the fits on all rows
+            (``P + 1`` fits); ``"refit"``: :func:`forward_errors` (every hyperparameter learned again without
+            the last block; ``2 (P + 1)`` fits in all). Both were measured to prefer the own GPs of the
+            moments where the joint model predicts them better on a held-out multisine (``docs/benchmarks.md``,
+            "Fourteenth session, i8-jointcx").
+        outputs: indices of the outputs that may leave the joint model (default all; ``(0, 1, 2)``: the forces
+            CX CY CZ, the choice that won there); the others keep it.
+
+    Returns:
+        :class:`SelectedOutputs` (the ``P + 1`` models fitted on all rows and the choice).
+
+    Raises:
+        As :func:`fit_gp`; ValueError: an unknown ``hyper``, or too few rows for the folds.
+    """
+    from .config import GPConfig
+    from .fit import fit_gp
+
+    if hyper not in ("refit", "fixed"):
+        raise ValueError(f"fit_selected: hyper must be 'refit' or 'fixed', got {hyper!r}")
+    cfg = GPConfig() if config is None else config
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
+    P = Y.shape[1]
+    names = list(output_names) if output_names is not None else None
+    joint, _ = fit_gp(X, Y, cfg, output_names=names)
+    names = list(joint.output_names)
+    own = []
+    for p in range(P):
+        rows = np.isfinite(Y[:, p])
+        own.append(fit_gp(X[rows], Y[rows][:, [p]], cfg, output_names=[names[p]])[0])
+    k = max(int(cfg.validation_folds if folds is None else folds), 2)
+    if hyper == "fixed":
+        return select_outputs(joint, own, X, Y, k, margin, outputs=outputs)
+    ej, ei = forward_errors(X, Y, cfg, names, k)
+    use = ej < margin * ei
+    if outputs is not None:
+        may = np.zeros(P, bool)
+        may[np.asarray(list(outputs), int)] = True
+        use = use | ~may
+    return SelectedOutputs(joint, tuple(own), use, ej, ei)

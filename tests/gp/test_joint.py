@@ -219,3 +219,58 @@ def test_axis_groups_learn_no_cross_axis_correlation_and_keep_the_within_axis_on
     c = model.output_correlation()
     assert np.all(c[np.ix_([0, 2, 4], [1, 3, 5])] == 0.0)
     assert abs(c[0, 2]) > 0.5 and abs(c[1, 3]) > 0.5
+
+
+
+def test_selected_outputs_correlation_is_zero_for_an_output_on_its_own_gp(gust_case):
+    """The learned correlation of the per-output selection: the joint model's between the outputs that use
+    it, 0 between an output predicted by its own GP and the others (cheap: the module's joint fit)."""
+    from gcs_sysid.gp.joint import SelectedOutputs
+
+    joint = gust_case[-1]
+    use = np.array([True, True, False])
+    C = SelectedOutputs(joint, (), use, np.zeros(3), np.ones(3)).output_correlation()
+    np.testing.assert_allclose(C[:2, :2], joint.output_correlation()[:2, :2])
+    assert np.all(C[2, :2] == 0.0) and np.all(C[:2, 2] == 0.0) and C[2, 2] == 1.0
+    np.testing.assert_allclose(SelectedOutputs(joint, (), np.ones(3, bool), np.zeros(3), np.ones(3)).output_correlation(),
+                               joint.output_correlation(), atol=1e-12)
+
+
+@pytest.mark.slow
+def test_fit_selected_fits_the_joint_model_and_own_gps_and_chooses_on_training_rows(gust_case):
+    """``fit_selected`` on the gust case's training rows: its joint model is the module's (same settings and
+    seed); with ``hyper="fixed"`` (the default) the choice is the blocked errors' (``select_outputs``) and
+    output 0 takes the joint model (its noise is read from output 1's); with ``"refit"`` the choice is the
+    forward errors' (``forward_errors``), and an output not in ``outputs`` keeps the joint model; each
+    output's prediction is its chosen model's."""
+    from gcs_sysid.gp.joint import fit_selected, forward_errors
+
+    X, Y, F, n, joint = gust_case
+    fixed = fit_selected(X[:n], Y[:n], CFG)
+    assert len(fixed.independent) == 3 and all(m.n_outputs == 1 for m in fixed.independent)
+    np.testing.assert_allclose(fixed.joint.predict(X[n:n + 20])[0], joint.predict(X[n:n + 20])[0])
+    np.testing.assert_array_equal(fixed.use_joint, fixed.err_joint < fixed.err_indep)
+    assert fixed.use_joint[0]
+    kept = select_outputs(fixed.joint, fixed.independent, X[:n], Y[:n], outputs=(1,))      # only output 1 may leave
+    np.testing.assert_array_equal(kept.use_joint, [True, fixed.use_joint[1], True])
+    sel = fit_selected(X[:n], Y[:n], CFG, hyper="refit", outputs=(0, 1))
+    ej, ei = forward_errors(X[:n], Y[:n], CFG)
+    np.testing.assert_allclose(sel.err_joint, ej)
+    np.testing.assert_allclose(sel.err_indep, ei)
+    np.testing.assert_array_equal(sel.use_joint, (ej < ei) | np.array([False, False, True]))
+    print("forward errors joint / own", ej, ei)
+    m, _ = sel.predict(X[n:], include_noise=False)
+    for p in range(3):
+        ref = (sel.joint.predict(X[n:], include_noise=False)[0][:, p] if sel.use_joint[p]
+               else sel.independent[p].predict(X[n:], include_noise=False)[0][:, 0])
+        np.testing.assert_allclose(m[:, p], ref)
+
+
+def test_fit_selected_refuses_bad_settings_before_fitting():
+    from gcs_sysid.gp.joint import fit_selected, forward_errors
+
+    X, Y = np.zeros((12, 2)), np.zeros((12, 2))
+    with pytest.raises(ValueError, match="hyper"):
+        fit_selected(X, Y, hyper="loo")
+    with pytest.raises(ValueError, match="folds"):
+        forward_errors(X, Y, folds=5)
