@@ -33,7 +33,7 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from benchmarks.jsbsim_harness.logfile import _REPO
-from truth_fits import ic_state
+from truth_fits import check_direct_fcs, ic_state
 
 SOURCE = _REPO / "data" / "jsbsim_models" / "rascal" / "Rascal110-JSBSim.xml"
 SOURCE_SHA256 = "d5b9e7435e3a04d7f8c4d3e37b6ecb9ca4865f98e17d38a50177e5a86d41dd20"   # README.md's
@@ -81,19 +81,7 @@ def test_the_rascal_flies_its_own_surfaces_and_no_propulsion():
     A yaw rate does not move the rudder (no yaw damper), so the harness's own damper flies it (k_r 0.4)."""
     spec = aircraft("rascal")
     assert spec.gains[5] == 0.4
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
-    assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.30, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
-    for _ in range(50):
-        fdm.run()
-    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
-        for ax in ("xyz" if f.startswith("forces") else "lmn"):
-            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
-    assert abs(fdm["forces/fbz-aero-lbs"]) > 5.0
+    check_direct_fcs(spec, min_lift_lbs=5.0)
 
 
 def test_the_rascal_is_statically_stable_and_yaws_adversely():

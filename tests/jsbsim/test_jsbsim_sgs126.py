@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft
-from truth_fits import ic_state
+from truth_fits import check_direct_fcs, ic_state
 
 FT = 0.3048
 
@@ -56,19 +56,7 @@ def test_the_sgs126_is_the_wheels_glider_flying_its_own_surfaces():
     root = ET.parse(stock_model_dir(spec) / "sgs126.xml").getroot()
     assert len(root.find("propulsion")) == 0
     assert spec.gains[5] == 0.4 and not spec.gear_up
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
-    assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.30, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
-    for _ in range(50):
-        fdm.run()
-    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
-        for ax in ("xyz" if f.startswith("forces") else "lmn"):
-            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
-    assert abs(fdm["forces/fbz-aero-lbs"]) > 100.0
+    check_direct_fcs(spec, min_lift_lbs=100.0)
 
 
 def test_the_sgs126_is_statically_stable_and_yaws_adversely():

@@ -169,6 +169,31 @@ def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.
     return fdm
 
 
+def check_direct_fcs(spec, min_lift_lbs: float) -> None:
+    """Assert that ``spec``'s FCS maps the normalised commands straight to the surfaces its aerodynamics
+    read (elevator -0.35..+0.30 rad, left aileron +-0.35 rad with the right its mirror, rudder +-0.35 rad),
+    that JSBSim has no engine, and that after 50 frames every non-gravity force and moment is aerodynamic
+    with at least ``min_lift_lbs`` of body-z force (the rascal's and sgs126's checks: both fly such an FCS).
+
+    Raises:
+        AssertionError: the first check that fails."""
+    import pytest
+
+    fdm = ic_state(spec, beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.30, rel=1e-9)
+    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
+    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
+    assert ic_state(spec, cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
+    for _ in range(50):
+        fdm.run()
+    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
+        for ax in ("xyz" if f.startswith("forces") else "lmn"):
+            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
+    assert abs(fdm["forces/fbz-aero-lbs"]) > min_lift_lbs
+
+
 def effect_state(spec, effects, cmds=(0.3, -0.4, 0.2), n=40, alpha_deg=None):
     """JSBSim (``FGFDMExec``) at the harness's initial condition with 4 deg of sideslip (and
     ``alpha_deg`` of alpha when given) and the fixed normalised commands ``cmds`` (elevator,
