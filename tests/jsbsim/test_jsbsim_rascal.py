@@ -33,7 +33,7 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from benchmarks.jsbsim_harness.logfile import _REPO
-from truth_fits import check_direct_fcs, ic_state
+from truth_fits import check_direct_fcs, cm_without_alpha_dot, ic_state
 
 SOURCE = _REPO / "data" / "jsbsim_models" / "rascal" / "Rascal110-JSBSim.xml"
 SOURCE_SHA256 = "d5b9e7435e3a04d7f8c4d3e37b6ecb9ca4865f98e17d38a50177e5a86d41dd20"   # README.md's
@@ -98,9 +98,7 @@ def test_the_rascal_is_statically_stable_and_yaws_adversely():
       project's sign). Cn at rest is its Cndi, +0.0007.
     """
     def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc
+        return cm_without_alpha_dot(aircraft("rascal"), alpha, de)
 
     c0, c4, c8 = cm(0.0), cm(4.0), cm(8.0)
     slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft
-from truth_fits import check_direct_fcs, ic_state
+from truth_fits import check_direct_fcs, cm_without_alpha_dot, ic_state
 
 FT = 0.3048
 
@@ -72,9 +72,7 @@ def test_the_sgs126_is_statically_stable_and_yaws_adversely():
       above the CG). Cn and Cl at rest are 0.
     """
     def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc
+        return cm_without_alpha_dot(aircraft("sgs126"), alpha, de)
 
     c0, c4, c8 = cm(0.0), cm(4.0), cm(8.0)
     slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731

@@ -169,6 +169,15 @@ def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.
     return fdm
 
 
+def cm_without_alpha_dot(spec, alpha_deg: float, elevator_cmd: float = 0.0) -> float:
+    """JSBSim's pitching-moment coefficient about the CG at :func:`ic_state` (``alpha_deg`` of alpha, the
+    normalised elevator command ``elevator_cmd``) less its ``Cmadot`` term (``run_ic`` gives an alpha-dot the
+    term reads): the static Cm the rascal's and sgs126's stability checks difference over alpha and elevator."""
+    fdm = ic_state(spec, alpha_deg=alpha_deg, cmds=(elevator_cmd, 0.0, 0.0))
+    qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
+    return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc
+
+
 def check_direct_fcs(spec, min_lift_lbs: float) -> None:
     """Assert that ``spec``'s FCS maps the normalised commands straight to the surfaces its aerodynamics
     read (elevator -0.35..+0.30 rad, left aileron +-0.35 rad with the right its mirror, rudder +-0.35 rad),
