@@ -16,8 +16,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))      # this directory's
 
 from benchmarks.jsbsim_harness import FlightConfig, make_flight  # noqa: E402
 
-#: The fast flight: c172x gliding, 40 s logged, light Milspec turbulence, seed 1, AHRS AOA_SSA.
-FAST = FlightConfig("c172x", duration_s=40.0, turbulence="light", seed=1)
+#: The fast flight: c172x gliding, 40 s logged, "calm" Milspec turbulence (severity 1, what the harness
+#: called light until the fifteenth session; docs/jsbsim.md, "Turbulence levels"), seed 1, AHRS AOA_SSA.
+#: The thresholds of the tests that share it were frozen on this flight; they check mechanisms (the
+#: Earth model, the lever arm, the aiding, the side-force floor, predict), not a level of turbulence.
+FAST = FlightConfig("c172x", duration_s=40.0, turbulence="calm", seed=1)
 
 
 @pytest.fixture(scope="session")

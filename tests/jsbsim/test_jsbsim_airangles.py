@@ -1,5 +1,5 @@
 """Air angles aided by the specific force (estimation/airangles.py) on the fast JSBSim flight
-(c172x, 40 s, light Milspec turbulence, seed 1, AOA_SSA = ArduPilot's AHRS estimate), against
+(c172x, 40 s, "calm" Milspec turbulence (the harness's light until the fifteenth session), seed 1, AOA_SSA = ArduPilot's AHRS estimate), against
 JSBSim's exact alpha and beta; the same flight with the aiding switched off is the reference.
 
 Thresholds FROZEN on 2026-11-21 from the first measurement (aided alpha / beta RMS error 0.116 / 0.079

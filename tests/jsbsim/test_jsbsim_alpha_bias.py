@@ -1,4 +1,4 @@
-"""What the reconstructed alpha's mean error is made of, on the fast JSBSim flight (c172x, 40 s, light
+"""What the reconstructed alpha's mean error is made of, on the fast JSBSim flight (c172x, 40 s, "calm" (the old light)
 Milspec turbulence, seed 1, AHRS AOA_SSA), against JSBSim's exact alpha and wind (slow: two more
 estimate_states runs).
 

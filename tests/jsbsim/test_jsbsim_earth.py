@@ -4,7 +4,7 @@ SCALED_IMU) carries the Coriolis acceleration. The lateral specific force the co
 have no offset against the truth with the Earth model, and shows the 0.006 m/s^2 offset without it
 (the failure this test guards against; docs/estimation.md).
 
-Thresholds FROZEN on 2026-11-22 from the first measurement on the fast flight (c172x, 40 s, light,
+Thresholds FROZEN on 2026-11-22 from the first measurement on the fast flight (c172x, 40 s, "calm" (the old light),
 seed 1): mean ay, az offset against the truth 0.0017, 0.0012 m/s^2 with the Earth model (the rest is
 the bias filter's error over 40 s), 0.0077, -0.0049 m/s^2 without it."""
 

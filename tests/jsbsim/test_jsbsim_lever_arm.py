@@ -3,7 +3,7 @@ right and 0.2 m above the CG (``make_sensors(imu_offset=...)``: ``f_cg + omega_d
 (omega x r)`` from JSBSim's inertial rates), the airframe file states the lever arm, and the
 estimator moves the specific force back to the CG with its own smoothed rates and accelerations.
 
-Thresholds FROZEN on 2026-11-22 from the first measurement (fast flight: c172x, 40 s, light, seed
+Thresholds FROZEN on 2026-11-22 from the first measurement (fast flight: c172x, 40 s, "calm" (the old light), seed
 1; the same noise draws as the IMU at the CG): see ``test_lever_arm_is_removed`` for the figures."""
 
 import tomllib
