@@ -81,8 +81,9 @@ _DEG = 57.29577951308232
 #: ``derived.py``) and ``sgs126`` (the fourteenth session's: the wheel's Schweizer SGS 1-26 glider, flown at
 #: 3000 ft where JSBSim's light turbulence is active) are used since as well. ``asw20`` (added in the fifteenth
 #: session, 2026-11-23: FlightGear's ASW 20 sailplane, checked into ``data/jsbsim_models/asw20`` and flown as
-#: ``asw20_glide``, at 3000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up
-#: (from JSBSim's truth and its XML), the method was never run on it before its final evaluation.
+#: ``asw20_glide``, at 3000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
+#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method was never
+#: run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
