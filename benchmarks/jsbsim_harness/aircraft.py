@@ -417,7 +417,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # elevator through an alias of fcs/elevator-pos-rad (so that delay:delta_e reaches it). Chosen in the
     # fifteenth session (docs/jsbsim.md, "The asw20") after the DG-101G (its XFLR5 tables jump at 2 deg of sideslip:
     # CY -0.012, -0.089, -0.015 per 1, 2, 3 deg, and Cm steps by 0.06 from beta 0 to 1 deg) and the Bocian (YASim).
-    # The fullest lateral set of the roster: CYb, CYp, CYr, CYDa, CYDr, Clb, Clp, Clr, Clda, ClDr, Cnb, Cnp, Cnr,
+    # A full lateral set: CYb, CYp, CYr, CYDa, CYDr, Clb, Clp, Clr, Clda, ClDr, Cnb, Cnp, Cnr,
     # Cnda, CnDr, plus CLq and CLadot. A direct FCS (aerosurface_scale, no damper): elevator -0.436..+0.384 rad,
     # left and right aileron both -0.436 x the command (the file's gain -1; the aerodynamics read the left
     # alone, Clda -0.214 x left: a positive left-aileron-pos-rad rolls it left, so delta_a = +left and the
