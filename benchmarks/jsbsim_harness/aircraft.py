@@ -78,10 +78,12 @@ _DEG = 57.29577951308232
 #: ``t37``, ``t6``, ``b747``, ``f16``, ``f4n`` and ``rascal`` (untouched until the eighth to thirteenth
 #: sessions' final evaluations; the f16 flown as the derived model ``f16_direct``, the f4n as ``F4N_fcs``,
 #: the rascal, ArduPilot's SITL Rascal 110 checked into ``data/jsbsim_models``, as ``Rascal110_glide``:
-#: ``derived.py``) are used since as well. ``sgs126`` (added in the fourteenth session, 2026-11-23: the
-#: wheel's Schweizer SGS 1-26 glider, flown at 3000 ft where JSBSim's light turbulence is active) is the
-#: held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up
-#: (from JSBSim's truth and its XML), the method was never run on it before its final evaluation.
+#: ``derived.py``) and ``sgs126`` (the fourteenth session's: the wheel's Schweizer SGS 1-26 glider, flown at
+#: 3000 ft where JSBSim's light turbulence is active) are used since as well. ``asw20`` (added in the fifteenth
+#: session, 2026-11-23: FlightGear's ASW 20 sailplane, checked into ``data/jsbsim_models/asw20`` and flown as
+#: ``asw20_glide``, at 3000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
+#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method was never
+#: run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -406,10 +408,47 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         amplitude_deg=(4.0, 8.0, 8.0), pulse_s=(0.7, 0.8, 1.3),
         notes="Schweizer SGS 1-26 glider (JSBSim sgs126), flown at 3000 ft in JSBSim's light turbulence; "
               "untouched by any tuning of the method"),
+    # asw20: FlightGear's ASW 20 sailplane (FGMEMBERS/asw20 Models/JSBSim/asw20-JSBSim.xml at 3ef71d9c, D-NXKT's
+    # 2013 conversion of Michael Selig's UIUC ASW 20; GPL-2.0-or-later), a 15-m-class single-seat sailplane: 728.7 lb,
+    # 49.2-ft span, 113 ft^2 (wing loading 6.4 lb/ft^2), no propulsion. The second aircraft from outside the wheel;
+    # its XML is checked in (data/jsbsim_models/asw20/, provenance and licence in its README.md) and flown as the
+    # derived model ``asw20_glide`` (derived.py): FlightGear's GenericEngine and WaterBallast systems and its Water
+    # Dumping channel removed (JSBSim alone cannot initialise it with them), the tail's CmDe table reading the
+    # elevator through an alias of fcs/elevator-pos-rad (so that delay:delta_e reaches it). Chosen in the
+    # fifteenth session (docs/jsbsim.md, "The asw20") after the DG-101G (its XFLR5 tables jump at 2 deg of sideslip:
+    # CY -0.012, -0.089, -0.015 per 1, 2, 3 deg, and Cm steps by 0.06 from beta 0 to 1 deg) and the Bocian (YASim).
+    # A full lateral set: CYb, CYp, CYr, CYDa, CYDr, Clb, Clp, Clr, Clda, ClDr, Cnb, Cnp, Cnr,
+    # Cnda, CnDr, plus CLq and CLadot. A direct FCS (aerosurface_scale, no damper): elevator -0.436..+0.384 rad,
+    # left and right aileron both -0.436 x the command (the file's gain -1; the aerodynamics read the left
+    # alone, Clda -0.214 x left: a positive left-aileron-pos-rad rolls it left, so delta_a = +left and the
+    # aileron's command scale is negative), rudder 31 x 0.01745 = 0.541 rad x the command; the elevator's
+    # command scale is its larger end (the b747's rule). Signs read from its aerodynamics: CmDe (a 3-D table,
+    # -0.786 per rad at alpha -2 deg) x elevator (positive = trailing edge down, nose down), Clda -0.214 x left
+    # (Cl_delta_a -0.214), CnDr -0.041 x rudder (positive = trailing edge left, nose left); Cnda -0.017 x left
+    # (Cn_delta_a -0.017: proverse, the file's comment "different sign in UIUC??"). Gear up (its one gear term
+    # CDDg 0.005 x gear-pos-norm); flaps at the file's default, -11 deg (CLDf -0.19, a constant). 65 kt (ic/vc-kts)
+    # at 3000 ft (the sgs126's altitude, in JSBSim's light turbulence): 32.5-41 m/s TAS and alpha about -2 deg in
+    # the standard flights, where its CL table is linear (no breakpoint between -16.7 and +2.28 deg; the lift slope
+    # falls from 5.7 to 4.3 per rad above); the sweep flies 24.6-42 m/s and alpha -4.8..4.9 deg. Its Cm has a
+    # break at alpha 0 (the Cmalpha table's slope +0.62 below, +0.37 above; JSBSim's static Cm_alpha -1.14 and
+    # -1.38 per rad). Pulses 0.5 / 0.6 / 0.9 s: short period about 4.6 rad/s (M_alpha -13 per s^2 at 35 m/s,
+    # Cmq -24), Dutch roll about 2.5 rad/s (Cnb 0.1 against Izz 1757 kg m^2), a doublet's best pulse about
+    # 2.3 / omega_n. Amplitudes 3 / 5 / 6 deg: 1.5-1.6 deg of elevator standard deviation in the standard light
+    # flights (the envelope test's floor is 1), surfaces at most -9.8..+9.9, 11 and 10.2 deg of their 25, 25 and
+    # 31 in the trial flights. Default gains. Set from the harness's truth only (alpha, beta, rates, excitation
+    # per axis, surfaces, sink), never from a method result; the first set-up tried passed (docs/jsbsim.md).
+    "asw20": AircraftSpec(
+        name="asw20", model="asw20_glide", airspeed_kts=65.0, altitude_ft=3000.0,
+        elevator_sign=1.0, aileron_sign=1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.43633, -1.0 / 0.43633, 1.0 / (31.0 * 0.01745)),
+        amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.5, 0.6, 0.9), gear_up=True,
+        notes="ASW 20 sailplane (FlightGear's JSBSim asw20-JSBSim.xml, checked in under data/jsbsim_models/asw20) "
+              "without FlightGear's engine and ballast systems (derived model asw20_glide, XML sha256 f9ca126483a12dcc), "
+              "gear up, gliding; untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal")
-HELD_OUT_AIRCRAFT = ("sgs126",)
-UNTOUCHED_AIRCRAFT = ("sgs126",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126")
+HELD_OUT_AIRCRAFT = ("asw20",)
+UNTOUCHED_AIRCRAFT = ("asw20",)
 
 
 def aircraft(name: str) -> AircraftSpec:

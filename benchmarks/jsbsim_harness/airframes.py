@@ -29,7 +29,8 @@ def airframe_doc(spec: AircraftSpec) -> dict:
     fdm["ic/h-sl-ft"] = spec.altitude_ft
     fdm["ic/vc-kts"] = spec.airspeed_kts
     fdm.run_ic()
-    ends = [math.degrees(1.0 / k) for k in spec.cmd_per_rad]
+    ends = [math.degrees(1.0 / abs(k)) for k in spec.cmd_per_rad]   # a command that moves the raw surface
+    # the other way (the asw20's ailerons) has a negative scale; the servo map is in the project's deltas
 
     def servo(name: str, ch: int, end: float, mix: str) -> dict:
         return {"name": name, "channel": ch, "pwm_min": 1100, "pwm_trim": 1500, "pwm_max": 1900,

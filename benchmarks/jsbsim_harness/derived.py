@@ -3,7 +3,9 @@ system replaced by a direct mapping from the harness's commands to the surfaces 
 given the empty ``<flight_control>`` element the harness's injected elevator delay needs
 (``F4N_fcs``, :func:`derive_f4n_fcs`; twelfth session), or a model from outside the wheel, checked into
 this repository, with its engine removed (``Rascal110_glide``, :func:`derive_rascal_glide`: ArduPilot's
-SITL Rascal 110; thirteenth session, :data:`REPO_DERIVED`).
+SITL Rascal 110; thirteenth session, :data:`REPO_DERIVED`), or FlightGear's ASW 20 sailplane with the
+parts that need FlightGear removed and its elevator table reading an alias (``asw20_glide``,
+:func:`derive_asw20_glide`; fifteenth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -56,11 +58,18 @@ import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-__all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide", "derived_xml",
-           "derived_sha", "install_derived_models", "ELEVATOR_ALIAS"]
+__all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
+           "derive_asw20_glide", "derived_xml", "derived_sha", "install_derived_models", "ELEVATOR_ALIAS",
+           "ELEVATOR_DEG_ALIAS"]
 
 #: The elevator alias the derived F-16's tables read (see the module docstring).
 ELEVATOR_ALIAS = "aero/function/elevator-pos-rad"
+
+#: The elevator alias, in degrees, the derived ASW 20's pitch table reads (:func:`derive_asw20_glide`).
+ELEVATOR_DEG_ALIAS = "aero/function/elevator-pos-deg"
+
+#: JSBSim's radians-to-degrees factor (``FGJSBBase::radtodeg``), with which it writes ``fcs/elevator-pos-deg``.
+_RADTODEG = 57.295779513082320876798154814105
 
 
 def _wheel_root() -> Path:
@@ -206,6 +215,66 @@ def derive_rascal_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def derive_asw20_glide(root: ET.Element) -> ET.Element:
+    """FlightGear's ASW 20 sailplane (``data/jsbsim_models/asw20/asw20-JSBSim.xml``) as JSBSim alone can
+    fly it, with one ``<property>`` read of the elevator in its aerodynamics (fifteenth session).
+
+    The file is D-NXKT's January 2013 conversion of Michael Selig's UIUC ASW 20 to JSBSim, written for
+    FlightGear. Three edits; nothing else changes:
+
+    - **Systems removed.** The two ``<system file=...>`` elements (``GenericEngine``: FlightGear's
+      generic motor, a thrust written into the ``GenericEngine`` external force; ``WaterBallast``:
+      dumping) name files that are not copied. Without them the external forces (winch, aerotow,
+      engine) keep JSBSim's magnitude 0, so every non-gravity force is aerodynamic.
+    - **One FlightGear channel removed.** The ``Water Dumping`` channel of ``<flight_control>`` tests
+      FlightGear's ``/sim/asw20/waterballast/valve``, which JSBSim alone does not have (``run_ic``
+      raises, as for the L17 and dr1). It writes only ``/sim/asw20/waterballast/dumping``, which nothing
+      reads.
+    - **Elevator alias.** The ``CmDe`` table (the tail's whole pitching moment: a 3-D table in alpha
+      with elevator breakpoints -20, 0, +20 deg) looks the elevator up as ``fcs/elevator-pos-deg``. A
+      function ``aero/function/elevator-pos-deg`` = 57.2957795... x ``fcs/elevator-pos-rad`` (JSBSim's
+      own conversion) is added to ``<aerodynamics>`` and the table looks it up there, so that
+      ``effects.py``'s ``delay:delta_e`` reaches the tail as it does the elevator's lift (``CLDe``).
+      The numbers are unchanged (a test checks JSBSim's moments against the file as copied).
+
+    Args:
+        root: the parsed ``asw20-JSBSim.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): the
+            two systems, the ``Water Dumping`` channel, ``<aerodynamics>`` or one table reading
+            ``fcs/elevator-pos-deg``.
+    """
+    root = copy.deepcopy(root)
+    systems = root.findall("system")
+    if sorted(s.get("file") for s in systems) != ["GenericEngine", "WaterBallast"]:
+        raise ValueError("asw20-JSBSim.xml: expected the systems GenericEngine and WaterBallast")
+    for s in systems:
+        root.remove(s)
+    fc = root.find("flight_control")
+    dump = [ch for ch in fc.findall("channel") if ch.get("name") == "Water Dumping"] if fc is not None else []
+    if len(dump) != 1:
+        raise ValueError("asw20-JSBSim.xml: no <flight_control> channel 'Water Dumping'")
+    fc.remove(dump[0])
+    aero = root.find("aerodynamics")
+    if aero is None:
+        raise ValueError("asw20-JSBSim.xml: no <aerodynamics>")
+    reads = [iv for iv in aero.iter("independentVar") if iv.text and iv.text.strip() == "fcs/elevator-pos-deg"]
+    if len(reads) != 1:
+        raise ValueError("asw20-JSBSim.xml: expected one table looking up fcs/elevator-pos-deg")
+    reads[0].text = ELEVATOR_DEG_ALIAS
+    alias = ET.Element("function", name=ELEVATOR_DEG_ALIAS)
+    _el(alias, "description", "elevator position, deg, the CmDe table reads (added by the harness's derivation)")
+    prod = _el(alias, "product")
+    _el(prod, "value", repr(_RADTODEG))
+    _el(prod, "property", "fcs/elevator-pos-rad")
+    aero.insert(0, alias)
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -226,6 +295,12 @@ REPO_DERIVED = {
                         "gcs-sysid's data/jsbsim_models/rascal/",
                         derive_rascal_glide, "engine and propeller removed (a glide with no propeller force); "
                                              "everything else unchanged."),
+    "asw20_glide": ("data/jsbsim_models/asw20/asw20-JSBSim.xml",
+                    "FlightGear's ASW 20 (FGMEMBERS/asw20 Models/JSBSim/asw20-JSBSim.xml at 3ef71d9c, GPL-2.0-or-later), "
+                    "copied into gcs-sysid's data/jsbsim_models/asw20/",
+                    derive_asw20_glide, "the GenericEngine and WaterBallast systems and the Water Dumping channel "
+                                        "(FlightGear's) removed; the CmDe table reads the elevator through an alias "
+                                        "in degrees of fcs/elevator-pos-rad; everything else unchanged."),
 }
 
 

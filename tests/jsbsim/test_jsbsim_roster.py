@@ -1,5 +1,5 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal and the untouched sgs126; docs/jsbsim.md, one section each), parametrised
+t37, t6, b747, f16, f4n, rascal, sgs126 and the untouched asw20; docs/jsbsim.md, one section each), parametrised
 over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
@@ -10,13 +10,14 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched sgs126's are slow too but its names', and its own
-default checks (no propulsion, its direct surfaces, static stability, light turbulence at its altitude,
-the summaries' label) are in ``test_jsbsim_sgs126.py`` (the rascal's in ``test_jsbsim_rascal.py``, the
-f4n's in ``test_jsbsim_f4n.py``, the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the
-eleventh to thirteenth sessions). Folded in the eleventh session from
+default suite, as before the fold); the untouched asw20's are slow too but its names', and its own
+default checks (the derivation, its surfaces, static stability, the summaries' label) are in
+``test_jsbsim_asw20.py`` (the sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in
+``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``, the f16's in ``test_jsbsim_f16.py``; tuning
+aircraft since the eleventh to fifteenth sessions). Folded in the eleventh session from
 ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
-value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth.
+value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
+in the fifteenth.
 """
 
 from dataclasses import dataclass
@@ -173,7 +174,27 @@ CASES = (
           ("cn", 3, 0.02, ("rel", 1e-6)), ("cn", 1, 0.0, ("abs", 1e-9))),
          (), 0.30, 1,
          dict(alpha=(-4.0, 8.0), beta=(9.0, 8.0), bank=(30.0, 25.0), speed=(15.0, 35.0), alt_min=500.0,
-              rate_std=1.0, rate_std_held=0.8, sink_min=0.2), untouched=True, closure=True),
+              rate_std=1.0, rate_std_held=0.8, sink_min=0.2), closure=True),
+    # asw20 (FlightGear's ASW 20 sailplane, flown as asw20_glide at 3000 ft: FlightGear's engine and ballast
+    # systems removed, its tail table reading the elevator through an alias): 728.7 lb, no point mass, no
+    # product of inertia. On JSBSim's own regressors (closure_slopes; the 30-s light flight's inertial-rate
+    # fit gives Cl_p -0.11 for its -0.68, the gusts' rotation over a 15-m span): Cl and Cn exactly its XML:
+    # Clb -0.0693, Clp -0.6843, Clr 0.1551, Clda -0.214 x left (delta_a = +left: Cl_delta_a -0.214), Cldr
+    # 0.0065; Cnb 0.1007, Cnp -0.0859, Cnr -0.0539, Cnda -0.017 x left (Cn_delta_a -0.017: proverse), Cndr
+    # -0.041; Cm_alpha -1.13 (its Cmalpha table, +0.37..+0.62 per rad, and the tail's CmDe table, -1.76),
+    # Cm_q -24.1 (Cmq -24.098), Cm_delta_e -0.79 (CmDe -0.79 per rad of elevator at alpha -2 deg),
+    # Cm_alpha_dot -1.86 (Cmadot -1.928). Five SIDE functions (CYb, CYp, CYr, CYDa, CYDr); the elevator read
+    # by CLDe and the alias the CmDe table looks up (CDDe reads fcs/mag-elevator-pos-rad). Gear up (CDDg).
+    # Envelope limits from the trial flights (docs/jsbsim.md, "The asw20").
+    Case("asw20", "asw20_glide", "asw2", 728.736, 0.0,
+         (("cm", 0, None, ("in", -1.3, -0.95)), ("cm", 1, -24.1, ("rel", 0.03)), ("cm", 2, -0.787, ("rel", 0.03)),
+          ("cm", 3, -1.9, ("rel", 0.1)), ("cl", 3, -0.214, ("rel", 1e-3)), ("cl", 0, -0.0693, ("rel", 1e-3)),
+          ("cl", 1, -0.6843, ("rel", 1e-3)), ("cl", 2, 0.1551, ("rel", 1e-3)), ("cl", 4, 0.0065, ("rel", 1e-3)),
+          ("cn", 4, -0.041, ("rel", 1e-3)), ("cn", 0, 0.1007, ("rel", 1e-3)), ("cn", 2, -0.0539, ("rel", 1e-3)),
+          ("cn", 3, -0.017, ("rel", 1e-3)), ("cn", 1, -0.0859, ("rel", 1e-3))),
+         ("CDDg",), 0.38397, 5,
+         dict(alpha=(-7.0, 7.0), beta=(8.0, 9.0), bank=(25.0, 25.0), speed=(20.0, 50.0), alt_min=400.0,
+              rate_std=1.5, rate_std_held=1.2, sink_min=0.0), untouched=True, closure=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -202,7 +223,7 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the sgs126
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the asw20
     alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
@@ -213,7 +234,7 @@ def test_names_resolve_and_roles(case):
     else:
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
-    assert {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal"} <= set(TUNING_AIRCRAFT)
+    assert {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126"} <= set(TUNING_AIRCRAFT)
 
 
 @pytest.mark.parametrize("case", _params())
@@ -326,7 +347,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", [p for p in _params() if p.values[0].name in ("rascal", "sgs126")])
+@pytest.mark.parametrize("case", [p for p in _params() if p.values[0].name in ("rascal", "sgs126", "asw20")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse

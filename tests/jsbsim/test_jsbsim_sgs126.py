@@ -1,4 +1,5 @@
-"""The sgs126 in the JSBSim harness: the fourteenth session's untouched aircraft (docs/jsbsim.md, "The sgs126").
+"""The sgs126 in the JSBSim harness: the fourteenth session's untouched aircraft, a tuning aircraft since its
+final evaluation was read (docs/jsbsim.md, "The sgs126").
 
 The model is the jsbsim wheel's stock Schweizer SGS 1-26 (``aircraft/sgs126/sgs126.xml``), a single-seat
 glider, flown as it is (no derived model). It is flown at 3000 ft, where JSBSim's light turbulence
@@ -9,19 +10,18 @@ The checks here use the XML and JSBSim's own properties; none of them flies the 
 - the model is the wheel's, with no propulsion at all, so every non-gravity force is aerodynamic;
 - the FCS maps the commands straight to the surfaces the aerodynamics read, with no damper;
 - it is statically stable about the CG, and its aileron yaws it the way its ``Cnda`` says;
-- light turbulence moves the air at its altitude (and not above 7500 ft);
-- the summaries label it "(untouched)" and nothing else.
+- light turbulence moves the air at its altitude (and not above 7500 ft).
+
+The summaries' label test moved to ``test_jsbsim_asw20.py`` in the fifteenth session (the asw20 is untouched).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
 map, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
 All of them but the names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the sgs126: its first evaluation is the final one,
-after the merge.
+No pipeline fit, GP, diagnosis or scoring runs in these tests.
 """
 
 import dataclasses
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -127,31 +127,3 @@ def test_turbulence_levels_at_its_altitude():
     assert np.all(high < 1e-9), high
     light = [gust_std(alt, "light") for alt in (3000.0, 8000.0, 15000.0)]
     assert np.all(np.array(light) > 0.4), light
-
-
-def test_summaries_mark_the_sgs126_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the sgs126 "(untouched)" and
-    no other aircraft, the rascal and f4n included (synthetic rows: no sgs126 result exists before the
-    final evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| sgs126 (untouched) | light") for ln in lines)
-    for ac in acs[:10]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| sgs126 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| rascal | clean |") for ln in lines)
