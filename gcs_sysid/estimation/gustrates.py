@@ -236,9 +236,9 @@ def dryden_rate_sigma(sigma: float, b: float, L: float = DRYDEN_L) -> np.ndarray
     ``sigma_q^2 = 3 sigma^2 / (pi L) int dOmega / (1 + (4b Omega/pi)^2) = (3 pi / 8) sigma^2 / (L b)`` and
     ``sigma_r^2 = (pi / 2) sigma^2 / (L b)`` (:data:`DRYDEN_RATE_FACTORS`). All three are independent of the
     airspeed and need only ``sigma^2 / L`` (:func:`gust_intensity`). Measured against JSBSim's own
-    rotational turbulence (``p - p_aero`` of the truth files, severity 3 and 4, five aircraft, with ``sigma``
-    from the truth's wind): ``p`` within 10 %, ``q`` and ``r`` 5-25 % low (``docs/benchmarks.md``,
-    "Fifteenth session, i8-rotgust2").
+    rotational turbulence (``p - p_aero`` of the truth files, severity 3 and 4, twelve aircraft, with ``sigma``
+    from the truth's wind): ratio 0.91-1.24 on ``p``, 0.67-1.07 on ``q``, 0.80-0.95 on ``r``
+    (``benchmarks/rate_floor.py``; ``docs/benchmarks.md``, "Fifteenth session, i8-rotgust2").
 
     Args:
         sigma: turbulence intensity, m/s (NaN gives NaN).
