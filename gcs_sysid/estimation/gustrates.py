@@ -54,7 +54,8 @@ __all__ = ["FRAMES", "MIN_MEAN_WIND", "DRYDEN_L", "DRYDEN_RATE_FACTORS", "GustRa
 
 FRAMES = ("path", "path-yaw", "mean-wind")   #: frames of :func:`gust_rates`
 MIN_MEAN_WIND = 1.0              #: m/s; below it the mean wind has no direction and ``"mean-wind"`` takes north
-#: m; MIL-F-8785C's Dryden scale length above 2000 ft (``L_u = L_v = L_w = 1750 ft``, sec. 3.7.2.3)
+#: m; the Dryden scale length of MIL-F-8785C's medium/high-altitude model (1750 ft above 2000 ft, sec. 3.7.2; the
+#: transverse spectrum ``sigma^2 L/pi (1 + 3 L^2 W^2)/(1 + L^2 W^2)^2``), the one JSBSim's ``ttMilspec`` flies there
 DRYDEN_L = 1750.0 * 0.3048
 #: ``sigma_(p,q,r) = k sigma_w / sqrt(L_w b)``: ``p`` MIL-F-8785C's own ``1.9``; ``q`` and ``r`` the Dryden
 #: ``w``/``v`` spectra's high-frequency level through the standard's gradient filters (:func:`dryden_rate_sigma`)
