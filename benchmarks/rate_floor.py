@@ -35,6 +35,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.eval_jsbsim import true_alpha_dot  # noqa: E402
 from benchmarks.jsbsim_harness import load_truth  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity  # noqa: E402
@@ -44,15 +45,6 @@ def _features(X: np.ndarray, adot: np.ndarray) -> np.ndarray:
     """``(T, 17)`` the oracle's terms: 1, the ten regressors, five products, ``alpha_dot_hat``."""
     a = X[:, 0]
     return np.c_[np.ones(len(X)), X, a * a, X[:, 1] ** 2, a * X[:, 1], a * X[:, 3], a * X[:, 5], adot]
-
-
-def _alpha_dot(truth) -> np.ndarray:
-    """The truth's ``alpha_dot`` (rad/s) from the body-axis ground velocity and the air angles (as ``eval_jsbsim``)."""
-    f = truth.fields
-    ud, wd = np.gradient(f["u"], truth.t), np.gradient(f["w"], truth.t)
-    ua = f["V"] * np.cos(f["alpha"]) * np.cos(f["beta"])
-    wa = f["V"] * np.sin(f["alpha"]) * np.cos(f["beta"])
-    return (ua * wd - wa * ud) / (ua**2 + wa**2)
 
 
 def floor(path: Path) -> dict:
@@ -71,7 +63,7 @@ def floor(path: Path) -> dict:
     X, Y = truth.at(truth.t)
     V = f["V"]
     airborne = np.isfinite(X).all(1) & np.isfinite(Y).all(1) & (V > 0.5 * np.nanmedian(V))
-    adot = _alpha_dot(truth) * c / (2.0 * V)
+    adot = true_alpha_dot(truth) * c / (2.0 * V)
     idx = np.nonzero(airborne & np.isfinite(adot))[0]
     cut = int(0.8 * len(idx))
     tr, te = idx[:cut], idx[cut:]
