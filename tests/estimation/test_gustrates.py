@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from gcs_sysid.estimation.ekf import dcm
-from gcs_sysid.estimation.gustrates import gust_rates, lag_filter
+from gcs_sysid.estimation.gustrates import (DRYDEN_L, DRYDEN_RATE_FACTORS, dryden_rate_sigma, gust_intensity,
+                                             gust_rates, lag_filter)
 
 DT, V, B = 0.02, 20.0, 2.0
 
@@ -112,3 +113,47 @@ def test_path_yaw_frame_keeps_r_g_and_leaves_q_g_at_zero():
     assert np.max(np.abs(full.rates[:, 1])) > 0.01
     assert np.all(yaw.rates[:, :2] == 0.0)
     assert any("q_g = 0" in n for n in yaw.notes)
+
+
+def _dryden_field(sigma, L, dx, n, rng):
+    """A frozen Dryden transverse gust along the path, ``(n,)`` m/s at spacing ``dx`` m: random phases on MIL-F-8785C's
+    one-sided spectrum ``sigma^2 L/pi (1 + 3 L^2 W^2) / (1 + L^2 W^2)^2`` (rad/m), so its variance is ``sigma^2``."""
+    W = 2 * np.pi * np.fft.rfftfreq(n, dx)
+    dW = W[1]
+    phi = sigma**2 * L / np.pi * (1 + 3 * (L * W) ** 2) / (1 + (L * W) ** 2) ** 2
+    amp = np.sqrt(2 * phi * dW) * n / 2
+    amp[0] = 0.0
+    spec = amp * np.exp(1j * rng.uniform(0, 2 * np.pi, len(W)))
+    return np.fft.irfft(spec, n), W, spec
+
+
+def test_gust_intensity_recovers_a_dryden_fields_sigma_and_hardly_depends_on_the_scale_length():
+    rng = np.random.default_rng(3)
+    sigma, L, Vg, dt = 1.8, 533.4, 25.0, 0.02
+    n = 2**16                                          # 1311 s at 25 m/s, 50 Hz
+    north = _dryden_field(sigma, L, Vg * dt, n, rng)[0]
+    east = _dryden_field(sigma, L, Vg * dt, n, rng)[0]
+    wind = np.c_[north + 3.0, east - 2.0, np.zeros(n)]     # a steady wind changes nothing
+    s = gust_intensity(dt, wind, np.full(n, Vg))
+    assert abs(s / sigma - 1) < 0.1
+    # sigma^2 / L (what the rates need) from a short lag barely moves with the L assumed
+    s_half = gust_intensity(dt, wind, np.full(n, Vg), L=L / 2)
+    assert abs((s_half**2 / (L / 2)) / (s**2 / L) - 1) < 0.15
+    assert np.isnan(gust_intensity(dt, wind[:5], np.full(5, Vg)))
+    with pytest.raises(ValueError):
+        gust_intensity(dt, wind[:, :1], np.full(n, Vg))
+
+
+def test_dryden_rate_sigma_matches_the_standards_gradient_filters_on_a_synthetic_field():
+    rng = np.random.default_rng(5)
+    sigma, L, b, dx = 2.0, 533.4, 10.0, 0.25
+    n = 2**19                                          # 131 km of path
+    _, W, spec = _dryden_field(sigma, L, dx, n, rng)
+    sp, sq, sr = dryden_rate_sigma(sigma, b, L)
+    for tau_b, s_formula in ((4.0, sq), (3.0, sr)):    # (s/V)/(1 + k b s/(pi V)) = d/dx / (1 + (k b / pi) d/dx)
+        rate = np.fft.irfft(spec * 1j * W / (1 + 1j * tau_b * b * W / np.pi), n)
+        assert abs(np.std(rate) / s_formula - 1) < 0.1, (tau_b, np.std(rate), s_formula)
+    assert sp == pytest.approx(1.9 * sigma / np.sqrt(L * b))
+    assert np.allclose(dryden_rate_sigma(sigma, b) * np.sqrt(DRYDEN_L * b) / sigma, DRYDEN_RATE_FACTORS)
+    with pytest.raises(ValueError):
+        dryden_rate_sigma(sigma, 0.0)
