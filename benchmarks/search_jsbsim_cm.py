@@ -15,8 +15,8 @@ made of:
   of the aided alpha), reference model refitted.
 * ``--truth-in-both alpha beta rates`` (fifteenth session, branch i9-turb): JSBSim's ``aero/alpha-rad``,
   ``aero/beta-rad`` and/or aero rates (``p_aero``, ``q_aero``, ``r_aero``: the rates the aerodynamics see, the
-  rotational gusts removed; the gyro's rate plus JSBSim's aero-minus-body rate, normalised with the measured
-  airspeed's truth) in place of the measured ones in *both* flights, and the reference model refitted on them
+  rotational gusts removed: the measured normalised rate plus JSBSim's aero-minus-body rate, normalised with
+  JSBSim's airspeed) in place of the measured ones in *both* flights, and the reference model refitted on them
   (``gcs_sysid.diagnose.fit.fit_model``): which regressor a miss in turbulence comes from.
 * ``--decompose``: for ``Cm:alpha^2`` flights, the untouched-segment gain that the *exact* injected
   term (``k alpha_true^2``) would give on the search's own Cm residual (the ceiling of any search at
