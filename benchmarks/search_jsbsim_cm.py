@@ -13,6 +13,11 @@ made of:
 * ``--instrumented-slopes``: the whole flight decoded with
   ``gcs_sysid.estimation.airangles.INSTRUMENTED_SLOPES = True`` (the elevator-instrumented lift slope
   of the aided alpha), reference model refitted.
+* ``--truth-in-both alpha beta rates`` (fifteenth session, branch i9-turb): JSBSim's ``aero/alpha-rad``,
+  ``aero/beta-rad`` and/or aero rates (``p_aero``, ``q_aero``, ``r_aero``: the rates the aerodynamics see, the
+  rotational gusts removed: the measured normalised rate plus JSBSim's aero-minus-body rate, normalised with
+  JSBSim's airspeed) in place of the measured ones in *both* flights, and the reference model refitted on them
+  (``gcs_sysid.diagnose.fit.fit_model``): which regressor a miss in turbulence comes from.
 * ``--decompose``: for ``Cm:alpha^2`` flights, the untouched-segment gain that the *exact* injected
   term (``k alpha_true^2``) would give on the search's own Cm residual (the ceiling of any search at
   this residual), again with the gust pitch rate (JSBSim's ``q_aero - q``, which the model's
@@ -47,7 +52,7 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-__all__ = ["decoded", "search_flight", "decompose_cm", "main"]
+__all__ = ["decoded", "with_truth", "search_flight", "decompose_cm", "main"]
 
 
 def decoded(tlog: Path, airframe: Path, cache: Path):
@@ -72,8 +77,37 @@ def _alpha_error(table, truth) -> dict:
             "slope": float(np.polyfit(at[ok], am[ok], 1)[0])}
 
 
+def with_truth(table, truth: dict, which, airframe):
+    """A copy of ``table`` with JSBSim's truth in place of the measured regressors named in ``which``.
+
+    Args:
+        table: the coefficient table (regressors ``X`` (T, 10), alpha beta in rad, rates normalised).
+        truth: the flight's ``-truth.npz`` arrays (``t``, ``alpha``, ``beta``, ``V``, ``p``/``q``/``r`` and
+            ``p_aero``/``q_aero``/``r_aero`` in rad/s).
+        which: any of ``"alpha"``, ``"beta"``, ``"rates"`` (the aero rates: the gyro's normalised rate plus
+            JSBSim's aero-minus-body rate normalised with the true airspeed, ``b/(2V)`` or ``c/(2V)``).
+        airframe: the airframe (``b``, ``c`` in m).
+
+    Returns:
+        the modified copy (the original is unchanged).
+    """
+    import copy
+
+    out = copy.deepcopy(table)
+    interp = lambda y: np.interp(out.t, truth["t"], y)  # noqa: E731
+    if "alpha" in which:
+        out.X[:, 0] = interp(truth["alpha"])
+    if "beta" in which:
+        out.X[:, 1] = interp(truth["beta"])
+    if "rates" in which:
+        V = interp(truth["V"])
+        for k, n, ref_len in ((2, "p", airframe.b), (3, "q", airframe.c), (4, "r", airframe.b)):
+            out.X[:, k] = out.X[:, k] + interp(truth[f"{n}_aero"] - truth[n]) * ref_len / (2.0 * V)
+    return out
+
+
 def search_flight(tlog: Path, model: dict, reference, airframe: Path, cache: Path, thresholds: dict,
-                  true_alpha: bool = False):
+                  true_alpha: bool = False, truth_in_both=()):
     """The sparse search on one cached flight; returns (result with residual, context, truth arrays, injected)."""
     from gcs_sysid.diagnose.context import DiagContext
     from gcs_sysid.diagnose.sparse import sparse_search
@@ -81,6 +115,8 @@ def search_flight(tlog: Path, model: dict, reference, airframe: Path, cache: Pat
     table, states, af = decoded(tlog, airframe, cache)
     truth = dict(np.load(tlog.with_name(tlog.stem + "-truth.npz")))
     injected = json.loads(tlog.with_name(tlog.stem + "-effects.json").read_text())["injected"]
+    if truth_in_both:
+        table = with_truth(table, truth, truth_in_both, af)
     if true_alpha:
         table.X[:, 0] = np.interp(table.t, truth["t"], truth["alpha"])
     ctx = DiagContext.build(table, af, model, states)
@@ -139,6 +175,8 @@ def main(argv=None) -> int:
     p.add_argument("--true-alpha", action="store_true")
     p.add_argument("--instrumented-slopes", action="store_true")
     p.add_argument("--decompose", action="store_true")
+    p.add_argument("--truth-in-both", nargs="+", default=(), choices=("alpha", "beta", "rates"),
+                   help="JSBSim's truth in place of these regressors in both flights, reference model refitted")
     a = p.parse_args(argv)
     from benchmarks.jsbsim_harness.aircraft import aircraft
     from gcs_sysid.diagnose import run_fit
@@ -161,6 +199,11 @@ def main(argv=None) -> int:
         run_fit(ref_tlog, af, model_path)
     model = model_as_dict(load_model(model_path))
     rt, rs, raf = decoded(ref_tlog, af, cache)
+    if a.truth_in_both:
+        from gcs_sysid.diagnose.fit import fit_model
+
+        rt = with_truth(rt, dict(np.load(run / f"{a.aircraft}-ref-sweep-truth.npz")), a.truth_in_both, raf)
+        model = model_as_dict(fit_model(rt)[0])
     reference = reference_context((rt, rs), raf, model)
     thr = json.loads(a.thresholds)
     print(f"reference alpha error: {_alpha_error(rt, dict(np.load(run / f'{a.aircraft}-ref-sweep-truth.npz')))}")
@@ -169,7 +212,7 @@ def main(argv=None) -> int:
         if a.glob not in tlog.name:
             continue
         t0 = time.perf_counter()
-        res, ctx, truth, inj = search_flight(tlog, model, reference, af, cache, thr, a.true_alpha)
+        res, ctx, truth, inj = search_flight(tlog, model, reference, af, cache, thr, a.true_alpha, a.truth_in_both)
         named = [f"{f['cause']} {_change(f):.4g} g{f['gain']['percent']:.0f}% sc{f['evidence']['score']:.2f}"
                  for f in res["findings"][:3]]
         terms = ""

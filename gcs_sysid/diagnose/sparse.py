@@ -313,6 +313,18 @@ def _library(ctx: DiagContext, knots=None) -> tuple[list[str], np.ndarray]:
     return candidate_library(ctx, lags_s=_LAGS_S, alpha_knots=knots)
 
 
+def _aligned(names: list[str], Phi: np.ndarray, to_names: list[str]) -> np.ndarray:
+    """The columns of ``Phi`` (T, K) named ``names`` rearranged as ``to_names`` (T, K'), zeros where absent."""
+    idx = {n: i for i, n in enumerate(names)}
+    if list(names) == list(to_names):
+        return Phi
+    out = np.zeros((Phi.shape[0], len(to_names)))
+    for k, n in enumerate(to_names):
+        if n in idx:
+            out[:, k] = Phi[:, idx[n]]
+    return out
+
+
 def _ridge_cv(Phi: np.ndarray, Y: np.ndarray, folds: int, max_rows: int,
               lambdas=(1e-4, 1e-3, 1e-2, 1e-1, 1.0)) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Ridge regression of each column of ``Y`` on all standardised candidates, the ridge chosen by block CV.
@@ -677,6 +689,12 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     if reference is not None:
         rctx, Rr = reference
         rnames, rPhi = _library(rctx, knots)
+        # this flight's library in the reference's columns (the ridge's weights are the reference's): a
+        # column constant on one flight is left out of that flight's library (candidate_library), e.g. a
+        # hinge above this flight's largest alpha; it enters here as zeros, a constant the centring of
+        # the inadequacy below removes (the JSBSim rascal's Cm:alpha^2 = -8 flight in light turbulence
+        # never reaches the reference's top alpha quantile, 7.9 deg, and crashed the search before)
+        Phi_r = _aligned(names, Phi, rnames)
         rtr, rte = _segments(rctx, segment_frac)
         Rr = np.nan_to_num(np.asarray(Rr, float))
         rows = np.r_[rtr, rte]
@@ -687,7 +705,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 continue
             if ridge is not None:
                 W, mu, sc, lam = ridge
-                base[:, j] = ((Phi - mu) / sc) @ W[:, j]
+                base[:, j] = ((Phi_r - mu) / sc) @ W[:, j]
                 if ref_ms is None:
                     ref_ms = np.zeros(6)
                 e = Rr[rows, j] - ((rPhi[rows] - mu) / sc) @ W[:, j]
@@ -715,7 +733,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             # (_with_uncertainty)
             Wb = _ridge_jackknife(rPhi[rows], Rr[rows], rctx.t[rows], ridge, max_rows,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0)
-            Ps = (Phi - ridge[1]) / ridge[2]
+            Ps = (Phi_r - ridge[1]) / ridge[2]
             base_jk = [(Ps @ W_b) * (base != 0).any(axis=0) for W_b in Wb]
             base_jk = [b - b[tr].mean(axis=0) for b in base_jk]
     Rd = R - base

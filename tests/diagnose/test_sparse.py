@@ -294,3 +294,26 @@ def test_a_wind_axis_side_force_scale_reads_k_minus_1(airframe):
         got[wind] = f[0]["estimate"] if f else None
     assert got[True] == pytest.approx(1.6, abs=0.02), got
     assert got[False] is None or got[False] < got[True] - 0.02, got
+
+
+def test_a_hinge_the_flight_never_reaches_does_not_break_the_differential_search(airframe):
+    """The reference's top alpha hinge lies above every alpha of the flight under test, so that column is
+    constant on this flight and left out of its library: the reference's ridge inadequacy is still applied
+    (the JSBSim rascal's ``Cm:alpha^2 = -8`` flight in light turbulence crashed the search with a shape
+    mismatch), and the flight's own change is still named."""
+    from gcs_sysid.diagnose.sparse import _library, alpha_quantile_knots
+
+    table, states = measured(BASE, seed=4, hidden=None, duration=90.0)
+    a = table.X[:, 0]
+    med = np.nanmedian(a)
+    table.X[:, 0] = np.where(a > med, med + 4.0 * (a - med), a)       # the reference flew to higher alpha
+    rctx = DiagContext.build(table, airframe, BASE, states)
+    ref = (rctx, rctx.Y - rctx.model_values())
+    ctx, R = _ctx(airframe, [(5, lambda t: -0.08 * t.x("delta_a"))], seed=5)
+    knots = alpha_quantile_knots(rctx)
+    assert np.nanmax(ctx.x("alpha")) < knots[-1]
+    assert len(_library(ctx, knots)[0]) < len(_library(rctx, knots)[0])
+    res = sparse_search(ctx, R, reference=ref)
+    causes = {f["cause"]: f for f in res["findings"]}
+    assert "Cn:delta_a" in causes, [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
+    assert causes["Cn:delta_a"]["estimate"] - causes["Cn:delta_a"]["model_value"] == pytest.approx(-0.08, rel=0.25)
