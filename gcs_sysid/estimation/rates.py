@@ -173,8 +173,10 @@ GUST_TAU_S = 2.0
 #: likelihood took it and CY went 7.8 -> 9.0 % on the f16 in the then "moderate", JSBSim severity 3); with the
 #: turbulence relabelled (light = severity 3) the plain y smoother took the gust-driven side force for noise (t6:
 #: 0.11 m/s^2 against the sensor's 0.05) and CY sat at twice the accelerometer's Wiener floor; offered the state,
-#: held-out CY t6 7.9 -> 5.0, sgs126 10.8-14.4 -> 6.2-8.3, rascal 14.6-16.0 -> 6.2-8.0 %, f16 6.2-7.4 -> 6.7-8.6
-#: (the one loss; docs/estimation.md, section 5, "The measured coefficients in MIL-F-8785C light turbulence").
+#: the measured held-out CY in light turbulence (eval_jsbsim, seeds 1-3) went t6 8.0-10.2 -> 4.5-6.3, rascal
+#: 14.8-16.0 -> 6.5-8.1, sgs126 10.9-14.7 -> 6.3-8.6, c172x 10.0-13.3 -> 9.8-12.8 %; the smoother alone on the f16's
+#: light flights 6.2-7.4 -> 6.7-8.6 % (the one loss; docs/estimation.md, section 5, "The measured coefficients in
+#: MIL-F-8785C light turbulence").
 #: x keeps the residual's Wiener correction alone.
 GUST_FORCE_AXES = (1, 2)
 #: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the motion's strength changes
