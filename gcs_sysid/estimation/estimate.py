@@ -145,7 +145,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             of a differential diagnosis): the alpha aiding then uses that flight's CZ slopes, so that both
             flights' alpha share one scale (:func:`gcs_sysid.estimation.airangles.aided_air_angles`, ``models``).
             None: fitted on this flight.
-        turbulence_state: offer the specific-force smoother's z axis the turbulence state
+        turbulence_state: offer the specific-force smoother's y and z axes the turbulence state
             (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default). False: the plain smoother, as the
             diagnosis and ``fit`` load their flights (:func:`gcs_sysid.diagnose.run.load_measurements`: on a
             clean JSBSim c172x flight the retained high-frequency CZ was named a zero-size elevator delay).

@@ -166,12 +166,19 @@ GUST_HZ = (2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 #: Correlation time of the turbulence state, s (its spectrum is flat below ``1/(2 pi tau)``, where the nominal
 #: part already follows the signal; 0.5 and 2 s gave the same CZ on the f16, 0.66 / 0.67 %).
 GUST_TAU_S = 2.0
-#: Axes of the specific force that are offered the turbulence state: z. A vertical gust changes the angle of
-#: attack and the lift at once (``CZ_alpha w_g / V``), the largest gust force, with the Dryden ``1/f^2`` tail up
-#: to the Nyquist frequency in moderate turbulence (f16: 26-260 x the accelerometer's noise at 4-24 Hz). On y the
-#: likelihood took the state and made CY worse (f16 moderate 7.8 -> 9.0 %): the side force's spectrum is not of
-#: that form; x and y keep the residual's Wiener correction (docs/estimation.md, section 5, "Moderate turbulence").
-GUST_FORCE_AXES = (2,)
+#: Axes of the specific force that are offered the turbulence state: y and z. A vertical gust changes the angle of
+#: attack and the lift at once (``CZ_alpha w_g / V``), a lateral gust the sideslip and the side force
+#: (``CY_beta v_g / V``); both Dryden spectra fall as ``1/f^2`` above ``V / L`` (MIL-F-8785C sec. 3.7.2), up to the
+#: Nyquist frequency in MIL-F-8785C light turbulence. Until the fifteenth session only z was offered it (on y the
+#: likelihood took it and CY went 7.8 -> 9.0 % on the f16 in the then "moderate", JSBSim severity 3); with the
+#: turbulence relabelled (light = severity 3) the plain y smoother took the gust-driven side force for noise (t6:
+#: 0.11 m/s^2 against the sensor's 0.05) and CY sat at twice the accelerometer's Wiener floor; offered the state,
+#: the measured held-out CY in light turbulence (eval_jsbsim, seeds 1-3) went t6 8.0-10.2 -> 4.5-6.3, rascal
+#: 14.8-16.0 -> 6.5-8.1, sgs126 10.9-14.7 -> 6.3-8.6, c172x 10.0-13.3 -> 9.8-12.8 %; the smoother alone on the f16's
+#: light flights 6.2-7.4 -> 6.7-8.6 % (the one loss; docs/estimation.md, section 5, "The measured coefficients in
+#: MIL-F-8785C light turbulence").
+#: x keeps the residual's Wiener correction alone.
+GUST_FORCE_AXES = (1, 2)
 #: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the motion's strength changes
 #: along a flight (manoeuvres and quiet legs; turbulence with altitude, MIL-F-8785C sec. 3.7, and in patches), a
 #: whole-record bandwidth cannot follow it; only the whole-record choice and narrower candidates are offered
@@ -996,9 +1003,9 @@ def smooth_specific_force(dt: float, f: np.ndarray, noise_floor: float = 1e-3,
         residual_axes: the axes (0 x, 1 y, 2 z) corrected (:data:`RESIDUAL_FORCE_AXES`).
         gust_hz: levels of the turbulence state (Hz where its ``1/f^2`` spectrum meets the white noise) offered
             by the likelihood (:data:`GUST_HZ`; ``()``: none, the plain smoother).
-        gust_axes: the axes offered it (:data:`GUST_FORCE_AXES`, z: the gust-driven lift); the state is a
-            first-order Gauss-Markov gust added to the measured force (:func:`_nominal_model`), taken on an
-            axis only if it gains more than the BIC penalty over the plain smoother's best bandwidth.
+        gust_axes: the axes offered it (:data:`GUST_FORCE_AXES`, y and z: the gust-driven side force and lift);
+            the state is a first-order Gauss-Markov gust added to the measured force (:func:`_nominal_model`),
+            taken on an axis only if it gains more than the BIC penalty over the plain smoother's best bandwidth.
 
     Returns:
         ``(f_smooth, f_sigma, noise_std)``: (T, 3), (T, 3) in m/s^2 and (3,) the

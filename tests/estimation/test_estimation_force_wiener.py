@@ -35,13 +35,15 @@ def test_force_content_above_the_smoother_bandwidth_is_recovered():
     Z = np.stack([z, z, z], 1)
     plain, plain_sig, _ = smooth_specific_force(DT, Z, residual_correction=False)
     corr, corr_sig, noise = smooth_specific_force(DT, Z)
-    e0, e1 = _err(plain[:, 1], f), _err(corr[:, 1], f)
+    # x: corrected and not offered the turbulence state (y is offered it since the fifteenth session, i8-meas, and
+    # takes it on this band: 8.6 %, the same with or without the correction)
+    e0, e1 = _err(plain[:, 0], f), _err(corr[:, 0], f)
     assert e1 < 0.8 * e0, (e0, e1)           # measured 10.2 -> 7.1 %
     # z (RESIDUAL_FORCE_AXES) is left to the smoother alone
     np.testing.assert_array_equal(corr[:, 2], plain[:, 2])
     # its own error goes into the sigma, and the noise estimate is the smoother's
-    assert np.all(corr_sig[:, 1] > plain_sig[:, 1])
-    assert abs(noise[1] - ACC_NOISE) < 0.01
+    assert np.all(corr_sig[:, 0] > plain_sig[:, 0])
+    assert abs(noise[0] - ACC_NOISE) < 0.01
 
 
 def test_slow_content_alone_is_not_made_worse():
