@@ -92,6 +92,14 @@ MOMENT_MARGIN = 0.0   #: the aided angle is kept if its moment-fit residual is a
 #: ``wind`` / ``CZ:V`` / ``Cm:V`` effects on clean sim flights (tests/diagnose), whose floors were set
 #: with the old alpha; switch on once those are re-measured (docs/estimation.md).
 INSTRUMENTED_SLOPES = False
+#: Hold ``|CZ_alpha|`` at least at the wing's lift slope (:func:`lift_slope`, Helmbold's formula, from ``b^2 / S``) in the
+#: first pass where the fitted one is flatter (or not identified), and leave :data:`FLOOR_DROPS` out of that pass
+#: (``docs/estimation.md``, "The lift-slope floor"). In MIL-F-8785C light turbulence the kinematic alpha's gust error
+#: is 1-7 deg against a 0.6-1.1 deg signal on the slow aircraft, the fitted slope a fifth of the lift slope or not
+#: identified, and the aiding fell back (sgs126 6/6 flights): with the floor every flight is aided and the aided
+#: alpha's error less its mean is 0.1-0.4 deg (``docs/benchmarks.md``, "Fifteenth session, i8-aiding").
+SLOPE_FLOOR = True
+FLOOR_DROPS = ("q_hat",)   #: columns left out of the first pass when the slope floor holds
 
 
 @dataclass
@@ -313,11 +321,33 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
     return out, sig, tau, float(np.sqrt(ratio * s2)), float(np.sqrt(s2))
 
 
+def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int]
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares ``y ~ A c`` with ``c[0]`` held at ``a1`` and only the columns ``keep`` (indices into ``A``,
+    not 0) refitted; the others are 0.
+
+    Args:
+        A: (N, P) band-passed regressors, the angle first. y: (N,) band-passed coefficient.
+        a1: the held slope of column 0. keep: the columns fitted.
+
+    Returns:
+        ``(c (P,), standard errors (P,) (NaN for the held and dropped ones), residuals (N,), covariance (P, P))``.
+    """
+    P = A.shape[1]
+    c, se, cov = np.zeros(P), np.full(P, np.nan), np.zeros((P, P))
+    c[0] = a1
+    if keep:
+        co, so, _, cv = _lstsq(A[:, keep], y - a1 * A[:, 0])
+        c[keep], se[keep] = co, so
+        cov[np.ix_(keep, keep)] = cv
+    return c, se, y - A @ c, cov
+
+
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
-          V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None
-          ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
+          slope_floor: float | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -361,6 +391,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                           f"({', '.join(names[1:])}): slopes fitted here")
     nq = 2 if quadratic else 1
     fit = None
+    floor_note = ""
     edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
     X_other = np.column_stack([others[k] for k in cols]) if cols else np.zeros((len(kin), 0))
@@ -385,10 +416,24 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                 method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {MIN_FIRST_STAGE_R2:g})"
         if not method.startswith(("2SLS", "given")):
             cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
+        floored = False
+        if slope_floor is not None and fixed is None and fit is None and not sign * cr[0] >= abs(slope_floor):
+            # errors in variables only attenuate the fitted slope (the kinematic angle's gust error), and the wing's
+            # own lift slope is a lower bound of the aircraft's (tail and fuselage add lift): the slope is held at
+            # that floor. The pitch rate then goes too: with the slope held, the residual carries the gust the
+            # kinematic angle misses, and the aircraft pitches into it, so a q_hat slope fitted here is the gust's
+            # (docs/estimation.md, "The lift-slope floor")
+            free, floored = float(cr[0]), True
+            keep = [j for j in range(1, A.shape[1]) if j < nq or cols[j - nq] not in FLOOR_DROPS]
+            cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep)
+            dropped = [k for k in cols if k in FLOOR_DROPS]
+            floor_note = (f"first pass with CZ_alpha held at the wing's lift slope {sign * abs(slope_floor):+.2f} "
+                          f"(fitted {free:+.2f}: attenuated by the kinematic angle's gust error)"
+                          + (f" and {', '.join(dropped)} left out" if dropped else ""))
         r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
-        a1, t_stat = c[1], (abs(c[1]) / max(cs[1], 1e-300) if fixed is None else np.inf)
+        a1, t_stat = c[1], (abs(c[1]) / max(cs[1], 1e-300) if fixed is None and not floored else np.inf)
         if sign * a1 <= 0 or t_stat < MIN_T_STAT:
             if fit is None:
                 return kin, sig, AxisFit(name, False, f"{'CZ_alpha' if name == 'alpha' else 'CY_beta'} not "
@@ -434,6 +479,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             band_hz=edge)
     if fit is not None and given_note:
         fit.slope_method = f"{fit.slope_method}: {given_note}"
+    if fit is not None and floor_note:
+        fit.slope_method = f"{fit.slope_method}; {floor_note}"
     gust_sig = sig          # the gust smoother's posterior 1-sigma, before the flight-common offset is added
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
@@ -642,9 +689,11 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     with np.errstate(invalid="ignore", divide="ignore"):
         hg = qbar * S / (mass * Vs)          # heave mode's rate per unit |CZ_alpha|, 1/s (heave_edge_hz)
     hg = float(np.nanmedian(hg[u])) if np.isfinite(hg[u]).any() else float("nan")
-    edge = heave_edge_hz(lift_slope(b * b / S), hg)
+    floor = lift_slope(b * b / S)          # the wing's lift slope, 1/rad (NaN: no span or area)
+    edge = heave_edge_hz(floor, hg)
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
-                         (models or {}).get("alpha"), band_hz=edge)
+                         (models or {}).get("alpha"), band_hz=edge,
+                         slope_floor=floor if SLOPE_FLOOR and np.isfinite(floor) else None)
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
