@@ -30,6 +30,12 @@ Circularity: the angles are then partly built from the same force measurements t
 learns ``CY(beta)`` and ``CZ(alpha)`` from. Judge it on held-out truth (``docs/benchmarks.md``),
 not on the angle error alone.
 
+In turbulence the kinematic alpha's gust error can exceed the manoeuvre's alpha many times over (MIL-F-8785C light
+turbulence, slow aircraft: 3-9 times), and the least-squares ``CZ_alpha`` is then a fraction of the lift slope or not
+identified. Errors in variables only attenuate it, and an aircraft's lift slope is not below its wing's, so the
+first pass holds ``|CZ_alpha|`` at least at the wing's slope from its aspect ratio (:data:`SLOPE_FLOOR`,
+:func:`lift_slope`; ``docs/estimation.md``, "The lift-slope floor").
+
 Two errors stay (:mod:`gcs_sysid.estimation.angleerrors`): the least-squares ``CZ_alpha`` is attenuated
 because the aircraft heaves with the gust the kinematic angle misses (``instrument_slopes``: the
 elevator as instrument, two-stage least squares), and the flight-mean vertical wind puts an offset
@@ -124,7 +130,8 @@ class AxisFit:
             the moment coefficients' variance (NaN: no moments given).
         slope_method: how the slopes were fitted: ``"2SLS"`` (alpha: the elevator and its delayed copies
             instrument the angle, :func:`gcs_sysid.estimation.angleerrors.iv_lstsq`), ``"OLS"`` or ``"given"``
-            (another flight's slopes, :func:`aided_air_angles` ``models``), followed by a note when a model was given.
+            (another flight's slopes, :func:`aided_air_angles` ``models``), followed by a note when a model was given,
+            and (alpha) when the first pass held ``CZ_alpha`` at the wing's lift slope (:data:`SLOPE_FLOOR`).
         first_stage_r2: the instruments' first-stage partial R^2 (NaN: no instruments).
         scale_sigma: standard uncertainty of the aided angle's relative scale: the aided and the kinematic
             angle's disagreement in scale, ``sqrt(d^2 + se_d^2)`` with ``d`` the slope of (aided - kinematic)
@@ -360,7 +367,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     flight's fit of this axis whose slopes are used instead of fitting them here (the constant is still this
     flight's), when its columns are this flight's (:func:`aided_air_angles`, ``models``); ``band_hz``: the edge
     above which the slopes are fitted, Hz (at least :data:`HIGHPASS_HZ`; alpha: :func:`heave_edge_hz`), None:
-    :data:`HIGHPASS_HZ`."""
+    :data:`HIGHPASS_HZ`; ``slope_floor``: the least magnitude of the angle's slope in the first pass, 1/rad (alpha: the
+    wing's lift slope, :data:`SLOPE_FLOOR`): a flatter or unidentified fitted slope is held there, the other columns
+    refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -647,7 +656,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
         offset, common to all samples); an axis whose slope is not identified (wrong sign or fewer than
-        :data:`MIN_T_STAT` standard errors), or with under :data:`MIN_VALID_S` s of usable data,
+        :data:`MIN_T_STAT` standard errors; for alpha only when :data:`SLOPE_FLOOR` is off or the wing's aspect
+        ratio is unknown, since the floor holds a flatter slope), or with under :data:`MIN_VALID_S` s of usable data,
         or a grid slower than :data:`MIN_RATE_HZ`, or that fails the moment cross-check, keeps its
         kinematic angle (``AxisFit.used`` False, ``reason`` says why).
 
