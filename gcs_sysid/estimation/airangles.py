@@ -105,6 +105,10 @@ INSTRUMENTED_SLOPES = False
 #: identified, and the aiding fell back (sgs126 6/6 flights): with the floor every flight is aided and the aided
 #: alpha's error less its mean is 0.1-0.4 deg (``docs/benchmarks.md``, "Fifteenth session, i8-aiding").
 SLOPE_FLOOR = True
+#: the floor holds only where the lateral gust found by the beta axis predicts at least this share of the kinematic
+#: alpha's in-band variance as gust error (:func:`gust_share`: errors in variables to explain a flat slope); below it,
+#: or with beta not aided, the fitted slope and the identification check stand as before
+FLOOR_MIN_GUST_SHARE = 0.1
 FLOOR_DROPS = ("q_hat",)   #: columns left out of the first pass when the slope floor holds
 
 
@@ -253,6 +257,39 @@ def lift_slope(aspect_ratio: float) -> float:
     if not np.isfinite(aspect_ratio) or aspect_ratio <= 0:
         return float("nan")
     return float(2.0 * np.pi * aspect_ratio / (2.0 + np.sqrt(aspect_ratio**2 + 4.0)))
+
+
+def gust_share(dt: float, alpha_kin: np.ndarray, use: np.ndarray, beta_fit: AxisFit, edge_hz: float) -> float:
+    """The share of the kinematic alpha's variance above ``edge_hz`` that the turbulence found on the lateral axis
+    predicts as its gust error: the witness of :data:`SLOPE_FLOOR`.
+
+    Errors in variables attenuate ``CZ_alpha`` only if the kinematic alpha has a gust error in the slopes' band. The
+    beta axis (fitted first, without a floor) measures the lateral gust angle as a Gauss-Markov state (stationary
+    1-sigma ``s``, correlation time ``tau``); in isotropic turbulence (MIL-F-8785C above 2000 ft: ``sigma_w =
+    sigma_v``) the vertical gust angle has the same spectrum, whose share above the edge is ``1 - (2 / pi) atan(2 pi
+    f tau)`` (first-order spectrum). Returns ``share x s^2 / var(highpassed kinematic alpha)``: 0.1 means the gust
+    error alone would attenuate a least-squares slope by about 10 %. Measured on the JSBSim tuning flights in
+    MIL-F-8785C light and moderate turbulence 0.16-3.8 (f16 0.16-0.18, t6 0.27-0.31, rascal and sgs126 1.0-3.8); on
+    the project's kinematic synthetic flight (tests/estimation/test_estimation_states.py: no gust, CZ unrelated to
+    alpha) beta is not aided and the share is 0.
+
+    Args:
+        dt: grid step, s. alpha_kin: (T,) kinematic alpha, rad. use: (T,) bool rows. beta_fit: the beta axis's
+        :class:`AxisFit`. edge_hz: the alpha slopes' band edge, Hz.
+
+    Returns:
+        The share (dimensionless, >= 0); 0 where beta was not aided or the record is too short.
+    """
+    if not beta_fit.used or not np.isfinite(beta_fit.gust_sigma) or not np.isfinite(beta_fit.tau_s):
+        return 0.0
+    ok = np.asarray(use, bool) & np.isfinite(alpha_kin)
+    segs = segments(ok, max(int(round(MIN_SEGMENT_S / dt)), 10))
+    if sum(s.stop - s.start for s in segs) * dt < MIN_VALID_S:
+        return 0.0
+    ah = _highpass(dt, np.asarray(alpha_kin, float)[:, None], segs, edge_hz)[:, 0]
+    va = float(np.nanvar(ah))
+    frac = 1.0 - 2.0 / np.pi * np.arctan(2.0 * np.pi * edge_hz * beta_fit.tau_s)
+    return float(frac * beta_fit.gust_sigma**2 / va) if va > 0 else 0.0
 
 
 def heave_edge_hz(slope: float, heave_gain: float, factor: float | None = None) -> float:
@@ -701,10 +738,13 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     hg = float(np.nanmedian(hg[u])) if np.isfinite(hg[u]).any() else float("nan")
     floor = lift_slope(b * b / S)          # the wing's lift slope, 1/rad (NaN: no span or area)
     edge = heave_edge_hz(floor, hg)
-    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
-                         (models or {}).get("alpha"), band_hz=edge,
-                         slope_floor=floor if SLOPE_FLOOR and np.isfinite(floor) else None)
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
+    share = gust_share(dt, alpha_kin, u, fb, edge)
+    held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
+                         (models or {}).get("alpha"), band_hz=edge, slope_floor=floor if held else None)
+    if "held at the wing's lift slope" in fa.slope_method:
+        fa.slope_method += f" (lateral gust witness: {100 * share:.0f} % of the kinematic alpha's in-band variance)"
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
                          "fin, P-factor) breaks the CY0 ~ 0 prior")
