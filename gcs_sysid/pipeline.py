@@ -403,8 +403,14 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
                 cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
-                suggestions = suggest_maneuvers(envelope, model, table, airframe, config=cfg,
-                                                heldout_error_pct=gate, identifiable=ident)
+                try:
+                    suggestions = suggest_maneuvers(envelope, model, table, airframe, config=cfg,
+                                                    heldout_error_pct=gate, identifiable=ident)
+                except InputError as e:
+                    # a limit the flown envelope cannot give (e.g. alpha_max from an alpha whose flight-common
+                    # offset, the mean vertical wind, puts its whole range below 0): the model and report stand
+                    suggestions = []
+                    notes.append(f"no manoeuvre suggestions: {e}")
             if suggestions:
                 draw("suggestions", "suggestions_figure", list(suggestions))
         metrics: dict[str, dict[str, float]] = {}

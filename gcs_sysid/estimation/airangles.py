@@ -30,6 +30,12 @@ Circularity: the angles are then partly built from the same force measurements t
 learns ``CY(beta)`` and ``CZ(alpha)`` from. Judge it on held-out truth (``docs/benchmarks.md``),
 not on the angle error alone.
 
+In turbulence the kinematic alpha's gust error can exceed the manoeuvre's alpha many times over (MIL-F-8785C light
+turbulence, slow aircraft: 3-9 times), and the least-squares ``CZ_alpha`` is then a fraction of the lift slope or not
+identified. Errors in variables only attenuate it, and an aircraft's lift slope is not below its wing's, so the
+first pass holds ``|CZ_alpha|`` at least at the wing's slope from its aspect ratio (:data:`SLOPE_FLOOR`,
+:func:`lift_slope`; ``docs/estimation.md``, "The lift-slope floor").
+
 Two errors stay (:mod:`gcs_sysid.estimation.angleerrors`): the least-squares ``CZ_alpha`` is attenuated
 because the aircraft heaves with the gust the kinematic angle misses (``instrument_slopes``: the
 elevator as instrument, two-stage least squares), and the flight-mean vertical wind puts an offset
@@ -92,6 +98,18 @@ MOMENT_MARGIN = 0.0   #: the aided angle is kept if its moment-fit residual is a
 #: ``wind`` / ``CZ:V`` / ``Cm:V`` effects on clean sim flights (tests/diagnose), whose floors were set
 #: with the old alpha; switch on once those are re-measured (docs/estimation.md).
 INSTRUMENTED_SLOPES = False
+#: Hold ``|CZ_alpha|`` at least at the wing's lift slope (:func:`lift_slope`, Helmbold's formula, from ``b^2 / S``) in the
+#: first pass where the fitted one is flatter (or not identified), and leave :data:`FLOOR_DROPS` out of that pass
+#: (``docs/estimation.md``, "The lift-slope floor"). In MIL-F-8785C light turbulence the kinematic alpha's gust error
+#: is 1-7 deg against a 0.6-1.1 deg signal on the slow aircraft, the fitted slope a fifth of the lift slope or not
+#: identified, and the aiding fell back (sgs126 6/6 flights): with the floor every flight is aided and the aided
+#: alpha's error less its mean is 0.1-0.4 deg (``docs/benchmarks.md``, "Fifteenth session, i8-aiding").
+SLOPE_FLOOR = True
+#: the floor holds only where the lateral gust found by the beta axis predicts at least this share of the kinematic
+#: alpha's in-band variance as gust error (:func:`gust_share`: errors in variables to explain a flat slope); below it,
+#: or with beta not aided, the fitted slope and the identification check stand as before
+FLOOR_MIN_GUST_SHARE = 0.1
+FLOOR_DROPS = ("q_hat",)   #: columns left out of the first pass when the slope floor holds
 
 
 @dataclass
@@ -116,7 +134,8 @@ class AxisFit:
             the moment coefficients' variance (NaN: no moments given).
         slope_method: how the slopes were fitted: ``"2SLS"`` (alpha: the elevator and its delayed copies
             instrument the angle, :func:`gcs_sysid.estimation.angleerrors.iv_lstsq`), ``"OLS"`` or ``"given"``
-            (another flight's slopes, :func:`aided_air_angles` ``models``), followed by a note when a model was given.
+            (another flight's slopes, :func:`aided_air_angles` ``models``), followed by a note when a model was given,
+            and (alpha) when the first pass held ``CZ_alpha`` at the wing's lift slope (:data:`SLOPE_FLOOR`).
         first_stage_r2: the instruments' first-stage partial R^2 (NaN: no instruments).
         scale_sigma: standard uncertainty of the aided angle's relative scale: the aided and the kinematic
             angle's disagreement in scale, ``sqrt(d^2 + se_d^2)`` with ``d`` the slope of (aided - kinematic)
@@ -240,6 +259,39 @@ def lift_slope(aspect_ratio: float) -> float:
     return float(2.0 * np.pi * aspect_ratio / (2.0 + np.sqrt(aspect_ratio**2 + 4.0)))
 
 
+def gust_share(dt: float, alpha_kin: np.ndarray, use: np.ndarray, beta_fit: AxisFit, edge_hz: float) -> float:
+    """The share of the kinematic alpha's variance above ``edge_hz`` that the turbulence found on the lateral axis
+    predicts as its gust error: the witness of :data:`SLOPE_FLOOR`.
+
+    Errors in variables attenuate ``CZ_alpha`` only if the kinematic alpha has a gust error in the slopes' band. The
+    beta axis (fitted first, without a floor) measures the lateral gust angle as a Gauss-Markov state (stationary
+    1-sigma ``s``, correlation time ``tau``); in isotropic turbulence (MIL-F-8785C above 2000 ft: ``sigma_w =
+    sigma_v``) the vertical gust angle has the same spectrum, whose share above the edge is ``1 - (2 / pi) atan(2 pi
+    f tau)`` (first-order spectrum). Returns ``share x s^2 / var(highpassed kinematic alpha)``: 0.1 means the gust
+    error alone would attenuate a least-squares slope by about 10 %. Measured on the JSBSim tuning flights in
+    MIL-F-8785C light and moderate turbulence 0.16-3.8 (f16 0.16-0.18, t6 0.27-0.31, rascal and sgs126 1.0-3.8); on
+    the project's kinematic synthetic flight (tests/estimation/test_estimation_states.py: no gust, CZ unrelated to
+    alpha) beta is not aided and the share is 0.
+
+    Args:
+        dt: grid step, s. alpha_kin: (T,) kinematic alpha, rad. use: (T,) bool rows. beta_fit: the beta axis's
+        :class:`AxisFit`. edge_hz: the alpha slopes' band edge, Hz.
+
+    Returns:
+        The share (dimensionless, >= 0); 0 where beta was not aided or the record is too short.
+    """
+    if not beta_fit.used or not np.isfinite(beta_fit.gust_sigma) or not np.isfinite(beta_fit.tau_s):
+        return 0.0
+    ok = np.asarray(use, bool) & np.isfinite(alpha_kin)
+    segs = segments(ok, max(int(round(MIN_SEGMENT_S / dt)), 10))
+    if sum(s.stop - s.start for s in segs) * dt < MIN_VALID_S:
+        return 0.0
+    ah = _highpass(dt, np.asarray(alpha_kin, float)[:, None], segs, edge_hz)[:, 0]
+    va = float(np.nanvar(ah))
+    frac = 1.0 - 2.0 / np.pi * np.arctan(2.0 * np.pi * edge_hz * beta_fit.tau_s)
+    return float(frac * beta_fit.gust_sigma**2 / va) if va > 0 else 0.0
+
+
 def heave_edge_hz(slope: float, heave_gain: float, factor: float | None = None) -> float:
     """The band edge above which the alpha model's slopes are fitted: ``max(HIGHPASS_HZ, factor x f_heave)``.
 
@@ -313,11 +365,33 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
     return out, sig, tau, float(np.sqrt(ratio * s2)), float(np.sqrt(s2))
 
 
+def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int]
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares ``y ~ A c`` with ``c[0]`` held at ``a1`` and only the columns ``keep`` (indices into ``A``,
+    not 0) refitted; the others are 0.
+
+    Args:
+        A: (N, P) band-passed regressors, the angle first. y: (N,) band-passed coefficient.
+        a1: the held slope of column 0. keep: the columns fitted.
+
+    Returns:
+        ``(c (P,), standard errors (P,) (NaN for the held and dropped ones), residuals (N,), covariance (P, P))``.
+    """
+    P = A.shape[1]
+    c, se, cov = np.zeros(P), np.full(P, np.nan), np.zeros((P, P))
+    c[0] = a1
+    if keep:
+        co, so, _, cv = _lstsq(A[:, keep], y - a1 * A[:, 0])
+        c[keep], se[keep] = co, so
+        cov[np.ix_(keep, keep)] = cv
+    return c, se, y - A @ c, cov
+
+
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
-          V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None
-          ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
+          slope_floor: float | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -330,7 +404,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     flight's fit of this axis whose slopes are used instead of fitting them here (the constant is still this
     flight's), when its columns are this flight's (:func:`aided_air_angles`, ``models``); ``band_hz``: the edge
     above which the slopes are fitted, Hz (at least :data:`HIGHPASS_HZ`; alpha: :func:`heave_edge_hz`), None:
-    :data:`HIGHPASS_HZ`."""
+    :data:`HIGHPASS_HZ`; ``slope_floor``: the least magnitude of the angle's slope in the first pass, 1/rad (alpha: the
+    wing's lift slope, :data:`SLOPE_FLOOR`): a flatter or unidentified fitted slope is held there, the other columns
+    refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -361,6 +437,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                           f"({', '.join(names[1:])}): slopes fitted here")
     nq = 2 if quadratic else 1
     fit = None
+    floor_note = ""
     edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
     X_other = np.column_stack([others[k] for k in cols]) if cols else np.zeros((len(kin), 0))
@@ -385,10 +462,24 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                 method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {MIN_FIRST_STAGE_R2:g})"
         if not method.startswith(("2SLS", "given")):
             cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
+        floored = False
+        if slope_floor is not None and fixed is None and fit is None and not sign * cr[0] >= abs(slope_floor):
+            # errors in variables only attenuate the fitted slope (the kinematic angle's gust error), and the wing's
+            # own lift slope is a lower bound of the aircraft's (tail and fuselage add lift): the slope is held at
+            # that floor. The pitch rate then goes too: with the slope held, the residual carries the gust the
+            # kinematic angle misses, and the aircraft pitches into it, so a q_hat slope fitted here is the gust's
+            # (docs/estimation.md, "The lift-slope floor")
+            free, floored = float(cr[0]), True
+            keep = [j for j in range(1, A.shape[1]) if j < nq or cols[j - nq] not in FLOOR_DROPS]
+            cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep)
+            dropped = [k for k in cols if k in FLOOR_DROPS]
+            floor_note = (f"first pass with CZ_alpha held at the wing's lift slope {sign * abs(slope_floor):+.2f} "
+                          f"(fitted {free:+.2f}: attenuated by the kinematic angle's gust error)"
+                          + (f" and {', '.join(dropped)} left out" if dropped else ""))
         r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
-        a1, t_stat = c[1], (abs(c[1]) / max(cs[1], 1e-300) if fixed is None else np.inf)
+        a1, t_stat = c[1], (abs(c[1]) / max(cs[1], 1e-300) if fixed is None and not floored else np.inf)
         if sign * a1 <= 0 or t_stat < MIN_T_STAT:
             if fit is None:
                 return kin, sig, AxisFit(name, False, f"{'CZ_alpha' if name == 'alpha' else 'CY_beta'} not "
@@ -434,6 +525,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             band_hz=edge)
     if fit is not None and given_note:
         fit.slope_method = f"{fit.slope_method}: {given_note}"
+    if fit is not None and floor_note:
+        fit.slope_method = f"{fit.slope_method}; {floor_note}"
     gust_sig = sig          # the gust smoother's posterior 1-sigma, before the flight-common offset is added
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
@@ -600,7 +693,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
         offset, common to all samples); an axis whose slope is not identified (wrong sign or fewer than
-        :data:`MIN_T_STAT` standard errors), or with under :data:`MIN_VALID_S` s of usable data,
+        :data:`MIN_T_STAT` standard errors; for alpha only when :data:`SLOPE_FLOOR` is off or the wing's aspect
+        ratio is unknown, since the floor holds a flatter slope), or with under :data:`MIN_VALID_S` s of usable data,
         or a grid slower than :data:`MIN_RATE_HZ`, or that fails the moment cross-check, keeps its
         kinematic angle (``AxisFit.used`` False, ``reason`` says why).
 
@@ -642,10 +736,15 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     with np.errstate(invalid="ignore", divide="ignore"):
         hg = qbar * S / (mass * Vs)          # heave mode's rate per unit |CZ_alpha|, 1/s (heave_edge_hz)
     hg = float(np.nanmedian(hg[u])) if np.isfinite(hg[u]).any() else float("nan")
-    edge = heave_edge_hz(lift_slope(b * b / S), hg)
-    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
-                         (models or {}).get("alpha"), band_hz=edge)
+    floor = lift_slope(b * b / S)          # the wing's lift slope, 1/rad (NaN: no span or area)
+    edge = heave_edge_hz(floor, hg)
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
+    share = gust_share(dt, alpha_kin, u, fb, edge)
+    held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
+    a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
+                         (models or {}).get("alpha"), band_hz=edge, slope_floor=floor if held else None)
+    if "held at the wing's lift slope" in fa.slope_method:
+        fa.slope_method += f" (lateral gust witness: {100 * share:.0f} % of the kinematic alpha's in-band variance)"
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
                          "fin, P-factor) breaks the CY0 ~ 0 prior")
