@@ -66,11 +66,11 @@ def test_the_score_fails_against_wrong_truth(measured):
 #: and the pa28 CY 10.25, Cn 14.28 % (turb15).
 SLOW_CASES = {
     ("sgs", "calm", "ahrs"): {"CX": 7.5, "CY": 5.0, "CZ": 1.0, "Cl": 21.0, "Cm": 14.0, "Cn": 10.5,
-                               "alpha_deg": 0.55, "beta_deg": 0.7},
+                              "alpha_deg": 0.55, "beta_deg": 0.7},
     ("c172x", "light", "ahrs"): {"CX": 5.0, "CY": 15.0, "CZ": 9.5, "Cl": 26.0, "Cm": 35.0, "Cn": 15.0,
-                                    "alpha_deg": 3.2, "beta_deg": 4.0},
+                                 "alpha_deg": 3.2, "beta_deg": 4.0},
     ("pa28", "calm", "vane"): {"CX": 1.5, "CY": 8.0, "CZ": 1.2, "Cl": 22.0, "Cm": 23.0, "Cn": 10.5,
-                                "alpha_deg": 0.15, "beta_deg": 0.15},
+                               "alpha_deg": 0.15, "beta_deg": 0.15},
 }
 
 
