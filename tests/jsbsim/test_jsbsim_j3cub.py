@@ -95,9 +95,10 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_pat
     """The J3Cub flies the evaluation's plans as a test pilot would: no knock-it-off, alpha far
     below the stall (about 13 deg), sideslip under 12 deg, bank under 20 deg, airspeed at least
     1.15 times the stall and far below the never-exceed speed, every axis excited (rates and surfaces), and the glide
-    loses height. The alpha ceiling (7.5 deg) and the sideslip limit (12 deg) were re-derived in the fifteenth session (turb15) from
-    the flights in MIL-F-8785C light / moderate turbulence (severity 3 / 4): the seed-100 sweep reaches alpha 6.3 deg,
-    the moderate standard flight (seed 2) 10.1 deg of sideslip (calm-air limits 6 and 10; docs/jsbsim.md, J3Cub)."""
+    loses height. The alpha ceiling (7.5 deg) and the sideslip limit (12 deg) were re-derived in the fifteenth
+    session (turb15) from the flights in MIL-F-8785C light / moderate turbulence (severity 3 / 4): the seed-100
+    sweep reaches alpha 6.3 deg, the moderate standard flight (seed 2) 10.1 deg of sideslip (calm-air limits 6
+    and 10; docs/jsbsim.md, J3Cub)."""
     spec = aircraft("j3cub")
     cfg = FlightConfig("j3cub", duration_s=120.0, turbulence=turbulence, seed=seed, plan=plan)
     rec = fly(cfg, _write_model(spec, [Effect(n, v) for n, v in effects], tmp_path) if effects else None)
