@@ -122,26 +122,31 @@ def _fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, pla
     return 0
 
 
-def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: str = PLAN):
-    """Fly the clean reference flight, fit the model; returns (files, model path, measurements)."""
+def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: str = PLAN,
+                    turbulence: str = "light"):
+    """Fly the clean reference flight, fit the model; returns (files, model path, measurements).
+    ``turbulence``: the harness level (the evaluation flies "light"; tests of a mechanism pass "calm")."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.diagnose.run import load_measurements
 
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan), [], out, stem=f"{ac}-ref")
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, turbulence=turbulence), [], out,
+                    stem=f"{ac}-ref")
     model_path = out / f"{ac}-ref-{plan}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
     return files, model_path, load_measurements(files.tlog, files.airframe)
 
 
 def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_path: Path, ref_meas,
-                  duration_s: float = DURATION_S, plan: str = PLAN) -> tuple[list[dict], dict, float]:
-    """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis)."""
+                  duration_s: float = DURATION_S, plan: str = PLAN,
+                  turbulence: str = "light") -> tuple[list[dict], dict, float]:
+    """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis).
+    ``turbulence`` as in :func:`reference_model`."""
     from gcs_sysid.diagnose import diagnose
     from gcs_sysid.diagnose.run import load_measurements
     from gcs_sysid.sim.model_file import load_model
 
     _LAST_PITOT.clear()
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan), effects, out)
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, turbulence=turbulence), effects, out)
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
     t0 = time.perf_counter()

@@ -105,10 +105,15 @@ def test_score_case_fails_a_wrong_or_invented_cause():
 @pytest.mark.parametrize("ac,name", [("c172x", "delay:delta_e"), ("sgs", "Cn:delta_a"), ("sgs", "CY:scale"),
                                      ("c172x", "Cl:alpha*beta")])
 def test_more_effects_are_found(tmp_path, ac, name):
+    """Flies "calm" (the harness's light until the fifteenth session): the search's thresholds were
+    frozen on these flights and the test checks the mechanism, not a level of turbulence. In
+    MIL-F-8785C light turbulence (severity 3) c172x ``delay:delta_e`` was named without its estimate
+    and c172x ``Cl:alpha*beta`` and sgs ``CY:scale`` were not named (fifteenth session, turb15)."""
     from benchmarks.eval_jsbsim_diagnose import diagnose_case, reference_model
 
-    _, model_path, ref = reference_model(ac, tmp_path)
-    findings, truth, _ = diagnose_case(ac, 2, [Effect(name, SIZES[name][1])], tmp_path, model_path, ref)
+    _, model_path, ref = reference_model(ac, tmp_path, turbulence="calm")
+    findings, truth, _ = diagnose_case(ac, 2, [Effect(name, SIZES[name][1])], tmp_path, model_path, ref,
+                                       turbulence="calm")
     sc = score_case(findings, truth)
     assert sc["effects"][0]["top"] and sc["effects"][0].get("est"), sc
 
@@ -178,11 +183,13 @@ def test_one_mps_pitot_bias_reads_within_25_percent(tmp_path):
     """The C182's 1 m/s pitot bias (seed 2) read 0.65 m/s: the exact re-fit's coefficient estimate (0.66) had
     the closed-form fit's reference value (+0.01) subtracted, while the same re-fit reads -0.18 on the
     reference flight. Measured against the re-reduced reference, coefficient by coefficient, it reads 0.82
-    (branch i9-scale, docs/diagnose.md)."""
+    (branch i9-scale, docs/diagnose.md). Flies "calm" (the harness's light until the fifteenth session,
+    the flights this was measured on); in MIL-F-8785C light turbulence nothing was named (turb15)."""
     from benchmarks.eval_jsbsim_diagnose import diagnose_case, reference_model
 
-    _, model_path, ref = reference_model("c182", tmp_path)
-    findings, truth, _ = diagnose_case("c182", 2, [Effect("bias:airspeed", 1.0)], tmp_path, model_path, ref)
+    _, model_path, ref = reference_model("c182", tmp_path, turbulence="calm")
+    findings, truth, _ = diagnose_case("c182", 2, [Effect("bias:airspeed", 1.0)], tmp_path, model_path, ref,
+                                       turbulence="calm")
     sc = score_case(findings, truth)
     assert sc["effects"][0]["top"] and sc["effects"][0]["est"], [(f["cause"], f["estimate"]) for f in findings]
 

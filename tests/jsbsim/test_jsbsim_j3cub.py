@@ -93,15 +93,19 @@ def test_every_hidden_effect_edits_the_j3cub_as_specified():
 @pytest.mark.parametrize("seed,turbulence,plan,effects", EVALUATION_FLIGHTS)
 def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(tmp_path, seed, turbulence, plan, effects):
     """The J3Cub flies the evaluation's plans as a test pilot would: no knock-it-off, alpha far
-    below the stall (about 13 deg), sideslip under 10 deg, bank under 20 deg, airspeed at least
-    1.15 times the stall and far below the never-exceed speed, every axis excited (rates and surfaces), and the glide loses height."""
+    below the stall (about 13 deg), sideslip under 12 deg, bank under 20 deg, airspeed at least
+    1.15 times the stall and far below the never-exceed speed, every axis excited (rates and surfaces), and the glide
+    loses height. The alpha ceiling (7.5 deg) and the sideslip limit (12 deg) were re-derived in the fifteenth
+    session (turb15) from the flights in MIL-F-8785C light / moderate turbulence (severity 3 / 4): the seed-100
+    sweep reaches alpha 6.3 deg, the moderate standard flight (seed 2) 10.1 deg of sideslip (calm-air limits 6
+    and 10; docs/jsbsim.md, J3Cub)."""
     spec = aircraft("j3cub")
     cfg = FlightConfig("j3cub", duration_s=120.0, turbulence=turbulence, seed=seed, plan=plan)
     rec = fly(cfg, _write_model(spec, [Effect(n, v) for n, v in effects], tmp_path) if effects else None)
     tr, d = rec.truth, np.degrees
     assert rec.meta["aborts"] == []
-    assert d(tr["alpha"]).max() < 6.0 and d(tr["alpha"]).min() > -5.0
-    assert d(np.abs(tr["beta"])).max() < 10.0 and d(np.abs(tr["phi"])).max() < 20.0
+    assert d(tr["alpha"]).max() < 7.5 and d(tr["alpha"]).min() > -5.0
+    assert d(np.abs(tr["beta"])).max() < 12.0 and d(np.abs(tr["phi"])).max() < 20.0
     # the model's power-off stall: about 31 kt EAS (967 lb, CL_max 1.62), 17.7 m/s TAS at 6000 ft;
     # never-exceed speed of the J-3: 106 kt (54 m/s)
     assert 1.15 * 17.7 < tr["V"].min() and tr["V"].max() < 45.0

@@ -412,8 +412,9 @@ def evaluation_envelope(name: str, seed: int, turbulence: str, plan: str, effect
 
     Returns:
         ``flight_envelope`` of its truth file plus ``wild`` (True when ``Cl:alpha*beta`` is
-        injected: the effect that reverses the dihedral effect) and ``alt_min`` (lowest altitude
-        above sea level, m).
+        injected: the effect that reverses the dihedral effect), ``alt_min`` (lowest altitude
+        above sea level, m) and ``sink_air_mps`` (mean sink through the air, m/s: the mean of the
+        truth's ``vd - wd``, the ground's down velocity less the air's).
     """
     from benchmarks.jsbsim_harness import FlightConfig, make_flight
     from benchmarks.jsbsim_harness.effects import Effect, make_effect_flight
@@ -424,7 +425,9 @@ def evaluation_envelope(name: str, seed: int, turbulence: str, plan: str, effect
              else make_flight(cfg, out_dir))
     with np.load(files.truth) as z:
         alt_min = float(z["alt"].min())
-    return flight_envelope(files.truth) | {"wild": any(n == "Cl:alpha*beta" for n, _ in effects), "alt_min": alt_min}
+        sink_air = float(np.mean(z["vd"] - z["wd"]))
+    return flight_envelope(files.truth) | {"wild": any(n == "Cl:alpha*beta" for n, _ in effects), "alt_min": alt_min,
+                                           "sink_air_mps": sink_air}
 
 
 def assert_in_envelope(e: dict, alpha, beta, bank, speed, rate_std: float, rate_std_held: float,
@@ -436,8 +439,12 @@ def assert_in_envelope(e: dict, alpha, beta, bank, speed, rate_std: float, rate_
             bank, deg. speed: (lowest, highest) TAS, m/s. rate_std, rate_std_held: least standard
             deviation of each body rate on the whole flight and the held-out last 20 %, deg/s.
         alt_min: lowest altitude above sea level, m.
-        sink_min: the glide sinks more than this, m/s (3 unless the aircraft glides flatter: the
-            rascal sinks 1.6-2.2 m/s at 20 m/s).
+        sink_min: the glide sinks through the air (``sink_air_mps``) more than this, m/s (3 unless
+            the aircraft glides flatter: the rascal sinks 1.6-2.2 m/s at 20 m/s). Through the air, not
+            over the ground (``sink_mps``), since the fifteenth session: the mean vertical gust of
+            MIL-F-8785C light turbulence over a 120-s flight is about 1-1.6 m/s (the rascal's seed-1
+            flights sank 0.31-0.36 m/s over the ground, 1.9-2.1 through the air; the sgs126's rose by
+            0.06-0.12 m/s and sank 1.0-1.3 through the air); in the old light turbulence the two agreed.
 
     Raises:
         AssertionError: a knock-it-off was flown, or a limit is exceeded; every surface moves by
@@ -449,4 +456,4 @@ def assert_in_envelope(e: dict, alpha, beta, bank, speed, rate_std: float, rate_
     assert max(map(abs, e["beta"])) < beta[w] and e["bank_max"] < bank[w], e
     assert speed[0] < e["V"][0] and e["V"][1] < speed[1], e["V"]
     assert min(e["rate_std"]) > rate_std and min(e["rate_std_held"]) > rate_std_held, e      # deg/s
-    assert min(e["surface_std"]) > 1.0 and e["sink_mps"] > sink_min and e["alt_min"] > alt_min, e
+    assert min(e["surface_std"]) > 1.0 and e["sink_air_mps"] > sink_min and e["alt_min"] > alt_min, e
