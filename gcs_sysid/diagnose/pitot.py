@@ -30,8 +30,10 @@ against GPS minus the autopilot's wind (:mod:`gcs_sysid.diagnose.wind_triangle`)
 on the coefficients are independent measurements of one change since the reference flight; when they
 agree and their fused change is at least :data:`MIN_T_FUSED` standard errors, the coefficients are
 refitted with the bias's exact effect (the pipeline re-run with the pitot corrected, one estimate per
-coefficient, their median) and the bias is named if that correction gains on the untouched rows. Only
-when that path does not name it does the signature path below decide.
+coefficient, their median) and the bias is named if the coefficients on their own see it
+(:data:`MIN_T_COEF_CONFIRM`, since 2026-11-23) and that correction gains on the untouched rows. Only
+when that path does not name it does the signature path below decide. An accepted pitot finding is
+ranked by its held-out gain among the others (:data:`RANK_BY_GAIN`).
 
 Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:15 UTC):
 ``MIN_T`` on the fit's coloured-residual t statistic, and the systematic error of the autopilot's
@@ -342,9 +344,12 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     """``bias:airspeed`` by the wind triangle and the coefficients together (:func:`fuse_pitot_evidence`).
 
     Accepted when both measurements agree, their combined change since the reference flight(s) is at
-    least :data:`MIN_T_FUSED` standard errors from 0 and the correction at that size gains at least
-    ``min_gain_pct`` on a coefficient's untouched rows (never used by either fit). The offsets the
-    bias makes count as its evidence here (the triangle measures the bias without the coefficients).
+    least :data:`MIN_T_FUSED` standard errors from 0, the coefficients on their own see it (at least
+    :data:`MIN_T_COEF_CONFIRM` of their standard errors on the fused estimate's side,
+    :func:`coefficients_confirm`) and the correction at that size gains at least ``min_gain_pct`` on a
+    coefficient's untouched rows (never used by either fit) or on the pitot's own reading
+    (:data:`SENSOR_GAIN`). The offsets the bias makes count as its evidence in that gain (the triangle
+    measures the bias without the coefficients), which is why the coefficients must confirm it first.
     """
     from .wind_triangle import change_since_references, triangle_gain, wind_triangle
 
