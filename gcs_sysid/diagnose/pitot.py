@@ -121,11 +121,13 @@ SENSOR_GAIN = True
 #: errors) and the fused t (:data:`MIN_T_FUSED`) alone let the triangle carry the finding by itself when the
 #: coefficients read nothing; the triangle's standard error on one flight omits the autopilot wind's wander (the
 #: project's simulated trainer, seed 13, no bias: triangle +0.50 +- 0.13 m/s, coefficients -0.14 +- 0.41, fused t 3.7,
-#: then accepted on a coefficient gain made of constant CY/Cl/Cn offsets once the gust projector was off). Real biases
-#: on the tuning aircraft read 1.2-10 of these standard errors (b747 1 m/s the least).
+#: then accepted on a coefficient gain made of constant CY/Cl/Cn offsets once the gust projector was off). Accepted real
+#: biases in the archived JSBSim records (old turbulence levels, ten aircraft) read 1.5-10.5 of these standard errors
+#: but one (b747 1 m/s, seed 7: 0.9, lost); at the new levels (rascal, t6) 2.0-7.0.
 MIN_T_COEF_CONFIRM = 1.0
-#: An accepted pitot finding takes its place among the findings by its held-out gain, like every other cause
-#: (:func:`with_pitot`; added 2026-11-23, branch i9-heave2). False: first whatever its gain (before).
+#: An accepted pitot finding takes its place among the findings by its held-out gain, like the catalogue's and the
+#: search's causes (:func:`with_pitot`; added 2026-11-23, branch i9-heave2). False: first whatever its gain (before;
+#: as :func:`gcs_sysid.diagnose.sparse.merge_findings` still keeps the other data-compatibility causes first).
 RANK_BY_GAIN = True
 
 
