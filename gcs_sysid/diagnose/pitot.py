@@ -32,8 +32,8 @@ agree and their fused change is at least :data:`MIN_T_FUSED` standard errors, th
 refitted with the bias's exact effect (the pipeline re-run with the pitot corrected, one estimate per
 coefficient, their median) and the bias is named if the coefficients on their own see it
 (:data:`MIN_T_COEF_CONFIRM`, since 2026-11-23) and that correction gains on the untouched rows. Only
-when that path does not name it does the signature path below decide. An accepted pitot finding is
-ranked by its held-out gain among the others (:data:`RANK_BY_GAIN`).
+when that path does not name it does the signature path below decide. An accepted pitot finding comes
+first (:data:`RANK_BY_GAIN`).
 
 Thresholds (frozen with those of :mod:`gcs_sysid.diagnose.physical`, 2026-11-22 00:15 UTC):
 ``MIN_T`` on the fit's coloured-residual t statistic, and the systematic error of the autopilot's
@@ -125,10 +125,13 @@ SENSOR_GAIN = True
 #: biases in the archived JSBSim records (old turbulence levels, ten aircraft) read 1.5-10.5 of these standard errors
 #: but one (b747 1 m/s, seed 7: 0.9, lost); at the new levels (rascal, t6) 2.0-7.0.
 MIN_T_COEF_CONFIRM = 1.0
-#: An accepted pitot finding takes its place among the findings by its held-out gain, like the catalogue's and the
-#: search's causes (:func:`with_pitot`; added 2026-11-23, branch i9-heave2). False: first whatever its gain (before;
-#: as :func:`gcs_sysid.diagnose.sparse.merge_findings` still keeps the other data-compatibility causes first).
-RANK_BY_GAIN = True
+#: True: an accepted pitot finding takes its place among the findings by its held-out gain, like the catalogue's and
+#: the search's causes (:func:`with_pitot`; tried 2026-11-23, branch i9-heave2). False (kept): first, as
+#: :func:`gcs_sysid.diagnose.sparse.merge_findings` keeps every data-compatibility cause first. Measured with True at
+#: the new turbulence levels (rascal, t6, c172x, band off): the pitot lost the top on 3 of the 9 2-m/s flights where it
+#: was named (``scale:CY`` first, 62-84 %), none of them found either way; with :data:`MIN_T_COEF_CONFIRM` the false
+#: pitot it guarded against is no longer accepted (``docs/benchmarks.md``, *Fifteenth session, i9-heave2*).
+RANK_BY_GAIN = False
 
 
 def wind_shift(ctx: DiagContext, flight) -> dict | None:
@@ -650,8 +653,8 @@ def _reference_values(references, airframe, model, cause: str) -> list[dict]:
 
 
 def with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
-    """Findings with an accepted pitot cause placed by its held-out gain (:data:`RANK_BY_GAIN`: before the
-    first remaining non-fault finding whose gain is not larger; faults stay first); the aero terms of its
+    """Findings with an accepted pitot cause first after the faults (with :data:`RANK_BY_GAIN`: placed by its held-out
+    gain, before the first remaining non-fault finding whose gain is not larger); the aero terms of its
     implied coefficients are its symptoms (``evidence.explains``) and leave the list. Writes ``data["pitot"]`` (the candidates and
     their checks) and appends its calibration notes to ``data["calibration"]``.
 
