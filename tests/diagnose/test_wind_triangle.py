@@ -8,7 +8,8 @@ then only to within that estimate's systematic error. Fast (no pipeline run)."""
 import numpy as np
 import pytest
 
-from gcs_sysid.diagnose.pitot import COEF_SYSTEMATIC_MPS, fuse_pitot_evidence
+from gcs_sysid.diagnose.pitot import (COEF_SYSTEMATIC_MPS, MIN_T_COEF_CONFIRM, MIN_T_FUSED, coefficients_confirm,
+                                      fuse_pitot_evidence)
 from gcs_sysid.diagnose.wind_triangle import (WIND_SYSTEMATIC_MPS, change_since_references, triangle_gain,
                                               wind_triangle)
 from gcs_sysid.telemetry.types import Flight, Stream
@@ -96,6 +97,20 @@ def test_fusion_needs_agreement():
     fx = fuse_pitot_evidence({"change_mps": -1.5, "std_error": 0.3}, 1.5, 0.2)
     assert not fx["agree"]
     assert fuse_pitot_evidence(None, 1.0, 0.2) is None
+
+
+def test_the_coefficients_must_see_the_bias_not_only_agree_with_it():
+    """Agreement within 3 standard errors and a fused t of 3 let the triangle carry a finding alone; the
+    coefficients must confirm it (``pitot.MIN_T_COEF_CONFIRM``). Numbers of the project's sim trainer (seed 13):
+    the wind flight with the heave band on (no pitot bias; the autopilot wind's wander) and the 2 m/s bias."""
+    false = fuse_pitot_evidence({"change_mps": 0.498, "std_error": 0.127}, -0.136, 0.414)
+    assert false["agree"] and false["t_statistic"] >= MIN_T_FUSED     # what named it before
+    assert not coefficients_confirm(false)
+    real = fuse_pitot_evidence({"change_mps": 2.512, "std_error": 0.127}, 1.925, 0.212)
+    assert real["agree"] and coefficients_confirm(real)
+    low = fuse_pitot_evidence({"change_mps": -1.07, "std_error": 0.42}, -MIN_T_COEF_CONFIRM * 1.05, 1.0)
+    assert coefficients_confirm(low)                                  # the sign is the fused estimate's
+    assert not coefficients_confirm(fuse_pitot_evidence({"change_mps": -1.07, "std_error": 0.42}, -0.9, 1.0))
 
 
 @pytest.mark.parametrize("bias", [0.0, 2.0])
