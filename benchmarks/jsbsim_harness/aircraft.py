@@ -456,8 +456,8 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # after the Bergfalke (YASim), the ASK 21 (no licence file; a FlightGear property in its Cm_q term), the Jabiru
     # J170 (the c172p's aerodynamics; its FCS reads fcs/*-pos-output, which nothing in JSBSim writes), the DHC-2
     # (YASim), the Skywalker X8 (no rudder) and two UAV models without a licence. A direct FCS (aerosurface_scale,
-    # zero-centred, no damper): elevator, left and right aileron (the right the same sign as the left; the aerodynamics read the
-    # left alone) and rudder all +-0.35 rad x the command. Signs read from its aerodynamics: Pitch_elevator
+    # zero-centred, no damper): elevator, left and right aileron (the right the same sign as the left; the
+    # aerodynamics read the left alone) and rudder all +-0.35 rad x the command. Signs read from its aerodynamics: Pitch_elevator
     # (-1 + 0.375 Mach) x elevator-pos (positive = trailing edge down), Roll_aileron +0.18 x left-aileron-pos
     # (positive = roll right: Cl_delta_a -0.18), Yaw_rudder -0.1 x rudder-pos (positive = trailing edge left, nose
     # left); Yaw_aileron -0.003 x left (adverse: Cn_delta_a +0.003). Gear up (Drag_gear 0.03 x gear-pos-norm).
