@@ -79,11 +79,12 @@ _DEG = 57.29577951308232
 #: sessions' final evaluations; the f16 flown as the derived model ``f16_direct``, the f4n as ``F4N_fcs``,
 #: the rascal, ArduPilot's SITL Rascal 110 checked into ``data/jsbsim_models``, as ``Rascal110_glide``:
 #: ``derived.py``) and ``sgs126`` (the fourteenth session's: the wheel's Schweizer SGS 1-26 glider, flown at
-#: 3000 ft where JSBSim's light turbulence is active) are used since as well. ``asw20`` (added in the fifteenth
-#: session, 2026-11-23: FlightGear's ASW 20 sailplane, checked into ``data/jsbsim_models/asw20`` and flown as
-#: ``asw20_glide``, at 3000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
-#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method was never
-#: run on it before its final evaluation.
+#: 3000 ft where JSBSim's light turbulence is active) and ``asw20`` (the fifteenth session's: FlightGear's ASW 20
+#: sailplane, checked into ``data/jsbsim_models/asw20`` and flown as ``asw20_glide``, at 3000 ft) are used since as
+#: well. ``iar80`` (added in the sixteenth session, 2026-11-23: FlightGear's JSBSim IAR-80 fighter, checked into
+#: ``data/jsbsim_models/iar80`` and flown as ``IAR80_glide``, engine and propeller removed, at 10000 ft) is the
+#: held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from
+#: JSBSim's truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -445,10 +446,45 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="ASW 20 sailplane (FlightGear's JSBSim asw20-JSBSim.xml, checked in under data/jsbsim_models/asw20) "
               "without FlightGear's engine and ballast systems (derived model asw20_glide, XML sha256 f9ca126483a12dcc), "
               "gear up, gliding; untouched by any tuning of the method"),
+    # iar80: FlightGear's JSBSim IAR-80 (FGMEMBERS/IAR-80-JSB IAR80-Jsb.xml at 6d011335, Aeromatic v0.95, 2015;
+    # GPL-2.0-or-later), the Romanian 1939 single-seat monoplane fighter: 6170.8 lb (4850 empty, a 459.2-lb payload
+    # and 861.6 lb of fuel, all at the CG), 36-ft span, 183 ft^2 (wing loading 33.7 lb/ft^2), retractable gear. The
+    # third aircraft from outside the wheel and the first powered one since the rascal; its XML is checked in
+    # (data/jsbsim_models/iar80/, provenance and licence in its README.md) and flown as the derived model
+    # ``IAR80_glide`` (derived.py): its engine and propeller removed (their files are not in the repository but as an
+    # editor's backup), its fuel tanks kept as mass. Chosen in the sixteenth session (docs/jsbsim.md, "The iar80")
+    # after the Bergfalke (YASim), the ASK 21 (no licence file; a FlightGear property in its Cm_q term), the Jabiru
+    # J170 (the c172p's aerodynamics; its FCS reads fcs/*-pos-output, which nothing in JSBSim writes), the DHC-2
+    # (YASim), the Skywalker X8 (no rudder) and two UAV models without a licence. A direct FCS (aerosurface_scale,
+    # zero-centred, no damper): elevator, left and right aileron (the right the same sign as the left; the
+    # aerodynamics read the left alone) and rudder all +-0.35 rad x the command. Signs read from its aerodynamics: Pitch_elevator
+    # (-1 + 0.375 Mach) x elevator-pos (positive = trailing edge down), Roll_aileron +0.18 x left-aileron-pos
+    # (positive = roll right: Cl_delta_a -0.18), Yaw_rudder -0.1 x rudder-pos (positive = trailing edge left, nose
+    # left); Yaw_aileron -0.003 x left (adverse: Cn_delta_a +0.003). Gear up (Drag_gear 0.03 x gear-pos-norm).
+    # 150 kt (ic/vc-kts) at 10000 ft: 98-110 m/s TAS in the standard trial flights, alpha -2..4 deg (1st-99th
+    # percentile); the sweep flies 69-130 m/s, 1.3 x the stall at its slowest (about 45 m/s EAS: CL_max 1.3 at
+    # 0.23 rad). Its CL table has a break at alpha 0 (5.5 per rad below, 4.48 above), which the sweep crosses. It
+    # sinks 9.6-11 m/s (lift-to-drag about 10), so a 135-s flight from 10000 ft ends above 1500 m; MIL-F-8785C light
+    # turbulence moves the air there (vertical gust 2.1-2.2 m/s standard deviation). Pulses 0.7 / 0.8 / 0.8 s: short
+    # period about 3.2 rad/s (Cm_alpha -0.5, Cmq -15, Iyy 4104 slug ft^2), Dutch roll about 2.9 rad/s (Cnb 0.12
+    # against Izz 7016 slug ft^2), roll mode about 3.4 per s. Amplitudes 4 / 4 / 4 deg: 3 deg gave 0.94 / 1.01 /
+    # 0.87 deg of surface standard deviation in the standard light flight (the envelope test's floor is 1); with 4
+    # deg 1.1-2.5 deg in every trial flight, surfaces at most -10.7..+10.4, 7.5 and 5.5 deg of their 20. Default
+    # gains. Set from the harness's truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never from
+    # a method result.
+    "iar80": AircraftSpec(
+        name="iar80", model="IAR80_glide", airspeed_kts=150.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(4.0, 4.0, 4.0), pulse_s=(0.7, 0.8, 0.8), gear_up=True,
+        notes="IAR-80 fighter (FlightGear's JSBSim IAR80-Jsb.xml, checked in under data/jsbsim_models/iar80) with its "
+              "engine and propeller removed (derived model IAR80_glide, XML sha256 2025fa83c41f3f74), gear up, gliding; "
+              "untouched by any tuning of the method"),
 }
-TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126")
-HELD_OUT_AIRCRAFT = ("asw20",)
-UNTOUCHED_AIRCRAFT = ("asw20",)
+TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
+                   "asw20")
+HELD_OUT_AIRCRAFT = ("iar80",)
+UNTOUCHED_AIRCRAFT = ("iar80",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -5,7 +5,8 @@ given the empty ``<flight_control>`` element the harness's injected elevator del
 this repository, with its engine removed (``Rascal110_glide``, :func:`derive_rascal_glide`: ArduPilot's
 SITL Rascal 110; thirteenth session, :data:`REPO_DERIVED`), or FlightGear's ASW 20 sailplane with the
 parts that need FlightGear removed and its elevator table reading an alias (``asw20_glide``,
-:func:`derive_asw20_glide`; fifteenth session).
+:func:`derive_asw20_glide`; fifteenth session), or FlightGear's JSBSim IAR-80 fighter with its engine and
+propeller removed (``IAR80_glide``, :func:`derive_iar80_glide`; sixteenth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -59,7 +60,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
-           "derive_asw20_glide", "derived_xml", "derived_sha", "install_derived_models", "ELEVATOR_ALIAS",
+           "derive_asw20_glide", "derive_iar80_glide", "derived_xml", "derived_sha", "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
 
 #: The elevator alias the derived F-16's tables read (see the module docstring).
@@ -275,6 +276,38 @@ def derive_asw20_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def derive_iar80_glide(root: ET.Element) -> ET.Element:
+    """FlightGear's JSBSim IAR-80 (``data/jsbsim_models/iar80/IAR80-Jsb.xml``) with its engine and propeller
+    removed (sixteenth session).
+
+    The file (FGMEMBERS/IAR-80-JSB, Aeromatic v0.95, 2015) drives a propeller (``Prop``) with a 14-cylinder
+    radial (``IAR-K14-1000A``); neither file is copied (the repository holds the engine only as an editor's
+    backup, ``Engines/IAR-K14-1000A~``, so JSBSim could not load it anyway). The harness glides every aircraft
+    with its engines stopped, so that every non-gravity force is aerodynamic, and a stopped engine would leave
+    JSBSim's windmilling propeller (the rule that rejected the p51d, B17 and C130). As for the rascal, the
+    ``<engine>`` element (engine, its two ``<feed>`` and the thruster) is removed; the two fuel tanks (399 and
+    462.6 lb, both at the CG) stay as mass. Everything else (metrics, mass balance, ground reactions, flight
+    control, aerodynamics, external reactions) is the file's (a test checks every other element).
+
+    Args:
+        root: the parsed ``IAR80-Jsb.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML has no ``<propulsion>`` with exactly one ``<engine>`` or no ``<aerodynamics>``
+            (another version of the file).
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    if len(engines) != 1 or root.find("aerodynamics") is None:
+        raise ValueError("IAR80-Jsb.xml: expected one <propulsion><engine> to remove and an <aerodynamics>")
+    prop.remove(engines[0])
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -301,6 +334,11 @@ REPO_DERIVED = {
                     derive_asw20_glide, "the GenericEngine and WaterBallast systems and the Water Dumping channel "
                                         "(FlightGear's) removed; the CmDe table reads the elevator through an alias "
                                         "in degrees of fcs/elevator-pos-rad; everything else unchanged."),
+    "IAR80_glide": ("data/jsbsim_models/iar80/IAR80-Jsb.xml",
+                    "FlightGear's JSBSim IAR-80 (FGMEMBERS/IAR-80-JSB IAR80-Jsb.xml at 6d011335, GPL-2.0-or-later), "
+                    "copied into gcs-sysid's data/jsbsim_models/iar80/",
+                    derive_iar80_glide, "engine and propeller removed (a glide with no propeller force); the fuel "
+                                        "tanks stay as mass; everything else unchanged."),
 }
 
 

@@ -1,4 +1,5 @@
-"""The asw20 in the JSBSim harness: the fifteenth session's untouched aircraft (docs/jsbsim.md, "The asw20").
+"""The asw20 in the JSBSim harness: the fifteenth session's untouched aircraft, a tuning aircraft since its final
+evaluation was read (docs/jsbsim.md, "The asw20").
 
 The model is FlightGear's ASW 20 sailplane (``Models/JSBSim/asw20-JSBSim.xml`` of FGMEMBERS/asw20 at commit
 3ef71d9c, GPL-2.0-or-later; D-NXKT's 2013 conversion of Michael Selig's UIUC ASW 20), checked in under
@@ -12,19 +13,18 @@ The checks here use the XML and JSBSim's own properties; none of them flies the 
 - the alias changes no number: JSBSim's forces and moments equal those of the file without it;
 - the FCS maps the commands straight to the surfaces the aerodynamics read, the aileron's the other way
   round (``cmd_per_rad`` negative), with no damper; no engine, no external force;
-- it is statically stable about the CG, and its aileron and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else.
+- it is statically stable about the CG, and its aileron and rudder act as its XML says.
+
+The summaries' label test moved to ``test_jsbsim_iar80.py`` in the sixteenth session (the iar80 is untouched).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
 map, gear, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
 All of them but the names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the asw20: its first evaluation is the final one,
-after the merge.
+No pipeline fit, GP, diagnosis or scoring runs in these tests.
 """
 
 import hashlib
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -184,31 +184,3 @@ def test_the_asw20_is_statically_stable_and_its_controls_act_as_its_xml_says():
     l3, n3, _, _ = lat(beta=4.0)
     assert l3 / np.radians(4.0) == pytest.approx(-0.0693, rel=1e-6)
     assert n3 / np.radians(4.0) == pytest.approx(0.1007, rel=1e-6)
-
-
-def test_summaries_mark_the_asw20_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the asw20 "(untouched)" and
-    no other aircraft, the sgs126 and rascal included (synthetic rows: no asw20 result exists before the
-    final evaluation). Moved here from ``test_jsbsim_sgs126.py`` (the fourteenth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| asw20 (untouched) | light") for ln in lines)
-    for ac in acs[:11]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| asw20 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| sgs126 | clean |") for ln in lines)

@@ -1,0 +1,165 @@
+"""The iar80 in the JSBSim harness: the sixteenth session's untouched aircraft (docs/jsbsim.md, "The iar80").
+
+The model is FlightGear's JSBSim IAR-80 (``IAR80-Jsb.xml`` of FGMEMBERS/IAR-80-JSB at commit 6d011335,
+GPL-2.0-or-later; Aeromatic v0.95, 2015), a single-seat piston fighter, checked in under
+``data/jsbsim_models/iar80/`` and flown as the derived model ``IAR80_glide`` (``derived.py``): its engine and
+propeller removed, its fuel tanks kept as mass. It is flown at 10000 ft, where MIL-F-8785C light turbulence
+moves the air.
+
+The checks here use the XML and JSBSim's own properties; none of them flies the harness:
+
+- the checked-in file is the one the README names, and the derivation removes the engine alone;
+- the FCS maps the commands straight to the surfaces the aerodynamics read (every surface +-0.35 rad, the right
+  aileron the same sign as the left), with no damper; no engine, no external force;
+- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says;
+- the summaries label it "(untouched)" and nothing else.
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
+map, gear (its ``Drag_gear`` reads 0 once the harness has retracted it), .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
+All of them but the names are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the iar80: its first evaluation is the final one,
+after the merge.
+"""
+
+import hashlib
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import ic_state
+
+SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
+SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
+
+
+def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+    """:func:`truth_fits.ic_state` for the iar80 (150 kt at 10000 ft)."""
+    return ic_state(aircraft("iar80"), alpha_deg, beta_deg, cmds, r_rad_s)
+
+
+def test_the_derivation_removes_only_the_engine():
+    """The checked-in XML is the README's (20021 bytes, its SHA-256). ``IAR80_glide`` is that XML with its one
+    ``<engine>`` (the IAR-K14-1000A radial, its two fuel feeds and the ``Prop`` thruster) removed from
+    ``<propulsion>``; the two fuel tanks and every other element are equal (metrics, mass balance, ground
+    reactions, flight control, aerodynamics, external reactions). The spec's notes carry the derived XML's hash."""
+    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
+    from benchmarks.jsbsim_harness.logfile import _REPO
+
+    raw = (_REPO / SRC).read_bytes()
+    assert len(raw) == 20021 and hashlib.sha256(raw).hexdigest() == SRC_SHA256
+    spec = aircraft("iar80")
+    assert spec.model == "IAR80_glide" and REPO_DERIVED[spec.model][0] == SRC
+    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
+    src, der = ET.fromstring(raw), ET.fromstring(derived_xml(spec.model))
+    canon = lambda e: ET.tostring(e, encoding="unicode").split()       # noqa: E731  (layout aside)
+    assert [c.tag for c in src] == [c.tag for c in der]
+    for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control", "aerodynamics", "external_reactions"):
+        assert canon(src.find(tag)) == canon(der.find(tag)), tag
+    engines = src.find("propulsion").findall("engine")
+    assert [e.get("file") for e in engines] == ["IAR-K14-1000A"] and engines[0].find("thruster").get("file") == "Prop"
+    assert der.find("propulsion").findall("engine") == []
+    assert list(map(canon, der.find("propulsion"))) == [canon(t) for t in src.find("propulsion").findall("tank")]
+
+
+def test_the_iar80_flies_its_own_surfaces_without_engine_or_external_force():
+    """The FCS maps the commands straight to the surfaces (``aerosurface_scale``, no damper): elevator, left
+    and right aileron and rudder all +-0.35 rad x the command; the right aileron moves as the left (the file's
+    Aeromatic FCS; only the left is read by the aerodynamics), so the harness reads the left alone
+    (``aileron_props``) with delta_a = -left. No engine; after 50 frames every non-gravity force and moment
+    is aerodynamic. A yaw rate does not move the rudder (no yaw damper), so the harness's own damper flies it."""
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    spec = aircraft("iar80")
+    assert spec.gains[5] == 0.4 and spec.gear_up and spec.aileron_props == ("fcs/left-aileron-pos-rad", None)
+    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.35, rel=1e-9)
+    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
+    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
+    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
+    da = np.radians(5.0)
+    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
+    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    for _ in range(50):
+        fdm.run()
+    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
+        for ax in ("xyz" if f.startswith("forces") else "lmn"):
+            assert fdm[f.format(ax, "external")] == 0.0
+            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
+    assert abs(fdm["forces/fbz-aero-lbs"]) > 3000.0
+
+
+def test_the_iar80_is_statically_stable_and_its_controls_act_as_its_xml_says():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic``, the harness's initial condition; the
+    aerodynamic reference point is 8.7 in above the CG).
+
+    - **Pitch:** without its ``Pitch_alphadot`` term, Cm falls with alpha: -0.48 per rad between -4 and 0 deg,
+      -0.55 between 0 and 4 deg (``Pitch_alpha`` -0.5, and the lift and drag acting 8.7 in above the CG: its lift
+      table has a break at alpha 0); no Cm0 of its own, Cm 0.008 at alpha 0 (the arm).
+    - **Elevator:** Cm per rad of elevator (-1 + 0.375 Mach, Mach 0.316 here: -0.88) -0.897 trailing edge up and
+      -0.865 down (``Drag_elevator`` reads the elevator's magnitude and acts through the arm).
+    - **Roll and yaw:** per rad of left aileron Cl +0.18 (``Roll_aileron``; the project's Cl_delta_a -0.18) and
+      Cn -0.003 (``Yaw_aileron``; Cn_delta_a +0.003, adverse); per rad of rudder Cl 0.01, Cn -0.1; Cl_beta -0.1216
+      (``Roll_beta`` -0.1 and ``Side_beta`` -1 acting 8.7 in above the CG), Cn_beta 0.12. Cl and Cn at rest are 0.
+    """
+    spec = aircraft("iar80")
+
+    def cm(alpha, de=0.0):
+        fdm = ic_state(spec, alpha_deg=alpha, cmds=(de, 0.0, 0.0))
+        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
+        return (fdm["moments/m-aero-lbsft"] - fdm["aero/moment/Pitch_alphadot"]) / qsc
+
+    cm_4, c0, c4 = cm(-4.0), cm(0.0), cm(4.0)
+    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
+    assert slope(cm_4, c0) == pytest.approx(-0.479, abs=0.01) and slope(c0, c4) == pytest.approx(-0.548, abs=0.01)
+    assert c0 == pytest.approx(0.0077, abs=0.002)
+    assert (cm(2.0, -0.5) - cm(2.0)) / (-0.5 * 0.35) == pytest.approx(-0.897, abs=0.005)
+    assert (cm(2.0, 0.5) - cm(2.0)) / (0.5 * 0.35) == pytest.approx(-0.865, abs=0.005)
+
+    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
+        fdm = _state(beta_deg=beta, cmds=cmds)
+        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
+        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb,
+                fdm["fcs/left-aileron-pos-rad"], fdm["fcs/rudder-pos-rad"])
+
+    (l0, n0, _, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
+    assert abs(l0) < 1e-12 and abs(n0) < 1e-12
+    assert l1 / a1 == pytest.approx(0.18, rel=1e-6) and n1 / a1 == pytest.approx(-0.003, rel=1e-6)
+    l2, n2, _, r2 = lat((0.0, 0.0, 0.4))
+    assert l2 / r2 == pytest.approx(0.01, rel=1e-6) and n2 / r2 == pytest.approx(-0.1, rel=1e-6)
+    l3, n3, _, _ = lat(beta=4.0)
+    assert l3 / np.radians(4.0) == pytest.approx(-0.1216, abs=5e-4)
+    assert n3 / np.radians(4.0) == pytest.approx(0.12, rel=1e-6)
+
+
+def test_summaries_mark_the_iar80_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the iar80 "(untouched)" and
+    no other aircraft, the asw20 and sgs126 included (synthetic rows: no iar80 result exists before the
+    final evaluation). Moved here from ``test_jsbsim_asw20.py`` (the fifteenth session's untouched aircraft)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| iar80 (untouched) | light") for ln in lines)
+    for ac in acs[:12]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| iar80 (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| asw20 | clean |") for ln in lines)
