@@ -133,11 +133,11 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: named (it stays in the residual, ``unexplained``, and is listed under ``not_named`` with why). The combined
 #: uncertainty (:func:`_with_uncertainty`) holds the air angles' own stated scale and offset uncertainty (type B),
 #: which the naming's coloured standard error (``min_abs_t``) does not; a finding whose own reported interval holds
-#: "no change" contradicts itself. In MIL-F-8785C light turbulence (asw20, t6; ``docs/diagnose.md``, "A change
-#: beyond its expanded uncertainty") the terms it removes are the air angles' error read as a cause: the asw20's
-#: ``Cm:alpha`` 0.53 +- 0.75 and 0.48 +- 0.69 on ``Cm:alpha^2`` flights, the t6's clean-flight ``CZ:alpha^2``
-#: -5.36 +- 3.07. No new threshold: the factor is the GUM's conventional one, chosen before any measurement with
-#: it; 0 off.
+#: "no change" contradicts itself. In MIL-F-8785C light turbulence (asw20, t6; ``docs/diagnose.md``, sparse search
+#: item 16, "A change within its expanded uncertainty is not named") the terms it removes are the air angles' error
+#: read as a cause: the asw20's ``Cm:alpha`` 0.53 +- 0.75 and 0.48 +- 0.69 on ``Cm:alpha^2`` flights, the t6's
+#: clean-flight ``CZ:alpha^2`` -5.36 +- 3.07. No new threshold: the factor is the GUM's conventional one, chosen
+#: before any measurement with it; 0 off.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -884,8 +884,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
 def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> dict:
     """Is a named term's change since the reference larger than its expanded uncertainty ``k u_c``?
 
-    ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (``evidence.uncertainty.combined``,
-    the finding's ``std_error``): this flight's and the reference's fits (coloured and block-jackknife), the
+    ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (the finding's ``std_error``
+    once ``evidence.uncertainty`` exists): this flight's and the reference's fits (coloured and block-jackknife), the
     reference inadequacy's jackknife and, as type B, the air angles' stated scale and offset uncertainty. The
     expanded uncertainty ``U = k u_c`` with the GUM's coverage factor ``k = 2`` (JCGM 100:2008 sec. 6.2-6.3, about
     95 % for a normal distribution) is the interval the finding itself reports; a change inside it is no evidence of
@@ -900,8 +900,9 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> d
         ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
         when no combined uncertainty was reported).
     """
-    u = (f.get("evidence") or {}).get("uncertainty") or {}
-    u_c = u.get("combined")
+    # the reported std_error is u_c once _with_uncertainty has run (errors_in_variables, when on, scales estimate
+    # change and std_error alike, so their ratio is the one the combined uncertainty gives)
+    u_c = f.get("std_error") if (f.get("evidence") or {}).get("uncertainty") else None
     change = float(f.get("estimate", np.nan)) - float(f.get("model_value", 0.0) or 0.0)
     if u_c is None or not np.isfinite(u_c) or u_c <= 0 or not np.isfinite(change):
         return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
