@@ -147,6 +147,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     from gcs_sysid.sim.model_file import load_model
 
     _LAST_PITOT.clear()
+    _LAST_NOT_NAMED.clear()
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, turbulence=turbulence), effects, out)
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
@@ -165,11 +166,15 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
                     flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states),
                     references=[Reference(ref_meas.table, ref_meas.states, ref_meas.flight, label=f"{ac}-ref")])
     _LAST_PITOT.update(_pitot_summary(diag.data))
+    _LAST_NOT_NAMED[:] = list((diag.data.get("sparse") or {}).get("not_named") or [])
     return diag.findings, truth, time.perf_counter() - t0
 
 
 #: the last diagnosed case's pitot evidence (:func:`_pitot_summary`), recorded with it in ``results.jsonl``
 _LAST_PITOT: dict = {}
+#: the terms the last case's sparse search did not name because their change lay within their expanded uncertainty
+#: (``sparse.beyond_expanded_uncertainty``; sixteenth session), recorded as ``not_named``
+_LAST_NOT_NAMED: list = []
 
 
 def _pitot_summary(data: dict) -> dict:
@@ -181,7 +186,15 @@ def _pitot_summary(data: dict) -> dict:
     fused = wt.get("fused") or {}
     ch = wt.get("change") or {}
     re = wt.get("coefficients_rereduced") or {}
+    flt = wt.get("flight") or {}
+    # the wind triangle on this flight and on the reference (absolute, m/s): the reference's own error enters every
+    # case's change alike (sixteenth session, branch i9-asw: the asw20's reference read +0.39 +- 0.38 m/s, 0.53 above
+    # its eight no-bias flights' mean); the exact re-fit's estimate by coefficient (change since the reference, m/s)
+    by = {c: {k: v.get(k) for k in ("estimate", "std_error", "used")}
+          for c, v in ((re.get("by_coefficient") or {}).items())}
     return {"triangle_mps": ch.get("change_mps"), "triangle_se": ch.get("std_error"),
+            "triangle_flight_mps": ch.get("flight_mps"), "triangle_reference_mps": ch.get("reference_mps"),
+            "triangle_heading_span_deg": flt.get("heading_span_deg"), "rereduced_by_coefficient": by or None,
             "coefficients_mps": fused.get("coefficients_mps"), "coefficients_se": fused.get("coefficients_se"),
             "fused_mps": fused.get("estimate"), "fused_t": fused.get("t_statistic"), "agree": fused.get("agree"),
             "screen": (wt.get("screen") or {}).get("passes"), "rereduced_mps": re.get("estimate"),
@@ -530,7 +543,7 @@ def main(argv=None) -> int:
             except RuntimeError as exc:       # the aircraft left the envelope with that effect
                 sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
             rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
-                   "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT),
+                   "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT), "not_named": list(_LAST_NOT_NAMED),
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
                                 | {"gain_pct": f.get("gain", {}).get("percent"),
                                    "std_error_decision": f.get("evidence", {}).get("std_error_decision"),

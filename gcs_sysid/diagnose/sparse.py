@@ -53,7 +53,8 @@ from .regression import ols
 from .search import alpha_quantile_knots, candidate_library, press_stepwise
 
 __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
-           "angle_nuisance", "untouched_confirmation", "scale_columns"]
+           "angle_nuisance", "untouched_confirmation", "scale_columns", "NAMING_COVERAGE_FACTOR",
+           "beyond_expanded_uncertainty"]
 
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out). Added and
@@ -126,6 +127,18 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: JSBSim f16's ``CY:scale`` 1.6 flights named ``Cl:beta`` beside ``scale:CY``, and the exact truth's Cl_beta moves
 #: by the side force's moment about the CG, AERORP 0.025 b above it; 0 off). ``min_t`` and ``min_gain_pct`` as the
 #: scale's.
+#: Added 2026-11-23 (sixteenth session, branch i9-asw; committed before the 10:35 UTC freeze): a named term's change
+#: since the reference must exceed its *expanded* uncertainty, ``naming_coverage_factor`` times the combined standard
+#: uncertainty the finding reports (GUM, JCGM 100:2008 sec. 6.2-6.3: coverage factor 2, about 95 %), or it is not
+#: named (it stays in the residual, ``unexplained``, and is listed under ``not_named`` with why). The combined
+#: uncertainty (:func:`_with_uncertainty`) holds the air angles' own stated scale and offset uncertainty (type B),
+#: which the naming's coloured standard error (``min_abs_t``) does not; a finding whose own reported interval holds
+#: "no change" contradicts itself. In MIL-F-8785C light turbulence (asw20, t6; ``docs/diagnose.md``, sparse search
+#: item 16, "A change within its expanded uncertainty is not named") the terms it removes are the air angles' error
+#: read as a cause: the asw20's ``Cm:alpha`` 0.53 +- 0.75 and 0.48 +- 0.69 on ``Cm:alpha^2`` flights, the t6's
+#: clean-flight ``CZ:alpha^2`` -5.36 +- 3.07. No new threshold: the factor is the GUM's conventional one, chosen
+#: before any measurement with it; 0 off.
+NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
               "hierarchy_tol": 0.03, "scale_coefficients": ("CY",), "min_scale_change": 0.1,
@@ -137,7 +150,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "delay_differential": True, "side_force_wind_axis": True, "delay_reference_same_fit": True,
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
-              "force_moment_arm_max": 0.1, "errors_in_variables": False}
+              "force_moment_arm_max": 0.1, "errors_in_variables": False,
+              "naming_coverage_factor": NAMING_COVERAGE_FACTOR}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -857,8 +871,46 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         for f in named:
             if f["cause"] in at_naming:
                 _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
+    k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
+    if k_cov > 0:
+        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov), cause=f["cause"]) for f in named
+                               if not beyond_expanded_uncertainty(f, k_cov)["beyond"]]
+        gone = {x["cause"] for x in result["not_named"]}
+        named = [f for f in named if f["cause"] not in gone]
     result["findings"] = named
     return result
+
+
+def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> dict:
+    """Is a named term's change since the reference larger than its expanded uncertainty ``k u_c``?
+
+    ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (the finding's ``std_error``
+    once ``evidence.uncertainty`` exists): this flight's and the reference's fits (coloured and block-jackknife), the
+    reference inadequacy's jackknife and, as type B, the air angles' stated scale and offset uncertainty. The
+    expanded uncertainty ``U = k u_c`` with the GUM's coverage factor ``k = 2`` (JCGM 100:2008 sec. 6.2-6.3, about
+    95 % for a normal distribution) is the interval the finding itself reports; a change inside it is no evidence of
+    a change. A finding without a combined uncertainty (a delay, a term :func:`_with_uncertainty` could not rebuild)
+    passes: its own decisions stand.
+
+    Args:
+        f: a named finding (``estimate``, ``model_value``, ``std_error``, ``evidence``); ``change = estimate -
+            model_value`` (``scale:`` findings: ``model_value`` 1). k: the coverage factor (> 0).
+
+    Returns:
+        ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
+        when no combined uncertainty was reported).
+    """
+    # the reported std_error is u_c once _with_uncertainty has run (errors_in_variables, when on, scales estimate
+    # change and std_error alike, so their ratio is the one the combined uncertainty gives)
+    u_c = f.get("std_error") if (f.get("evidence") or {}).get("uncertainty") else None
+    change = float(f.get("estimate", np.nan)) - float(f.get("model_value", 0.0) or 0.0)
+    if u_c is None or not np.isfinite(u_c) or u_c <= 0 or not np.isfinite(change):
+        return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
+                "why": None}
+    beyond = bool(abs(change) > k * float(u_c))
+    return {"beyond": beyond, "change": change, "combined_std_uncertainty": float(u_c), "coverage_factor": float(k),
+            "why": None if beyond else f"change {change:.4g} within its expanded uncertainty {k:g} x {u_c:.3g} "
+                                       "(the air angles' stated uncertainty and both flights' fits): not a change"}
 
 
 def _with_errors_in_variables(f: dict, names: list[str], Phi: np.ndarray, X: np.ndarray, r: np.ndarray,

@@ -317,3 +317,32 @@ def test_a_hinge_the_flight_never_reaches_does_not_break_the_differential_search
     causes = {f["cause"]: f for f in res["findings"]}
     assert "Cn:delta_a" in causes, [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
     assert causes["Cn:delta_a"]["estimate"] - causes["Cn:delta_a"]["model_value"] == pytest.approx(-0.08, rel=0.25)
+
+
+def test_a_change_within_its_expanded_uncertainty_is_not_a_change():
+    """GUM coverage factor 2 on the combined uncertainty a named term reports (``naming_coverage_factor``).
+
+    The numbers are the asw20's in MIL-F-8785C light turbulence (sixteenth session, branch i9-asw): on the
+    ``Cm:alpha^2 = -8`` flight of seed 2 the search named ``Cm:alpha`` 0.528 with a combined standard uncertainty of
+    0.752 (the air angles' stated offset and scale uncertainty, type B), while ``Cn:delta_a`` read -0.0500 +- 0.0014.
+    """
+    from gcs_sysid.diagnose.sparse import NAMING_COVERAGE_FACTOR, THRESHOLDS, beyond_expanded_uncertainty
+
+    assert NAMING_COVERAGE_FACTOR == 2.0 and THRESHOLDS["naming_coverage_factor"] == NAMING_COVERAGE_FACTOR
+
+    def finding(estimate, model_value, u_c):
+        ev = {} if u_c is None else {"uncertainty": {"combined": u_c}}
+        return {"estimate": estimate, "model_value": model_value, "std_error": u_c, "evidence": ev}
+
+    inside = beyond_expanded_uncertainty(finding(0.528, 0.0, 0.752))
+    assert not inside["beyond"] and inside["change"] == pytest.approx(0.528) and "not a change" in inside["why"]
+    assert beyond_expanded_uncertainty(finding(-0.0438, 0.0062, 0.0014))["beyond"]
+    # the factor, not a t of 1: 1.5 standard uncertainties is still inside the interval; 2.5 is outside
+    assert not beyond_expanded_uncertainty(finding(1.5, 0.0, 1.0))["beyond"]
+    assert beyond_expanded_uncertainty(finding(-2.5, 0.0, 1.0))["beyond"]
+    # a scale finding's change is its factor minus 1 (model_value 1)
+    assert not beyond_expanded_uncertainty(finding(1.05, 1.0, 0.03))["beyond"]
+    assert beyond_expanded_uncertainty(finding(1.3, 1.0, 0.03))["beyond"]
+    # no combined uncertainty reported (a delay): its own decisions stand
+    assert beyond_expanded_uncertainty(finding(0.06, 0.0, None))["beyond"]
+    assert beyond_expanded_uncertainty(finding(0.5, 0.0, 1.0), k=0.25)["beyond"]

@@ -41,3 +41,22 @@ def test_a_named_cause_is_scored_first_and_clean_flights_stay_strict():
     assert sc["effects"][0]["top"] and sc["effects"][0]["top_alias"] and sc["ok"] and sc["ok_alias"]
     sc = score_case([_finding("CY:beta", -2.3, -1.467, 97.0, [_ALIAS])], {"injected": []})
     assert sc["ok"] is False and sc["ok_alias"] is False
+
+
+def test_the_pitot_record_keeps_each_flights_own_wind_triangle_and_the_refit_by_coefficient():
+    """``_pitot_summary`` (sixteenth session, branch i9-asw): the change since the reference alone hid that the
+    asw20's reference flight read +0.39 m/s on the wind triangle, which every case's change carries."""
+    from benchmarks.eval_jsbsim_diagnose import _pitot_summary
+
+    wt = {"flight": {"bias_mps": 0.717, "heading_span_deg": 26.4},
+          "change": {"change_mps": 0.330, "std_error": 0.572, "flight_mps": 0.717, "reference_mps": 0.386},
+          "fused": {"estimate": 0.186, "t_statistic": 0.9, "agree": True, "coefficients_mps": 0.16,
+                    "coefficients_se": 0.22},
+          "coefficients_rereduced": {"estimate": 2.05, "by_coefficient": {
+              "CY": {"estimate": 1.37, "std_error": 0.16, "used": True, "flight": 1.3, "reference": -0.07}}},
+          "screen": {"passes": False}, "why": "the screen did not pass"}
+    s = _pitot_summary({"pitot": {"wind_triangle": wt}})
+    assert s["triangle_flight_mps"] == 0.717 and s["triangle_reference_mps"] == 0.386
+    assert s["triangle_mps"] == 0.330 and s["triangle_heading_span_deg"] == 26.4
+    assert s["rereduced_by_coefficient"] == {"CY": {"estimate": 1.37, "std_error": 0.16, "used": True}}
+    assert _pitot_summary({}) == {}
