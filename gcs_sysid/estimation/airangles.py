@@ -792,6 +792,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         U = [get(k) for k in BETA_INSTRUMENTS if k in controls]
         U = [x for x in U if np.isfinite(x[u]).all() and np.nanstd(x[u]) > 1e-9] if u.any() else []
         inst_b = lagged_instruments(dt, np.column_stack(U)) if U else None
+        if inst_b is not None and not np.isfinite(inst_b[u]).all():    # a delay reaches outside the finite record
+            inst_b = None
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
                           endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=BETA_MIN_FIRST_STAGE_R2)
     share = gust_share(dt, alpha_kin, u, fb, edge)
