@@ -444,7 +444,7 @@ def test_side_force_slopes_are_instrumented_by_the_rudder():
     squares in every pass, said in the note."""
     for seed in (1,):
         args, beta = _weathercock_record(seed)
-        iv, ls = aided_air_angles(*args), aided_air_angles(*args, instrument_beta=False)
+        iv, ls = aided_air_angles(*args, instrument_beta=True), aided_air_angles(*args, instrument_beta=False)
         fb, fo = iv.axes[1], ls.axes[1]
         assert fb.used and fb.slope_method.startswith("2SLS (beta, r_hat instrumented)"), fb.slope_method
         assert fo.slope_method == "OLS"
@@ -453,7 +453,7 @@ def test_side_force_slopes_are_instrumented_by_the_rudder():
         assert np.std(iv.beta - beta) < 0.6 * np.std(ls.beta - beta)
         assert any("2SLS (beta, r_hat instrumented)" in n for n in describe(iv))
     args, _ = _weathercock_record(1, rudder=0.1)
-    weak, ls = aided_air_angles(*args), aided_air_angles(*args, instrument_beta=False)
+    weak, ls = aided_air_angles(*args, instrument_beta=True), aided_air_angles(*args, instrument_beta=False)
     assert "instruments too weak in pass 1" in weak.axes[1].slope_method, weak.axes[1].slope_method
     assert weak.axes[1].first_stage_r2 < 0.1
     np.testing.assert_array_equal(weak.beta, ls.beta)
