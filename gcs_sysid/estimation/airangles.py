@@ -36,6 +36,14 @@ identified. Errors in variables only attenuate it, and an aircraft's lift slope 
 first pass holds ``|CZ_alpha|`` at least at the wing's slope from its aspect ratio (:data:`SLOPE_FLOOR`,
 :func:`lift_slope`; ``docs/estimation.md``, "The lift-slope floor").
 
+The side force has the same errors in variables with another sign pattern: the aircraft weathercocks into the lateral
+gust (the kinematic sideslip takes the gust the aircraft turns into with the opposite sign) and rolls and yaws with it,
+so least squares on the kinematic sideslip gives ``CY_beta`` and the rate terms the gust's share. The controls move the
+sideslip and the rates and do not see the air: the side-force model's slopes are fitted by two-stage least squares with
+the rudder, the aileron and their delays as instruments of ``beta``, ``p_hat`` and ``r_hat`` (:data:`INSTRUMENTED_BETA`;
+Söderström and Stoica, *Instrumental variable methods for system identification*, Springer 1983; Morelli and Klein
+2016 sec. 5.4), falling back to least squares where they are weak (:data:`BETA_MIN_FIRST_STAGE_R2`).
+
 Two errors stay (:mod:`gcs_sysid.estimation.angleerrors`): the least-squares ``CZ_alpha`` is attenuated
 because the aircraft heaves with the gust the kinematic angle misses (``instrument_slopes``: the
 elevator as instrument, two-stage least squares), and the flight-mean vertical wind puts an offset
@@ -98,6 +106,25 @@ MOMENT_MARGIN = 0.0   #: the aided angle is kept if its moment-fit residual is a
 #: ``wind`` / ``CZ:V`` / ``Cm:V`` effects on clean sim flights (tests/diagnose), whose floors were set
 #: with the old alpha; switch on once those are re-measured (docs/estimation.md).
 INSTRUMENTED_SLOPES = False
+#: Default of ``aided_air_angles(instrument_beta=None)``: fit the side-force model's slopes by two-stage least squares
+#: with the rudder and the aileron and their delayed copies (:data:`.angleerrors.INSTRUMENT_LAGS_S`) as instruments of
+#: the sideslip and of the rates that answer the lateral gust (:data:`BETA_ENDOGENOUS`); least squares in every pass
+#: where the instruments are weaker than :data:`BETA_MIN_FIRST_STAGE_R2` in any pass. The aircraft weathercocks into the
+#: lateral gust the kinematic sideslip misses, so least squares flattens ``CY_beta`` and gives the yaw rate the gust's
+#: side force (MIL-F-8785C light turbulence: rascal -0.61..-0.71 against JSBSim's -1.03, ``CY_r_hat`` -1.9 against 0),
+#: and the aided sideslip inherits the fit: the GP's side-force map is then wrong at the true sideslip, where the
+#: truth's sideslip in the training regressors makes it right (``docs/estimation.md``, "Instrumented side-force
+#: slopes"; ``docs/benchmarks.md``, "Sixteenth session, i8-iv").
+INSTRUMENTED_BETA = False   # opt-in: the t6 diagnosis eval got worse with it on (docs/benchmarks.md, i8-iv)
+BETA_INSTRUMENTS = ("delta_r", "delta_a")   #: the controls that instrument the side-force model (with their delays)
+#: columns of the side-force model instrumented with the sideslip: the aircraft rolls and yaws with the lateral gust,
+#: so their least-squares slopes take the gust's side force the kinematic sideslip misses
+BETA_ENDOGENOUS = ("p_hat", "r_hat")
+#: the least first-stage partial R^2 of the beta instruments in every pass (:func:`.angleerrors.iv_lstsq`, the smallest
+#: over the instrumented columns). On the JSBSim flights (rascal, t6, asw20; 90 s, manoeuvres in every axis) it is
+#: 0.11-0.17 in light turbulence and 0.03-0.10 in moderate; the flights with a pass below 0.1 (t6 light s2: 0.12 then
+#: 0.07) had 2SLS slopes 25-65 % off JSBSim's (weak instruments: Staiger and Stock, Econometrica 65, 1997)
+BETA_MIN_FIRST_STAGE_R2 = 0.1
 #: Hold ``|CZ_alpha|`` at least at the wing's lift slope (:func:`lift_slope`, Helmbold's formula, from ``b^2 / S``) in the
 #: first pass where the fitted one is flatter (or not identified), and leave :data:`FLOOR_DROPS` out of that pass
 #: (``docs/estimation.md``, "The lift-slope floor"). In MIL-F-8785C light turbulence the kinematic alpha's gust error
@@ -391,7 +418,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
           V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
-          slope_floor: float | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          slope_floor: float | None = None, endog: tuple[str, ...] = (),
+          min_first_stage: float = MIN_FIRST_STAGE_R2) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -406,7 +434,10 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     above which the slopes are fitted, Hz (at least :data:`HIGHPASS_HZ`; alpha: :func:`heave_edge_hz`), None:
     :data:`HIGHPASS_HZ`; ``slope_floor``: the least magnitude of the angle's slope in the first pass, 1/rad (alpha: the
     wing's lift slope, :data:`SLOPE_FLOOR`): a flatter or unidentified fitted slope is held there, the other columns
-    refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor."""
+    refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor;
+    ``endog``: the other columns instrumented with the angle (beta: ``p_hat``, ``r_hat``, which answer the gust,
+    :data:`INSTRUMENTED_BETA`); ``min_first_stage``: the instruments' least first-stage partial R^2, below which the
+    slopes fall back to ordinary least squares."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -441,7 +472,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
     X_other = np.column_stack([others[k] for k in cols]) if cols else np.zeros((len(kin), 0))
-    for _ in range(passes):
+    for ipass in range(passes):
         A = np.column_stack([ang] + ([(ang - ctr) ** 2] if quadratic else []) + [X_other])
         # slopes from the band above the edge (HIGHPASS_HZ, or for alpha the heave mode's corner where that is
         # higher: heave_edge_hz), where the kinematic angle is good (its gust errors are slow: the turbulence
@@ -456,10 +487,25 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             # errors in variables: the kinematic angle misses the gust, and the aircraft's answer to the gust
             # correlates the two; instruments that move the angle but not the air give a consistent slope
             Zh = _highpass(dt, instruments, segs, edge)
-            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], [0], Zh[m])
-            method = "2SLS"
-            if not fs_r2 >= MIN_FIRST_STAGE_R2:
-                method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {MIN_FIRST_STAGE_R2:g})"
+            en = [0] + [nq + cols.index(k) for k in endog if k in cols]
+            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], en, Zh[m])
+            method = "2SLS" + (f" ({', '.join([name] + [k for k in endog if k in cols])} instrumented)" if len(en) > 1
+                               else "")
+            if not fs_r2 >= min_first_stage:
+                method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {min_first_stage:g})"
+                if endog:
+                    # a pass with weak instruments: least squares in every pass. The passes feed each other (each
+                    # fits on the angle the last one aided), so a 2SLS pass followed by a least-squares pass keeps the
+                    # first one's slope; and the aided angle that a wrong 2SLS slope gives is the one the controls
+                    # then explain badly (JSBSim t6 light s2: first-stage R2 0.12, then 0.07; CY_beta -1.10 against
+                    # JSBSim's -1.47 and least squares' -1.46)
+                    a_ls, s_ls, refit = _axis(name, dt, kin0, coeff, others, use, passes, sign, quadratic, symmetric,
+                                              moments, None, V, given, band_hz, slope_floor)
+                    ols = refit.slope_method
+                    refit.slope_method = (f"{ols}; instruments too weak in pass {ipass + 1} (first-stage R2 "
+                                          f"{fs_r2:.2f} < {min_first_stage:g}): least squares in every pass")
+                    refit.first_stage_r2 = fs_r2
+                    return a_ls, s_ls, refit
         if not method.startswith(("2SLS", "given")):
             cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
         floored = False
@@ -660,8 +706,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      f_body: np.ndarray, rates: np.ndarray, controls: dict[str, np.ndarray], mass: float,
                      S: float, b: float, c: float, use: np.ndarray, passes: int = 2,
                      rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None,
-                     instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None
-                     ) -> AidedAngles:
+                     instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None,
+                     instrument_beta: bool | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -689,6 +735,9 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             fitting them on this flight, so that both flights' aided alpha share one scale (a fitted slope's
             error scales the aided alpha at manoeuvre frequencies: ``docs/estimation.md``). Used only when its
             terms are this flight's (else fitted here, said in ``AxisFit.slope_method``). None: fitted here.
+        instrument_beta: fit the side-force model's slopes (``CY_beta`` and the rate terms :data:`BETA_ENDOGENOUS`) by
+            two-stage least squares with :data:`BETA_INSTRUMENTS` and their delayed copies as instruments, falling
+            back to least squares below :data:`BETA_MIN_FIRST_STAGE_R2`; None: :data:`INSTRUMENTED_BETA`.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -738,7 +787,15 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     hg = float(np.nanmedian(hg[u])) if np.isfinite(hg[u]).any() else float("nan")
     floor = lift_slope(b * b / S)          # the wing's lift slope, 1/rad (NaN: no span or area)
     edge = heave_edge_hz(floor, hg)
-    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat)
+    inst_b = None
+    if INSTRUMENTED_BETA if instrument_beta is None else instrument_beta:
+        U = [get(k) for k in BETA_INSTRUMENTS if k in controls]
+        U = [x for x in U if np.isfinite(x[u]).all() and np.nanstd(x[u]) > 1e-9] if u.any() else []
+        inst_b = lagged_instruments(dt, np.column_stack(U)) if U else None
+        if inst_b is not None and not np.isfinite(inst_b[u]).all():    # a delay reaches outside the finite record
+            inst_b = None
+    be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
+                          endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=BETA_MIN_FIRST_STAGE_R2)
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
