@@ -40,7 +40,7 @@ The side force has the same errors in variables with another sign pattern: the a
 gust (the kinematic sideslip takes the gust the aircraft turns into with the opposite sign) and rolls and yaws with it,
 so least squares on the kinematic sideslip gives ``CY_beta`` and the rate terms the gust's share. The controls move the
 sideslip and the rates and do not see the air: the side-force model's slopes are fitted by two-stage least squares with
-the rudder, the aileron and their delays as instruments of ``beta``, ``p_hat`` and ``r_hat`` (:data:`INSTRUMENTED_BETA`;
+the rudder, the aileron and their delays as instruments of ``beta``, ``p_hat`` and ``r_hat`` (opt-in, :data:`INSTRUMENTED_BETA`, off by default: the t6 diagnosis got worse with it on;
 Söderström and Stoica, *Instrumental variable methods for system identification*, Springer 1983; Morelli and Klein
 2016 sec. 5.4), falling back to least squares where they are weak (:data:`BETA_MIN_FIRST_STAGE_R2`).
 
@@ -109,7 +109,7 @@ INSTRUMENTED_SLOPES = False
 #: Default of ``aided_air_angles(instrument_beta=None)``: fit the side-force model's slopes by two-stage least squares
 #: with the rudder and the aileron and their delayed copies (:data:`.angleerrors.INSTRUMENT_LAGS_S`) as instruments of
 #: the sideslip and of the rates that answer the lateral gust (:data:`BETA_ENDOGENOUS`); least squares in every pass
-#: where the instruments are weaker than :data:`BETA_MIN_FIRST_STAGE_R2` in any pass. The aircraft weathercocks into the
+#: where the instruments are weaker than :data:`BETA_MIN_FIRST_STAGE_R2` in any pass (opt-in: off by default). The aircraft weathercocks into the
 #: lateral gust the kinematic sideslip misses, so least squares flattens ``CY_beta`` and gives the yaw rate the gust's
 #: side force (MIL-F-8785C light turbulence: rascal -0.61..-0.71 against JSBSim's -1.03, ``CY_r_hat`` -1.9 against 0),
 #: and the aided sideslip inherits the fit: the GP's side-force map is then wrong at the true sideslip, where the
