@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import cm_without_alpha_dot, ic_state
+from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state
 
 SRC = "data/jsbsim_models/asw20/asw20-JSBSim.xml"
 SRC_SHA256 = "c3a7877a124d79fcc82340614703cc07795993a06552ad6df9f05b10d1bdbc48"
@@ -136,13 +136,7 @@ def test_the_asw20_flies_its_own_surfaces_without_engine_or_external_force():
     da = np.radians(5.0)
     cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
     assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
-    for _ in range(50):
-        fdm.run()
-    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
-        for ax in ("xyz" if f.startswith("forces") else "lmn"):
-            assert fdm[f.format(ax, "external")] == 0.0
-            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
-    assert abs(fdm["forces/fbz-aero-lbs"]) > 300.0
+    assert_aero_is_the_only_force(fdm, 300.0, external_zero=True)
 
 
 def test_the_asw20_is_statically_stable_and_its_controls_act_as_its_xml_says():

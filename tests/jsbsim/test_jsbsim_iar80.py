@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import ic_state
+from truth_fits import assert_aero_is_the_only_force, ic_state
 
 SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
 SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
@@ -85,13 +85,7 @@ def test_the_iar80_flies_its_own_surfaces_without_engine_or_external_force():
     da = np.radians(5.0)
     cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
     assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
-    for _ in range(50):
-        fdm.run()
-    for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
-        for ax in ("xyz" if f.startswith("forces") else "lmn"):
-            assert fdm[f.format(ax, "external")] == 0.0
-            assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
-    assert abs(fdm["forces/fbz-aero-lbs"]) > 3000.0
+    assert_aero_is_the_only_force(fdm, 3000.0, external_zero=True)
 
 
 def test_the_iar80_is_statically_stable_and_its_controls_act_as_its_xml_says():

@@ -195,10 +195,22 @@ def check_direct_fcs(spec, min_lift_lbs: float) -> None:
     assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
     assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
     assert ic_state(spec, cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
+    assert_aero_is_the_only_force(fdm, min_lift_lbs)
+
+
+def assert_aero_is_the_only_force(fdm, min_lift_lbs: float, external_zero: bool = False) -> None:
+    """Run ``fdm`` 50 frames, then JSBSim's total body forces (lbs) and moments (lbs ft) must equal its
+    aerodynamic ones on every axis (no engine, ground or other force), with at least ``min_lift_lbs`` of
+    body-z aerodynamic force; ``external_zero``: the external forces and moments are also exactly 0.
+
+    Raises:
+        AssertionError: the first axis that differs, or too little lift."""
     for _ in range(50):
         fdm.run()
     for f in ("forces/fb{}-{}-lbs", "moments/{}-{}-lbsft"):
         for ax in ("xyz" if f.startswith("forces") else "lmn"):
+            if external_zero:
+                assert fdm[f.format(ax, "external")] == 0.0
             assert fdm[f.format(ax, "total")] == fdm[f.format(ax, "aero")], (f, ax)
     assert abs(fdm["forces/fbz-aero-lbs"]) > min_lift_lbs
 
