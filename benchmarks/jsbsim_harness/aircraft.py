@@ -81,8 +81,10 @@ _DEG = 57.29577951308232
 #: ``derived.py``) and ``sgs126`` (the fourteenth session's: the wheel's Schweizer SGS 1-26 glider, flown at
 #: 3000 ft where JSBSim's light turbulence is active) and ``asw20`` (the fifteenth session's: FlightGear's ASW 20
 #: sailplane, checked into ``data/jsbsim_models/asw20`` and flown as ``asw20_glide``, at 3000 ft) are used since as
-#: well. ``iar80`` (added in the sixteenth session, 2026-11-23: FlightGear's JSBSim IAR-80 fighter, checked into
-#: ``data/jsbsim_models/iar80`` and flown as ``IAR80_glide``, engine and propeller removed, at 10000 ft) is the
+#: well, as is ``iar80`` (the sixteenth session's: FlightGear's JSBSim IAR-80 fighter, checked into
+#: ``data/jsbsim_models/iar80`` and flown as ``IAR80_glide``, engine and propeller removed, at 10000 ft). ``c684``
+#: (added in the seventeenth session, 2026-11-23: FlightGear's JSBSim Caudron C.684 racer, checked into
+#: ``data/jsbsim_models/c684`` and flown as ``C684_glide``, engine and propeller removed, at 6000 ft) is the
 #: held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from
 #: JSBSim's truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
@@ -480,11 +482,37 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="IAR-80 fighter (FlightGear's JSBSim IAR80-Jsb.xml, checked in under data/jsbsim_models/iar80) with its "
               "engine and propeller removed (derived model IAR80_glide, XML sha256 2025fa83c41f3f74), gear up, gliding; "
               "untouched by any tuning of the method"),
+    # c684: FlightGear's JSBSim Caudron C.684 Super Rafale (FGMEMBERS/C684 C684.xml at 05ad4b2c, Guillaume Chauvat
+    # 2008, version 0.4.13; GPL-2.0-or-later), a 1930s French two-seat racing and touring monoplane: 2138.5 lb as
+    # loaded (640 kg empty, pilot and passenger 85 kg each on the centre line, 80 kg of fuel in each of two tanks
+    # 0.2 m either side of it), 7.70-m span, 9.00 m^2 (wing loading 22 lb/ft^2, aspect ratio 6.6), fixed tailwheel
+    # gear. The fourth aircraft from outside the wheel; its XML is checked in (data/jsbsim_models/c684/, provenance
+    # and licence in its README.md) and flown as the derived model ``C684_glide`` (derived.py): its engine, propeller
+    # and engine system removed, the gear's 2008 ``FIXED`` flags written 0 for JSBSim 1.3.3. Chosen in the
+    # seventeenth session (docs/jsbsim.md, "The c684") as the one screened model whose aerodynamics are not an
+    # Aeromatic template: a hand-made CL table on aero/alpha-wing-rad (0.043-rad incidence), Cl_beta, Cl_p and
+    # Cl_delta_a tables in alpha, an adverse yaw proportional to the lift (Cnda = -0.008 x CL x left aileron), a
+    # constant Cl0 (-0.0011) and a stiff pitch axis (Cm_alpha -2.3, Cm_delta_e -1.3, Cmq -15, Cmadot -8). Its FCS
+    # is direct but unequal: elevator -0.35 (trailing edge up) / +0.30 rad, aileron 20 / 15 deg (the right the
+    # mirror of the left; the aerodynamics read the left alone), rudder +-20 deg; ``cmd_per_rad`` takes the larger
+    # side of each (so the airframe's ends cover every deflection; the autopilot flies either side, the log carries
+    # JSBSim's surface positions). Signs read from its aerodynamics: Cmde -1.3 x elevator-pos (positive = trailing
+    # edge down), Clda +0.12 x left-aileron-pos (positive = roll right: Cl_delta_a -0.12), Cndr -0.065 x
+    # rudder-pos (positive = trailing edge left, nose left). Set from the harness's truth only (alpha, beta, rates,
+    # excitation per axis, surfaces, sink), never from a method result.
+    "c684": AircraftSpec(
+        name="c684", model="C684_glide", airspeed_kts=125.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / (20.0 * 0.01745), 1.0 / (20.0 * 0.01745)),
+        amplitude_deg=(3.0, 4.0, 4.0), pulse_s=(0.5, 0.8, 0.8),
+        notes="Caudron C.684 racer (FlightGear's JSBSim C684.xml, checked in under data/jsbsim_models/c684) with its "
+              "engine, propeller and engine system removed (derived model C684_glide, XML sha256 4d332e34ee7966d7), "
+              "fixed gear, gliding; untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20")
-HELD_OUT_AIRCRAFT = ("iar80",)
-UNTOUCHED_AIRCRAFT = ("iar80",)
+                   "asw20", "iar80")
+HELD_OUT_AIRCRAFT = ("c684",)
+UNTOUCHED_AIRCRAFT = ("c684",)
 
 
 def aircraft(name: str) -> AircraftSpec:

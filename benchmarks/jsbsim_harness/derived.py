@@ -6,7 +6,9 @@ this repository, with its engine removed (``Rascal110_glide``, :func:`derive_ras
 SITL Rascal 110; thirteenth session, :data:`REPO_DERIVED`), or FlightGear's ASW 20 sailplane with the
 parts that need FlightGear removed and its elevator table reading an alias (``asw20_glide``,
 :func:`derive_asw20_glide`; fifteenth session), or FlightGear's JSBSim IAR-80 fighter with its engine and
-propeller removed (``IAR80_glide``, :func:`derive_iar80_glide`; sixteenth session).
+propeller removed (``IAR80_glide``, :func:`derive_iar80_glide`; sixteenth session), or FlightGear's JSBSim
+Caudron C.684 racer with its engine, propeller and engine system removed (``C684_glide``,
+:func:`derive_c684_glide`; seventeenth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -60,7 +62,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
-           "derive_asw20_glide", "derive_iar80_glide", "derived_xml", "derived_sha", "install_derived_models", "ELEVATOR_ALIAS",
+           "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derived_xml", "derived_sha", "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
 
 #: The elevator alias the derived F-16's tables read (see the module docstring).
@@ -308,6 +310,53 @@ def derive_iar80_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def derive_c684_glide(root: ET.Element) -> ET.Element:
+    """FlightGear's JSBSim Caudron C.684 (``data/jsbsim_models/c684/C684.xml``) with its engine, propeller and
+    engine system removed, as JSBSim 1.3.3 can load it (seventeenth session).
+
+    The file (FGMEMBERS/C684, Guillaume Chauvat 2008, version 0.4.13) drives a variable-pitch propeller
+    (``ratier_variable``) with a six-cylinder engine (``6Pfi``) and names one system file (``engine``: the
+    pitch selector and starter logic of FlightGear's cockpit). Three edits; nothing else changes (a test
+    checks every other element):
+
+    - **Engine removed.** The ``<engine>`` element (engine, its two ``<feed>`` and the thruster) is removed,
+      as the rascal's and iar80's: the harness glides every aircraft with its engines stopped, so that every
+      non-gravity force is aerodynamic, and a stopped engine would leave JSBSim's windmilling propeller. The
+      two fuel tanks (80 kg each, 0.2 m either side of the centre line) stay as mass.
+    - **Engine system removed.** ``<system file="engine"/>`` names a file that is not copied (it drives the
+      removed engine's propeller pitch and starter).
+    - **Gear flag.** The three wheels say ``<retractable>FIXED</retractable>``, the 2008 syntax; JSBSim 1.3.3
+      expects a number and refuses to load the file ("Expecting a numeric attribute value, but got: FIXED").
+      They are written ``0`` (not retractable), which is what FIXED meant. The gear touches nothing in
+      flight (no aerodynamic function reads it).
+
+    Args:
+        root: the parsed ``C684.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): one
+            ``<propulsion><engine>``, the one system ``engine``, three ``retractable`` flags reading FIXED,
+            or ``<aerodynamics>``.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    systems = root.findall("system")
+    flags = list(root.iter("retractable"))
+    if (len(engines) != 1 or [s.get("file") for s in systems] != ["engine"] or root.find("aerodynamics") is None
+            or len(flags) != 3 or any((f.text or "").strip() != "FIXED" for f in flags)):
+        raise ValueError("C684.xml: expected one <propulsion><engine>, the system 'engine', three <retractable>"
+                         "FIXED</retractable> and an <aerodynamics>")
+    prop.remove(engines[0])
+    root.remove(systems[0])
+    for f in flags:
+        f.text = "0"
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -339,6 +388,12 @@ REPO_DERIVED = {
                     "copied into gcs-sysid's data/jsbsim_models/iar80/",
                     derive_iar80_glide, "engine and propeller removed (a glide with no propeller force); the fuel "
                                         "tanks stay as mass; everything else unchanged."),
+    "C684_glide": ("data/jsbsim_models/c684/C684.xml",
+                   "FlightGear's JSBSim Caudron C.684 (FGMEMBERS/C684 C684.xml at 05ad4b2c, GPL-2.0-or-later), "
+                   "copied into gcs-sysid's data/jsbsim_models/c684/",
+                   derive_c684_glide, "engine, propeller and the engine system removed (a glide with no propeller "
+                                      "force); the fuel tanks stay as mass; the gear's FIXED flags written 0 "
+                                      "(JSBSim 1.3.3's syntax); everything else unchanged."),
 }
 
 
