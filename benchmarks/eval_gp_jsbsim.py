@@ -80,10 +80,10 @@ Usage::
     python benchmarks/eval_gp_jsbsim.py --summarize /tmp/gp.jsonl
 
 ``pa28``, ``j3cub`` (``J3Cub``), ``c182``, ``t37``, ``t6`` (``t6texan2``), ``b747`` (``B747``), ``f16``
-(``f16_direct``), ``f4n`` (``F4N_fcs``), ``rascal`` (``Rascal110_glide``), ``sgs126`` and ``asw20`` (``asw20_glide``)
-were held out in earlier sessions and have been evaluated: they count as used. ``iar80`` (FlightGear's JSBSim IAR-80
-fighter without its propeller, ``IAR80_glide``) is the held-out, untouched one: never in the defaults, made and scored
-only in the final evaluation.
+(``f16_direct``), ``f4n`` (``F4N_fcs``), ``rascal`` (``Rascal110_glide``), ``sgs126``, ``asw20`` (``asw20_glide``) and
+``iar80`` (``IAR80_glide``) were held out in earlier sessions and have been evaluated: they count as used. ``c684``
+(FlightGear's JSBSim Caudron C.684 racer without its propeller, ``C684_glide``) is the held-out, untouched one: never
+in the defaults, made and scored only in the final evaluation.
 """
 
 from __future__ import annotations
@@ -527,9 +527,9 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
     ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
     ap.add_argument("--make", action="store_true", help=make_help)
     ap.add_argument("--aircraft", nargs="+", default=aircraft, type=aircraft_argument,
-                    help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80) or "
-                         "JSBSim model names (J3Cub, T37, t6texan2, B747, f16_direct, F4N_fcs, Rascal110_glide, "
-                         "asw20_glide, IAR80_glide); iar80 is the untouched "
+                    help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
+                         "c684) or JSBSim model names (J3Cub, T37, t6texan2, B747, f16_direct, F4N_fcs, "
+                         "Rascal110_glide, asw20_glide, IAR80_glide, C684_glide); c684 is the untouched "
                          "aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])

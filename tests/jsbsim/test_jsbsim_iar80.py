@@ -1,4 +1,5 @@
-"""The iar80 in the JSBSim harness: the sixteenth session's untouched aircraft (docs/jsbsim.md, "The iar80").
+"""The iar80 in the JSBSim harness: the sixteenth session's untouched aircraft, a tuning aircraft since its final
+evaluation was read (docs/jsbsim.md, "The iar80").
 
 The model is FlightGear's JSBSim IAR-80 (``IAR80-Jsb.xml`` of FGMEMBERS/IAR-80-JSB at commit 6d011335,
 GPL-2.0-or-later; Aeromatic v0.95, 2015), a single-seat piston fighter, checked in under
@@ -11,19 +12,18 @@ The checks here use the XML and JSBSim's own properties; none of them flies the 
 - the checked-in file is the one the README names, and the derivation removes the engine alone;
 - the FCS maps the commands straight to the surfaces the aerodynamics read (every surface +-0.35 rad, the right
   aileron the same sign as the left), with no damper; no engine, no external force;
-- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else.
+- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says.
+
+The summaries' label test moved to ``test_jsbsim_c684.py`` in the seventeenth session (the c684 is untouched).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
 map, gear (its ``Drag_gear`` reads 0 once the harness has retracted it), .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
 All of them but the names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the iar80: its first evaluation is the final one,
-after the merge.
+No pipeline fit, GP, diagnosis or scoring runs in these tests.
 """
 
 import hashlib
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -130,30 +130,3 @@ def test_the_iar80_is_statically_stable_and_its_controls_act_as_its_xml_says():
     assert l3 / np.radians(4.0) == pytest.approx(-0.1216, abs=5e-4)
     assert n3 / np.radians(4.0) == pytest.approx(0.12, rel=1e-6)
 
-
-def test_summaries_mark_the_iar80_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the iar80 "(untouched)" and
-    no other aircraft, the asw20 and sgs126 included (synthetic rows: no iar80 result exists before the
-    final evaluation). Moved here from ``test_jsbsim_asw20.py`` (the fifteenth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| iar80 (untouched) | light") for ln in lines)
-    for ac in acs[:12]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| iar80 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| asw20 | clean |") for ln in lines)

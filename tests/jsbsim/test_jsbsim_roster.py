@@ -1,5 +1,5 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20 and the untouched iar80; docs/jsbsim.md, one section each),
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80 and the untouched c684; docs/jsbsim.md, one section each),
 parametrised over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
@@ -10,14 +10,14 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched iar80's are slow too but its names', and its own
+default suite, as before the fold); the untouched c684's are slow too but its names', and its own
 default checks (the derivation, its surfaces, static stability, the summaries' label) are in
-``test_jsbsim_iar80.py`` (the asw20's in ``test_jsbsim_asw20.py``, the sgs126's in ``test_jsbsim_sgs126.py``,
-the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``, the f16's in
-``test_jsbsim_f16.py``; tuning aircraft since the eleventh to sixteenth sessions). Folded in the eleventh session
+``test_jsbsim_c684.py`` (the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to seventeenth sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
-in the fifteenth, the iar80 in the sixteenth.
+in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth.
 """
 
 from dataclasses import dataclass
@@ -222,7 +222,29 @@ CASES = (
           ("cn", 3, 0.003, ("rel", 0.01)), ("cn", 1, 0.0, ("abs", 1e-6))),
          ("aero/force/Drag_gear",), 0.35, 1,
          dict(alpha=(-9.0, 9.0), beta=(8.0, 9.0), bank=(20.0, 25.0), speed=(60.0, 145.0), alt_min=1000.0,
-              rate_std=1.5, rate_std_held=1.5, sink_min=5.0), untouched=True, closure=True),
+              rate_std=1.5, rate_std_held=1.5, sink_min=5.0), closure=True),
+    # c684 (FlightGear's JSBSim Caudron C.684, Guillaume Chauvat 2008, hand-made tables; flown as C684_glide at 6000
+    # ft: its engine, propeller and engine system removed): 640 kg empty + pilot and passenger 85 kg each on the
+    # centre line (x 3.5 and 4.0 m, 0.2 m above the CG's z: the product of inertia, project Ixz 37.86 kg m^2) + 2 x
+    # 80 kg of fuel 0.2 m either side of the centre line. The aerodynamic reference point is 0.287 m ahead of the
+    # loaded CG and 0.15 m below it. On JSBSim's own regressors (closure_slopes, the 30-s calm flight): Cm_alpha
+    # -0.869 (Cmalpha -2.3 less the lift ahead of the CG), Cm_q -14.6 (Cmq -15), Cm_delta_e -1.250 (Cmde -1.3 and
+    # CLde through the arm), Cm_alpha_dot -8.3 (Cmadot -8); Cl_beta -0.056 (the Clb table in alpha, -0.08 at 0, and
+    # the side force below the CG), Cl_p -0.448 (the Clp table in alpha and p, -0.45 at alpha 0), Cl_r 0.200, Cl_delta_a
+    # -0.1197 (the Clda table, 0.12 at alpha 0), Cl_delta_r 0; Cn_beta 0.141 (Cnb 0.18 less the side force ahead of
+    # the CG), Cn_p 0, Cn_r -0.120, Cn_delta_a +0.0028 (Cnda -0.008 x CL x left: adverse, with the lift), Cn_delta_r
+    # -0.065. One SIDE function; the elevator read by CLde and Cmde (CDde reads fcs/elevator-pos-norm, not delayed).
+    # Fixed gear, no gear drag. Envelope limits from the trial flights (docs/jsbsim.md, "The c684"): alpha -3.7..5.4
+    # deg, sideslip 3.7, bank 12, TAS 51-92 m/s, sink 7.2-8.0 m/s, rate standard deviations at least 2.2 deg/s.
+    Case("c684", "C684_glide", "c68", 2138.484, 37.8557,
+         (("cm", 0, None, ("in", -0.95, -0.78)), ("cm", 1, -15.0, ("rel", 0.05)), ("cm", 2, -1.25, ("rel", 0.03)),
+          ("cm", 3, -8.0, ("rel", 0.12)), ("cl", 3, None, ("in", -0.1205, -0.114)), ("cl", 0, None, ("in", -0.07, -0.05)),
+          ("cl", 1, None, ("in", -0.46, -0.43)), ("cl", 2, 0.2, ("rel", 0.01)), ("cl", 4, 0.0, ("abs", 1e-4)),
+          ("cn", 4, -0.065, ("rel", 1e-3)), ("cn", 0, 0.141, ("abs", 3e-3)), ("cn", 2, -0.12, ("rel", 0.01)),
+          ("cn", 3, None, ("in", 0.001, 0.006)), ("cn", 1, 0.0, ("abs", 1e-4))),
+         (), 0.30, 1,
+         dict(alpha=(-9.0, 9.0), beta=(8.0, 9.0), bank=(20.0, 25.0), speed=(45.0, 105.0), alt_min=300.0,
+              rate_std=1.5, rate_std_held=1.5, sink_min=3.0), untouched=True, closure=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -251,7 +273,7 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the iar80
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the c684
     alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
@@ -262,7 +284,7 @@ def test_names_resolve_and_roles(case):
     else:
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
-    used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20"}
+    used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
@@ -393,7 +415,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [p for p in _params()
-                                  if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80")])
+                                  if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
