@@ -62,7 +62,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
-           "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derived_xml", "derived_sha", "install_derived_models", "ELEVATOR_ALIAS",
+           "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derived_xml", "derived_sha",
+           "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
 
 #: The elevator alias the derived F-16's tables read (see the module docstring).
