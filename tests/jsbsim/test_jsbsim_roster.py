@@ -430,7 +430,10 @@ def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypa
         argv = ["--aircraft", case.model.upper(), "--seeds", "1", *extra, "--fly-only"]
         assert main(argv) == 0 and main(argv) == 0
         cap = capsys.readouterr()
-        assert [ln.split()[column] for ln in cap.out.splitlines()] == ["flown"] * n + ["reused"] * n, cap.out
+        # the flights' lines alone: JSBSim's loader prints its own warnings there too (the c684's one-argument
+        # <product> ground-effect functions)
+        lines = [ln for ln in cap.out.splitlines() if " flown " in ln or " reused " in ln]
+        assert [ln.split()[column] for ln in lines] == ["flown"] * n + ["reused"] * n, cap.out
         assert (f"{case.name} is the untouched aircraft" in cap.err) == case.untouched
     assert read_log(tmp_path / "f" / f"{case.name}-light-s1-ahrs.tlog").streams["servo"].t.size > 50
     assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
