@@ -492,7 +492,8 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # seventeenth session (docs/jsbsim.md, "The c684") as the one screened model whose aerodynamics are not an
     # Aeromatic template: a hand-made CL table on aero/alpha-wing-rad (0.043-rad incidence), Cl_beta, Cl_p and
     # Cl_delta_a tables in alpha, an adverse yaw proportional to the lift (Cnda = -0.008 x CL x left aileron), a
-    # constant Cl0 (-0.0011) and a stiff pitch axis (Cm_alpha -2.3, Cm_delta_e -1.3, Cmq -15, Cmadot -8). Its FCS
+    # constant Cl0 (-0.0011); its file's Cmalpha -2.3 (on alpha-wing) is -0.87 about the loaded CG, 0.287 m aft of
+    # the aerodynamic reference point (Cmde -1.3, Cmq -15, Cmadot -8). Its FCS
     # is direct but unequal: elevator -0.35 (trailing edge up) / +0.30 rad, aileron 20 / 15 deg (the right the
     # mirror of the left; the aerodynamics read the left alone), rudder +-20 deg; ``cmd_per_rad`` takes the larger
     # side of each (so the airframe's ends cover every deflection; the autopilot flies either side, the log carries
