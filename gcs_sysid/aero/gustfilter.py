@@ -1,33 +1,36 @@
-"""Filter-error estimate of the rotational gusts ``p_g`` and ``r_g`` from the measured roll and yaw moments.
+"""Filter-error estimate of the rolling gust ``p_g`` from the measured roll moment, its process model fitted.
 
-The aerodynamic roll and yaw moments read the body's rotation relative to the air, ``p - p_g`` and ``r - r_g``;
-a gyro measures ``p`` and ``r``. ``p_g`` (the span-wise gradient ``dw_g/dy``) is not observable from one point's
-air data (:mod:`gcs_sysid.estimation.gustrates`), but it is observable through the moment it causes. This module
-treats it as Jategaonkar's filter-error method treats turbulence: as process noise of the state-space model whose
-output is the measured coefficient, estimated by a Kalman filter and Rauch-Tung-Striebel smoother, alternated with
-the model's parameters (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5 "filter
-error method", ch. 7 "estimation in turbulence"; the alternation is the EM algorithm of Shumway and Stoffer,
-"An approach to time series smoothing and forecasting using the EM algorithm", J. Time Series Anal. 3(4), 1982).
+The aerodynamic roll moment reads the body's rotation relative to the air, ``p - p_g``; a gyro measures ``p``.
+``p_g`` (the span-wise gradient ``dw_g/dy``) is not observable from one point's air data
+(:mod:`gcs_sysid.estimation.gustrates`), but it is observable through the moment it causes. This module treats it
+as the filter-error method treats turbulence: as a process-noise state of the model whose output is the measured
+rolling-moment coefficient, estimated by a Kalman filter and a Rauch-Tung-Striebel smoother, with the model's
+parameters, the gust's correlation time and intensity and the measurement noise all estimated together by
+maximising the likelihood of the innovations (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA
+2015, ch. 5 "Filter error method", sec. 5.3-5.5 (steady-state gain, the innovations' likelihood, the measurement
+noise covariance estimated with the parameters); Morelli and Klein, *Aircraft System Identification*, 2nd ed.,
+2016, ch. 7 (output error and filter error in turbulence)).
 
-State (dimensionless, the hats' units): ``s = (p_g b/(2V), r_g b/(2V))``, each a first-order Gauss-Markov
-process, MIL-F-8785C's Dryden form (sec. 3.7.2): ``p_g`` white noise through ``1/(1 + (4b/(pi V)) s)``, ``r_g``
-the lateral gust's along-path derivative through ``1/(1 + (3b/(pi V)) s)`` (flat above the gust's break
-frequency, so first-order there)::
+State (dimensionless, the hats' unit): ``g = p_g b/(2V)``, a first-order Gauss-Markov process (the Dryden
+rolling-gust form of MIL-F-8785C sec. 3.7.2 with its time constant and intensity left free: JSBSim's ``p_g`` is
+correlated much longer than the Dryden ``4b/(pi V)`` suggests, ``docs/benchmarks.md`` "Sixteenth session,
+i8-fe")::
 
-    s_k+1 = diag(a_p, a_r) s_k + w_k,   a = exp(-dt / tau),   Q = diag(sig_hat^2 (1 - a^2))
-    sig_hat = sigma_(p,r) b / (2V)   (gustrates.dryden_rate_sigma of gustrates.gust_intensity)
+    g_k+1 = a g_k + w_k,   a = exp(-dt / tau),   var w = sigma^2 (1 - a^2)   (stationary variance sigma^2)
 
-Measurement (the first-pass linear model ``C = theta . x`` on ``x = (1, alpha, beta, p_hat, r_hat, delta_a,
-delta_r)`` with the gyro's hats; ``z`` is the measured coefficient less the model at the gyro's rates)::
+Measurement: the measured Cl on the lateral linear model ``x = (1, alpha, beta, p_hat, r_hat, delta_a, delta_r)``
+with the gyro's hats, the air-relative roll rate being ``p_hat - g``::
 
-    z_l = Cl_meas - theta_l . x = -Cl_p p_hat_g - Cl_r r_hat_g + e_l
-    z_n = Cn_meas - theta_n . x = -Cn_p p_hat_g - Cn_r r_hat_g + e_n,   e ~ N(0, diag(R_l, R_n))
+    Cl_k = theta . x_k - Cl_p g_k + e_k,   e ~ N(0, R)
 
-EM: the E-step smooths ``s`` (mean ``s_hat``, covariance ``P``); the M-step refits ``theta`` by least squares
-on the air-relative hats ``p_hat - p_hat_g`` with the smoothed covariance added to the normal equations
-(``E[x x^T] = x_hat x_hat^T + P``, the errors-in-variables correction that keeps ``Cl_p`` from attenuating) and
-``R`` from the expected squared residual. The Dryden process-noise level stays fixed (known from the gust
-intensity, not learned): a free level would let ``p_g`` take any unmodelled roll moment.
+Parameters: the roll-damping slope ``Cl_p`` (it sets the gust's gain), ``tau``, ``sigma`` and ``R`` by
+Nelder-Mead on the negative log-likelihood of the innovations, the other six slopes of ``theta`` profiled out
+exactly by generalised least squares on the whitened innovations (they enter the innovations linearly). Nothing is
+tuned: ``R`` is the white part of the roll-moment residual, ``sigma`` and ``tau`` its coloured part's level and
+bandwidth (a white floor under a Lorentzian spectrum; the three are identified by the residual's spectrum).
+
+The yaw gust ``r_g`` is not estimated: even with the truth's slopes the yaw moment gives it with correlation 0.4-0.6
+(``docs/benchmarks.md``, "Sixteenth session, i8-fe").
 """
 
 from __future__ import annotations
@@ -36,62 +39,58 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..estimation.gustrates import dryden_rate_sigma, gust_intensity
-from ..estimation.kalman import steady_state, steady_state_smoother
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["GUST_FILTER", "GUST_FILTER_AXES", "GUST_FILTER_NOISE_SCALE", "LAT_TERMS", "stated_moment_variance", "GustFilterResult", "smooth_rotational_gusts", "filter_gust_table"]
+__all__ = ["GUST_FILTER", "INSTRUMENT_DELAYS_S", "LAT_TERMS", "RollGustFit", "fit_roll_gust", "instruments",
+           "stated_moment_variance", "filter_gust_table"]
 
-#: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on the hats
-#: less the filter-error gust rates.
+#: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
+#: less the filter-error rolling gust.
 GUST_FILTER = False
-#: The gust rates taken out of the training hats: ``p`` only. ``r_g`` is smoothed with it but left in: even with the
-#: truth's own slopes the yaw moment gives it with correlation 0.4-0.6 and an error larger than its SD
-#: (``docs/benchmarks.md``, "Sixteenth session, i8-fe").
-GUST_FILTER_AXES = ("p",)
-#: The measurement noise variance over the stated one (``p_dot r_dot`` sigma through the moment equations).
-GUST_FILTER_NOISE_SCALE = 100.0
-#: The first-pass linear model's regressors (an intercept first), the lateral-directional set.
+#: The lateral linear model's regressors (an intercept first).
 LAT_TERMS = ("alpha", "beta", "p_hat", "r_hat", "delta_a", "delta_r")
-_IP, _IR = LAT_TERMS.index("p_hat") + 1, LAT_TERMS.index("r_hat") + 1     # columns in the design (intercept 0)
+_IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
+#: Delays (s) of the aileron and rudder used as instruments for the rates and the sideslip (the controls are set by
+#: the pilot's programme, not by the gust; their delayed values carry the aircraft's response to them).
+INSTRUMENT_DELAYS_S = (0.1, 0.2, 0.4, 0.8, 1.6)
+#: Fewest usable rows (in runs of at least ``_MIN_RUN``) the fit accepts.
+_MIN_ROWS, _MIN_RUN = 200, 50
 
 
 @dataclass(frozen=True)
-class GustFilterResult:
-    """Smoothed rotational gusts and the model they were estimated with.
+class RollGustFit:
+    """The smoothed rolling gust and the model it was estimated with (:func:`fit_roll_gust`).
 
     Attributes:
-        s: ``(T, 2)`` smoothed ``p_hat_g r_hat_g`` (dimensionless, the hats' units); 0 (the prior mean) outside
-            the rows given.
-        P: ``(T, 2, 2)`` their smoothed covariance; the prior's outside the rows given.
-        prior_var: ``(T, 2)`` the prior (Dryden) variance of ``p_hat_g r_hat_g``.
-        theta: ``(2, 7)`` the final linear model of Cl and Cn on ``(1,) + LAT_TERMS`` (air-relative hats).
-        theta0: ``(2, 7)`` the first pass's (gyro hats).
-        R: ``(2,)`` the measurement noise variances of Cl and Cn.
-        n_iter: EM iterations run; converged: the relative change of ``theta`` fell under the tolerance.
-        sigma_rates: ``(3,)`` ``sigma_p sigma_q sigma_r`` rad/s used.
+        g: ``(T,)`` smoothed ``p_hat_g = p_g b/(2V)`` (dimensionless); 0 (the prior mean) outside the rows used.
+        g_var: ``(T,)`` its smoothed variance; ``sigma**2`` (the prior's) outside the rows used.
+        used: ``(T,)`` bool, the rows the fit used.
+        theta: ``(7,)`` the linear model of Cl on ``(1,) + LAT_TERMS`` with the air-relative ``p_hat - g``.
+        theta0: ``(7,)`` ordinary least squares on the gyro's hats (the start).
+        Cl_p: ``theta[3]``.
+        tau: the gust's correlation time, s.
+        sigma: its standard deviation (``p_hat_g``, dimensionless).
+        R: the measurement noise variance of Cl.
+        nll: the innovations' negative log-likelihood at the optimum; nll_white: with no gust state
+            (``sigma -> 0``, ordinary least squares, its R fitted).
+        nfev: likelihood evaluations; converged: Nelder-Mead's flag.
         notes: one-line statements.
     """
 
-    s: np.ndarray
-    P: np.ndarray
-    prior_var: np.ndarray
+    g: np.ndarray
+    g_var: np.ndarray
+    used: np.ndarray
     theta: np.ndarray
     theta0: np.ndarray
-    R: np.ndarray
-    n_iter: int
+    Cl_p: float
+    tau: float
+    sigma: float
+    R: float
+    nll: float
+    nll_white: float
+    nfev: int
     converged: bool
-    sigma_rates: np.ndarray
     notes: tuple[str, ...]
-
-
-def _unused_lstsq(A, y, P=None, w=None):
-    """Least squares ``y ~ A theta`` with ``P`` ``(n, 2, 2)`` added to the normal equations' rate block."""
-    G = A.T @ A
-    if P is not None:
-        G[np.ix_([_IP, _IR], [_IP, _IR])] += P.sum(0)
-    G += 1e-9 * np.trace(G) / len(G) * np.eye(len(G))
-    return np.linalg.solve(G, A.T @ y)
 
 
 def _segments(use: np.ndarray, min_len: int) -> list[tuple[int, int]]:
@@ -100,151 +99,195 @@ def _segments(use: np.ndarray, min_len: int) -> list[tuple[int, int]]:
     return [(a, b) for a, b in zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0]) if b - a >= min_len]
 
 
-def _innovations(F, Q, H, R, series, segs):
-    """Innovations of each ``(T, 2)`` series under the steady-state filter, stacked over the segments."""
-    gain = steady_state(F, Q, H, R)
+@dataclass(frozen=True)
+class _Gains:
+    """Steady-state scalar gains: filter ``K``, predicted ``P``, innovation ``S``, smoother ``C`` and ``Ps``."""
+
+    K: float
+    P: float
+    S: float
+    C: float
+    Ps: float
+
+
+def _gains(a: float, sigma2: float, h: float, R: float) -> _Gains:
+    """Steady-state scalar filter and RTS smoother for ``g' = a g + w`` (``var w = sigma2 (1 - a^2)``),
+    ``z = h g + e`` (``var e = R``): the positive root of the scalar Riccati equation
+    ``h^2 P^2 + (R (1 - a^2) - q h^2) P - q R = 0``, written so that ``h = 0`` gives the prior ``q / (1 - a^2)``
+    (Simon, *Optimal State Estimation*, 2006, ch. 7 and 9; the scalar case of :func:`~gcs_sysid.estimation.kalman.
+    steady_state`)."""
+    q = sigma2 * (1 - a * a)
+    c = R * (1 - a * a) - q * h * h
+    P = 2 * q * R / (c + np.sqrt(c * c + 4 * h * h * q * R))
+    S = h * h * P + R
+    K = P * h / S
+    Pf = P * R / S
+    C = a * R / S
+    Ps = (Pf - C * C * P) / (1 - C * C)
+    return _Gains(K, P, S, C, Ps)
+
+
+def _innovations(M: np.ndarray, a: float, ss, h: float, segs) -> np.ndarray:
+    """Innovations of each column of ``M`` ``(T, m)`` under the steady-state filter, stacked over the segments.
+
+    ``xp_k+1 = a (1 - K h) xp_k + a K z_k`` and ``nu_k = z_k - h xp_k`` (the prediction starts at the prior mean
+    0 in each segment), run by ``scipy.signal.lfilter``.
+    """
+    from scipy.signal import lfilter
+
+    K = ss.K
     out = []
-    for z in series:
-        out.append(np.concatenate([steady_state_smoother(F, gain, H, z[a:b], np.zeros(2), smooth=False)[1]
-                                   for a, b in segs]))
-    return gain, out
+    for s0, s1 in segs:
+        z = M[s0:s1]
+        xp = lfilter([0.0, a * K], [1.0, -a * (1 - K * h)], z, axis=0)
+        out.append(z - h * xp)
+    return np.concatenate(out)
 
 
-def _profile(h, F, Q, R, A, y, segs, rate_cols):
-    """For the rate slopes ``h`` ``(2, 2)``: the GLS estimate of the other slopes and the negative log-likelihood."""
-    H = -h
-    other = [j for j in range(A.shape[1]) if j not in rate_cols]
-    z0 = y - A[:, rate_cols] @ h.T                                   # (T, 2): the measurement less the rate terms
-    cols = []
-    for j in other:
-        for ch in range(2):
-            c = np.zeros_like(y)
-            c[:, ch] = A[:, j]
-            cols.append(c)
-    gain, inn = _innovations(F, Q, H, R, [z0] + cols, segs)
-    W = np.linalg.cholesky(np.linalg.inv(gain.S))                  # whitening: nu' S^-1 nu = |W' nu|^2
-    yv = (inn[0] @ W).ravel()
-    M = np.stack([(c @ W).ravel() for c in inn[1:]], 1)
-    beta = np.linalg.lstsq(M, yv, rcond=None)[0]
-    r = yv - M @ beta
-    n = len(inn[0])
-    nll = 0.5 * float(r @ r) + 0.5 * n * float(np.log(np.linalg.det(gain.S)))
-    theta = np.zeros((2, A.shape[1]))
-    theta[:, rate_cols] = h
-    for k, j in enumerate(other):
-        theta[0, j], theta[1, j] = beta[2 * k], beta[2 * k + 1]
-    return nll, theta, gain
+def _nll(v, z, segs, dt, h):
+    """Innovations' negative log-likelihood of ``z`` for ``v = (log tau, log sigma, log R)``; also the gains."""
+    tau, sig, R = np.exp(v)
+    a = float(np.exp(-dt / tau))
+    ss = _gains(a, sig * sig, h, R)
+    nu = _innovations(z[:, None], a, ss, h, segs)[:, 0]
+    return 0.5 * float(nu @ nu) / ss.S + 0.5 * len(nu) * np.log(2 * np.pi * ss.S), ss, a
 
 
-def smooth_rotational_gusts(dt: float, X: np.ndarray, Y: np.ndarray, rows: np.ndarray, V: np.ndarray, b: float,
-                            sigma_rates: np.ndarray, R: np.ndarray, fit_noise: bool = False, fit_tau: bool = False, max_iter: int = 400,
-                            tol: float = 1e-4) -> GustFilterResult:
-    """Filter-error estimate of ``p_hat_g r_hat_g`` from the measured Cl and Cn (module docstring).
+def _lagged(x: np.ndarray, k: int) -> np.ndarray:
+    """``x`` delayed by ``k`` rows (NaN where the delay reaches before the record)."""
+    out = np.full_like(x, np.nan)
+    out[k:] = x[: len(x) - k]
+    return out
 
-    The model is time-invariant at the training rows' median airspeed, so the steady-state Kalman filter and RTS
-    smoother are exact after their start (:func:`~gcs_sysid.estimation.kalman.steady_state_smoother`); the
-    likelihood of the innovations is maximised over the four rate slopes (Nelder-Mead) with the other slopes
-    profiled out by generalised least squares on the whitened innovations (Jategaonkar 2015, ch. 5: the
-    filter-error method with steady-state gain).
+
+def instruments(X: np.ndarray, dt: float) -> np.ndarray:
+    """``(T, 4 + 2 len(INSTRUMENT_DELAYS_S))`` instruments: ``1, alpha, delta_a, delta_r`` and the two controls
+    delayed by :data:`INSTRUMENT_DELAYS_S` (NaN where a delay reaches before the record)."""
+    da, dr = X[:, REGRESSORS.index("delta_a")], X[:, REGRESSORS.index("delta_r")]
+    cols = [np.ones(len(X)), X[:, REGRESSORS.index("alpha")], da, dr]
+    for d in INSTRUMENT_DELAYS_S:
+        k = max(1, int(round(d / dt)))
+        cols += [_lagged(da, k), _lagged(dr, k)]
+    return np.stack(cols, 1)
+
+
+def _smooth(z: np.ndarray, a: float, ss, h: float) -> np.ndarray:
+    """Steady-state RTS smoothed ``g`` of one segment's measurement ``z`` ``(n,)``."""
+    from scipy.signal import lfilter
+
+    K, C = ss.K, ss.C
+    xp = lfilter([0.0, a * K], [1.0, -a * (1 - K * h)], z)
+    xf = xp + K * (z - h * xp)
+    # backward: xs_k = xf_k + C (xs_k+1 - a xf_k), xs_n-1 = xf_n-1
+    rev = xf[::-1]
+    xs = lfilter([1.0 - C * a], [1.0, -C], rev, zi=[C * a * rev[0]])[0]
+    return xs[::-1]
+
+
+def fit_roll_gust(dt: float, X: np.ndarray, Y: np.ndarray, rows: np.ndarray, R: float | None = None,
+                  max_fev: int = 600) -> RollGustFit:
+    """Filter-error estimate of ``p_hat_g`` from the measured Cl, its process model fitted (module docstring).
+
+    The model is time-invariant (the hats carry the airspeed), so the steady-state Kalman filter and RTS smoother
+    are exact after their start (Jategaonkar 2015, sec. 5.3); each run of usable rows starts from the prior
+    (``g = 0``). The innovations' likelihood is maximised over ``Cl_p, log tau, log sigma, log R`` by Nelder-Mead
+    from ordinary least squares (``tau`` starts at 1 s, the residual's variance split evenly between ``sigma``
+    and ``R``), the other slopes profiled out by GLS.
 
     Args:
         dt: grid interval, s.
         X: ``(T, 10)`` regressors in the order of :data:`~gcs_sysid.aero.table.REGRESSORS` (gyro hats).
-        Y: ``(T, 6)`` measured coefficients in the order of :data:`~gcs_sysid.aero.table.COEFFICIENTS`.
-        rows: ``(T,)`` bool, the rows whose moments may be used (training rows: never the held-out segment);
-            the others get the prior (``s = 0``, the prior variance).
-        V: ``(T,)`` true airspeed, m/s (the Dryden time constants and the hats' scale).
-        b: wing span, m.
-        sigma_rates: ``(3,)`` ``sigma_p sigma_q sigma_r`` rad/s (:func:`~gcs_sysid.estimation.gustrates.dryden_rate_sigma`).
-        R: ``(2,)`` the measured Cl's and Cn's white-noise variances (the estimator's stated ones).
-        max_iter, tol: Nelder-Mead's evaluations and tolerance.
+        Y: ``(T, 6)`` measured coefficients in the order of :data:`~gcs_sysid.aero.table.COEFFICIENTS` (Cl used).
+        rows: ``(T,)`` bool, the rows whose roll moment may be used (training rows, never a held-out segment).
+        max_fev: Nelder-Mead's likelihood evaluations at most.
 
     Returns:
-        :class:`GustFilterResult`.
+        :class:`RollGustFit`; ``g`` is 0 with the prior variance outside the rows used.
 
     Raises:
-        ValueError: shapes that disagree, ``b`` or ``dt`` not positive, fewer than 200 usable rows in runs of
-            at least 50, or a non-finite or non-positive ``sigma_rates`` or ``R``.
+        ValueError: shapes that disagree, ``dt`` not positive, or fewer than 200 usable (finite) rows in runs of
+            at least 50.
 
-    Source: Jategaonkar (2015) ch. 5 and 7; Rauch, Tung and Striebel (1965); MIL-F-8785C sec. 3.7.2.
+    Source: Jategaonkar (2015) ch. 5; Morelli and Klein (2016) ch. 7; Rauch, Tung and Striebel (1965);
+    MIL-F-8785C sec. 3.7.2 (the first-order rolling-gust form).
     """
     from scipy.optimize import minimize
 
-    X, Y, V = np.asarray(X, float), np.asarray(Y, float), np.asarray(V, float)
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
     T = len(X)
-    if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or V.shape != (T,) or len(rows) != T:
-        raise ValueError(f"smooth_rotational_gusts: X (T, 10), Y (T, 6), V and rows (T,) expected, got {X.shape}, "
-                         f"{Y.shape}, {V.shape}, {np.shape(rows)}")
-    if not (b > 0 and dt > 0):
-        raise ValueError(f"smooth_rotational_gusts: span and dt must be positive, got b={b}, dt={dt}")
-    sig = np.asarray(sigma_rates, float)
-    Rv = np.asarray(R, float)
-    if sig.shape != (3,) or not (np.isfinite(sig).all() and (sig > 0).all()):
-        raise ValueError(f"smooth_rotational_gusts: sigma_rates must be 3 positive rad/s values, got {sig}")
-    if Rv.shape != (2,) or not (np.isfinite(Rv).all() and (Rv > 0).all()):
-        raise ValueError(f"smooth_rotational_gusts: R must be 2 positive variances, got {Rv}")
-    cols = [REGRESSORS.index(k) for k in LAT_TERMS]
-    il, in_ = COEFFICIENTS.index("Cl"), COEFFICIENTS.index("Cn")
-    A = np.c_[np.ones(T), X[:, cols]]
-    y = Y[:, [il, in_]]
-    use = np.asarray(rows, bool) & np.isfinite(A).all(1) & np.isfinite(y).all(1) & np.isfinite(V) & (V > 1.0)
-    segs = _segments(use, 50)
-    if sum(b_ - a_ for a_, b_ in segs) < 200:
-        raise ValueError(f"smooth_rotational_gusts: {int(use.sum())} usable rows, at least 200 in runs of 50 needed")
-    seg_rows = np.zeros(T, bool)
+    if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or np.shape(rows) != (T,):
+        raise ValueError(f"fit_roll_gust: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}) and rows (T,) "
+                         f"expected, got {X.shape}, {Y.shape}, {np.shape(rows)}")
+    if not dt > 0:
+        raise ValueError(f"fit_roll_gust: dt must be positive, got {dt}")
+    A = np.c_[np.ones(T), X[:, [REGRESSORS.index(k) for k in LAT_TERMS]]]
+    y = Y[:, COEFFICIENTS.index("Cl")]
+    use = np.asarray(rows, bool) & np.isfinite(A).all(1) & np.isfinite(y)
+    segs = _segments(use, _MIN_RUN)
+    n_used = sum(b - a for a, b in segs)
+    if n_used < _MIN_ROWS:
+        raise ValueError(f"fit_roll_gust: {int(use.sum())} usable rows, at least {_MIN_ROWS} in runs of "
+                         f"{_MIN_RUN} needed")
+    used = np.zeros(T, bool)
     for a_, b_ in segs:
-        seg_rows[a_:b_] = True
-    Vm = float(np.median(V[seg_rows]))
-    tau0 = np.array([4.0 * b / (np.pi * Vm), 3.0 * b / (np.pi * Vm)])
-    sh2 = (np.array([sig[0], sig[2]]) * b / (2.0 * Vm)) ** 2             # prior variance, hats
-
-    def model(log_k):
-        a = np.exp(-dt / (tau0 * np.exp(log_k)))
-        return np.diag(a), np.diag(sh2 * (1 - a**2))
-
-    F, Q = model(0.0)
-    Rm = np.diag(Rv)
-    Au, yu = A[seg_rows], y[seg_rows]
-    theta0 = np.stack([np.linalg.lstsq(Au, yu[:, j], rcond=None)[0] for j in range(2)])
-    rc = [_IP, _IR]
-    scale = np.maximum(np.abs(theta0[:, rc]), 0.02)
-    Ac, yc = A.copy(), y.copy()
-    Ac[~seg_rows], yc[~seg_rows] = 0.0, 0.0
-
-    def unpack(v):
-        Rk = Rm * (np.exp(v[4]) if fit_noise else 1.0)
-        return (v[:4].reshape(2, 2) * scale, Rk) + (model(v[-1]) if fit_tau else (F, Q))
-
-    def nll(v):
-        h, Rk, Fk, Qk = unpack(v)
-        return _profile(h, Fk, Qk, Rk, Ac, yc, segs, rc)[0]
-
-    v0 = np.r_[(theta0[:, rc] / scale).ravel(), [0.0] * (int(fit_noise) + int(fit_tau))]
-    opt = minimize(nll, v0, method="Nelder-Mead", options={"maxfev": max_iter, "xatol": tol, "fatol": 1e-3})
-    h_opt, Rm, F, Q = unpack(opt.x)
-    Rv = np.diag(Rm).copy()
-    tau_k = float(np.exp(opt.x[-1])) if fit_tau else 1.0
-    _, theta, gain = _profile(h_opt, F, Q, Rm, Ac, yc, segs, rc)
-    H = -theta[:, rc]
-    s = np.zeros((T, 2))
-    z = y - A @ theta.T
+        used[a_:b_] = True
+    theta0 = np.linalg.lstsq(A[used], y[used], rcond=None)[0]
+    Z = instruments(X, dt)
+    iv = used & np.isfinite(Z).all(1)
+    if iv.sum() < _MIN_ROWS:
+        raise ValueError(f"fit_roll_gust: {int(iv.sum())} rows with all instruments, at least {_MIN_ROWS} needed")
+    Ahat = Z[iv] @ np.linalg.lstsq(Z[iv], A[iv], rcond=None)[0]            # first stage
+    theta = np.linalg.lstsq(Ahat, y[iv], rcond=None)[0]                    # second stage (2SLS)
+    if not theta[_IP] < 0:
+        raise ValueError(f"fit_roll_gust: the instrumented roll damping Cl_p = {theta[_IP]:.3f} is not negative "
+                         "(weak instruments)")
+    h = -theta[_IP]
+    z = np.where(used, y - np.where(used[:, None], A, 0.0) @ theta, 0.0)
+    zv = float(np.var(z[used]))
+    nll_white = 0.5 * n_used * (1 + np.log(2 * np.pi * zv))
+    v0 = np.array([0.0, 0.5 * np.log(0.5 * zv / h**2), np.log(0.5 * zv)])
+    # numerical guards only: tau between one step and the longest run, the variances within 1e-8 .. 1e4 of z's
+    span = max(b_ - a_ for a_, b_ in segs) * dt
+    bounds = [(np.log(dt), np.log(span)), (v0[1] + 0.5 * np.log(1e-8), v0[1] + 0.5 * np.log(1e4)),
+              (np.log(1e-8 * zv), np.log(zv))]
+    if R is None:
+        opt = minimize(lambda v: _nll(v, z, segs, dt, h)[0], v0, method="Nelder-Mead", bounds=bounds,
+                       options={"maxfev": max_fev, "xatol": 1e-4, "fatol": 1e-3})
+        x_opt = opt.x
+    else:
+        lr = np.log(R)
+        opt = minimize(lambda v: _nll(np.r_[v, lr], z, segs, dt, h)[0], v0[:2], method="Nelder-Mead",
+                       bounds=bounds[:2], options={"maxfev": max_fev, "xatol": 1e-4, "fatol": 1e-3})
+        x_opt = np.r_[opt.x, lr]
+    nll, ss, a = _nll(x_opt, z, segs, dt, h)
+    tau, sig, R = (float(x) for x in np.exp(x_opt))
+    g = np.zeros(T)
     for a_, b_ in segs:
-        s[a_:b_] = steady_state_smoother(F, gain, H, z[a_:b_], np.zeros(2))[0]
-    P = np.where(seg_rows[:, None, None], gain.Ps[None], np.diag(sh2)[None])
-    prior_var = np.broadcast_to(sh2, (T, 2)).copy()
-    notes = (f"rotational gusts p_g, r_g smoothed from the measured Cl and Cn (filter-error method, steady-state "
-             f"gain, {opt.nfev} evaluations{'' if opt.success else ', not converged'}; Dryden sigma_p {sig[0]:.3f}, "
-             f"sigma_r {sig[2]:.3f} rad/s); Cl_p {theta0[0, _IP]:.3f} -> {theta[0, _IP]:.3f}, "
-             f"Cn_r {theta0[1, _IR]:.3f} -> {theta[1, _IR]:.3f}",)
-    return GustFilterResult(s, P, prior_var, theta, theta0, Rv, int(opt.nfev), bool(opt.success), sig, notes)
+        g[a_:b_] = _smooth(y[a_:b_] - A[a_:b_] @ theta, a, ss, h)
+    g_var = np.where(used, ss.Ps, sig * sig)
+    notes = (f"rolling gust p_g smoothed from the measured Cl (filter-error method, fitted first-order process: "
+             f"tau {tau:.2f} s, sigma(p_hat_g) {sig:.4f}, R {R:.2e}; {opt.nfev} evaluations"
+             f"{'' if opt.success else ', not converged'}); Cl_p {theta0[_IP]:.3f} -> {theta[_IP]:.3f}; "
+             f"-log L {nll:.0f} against {nll_white:.0f} without the gust",)
+    return RollGustFit(g, g_var, used, theta, theta0, float(theta[_IP]), tau, sig, R, float(nll), float(nll_white),
+                       int(opt.nfev), bool(opt.success), notes)
 
 
 def stated_moment_variance(states, airframe, qbar: np.ndarray, rows: np.ndarray) -> np.ndarray | None:
-    """Mean over ``rows`` of the measured Cl's and Cn's white-noise variance the rate smoother states, ``(2,)``.
+    """Mean over ``rows`` of the measured Cl's and Cn's noise variance that the rate smoother states, ``(2,)``.
 
     ``Cl = (Ixx p_dot - Ixz r_dot + ...) / (qbar S b)`` (:func:`gcs_sysid.aero.coefficients.aero_moments`), so
     ``var Cl = (Ixx s_p)^2 + (Ixz s_r)^2`` over ``(qbar S b)^2`` with ``s_p s_r`` the stated 1-sigma of
-    ``p_dot r_dot`` (``states.sigma``), and likewise Cn with ``Izz`` and ``Ixz``. None when not stated.
+    ``p_dot r_dot`` (``states.sigma``), and likewise Cn with ``Izz`` and ``Ixz``.
+
+    Args:
+        states: the smoothed states (``sigma`` a dict of ``(T,)`` 1-sigma arrays, rad/s^2).
+        airframe: ``S`` m^2, ``b`` m, ``Ixx Izz Ixz`` kg m^2.
+        qbar: ``(T,)`` dynamic pressure, Pa.
+        rows: ``(T,)`` bool.
+
+    Returns:
+        ``(2,)`` variances (Cl, Cn), or None when ``p_dot r_dot`` are not stated or the mean is not positive.
     """
     sig = getattr(states, "sigma", None) or {}
     if "p_dot" not in sig or "r_dot" not in sig:
@@ -258,53 +301,44 @@ def stated_moment_variance(states, airframe, qbar: np.ndarray, rows: np.ndarray)
     return out if np.isfinite(out).all() and (out > 0).all() else None
 
 
-def filter_gust_table(table, states, airframe, train: np.ndarray, axes: tuple[str, ...] = GUST_FILTER_AXES,
-                      noise_scale: float = GUST_FILTER_NOISE_SCALE):
-    """The table with the training rows' hats less the smoothed gust rates (module docstring).
 
-    Only the rows in ``train`` are changed and only their moments are used; every other row keeps the gyro's hats
-    (``p_g = 0``, the prior mean) and states the prior variance of ``p_hat_g`` (``r_hat_g``) in ``x_var`` (the
-    training rows state the smoothed variance), so the GP's band carries the gust the regressors leave out.
+def filter_gust_table(table, states, airframe, train: np.ndarray):
+    """The table with the training rows' ``p_hat`` less the smoothed rolling gust (:func:`fit_roll_gust`).
+
+    Only the rows the fit used change and only their roll moments are used; every other row keeps the gyro's
+    ``p_hat`` (``p_g = 0``, the prior mean) and states the prior variance ``sigma**2`` of ``p_hat_g`` in ``x_var``
+    (the rows used add the smoothed variance), so the GP's band carries the gust the regressors leave out.
 
     Args:
-        table: :class:`~gcs_sysid.aero.table.CoefficientTable`.
-        states: the smoothed states (``wn we wd V`` for the gust intensity; ``sigma`` of ``p_dot r_dot``).
-        airframe: span and inertia.
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``t`` ``(T,)`` s, ``X`` ``(T, 10)``, ``Y``
+            ``(T, 6)``, ``valid``, ``x_var``).
+        states: the smoothed states (their stated ``p_dot r_dot`` 1-sigma give the measurement noise,
+            :func:`stated_moment_variance`).
+        airframe: span, area and inertia.
         train: ``(T,)`` bool training rows.
-        axes: the gust rates taken out of the hats, among ``"p"`` and ``"r"`` (:data:`GUST_FILTER_AXES`).
-        noise_scale: the measurement noise variance over the stated one (:data:`GUST_FILTER_NOISE_SCALE`).
 
     Returns:
-        ``(table, GustFilterResult | None)``: a new table (the input is not changed), or the input with a note
-        and None when the gust intensity, the stated moment noise or the rows cannot be had.
+        ``(table, RollGustFit | None)``: a new table (the input is not changed), or the input with a note saying
+        why and None when the fit cannot be made (too few rows, no stated noise, weak instruments).
     """
     from dataclasses import replace
 
-    d = states.data
     T = len(table.t)
-    train = np.asarray(train, bool)
-    need = [k for k in ("wn", "we", "wd", "V") if k not in d]
-    if need or T < 3:
-        return replace(table, notes=list(table.notes) + [f"gust filter not run: no {' '.join(need) or 'grid'} in the states"]), None
+    if T < 3:
+        return replace(table, notes=list(table.notes) + ["gust filter not run: fewer than 3 rows"]), None
     dt = float(np.median(np.diff(table.t)))
-    V = np.asarray(d["V"], float)
-    wind = np.stack([d["wn"], d["we"], d["wd"]], 1)
-    sigma = gust_intensity(dt, wind[train], V[train]) if train.sum() > 20 else float("nan")
-    R = stated_moment_variance(states, airframe, table.qbar, train & table.valid)
-    if not (np.isfinite(sigma) and sigma > 0) or R is None:
-        why = "no gust intensity from the wind" if R is not None else "no stated p_dot r_dot noise"
-        return replace(table, notes=list(table.notes) + [f"gust filter not run: {why}"]), None
+    rows = np.asarray(train, bool) & table.valid
+    Rs = stated_moment_variance(states, airframe, table.qbar, rows)
+    if Rs is None:
+        return replace(table, notes=list(table.notes) + ["gust filter not run: no stated p_dot r_dot noise"]), None
     try:
-        G = smooth_rotational_gusts(dt, table.X, table.Y, train & table.valid, V, airframe.b,
-                                    dryden_rate_sigma(sigma, airframe.b), R * noise_scale)
+        G = fit_roll_gust(dt, table.X, table.Y, rows, R=float(Rs[0]))
     except ValueError as e:
         return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
+    j = REGRESSORS.index("p_hat")
     X = table.X.copy()
+    X[:, j] -= G.g
     xv = np.full((T, len(REGRESSORS)), np.nan) if table.x_var is None else table.x_var.copy()
-    for k, ax in enumerate(("p", "r")):
-        if ax in axes:
-            j = REGRESSORS.index(f"{ax}_hat")
-            X[:, j] -= G.s[:, k]
-            xv[:, j] = G.P[:, k, k]
-    note = G.notes[0] + f" (gust intensity {sigma:.2f} m/s; taken out of {', '.join(a + '_hat' for a in axes)} on the training rows)"
+    xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + G.g_var
+    note = G.notes[0] + " (taken out of p_hat on the training rows)"
     return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), G
