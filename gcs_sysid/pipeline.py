@@ -69,7 +69,7 @@ class ReplayOptions:
             cross-validation error; when the first two fail the model is fitted without the column. False: the
             ten regressors alone.
         gust_filter: train the GP on ``p_hat`` less the rotational gust ``p_g`` smoothed from the training rows'
-            own measured Cl and Cn (the filter-error method, :func:`gcs_sysid.aero.gustfilter.filter_gust_table`);
+            own measured Cl (the filter-error method, :func:`gcs_sysid.aero.gustfilter.filter_gust_table`);
             the held-out rows keep the gyro's hats (``p_g = 0``, its prior mean, with the prior variance stated in
             the band). None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
     """

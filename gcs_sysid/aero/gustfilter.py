@@ -4,12 +4,10 @@ The aerodynamic roll moment reads the body's rotation relative to the air, ``p -
 ``p_g`` (the span-wise gradient ``dw_g/dy``) is not observable from one point's air data
 (:mod:`gcs_sysid.estimation.gustrates`), but it is observable through the moment it causes. This module treats it
 as the filter-error method treats turbulence: as a process-noise state of the model whose output is the measured
-rolling-moment coefficient, estimated by a Kalman filter and a Rauch-Tung-Striebel smoother, with the model's
-parameters, the gust's correlation time and intensity and the measurement noise all estimated together by
-maximising the likelihood of the innovations (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA
-2015, ch. 5 "Filter error method", sec. 5.3-5.5 (steady-state gain, the innovations' likelihood, the measurement
-noise covariance estimated with the parameters); Morelli and Klein, *Aircraft System Identification*, 2nd ed.,
-2016, ch. 7 (output error and filter error in turbulence)).
+rolling-moment coefficient, estimated by a Kalman filter and a Rauch-Tung-Striebel smoother, the gust's correlation
+time and intensity estimated by maximising the likelihood of the innovations (Jategaonkar, *Flight Vehicle System
+Identification*, 2nd ed., AIAA 2015, ch. 5 "Filter error method": steady-state gain, the innovations' likelihood;
+Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 7).
 
 State (dimensionless, the hats' unit): ``g = p_g b/(2V)``, a first-order Gauss-Markov process (the Dryden
 rolling-gust form of MIL-F-8785C sec. 3.7.2 with its time constant and intensity left free: JSBSim's ``p_g`` is
@@ -23,11 +21,15 @@ with the gyro's hats, the air-relative roll rate being ``p_hat - g``::
 
     Cl_k = theta . x_k - Cl_p g_k + e_k,   e ~ N(0, R)
 
-Parameters: the roll-damping slope ``Cl_p`` (it sets the gust's gain), ``tau``, ``sigma`` and ``R`` by
-Nelder-Mead on the negative log-likelihood of the innovations, the other six slopes of ``theta`` profiled out
-exactly by generalised least squares on the whitened innovations (they enter the innovations linearly). Nothing is
-tuned: ``R`` is the white part of the roll-moment residual, ``sigma`` and ``tau`` its coloured part's level and
-bandwidth (a white floor under a Lorentzian spectrum; the three are identified by the residual's spectrum).
+Slopes: ``theta`` by two-stage least squares with ``1, alpha, delta_a, delta_r`` and the two controls delayed by
+:data:`INSTRUMENT_DELAYS_S` as instruments. The rate's response to the gust correlates the gyro's ``p_hat`` with
+``g``: ordinary least squares attenuates ``Cl_p`` (asw20 -0.07 against the truth's -0.68), and so does the
+innovations' likelihood when ``Cl_p`` is among its parameters (-0.28 to -0.38: its whitening weights the high
+frequencies, where ``p_hat`` moves mostly in response to ``g``); the instruments give -0.51 to -0.53.
+Process and noise: ``tau`` and ``sigma`` by Nelder-Mead on the innovations' negative log-likelihood with ``theta``
+fixed; ``R`` is the measured Cl's noise variance that the rate smoother states (:func:`stated_moment_variance`;
+nothing scaled). Fitting ``R`` too (``R=None``) drives it to its lower bound on JSBSim's flights: the measured Cl
+comes from a smoothed ``p_dot`` and has no white floor at 50 Hz.
 
 The yaw gust ``r_g`` is not estimated: even with the truth's slopes the yaw moment gives it with correlation 0.4-0.6
 (``docs/benchmarks.md``, "Sixteenth session, i8-fe").
@@ -65,14 +67,14 @@ class RollGustFit:
         g: ``(T,)`` smoothed ``p_hat_g = p_g b/(2V)`` (dimensionless); 0 (the prior mean) outside the rows used.
         g_var: ``(T,)`` its smoothed variance; ``sigma**2`` (the prior's) outside the rows used.
         used: ``(T,)`` bool, the rows the fit used.
-        theta: ``(7,)`` the linear model of Cl on ``(1,) + LAT_TERMS`` with the air-relative ``p_hat - g``.
-        theta0: ``(7,)`` ordinary least squares on the gyro's hats (the start).
+        theta: ``(7,)`` the linear model of Cl on ``(1,) + LAT_TERMS`` (two-stage least squares).
+        theta0: ``(7,)`` ordinary least squares on the gyro's hats (for comparison).
         Cl_p: ``theta[3]``.
         tau: the gust's correlation time, s.
         sigma: its standard deviation (``p_hat_g``, dimensionless).
         R: the measurement noise variance of Cl.
-        nll: the innovations' negative log-likelihood at the optimum; nll_white: with no gust state
-            (``sigma -> 0``, ordinary least squares, its R fitted).
+        nll: the innovations' negative log-likelihood at the optimum; nll_white: the residual taken as white
+            noise of its own variance (no gust state).
         nfev: likelihood evaluations; converged: Nelder-Mead's flag.
         notes: one-line statements.
     """
@@ -190,23 +192,24 @@ def fit_roll_gust(dt: float, X: np.ndarray, Y: np.ndarray, rows: np.ndarray, R: 
 
     The model is time-invariant (the hats carry the airspeed), so the steady-state Kalman filter and RTS smoother
     are exact after their start (Jategaonkar 2015, sec. 5.3); each run of usable rows starts from the prior
-    (``g = 0``). The innovations' likelihood is maximised over ``Cl_p, log tau, log sigma, log R`` by Nelder-Mead
-    from ordinary least squares (``tau`` starts at 1 s, the residual's variance split evenly between ``sigma``
-    and ``R``), the other slopes profiled out by GLS.
+    (``g = 0``). The slopes come from two-stage least squares (:func:`instruments`); the innovations' likelihood
+    of the residual is then maximised over ``log tau, log sigma`` (and ``log R`` when ``R`` is None) by Nelder-Mead
+    from ``tau`` = 1 s and the residual's variance split evenly between the gust and the noise.
 
     Args:
         dt: grid interval, s.
         X: ``(T, 10)`` regressors in the order of :data:`~gcs_sysid.aero.table.REGRESSORS` (gyro hats).
         Y: ``(T, 6)`` measured coefficients in the order of :data:`~gcs_sysid.aero.table.COEFFICIENTS` (Cl used).
         rows: ``(T,)`` bool, the rows whose roll moment may be used (training rows, never a held-out segment).
+        R: the measured Cl's noise variance; None: fitted with ``tau`` and ``sigma``.
         max_fev: Nelder-Mead's likelihood evaluations at most.
 
     Returns:
         :class:`RollGustFit`; ``g`` is 0 with the prior variance outside the rows used.
 
     Raises:
-        ValueError: shapes that disagree, ``dt`` not positive, or fewer than 200 usable (finite) rows in runs of
-            at least 50.
+        ValueError: shapes that disagree, ``dt`` not positive, fewer than 200 usable (finite) rows in runs of
+            at least 50 or with all instruments, or an instrumented ``Cl_p`` that is not negative.
 
     Source: Jategaonkar (2015) ch. 5; Morelli and Klein (2016) ch. 7; Rauch, Tung and Striebel (1965);
     MIL-F-8785C sec. 3.7.2 (the first-order rolling-gust form).
