@@ -167,13 +167,14 @@ def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
-             gust_rates: str | None = None) -> dict:
+             gust_rates: str | None = None, gust_filter: bool | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
-    what a simulator using the model would give it)."""
+    what a simulator using the model would give it). ``gust_filter``: ``ReplayOptions.gust_filter`` (None: the
+    default)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -183,7 +184,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
-    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False, gust_rates=gust_rates))
+    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False, gust_rates=gust_rates,
+                                                                          gust_filter=gust_filter))
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
@@ -197,7 +199,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
-                 "gust_rates": gust_rates,
+                 "gust_rates": gust_rates, "gust_filter": gust_filter,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
     row["meas_all"] = _errs(tab.Y[ok], Yt[ok])
@@ -324,6 +326,9 @@ def main(argv=None) -> int:
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
+    ap.add_argument("--gust-filter", default=None, choices=("on", "off"),
+                    help="train the GP on p_hat less the filter-error p_g (ReplayOptions.gust_filter; default: the "
+                         "replay's default, gcs_sysid.aero.gustfilter.GUST_FILTER)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
@@ -356,7 +361,8 @@ def main(argv=None) -> int:
     for ac in a.aircraft:
         for turb in a.turbulence:
             for seed in a.seeds:
-                row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates)
+                row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates,
+                               None if a.gust_filter is None else a.gust_filter == "on")
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

@@ -68,6 +68,10 @@ class ReplayOptions:
             kept when its slope is significant with coloured residuals, negative, and lowers Cm's blocked
             cross-validation error; when the first two fail the model is fitted without the column. False: the
             ten regressors alone.
+        gust_filter: train the GP on ``p_hat`` less the rotational gust ``p_g`` smoothed from the training rows'
+            own measured Cl (the filter-error method, :func:`gcs_sysid.aero.gustfilter.filter_gust_table`);
+            the held-out rows keep the gyro's hats (``p_g = 0``, its prior mean, with the prior variance stated in
+            the band). None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
     """
 
     rate_hz: float = 50.0
@@ -85,6 +89,7 @@ class ReplayOptions:
     can_offset: float | None = None
     gust_rates: str | None = None
     alpha_dot_hat: bool = True
+    gust_filter: bool | None = None
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
@@ -327,6 +332,11 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
+        from .aero.gustfilter import GUST_FILTER, filter_gust_table
+
+        if GUST_FILTER if options.gust_filter is None else options.gust_filter:
+            with _stage("gust filter", timings, bar):
+                table = filter_gust_table(table, states, airframe, train)[0]
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]

@@ -1,0 +1,347 @@
+"""Filter-error estimate of the rolling gust ``p_g`` from the measured roll moment, its process model fitted.
+
+The aerodynamic roll moment reads the body's rotation relative to the air, ``p - p_g``; a gyro measures ``p``.
+``p_g`` (the span-wise gradient ``dw_g/dy``) is not observable from one point's air data
+(:mod:`gcs_sysid.estimation.gustrates`), but it is observable through the moment it causes. This module treats it
+as the filter-error method treats turbulence: as a process-noise state of the model whose output is the measured
+rolling-moment coefficient, estimated by a Kalman filter and a Rauch-Tung-Striebel smoother, the gust's correlation
+time and intensity estimated by maximising the likelihood of the innovations (Jategaonkar, *Flight Vehicle System
+Identification*, 2nd ed., AIAA 2015, ch. 5 "Filter error method": steady-state gain, the innovations' likelihood;
+Morelli and Klein, *Aircraft System Identification*, 2nd ed., 2016, ch. 7).
+
+State (dimensionless, the hats' unit): ``g = p_g b/(2V)``, a first-order Gauss-Markov process (the Dryden
+rolling-gust form of MIL-F-8785C sec. 3.7.2 with its time constant and intensity left free: JSBSim's ``p_g`` is
+correlated much longer than the Dryden ``4b/(pi V)`` suggests, ``docs/benchmarks.md`` "Sixteenth session,
+i8-fe")::
+
+    g_k+1 = a g_k + w_k,   a = exp(-dt / tau),   var w = sigma^2 (1 - a^2)   (stationary variance sigma^2)
+
+Measurement: the measured Cl on the lateral linear model ``x = (1, alpha, beta, p_hat, r_hat, delta_a, delta_r)``
+with the gyro's hats, the air-relative roll rate being ``p_hat - g``::
+
+    Cl_k = theta . x_k - Cl_p g_k + e_k,   e ~ N(0, R)
+
+Slopes: ``theta`` by two-stage least squares with ``1, alpha, delta_a, delta_r`` and the two controls delayed by
+:data:`INSTRUMENT_DELAYS_S` as instruments. The rate's response to the gust correlates the gyro's ``p_hat`` with
+``g``: ordinary least squares attenuates ``Cl_p`` (asw20 -0.07 against the truth's -0.68), and so does the
+innovations' likelihood when ``Cl_p`` is among its parameters (-0.28 to -0.38: its whitening weights the high
+frequencies, where ``p_hat`` moves mostly in response to ``g``); the instruments give -0.51 to -0.53.
+Process and noise: ``tau`` and ``sigma`` by Nelder-Mead on the innovations' negative log-likelihood with ``theta``
+fixed; ``R`` is the measured Cl's noise variance that the rate smoother states (:func:`stated_moment_variance`;
+nothing scaled). Fitting ``R`` too (``R=None``) drives it to its lower bound on JSBSim's flights: the measured Cl
+comes from a smoothed ``p_dot`` and has no white floor at 50 Hz.
+
+The yaw gust ``r_g`` is not estimated: even with the truth's slopes the yaw moment gives it with correlation 0.4-0.6
+(``docs/benchmarks.md``, "Sixteenth session, i8-fe").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .table import COEFFICIENTS, REGRESSORS
+
+__all__ = ["GUST_FILTER", "INSTRUMENT_DELAYS_S", "LAT_TERMS", "RollGustFit", "fit_roll_gust", "instruments",
+           "stated_moment_variance", "filter_gust_table"]
+
+#: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
+#: less the filter-error rolling gust.
+GUST_FILTER = False
+#: The lateral linear model's regressors (an intercept first).
+LAT_TERMS = ("alpha", "beta", "p_hat", "r_hat", "delta_a", "delta_r")
+_IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
+#: Delays (s) of the aileron and rudder used as instruments for the rates and the sideslip (the controls are set by
+#: the pilot's programme, not by the gust; their delayed values carry the aircraft's response to them).
+INSTRUMENT_DELAYS_S = (0.1, 0.2, 0.4, 0.8, 1.6)
+#: Fewest usable rows (in runs of at least ``_MIN_RUN``) the fit accepts.
+_MIN_ROWS, _MIN_RUN = 200, 50
+
+
+@dataclass(frozen=True)
+class RollGustFit:
+    """The smoothed rolling gust and the model it was estimated with (:func:`fit_roll_gust`).
+
+    Attributes:
+        g: ``(T,)`` smoothed ``p_hat_g = p_g b/(2V)`` (dimensionless); 0 (the prior mean) outside the rows used.
+        g_var: ``(T,)`` its smoothed variance; ``sigma**2`` (the prior's) outside the rows used.
+        used: ``(T,)`` bool, the rows the fit used.
+        theta: ``(7,)`` the linear model of Cl on ``(1,) + LAT_TERMS`` (two-stage least squares).
+        theta0: ``(7,)`` ordinary least squares on the gyro's hats (for comparison).
+        Cl_p: ``theta[3]``.
+        tau: the gust's correlation time, s.
+        sigma: its standard deviation (``p_hat_g``, dimensionless).
+        R: the measurement noise variance of Cl.
+        nll: the innovations' negative log-likelihood at the optimum; nll_white: the residual taken as white
+            noise of its own variance (no gust state).
+        nfev: likelihood evaluations; converged: Nelder-Mead's flag.
+        notes: one-line statements.
+    """
+
+    g: np.ndarray
+    g_var: np.ndarray
+    used: np.ndarray
+    theta: np.ndarray
+    theta0: np.ndarray
+    Cl_p: float
+    tau: float
+    sigma: float
+    R: float
+    nll: float
+    nll_white: float
+    nfev: int
+    converged: bool
+    notes: tuple[str, ...]
+
+
+def _segments(use: np.ndarray, min_len: int) -> list[tuple[int, int]]:
+    """``[start, stop)`` of the runs of True in ``use`` at least ``min_len`` long."""
+    d = np.diff(np.r_[0, use.astype(int), 0])
+    return [(a, b) for a, b in zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0]) if b - a >= min_len]
+
+
+@dataclass(frozen=True)
+class _Gains:
+    """Steady-state scalar gains: filter ``K``, predicted ``P``, innovation ``S``, smoother ``C`` and ``Ps``."""
+
+    K: float
+    P: float
+    S: float
+    C: float
+    Ps: float
+
+
+def _gains(a: float, sigma2: float, h: float, R: float) -> _Gains:
+    """Steady-state scalar filter and RTS smoother for ``g' = a g + w`` (``var w = sigma2 (1 - a^2)``),
+    ``z = h g + e`` (``var e = R``): the positive root of the scalar Riccati equation
+    ``h^2 P^2 + (R (1 - a^2) - q h^2) P - q R = 0``, written so that ``h = 0`` gives the prior ``q / (1 - a^2)``
+    (Simon, *Optimal State Estimation*, 2006, ch. 7 and 9; the scalar case of :func:`~gcs_sysid.estimation.kalman.
+    steady_state`)."""
+    q = sigma2 * (1 - a * a)
+    c = R * (1 - a * a) - q * h * h
+    P = 2 * q * R / (c + np.sqrt(c * c + 4 * h * h * q * R))
+    S = h * h * P + R
+    K = P * h / S
+    Pf = P * R / S
+    C = a * R / S
+    Ps = (Pf - C * C * P) / (1 - C * C)
+    return _Gains(K, P, S, C, Ps)
+
+
+def _innovations(M: np.ndarray, a: float, ss, h: float, segs) -> np.ndarray:
+    """Innovations of each column of ``M`` ``(T, m)`` under the steady-state filter, stacked over the segments.
+
+    ``xp_k+1 = a (1 - K h) xp_k + a K z_k`` and ``nu_k = z_k - h xp_k`` (the prediction starts at the prior mean
+    0 in each segment), run by ``scipy.signal.lfilter``.
+    """
+    from scipy.signal import lfilter
+
+    K = ss.K
+    out = []
+    for s0, s1 in segs:
+        z = M[s0:s1]
+        xp = lfilter([0.0, a * K], [1.0, -a * (1 - K * h)], z, axis=0)
+        out.append(z - h * xp)
+    return np.concatenate(out)
+
+
+def _nll(v, z, segs, dt, h):
+    """Innovations' negative log-likelihood of ``z`` for ``v = (log tau, log sigma, log R)``; also the gains."""
+    tau, sig, R = np.exp(v)
+    a = float(np.exp(-dt / tau))
+    ss = _gains(a, sig * sig, h, R)
+    nu = _innovations(z[:, None], a, ss, h, segs)[:, 0]
+    return 0.5 * float(nu @ nu) / ss.S + 0.5 * len(nu) * np.log(2 * np.pi * ss.S), ss, a
+
+
+def _lagged(x: np.ndarray, k: int) -> np.ndarray:
+    """``x`` delayed by ``k`` rows (NaN where the delay reaches before the record)."""
+    out = np.full_like(x, np.nan)
+    out[k:] = x[: len(x) - k]
+    return out
+
+
+def instruments(X: np.ndarray, dt: float) -> np.ndarray:
+    """``(T, 4 + 2 len(INSTRUMENT_DELAYS_S))`` instruments: ``1, alpha, delta_a, delta_r`` and the two controls
+    delayed by :data:`INSTRUMENT_DELAYS_S` (NaN where a delay reaches before the record)."""
+    da, dr = X[:, REGRESSORS.index("delta_a")], X[:, REGRESSORS.index("delta_r")]
+    cols = [np.ones(len(X)), X[:, REGRESSORS.index("alpha")], da, dr]
+    for d in INSTRUMENT_DELAYS_S:
+        k = max(1, int(round(d / dt)))
+        cols += [_lagged(da, k), _lagged(dr, k)]
+    return np.stack(cols, 1)
+
+
+def _smooth(z: np.ndarray, a: float, ss, h: float) -> np.ndarray:
+    """Steady-state RTS smoothed ``g`` of one segment's measurement ``z`` ``(n,)``."""
+    from scipy.signal import lfilter
+
+    K, C = ss.K, ss.C
+    xp = lfilter([0.0, a * K], [1.0, -a * (1 - K * h)], z)
+    xf = xp + K * (z - h * xp)
+    # backward: xs_k = xf_k + C (xs_k+1 - a xf_k), xs_n-1 = xf_n-1
+    rev = xf[::-1]
+    xs = lfilter([1.0 - C * a], [1.0, -C], rev, zi=[C * a * rev[0]])[0]
+    return xs[::-1]
+
+
+def fit_roll_gust(dt: float, X: np.ndarray, Y: np.ndarray, rows: np.ndarray, R: float | None = None,
+                  max_fev: int = 600) -> RollGustFit:
+    """Filter-error estimate of ``p_hat_g`` from the measured Cl, its process model fitted (module docstring).
+
+    The model is time-invariant (the hats carry the airspeed), so the steady-state Kalman filter and RTS smoother
+    are exact after their start (Jategaonkar 2015, sec. 5.3); each run of usable rows starts from the prior
+    (``g = 0``). The slopes come from two-stage least squares (:func:`instruments`); the innovations' likelihood
+    of the residual is then maximised over ``log tau, log sigma`` (and ``log R`` when ``R`` is None) by Nelder-Mead
+    from ``tau`` = 1 s and the residual's variance split evenly between the gust and the noise.
+
+    Args:
+        dt: grid interval, s.
+        X: ``(T, 10)`` regressors in the order of :data:`~gcs_sysid.aero.table.REGRESSORS` (gyro hats).
+        Y: ``(T, 6)`` measured coefficients in the order of :data:`~gcs_sysid.aero.table.COEFFICIENTS` (Cl used).
+        rows: ``(T,)`` bool, the rows whose roll moment may be used (training rows, never a held-out segment).
+        R: the measured Cl's noise variance; None: fitted with ``tau`` and ``sigma``.
+        max_fev: Nelder-Mead's likelihood evaluations at most.
+
+    Returns:
+        :class:`RollGustFit`; ``g`` is 0 with the prior variance outside the rows used.
+
+    Raises:
+        ValueError: shapes that disagree, ``dt`` not positive, fewer than 200 usable (finite) rows in runs of
+            at least 50 or with all instruments, or an instrumented ``Cl_p`` that is not negative.
+
+    Source: Jategaonkar (2015) ch. 5; Morelli and Klein (2016) ch. 7; Rauch, Tung and Striebel (1965);
+    MIL-F-8785C sec. 3.7.2 (the first-order rolling-gust form).
+    """
+    from scipy.optimize import minimize
+
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
+    T = len(X)
+    if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or np.shape(rows) != (T,):
+        raise ValueError(f"fit_roll_gust: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}) and rows (T,) "
+                         f"expected, got {X.shape}, {Y.shape}, {np.shape(rows)}")
+    if not dt > 0:
+        raise ValueError(f"fit_roll_gust: dt must be positive, got {dt}")
+    A = np.c_[np.ones(T), X[:, [REGRESSORS.index(k) for k in LAT_TERMS]]]
+    y = Y[:, COEFFICIENTS.index("Cl")]
+    use = np.asarray(rows, bool) & np.isfinite(A).all(1) & np.isfinite(y)
+    segs = _segments(use, _MIN_RUN)
+    n_used = sum(b - a for a, b in segs)
+    if n_used < _MIN_ROWS:
+        raise ValueError(f"fit_roll_gust: {int(use.sum())} usable rows, at least {_MIN_ROWS} in runs of "
+                         f"{_MIN_RUN} needed")
+    used = np.zeros(T, bool)
+    for a_, b_ in segs:
+        used[a_:b_] = True
+    theta0 = np.linalg.lstsq(A[used], y[used], rcond=None)[0]
+    Z = instruments(X, dt)
+    iv = used & np.isfinite(Z).all(1)
+    if iv.sum() < _MIN_ROWS:
+        raise ValueError(f"fit_roll_gust: {int(iv.sum())} rows with all instruments, at least {_MIN_ROWS} needed")
+    Ahat = Z[iv] @ np.linalg.lstsq(Z[iv], A[iv], rcond=None)[0]            # first stage
+    theta = np.linalg.lstsq(Ahat, y[iv], rcond=None)[0]                    # second stage (2SLS)
+    if not theta[_IP] < 0:
+        raise ValueError(f"fit_roll_gust: the instrumented roll damping Cl_p = {theta[_IP]:.3f} is not negative "
+                         "(weak instruments)")
+    h = -theta[_IP]
+    z = np.where(used, y - np.where(used[:, None], A, 0.0) @ theta, 0.0)
+    zv = float(np.var(z[used]))
+    nll_white = 0.5 * n_used * (1 + np.log(2 * np.pi * zv))
+    v0 = np.array([0.0, 0.5 * np.log(0.5 * zv / h**2), np.log(0.5 * zv)])
+    # numerical guards only: tau between one step and the longest run, the variances within 1e-8 .. 1e4 of z's
+    span = max(b_ - a_ for a_, b_ in segs) * dt
+    bounds = [(np.log(dt), np.log(span)), (v0[1] + 0.5 * np.log(1e-8), v0[1] + 0.5 * np.log(1e4)),
+              (np.log(1e-8 * zv), np.log(zv))]
+    if R is None:
+        opt = minimize(lambda v: _nll(v, z, segs, dt, h)[0], v0, method="Nelder-Mead", bounds=bounds,
+                       options={"maxfev": max_fev, "xatol": 1e-4, "fatol": 1e-3})
+        x_opt = opt.x
+    else:
+        lr = np.log(R)
+        opt = minimize(lambda v: _nll(np.r_[v, lr], z, segs, dt, h)[0], v0[:2], method="Nelder-Mead",
+                       bounds=bounds[:2], options={"maxfev": max_fev, "xatol": 1e-4, "fatol": 1e-3})
+        x_opt = np.r_[opt.x, lr]
+    nll, ss, a = _nll(x_opt, z, segs, dt, h)
+    tau, sig, R = (float(x) for x in np.exp(x_opt))
+    g = np.zeros(T)
+    for a_, b_ in segs:
+        g[a_:b_] = _smooth(y[a_:b_] - A[a_:b_] @ theta, a, ss, h)
+    g_var = np.where(used, ss.Ps, sig * sig)
+    notes = (f"rolling gust p_g smoothed from the measured Cl (filter-error method, fitted first-order process: "
+             f"tau {tau:.2f} s, sigma(p_hat_g) {sig:.4f}, R {R:.2e}; {opt.nfev} evaluations"
+             f"{'' if opt.success else ', not converged'}); Cl_p {theta0[_IP]:.3f} -> {theta[_IP]:.3f}; "
+             f"-log L {nll:.0f} against {nll_white:.0f} without the gust",)
+    return RollGustFit(g, g_var, used, theta, theta0, float(theta[_IP]), tau, sig, R, float(nll), float(nll_white),
+                       int(opt.nfev), bool(opt.success), notes)
+
+
+def stated_moment_variance(states, airframe, qbar: np.ndarray, rows: np.ndarray) -> np.ndarray | None:
+    """Mean over ``rows`` of the measured Cl's and Cn's noise variance that the rate smoother states, ``(2,)``.
+
+    ``Cl = (Ixx p_dot - Ixz r_dot + ...) / (qbar S b)`` (:func:`gcs_sysid.aero.coefficients.aero_moments`), so
+    ``var Cl = (Ixx s_p)^2 + (Ixz s_r)^2`` over ``(qbar S b)^2`` with ``s_p s_r`` the stated 1-sigma of
+    ``p_dot r_dot`` (``states.sigma``), and likewise Cn with ``Izz`` and ``Ixz``.
+
+    Args:
+        states: the smoothed states (``sigma`` a dict of ``(T,)`` 1-sigma arrays, rad/s^2).
+        airframe: ``S`` m^2, ``b`` m, ``Ixx Izz Ixz`` kg m^2.
+        qbar: ``(T,)`` dynamic pressure, Pa.
+        rows: ``(T,)`` bool.
+
+    Returns:
+        ``(2,)`` variances (Cl, Cn), or None when ``p_dot r_dot`` are not stated or the mean is not positive.
+    """
+    sig = getattr(states, "sigma", None) or {}
+    if "p_dot" not in sig or "r_dot" not in sig:
+        return None
+    sp, sr = np.asarray(sig["p_dot"], float), np.asarray(sig["r_dot"], float)
+    qsb = np.asarray(qbar, float) * airframe.S * airframe.b
+    with np.errstate(invalid="ignore", divide="ignore"):
+        vl = ((airframe.Ixx * sp) ** 2 + (airframe.Ixz * sr) ** 2) / qsb**2
+        vn = ((airframe.Izz * sr) ** 2 + (airframe.Ixz * sp) ** 2) / qsb**2
+    out = np.array([np.nanmean(vl[rows]), np.nanmean(vn[rows])]) if np.any(rows) else np.full(2, np.nan)
+    return out if np.isfinite(out).all() and (out > 0).all() else None
+
+
+
+def filter_gust_table(table, states, airframe, train: np.ndarray):
+    """The table with the training rows' ``p_hat`` less the smoothed rolling gust (:func:`fit_roll_gust`).
+
+    Only the rows the fit used change and only their roll moments are used; every other row keeps the gyro's
+    ``p_hat`` (``p_g = 0``, the prior mean) and states the prior variance ``sigma**2`` of ``p_hat_g`` in ``x_var``
+    (the rows used add the smoothed variance), so the GP's band carries the gust the regressors leave out.
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``t`` ``(T,)`` s, ``X`` ``(T, 10)``, ``Y``
+            ``(T, 6)``, ``valid``, ``x_var``).
+        states: the smoothed states (their stated ``p_dot r_dot`` 1-sigma give the measurement noise,
+            :func:`stated_moment_variance`).
+        airframe: span, area and inertia.
+        train: ``(T,)`` bool training rows.
+
+    Returns:
+        ``(table, RollGustFit | None)``: a new table (the input is not changed), or the input with a note saying
+        why and None when the fit cannot be made (too few rows, no stated noise, weak instruments).
+    """
+    from dataclasses import replace
+
+    T = len(table.t)
+    if T < 3:
+        return replace(table, notes=list(table.notes) + ["gust filter not run: fewer than 3 rows"]), None
+    dt = float(np.median(np.diff(table.t)))
+    rows = np.asarray(train, bool) & table.valid
+    Rs = stated_moment_variance(states, airframe, table.qbar, rows)
+    if Rs is None:
+        return replace(table, notes=list(table.notes) + ["gust filter not run: no stated p_dot r_dot noise"]), None
+    try:
+        G = fit_roll_gust(dt, table.X, table.Y, rows, R=float(Rs[0]))
+    except ValueError as e:
+        return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
+    j = REGRESSORS.index("p_hat")
+    X = table.X.copy()
+    X[:, j] -= G.g
+    xv = np.full((T, len(REGRESSORS)), np.nan) if table.x_var is None else table.x_var.copy()
+    xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + G.g_var
+    note = G.notes[0] + " (taken out of p_hat on the training rows)"
+    return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), G
