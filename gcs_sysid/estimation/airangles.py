@@ -115,7 +115,8 @@ INSTRUMENTED_SLOPES = False
 #: and the aided sideslip inherits the fit: the GP's side-force map is then wrong at the true sideslip, where the
 #: truth's sideslip in the training regressors makes it right (``docs/estimation.md``, "Instrumented side-force
 #: slopes"; ``docs/benchmarks.md``, "Sixteenth session, i8-iv").
-INSTRUMENTED_BETA = False   # opt-in: the t6 diagnosis eval got worse with it on (docs/benchmarks.md, i8-iv)
+INSTRUMENTED_BETA = False   # opt-in: with it on the diagnosis lost CY:scale (t6: estimators differing between flights,
+#   fixed by the shared estimator; rascal 2/6 -> 0/6 even with it: docs/benchmarks.md, i8-iv and i9-ivdiag)
 BETA_INSTRUMENTS = ("delta_r", "delta_a")   #: the controls that instrument the side-force model (with their delays)
 #: columns of the side-force model instrumented with the sideslip: the aircraft rolls and yaws with the lateral gust,
 #: so their least-squares slopes take the gust's side force the kinematic sideslip misses
