@@ -152,12 +152,11 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
     t0 = time.perf_counter()
-    # as run_diagnose does: with SHARE_ALPHA_MODEL the test flight's alpha is aided with the reference's
-    # force model (one alpha scale for both)
-    from gcs_sysid.diagnose import run as diagnose_run
+    # as run_diagnose does: the test flight's sideslip is aided with the reference's side-force estimator, and with
+    # SHARE_ALPHA_MODEL its alpha with the reference's force model (one alpha scale for both)
+    from gcs_sysid.diagnose.run import shared_angle_models
 
-    meas = load_measurements(files.tlog, files.airframe, angle_models=ref_meas.states.angle_fits
-                             if diagnose_run.SHARE_ALPHA_MODEL else None)
+    meas = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits))
     from gcs_sysid.diagnose.differential import Reference
 
     # as the CLI does with the flight recorded in <model>.fit.json: the reference carries its decoded
@@ -353,6 +352,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     from gcs_sysid.aero.table import COEFFICIENTS
     from gcs_sysid.diagnose.context import DiagContext, model_as_dict
     from gcs_sysid.diagnose.run import load_measurements
+    from gcs_sysid.diagnose.run import shared_angle_models
     from gcs_sysid.diagnose.sparse import _library, alpha_quantile_knots, reference_context, sparse_search
     from gcs_sysid.sim.model_file import load_model
 
@@ -362,7 +362,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     est: dict[str, list[float]] = {c: [] for c in _FORCED}
     for cs in clean_seeds:
         files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan), [], out)
-        m = load_measurements(files.tlog, files.airframe)
+        m = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits))
         ctx = DiagContext.build(m.table, m.airframe, model, m.states)
         res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, keep_residual=True)
         names, Phi = _library(ctx, knots)

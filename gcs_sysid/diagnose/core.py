@@ -355,7 +355,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         say("diagnose: pitot causes on their whole signature")
         from .pitot import airspeed_cause, with_pitot
 
-        pitot = airspeed_cause(ctx, R0, proj, flight, references, airframe, model0, min_score, min_gain_pct)
+        pitot = airspeed_cause(ctx, R0, proj, flight, references, airframe, model0, min_score, min_gain_pct,
+                               angle_fits=getattr(states, "angle_fits", None))
     fault_summary = None
     if flight is not None:
         say("diagnose: actuator and engine faults in the telemetry")

@@ -178,7 +178,8 @@ def _null(cause: str) -> float:
 
 
 def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, references=(), airframe=None,
-                   model=None, min_score: float = 30.0, min_gain_pct: float = 10.0) -> dict:
+                   model=None, min_score: float = 30.0, min_gain_pct: float = 10.0,
+                   angle_fits: dict | None = None) -> dict:
     """Fit and judge ``bias:airspeed`` and ``scale:airspeed`` on the coefficients (see the module doc).
 
     Args:
@@ -189,6 +190,8 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         references: :class:`~gcs_sysid.diagnose.differential.Reference` flights (same model).
         airframe, model: for the reference contexts.
         min_score, min_gain_pct: the usual acceptance on the acceptance rows.
+        angle_fits: the flight's ``FlightStates.angle_fits``: its re-reduction with the pitot corrected aids the
+            sideslip with the same side-force estimator (:func:`_unit_delta_rereduced`); None: its own choice.
 
     Returns:
         ``{"candidates": [...], "finding": dict | None, "calibration": [str], "delta"}``; ``delta`` (T, 6)
@@ -249,7 +252,7 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         if cand["accepted"] and (best is None or f.score > best[0].score):
             best = (f, cand, gate)
     fused = _fused_candidate(ctx, R, proj, flight, references, airframe, model, out["candidates"], gain_rows,
-                             min_gain_pct)
+                             min_gain_pct, angle_fits)
     out["wind_triangle"] = fused
     delta = fused.pop("_delta", None) if fused is not None else None
     if fused is not None and fused["accepted"]:
@@ -345,7 +348,8 @@ def screen(fused: dict, change: dict) -> dict:
             "linearise_at_mps": float(fused["estimate"] if by_fused else change["change_mps"])}
 
 
-def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidates, gain_rows, min_gain_pct):
+def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidates, gain_rows, min_gain_pct,
+                     angle_fits=None):
     """``bias:airspeed`` by the wind triangle and the coefficients together (:func:`fuse_pitot_evidence`).
 
     Accepted when both measurements agree, their combined change since the reference flight(s) is at
@@ -355,6 +359,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     coefficient's untouched rows (never used by either fit) or on the pitot's own reading
     (:data:`SENSOR_GAIN`). The offsets the bias makes count as its evidence in that gain (the triangle
     measures the bias without the coefficients), which is why the coefficients must confirm it first.
+    ``angle_fits``: as :func:`airspeed_cause`.
     """
     from .wind_triangle import change_since_references, triangle_gain, wind_triangle
 
@@ -389,7 +394,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
         out["why"] = "the screen (wind triangle and closed-form coefficient fit) did not pass"
         out["checks"] = {"measurements_agree": fused["agree"], "significant": False}
         return out
-    D1 = _unit_delta_rereduced(ctx, flight, out["screen"]["linearise_at_mps"])
+    D1 = _unit_delta_rereduced(ctx, flight, out["screen"]["linearise_at_mps"], angle_fits)
     if D1 is not None:
         # the same exact re-fit on the reference flight(s), coefficient by coefficient: the differential
         # baseline of each coefficient's estimate (_rereduced_baseline); without one, the closed-form
@@ -461,10 +466,15 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     return out
 
 
-def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float) -> np.ndarray | None:
+def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float, angle_fits: dict | None = None) -> np.ndarray | None:
     """Change of the residual (T, 6) per m/s of pitot bias, from the pipeline re-run with the pitot reading
     ``b0`` m/s (TAS) less (estimation and coefficients as :func:`gcs_sysid.diagnose.run.load_measurements`
     computes them); None when the flight cannot be re-reduced (no pitot stream, another grid, ``b0`` ~ 0).
+    ``angle_fits``: the flight's own ``FlightStates.angle_fits``; its beta fit is given to the re-run so that the
+    side-force slopes are fitted by the same estimator (with :data:`gcs_sysid.estimation.airangles.INSTRUMENTED_BETA`
+    2SLS or least squares; a re-run that chose the other would put the estimators' difference into the per-m/s
+    effect: the JSBSim t6's 2-m/s bias read 2.37 against 1.88 m/s, ``docs/benchmarks.md``, "Seventeenth session,
+    i9-ivdiag"). None: the re-run chooses its own.
     """
     import dataclasses
 
@@ -487,8 +497,10 @@ def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float) -> np.ndarray | N
     if not changed:
         return None
     try:
+        beta_fit = (angle_fits or {}).get("beta")
         states = estimate_states(dataclasses.replace(flight, streams=streams), ctx.airframe,
-                                 turbulence_state=False)      # as load_measurements
+                                 turbulence_state=False,      # as load_measurements
+                                 angle_models={"beta": beta_fit} if beta_fit is not None else None)
         table = compute_coefficients(states, ctx.airframe)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError, KeyError):
         return None
@@ -583,7 +595,7 @@ def _rereduced_baseline(references, airframe, model, b0: float) -> dict | None:
             continue
         try:
             rctx = DiagContext.build(ref.table, airframe, model, ref.states, None, None)
-            D1 = _unit_delta_rereduced(rctx, ref.flight, b0)
+            D1 = _unit_delta_rereduced(rctx, ref.flight, b0, getattr(ref.states, "angle_fits", None))
             if D1 is None:
                 continue
             _, _, per = _fit_unit_delta(rctx, np.nan_to_num(rctx.Y - rctx.model_values()), D1)

@@ -56,6 +56,25 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
 SHARE_ALPHA_MODEL = False
 
 
+def shared_angle_models(fits: dict | None) -> dict | None:
+    """The reference flight's air-angle fits that the flight under test is aided with.
+
+    The sideslip's always: with :data:`gcs_sysid.estimation.airangles.INSTRUMENTED_BETA` the reference flight decides
+    between two-stage and ordinary least squares for the side-force slopes and the flight under test uses the same
+    estimator (its slopes still its own), so that the two aided sideslips carry the same errors in variables
+    (``docs/benchmarks.md``, "Seventeenth session, i9-ivdiag"); without it the given beta fit changes nothing. The
+    angle of attack's slopes only with :data:`SHARE_ALPHA_MODEL`.
+
+    Args:
+        fits: the reference's ``FlightStates.angle_fits`` (``{"alpha": AxisFit, "beta": AxisFit}``) or None.
+
+    Returns:
+        the ``angle_models`` for :func:`load_measurements`, or None.
+    """
+    out = {k: v for k, v in (fits or {}).items() if k == "beta" or (k == "alpha" and SHARE_ALPHA_MODEL)}
+    return out or None
+
+
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
                       progress=None, notify=None, gust_rates: str | None = None,
                       angle_models: dict | None = None) -> Measurements:
@@ -66,8 +85,9 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         airframe_path: airframe TOML.
         t_from, t_to: vehicle-time window, s (None = open).
         notify: called with one line per damage found in the log (None: not shown).
-        angle_models: a reference flight's ``states.angle_fits``: this flight's alpha is aided with its
-            force model (one alpha scale for both; :func:`gcs_sysid.estimation.estimate_states`). None: own.
+        angle_models: a reference flight's ``states.angle_fits`` (:func:`shared_angle_models`): this flight's alpha
+            is aided with its force model (one alpha scale for both) and its sideslip with its side-force estimator
+            (:func:`gcs_sysid.estimation.estimate_states`). None: own.
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
@@ -168,8 +188,8 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
     with StagedDir(out_dir, "diagnose", DIAGNOSE_OUTPUTS) as stage:
         kw = {**kw, **_references(model_path, airframe_path, references, progress)}
         refs = kw.get("references") or []
-        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=getattr(
-            refs[0].states, "angle_fits", None) if SHARE_ALPHA_MODEL and refs else None)
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=shared_angle_models(
+            getattr(refs[0].states, "angle_fits", None)) if refs else None)
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag

@@ -115,7 +115,8 @@ INSTRUMENTED_SLOPES = False
 #: and the aided sideslip inherits the fit: the GP's side-force map is then wrong at the true sideslip, where the
 #: truth's sideslip in the training regressors makes it right (``docs/estimation.md``, "Instrumented side-force
 #: slopes"; ``docs/benchmarks.md``, "Sixteenth session, i8-iv").
-INSTRUMENTED_BETA = False   # opt-in: the t6 diagnosis eval got worse with it on (docs/benchmarks.md, i8-iv)
+INSTRUMENTED_BETA = False   # opt-in: with it on the diagnosis lost CY:scale (t6: estimators differing between flights,
+#   fixed by the shared estimator; rascal 2/6 -> 0/6 even with it: docs/benchmarks.md, i8-iv and i9-ivdiag)
 BETA_INSTRUMENTS = ("delta_r", "delta_a")   #: the controls that instrument the side-force model (with their delays)
 #: columns of the side-force model instrumented with the sideslip: the aircraft rolls and yaws with the lateral gust,
 #: so their least-squares slopes take the gust's side force the kinematic sideslip misses
@@ -734,7 +735,11 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             (``CZ_alpha``, the curvature, ``CZ_q_hat``, ``CZ_delta_e``; its constant is fitted here) instead of
             fitting them on this flight, so that both flights' aided alpha share one scale (a fitted slope's
             error scales the aided alpha at manoeuvre frequencies: ``docs/estimation.md``). Used only when its
-            terms are this flight's (else fitted here, said in ``AxisFit.slope_method``). None: fitted here.
+            terms are this flight's (else fitted here, said in ``AxisFit.slope_method``). ``{"beta": AxisFit}``: with
+            ``instrument_beta`` on, the beta axis uses that flight's side-force *estimator* (2SLS where that flight's
+            ``slope_method`` is 2SLS, with no fallback of its own; least squares where that flight fell back), its
+            slopes still fitted here, so that two flights compared by a differential diagnosis carry the same errors in
+            variables (``docs/benchmarks.md``, "Seventeenth session, i9-ivdiag"). None: fitted here.
         instrument_beta: fit the side-force model's slopes (``CY_beta`` and the rate terms :data:`BETA_ENDOGENOUS`) by
             two-stage least squares with :data:`BETA_INSTRUMENTS` and their delayed copies as instruments, falling
             back to least squares below :data:`BETA_MIN_FIRST_STAGE_R2`; None: :data:`INSTRUMENTED_BETA`.
@@ -788,14 +793,27 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     floor = lift_slope(b * b / S)          # the wing's lift slope, 1/rad (NaN: no span or area)
     edge = heave_edge_hz(floor, hg)
     inst_b = None
-    if INSTRUMENTED_BETA if instrument_beta is None else instrument_beta:
+    on_b = INSTRUMENTED_BETA if instrument_beta is None else instrument_beta
+    min_fs_b, given_b, est_note = BETA_MIN_FIRST_STAGE_R2, (models or {}).get("beta"), ""
+    if on_b and given_b is not None and given_b.used:
+        # a differential diagnosis compares two flights through their aided sideslips: both must come from one
+        # estimator, or their errors in variables differ (least squares: CY_beta flattened and the gust's side
+        # force given to r_hat; 2SLS: neither) and the difference reads as a change of the side force. The
+        # given flight (the reference) decided between 2SLS and least squares; this flight follows it, with no
+        # fallback of its own (its slopes are still fitted here: a changed side force changes them)
+        on_b = given_b.slope_method.startswith("2SLS")
+        min_fs_b = 0.0 if on_b else min_fs_b
+        est_note = (f"; estimator of the given model (another flight's fit of the same aircraft): "
+                    f"{'2SLS' if on_b else 'least squares'}, first-stage R2 there {given_b.first_stage_r2:.2f}")
+    if on_b:
         U = [get(k) for k in BETA_INSTRUMENTS if k in controls]
         U = [x for x in U if np.isfinite(x[u]).all() and np.nanstd(x[u]) > 1e-9] if u.any() else []
         inst_b = lagged_instruments(dt, np.column_stack(U)) if U else None
         if inst_b is not None and not np.isfinite(inst_b[u]).all():    # a delay reaches outside the finite record
             inst_b = None
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
-                          endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=BETA_MIN_FIRST_STAGE_R2)
+                          endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=min_fs_b)
+    fb.slope_method += est_note
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,

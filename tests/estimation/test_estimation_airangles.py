@@ -457,3 +457,35 @@ def test_side_force_slopes_are_instrumented_by_the_rudder():
     assert "instruments too weak in pass 1" in weak.axes[1].slope_method, weak.axes[1].slope_method
     assert weak.axes[1].first_stage_r2 < 0.1
     np.testing.assert_array_equal(weak.beta, ls.beta)
+
+
+def test_a_given_flight_decides_the_side_force_estimator(monkeypatch):
+    """A differential diagnosis aids the flight under test with the reference flight's side-force estimator
+    (``models={"beta": AxisFit}``): where the reference's instruments were too weak (least squares; here a first-stage
+    threshold above the record's R2), the test flight uses least squares too, although its own would pass (its first
+    stage is the reference's: the same regressors and controls, only the side force is scaled; the JSBSim
+    t6: reference first-stage R2 0.08, its ``CY:scale`` flights 0.10-0.14, and the two estimators' different errors in
+    variables read as ``CY:beta``); where the reference used 2SLS, the test flight does too, with no fallback of its
+    own. The slopes stay the flight's own: a side force scaled by 1.6 gives a 1.6 times steeper ``CY_beta``."""
+    import gcs_sysid.estimation.airangles as aa
+
+    args, _ = _weathercock_record(1)
+    scaled = list(args)
+    scaled[5] = args[5] * np.array([1.0, 1.6, 1.0])          # the side force scaled by 1.6
+    ref_iv = aided_air_angles(*args, instrument_beta=True).axes[1]
+    with monkeypatch.context() as mp:
+        mp.setattr(aa, "BETA_MIN_FIRST_STAGE_R2", 0.99)      # a reference whose instruments are too weak
+        ref_ls = aided_air_angles(*args, instrument_beta=True).axes[1]
+        forced = aided_air_angles(*scaled, instrument_beta=True, models={"beta": ref_iv}).axes[1]
+    assert ref_ls.used and ref_ls.slope_method.startswith("OLS") and ref_iv.slope_method.startswith("2SLS")
+    follow = aided_air_angles(*scaled, instrument_beta=True, models={"beta": ref_ls})
+    ls = aided_air_angles(*scaled, instrument_beta=False)
+    fb = follow.axes[1]
+    assert fb.slope_method.startswith("OLS") and "estimator of the given model" in fb.slope_method, fb.slope_method
+    np.testing.assert_array_equal(follow.beta, ls.beta)
+    assert abs(fb.coef[1] / ref_ls.coef[1] - 1.6) < 0.05, (fb.coef, ref_ls.coef)
+    assert forced.slope_method.startswith("2SLS") and "estimator of the given model" in forced.slope_method
+    assert abs(forced.coef[1] / ref_iv.coef[1] - 1.6) < 0.05, (forced.coef, ref_iv.coef)
+    # without INSTRUMENTED_BETA a given sideslip fit changes nothing (least squares on both flights)
+    np.testing.assert_array_equal(aided_air_angles(*scaled, instrument_beta=False, models={"beta": ref_iv}).beta,
+                                  ls.beta)
