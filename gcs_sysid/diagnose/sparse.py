@@ -141,9 +141,9 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: clean-flight ``CZ:alpha^2`` -5.36 +- 3.07. No new threshold: the factor is the GUM's conventional one, chosen
 #: before any measurement with it; 0 off.
 #: Added 2026-11-23 (seventeenth session, branch i9-gain; before the 13:45 UTC freeze): ``centred_estimate`` (a named
-#: monomial's reported estimate is its coefficient at the flight's mean regressors in the well-formulated fit: the
-#: selected terms plus the named term's lower-order parents, every other selected term's share of the named
-#: monomial at that point moved onto it; :func:`_centred_weights`, :func:`_with_uncertainty`). It names, drops and
+#: monomial's reported estimate comes from the well-formulated fit: the selected terms plus the named term's
+#: lower-order parents, every other selected term in the named term's own regressors (``alpha^3``, a hinge in alpha
+#: beside ``alpha^2``) projected onto it over the training rows; :func:`_centred_weights`, :func:`_with_uncertainty`). It names, drops and
 #: judges nothing: ``evidence.correction`` and ``evidence.std_error_decision`` keep the selected fit's change and
 #: standard error, which every decision reads. No threshold; False off.
 NAMING_COVERAGE_FACTOR = 2.0
@@ -886,8 +886,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         gone = {x["cause"] for x in result["not_named"]}
         named = [f for f in named if f["cause"] not in gone]
     if th.get("centred_estimate", False) and th.get("honest_std_error", True):
-        # the reported estimate of a named monomial: its Taylor coefficient at the flight's mean regressors in the
-        # well-formulated fit (every decision above was made on the selected fit and is kept; _with_uncertainty)
+        # the reported estimate of a named monomial from the well-formulated fit, companions in its own regressors
+        # projected onto it (every decision above was made on the selected fit and is kept; _with_uncertainty)
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
         for f in named:
@@ -1166,9 +1166,9 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         centred: the *centred estimate* (``THRESHOLDS["centred_estimate"]``; seventeenth session): the named
             monomial is refitted in the well-formulated fit, the selected terms plus its lower-order parents
             (:func:`_parent_terms`; the marginality principle of polynomial regression: Nelder, J. R. Statist. Soc. A
-            140 (1977) 48, sec. 2; Peixoto, Am. Statist. 41 (1987) 311), reparameterised so that its coefficient is
-            the fitted function's named Taylor coefficient at the training rows' mean regressors
-            (:func:`_centred_weights`, :func:`_centre_columns`; the reference's part at the reference's mean). The
+            140 (1977) 48, sec. 2; Peixoto, Am. Statist. 41 (1987) 311), reparameterised so that its coefficient
+            takes up the selected terms in its own regressors by their projection on it and its parents over the
+            training rows (:func:`_centred_weights`, :func:`_centre_columns`; the reference's part over its own rows). The
             finding's ``estimate`` becomes ``model_value +`` that coefficient and ``std_error`` its combined
             uncertainty (every component refitted the same way); ``evidence.correction`` and
             ``evidence.std_error_decision`` keep the selected fit's change and standard error (what the decisions
