@@ -143,7 +143,8 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: Added 2026-11-23 (seventeenth session, branch i9-gain; before the 13:45 UTC freeze): ``centred_estimate`` (a named
 #: monomial's reported estimate comes from the well-formulated fit: the selected terms plus the named term's
 #: lower-order parents, every other selected term in the named term's own regressors (``alpha^3``, a hinge in alpha
-#: beside ``alpha^2``) projected onto it over the training rows; :func:`_centred_weights`, :func:`_with_uncertainty`). It names, drops and
+#: beside ``alpha^2``) projected onto it over the training rows; :func:`_centred_weights`,
+#: :func:`_with_uncertainty`). It names, drops and
 #: judges nothing: ``evidence.correction`` and ``evidence.std_error_decision`` keep the selected fit's change and
 #: standard error, which every decision reads. No threshold; False off.
 NAMING_COVERAGE_FACTOR = 2.0
@@ -1168,7 +1169,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             (:func:`_parent_terms`; the marginality principle of polynomial regression: Nelder, J. R. Statist. Soc. A
             140 (1977) 48, sec. 2; Peixoto, Am. Statist. 41 (1987) 311), reparameterised so that its coefficient
             takes up the selected terms in its own regressors by their projection on it and its parents over the
-            training rows (:func:`_centred_weights`, :func:`_centre_columns`; the reference's part over its own rows). The
+            training rows (:func:`_centred_weights`, :func:`_centre_columns`; the reference's part over its own
+            rows). The
             finding's ``estimate`` becomes ``model_value +`` that coefficient and ``std_error`` its combined
             uncertainty (every component refitted the same way); ``evidence.correction`` and
             ``evidence.std_error_decision`` keep the selected fit's change and standard error (what the decisions
