@@ -41,7 +41,9 @@ Bartlett-window one the thresholds were frozen with.
 from __future__ import annotations
 
 import re
+from collections import Counter
 from dataclasses import replace
+from math import comb
 
 import numpy as np
 
@@ -50,7 +52,7 @@ from .aliases import ALIAS_CONDITION_INDEX, find_aliases, separation_advice
 from .context import DiagContext
 from .lift_alpha import lift_alpha_error
 from .regression import ols
-from .search import alpha_quantile_knots, candidate_library, press_stepwise
+from .search import _BASE, alpha_quantile_knots, candidate_library, press_stepwise
 
 __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
            "angle_nuisance", "untouched_confirmation", "scale_columns", "NAMING_COVERAGE_FACTOR",
@@ -138,6 +140,13 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: read as a cause: the asw20's ``Cm:alpha`` 0.53 +- 0.75 and 0.48 +- 0.69 on ``Cm:alpha^2`` flights, the t6's
 #: clean-flight ``CZ:alpha^2`` -5.36 +- 3.07. No new threshold: the factor is the GUM's conventional one, chosen
 #: before any measurement with it; 0 off.
+#: Added 2026-11-23 (seventeenth session, branch i9-gain; before the 13:45 UTC freeze): ``centred_estimate`` (a named
+#: monomial's reported estimate comes from the well-formulated fit: the selected terms plus the named term's
+#: lower-order parents, every other selected term in the named term's own regressors (``alpha^3``, a hinge in alpha
+#: beside ``alpha^2``) projected onto it over the training rows; :func:`_centred_weights`,
+#: :func:`_with_uncertainty`). It names, drops and
+#: judges nothing: ``evidence.correction`` and ``evidence.std_error_decision`` keep the selected fit's change and
+#: standard error, which every decision reads. No threshold; False off.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -151,7 +160,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
-              "naming_coverage_factor": NAMING_COVERAGE_FACTOR}
+              "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -877,6 +886,17 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                                if not beyond_expanded_uncertainty(f, k_cov)["beyond"]]
         gone = {x["cause"] for x in result["not_named"]}
         named = [f for f in named if f["cause"] not in gone]
+    if th.get("centred_estimate", False) and th.get("honest_std_error", True):
+        # the reported estimate of a named monomial from the well-formulated fit, companions in its own regressors
+        # projected onto it (every decision above was made on the selected fit and is kept; _with_uncertainty)
+        Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
+        model0 = reference[0].model if reference is not None else ctx.model
+        for f in named:
+            if f["cause"] in at_naming and "errors_in_variables" not in f["evidence"]:
+                _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
+                                  bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
+                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
+                                  centred=True)
     result["findings"] = named
     return result
 
@@ -1037,9 +1057,91 @@ def _ridge_jackknife(Phi: np.ndarray, Y: np.ndarray, t: np.ndarray, ridge, max_r
     return out
 
 
+def _monomial_name(factors: Counter) -> str:
+    """A monomial's name as :func:`gcs_sysid.diagnose.search.candidate_library` spells it (``alpha^2*beta``)."""
+    return "*".join(n if factors[n] == 1 else f"{n}^{factors[n]}" for n in _BASE if factors[n] > 0)
+
+
+def _parent_terms(named: str) -> list[str]:
+    """The lower-order parents of a monomial: every monomial made of a proper, non-empty part of its factors.
+
+    ``alpha^2`` -> ``alpha``; ``alpha*beta`` -> ``alpha``, ``beta``; ``alpha^2*beta`` -> ``alpha``, ``alpha^2``,
+    ``beta``, ``alpha*beta``. Empty for a term that is no monomial of the library's regressors (hinges, lags,
+    ``alpha_dot_hat``, ``scale:``) or of degree 1.
+    """
+    fac = _factors(named)
+    if fac is None or not all(x in _BASE for x in fac):
+        return []
+    c = Counter(fac)
+    keys = [n for n in _BASE if c[n] > 0]
+    out = []
+    for powers in np.ndindex(*[c[n] + 1 for n in keys]):
+        sub = Counter({n: int(p) for n, p in zip(keys, powers) if p > 0})
+        if 0 < sum(sub.values()) < len(fac):
+            out.append(_monomial_name(sub))
+    return sorted(out, key=lambda t: (len(_factors(t)), t))
+
+
+def _term_regressors(term: str) -> set | None:
+    """The regressors a library term is a function of (a hinge in alpha: ``{"alpha"}``); None for lags,
+    ``alpha_dot_hat`` and ``scale:`` columns."""
+    if term.startswith("max(0,alpha-"):
+        return {"alpha"}
+    fac = _factors(term)
+    return set(fac) if fac is not None and all(x in _BASE for x in fac) else None
+
+
+def _centred_weights(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray) -> np.ndarray:
+    """How much of the named monomial each selected term holds over the flight: a least-squares projection.
+
+    A selected term that is a function of the named monomial's regressors only (``alpha^3`` or a hinge in alpha
+    beside ``alpha^2``; ``alpha^2*beta`` beside ``alpha*beta``), other than the named term and its parents, is
+    projected on ``[1, parents, named]`` over ``rows``; ``w_j`` is the named coefficient of that projection (1
+    for the named term, 0 for its parents and for terms in other regressors). So ``sum_j w_j theta_j`` over a fit's
+    coefficients is the named coefficient of the best description, in the named term and its parents, of the
+    fitted correction's part in those regressors over this flight's data: for a fitted correction that is the
+    named monomial times k (an injected ``k alpha^2``) it is k whatever else was selected beside it, and it does
+    not depend on the origin of the regressors (a term such as ``alpha^3`` holds about ``3 mean(alpha)`` of
+    ``alpha^2``, so the bare coefficient moves with the flight's mean alpha and the companions chosen).
+
+    Args:
+        A: (N, 1 + K) the fit's columns, constant first. terms: (K,) their names (the named term's parents among
+            them). named: the named monomial. rows: rows of A to project over (the training rows).
+
+    Returns:
+        (K,) weights.
+    """
+    i = terms.index(named)
+    own = _term_regressors(named) or set()
+    parents = set(_parent_terms(named))
+    base = [0] + [1 + k for k, t in enumerate(terms) if t in parents] + [1 + i]
+    B = A[rows][:, base]
+    w = np.zeros(len(terms))
+    w[i] = 1.0
+    for k, t in enumerate(terms):
+        v = _term_regressors(t)
+        if k == i or t in parents or v is None or not v <= own:
+            continue
+        w[k] = float(np.linalg.lstsq(B, A[rows, 1 + k], rcond=None)[0][-1])
+    return w
+
+
+def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray) -> np.ndarray:
+    """Columns ``[1, terms...]`` (N, 1 + K) reparameterised so that the named term's coefficient is
+    :func:`_centred_weights`' ``sum_j w_j theta_j``: column j becomes ``a_j - w_j a_named`` (the same span, so the
+    same fitted function; ``theta'_named = w . theta``)."""
+    w = _centred_weights(A, terms, named, rows)
+    i = 1 + terms.index(named)
+    out = np.array(A, float, copy=True)
+    for j, wj in enumerate(w):
+        if 1 + j != i and wj != 0.0:
+            out[:, 1 + j] = out[:, 1 + j] - wj * out[:, i]
+    return out
+
+
 def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
                       M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
-                      inadequacy_jk: list[np.ndarray] | None = None) -> None:
+                      inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False) -> None:
     """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
 
     The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
@@ -1062,6 +1164,18 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             left out, minus the one subtracted, on this flight ((T, 6) each; :func:`_ridge_jackknife`): the
             term refitted on the residual each would leave gives the inadequacy's share (delete-a-block
             jackknife), a further type-A component of the reference.
+        centred: the *centred estimate* (``THRESHOLDS["centred_estimate"]``; seventeenth session): the named
+            monomial is refitted in the well-formulated fit, the selected terms plus its lower-order parents
+            (:func:`_parent_terms`; the marginality principle of polynomial regression: Nelder, J. R. Statist. Soc. A
+            140 (1977) 48, sec. 2; Peixoto, Am. Statist. 41 (1987) 311), reparameterised so that its coefficient
+            takes up the selected terms in its own regressors by their projection on it and its parents over the
+            training rows (:func:`_centred_weights`, :func:`_centre_columns`; the reference's part over its own
+            rows). The
+            finding's ``estimate`` becomes ``model_value +`` that coefficient and ``std_error`` its combined
+            uncertainty (every component refitted the same way); ``evidence.correction`` and
+            ``evidence.std_error_decision`` keep the selected fit's change and standard error (what the decisions
+            read), ``evidence.centred_estimate`` says what was done. Only when the parents were missing or another
+            selected term holds the named monomial (otherwise the estimate is unchanged and nothing is done).
     """
     from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
@@ -1071,7 +1185,22 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
     named = f"scale:{coef}" if f["cause"].startswith("scale:") else f["cause"].split(":", 1)[1]
     if named not in terms:
         return
+    if centred:
+        fac = _factors(named)
+        if fac is None or not all(x in _BASE for x in fac):
+            return
+        # the named term's parents, leaving out any that is constant on the training rows (collinear with 1)
+        Xt = np.nan_to_num(X[tr])
+        missing = [p for p in _parent_terms(named) if p not in terms
+                   and np.ptp(np.prod([Xt[:, REGRESSORS.index(x)] for x in _factors(p)], axis=0)) > 0]
+        own_vars = _term_regressors(named)
+        holders = [t for t in terms if t != named and t not in _parent_terms(named)
+                   and (_term_regressors(t) or {"-"}) <= own_vars]
+        if not missing and not holders:
+            return
+        terms = terms + missing
     i = 1 + terms.index(named)
+
 
     def columns(Xp: np.ndarray) -> np.ndarray:
         lib = None
@@ -1089,7 +1218,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                     nm, P = _library(replace(ctx, X=Xp), knots)
                     lib = ({n: k for k, n in enumerate(nm)}, P)
                 cols.append(lib[1][:, lib[0][t]])
-        return np.nan_to_num(np.column_stack(cols))
+        A = np.nan_to_num(np.column_stack(cols))
+        return _centre_columns(A, terms, named, tr) if centred else A
 
     rr = np.nan_to_num(r - r[tr].mean())
     try:
@@ -1100,9 +1230,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
     if ref_after is not None and len(ref_after) > 5:
         rnames, rPhi, Rr, rows, S0r, tref = ref_after
         ridx = {n: k for k, n in enumerate(rnames)}
-        if all(t == f"scale:{coef}" or t in ridx for t in terms) and rows.size >= 50:
+        if all(t == f"scale:{coef}" or t in ridx for t in terms) and rows.size >= 50 \
+                and (not centred or all(v in ridx for v in _factors(named))):
             A = np.column_stack([np.ones(rows.size)] + [S0r[rows, j] if t == f"scale:{coef}" else rPhi[rows, ridx[t]]
                                                          for t in terms])
+            if centred:       # projected over the reference's own rows
+                A = _centre_columns(A, terms, named, np.arange(rows.size))
             try:
                 ref = fit_standard_errors(tref[rows], np.nan_to_num(A), Rr[rows, j] - Rr[rows, j].mean(),
                                           ["1"] + terms, block_s)
@@ -1127,7 +1260,22 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                    **typeb})
     if not np.isfinite(u_c) or u_c <= 0:
         return
-    f["evidence"]["std_error_decision"] = float(f["std_error"])
+    if centred:
+        mv = float(f.get("model_value", 0.0) or 0.0)
+        ev = f["evidence"]
+        ev.setdefault("correction", float(f["estimate"]) - mv)
+        ev.setdefault("std_error_decision", float(f["std_error"]))
+        ev["centred_estimate"] = {
+            "change": float(own["theta"][i]), "change_selected_fit": float(f["estimate"]) - mv,
+            "std_error_selected_fit": float(f["std_error"]), "terms": terms, "parents_added": missing,
+            "holders": holders,
+            "weights": dict(zip(terms, _centred_weights(columns(X), terms, named, tr).tolist())),
+            "method": "the selected terms plus the named term's parents (marginality principle; Nelder 1977, Peixoto "
+                      "1987); the terms in the named term's own regressors projected on it and its parents over the "
+                      "training rows (the reference's part over the reference's rows)"}
+        f["estimate"] = mv + float(own["theta"][i])
+    else:
+        f["evidence"]["std_error_decision"] = float(f["std_error"])
     f["evidence"]["uncertainty"] = {
         "method": "GUM (JCGM 100:2008) eq. 10: type A = max(Morelli-Klein coloured, Kuensch 1989 block "
                   f"jackknife over {block_s:g}-s blocks) for this flight and the reference; type B = the air "

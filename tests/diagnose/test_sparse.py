@@ -346,3 +346,40 @@ def test_a_change_within_its_expanded_uncertainty_is_not_a_change():
     # no combined uncertainty reported (a delay): its own decisions stand
     assert beyond_expanded_uncertainty(finding(0.06, 0.0, None))["beyond"]
     assert beyond_expanded_uncertainty(finding(0.5, 0.0, 1.0), k=0.25)["beyond"]
+
+
+def test_centred_estimate_is_the_named_coefficient_whatever_companion_is_selected():
+    """centred_estimate (seventeenth session): a correction that is exactly k alpha^2, fitted with alpha^3 and a
+    hinge in alpha beside alpha^2 (as the JSBSim iar80's search selected), reads k through the reparameterised
+    columns; the bare alpha^2 coefficient of a fit whose companions move it does not. Parents are listed in the
+    library's spelling. Mechanism check on synthetic columns (no flight)."""
+    from gcs_sysid.diagnose.sparse import _centre_columns, _parent_terms
+
+    assert _parent_terms("alpha^2") == ["alpha"]
+    assert _parent_terms("alpha*beta") == ["alpha", "beta"]
+    assert set(_parent_terms("alpha^2*beta")) == {"alpha", "beta", "alpha^2", "alpha*beta"}
+    assert _parent_terms("max(0,alpha-1.0deg)") == [] and _parent_terms("alpha") == []
+    rng = np.random.default_rng(0)
+    a = 0.03 + 0.035 * rng.standard_normal(3000)          # mean alpha 1.7 deg, sd 2 deg
+    d = rng.standard_normal(3000)
+    k = -8.0
+    # the selection's fitted correction: k alpha^2 written with companions that share its curvature
+    terms = ["alpha^2", "alpha^3", "max(0,alpha-0.8deg)", "alpha", "delta_e"]
+    A = np.column_stack([np.ones_like(a), a**2, a**3, np.maximum(0, a - np.radians(0.8)), a, d])
+    theta = np.array([0.0, k - 3.0, 40.0, -0.2, 0.01, 0.0])
+    y = A @ theta
+    # least squares on the same columns returns theta: the bare alpha^2 coefficient is k - 3
+    assert np.linalg.lstsq(A, y, rcond=None)[0][1] == pytest.approx(k - 3.0)
+    # the reparameterised columns give the named coefficient of the best [1, alpha, alpha^2] description
+    rows = np.arange(a.size)
+    Ac = _centre_columns(A, terms, "alpha^2", rows)
+    th_c = np.linalg.lstsq(Ac, y, rcond=None)[0]
+    B = np.column_stack([np.ones_like(a), a, a**2])
+    expected = np.linalg.lstsq(B, y - d * theta[5], rcond=None)[0][2]
+    assert th_c[1] == pytest.approx(expected, rel=1e-8)
+    assert np.allclose(Ac @ th_c, y)                         # the same fitted function
+    # a correction that is only k alpha^2 reads k exactly, whatever companions the fit carries
+    y2 = k * a**2 + 0.5 * d
+    assert np.linalg.lstsq(Ac, y2, rcond=None)[0][1] == pytest.approx(k, rel=1e-8)
+    # the delta_e column is in other regressors: left alone
+    assert np.allclose(Ac[:, 5], d)
