@@ -964,7 +964,7 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
     if np.any(s < 1.0):
         history.notes.append("gp: blocked validation shrank the latent GP to " + ", ".join(
             f"{v:g}" for v in s) + " of its learned prior std per output")
-    if cfg.coupling_validation and Ys.shape[1] > 1:
+    if cfg.gates_coupling and Ys.shape[1] > 1:
         from .joint import gate_coupling
 
         t0 = time.perf_counter()

@@ -66,9 +66,12 @@ CFG = replace(FAST, local=False, input_noise=False, noise_correlation=True)
 
 def test_correlated_noise_is_learned_in_the_likelihood_not_the_output_covariance():
     """A gust-like noise moves outputs 0 and 1 together while their functions are unrelated: the full
-    noise covariance learns the correlation (~0.8), the output correlation of B stays below 0.5."""
+    noise covariance learns the correlation (~0.8), the output correlation of B stays below 0.5. What the
+    likelihood learns, so without the coupling gate (``coupling_validation``, on by default since the sixteenth
+    session), which keeps a coupling only where it lowers the blocked error by 1 % (here the noise coupling's
+    blocked-error ratio is 0.996 for output 0, so the gate drops it, with the paired-t rule and the ratio rule alike)."""
     X, Y, _ = _independent_outputs(400, 0.8, seed=5)
-    model, _ = fit_gp(X, Y, CFG)
+    model, _ = fit_gp(X, Y, replace(CFG, coupling_validation=False))
     assert model.noise_correlation()[0, 1] == pytest.approx(0.8, abs=0.12)
     assert abs(model.noise_correlation()[0, 2]) < 0.25
     c = model.output_correlation()
