@@ -20,7 +20,9 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  (``GPConfig.noise_correlation``: the gusts' correlated error between outputs)
     ``dec``      ``joint`` with its cross-output coupling removed after the fit (``gp.joint.decoupled_model``:
                  ``B`` diagonal, every other hyperparameter kept): ``joint - dec`` is what the coupling does
-    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal)
+    ``jointnf``  ``jointn`` with the shared error started in the noise (``GPConfig.noise_start = "noise"``:
+                 ``B`` starts diagonal, the noise correlation at the ridge residual's)
+    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``
     ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
     ``jointsel`` per output ``joint`` or that output's ``indep`` GP, whichever has the lower blocked
                  cross-validation error on the training rows (``gp.joint.select_outputs``, 5 time blocks,
@@ -80,7 +82,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
+ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "dec", "decn", "decnf", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
 PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joint0", "none"),
@@ -90,7 +92,8 @@ PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joi
          ("jointk", "indep", "none"), ("jointk", "joint", "none"),
          ("jointf", "indep", "none"), ("jointf", "joint", "none"),
          ("jointo", "indep", "none"), ("jointo", "joint", "none"),
-         ("jointn", "indep", "none"), ("lmc", "indep", "none"),
+         ("jointn", "indep", "none"), ("jointnf", "indep", "none"), ("jointnf", "joint", "none"),
+         ("jointnf", "jointn", "none"), ("jointnf", "decnf", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
@@ -157,6 +160,7 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                                ("jointf", replace(base, output_groups="kernels-free")),
                                ("jointo", replace(base, output_groups="output-kernels")),
                                ("jointn", replace(base, noise_correlation=True)),
+                               ("jointnf", replace(base, noise_correlation=True, noise_start="noise")),
                                ("lmc", replace(base, latent_kernels=2))):
                     if (v == "lmc" and not lmc) or v not in models_wanted:
                         continue
@@ -167,7 +171,7 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                     for k in ("coupled", "ratio", "noise_coupled", "noise_ratio"):   # the coupling gate's choice
                         if k in hist.validation:
                             corr[v]["gate_" + k] = hist.validation[k]
-                for v, src in (("dec", "joint"), ("decn", "jointn")):
+                for v, src in (("dec", "joint"), ("decn", "jointn"), ("decnf", "jointnf")):
                     if v in models_wanted and src in models:
                         models[v], times[v] = decoupled_model(models[src]), 0.0
                 preds = {v: _pred(m, X[h]) for v, m in models.items()}
@@ -294,7 +298,7 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn",
+    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf",
               "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]

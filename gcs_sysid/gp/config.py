@@ -77,6 +77,13 @@ class GPConfig:
             not only one variance per output; ``docs/gp.md``, "Noise". Off by default: on the
             JSBSim flights it lowered the errors a little (0.1-1.5 points) but costs ~0.2 s CPU
             per fit in the replay, which is at its speed limit (``docs/benchmarks.md``).
+        noise_start: where the residual's cross-output covariance starts, with ``noise_correlation``:
+            ``"signal"`` (the default, the start before the seventeenth session): 0.7 of the ridge
+            residual's covariance in ``B``, the noise independent (0.3 of each output's variance);
+            ``"noise"``: ``B`` starts diagonal (the same 0.7 of each variance) and the noise covariance
+            at the residual's cross-output correlation, so the shared error starts as noise and the
+            bound moves it into ``B`` only as far as it climbs (``docs/gp.md``, "Noise: where the shared
+            error starts"). Ignored without ``noise_correlation`` and with missing outputs.
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
@@ -193,6 +200,7 @@ class GPConfig:
     swap_pool: int = 256
     hyper_every: int = 0
     noise_correlation: bool = False
+    noise_start: str = "signal"
     input_noise: bool = True
     residual_correlation: bool = False
     validation_folds: int = 5
@@ -238,6 +246,8 @@ class GPConfig:
                 int(self.latent_kernels) != 1 or self.coupling_validation is True):
             raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
                              "latent_kernels=1 and coupling_validation=False")
+        if self.noise_start not in ("signal", "noise"):
+            raise InputError(f"GPConfig.noise_start must be 'signal' or 'noise', got {self.noise_start!r}")
         if self.inducing not in ("mi", "kmeans", "random"):
             raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
         if not (self.learning_rate > 0 and self.local_learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0

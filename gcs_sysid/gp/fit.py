@@ -498,7 +498,10 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
 
     With ``cfg.latent_kernels = J > 1`` the residual covariance is shared equally between the
     kernels (``B_j = B0 / J``) and the length-scales start at :func:`lmc_start_factors` times the
-    ICM start.
+    ICM start. ``B0`` is 0.7 of the residual covariance and each noise variance 0.3 of the residual's;
+    with ``cfg.noise_correlation`` and ``cfg.noise_start = "noise"`` (complete rows, no per-group kernels)
+    ``B0`` keeps only its diagonal and the noise correlation starts at the residual's, so the noise
+    covariance starts at 0.3 of the residual covariance, cross-output part included.
     """
     P = Ys.shape[1]
     R = Ys
@@ -522,6 +525,7 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         Cr = _residual_cov_missing(Xs, Ys, obs, cfg.linear_mean)
     per_group = _per_group(cfg, groups)
     J = int(cfg.latent_kernels)
+    noise_first = bool(cfg.noise_correlation and cfg.noise_start == "noise" and obs.all() and not per_group)
     n_active = max(int(active.sum()), 1)
     ls0 = np.log(0.5 * np.sqrt(n_active))
     if per_group:                      # kernel g on group g's block of the residual covariance, whole
@@ -531,6 +535,8 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         mask = None
     else:
         B0 = 0.7 * Cr / J
+        if noise_first:                # the cross-output part starts in the noise (GPConfig.noise_start)
+            B0 = np.diag(np.diag(B0))
         mask = factor_mask(groups, int(cfg.rank))
         L0, kappa = _split_B(B0, cfg.rank, mask)
         kappa = kappa + 1e-4
@@ -548,6 +554,10 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         raw["lmc_log_kappa"] = np.repeat(np.log(kappa)[None], J - 1, axis=0)
     if cfg.noise_correlation:
         raw["noise_off"] = np.zeros((P, P))
+    if noise_first:                    # the residual's correlation, as the unconstrained factor of the noise's
+        d = np.sqrt(np.diag(Cr))
+        Rl = np.linalg.cholesky(Cr / np.outer(d, d))      # positive definite: Cr carries + 1e-6 I
+        raw["noise_off"] = np.tril(Rl / np.diag(Rl)[:, None], -1)    # inverse of noise_correlation_factor
     if cfg.train_inducing:
         raw["Z"] = np.asarray(Z, float)
     fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
