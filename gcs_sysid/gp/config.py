@@ -97,11 +97,11 @@ class GPConfig:
             place"); 0 or 1: keep both as learned (the model before this check).
         coupling_validation: with the blocked validation, keep the cross-output coupling (the
             off-diagonals of ``B`` and of the noise covariance) only for the outputs whose blocked
-            error it lowers by 1 % in a paired t-test over the time blocks that the gain passes at 5 %
-            (:func:`gcs_sysid.gp.joint.gate_coupling`; ``docs/gp.md``, "Joint vs independent outputs" and
-            "The coupling on isotopic flight tables"). ``None`` (the default since the sixteenth session):
-            on wherever it applies (not with the per-group kernels of ``output_groups``); ``True``: on
-            (refused with those kernels); ``False``: off (the default before; saved models keep theirs).
+            error it lowers by 1 % (:func:`gcs_sysid.gp.joint.gate_coupling`, rule ``"ratio"``; its opt-in
+            rule ``"paired-t"`` also asks the gain to pass a paired t-test over the time blocks at 5 %;
+            ``docs/gp.md``, "Joint vs independent outputs"). ``False`` (the default): off; ``None``: on
+            wherever it applies (not with the per-group kernels of ``output_groups``); ``True``: on
+            (refused with those kernels).
             Why: on the JSBSim flights' isotopic tables the coupling of ``B``, learned under one noise
             variance per output, took up the gusts' cross-output error (CY-Cn, Cl-Cn) and never lowered the
             held-out error against the truth (asw20: joint worse than its decoupled self on 17 of 24 pairs

@@ -96,8 +96,8 @@ def coupling_gain_significant(sse_coupled: np.ndarray, sse_decoupled: np.ndarray
     validation folds; Bergmeir and Benitez 2012 on blocked folds of time series). The decoupled model is
     the simpler one (Occam; Rasmussen and Williams 2006, sec. 5.2-5.3): it stays unless the data show the
     coupling better on held-back time in a way one block alone cannot give. With 5 blocks a gain that
-    comes from one block has ``t ~ 1`` whatever its size (``docs/gp.md``, "The coupling on isotopic
-    flight tables").
+    comes from one block has ``t ~ 1`` whatever its size (``docs/benchmarks.md``, "Sixteenth session: what
+    was measured and not merged").
 
     Args:
         sse_coupled, sse_decoupled: ``(K, P)`` squared-error sums per block and output (``K >= 2``).
@@ -155,12 +155,12 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
     2. signal: output ``p`` benefits when its error with the learned ``B`` (and the gated
        ``Sigma``) is below ``margin`` times that with ``B`` diagonal.
 
-    ``rule="paired-t"`` (the default since the sixteenth session) also asks that the gain hold across the
+    ``rule="paired-t"`` (opt-in; ``fit_gp`` uses ``"ratio"``) also asks that the gain hold across the
     blocks: the per-block differences pass a one-sided paired t-test at :data:`COUPLING_LEVEL`
     (:func:`coupling_gain_significant`). ``rule="ratio"`` is the total ratio alone (the gate before). On
     the JSBSim flights' short logs the ratio alone kept couplings whose blocked gain came from one block
-    of five and that cost the held-out error against the truth (``docs/gp.md``, "The coupling on
-    isotopic flight tables").
+    of five and that cost the held-out error against the truth (``docs/benchmarks.md``, "Sixteenth session:
+    what was measured and not merged"), but it also dropped a real shared latent in ``tests/gp/test_honest.py``.
 
     With missing outputs (NaN in ``Ys``: heterotopic rows) the error of each output is its *gap*
     error instead: in every block only that output's entries are held back, the other outputs of
