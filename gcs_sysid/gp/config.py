@@ -83,7 +83,8 @@ class GPConfig:
             ``"noise"``: ``B`` starts diagonal (the same 0.7 of each variance) and the noise covariance
             at the residual's cross-output correlation, so the shared error starts as noise and the
             bound moves it into ``B`` only as far as it climbs (``docs/gp.md``, "Noise: where the shared
-            error starts"). Ignored without ``noise_correlation`` and with missing outputs.
+            error starts"). Ignored without ``noise_correlation``, with missing outputs and with the
+            per-group kernels of ``output_groups``.
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").

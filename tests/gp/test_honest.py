@@ -102,6 +102,9 @@ def test_a_shared_function_is_found_in_B_under_correlated_noise(start):
                                     n_inducing_hyper=48))
     assert model.output_correlation()[0, 1] < -0.8
     assert model.noise_correlation()[0, 1] == pytest.approx(0.5, abs=0.2)
+
+
+def test_noise_start_is_checked():
     with pytest.raises(InputError, match="noise_start"):
         replace(CFG, noise_start="both")
 
