@@ -22,7 +22,9 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  ``B`` diagonal, every other hyperparameter kept): ``joint - dec`` is what the coupling does
     ``jointnf``  ``jointn`` with the shared error started in the noise (``GPConfig.noise_start = "noise"``:
                  ``B`` starts diagonal, the noise correlation at the ridge residual's)
-    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``
+    ``jointnt``  ``jointn`` with the hyperparameters learned on every 10th training row (``GPConfig.hyper_stride``:
+                 0.2 s apart at 50 Hz, where the gusts' coloured error is less alike)
+    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``, ``decnt`` for ``jointnt``
     ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
     ``jointsel`` per output ``joint`` or that output's ``indep`` GP, whichever has the lower blocked
                  cross-validation error on the training rows (``gp.joint.select_outputs``, 5 time blocks,
@@ -82,7 +84,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "dec", "decn", "decnf", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
+ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt", "dec", "decn", "decnf", "decnt", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
 PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joint0", "none"),
@@ -93,7 +95,9 @@ PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joi
          ("jointf", "indep", "none"), ("jointf", "joint", "none"),
          ("jointo", "indep", "none"), ("jointo", "joint", "none"),
          ("jointn", "indep", "none"), ("jointnf", "indep", "none"), ("jointnf", "joint", "none"),
-         ("jointnf", "jointn", "none"), ("jointnf", "decnf", "none"), ("lmc", "indep", "none"),
+         ("jointnf", "jointn", "none"), ("jointnf", "decnf", "none"),
+         ("jointnt", "indep", "none"), ("jointnt", "joint", "none"), ("jointnt", "jointn", "none"),
+         ("jointnt", "decnt", "none"), ("decnt", "indep", "none"), ("decnt", "joint", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
@@ -161,6 +165,7 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                                ("jointo", replace(base, output_groups="output-kernels")),
                                ("jointn", replace(base, noise_correlation=True)),
                                ("jointnf", replace(base, noise_correlation=True, noise_start="noise")),
+                               ("jointnt", replace(base, noise_correlation=True, hyper_stride=10)),
                                ("lmc", replace(base, latent_kernels=2))):
                     if (v == "lmc" and not lmc) or v not in models_wanted:
                         continue
@@ -171,7 +176,7 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                     for k in ("coupled", "ratio", "noise_coupled", "noise_ratio"):   # the coupling gate's choice
                         if k in hist.validation:
                             corr[v]["gate_" + k] = hist.validation[k]
-                for v, src in (("dec", "joint"), ("decn", "jointn"), ("decnf", "jointnf")):
+                for v, src in (("dec", "joint"), ("decn", "jointn"), ("decnf", "jointnf"), ("decnt", "jointnt")):
                     if v in models_wanted and src in models:
                         models[v], times[v] = decoupled_model(models[src]), 0.0
                 preds = {v: _pred(m, X[h]) for v, m in models.items()}
@@ -298,7 +303,7 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf",
+    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt",
               "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]

@@ -85,6 +85,11 @@ class GPConfig:
             bound moves it into ``B`` only as far as it climbs (``docs/gp.md``, "Noise: where the shared
             error starts"). Ignored without ``noise_correlation``, with missing outputs and with the
             per-group kernels of ``output_groups``.
+        hyper_stride: learn the global hyperparameters on every ``hyper_stride``-th training row in time
+            order (then at most ``n_train_max`` of them at random); 1 (the default): any ``n_train_max`` rows.
+            Rows that close in time share the gusts' coloured error, which the bound, counting rows as
+            independent, explains as signal (``docs/gp.md``, "Noise: where the shared error starts"). The
+            posterior still conditions on every row. Opt-in, measured only by ``eval_gp_joint``.
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
@@ -202,6 +207,7 @@ class GPConfig:
     hyper_every: int = 0
     noise_correlation: bool = False
     noise_start: str = "signal"
+    hyper_stride: int = 1
     input_noise: bool = True
     residual_correlation: bool = False
     validation_folds: int = 5
@@ -247,6 +253,8 @@ class GPConfig:
                 int(self.latent_kernels) != 1 or self.coupling_validation is True):
             raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
                              "latent_kernels=1 and coupling_validation=False")
+        if int(self.hyper_stride) < 1:
+            raise InputError(f"GPConfig.hyper_stride must be >= 1, got {self.hyper_stride!r}")
         if self.noise_start not in ("signal", "noise"):
             raise InputError(f"GPConfig.noise_start must be 'signal' or 'noise', got {self.noise_start!r}")
         if self.inducing not in ("mi", "kmeans", "random"):

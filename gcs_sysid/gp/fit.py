@@ -725,7 +725,11 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         terms[:, ~kern] = np.asarray(masks[1], bool)[:, ~kern]
     if terms is not None:
         history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(k)] for k in terms]
-    sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
+    if int(cfg.hyper_stride) > 1:      # every k-th row in time order: coloured noise decorrelates (opt-in)
+        every = np.arange(0, len(Xs), int(cfg.hyper_stride))
+        sub = every[np.sort(random_points(len(every), cfg.n_train_max, cfg.seed))]
+    else:
+        sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
     obs = np.isfinite(Ys[sub])
     # missing outputs (heterotopic rows): the bound over the observed entries (None: all observed)
     mask_h = None if obs.all() else jax.device_put(obs.astype(float))

@@ -104,9 +104,11 @@ def test_a_shared_function_is_found_in_B_under_correlated_noise(start):
     assert model.noise_correlation()[0, 1] == pytest.approx(0.5, abs=0.2)
 
 
-def test_noise_start_is_checked():
+def test_noise_start_and_hyper_stride_are_checked():
     with pytest.raises(InputError, match="noise_start"):
         replace(CFG, noise_start="both")
+    with pytest.raises(InputError, match="hyper_stride"):
+        replace(CFG, hyper_stride=0)
 
 
 def test_independent_noise_gives_no_learned_output_correlation_above_half():
