@@ -842,7 +842,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg),
                           masks=(kernel, allowed))
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
-    n_hyper = int(min(cfg.n_train_max, len(Xs)))
+    n_hyper = int(min(cfg.n_train_max, -(-len(Xs) // max(int(cfg.hyper_stride), 1))))   # the rows fit_global sees
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
     rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.metric_lengthscale()), cfg.store_cell, cfg.store_max,
                                   cfg.seed).add_dropped(Xs, Ys)
