@@ -20,7 +20,11 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  (``GPConfig.noise_correlation``: the gusts' correlated error between outputs)
     ``dec``      ``joint`` with its cross-output coupling removed after the fit (``gp.joint.decoupled_model``:
                  ``B`` diagonal, every other hyperparameter kept): ``joint - dec`` is what the coupling does
-    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal)
+    ``jointnf``  ``jointn`` with the shared error started in the noise (``GPConfig.noise_start = "noise"``:
+                 ``B`` starts diagonal, the noise correlation at the ridge residual's)
+    ``jointnt``  ``jointn`` with the hyperparameters learned on every 10th training row (``GPConfig.hyper_stride``:
+                 0.2 s apart at 50 Hz, where the gusts' coloured error is less alike)
+    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``, ``decnt`` for ``jointnt``
     ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
     ``jointsel`` per output ``joint`` or that output's ``indep`` GP, whichever has the lower blocked
                  cross-validation error on the training rows (``gp.joint.select_outputs``, 5 time blocks,
@@ -80,15 +84,20 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "jointa", "jointk", "jointf", "jointo", "jointn", "dec", "decn", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
+ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt", "dec", "decn", "decnf", "decnt", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
-PAIRS = (("joint", "indep", "none"), ("jointself", "indep", "none"), ("jointself", "joint", "none"), ("jointse", "indep", "none"), ("jointse", "joint", "none"), ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
+PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joint0", "none"),
+         ("jointv", "indep", "none"), ("jointv", "joint", "none"),
+         ("jointvn", "indep", "none"), ("jointvn", "joint", "none"), ("jointself", "indep", "none"), ("jointself", "joint", "none"), ("jointse", "indep", "none"), ("jointse", "joint", "none"), ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
          ("jointsel", "indep", "none"), ("jointsel", "joint", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
          ("jointk", "indep", "none"), ("jointk", "joint", "none"),
          ("jointf", "indep", "none"), ("jointf", "joint", "none"),
          ("jointo", "indep", "none"), ("jointo", "joint", "none"),
-         ("jointn", "indep", "none"), ("lmc", "indep", "none"),
+         ("jointn", "indep", "none"), ("jointnf", "indep", "none"), ("jointnf", "joint", "none"),
+         ("jointnf", "jointn", "none"), ("jointnf", "decnf", "none"),
+         ("jointnt", "indep", "none"), ("jointnt", "joint", "none"), ("jointnt", "jointn", "none"),
+         ("jointnt", "decnt", "none"), ("decnt", "indep", "none"), ("decnt", "joint", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
@@ -147,19 +156,27 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
             corr: dict = {}
             gone = np.zeros(len(X), bool)
             if pattern == "none":
-                for v, cfg in (("joint", base), ("jointa", replace(base, output_groups="axes")),
+                for v, cfg in (("joint", base), ("joint0", replace(base, coupling_validation=False)),
+                               ("jointv", replace(base, coupling_validation=True)),
+                               ("jointvn", replace(base, coupling_validation=True, noise_correlation=True)),
+                               ("jointa", replace(base, output_groups="axes")),
                                ("jointk", replace(base, output_groups="kernels")),
                                ("jointf", replace(base, output_groups="kernels-free")),
                                ("jointo", replace(base, output_groups="output-kernels")),
                                ("jointn", replace(base, noise_correlation=True)),
+                               ("jointnf", replace(base, noise_correlation=True, noise_start="noise")),
+                               ("jointnt", replace(base, noise_correlation=True, hyper_stride=10)),
                                ("lmc", replace(base, latent_kernels=2))):
                     if (v == "lmc" and not lmc) or v not in models_wanted:
                         continue
                     t0 = time.perf_counter()
-                    models[v] = fit_gp(X[tr], Y[tr], cfg)[0]
+                    models[v], hist = fit_gp(X[tr], Y[tr], cfg)
                     times[v] = time.perf_counter() - t0
                     corr[v] = _correlations(models[v], X[tr], Xt[tr], Yt[tr])
-                for v, src in (("dec", "joint"), ("decn", "jointn")):
+                    for k in ("coupled", "ratio", "noise_coupled", "noise_ratio"):   # the coupling gate's choice
+                        if k in hist.validation:
+                            corr[v]["gate_" + k] = hist.validation[k]
+                for v, src in (("dec", "joint"), ("decn", "jointn"), ("decnf", "jointnf"), ("decnt", "jointnt")):
                     if v in models_wanted and src in models:
                         models[v], times[v] = decoupled_model(models[src]), 0.0
                 preds = {v: _pred(m, X[h]) for v, m in models.items()}
@@ -275,7 +292,7 @@ def summarize(paths) -> str:
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
     out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
             "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo"):
+    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo"):
         for ac in sorted({r["aircraft"] for r in rows}):
             for L in lengths:
                 g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
@@ -286,7 +303,8 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "lmc", "hjoint"):
+    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt",
+              "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:

@@ -22,7 +22,8 @@ the held-out rows against the truth:
 Variants (``--variants``): ``diag`` the GP with one noise variance per output (before issue 8),
 ``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),
 ``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the shipped
-default is the input noise without ``full``, for the replay's speed), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
+default is the input noise without ``full``, for the replay's speed; with the coupling gate, on by default since
+the sixteenth session), ``nigp0`` = ``nigp`` without the coupling gate (the default before), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
 of the least-squares model (LS as the prior mean), ``indep`` six
 independent one-output GPs (same settings, each its own hyperparameters), ``lmc`` = ``nigp`` with a
 linear model of coregionalisation of two latent kernels (``GPConfig.latent_kernels = 2``: per-output
@@ -105,7 +106,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
                                 truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "ls")
+VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "ls")
 
 #: |truth correlation| below which the truth "has none" (the flags of the joint variants)
 TRUTH_NONE = 0.2
@@ -157,6 +158,12 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=variant == "full", input_noise=False)
     if variant in ("nigp", "dec", "sel"):
         return replace(base, noise_correlation=True, input_noise=True)
+    if variant == "nigp0":        # nigp without the coupling gate (the default before the sixteenth session)
+        return replace(base, noise_correlation=True, input_noise=True, coupling_validation=False)
+    if variant == "nigpd":        # nigp with one noise variance per output (the replay's GPConfig())
+        return replace(base, noise_correlation=False, input_noise=True)
+    if variant == "nigpnf":       # nigp with the shared error started in the noise (GPConfig.noise_start)
+        return replace(base, noise_correlation=True, input_noise=True, noise_start="noise")
     if variant == "nigpv":
         return replace(base, noise_correlation=True, input_noise=True, coupling_validation=True)
     if variant == "nigpa":        # the longitudinal and lateral outputs' factors of B kept apart (GPConfig.output_groups)
@@ -251,7 +258,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             else:
                 model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
                 model = with_offset_covariance(model, off)
-                if v in ("nigpv", "nigpa", "nigpk", "nigpf", "nigpo"):
+                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
@@ -503,7 +510,7 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]

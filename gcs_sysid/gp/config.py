@@ -77,6 +77,19 @@ class GPConfig:
             not only one variance per output; ``docs/gp.md``, "Noise". Off by default: on the
             JSBSim flights it lowered the errors a little (0.1-1.5 points) but costs ~0.2 s CPU
             per fit in the replay, which is at its speed limit (``docs/benchmarks.md``).
+        noise_start: where the residual's cross-output covariance starts, with ``noise_correlation``:
+            ``"signal"`` (the default, the start before the seventeenth session): 0.7 of the ridge
+            residual's covariance in ``B``, the noise independent (0.3 of each output's variance);
+            ``"noise"``: ``B`` starts diagonal (the same 0.7 of each variance) and the noise covariance
+            at the residual's cross-output correlation, so the shared error starts as noise and the
+            bound moves it into ``B`` only as far as it climbs (``docs/gp.md``, "Noise: where the shared
+            error starts"). Ignored without ``noise_correlation``, with missing outputs and with the
+            per-group kernels of ``output_groups``.
+        hyper_stride: learn the global hyperparameters on every ``hyper_stride``-th training row in time
+            order (then at most ``n_train_max`` of them at random); 1 (the default): any ``n_train_max`` rows.
+            Rows that close in time share the gusts' coloured error, which the bound, counting rows as
+            independent, explains as signal (``docs/gp.md``, "Noise: where the shared error starts"). The
+            posterior still conditions on every row. Opt-in, measured only by ``eval_gp_joint``.
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
@@ -90,8 +103,15 @@ class GPConfig:
             place"); 0 or 1: keep both as learned (the model before this check).
         coupling_validation: with the blocked validation, keep the cross-output coupling (the
             off-diagonals of ``B`` and of the noise covariance) only for the outputs whose blocked
-            error it lowers by 1 % (:func:`gcs_sysid.gp.joint.gate_coupling`; ``docs/gp.md``,
-            "Joint vs independent outputs"). Off by default.
+            error it lowers by 1 % (:func:`gcs_sysid.gp.joint.gate_coupling`, rule ``"ratio"``; its opt-in
+            rule ``"paired-t"`` also asks the gain to pass a paired t-test over the time blocks at 5 %;
+            ``docs/gp.md``, "Joint vs independent outputs"). ``False`` (the default): off; ``None``: on
+            wherever it applies (not with the per-group kernels of ``output_groups``); ``True``: on
+            (refused with those kernels).
+            Why: on the JSBSim flights' isotopic tables the coupling of ``B``, learned under one noise
+            variance per output, took up the gusts' cross-output error (CY-Cn, Cl-Cn) and never lowered the
+            held-out error against the truth (asw20: joint worse than its decoupled self on 17 of 24 pairs
+            with 20 s of training, better on none).
         output_groups: ``"axes"``: when the outputs are the body-axis coefficients (named
             ``CX CY CZ Cl Cm Cn``, the pipeline's), the shared factors ``L`` of every
             coregionalisation matrix are split between the longitudinal outputs (CX, CZ, Cm) and the
@@ -186,10 +206,12 @@ class GPConfig:
     swap_pool: int = 256
     hyper_every: int = 0
     noise_correlation: bool = False
+    noise_start: str = "signal"
+    hyper_stride: int = 1
     input_noise: bool = True
     residual_correlation: bool = False
     validation_folds: int = 5
-    coupling_validation: bool = False
+    coupling_validation: bool | None = False
     output_groups: str = "none"
     mean_only_inputs: tuple[str, ...] = ()
     mean_only_outputs: tuple[str, ...] = ()
@@ -228,14 +250,26 @@ class GPConfig:
             raise InputError("GPConfig.output_groups must be 'axes', 'kernels', 'kernels-free', 'output-kernels' or "
                              f"'none', got {self.output_groups!r}")
         if self.output_groups in ("kernels", "kernels-free", "output-kernels") and (
-                int(self.latent_kernels) != 1 or self.coupling_validation):
+                int(self.latent_kernels) != 1 or self.coupling_validation is True):
             raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
                              "latent_kernels=1 and coupling_validation=False")
+        if int(self.hyper_stride) < 1:
+            raise InputError(f"GPConfig.hyper_stride must be >= 1, got {self.hyper_stride!r}")
+        if self.noise_start not in ("signal", "noise"):
+            raise InputError(f"GPConfig.noise_start must be 'signal' or 'noise', got {self.noise_start!r}")
         if self.inducing not in ("mi", "kmeans", "random"):
             raise InputError(f"GPConfig.inducing must be 'mi', 'kmeans' or 'random', got {self.inducing!r}")
         if not (self.learning_rate > 0 and self.local_learning_rate > 0 and self.jitter > 0 and self.prior_std >= 0
                 and self.tol >= 0):
             raise InputError("GPConfig: learning rates and jitter must be > 0, prior_std and tol >= 0")
+
+    @property
+    def gates_coupling(self) -> bool:
+        """Whether ``fit_gp`` runs the coupling gate (``coupling_validation``; ``None``: wherever it applies,
+        i.e. not with the per-group kernels of ``output_groups``)."""
+        if self.coupling_validation is None:
+            return self.output_groups not in ("kernels", "kernels-free", "output-kernels")
+        return bool(self.coupling_validation)
 
     def to_dict(self) -> dict:
         """JSON-able settings."""

@@ -498,7 +498,10 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
 
     With ``cfg.latent_kernels = J > 1`` the residual covariance is shared equally between the
     kernels (``B_j = B0 / J``) and the length-scales start at :func:`lmc_start_factors` times the
-    ICM start.
+    ICM start. ``B0`` is 0.7 of the residual covariance and each noise variance 0.3 of the residual's;
+    with ``cfg.noise_correlation`` and ``cfg.noise_start = "noise"`` (complete rows, no per-group kernels)
+    ``B0`` keeps only its diagonal and the noise correlation starts at the residual's, so the noise
+    covariance starts at 0.3 of the residual covariance, cross-output part included.
     """
     P = Ys.shape[1]
     R = Ys
@@ -522,6 +525,7 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         Cr = _residual_cov_missing(Xs, Ys, obs, cfg.linear_mean)
     per_group = _per_group(cfg, groups)
     J = int(cfg.latent_kernels)
+    noise_first = bool(cfg.noise_correlation and cfg.noise_start == "noise" and obs.all() and not per_group)
     n_active = max(int(active.sum()), 1)
     ls0 = np.log(0.5 * np.sqrt(n_active))
     if per_group:                      # kernel g on group g's block of the residual covariance, whole
@@ -531,6 +535,8 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         mask = None
     else:
         B0 = 0.7 * Cr / J
+        if noise_first:                # the cross-output part starts in the noise (GPConfig.noise_start)
+            B0 = np.diag(np.diag(B0))
         mask = factor_mask(groups, int(cfg.rank))
         L0, kappa = _split_B(B0, cfg.rank, mask)
         kappa = kappa + 1e-4
@@ -548,6 +554,10 @@ def _init_global(Xs, Ys, active, cfg: GPConfig, Z, terms: np.ndarray | None = No
         raw["lmc_log_kappa"] = np.repeat(np.log(kappa)[None], J - 1, axis=0)
     if cfg.noise_correlation:
         raw["noise_off"] = np.zeros((P, P))
+    if noise_first:                    # the residual's correlation, as the unconstrained factor of the noise's
+        d = np.sqrt(np.diag(Cr))
+        Rl = np.linalg.cholesky(Cr / np.outer(d, d))      # positive definite: Cr carries + 1e-6 I
+        raw["noise_off"] = np.tril(Rl / np.diag(Rl)[:, None], -1)    # inverse of noise_correlation_factor
     if cfg.train_inducing:
         raw["Z"] = np.asarray(Z, float)
     fixed = {"active": np.asarray(active, bool), "Z": np.asarray(Z, float),
@@ -715,7 +725,11 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         terms[:, ~kern] = np.asarray(masks[1], bool)[:, ~kern]
     if terms is not None:
         history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(k)] for k in terms]
-    sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
+    if int(cfg.hyper_stride) > 1:      # every k-th row in time order: coloured noise decorrelates (opt-in)
+        every = np.arange(0, len(Xs), int(cfg.hyper_stride))
+        sub = every[np.sort(random_points(len(every), cfg.n_train_max, cfg.seed))]
+    else:
+        sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
     obs = np.isfinite(Ys[sub])
     # missing outputs (heterotopic rows): the bound over the observed entries (None: all observed)
     mask_h = None if obs.all() else jax.device_put(obs.astype(float))
@@ -828,7 +842,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg),
                           masks=(kernel, allowed))
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
-    n_hyper = int(min(cfg.n_train_max, len(Xs)))
+    n_hyper = int(min(cfg.n_train_max, -(-len(Xs) // max(int(cfg.hyper_stride), 1))))   # the rows fit_global sees
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
     rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.metric_lengthscale()), cfg.store_cell, cfg.store_max,
                                   cfg.seed).add_dropped(Xs, Ys)
@@ -964,7 +978,7 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
     if np.any(s < 1.0):
         history.notes.append("gp: blocked validation shrank the latent GP to " + ", ".join(
             f"{v:g}" for v in s) + " of its learned prior std per output")
-    if cfg.coupling_validation and Ys.shape[1] > 1:
+    if cfg.gates_coupling and Ys.shape[1] > 1:
         from .joint import gate_coupling
 
         t0 = time.perf_counter()
