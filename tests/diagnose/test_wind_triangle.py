@@ -131,7 +131,7 @@ def test_triangle_alone_screen_with_no_finite_refit_names_nothing(monkeypatch):
     monkeypatch.setattr(wt, "change_since_references",
                         lambda tri, refs: {"change_mps": 1.5, "std_error": 0.3, "t_statistic": 5.0})
     monkeypatch.setattr(pitot, "_reference_triangles", lambda *a: [])
-    monkeypatch.setattr(pitot, "_unit_delta_rereduced", lambda ctx, flight, b: np.zeros((10, 6)))
+    monkeypatch.setattr(pitot, "_unit_delta_rereduced", lambda ctx, flight, b, angle_fits=None: np.zeros((10, 6)))
     monkeypatch.setattr(pitot, "_fit_unit_delta", lambda ctx, R, D1, base=None: (np.nan, np.nan, {}))
     ctx = SimpleNamespace(t=np.arange(10.0), states=None, valid=np.ones(10, bool))
     out = pitot._fused_candidate(ctx, None, None, None, [], None, None,
