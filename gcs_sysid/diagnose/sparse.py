@@ -43,7 +43,6 @@ from __future__ import annotations
 import re
 from collections import Counter
 from dataclasses import replace
-from math import comb
 
 import numpy as np
 
