@@ -509,6 +509,29 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="Caudron C.684 racer (FlightGear's JSBSim C684.xml, checked in under data/jsbsim_models/c684) with its "
               "engine, propeller and engine system removed (derived model C684_glide, XML sha256 4d332e34ee7966d7), "
               "fixed gear, gliding; untouched by any tuning of the method"),
+    # ultrastick: the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 (UASLab/OpenFlightSim
+    # Simulation/aircraft/UltraStick120 at 1650a6e3; MIT), a 7.4-kg radio-controlled research UAV: 1.92-m span,
+    # 0.786 m^2 (wing loading 9.4 kg/m^2), measured inertia with a product (Ixz 0.19 kg m^2), fixed gear. The fifth
+    # model from outside the wheel and the first not from FlightGear or ArduPilot; its files are checked in
+    # (data/jsbsim_models/ultrastick120/, provenance and licence in its README.md) and flown as the derived model
+    # ``UltraStick120_glide`` (derived.py): its Metrics, Mass, Gear and Aero files assembled into one, no
+    # propulsion, the lab's control laws, actuators and sensors replaced by direct surfaces (+-30 deg, the lab's
+    # actuator limits). Chosen in the eighteenth session (docs/jsbsim.md, "The ultrastick"): its aerodynamics
+    # are vortex-lattice (AVL) tables in alpha of every derivative of all six coefficients, each aileron with
+    # its own tables (CL, CD, CY, Cl, Cm, Cn of each side). Signs read from its aerodynamics: dCMm/dElev -1.2
+    # (positive = trailing edge down), dCMl/dAilL +0.11 and dCMl/dAilR -0.11 (each positive = trailing edge
+    # down; the right is driven as the mirror of the left, so delta_a = -left: Cl_delta_a -0.22),
+    # dCMn/dRud -0.04 (positive = trailing edge left, nose left). Set from the harness's truth only (alpha,
+    # beta, rates, excitation per axis, surfaces, sink), never from a method result.
+    "ultrastick": AircraftSpec(
+        name="ultrastick", model="UltraStick120_glide", airspeed_kts=45.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/posAilL_rad", "fcs/posAilR_rad"), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988),
+        amplitude_deg=(5.0, 4.0, 5.0), pulse_s=(0.3, 0.4, 0.5), gains=(0.5, 0.15, 0.01, 0.2, 0.05, 0.2),
+        notes="Ultra Stick 120 UAV (UASLab OpenFlightSim JSBSim model, checked in under "
+              "data/jsbsim_models/ultrastick120) without propulsion, direct surfaces (derived model "
+              "UltraStick120_glide, XML sha256 df846fb42f873137), fixed gear, gliding; untouched by any tuning of the "
+              "method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
                    "asw20", "iar80")

@@ -8,7 +8,9 @@ parts that need FlightGear removed and its elevator table reading an alias (``as
 :func:`derive_asw20_glide`; fifteenth session), or FlightGear's JSBSim IAR-80 fighter with its engine and
 propeller removed (``IAR80_glide``, :func:`derive_iar80_glide`; sixteenth session), or FlightGear's JSBSim
 Caudron C.684 racer with its engine, propeller and engine system removed (``C684_glide``,
-:func:`derive_c684_glide`; seventeenth session).
+:func:`derive_c684_glide`; seventeenth session), or the University of Minnesota UAS Lab's JSBSim Ultra Stick 120
+UAV assembled from its files into one, gliding, with direct surfaces (``UltraStick120_glide``,
+:func:`derive_ultrastick120_glide`; eighteenth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -62,7 +64,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
-           "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derived_xml", "derived_sha",
+           "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
+           "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
 
@@ -358,6 +361,98 @@ def derive_c684_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+#: The checked-in UltraStick 120 files :func:`derive_ultrastick120_glide` assembles (beside the main file).
+_US120_DIR = Path(__file__).resolve().parents[2] / "data" / "jsbsim_models" / "ultrastick120"
+
+#: The main file's sections (tag, file) in the stored version (UASLab/OpenFlightSim at 1650a6e3).
+_US120_SECTIONS = [("flight_control", "Systems/FlightControl.xml"), ("system", "Systems/Effectors.xml"),
+                   ("mass_balance", "Mass.xml"), ("ground_reactions", "Gear.xml"), ("propulsion", "Propulsion.xml"),
+                   ("metrics", "Metrics.xml"), ("aerodynamics", "Aero.xml"), ("system", "Systems/SensorImu.xml"),
+                   ("system", "Systems/SensorGps.xml"), ("system", "Systems/SensorPitot.xml"),
+                   ("system", "Systems/Sensor5Hole.xml")]
+
+#: Surface travel of the UltraStick 120's actuators (``Systems/Effectors.xml``: every actuator clips at
+#: +-0.5235987755982988 rad, 30 deg).
+US120_SURFACE_RAD = 0.5235987755982988
+
+
+def derive_ultrastick120_glide(root: ET.Element) -> ET.Element:
+    """The University of Minnesota UAS Lab's JSBSim Ultra Stick 120 (``data/jsbsim_models/ultrastick120/``,
+    UASLab/OpenFlightSim ``Simulation/aircraft/UltraStick120`` at 1650a6e3, MIT) as one file, gliding, with
+    a direct flight-control system (eighteenth session).
+
+    The model is split over files the main ``UltraStick120.xml`` names (``<metrics file="Metrics.xml"/>``
+    and so on). The derivation reads the checked-in ``Metrics.xml``, ``Mass.xml``, ``Gear.xml`` and
+    ``Aero.xml`` (unchanged) into one ``<fdm_config>``, and:
+
+    - **No propulsion.** ``Propulsion.xml`` (an electric motor and an APC 16x8 propeller) is not copied: an
+      empty ``<propulsion/>``, so that every non-gravity force is aerodynamic (the harness glides every aircraft).
+    - **A direct flight-control system** replaces ``Systems/FlightControl.xml`` (the lab's control laws and
+      excitation) and ``Systems/Effectors.xml`` (six actuators: first-order lag 57 rad/s, 0.02-s delay,
+      2-deg hysteresis, +-30 deg): ``aerosurface_scale`` of the harness's normalised commands, +-30 deg
+      (:data:`US120_SURFACE_RAD`), as the other derived models (the harness's servos are the actuators).
+      Elevator -> ``fcs/elevator-pos-rad``, rudder -> ``fcs/rudder-pos-rad``, aileron -> ``fcs/posAilL_rad``
+      and its mirror ``fcs/posAilR_rad`` (the lab's names; each has its own tables); the two flaps
+      (``fcs/posFlapL_rad``, ``fcs/posFlapR_rad``) are declared 0 (the harness's log has no flap channel).
+    - **Surface names.** The aerodynamics' reads of ``fcs/posElev_rad`` and ``fcs/posRud_rad`` are written
+      ``fcs/elevator-pos-rad`` and ``fcs/rudder-pos-rad`` (the properties the harness logs and ``effects.py``'s
+      ``delay:delta_e`` redirects); no number changes.
+    - **Sensors** (``Systems/Sensor*.xml``: the lab's IMU, GPS, pitot and five-hole-probe models) are not
+      copied: the harness has its own sensors.
+
+    Args:
+        root: the parsed ``UltraStick120.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the main file does not name the expected sections (another version), or a checked-in
+            section file has another root element.
+    """
+    got = [(c.tag, c.get("file")) for c in root]
+    if got != _US120_SECTIONS:
+        raise ValueError(f"UltraStick120.xml: expected the sections {_US120_SECTIONS}, got {got}")
+    new = ET.Element("fdm_config", {"name": "UltraStick120_glide", "version": "2.0", "release": "ALPHA"})
+    head = ET.SubElement(new, "fileheader")
+    ET.SubElement(head, "author").text = "University of Minnesota UAS Laboratories (OpenFlightSim, MIT)"
+    ET.SubElement(head, "description").text = "Ultra Stick 120 UAV, gliding, direct surfaces (gcs-sysid derivation)"
+    parts = {}
+    for tag in ("metrics", "mass_balance", "ground_reactions", "aerodynamics"):
+        f = dict((t, f) for t, f in _US120_SECTIONS if t == tag)[tag]
+        part = ET.parse(_US120_DIR / f).getroot()
+        if part.tag != tag:
+            raise ValueError(f"{f}: root <{part.tag}>, expected <{tag}>")
+        parts[tag] = part
+    new.append(parts["metrics"])
+    new.append(parts["mass_balance"])
+    new.append(parts["ground_reactions"])
+    ET.SubElement(new, "propulsion")
+    fcs = ET.SubElement(new, "flight_control", {"name": "UltraStick120_glide direct surfaces"})
+    for flap in ("fcs/posFlapL_rad", "fcs/posFlapR_rad"):
+        ET.SubElement(fcs, "property", {"value": "0"}).text = flap
+    for channel, cmd, outs in (("Pitch", "fcs/elevator-cmd-norm", [("Elevator", "", "fcs/elevator-pos-rad")]),
+                               ("Roll", "fcs/aileron-cmd-norm", [("Left Aileron", "", "fcs/posAilL_rad"),
+                                                                 ("Right Aileron", "-", "fcs/posAilR_rad")]),
+                               ("Yaw", "fcs/rudder-cmd-norm", [("Rudder", "", "fcs/rudder-pos-rad")])):
+        ch = ET.SubElement(fcs, "channel", {"name": channel})
+        for name, sign, out in outs:
+            comp = ET.SubElement(ch, "aerosurface_scale", {"name": f"{name} Control"})
+            ET.SubElement(comp, "input").text = sign + cmd
+            rng = ET.SubElement(comp, "range")
+            ET.SubElement(rng, "min").text = repr(-US120_SURFACE_RAD)
+            ET.SubElement(rng, "max").text = repr(US120_SURFACE_RAD)
+            ET.SubElement(comp, "output").text = out
+    aero = parts["aerodynamics"]
+    rename = {"fcs/posElev_rad": "fcs/elevator-pos-rad", "fcs/posRud_rad": "fcs/rudder-pos-rad"}
+    for el in aero.iter("property"):
+        t = (el.text or "").strip()
+        if t in rename:
+            el.text = rename[t]
+    new.append(aero)
+    return new
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -395,6 +490,14 @@ REPO_DERIVED = {
                    derive_c684_glide, "engine, propeller and the engine system removed (a glide with no propeller "
                                       "force); the fuel tanks stay as mass; the gear's FIXED flags written 0 "
                                       "(JSBSim 1.3.3's syntax); everything else unchanged."),
+    "UltraStick120_glide": ("data/jsbsim_models/ultrastick120/UltraStick120.xml",
+                            "the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 (UASLab/OpenFlightSim "
+                            "Simulation/aircraft/UltraStick120 at 1650a6e3, MIT), copied into gcs-sysid's "
+                            "data/jsbsim_models/ultrastick120/",
+                            derive_ultrastick120_glide, "its Metrics, Mass, Gear and Aero files in one file; no "
+                            "propulsion; the lab's control laws, actuators and sensors replaced by direct surfaces "
+                            "(+-30 deg); the aerodynamics read fcs/elevator-pos-rad and fcs/rudder-pos-rad for the "
+                            "lab's posElev_rad and posRud_rad; flaps 0; no number changed."),
 }
 
 
