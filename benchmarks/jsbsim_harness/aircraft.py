@@ -82,10 +82,12 @@ _DEG = 57.29577951308232
 #: 3000 ft where JSBSim's light turbulence is active) and ``asw20`` (the fifteenth session's: FlightGear's ASW 20
 #: sailplane, checked into ``data/jsbsim_models/asw20`` and flown as ``asw20_glide``, at 3000 ft) are used since as
 #: well, as is ``iar80`` (the sixteenth session's: FlightGear's JSBSim IAR-80 fighter, checked into
-#: ``data/jsbsim_models/iar80`` and flown as ``IAR80_glide``, engine and propeller removed, at 10000 ft). ``c684``
-#: (added in the seventeenth session, 2026-11-23: FlightGear's JSBSim Caudron C.684 racer, checked into
-#: ``data/jsbsim_models/c684`` and flown as ``C684_glide``, engine and propeller removed, at 6000 ft) is the
-#: held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from
+#: ``data/jsbsim_models/iar80`` and flown as ``IAR80_glide``, engine and propeller removed, at 10000 ft) and ``c684``
+#: (the seventeenth session's: FlightGear's JSBSim Caudron C.684 racer, checked into ``data/jsbsim_models/c684`` and
+#: flown as ``C684_glide``, engine and propeller removed, at 6000 ft). ``ultrastick`` (added in the eighteenth
+#: session, 2026-11-23: the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV, checked into
+#: ``data/jsbsim_models/ultrastick120`` and flown as ``UltraStick120_glide``, no propulsion, direct surfaces, at
+#: 10000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from
 #: JSBSim's truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
@@ -534,9 +536,9 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20", "iar80")
-HELD_OUT_AIRCRAFT = ("c684",)
-UNTOUCHED_AIRCRAFT = ("c684",)
+                   "asw20", "iar80", "c684")
+HELD_OUT_AIRCRAFT = ("ultrastick",)
+UNTOUCHED_AIRCRAFT = ("ultrastick",)
 
 
 def aircraft(name: str) -> AircraftSpec:
