@@ -1,4 +1,5 @@
-"""The c684 in the JSBSim harness: the seventeenth session's untouched aircraft (docs/jsbsim.md, "The c684").
+"""The c684 in the JSBSim harness: the seventeenth session's untouched aircraft, used since the eighteenth
+(docs/jsbsim.md, "The c684").
 
 The model is FlightGear's JSBSim Caudron C.684 Super Rafale (``C684.xml`` of FGMEMBERS/C684 at commit 05ad4b2c,
 GPL-2.0-or-later; Guillaume Chauvat 2008, hand-made tables), a 1930s French racing two-seater, checked in under
@@ -12,19 +13,19 @@ turbulence: a mechanism check); none of them flies the harness:
 - the checked-in file is the one the README names, and the derivation makes only its three edits;
 - the FCS maps the commands straight to the surfaces the aerodynamics read, with unequal ends (elevator
   -0.35 / +0.30 rad, ailerons 20 / 15 deg mirrored, rudder +-20 deg) and no damper; no engine, no external force;
-- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else.
+- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says.
+
+The summaries' label test moved to ``test_jsbsim_ultrastick.py`` in the eighteenth session (the ultrastick is
+untouched; the c684 is a tuning aircraft).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
 map, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
 All of them but the names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the c684: its first evaluation is the final one,
-after the merge.
+No pipeline fit, GP, diagnosis or scoring ran on the c684 before the seventeenth session's final evaluation.
 """
 
 import hashlib
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -149,31 +150,3 @@ def test_the_c684_is_statically_stable_and_its_controls_act_as_its_xml_says():
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.141, abs=2e-3), a
 
-
-def test_summaries_mark_the_c684_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the c684 "(untouched)" and
-    no other aircraft, the iar80 and asw20 included (synthetic rows: no c684 result exists before the
-    final evaluation). Moved here from ``test_jsbsim_iar80.py`` (the sixteenth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| c684 (untouched) | light") for ln in lines)
-    for ac in acs[:13]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| c684 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| iar80 | clean |") for ln in lines)

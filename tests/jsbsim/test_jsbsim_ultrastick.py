@@ -1,0 +1,180 @@
+"""The ultrastick in the JSBSim harness: the eighteenth session's untouched aircraft (docs/jsbsim.md, "The ultrastick").
+
+The model is the University of Minnesota UAS Laboratories' JSBSim Ultra Stick 120 (UASLab/OpenFlightSim
+``Simulation/aircraft/UltraStick120`` at commit 1650a6e3, MIT), a 7.4-kg research UAV whose aerodynamics are
+vortex-lattice tables in alpha of every derivative of the six coefficients. Its files are checked in under
+``data/jsbsim_models/ultrastick120/`` and flown as the derived model ``UltraStick120_glide`` (``derived.py``):
+the Metrics, Mass, Gear and Aero files in one, no propulsion, direct surfaces (+-30 deg) for the lab's control
+laws, actuators and sensors. It is flown at 45 kt (``ic/vc-kts``) and 10000 ft.
+
+The checks here use the files and JSBSim's own properties (the harness's initial condition, ``run_ic``, no
+turbulence: a mechanism check); none of them flies the harness:
+
+- the checked-in files are the README's, and the derivation changes no number;
+- the FCS maps the commands straight to the surfaces (+-30 deg, the right aileron the left's mirror), flaps 0;
+  no engine, no external force;
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its tables say;
+- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_c684.py``).
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
+map, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
+All of them but the names are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the ultrastick: its first evaluation is the final one,
+after the merge.
+"""
+
+import hashlib
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import assert_aero_is_the_only_force, ic_state
+
+DIR = "data/jsbsim_models/ultrastick120"
+#: file -> (bytes, SHA-256), as the README lists them.
+FILES = {
+    "UltraStick120.xml": (554, "f3126cd0de1ca74d9372d967e4c90cf57452e15572f13990c6fc67447932ba12"),
+    "Aero.xml": (64633, "51cc33123dfd437a398a4f9f720a1ffa8613da5a482fdcf831bf82759acf0751"),
+    "Mass.xml": (430, "16d06b38088ffe963d9916d4bcca67b083f939b1e9b9dbc94d87b7a841c7a4c3"),
+    "Metrics.xml": (561, "a1fcb576eb571091fe01c46f73a9d53d651bdc9636005ed8a9db818ecc318e42"),
+    "Gear.xml": (1702, "fbfa16e648947d212bbcbd28e1ebb94a3d8bab3d4fc9b88d52455bf134b02c7b"),
+}
+SURFACE = 0.5235987755982988      # every surface's end, rad (the lab's actuator clip, 30 deg)
+
+
+def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+    """:func:`truth_fits.ic_state` for the ultrastick (45 kt at 10000 ft)."""
+    return ic_state(aircraft("ultrastick"), alpha_deg, beta_deg, cmds, r_rad_s)
+
+
+def test_the_derivation_assembles_the_files_and_changes_no_number():
+    """The checked-in files are the README's (bytes and SHA-256). ``UltraStick120_glide`` holds ``Metrics.xml``,
+    ``Mass.xml`` and ``Gear.xml`` as they are, an empty ``<propulsion>``, a direct ``<flight_control>`` and
+    ``Aero.xml`` with its reads of ``fcs/posElev_rad`` and ``fcs/posRud_rad`` renamed ``fcs/elevator-pos-rad``
+    and ``fcs/rudder-pos-rad`` (nothing else: the same functions, tables and numbers); no system. The spec's notes
+    carry the derived XML's hash."""
+    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
+    from benchmarks.jsbsim_harness.logfile import _REPO
+
+    for name, (n, sha) in FILES.items():
+        raw = (_REPO / DIR / name).read_bytes()
+        assert len(raw) == n and hashlib.sha256(raw).hexdigest() == sha, name
+    spec = aircraft("ultrastick")
+    assert spec.model == "UltraStick120_glide" and REPO_DERIVED[spec.model][0] == f"{DIR}/UltraStick120.xml"
+    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
+    der = ET.fromstring(derived_xml(spec.model))
+    canon = lambda e: "".join(ET.tostring(e, encoding="unicode").split())   # noqa: E731  (layout aside: ET.indent)
+    assert [c.tag for c in der] == ["fileheader", "metrics", "mass_balance", "ground_reactions", "propulsion",
+                                    "flight_control", "aerodynamics"]
+    for tag, name in (("metrics", "Metrics.xml"), ("mass_balance", "Mass.xml"), ("ground_reactions", "Gear.xml")):
+        assert canon(der.find(tag)) == canon(ET.parse(_REPO / DIR / name).getroot()), tag
+    assert list(der.find("propulsion")) == []
+    aero = ET.parse(_REPO / DIR / "Aero.xml").getroot()
+    reads = [p.text for p in aero.iter("property")]
+    assert reads.count("fcs/posElev_rad") == 6 and reads.count("fcs/posRud_rad") == 6
+    for p in aero.iter("property"):
+        p.text = {"fcs/posElev_rad": "fcs/elevator-pos-rad", "fcs/posRud_rad": "fcs/rudder-pos-rad"}.get(p.text, p.text)
+    assert canon(aero) == canon(der.find("aerodynamics"))
+
+
+def test_the_ultrastick_flies_direct_surfaces_without_engine_or_external_force():
+    """The FCS maps each command straight to its surface, +-30 deg (``aerosurface_scale``, no actuator dynamics,
+    no damper): elevator -> ``fcs/elevator-pos-rad``, rudder -> ``fcs/rudder-pos-rad``, aileron ->
+    ``fcs/posAilL_rad`` and ``fcs/posAilR_rad`` = -left (each positive trailing edge down: the harness reads both,
+    delta_a = -0.5 (left - right) = -left); the flaps stay 0. No engine; after 50 frames every non-gravity
+    force and moment is aerodynamic. A yaw rate does not move the rudder."""
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    spec = aircraft("ultrastick")
+    assert not spec.gear_up and spec.aileron_props == ("fcs/posAilL_rad", "fcs/posAilR_rad")
+    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * SURFACE, rel=1e-9)
+    assert fdm["fcs/posAilL_rad"] == pytest.approx(-0.4 * SURFACE, rel=1e-9)
+    assert fdm["fcs/posAilR_rad"] == pytest.approx(0.4 * SURFACE, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * SURFACE, rel=1e-9)
+    assert fdm["fcs/posFlapL_rad"] == 0.0 and fdm["fcs/posFlapR_rad"] == 0.0
+    da = np.radians(5.0)      # trailing edge down on the right
+    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
+    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aero_is_the_only_force(fdm, 5.0, external_zero=True)      # it weighs 16.3 lb
+
+
+def test_the_ultrastick_is_statically_stable_and_its_controls_act_as_its_tables_say():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic`` at the harness's initial condition). The
+    aerodynamic reference point is 7 mm ahead of the CG and 0.072 m below it; the model has no alpha-dot term.
+
+    - **Pitch:** Cm falls with alpha: -0.93 per rad between -4 and 0 deg, -0.70 between 0 and 4 deg
+      (``dCMm__alpha_rad`` -0.81..-1.15 per rad in its table, with the ``CMm__zero`` table); per rad of
+      elevator -1.196 at alpha 2 deg (``dCMm__dElev_rad`` -1.206 there, less the lift and drag of the
+      elevator through the arm).
+    - **Roll and yaw:** per rad of left aileron (the right its mirror) Cl +0.2172 at alpha 2 deg (the two
+      tables: 0.1089 + 0.1089; the project's Cl_delta_a -0.217) and Cn -0.0038 (-0.0019 - 0.0019: an
+      alpha-dependent cross term, Cn_delta_a +0.0038 in the project's sign), the same either side; per rad of
+      rudder Cn -0.0392 (``dCMn__dRud_rad`` -0.0395) and Cl -0.0037 (-0.0006 and the rudder's side force
+      acting below the CG); Cl_beta changes sign with alpha (+0.021 at -2 deg, -0.016 at 2, -0.037 at 6:
+      its ``dCMl__beta_rad`` table), Cn_beta 0.068-0.075.
+    """
+    spec = aircraft("ultrastick")
+
+    def cm(alpha, de=0.0):
+        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
+        return fdm["moments/m-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"])
+
+    cm_4, c0, c4 = cm(-4.0), cm(0.0), cm(4.0)
+    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
+    assert slope(cm_4, c0) == pytest.approx(-0.930, abs=0.01) and slope(c0, c4) == pytest.approx(-0.695, abs=0.01)
+    for c in (-0.3, 0.3):
+        assert (cm(2.0, c) - cm(2.0)) / (c * SURFACE) == pytest.approx(-1.196, abs=0.005)
+
+    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
+        fdm = _state(alpha_deg=alpha, beta_deg=beta, cmds=cmds)
+        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
+        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb, fdm["fcs/posAilL_rad"],
+                fdm["fcs/rudder-pos-rad"])
+
+    l0, n0, _, _ = lat()
+    assert abs(l0) < 1e-5 and abs(n0) < 1e-5
+    for c in (0.3, -0.3):
+        l1, n1, a1, _ = lat((0.0, c, 0.0))
+        assert (l1 - l0) / a1 == pytest.approx(0.2172, abs=1e-3) and (n1 - n0) / a1 == pytest.approx(-0.0038, abs=3e-4)
+    l2, n2, _, r2 = lat((0.0, 0.0, 0.3))
+    assert (n2 - n0) / r2 == pytest.approx(-0.0392, abs=5e-4) and (l2 - l0) / r2 == pytest.approx(-0.0037, abs=5e-4)
+    for a, clb, cnb in ((-2.0, 0.0213, 0.0680), (2.0, -0.0164, 0.0683), (6.0, -0.0374, 0.0745)):
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(beta=4.0, alpha=a)
+        assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
+        assert (n3 - nb) / np.radians(4.0) == pytest.approx(cnb, abs=5e-4), a
+
+
+def test_summaries_mark_the_ultrastick_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the ultrastick "(untouched)" and
+    no other aircraft, the c684 and iar80 included (synthetic rows: no ultrastick result exists before the
+    final evaluation). Moved here from ``test_jsbsim_c684.py`` (the seventeenth session's untouched aircraft)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
+           "c684", "ultrastick")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| ultrastick (untouched) | light") for ln in lines)
+    for ac in acs[:14]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| ultrastick (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| c684 | clean |") for ln in lines)
