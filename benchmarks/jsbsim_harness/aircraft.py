@@ -529,7 +529,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         name="ultrastick", model="UltraStick120_glide", airspeed_kts=45.0, altitude_ft=10000.0,
         elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/posAilL_rad", "fcs/posAilR_rad"), rudder_sign=1.0,
         cmd_per_rad=(1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988),
-        amplitude_deg=(5.0, 4.0, 5.0), pulse_s=(0.3, 0.4, 0.5), gains=(0.5, 0.15, 0.01, 0.2, 0.05, 0.2),
+        amplitude_deg=(5.0, 4.0, 5.0), pulse_s=(0.3, 0.4, 0.5), gains=(0.25, 0.05, 0.01, 0.2, 0.05, 0.2),
         notes="Ultra Stick 120 UAV (UASLab OpenFlightSim JSBSim model, checked in under "
               "data/jsbsim_models/ultrastick120) without propulsion, direct surfaces (derived model "
               "UltraStick120_glide, XML sha256 df846fb42f873137), fixed gear, gliding; untouched by any tuning of the "

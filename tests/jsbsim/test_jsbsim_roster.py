@@ -1,5 +1,6 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80 and the untouched c684; docs/jsbsim.md, one section each),
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684 and the untouched ultrastick; docs/jsbsim.md, one section
+each),
 parametrised over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
@@ -10,14 +11,14 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched c684's are slow too but its names', and its own
+default suite, as before the fold); the untouched ultrastick's are slow too but its names', and its own
 default checks (the derivation, its surfaces, static stability, the summaries' label) are in
-``test_jsbsim_c684.py`` (the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+``test_jsbsim_ultrastick.py`` (the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to seventeenth sessions). Folded in the eleventh session
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to eighteenth sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
-in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth.
+in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth.
 """
 
 from dataclasses import dataclass
@@ -244,7 +245,30 @@ CASES = (
           ("cn", 3, None, ("in", 0.001, 0.006)), ("cn", 1, 0.0, ("abs", 1e-4))),
          (), 0.30, 1,
          dict(alpha=(-9.0, 9.0), beta=(8.0, 9.0), bank=(20.0, 25.0), speed=(45.0, 105.0), alt_min=300.0,
-              rate_std=1.5, rate_std_held=1.5, sink_min=3.0), untouched=True, closure=True),
+              rate_std=1.5, rate_std_held=1.5, sink_min=3.0), closure=True),
+    # ultrastick (the University of Minnesota UAS Lab's JSBSim Ultra Stick 120, vortex-lattice tables in alpha of
+    # every derivative; flown as UltraStick120_glide at 10000 ft: its files in one, no propulsion, direct surfaces
+    # +-30 deg): 7.411 kg (16.34 lb), the lab's measured inertia with its product (file ixz 0.1898 kg m^2: the
+    # project's Ixz -0.1898). The aerodynamic reference point is 7 mm ahead of the CG and 0.072 m below it. On the
+    # 30-s calm flight (derivative_slopes: the model has no alpha-dot term): Cm_alpha -0.77 (dCMm__alpha_rad
+    # -0.84..-1.15 and the CMm__zero table), Cm_q -9.4 (dCMm__dqHat_rps -9.4..-10.3), Cm_delta_e -1.17
+    # (dCMm__dElev_rad -1.21 less the arm); Cl_beta -0.022 (dCMl__beta_rad changes sign with alpha: +0.012 at -2
+    # deg, -0.025 at 2), Cl_p -0.445, Cl_r +0.026 (its table in alpha, -0.020 at -2 deg, +0.021 at 2), Cl_delta_a
+    # -0.218 (each aileron's table, 0.109 + 0.109 with the right the mirror), Cl_delta_r -0.004 (the rudder's side
+    # force below the CG); Cn_beta 0.070, Cn_p +0.087 (its table: -0.087 at alpha -2 deg, +0.093 at 2), Cn_r
+    # -0.077, Cn_delta_a +0.0044 (the two ailerons' tables, alpha-dependent), Cn_delta_r -0.038. One SIDE function
+    # (CY summed from its tables: CY:scale scales every CY term); the elevator read by six tables (CL, CD, CY, Cl,
+    # Cm, Cn). Fixed gear, no gear drag. Envelope limits from the trial and evaluation flights (docs/jsbsim.md,
+    # "The ultrastick").
+    Case("ultrastick", "UltraStick120_glide", "ultrastik", 16.33846, -0.189797,
+         (("cm", 0, None, ("in", -0.95, -0.6)), ("cm", 1, None, ("in", -11.0, -8.5)), ("cm", 2, -1.17, ("rel", 0.03)),
+          ("cl", 3, -0.218, ("rel", 0.01)), ("cl", 0, None, ("in", -0.04, -0.005)), ("cl", 1, -0.445, ("rel", 0.02)),
+          ("cl", 2, None, ("in", 0.0, 0.06)), ("cl", 4, None, ("in", -0.006, -0.002)),
+          ("cn", 4, -0.038, ("rel", 0.03)), ("cn", 0, 0.070, ("rel", 0.05)), ("cn", 2, -0.077, ("rel", 0.02)),
+          ("cn", 3, None, ("in", 0.002, 0.007)), ("cn", 1, None, ("in", 0.05, 0.12))),
+         (), 0.5235987755982988, 1,
+         dict(alpha=(-6.0, 12.0), beta=(9.0, 11.0), bank=(25.0, 30.0), speed=(15.0, 45.0), alt_min=500.0,
+              rate_std=1.5, rate_std_held=1.5, sink_min=5.0), n_elevator_reads=6, untouched=True, min_lbf=0.5),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -273,7 +297,7 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the c684
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the ultrastick
     alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
@@ -284,7 +308,7 @@ def test_names_resolve_and_roles(case):
     else:
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
-    used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80"}
+    used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
@@ -415,7 +439,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [p for p in _params()
-                                  if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684")])
+                                  if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
