@@ -267,7 +267,7 @@ CASES = (
           ("cn", 4, -0.038, ("rel", 0.03)), ("cn", 0, 0.070, ("rel", 0.05)), ("cn", 2, -0.082, ("rel", 0.03)),
           ("cn", 3, None, ("in", 0.002, 0.008)), ("cn", 1, None, ("in", 0.05, 0.12))),
          (), 0.5235987755982988, 1,
-         dict(alpha=(-6.0, 12.0), beta=(9.0, 11.0), bank=(25.0, 30.0), speed=(15.0, 45.0), alt_min=500.0,
+         dict(alpha=(-9.0, 15.0), beta=(9.0, 11.0), bank=(25.0, 30.0), speed=(15.0, 45.0), alt_min=500.0,
               rate_std=1.5, rate_std_held=1.5, sink_min=5.0), n_elevator_reads=6, untouched=True, min_lbf=0.3),
 )
 BY_NAME = {c.name: c for c in CASES}
