@@ -523,8 +523,14 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # its own tables (CL, CD, CY, Cl, Cm, Cn of each side). Signs read from its aerodynamics: dCMm/dElev -1.2
     # (positive = trailing edge down), dCMl/dAilL +0.11 and dCMl/dAilR -0.11 (each positive = trailing edge
     # down; the right is driven as the mirror of the left, so delta_a = -left: Cl_delta_a -0.22),
-    # dCMn/dRud -0.04 (positive = trailing edge left, nose left). Set from the harness's truth only (alpha,
-    # beta, rates, excitation per axis, surfaces, sink), never from a method result.
+    # dCMn/dRud -0.04 (positive = trailing edge left, nose left). 45 kt (ic/vc-kts) at 10000 ft: 23-34 m/s TAS,
+    # alpha about 0..6 deg in the standard flights (p1-p99), -2..8 in the sweeps; its drag (CD__zero 0.106) makes
+    # the glide steep (lift-to-drag about 2, sink 13-16 m/s), hence the height. Pulses 0.3 / 0.4 / 0.5 s: short
+    # period about 10 rad/s, roll mode about 9 per s, Dutch roll about 4 rad/s. Amplitudes 5 / 4 / 5 deg and gains
+    # (0.25, 0.05, 0.01, 0.2, 0.05, 0.2): its control power per unit of qbar is about ten times the c684's, so the
+    # default rate gains fought the maneuvers (surface standard deviation 0.6-0.7 deg); with k_theta 0.5 and k_q
+    # 0.15 an injected 0.12-s elevator delay rolled it out of the envelope (seeds 1 and 2). Set from the harness's
+    # truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never from a method result.
     "ultrastick": AircraftSpec(
         name="ultrastick", model="UltraStick120_glide", airspeed_kts=45.0, altitude_ft=10000.0,
         elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/posAilL_rad", "fcs/posAilR_rad"), rudder_sign=1.0,
