@@ -24,6 +24,10 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  ``B`` starts diagonal, the noise correlation at the ridge residual's)
     ``jointnt``  ``jointn`` with the hyperparameters learned on every 10th training row (``GPConfig.hyper_stride``:
                  0.2 s apart at 50 Hz, where the gusts' coloured error is less alike)
+    ``decntc``   ``GPConfig(noise_correlation=True, hyper_stride=10, coupling="off")``: ``decnt`` with the coupling
+                 removed inside the fit (before the blocked validation and the posterior), eighteenth session
+    ``decnta``   the same with the stride from the training residual's decorrelation time (``hyper_stride=0``;
+                 ``pipeline.DECORRELATED_GP``)
     ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``, ``decnt`` for ``jointnt``
     ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
     ``jointsel`` per output ``joint`` or that output's ``indep`` GP, whichever has the lower blocked
@@ -84,7 +88,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt", "dec", "decn", "decnf", "decnt", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
+ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt", "dec", "decn", "decnf", "decnt", "decntc", "decnta", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
 PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joint0", "none"),
@@ -97,7 +101,9 @@ PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joi
          ("jointn", "indep", "none"), ("jointnf", "indep", "none"), ("jointnf", "joint", "none"),
          ("jointnf", "jointn", "none"), ("jointnf", "decnf", "none"),
          ("jointnt", "indep", "none"), ("jointnt", "joint", "none"), ("jointnt", "jointn", "none"),
-         ("jointnt", "decnt", "none"), ("decnt", "indep", "none"), ("decnt", "joint", "none"), ("lmc", "indep", "none"),
+         ("jointnt", "decnt", "none"), ("decnt", "indep", "none"), ("decnt", "joint", "none"),
+         ("decntc", "indep", "none"), ("decntc", "joint", "none"), ("decnta", "indep", "none"),
+         ("decnta", "joint", "none"), ("decnta", "decntc", "none"), ("lmc", "indep", "none"),
          ("joint", "dec", "none"), ("jointn", "decn", "none"), ("jointn", "joint", "none"),
          ("hjoint", "hindep", "rates"), ("hjoint", "hdec", "rates"), ("hjoint", "hdrop", "rates"),
          ("hjoint", "hindep", "block"), ("hjoint", "hdec", "block"), ("hjoint", "hdrop", "block"))
@@ -166,6 +172,8 @@ def score(path: Path, lengths, patterns, lmc: bool = False, models=ISO_MODELS):
                                ("jointn", replace(base, noise_correlation=True)),
                                ("jointnf", replace(base, noise_correlation=True, noise_start="noise")),
                                ("jointnt", replace(base, noise_correlation=True, hyper_stride=10)),
+                               ("decntc", replace(base, noise_correlation=True, hyper_stride=10, coupling="off")),
+                               ("decnta", replace(base, noise_correlation=True, hyper_stride=0, coupling="off")),
                                ("lmc", replace(base, latent_kernels=2))):
                     if (v == "lmc" and not lmc) or v not in models_wanted:
                         continue

@@ -333,6 +333,9 @@ def main(argv=None) -> int:
                          "replay's default, gcs_sysid.aero.gustfilter.GUST_FILTER)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
+    ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated"),
+                    help="the replay's GP settings: 'decorrelated' sets gcs_sysid.pipeline.USE_DECORRELATED_GP "
+                         "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md)")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
@@ -357,6 +360,10 @@ def main(argv=None) -> int:
                     print(f"{files.tlog}  {'reused' if files.recording is None else 'flown'} "
                           f"[{time.perf_counter() - t0:.1f} s]", flush=True)
         return 0
+    if a.gp_fit is not None:
+        import gcs_sysid.pipeline as pipeline
+
+        pipeline.USE_DECORRELATED_GP = a.gp_fit == "decorrelated"
     work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
     rows = []
     print(f"{'flight':32s} {'':5s} " + " ".join(f"{c:>6s}" for c in COEFFICIENTS) + "   cov95  alpha/beta err deg")
@@ -365,6 +372,7 @@ def main(argv=None) -> int:
             for seed in a.seeds:
                 row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates,
                                None if a.gust_filter is None else a.gust_filter == "on")
+                row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

@@ -102,6 +102,15 @@ ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("C
 #: F-16's light bands back above 98 % (fourteenth session, i8-adotgate; left off at the merge, docs/gp.md).
 ALPHA_DOT_PARTNER_RULE = {"mean_only_partners": ("q_hat",), "mean_only_ratio": 1.0}
 
+#: The GP settings of the decorrelated fit (eighteenth session, i8-decnt; ``docs/gp.md``, "The stride from the
+#: decorrelation time"): the hyperparameters learned with the full noise covariance on rows one decorrelation time
+#: of the training residual apart (``hyper_stride=0``), then the cross-output coupling removed (``coupling="off"``).
+DECORRELATED_GP = {"noise_correlation": True, "hyper_stride": 0, "coupling": "off"}
+
+#: Whether the replay's fit uses :data:`DECORRELATED_GP`. Off: opt-in (see docs/benchmarks.md, eighteenth session,
+#: i8-decnt, for what it gains and loses in eval_jsbsim).
+USE_DECORRELATED_GP = False
+
 
 def gp_inputs(table, rows: np.ndarray, with_alpha_dot: bool) -> tuple[np.ndarray, np.ndarray | None]:
     """The GP's inputs of ``rows`` (``(T,)`` bool) of a :class:`~gcs_sysid.aero.table.CoefficientTable`:
@@ -379,6 +388,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                  f"{len(X_train)} new samples)")
                 else:
                     cfg = GPConfig(**(ALPHA_DOT_GP if use_adot else {}),
+                                   **(DECORRELATED_GP if USE_DECORRELATED_GP else {}),
                                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
                     names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
                     model, _history = fit_gp(X_train, Y_train, cfg, input_names=names,

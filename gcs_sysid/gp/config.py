@@ -90,6 +90,22 @@ class GPConfig:
             Rows that close in time share the gusts' coloured error, which the bound, counting rows as
             independent, explains as signal (``docs/gp.md``, "Noise: where the shared error starts"). The
             posterior still conditions on every row. Opt-in, measured only by ``eval_gp_joint``.
+            0: the stride from the data (eighteenth session): the decorrelation time of the training
+            residual, the median over outputs of the first lag where the autocorrelation of a ridge
+            least-squares fit's residual on the rows in time order falls below 1/e
+            (:func:`gcs_sysid.gp.colored.decorrelation_lag`; rows that far apart are worth ~0.46 of an
+            independent row each, Bayley and Hammersley 1946); recorded in ``history.validation["hyper_stride"]``
+            (``docs/gp.md``, "The stride from the decorrelation time").
+        coupling: ``"learned"`` (the default): the cross-output coupling (the off-diagonals of ``B`` and, with
+            ``noise_correlation``, of the noise covariance) is kept as the bound learned it; ``"off"``: the
+            hyperparameters are learned with it (so the gusts' shared error has somewhere to go other than the
+            length-scales and the per-output noise), then ``B`` and the noise covariance are made diagonal
+            (:func:`gcs_sysid.gp.joint.decoupled`) before the blocked validation, the posterior and every
+            hyperparameter refresh. What the outputs then still share: one kernel (one set of ARD length-scales),
+            the inducing inputs, the bound the per-output latent and noise variances were learned in, and the
+            regressors' input-noise variances (NIGP); each output's posterior conditions on its own column only.
+            Refused with ``coupling_validation=True`` and ``output_groups="kernels-free"`` (no one latent per
+            output to keep).
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
@@ -208,6 +224,7 @@ class GPConfig:
     noise_correlation: bool = False
     noise_start: str = "signal"
     hyper_stride: int = 1
+    coupling: str = "learned"
     input_noise: bool = True
     residual_correlation: bool = False
     validation_folds: int = 5
@@ -253,8 +270,14 @@ class GPConfig:
                 int(self.latent_kernels) != 1 or self.coupling_validation is True):
             raise InputError("GPConfig.output_groups='kernels' gives each output group its own kernel: it needs "
                              "latent_kernels=1 and coupling_validation=False")
-        if int(self.hyper_stride) < 1:
-            raise InputError(f"GPConfig.hyper_stride must be >= 1, got {self.hyper_stride!r}")
+        if int(self.hyper_stride) < 0:
+            raise InputError(f"GPConfig.hyper_stride must be >= 0 (0: from the residual's decorrelation time), got "
+                             f"{self.hyper_stride!r}")
+        if self.coupling not in ("learned", "off"):
+            raise InputError(f"GPConfig.coupling must be 'learned' or 'off', got {self.coupling!r}")
+        if self.coupling == "off" and (self.coupling_validation is True or self.output_groups == "kernels-free"):
+            raise InputError("GPConfig.coupling='off' removes the coupling: it cannot go with coupling_validation=True "
+                             "or output_groups='kernels-free'")
         if self.noise_start not in ("signal", "noise"):
             raise InputError(f"GPConfig.noise_start must be 'signal' or 'noise', got {self.noise_start!r}")
         if self.inducing not in ("mi", "kmeans", "random"):
@@ -267,6 +290,8 @@ class GPConfig:
     def gates_coupling(self) -> bool:
         """Whether ``fit_gp`` runs the coupling gate (``coupling_validation``; ``None``: wherever it applies,
         i.e. not with the per-group kernels of ``output_groups``)."""
+        if self.coupling == "off":
+            return False
         if self.coupling_validation is None:
             return self.output_groups not in ("kernels", "kernels-free", "output-kernels")
         return bool(self.coupling_validation)

@@ -725,8 +725,10 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         terms[:, ~kern] = np.asarray(masks[1], bool)[:, ~kern]
     if terms is not None:
         history.validation["linear_terms"] = [[int(d) for d in np.flatnonzero(k)] for k in terms]
-    if int(cfg.hyper_stride) > 1:      # every k-th row in time order: coloured noise decorrelates (opt-in)
-        every = np.arange(0, len(Xs), int(cfg.hyper_stride))
+    stride = hyper_stride_of(Xs, Ys, active, cfg)
+    history.validation["hyper_stride"] = stride
+    if stride > 1:                     # every k-th row in time order: coloured noise decorrelates (opt-in)
+        every = np.arange(0, len(Xs), stride)
         sub = every[np.sort(random_points(len(every), cfg.n_train_max, cfg.seed))]
     else:
         sub = random_points(len(Xs), cfg.n_train_max, cfg.seed)
@@ -769,7 +771,30 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
             fixed = reselect(raw, fixed, Mh)
     if Mh < M:
         fixed = reselect(raw, fixed, M)
-    return _constrain_global_jit(raw, fixed)
+    params = _constrain_global_jit(raw, fixed)
+    if cfg.coupling == "off":          # learned with the coupling, kept without it (GPConfig.coupling)
+        from .joint import decoupled
+
+        params = decoupled(params)
+    return params
+
+
+def hyper_stride_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> int:
+    """The stride between the rows the global hyperparameters are learned on (``GPConfig.hyper_stride``).
+
+    ``cfg.hyper_stride >= 1``: that number. 0: the training residual's decorrelation time in rows, the median
+    over outputs of :func:`gcs_sysid.gp.colored.decorrelation_lag` (first lag with autocorrelation below 1/e)
+    of :func:`gcs_sysid.gp.colored.linear_residual` (ridge fit on the ``active`` columns), rounded up; at most
+    ``N // 20`` so that at least ~20 rows remain. Rows in time order: ``Xs (N, D)``, ``Ys (N, P)``
+    standardised.
+    """
+    if int(cfg.hyper_stride) >= 1:
+        return int(cfg.hyper_stride)
+    from .colored import decorrelation_lag, linear_residual
+
+    act = np.asarray(active, bool)
+    lag = decorrelation_lag(linear_residual(Xs[:, act], Ys))
+    return int(max(1, min(int(np.ceil(np.median(lag))), len(Xs) // 20)))
 
 
 def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=None
@@ -842,7 +867,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     params = learn_global(Xs, Ys, scaler.active, cfg, M, history, groups=output_groups(output_names, cfg),
                           masks=(kernel, allowed))
     history.timings["hyperparameters"] = time.perf_counter() - t1 - history.timings["init"]
-    n_hyper = int(min(cfg.n_train_max, -(-len(Xs) // max(int(cfg.hyper_stride), 1))))   # the rows fit_global sees
+    stride = int(history.validation.get("hyper_stride", max(int(cfg.hyper_stride), 1)))
+    n_hyper = int(min(cfg.n_train_max, -(-len(Xs) // stride)))   # the rows fit_global sees
     # the rows kept for the local layer and later refreshes: all of them up to store_max, then thinned by region
     rows, Xd, Yd = RowStore.empty(D, P, np.asarray(params.metric_lengthscale()), cfg.store_cell, cfg.store_max,
                                   cfg.seed).add_dropped(Xs, Ys)

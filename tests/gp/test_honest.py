@@ -121,7 +121,24 @@ def test_noise_start_and_hyper_stride_are_checked():
     with pytest.raises(InputError, match="noise_start"):
         replace(CFG, noise_start="both")
     with pytest.raises(InputError, match="hyper_stride"):
-        replace(CFG, hyper_stride=0)
+        replace(CFG, hyper_stride=-1)
+    assert replace(CFG, hyper_stride=0).hyper_stride == 0          # 0: from the residual's decorrelation time
+    with pytest.raises(InputError, match="coupling"):
+        replace(CFG, coupling="none")
+    with pytest.raises(InputError, match="coupling"):
+        replace(CFG, coupling="off", coupling_validation=True)
+    assert not replace(CFG, coupling="off", coupling_validation=None).gates_coupling
+
+
+def test_coupling_off_learns_with_the_coupling_and_keeps_none():
+    """``GPConfig.coupling = "off"`` on the correlated-noise data: B and the noise covariance are diagonal in the
+    returned model (every output conditioned on its own column), and each output still fits its function."""
+    X, Y, F = _independent_outputs(400, 0.8, seed=5)
+    model, _ = fit_gp(X, Y, replace(CFG, coupling_validation=False, coupling="off"))
+    assert np.allclose(model.output_correlation(), np.eye(3), atol=1e-12)
+    assert np.allclose(model.noise_correlation(), np.eye(3), atol=1e-12)
+    mean = np.asarray(model.predict(X, include_noise=False)[0])
+    assert np.all(np.sqrt(np.mean((mean - F) ** 2, 0)) < 0.15)
 
 
 def test_independent_noise_gives_no_learned_output_correlation_above_half():
