@@ -381,17 +381,17 @@ def main(argv=None) -> int:
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
                     help="only print the markdown table of earlier --json results (medians over seeds)")
-    ap.add_argument("--iv-beta", default=None, choices=("off", "r2", "f"),
+    ap.add_argument("--iv-beta", default=None, choices=("off", "r2", "f", "fuller"),
                     help="the side-force slopes: least squares (off), 2SLS with the first-stage R2 floor (r2: "
                          "INSTRUMENTED_BETA), or 2SLS where the effective-sample first-stage F passes (f: "
-                         "BETA_WEAK_TEST='f'); default: the package's defaults")
+                         "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     a = ap.parse_args(argv)
     if a.iv_beta is not None:
         from gcs_sysid.estimation import airangles
 
         airangles.INSTRUMENTED_BETA = a.iv_beta != "off"
-        airangles.BETA_WEAK_TEST = "f" if a.iv_beta == "f" else None
+        airangles.BETA_WEAK_TEST = a.iv_beta if a.iv_beta in ("f", "fuller") else None
     if a.summarize:
         print(summarize(a.summarize))
         return 0

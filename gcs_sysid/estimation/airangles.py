@@ -68,7 +68,7 @@ import numpy as np
 from scipy.signal import butter, lfilter, sosfiltfilt
 
 from ..jackknife import block_jackknife_cov
-from .angleerrors import MIN_FIRST_STAGE_R2, first_stage_f, iv_lstsq, lagged_instruments, mean_wind_sigma
+from .angleerrors import MIN_FIRST_STAGE_R2, effective_n, first_stage_f, iv_lstsq, lagged_instruments, mean_wind_sigma
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
 
@@ -128,7 +128,8 @@ BETA_ENDOGENOUS = ("p_hat", "r_hat")
 BETA_MIN_FIRST_STAGE_R2 = 0.1
 #: The weak-instrument test of the beta instruments (with :data:`INSTRUMENTED_BETA`): None: the first-stage R^2 floor
 #: :data:`BETA_MIN_FIRST_STAGE_R2`; ``"f"``: the first-stage F statistic on the effective sample size
-#: (:func:`.angleerrors.first_stage_f`) against :data:`BETA_MIN_FIRST_STAGE_F` (opt-in)
+#: (:func:`.angleerrors.first_stage_f`) against :data:`BETA_MIN_FIRST_STAGE_F` (opt-in); ``"fuller"``: Fuller's k-class
+#: (:func:`.angleerrors.iv_lstsq`, ``fuller_n``: the effective sample) on every flight, no fallback (opt-in)
 BETA_WEAK_TEST: str | None = None
 BETA_MIN_FIRST_STAGE_F = 10.0   #: Staiger and Stock's (1997) rule of thumb (Stock and Yogo 2005: critical values near 10)
 WEAK_F_MAX_LAG_S = 2.0          #: the autocorrelation lags summed for the effective sample size, s
@@ -498,10 +499,17 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             # correlates the two; instruments that move the angle but not the air give a consistent slope
             Zh = _highpass(dt, instruments, segs, edge)
             en = [0] + [nq + cols.index(k) for k in endog if k in cols]
-            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], en, Zh[m])
+            n_full = None
+            if weak_test == "fuller":
+                n_full = effective_n(yh[m], Ah[m][:, 0], max(int(round(WEAK_F_MAX_LAG_S / dt)), 1))
+            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], en, Zh[m], fuller_n=n_full)
             method = "2SLS" + (f" ({', '.join([name] + [k for k in endog if k in cols])} instrumented)" if len(en) > 1
                                else "")
+            if n_full is not None:
+                method += f" by Fuller's k-class (alpha 1, {n_full:.0f} effective samples)"
             weak, why = not fs_r2 >= min_first_stage, f"first-stage R2 {fs_r2:.2f} < {min_first_stage:g}"
+            if weak_test == "fuller":
+                weak = False
             if weak_test == "f" and min_first_stage > 0:
                 f_st, _, n_eff = first_stage_f(Ah[m], en, Zh[m], max(int(round(WEAK_F_MAX_LAG_S / dt)), 1))
                 weak = not f_st >= BETA_MIN_FIRST_STAGE_F

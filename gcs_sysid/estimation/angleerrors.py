@@ -72,7 +72,7 @@ def lagged_instruments(dt: float, u: np.ndarray, lags_s: tuple[float, ...] = INS
     return np.hstack(out)
 
 
-def iv_lstsq(A: np.ndarray, y: np.ndarray, endog: list[int], Z: np.ndarray
+def iv_lstsq(A: np.ndarray, y: np.ndarray, endog: list[int], Z: np.ndarray, fuller_n: float | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """Two-stage least squares ``y ~ A c`` with the columns ``endog`` of ``A`` instrumented by ``Z``.
 
@@ -80,9 +80,16 @@ def iv_lstsq(A: np.ndarray, y: np.ndarray, endog: list[int], Z: np.ndarray
     ``[Z, A_exog]``; second stage: ``y`` on ``A`` with the endogenous columns replaced by their fitted
     values. Residuals are ``y - A c`` (with the actual columns); covariance ``s^2 (Ah' Ah)^-1``.
 
+    With ``fuller_n`` the slopes are Fuller's k-class estimator instead (``alpha = 1``; Fuller, Econometrica 45,
+    1977): ``c = (A' (I - k M) A)^-1 A' (I - k M) y`` with ``M`` the residual maker of ``W = [Z, A_exog]``,
+    ``k = lambda - 1 / (fuller_n - cols(W))`` and ``lambda`` LIML's least eigenvalue of ``(Y' M Y)^-1 Y' M_X Y``,
+    ``Y = [y, A_endog]``, ``M_X`` the residual maker of ``A_exog`` (``k = 1`` is 2SLS). Less biased than 2SLS with
+    weak instruments and, unlike LIML, with finite moments (Hahn, Hausman and Kuersteiner, Econometrics J. 7, 2004).
+    ``fuller_n`` is the sample size in the correction (the effective one for serially correlated data).
+
     Args:
         A: (N, P) regressors. y: (N,) regressand. endog: indices of the noisy columns of ``A``.
-        Z: (N, Q) instruments, ``Q >= len(endog)``.
+        Z: (N, Q) instruments, ``Q >= len(endog)``. fuller_n: None: 2SLS; else Fuller's k-class with this ``N``.
 
     Returns:
         ``(c (P,), standard errors (P,), residuals (N,), covariance (P, P), first-stage partial R^2)``:
@@ -105,13 +112,25 @@ def iv_lstsq(A: np.ndarray, y: np.ndarray, endog: list[int], Z: np.ndarray
             left = A[:, j] - A[:, j].mean()
         explained = Ah[:, j] - (A[:, exog] @ pe if exog else A[:, j].mean())
         r2 = min(r2, float(explained @ explained) / max(float(left @ left), 1e-300))
-    c, *_ = np.linalg.lstsq(Ah, y, rcond=None)
+    if fuller_n is None:
+        c, *_ = np.linalg.lstsq(Ah, y, rcond=None)
+        G = Ah.T @ Ah
+    else:
+        res_w = lambda X: X - W @ np.linalg.lstsq(W, X, rcond=None)[0]  # noqa: E731
+        Y = np.column_stack([y, A[:, endog]])
+        RY = res_w(Y)
+        RX = Y - A[:, exog] @ np.linalg.lstsq(A[:, exog], Y, rcond=None)[0] if exog else Y - Y.mean(0)
+        lam = float(np.min(np.real(np.linalg.eigvals(np.linalg.solve(RY.T @ RY, RX.T @ RX)))))
+        k = lam - 1.0 / max(fuller_n - W.shape[1], 1.0)
+        RA, ry = res_w(A), RY[:, 0]
+        G = A.T @ A - k * (RA.T @ RA)
+        c = np.linalg.solve(G, A.T @ y - k * (RA.T @ ry))
     e = y - A @ c
     s2 = float(e @ e) / max(len(y) - A.shape[1], 1)
     try:
-        cov = np.linalg.inv(Ah.T @ Ah) * s2
+        cov = np.linalg.inv(G) * s2
     except np.linalg.LinAlgError:
-        cov = np.linalg.pinv(Ah.T @ Ah) * s2
+        cov = np.linalg.pinv(G) * s2
     return c, np.sqrt(np.maximum(np.diag(cov), 0.0)), e, cov, r2
 
 

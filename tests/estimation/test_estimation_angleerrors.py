@@ -170,3 +170,29 @@ def test_first_stage_f_on_the_effective_sample_tells_a_weak_instrument_from_a_st
         assert n_eff < n / 8
         assert (f > 10) == strong
         assert f_iid > 10      # what the iid count would have said
+
+
+def test_fuller_k_class_is_less_biased_than_2sls_with_many_weak_instruments():
+    """Twelve instruments, two of them weakly relevant (first-stage R^2 about 0.01): 2SLS leans to least squares'
+    bias, Fuller's k-class (alpha 1) much less (Fuller 1977; Hahn, Hausman and Kuersteiner 2004)."""
+    b2, bf, bo = [], [], []
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        n = 3000
+        z, u, g = rng.standard_normal((n, 12)), rng.standard_normal(n), rng.standard_normal(n)
+        x = z @ np.r_[0.1, 0.05, np.zeros(10)] + g + 0.5 * u
+        A = np.c_[x, rng.standard_normal(n)]
+        y = 2.0 * x + u
+        b2.append(iv_lstsq(A, y, [0], z)[0][0])
+        bf.append(iv_lstsq(A, y, [0], z, fuller_n=n)[0][0])
+        bo.append(np.linalg.lstsq(A, y, rcond=None)[0][0])
+    bias = lambda b: abs(np.median(b) - 2.0)  # noqa: E731
+    assert bias(bo) > 0.3
+    assert bias(bf) < 0.5 * bias(b2)
+    # with a strong instrument both are 2SLS's (k -> 1)
+    rng = np.random.default_rng(99)
+    z, u = rng.standard_normal((3000, 1)), rng.standard_normal(3000)
+    x = 2.0 * z[:, 0] + 0.5 * u + rng.standard_normal(3000)
+    A = np.c_[x]
+    y = 2.0 * x + u
+    assert abs(iv_lstsq(A, y, [0], z)[0][0] - iv_lstsq(A, y, [0], z, fuller_n=3000)[0][0]) < 0.01
