@@ -28,6 +28,10 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
   terms  (JSON only, ``band_terms``) each variance term of the two bands per coefficient, as the RMS of
          its sigma in % of the truth's RMS (:func:`band_terms`; read against ``gp`` and ``true``)
   air    alpha and beta RMS errors of the reconstructed air data, deg (all valid rows)
+  cy_diag  (JSON only) where the model's CY error at the true conditions (``tair``) comes from
+         (:func:`cy_diagnosis`: the aided sideslip's scale against JSBSim's, the model's and JSBSim's local CY
+         slopes on the true regressors, the error split into bias / linear / rest); ``--iv-beta`` picks the
+         side-force slopes' estimator (``docs/estimation.md``, "Weak-instrument treatments")
 
 Usage::
 
