@@ -28,6 +28,10 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
   terms  (JSON only, ``band_terms``) each variance term of the two bands per coefficient, as the RMS of
          its sigma in % of the truth's RMS (:func:`band_terms`; read against ``gp`` and ``true``)
   air    alpha and beta RMS errors of the reconstructed air data, deg (all valid rows)
+  cy_diag  (JSON only) where the model's CY error at the true conditions (``tair``) comes from
+         (:func:`cy_diagnosis`: the aided sideslip's scale against JSBSim's, the model's and JSBSim's local CY
+         slopes on the true regressors, the error split into bias / linear / rest); ``--iv-beta`` picks the
+         side-force slopes' estimator (``docs/estimation.md``, "Weak-instrument treatments")
 
 Usage::
 
@@ -272,7 +276,53 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["beta_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 1] - Xt[ok, 1]) ** 2))))
     row["alpha_rms_deg"] = float(np.degrees(np.std(Xt[ok, 0])))
     row["beta_rms_deg"] = float(np.degrees(np.sqrt(np.mean(Xt[ok, 1] ** 2))))
+    row["cy_diag"] = cy_diagnosis(tab.X[h], Xt_air[h], np.asarray(ma)[:, 1], Yt[h, 1])
     return row
+
+
+#: the side-force regressors of :func:`cy_diagnosis`'s local linear fits (a diagnosis only)
+CY_DIAG_COLUMNS = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")
+
+
+def cy_diagnosis(X_est: np.ndarray, X_true: np.ndarray, cy_model: np.ndarray, cy_true: np.ndarray) -> dict:
+    """Where the model's CY error at the true conditions comes from (a diagnosis: reads the truth, scores only).
+
+    Args:
+        X_est: (N, 10) the pipeline's regressors (:data:`gcs_sysid.aero.table.REGRESSORS` order) on the held-out rows.
+        X_true: (N, 10) JSBSim's regressors there (the rates its aerodynamics reads). cy_model: (N,) the model's CY
+            at ``X_true``. cy_true: (N,) JSBSim's CY.
+
+    Returns:
+        ``beta_scale``, ``beta_offset_deg``, ``beta_resid_deg``: the reconstructed sideslip regressed on the true one
+        (errors in variables: a scale below 1 with an error that correlates with the truth); ``CY_beta_model`` /
+        ``CY_beta_true`` (1/rad) and the same for the other :data:`CY_DIAG_COLUMNS`: least-squares slopes of the
+        model's and of JSBSim's CY on the true regressors (with a constant); ``err_pct``: the model's RMS error, % of
+        the truth's RMS, split into ``bias_pct`` (its mean), ``linear_pct`` (what is linear in the true regressors
+        beyond the mean: the slopes' errors) and ``rest_pct`` (the remainder: shape), in quadrature.
+    """
+    from gcs_sysid.aero.table import REGRESSORS
+
+    idx = [REGRESSORS.index(k) for k in CY_DIAG_COLUMNS]
+    ok = np.isfinite(X_est[:, 1]) & np.isfinite(X_true[:, idx]).all(1) & np.isfinite(cy_model) & np.isfinite(cy_true)
+    b_e, b_t = X_est[ok, 1], X_true[ok, 1]
+    G = np.c_[np.ones(ok.sum()), b_t]
+    sb, *_ = np.linalg.lstsq(G, b_e, rcond=None)
+    A = np.c_[np.ones(ok.sum()), X_true[ok][:, idx]]
+    cm, *_ = np.linalg.lstsq(A, cy_model[ok], rcond=None)
+    ct, *_ = np.linalg.lstsq(A, cy_true[ok], rcond=None)
+    e = cy_model[ok] - cy_true[ok]
+    rms = float(np.sqrt(np.mean(cy_true[ok] ** 2)))
+    ce, *_ = np.linalg.lstsq(A, e, rcond=None)
+    lin = A @ ce - np.mean(e)
+    rest = e - A @ ce
+    out = {"beta_scale": float(sb[1]), "beta_offset_deg": float(np.degrees(sb[0])),
+           "beta_resid_deg": float(np.degrees(np.std(b_e - G @ sb))),
+           "err_pct": float(100 * np.sqrt(np.mean(e ** 2)) / rms), "bias_pct": float(100 * abs(np.mean(e)) / rms),
+           "linear_pct": float(100 * np.sqrt(np.mean(lin ** 2)) / rms),
+           "rest_pct": float(100 * np.sqrt(np.mean(rest ** 2)) / rms)}
+    for j, k in enumerate(CY_DIAG_COLUMNS):
+        out[f"CY_{k}_model"], out[f"CY_{k}_true"] = float(cm[j + 1]), float(ct[j + 1])
+    return out
 
 
 def _fmt(d: dict) -> str:
@@ -340,8 +390,17 @@ def main(argv=None) -> int:
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
                     help="only print the markdown table of earlier --json results (medians over seeds)")
+    ap.add_argument("--iv-beta", default=None, choices=("off", "r2", "f", "fuller"),
+                    help="the side-force slopes: least squares (off), 2SLS with the first-stage R2 floor (r2: "
+                         "INSTRUMENTED_BETA), or 2SLS where the effective-sample first-stage F passes (f: "
+                         "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     a = ap.parse_args(argv)
+    if a.iv_beta is not None:
+        from gcs_sysid.estimation import airangles
+
+        airangles.INSTRUMENTED_BETA = a.iv_beta != "off"
+        airangles.BETA_WEAK_TEST = a.iv_beta if a.iv_beta in ("f", "fuller") else None
     if a.summarize:
         print(summarize(a.summarize))
         return 0

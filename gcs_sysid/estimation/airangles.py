@@ -68,7 +68,7 @@ import numpy as np
 from scipy.signal import butter, lfilter, sosfiltfilt
 
 from ..jackknife import block_jackknife_cov
-from .angleerrors import MIN_FIRST_STAGE_R2, iv_lstsq, lagged_instruments, mean_wind_sigma
+from .angleerrors import MIN_FIRST_STAGE_R2, effective_n, first_stage_f, iv_lstsq, lagged_instruments, mean_wind_sigma
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
 
@@ -126,6 +126,13 @@ BETA_ENDOGENOUS = ("p_hat", "r_hat")
 #: 0.11-0.17 in light turbulence and 0.03-0.10 in moderate; the flights with a pass below 0.1 (t6 light s2: 0.12 then
 #: 0.07) had 2SLS slopes 25-65 % off JSBSim's (weak instruments: Staiger and Stock, Econometrica 65, 1997)
 BETA_MIN_FIRST_STAGE_R2 = 0.1
+#: The weak-instrument test of the beta instruments (with :data:`INSTRUMENTED_BETA`): None: the first-stage R^2 floor
+#: :data:`BETA_MIN_FIRST_STAGE_R2`; ``"f"``: the first-stage F statistic on the effective sample size
+#: (:func:`.angleerrors.first_stage_f`) against :data:`BETA_MIN_FIRST_STAGE_F` (opt-in); ``"fuller"``: Fuller's k-class
+#: (:func:`.angleerrors.iv_lstsq`, ``fuller_n``: the effective sample) on every flight, no fallback (opt-in)
+BETA_WEAK_TEST: str | None = None
+BETA_MIN_FIRST_STAGE_F = 10.0   #: Staiger and Stock's (1997) rule of thumb (Stock and Yogo 2005: critical values near 10)
+WEAK_F_MAX_LAG_S = 2.0          #: the autocorrelation lags summed for the effective sample size, s
 #: Hold ``|CZ_alpha|`` at least at the wing's lift slope (:func:`lift_slope`, Helmbold's formula, from ``b^2 / S``) in the
 #: first pass where the fitted one is flatter (or not identified), and leave :data:`FLOOR_DROPS` out of that pass
 #: (``docs/estimation.md``, "The lift-slope floor"). In MIL-F-8785C light turbulence the kinematic alpha's gust error
@@ -420,7 +427,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
           V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
           slope_floor: float | None = None, endog: tuple[str, ...] = (),
-          min_first_stage: float = MIN_FIRST_STAGE_R2) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None
+          ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -438,7 +446,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor;
     ``endog``: the other columns instrumented with the angle (beta: ``p_hat``, ``r_hat``, which answer the gust,
     :data:`INSTRUMENTED_BETA`); ``min_first_stage``: the instruments' least first-stage partial R^2, below which the
-    slopes fall back to ordinary least squares."""
+    slopes fall back to ordinary least squares; ``weak_test``: ``"f"`` tests the instruments by their first-stage F
+    on the effective sample size instead (:func:`.angleerrors.first_stage_f`, at least
+    :data:`BETA_MIN_FIRST_STAGE_F`; ``min_first_stage`` 0 skips the test), None: by ``min_first_stage``."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -489,11 +499,25 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             # correlates the two; instruments that move the angle but not the air give a consistent slope
             Zh = _highpass(dt, instruments, segs, edge)
             en = [0] + [nq + cols.index(k) for k in endog if k in cols]
-            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], en, Zh[m])
+            n_full = None
+            if weak_test == "fuller":
+                n_full = effective_n(yh[m], Ah[m][:, 0], max(int(round(WEAK_F_MAX_LAG_S / dt)), 1))
+            cr, csr, res, cov_r, fs_r2 = iv_lstsq(Ah[m], yh[m], en, Zh[m], fuller_n=n_full)
             method = "2SLS" + (f" ({', '.join([name] + [k for k in endog if k in cols])} instrumented)" if len(en) > 1
                                else "")
-            if not fs_r2 >= min_first_stage:
-                method = f"OLS (instruments too weak: first-stage R2 {fs_r2:.2f} < {min_first_stage:g})"
+            if n_full is not None:
+                method += f" by Fuller's k-class (alpha 1, {n_full:.0f} effective samples)"
+            weak, why = not fs_r2 >= min_first_stage, f"first-stage R2 {fs_r2:.2f} < {min_first_stage:g}"
+            if weak_test == "fuller":
+                weak = False
+            if weak_test == "f" and min_first_stage > 0:
+                f_st, _, n_eff = first_stage_f(Ah[m], en, Zh[m], max(int(round(WEAK_F_MAX_LAG_S / dt)), 1))
+                weak = not f_st >= BETA_MIN_FIRST_STAGE_F
+                why = (f"first-stage F {f_st:.1f} {'<' if weak else '>='} {BETA_MIN_FIRST_STAGE_F:g} on "
+                       f"{n_eff:.0f} effective samples, R2 {fs_r2:.2f}")
+                method += f" ({why})" if not weak else ""
+            if weak:
+                method = f"OLS (instruments too weak: {why})"
                 if endog:
                     # a pass with weak instruments: least squares in every pass. The passes feed each other (each
                     # fits on the angle the last one aided), so a 2SLS pass followed by a least-squares pass keeps the
@@ -503,8 +527,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                     a_ls, s_ls, refit = _axis(name, dt, kin0, coeff, others, use, passes, sign, quadratic, symmetric,
                                               moments, None, V, given, band_hz, slope_floor)
                     ols = refit.slope_method
-                    refit.slope_method = (f"{ols}; instruments too weak in pass {ipass + 1} (first-stage R2 "
-                                          f"{fs_r2:.2f} < {min_first_stage:g}): least squares in every pass")
+                    refit.slope_method = (f"{ols}; instruments too weak in pass {ipass + 1} ({why}): least squares "
+                                          f"in every pass")
                     refit.first_stage_r2 = fs_r2
                     return a_ls, s_ls, refit
         if not method.startswith(("2SLS", "given")):
@@ -812,7 +836,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         if inst_b is not None and not np.isfinite(inst_b[u]).all():    # a delay reaches outside the finite record
             inst_b = None
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
-                          endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=min_fs_b)
+                          endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=min_fs_b,
+                          weak_test=BETA_WEAK_TEST)
     fb.slope_method += est_note
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE

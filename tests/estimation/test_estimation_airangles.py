@@ -489,3 +489,25 @@ def test_a_given_flight_decides_the_side_force_estimator(monkeypatch):
     # without INSTRUMENTED_BETA a given sideslip fit changes nothing (least squares on both flights)
     np.testing.assert_array_equal(aided_air_angles(*scaled, instrument_beta=False, models={"beta": ref_iv}).beta,
                                   ls.beta)
+
+
+def test_weak_instrument_tests_of_the_side_force_slopes(monkeypatch):
+    """``BETA_WEAK_TEST``: ``"f"`` keeps 2SLS where the rudder is strong (its first-stage F on the effective sample
+    passes 10, said in the note) and falls back to least squares everywhere with a small rudder (identical sideslip);
+    ``"fuller"`` fits the slopes by Fuller's k-class without a fallback, near the record's ``CY_beta`` -0.5 on the
+    strong record."""
+    import gcs_sysid.estimation.airangles as aa
+
+    args, _ = _weathercock_record(1)
+    weak_args, _ = _weathercock_record(1, rudder=0.1)
+    with monkeypatch.context() as mp:
+        mp.setattr(aa, "BETA_WEAK_TEST", "f")
+        strong = aided_air_angles(*args, instrument_beta=True).axes[1]
+        weak = aided_air_angles(*weak_args, instrument_beta=True)
+        mp.setattr(aa, "BETA_WEAK_TEST", "fuller")
+        fuller = aided_air_angles(*args, instrument_beta=True).axes[1]
+    assert strong.slope_method.startswith("2SLS") and "first-stage F" in strong.slope_method, strong.slope_method
+    assert "instruments too weak in pass 1 (first-stage F" in weak.axes[1].slope_method, weak.axes[1].slope_method
+    np.testing.assert_array_equal(weak.beta, aided_air_angles(*weak_args, instrument_beta=False).beta)
+    assert "Fuller's k-class" in fuller.slope_method, fuller.slope_method
+    assert abs(fuller.coef[1] / -0.5 - 1) < 0.1, fuller.coef

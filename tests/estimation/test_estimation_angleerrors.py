@@ -139,3 +139,60 @@ def test_aiding_adds_no_offset_and_reports_the_mean_wind_sigma():
     assert np.isfinite(ax.bias_sigma) and ax.bias_sigma > 0
     assert np.all(res.alpha_sigma >= ax.bias_sigma - 1e-12)
     assert any("mean vertical wind" in n for n in describe(res))
+
+
+def test_effective_n_counts_independent_samples():
+    """White series keep N; two series smoothed over 25 samples keep about N / (1 + 2 sum rho^2) (Bartlett 1946)."""
+    from gcs_sysid.estimation.angleerrors import effective_n
+
+    rng = np.random.default_rng(3)
+    n = 4000
+    assert effective_n(rng.standard_normal(n), rng.standard_normal(n), 100) > 0.9 * n
+    sm = lambda x: np.convolve(x, np.ones(25) / 5.0, "same")  # noqa: E731
+    ne = effective_n(sm(rng.standard_normal(n)), sm(rng.standard_normal(n)), 100)
+    # the boxcar's autocorrelation is the triangle 1 - k/25: 1 + 2 sum (1 - k/25)^2 = 17.3
+    assert 0.6 * n / 17.3 < ne < 1.6 * n / 17.3
+
+
+def test_first_stage_f_on_the_effective_sample_tells_a_weak_instrument_from_a_strong_one():
+    """The iid F of a weak instrument on serially correlated data looks strong (N counts every sample); on the
+    effective sample it is under Staiger and Stock's 10, and a strong instrument stays well above."""
+    from gcs_sysid.estimation.angleerrors import first_stage_f
+
+    rng = np.random.default_rng(4)
+    n = 4000
+    sm = lambda x: np.convolve(x, np.ones(25) / 5.0, "same")  # noqa: E731
+    z, noise, other = sm(rng.standard_normal(n)), sm(rng.standard_normal(n)), rng.standard_normal(n)
+    for scale, strong in ((0.05, False), (1.5, True)):
+        A = np.c_[scale * z + noise, other]
+        f, r2, n_eff = first_stage_f(A, [0], z[:, None], 100)
+        f_iid = (r2 / 1) / ((1 - r2) / (n - 2))
+        assert n_eff < n / 8
+        assert (f > 10) == strong
+        assert f_iid > 10      # what the iid count would have said
+
+
+def test_fuller_k_class_is_less_biased_than_2sls_with_many_weak_instruments():
+    """Twelve instruments, two of them weakly relevant (first-stage R^2 about 0.01): 2SLS leans to least squares'
+    bias, Fuller's k-class (alpha 1) much less (Fuller 1977; Hahn, Hausman and Kuersteiner 2004)."""
+    b2, bf, bo = [], [], []
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        n = 3000
+        z, u, g = rng.standard_normal((n, 12)), rng.standard_normal(n), rng.standard_normal(n)
+        x = z @ np.r_[0.1, 0.05, np.zeros(10)] + g + 0.5 * u
+        A = np.c_[x, rng.standard_normal(n)]
+        y = 2.0 * x + u
+        b2.append(iv_lstsq(A, y, [0], z)[0][0])
+        bf.append(iv_lstsq(A, y, [0], z, fuller_n=n)[0][0])
+        bo.append(np.linalg.lstsq(A, y, rcond=None)[0][0])
+    bias = lambda b: abs(np.median(b) - 2.0)  # noqa: E731
+    assert bias(bo) > 0.3
+    assert bias(bf) < 0.5 * bias(b2)
+    # with a strong instrument both are 2SLS's (k -> 1)
+    rng = np.random.default_rng(99)
+    z, u = rng.standard_normal((3000, 1)), rng.standard_normal(3000)
+    x = 2.0 * z[:, 0] + 0.5 * u + rng.standard_normal(3000)
+    A = np.c_[x]
+    y = 2.0 * x + u
+    assert abs(iv_lstsq(A, y, [0], z)[0][0] - iv_lstsq(A, y, [0], z, fuller_n=3000)[0][0]) < 0.01

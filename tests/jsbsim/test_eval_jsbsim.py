@@ -45,6 +45,25 @@ def test_summary_has_the_aero_rate_score_when_the_rows_have_it(tmp_path):
     assert len(line) == 1 and "| 2.5 |" in line[0] and "| 97 |" in line[0]
 
 
+def test_cy_diagnosis_splits_a_spurious_rate_slope_from_the_bias():
+    """A model with JSBSim's CY_beta, a spurious CY_r_hat and an offset: the diagnosis returns the model's and the
+    truth's local slopes, a sideslip scale of 1 for an unbiased estimate, and the error as bias + linear (no rest)."""
+    rng = np.random.default_rng(5)
+    n = 2000
+    Xt = rng.standard_normal((n, 10)) * 0.05
+    Xe = Xt.copy()
+    Xe[:, 1] += 0.01 * rng.standard_normal(n)
+    cy_true = -1.0 * Xt[:, 1]
+    cy_model = cy_true - 1.8 * Xt[:, 4] + 0.01
+    d = eval_jsbsim.cy_diagnosis(Xe, Xt, cy_model, cy_true)
+    assert d["CY_beta_true"] == pytest.approx(-1.0, abs=1e-9) and d["CY_beta_model"] == pytest.approx(-1.0, abs=1e-9)
+    assert d["CY_r_hat_model"] == pytest.approx(-1.8, abs=1e-9) and d["CY_r_hat_true"] == pytest.approx(0.0, abs=1e-9)
+    assert d["beta_scale"] == pytest.approx(1.0, abs=0.02)
+    assert d["rest_pct"] < 1e-6
+    assert d["err_pct"] ** 2 == pytest.approx(d["bias_pct"] ** 2 + d["linear_pct"] ** 2, rel=1e-2)
+    assert d["linear_pct"] == pytest.approx(180.0, rel=0.1)   # 1.8 x RMS(r_hat) / RMS(beta), equal RMS
+
+
 @pytest.mark.slow
 def test_one_flight_is_scored(tmp_path):
     row = eval_jsbsim.evaluate("sgs", 4, "light", "vane", 40.0, tmp_path)
