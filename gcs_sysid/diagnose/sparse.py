@@ -159,7 +159,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
-              "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True}
+              "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
+              "scale_beta_allowance": False, "coverage_on_centred": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -879,15 +880,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         for f in named:
             if f["cause"] in at_naming:
                 _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
-    k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
-    if k_cov > 0:
-        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov), cause=f["cause"]) for f in named
-                               if not beyond_expanded_uncertainty(f, k_cov)["beyond"]]
-        gone = {x["cause"] for x in result["not_named"]}
-        named = [f for f in named if f["cause"] not in gone]
-    if th.get("centred_estimate", False) and th.get("honest_std_error", True):
+    def centre(named):
         # the reported estimate of a named monomial from the well-formulated fit, companions in its own regressors
-        # projected onto it (every decision above was made on the selected fit and is kept; _with_uncertainty)
+        # projected onto it (the selection's decisions are kept: evidence.correction, std_error_decision)
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
         for f in named:
@@ -896,6 +891,21 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
                                   centred=True)
+
+    centred = bool(th.get("centred_estimate", False) and th.get("honest_std_error", True))
+    if centred and th.get("coverage_on_centred", False):
+        # the coverage test below then reads the well-formulated fit's change and combined uncertainty: a bare
+        # alpha^2 without its parent alpha moves with an offset of the measured alpha, so its type-B offset
+        # component is not the change's (the c684's Cm:alpha^2 -5.0 +- 4.8 against -8; eighteenth session)
+        centre(named)
+    k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
+    if k_cov > 0:
+        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov), cause=f["cause"]) for f in named
+                               if not beyond_expanded_uncertainty(f, k_cov)["beyond"]]
+        gone = {x["cause"] for x in result["not_named"]}
+        named = [f for f in named if f["cause"] not in gone]
+    if centred and not th.get("coverage_on_centred", False):
+        centre(named)          # every decision above was made on the selected fit and is kept (_with_uncertainty)
     result["findings"] = named
     return result
 
