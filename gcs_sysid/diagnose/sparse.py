@@ -146,6 +146,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`_with_uncertainty`). It names, drops and
 #: judges nothing: ``evidence.correction`` and ``evidence.std_error_decision`` keep the selected fit's change and
 #: standard error, which every decision reads. No threshold; False off.
+#: Added 2026-11-23 (eighteenth session, branch i9-c684), both **off** (opt-in): ``scale_beta_allowance`` (read by
+#: ``diagnose`` for the differential step: a ``scale:CY`` finding is judged against a between-flight scale of the
+#: measured sideslip fitted on Cl and Cn, as a ``CY:beta`` finding is, with the scale's own column;
+#: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance` ``column``; no new threshold) and
+#: ``coverage_on_centred`` (the naming's coverage test reads the centred estimate's change and combined uncertainty
+#: instead of the selected fit's). Measured in ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
