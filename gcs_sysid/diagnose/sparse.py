@@ -150,8 +150,8 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ``diagnose`` for the differential step: a ``scale:CY`` finding is judged against a between-flight scale of the
 #: measured sideslip fitted on Cl and Cn, as a ``CY:beta`` finding is, with the scale's own column;
 #: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance` ``column``; no new threshold) and
-#: ``coverage_on_centred`` (the naming's coverage test reads the centred estimate's change and combined uncertainty
-#: instead of the selected fit's). Measured in ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
+#: ``coverage_type_a`` (the naming's coverage test reads the combined uncertainty without its type-B air-angle
+#: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -166,7 +166,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
-              "scale_beta_allowance": False, "coverage_on_centred": False}
+              "scale_beta_allowance": False, "coverage_type_a": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -886,9 +886,16 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         for f in named:
             if f["cause"] in at_naming:
                 _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
-    def centre(named):
+    k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
+    if k_cov > 0:
+        ta = bool(th.get("coverage_type_a", False))
+        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov, ta), cause=f["cause"]) for f in named
+                               if not beyond_expanded_uncertainty(f, k_cov, ta)["beyond"]]
+        gone = {x["cause"] for x in result["not_named"]}
+        named = [f for f in named if f["cause"] not in gone]
+    if th.get("centred_estimate", False) and th.get("honest_std_error", True):
         # the reported estimate of a named monomial from the well-formulated fit, companions in its own regressors
-        # projected onto it (the selection's decisions are kept: evidence.correction, std_error_decision)
+        # projected onto it (every decision above was made on the selected fit and is kept; _with_uncertainty)
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
         for f in named:
@@ -897,26 +904,11 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
                                   centred=True)
-
-    centred = bool(th.get("centred_estimate", False) and th.get("honest_std_error", True))
-    if centred and th.get("coverage_on_centred", False):
-        # the coverage test below then reads the well-formulated fit's change and combined uncertainty: a bare
-        # alpha^2 without its parent alpha moves with an offset of the measured alpha, so its type-B offset
-        # component is not the change's (the c684's Cm:alpha^2 -5.0 +- 4.8 against -8; eighteenth session)
-        centre(named)
-    k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
-    if k_cov > 0:
-        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov), cause=f["cause"]) for f in named
-                               if not beyond_expanded_uncertainty(f, k_cov)["beyond"]]
-        gone = {x["cause"] for x in result["not_named"]}
-        named = [f for f in named if f["cause"] not in gone]
-    if centred and not th.get("coverage_on_centred", False):
-        centre(named)          # every decision above was made on the selected fit and is kept (_with_uncertainty)
     result["findings"] = named
     return result
 
 
-def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> dict:
+def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type_a_only: bool = False) -> dict:
     """Is a named term's change since the reference larger than its expanded uncertainty ``k u_c``?
 
     ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (the finding's ``std_error``
@@ -930,6 +922,14 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> d
     Args:
         f: a named finding (``estimate``, ``model_value``, ``std_error``, ``evidence``); ``change = estimate -
             model_value`` (``scale:`` findings: ``model_value`` 1). k: the coverage factor (> 0).
+        type_a_only: judge the change against the combined uncertainty *without* its type-B air-angle components
+            (``THRESHOLDS["coverage_type_a"]``; eighteenth session, branch i9-c684; off). Those are computed by
+            refitting the same residual on columns built from the rescaled or shifted angle
+            (:func:`gcs_sysid.diagnose.uncertainty.angle_sensitivity`), so they are proportional to the change
+            itself (a term of degree n in an angle whose stated scale uncertainty is u reads ``~ n u |change|``) and
+            vanish when nothing changed: they size a change, they do not make one. With them, a stated alpha scale
+            uncertainty above about 25 % makes every ``alpha^2`` change fail the test whatever its size (the c684's
+            stated 0.43: ``Cm:alpha^2`` -5.4 +- 7.05, of which 7.04 is the alpha scale).
 
     Returns:
         ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
@@ -942,6 +942,12 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> d
     if u_c is None or not np.isfinite(u_c) or u_c <= 0 or not np.isfinite(change):
         return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
                 "why": None}
+    if type_a_only:
+        tb = ((f.get("evidence") or {}).get("uncertainty") or {}).get("type_b") or {}
+        u_c = float(np.sqrt(max(float(u_c) ** 2 - sum(float(v) ** 2 for v in tb.values() if np.isfinite(v)), 0.0)))
+        if not u_c > 0:
+            return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
+                    "why": None}
     beyond = bool(abs(change) > k * float(u_c))
     return {"beyond": beyond, "change": change, "combined_std_uncertainty": float(u_c), "coverage_factor": float(k),
             "why": None if beyond else f"change {change:.4g} within its expanded uncertainty {k:g} x {u_c:.3g} "
