@@ -151,7 +151,8 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: measured sideslip fitted on Cl and Cn, as a ``CY:beta`` finding is, with the scale's own column;
 #: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance` ``column``; no new threshold) and
 #: ``coverage_type_a`` (the naming's coverage test reads the combined uncertainty without its type-B air-angle
-#: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
+#: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in
+#: ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
