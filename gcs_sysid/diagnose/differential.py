@@ -131,7 +131,7 @@ def _refit_other(ctx: DiagContext, R: np.ndarray, finding: dict, ref: Reference,
 
 
 def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, coef: str, term: str,
-                     min_t: float = 3.0, min_gain_pct: float = 10.0) -> dict:
+                     min_t: float = 3.0, min_gain_pct: float = 10.0, column: np.ndarray | None = None) -> dict:
     """Is an aero finding more than a between-flight offset of its coefficient?
 
     Flights of one aircraft differ by near-constant coefficient offsets that are no cause (the
@@ -146,6 +146,8 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
         X: (T, 10) regressors. R: (T, 6) residual without the finding (measured minus model).
         train, test: (T,) selection and held-out rows. coef, term: the finding (``"CZ"``, ``"alpha"``).
         min_t, min_gain_pct: the tests above.
+        column: (T,) the finding's own column where ``term`` is no vocabulary monomial (``scale:CY``: the model's
+            side force, :func:`_scale_column`); None: ``term_matrix(X, [term])``.
 
     Returns:
         ``{"offset_only": bool, "estimate", "std_error", "t", "gain_beyond_offset_percent", "why"}``.
@@ -154,7 +156,7 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
     if term == "1":
         return {"offset_only": True, "why": f"{coef}:1 is a between-flight offset of {coef}"}
     try:
-        phi = term_matrix(X, [term])[:, 0]
+        phi = np.asarray(column, float) if column is not None else term_matrix(X, [term])[:, 0]
     except SysidError:                  # a term outside the vocabulary: the search fitted its own constant
         return {"offset_only": False, "why": "term outside the vocabulary (the sparse search's own constant)"}
     r = R[:, j]
@@ -218,7 +220,7 @@ def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.n
 def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
                           scale_se: bool = True, jackknife: dict | None = None,
-                          along_term: bool = False) -> dict | None:
+                          along_term: bool = False, column: np.ndarray | None = None) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -253,6 +255,9 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
             need not be among the term's factors, ``n_j = phi dC_j/dx`` and the document's keys read
             ``error_along_term`` (``scale`` is ``s``, in radians per unit of the term: the true angle is the
             measured one plus ``s phi``, as the scale's ``1 + s`` multiplies the measured angle).
+        column: (T,) the finding's own column where ``term`` is no vocabulary monomial: ``scale:CY`` judged against
+            a between-flight scale of the measured sideslip (:func:`_scale_column`; eighteenth session, branch
+            i9-c684); the angle need not be among the term's factors then. None: ``term_matrix(X, [term])``.
         jackknife: ``{"t": (T,) s, "block_s": s, "reference": (t_r, X_r, R_r, rows_r) or None}``: the term
             beyond the scale is also judged with the block-jackknife standard error
             (:func:`block_jackknife_se`) of this flight's slope and of the reference flight's (the model's
@@ -272,7 +277,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     from .context import evaluate_model
 
     group = ANGLE_COEFFICIENTS[angle]
-    if coef not in group or (not along_term and angle not in _angle_factors(term)):
+    if coef not in group or (not along_term and column is None and angle not in _angle_factors(term)):
         return None
     ia = REGRESSORS.index(angle)
     eps = 1e-3
@@ -310,10 +315,11 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     j = COEFFICIENTS.index(coef)
     R_adj = np.array(R, float, copy=True)
     R_adj[:, j] = R[:, j] - s_hat * N[:, j]
-    beyond = offset_allowance(X, R_adj, train, test, coef, term, min_t=min_t, min_gain_pct=min_gain_pct)
+    beyond = offset_allowance(X, R_adj, train, test, coef, term, min_t=min_t, min_gain_pct=min_gain_pct,
+                              column=column)
     if scale_se and "std_error" in beyond and np.isfinite(se_s):
         try:
-            phi = term_matrix(X, [term])[:, 0]
+            phi = np.asarray(column, float) if column is not None else term_matrix(X, [term])[:, 0]
         except SysidError:
             phi = None
         m = ok & np.isfinite(phi) if phi is not None else ok[:0]
@@ -487,6 +493,17 @@ def _force_changes(diag, fitted: dict, cause: str) -> dict:
         if d is not None and np.isfinite(d).any():
             out[c] = out.get(c, 0.0) + d
     return out
+
+
+def _scale_column(model, X: np.ndarray, coef: str, wind_axis: bool = True) -> np.ndarray:
+    """The column (T,) of ``scale:<coef>`` on regressors ``X`` (T, 10): what a scale of that coefficient adds per unit
+    of ``k - 1`` (:func:`gcs_sysid.diagnose.sparse.scale_columns` of the model's prediction; CY: its wind-axis side
+    force)."""
+    from .context import evaluate_model
+    from .sparse import scale_columns
+
+    M = np.nan_to_num(evaluate_model(model, X))
+    return scale_columns(M, np.nan_to_num(X), wind_axis)[:, COEFFICIENTS.index(coef)]
 
 
 def _note_allowance(doc: dict, f: dict, allowance: dict, summary: str) -> None:
@@ -725,7 +742,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
                  alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
                  delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
-                 force_moment_arm_max: float = 0.0) -> dict:
+                 force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
+                 scale_wind_axis: bool = True) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -769,6 +787,15 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             also judged beyond those force changes' moment about the CG, each with a free arm of at most this
             many reference lengths (:func:`force_moment_allowance`; ``sparse.THRESHOLDS["force_moment_arm_max"]``;
             added in the twelfth session, branch i9-second); 0: off.
+        scale_beta_allowance: also judge a ``scale:<coef>`` finding of a sideslip coefficient (``scale:CY``) against
+            a between-flight scale of the measured sideslip (:func:`angle_scale_allowance` with the finding's own
+            column, :func:`_scale_column`), as a ``CY:beta`` finding is (``sparse.THRESHOLDS["scale_beta_allowance"]``;
+            eighteenth session, branch i9-c684). A sideslip scale ``1 + s`` moves CY by ``s beta dCY/dbeta``, which on
+            an airframe whose side force is mostly its sideslip slope is ``s`` times the model's CY: the column of
+            ``scale:CY``; before, only a finding named ``CY:beta`` was judged so, and the c684's clean seed 13 named
+            ``scale:CY`` 1.146 where its sideslip read 8 % smaller against the truth than the reference's.
+            False: off.
+        scale_wind_axis: the scale's column in the search's convention (``sparse.THRESHOLDS["side_force_wind_axis"]``).
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -888,6 +915,22 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 continue
             if moment is not None:
                 f["evidence"]["force_moment_allowance"] = moment
+        if scale_beta_allowance and cause.startswith("scale:") and cause[6:] in BETA_COEFFICIENTS:
+            # a side-force scale is judged against a between-flight scale of the measured sideslip, as CY:beta is: on
+            # an airframe whose side force is mostly CY_beta beta the two are one column (the c684, eighteenth session)
+            coef = cause[6:]
+            R_wo = diag.residual_before
+            if search_residual is not None and f.get("source") == "sparse search":
+                R_wo = np.where(valid0[:, None], search_residual, np.nan)
+            col = _scale_column(diag.model, diag.X, coef, scale_wind_axis)
+            scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model, coef,
+                                          cause, "beta", min_t=min_t, min_gain_pct=min_gain_pct,
+                                          scale_se=angle_scale_se, column=col)
+            if scale is not None and scale["scale_only"]:
+                _note_allowance(doc, f, scale, f"{cause}: a between-flight scale of the measured sideslip, not a cause")
+                continue
+            if scale is not None:
+                f["evidence"]["beta_scale_allowance"] = scale
         null = 0.0 if is_aero else _null_value(cause, airframe)
         # an aero finding's correction is its change from the model's value (catalogue: evidence.correction;
         # sparse search: estimate - model_value)

@@ -146,6 +146,13 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`_with_uncertainty`). It names, drops and
 #: judges nothing: ``evidence.correction`` and ``evidence.std_error_decision`` keep the selected fit's change and
 #: standard error, which every decision reads. No threshold; False off.
+#: Added 2026-11-23 (eighteenth session, branch i9-c684), both **off** (opt-in): ``scale_beta_allowance`` (read by
+#: ``diagnose`` for the differential step: a ``scale:CY`` finding is judged against a between-flight scale of the
+#: measured sideslip fitted on Cl and Cn, as a ``CY:beta`` finding is, with the scale's own column;
+#: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance` ``column``; no new threshold) and
+#: ``coverage_type_a`` (the naming's coverage test reads the combined uncertainty without its type-B air-angle
+#: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in
+#: ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -159,7 +166,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alpha_jackknife_s": 15.0, "delay_change_min_t": 3.0,
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
-              "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True}
+              "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
+              "scale_beta_allowance": False, "coverage_type_a": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -881,8 +889,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
     k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
     if k_cov > 0:
-        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov), cause=f["cause"]) for f in named
-                               if not beyond_expanded_uncertainty(f, k_cov)["beyond"]]
+        ta = bool(th.get("coverage_type_a", False))
+        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov, ta), cause=f["cause"]) for f in named
+                               if not beyond_expanded_uncertainty(f, k_cov, ta)["beyond"]]
         gone = {x["cause"] for x in result["not_named"]}
         named = [f for f in named if f["cause"] not in gone]
     if th.get("centred_estimate", False) and th.get("honest_std_error", True):
@@ -900,7 +909,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     return result
 
 
-def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> dict:
+def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type_a_only: bool = False) -> dict:
     """Is a named term's change since the reference larger than its expanded uncertainty ``k u_c``?
 
     ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (the finding's ``std_error``
@@ -914,6 +923,14 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> d
     Args:
         f: a named finding (``estimate``, ``model_value``, ``std_error``, ``evidence``); ``change = estimate -
             model_value`` (``scale:`` findings: ``model_value`` 1). k: the coverage factor (> 0).
+        type_a_only: judge the change against the combined uncertainty *without* its type-B air-angle components
+            (``THRESHOLDS["coverage_type_a"]``; eighteenth session, branch i9-c684; off). Those are computed by
+            refitting the same residual on columns built from the rescaled or shifted angle
+            (:func:`gcs_sysid.diagnose.uncertainty.angle_sensitivity`), so they are proportional to the change
+            itself (a term of degree n in an angle whose stated scale uncertainty is u reads ``~ n u |change|``) and
+            vanish when nothing changed: they size a change, they do not make one. With them, a stated alpha scale
+            uncertainty above about 25 % makes every ``alpha^2`` change fail the test whatever its size (the c684's
+            stated 0.43: ``Cm:alpha^2`` -5.4 +- 7.05, of which 7.04 is the alpha scale).
 
     Returns:
         ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
@@ -926,6 +943,12 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR) -> d
     if u_c is None or not np.isfinite(u_c) or u_c <= 0 or not np.isfinite(change):
         return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
                 "why": None}
+    if type_a_only:
+        tb = ((f.get("evidence") or {}).get("uncertainty") or {}).get("type_b") or {}
+        u_c = float(np.sqrt(max(float(u_c) ** 2 - sum(float(v) ** 2 for v in tb.values() if np.isfinite(v)), 0.0)))
+        if not u_c > 0:
+            return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
+                    "why": None}
     beyond = bool(abs(change) > k * float(u_c))
     return {"beyond": beyond, "change": change, "combined_std_uncertainty": float(u_c), "coverage_factor": float(k),
             "why": None if beyond else f"change {change:.4g} within its expanded uncertainty {k:g} x {u_c:.3g} "

@@ -206,3 +206,28 @@ def test_a_moment_that_is_a_named_side_force_change_about_an_offset_point_is_an_
     # no arm from CZ to Cl on a symmetric airframe; a force coefficient is no moment
     assert force_moment_allowance(X, R, train, test, "Cl", "beta", {"CZ": dF}) is None
     assert force_moment_allowance(X, R, train, test, "CY", "beta", {"CY": dF}) is None
+
+
+def test_a_side_force_scale_finding_is_judged_against_the_sideslip_scale():
+    """``scale:CY`` is the model's side force, which on an airframe whose side force is mostly its sideslip slope is
+    the column a sideslip scale moves: the c684's clean seed 13 named ``scale:CY`` 1.146 where its aided sideslip read
+    8 % smaller against the truth than the reference flight's (eighteenth session, branch i9-c684). Judged with its
+    own column (``_scale_column``), a sideslip 0.85 of the truth is an allowance; a side force 1.3 times the model's,
+    Cl and Cn untouched, stays a finding. Without the column the finding was not judged at all (None)."""
+    from gcs_sysid.diagnose.differential import _scale_column, angle_scale_allowance
+
+    X, noise, train, test = _flight(3)
+    ib, j = REGRESSORS.index("beta"), COEFFICIENTS.index("CY")
+    col = _scale_column(MODEL, X, "CY")
+    assert angle_scale_allowance(X, noise, train, test, MODEL, "CY", "scale:CY", "beta") is None
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / 0.85
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    assert not offset_allowance(X, R, train, test, "CY", "scale:CY", column=col)["offset_only"]
+    a = angle_scale_allowance(X, R, train, test, MODEL, "CY", "scale:CY", "beta", column=col)
+    assert a is not None and a["scale_only"], a
+    R2 = noise.copy()
+    R2[:, j] += 0.3 * col
+    b = angle_scale_allowance(X, R2, train, test, MODEL, "CY", "scale:CY", "beta", column=col)
+    assert b is not None and not b["scale_only"], b
+    assert abs(b["scale"]) < 0.02
