@@ -145,6 +145,14 @@ SLOPE_FLOOR = True
 #: or with beta not aided, the fitted slope and the identification check stand as before
 FLOOR_MIN_GUST_SHARE = 0.1
 FLOOR_DROPS = ("q_hat",)   #: columns left out of the first pass when the slope floor holds
+#: Opt-in (default False; eighteenth session, i8-alpha): keep the aided alpha's flight mean at the kinematic alpha's
+#: (the gust state's mean over the aided rows is removed after every pass). The flight-mean vertical wind is not
+#: observable (it goes into CZ0), so the aiding has no information on alpha's mean; but its force-derived angle,
+#: linearised at the kinematic angle with the local slope ``CZ_alpha + 2 CZ_alpha2 (alpha - alpha0)``, divides a
+#: residual that correlates with the kinematic angle's gust error by a slope that moves with that same error, and its
+#: mean moves away from the kinematic one by 0.3-1.0 deg on the slow aircraft (rascal, sgs126, asw20 in MIL-F-8785C
+#: light turbulence; ``docs/benchmarks.md``, "Eighteenth session, i8-alpha").
+KINEMATIC_MEAN = False
 
 
 @dataclass
@@ -588,6 +596,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             it, ir = TAUS_S.index(fit.tau_s), RATIOS.index(fit.ratio)
             taus, ratios = TAUS_S[max(it - 1, 0):it + 2], RATIOS[max(ir - 1, 0):ir + 2]
         g, gs, tau, s_g, s_v = _gust_smoother(dt, z, segs, taus, ratios)
+        if KINEMATIC_MEAN and name == "alpha" and np.any(m & np.isfinite(g)):
+            g = g - float(np.nanmean(g[m]))    # the flight mean stays the kinematic one (KINEMATIC_MEAN)
         ang = np.where(m, kin + g, kin)
         sig = gs
         fit = AxisFit(name, True, "", names, c, cs, tau, s_g, s_v, RATIOS[int(np.argmin(np.abs(
