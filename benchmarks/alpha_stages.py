@@ -21,6 +21,8 @@ Stages (one exact quantity swapped at a time):
 * ``aided``: the pipeline's aided alpha (the replay's);
 * ``aid|Tkin``: the aiding run on ``Tkin`` in place of ``kin`` (the kinematic inputs' own errors removed);
 * ``aid|slope``: the aiding given the CZ slopes fitted on JSBSim's regressors and coefficient (same band);
+* ``pct_CZ_aided``, ``pct_Cm_aided``: ``|C_alpha x offset| / RMS(C)`` in %, what the offset alone costs a model
+  learned on the flight at the true alpha in eval_jsbsim's ``error_pct`` (``C_alpha`` fitted on the truth);
 * ``aid|mean``: the aiding with ``airangles.KINEMATIC_MEAN`` on (its mean kept at the kinematic alpha's);
 * ``aid|V``: the aiding with JSBSim's airspeed and dynamic pressure.
 
@@ -146,6 +148,15 @@ def stages(tlog: Path, aircraft: str) -> dict:
                                  rcond=None)
         out["CZ_alpha_fit"], out["CZ_alpha_true"] = float(fa.coef[1]), float(ct[0])
         out["dCZ"] = float(abs(ct[0] * np.radians(S["aided"]["off"])) / np.nanstd(ip(tr.Y[:, 2])[m]))
+        # what the offset alone costs a model at the true alpha, in eval_jsbsim's error_pct (RMS error over RMS
+        # of the true coefficient): |C_alpha x offset| / RMS(C), with C_alpha of CZ and Cm fitted on the truth
+        B = np.column_stack([Xi[:, 0], Xi[:, 3], Xi[:, 5]])[m]
+        for j, cname in ((2, "CZ"), (4, "Cm")):
+            yt = ip(tr.Y[:, j])[m]
+            cj, *_ = np.linalg.lstsq(_highpass(B, dt, fa.band_hz), _highpass(yt, dt, fa.band_hz), rcond=None)
+            out[f"{cname}_alpha_true"] = float(cj[0])
+            for k in ("aided", "kin"):
+                out[f"pct_{cname}_{k}"] = float(100 * abs(cj[0] * np.radians(S[k]["off"])) / np.sqrt(np.mean(yt**2)))
         if len(fa.columns) == 5:
             given = aa.AxisFit("alpha", True, "", fa.columns, np.r_[0.0, ct], np.zeros(5))
             S["aid|slope"] = split(aa.aided_air_angles(*args, **dict(kw, models={"alpha": given})).alpha, at, m, dt)
