@@ -41,6 +41,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -179,7 +180,8 @@ def show(r: dict) -> str:
     head = (f"{r['flight']}: true alpha sd {r['sd']:.2f} deg, mean w_d/V {r['wV']:+.2f} deg, gamma {r['gamma']:+.1f} "
             f"deg, V {r['V']:.1f} m/s, V est/true {r['Vratio']:.3f}")
     if "wind_rms_err" in r:
-        head += f", wind err mean {r['wind_mean_err'][0]:+.2f} {r['wind_mean_err'][1]:+.2f} rms {r['wind_rms_err']:.2f} m/s"
+        we = r["wind_mean_err"]
+        head += f", wind err mean {we[0]:+.2f} {we[1]:+.2f} rms {r['wind_rms_err']:.2f} m/s"
     if "CZ_alpha_fit" in r:
         head += f", CZ_alpha fit {r['CZ_alpha_fit']:+.2f} true {r['CZ_alpha_true']:+.2f}, dCZ {r['dCZ']:.2f}"
     lines = [head]
@@ -196,7 +198,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--turbulence", default=None, help="only this level")
     ap.add_argument("--json", default=None, help="append one JSON line per flight here")
     a = ap.parse_args(argv)
-    import json
     for w in a.work:
         for tlog in sorted(Path(w).glob("*.tlog")):
             ac, turb = tlog.stem.split("-")[:2]
