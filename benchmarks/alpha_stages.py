@@ -155,7 +155,7 @@ def stages(tlog: Path, aircraft: str) -> dict:
         for j, cname in ((2, "CZ"), (4, "Cm")):
             yt = ip(tr.Y[:, j])[m]
             cj, *_ = np.linalg.lstsq(_highpass(B, dt, fa.band_hz), _highpass(yt, dt, fa.band_hz), rcond=None)
-            out[f"{cname}_alpha_true"] = float(cj[0])
+            out[f"{cname}_alpha_true_lin"] = float(cj[0])     # linear fit (alpha, q_hat, delta_e)
             for k in ("aided", "kin"):
                 out[f"pct_{cname}_{k}"] = float(100 * abs(cj[0] * np.radians(S[k]["off"])) / np.sqrt(np.mean(yt**2)))
         if len(fa.columns) == 5:
