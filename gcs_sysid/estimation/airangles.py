@@ -153,6 +153,12 @@ FLOOR_DROPS = ("q_hat",)   #: columns left out of the first pass when the slope 
 #: mean moves away from the kinematic one by 0.3-1.0 deg on the slow aircraft (rascal, sgs126, asw20 in MIL-F-8785C
 #: light turbulence; ``docs/benchmarks.md``, "Eighteenth session, i8-alpha").
 KINEMATIC_MEAN = False
+#: Opt-in (default False; eighteenth session, i8-alpha): where the lift-slope floor holds, leave the curvature
+#: ``(alpha - alpha0)^2`` out of the first pass too (as :data:`FLOOR_DROPS`); the later passes fit it on the aided angle.
+#: Fitted on the kinematic angle it is that angle's gust error squared (rascal, sgs126, asw20 light: -16..+11 per rad^2
+#: against JSBSim's -0.1..0.3), and it moves the aided alpha's mean (``docs/benchmarks.md``, "Eighteenth session,
+#: i8-alpha").
+FLOOR_DROPS_CURVATURE = False
 
 
 @dataclass
@@ -549,7 +555,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             # kinematic angle misses, and the aircraft pitches into it, so a q_hat slope fitted here is the gust's
             # (docs/estimation.md, "The lift-slope floor")
             free, floored = float(cr[0]), True
-            keep = [j for j in range(1, A.shape[1]) if j < nq or cols[j - nq] not in FLOOR_DROPS]
+            keep = [j for j in range(1, A.shape[1]) if (j < nq and not FLOOR_DROPS_CURVATURE)
+                    or (j >= nq and cols[j - nq] not in FLOOR_DROPS)]
             cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep)
             dropped = [k for k in cols if k in FLOOR_DROPS]
             floor_note = (f"first pass with CZ_alpha held at the wing's lift slope {sign * abs(slope_floor):+.2f} "
