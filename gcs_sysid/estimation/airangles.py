@@ -558,7 +558,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             keep = [j for j in range(1, A.shape[1]) if (j < nq and not FLOOR_DROPS_CURVATURE)
                     or (j >= nq and cols[j - nq] not in FLOOR_DROPS)]
             cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep)
-            dropped = [k for k in cols if k in FLOOR_DROPS]
+            dropped = (([names[2]] if quadratic and FLOOR_DROPS_CURVATURE else [])
+                       + [k for k in cols if k in FLOOR_DROPS])
             floor_note = (f"first pass with CZ_alpha held at the wing's lift slope {sign * abs(slope_floor):+.2f} "
                           f"(fitted {free:+.2f}: attenuated by the kinematic angle's gust error)"
                           + (f" and {', '.join(dropped)} left out" if dropped else ""))
