@@ -395,7 +395,21 @@ def main(argv=None) -> int:
                          "INSTRUMENTED_BETA), or 2SLS where the effective-sample first-stage F passes (f: "
                          "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
+    ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
+                    help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."
+                         "KINEMATIC_MEAN; default: the package's default, off)")
+    ap.add_argument("--floor-drops-curvature", default=None, choices=("on", "off"),
+                    help="leave alpha's curvature out of the floored first pass (gcs_sysid.estimation.airangles."
+                         "FLOOR_DROPS_CURVATURE; default: the package's default, off)")
     a = ap.parse_args(argv)
+    if a.kinematic_mean is not None:
+        from gcs_sysid.estimation import airangles
+
+        airangles.KINEMATIC_MEAN = a.kinematic_mean == "on"
+    if a.floor_drops_curvature is not None:
+        from gcs_sysid.estimation import airangles
+
+        airangles.FLOOR_DROPS_CURVATURE = a.floor_drops_curvature == "on"
     if a.iv_beta is not None:
         from gcs_sysid.estimation import airangles
 

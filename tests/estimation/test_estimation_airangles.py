@@ -511,3 +511,44 @@ def test_weak_instrument_tests_of_the_side_force_slopes(monkeypatch):
     np.testing.assert_array_equal(weak.beta, aided_air_angles(*weak_args, instrument_beta=False).beta)
     assert "Fuller's k-class" in fuller.slope_method, fuller.slope_method
     assert abs(fuller.coef[1] / -0.5 - 1) < 0.1, fuller.coef
+
+
+def test_kinematic_mean_keeps_the_aided_alpha_mean_at_the_kinematic_one(monkeypatch):
+    """Opt-in ``KINEMATIC_MEAN`` (eighteenth session, i8-alpha): with a curved CZ and a large slow gust error in the
+    kinematic alpha the aiding's linearisation moves alpha's flight mean (measured -0.20 deg here, 0.3-0.9 deg on
+    JSBSim's slow aircraft); with the flag the mean is the kinematic one and the rest of the error is unchanged."""
+    import gcs_sysid.estimation.airangles as aa
+
+    rng = np.random.default_rng(4)
+    rec, alpha, _ = _record(seed=4)
+    n = len(alpha)
+    rec["alpha_kin"] = rec["alpha_kin"] - _gauss_markov(rng, n, 20.0, np.radians(4.0)) - np.radians(1.0)
+    rec["f_body"][:, 2] += rec["qbar"] * S / MASS * 8.0 * (alpha - alpha.mean()) ** 2
+    base = _run(rec)
+    monkeypatch.setattr(aa, "KINEMATIC_MEAN", True)
+    kept = _run(rec)
+    assert base.axes[0].used and kept.axes[0].used
+    d_base = np.degrees(np.mean(base.alpha - rec["alpha_kin"]))
+    d_kept = np.degrees(np.mean(kept.alpha - rec["alpha_kin"]))
+    assert abs(d_base) > 0.1, d_base                    # the default moves the mean (measured -0.20 deg)
+    assert abs(d_kept) < 1e-6, d_kept
+    sd_base, sd_kept = np.std(base.alpha - alpha), np.std(kept.alpha - alpha)
+    assert abs(sd_kept / sd_base - 1.0) < 0.01, (sd_base, sd_kept)
+    assert np.allclose(kept.beta, base.beta)            # beta is not touched
+
+
+def test_floor_drops_curvature_leaves_the_curvature_out_of_the_floored_pass(monkeypatch):
+    """Opt-in ``FLOOR_DROPS_CURVATURE`` (eighteenth session, i8-alpha): where the lift-slope floor holds, the first pass
+    leaves the curvature out too and says so; the later pass fits it on the aided angle, and the aided alpha stays as
+    good as with the default on the floored riding record (error SD within 20 %)."""
+    import gcs_sysid.estimation.airangles as aa
+
+    args, alpha, _ = _riding_record(2)
+    args = _with_lateral_gust(args, 2)
+    base = aided_air_angles(*args)
+    monkeypatch.setattr(aa, "FLOOR_DROPS_CURVATURE", True)
+    new = aided_air_angles(*args)
+    fb, fn = base.axes[0], new.axes[0]
+    assert fb.used and fn.used
+    assert "(alpha - alpha0)^2" in fn.slope_method and "(alpha - alpha0)^2" not in fb.slope_method
+    assert np.std(new.alpha - alpha) < 1.2 * np.std(base.alpha - alpha)
