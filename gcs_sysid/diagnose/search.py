@@ -27,9 +27,11 @@ import numpy as np
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from .context import DiagContext
 
-__all__ = ["candidate_library", "alpha_quantile_knots", "press_stepwise", "search_residual"]
+__all__ = ["LIBRARY_REGRESSORS", "candidate_library", "alpha_quantile_knots", "press_stepwise", "search_residual"]
 
-_BASE = ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "delta_a", "delta_r", "delta_t")
+#: The regressors the candidate library builds its monomials from (products to degree 3), in the order a term's
+#: factors are written (``alpha*beta``, ``alpha^2``); shared with :mod:`.sparse`, which parses and names the terms.
+LIBRARY_REGRESSORS = ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "delta_a", "delta_r", "delta_t")
 
 
 def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
@@ -48,10 +50,10 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
         (names, Phi): names (K,) and values (T, K); constant columns left out.
     """
     X = np.nan_to_num(ctx.X)
-    cols = {n: X[:, REGRESSORS.index(n)] for n in _BASE}
+    cols = {n: X[:, REGRESSORS.index(n)] for n in LIBRARY_REGRESSORS}
     names, out = [], []
     for d in range(1, degree + 1):
-        for combo in combinations_with_replacement(_BASE, d):
+        for combo in combinations_with_replacement(LIBRARY_REGRESSORS, d):
             v = np.prod([cols[n] for n in combo], axis=0)
             parts = []
             for n in dict.fromkeys(combo):

@@ -51,7 +51,7 @@ from .aliases import ALIAS_CONDITION_INDEX, find_aliases, separation_advice
 from .context import DiagContext
 from .lift_alpha import lift_alpha_error
 from .regression import ols
-from .search import _BASE, alpha_quantile_knots, candidate_library, press_stepwise
+from .search import LIBRARY_REGRESSORS, alpha_quantile_knots, candidate_library, press_stepwise
 
 __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
            "angle_nuisance", "untouched_confirmation", "scale_columns", "NAMING_COVERAGE_FACTOR",
@@ -1081,7 +1081,7 @@ def _ridge_jackknife(Phi: np.ndarray, Y: np.ndarray, t: np.ndarray, ridge, max_r
 
 def _monomial_name(factors: Counter) -> str:
     """A monomial's name as :func:`gcs_sysid.diagnose.search.candidate_library` spells it (``alpha^2*beta``)."""
-    return "*".join(n if factors[n] == 1 else f"{n}^{factors[n]}" for n in _BASE if factors[n] > 0)
+    return "*".join(n if factors[n] == 1 else f"{n}^{factors[n]}" for n in LIBRARY_REGRESSORS if factors[n] > 0)
 
 
 def _parent_terms(named: str) -> list[str]:
@@ -1092,10 +1092,10 @@ def _parent_terms(named: str) -> list[str]:
     ``alpha_dot_hat``, ``scale:``) or of degree 1.
     """
     fac = _factors(named)
-    if fac is None or not all(x in _BASE for x in fac):
+    if fac is None or not all(x in LIBRARY_REGRESSORS for x in fac):
         return []
     c = Counter(fac)
-    keys = [n for n in _BASE if c[n] > 0]
+    keys = [n for n in LIBRARY_REGRESSORS if c[n] > 0]
     out = []
     for powers in np.ndindex(*[c[n] + 1 for n in keys]):
         sub = Counter({n: int(p) for n, p in zip(keys, powers) if p > 0})
@@ -1110,7 +1110,7 @@ def _term_regressors(term: str) -> set | None:
     if term.startswith("max(0,alpha-"):
         return {"alpha"}
     fac = _factors(term)
-    return set(fac) if fac is not None and all(x in _BASE for x in fac) else None
+    return set(fac) if fac is not None and all(x in LIBRARY_REGRESSORS for x in fac) else None
 
 
 def _centred_weights(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray) -> np.ndarray:
@@ -1209,7 +1209,7 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         return
     if centred:
         fac = _factors(named)
-        if fac is None or not all(x in _BASE for x in fac):
+        if fac is None or not all(x in LIBRARY_REGRESSORS for x in fac):
             return
         # the named term's parents, leaving out any that is constant on the training rows (collinear with 1)
         Xt = np.nan_to_num(X[tr])
