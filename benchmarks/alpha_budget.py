@@ -124,20 +124,29 @@ def budget(tlog: Path, aircraft: str) -> str:
     return "\n".join(out)
 
 
+def flown_logs(work: list[str], aircraft: str | None = None, turbulence: str | None = None):
+    """The eval_jsbsim flights in the work directories ``work`` that have their truth file beside them.
+
+    Yields ``(tlog Path, aircraft name, turbulence level)`` read from the file name
+    (``<aircraft>-<turbulence>-...tlog``), sorted per directory, only ``aircraft`` / ``turbulence`` where given.
+    """
+    for w in work:
+        for tlog in sorted(Path(w).glob("*.tlog")):
+            ac, turb = tlog.stem.split("-")[:2]
+            if (aircraft and ac != aircraft) or (turbulence and turb != turbulence):
+                continue
+            if tlog.with_name(tlog.stem + "-truth.npz").exists():
+                yield tlog, ac, turb
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("work", nargs="+", help="eval_jsbsim work directories")
     ap.add_argument("--aircraft", default=None, help="only this aircraft (default: all found)")
     ap.add_argument("--turbulence", default=None, help="only this level")
     a = ap.parse_args(argv)
-    for w in a.work:
-        for tlog in sorted(Path(w).glob("*.tlog")):
-            ac, turb = tlog.stem.split("-")[:2]
-            if (a.aircraft and ac != a.aircraft) or (a.turbulence and turb != a.turbulence):
-                continue
-            if not tlog.with_name(tlog.stem + "-truth.npz").exists():
-                continue
-            print(budget(tlog, ac), flush=True)
+    for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
+        print(budget(tlog, ac), flush=True)
     return 0
 
 

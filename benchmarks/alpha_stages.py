@@ -52,7 +52,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import gcs_sysid.estimation.airangles as aa  # noqa: E402
 import gcs_sysid.estimation.estimate as est  # noqa: E402
-from benchmarks.alpha_budget import _highpass  # noqa: E402
+from benchmarks.alpha_budget import _highpass, flown_logs  # noqa: E402
 from benchmarks.jsbsim_harness.truth import load_truth  # noqa: E402
 from gcs_sysid.airframe import load_airframe  # noqa: E402
 from gcs_sysid.telemetry import read_log  # noqa: E402
@@ -198,18 +198,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--turbulence", default=None, help="only this level")
     ap.add_argument("--json", default=None, help="append one JSON line per flight here")
     a = ap.parse_args(argv)
-    for w in a.work:
-        for tlog in sorted(Path(w).glob("*.tlog")):
-            ac, turb = tlog.stem.split("-")[:2]
-            if (a.aircraft and ac != a.aircraft) or (a.turbulence and turb != a.turbulence):
-                continue
-            if not tlog.with_name(tlog.stem + "-truth.npz").exists():
-                continue
-            r = stages(tlog, ac)
-            print(show(r), flush=True)
-            if a.json:
-                with open(a.json, "a") as fh:
-                    fh.write(json.dumps(r) + "\n")
+    for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
+        r = stages(tlog, ac)
+        print(show(r), flush=True)
+        if a.json:
+            with open(a.json, "a") as fh:
+                fh.write(json.dumps(r) + "\n")
     return 0
 
 
