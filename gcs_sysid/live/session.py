@@ -16,8 +16,10 @@ runs and the :class:`~gcs_sysid.live.learner.Learner` itself (with its model) af
 from __future__ import annotations
 
 import queue
+import signal
 import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -29,7 +31,7 @@ from .requests import rates_from_params
 from .edge import LiveEdge
 from .learner import LearnOptions, Learner
 
-__all__ = ["ListenOptions", "LiveSession", "run_listen", "TICK_S"]
+__all__ = ["ListenOptions", "LiveSession", "run_listen", "stop_on_signals", "TICK_S"]
 
 TICK_S = 0.25
 _EDGE = {"RAW_IMU", "SCALED_IMU", "HIGHRES_IMU", "ATTITUDE", "VFR_HUD", "AOA_SSA"}
@@ -127,6 +129,7 @@ class LiveSession:
             self._told_events = 0
             self._learner_error: str | None = None
             self._stop = threading.Event()
+            self._signalled: int | None = None   # set by the handler of run_listen's stop_on_signals
             self._closed: dict | None = None
             self._learn_thread = threading.Thread(target=self._learn_loop, name="gcs-sysid-learn", daemon=True)
             if isinstance(self.learner, Learner):   # behind: coalesce steps, defer the map (Learner.behind)
@@ -355,19 +358,19 @@ class LiveSession:
         self.start_learning()
         interrupted = False
         try:
-            while not self._stop.is_set() and (self.options.duration_s is None
+            while not self._stop.is_set() and self._signalled is None and (self.options.duration_s is None
                                                or time.time() - self.started < self.options.duration_s):
                 time.sleep(TICK_S)
                 self.tick()
                 if on_tick is not None:
                     on_tick(self.snapshot())
-        except KeyboardInterrupt:
+        except KeyboardInterrupt:   # a host without stop_on_signals
             interrupted = True
         except Exception as exc:   # a bug in the schedule: still stop cleanly and write the report
             self.events.append(f"session stopped by an internal error: {type(exc).__name__}: {exc}")
             self.close(False)
             raise
-        return self.close(interrupted)
+        return self.close(interrupted or self._signalled is not None)
 
     def start_learning(self) -> None:
         """Start the learner thread (once; :meth:`run` does it, a host that feeds packets calls it)."""
@@ -424,6 +427,37 @@ class LiveSession:
         return snap
 
 
+@contextmanager
+def stop_on_signals(session: LiveSession, signals=(signal.SIGINT, signal.SIGTERM)):
+    """While the block runs, SIGINT and SIGTERM end ``session`` at its next tick instead of raising.
+
+    Python raises ``KeyboardInterrupt`` wherever the main thread happens to be when the signal lands,
+    including between a lock's acquisition and the ``with`` block that would release it (a
+    ``queue.Queue`` call in :meth:`LiveSession.tick`): the session's clean end then waits on that lock
+    for ever. Here the handler only records the signal; :meth:`LiveSession.run` reads it at the top
+    of its loop (within :data:`TICK_S`) and closes as after a Ctrl-C. A second signal before the
+    session has closed raises ``KeyboardInterrupt`` as before (the user insists: the report is given up,
+    ``raw.tlog`` keeps what was received). Off the main thread (an embedding host) nothing is installed.
+
+    Source: the Python library reference, ``signal``, "Note on signal handlers and exceptions".
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):
+        if session._signalled is not None:
+            raise KeyboardInterrupt
+        session._signalled = signum
+
+    previous = {s: signal.signal(s, handler) for s in signals}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
 def run_listen(airframe_path: str | Path, out_dir: str | Path, options: ListenOptions) -> dict:
     """Listen on ``options.connection`` (see :class:`ListenOptions`) with the rich console if asked.
 
@@ -437,11 +471,14 @@ def run_listen(airframe_path: str | Path, out_dir: str | Path, options: ListenOp
         raise InputError(f"--duration {options.duration_s}: must be > 0 s")
     session = LiveSession(airframe, out_dir, options)
     try:   # Ctrl-C at any moment from here on ends the session cleanly, with its report
-        if not options.console:
-            return session.run()
-        from .console import LiveConsole
+        with stop_on_signals(session):
+            if not options.console:
+                return session.run()
+            from .console import LiveConsole
 
-        with LiveConsole() as console:
-            return session.run(on_tick=console.update)
+            with LiveConsole() as console:
+                return session.run(on_tick=console.update)
     except KeyboardInterrupt:
+        if session._closed is not None:   # a second signal during the close: the report is given up
+            raise
         return session.close(interrupted=True)
