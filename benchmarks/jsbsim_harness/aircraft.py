@@ -540,6 +540,20 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "data/jsbsim_models/ultrastick120) without propulsion, direct surfaces (derived model "
               "UltraStick120_glide, XML sha256 df846fb42f873137), fixed gear, gliding; untouched by any tuning of the "
               "method"),
+    # b737: JSBSim's stock Boeing 737 (737.xml, Dave Culp and Aeromatic, GPL in its header; the wheel's, flown
+    # as it is), the nineteenth session's untouched aircraft. Chosen with one screening rule relaxed (docs/
+    # jsbsim.md, "The b737"): its aerodynamics are the b747's term set function for function (the thirteenth
+    # session set it aside as a near-copy), with other numbers (Cnb 0.26, Cnr -0.35, Cndr -0.20, Clb -0.09,
+    # Clr 0.09, Cmalpha -0.6, Cmq -27, Cmadot -16, Clda and Cmde in Mach). Its own yaw damper (1.0 x r-aero
+    # above Mach 0.11, in the rudder channel, not clipped short of the rudder's +-0.35 rad) stays in the loop,
+    # as the b747's did: k_r 0. Both CFM56 on "direct" thrusters (no force once stopped), gear up.
+    "b737": AircraftSpec(
+        name="b737", model="737", airspeed_kts=250.0, altitude_ft=12000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.3, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(3.5, 6.0, 5.0), pulse_s=(0.7, 0.8, 1.0), gains=(0.8, 0.8, 0.004, 1.0, 0.4, 0.0), gear_up=True,
+        notes="Boeing 737 (JSBSim 737), engines shut down, gear up, gliding, its own yaw damper in the loop; "
+              "untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
                    "asw20", "iar80", "c684")
