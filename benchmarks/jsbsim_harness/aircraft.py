@@ -84,10 +84,11 @@ _DEG = 57.29577951308232
 #: well, as is ``iar80`` (the sixteenth session's: FlightGear's JSBSim IAR-80 fighter, checked into
 #: ``data/jsbsim_models/iar80`` and flown as ``IAR80_glide``, engine and propeller removed, at 10000 ft) and ``c684``
 #: (the seventeenth session's: FlightGear's JSBSim Caudron C.684 racer, checked into ``data/jsbsim_models/c684`` and
-#: flown as ``C684_glide``, engine and propeller removed, at 6000 ft). ``ultrastick`` (added in the eighteenth
-#: session, 2026-11-23: the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV, checked into
-#: ``data/jsbsim_models/ultrastick120`` and flown as ``UltraStick120_glide``, no propulsion, direct surfaces, at
-#: 10000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from
+#: flown as ``C684_glide``, engine and propeller removed, at 6000 ft) and ``ultrastick`` (the eighteenth session's:
+#: the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV, checked into ``data/jsbsim_models/ultrastick120``
+#: and flown as ``UltraStick120_glide``, no propulsion, direct surfaces, at 10000 ft). ``b737`` (added in the nineteenth
+#: session, 2026-11-23: JSBSim's stock Boeing 737, the wheel's ``737``, engines shut down, gear up, its own yaw damper in
+#: the loop, at 12000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``, ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from
 #: JSBSim's truth and its XML), the method was never run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
@@ -556,9 +557,9 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20", "iar80", "c684")
-HELD_OUT_AIRCRAFT = ("ultrastick",)
-UNTOUCHED_AIRCRAFT = ("ultrastick",)
+                   "asw20", "iar80", "c684", "ultrastick")
+HELD_OUT_AIRCRAFT = ("b737",)
+UNTOUCHED_AIRCRAFT = ("b737",)
 
 
 def aircraft(name: str) -> AircraftSpec:
