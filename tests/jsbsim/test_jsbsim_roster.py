@@ -1,6 +1,6 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684 and the untouched ultrastick; docs/jsbsim.md, one section
-each),
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick and the untouched b737; docs/jsbsim.md, one
+section each),
 parametrised over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
@@ -11,14 +11,15 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched ultrastick's are slow too but its names', and its own
-default checks (the derivation, its surfaces, static stability, the summaries' label) are in
-``test_jsbsim_ultrastick.py`` (the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+default suite, as before the fold); the untouched b737's are slow too but its names', and its own
+default checks (its model, surfaces, yaw damper, static stability, the summaries' label) are in
+``test_jsbsim_b737.py`` (the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to eighteenth sessions). Folded in the eleventh session
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to nineteenth sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
-in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth.
+in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
+b737 in the nineteenth.
 """
 
 from dataclasses import dataclass
@@ -268,7 +269,29 @@ CASES = (
           ("cn", 3, None, ("in", 0.002, 0.008)), ("cn", 1, None, ("in", 0.05, 0.12))),
          (), 0.5235987755982988, 1,
          dict(alpha=(-9.0, 15.0), beta=(9.0, 11.0), bank=(25.0, 30.0), speed=(15.0, 45.0), alt_min=500.0,
-              rate_std=1.5, rate_std_held=1.5, sink_min=5.0), n_elevator_reads=6, untouched=True, min_lbf=0.3),
+              rate_std=1.5, rate_std_held=1.5, sink_min=5.0), n_elevator_reads=6, min_lbf=0.3),
+    # b737 (JSBSim's stock Boeing 737, the wheel's 737.xml, Dave Culp and Aeromatic; flown as it is at 250 kt and 12000
+    # ft, engines shut down, gear up, its own yaw damper in the loop): 83000 lb empty + 24000 lb of fuel in three
+    # tanks on and either side of the centre line (project Ixz -25908.5 kg m^2: <ixz> 8000 slug ft^2 with
+    # negated_crossproduct_inertia and the tanks 22 in above the CG). The aerodynamic reference point is 14 in aft of
+    # the empty CG, 15 in aft of the loaded one, and 64 in above it. On the 30-s calm flight (derivative_slopes, as the
+    # b747's): Cm_alpha -0.99 (Cmalpha -0.6 and the lift aft of the CG), Cm_q -43.4 (Cmq -27 with Cmadot -16: the
+    # fit has no alpha-dot), Cm_delta_e -0.987 (Cmde (-1.2 + 0.45 Mach) at Mach 0.55 and CLde through the arm);
+    # Cl_beta -0.1439 (Clb -0.09 and the side force, CYb -1, acting 64 in below the reference point), Cl_p -0.400,
+    # Cl_r 0.090, Cl_delta_a -0.0815 (Clda (0.1 - 0.0335 Mach) x left), Cl_delta_r 0.010; Cn_beta 0.2729 (Cnb 0.26
+    # and the side force aft of the CG), Cn_p 0, Cn_r -0.350, Cn_delta_a 0 (no Cnda function), Cn_delta_r -0.200.
+    # One SIDE function; the elevator read by CLde and Cmde (CDde reads fcs/mag-elevator-pos-rad, not delayed). Gear
+    # up (CDgear). Envelope limits from the trial flights (docs/jsbsim.md, "The b737"): alpha -7.5..7.6 deg,
+    # sideslip 5.8, bank 9.8 (Cl:alpha*beta = 3), TAS 127-217 m/s, sink through the air 15.9-20.3 m/s, lowest 902 m,
+    # rate standard deviations at least 1.07 deg/s (the pitch rate, moderate, held-out 20 %).
+    Case("b737", "737", "b73", 107000, -25908.5,
+         (("cm", 0, None, ("in", -1.2, -0.85)), ("cm", 2, -0.987, ("rel", 0.02)), ("cl", 3, -0.0815, ("rel", 0.02)),
+          ("cl", 0, -0.1439, ("rel", 0.02)), ("cl", 1, -0.4, ("rel", 0.02)), ("cl", 2, 0.0901, ("rel", 0.03)),
+          ("cl", 4, 0.01, ("rel", 0.05)), ("cn", 4, -0.2, ("rel", 0.02)), ("cn", 0, 0.2729, ("rel", 0.02)),
+          ("cn", 2, -0.35, ("rel", 0.02)), ("cn", 3, 0.0, ("abs", 1e-3)), ("cn", 1, 0.0, ("abs", 1e-3))),
+         ("CDgear",), 0.3, 1,
+         dict(alpha=(-9.0, 9.0), beta=(8.0, 9.0), bank=(15.0, 20.0), speed=(110.0, 240.0), alt_min=500.0,
+              rate_std=0.8, rate_std_held=0.7, sink_min=5.0), untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -297,7 +320,7 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the ultrastick
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the b737
     alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
@@ -308,7 +331,8 @@ def test_names_resolve_and_roles(case):
     else:
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
-    used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684"}
+    used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684",
+            "ultrastick"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
@@ -439,7 +463,8 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [p for p in _params()
-                                  if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick")])
+                                  if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick",
+                                                          "b737")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse

@@ -1,4 +1,5 @@
-"""The ultrastick in the JSBSim harness: the eighteenth session's untouched aircraft (docs/jsbsim.md, "The ultrastick").
+"""The ultrastick in the JSBSim harness: the eighteenth session's untouched aircraft, a tuning aircraft since the
+nineteenth (docs/jsbsim.md, "The ultrastick").
 
 The model is the University of Minnesota UAS Laboratories' JSBSim Ultra Stick 120 (UASLab/OpenFlightSim
 ``Simulation/aircraft/UltraStick120`` at commit 1650a6e3, MIT), a 7.4-kg research UAV whose aerodynamics are
@@ -13,19 +14,18 @@ turbulence: a mechanism check); none of them flies the harness:
 - the checked-in files are the README's, and the derivation changes no number;
 - the FCS maps the commands straight to the surfaces (+-30 deg, the right aileron the left's mirror), flaps 0;
   no engine, no external force;
-- it is statically stable about the CG, and its elevator, ailerons and rudder act as its tables say;
-- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_c684.py``).
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its tables say.
+
+The summaries' label test moved to ``test_jsbsim_b737.py`` in the nineteenth session (the b737 is untouched now).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
 map, .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
 All of them but the names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the ultrastick: its first evaluation is the final one,
-after the merge.
+No pipeline fit, GP, diagnosis or scoring ran on the ultrastick before the eighteenth session's final evaluation.
 """
 
 import hashlib
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -149,32 +149,3 @@ def test_the_ultrastick_is_statically_stable_and_its_controls_act_as_its_tables_
         l3, n3, _, _ = lat(beta=4.0, alpha=a)
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(cnb, abs=5e-4), a
-
-
-def test_summaries_mark_the_ultrastick_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the ultrastick "(untouched)" and
-    no other aircraft, the c684 and iar80 included (synthetic rows: no ultrastick result exists before the
-    final evaluation). Moved here from ``test_jsbsim_c684.py`` (the seventeenth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| ultrastick (untouched) | light") for ln in lines)
-    for ac in acs[:14]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| ultrastick (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| c684 | clean |") for ln in lines)
