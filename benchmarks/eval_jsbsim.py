@@ -388,9 +388,10 @@ def main(argv=None) -> int:
     ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated"),
                     help="the replay's GP settings: 'decorrelated' sets gcs_sysid.pipeline.USE_DECORRELATED_GP "
                          "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md)")
-    ap.add_argument("--cy-rate-prior", default=None, type=float, metavar="STD",
-                    help="a zero-mean prior of this std on CY's p_hat and r_hat slopes in the GP's linear mean "
-                         "(gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD; 0: none; default: the package's default)")
+    ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
+                    help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
+                         "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
+                         "none; default: the package's default")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
@@ -445,7 +446,7 @@ def main(argv=None) -> int:
     if a.cy_rate_prior is not None:
         import gcs_sysid.pipeline as pipeline
 
-        pipeline.SIDE_FORCE_RATE_PRIOR_STD = a.cy_rate_prior if a.cy_rate_prior > 0 else None
+        pipeline.SIDE_FORCE_RATE_PRIOR_STD = None if a.cy_rate_prior == "off" else float(a.cy_rate_prior)
     work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
     rows = []
     print(f"{'flight':32s} {'':5s} " + " ".join(f"{c:>6s}" for c in COEFFICIENTS) + "   cov95  alpha/beta err deg")

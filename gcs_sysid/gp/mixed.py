@@ -11,7 +11,8 @@ linear model ``z = X theta + v``, ``Var(v) = c s^2 I``, and stochastic prior inf
 (``R`` picks the slopes with a prior, ``S = diag(sigma_k^2)``; ``s^2`` the least-squares residual
 variance, ``c`` the residual's long-run variance ratio, :func:`gcs_sysid.gp.colored.variance_inflation`,
 so coloured residuals count as the fewer independent samples they are). ``sigma -> inf`` gives least
-squares, ``sigma -> 0`` the fit with those slopes fixed at zero.
+squares, ``sigma = 0`` the fit with those slopes fixed at zero (the columns left out: Morelli and Klein's
+parameters fixed at a priori values).
 
 Why on the target and not on the GP's linear-mean weights (``GPConfig.mean_prior``): a prior on a
 mean weight moves only the weight; the GP's kernel, which sees the same input, takes up whatever
@@ -38,7 +39,7 @@ def mixed_estimate(X: np.ndarray, z: np.ndarray, prior_std: np.ndarray) -> tuple
     Args:
         X: ``(N, D)`` regressors in time order (an intercept is added; columns that do not vary get slope 0).
         z: ``(N,)`` output.
-        prior_std: ``(D,)`` prior std of each slope in the data's units (``inf``: no prior).
+        prior_std: ``(D,)`` prior std of each slope in the data's units (``inf``: no prior; 0: fixed at 0).
 
     Returns:
         ``(theta_ls, theta_me)``, each ``(D + 1,)``, intercept first.
@@ -65,11 +66,14 @@ def mixed_estimate(X: np.ndarray, z: np.ndarray, prior_std: np.ndarray) -> tuple
     v = z - A @ b_ls
     s2 = float(v @ v) / max(N - A.shape[1], 1)
     c = float(variance_inflation(v[:, None])[0])
-    prec = np.zeros(A.shape[1])                       # prior precision of the standardised slopes
-    with np.errstate(divide="ignore"):
-        prec[1:] = np.where(np.isinf(sd[act]), 0.0, 1.0 / np.maximum(sd[act] * sx[act], 1e-300) ** 2)
-    H = A.T @ A / (c * s2 + 1e-300) + np.diag(prec)
-    b_me = np.linalg.solve(H, A.T @ z / (c * s2 + 1e-300))
+    free = np.r_[True, sd[act] > 0]                   # sd 0: the slope fixed at 0, its column left out
+    Af = A[:, free]
+    prec = np.zeros(Af.shape[1])                      # prior precision of the standardised slopes
+    sdf = sd[act][free[1:]] * sx[act][free[1:]]
+    prec[1:] = np.where(np.isinf(sdf), 0.0, 1.0 / np.where(np.isinf(sdf), 1.0, sdf) ** 2)
+    w = 1.0 / max(c * s2, 1e-300)
+    b_me = np.zeros(A.shape[1])
+    b_me[free] = np.linalg.solve(Af.T @ Af * w + np.diag(prec), Af.T @ z * w)
 
     def raw(b):                                       # back to the data's units, intercept first
         th = np.zeros(D + 1)

@@ -47,6 +47,10 @@ def test_tight_prior_keeps_the_yaw_rate_slope_at_its_true_value_where_least_squa
     r_ls = cy - np.c_[np.ones(len(X)), X] @ np.linalg.lstsq(np.c_[np.ones(len(X)), X], cy, rcond=None)[0]
     r_me = Y2[:, 0] - np.c_[np.ones(len(X)), X] @ np.linalg.lstsq(np.c_[np.ones(len(X)), X], Y2[:, 0], rcond=None)[0]
     assert np.allclose(r_ls, r_me, atol=1e-10)
+    # sd 0: the slope fixed at 0, the restricted least-squares fit
+    th_ls, th_0 = mixed_estimate(X, cy, np.array([np.inf, 0.0, np.inf]))
+    restricted = np.linalg.lstsq(np.c_[np.ones(len(X)), X[:, [0, 2]]], cy, rcond=None)[0]
+    assert th_0[2] == 0.0 and np.allclose(th_0[[0, 1, 3]], restricted, rtol=1e-8, atol=1e-12)
 
 
 def test_weak_prior_leaves_a_slope_the_data_determine_and_no_prior_changes_nothing():
