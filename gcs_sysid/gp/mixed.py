@@ -14,8 +14,8 @@ so coloured residuals count as the fewer independent samples they are). ``sigma 
 squares, ``sigma = 0`` the fit with those slopes fixed at zero (the columns left out: Morelli and Klein's
 parameters fixed at a priori values).
 
-Why on the target and not on the GP's linear-mean weights (``GPConfig.mean_prior``): a prior on a
-mean weight moves only the weight; the GP's kernel, which sees the same input, takes up whatever
+Why on the target and not on the GP's linear-mean weights (a cap on one weight's prior std, tried and
+not kept): a prior on a mean weight moves only the weight; the GP's kernel, which sees the same input, takes up whatever
 slope the weight gives back (a synthetic check: the mean weight of ``r_hat`` 0.02-prior -> -0.003,
 the model's slope along ``r_hat`` -1.89 either way, ``docs/gp.md``). Here the target's linear part is
 replaced by the mixed estimate's, ``z' = z - X (theta_LS - theta_ME)``: least squares of ``z'`` on
