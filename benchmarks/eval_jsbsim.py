@@ -80,6 +80,7 @@ from benchmarks.jsbsim_harness import (UNTOUCHED_AIRCRAFT, FlightConfig, coeffic
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
+import gcs_sysid.pipeline as _pipeline  # noqa: E402
 
 THESIS_FORCES, THESIS_MOMENTS = 19.8, 23.8
 
@@ -207,6 +208,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
                  "gust_rates": gust_rates, "gust_filter": gust_filter,
+                 "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
     row["meas_all"] = _errs(tab.Y[ok], Yt[ok])
@@ -388,6 +390,10 @@ def main(argv=None) -> int:
     ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated"),
                     help="the replay's GP settings: 'decorrelated' sets gcs_sysid.pipeline.USE_DECORRELATED_GP "
                          "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md)")
+    ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
+                    help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
+                         "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
+                         "none; default: the package's default")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
@@ -439,6 +445,10 @@ def main(argv=None) -> int:
         import gcs_sysid.pipeline as pipeline
 
         pipeline.USE_DECORRELATED_GP = a.gp_fit == "decorrelated"
+    if a.cy_rate_prior is not None:
+        import gcs_sysid.pipeline as pipeline
+
+        pipeline.SIDE_FORCE_RATE_PRIOR_STD = None if a.cy_rate_prior == "off" else float(a.cy_rate_prior)
     work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
     rows = []
     print(f"{'flight':32s} {'':5s} " + " ".join(f"{c:>6s}" for c in COEFFICIENTS) + "   cov95  alpha/beta err deg")

@@ -111,6 +111,20 @@ DECORRELATED_GP = {"noise_correlation": True, "hyper_stride": 0, "coupling": "of
 #: i8-decnt, for what it gains and loses in eval_jsbsim).
 USE_DECORRELATED_GP = False
 
+#: Opt-in (nineteenth session, i8-cyr): the std (CY per unit ``p_hat`` / ``r_hat``) of a zero-mean prior on CY's two
+#: rate slopes, imposed by mixed estimation on the GP's training target (:func:`gcs_sysid.gp.mixed.apply_slope_prior`;
+#: Theil and Goldberger 1961; ``docs/gp.md``, "Prior knowledge on the side-force rate slopes"). None: no prior (the
+#: default). The gust's side force lands on ``r_hat`` (the aircraft yaws with the gust the aided sideslip misses):
+#: CY_r_hat -1.7..-2.2 on the c684 and rascal against JSBSim's 0. JSBSim's models that have the terms: CY_r
+#: 0.14..0.30 (the F-16's 0.9), CY_p -0.2..0.1.
+SIDE_FORCE_RATE_PRIOR_STD: float | None = None
+
+
+def side_force_rate_prior(std: float | None) -> tuple:
+    """The prior of :func:`gcs_sysid.gp.mixed.apply_slope_prior` on CY's ``p_hat`` and ``r_hat`` slopes, std ``std``
+    (CY per unit rate); ``()`` for None."""
+    return () if std is None else (("CY", "p_hat", float(std)), ("CY", "r_hat", float(std)))
+
 
 def gp_inputs(table, rows: np.ndarray, with_alpha_dot: bool) -> tuple[np.ndarray, np.ndarray | None]:
     """The GP's inputs of ``rows`` (``(T,)`` bool) of a :class:`~gcs_sysid.aero.table.CoefficientTable`:
@@ -391,6 +405,15 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                    **(DECORRELATED_GP if USE_DECORRELATED_GP else {}),
                                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
                     names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
+                    prior = side_force_rate_prior(SIDE_FORCE_RATE_PRIOR_STD)
+                    if prior:                    # the target's linear part: the mixed estimate's (opt-in)
+                        from .gp.mixed import apply_slope_prior
+
+                        Y_train, info = apply_slope_prior(X_train[:, :len(REGRESSORS)], Y_train, REGRESSORS,
+                                                          [COEFFICIENTS[i] for i in fit_cols], prior)
+                        notes += [f"{o}: prior on its {', '.join(d['inputs'])} slopes (mixed estimation): "
+                                  + ", ".join(f"{k} {d['ls'][k]:.3g} -> {d['mixed'][k]:.3g}" for k in d["inputs"])
+                                  for o, d in info.items()]
                     model, _history = fit_gp(X_train, Y_train, cfg, input_names=names,
                                              output_names=[COEFFICIENTS[i] for i in fit_cols])
                     use_adot = use_adot and model.n_inputs == len(REGRESSORS) + 1   # kept by the gates
