@@ -152,17 +152,17 @@ def flight(tlog: Path, aircraft: str, edges: tuple[str, ...] = EDGES) -> dict:
     return out
 
 
-def show(r: dict) -> str:
-    """One flight as two markdown rows: the edges' ``CY_beta / CY_r_hat / error SD / scale``, then the gust
-    regression's ``g on beta / g on r_hat`` per band."""
+def show(r: dict) -> tuple[str, str]:
+    """One flight as two markdown rows: the edges' ``CY_beta / CY_r_hat / error SD / scale`` (:data:`EDGES`), and
+    the gust regression's ``g on beta_kin / g on r_hat`` per band (:data:`BANDS`)."""
     def cell(d):
         if not d.get("used"):
             return "not aided"
         return f"{d.get('beta', np.nan):.2f} / {d.get('r_hat', np.nan):.2f} / {d['err_sd']:.2f} / {d['scale']:.2f}"
     head = f"| {r['flight']} | {r['true_sd']:.2f} | {r['kin_err_sd']:.2f} | {r.get('wc_hz', np.nan):.2f} | "
     e = head + " | ".join(cell(r["edges"].get(k, {})) for k in EDGES) + " |"
-    g = head + " | ".join(f"{v['beta']:+.2f} / {v['r_hat']:+.2f}" for v in r["gust"].values()) + " |"
-    return e + "\n" + g
+    g = f"| {r['flight']} | " + " | ".join(f"{v['beta']:+.2f} / {v['r_hat']:+.2f}" for v in r["gust"].values()) + " |"
+    return e, g
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -173,12 +173,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", default=None, help="append one JSON line per flight here")
     a = ap.parse_args(argv)
     print("| flight | true SD | kin err SD | wc Hz | " + " | ".join(f"edge {k}" for k in EDGES) + " |")
+    print("|---" * (4 + len(EDGES)) + "|")
+    gust = []
     for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
         r = flight(tlog, ac)
-        print(show(r), flush=True)
+        e, g = show(r)
+        print(e, flush=True)
+        gust.append(g)
         if a.json:
             with open(a.json, "a") as fh:
                 fh.write(json.dumps(r) + "\n")
+    print("\n| flight | " + " | ".join(f"{lo}-{hi or ''} Hz: g on beta_kin / r_hat" for lo, hi in BANDS) + " |")
+    print("|---" * (1 + len(BANDS)) + "|")
+    print("\n".join(gust))
     return 0
 
 
