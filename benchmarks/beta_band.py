@@ -30,7 +30,6 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -41,13 +40,9 @@ from scipy.signal import butter, sosfiltfilt
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import gcs_sysid.estimation.airangles as aa  # noqa: E402
-import gcs_sysid.estimation.estimate as est  # noqa: E402
-from benchmarks.alpha_budget import flown_logs  # noqa: E402
+from benchmarks.alpha_budget import captured_aiding, flown_logs, work_parser  # noqa: E402
 from benchmarks.jsbsim_harness.truth import load_truth  # noqa: E402
-from gcs_sysid.airframe import load_airframe  # noqa: E402
-from gcs_sysid.telemetry import read_log  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
 COLUMNS = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")     #: the side-force model's columns (airangles)
 EDGES = ("0.3", "0.4", "0.5", "0.8", "1.2", "wc")               #: slope band edges tried, Hz ("wc": the corner)
 BANDS = ((0.3, None), (0.3, 0.6), (0.6, 1.2), (1.2, 2.4))      #: bands of the gust regression, Hz (None: open)
@@ -101,20 +96,14 @@ def directional_hz(dt: float, beta: np.ndarray, X_other: np.ndarray, Cn: np.ndar
 
 
 def flight(tlog: Path, aircraft: str, edges: tuple[str, ...] = EDGES) -> dict:
-    """Both measurements of the module docstring for one flight (angles in deg, slopes per rad)."""
-    cap: dict = {}
-    orig = est.aided_air_angles
+    """Both measurements of the module docstring for one flight (angles in deg, slopes per rad).
 
-    def capture(*a, **k):
-        cap["a"], cap["k"] = a, k
-        return orig(*a, **k)
-
-    est.aided_air_angles = capture
-    try:
-        st = est.estimate_states(read_log(tlog), load_airframe(REPO / "data" / "airframes" / f"jsbsim-{aircraft}.toml"))
-    finally:
-        est.aided_air_angles = orig
-    a, kw = cap["a"], cap["k"]
+    Raises:
+        ValueError: the estimator did not reach the aiding (no aided angles to measure).
+    """
+    st, a, kw = captured_aiding(tlog, aircraft)
+    if a is None:
+        raise ValueError(f"{tlog.stem}: the estimator did not reach the aiding")
     dt, bkin, V, qbar, rates, ctrl, S, b, use = a[0], a[2], a[3], a[4], a[6], a[7], a[9], a[10], a[12]
     tr = load_truth(tlog.with_name(tlog.stem + "-truth.npz"))
     bt = np.interp(st.t, tr.t, tr.X[:, 1], left=np.nan, right=np.nan)
@@ -166,12 +155,7 @@ def show(r: dict) -> tuple[str, str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("work", nargs="+", help="directories with eval_jsbsim's *.tlog and *-truth.npz")
-    ap.add_argument("--aircraft", default=None, help="only this aircraft (default: all found)")
-    ap.add_argument("--turbulence", default=None, help="only this level")
-    ap.add_argument("--json", default=None, help="append one JSON line per flight here")
-    a = ap.parse_args(argv)
+    a = work_parser(__doc__.split("\n")[0], json_out=True).parse_args(argv)
     print("| flight | true SD | kin err SD | wc Hz | " + " | ".join(f"edge {k}" for k in EDGES) + " |")
     print("|---" * (4 + len(EDGES)) + "|")
     gust = []

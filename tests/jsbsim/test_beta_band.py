@@ -49,3 +49,15 @@ def test_directional_corner_from_the_yawing_moment():
     assert abs(cn_beta - 0.09) < 0.005
     assert abs(f - np.sqrt(qbar * S * b * 0.09 / izz) / (2 * np.pi)) < 0.02
     assert bb.directional_hz(DT, beta, r_hat[:, None], -cn, qbar, S, b, izz)[0] == 0.0   # unstable: no corner
+
+
+def test_rows_and_command_line():
+    r = {"flight": "x-light-s1-ahrs", "true_sd": 1.0, "kin_err_sd": 3.0, "wc_hz": 0.64,
+         "edges": {"0.3": {"used": True, "beta": -0.69, "r_hat": -1.86, "err_sd": 0.66, "scale": 1.0},
+                   "1.2": {"used": False, "err_sd": 1.0, "scale": 1.0}},
+         "gust": {"0.3-": {"beta": -0.34, "r_hat": 1.85}}}
+    e, g = bb.show(r)
+    assert "-0.69 / -1.86 / 0.66 / 1.00" in e and "not aided" in e and e.count("|") == 4 + len(bb.EDGES) + 1
+    assert g == "| x-light-s1-ahrs | -0.34 / +1.85 |"
+    a = bb.work_parser("d", json_out=True).parse_args(["D1", "D2", "--aircraft", "rascal", "--json", "f"])
+    assert a.work == ["D1", "D2"] and a.aircraft == "rascal" and a.json == "f" and a.turbulence is None
