@@ -72,8 +72,11 @@ def _highpass(x: np.ndarray, dt: float, edge: float) -> np.ndarray:
     return sosfiltfilt(sos, x - x.mean(axis=0), axis=0)
 
 
-def budget(tlog: Path, aircraft: str) -> str:
-    """The budget of one flight as text (see the module docstring)."""
+def captured_aiding(tlog: Path, aircraft: str) -> tuple:
+    """Run the replay's estimator on ``tlog`` with the JSBSim airframe of ``aircraft`` and capture the inputs of the
+    specific-force aiding: ``(states, args, kwargs)`` of the
+    :func:`gcs_sysid.estimation.airangles.aided_air_angles` call (``args`` None where the estimator did not reach
+    the aiding)."""
     cap: dict = {}
     orig = est.aided_air_angles
 
@@ -86,9 +89,14 @@ def budget(tlog: Path, aircraft: str) -> str:
         st = est.estimate_states(read_log(tlog), load_airframe(REPO / "data" / "airframes" / f"jsbsim-{aircraft}.toml"))
     finally:
         est.aided_air_angles = orig
-    if "a" not in cap:
+    return st, cap.get("a"), cap.get("k")
+
+
+def budget(tlog: Path, aircraft: str) -> str:
+    """The budget of one flight as text (see the module docstring)."""
+    st, args, kw = captured_aiding(tlog, aircraft)
+    if args is None:
         return f"{tlog.stem}: the estimator did not reach the aiding"
-    args, kw = cap["a"], cap["k"]
     dt, akin, _, _, _, _, rates, ctrl, _, _, _, c, use = args[:13]
     tr = load_truth(tlog.with_name(tlog.stem + "-truth.npz"))
     t = st.t
@@ -139,12 +147,20 @@ def flown_logs(work: list[str], aircraft: str | None = None, turbulence: str | N
                 yield tlog, ac, turb
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("work", nargs="+", help="eval_jsbsim work directories")
+def work_parser(description: str, json_out: bool = False) -> argparse.ArgumentParser:
+    """The command line of the flight-walking attribution scripts: work directories, ``--aircraft``,
+    ``--turbulence`` (:func:`flown_logs`) and, with ``json_out``, ``--json`` (one JSON line per flight)."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("work", nargs="+", help="directories with eval_jsbsim's *.tlog and *-truth.npz")
     ap.add_argument("--aircraft", default=None, help="only this aircraft (default: all found)")
     ap.add_argument("--turbulence", default=None, help="only this level")
-    a = ap.parse_args(argv)
+    if json_out:
+        ap.add_argument("--json", default=None, help="append one JSON line per flight here")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    a = work_parser(__doc__.split("\n")[0]).parse_args(argv)
     for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
         print(budget(tlog, ac), flush=True)
     return 0

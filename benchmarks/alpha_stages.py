@@ -40,7 +40,6 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -52,7 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import gcs_sysid.estimation.airangles as aa  # noqa: E402
 import gcs_sysid.estimation.estimate as est  # noqa: E402
-from benchmarks.alpha_budget import _highpass, flown_logs  # noqa: E402
+from benchmarks.alpha_budget import _highpass, flown_logs, work_parser  # noqa: E402
 from benchmarks.jsbsim_harness.truth import load_truth  # noqa: E402
 from gcs_sysid.airframe import load_airframe  # noqa: E402
 from gcs_sysid.telemetry import read_log  # noqa: E402
@@ -192,12 +191,7 @@ def show(r: dict) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("work", nargs="+", help="directories with eval_jsbsim's *.tlog and *-truth.npz")
-    ap.add_argument("--aircraft", default=None, help="only this aircraft (default: all found)")
-    ap.add_argument("--turbulence", default=None, help="only this level")
-    ap.add_argument("--json", default=None, help="append one JSON line per flight here")
-    a = ap.parse_args(argv)
+    a = work_parser(__doc__.split("\n")[0], json_out=True).parse_args(argv)
     for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
         r = stages(tlog, ac)
         print(show(r), flush=True)

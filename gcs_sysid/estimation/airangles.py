@@ -750,7 +750,7 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      S: float, b: float, c: float, use: np.ndarray, passes: int = 2,
                      rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None,
                      instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None,
-                     instrument_beta: bool | None = None) -> AidedAngles:
+                     instrument_beta: bool | None = None, beta_band_hz: float | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -785,6 +785,11 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         instrument_beta: fit the side-force model's slopes (``CY_beta`` and the rate terms :data:`BETA_ENDOGENOUS`) by
             two-stage least squares with :data:`BETA_INSTRUMENTS` and their delayed copies as instruments, falling
             back to least squares below :data:`BETA_MIN_FIRST_STAGE_R2`; None: :data:`INSTRUMENTED_BETA`.
+        beta_band_hz: the edge above which the side-force model's slopes are fitted, Hz (at least
+            :data:`HIGHPASS_HZ`); None: :data:`HIGHPASS_HZ`. For measurement only (``benchmarks/beta_band.py``):
+            raising it to the directional (weathercock) corner does not remove the gust's side force from
+            ``CY_r_hat`` and worsens the aided sideslip (``docs/estimation.md``, "The sideslip's band and the
+            directional mode").
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -855,7 +860,7 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             inst_b = None
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
                           endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=min_fs_b,
-                          weak_test=BETA_WEAK_TEST)
+                          weak_test=BETA_WEAK_TEST, band_hz=beta_band_hz)
     fb.slope_method += est_note
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE

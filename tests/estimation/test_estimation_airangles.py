@@ -552,3 +552,18 @@ def test_floor_drops_curvature_leaves_the_curvature_out_of_the_floored_pass(monk
     assert fb.used and fn.used
     assert "(alpha - alpha0)^2" in fn.slope_method and "(alpha - alpha0)^2" not in fb.slope_method
     assert np.std(new.alpha - alpha) < 1.2 * np.std(base.alpha - alpha)
+
+
+def test_beta_band_edge_is_the_side_force_slopes_band():
+    # nineteenth session, i8-betaband: beta_band_hz sets the side-force model's band (measurement only); None is
+    # the default edge, bit for bit, and an edge below HIGHPASS_HZ is raised to it
+    from gcs_sysid.estimation.airangles import HIGHPASS_HZ
+    rec, _, _ = _record(seed=7)
+    T = len(rec["V"])
+    args = (DT, rec["alpha_kin"], rec["beta_kin"], rec["V"], rec["qbar"], rec["f_body"], rec["rates"],
+            rec["controls"], MASS, S, B, C, np.ones(T, bool))
+    base, same = aided_air_angles(*args), aided_air_angles(*args, beta_band_hz=None)
+    assert np.array_equal(base.beta, same.beta) and base.axes[1].band_hz == HIGHPASS_HZ
+    hi, lo = aided_air_angles(*args, beta_band_hz=0.5), aided_air_angles(*args, beta_band_hz=0.1)
+    assert hi.axes[1].used and hi.axes[1].band_hz == 0.5 and lo.axes[1].band_hz == HIGHPASS_HZ
+    assert np.array_equal(hi.alpha, base.alpha) and not np.array_equal(hi.beta, base.beta)
