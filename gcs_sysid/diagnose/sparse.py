@@ -909,7 +909,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
     k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
     if k_cov > 0:
-        ta, tn = bool(th.get("coverage_type_a", False)), bool(th.get("coverage_under_null", False))
+        ta, tn = bool(th.get("coverage_type_a", False)), th.get("coverage_under_null", False)
+        tn = tn if tn == "own_angles" else bool(tn)
         result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov, ta, tn), cause=f["cause"]) for f in named
                                if not beyond_expanded_uncertainty(f, k_cov, ta, tn)["beyond"]]
         gone = {x["cause"] for x in result["not_named"]}
@@ -930,7 +931,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
 
 
 def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type_a_only: bool = False,
-                                under_null: bool = False) -> dict:
+                                under_null: bool | str = False) -> dict:
     """Is a named term's change since the reference larger than its expanded uncertainty ``k u_c``?
 
     ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (the finding's ``std_error``
@@ -956,7 +957,9 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
             (``evidence.uncertainty.combined_under_no_change``: the type-A components with the air angles' stated
             uncertainty carried through the unchanged model, :mod:`gcs_sysid.diagnose.null_uncertainty`;
             ``THRESHOLDS["coverage_under_null"]``; nineteenth session, branch i9-null; off). Takes precedence over
-            ``type_a_only``; a finding without it is judged as before.
+            ``type_a_only``; a finding without it is judged as before. ``"own_angles"``: only the angles the named
+            term is a function of count (``combined_under_no_change_own_angles``; a term in ``delta_a`` then carries
+            no sideslip component, whose error along it the differential step judges from the data).
 
     Returns:
         ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
@@ -969,7 +972,8 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
     if u_c is None or not np.isfinite(u_c) or u_c <= 0 or not np.isfinite(change):
         return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
                 "why": None}
-    u_null = ((f.get("evidence") or {}).get("uncertainty") or {}).get("combined_under_no_change")
+    u_null = ((f.get("evidence") or {}).get("uncertainty") or {}).get(
+        "combined_under_no_change_own_angles" if under_null == "own_angles" else "combined_under_no_change")
     if under_null and u_null is not None and np.isfinite(u_null) and u_null > 0:
         u_c = float(u_null)
     elif type_a_only:
@@ -1330,6 +1334,13 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                    **typeb})
     u_null = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
                       **typeb_null}) if null is not None else None
+    # the variant "own_angles": only the angles the named term is a function of (None: lags, alpha_dot_hat and
+    # scale: columns, a function of every angle the model uses); the others' errors along a term are judged by the
+    # differential step's data-fitted allowances (angle_scale_allowance, angle_error_allowance)
+    own_angles = _term_regressors(named) if not named.startswith("scale:") else None
+    typeb_own = {k: v for k, v in typeb_null.items() if own_angles is None or k.rsplit("_", 1)[0] in own_angles}
+    u_null_own = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
+                          **typeb_own}) if null is not None else None
     if not np.isfinite(u_c) or u_c <= 0:
         return
     if centred:
@@ -1355,7 +1366,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         "type_a": {k: float(v) for k, v in parts.items()}, "type_b": typeb, "air_data": angle_u or {},
         "combined": u_c}
     if null is not None:
-        f["evidence"]["uncertainty"].update(type_b_under_no_change=typeb_null, combined_under_no_change=u_null)
+        f["evidence"]["uncertainty"].update(type_b_under_no_change=typeb_null, combined_under_no_change=u_null,
+                                            combined_under_no_change_own_angles=u_null_own)
     f["std_error"] = u_c
 
 

@@ -87,3 +87,10 @@ def test_the_coverage_test_reads_the_uncertainty_under_no_change_when_asked():
     old = {"estimate": -5.41, "model_value": 0.0, "std_error": 7.054,
            "evidence": {"uncertainty": {"type_b": {"alpha_scale": 7.044}, "combined": 7.054}}}
     assert not beyond_expanded_uncertainty(old, 2.0, under_null=True)["beyond"]
+
+
+def test_own_angles_reads_only_the_named_terms_angles():
+    unc = {"combined": 0.013, "combined_under_no_change": 0.042, "combined_under_no_change_own_angles": 0.012}
+    f = {"estimate": -0.083, "model_value": 0.0, "std_error": 0.013, "evidence": {"uncertainty": unc}}
+    assert not beyond_expanded_uncertainty(f, 2.0, under_null=True)["beyond"]
+    assert beyond_expanded_uncertainty(f, 2.0, under_null="own_angles")["beyond"]
