@@ -910,7 +910,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
     if k_cov > 0:
         ta, tn = bool(th.get("coverage_type_a", False)), th.get("coverage_under_null", False)
-        tn = tn if tn == "own_angles" else bool(tn)
+        tn = tn if tn == "alpha" else bool(tn)
         result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov, ta, tn), cause=f["cause"]) for f in named
                                if not beyond_expanded_uncertainty(f, k_cov, ta, tn)["beyond"]]
         gone = {x["cause"] for x in result["not_named"]}
@@ -957,9 +957,9 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
             (``evidence.uncertainty.combined_under_no_change``: the type-A components with the air angles' stated
             uncertainty carried through the unchanged model, :mod:`gcs_sysid.diagnose.null_uncertainty`;
             ``THRESHOLDS["coverage_under_null"]``; nineteenth session, branch i9-null; off). Takes precedence over
-            ``type_a_only``; a finding without it is judged as before. ``"own_angles"``: only the angles the named
-            term is a function of count (``combined_under_no_change_own_angles``; a term in ``delta_a`` then carries
-            no sideslip component, whose error along it the differential step judges from the data).
+            ``type_a_only``; a finding without it is judged as before. ``"alpha"``: the angle of attack's components
+            under no change, the sideslip's as before (``combined_under_no_change_alpha``; a sideslip scale error along
+            CY is what the differential step judges from Cl and Cn).
 
     Returns:
         ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
@@ -973,7 +973,7 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
         return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
                 "why": None}
     u_null = ((f.get("evidence") or {}).get("uncertainty") or {}).get(
-        "combined_under_no_change_own_angles" if under_null == "own_angles" else "combined_under_no_change")
+        "combined_under_no_change_alpha" if under_null == "alpha" else "combined_under_no_change")
     if under_null and u_null is not None and np.isfinite(u_null) and u_null > 0:
         u_c = float(u_null)
     elif type_a_only:
@@ -1334,13 +1334,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                    **typeb})
     u_null = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
                       **typeb_null}) if null is not None else None
-    # the variant "own_angles": only the angles the named term is a function of (None: lags, alpha_dot_hat and
-    # scale: columns, a function of every angle the model uses); the others' errors along a term are judged by the
-    # differential step's data-fitted allowances (angle_scale_allowance, angle_error_allowance)
-    own_angles = _term_regressors(named) if not named.startswith("scale:") else None
-    typeb_own = {k: v for k, v in typeb_null.items() if own_angles is None or k.rsplit("_", 1)[0] in own_angles}
-    u_null_own = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
-                          **typeb_own}) if null is not None else None
+    # the variant "alpha": the alpha components under no change, the sideslip's as before (its own column): a
+    # sideslip scale error along CY is what the differential step judges from Cl and Cn (angle_scale_allowance)
+    typeb_alpha = {**{k: v for k, v in typeb.items() if not k.startswith("alpha_")},
+                   **{k: v for k, v in typeb_null.items() if k.startswith("alpha_")}}
+    u_null_alpha = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
+                            **typeb_alpha}) if null is not None else None
     if not np.isfinite(u_c) or u_c <= 0:
         return
     if centred:
@@ -1367,7 +1366,7 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         "combined": u_c}
     if null is not None:
         f["evidence"]["uncertainty"].update(type_b_under_no_change=typeb_null, combined_under_no_change=u_null,
-                                            combined_under_no_change_own_angles=u_null_own)
+                                            combined_under_no_change_alpha=u_null_alpha)
     f["std_error"] = u_c
 
 

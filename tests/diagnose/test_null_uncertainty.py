@@ -89,8 +89,8 @@ def test_the_coverage_test_reads_the_uncertainty_under_no_change_when_asked():
     assert not beyond_expanded_uncertainty(old, 2.0, under_null=True)["beyond"]
 
 
-def test_own_angles_reads_only_the_named_terms_angles():
-    unc = {"combined": 0.013, "combined_under_no_change": 0.042, "combined_under_no_change_own_angles": 0.012}
-    f = {"estimate": -0.083, "model_value": 0.0, "std_error": 0.013, "evidence": {"uncertainty": unc}}
+def test_the_alpha_variant_reads_the_alpha_components_under_no_change_only():
+    unc = {"combined": 0.20, "combined_under_no_change": 0.42, "combined_under_no_change_alpha": 0.05}
+    f = {"estimate": 1.3, "model_value": 1.0, "std_error": 0.20, "evidence": {"uncertainty": unc}}
     assert not beyond_expanded_uncertainty(f, 2.0, under_null=True)["beyond"]
-    assert beyond_expanded_uncertainty(f, 2.0, under_null="own_angles")["beyond"]
+    assert beyond_expanded_uncertainty(f, 2.0, under_null="alpha")["beyond"]
