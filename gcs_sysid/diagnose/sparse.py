@@ -153,6 +153,13 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ``coverage_type_a`` (the naming's coverage test reads the combined uncertainty without its type-B air-angle
 #: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in
 #: ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
+#: Added 2026-11-23 (nineteenth session, branch i9-null), **off** (opt-in): ``coverage_under_null`` (the naming's
+#: coverage test reads the combined uncertainty *under no change*: the type-A components with the air angles'
+#: stated scale and offset uncertainty carried through the *unchanged model's* prediction, nuisance and fit, not
+#: through the term's own column times its own estimate; :mod:`gcs_sysid.diagnose.null_uncertainty`,
+#: :func:`beyond_expanded_uncertainty`); ``"alpha"``: alpha's components under no change, the sideslip's as before.
+#: No new threshold. Off: with either value the t6's clean seed-14 ``CZ:alpha^2`` is named again (measured in
+#: ``docs/benchmarks.md``, *Nineteenth session, i9-null*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -167,7 +174,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
-              "scale_beta_allowance": False, "coverage_type_a": False}
+              "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -776,6 +783,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     # a delay is refined on it, as a parameter against the reference's own (_differential_delay)
     Rn = R.copy()
     M0 = np.nan_to_num(ctx.Y) - R          # the model's own prediction (R is measured minus model)
+    null_nuisance = None
     Xc = ctx.X
     if th.get("angle_nuisance", True):
         model0 = reference[0].model if reference is not None else ctx.model
@@ -783,6 +791,13 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         # test flight, whatever effect it carries
         wref = np.where(ref_ms > 0, 1.0 / np.where(ref_ms > 0, ref_ms, 1.0), 0.0) if ref_ms is not None else None
         N, info, err = angle_nuisance(ctx, Rd, tr, model0, wref, scale=bool(th.get("angle_scale", False)))
+        if th.get("coverage_under_null", False):
+            # the same nuisance, with the same weights, on a no-change residual (null_uncertainty)
+            ms_d = np.mean(np.nan_to_num(Rd[tr]) ** 2, axis=0)
+            w_null = wref if wref is not None else np.where(ms_d > 0, 1.0 / np.where(ms_d > 0, ms_d, 1.0), 0.0)
+
+            def null_nuisance(R0, _m=model0, _w=w_null, _s=bool(th.get("angle_scale", False))):
+                return R0 - angle_nuisance(ctx, R0, tr, _m, _w, scale=_s)[0]
         if th.get("angle_error_centred", True):
             # the fit has a free constant per coefficient, so the level of the angle error is not
             # determined (e0 trades with the constants): the library keeps the measured mean angle
@@ -874,6 +889,11 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     if ref_after is not None:
         for f in named:
             _with_reference_error(f, ref_after)
+    null = None
+    if th.get("coverage_under_null", False):
+        model_null = reference[0].model if reference is not None else ctx.model
+        null = {"predict": lambda Xp, _m=model_null: np.nan_to_num(ctx.model_values(Xp, _m)) * ctx.active[None, :],
+                "X": np.nan_to_num(ctx.X), "nuisance": null_nuisance}
     if th.get("honest_std_error", True):
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
@@ -881,7 +901,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             if f["cause"] in at_naming:
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
-                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk])
+                                  float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
+                                  null=null)
     if th.get("errors_in_variables", False) and angle_sigma:
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         for f in named:
@@ -889,9 +910,10 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_errors_in_variables(f, names, Phi, Xlib, at_naming[f["cause"]], tr, angle_sigma)
     k_cov = float(th.get("naming_coverage_factor", 0.0) or 0.0)
     if k_cov > 0:
-        ta = bool(th.get("coverage_type_a", False))
-        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov, ta), cause=f["cause"]) for f in named
-                               if not beyond_expanded_uncertainty(f, k_cov, ta)["beyond"]]
+        ta, tn = bool(th.get("coverage_type_a", False)), th.get("coverage_under_null", False)
+        tn = tn if tn == "alpha" else bool(tn)
+        result["not_named"] = [dict(beyond_expanded_uncertainty(f, k_cov, ta, tn), cause=f["cause"]) for f in named
+                               if not beyond_expanded_uncertainty(f, k_cov, ta, tn)["beyond"]]
         gone = {x["cause"] for x in result["not_named"]}
         named = [f for f in named if f["cause"] not in gone]
     if th.get("centred_estimate", False) and th.get("honest_std_error", True):
@@ -904,12 +926,13 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
-                                  centred=True)
+                                  centred=True, null=null)
     result["findings"] = named
     return result
 
 
-def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type_a_only: bool = False) -> dict:
+def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type_a_only: bool = False,
+                                under_null: bool | str = False) -> dict:
     """Is a named term's change since the reference larger than its expanded uncertainty ``k u_c``?
 
     ``u_c`` is the combined standard uncertainty :func:`_with_uncertainty` reported (the finding's ``std_error``
@@ -931,6 +954,13 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
             vanish when nothing changed: they size a change, they do not make one. With them, a stated alpha scale
             uncertainty above about 25 % makes every ``alpha^2`` change fail the test whatever its size (the c684's
             stated 0.43: ``Cm:alpha^2`` -5.4 +- 7.05, of which 7.04 is the alpha scale).
+        under_null: judge the change against its combined uncertainty *under no change*
+            (``evidence.uncertainty.combined_under_no_change``: the type-A components with the air angles' stated
+            uncertainty carried through the unchanged model, :mod:`gcs_sysid.diagnose.null_uncertainty`;
+            ``THRESHOLDS["coverage_under_null"]``; nineteenth session, branch i9-null; off). Takes precedence over
+            ``type_a_only``; a finding without it is judged as before. ``"alpha"``: the angle of attack's components
+            under no change, the sideslip's as before (``combined_under_no_change_alpha``; a sideslip scale error along
+            CY is what the differential step judges from Cl and Cn).
 
     Returns:
         ``{"beyond": bool, "change", "combined_std_uncertainty", "coverage_factor", "why"}`` (the last three None
@@ -943,7 +973,11 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
     if u_c is None or not np.isfinite(u_c) or u_c <= 0 or not np.isfinite(change):
         return {"beyond": True, "change": change, "combined_std_uncertainty": None, "coverage_factor": None,
                 "why": None}
-    if type_a_only:
+    u_null = ((f.get("evidence") or {}).get("uncertainty") or {}).get(
+        "combined_under_no_change_alpha" if under_null == "alpha" else "combined_under_no_change")
+    if under_null and u_null is not None and np.isfinite(u_null) and u_null > 0:
+        u_c = float(u_null)
+    elif type_a_only:
         tb = ((f.get("evidence") or {}).get("uncertainty") or {}).get("type_b") or {}
         u_c = float(np.sqrt(max(float(u_c) ** 2 - sum(float(v) ** 2 for v in tb.values() if np.isfinite(v)), 0.0)))
         if not u_c > 0:
@@ -1163,7 +1197,8 @@ def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarra
 
 def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
                       M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
-                      inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False) -> None:
+                      inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False,
+                      null: dict | None = None) -> None:
     """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
 
     The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
@@ -1198,6 +1233,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             ``evidence.std_error_decision`` keep the selected fit's change and standard error (what the decisions
             read), ``evidence.centred_estimate`` says what was done. Only when the parents were missing or another
             selected term holds the named monomial (otherwise the estimate is unchanged and nothing is done).
+        null: ``{"predict": X -> (T, 6) the unchanged model, "X": (T, 10) the measured regressors, "nuisance":
+            R -> R or None}`` (``THRESHOLDS["coverage_under_null"]``): also the air angles' type-B components
+            *under no change* (:func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity`, on the same
+            columns and rows) and their combination with the type-A ones, ``evidence.uncertainty.type_b_under_no_change``
+            and ``combined_under_no_change`` (what :func:`beyond_expanded_uncertainty` ``under_null`` reads); the
+            reported ``std_error`` is unchanged by it. None: not computed.
     """
     from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
@@ -1276,10 +1317,30 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         sens = angle_sensitivity(columns, X, rr, tr, i, REGRESSORS.index(angle), float(u.get("scale", 0.0)),
                                  float(u.get("offset_rad", 0.0)))
         typeb.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
+    typeb_null = {}
+    if null is not None:
+        from .null_uncertainty import angle_null_sensitivity
+
+        A0 = columns(X)
+        for angle, u in (angle_u or {}).items():
+            if not (u.get("scale", 0) > 0 or u.get("offset_rad", 0) > 0):
+                continue
+            sens = angle_null_sensitivity(null["predict"], null["X"], A0, i, j, tr, REGRESSORS.index(angle),
+                                          float(u.get("scale", 0.0)), float(u.get("offset_rad", 0.0)),
+                                          null.get("nuisance"))
+            typeb_null.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
     u_c = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
                    **typeb})
+    u_null = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
+                      **typeb_null}) if null is not None else None
+    # the variant "alpha": the alpha components under no change, the sideslip's as before (its own column): a
+    # sideslip scale error along CY is what the differential step judges from Cl and Cn (angle_scale_allowance)
+    typeb_alpha = {**{k: v for k, v in typeb.items() if not k.startswith("alpha_")},
+                   **{k: v for k, v in typeb_null.items() if k.startswith("alpha_")}}
+    u_null_alpha = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
+                            **typeb_alpha}) if null is not None else None
     if not np.isfinite(u_c) or u_c <= 0:
         return
     if centred:
@@ -1304,6 +1365,9 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                   "angles' scale and offset uncertainty the reconstruction reports, propagated by central differences",
         "type_a": {k: float(v) for k, v in parts.items()}, "type_b": typeb, "air_data": angle_u or {},
         "combined": u_c}
+    if null is not None:
+        f["evidence"]["uncertainty"].update(type_b_under_no_change=typeb_null, combined_under_no_change=u_null,
+                                            combined_under_no_change_alpha=u_null_alpha)
     f["std_error"] = u_c
 
 

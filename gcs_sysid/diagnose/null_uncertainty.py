@@ -1,0 +1,107 @@
+"""The air angles' type-B uncertainty of a named change *under no change* (the naming test's null hypothesis).
+
+A named term is a change since the reference flight, and the naming test asks whether the change exceeds what
+no change could have produced (:func:`gcs_sysid.diagnose.sparse.beyond_expanded_uncertainty`: ``|change| > k u``,
+GUM JCGM 100:2008 sec. 6.2-6.3, ``k = 2``). The combined uncertainty the finding *reports*
+(:func:`gcs_sysid.diagnose.sparse._with_uncertainty`) carries the air angles' stated scale and offset uncertainty
+through the term's *own* column times its *own* estimate (:func:`gcs_sysid.diagnose.uncertainty.angle_sensitivity`):
+that sizes the change (a term of degree n in an angle whose relative scale is uncertain by ``u`` is uncertain by
+``~ n u |change|``), but it is the uncertainty of the estimate under the *alternative*. It grows with the change,
+so with a stated alpha-scale uncertainty above ``1 / (2 n k) ~ 0.25`` no ``alpha^2`` change of any size can pass
+(c684: ``Cm:alpha^2`` -5.4 +- 7.05, 7.04 of it the stated 43 % alpha scale; ``docs/diagnose.md``).
+
+The test's reference distribution is the estimate's distribution when nothing changed (a significance test is
+computed under its null hypothesis: Lehmann and Romano, *Testing Statistical Hypotheses*, 3rd ed., sec. 3.1).
+Then the coefficient the flight measures is the unchanged model's, seen through angles whose scale (about
+their flight mean) and offset differ from the reference's by ``s`` and ``o``:
+
+    R_0(t) = M(x_true(t)) - M(x(t)),  x = x_true (1 + s) (about the mean) + o,
+
+so to first order ``R_0 ~ -(s (x - mean) + o) dM/dx`` (GUM sec. 5.1.3, a sensitivity coefficient found
+numerically). What the search would read from ``R_0`` is the same chain as on the measured residual: the angle
+nuisance fitted on CX and CZ and removed (:func:`gcs_sysid.diagnose.sparse.angle_nuisance`, linear in the
+residual for fixed weights), then the least-squares fit of the selected terms (Morelli and Klein, *Aircraft System
+Identification*, 2nd ed., sec. 5.1, eq. 5.9: ``theta = (A'A)^-1 A' r``, linear in ``r``). With ``s`` of standard
+uncertainty ``u_s`` (the reconstruction's own, :func:`gcs_sysid.diagnose.uncertainty.air_data_uncertainty`: this
+flight's and the reference's in quadrature) the named coefficient's type-B standard uncertainty under no change is
+``|theta(R_0(+u_s)) - theta(R_0(-u_s))| / 2`` (central difference, GUM sec. 5.1.3 note), and the same for the
+offset. It does not depend on the change: it is what an angle error alone makes of the *unchanged* model on this
+flight (its manoeuvres, its trim, its selected columns). Combined with the type-A components (this flight's fit,
+the reference's, the reference inadequacy's jackknife; GUM eq. 10) it gives the standard uncertainty of the
+estimate under the null, which the naming test compares the change with (``sparse.THRESHOLDS["coverage_under_null"]``;
+nineteenth session, branch i9-null). The reported ``std_error`` is left as it is (the estimate's own interval).
+
+Left out: the reference's inadequacy (the ridge of :func:`gcs_sysid.diagnose.sparse.sparse_search`) is not
+differentiated, only the model (on the c684 it is 0.0014 RMS in Cm against a residual of 0.008).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["null_residual", "angle_null_sensitivity"]
+
+
+def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, rows: np.ndarray, k_angle: int,
+                  what: str, u: float) -> np.ndarray:
+    """Half the difference of the no-change residual at an angle error of ``+u`` and ``-u``.
+
+    Args:
+        predict: ``X -> (T, 6)`` the unchanged model's coefficients on regressors ``X`` (finite; inactive
+            coefficients 0). X: (T, 10) the measured regressors. rows: (N,) the rows the angle's mean is taken over.
+        k_angle: column of the angle in ``X``. what: ``"scale"`` (relative, about the mean over ``rows``) or
+            ``"offset"`` (rad). u: the error's standard uncertainty (> 0).
+
+    Returns:
+        (T, 6) ``(R_0(+u) - R_0(-u)) / 2`` with ``R_0(s) = M(x_true) - M(x)``: the measured angle ``x`` is the true
+        one scaled by ``1 + s`` (shifted by ``s``), so ``x_true = mean + (x - mean) / (1 + s)`` (``x - s``).
+
+    Raises:
+        ValueError: ``what`` not ``"scale"`` or ``"offset"``.
+    """
+    if what not in ("scale", "offset"):
+        raise ValueError(f"null_residual: what must be 'scale' or 'offset', got {what!r}")
+    X = np.nan_to_num(np.asarray(X, float))
+    mean = float(np.mean(X[rows, k_angle]))
+    out = []
+    for sgn in (1.0, -1.0):
+        Xt = X.copy()
+        if what == "scale":
+            Xt[:, k_angle] = mean + (X[:, k_angle] - mean) / (1.0 + sgn * u)
+        else:
+            Xt[:, k_angle] = X[:, k_angle] - sgn * u
+        out.append(np.nan_to_num(np.asarray(predict(Xt), float)))
+    return (out[0] - out[1]) / 2.0
+
+
+def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, A: np.ndarray, index: int,
+                           j: int, rows: np.ndarray, k_angle: int, scale: float, offset: float,
+                           nuisance: Callable[[np.ndarray], np.ndarray] | None = None) -> dict:
+    """Type-B standard uncertainty of one fitted coefficient under no change, from an angle's scale and offset.
+
+    Args:
+        predict: see :func:`null_residual`. X: (T, 10) the measured regressors (before any nuisance correction).
+        A: (T, P) the fit's columns (constant first), as the search built them; held fixed (the estimator's
+            columns are the measured ones). index: the named coefficient's column in ``A``. j: the coefficient
+            (0-5, ``COEFFICIENTS``) the term was fitted in. rows: (N,) the fit's rows. k_angle: the angle's column
+            in ``X``. scale: standard uncertainty of the angle's relative scale. offset: of its offset, rad.
+        nuisance: ``R (T, 6) -> R (T, 6)`` what the search removes before fitting (the angle nuisance, linear
+            in ``R``), applied to the no-change residual as to the measured one; None: nothing removed.
+
+    Returns:
+        ``{"scale": u, "offset": u}`` (units of the coefficient; 0 where the input uncertainty is 0).
+    """
+    out = {}
+    An = np.nan_to_num(np.asarray(A, float)[rows])
+    for what, u in (("scale", scale), ("offset", offset)):
+        if not u > 0:
+            out[what] = 0.0
+            continue
+        d = null_residual(predict, X, rows, k_angle, what, float(u))
+        if nuisance is not None:
+            d = nuisance(d)
+        r = np.nan_to_num(d[rows, j])
+        out[what] = float(abs(np.linalg.lstsq(An, r - r.mean(), rcond=None)[0][index]))
+    return out
