@@ -478,7 +478,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                             angle_error_along=tuple(_SPARSE_TH.get("angle_error_along_term", ())),
                                             force_moment_arm_max=float(_SPARSE_TH.get("force_moment_arm_max", 0.0)),
                                             scale_beta_allowance=bool(_SPARSE_TH.get("scale_beta_allowance", False)),
-                                            scale_wind_axis=bool(_SPARSE_TH.get("side_force_wind_axis", False)))
+                                            scale_wind_axis=bool(_SPARSE_TH.get("side_force_wind_axis", False)),
+                                            angle_error_beside_named=bool(_SPARSE_TH.get("angle_error_beside_named",
+                                                                                         False)))
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

@@ -168,7 +168,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
               "scale_beta_allowance": False, "coverage_type_a": False,
-              "angle_offset_level": False}
+              "angle_offset_level": False, "angle_error_beside_named": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
