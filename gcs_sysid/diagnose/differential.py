@@ -785,7 +785,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
                  delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
                  force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
-                 scale_wind_axis: bool = True, angle_error_beside_named: bool = False) -> dict:
+                 scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
+                 beside_residual: np.ndarray | None = None) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -841,7 +842,11 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         angle_error_beside_named: the angle's error along a finding's term (``angle_error_along``) is fitted on the
             other coefficients with the other named aero findings' terms there free (:func:`_named_columns`,
             ``beside`` of :func:`angle_scale_allowance`; ``sparse.THRESHOLDS["angle_error_beside_named"]``, nineteenth
-            session, branch i9-ultra). False: off.
+            session, branch i9-ultra), on ``beside_residual`` where given for a search finding. False: off.
+        beside_residual: (T, 6) the search's differential residual (after the reference's inadequacy and the angle
+            nuisance; ``sparse_search(keep_residual=True)``), on which ``angle_error_beside_named`` fits a search
+            finding's angle error and judges it: on the raw residual the reference's own inadequacy (the ultrastick's
+            Cn ridge) stays in the other coefficients and the error along ``p_hat`` was not found. None: the raw one.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -935,7 +940,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             for angle in angle_error_along if scaled is None else ():
                 # an error of the measured angle along the finding's own term (angle_error_allowance)
                 if angle_error_beside_named:
-                    err = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
+                    R_e = np.where(valid0[:, None], beside_residual, np.nan) \
+                        if beside_residual is not None and f.get("source") == "sparse search" else R_wo
+                    err = angle_scale_allowance(diag.X, R_e, diag.train & valid0, diag.test & valid0, diag.model,
                                                 coef, term, angle, min_t, min_gain_pct, angle_scale_se,
                                                 along_term=True, beside=_named_columns(diag, cause))
                 else:
