@@ -423,7 +423,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             search_reference = (references[0].table, references[0].states)
         from .sparse import THRESHOLDS as _SPARSE_TH
 
-        keep_rd = bool(_SPARSE_TH.get("allowance_on_search_residual", False))
+        keep_rd = bool(_SPARSE_TH.get("allowance_on_search_residual", False)) \
+            or bool(_SPARSE_TH.get("angle_error_beside_named", False))
         from .uncertainty import air_data_uncertainty
 
         data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0),
@@ -436,6 +437,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)
         data["sparse"].pop("rows", None)
+        data["sparse"].pop("scale_columns", None)     # an array kept with the residual (not JSON)
         inadequacy = data["sparse"].pop("inadequacy_prediction", None)
         findings[:] = merge_findings(findings, data["sparse"])
         data["timings"]["search_s"] = float(time.perf_counter() - t1)
@@ -469,7 +471,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         t1 = time.perf_counter()
         data["differential"] = differential(diag, list(references), airframe,
                                             threshold_pct=unexplained_threshold_pct,
-                                            search_residual=search_residual if search else None,
+                                            search_residual=search_residual if search and
+                                            _SPARSE_TH.get("allowance_on_search_residual", False) else None,
                                             angle_scale_se=bool(_SPARSE_TH.get("angle_scale_se", False)),
                                             alpha_scale=bool(_SPARSE_TH.get("alpha_scale_allowance", False)),
                                             delay_same_fit=bool(_SPARSE_TH.get("delay_reference_same_fit", False)),
@@ -478,7 +481,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                             angle_error_along=tuple(_SPARSE_TH.get("angle_error_along_term", ())),
                                             force_moment_arm_max=float(_SPARSE_TH.get("force_moment_arm_max", 0.0)),
                                             scale_beta_allowance=bool(_SPARSE_TH.get("scale_beta_allowance", False)),
-                                            scale_wind_axis=bool(_SPARSE_TH.get("side_force_wind_axis", False)))
+                                            scale_wind_axis=bool(_SPARSE_TH.get("side_force_wind_axis", False)),
+                                            angle_error_beside_named=bool(_SPARSE_TH.get("angle_error_beside_named",
+                                                                                         False)),
+                                            beside_residual=search_residual if search else None)
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

@@ -220,7 +220,8 @@ def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.n
 def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
                           scale_se: bool = True, jackknife: dict | None = None,
-                          along_term: bool = False, column: np.ndarray | None = None) -> dict | None:
+                          along_term: bool = False, column: np.ndarray | None = None,
+                          beside: dict | None = None) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -255,6 +256,12 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
             need not be among the term's factors, ``n_j = phi dC_j/dx`` and the document's keys read
             ``error_along_term`` (``scale`` is ``s``, in radians per unit of the term: the true angle is the
             measured one plus ``s phi``, as the scale's ``1 + s`` multiplies the measured angle).
+        beside: ``{coef: (T, k) columns}``: the other named findings' own columns in the *other* coefficients the
+            angle's error is fitted on; each is partialled out of that coefficient's residual and contribution first
+            (Frisch-Waugh-Lovell: the error fitted jointly with free slopes of those findings), so a real change named
+            there is not read as the angle's error (``sparse.THRESHOLDS["angle_error_beside_named"]``; nineteenth
+            session, branch i9-ultra: the ultrastick's ``Cn:delta_a`` flights named ``CY:p_hat`` beside it). None:
+            as before.
         column: (T,) the finding's own column where ``term`` is no vocabulary monomial: ``scale:CY`` judged against
             a between-flight scale of the measured sideslip (:func:`_scale_column`; eighteenth session, branch
             i9-c684); the angle need not be among the term's factors then. None: ``term_matrix(X, [term])``.
@@ -304,6 +311,12 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     for c in others:
         j = COEFFICIENTS.index(c)
         r, n = R[ok, j] - R[ok, j].mean(), N[ok, j] - N[ok, j].mean()
+        B = (beside or {}).get(c)
+        if B is not None and np.size(B):
+            B = np.nan_to_num(np.asarray(B, float).reshape(len(X), -1)[ok])
+            B = np.column_stack([np.ones(len(B)), B])
+            r = r - B @ np.linalg.lstsq(B, r, rcond=None)[0]
+            n = n - B @ np.linalg.lstsq(B, n, rcond=None)[0]
         w = 1.0 / max(float(np.var(r)), 1e-30)
         num, den = num + w * float(n @ r), den + w * float(n @ n)
         cols.append((r * np.sqrt(w), n * np.sqrt(w)))
@@ -449,6 +462,35 @@ def force_moment_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test
            f"{gain:.0f} % on the held-out rows beyond them")
     return {"moment_only": bool(only), "arms": arms, "arms_std_error": arms_se, "arm_max": float(arm_max),
             "estimate": th, "std_error": se, "t": float(t), "gain_beyond_arm_percent": gain, "why": why}
+
+
+def _named_columns(diag, cause: str) -> dict:
+    """Coefficient -> (T, k) the own columns of the *other* named aero findings (``"Cn:delta_a"`` -> ``delta_a``).
+
+    For :func:`angle_scale_allowance`'s ``beside``: the JSBSim ultrastick's ``Cn:delta_a`` = -0.06 flights (seeds 2
+    and 3) also named ``CY:p_hat`` +0.106 and +0.115: against the truth the aided sideslip's error follows ``p_hat``
+    with a slope of 1.24-1.27 there and 0.785 on the reference (so ``-CY_beta`` x 0.47 = +0.088 in CY and
+    ``-Cn_beta`` x 0.47 = -0.025 in Cn, read -0.032..-0.036). The error along ``p_hat`` is fitted on Cn, whose
+    residual also holds the named ``delta_a`` change (correlated with ``p_hat`` through the roll response): left
+    in, it biases the error's fit. Terms outside the vocabulary (lags, hinges, ``scale:``) are left out, and so is a
+    finding of the judged finding's own term: there the other coefficient's change *is* what the angle's error
+    along that term would make, and partialled out it leaves the error to the coefficients that barely see it
+    (ultrastick seed 1, ``CY:delta_a`` and ``Cn:delta_a`` both named: the error then came from Cl alone and
+    removed ``Cn:delta_a``).
+    """
+    cols: dict = {}
+    own = cause.split(":", 1)[1] if ":" in cause else None
+    for f in diag.findings:
+        c = f.get("coefficient")
+        if f["cause"] == cause or f.get("kind") == "fault" or f["cause"].split(":")[0] not in COEFFICIENTS \
+                or f["cause"].split(":", 1)[1] == own:
+            continue
+        try:
+            phi = term_matrix(diag.X, [f["cause"].split(":", 1)[1]])[:, 0]
+        except SysidError:
+            continue
+        cols.setdefault(c, []).append(phi)
+    return {c: np.column_stack(v) for c, v in cols.items()}
 
 
 def _force_changes(diag, fitted: dict, cause: str) -> dict:
@@ -743,7 +785,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
                  delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
                  force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
-                 scale_wind_axis: bool = True) -> dict:
+                 scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
+                 beside_residual: np.ndarray | None = None) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -796,6 +839,14 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             ``scale:CY`` 1.146 where its sideslip read 8 % smaller against the truth than the reference's.
             False: off.
         scale_wind_axis: the scale's column in the search's convention (``sparse.THRESHOLDS["side_force_wind_axis"]``).
+        angle_error_beside_named: the angle's error along a finding's term (``angle_error_along``) is fitted on the
+            other coefficients with the other named aero findings' terms there free (:func:`_named_columns`,
+            ``beside`` of :func:`angle_scale_allowance`; ``sparse.THRESHOLDS["angle_error_beside_named"]``, nineteenth
+            session, branch i9-ultra), on ``beside_residual`` where given for a search finding. False: off.
+        beside_residual: (T, 6) the search's differential residual (after the reference's inadequacy and the angle
+            nuisance; ``sparse_search(keep_residual=True)``), on which ``angle_error_beside_named`` fits a search
+            finding's angle error and judges it: on the raw residual the reference's own inadequacy (the ultrastick's
+            Cn ridge) stays in the other coefficients and the error along ``p_hat`` was not found. None: the raw one.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -888,9 +939,16 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                     f["evidence"][f"{angle}_scale_allowance"] = scale
             for angle in angle_error_along if scaled is None else ():
                 # an error of the measured angle along the finding's own term (angle_error_allowance)
-                err = angle_error_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
-                                            coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                            scale_se=angle_scale_se)
+                if angle_error_beside_named:
+                    R_e = np.where(valid0[:, None], beside_residual, np.nan) \
+                        if beside_residual is not None and f.get("source") == "sparse search" else R_wo
+                    err = angle_scale_allowance(diag.X, R_e, diag.train & valid0, diag.test & valid0, diag.model,
+                                                coef, term, angle, min_t, min_gain_pct, angle_scale_se,
+                                                along_term=True, beside=_named_columns(diag, cause))
+                else:
+                    err = angle_error_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
+                                                coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
+                                                scale_se=angle_scale_se)
                 if err is not None and err["scale_only"]:
                     scaled = err
                     break

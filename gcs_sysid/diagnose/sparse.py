@@ -174,7 +174,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
-              "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": False}
+              "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": False,
+              "angle_offset_level": False, "angle_error_beside_named": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -723,6 +724,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     base_mean = np.zeros(R.shape[1])       # the inadequacy's level on this flight (kept for the lift alpha)
     ref_ms = None
     ref_after = None                       # the reference's residual after its inadequacy: (names, Phi, R, rows, M0)
+    ridge, Wb, rnames = None, None, None
     if reference is not None:
         rctx, Rr = reference
         rnames, rPhi = _library(rctx, knots)
@@ -798,7 +800,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
 
             def null_nuisance(R0, _m=model0, _w=w_null, _s=bool(th.get("angle_scale", False))):
                 return R0 - angle_nuisance(ctx, R0, tr, _m, _w, scale=_s)[0]
-        if th.get("angle_error_centred", True):
+        offset_level = bool(th.get("angle_offset_level", False)) and reference is not None
+        if th.get("angle_error_centred", True) and not offset_level:
             # the fit has a free constant per coefficient, so the level of the angle error is not
             # determined (e0 trades with the constants): the library keeps the measured mean angle
             # rather than an arbitrary shift of it (which turns alpha^2 into alpha^3 or alpha^2*delta_e)
@@ -832,6 +835,16 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["lift_alpha"] = info2
         if np.any(err):                    # the library on the corrected angles
             names, Phi = _library(replace(ctx, X=Xc), knots)
+            if offset_level and ridge is not None:
+                # the reference's inadequacy, predicted on the angles brought to the reference's level
+                # (_inadequacy_at_reference_level): its terms in alpha (the ultrastick's CY and Cn in
+                # alpha*delta_a) read a between-flight alpha offset as a change of their control's slope
+                base_new, base_jk = _inadequacy_at_reference_level(names, Phi, rnames, ridge, Wb, base, tr)
+                Rd = Rd + base - base_new
+                base = base_new
+                result["inadequacy_prediction"] = base.copy()
+                result["angle_offset_level"] = {"alpha_rad": float(err[tr, 0].mean()) if tr.size else 0.0,
+                                                "beta_rad": float(err[tr, 1].mean()) if tr.size else 0.0}
     # the scale candidates on the angles the library uses (corrected by the nuisance when it ran)
     S0 = np.nan_to_num(scale_columns(M0, np.nan_to_num(Xc if th.get("angle_nuisance", True) else ctx.X),
                                      bool(th.get("side_force_wind_axis", False))))
@@ -1078,6 +1091,41 @@ def _with_reference_error(f: dict, ref_after) -> None:
         return
     f["evidence"]["std_error_parts"] = {"flight": float(f["std_error"]), "reference": se_ref}
     f["std_error"] = float(np.hypot(f["std_error"], se_ref))
+
+
+def _inadequacy_at_reference_level(names: list[str], Phi: np.ndarray, rnames: list[str], ridge, Wb,
+                                   base: np.ndarray, tr: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The reference's ridge inadequacy predicted on this flight's library at corrected air angles.
+
+    ``THRESHOLDS["angle_offset_level"]`` (nineteenth session, branch i9-ultra; off by default). The angle
+    nuisance (:func:`angle_nuisance`) fits the test flight's angle error against the reference's
+    calibration, level ``e0`` included; where the model's derivatives in alpha vary with alpha (a CX in
+    ``alpha^2``, a Cn in ``alpha*delta_a``) that level is determined, and on the JSBSim ultrastick it matches
+    the between-flight offset of the aided alpha against the truth (seed 1: -0.093 rad fitted, -0.0934 rad
+    true; the reference reads +2.56 deg, the seed-1 flights -2.79 deg: MIL-F-8785C's flight-mean vertical
+    wind over a 23 m/s airspeed). Predicted on the *measured* angles, the reference's inadequacy (fitted on
+    the reference's angles, with terms in alpha) moves by its alpha slope times that offset: the ultrastick's
+    CY ridge read the 5.35-deg offset as a CY ``delta_a`` change of -0.051 on every seed-1 flight.
+
+    Args:
+        names, Phi: this flight's library on the corrected angles (K names; (T, K)).
+        rnames: the reference's library names (K'). ridge: ``(W (K', 6), mu, sc, lam)`` of :func:`_ridge_cv`.
+        Wb: the delete-a-block refits ``[W_b (K', 6)]`` (:func:`_ridge_jackknife`) or None.
+        base: (T, 6) the inadequacy as predicted before (its zero columns stay zero). tr: training rows.
+
+    Returns:
+        (the inadequacy (T, 6) centred on ``tr``, its delete-a-block refits as predicted here, each (T, 6)).
+    """
+    W, mu, sc, _ = ridge
+    Ps = (_aligned(names, Phi, rnames) - mu) / sc
+    on = (base != 0).any(axis=0)
+    out = (Ps @ W) * on
+    out = out - out[tr].mean(axis=0) if tr.size else out
+    jk = []
+    for W_b in (Wb or []):
+        b = (Ps @ W_b) * on
+        jk.append(b - b[tr].mean(axis=0) if tr.size else b)
+    return out, jk
 
 
 def _ridge_jackknife(Phi: np.ndarray, Y: np.ndarray, t: np.ndarray, ridge, max_rows: int,
