@@ -1,4 +1,5 @@
-"""The b737 in the JSBSim harness: the nineteenth session's untouched aircraft (docs/jsbsim.md, "The b737").
+"""The b737 in the JSBSim harness: the nineteenth session's untouched aircraft, a tuning aircraft since the twentieth
+(docs/jsbsim.md, "The b737").
 
 The model is JSBSim's stock Boeing 737 (the jsbsim wheel's ``aircraft/737/737.xml``: Dave Culp and Aeromatic, GPL
 in its header), flown as it is: both CFM56 shut down on their "direct" thrusters, gear up, its own yaw damper in the
@@ -12,17 +13,16 @@ mechanism check); none of them flies the harness:
 - the FCS maps the commands straight to the surfaces (elevator +-0.3 rad, ailerons +-0.35 rad with the right the
   left's mirror, rudder +-0.35 rad) and adds its yaw damper (1.0 x ``velocities/r-aero-rad_sec`` to the normalised
   rudder above Mach 0.11); the engines give no force once stopped;
-- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_ultrastick.py``).
+- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says.
+
+The summaries' label test moved to ``test_jsbsim_c172p.py`` in the twentieth session (the c172p is untouched now).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, gear,
 .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the
 names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the b737: its first evaluation is the final one, after the merge.
+No pipeline fit, GP, diagnosis or scoring ran on the b737 before the nineteenth session's final evaluation.
 """
-
-import json
 
 import numpy as np
 import pytest
@@ -108,31 +108,3 @@ def test_the_b737_is_statically_stable_and_its_controls_act_as_its_xml_says():
     assert (l3 - l0) / np.radians(4.0) == pytest.approx(-0.145, abs=2e-3)
     assert (n3 - n0) / np.radians(4.0) == pytest.approx(0.273, abs=3e-3)
 
-
-def test_summaries_mark_the_b737_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the b737 "(untouched)" and no other
-    aircraft, the ultrastick, c684 and b747 included (synthetic rows: no b737 result exists before the final
-    evaluation). Moved here from ``test_jsbsim_ultrastick.py`` (the eighteenth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| b737 (untouched) | light") for ln in lines)
-    for ac in acs[:15]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| b737 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| ultrastick | clean |") for ln in lines)

@@ -1,6 +1,6 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick and the untouched b737; docs/jsbsim.md, one
-section each),
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737 and the untouched c172p; docs/jsbsim.md,
+one section each),
 parametrised over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
@@ -11,15 +11,15 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched b737's are slow too but its names', and its own
-default checks (its model, surfaces, yaw damper, static stability, the summaries' label) are in
-``test_jsbsim_b737.py`` (the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+default suite, as before the fold); the untouched c172p's are slow too but its names', and its own
+default checks (its model, surfaces, engine, static stability, the summaries' label) are in
+``test_jsbsim_c172p.py`` (the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to nineteenth sessions). Folded in the eleventh session
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twentieth sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
 in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
-b737 in the nineteenth.
+b737 in the nineteenth, the c172p in the twentieth.
 """
 
 from dataclasses import dataclass
@@ -291,7 +291,28 @@ CASES = (
           ("cn", 2, -0.35, ("rel", 0.02)), ("cn", 3, 0.0, ("abs", 1e-3)), ("cn", 1, 0.0, ("abs", 1e-3))),
          ("CDgear",), 0.3, 1,
          dict(alpha=(-9.0, 9.0), beta=(8.0, 9.0), bank=(15.0, 20.0), speed=(110.0, 240.0), alt_min=500.0,
-              rate_std=0.8, rate_std_held=0.7, sink_min=5.0), untouched=True),
+              rate_std=0.8, rate_std_held=0.7, sink_min=5.0)),
+    # c172p (JSBSim's stock Cessna 172P, the wheel's c172p.xml, FlightGear's C172P model; flown as it is at 80 kt and
+    # 4000 ft, engine shut down, fixed gear): 1500 lb empty + 200 lb of fuel in two wing tanks; its 180-lb pilot at
+    # y = -14 in emptied by the harness (project Ixz 17.74 kg m^2: JSBSim's -13.08 slug ft^2 with the tanks). The
+    # c172x's term set with its own numbers. On the 30-s calm flight (derivative_slopes, as the c182's): Cm_alpha
+    # -1.64 (Cmalpha -1.8 and the arms; the fit has no alpha-dot: Cm_q -16.5 holds Cmq -12.4 and part of Cmadot
+    # -7.27), Cm_delta_e -1.025 (Cmde -1.122 on the wash dynamic pressure, CLDe 0.43 through the arm); Cl_beta -0.0964
+    # (the Clb table and the side force; -0.113 at the IC, the fit's beta and r_hat share the Dutch roll), Cl_p
+    # -0.450, Cl_r 0.165 (the Clr table in alpha), Cl_delta_a -0.218 (ClDa 0.229 x left), Cl_delta_r 0.0235; Cn_beta
+    # 0.0577, Cn_r -0.094, Cn_delta_a +0.0058 (Cnda -0.0053 x left: adverse), Cn_delta_r -0.0432. Five SIDE functions
+    # (CYb, CYda of value 0, CYdr, CYp, CYr); the elevator read by CLDe and Cmde (CDDe reads its magnitude). Envelope
+    # limits from the 50 pre-flown final-evaluation flights (docs/jsbsim.md, "The c172p"): alpha -2.0..8.4 deg,
+    # sideslip 8.0 clean and 9.9 with Cl:alpha*beta, bank 15.4 and 16.9, TAS 31.3-55.8 m/s, lowest 385 m, sink
+    # through the air 4.9-5.6 m/s, rate standard deviations at least 2.0 deg/s (held-out 20 %).
+    Case("c172p", "c172p", "c172q", 1700, 17.739127,
+         (("cm", 0, None, ("in", -1.9, -1.4)), ("cm", 2, -1.0247, ("rel", 0.02)), ("cl", 3, -0.2182, ("rel", 0.02)),
+          ("cl", 0, -0.0964, ("rel", 0.03)), ("cl", 1, -0.4501, ("rel", 0.02)), ("cl", 2, 0.1649, ("rel", 0.03)),
+          ("cl", 4, 0.0235, ("rel", 0.05)), ("cn", 4, -0.0432, ("rel", 0.02)), ("cn", 0, 0.0577, ("rel", 0.03)),
+          ("cn", 2, -0.0943, ("rel", 0.03)), ("cn", 3, 0.0058, ("rel", 0.1))),
+         (), 23.0 * 0.01745, 5,
+         dict(alpha=(-4.0, 11.0), beta=(10.0, 12.0), bank=(20.0, 25.0), speed=(28.0, 60.0), alt_min=300.0,
+              rate_std=1.5, rate_std_held=1.5), untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -320,7 +341,7 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the b737
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the c172p
     alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
@@ -332,7 +353,7 @@ def test_names_resolve_and_roles(case):
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
     used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684",
-            "ultrastick"}
+            "ultrastick", "b737"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
@@ -464,7 +485,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [p for p in _params()
                                   if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick",
-                                                          "b737")])
+                                                          "b737", "c172p")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
