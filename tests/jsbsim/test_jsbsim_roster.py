@@ -298,7 +298,7 @@ CASES = (
     # c172x's term set with its own numbers. On the 30-s calm flight (derivative_slopes, as the c182's): Cm_alpha
     # -1.64 (Cmalpha -1.8 and the arms; the fit has no alpha-dot: Cm_q -16.5 holds Cmq -12.4 and part of Cmadot
     # -7.27), Cm_delta_e -1.025 (Cmde -1.122 on the wash dynamic pressure, CLDe 0.43 through the arm); Cl_beta -0.0964
-    # (the Clb table and the side force; -0.113 at the IC, the fit's beta and r_hat share the Dutch roll), Cl_p
+    # (the Clb table and the side force: -0.113 at the IC, -0.1138 with closure_slopes on the light flight), Cl_p
     # -0.450, Cl_r 0.165 (the Clr table in alpha), Cl_delta_a -0.218 (ClDa 0.229 x left), Cl_delta_r 0.0235; Cn_beta
     # 0.0577, Cn_r -0.094, Cn_delta_a +0.0058 (Cnda -0.0053 x left: adverse), Cn_delta_r -0.0432. Five SIDE functions
     # (CYb, CYda of value 0, CYdr, CYp, CYr); the elevator read by CLDe and Cmde (CDDe reads its magnitude). Envelope
