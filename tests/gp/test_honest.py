@@ -104,7 +104,8 @@ def test_coupling_on_all_rows_separates_the_noise_correlation_from_B():
 
     X, Y, _ = _independent_outputs(1200, 0.8, seed=1)
     Xs, Ys = (X - X.mean(0)) / X.std(0), (Y - Y.mean(0)) / Y.std(0)
-    raw, fixed = _init_global(Xs, Ys, np.ones(3, bool), CFG, Xs[np.random.default_rng(0).choice(1200, 24, replace=False)])
+    Z = Xs[np.random.default_rng(0).choice(1200, 24, replace=False)]
+    raw, fixed = _init_global(Xs, Ys, np.ones(3, bool), CFG, Z)
     raw = dict(raw, log_ls=np.log(np.full(3, 1.5)), L=np.array([[0.8, 0.0], [0.8, 0.0], [0.0, 0.6]]),
                log_kappa=np.log(np.full(3, 0.1)), log_noise=np.log(np.full(3, 0.1)), noise_off=np.zeros((3, 3)))
 
