@@ -37,7 +37,9 @@ whose blocked cross-validation error it lowers (``GPConfig.coupling_validation``
 with each shared factor of ``B`` on the longitudinal or the lateral outputs only
 (``GPConfig(output_groups="axes")``), ``nigpk`` = ``nigp`` with one latent kernel (own length-scales) per
 axis (``GPConfig(output_groups="kernels")``), ``nigpf`` = the same with free loadings
-(``"kernels-free"``), ``nigpo`` = one kernel per output (``"output-kernels"``), and ``ls`` (cached).
+(``"kernels-free"``), ``nigpo`` = one kernel per output (``"output-kernels"``), ``nigpr`` = ``nigp`` with
+``B`` and the noise covariance learned again on every training row (``GPConfig.coupling_rows = "all"``,
+twentieth session), and ``ls`` (cached).
 
 For the joint variants each line also carries the output correlations (issue 8, "no learned
 output correlation above 0.5 where the truth has none"): ``corr_learned`` (``output_correlation``),
@@ -107,7 +109,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
                                 truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "ls")
+VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "ls")
 
 #: |truth correlation| below which the truth "has none" (the flags of the joint variants)
 TRUTH_NONE = 0.2
@@ -175,6 +177,8 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True, output_groups="kernels-free")
     if variant == "nigpo":        # one kernel per output, loading on its axis (GPConfig.output_groups="output-kernels")
         return replace(base, noise_correlation=True, input_noise=True, output_groups="output-kernels")
+    if variant == "nigpr":        # nigp with B and the noise covariance learned again on every row (GPConfig.coupling_rows)
+        return replace(base, noise_correlation=True, input_noise=True, coupling_rows="all")
     if variant == "nigpc":
         return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
@@ -259,7 +263,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             else:
                 model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
                 model = with_offset_covariance(model, off)
-                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo"):
+                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
@@ -511,7 +515,7 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]

@@ -769,6 +769,11 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         history.elbo.extend((-np.asarray(values) * (Xh.shape[0] * P if mask_h is None else obs.sum())).tolist())
         if stage == 0 and cfg.reselect and cfg.steps > first and not cfg.train_inducing:
             fixed = reselect(raw, fixed, Mh)
+    if (cfg.coupling_rows == "all" and len(sub) < len(Xs) and mask_h is None and np.isfinite(Ys).all()
+            and int(cfg.latent_kernels) == 1 and not _per_group(cfg, groups)):
+        t1 = time.perf_counter()
+        raw = coupling_on_all_rows(raw, fixed, Xs, Ys, cfg)
+        history.timings["coupling_rows"] = time.perf_counter() - t1
     if Mh < M:
         fixed = reselect(raw, fixed, M)
     params = _constrain_global_jit(raw, fixed)
@@ -777,6 +782,48 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
 
         params = decoupled(params)
     return params
+
+
+#: the hyperparameters :func:`coupling_on_all_rows` learns again (the rest of ``raw`` is held)
+COUPLING_KEYS = ("L", "log_kappa", "log_noise", "noise_off")
+
+
+def _coupling_loss(free, held, fixed, st):
+    """``-ELBO`` per entry of the statistics ``st`` with ``free`` (``COUPLING_KEYS``) over ``held``."""
+    params = constrain_global(dict(held, **free), fixed)
+    return -elbo(params, st) / (st.n * params.noise.shape[0])
+
+
+def coupling_on_all_rows(raw: dict, fixed: dict, Xs: np.ndarray, Ys: np.ndarray, cfg: GPConfig) -> dict:
+    """The coregionalisation ``B`` and the noise covariance learned again on every row (``GPConfig.coupling_rows``).
+
+    The bound of :func:`learn_global` sees ``n_train_max`` random rows; on a coloured 50 Hz flight those
+    determine an off-diagonal of ``B`` poorly (``docs/gp.md``, "Coupling from every row"). Here the
+    kernel (length-scales) and the inducing inputs ``fixed["Z"]`` are held, the sufficient statistics of
+    all rows are accumulated once (:func:`gcs_sysid.gp.batching.global_stats`; they depend on neither
+    ``B`` nor the noise), and Adam climbs the same collapsed bound (Titsias 2009) in ``B``'s factor
+    ``L``, its independent part ``kappa``, the noise variances and, with ``noise_correlation``, the
+    noise correlation, from where the subset left them. The model is the multi-task GP with a free
+    noise covariance, ``B kron K + Sigma kron I`` (Bonilla, Chai and Williams 2008, "Multi-task Gaussian
+    process prediction", NIPS 20, sec. 2; Alvarez, Rosasco and Lawrence 2012, "Kernels for vector-valued
+    functions: a review", Found. Trends Mach. Learn. 4(3), sec. 4.2 and 6.1): with every row the signal's
+    and the noise's cross-output covariances are separated by the same data the posterior conditions on.
+
+    Args:
+        raw, fixed: unconstrained and fixed parameters of :func:`learn_global` (complete rows, one kernel).
+        Xs: ``(N, D)``, Ys: ``(N, P)`` standardised rows, every entry finite.
+        cfg: settings (``steps // 2`` steps at most, ``learning_rate``, ``tol``, ``batch_size``).
+
+    Returns:
+        ``raw`` with the ``COUPLING_KEYS`` entries learned again.
+    """
+    params = _constrain_global_jit(raw, fixed)
+    st = global_stats(params, Xs, Ys, int(cfg.batch_size))
+    free = {k: raw[k] for k in COUPLING_KEYS if k in raw}
+    held = {k: v for k, v in raw.items() if k not in free}
+    free, _, _ = _adam(_coupling_loss, free, _adam_init(free), cfg.learning_rate, (held, fixed, st),
+                       max(int(cfg.steps) // 2, 1), cfg.tol)
+    return dict(held, **free)
 
 
 def hyper_stride_of(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConfig) -> int:
