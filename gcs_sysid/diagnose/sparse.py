@@ -1106,6 +1106,10 @@ def _inadequacy_at_reference_level(names: list[str], Phi: np.ndarray, rnames: li
     wind over a 23 m/s airspeed). Predicted on the *measured* angles, the reference's inadequacy (fitted on
     the reference's angles, with terms in alpha) moves by its alpha slope times that offset: the ultrastick's
     CY ridge read the 5.35-deg offset as a CY ``delta_a`` change of -0.051 on every seed-1 flight.
+    It stays off (twentieth session, branch i9-offset): on the JSBSim c172x the level is within 0.1-0.3 deg
+    of the truth, but on the SGS it reads 0.4-2.2 deg high on all twelve flights probed, and there the option
+    loses estimates (seed 3's ``scale:CY`` 1.6: 0.555 -> 0.217); ``docs/benchmarks.md``, *Twentieth session,
+    i9-offset*.
 
     Args:
         names, Phi: this flight's library on the corrected angles (K names; (T, K)).
