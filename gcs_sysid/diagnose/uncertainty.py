@@ -127,8 +127,7 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
             uo = b if np.isfinite(b) else 0.0
         out[name] = {"scale": us, "offset_rad": uo}
         if name == "alpha":
-            uc = float(getattr(fit, "curvature_sigma", float("nan"))) if fit is not None and getattr(fit, "used", False) \
-                else float("nan")
+            uc = float(getattr(fit, "curvature_sigma", float("nan")))
             out[name]["curvature"] = uc if np.isfinite(uc) else 0.0
     return out
 

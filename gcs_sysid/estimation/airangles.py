@@ -246,13 +246,14 @@ class AxisFit:
         (its curvature is divided out by the same slope). The fixed point is not identified by the data: where it
         lands follows the first pass on the kinematic angle (its gust error squared). Against JSBSim's exact alpha
         (t6 and b737, clean flights and their references, light turbulence) the aided alpha's curvature error is
-        ``CZ_alpha2 / |CZ_alpha|`` within 0.01-0.41 /rad on 11 of 12 flights (t6 s13: 0.64) (t6 s14: fitted -4.55 / 4.65 = -0.98,
-        JSBSim -0.78; b737 s13: -5.11 / 4.91 = -1.04, JSBSim -0.89; ``docs/benchmarks.md``, "Twentieth session,
-        i9-curv"), while the fit's own standard error of ``CZ_alpha2`` (0.05-0.17) is 20-100 times smaller than
-        its between-flight scatter (-5.1..+5.7). So the whole fitted curvature is stated as possible error of the
-        angle (a type-B evaluation from the available information, GUM JCGM 100:2008 sec. 4.3.1; Morelli and Klein,
-        *Aircraft System Identification*, 2nd ed., ch. 5, errors in the regressors of an equation-error fit), with its standard error in
-        quadrature, as :attr:`scale_sigma` states the scale: ``sqrt(CZ_alpha2^2 + se^2) / |CZ_alpha|``.
+        ``CZ_alpha2 / |CZ_alpha|`` within 0.01-0.41 /rad on 11 of 12 flights (t6 s13: 0.64; t6 s14: fitted
+        -4.55 / 4.65 = -0.98, JSBSim -0.78; b737 s13: -5.11 / 4.91 = -1.04, JSBSim -0.89; ``docs/benchmarks.md``,
+        "Twentieth session, i9-curv"), while the fit's own standard error of ``CZ_alpha2`` (0.05-0.17) is 20-100
+        times smaller than its between-flight scatter (-5.1..+5.7). So the whole fitted curvature is stated as
+        possible error of the angle (a type-B evaluation from the available information, GUM JCGM 100:2008 sec. 4.3.1; Morelli and
+        Klein, *Aircraft System Identification*, 2nd ed., ch. 5, errors in the regressors of an equation-error fit),
+        with its standard error in quadrature, as :attr:`scale_sigma` states the scale:
+        ``sqrt(CZ_alpha2^2 + se^2) / |CZ_alpha|``.
 
         Returns:
             1/rad (0.5 = half a radian of angle error per rad^2 of centred angle squared); NaN where the axis was
