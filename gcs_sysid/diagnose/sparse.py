@@ -169,7 +169,8 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: diagnosis flights it names every effect case as ``"alpha"`` did (b737 top 23 -> 30/38, all three 17 -> 20/37;
 #: c684 top 16 -> 18/38; ultrastick top 18 -> 20/38, gain 17 -> 20/38 against main's defaults; t6, rascal unchanged)
 #: and no clean flight names an alpha term (t6 s14 and b737 s13 ``CZ:alpha^2`` covered: t6 5/5, b737 5/5 where main
-#: had 4/5; the c684's s13 ``scale:CY`` as in main); ``docs/benchmarks.md``, *Twentieth session, i9-curv*. Not measured: the other 12 tuning aircraft.
+#: had 4/5; the c684's s13 ``scale:CY`` as in main); ``docs/benchmarks.md``, *Twentieth session, i9-curv*. Not
+#: measured: the other 12 tuning aircraft.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,

@@ -250,9 +250,9 @@ class AxisFit:
         -4.55 / 4.65 = -0.98, JSBSim -0.78; b737 s13: -5.11 / 4.91 = -1.04, JSBSim -0.89; ``docs/benchmarks.md``,
         "Twentieth session, i9-curv"), while the fit's own standard error of ``CZ_alpha2`` (0.05-0.17) is 20-100
         times smaller than its between-flight scatter (-5.1..+5.7). So the whole fitted curvature is stated as
-        possible error of the angle (a type-B evaluation from the available information, GUM JCGM 100:2008 sec. 4.3.1; Morelli and
-        Klein, *Aircraft System Identification*, 2nd ed., ch. 5, errors in the regressors of an equation-error fit),
-        with its standard error in quadrature, as :attr:`scale_sigma` states the scale:
+        possible error of the angle (a type-B evaluation from the available information, GUM JCGM 100:2008
+        sec. 4.3.1; Morelli and Klein, *Aircraft System Identification*, 2nd ed., ch. 5, errors in the regressors of
+        an equation-error fit), with its standard error in quadrature, as :attr:`scale_sigma` states the scale:
         ``sqrt(CZ_alpha2^2 + se^2) / |CZ_alpha|``.
 
         Returns:
