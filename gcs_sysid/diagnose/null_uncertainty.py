@@ -31,6 +31,15 @@ the reference's, the reference inadequacy's jackknife; GUM eq. 10) it gives the 
 estimate under the null, which the naming test compares the change with (``sparse.THRESHOLDS["coverage_under_null"]``;
 nineteenth session, branch i9-null). The reported ``std_error`` is left as it is (the estimate's own interval).
 
+The angle's *curvature* (twentieth session, branch i9-curv): the aided alpha carries a flight-common error
+``c (x - mean)^2`` as well, the aiding's fitted lift curvature read as the angle's
+(:attr:`gcs_sysid.estimation.airangles.AxisFit.curvature_sigma`; against JSBSim's alpha, t6 clean seed 14 -0.78 /rad
+and its reference +0.36: the between-flight difference makes ``CZ:alpha^2`` -5.45 on a clean flight). It is carried
+the same way, ``x_true = x - c ((x - mean)^2 - mean((x - mean)^2))`` (centred over the fit's rows, so that it moves
+no mean: the offset is its own component), at ``c = +- u_c`` (``sparse.THRESHOLDS["coverage_curvature"]``). A
+measured angle's error entering an equation-error fit through the model is the errors-in-the-regressors case of
+Morelli and Klein ch. 5; its type-B propagation is GUM sec. 5.1.3 as above.
+
 Left out: the reference's inadequacy (the ridge of :func:`gcs_sysid.diagnose.sparse.sparse_search`) is not
 differentiated, only the model (on the c684 it is 0.0014 RMS in Cm against a residual of 0.008).
 """
@@ -52,24 +61,29 @@ def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, ro
         predict: ``X -> (T, 6)`` the unchanged model's coefficients on regressors ``X`` (finite; inactive
             coefficients 0). X: (T, 10) the measured regressors. rows: (N,) the rows the angle's mean is taken over.
         k_angle: column of the angle in ``X``. what: ``"scale"`` (relative, about the mean over ``rows``) or
-            ``"offset"`` (rad). u: the error's standard uncertainty (> 0).
+            ``"offset"`` (rad) or ``"curvature"`` (1/rad: ``x = x_true + s ((x - mean)^2 - m2)``, ``m2`` the mean of
+            ``(x - mean)^2`` over ``rows``; first order in ``s``). u: the error's standard uncertainty (> 0).
 
     Returns:
         (T, 6) ``(R_0(+u) - R_0(-u)) / 2`` with ``R_0(s) = M(x_true) - M(x)``: the measured angle ``x`` is the true
         one scaled by ``1 + s`` (shifted by ``s``), so ``x_true = mean + (x - mean) / (1 + s)`` (``x - s``).
 
     Raises:
-        ValueError: ``what`` not ``"scale"`` or ``"offset"``.
+        ValueError: ``what`` not ``"scale"``, ``"offset"`` or ``"curvature"``.
     """
-    if what not in ("scale", "offset"):
-        raise ValueError(f"null_residual: what must be 'scale' or 'offset', got {what!r}")
+    if what not in ("scale", "offset", "curvature"):
+        raise ValueError(f"null_residual: what must be 'scale', 'offset' or 'curvature', got {what!r}")
     X = np.nan_to_num(np.asarray(X, float))
     mean = float(np.mean(X[rows, k_angle]))
+    d2 = (X[:, k_angle] - mean) ** 2
+    d2 = d2 - float(np.mean(d2[rows]))
     out = []
     for sgn in (1.0, -1.0):
         Xt = X.copy()
         if what == "scale":
             Xt[:, k_angle] = mean + (X[:, k_angle] - mean) / (1.0 + sgn * u)
+        elif what == "curvature":
+            Xt[:, k_angle] = X[:, k_angle] - sgn * u * d2
         else:
             Xt[:, k_angle] = X[:, k_angle] - sgn * u
         out.append(np.nan_to_num(np.asarray(predict(Xt), float)))
@@ -78,8 +92,10 @@ def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, ro
 
 def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, A: np.ndarray, index: int,
                            j: int, rows: np.ndarray, k_angle: int, scale: float, offset: float,
-                           nuisance: Callable[[np.ndarray], np.ndarray] | None = None) -> dict:
-    """Type-B standard uncertainty of one fitted coefficient under no change, from an angle's scale and offset.
+                           nuisance: Callable[[np.ndarray], np.ndarray] | None = None,
+                           curvature: float = 0.0) -> dict:
+    """Type-B standard uncertainty of one fitted coefficient under no change, from an angle's scale, offset and
+    curvature.
 
     Args:
         predict: see :func:`null_residual`. X: (T, 10) the measured regressors (before any nuisance correction).
@@ -89,13 +105,16 @@ def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.nd
             in ``X``. scale: standard uncertainty of the angle's relative scale. offset: of its offset, rad.
         nuisance: ``R (T, 6) -> R (T, 6)`` what the search removes before fitting (the angle nuisance, linear
             in ``R``), applied to the no-change residual as to the measured one; None: nothing removed.
+        curvature: standard uncertainty of the angle's curvature error, 1/rad
+            (:attr:`gcs_sysid.estimation.airangles.AxisFit.curvature_sigma`); 0: left out (and not in the result).
 
     Returns:
-        ``{"scale": u, "offset": u}`` (units of the coefficient; 0 where the input uncertainty is 0).
+        ``{"scale": u, "offset": u}`` and, with ``curvature > 0``, ``"curvature": u`` (units of the coefficient; 0
+        where the input uncertainty is 0).
     """
     out = {}
     An = np.nan_to_num(np.asarray(A, float)[rows])
-    for what, u in (("scale", scale), ("offset", offset)):
+    for what, u in (("scale", scale), ("offset", offset)) + ((("curvature", curvature),) if curvature > 0 else ()):
         if not u > 0:
             out[what] = 0.0
             continue

@@ -160,6 +160,17 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`beyond_expanded_uncertainty`); ``"alpha"``: alpha's components under no change, the sideslip's as before.
 #: No new threshold. Off: with either value the t6's clean seed-14 ``CZ:alpha^2`` is named again (measured in
 #: ``docs/benchmarks.md``, *Nineteenth session, i9-null*).
+#: Added 2026-11-23 (twentieth session, branch i9-curv): ``coverage_curvature`` (read only with
+#: ``coverage_under_null``): the aided alpha's stated curvature uncertainty
+#: (:attr:`gcs_sysid.estimation.airangles.AxisFit.curvature_sigma`, the
+#: aiding's fitted ``CZ_alpha2 / |CZ_alpha|``) is carried under no change as a third alpha component beside the scale
+#: and offset (:func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity`). No new threshold. With it
+#: ``coverage_under_null = "alpha"`` is **on by default** (rule 8): on the t6, b737, c684, ultrastick and rascal
+#: diagnosis flights it names every effect case as ``"alpha"`` did (b737 top 23 -> 30/38, all three 17 -> 20/37;
+#: c684 top 16 -> 18/38; ultrastick top 18 -> 20/38, gain 17 -> 20/38 against main's defaults; t6, rascal unchanged)
+#: and no clean flight names an alpha term (t6 s14 and b737 s13 ``CZ:alpha^2`` covered: t6 5/5, b737 5/5 where main
+#: had 4/5; the c684's s13 ``scale:CY`` as in main); ``docs/benchmarks.md``, *Twentieth session, i9-curv*. Not
+#: measured: the other 12 tuning aircraft.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -174,8 +185,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
-              "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": False,
-              "angle_offset_level": False, "angle_error_beside_named": False}
+              "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
+              "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -906,7 +917,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     if th.get("coverage_under_null", False):
         model_null = reference[0].model if reference is not None else ctx.model
         null = {"predict": lambda Xp, _m=model_null: np.nan_to_num(ctx.model_values(Xp, _m)) * ctx.active[None, :],
-                "X": np.nan_to_num(ctx.X), "nuisance": null_nuisance}
+                "X": np.nan_to_num(ctx.X), "nuisance": null_nuisance,
+                "curvature": bool(th.get("coverage_curvature", False))}
     if th.get("honest_std_error", True):
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
@@ -970,7 +982,8 @@ def beyond_expanded_uncertainty(f: dict, k: float = NAMING_COVERAGE_FACTOR, type
         under_null: judge the change against its combined uncertainty *under no change*
             (``evidence.uncertainty.combined_under_no_change``: the type-A components with the air angles' stated
             uncertainty carried through the unchanged model, :mod:`gcs_sysid.diagnose.null_uncertainty`;
-            ``THRESHOLDS["coverage_under_null"]``; nineteenth session, branch i9-null; off). Takes precedence over
+            ``THRESHOLDS["coverage_under_null"]``; nineteenth session, branch i9-null; on by default as ``"alpha"``
+            since the twentieth session, branch i9-curv). Takes precedence over
             ``type_a_only``; a finding without it is judged as before. ``"alpha"``: the angle of attack's components
             under no change, the sideslip's as before (``combined_under_no_change_alpha``; a sideslip scale error along
             CY is what the differential step judges from Cl and Cn).
@@ -1379,8 +1392,9 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                 continue
             sens = angle_null_sensitivity(null["predict"], null["X"], A0, i, j, tr, REGRESSORS.index(angle),
                                           float(u.get("scale", 0.0)), float(u.get("offset_rad", 0.0)),
-                                          null.get("nuisance"))
-            typeb_null.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
+                                          null.get("nuisance"),
+                                          float(u.get("curvature", 0.0)) if null.get("curvature") else 0.0)
+            typeb_null.update({f"{angle}_{k}": v for k, v in sens.items()})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
     u_c = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),

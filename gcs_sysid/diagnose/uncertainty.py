@@ -92,6 +92,10 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
     from another flight carries no scale uncertainty of its own here (0). The scale also takes the aided
     and the kinematic angle's disagreement in scale (``AxisFit.scale_sigma``) in quadrature: the kinematic
     angle's scale is set by geometry, the aided one's by a force slope that errors in variables attenuate.
+    Alpha also gets ``"curvature"``, 1/rad: the aided angle's flight-common curvature error
+    (:attr:`gcs_sysid.estimation.airangles.AxisFit.curvature_sigma`, the aiding's fitted ``CZ_alpha2`` over
+    ``|CZ_alpha|``); only the naming test under no change reads it
+    (:func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity`; twentieth session, branch i9-curv).
 
     The change is this flight's fit minus the reference's, and the reference's angle errors stay in the
     model (the angle nuisance brings this flight's angle to the reference's scale; a term of degree ``k``
@@ -103,7 +107,8 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
         reference_fits: the same of the reference flight, or None.
 
     Returns:
-        ``{"alpha": {"scale": u_s, "offset_rad": u_o}, "beta": {...}}`` (dimensionless, rad; 0 where unknown).
+        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c}, "beta": {"scale": u_s, "offset_rad": u_o}}``
+        (dimensionless, rad, 1/rad; 0 where unknown).
     """
     if reference_fits is not None:
         a, b = air_data_uncertainty(angle_fits), air_data_uncertainty(reference_fits)
@@ -121,6 +126,9 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
             b = float(getattr(fit, "bias_sigma", float("nan")))
             uo = b if np.isfinite(b) else 0.0
         out[name] = {"scale": us, "offset_rad": uo}
+        if name == "alpha":
+            uc = float(getattr(fit, "curvature_sigma", float("nan")))
+            out[name]["curvature"] = uc if np.isfinite(uc) else 0.0
     return out
 
 

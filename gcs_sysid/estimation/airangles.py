@@ -234,6 +234,44 @@ class AxisFit:
     map_cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     band_hz: float = HIGHPASS_HZ
 
+    @property
+    def curvature_sigma(self) -> float:
+        """Standard uncertainty of the aided angle's flight-common *curvature* error, 1/rad (alpha only).
+
+        The aided angle ``x`` may carry ``e(x) = c (x - mean)^2`` that the kinematic one does not: the force model's
+        curvature ``CZ_alpha2`` (the column ``(alpha - alpha0)^2``) and a curvature of the angle's error are one and
+        the same to the aiding. Its later passes fit the model on the angle the last pass aided, and a measured
+        coefficient linear in the true angle, ``CZ = CZ_alpha alpha_true``, read on ``alpha = alpha_true + c (alpha -
+        mean)^2`` shows the curvature ``CZ_alpha2 = -CZ_alpha c``; the force-derived angle then keeps that ``c``
+        (its curvature is divided out by the same slope). The fixed point is not identified by the data: where it
+        lands follows the first pass on the kinematic angle (its gust error squared). Against JSBSim's exact alpha
+        (t6 and b737, clean flights and their references, light turbulence) the aided alpha's curvature error is
+        ``CZ_alpha2 / |CZ_alpha|`` within 0.01-0.41 /rad on 11 of 12 flights (t6 s13: 0.64; t6 s14: fitted
+        -4.55 / 4.65 = -0.98, JSBSim -0.78; b737 s13: -5.11 / 4.91 = -1.04, JSBSim -0.89; ``docs/benchmarks.md``,
+        "Twentieth session, i9-curv"), while the fit's own standard error of ``CZ_alpha2`` (0.05-0.17) is 20-100
+        times smaller than its between-flight scatter (-5.1..+5.7). So the whole fitted curvature is stated as
+        possible error of the angle (a type-B evaluation from the available information, GUM JCGM 100:2008
+        sec. 4.3.1; Morelli and Klein, *Aircraft System Identification*, 2nd ed., ch. 5, errors in the regressors of
+        an equation-error fit), with its standard error in quadrature, as :attr:`scale_sigma` states the scale:
+        ``sqrt(CZ_alpha2^2 + se^2) / |CZ_alpha|``.
+
+        Returns:
+            1/rad (0.5 = half a radian of angle error per rad^2 of centred angle squared); NaN where the axis was
+            not aided or its model holds no curvature column (the sideslip's).
+        """
+        cols = tuple(self.columns)
+        q = f"({self.name} - {self.name}0)^2"
+        if not self.used or q not in cols or len(self.coef) <= cols.index(q):
+            return float("nan")
+        i = cols.index(q)
+        c = np.asarray(self.coef, float)
+        s = np.asarray(self.coef_sigma, float)
+        a1 = abs(float(c[1])) if c.size > 1 else 0.0
+        if not a1 > 0 or not np.isfinite(c[i]):
+            return float("nan")
+        se = float(s[i]) if s.size > i and np.isfinite(s[i]) else 0.0
+        return float(np.hypot(c[i], se) / a1)
+
 
 @dataclass
 class AidedAngles:

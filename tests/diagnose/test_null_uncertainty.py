@@ -75,7 +75,8 @@ def test_unlike_the_own_column_component_it_does_not_grow_with_the_change():
 
 
 def test_the_coverage_test_reads_the_uncertainty_under_no_change_when_asked():
-    assert THRESHOLDS["coverage_under_null"] is False                # opt-in
+    # on by default since the twentieth session (branch i9-curv), with alpha's curvature carried under no change
+    assert THRESHOLDS["coverage_under_null"] == "alpha" and THRESHOLDS["coverage_curvature"] is True
     unc = {"type_b": {"alpha_scale": 7.044}, "combined": 7.054, "type_b_under_no_change": {"alpha_scale": 0.665},
            "combined_under_no_change": 0.764}
     f = {"estimate": -5.41, "model_value": 0.0, "std_error": 7.054, "evidence": {"uncertainty": unc}}
