@@ -153,7 +153,7 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ``coverage_type_a`` (the naming's coverage test reads the combined uncertainty without its type-B air-angle
 #: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in
 #: ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
-#: Added 2026-11-23 (nineteenth session, branch i9-null), **off** (opt-in): ``coverage_under_null`` (the naming's
+#: Added 2026-11-23 (nineteenth session, branch i9-null), off until the twentieth: ``coverage_under_null`` (the naming's
 #: coverage test reads the combined uncertainty *under no change*: the type-A components with the air angles'
 #: stated scale and offset uncertainty carried through the *unchanged model's* prediction, nuisance and fit, not
 #: through the term's own column times its own estimate; :mod:`gcs_sysid.diagnose.null_uncertainty`,
@@ -169,8 +169,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: diagnosis flights it names every effect case as ``"alpha"`` did (b737 top 23 -> 30/38, all three 17 -> 20/37;
 #: c684 top 16 -> 18/38; ultrastick top 18 -> 20/38, gain 17 -> 20/38 against main's defaults; t6, rascal unchanged)
 #: and no clean flight names an alpha term (t6 s14 and b737 s13 ``CZ:alpha^2`` covered: t6 5/5, b737 5/5 where main
-#: had 4/5; the c684's s13 ``scale:CY`` as in main); ``docs/benchmarks.md``, *Twentieth session, i9-curv*. Not
-#: measured: the other 12 tuning aircraft.
+#: had 4/5; the c684's s13 ``scale:CY`` as in main); ``docs/benchmarks.md``, *Twentieth session, i9-curv*. Checked at
+#: the merge on i9-offset's c172x and sgs flights: the same counts as main's defaults, clean 5/5 on both (the c172x's
+#: 0.12-s delay no longer named as ``CZ:delta_e``; one sgs ``Cm:alpha^2 = -4`` flight names ``Cm:alpha*delta_e^2``
+#: where main named nothing). Not measured: the other 10 tuning aircraft.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
