@@ -106,9 +106,15 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
         angle_fits: ``{"alpha": AxisFit, "beta": AxisFit}`` of this flight, or None.
         reference_fits: the same of the reference flight, or None.
 
+    Alpha also gets ``"loading_delta_e"`` (:func:`elevator_loading`, rad/rad; where the aiding has a ``delta_e``
+    column), and with ``reference_fits`` in its place ``"map_delta_e"``: the two loadings' absolute difference (not
+    their quadrature sum: a signed property of how each alpha was built), the alpha error along ``delta_e`` that only
+    the naming test under no change reads, with ``sparse.THRESHOLDS["coverage_map_delta_e"]`` (twentieth session,
+    branch i9-elev; off).
+
     Returns:
-        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c}, "beta": {"scale": u_s, "offset_rad": u_o}}``
-        (dimensionless, rad, 1/rad; 0 where unknown).
+        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m]}, "beta": {"scale": u_s,
+        "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad; 0 where unknown).
     """
     if reference_fits is not None:
         a, b = air_data_uncertainty(angle_fits), air_data_uncertainty(reference_fits)
@@ -144,7 +150,9 @@ def elevator_loading(fit) -> float | None:
     """The aided alpha's loading on the elevator, rad of alpha per rad of ``delta_e``: ``-CZ_delta_e / CZ_alpha``
     of the aiding's force model (:class:`gcs_sysid.estimation.airangles.AxisFit`; the aided angle is the lift's
     excursion less the model's other terms over the slope, so an error ``e`` in the fitted ``CZ_delta_e`` is an
-    alpha error ``-e / CZ_alpha * delta_e``). None: alpha not aided, or no ``delta_e`` column.
+    alpha error ``-e / CZ_alpha * delta_e``). The aircraft's true ``CZ_delta_e`` is a share of it common to two flights
+    of one aircraft, so only a difference of two loadings is an angle error. None: alpha not aided, or no ``delta_e``
+    column.
 
     Two flights' aiding fits of the same aircraft differ in ``CZ_delta_e`` by errors in variables (the kinematic
     witness's gust error, the elevator's correlation with alpha), so their alphas differ by ``(l_f - l_ref)
