@@ -54,7 +54,7 @@ __all__ = ["null_residual", "angle_null_sensitivity"]
 
 
 def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, rows: np.ndarray, k_angle: int,
-                  what: str, u: float) -> np.ndarray:
+                  what: str, u: float, along: int | None = None) -> np.ndarray:
     """Half the difference of the no-change residual at an angle error of ``+u`` and ``-u``.
 
     Args:
@@ -62,18 +62,25 @@ def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, ro
             coefficients 0). X: (T, 10) the measured regressors. rows: (N,) the rows the angle's mean is taken over.
         k_angle: column of the angle in ``X``. what: ``"scale"`` (relative, about the mean over ``rows``) or
             ``"offset"`` (rad) or ``"curvature"`` (1/rad: ``x = x_true + s ((x - mean)^2 - m2)``, ``m2`` the mean of
-            ``(x - mean)^2`` over ``rows``; first order in ``s``). u: the error's standard uncertainty (> 0).
+            ``(x - mean)^2`` over ``rows``; first order in ``s``) or ``"along"`` (rad per unit of regressor
+            ``along``: ``x = x_true + s (X[:, along] - mean)``, the mean over ``rows``: an aided angle's error that
+            follows another regressor, e.g. the elevator, ``gcs_sysid.diagnose.uncertainty.elevator_loading``).
+            u: the error's standard uncertainty (> 0). along: the regressor's column (``what="along"`` only).
 
     Returns:
         (T, 6) ``(R_0(+u) - R_0(-u)) / 2`` with ``R_0(s) = M(x_true) - M(x)``: the measured angle ``x`` is the true
         one scaled by ``1 + s`` (shifted by ``s``), so ``x_true = mean + (x - mean) / (1 + s)`` (``x - s``).
 
     Raises:
-        ValueError: ``what`` not ``"scale"``, ``"offset"`` or ``"curvature"``.
+        ValueError: ``what`` not ``"scale"``, ``"offset"``, ``"curvature"`` or ``"along"``, or ``"along"``
+            without ``along``.
     """
-    if what not in ("scale", "offset", "curvature"):
-        raise ValueError(f"null_residual: what must be 'scale', 'offset' or 'curvature', got {what!r}")
+    if what not in ("scale", "offset", "curvature", "along"):
+        raise ValueError(f"null_residual: what must be 'scale', 'offset', 'curvature' or 'along', got {what!r}")
+    if what == "along" and along is None:
+        raise ValueError("null_residual: what='along' needs the column 'along'")
     X = np.nan_to_num(np.asarray(X, float))
+    dv = X[:, along] - float(np.mean(X[rows, along])) if what == "along" else None
     mean = float(np.mean(X[rows, k_angle]))
     d2 = (X[:, k_angle] - mean) ** 2
     d2 = d2 - float(np.mean(d2[rows]))
@@ -84,6 +91,8 @@ def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, ro
             Xt[:, k_angle] = mean + (X[:, k_angle] - mean) / (1.0 + sgn * u)
         elif what == "curvature":
             Xt[:, k_angle] = X[:, k_angle] - sgn * u * d2
+        elif what == "along":
+            Xt[:, k_angle] = X[:, k_angle] - sgn * u * dv
         else:
             Xt[:, k_angle] = X[:, k_angle] - sgn * u
         out.append(np.nan_to_num(np.asarray(predict(Xt), float)))
@@ -93,7 +102,7 @@ def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, ro
 def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, A: np.ndarray, index: int,
                            j: int, rows: np.ndarray, k_angle: int, scale: float, offset: float,
                            nuisance: Callable[[np.ndarray], np.ndarray] | None = None,
-                           curvature: float = 0.0) -> dict:
+                           curvature: float = 0.0, map_delta_e: float = 0.0, k_delta_e: int | None = None) -> dict:
     """Type-B standard uncertainty of one fitted coefficient under no change, from an angle's scale, offset and
     curvature.
 
@@ -107,18 +116,28 @@ def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.nd
             in ``R``), applied to the no-change residual as to the measured one; None: nothing removed.
         curvature: standard uncertainty of the angle's curvature error, 1/rad
             (:attr:`gcs_sysid.estimation.airangles.AxisFit.curvature_sigma`); 0: left out (and not in the result).
+        map_delta_e: the difference of the two flights' aided-alpha loadings on the elevator, rad/rad
+            (``air_data_uncertainty(...)["alpha"]["map_delta_e"]``, ``sparse.THRESHOLDS["coverage_map_delta_e"]``),
+            carried as the angle's error along column ``k_delta_e``; 0 or ``k_delta_e`` None: left out (and not in
+            the result).
 
     Returns:
-        ``{"scale": u, "offset": u}`` and, with ``curvature > 0``, ``"curvature": u`` (units of the coefficient; 0
-        where the input uncertainty is 0).
+        ``{"scale": u, "offset": u}`` and, with ``curvature > 0``, ``"curvature": u``, with ``map_delta_e > 0``,
+        ``"map_delta_e": u`` (units of the coefficient; 0 where the input uncertainty is 0).
     """
     out = {}
     An = np.nan_to_num(np.asarray(A, float)[rows])
-    for what, u in (("scale", scale), ("offset", offset)) + ((("curvature", curvature),) if curvature > 0 else ()):
+    parts = (("scale", scale), ("offset", offset)) + ((("curvature", curvature),) if curvature > 0 else ())
+    if map_delta_e > 0 and k_delta_e is not None:
+        parts = parts + (("map_delta_e", map_delta_e),)
+    for what, u in parts:
         if not u > 0:
             out[what] = 0.0
             continue
-        d = null_residual(predict, X, rows, k_angle, what, float(u))
+        if what == "map_delta_e":
+            d = null_residual(predict, X, rows, k_angle, "along", float(u), along=k_delta_e)
+        else:
+            d = null_residual(predict, X, rows, k_angle, what, float(u))
         if nuisance is not None:
             d = nuisance(d)
         r = np.nan_to_num(d[rows, j])

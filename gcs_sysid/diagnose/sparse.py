@@ -173,6 +173,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: the merge on i9-offset's c172x and sgs flights: the same counts as main's defaults, clean 5/5 on both (the c172x's
 #: 0.12-s delay no longer named as ``CZ:delta_e``; one sgs ``Cm:alpha^2 = -4`` flight names ``Cm:alpha*delta_e^2``
 #: where main named nothing). Not measured: the other 10 tuning aircraft.
+#: Added 2026-11-23 (twentieth session, branch i9-elev): ``coverage_map_delta_e`` (read only with
+#: ``coverage_under_null``), **off**: the difference of the two flights' aided-alpha loadings on the elevator
+#: (:func:`gcs_sysid.diagnose.uncertainty.elevator_loading`, ``-CZ_delta_e / CZ_alpha`` of each aiding fit) carried
+#: under no change as a fourth alpha component (the angle's error along ``delta_e``). No new threshold. Measured
+#: post hoc on the c172p's final-evaluation flights and the c172x's (``docs/benchmarks.md``, *Twentieth session,
+#: i9-elev*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -188,7 +194,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
-              "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True}
+              "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
+              "coverage_map_delta_e": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -920,7 +927,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         model_null = reference[0].model if reference is not None else ctx.model
         null = {"predict": lambda Xp, _m=model_null: np.nan_to_num(ctx.model_values(Xp, _m)) * ctx.active[None, :],
                 "X": np.nan_to_num(ctx.X), "nuisance": null_nuisance,
-                "curvature": bool(th.get("coverage_curvature", False))}
+                "curvature": bool(th.get("coverage_curvature", False)),
+                "map_delta_e": bool(th.get("coverage_map_delta_e", False))}
     if th.get("honest_std_error", True):
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
@@ -1395,7 +1403,9 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             sens = angle_null_sensitivity(null["predict"], null["X"], A0, i, j, tr, REGRESSORS.index(angle),
                                           float(u.get("scale", 0.0)), float(u.get("offset_rad", 0.0)),
                                           null.get("nuisance"),
-                                          float(u.get("curvature", 0.0)) if null.get("curvature") else 0.0)
+                                          float(u.get("curvature", 0.0)) if null.get("curvature") else 0.0,
+                                          map_delta_e=float(u.get("map_delta_e", 0.0)) if null.get("map_delta_e")
+                                          else 0.0, k_delta_e=REGRESSORS.index("delta_e"))
             typeb_null.update({f"{angle}_{k}": v for k, v in sens.items()})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None

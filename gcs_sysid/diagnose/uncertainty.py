@@ -39,7 +39,7 @@ from ..jackknife import block_jackknife_cov
 from .regression import ols
 
 __all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "air_data_uncertainty",
-           "angle_sensitivity", "combine"]
+           "elevator_loading", "angle_sensitivity", "combine"]
 
 #: block length of the delete-a-block jackknife, s (the diagnosis's ``alpha_jackknife_s``: longer than the
 #: gusts' correlation times of 1-5 s at light aircraft speeds, short enough to give 5-8 blocks per flight)
@@ -106,13 +106,24 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
         angle_fits: ``{"alpha": AxisFit, "beta": AxisFit}`` of this flight, or None.
         reference_fits: the same of the reference flight, or None.
 
+    Alpha also gets ``"loading_delta_e"`` (:func:`elevator_loading`, rad/rad; where the aiding has a ``delta_e``
+    column), and with ``reference_fits`` in its place ``"map_delta_e"``: the two loadings' absolute difference (not
+    their quadrature sum: a signed property of how each alpha was built), the alpha error along ``delta_e`` that only
+    the naming test under no change reads, with ``sparse.THRESHOLDS["coverage_map_delta_e"]`` (twentieth session,
+    branch i9-elev; off).
+
     Returns:
-        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c}, "beta": {"scale": u_s, "offset_rad": u_o}}``
-        (dimensionless, rad, 1/rad; 0 where unknown).
+        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m]}, "beta": {"scale": u_s,
+        "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad; 0 where unknown).
     """
     if reference_fits is not None:
         a, b = air_data_uncertainty(angle_fits), air_data_uncertainty(reference_fits)
-        return {n: {k: float(np.hypot(a[n][k], b[n][k])) for k in a[n]} for n in a}
+        out = {n: {k: float(np.hypot(a[n][k], b[n][k])) for k in a[n] if k != "loading_delta_e"} for n in a}
+        la, lb = a["alpha"].get("loading_delta_e"), b["alpha"].get("loading_delta_e")
+        if la is not None and lb is not None:
+            # a signed property of how each flight's alpha was built, not an independent error: their difference
+            out["alpha"]["map_delta_e"] = float(abs(la - lb))
+        return out
     out = {}
     for name in ("alpha", "beta"):
         fit = (angle_fits or {}).get(name)
@@ -129,7 +140,36 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
         if name == "alpha":
             uc = float(getattr(fit, "curvature_sigma", float("nan")))
             out[name]["curvature"] = uc if np.isfinite(uc) else 0.0
+            ld = elevator_loading(fit)
+            if ld is not None:
+                out[name]["loading_delta_e"] = ld
     return out
+
+
+def elevator_loading(fit) -> float | None:
+    """The aided alpha's loading on the elevator, rad of alpha per rad of ``delta_e``: ``-CZ_delta_e / CZ_alpha``
+    of the aiding's force model (:class:`gcs_sysid.estimation.airangles.AxisFit`; the aided angle is the lift's
+    excursion less the model's other terms over the slope, so an error ``e`` in the fitted ``CZ_delta_e`` is an
+    alpha error ``-e / CZ_alpha * delta_e``). The aircraft's true ``CZ_delta_e`` is a share of it common to two flights
+    of one aircraft, so only a difference of two loadings is an angle error. None: alpha not aided, or no ``delta_e``
+    column.
+
+    Two flights' aiding fits of the same aircraft differ in ``CZ_delta_e`` by errors in variables (the kinematic
+    witness's gust error, the elevator's correlation with alpha), so their alphas differ by ``(l_f - l_ref)
+    delta_e``, which loads every elevator term: on the c172p's clean seed 13 ``l`` 0.277 against the reference's
+    0.151 (against JSBSim's alpha the error's slope on ``delta_e`` is 0.342 against 0.210) made ``Cm:delta_e``
+    +0.19 and ``CZ:delta_e`` +0.55 (``docs/benchmarks.md``, "Twentieth session, i9-elev").
+    """
+    if fit is None or not getattr(fit, "used", False):
+        return None
+    cols = list(getattr(fit, "columns", ()) or ())
+    c = np.asarray(getattr(fit, "coef", ()), float)
+    if "delta_e" not in cols or "alpha" not in cols or c.size != len(cols):
+        return None
+    a, d = float(c[cols.index("alpha")]), float(c[cols.index("delta_e")])
+    if not (np.isfinite(a) and np.isfinite(d)) or a == 0.0:
+        return None
+    return -d / a
 
 
 def angle_sensitivity(columns: Callable[[np.ndarray], np.ndarray], X: np.ndarray, r: np.ndarray,
