@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state
+from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state, lateral_coefficients
 
 SRC = "data/jsbsim_models/asw20/asw20-JSBSim.xml"
 SRC_SHA256 = "c3a7877a124d79fcc82340614703cc07795993a06552ad6df9f05b10d1bdbc48"
@@ -166,9 +166,7 @@ def test_the_asw20_is_statically_stable_and_its_controls_act_as_its_xml_says():
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
         fdm = _state(beta_deg=beta, cmds=cmds)
-        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
-        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb,
-                fdm["fcs/left-aileron-pos-rad"], fdm["fcs/rudder-pos-rad"])
+        return lateral_coefficients(fdm)
 
     (l0, n0, _, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
     assert abs(l0) < 1e-12 and abs(n0) < 1e-12

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state
+from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
 
 
 def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
@@ -93,9 +93,7 @@ def test_the_b737_is_statically_stable_and_its_controls_act_as_its_xml_says():
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
         fdm = _state(beta_deg=beta, cmds=cmds)
-        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
-        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb, fdm["fcs/left-aileron-pos-rad"],
-                fdm["fcs/rudder-pos-rad"])
+        return lateral_coefficients(fdm)
 
     l0, n0, _, _ = lat()
     assert abs(l0) < 1e-5 and abs(n0) < 1e-5

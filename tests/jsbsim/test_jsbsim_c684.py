@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state
+from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state, lateral_coefficients
 
 SRC = "data/jsbsim_models/c684/C684.xml"
 SRC_SHA256 = "fb02bd7d563c8877ebcaaffe81e17ab62efd456ec65027436349e696765e826d"
@@ -132,9 +132,7 @@ def test_the_c684_is_statically_stable_and_its_controls_act_as_its_xml_says():
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
         fdm = _state(alpha_deg=alpha, beta_deg=beta, cmds=cmds)
-        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
-        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb,
-                fdm["fcs/left-aileron-pos-rad"], fdm["fcs/rudder-pos-rad"], np.sqrt(fdm["aero/cl-squared"]))
+        return lateral_coefficients(fdm) + (np.sqrt(fdm["aero/cl-squared"]),)
 
     l0, n0, _, _, cl = lat()
     assert l0 == pytest.approx(-0.0011, rel=1e-6) and abs(n0) < 1e-12

@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state
+from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
 
 SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
 SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
@@ -117,9 +117,7 @@ def test_the_iar80_is_statically_stable_and_its_controls_act_as_its_xml_says():
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
         fdm = _state(beta_deg=beta, cmds=cmds)
-        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
-        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb,
-                fdm["fcs/left-aileron-pos-rad"], fdm["fcs/rudder-pos-rad"])
+        return lateral_coefficients(fdm)
 
     (l0, n0, _, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
     assert abs(l0) < 1e-12 and abs(n0) < 1e-12

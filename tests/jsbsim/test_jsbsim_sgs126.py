@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft
-from truth_fits import check_direct_fcs, cm_without_alpha_dot, ic_state
+from truth_fits import check_direct_fcs, cm_without_alpha_dot, ic_state, lateral_coefficients
 
 FT = 0.3048
 
@@ -82,9 +82,7 @@ def test_the_sgs126_is_statically_stable_and_yaws_adversely():
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
         fdm = _state(alpha_deg=2.0, beta_deg=beta, cmds=cmds)
-        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
-        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb,
-                fdm["fcs/left-aileron-pos-rad"], fdm["fcs/rudder-pos-rad"])
+        return lateral_coefficients(fdm)
 
     (l0, n0, a0, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
     assert abs(l0) < 1e-12 and abs(n0) < 1e-12

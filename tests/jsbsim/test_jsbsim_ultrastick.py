@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state
+from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
 
 DIR = "data/jsbsim_models/ultrastick120"
 #: file -> (bytes, SHA-256), as the README lists them.
@@ -133,9 +133,7 @@ def test_the_ultrastick_is_statically_stable_and_its_controls_act_as_its_tables_
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
         fdm = _state(alpha_deg=alpha, beta_deg=beta, cmds=cmds)
-        qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
-        return (fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb, fdm["fcs/posAilL_rad"],
-                fdm["fcs/rudder-pos-rad"])
+        return lateral_coefficients(fdm, aileron="fcs/posAilL_rad")
 
     l0, n0, _, _ = lat()
     assert abs(l0) < 1e-5 and abs(n0) < 1e-5

@@ -169,6 +169,22 @@ def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.
     return fdm
 
 
+def lateral_coefficients(fdm, aileron: str = "fcs/left-aileron-pos-rad",
+                         rudder: str = "fcs/rudder-pos-rad") -> tuple[float, float, float, float]:
+    """JSBSim's rolling and yawing moment coefficients and the surfaces that made them, from one state.
+
+    Args:
+        fdm: a JSBSim FGFDMExec after ``run_ic`` (the aircraft's reference area, span and dynamic pressure set).
+        aileron, rudder: the properties holding the surface deflections, rad (a model's own names).
+
+    Returns:
+        ``(Cl, Cn, delta_a, delta_r)``: ``L / (qbar S b)``, ``N / (qbar S b)`` from JSBSim's aerodynamic moments
+        about the CG (lbs ft over psf ft^2 ft: dimensionless), and the two deflections, rad.
+    """
+    qsb = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]
+    return fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb, fdm[aileron], fdm[rudder]
+
+
 def cm_without_alpha_dot(spec, alpha_deg: float, elevator_cmd: float = 0.0) -> float:
     """JSBSim's pitching-moment coefficient about the CG at :func:`ic_state` (``alpha_deg`` of alpha, the
     normalised elevator command ``elevator_cmd``) less its ``Cmadot`` term (``run_ic`` gives an alpha-dot the
