@@ -88,10 +88,8 @@ _DEG = 57.29577951308232
 #: the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV, checked into ``data/jsbsim_models/ultrastick120``
 #: and flown as ``UltraStick120_glide``, no propulsion, direct surfaces, at 10000 ft) and ``b737`` (the nineteenth
 #: session's: JSBSim's stock Boeing 737, the wheel's ``737``, engines shut down, gear up, its own yaw damper in the
-#: loop, at 12000 ft). ``c172p`` (added in the twentieth session, 2026-11-23: JSBSim's stock Cessna 172P, the wheel's
-#: ``c172p``, engine shut down, fixed gear, at 4000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
-#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method was never run on
-#: it before its final evaluation.
+#: loop, at 12000 ft) and ``c172p`` (the twentieth session's: JSBSim's stock Cessna 172P, the wheel's ``c172p``,
+#: engine shut down, fixed gear, at 4000 ft). No aircraft is held out or untouched until the next one is added.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -578,9 +576,9 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20", "iar80", "c684", "ultrastick", "b737")
-HELD_OUT_AIRCRAFT = ("c172p",)
-UNTOUCHED_AIRCRAFT = ("c172p",)
+                   "asw20", "iar80", "c684", "ultrastick", "b737", "c172p")
+HELD_OUT_AIRCRAFT = ()
+UNTOUCHED_AIRCRAFT = ()
 
 
 def aircraft(name: str) -> AircraftSpec:

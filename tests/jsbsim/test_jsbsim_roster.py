@@ -1,5 +1,5 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737 and the untouched c172p; docs/jsbsim.md,
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737 and c172p; docs/jsbsim.md,
 one section each),
 parametrised over the roster.
 
@@ -11,11 +11,10 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched c172p's are slow too but its names', and its own
-default checks (its model, surfaces, engine, static stability, the summaries' label) are in
-``test_jsbsim_c172p.py`` (the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+default suite, as before the fold); their own default checks (model, surfaces, static stability) are in
+``test_jsbsim_c172p.py`` (the c172p's), the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twentieth sessions). Folded in the eleventh session
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-first sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
 in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
@@ -312,7 +311,7 @@ CASES = (
           ("cn", 2, -0.0943, ("rel", 0.03)), ("cn", 3, 0.0058, ("rel", 0.1))),
          (), 23.0 * 0.01745, 5,
          dict(alpha=(-4.0, 11.0), beta=(10.0, 12.0), bank=(20.0, 25.0), speed=(28.0, 60.0), alt_min=300.0,
-              rate_std=1.5, rate_std_held=1.5), untouched=True),
+              rate_std=1.5, rate_std_held=1.5)),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -341,8 +340,8 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the c172p
-    alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the
+    untouched aircraft alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
     assert_names_resolve(case.name, case.model, case.typo)
@@ -353,7 +352,7 @@ def test_names_resolve_and_roles(case):
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
     used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684",
-            "ultrastick", "b737"}
+            "ultrastick", "b737", "c172p"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
