@@ -225,6 +225,19 @@ def derive_rascal_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def _insert_elevator_deg_alias(aero: ET.Element, reader: str) -> None:
+    """Insert, as the first child of ``aero`` (an ``<aerodynamics>`` element, modified in place), the function
+    :data:`ELEVATOR_DEG_ALIAS` = :data:`_RADTODEG` x ``fcs/elevator-pos-rad`` (JSBSim's own conversion, so the
+    numbers are unchanged), described as what ``reader`` (the model's term that reads it) looks up. The derivations
+    of the asw20 and the eternity point their one read of ``fcs/elevator-pos-deg`` at it."""
+    alias = ET.Element("function", name=ELEVATOR_DEG_ALIAS)
+    _el(alias, "description", f"elevator position, deg, {reader} reads (added by the harness's derivation)")
+    prod = _el(alias, "product")
+    _el(prod, "value", repr(_RADTODEG))
+    _el(prod, "property", "fcs/elevator-pos-rad")
+    aero.insert(0, alias)
+
+
 def derive_asw20_glide(root: ET.Element) -> ET.Element:
     """FlightGear's ASW 20 sailplane (``data/jsbsim_models/asw20/asw20-JSBSim.xml``) as JSBSim alone can
     fly it, with one ``<property>`` read of the elevator in its aerodynamics (fifteenth session).
@@ -276,12 +289,7 @@ def derive_asw20_glide(root: ET.Element) -> ET.Element:
     if len(reads) != 1:
         raise ValueError("asw20-JSBSim.xml: expected one table looking up fcs/elevator-pos-deg")
     reads[0].text = ELEVATOR_DEG_ALIAS
-    alias = ET.Element("function", name=ELEVATOR_DEG_ALIAS)
-    _el(alias, "description", "elevator position, deg, the CmDe table reads (added by the harness's derivation)")
-    prod = _el(alias, "product")
-    _el(prod, "value", repr(_RADTODEG))
-    _el(prod, "property", "fcs/elevator-pos-rad")
-    aero.insert(0, alias)
+    _insert_elevator_deg_alias(aero, "the CmDe table")
     return root
 
 
@@ -502,12 +510,7 @@ def derive_eternity_glide(root: ET.Element) -> ET.Element:
     prop.remove(engines[0])
     fc.remove(throttle[0])
     reads[0].text = ELEVATOR_DEG_ALIAS
-    alias = ET.Element("function", name=ELEVATOR_DEG_ALIAS)
-    _el(alias, "description", "elevator position, deg, Pitch_elevator reads (added by the harness's derivation)")
-    prod = _el(alias, "product")
-    _el(prod, "value", repr(_RADTODEG))
-    _el(prod, "property", "fcs/elevator-pos-rad")
-    aero.insert(0, alias)
+    _insert_elevator_deg_alias(aero, "Pitch_elevator")
     return root
 
 
