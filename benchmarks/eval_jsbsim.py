@@ -39,7 +39,7 @@ Usage::
     python benchmarks/eval_jsbsim.py --aircraft c172x sgs pa28 --seeds 1 2 3 --turbulence light moderate
     python benchmarks/eval_jsbsim.py --aoa vane             # AOA_SSA = exact vane angles
     python benchmarks/eval_jsbsim.py --summarize results.jsonl   # markdown table of --json results
-    python benchmarks/eval_jsbsim.py --aircraft c172p --work DIR --fly-only   # fly (or reuse) only
+    python benchmarks/eval_jsbsim.py --aircraft eternity --work DIR --fly-only   # fly (or reuse) only
 
 ``pa28`` (held out since 2026-11-21), ``j3cub`` (the J-3 Cub, ``J3Cub`` also accepted; the
 sixth session's untouched aircraft), ``c182`` (the seventh session's) and ``t37`` (the eighth
@@ -55,8 +55,10 @@ fifteenth session's) and ``iar80`` (FlightGear's JSBSim IAR-80 fighter without i
 propeller at 6000 ft, ``C684_glide`` also accepted; the seventeenth session's) and ``ultrastick`` (the University of
 Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV without propulsion at 10000 ft, ``UltraStick120_glide`` also
 accepted; the eighteenth session's) and ``b737`` (JSBSim's stock Boeing 737, engines shut down, its own yaw damper in
-the loop, at 12000 ft; ``737`` also accepted; the nineteenth session's). ``c172p`` (JSBSim's stock Cessna 172P, engine
-shut down, at 4000 ft) is the held-out, untouched one: never in the default list,
+the loop, at 12000 ft; ``737`` also accepted; the nineteenth session's) and ``c172p`` (JSBSim's stock Cessna 172P,
+engine shut down, at 4000 ft; the twentieth session's). ``eternity`` (ENAC's Eternity UAV from Paparazzi's JSBSim
+models without its motor, at 10000 ft; ``Eternity_glide`` also accepted) is the held-out, untouched one: never in the
+default list,
 evaluated once after the thresholds are frozen.
 A flight already in ``--work``, flown by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
 ``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
@@ -375,9 +377,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p) or JSBSim model names (J3Cub, T37, t6texan2, B747, f16_direct, "
-                         "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737); "
-                         "c172p is the untouched "
+                         "c684 ultrastick b737 c172p eternity) or JSBSim model names (J3Cub, T37, t6texan2, B747, "
+                         "f16_direct, "
+                         "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
+                         "Eternity_glide); "
+                         "eternity is the untouched "
                          "aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])

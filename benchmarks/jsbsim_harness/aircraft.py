@@ -88,10 +88,8 @@ _DEG = 57.29577951308232
 #: the University of Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV, checked into ``data/jsbsim_models/ultrastick120``
 #: and flown as ``UltraStick120_glide``, no propulsion, direct surfaces, at 10000 ft) and ``b737`` (the nineteenth
 #: session's: JSBSim's stock Boeing 737, the wheel's ``737``, engines shut down, gear up, its own yaw damper in the
-#: loop, at 12000 ft). ``c172p`` (added in the twentieth session, 2026-11-23: JSBSim's stock Cessna 172P, the wheel's
-#: ``c172p``, engine shut down, fixed gear, at 4000 ft) is the held-out, untouched case (``HELD_OUT_AIRCRAFT``,
-#: ``UNTOUCHED_AIRCRAFT``): only its harness was set up (from JSBSim's truth and its XML), the method was never run on
-#: it before its final evaluation.
+#: loop, at 12000 ft) and ``c172p`` (the twentieth session's: JSBSim's stock Cessna 172P, the wheel's ``c172p``,
+#: engine shut down, fixed gear, at 4000 ft). No aircraft is held out or untouched until the next one is added.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -576,11 +574,37 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.7, 0.8, 1.0),
         notes="Cessna 172P (JSBSim c172p), engine shut down, gliding; lateral point masses emptied; untouched by "
               "any tuning of the method"),
+    # eternity: ENAC's Eternity UAV in Paparazzi's JSBSim simulator (paparazzi/paparazzi conf/simulator/jsbsim/
+    # aircraft/Eternity.xml at 5399bd98, Murat Bronz 2015, GPL-2.0-or-later): 0.90 kg, 1.0-m span, 0.145 m^2
+    # (wing loading 61 N/m^2, aspect ratio 6.9), its coefficients "according to wind-tunnel measurements and AVL
+    # results" (its header), inertia 0.080 / 0.033 / 0.107 kg m^2 (the easystar file's it was made from), no
+    # product. The sixth model from outside the wheel and the first from Paparazzi; checked in
+    # (data/jsbsim_models/eternity/, provenance and licence in its README.md) and flown as the derived model
+    # ``Eternity_glide`` (derived.py): motor, propeller and throttle channel removed, its elevator moment reading
+    # an alias. Chosen in the twenty-first session (docs/jsbsim.md, "The eternity"). A direct FCS
+    # (aerosurface_scale, zero-centred): elevator -20 / +15 deg, both ailerons +-20 deg the same sign (the
+    # aerodynamics read the left alone), rudder +-27 deg with a gain of -0.01745 (a positive command moves the
+    # rudder to negative positions). Signs read from its aerodynamics: Pitch_elevator -0.0119 per deg of
+    # elevator-pos (positive = trailing edge down), Roll_aileron +0.2966 x left-aileron-pos (positive = roll
+    # right: Cl_delta_a -0.2966), Yaw_rudder +0.043 x rudder-pos (positive = nose right, trailing edge right:
+    # delta_r = -rudder-pos, Cn_delta_r -0.043), Yaw_aileron -0.021 x left (adverse: Cn_delta_a +0.021).
+    # ``cmd_per_rad`` takes the larger end of each surface, the rudder's negative for its gain's sign. Its lift
+    # acts 2 in behind the CG (AERORP x 4, CG x 2), so it trims at a negative alpha with the elevator trailing
+    # edge up. Set from the harness's truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never
+    # from a method result.
+    "eternity": AircraftSpec(
+        name="eternity", model="Eternity_glide", airspeed_kts=34.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=-1.0,
+        cmd_per_rad=(1.0 / (20.0 * 0.01745), 1.0 / (20.0 * 0.01745), -1.0 / (27.0 * 0.01745)),
+        amplitude_deg=(5.0, 4.0, 5.0), pulse_s=(0.2, 0.3, 0.5), gains=(0.5, 0.1, 0.01, 0.2, 0.05, 0.2),
+        notes="Eternity UAV (Paparazzi's JSBSim Eternity.xml, checked in under data/jsbsim_models/eternity) without "
+              "its motor and propeller (derived model Eternity_glide, XML sha256 ada8d7c7cccebe1a), gliding; "
+              "untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20", "iar80", "c684", "ultrastick", "b737")
-HELD_OUT_AIRCRAFT = ("c172p",)
-UNTOUCHED_AIRCRAFT = ("c172p",)
+                   "asw20", "iar80", "c684", "ultrastick", "b737", "c172p")
+HELD_OUT_AIRCRAFT = ("eternity",)
+UNTOUCHED_AIRCRAFT = ("eternity",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -10,7 +10,9 @@ propeller removed (``IAR80_glide``, :func:`derive_iar80_glide`; sixteenth sessio
 Caudron C.684 racer with its engine, propeller and engine system removed (``C684_glide``,
 :func:`derive_c684_glide`; seventeenth session), or the University of Minnesota UAS Lab's JSBSim Ultra Stick 120
 UAV assembled from its files into one, gliding, with direct surfaces (``UltraStick120_glide``,
-:func:`derive_ultrastick120_glide`; eighteenth session).
+:func:`derive_ultrastick120_glide`; eighteenth session), or ENAC's Eternity UAV from Paparazzi with its motor and
+propeller removed and its elevator moment reading an alias (``Eternity_glide``, :func:`derive_eternity_glide`;
+twenty-first session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -65,6 +67,7 @@ from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
+           "derive_eternity_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -222,6 +225,19 @@ def derive_rascal_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def _insert_elevator_deg_alias(aero: ET.Element, reader: str) -> None:
+    """Insert, as the first child of ``aero`` (an ``<aerodynamics>`` element, modified in place), the function
+    :data:`ELEVATOR_DEG_ALIAS` = :data:`_RADTODEG` x ``fcs/elevator-pos-rad`` (JSBSim's own conversion, so the
+    numbers are unchanged), described as what ``reader`` (the model's term that reads it) looks up. The derivations
+    of the asw20 and the eternity point their one read of ``fcs/elevator-pos-deg`` at it."""
+    alias = ET.Element("function", name=ELEVATOR_DEG_ALIAS)
+    _el(alias, "description", f"elevator position, deg, {reader} reads (added by the harness's derivation)")
+    prod = _el(alias, "product")
+    _el(prod, "value", repr(_RADTODEG))
+    _el(prod, "property", "fcs/elevator-pos-rad")
+    aero.insert(0, alias)
+
+
 def derive_asw20_glide(root: ET.Element) -> ET.Element:
     """FlightGear's ASW 20 sailplane (``data/jsbsim_models/asw20/asw20-JSBSim.xml``) as JSBSim alone can
     fly it, with one ``<property>`` read of the elevator in its aerodynamics (fifteenth session).
@@ -273,12 +289,7 @@ def derive_asw20_glide(root: ET.Element) -> ET.Element:
     if len(reads) != 1:
         raise ValueError("asw20-JSBSim.xml: expected one table looking up fcs/elevator-pos-deg")
     reads[0].text = ELEVATOR_DEG_ALIAS
-    alias = ET.Element("function", name=ELEVATOR_DEG_ALIAS)
-    _el(alias, "description", "elevator position, deg, the CmDe table reads (added by the harness's derivation)")
-    prod = _el(alias, "product")
-    _el(prod, "value", repr(_RADTODEG))
-    _el(prod, "property", "fcs/elevator-pos-rad")
-    aero.insert(0, alias)
+    _insert_elevator_deg_alias(aero, "the CmDe table")
     return root
 
 
@@ -453,6 +464,56 @@ def derive_ultrastick120_glide(root: ET.Element) -> ET.Element:
     return new
 
 
+def derive_eternity_glide(root: ET.Element) -> ET.Element:
+    """ENAC's Eternity UAV from Paparazzi (``data/jsbsim_models/eternity/Eternity.xml``: paparazzi/paparazzi
+    ``conf/simulator/jsbsim/aircraft/Eternity.xml`` at 5399bd98, Murat Bronz 2015, GPL-2.0-or-later) with its motor
+    and propeller removed and its elevator moment reading an alias (twenty-first session).
+
+    Three edits; nothing else changes (a test checks every other element):
+
+    - **Motor removed.** The ``<engine>`` element (the ``HB2815-2000`` motor, its ``<feed>`` and the ``apc6x4``
+      propeller; neither file is copied) is removed, as the rascal's, iar80's and c684's: the harness glides every
+      aircraft, so that every non-gravity force is aerodynamic. The empty fuel tank (0 lb) stays.
+    - **Throttle channel removed.** The ``Throttle`` channel of ``<flight_control>`` reads
+      ``fcs/throttle-cmd-norm``, which JSBSim creates per engine: without the engine ``run_ic`` raises. It writes
+      only ``fcs/throttle-pos-norm``, which only the removed engine read.
+    - **Elevator alias.** ``Pitch_elevator`` (the elevator's whole pitching moment, -0.0119 per deg) reads
+      ``fcs/elevator-pos-deg``. A function :data:`ELEVATOR_DEG_ALIAS` = 57.2957795... x ``fcs/elevator-pos-rad``
+      (JSBSim's own conversion) is added to ``<aerodynamics>`` and the moment reads it there, so that
+      ``effects.py``'s ``delay:delta_e`` reaches the moment as it does the elevator's lift (``Lift_elevator``), as
+      for the asw20 (:func:`derive_asw20_glide`). The numbers are unchanged. ``Drag_elevator`` reads the
+      normalised command ``fcs/elevator-pos-norm`` (0.03 x its magnitude) and is left as it is (the injected
+      delay does not reach it: a drag term of at most 0.03).
+
+    Args:
+        root: the parsed ``Eternity.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): one
+            ``<propulsion><engine>``, the ``Throttle`` channel, ``<aerodynamics>`` or one ``<property>`` read of
+            ``fcs/elevator-pos-deg``.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    fc = root.find("flight_control")
+    throttle = [ch for ch in fc.findall("channel") if ch.get("name") == "Throttle"] if fc is not None else []
+    aero = root.find("aerodynamics")
+    reads = [p for p in aero.iter("property") if (p.text or "").strip() == "fcs/elevator-pos-deg"] \
+        if aero is not None else []
+    if len(engines) != 1 or len(throttle) != 1 or len(reads) != 1:
+        raise ValueError("Eternity.xml: expected one <propulsion><engine>, the Throttle channel, an <aerodynamics> "
+                         "and one <property> read of fcs/elevator-pos-deg")
+    prop.remove(engines[0])
+    fc.remove(throttle[0])
+    reads[0].text = ELEVATOR_DEG_ALIAS
+    _insert_elevator_deg_alias(aero, "Pitch_elevator")
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -498,6 +559,14 @@ REPO_DERIVED = {
                             "propulsion; the lab's control laws, actuators and sensors replaced by direct surfaces "
                             "(+-30 deg); the aerodynamics read fcs/elevator-pos-rad and fcs/rudder-pos-rad for the "
                             "lab's posElev_rad and posRud_rad; flaps 0; no number changed."),
+    "Eternity_glide": ("data/jsbsim_models/eternity/Eternity.xml",
+                       "ENAC's Eternity UAV from Paparazzi (paparazzi/paparazzi conf/simulator/jsbsim/aircraft/"
+                       "Eternity.xml at 5399bd98, Murat Bronz 2015, GPL-2.0-or-later), copied into gcs-sysid's "
+                       "data/jsbsim_models/eternity/",
+                       derive_eternity_glide, "motor, propeller and throttle channel removed (a glide with no "
+                                              "propeller force); "
+                                              "Pitch_elevator reads the elevator through an alias in degrees of "
+                                              "fcs/elevator-pos-rad; everything else unchanged."),
 }
 
 

@@ -1,4 +1,5 @@
-"""The c172p in the JSBSim harness: the twentieth session's untouched aircraft (docs/jsbsim.md, "The c172p").
+"""The c172p in the JSBSim harness: the twentieth session's untouched aircraft, a tuning aircraft since the
+twenty-first (docs/jsbsim.md, "The c172p").
 
 The model is JSBSim's stock Cessna 172P (the jsbsim wheel's ``aircraft/c172p/c172p.xml``, FlightGear's C172P flight
 model), flown as it is: engine shut down (its propeller stops: no force), fixed gear, its pilot's point mass (180 lb
@@ -13,17 +14,16 @@ mechanism check); none of them flies the harness:
 - the FCS maps the commands straight to the surfaces (elevator -28 / +23 deg, left aileron -20 / +15 deg with the right
   its mirror, rudder +-16 deg, each x 0.01745), flaps 0; the stopped engine gives no force, and the propeller-wash
   dynamic pressure the elevator and rudder moments read is 0.5 rho u^2 on the body-axis airspeed;
-- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_b737.py``).
+- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says.
+
+The summaries' label test moves on with the untouched aircraft (twenty-first session).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
 hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
 are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the c172p: its first evaluation is the final one, after the merge.
+No pipeline fit, GP, diagnosis or scoring ran on the c172p before the twentieth session's final evaluation.
 """
-
-import json
 
 import numpy as np
 import pytest
@@ -116,32 +116,3 @@ def test_the_c172p_is_statically_stable_and_its_controls_act_as_its_xml_says():
         l3, n3, _, _ = lat(beta=4.0, alpha=a)
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.113, abs=3e-3), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0592, abs=1e-3), a
-
-
-def test_summaries_mark_the_c172p_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the c172p "(untouched)" and no other
-    aircraft, the b737, ultrastick and c172x included (synthetic rows: no c172p result exists before the final
-    evaluation). Moved here from ``test_jsbsim_b737.py`` (the nineteenth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| c172p (untouched) | light") for ln in lines)
-    for ac in acs[:16]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| c172p (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| b737 | clean |") for ln in lines)

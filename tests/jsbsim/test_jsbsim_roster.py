@@ -1,6 +1,6 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737 and the untouched c172p; docs/jsbsim.md,
-one section each),
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p and the untouched eternity;
+docs/jsbsim.md, one section each),
 parametrised over the roster.
 
 Only the harness is checked, on JSBSim's exact truth and its own properties: the names and roles,
@@ -11,15 +11,15 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched c172p's are slow too but its names', and its own
-default checks (its model, surfaces, engine, static stability, the summaries' label) are in
-``test_jsbsim_c172p.py`` (the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+default suite, as before the fold); the untouched eternity's are slow too but its names', and its own
+default checks (its model, surfaces, static stability, the summaries' label) are in
+``test_jsbsim_eternity.py`` (the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twentieth sessions). Folded in the eleventh session
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-first sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
 in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
-b737 in the nineteenth, the c172p in the twentieth.
+b737 in the nineteenth, the c172p in the twentieth, the eternity in the twenty-first.
 """
 
 from dataclasses import dataclass
@@ -312,7 +312,25 @@ CASES = (
           ("cn", 2, -0.0943, ("rel", 0.03)), ("cn", 3, 0.0058, ("rel", 0.1))),
          (), 23.0 * 0.01745, 5,
          dict(alpha=(-4.0, 11.0), beta=(10.0, 12.0), bank=(20.0, 25.0), speed=(28.0, 60.0), alt_min=300.0,
-              rate_std=1.5, rate_std_held=1.5), untouched=True),
+              rate_std=1.5, rate_std_held=1.5)),
+    # eternity (ENAC's Eternity UAV in Paparazzi's JSBSim simulator, Eternity.xml at 5399bd98, GPL-2.0-or-later; the
+    # derived Eternity_glide: motor, propeller and throttle channel removed, its elevator moment reading an alias):
+    # 0.90 kg (1.98 lb), no product of inertia, one SIDE function (Side_beta), the elevator read by Lift_elevator and
+    # the alias (Drag_elevator reads the normalised command, not counted). On the 30-s calm flight
+    # (derivative_slopes): Cm_alpha -1.76 (Pitch_alpha -0.3215 and the lift's 2-in arm; no alpha-dot in the fit: Cm_q
+    # -12.8 holds Pitch_damp -8.8 and part of Pitch_alphadot -7), Cm_delta_e -0.698 (-0.761 at the IC: the fit's
+    # alpha and delta_e share the short period); Cl_beta -0.094, Cl_p -0.4659, Cl_r 0.1345, Cl_delta_a -0.2966,
+    # Cl_delta_r -0.00166 (Roll_rudder 0.00166 x the position, delta_r = -position); Cn_beta 0.0653, Cn_r -0.0914,
+    # Cn_delta_a +0.021 (adverse), Cn_delta_r -0.043, Cn_p 0 (none in the file). Envelope limits from the pre-flown
+    # final-evaluation flights (docs/jsbsim.md, "The eternity").
+    Case("eternity", "Eternity_glide", "eternty", 1.98416, 0.0,
+         (("cm", 0, None, ("in", -2.0, -1.5)), ("cm", 2, -0.698, ("rel", 0.03)), ("cl", 3, -0.2966, ("rel", 0.01)),
+          ("cl", 0, -0.094, ("rel", 0.01)), ("cl", 1, -0.4659, ("rel", 0.01)), ("cl", 2, 0.1345, ("rel", 0.01)),
+          ("cl", 4, -0.00166, ("abs", 2e-4)), ("cn", 4, -0.043, ("rel", 0.01)), ("cn", 0, 0.0653, ("rel", 0.03)),
+          ("cn", 2, -0.0914, ("rel", 0.02)), ("cn", 3, 0.021, ("rel", 0.03)), ("cn", 1, 0.0, ("abs", 2e-3))),
+         (), 15.0 * 0.01745, 1,
+         dict(alpha=(-12.0, 8.0), beta=(10.0, 12.0), bank=(25.0, 30.0), speed=(14.0, 32.0), alt_min=1500.0,
+              rate_std=4.0, rate_std_held=4.0), min_lbf=0.05, untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -341,8 +359,8 @@ def short_flight(tmp_path_factory):
 
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
-    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the c172p
-    alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
+    """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the
+    untouched aircraft alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
     assert_names_resolve(case.name, case.model, case.typo)
@@ -353,7 +371,7 @@ def test_names_resolve_and_roles(case):
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
     used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684",
-            "ultrastick", "b737"}
+            "ultrastick", "b737", "c172p"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
@@ -485,7 +503,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [p for p in _params()
                                   if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick",
-                                                          "b737", "c172p")])
+                                                          "b737", "c172p", "eternity")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
