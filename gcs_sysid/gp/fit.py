@@ -963,7 +963,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         local_params = validated_local(local_params, params, rows.X, resid, cfg, history, search)
         history.timings["local"] = time.perf_counter() - t3
     history.timings["total"] = time.perf_counter() - t0
-    notes += [n for n in history.notes if n.startswith("gp: blocked validation")]
+    notes += [n for n in history.notes if n.startswith(("gp: blocked validation", "gp: likelihood-ratio"))]
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
                           n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var,
@@ -1062,7 +1062,34 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
             history.notes.append(f"gp: blocked validation decoupled the signal of {int(np.sum(~info['coupled']))} of "
                                  f"{len(info['coupled'])} outputs from the others (the coupling did not lower their "
                                  "blocked error)")
+    if (cfg.coupling_test == "lr" and cfg.coupling != "off" and Ys.shape[1] > 1
+            and cfg.output_groups not in ("kernels", "kernels-free", "output-kernels")):
+        params = _tested_coupling(params, stats, Xs, Ys, cfg, history)
     return params, stats
+
+
+def _tested_coupling(params: GlobalParams, stats, Xs: np.ndarray, Ys: np.ndarray, cfg: GPConfig, history: FitHistory
+                     ) -> GlobalParams:
+    """``GPConfig.coupling_test = "lr"``: :func:`gcs_sysid.gp.joint.lr_coupling` on the statistics ``stats`` of every
+    row, the statistic deflated by the long-run variance ratio of the ridge residual of ``Ys (N, P)`` on
+    ``Xs (N, D)`` (time order; the median over outputs of :func:`gcs_sysid.gp.colored.variance_inflation`), the
+    degrees of freedom at most the shared factors' rank ``cfg.rank * cfg.latent_kernels``. Records ``lr_coupled``,
+    ``lr_stat``, ``lr_share`` in ``history.validation`` and a note when an output is decoupled."""
+    from .colored import linear_residual, variance_inflation
+    from .joint import lr_coupling
+
+    t0 = time.perf_counter()
+    R = linear_residual(Xs, Ys)
+    vif = [variance_inflation(R[np.isfinite(R[:, p]), p][:, None])[0] for p in range(R.shape[1])]
+    params, info = lr_coupling(params, stats, 1.0 / float(np.median(vif)),
+                               df_max=max(1, int(cfg.rank) * int(cfg.latent_kernels)))
+    history.timings["coupling_test"] = time.perf_counter() - t0
+    history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
+    if not np.all(info["lr_coupled"]):
+        history.notes.append(f"gp: likelihood-ratio test on every row decoupled the signal of "
+                             f"{int(np.sum(~info['lr_coupled']))} of {len(info['lr_coupled'])} outputs from the others "
+                             "(the bound did not support their coupling)")
+    return params
 
 
 def validated_local(local: LocalParams, params: GlobalParams, Xs: np.ndarray, resid: np.ndarray, cfg: GPConfig,
