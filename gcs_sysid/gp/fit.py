@@ -1056,12 +1056,8 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
 
         t0 = time.perf_counter()
         params, info = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
-        history.timings["validation_coupling"] = time.perf_counter() - t0
-        history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
-        if not np.all(info["coupled"]):
-            history.notes.append(f"gp: blocked validation decoupled the signal of {int(np.sum(~info['coupled']))} of "
-                                 f"{len(info['coupled'])} outputs from the others (the coupling did not lower their "
-                                 "blocked error)")
+        _record_coupling(history, "validation_coupling", t0, info, "coupled", "blocked validation",
+                         "the coupling did not lower their blocked error")
     if (cfg.coupling_test == "lr" and cfg.coupling != "off" and Ys.shape[1] > 1
             and cfg.output_groups not in ("kernels", "kernels-free", "output-kernels")):
         params = _tested_coupling(params, stats, Xs, Ys, cfg, history)
@@ -1083,13 +1079,20 @@ def _tested_coupling(params: GlobalParams, stats, Xs: np.ndarray, Ys: np.ndarray
     vif = [variance_inflation(R[np.isfinite(R[:, p]), p][:, None])[0] for p in range(R.shape[1])]
     params, info = lr_coupling(params, stats, 1.0 / float(np.median(vif)),
                                df_max=max(1, int(cfg.rank) * int(cfg.latent_kernels)))
-    history.timings["coupling_test"] = time.perf_counter() - t0
-    history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
-    if not np.all(info["lr_coupled"]):
-        history.notes.append(f"gp: likelihood-ratio test on every row decoupled the signal of "
-                             f"{int(np.sum(~info['lr_coupled']))} of {len(info['lr_coupled'])} outputs from the others "
-                             "(the bound did not support their coupling)")
+    _record_coupling(history, "coupling_test", t0, info, "lr_coupled", "likelihood-ratio test on every row",
+                     "the bound did not support their coupling")
     return params
+
+
+def _record_coupling(history: FitHistory, timing: str, t0: float, info: dict, key: str, who: str, why: str) -> None:
+    """Record a coupling stage in ``history``: its time since ``t0`` under ``timing``, ``info``'s ``(P,)`` arrays in
+    ``validation`` and, when ``info[key]`` leaves an output uncoupled, the note ``"gp: {who} decoupled the signal of
+    n of P outputs from the others ({why})"``."""
+    history.timings[timing] = time.perf_counter() - t0
+    history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
+    if not np.all(info[key]):
+        history.notes.append(f"gp: {who} decoupled the signal of {int(np.sum(~info[key]))} of {len(info[key])} outputs "
+                             f"from the others ({why})")
 
 
 def validated_local(local: LocalParams, params: GlobalParams, Xs: np.ndarray, resid: np.ndarray, cfg: GPConfig,
