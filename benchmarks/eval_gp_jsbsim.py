@@ -39,13 +39,18 @@ with each shared factor of ``B`` on the longitudinal or the lateral outputs only
 axis (``GPConfig(output_groups="kernels")``), ``nigpf`` = the same with free loadings
 (``"kernels-free"``), ``nigpo`` = one kernel per output (``"output-kernels"``), ``nigpr`` = ``nigp`` with
 ``B`` and the noise covariance learned again on every training row (``GPConfig.coupling_rows = "all"``,
-twentieth session), and ``ls`` (cached).
+twentieth session), ``nigpt`` = ``nigp`` with the signal coupling kept only for the outputs whose coupling
+the bound on every training row supports by a deflated likelihood-ratio test (``GPConfig.coupling_test = "lr"``,
+twenty-first session), and ``ls`` (cached).
 
 For the joint variants each line also carries the output correlations (issue 8, "no learned
 output correlation above 0.5 where the truth has none"): ``corr_learned`` (``output_correlation``),
 ``latent_std`` (sqrt of ``B``'s diagonal, data units), ``noise_corr`` (``noise_correlation``),
 ``corr_model_nl`` (the model's global mean over the training rows, its part not linear in the
-regressors, correlated across outputs) and the truth's counterparts ``truth`` from
+regressors, correlated across outputs), ``corr_model_quad`` (the truth's statistic applied to the model's
+predictions: the nonlinear part of a quadratic response surface of the global mean on the measured regressors;
+the prediction correlation comparable with ``truth["signal_corr"]``; ``std_model_quad`` its std per output,
+data units) and the truth's counterparts ``truth`` from
 ``gp.joint.truth_correlation`` on the exact regressors and coefficients of the training rows
 (``signal_corr``: the nonlinear part of a quadratic response surface; ``rest_corr``: what it
 leaves, the part no function of the regressors explains); matrices flattened row-major. ``flags``
@@ -109,7 +114,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
                                 truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "ls")
+VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "ls")
 
 #: |truth correlation| below which the truth "has none" (the flags of the joint variants)
 TRUTH_NONE = 0.2
@@ -179,6 +184,8 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True, output_groups="output-kernels")
     if variant == "nigpr":        # nigp with B and the noise covariance learned again on every row (GPConfig.coupling_rows)
         return replace(base, noise_correlation=True, input_noise=True, coupling_rows="all")
+    if variant == "nigpt":        # nigp, coupling kept where the every-row bound supports it (GPConfig.coupling_test)
+        return replace(base, noise_correlation=True, input_noise=True, coupling_test="lr")
     if variant == "nigpc":
         return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
@@ -263,7 +270,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             else:
                 model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
                 model = with_offset_covariance(model, off)
-                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr"):
+                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
@@ -432,6 +439,7 @@ def _correlations(model, X, Xt, Yt) -> dict:
     gm, _ = model.predict_global(X, include_noise=False)
     model_nl, _ = correlation(nonlinear_part(X, gm))
     truth = truth_correlation(Xt, Yt)
+    quad = truth_correlation(X, gm)       # the truth's statistic on the model's predictions (measured regressors)
     learned = model.output_correlation()
     P = learned.shape[0]
     flags = [(i, j) for i in range(P) for j in range(i + 1, P)
@@ -442,7 +450,9 @@ def _correlations(model, X, Xt, Yt) -> dict:
     r = lambda a: [float(f"{x:.4g}") for x in np.ravel(a)]  # noqa: E731   (flattened, 4 significant digits)
     return {"corr_learned": r(learned), "latent_std": r(latent * model.scaler.y_std),
             "noise_corr": r(model.noise_correlation()), "noise_std": r(noise * model.scaler.y_std),
-            "corr_model_nl": r(model_nl), "truth": {k: r(v) for k, v in truth.items()},
+            "corr_model_nl": r(model_nl), "corr_model_quad": r(quad["signal_corr"]),
+            "std_model_quad": r(quad["signal_std"]),
+            "truth": {k: r(v) for k, v in truth.items()},
             "flags": [name(i, j) for i, j in flags],
             "flags_carrying": [name(i, j) for i, j in flags if carries[i] and carries[j]]}
 
@@ -515,7 +525,7 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("nigpt", "nigp"), ("nigpt", "indep"), ("nigpt", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]

@@ -117,6 +117,17 @@ class GPConfig:
             correlation was 0.28-0.69 over the subset's seed, 0.25 with every row (the truth's 0.26;
             ``docs/gp.md``, "Coupling from every row"). Complete rows, one kernel, no per-group kernels
             (otherwise ignored).
+        coupling_test: ``"none"`` (the default): ``B``'s off-diagonals are kept as learned (and as the coupling gate
+            left them); ``"lr"`` (opt-in, twenty-first session): after the blocked validation's latent scales, an
+            output keeps its signal coupling to the others only where the collapsed bound on the statistics of
+            *every* training row supports it by a likelihood-ratio test, the statistic deflated for the rows'
+            colour (one over the training residual's long-run variance ratio,
+            :func:`gcs_sysid.gp.colored.variance_inflation`); backward elimination of outputs at level
+            :data:`gcs_sysid.gp.joint.LR_LEVEL` (:func:`gcs_sysid.gp.joint.lr_coupling`). The noise covariance is
+            kept. Why: an off-diagonal the data do not determine (the b737's Cl-Cm 0.28-0.69 over the subset's
+            seed; a latent part the validation shrank to ~0) is reported by ``output_correlation()`` at full size
+            (``docs/gp.md``, "Coupling the data determine"). Costs ``O(P^2)`` bound evaluations on the
+            statistics the posterior uses anyway. Not with the per-group kernels of ``output_groups``.
         input_noise: learn one input-noise variance per regressor (errors in variables, NIGP)
             and add ``grad m^T Sigma_x grad m`` to the predictive variance at estimated
             regressors (``docs/gp.md``, "Noisy inputs").
@@ -237,6 +248,7 @@ class GPConfig:
     hyper_stride: int = 1
     coupling: str = "learned"
     coupling_rows: str = "subset"
+    coupling_test: str = "none"
     input_noise: bool = True
     residual_correlation: bool = False
     validation_folds: int = 5
@@ -292,6 +304,8 @@ class GPConfig:
                              "or output_groups='kernels-free'")
         if self.coupling_rows not in ("subset", "all"):
             raise InputError(f"GPConfig.coupling_rows must be 'subset' or 'all', got {self.coupling_rows!r}")
+        if self.coupling_test not in ("none", "lr"):
+            raise InputError(f"GPConfig.coupling_test must be 'none' or 'lr', got {self.coupling_test!r}")
         if self.noise_start not in ("signal", "noise"):
             raise InputError(f"GPConfig.noise_start must be 'signal' or 'noise', got {self.noise_start!r}")
         if self.inducing not in ("mi", "kmeans", "random"):

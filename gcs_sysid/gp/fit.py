@@ -963,7 +963,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         local_params = validated_local(local_params, params, rows.X, resid, cfg, history, search)
         history.timings["local"] = time.perf_counter() - t3
     history.timings["total"] = time.perf_counter() - t0
-    notes += [n for n in history.notes if n.startswith("gp: blocked validation")]
+    notes += [n for n in history.notes if n.startswith(("gp: blocked validation", "gp: likelihood-ratio"))]
     history.notes = list(notes)
     model = LocalGlobalGP(cfg, scaler, params, stats, post, local_params, store, input_names, output_names,
                           n_hyper=n_hyper, notes=tuple(notes), rows=rows, evicted=evicted, input_var=input_var,
@@ -1056,13 +1056,43 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
 
         t0 = time.perf_counter()
         params, info = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
-        history.timings["validation_coupling"] = time.perf_counter() - t0
-        history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
-        if not np.all(info["coupled"]):
-            history.notes.append(f"gp: blocked validation decoupled the signal of {int(np.sum(~info['coupled']))} of "
-                                 f"{len(info['coupled'])} outputs from the others (the coupling did not lower their "
-                                 "blocked error)")
+        _record_coupling(history, "validation_coupling", t0, info, "coupled", "blocked validation",
+                         "the coupling did not lower their blocked error")
+    if (cfg.coupling_test == "lr" and cfg.coupling != "off" and Ys.shape[1] > 1
+            and cfg.output_groups not in ("kernels", "kernels-free", "output-kernels")):
+        params = _tested_coupling(params, stats, Xs, Ys, cfg, history)
     return params, stats
+
+
+def _tested_coupling(params: GlobalParams, stats, Xs: np.ndarray, Ys: np.ndarray, cfg: GPConfig, history: FitHistory
+                     ) -> GlobalParams:
+    """``GPConfig.coupling_test = "lr"``: :func:`gcs_sysid.gp.joint.lr_coupling` on the statistics ``stats`` of every
+    row, the statistic deflated by the long-run variance ratio of the ridge residual of ``Ys (N, P)`` on
+    ``Xs (N, D)`` (time order; the median over outputs of :func:`gcs_sysid.gp.colored.variance_inflation`), the
+    degrees of freedom at most the shared factors' rank ``cfg.rank * cfg.latent_kernels``. Records ``lr_coupled``,
+    ``lr_stat``, ``lr_share`` in ``history.validation`` and a note when an output is decoupled."""
+    from .colored import linear_residual, variance_inflation
+    from .joint import lr_coupling
+
+    t0 = time.perf_counter()
+    R = linear_residual(Xs, Ys)
+    vif = [variance_inflation(R[np.isfinite(R[:, p]), p][:, None])[0] for p in range(R.shape[1])]
+    params, info = lr_coupling(params, stats, 1.0 / float(np.median(vif)),
+                               df_max=max(1, int(cfg.rank) * int(cfg.latent_kernels)))
+    _record_coupling(history, "coupling_test", t0, info, "lr_coupled", "likelihood-ratio test on every row",
+                     "the bound did not support their coupling")
+    return params
+
+
+def _record_coupling(history: FitHistory, timing: str, t0: float, info: dict, key: str, who: str, why: str) -> None:
+    """Record a coupling stage in ``history``: its time since ``t0`` under ``timing``, ``info``'s ``(P,)`` arrays in
+    ``validation`` and, when ``info[key]`` leaves an output uncoupled, the note ``"gp: {who} decoupled the signal of
+    n of P outputs from the others ({why})"``."""
+    history.timings[timing] = time.perf_counter() - t0
+    history.validation.update({k: [v.item() for v in a] for k, a in info.items()})
+    if not np.all(info[key]):
+        history.notes.append(f"gp: {who} decoupled the signal of {int(np.sum(~info[key]))} of {len(info[key])} outputs "
+                             f"from the others ({why})")
 
 
 def validated_local(local: LocalParams, params: GlobalParams, Xs: np.ndarray, resid: np.ndarray, cfg: GPConfig,
