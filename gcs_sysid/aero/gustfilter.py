@@ -305,7 +305,7 @@ def stated_moment_variance(states, airframe, qbar: np.ndarray, rows: np.ndarray)
 
 
 
-def filter_gust_table(table, states, airframe, train: np.ndarray):
+def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = "2sls"):
     """The table with the training rows' ``p_hat`` less the smoothed rolling gust (:func:`fit_roll_gust`).
 
     Only the rows the fit used change and only their roll moments are used; every other row keeps the gyro's
@@ -319,6 +319,9 @@ def filter_gust_table(table, states, airframe, train: np.ndarray):
             :func:`stated_moment_variance`).
         airframe: span, area and inertia.
         train: ``(T,)`` bool training rows.
+        method: ``"2sls"`` (:func:`fit_roll_gust`: the measured Cl as the output, two-stage least squares) or
+            ``"roll"`` (:func:`gcs_sysid.aero.rollgust.fit_roll_dynamics`: the gust a state of the roll dynamics,
+            the slopes and the gust estimated together from the causal step moment; needs the states' ``p``).
 
     Returns:
         ``(table, RollGustFit | None)``: a new table (the input is not changed), or the input with a note saying
@@ -331,6 +334,20 @@ def filter_gust_table(table, states, airframe, train: np.ndarray):
         return replace(table, notes=list(table.notes) + ["gust filter not run: fewer than 3 rows"]), None
     dt = float(np.median(np.diff(table.t)))
     rows = np.asarray(train, bool) & table.valid
+    if method not in ("2sls", "roll"):
+        raise ValueError(f"filter_gust_table: method must be '2sls' or 'roll', got {method!r}")
+    if method == "roll":
+        from .rollgust import fit_roll_dynamics
+
+        d = getattr(states, "data", {})
+        if "p" not in d or len(d["p"]) != T:
+            return replace(table, notes=list(table.notes) + ["gust filter not run: no p on the table's grid"]), None
+        try:
+            G = fit_roll_dynamics(dt, table.X, table.Y, d["p"], table.qbar, rows, airframe.Ixx, airframe.S,
+                                  airframe.b)
+        except ValueError as e:
+            return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
+        return _take_out(table, G), G
     Rs = stated_moment_variance(states, airframe, table.qbar, rows)
     if Rs is None:
         return replace(table, notes=list(table.notes) + ["gust filter not run: no stated p_dot r_dot noise"]), None
@@ -338,10 +355,18 @@ def filter_gust_table(table, states, airframe, train: np.ndarray):
         G = fit_roll_gust(dt, table.X, table.Y, rows, R=float(Rs[0]))
     except ValueError as e:
         return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
+    return _take_out(table, G), G
+
+
+def _take_out(table, G: RollGustFit):
+    """The table with ``G.g`` taken out of ``p_hat`` and ``G.g_var`` added to its ``x_var`` (a new table)."""
+    from dataclasses import replace
+
+    T = len(table.t)
     j = REGRESSORS.index("p_hat")
     X = table.X.copy()
     X[:, j] -= G.g
     xv = np.full((T, len(REGRESSORS)), np.nan) if table.x_var is None else table.x_var.copy()
     xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + G.g_var
     note = G.notes[0] + " (taken out of p_hat on the training rows)"
-    return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), G
+    return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note])
