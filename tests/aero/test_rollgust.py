@@ -21,7 +21,7 @@ CLP, CLB, CLDA = -0.5, -0.1, -0.25
 SIG_PG = 0.08                      # rad/s, the rolling gust's SD
 
 
-def _record(n=5000, seed=0):
+def _record(n=5000, seed=0, gust_in_moment=True):
     """``(X, Y, p, g)``: regressors with the gyro's hats, the measured Cl, the rate on the grid and the true
     ``p_hat_g``."""
     rng = np.random.default_rng(seed)
@@ -30,13 +30,14 @@ def _record(n=5000, seed=0):
     m, d = n * SUB, DT / SUB
     a = np.exp(-d / tau)
     pg = lfilter([np.sqrt(1 - a * a) * SIG_PG], [1, -a], rng.normal(size=m))
+    pm = pg if gust_in_moment else np.zeros(m)   # JSBSim's pa28: the moment reads the gyro's rate
     da = np.repeat(rng.normal(0, 0.05, m // (40 * SUB) + 1), 40 * SUB)[:m]
     al = np.exp(-d / 1.5)
     beta = lfilter([1 - al], [1, -al], rng.normal(0, 0.3, m))
     p = np.zeros(m)
     pdot = np.zeros(m)
     for i in range(m):
-        pdot[i] = k * (CLB * beta[i] + CLP * h * (p[i] - pg[i]) + CLDA * da[i])
+        pdot[i] = k * (CLB * beta[i] + CLP * h * (p[i] - pm[i]) + CLDA * da[i])
         if i + 1 < m:
             p[i + 1] = p[i] + d * pdot[i]
     j = np.arange(0, m, SUB)
@@ -82,3 +83,30 @@ def test_rejects_bad_input():
         rg.fit_roll_dynamics(DT, X, Y, p, q, np.zeros(len(X), bool), IXX, S, B)
     with pytest.raises(ValueError, match="expected"):
         rg.fit_roll_dynamics(DT, X[:, :5], Y, p, q, np.ones(len(X), bool), IXX, S, B)
+
+
+def test_roll_filter_applied_only_where_the_moment_reads_the_gust():
+    """``filter_gust_table(method="roll")`` takes the gust out of the training rows' ``p_hat`` when its fitted SD
+    is near MIL-F-8785C's Dryden one from the wind (a wind scaled so that it is the simulated gust's: 0.80-0.90 on
+    seeds 0-2), and leaves the table alone, saying why, when the moment does not read the gust (0.00)."""
+    from types import SimpleNamespace
+
+    from gcs_sysid.aero.gustfilter import ROLL_MIN_DRYDEN_RATIO, filter_gust_table
+    from gcs_sysid.aero.table import CoefficientTable
+    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
+
+    rng = np.random.default_rng(7)
+    wind = np.c_[np.cumsum(rng.normal(size=(5000, 2)), 0), np.zeros(5000)]
+    unit = dryden_rate_sigma(gust_intensity(DT, wind, np.full(5000, V)), B)[0] * B / (2 * V)
+    air = SimpleNamespace(Ixx=IXX, S=S, b=B)
+    out = []
+    for reads in (True, False):
+        X, Y, p, g = _record(gust_in_moment=reads)
+        w = wind * np.std(g) / unit
+        tab = CoefficientTable(np.arange(len(X)) * DT, X, Y, np.ones(len(X), bool), np.full(len(X), QBAR))
+        st = SimpleNamespace(data={"p": p, "wn": w[:, 0], "we": w[:, 1], "wd": w[:, 2]})
+        out.append(filter_gust_table(tab, st, air, np.ones(len(X), bool), method="roll") + (tab,))
+    (t1, G1, tab1), (t2, G2, tab2) = out
+    assert G1 is not None and not np.allclose(t1.X[:, REGRESSORS.index("p_hat")], tab1.X[:, REGRESSORS.index("p_hat")])
+    assert G2 is None and np.array_equal(t2.X, tab2.X)
+    assert "not applied" in t2.notes[-1] and f"at least {ROLL_MIN_DRYDEN_RATIO}" in t2.notes[-1]
