@@ -178,7 +178,7 @@ def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
-             gust_rates: str | None = None, gust_filter: bool | None = None) -> dict:
+             gust_rates: str | None = None, gust_filter: bool | str | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
@@ -387,9 +387,11 @@ def main(argv=None) -> int:
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
-    ap.add_argument("--gust-filter", default=None, choices=("on", "off"),
-                    help="train the GP on p_hat less the filter-error p_g (ReplayOptions.gust_filter; default: the "
-                         "replay's default, gcs_sysid.aero.gustfilter.GUST_FILTER)")
+    ap.add_argument("--gust-filter", default=None, choices=("on", "off", "roll"),
+                    help="train the GP on p_hat less the filter-error p_g (ReplayOptions.gust_filter; 'on': the "
+                         "measured Cl as output, 2SLS slopes; 'roll': p_g a state of the roll dynamics, "
+                         "gcs_sysid.aero.rollgust; default: the replay's default, "
+                         "gcs_sysid.aero.gustfilter.GUST_FILTER)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated"),
@@ -461,7 +463,8 @@ def main(argv=None) -> int:
         for turb in a.turbulence:
             for seed in a.seeds:
                 row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates,
-                               None if a.gust_filter is None else a.gust_filter == "on")
+                               None if a.gust_filter is None else
+                               {"on": True, "off": False, "roll": "roll"}[a.gust_filter])
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"

@@ -71,7 +71,9 @@ class ReplayOptions:
         gust_filter: train the GP on ``p_hat`` less the rotational gust ``p_g`` smoothed from the training rows'
             own measured Cl (the filter-error method, :func:`gcs_sysid.aero.gustfilter.filter_gust_table`);
             the held-out rows keep the gyro's hats (``p_g = 0``, its prior mean, with the prior variance stated in
-            the band). None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
+            the band). True or ``"2sls"``: the measured Cl as the filter's output, slopes by two-stage least
+            squares; ``"roll"``: the gust a state of the roll dynamics, estimated with the slopes from the causal
+            step moment (:mod:`gcs_sysid.aero.rollgust`). None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
     """
 
     rate_hz: float = 50.0
@@ -89,7 +91,7 @@ class ReplayOptions:
     can_offset: float | None = None
     gust_rates: str | None = None
     alpha_dot_hat: bool = True
-    gust_filter: bool | None = None
+    gust_filter: bool | str | None = None
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
@@ -357,9 +359,11 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         train = table.valid & ~held
         from .aero.gustfilter import GUST_FILTER, filter_gust_table
 
-        if GUST_FILTER if options.gust_filter is None else options.gust_filter:
+        gust_filter = GUST_FILTER if options.gust_filter is None else options.gust_filter
+        if gust_filter:
             with _stage("gust filter", timings, bar):
-                table = filter_gust_table(table, states, airframe, train)[0]
+                table = filter_gust_table(table, states, airframe, train,
+                                          method=gust_filter if isinstance(gust_filter, str) else "2sls")[0]
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]

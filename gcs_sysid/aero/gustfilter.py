@@ -43,12 +43,18 @@ import numpy as np
 
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["GUST_FILTER", "INSTRUMENT_DELAYS_S", "LAT_TERMS", "RollGustFit", "fit_roll_gust", "instruments",
+__all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "INSTRUMENT_DELAYS_S", "LAT_TERMS", "RollGustFit", "fit_roll_gust",
+           "instruments",
            "stated_moment_variance", "filter_gust_table"]
 
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
 #: less the filter-error rolling gust.
 GUST_FILTER = False
+#: ``method="roll"`` applies the fitted gust only when its SD is at least this fraction of the Dryden rolling gust
+#: expected from the reconstructed wind: JSBSim's pa28, whose roll damping reads the gyro's rate (no gust in its
+#: moment), fits 0.1 of it; the aircraft whose moment reads ``p - p_g`` fit 0.4-0.7 (the fit states about half the
+#: true SD, its ``R`` at the bound); twenty-first session, i8-rollfe.
+ROLL_MIN_DRYDEN_RATIO = 0.25
 #: The lateral linear model's regressors (an intercept first).
 LAT_TERMS = ("alpha", "beta", "p_hat", "r_hat", "delta_a", "delta_r")
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
@@ -305,7 +311,7 @@ def stated_moment_variance(states, airframe, qbar: np.ndarray, rows: np.ndarray)
 
 
 
-def filter_gust_table(table, states, airframe, train: np.ndarray):
+def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = "2sls"):
     """The table with the training rows' ``p_hat`` less the smoothed rolling gust (:func:`fit_roll_gust`).
 
     Only the rows the fit used change and only their roll moments are used; every other row keeps the gyro's
@@ -319,6 +325,9 @@ def filter_gust_table(table, states, airframe, train: np.ndarray):
             :func:`stated_moment_variance`).
         airframe: span, area and inertia.
         train: ``(T,)`` bool training rows.
+        method: ``"2sls"`` (:func:`fit_roll_gust`: the measured Cl as the output, two-stage least squares) or
+            ``"roll"`` (:func:`gcs_sysid.aero.rollgust.fit_roll_dynamics`: the gust a state of the roll dynamics,
+            the slopes and the gust estimated together from the causal step moment; needs the states' ``p``).
 
     Returns:
         ``(table, RollGustFit | None)``: a new table (the input is not changed), or the input with a note saying
@@ -331,6 +340,26 @@ def filter_gust_table(table, states, airframe, train: np.ndarray):
         return replace(table, notes=list(table.notes) + ["gust filter not run: fewer than 3 rows"]), None
     dt = float(np.median(np.diff(table.t)))
     rows = np.asarray(train, bool) & table.valid
+    if method not in ("2sls", "roll"):
+        raise ValueError(f"filter_gust_table: method must be '2sls' or 'roll', got {method!r}")
+    if method == "roll":
+        from .rollgust import fit_roll_dynamics
+
+        d = getattr(states, "data", {})
+        if "p" not in d or len(d["p"]) != T:
+            return replace(table, notes=list(table.notes) + ["gust filter not run: no p on the table's grid"]), None
+        try:
+            G = fit_roll_dynamics(dt, table.X, table.Y, d["p"], table.qbar, rows, airframe.Ixx, airframe.S,
+                                  airframe.b)
+        except ValueError as e:
+            return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
+        ratio = _dryden_ratio(G, d, table, dt, airframe.b)
+        if not ratio >= ROLL_MIN_DRYDEN_RATIO:
+            why = (f"gust filter not applied: the fitted rolling gust's SD is {ratio:.2f} of MIL-F-8785C's "
+                   f"1.9 sigma/sqrt(L b) from the reconstructed wind (at least {ROLL_MIN_DRYDEN_RATIO} needed: "
+                   "the roll moment does not read the gust); " + G.notes[0])
+            return replace(table, notes=list(table.notes) + [why]), None
+        return _take_out(table, G, f"; its SD {ratio:.2f} of the Dryden one from the wind"), G
     Rs = stated_moment_variance(states, airframe, table.qbar, rows)
     if Rs is None:
         return replace(table, notes=list(table.notes) + ["gust filter not run: no stated p_dot r_dot noise"]), None
@@ -338,10 +367,36 @@ def filter_gust_table(table, states, airframe, train: np.ndarray):
         G = fit_roll_gust(dt, table.X, table.Y, rows, R=float(Rs[0]))
     except ValueError as e:
         return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
+    return _take_out(table, G), G
+
+
+def _dryden_ratio(G: RollGustFit, data: dict, table, dt: float, b: float) -> float:
+    """The fitted ``p_hat_g`` SD over the Dryden one expected from the reconstructed wind on the rows used
+    (:func:`gcs_sysid.estimation.gustrates.gust_intensity`, :func:`~gcs_sysid.estimation.gustrates.dryden_rate_sigma`,
+    ``sigma_p b/(2V)``); NaN without the wind."""
+    from ..estimation.gustrates import dryden_rate_sigma, gust_intensity
+
+    if not all(k in data for k in ("wn", "we", "wd")):
+        return float("nan")
+    V = table.X[:, REGRESSORS.index("V")]
+    u = G.used
+    try:
+        sig = gust_intensity(dt, np.stack([data["wn"], data["we"], data["wd"]], 1)[u], V[u])
+        exp_g = dryden_rate_sigma(sig, b)[0] * b / (2 * float(np.mean(V[u])))
+    except ValueError:
+        return float("nan")
+    return float(G.sigma / exp_g) if exp_g > 0 else float("nan")
+
+
+def _take_out(table, G: RollGustFit, extra: str = ""):
+    """The table with ``G.g`` taken out of ``p_hat`` and ``G.g_var`` added to its ``x_var`` (a new table)."""
+    from dataclasses import replace
+
+    T = len(table.t)
     j = REGRESSORS.index("p_hat")
     X = table.X.copy()
     X[:, j] -= G.g
     xv = np.full((T, len(REGRESSORS)), np.nan) if table.x_var is None else table.x_var.copy()
     xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + G.g_var
-    note = G.notes[0] + " (taken out of p_hat on the training rows)"
-    return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), G
+    note = G.notes[0] + extra + " (taken out of p_hat on the training rows)"
+    return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note])

@@ -1,0 +1,208 @@
+"""The rolling gust as a state of the roll dynamics: filter-error estimate of ``Cl``'s slopes and ``p_g`` together.
+
+JSBSim's aerodynamics (and the air's) read the body's roll rate relative to the air, ``p - p_g``
+(``FGAuxiliary``: ``vAeroPQR = vPQR - TurbPQR``); a gyro measures ``p``. The gust drives the roll response, so the
+gyro's ``p`` is correlated with the ``Cl_p p_g`` term a regression of the measured ``Cl`` leaves in its residual:
+least squares attenuates ``Cl_p``, ``Cl_delta_a`` and ``Cl_beta`` (c172p ``Cl_p`` -0.22 against JSBSim's -0.49,
+``docs/benchmarks.md``, "Twentieth session, i8-roll").
+
+Roll equation (Stevens, Lewis and Johnson, *Aircraft Control and Simulation*, 3rd ed., 2016, eq. 1.7-18), with
+the gust as a state (the filter-error method: Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA
+2015, ch. 5, process noise entering the state equation; Morelli and Klein, *Aircraft System Identification*, 2nd
+ed., 2016, ch. 6-7)::
+
+    Ixx p_dot - Ixz (r_dot + p q) + (Izz - Iyy) q r = qbar S b Cl(beta, (p - p_g) b/(2V), r_hat, delta_a, delta_r)
+    d p_g/dt = -p_g / tau + white,   tau = 4 b / (pi V)        (MIL-F-8785C sec. 3.7.2; MIL-HDBK-1797)
+
+``p`` is a state that the gyro measures, not a regressor: the model pairs the moment over one grid step
+``[k, k+1]`` with the rate ``p_k`` the step starts from, which the gust's innovations inside the step have not
+reached yet. The pipeline's ``Cl`` takes ``p_dot`` from a smoother consistent with its rate (a central, non-causal
+derivative); advanced by half a step (``+ Ixx dt/2 p_ddot / (qbar S b)``, :func:`causal_roll_moment`) it is the
+step's moment. Paired at the same instant, the gyro's ``p`` answers the gust's innovation within the step and the
+innovations' likelihood attenuates ``Cl_p`` (the seventeenth session's finding for :mod:`gcs_sysid.aero.gustfilter`,
+``docs/benchmarks.md``, "Seventeenth session, i8-fe2"; c172p light s1 here: -0.31 paired at the instant, -0.38
+with the step's moment, JSBSim -0.49).
+
+The gust term enters the output as a first-order Gauss-Markov process ``s = -Cl_p p_hat_g`` (Cl units), so the
+model of the step's roll moment is linear in the slopes::
+
+    Cl_k+1/2 = theta . x_k + s_k + e_k,   s_k+1 = a s_k + w_k,   a = exp(-dt/tau),  var w = sigma^2 (1 - a^2)
+
+with ``x = (1, alpha, beta, p_hat, r_hat, delta_a, delta_r)`` at ``k``. For given ``(sigma, R)`` the slopes are
+generalised least squares through the steady-state Kalman filter's innovations of the moment and of each column of
+``x`` (the concentrated likelihood; Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*, 1989,
+sec. 3.4); ``sigma`` and ``R`` maximise it (Nelder-Mead; ``R`` goes to its lower bound on JSBSim's flights, as in
+:mod:`~gcs_sysid.aero.gustfilter`: the smoothed moment has no white floor, and ``sigma`` comes out at about half
+the truth's). The step integrates the rate's own damping, ``(e^{L_p dt} - 1)/(L_p dt)`` (``L_p = qbar S b Cl_p
+b/(2 V Ixx)``), which is divided out of the slopes afterwards. ``p_g`` is the Rauch-Tung-Striebel smoothed ``s``
+over ``-Cl_p``.
+
+On the pipeline's own data of JSBSim flights, light turbulence, seed 1 (``docs/benchmarks.md``, "Twenty-first
+session, i8-rollfe"): ``Cl_p`` c172p -0.22 (least squares) -> -0.38 (JSBSim -0.49), c172x -0.30 -> -0.46 (-0.47),
+j3cub -0.15 -> -0.49 (-0.52); ``Cl_delta_a`` -0.14 -> -0.21 (-0.23), -0.17 -> -0.23 (-0.23), -0.13 -> -0.33 (-0.35);
+``corr(p_g_hat, p_g)`` 0.92-0.96. Not better everywhere: on the b737 (gust term 29 % of Cl, large sideslip) ``Cl_p``
+and ``Cl_beta`` move away from JSBSim's; where the moment does not read the gust (JSBSim's pa28) the state takes up
+coloured error and ``Cl_p`` overshoots by 27 %, which is why :func:`gcs_sysid.aero.gustfilter.filter_gust_table`
+applies the fit only when its SD is near the Dryden one expected from the wind.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .gustfilter import LAT_TERMS, RollGustFit, _gains, _innovations, _segments, _smooth
+from .table import COEFFICIENTS, REGRESSORS
+
+__all__ = ["ROLL_TAU", "RollDynamicsFit", "dryden_roll_tau", "causal_roll_moment", "fit_roll_dynamics"]
+
+_IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
+_MIN_ROWS, _MIN_RUN = 200, 50
+#: The gust's correlation time: ``"dryden"`` (``4 b/(pi V)``, MIL-F-8785C) or ``"fit"`` (a third likelihood
+#: parameter; on JSBSim's flights it runs to 1-13 s where the slopes leave slow residue and the proxy true-air Cl
+#: gets worse, c172x s1 15 -> 72 %).
+ROLL_TAU = "dryden"
+
+
+@dataclass(frozen=True)
+class RollDynamicsFit(RollGustFit):
+    """:class:`~gcs_sysid.aero.gustfilter.RollGustFit` (``theta`` the filter-error slopes, ``theta0`` least squares
+    of the pipeline's ``Cl`` on the gyro's hats) plus the roll damping ``L_p`` (1/s) the step correction used."""
+
+    L_p: float = float("nan")
+
+
+def dryden_roll_tau(b: float, V: float) -> float:
+    """The Dryden rolling gust's time constant ``4 b/(pi V)``, s (MIL-F-8785C sec. 3.7.2, the ``p_g`` filter's
+    break frequency ``pi V/(4 b)``).
+
+    Raises:
+        ValueError: ``b`` or ``V`` not positive.
+    """
+    if not (b > 0 and V > 0):
+        raise ValueError(f"dryden_roll_tau: span and airspeed must be positive, got b={b}, V={V}")
+    return 4.0 * b / (np.pi * V)
+
+
+def causal_roll_moment(dt: float, Cl: np.ndarray, p: np.ndarray, qbar: np.ndarray, Ixx: float, S: float,
+                       b: float) -> np.ndarray:
+    """``(T,)`` the rolling-moment coefficient over each step ``[k, k+1]``: the measured ``Cl`` with its ``Ixx p_dot``
+    term advanced half a step, ``+ Ixx ((p_k+1 - p_k)/dt - (p_k+1 - p_k-1)/(2 dt)) / (qbar S b)`` (the forward
+    difference less the central one, ``dt/2 p_ddot``); NaN in the first and last rows.
+
+    Args:
+        dt: grid interval, s. Cl: ``(T,)`` the pipeline's measured Cl. p: ``(T,)`` the smoothed roll rate, rad/s.
+        qbar: ``(T,)`` Pa. Ixx: kg m^2. S: m^2. b: m.
+    """
+    p = np.asarray(p, float)
+    adv = np.full(len(p), np.nan)
+    adv[1:-1] = (p[2:] - 2 * p[1:-1] + p[:-2]) / (2 * dt)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.asarray(Cl, float) + Ixx * adv / (np.asarray(qbar, float) * S * b)
+
+
+def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
+                      rows: np.ndarray, Ixx: float, S: float, b: float, tau: str = ROLL_TAU,
+                      max_fev: int = 400) -> RollDynamicsFit:
+    """Filter-error slopes of the lateral ``Cl`` and the smoothed rolling gust (module docstring).
+
+    Args:
+        dt: grid interval, s.
+        X: ``(T, 10)`` regressors (:data:`~gcs_sysid.aero.table.REGRESSORS`, gyro hats).
+        Y: ``(T, 6)`` measured coefficients (:data:`~gcs_sysid.aero.table.COEFFICIENTS`; Cl used).
+        p: ``(T,)`` the smoothed roll rate, rad/s.
+        qbar: ``(T,)`` dynamic pressure, Pa.
+        rows: ``(T,)`` bool, the rows whose roll moment may be used (never a held-out segment).
+        Ixx, S, b: kg m^2, m^2, m.
+        tau: ``"dryden"`` (``4 b/(pi V)`` at the rows' mean airspeed) or ``"fit"``.
+        max_fev: Nelder-Mead's likelihood evaluations at most.
+
+    Returns:
+        :class:`RollDynamicsFit`; ``g`` (``p_hat_g``) is 0 with the prior variance outside the rows used.
+
+    Raises:
+        ValueError: shapes that disagree, ``dt`` not positive, fewer than 200 usable rows in runs of at least 50,
+            an unknown ``tau``, or a roll damping ``Cl_p`` that is not negative.
+    """
+    from scipy.optimize import minimize
+
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
+    T = len(X)
+    shapes = [np.shape(v) for v in (p, qbar, rows)]
+    if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or any(s != (T,) for s in shapes):
+        raise ValueError(f"fit_roll_dynamics: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}) and p, p_dot, "
+                         f"qbar, rows (T,) expected, got {X.shape}, {Y.shape}, {shapes}")
+    if not dt > 0:
+        raise ValueError(f"fit_roll_dynamics: dt must be positive, got {dt}")
+    if tau not in ("dryden", "fit"):
+        raise ValueError(f"fit_roll_dynamics: tau must be 'dryden' or 'fit', got {tau!r}")
+    cols = [REGRESSORS.index(k) for k in LAT_TERMS]
+    A0 = np.c_[np.ones(T), X[:, cols]]
+    A = A0.copy()                                    # at k: the state the step starts from, the inputs it holds
+    A[-1] = np.nan
+    y = causal_roll_moment(dt, Y[:, COEFFICIENTS.index("Cl")], p, qbar, Ixx, S, b)
+    r = np.asarray(rows, bool)
+    use = r & np.r_[r[1:], False] & np.r_[False, r[:-1]] & np.isfinite(A).all(1) & np.isfinite(y)
+    segs = _segments(use, _MIN_RUN)
+    used = np.zeros(T, bool)
+    for s0, s1 in segs:
+        used[s0:s1] = True
+    if used.sum() < _MIN_ROWS:
+        raise ValueError(f"fit_roll_dynamics: {int(use.sum())} usable rows, at least {_MIN_ROWS} in runs of "
+                         f"{_MIN_RUN} needed")
+    Cl = Y[:, COEFFICIENTS.index("Cl")]
+    ok0 = used & np.isfinite(Cl)
+    theta0 = np.linalg.lstsq(A0[ok0], Cl[ok0], rcond=None)[0]
+    Vbar = float(np.mean(X[used, REGRESSORS.index("V")]))
+    tau_d = dryden_roll_tau(b, Vbar)
+    M = np.where(used[:, None], np.c_[y, A], 0.0)
+    th_ls = np.linalg.lstsq(M[used, 1:], M[used, 0], rcond=None)[0]
+    zv = float(np.var(M[used, 0] - M[used, 1:] @ th_ls))
+    n_used = int(used.sum())
+
+    def nll(v):
+        sig, R = np.exp(v[0]), np.exp(v[1])
+        tau_ = float(np.exp(v[2])) if tau == "fit" else tau_d
+        a = float(np.exp(-dt / tau_))
+        ss = _gains(a, sig * sig, 1.0, R)
+        if not (np.isfinite(ss.S) and ss.S > 0):
+            return np.inf, None, a, ss
+        E = _innovations(M, a, ss, 1.0, segs)         # GLS: every column through the same steady-state filter
+        th = np.linalg.lstsq(E[:, 1:], E[:, 0], rcond=None)[0]
+        nu = E[:, 0] - E[:, 1:] @ th
+        return 0.5 * float(nu @ nu) / ss.S + 0.5 * len(nu) * np.log(2 * np.pi * ss.S), th, a, ss
+
+    v0 = [0.5 * np.log(0.5 * zv), np.log(0.5 * zv)] + ([np.log(tau_d)] if tau == "fit" else [])
+    span = max(s1 - s0 for s0, s1 in segs) * dt
+    bounds = [(v0[0] + 0.5 * np.log(1e-8), v0[0] + 0.5 * np.log(1e4)), (np.log(1e-10 * zv), np.log(zv))]
+    if tau == "fit":
+        bounds.append((np.log(dt), np.log(span)))
+    opt = minimize(lambda v: nll(v)[0], v0, method="Nelder-Mead", bounds=bounds,
+                   options={"maxfev": max_fev, "xatol": 1e-3, "fatol": 1e-2})
+    f, th, a, ss = nll(opt.x)
+    if th is None or not th[_IP] < 0:
+        raise ValueError("fit_roll_dynamics: no likelihood optimum with a negative roll damping Cl_p")
+    sig, R = float(np.exp(opt.x[0])), float(np.exp(opt.x[1]))
+    tau_ = float(np.exp(opt.x[2])) if tau == "fit" else tau_d
+    # divide the step's integration of the damping out: y = (e^{Lp dt} - 1)/(Lp dt) (Lp p + forcing)
+    k_h = float(np.mean(np.asarray(qbar, float)[used] * S * b / Ixx * b / (2 * X[used, REGRESSORS.index("V")])))
+    Lf = k_h * th[_IP]
+    if not 1 + Lf * dt > 0:
+        raise ValueError(f"fit_roll_dynamics: roll damping {Lf:.1f} 1/s too fast for the step {dt} s")
+    Lp = float(np.log1p(Lf * dt) / dt)
+    theta = th * (Lp * dt) / np.expm1(Lp * dt)
+    s = np.zeros(T)
+    for s0, s1 in segs:
+        s[s0:s1] = _smooth(M[s0:s1, 0] - M[s0:s1, 1:] @ th, a, ss, 1.0)
+    g = np.where(used, -s / th[_IP], 0.0)
+    sg2 = sig * sig / th[_IP] ** 2
+    g_var = np.where(used, ss.Ps / th[_IP] ** 2, sg2)
+    nll_white = 0.5 * n_used * (1 + np.log(2 * np.pi * zv))
+    notes = (f"rolling gust p_g as a state of the roll dynamics (filter-error method, causal step moment; "
+             f"{'Dryden' if tau == 'dryden' else 'fitted'} tau {tau_:.2f} s, sigma(p_hat_g) {np.sqrt(sg2):.4f}, "
+             f"R {R:.2e}; {opt.nfev} evaluations{'' if opt.success else ', not converged'}): Cl_p "
+             f"{theta0[_IP]:.3f} (least squares) -> {theta[_IP]:.3f}, Cl_beta {theta0[2]:.3f} -> {theta[2]:.3f}, "
+             f"Cl_delta_a {theta0[5]:.3f} -> {theta[5]:.3f}; -log L {f:.0f} against {nll_white:.0f} without the gust",)
+    return RollDynamicsFit(g, g_var, used, theta, theta0, float(theta[_IP]), tau_, float(np.sqrt(sg2)), R, float(f),
+                           float(nll_white), int(opt.nfev), bool(opt.success), notes, L_p=Lp)
