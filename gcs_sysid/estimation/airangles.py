@@ -166,7 +166,7 @@ FLOOR_DROPS_CURVATURE = False
 #: +0.6..+1.2 against JSBSim's -0.39; the aided alpha then carries ``-CZ_delta_e / CZ_alpha`` of the elevator).
 ALPHA_PROFILE_COLUMNS: tuple[str, ...] = ()
 PROFILE_REFIT = False      #: refit the other free columns for each candidate (a profile likelihood; measured: c172p
-#: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares'
+#: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
 PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
 
 
