@@ -416,7 +416,14 @@ def main(argv=None) -> int:
     ap.add_argument("--floor-drops-curvature", default=None, choices=("on", "off"),
                     help="leave alpha's curvature out of the floored first pass (gcs_sysid.estimation.airangles."
                          "FLOOR_DROPS_CURVATURE; default: the package's default, off)")
+    ap.add_argument("--alpha-profile", nargs="*", default=None, metavar="COLUMN",
+                    help="the alpha aiding's columns whose slopes the gust model's likelihood chooses (gcs_sysid."
+                         "estimation.airangles.ALPHA_PROFILE_COLUMNS, e.g. delta_e; default: the package's, none)")
     a = ap.parse_args(argv)
+    if a.alpha_profile is not None:
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.ALPHA_PROFILE_COLUMNS = tuple(a.alpha_profile)
     if a.kinematic_mean is not None:
         from gcs_sysid.estimation import airangles
 

@@ -491,7 +491,14 @@ def main(argv=None) -> int:
     p.add_argument("--share-alpha-model", action="store_true",
                    help="aid each flight's alpha with the reference flight's CZ slopes "
                         "(gcs_sysid.diagnose.run.SHARE_ALPHA_MODEL; off by default)")
+    p.add_argument("--alpha-profile", nargs="*", default=None, metavar="COLUMN",
+                    help="the alpha aiding's columns whose slopes the gust model's likelihood chooses (gcs_sysid."
+                         "estimation.airangles.ALPHA_PROFILE_COLUMNS, e.g. delta_e; default: the package's, none)")
     a = p.parse_args(argv)
+    if a.alpha_profile is not None:
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.ALPHA_PROFILE_COLUMNS = tuple(a.alpha_profile)
     if a.share_alpha_model:
         from gcs_sysid.diagnose import run as diagnose_run
 

@@ -159,6 +159,15 @@ KINEMATIC_MEAN = False
 #: against JSBSim's -0.1..0.3), and it moves the aided alpha's mean (``docs/benchmarks.md``, "Eighteenth session,
 #: i8-alpha").
 FLOOR_DROPS_CURVATURE = False
+#: Opt-in (default (); twenty-first session, i8-aid): the columns of the alpha model whose slopes are chosen by the
+#: *gust model's likelihood* instead of least squares (``"delta_e"``; the curvature as ``"(alpha - alpha0)^2"``), see
+#: :func:`_profile_columns`. In turbulence the kinematic alpha carries the vertical gust, the stabilising autopilot moves
+#: the elevator against the gust's pitch, and least squares gives ``CZ_delta_e`` the gust's normal force (c172p light:
+#: +0.6..+1.2 against JSBSim's -0.39; the aided alpha then carries ``-CZ_delta_e / CZ_alpha`` of the elevator).
+ALPHA_PROFILE_COLUMNS: tuple[str, ...] = ()
+PROFILE_REFIT = False      #: refit the other free columns for each candidate (a profile likelihood; measured: c172p
+#: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
+PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
 
 
 @dataclass
@@ -411,14 +420,10 @@ def heave_edge_hz(slope: float, heave_gain: float, factor: float | None = None) 
     return float(min(max(HIGHPASS_HZ, f_h), max(HIGHPASS_HZ, MAX_EDGE_HZ)))
 
 
-def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, ...],
-                   ratios: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, float, float, float]:
-    """Smooth ``z = g + v`` (g first-order Gauss-Markov, v white) on each segment.
-
-    Returns ``(g_smoothed (T,), g_sigma (T,), tau_s, gust_sigma, noise_sigma)``; NaN outside the
-    segments. The model's two ratios are chosen by the concentrated likelihood (scale profiled out).
-    """
-    H, R = np.eye(1), np.eye(1)
+def _gm_search(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, ...],
+               ratios: tuple[float, ...]) -> tuple[float, float, float, float]:
+    """The Gauss-Markov gust model's concentrated log-likelihood of ``z = g + v`` (T,), maximised over ``taus`` x
+    ``ratios`` (the noise scale profiled out; Harvey 1989 ch. 3). Returns ``(loglik, tau_s, ratio, s2)``."""
     best = None
     n = sum(s.stop - s.start for s in segs)
     for tau in taus:
@@ -439,7 +444,18 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
             ll = -0.5 * n * (np.log(max(ssq / n, 1e-300)) + np.log(S))
             if best is None or ll > best[0]:
                 best = (ll, tau, ratio, ssq / n)
-    _, tau, ratio, s2 = best
+    return best
+
+
+def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, ...],
+                   ratios: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """Smooth ``z = g + v`` (g first-order Gauss-Markov, v white) on each segment.
+
+    Returns ``(g_smoothed (T,), g_sigma (T,), tau_s, gust_sigma, noise_sigma)``; NaN outside the
+    segments. The model's two ratios are chosen by the concentrated likelihood (scale profiled out).
+    """
+    H, R = np.eye(1), np.eye(1)
+    _, tau, ratio, s2 = _gm_search(dt, z, segs, taus, ratios)
     phi = float(np.exp(-dt / tau))
     F = np.array([[phi]])
     g = steady_state(F, np.array([[ratio * (1.0 - phi * phi)]]), H, R)
@@ -472,6 +488,72 @@ def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int]
         c[keep], se[keep] = co, so
         cov[np.ix_(keep, keep)] = cv
     return c, se, y - A @ c, cov
+
+
+def _profile_columns(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray, coeff: np.ndarray, kin: np.ndarray,
+                     ang: np.ndarray, m: np.ndarray, segs: list[slice], cr: np.ndarray, free: list[int],
+                     prof: list[int], quadratic: bool, ctr: float, sign: float, taus: tuple[float, ...],
+                     ratios: tuple[float, ...]) -> tuple[np.ndarray, list[tuple[float, float]]]:
+    """The slopes of the columns ``prof`` chosen by the gust model's likelihood (:data:`ALPHA_PROFILE_COLUMNS`).
+
+    Least squares on the kinematic angle gives a column the part of the gust's force that correlates with it (errors
+    in variables; in closed loop the stabilising autopilot moves the elevator against the gust's pitch, so
+    ``CZ_delta_e`` takes the gust's normal force). The aiding's own model says what the gust is: a first-order
+    Gauss-Markov state ``g`` seen as ``z = angle_f - angle_kin = g + v`` (v white). A wrong slope ``d`` leaves
+    ``(d_true - d) x / CZ_alpha`` in ``z``, shaped like the regressor ``x`` (the elevator's steps and doublets), not like
+    the gust. So ``d`` is chosen by the concentrated likelihood of ``z`` under the gust model (maximised over the
+    correlation time and the variance ratio, :func:`_gm_search`), the other free columns refitted by least squares for
+    each ``d`` (a profile likelihood): the filter-error method's parameter estimate with the gust as process noise
+    (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., 2015, ch. 5; Maine and Iliff, NASA RP-1168, 1986,
+    ch. 6-7, process noise and the output-error/filter-error likelihood), restricted to the columns least squares cannot
+    separate from the gust. Searched (bounded Brent, scipy ``minimize_scalar``) within :data:`PROFILE_HALF_WIDTH` of
+    the least-squares value.
+
+    Args:
+        dt: grid step, s. Ahm: (N, P) band-passed columns on the aided rows (the angle first). yhm: (N,) band-passed
+        coefficient. A: (T, P) the columns. coeff: (T,) measured coefficient. kin, ang: (T,) kinematic and current
+        angle, rad. m: (T,) bool aided rows. segs: their segments. cr: (P,) the least-squares slopes. free: columns
+        refitted with each candidate (the held slope of a floored pass excluded). prof: the profiled columns (indices
+        into ``A``). quadratic: column 1 is the curvature (the local slope then moves with the angle). ctr: the
+        curvature's centre, rad. sign: the angle slope's expected sign. taus, ratios: the gust model's grid.
+
+    Returns:
+        ``(slopes (P,), [(least squares, chosen) per profiled column])``.
+    """
+    from scipy.optimize import minimize_scalar
+
+    cr = np.asarray(cr, float).copy()
+    moved = []
+    for j in prof:
+        others = [i for i in free if i != j]
+
+        def refit(d: float, j: int = j, others: list[int] = others) -> np.ndarray:
+            c = cr.copy()
+            c[j] = d
+            if others:
+                held = [i for i in range(len(c)) if i not in others]
+                c[others] = np.linalg.lstsq(Ahm[:, others], yhm - Ahm[:, held] @ c[held], rcond=None)[0]
+            return c
+
+        def nll(d: float) -> float:
+            c = refit(d)
+            model = float(np.mean(coeff[m] - A[m] @ c)) + A[m] @ c
+            slope = np.full(int(m.sum()), c[0])
+            if quadratic:
+                slope = sign * np.maximum(sign * (slope + 2.0 * c[1] * (ang[m] - ctr)), 0.5 * abs(c[0]))
+            if not sign * c[0] > 0:
+                return np.inf
+            z = np.full(len(kin), np.nan)
+            z[m] = ang[m] + (coeff[m] - model) / slope - kin[m]
+            return -_gm_search(dt, z, segs, taus, ratios)[0]
+
+        b = float(cr[j])
+        r = minimize_scalar(nll, bounds=(b - PROFILE_HALF_WIDTH, b + PROFILE_HALF_WIDTH), method="bounded",
+                            options={"xatol": 0.005})
+        d = float(r.x) if np.isfinite(r.fun) else b
+        cr = refit(d)
+        moved.append((b, d))
+    return cr, moved
 
 
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
@@ -531,7 +613,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                           f"({', '.join(names[1:])}): slopes fitted here")
     nq = 2 if quadratic else 1
     fit = None
-    floor_note = ""
+    floor_note = profile_note = ""
+    keep: list[int] = []
     edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
     X_other = np.column_stack([others[k] for k in cols]) if cols else np.zeros((len(kin), 0))
@@ -601,6 +684,24 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             floor_note = (f"first pass with CZ_alpha held at the wing's lift slope {sign * abs(slope_floor):+.2f} "
                           f"(fitted {free:+.2f}: attenuated by the kinematic angle's gust error)"
                           + (f" and {', '.join(dropped)} left out" if dropped else ""))
+        prof = ([names.index(k) - 1 for k in ALPHA_PROFILE_COLUMNS if k in names[2:]]
+                if name == "alpha" and fixed is None and not method.startswith("2SLS") else [])
+        if prof:
+            # the columns least squares cannot separate from the gust get the slope under which the force-derived
+            # angle's departure from the kinematic one is most like a Gauss-Markov gust (maximum likelihood)
+            if fit is None:
+                taus_p, ratios_p = TAUS_S, RATIOS
+            else:
+                it, ir = TAUS_S.index(fit.tau_s), RATIOS.index(fit.ratio)
+                taus_p, ratios_p = TAUS_S[max(it - 1, 0):it + 2], RATIOS[max(ir - 1, 0):ir + 2]
+            free_p = (keep if floored else list(range(A.shape[1]))) if PROFILE_REFIT else []
+            cr, moved = _profile_columns(dt, Ah[m], yh[m], A, coeff, kin, ang, m, segs, cr, free_p, prof, quadratic,
+                                         ctr, sign, taus_p, ratios_p)
+            res = yh[m] - Ah[m] @ cr
+            csr = csr.copy()
+            csr[prof] = np.nan
+            profile_note = "; by the gust model's likelihood: " + ", ".join(
+                f"{names[j + 1]} {a:+.2f} (least squares {b:+.2f})" for j, (b, a) in zip(prof, moved))
         r2 = 1.0 - float(np.var(res)) / max(float(np.var(yh[m])), 1e-300)
         c0 = float(np.mean(coeff[m] - A[m] @ cr))
         c, cs = np.r_[c0, cr], np.r_[np.nan, csr]
@@ -654,6 +755,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         fit.slope_method = f"{fit.slope_method}: {given_note}"
     if fit is not None and floor_note:
         fit.slope_method = f"{fit.slope_method}; {floor_note}"
+    if fit is not None and profile_note:
+        fit.slope_method += profile_note
     gust_sig = sig          # the gust smoother's posterior 1-sigma, before the flight-common offset is added
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
