@@ -102,7 +102,8 @@ def null_residual(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, ro
 def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, A: np.ndarray, index: int,
                            j: int, rows: np.ndarray, k_angle: int, scale: float, offset: float,
                            nuisance: Callable[[np.ndarray], np.ndarray] | None = None,
-                           curvature: float = 0.0, map_delta_e: float = 0.0, k_delta_e: int | None = None) -> dict:
+                           curvature: float = 0.0, map_delta_e: float = 0.0, k_delta_e: int | None = None,
+                           scale_step: float = 0.0) -> dict:
     """Type-B standard uncertainty of one fitted coefficient under no change, from an angle's scale, offset and
     curvature.
 
@@ -120,6 +121,14 @@ def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.nd
             (``air_data_uncertainty(...)["alpha"]["map_delta_e"]``, ``sparse.THRESHOLDS["coverage_map_delta_e"]``),
             carried as the angle's error along column ``k_delta_e``; 0 or ``k_delta_e`` None: left out (and not in
             the result).
+        scale_step: the largest relative step of the scale's central difference (``sparse.THRESHOLDS
+            ["coverage_scale_step"]``; twenty-first session, branch i9-aidnull); with ``scale > scale_step > 0`` the
+            difference is taken at ``+- scale_step`` and multiplied by ``scale / scale_step``: the first-order
+            sensitivity coefficient times the standard uncertainty (GUM eq. 10), instead of the difference at ``+-
+            scale``, which for a stated scale uncertainty near 1 reads the model at ``x_true = mean + (x - mean) /
+            (1 - scale)``, the pole of the scale's parametrization (c172p seed 2, the alpha aiding profiled: 0.976
+            -> alpha's excursions 42 times the measured, ``Cn:delta_a`` +- 0.104 under no change against 0.0017
+            from the fits). 0: the step is ``scale`` (as before).
 
     Returns:
         ``{"scale": u, "offset": u}`` and, with ``curvature > 0``, ``"curvature": u``, with ``map_delta_e > 0``,
@@ -136,6 +145,9 @@ def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.nd
             continue
         if what == "map_delta_e":
             d = null_residual(predict, X, rows, k_angle, "along", float(u), along=k_delta_e)
+        elif what == "scale" and 0.0 < scale_step < u:
+            # first order: the difference at a step where 1 / (1 + s) is linear, times u over the step
+            d = null_residual(predict, X, rows, k_angle, what, float(scale_step)) * (float(u) / float(scale_step))
         else:
             d = null_residual(predict, X, rows, k_angle, what, float(u))
         if nuisance is not None:

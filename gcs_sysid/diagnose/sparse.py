@@ -179,6 +179,14 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: under no change as a fourth alpha component (the angle's error along ``delta_e``). No new threshold. Measured
 #: post hoc on the c172p's final-evaluation flights and the c172x's (``docs/benchmarks.md``, *Twentieth session,
 #: i9-elev*).
+#: Added 2026-11-24 (twenty-first session, branch i9-aidnull): ``coverage_scale_step`` (read only with
+#: ``coverage_under_null``), **off** (0.0): the largest relative step of the angle scale's central difference under
+#: no change; a stated scale uncertainty above it is carried as the first-order sensitivity at this step times the
+#: uncertainty (GUM eq. 10; :func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity` ``scale_step``), not
+#: the difference at ``+- u``, whose minus branch nears the pole of ``x_true = mean + (x - mean) / (1 + s)`` as ``u``
+#: nears 1. No new threshold tuned: 0.1 is where ``1 / (1 + s)`` is linear within 1 %, chosen before measuring.
+#: Measured with the alpha aiding profiled (``airangles.ALPHA_PROFILE_COLUMNS``), in ``docs/benchmarks.md``,
+#: *Twenty-first session, i9-aidnull*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -195,7 +203,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
-              "coverage_map_delta_e": False}
+              "coverage_map_delta_e": False, "coverage_scale_step": 0.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -928,7 +936,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         null = {"predict": lambda Xp, _m=model_null: np.nan_to_num(ctx.model_values(Xp, _m)) * ctx.active[None, :],
                 "X": np.nan_to_num(ctx.X), "nuisance": null_nuisance,
                 "curvature": bool(th.get("coverage_curvature", False)),
-                "map_delta_e": bool(th.get("coverage_map_delta_e", False))}
+                "map_delta_e": bool(th.get("coverage_map_delta_e", False)),
+                "scale_step": float(th.get("coverage_scale_step", 0.0) or 0.0)}
     if th.get("honest_std_error", True):
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         model0 = reference[0].model if reference is not None else ctx.model
@@ -1405,7 +1414,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                                           null.get("nuisance"),
                                           float(u.get("curvature", 0.0)) if null.get("curvature") else 0.0,
                                           map_delta_e=float(u.get("map_delta_e", 0.0)) if null.get("map_delta_e")
-                                          else 0.0, k_delta_e=REGRESSORS.index("delta_e"))
+                                          else 0.0, k_delta_e=REGRESSORS.index("delta_e"),
+                                          scale_step=float(null.get("scale_step", 0.0)))
             typeb_null.update({f"{angle}_{k}": v for k, v in sens.items()})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
