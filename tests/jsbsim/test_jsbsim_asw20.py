@@ -24,14 +24,14 @@ All of them but the names are slow.
 No pipeline fit, GP, diagnosis or scoring runs in these tests.
 """
 
-import hashlib
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state, lateral_coefficients
+from truth_fits import (assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot,
+                         ic_state, lateral_coefficients)
 
 SRC = "data/jsbsim_models/asw20/asw20-JSBSim.xml"
 SRC_SHA256 = "c3a7877a124d79fcc82340614703cc07795993a06552ad6df9f05b10d1bdbc48"
@@ -52,15 +52,9 @@ def test_the_derivation_removes_only_flightgears_parts_and_aliases_the_elevator(
 
     and every other element equal (metrics, mass balance, ground reactions, external reactions, propulsion,
     the other FCS channels, every aerodynamic function). The spec's notes carry the derived XML's hash."""
-    from benchmarks.jsbsim_harness.derived import ELEVATOR_DEG_ALIAS, REPO_DERIVED, derived_sha, derived_xml
-    from benchmarks.jsbsim_harness.logfile import _REPO
+    from benchmarks.jsbsim_harness.derived import ELEVATOR_DEG_ALIAS, derived_xml
 
-    raw = (_REPO / SRC).read_bytes()
-    assert len(raw) == 40719 and hashlib.sha256(raw).hexdigest() == SRC_SHA256
-    spec = aircraft("asw20")
-    assert spec.model == "asw20_glide" and REPO_DERIVED[spec.model][0] == SRC
-    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
-    src, der = ET.fromstring(raw), ET.fromstring(derived_xml(spec.model))
+    src, der, spec = checked_in_model("asw20", "asw20_glide", SRC, 40719, SRC_SHA256)
     canon = lambda e: ET.tostring(e, encoding="unicode").split()       # noqa: E731  (layout aside)
     assert [c.tag for c in src if c.tag != "system"] == [c.tag for c in der]
     assert sorted(s.get("file") for s in src.findall("system")) == ["GenericEngine", "WaterBallast"]

@@ -25,14 +25,14 @@ All of them but the names are slow.
 No pipeline fit, GP, diagnosis or scoring ran on the c684 before the seventeenth session's final evaluation.
 """
 
-import hashlib
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, cm_without_alpha_dot, ic_state, lateral_coefficients
+from truth_fits import (assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot,
+                         ic_state, lateral_coefficients)
 
 SRC = "data/jsbsim_models/c684/C684.xml"
 SRC_SHA256 = "fb02bd7d563c8877ebcaaffe81e17ab62efd456ec65027436349e696765e826d"
@@ -50,15 +50,7 @@ def test_the_derivation_removes_the_engine_and_its_system_and_fixes_the_gear_fla
     ``<system file="engine"/>`` removed and the three wheels' ``<retractable>FIXED</retractable>`` written ``0``;
     the fuel tanks and every other element are equal (metrics, mass balance, flight control, aerodynamics; the
     ground reactions but the three flags). The spec's notes carry the derived XML's hash."""
-    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
-    from benchmarks.jsbsim_harness.logfile import _REPO
-
-    raw = (_REPO / SRC).read_bytes()
-    assert len(raw) == 28423 and hashlib.sha256(raw).hexdigest() == SRC_SHA256
-    spec = aircraft("c684")
-    assert spec.model == "C684_glide" and REPO_DERIVED[spec.model][0] == SRC
-    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
-    src, der = ET.fromstring(raw), ET.fromstring(derived_xml(spec.model))
+    src, der, spec = checked_in_model("c684", "C684_glide", SRC, 28423, SRC_SHA256)
     canon = lambda e: "".join(ET.tostring(e, encoding="unicode").split())   # noqa: E731  (layout aside: ET.indent)
     assert [c.tag for c in src if c.tag != "system"] == [c.tag for c in der]
     assert [s.get("file") for s in src.findall("system")] == ["engine"] and der.findall("system") == []

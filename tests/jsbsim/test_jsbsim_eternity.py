@@ -24,7 +24,6 @@ merge.
 """
 
 import copy
-import hashlib
 import json
 import xml.etree.ElementTree as ET
 
@@ -32,7 +31,7 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
+from truth_fits import assert_aero_is_the_only_force, checked_in_model, ic_state, lateral_coefficients
 
 SRC = "data/jsbsim_models/eternity/Eternity.xml"
 SRC_SHA256 = "2341802f2ba31fea2d561a94a66957f88fa478ffcdc8fedb45f70f4772fa4bc7"
@@ -51,15 +50,9 @@ def test_the_derivation_removes_the_motor_and_throttle_and_aliases_the_elevator(
     x ``fcs/elevator-pos-rad``) for ``fcs/elevator-pos-deg``; the empty tank and every other element are equal
     (metrics, mass balance, ground reactions, the other FCS channels, every aerodynamic function but that read).
     The spec's notes carry the derived XML's hash."""
-    from benchmarks.jsbsim_harness.derived import ELEVATOR_DEG_ALIAS, REPO_DERIVED, derived_sha, derived_xml
-    from benchmarks.jsbsim_harness.logfile import _REPO
+    from benchmarks.jsbsim_harness.derived import ELEVATOR_DEG_ALIAS
 
-    raw = (_REPO / SRC).read_bytes()
-    assert len(raw) == 22336 and hashlib.sha256(raw).hexdigest() == SRC_SHA256
-    spec = aircraft("eternity")
-    assert spec.model == "Eternity_glide" and REPO_DERIVED[spec.model][0] == SRC
-    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
-    src, der = ET.fromstring(raw), ET.fromstring(derived_xml(spec.model))
+    src, der, spec = checked_in_model("eternity", "Eternity_glide", SRC, 22336, SRC_SHA256)
     ET.indent(src, space=" ")
 
     def same(a, b):      # the elements, their text and children, not their own tails (the last child's differs)

@@ -23,14 +23,13 @@ All of them but the names are slow.
 No pipeline fit, GP, diagnosis or scoring runs in these tests.
 """
 
-import hashlib
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
+from truth_fits import assert_aero_is_the_only_force, checked_in_model, ic_state, lateral_coefficients
 
 SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
 SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
@@ -46,15 +45,7 @@ def test_the_derivation_removes_only_the_engine():
     ``<engine>`` (the IAR-K14-1000A radial, its two fuel feeds and the ``Prop`` thruster) removed from
     ``<propulsion>``; the two fuel tanks and every other element are equal (metrics, mass balance, ground
     reactions, flight control, aerodynamics, external reactions). The spec's notes carry the derived XML's hash."""
-    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
-    from benchmarks.jsbsim_harness.logfile import _REPO
-
-    raw = (_REPO / SRC).read_bytes()
-    assert len(raw) == 20021 and hashlib.sha256(raw).hexdigest() == SRC_SHA256
-    spec = aircraft("iar80")
-    assert spec.model == "IAR80_glide" and REPO_DERIVED[spec.model][0] == SRC
-    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
-    src, der = ET.fromstring(raw), ET.fromstring(derived_xml(spec.model))
+    src, der, spec = checked_in_model("iar80", "IAR80_glide", SRC, 20021, SRC_SHA256)
     canon = lambda e: ET.tostring(e, encoding="unicode").split()       # noqa: E731  (layout aside)
     assert [c.tag for c in src] == [c.tag for c in der]
     for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control", "aerodynamics", "external_reactions"):

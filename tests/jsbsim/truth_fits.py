@@ -485,3 +485,30 @@ def assert_in_envelope(e: dict, alpha, beta, bank, speed, rate_std: float, rate_
     assert speed[0] < e["V"][0] and e["V"][1] < speed[1], e["V"]
     assert min(e["rate_std"]) > rate_std and min(e["rate_std_held"]) > rate_std_held, e      # deg/s
     assert min(e["surface_std"]) > 1.0 and e["sink_air_mps"] > sink_min and e["alt_min"] > alt_min, e
+
+
+def checked_in_model(name: str, model: str, src: str, n_bytes: int, sha256: str):
+    """The checked-in XML ``src`` (a path from the repository root) of the harness aircraft ``name`` is the copy its
+    README describes (``n_bytes`` long, SHA-256 ``sha256``), the aircraft flies it as the derived ``model``, and the
+    spec's notes name the derived XML's digest.
+
+    Returns:
+        ``(source_root, derived_root, spec)``: the parsed source and derived XML (``ElementTree`` elements) and the
+        :class:`~benchmarks.jsbsim_harness.AircraftSpec`.
+
+    Raises:
+        AssertionError: one of these fails.
+    """
+    import hashlib
+    import xml.etree.ElementTree as ET
+
+    from benchmarks.jsbsim_harness import aircraft
+    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
+    from benchmarks.jsbsim_harness.logfile import _REPO
+
+    raw = (_REPO / src).read_bytes()
+    assert len(raw) == n_bytes and hashlib.sha256(raw).hexdigest() == sha256
+    spec = aircraft(name)
+    assert spec.model == model and REPO_DERIVED[spec.model][0] == src
+    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
+    return ET.fromstring(raw), ET.fromstring(derived_xml(spec.model)), spec
