@@ -89,7 +89,11 @@ _DEG = 57.29577951308232
 #: and flown as ``UltraStick120_glide``, no propulsion, direct surfaces, at 10000 ft) and ``b737`` (the nineteenth
 #: session's: JSBSim's stock Boeing 737, the wheel's ``737``, engines shut down, gear up, its own yaw damper in the
 #: loop, at 12000 ft) and ``c172p`` (the twentieth session's: JSBSim's stock Cessna 172P, the wheel's ``c172p``,
-#: engine shut down, fixed gear, at 4000 ft). No aircraft is held out or untouched until the next one is added.
+#: engine shut down, fixed gear, at 4000 ft) and ``eternity`` (the twenty-first session's: ENAC's Eternity UAV from
+#: Paparazzi, checked into ``data/jsbsim_models/eternity`` and flown as ``Eternity_glide``, motor removed, at
+#: 10000 ft). ``us25e`` (the University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics,
+#: checked into ``data/jsbsim_models/ultrastick25e`` and flown as ``UltraStick25e_glide``; added in the twenty-second
+#: session) is held out and untouched: no part of the method has run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -600,11 +604,31 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="Eternity UAV (Paparazzi's JSBSim Eternity.xml, checked in under data/jsbsim_models/eternity) without "
               "its motor and propeller (derived model Eternity_glide, XML sha256 ada8d7c7cccebe1a), gliding; "
               "untouched by any tuning of the method"),
+    # us25e: the University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics (UASLab/
+    # OpenFlightSim Simulation/aircraft/UltraStick25e, MIT; the main file at 06a2b255, its parts at 1650a6e3): 1.96
+    # kg, 1.27-m span, 0.3097 m^2 (wing loading 62 N/m^2), one constant per derivative on all six axes (the lab's
+    # linear model: CY_p, CY_r, Cn_p and a product of inertia Ixz included), inertia 0.0715 / 0.0864 / 0.1536 kg m^2.
+    # The seventh model from outside the wheel; checked in (data/jsbsim_models/ultrastick25e/, provenance and
+    # licence in its README.md) and flown as the derived model ``UltraStick25e_glide`` (derived.py), assembled and
+    # flown as the ultrastick's: no propulsion, direct surfaces +-30 deg (the lab's actuator travel). Chosen in the
+    # twenty-second session (docs/jsbsim.md, "The us25e"). Signs read from its aerodynamics: dCMm/dElev -0.8488
+    # (positive = trailing edge down), dCMl/dAilL +0.0823 and dCMl/dAilR -0.0823 (the right driven as the mirror of
+    # the left, so delta_a = -left: Cl_delta_a -0.1646), dCMn/dRud -0.1811 (positive = nose left). Set from the
+    # harness's truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never from a method result.
+    "us25e": AircraftSpec(
+        name="us25e", model="UltraStick25e_glide", airspeed_kts=34.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/posAilL_rad", "fcs/posAilR_rad"), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988),
+        amplitude_deg=(5.0, 5.0, 4.0), pulse_s=(0.2, 0.3, 0.5), gains=(0.25, 0.05, 0.01, 0.2, 0.05, 0.4),
+        notes="Ultra Stick 25e UAV (UASLab OpenFlightSim JSBSim model with its OpenFlight aerodynamics, checked in "
+              "under data/jsbsim_models/ultrastick25e) without propulsion, direct surfaces (derived model "
+              "UltraStick25e_glide, XML sha256 8ea2d4e4a54bfe4f), fixed gear, gliding; untouched by any tuning of the "
+              "method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20", "iar80", "c684", "ultrastick", "b737", "c172p")
-HELD_OUT_AIRCRAFT = ("eternity",)
-UNTOUCHED_AIRCRAFT = ("eternity",)
+                   "asw20", "iar80", "c684", "ultrastick", "b737", "c172p", "eternity")
+HELD_OUT_AIRCRAFT = ("us25e",)
+UNTOUCHED_AIRCRAFT = ("us25e",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -12,7 +12,8 @@ Caudron C.684 racer with its engine, propeller and engine system removed (``C684
 UAV assembled from its files into one, gliding, with direct surfaces (``UltraStick120_glide``,
 :func:`derive_ultrastick120_glide`; eighteenth session), or ENAC's Eternity UAV from Paparazzi with its motor and
 propeller removed and its elevator moment reading an alias (``Eternity_glide``, :func:`derive_eternity_glide`;
-twenty-first session).
+twenty-first session), or the same lab's Ultra Stick 25e with its OpenFlight aerodynamics, assembled and
+flown as the Ultra Stick 120 (``UltraStick25e_glide``, :func:`derive_ultrastick25e_glide`; twenty-second session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -67,7 +68,7 @@ from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
-           "derive_eternity_glide",
+           "derive_eternity_glide", "derive_ultrastick25e_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -421,17 +422,44 @@ def derive_ultrastick120_glide(root: ET.Element) -> ET.Element:
         ValueError: the main file does not name the expected sections (another version), or a checked-in
             section file has another root element.
     """
+    return _openflightsim_glide(root, "UltraStick120", _US120_SECTIONS, _US120_DIR, "UltraStick120_glide",
+                                "Ultra Stick 120 UAV, gliding, direct surfaces (gcs-sysid derivation)")
+
+
+def _openflightsim_glide(root: ET.Element, main: str, sections: list, folder: Path, name: str,
+                         description: str) -> ET.Element:
+    """Assemble one of UASLab/OpenFlightSim's split JSBSim models into one gliding file with direct surfaces
+    (:func:`derive_ultrastick120_glide`, :func:`derive_ultrastick25e_glide`).
+
+    Args:
+        root: the parsed main file (``<main>.xml``, not modified).
+        main: the main file's stem, for the error messages.
+        sections: the main file's ``(tag, file)`` children expected, in order.
+        folder: the checked-in folder holding the section files.
+        name: the derived model's ``fdm_config`` name.
+        description: its ``fileheader`` description.
+
+    Returns:
+        a new root element: metrics, mass, gear and aerodynamics as checked in, an empty ``<propulsion/>``,
+        and a ``<flight_control>`` of ``aerosurface_scale`` components (+-:data:`US120_SURFACE_RAD`, the lab's
+        actuator travel) from the harness's normalised commands; flaps 0; ``fcs/posElev_rad`` and
+        ``fcs/posRud_rad`` read as ``fcs/elevator-pos-rad`` and ``fcs/rudder-pos-rad``.
+
+    Raises:
+        ValueError: the main file does not name ``sections`` (another version), or a checked-in section file
+            has another root element.
+    """
     got = [(c.tag, c.get("file")) for c in root]
-    if got != _US120_SECTIONS:
-        raise ValueError(f"UltraStick120.xml: expected the sections {_US120_SECTIONS}, got {got}")
-    new = ET.Element("fdm_config", {"name": "UltraStick120_glide", "version": "2.0", "release": "ALPHA"})
+    if got != sections:
+        raise ValueError(f"{main}.xml: expected the sections {sections}, got {got}")
+    new = ET.Element("fdm_config", {"name": name, "version": "2.0", "release": "ALPHA"})
     head = ET.SubElement(new, "fileheader")
     ET.SubElement(head, "author").text = "University of Minnesota UAS Laboratories (OpenFlightSim, MIT)"
-    ET.SubElement(head, "description").text = "Ultra Stick 120 UAV, gliding, direct surfaces (gcs-sysid derivation)"
+    ET.SubElement(head, "description").text = description
     parts = {}
     for tag in ("metrics", "mass_balance", "ground_reactions", "aerodynamics"):
-        f = dict((t, f) for t, f in _US120_SECTIONS if t == tag)[tag]
-        part = ET.parse(_US120_DIR / f).getroot()
+        f = dict((t, f) for t, f in sections if t == tag)[tag]
+        part = ET.parse(folder / f).getroot()
         if part.tag != tag:
             raise ValueError(f"{f}: root <{part.tag}>, expected <{tag}>")
         parts[tag] = part
@@ -439,7 +467,7 @@ def derive_ultrastick120_glide(root: ET.Element) -> ET.Element:
     new.append(parts["mass_balance"])
     new.append(parts["ground_reactions"])
     ET.SubElement(new, "propulsion")
-    fcs = ET.SubElement(new, "flight_control", {"name": "UltraStick120_glide direct surfaces"})
+    fcs = ET.SubElement(new, "flight_control", {"name": f"{name} direct surfaces"})
     for flap in ("fcs/posFlapL_rad", "fcs/posFlapR_rad"):
         ET.SubElement(fcs, "property", {"value": "0"}).text = flap
     for channel, cmd, outs in (("Pitch", "fcs/elevator-cmd-norm", [("Elevator", "", "fcs/elevator-pos-rad")]),
@@ -447,8 +475,8 @@ def derive_ultrastick120_glide(root: ET.Element) -> ET.Element:
                                                                  ("Right Aileron", "-", "fcs/posAilR_rad")]),
                                ("Yaw", "fcs/rudder-cmd-norm", [("Rudder", "", "fcs/rudder-pos-rad")])):
         ch = ET.SubElement(fcs, "channel", {"name": channel})
-        for name, sign, out in outs:
-            comp = ET.SubElement(ch, "aerosurface_scale", {"name": f"{name} Control"})
+        for surface, sign, out in outs:
+            comp = ET.SubElement(ch, "aerosurface_scale", {"name": f"{surface} Control"})
             ET.SubElement(comp, "input").text = sign + cmd
             rng = ET.SubElement(comp, "range")
             ET.SubElement(rng, "min").text = repr(-US120_SURFACE_RAD)
@@ -462,6 +490,47 @@ def derive_ultrastick120_glide(root: ET.Element) -> ET.Element:
             el.text = rename[t]
     new.append(aero)
     return new
+
+
+#: The checked-in UltraStick 25e files :func:`derive_ultrastick25e_glide` assembles (beside the main file).
+_US25E_DIR = Path(__file__).resolve().parents[2] / "data" / "jsbsim_models" / "ultrastick25e"
+
+#: The main file's sections (tag, file) in the stored version (UASLab/OpenFlightSim
+#: ``Simulation/aircraft/UltraStick25e/UltraStick25e.xml`` at 06a2b255).
+_US25E_SECTIONS = [("flight_control", "Systems\\FlightControl.xml"), ("system", "Systems\\Effectors.xml"),
+                   ("mass_balance", "MassOpenFlight.xml"), ("ground_reactions", "Gear.xml"),
+                   ("propulsion", "PropulsionDirect.xml"), ("metrics", "MetricsOpenFlight.xml"),
+                   ("aerodynamics", "AeroOpenFlight.xml"), ("system", "Systems\\SensorImu.xml"),
+                   ("system", "Systems\\SensorGps.xml"), ("system", "Systems\\SensorPitot.xml")]
+
+
+def derive_ultrastick25e_glide(root: ET.Element) -> ET.Element:
+    """The University of Minnesota UAS Lab's JSBSim Ultra Stick 25e with its OpenFlight aerodynamics
+    (``data/jsbsim_models/ultrastick25e/``, UASLab/OpenFlightSim ``Simulation/aircraft/UltraStick25e``, MIT) as one
+    file, gliding, with a direct flight-control system (twenty-second session).
+
+    The main ``UltraStick25e.xml`` names ``MassOpenFlight.xml``, ``Gear.xml``, ``MetricsOpenFlight.xml`` and
+    ``AeroOpenFlight.xml`` (the lab's earlier OpenFlight linear model of the 1.96-kg, 1.27-m Ultra Stick 25e: one
+    constant per derivative on all six axes). Assembled as :func:`derive_ultrastick120_glide` does
+    (:func:`_openflightsim_glide`): the four files unchanged, no propulsion (``PropulsionDirect.xml`` not copied),
+    the lab's control laws (``Systems/FlightControl.xml``), actuators (``Systems/Effectors.xml``: lag 33 rad/s,
+    0.02-s delay, 1-deg hysteresis, +-30 deg) and sensors replaced by direct surfaces of +-30 deg, flaps 0,
+    ``fcs/posElev_rad`` and ``fcs/posRud_rad`` read as ``fcs/elevator-pos-rad`` and ``fcs/rudder-pos-rad``. No
+    number changes.
+
+    Args:
+        root: the parsed ``UltraStick25e.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the main file does not name the expected sections (another version), or a checked-in
+            section file has another root element.
+    """
+    return _openflightsim_glide(root, "UltraStick25e", _US25E_SECTIONS, _US25E_DIR, "UltraStick25e_glide",
+                                "Ultra Stick 25e UAV (OpenFlight aerodynamics), gliding, direct surfaces "
+                                "(gcs-sysid derivation)")
 
 
 def derive_eternity_glide(root: ET.Element) -> ET.Element:
@@ -567,6 +636,15 @@ REPO_DERIVED = {
                                               "propeller force); "
                                               "Pitch_elevator reads the elevator through an alias in degrees of "
                                               "fcs/elevator-pos-rad; everything else unchanged."),
+    "UltraStick25e_glide": ("data/jsbsim_models/ultrastick25e/UltraStick25e.xml",
+                            "the University of Minnesota UAS Lab's JSBSim Ultra Stick 25e with its OpenFlight "
+                            "aerodynamics (UASLab/OpenFlightSim Simulation/aircraft/UltraStick25e, MIT), copied into "
+                            "gcs-sysid's data/jsbsim_models/ultrastick25e/",
+                            derive_ultrastick25e_glide, "its MetricsOpenFlight, MassOpenFlight, Gear and "
+                            "AeroOpenFlight files in one file; no propulsion; the lab's control laws, actuators and "
+                            "sensors replaced by direct surfaces (+-30 deg); the aerodynamics read "
+                            "fcs/elevator-pos-rad and fcs/rudder-pos-rad for the lab's posElev_rad and posRud_rad; "
+                            "flaps 0; no number changed."),
 }
 
 

@@ -1,4 +1,5 @@
-"""The eternity in the JSBSim harness: the twenty-first session's untouched aircraft (docs/jsbsim.md, "The eternity").
+"""The eternity in the JSBSim harness: the twenty-first session's untouched aircraft, a tuning aircraft since the
+twenty-second session (docs/jsbsim.md, "The eternity").
 
 The model is ENAC's Eternity UAV in Paparazzi's JSBSim simulator (``conf/simulator/jsbsim/aircraft/Eternity.xml`` of
 paparazzi/paparazzi at commit 5399bd98, Murat Bronz 2015, GPL-2.0-or-later; its coefficients from wind-tunnel
@@ -12,19 +13,19 @@ turbulence: a mechanism check); none of them flies the harness:
 - the checked-in file is the one the README names, and the derivation makes only its three edits;
 - the FCS maps the commands straight to the surfaces (elevator -20 / +15 deg, both ailerons +-20 deg with the same
   sign, rudder +-27 deg with a negative gain); no engine, no force but the aerodynamic one;
-- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_c172p.py``).
+- it is statically stable about the CG, and its elevator, aileron and rudder act as its XML says.
+
+The summaries' label test moves on with the untouched aircraft (twenty-second session: ``test_jsbsim_us25e.py``).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
 hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
 are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the eternity: its first evaluation is the final one, after the
-merge.
+No pipeline fit, GP, diagnosis or scoring ran on the eternity before its final evaluation (twenty-first session);
+it is a tuning aircraft since.
 """
 
 import copy
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -139,32 +140,3 @@ def test_the_eternity_is_statically_stable_and_its_controls_act_as_its_xml_says(
         l3, n3, _, _ = lateral_coefficients(_state(alpha_deg=a, beta_deg=4.0))
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.094, abs=1e-3), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.065, abs=1e-3), a
-
-
-def test_summaries_mark_the_eternity_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the eternity "(untouched)" and no other
-    aircraft, the c172p, b737 and c172x included (synthetic rows: no eternity result exists before the final
-    evaluation). Moved here from ``test_jsbsim_c172p.py`` (the twentieth session's untouched aircraft)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| eternity (untouched) | light") for ln in lines)
-    for ac in acs[:17]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| eternity (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| c172p | clean |") for ln in lines)

@@ -1,5 +1,5 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p and the untouched eternity;
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p, eternity and the untouched us25e;
 docs/jsbsim.md, one section each),
 parametrised over the roster.
 
@@ -11,15 +11,16 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); the untouched eternity's are slow too but its names', and its own
+default suite, as before the fold); the untouched us25e's are slow too but its names', and its own
 default checks (its model, surfaces, static stability, the summaries' label) are in
-``test_jsbsim_eternity.py`` (the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+``test_jsbsim_us25e.py`` (the eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-first sessions). Folded in the eleventh session
+the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-second sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
 in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
-b737 in the nineteenth, the c172p in the twentieth, the eternity in the twenty-first.
+b737 in the nineteenth, the c172p in the twentieth, the eternity in the twenty-first, the us25e in the
+twenty-second.
 """
 
 from dataclasses import dataclass
@@ -322,7 +323,7 @@ CASES = (
     # alpha and delta_e share the short period); Cl_beta -0.094, Cl_p -0.4659, Cl_r 0.1345, Cl_delta_a -0.2966,
     # Cl_delta_r -0.00166 (Roll_rudder 0.00166 x the position, delta_r = -position); Cn_beta 0.0653, Cn_r -0.0914,
     # Cn_delta_a +0.021 (adverse), Cn_delta_r -0.043, Cn_p 0 (none in the file). Envelope limits from the pre-flown
-    # final-evaluation flights (docs/jsbsim.md, "The eternity").
+    # final-evaluation flights (docs/jsbsim.md, "The eternity"). A tuning aircraft since the twenty-second session.
     Case("eternity", "Eternity_glide", "eternty", 1.98416, 0.0,
          (("cm", 0, None, ("in", -2.0, -1.5)), ("cm", 2, -0.698, ("rel", 0.03)), ("cl", 3, -0.2966, ("rel", 0.01)),
           ("cl", 0, -0.094, ("rel", 0.01)), ("cl", 1, -0.4659, ("rel", 0.01)), ("cl", 2, 0.1345, ("rel", 0.01)),
@@ -330,7 +331,29 @@ CASES = (
           ("cn", 2, -0.0914, ("rel", 0.02)), ("cn", 3, 0.021, ("rel", 0.03)), ("cn", 1, 0.0, ("abs", 2e-3))),
          (), 15.0 * 0.01745, 1,
          dict(alpha=(-12.0, 8.0), beta=(10.0, 12.0), bank=(25.0, 30.0), speed=(14.0, 32.0), alt_min=1500.0,
-              rate_std=4.0, rate_std_held=4.0), min_lbf=0.05, untouched=True),
+              rate_std=4.0, rate_std_held=4.0), min_lbf=0.05),
+    # us25e (the University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics, UASLab/
+    # OpenFlightSim Simulation/aircraft/UltraStick25e, MIT; the derived UltraStick25e_glide: its files in one, no
+    # propulsion, direct surfaces +-30 deg): 1.959 kg (4.3189 lb), project Ixz 0.0140 kg m^2 (JSBSim's -0.014), one
+    # SIDE function (the sum SIDE__CY of CY__beta, CY__dpHat, CY__drHat, CY__dRud), the elevator read by CL, CD and
+    # CMm. On the 30-s calm flight (derivative_slopes) every slope is the file's constant, the arm of the reference
+    # point (4.5 mm ahead of the CG) aside: Cm_alpha -0.641 (dCMm__alpha -0.723 and the lift through the arm),
+    # Cm_q -13.42 (dCMm__dqHat -13.57; no alpha-dot moment), Cm_delta_e -0.847; Cl_beta -0.0545, Cl_p -0.4496, Cl_r
+    # 0.1086, Cl_delta_a -0.1646 (0.0823 x left - 0.0823 x right, right = -left), Cl_delta_r 0.0115; Cn_beta 0.0704,
+    # Cn_p 0.1179, Cn_r -0.1828, Cn_delta_a +0.0574 (adverse), Cn_delta_r -0.1804. Envelope limits from the pre-flown
+    # final-evaluation flights (docs/jsbsim.md, "The us25e"): alpha -4.4..9.3 deg, sideslip 9.1 clean and 11.4 with
+    # Cl:alpha*beta, bank 21.2 and 31.1, TAS 17.2-27.2 m/s, lowest 2380 m, sink through the air 3.7-4.3 m/s, rate
+    # standard deviations at least 3.7 deg/s (3.8 held out), surfaces' at least 1.45 / 1.20 / 0.54 deg; its rudder
+    # floor is 0.4 deg (its Cn_delta_r is 2.5 times its Cn_beta: truth_fits.assert_in_envelope).
+    Case("us25e", "UltraStick25e_glide", "us25f", 4.318856, 0.0139987,
+         (("cm", 0, None, ("in", -0.70, -0.58)), ("cm", 2, -0.8471, ("rel", 0.01)), ("cl", 3, -0.1646, ("rel", 0.01)),
+          ("cl", 0, -0.0545, ("rel", 0.01)), ("cl", 1, -0.4496, ("rel", 0.01)), ("cl", 2, 0.1086, ("rel", 0.01)),
+          ("cl", 4, 0.0115, ("rel", 0.02)), ("cn", 4, -0.1804, ("rel", 0.01)), ("cn", 0, 0.0704, ("rel", 0.01)),
+          ("cn", 2, -0.1828, ("rel", 0.01)), ("cn", 3, 0.0574, ("rel", 0.01)), ("cn", 1, 0.1179, ("rel", 0.02))),
+         (), 0.5235987755982988, 1,
+         dict(alpha=(-6.0, 11.0), beta=(11.0, 13.5), bank=(25.0, 35.0), speed=(15.0, 30.0), alt_min=2000.0,
+              rate_std=3.0, rate_std_held=3.0, surface_std_min=(1.0, 1.0, 0.4)),
+         n_elevator_reads=3, min_lbf=0.05, untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -371,7 +394,7 @@ def test_names_resolve_and_roles(case):
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
     used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684",
-            "ultrastick", "b737", "c172p"}
+            "ultrastick", "b737", "c172p", "eternity"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
@@ -503,7 +526,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [p for p in _params()
                                   if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick",
-                                                          "b737", "c172p", "eternity")])
+                                                          "b737", "c172p", "eternity", "us25e")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse

@@ -1,0 +1,176 @@
+"""The us25e in the JSBSim harness: the twenty-second session's untouched aircraft (docs/jsbsim.md, "The us25e").
+
+The model is the University of Minnesota UAS Laboratories' JSBSim Ultra Stick 25e with its OpenFlight aerodynamics
+(UASLab/OpenFlightSim ``Simulation/aircraft/UltraStick25e``, the main file at 06a2b255, its parts at 1650a6e3, MIT),
+a 1.96-kg, 1.27-m-span research UAV whose aerodynamics are one constant per derivative on all six axes. Its files
+are checked in under ``data/jsbsim_models/ultrastick25e/`` and flown as the derived model ``UltraStick25e_glide``
+(``derived.py``): the MetricsOpenFlight, MassOpenFlight, Gear and AeroOpenFlight files in one, no propulsion, direct
+surfaces (+-30 deg) for the lab's control laws, actuators and sensors.
+
+The checks here use the files and JSBSim's own properties (the harness's initial condition, ``run_ic``, no
+turbulence: a mechanism check); none of them flies the harness:
+
+- the checked-in files are the README's, and the derivation changes no number;
+- the FCS maps the commands straight to the surfaces (+-30 deg, the right aileron the left's mirror), flaps 0;
+  no engine, no external force;
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its constants say;
+- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_eternity.py``).
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
+hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
+are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the us25e: its first evaluation is the final one, after the merge.
+"""
+
+import hashlib
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
+
+DIR = "data/jsbsim_models/ultrastick25e"
+#: file -> (bytes, SHA-256), as the README lists them.
+FILES = {
+    "UltraStick25e.xml": (550, "8d3e72ec043cd4d968e2d90f24f8f5d8839aefc39db9185891f01e1317a42b8e"),
+    "AeroOpenFlight.xml": (26790, "43ff5c1ea59acfebf1ea049b603d2d2451c203f0bbb40bb167955d543a80d7e5"),
+    "MassOpenFlight.xml": (426, "cddd379a722134ef3a1aa7d68c28360053ab0cc7ac58aede39174604c4e31c37"),
+    "MetricsOpenFlight.xml": (521, "ce119e72d565d7a7c2db14aa3cb8f13400b06d37d6db1afb24117ec413df1497"),
+    "Gear.xml": (1677, "7330a6bf1a1fca3f33c260eeb334cd094700c2c65fd4c8caf928526c61cefc9d"),
+}
+SURFACE = 0.5235987755982988      # every surface's end, rad (the lab's actuator clip, 30 deg)
+
+
+def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+    """:func:`truth_fits.ic_state` for the us25e."""
+    return ic_state(aircraft("us25e"), alpha_deg, beta_deg, cmds, r_rad_s)
+
+
+def test_the_derivation_assembles_the_files_and_changes_no_number():
+    """The checked-in files are the README's (bytes and SHA-256). ``UltraStick25e_glide`` holds
+    ``MetricsOpenFlight.xml``, ``MassOpenFlight.xml`` and ``Gear.xml`` as they are, an empty ``<propulsion>``, a
+    direct ``<flight_control>`` and ``AeroOpenFlight.xml`` with its reads of ``fcs/posElev_rad`` (3) and
+    ``fcs/posRud_rad`` (4) renamed ``fcs/elevator-pos-rad`` and ``fcs/rudder-pos-rad`` (nothing else: the same
+    functions and numbers); no system. The spec's notes carry the derived XML's hash."""
+    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
+    from benchmarks.jsbsim_harness.logfile import _REPO
+
+    for name, (n, sha) in FILES.items():
+        raw = (_REPO / DIR / name).read_bytes()
+        assert len(raw) == n and hashlib.sha256(raw).hexdigest() == sha, name
+    spec = aircraft("us25e")
+    assert spec.model == "UltraStick25e_glide" and REPO_DERIVED[spec.model][0] == f"{DIR}/UltraStick25e.xml"
+    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
+    der = ET.fromstring(derived_xml(spec.model))
+    canon = lambda e: "".join(ET.tostring(e, encoding="unicode").split())   # noqa: E731  (layout aside: ET.indent)
+    assert [c.tag for c in der] == ["fileheader", "metrics", "mass_balance", "ground_reactions", "propulsion",
+                                    "flight_control", "aerodynamics"]
+    for tag, name in (("metrics", "MetricsOpenFlight.xml"), ("mass_balance", "MassOpenFlight.xml"),
+                      ("ground_reactions", "Gear.xml")):
+        assert canon(der.find(tag)) == canon(ET.parse(_REPO / DIR / name).getroot()), tag
+    assert list(der.find("propulsion")) == [] and der.find("system") is None
+    aero = ET.parse(_REPO / DIR / "AeroOpenFlight.xml").getroot()
+    reads = [p.text for p in aero.iter("property")]
+    assert reads.count("fcs/posElev_rad") == 3 and reads.count("fcs/posRud_rad") == 4
+    for p in aero.iter("property"):
+        p.text = {"fcs/posElev_rad": "fcs/elevator-pos-rad", "fcs/posRud_rad": "fcs/rudder-pos-rad"}.get(p.text, p.text)
+    assert canon(aero) == canon(der.find("aerodynamics"))
+
+
+def test_the_us25e_flies_direct_surfaces_without_engine_or_external_force():
+    """The FCS maps each command straight to its surface, +-30 deg (``aerosurface_scale``, no actuator dynamics,
+    no damper): elevator -> ``fcs/elevator-pos-rad``, rudder -> ``fcs/rudder-pos-rad``, aileron ->
+    ``fcs/posAilL_rad`` and ``fcs/posAilR_rad`` = -left (the harness reads both, delta_a = -0.5 (left - right) =
+    -left); the flaps stay 0. No engine; after 50 frames every non-gravity force and moment is aerodynamic (1.959
+    kg: 4.32 lb). A yaw rate does not move the rudder."""
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    spec = aircraft("us25e")
+    assert not spec.gear_up and spec.aileron_props == ("fcs/posAilL_rad", "fcs/posAilR_rad")
+    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert fdm["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * SURFACE, rel=1e-9)
+    assert fdm["fcs/posAilL_rad"] == pytest.approx(-0.4 * SURFACE, rel=1e-9)
+    assert fdm["fcs/posAilR_rad"] == pytest.approx(0.4 * SURFACE, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * SURFACE, rel=1e-9)
+    assert fdm["fcs/posFlapL_rad"] == 0.0 and fdm["fcs/posFlapR_rad"] == 0.0
+    da = np.radians(5.0)      # trailing edge down on the right
+    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
+    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aero_is_the_only_force(fdm, 1.0, external_zero=True)
+
+
+def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_say():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic`` at the harness's initial condition, Mach 0.072).
+    The aerodynamic reference point is 4.5 mm ahead of the CG at its height; ``dCMm__alphaDot`` is 0.
+
+    - **Pitch:** Cm falls with alpha at -0.641 per rad over -4..8 deg (``dCMm__alpha`` -0.723 and the lift
+      ``dCL__alpha`` 4.58 through the 4.5-mm arm, 0.018 chords); the file's ``CMm`` coefficient is ``CMm__zero``
+      -0.0278 at alpha 0 (its sum reads all nine terms, the stray ``>`` of the stored file aside); per rad of
+      elevator -0.847 (``dCMm__dElev`` -0.8488 and ``dCL__dElev`` 0.0983 through the arm).
+    - **Roll and yaw:** per rad of left aileron (the right its mirror) Cl +0.1646 (0.0823 + 0.0823: the project's
+      Cl_delta_a -0.1646) and Cn -0.0574 (adverse: Cn_delta_a +0.0574); per rad of rudder Cn -0.1804 (``dCMn__dRud``
+      -0.1811 and the rudder's side force through the arm) and Cl +0.0115; Cl_beta -0.0545 and Cn_beta 0.0704
+      (``dCMn__beta`` 0.0723 less the side force's arm), the same at every alpha (constants).
+    """
+    def cm(alpha, de=0.0):
+        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
+        return fdm["moments/m-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"])
+
+    c_4, c0, c4, c8 = cm(-4.0), cm(0.0), cm(4.0), cm(8.0)
+    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
+    for a, b in ((c_4, c0), (c0, c4), (c4, c8)):
+        assert slope(a, b) == pytest.approx(-0.641, abs=0.003)
+    assert _state(alpha_deg=0.0)["aero/coefficient/CMm"] == pytest.approx(-0.0278, abs=1e-9)
+    for c in (-0.3, 0.3):
+        assert (cm(2.0, c) - cm(2.0)) / (c * SURFACE) == pytest.approx(-0.847, abs=0.002)
+
+    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
+        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds), aileron="fcs/posAilL_rad")
+
+    l0, n0, _, _ = lat()
+    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
+    for c in (0.3, -0.3):
+        l1, n1, a1, _ = lat((0.0, c, 0.0))
+        assert (l1 - l0) / a1 == pytest.approx(0.1646, abs=1e-4) and (n1 - n0) / a1 == pytest.approx(-0.0574, abs=1e-4)
+        l2, n2, _, r2 = lat((0.0, 0.0, c))
+        assert (n2 - n0) / r2 == pytest.approx(-0.1804, abs=2e-4) and (l2 - l0) / r2 == pytest.approx(0.0115, abs=1e-4)
+    for a in (-2.0, 2.0, 6.0):
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(beta=4.0, alpha=a)
+        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.0545, abs=1e-4), a
+        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0704, abs=3e-4), a
+
+
+def test_summaries_mark_the_us25e_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the us25e "(untouched)" and no other
+    aircraft, the eternity, c172p and ultrastick included (synthetic rows: no us25e result exists before the final
+    evaluation). Moved here from ``test_jsbsim_eternity.py`` (the twenty-first session's untouched aircraft)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
+           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| us25e (untouched) | light") for ln in lines)
+    for ac in acs[:18]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| us25e (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| eternity | clean |") for ln in lines)
