@@ -613,13 +613,18 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # flown as the ultrastick's: no propulsion, direct surfaces +-30 deg (the lab's actuator travel). Chosen in the
     # twenty-second session (docs/jsbsim.md, "The us25e"). Signs read from its aerodynamics: dCMm/dElev -0.8488
     # (positive = trailing edge down), dCMl/dAilL +0.0823 and dCMl/dAilR -0.0823 (the right driven as the mirror of
-    # the left, so delta_a = -left: Cl_delta_a -0.1646), dCMn/dRud -0.1811 (positive = nose left). Set from the
-    # harness's truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never from a method result.
+    # the left, so delta_a = -left: Cl_delta_a -0.1646), dCMn/dRud -0.1811 (positive = nose left). 34 kt at 10000 ft:
+    # 17-28 m/s TAS, alpha about -1..6 deg (p1-p99). Pulses 0.2 / 0.3 / 0.5 s (short period about 12 rad/s, Dutch
+    # roll about 7 rad/s, roll mode about 16 per s), amplitudes 5 / 5 / 4.5 deg, the ultrastick's gains but a yaw
+    # damper of 0.4: its rudder is 2.5 times its Cn_beta (a degree of rudder holds 2.5 deg of sideslip), so the rudder
+    # is small (sideslip under 10 deg clean, no knock-it-off with Cl:alpha*beta = 3) and its standard deviation under
+    # 1 deg (docs/jsbsim.md, "The us25e"). Set from the harness's truth only (alpha, beta, rates, excitation per axis,
+    # surfaces, sink), never from a method result.
     "us25e": AircraftSpec(
         name="us25e", model="UltraStick25e_glide", airspeed_kts=34.0, altitude_ft=10000.0,
         elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/posAilL_rad", "fcs/posAilR_rad"), rudder_sign=1.0,
         cmd_per_rad=(1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988, 1.0 / 0.5235987755982988),
-        amplitude_deg=(5.0, 5.0, 4.0), pulse_s=(0.2, 0.3, 0.5), gains=(0.25, 0.05, 0.01, 0.2, 0.05, 0.4),
+        amplitude_deg=(5.0, 5.0, 4.5), pulse_s=(0.2, 0.3, 0.5), gains=(0.25, 0.05, 0.01, 0.2, 0.05, 0.4),
         notes="Ultra Stick 25e UAV (UASLab OpenFlightSim JSBSim model with its OpenFlight aerodynamics, checked in "
               "under data/jsbsim_models/ultrastick25e) without propulsion, direct surfaces (derived model "
               "UltraStick25e_glide, XML sha256 8ea2d4e4a54bfe4f), fixed gear, gliding; untouched by any tuning of the "
