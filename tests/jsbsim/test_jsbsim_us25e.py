@@ -23,15 +23,14 @@ are slow.
 No pipeline fit, GP, diagnosis or scoring runs on the us25e: its first evaluation is the final one, after the merge.
 """
 
-import hashlib
 import json
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
+from truth_fits import (assert_openflightsim_assembly, assert_openflightsim_direct_surfaces, ic_state,
+                        lateral_coefficients)
 
 DIR = "data/jsbsim_models/ultrastick25e"
 #: file -> (bytes, SHA-256), as the README lists them.
@@ -56,29 +55,10 @@ def test_the_derivation_assembles_the_files_and_changes_no_number():
     direct ``<flight_control>`` and ``AeroOpenFlight.xml`` with its reads of ``fcs/posElev_rad`` (3) and
     ``fcs/posRud_rad`` (4) renamed ``fcs/elevator-pos-rad`` and ``fcs/rudder-pos-rad`` (nothing else: the same
     functions and numbers); no system. The spec's notes carry the derived XML's hash."""
-    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
-    from benchmarks.jsbsim_harness.logfile import _REPO
-
-    for name, (n, sha) in FILES.items():
-        raw = (_REPO / DIR / name).read_bytes()
-        assert len(raw) == n and hashlib.sha256(raw).hexdigest() == sha, name
-    spec = aircraft("us25e")
-    assert spec.model == "UltraStick25e_glide" and REPO_DERIVED[spec.model][0] == f"{DIR}/UltraStick25e.xml"
-    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
-    der = ET.fromstring(derived_xml(spec.model))
-    canon = lambda e: "".join(ET.tostring(e, encoding="unicode").split())   # noqa: E731  (layout aside: ET.indent)
-    assert [c.tag for c in der] == ["fileheader", "metrics", "mass_balance", "ground_reactions", "propulsion",
-                                    "flight_control", "aerodynamics"]
-    for tag, name in (("metrics", "MetricsOpenFlight.xml"), ("mass_balance", "MassOpenFlight.xml"),
-                      ("ground_reactions", "Gear.xml")):
-        assert canon(der.find(tag)) == canon(ET.parse(_REPO / DIR / name).getroot()), tag
-    assert list(der.find("propulsion")) == [] and der.find("system") is None
-    aero = ET.parse(_REPO / DIR / "AeroOpenFlight.xml").getroot()
-    reads = [p.text for p in aero.iter("property")]
-    assert reads.count("fcs/posElev_rad") == 3 and reads.count("fcs/posRud_rad") == 4
-    for p in aero.iter("property"):
-        p.text = {"fcs/posElev_rad": "fcs/elevator-pos-rad", "fcs/posRud_rad": "fcs/rudder-pos-rad"}.get(p.text, p.text)
-    assert canon(aero) == canon(der.find("aerodynamics"))
+    assert aircraft("us25e").model == "UltraStick25e_glide"
+    assert_openflightsim_assembly("us25e", DIR, FILES, (("metrics", "MetricsOpenFlight.xml"),
+                                  ("mass_balance", "MassOpenFlight.xml"), ("ground_reactions", "Gear.xml"),
+                                  ("aerodynamics", "AeroOpenFlight.xml")), {"fcs/posElev_rad": 3, "fcs/posRud_rad": 4})
 
 
 def test_the_us25e_flies_direct_surfaces_without_engine_or_external_force():
@@ -87,22 +67,8 @@ def test_the_us25e_flies_direct_surfaces_without_engine_or_external_force():
     ``fcs/posAilL_rad`` and ``fcs/posAilR_rad`` = -left (the harness reads both, delta_a = -0.5 (left - right) =
     -left); the flaps stay 0. No engine; after 50 frames every non-gravity force and moment is aerodynamic (1.959
     kg: 4.32 lb). A yaw rate does not move the rudder."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
-    spec = aircraft("us25e")
-    assert not spec.gear_up and spec.aileron_props == ("fcs/posAilL_rad", "fcs/posAilR_rad")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
-    assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * SURFACE, rel=1e-9)
-    assert fdm["fcs/posAilL_rad"] == pytest.approx(-0.4 * SURFACE, rel=1e-9)
-    assert fdm["fcs/posAilR_rad"] == pytest.approx(0.4 * SURFACE, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * SURFACE, rel=1e-9)
-    assert fdm["fcs/posFlapL_rad"] == 0.0 and fdm["fcs/posFlapR_rad"] == 0.0
-    da = np.radians(5.0)      # trailing edge down on the right
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
-    assert_aero_is_the_only_force(fdm, 1.0, external_zero=True)
+    assert_openflightsim_direct_surfaces("us25e", SURFACE, 1.0)
+    assert _state()["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
 
 
 def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_say():

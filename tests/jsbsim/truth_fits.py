@@ -518,3 +518,79 @@ def checked_in_model(name: str, model: str, src: str, n_bytes: int, sha256: str)
     assert spec.model == model and REPO_DERIVED[spec.model][0] == src
     assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
     return ET.fromstring(raw), ET.fromstring(derived_xml(spec.model)), spec
+
+
+def assert_openflightsim_assembly(name: str, folder: str, files: dict, parts: tuple, reads: dict) -> None:
+    """The checked-in files of a UASLab/OpenFlightSim model (the ultrastick's, the us25e's) are the ones its README
+    lists, and its derived model assembles them changing no number (``derived._openflightsim_glide``).
+
+    Args:
+        name: the harness aircraft.
+        folder: the checked-in folder, from the repository root.
+        files: file name -> (bytes, SHA-256), the main file first (the README's table).
+        parts: ``(tag, file)`` of the metrics, mass and gear files and, last, ``("aerodynamics", file)``.
+        reads: the aerodynamics' ``<property>`` reads renamed by the derivation -> how many there are
+            (``fcs/posElev_rad`` -> ``fcs/elevator-pos-rad``, ``fcs/posRud_rad`` -> ``fcs/rudder-pos-rad``).
+
+    Raises:
+        AssertionError: a file differs from the README, the derived model has another layout (the fileheader,
+            the three parts, an empty propulsion, the direct FCS, the aerodynamics; no system), a part differs
+            from its file, or the aerodynamics differ from the file but for the renamed reads.
+    """
+    import hashlib
+    import xml.etree.ElementTree as ET
+
+    from benchmarks.jsbsim_harness import aircraft
+    from benchmarks.jsbsim_harness.derived import REPO_DERIVED, derived_sha, derived_xml
+    from benchmarks.jsbsim_harness.logfile import _REPO
+
+    for f, (n, sha) in files.items():
+        raw = (_REPO / folder / f).read_bytes()
+        assert len(raw) == n and hashlib.sha256(raw).hexdigest() == sha, f
+    spec = aircraft(name)
+    assert REPO_DERIVED[spec.model][0] == f"{folder}/{next(iter(files))}"
+    assert f"XML sha256 {derived_sha(spec.model)}" in spec.notes
+    der = ET.fromstring(derived_xml(spec.model))
+    canon = lambda e: "".join(ET.tostring(e, encoding="unicode").split())   # noqa: E731  (layout aside: ET.indent)
+    assert [c.tag for c in der] == ["fileheader", "metrics", "mass_balance", "ground_reactions", "propulsion",
+                                    "flight_control", "aerodynamics"]
+    for tag, f in parts[:-1]:
+        assert canon(der.find(tag)) == canon(ET.parse(_REPO / folder / f).getroot()), tag
+    assert list(der.find("propulsion")) == [] and der.find("system") is None
+    aero = ET.parse(_REPO / folder / parts[-1][1]).getroot()
+    got = [p.text for p in aero.iter("property")]
+    assert {k: got.count(k) for k in reads} == reads
+    rename = {"fcs/posElev_rad": "fcs/elevator-pos-rad", "fcs/posRud_rad": "fcs/rudder-pos-rad"}
+    for p in aero.iter("property"):
+        p.text = rename.get(p.text, p.text)
+    assert canon(aero) == canon(der.find("aerodynamics"))
+
+
+def assert_openflightsim_direct_surfaces(name: str, surface_rad: float, min_lift_lbs: float) -> None:
+    """A UASLab/OpenFlightSim derived model (the ultrastick's, the us25e's) maps each command straight to its surface,
+    +-``surface_rad`` (``aerosurface_scale``, no actuator dynamics, no damper): elevator -> ``fcs/elevator-pos-rad``,
+    rudder -> ``fcs/rudder-pos-rad``, aileron -> ``fcs/posAilL_rad`` and ``fcs/posAilR_rad`` = -left (the harness reads
+    both, delta_a = -0.5 (left - right) = -left); the flaps stay 0; a yaw rate does not move the rudder. No engine;
+    after 50 frames every non-gravity force and moment is aerodynamic, at least ``min_lift_lbs`` of lift.
+
+    Raises:
+        AssertionError: the first check that fails.
+    """
+    import pytest
+
+    from benchmarks.jsbsim_harness import aircraft
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    spec = aircraft(name)
+    assert not spec.gear_up and spec.aileron_props == ("fcs/posAilL_rad", "fcs/posAilR_rad")
+    fdm = ic_state(spec, 2.0, 4.0, (0.3, -0.4, 0.2), 0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * surface_rad, rel=1e-9)
+    assert fdm["fcs/posAilL_rad"] == pytest.approx(-0.4 * surface_rad, rel=1e-9)
+    assert fdm["fcs/posAilR_rad"] == pytest.approx(0.4 * surface_rad, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * surface_rad, rel=1e-9)
+    assert fdm["fcs/posFlapL_rad"] == 0.0 and fdm["fcs/posFlapR_rad"] == 0.0
+    da = np.radians(5.0)      # trailing edge down on the right
+    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
+    assert _deflections(ic_state(spec, 2.0, 0.0, (0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aero_is_the_only_force(fdm, min_lift_lbs, external_zero=True)
