@@ -41,7 +41,9 @@ axis (``GPConfig(output_groups="kernels")``), ``nigpf`` = the same with free loa
 ``B`` and the noise covariance learned again on every training row (``GPConfig.coupling_rows = "all"``,
 twentieth session), ``nigpt`` = ``nigp`` with the signal coupling kept only for the outputs whose coupling
 the bound on every training row supports by a deflated likelihood-ratio test (``GPConfig.coupling_test = "lr"``,
-twenty-first session), and ``ls`` (cached).
+twenty-first session; since the twenty-second ``GPConfig``'s default, so ``nigp`` is the same), ``nigpu`` = ``nigp``
+with ``B``'s couplings as learned, untested (``coupling_test = "none"``, the default until the twenty-second
+session), and ``ls`` (cached).
 
 For the joint variants each line also carries the output correlations (issue 8, "no learned
 output correlation above 0.5 where the truth has none"): ``corr_learned`` (``output_correlation``),
@@ -115,7 +117,7 @@ from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
                                 truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "ls")
+VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "nigpu", "ls")
 
 #: |truth correlation| below which the truth "has none" (the flags of the joint variants)
 TRUTH_NONE = 0.2
@@ -185,8 +187,10 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True, output_groups="output-kernels")
     if variant == "nigpr":        # nigp with B and the noise covariance learned again on every row (GPConfig.coupling_rows)
         return replace(base, noise_correlation=True, input_noise=True, coupling_rows="all")
-    if variant == "nigpt":        # nigp, coupling kept where the every-row bound supports it (GPConfig.coupling_test)
-        return replace(base, noise_correlation=True, input_noise=True, coupling_test="lr")
+    if variant == "nigpt":        # nigp, coupling kept where the every-row bound supports it (GPConfig.coupling_test;
+        return replace(base, noise_correlation=True, input_noise=True, coupling_test="lr")   # the default since s22)
+    if variant == "nigpu":        # nigp with B's couplings as learned, untested (the default until the twenty-second session)
+        return replace(base, noise_correlation=True, input_noise=True, coupling_test="none")
     if variant == "nigpc":
         return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
     if variant == "lsres":
@@ -271,7 +275,7 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             else:
                 model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
                 model = with_offset_covariance(model, off)
-                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt"):
+                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "nigpu"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = model.predict(X[h], include_noise=False)
@@ -526,7 +530,7 @@ def summarize(paths) -> str:
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("nigpt", "nigp"), ("nigpt", "indep"), ("nigpt", "ls"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("nigpt", "nigp"), ("nigpt", "indep"), ("nigpt", "ls"), ("nigp", "nigpu"), ("nigpu", "indep"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]

@@ -242,6 +242,13 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
                                           for i in range(6)]))
     row["cov_gp_obs_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma_obs[h, i], Yt[h, i]) for i in range(6)]
     model = load_gp(Path(res.model_path))
+    if hasattr(model, "output_correlation"):
+        # the largest learned correlation between two outputs' latent parts (issue 8: none above 0.5 where the
+        # truth has none); gcs_sysid.pipeline.GP_COUPLING_TEST "lr" (the default) drops B's couplings the data do not support
+        C = np.abs(np.asarray(model.output_correlation(), float))
+        np.fill_diagonal(C, 0.0)
+        row["max_corr"] = float(np.nanmax(C)) if C.size else 0.0
+        row["gp_coupling_test"] = _pipeline.GP_COUPLING_TEST
     if model.discrepancy is not None and model.n_outputs == 6:
         # a diagnosis, not a criterion: the coefficient band with its coloured noise share floored at the
         # blocked validation's discrepancy d (as at exact conditions)
@@ -395,9 +402,11 @@ def main(argv=None) -> int:
                          "gcs_sysid.aero.gustfilter.GUST_FILTER)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
-    ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated"),
+    ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated", "untested"),
                     help="the replay's GP settings: 'decorrelated' sets gcs_sysid.pipeline.USE_DECORRELATED_GP "
-                         "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md)")
+                         "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); 'untested' sets "
+                         "gcs_sysid.pipeline.GP_COUPLING_TEST = 'none' (B's couplings kept as learned, without the "
+                         "every-row likelihood-ratio test: the default until the twenty-second session)")
     ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
                     help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
                          "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
@@ -460,6 +469,7 @@ def main(argv=None) -> int:
         import gcs_sysid.pipeline as pipeline
 
         pipeline.USE_DECORRELATED_GP = a.gp_fit == "decorrelated"
+        pipeline.GP_COUPLING_TEST = "none" if a.gp_fit == "untested" else "lr"
     if a.cy_rate_prior is not None:
         import gcs_sysid.pipeline as pipeline
 

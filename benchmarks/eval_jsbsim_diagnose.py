@@ -34,6 +34,11 @@ each injected cause must be named or an alias of some finding. Why: when two can
 on the flight (the t6's ``scale:CY`` and ``CY:beta``, partial correlation 0.99997), no data from that
 flight can rank them, and the diagnosis reports both readings; scoring only the first would score a coin
 the data never tossed. A clean flight is still ``ok`` only when nothing is named (aliases name nothing).
+Since the twenty-second session (decided before its freeze) an injected ``CY:scale`` is also read, in the
+with-aliases scores only, by a ``CY:beta`` finding when the flown model's side force is that one term
+(``side_terms`` 1: the eternity, t6 and b737; :func:`side_axis_terms`): a factor on ``CY_beta beta`` is that factor
+on ``CY_beta``, one hypothesis of the aircraft whatever the flight shows, scored as ``estimate / model_value - 1``
+against ``body_axis_value`` (:func:`_one_term_alias`).
 
 Usage::
 
@@ -251,7 +256,32 @@ def scoring_truth(truth: dict, truth_npz) -> dict:
             e["value"] = e["wind_axis_value"] = k - 1.0
             if "body_axis_value" not in e:
                 e["body_axis_value"] = side_force_scale_truth(truth_npz, k)
+            if "side_terms" not in e and truth.get("aircraft"):
+                e["side_terms"] = len(side_axis_terms(truth["aircraft"]))
     return out
+
+
+def side_axis_terms(ac: str) -> list[str]:
+    """The names of the functions summed on the SIDE axis of aircraft ``ac``'s flown (stock or derived) JSBSim
+    model, read from its XML in the wheel's aircraft folder; [] when the model cannot be read.
+
+    Used by :func:`score_case`'s one-term alias (twenty-second session): on a model whose side force is one
+    term (eternity, t6, b737: ``CY_beta`` alone), a scale of the whole side force *is* a change of that term's
+    derivative, so a ``CY:beta`` finding reads the injected ``CY:scale``."""
+    import xml.etree.ElementTree as ET
+
+    from benchmarks.jsbsim_harness.aircraft import aircraft
+    from benchmarks.jsbsim_harness.effects import stock_model_dir
+
+    try:
+        spec = aircraft(ac)
+        root = ET.parse(stock_model_dir(spec) / f"{spec.model}.xml").getroot()
+    except (KeyError, ValueError, OSError, ET.ParseError):
+        return []
+    for ax in root.iter("axis"):
+        if ax.get("name") == "SIDE":
+            return [f.get("name") or "" for f in ax.findall("function")]
+    return []
 
 
 def rescore(path: str) -> list[dict]:
@@ -288,6 +318,11 @@ def _estimate_scores(f: dict, e: dict) -> dict:
                 std_error_decision=se_d, cover_decision=se_d > 0 and abs(est - e["value"]) <= 2 * se_d)
 
 
+def _g3(x) -> str:
+    """``x`` to 3 significant figures, or "?" when it is None (an alias without an estimate)."""
+    return "?" if x is None else f"{x:.3g}"
+
+
 def _with_alias(findings: list[dict], cause: str) -> tuple[dict | None, dict | None]:
     """``(finding, alias)``: the first finding whose reported aliases include ``cause`` and that alias."""
     for f in findings:
@@ -295,6 +330,32 @@ def _with_alias(findings: list[dict], cause: str) -> tuple[dict | None, dict | N
             if a["cause"] == cause:
                 return f, a
     return None, None
+
+
+def _one_term_alias(findings: list[dict], e: dict) -> dict | None:
+    """The with-aliases score of an injected ``scale:CY`` read by a ``CY:beta`` finding, when the flown model's side
+    force is that one term (``e["side_terms"] == 1``, :func:`side_axis_terms`); None otherwise.
+
+    A factor ``k`` on a side force ``CY_beta beta`` is the factor ``k`` on ``CY_beta``: the two causes are one
+    hypothesis of the aircraft, whatever the data (decided in the twenty-second session, before its freeze, after
+    the eternity's six ``CY:scale`` cases were all named ``CY:beta``). The estimate is the finding's relative
+    change of the body-axis derivative, ``estimate / model_value - 1``, scored against the body-axis equivalent
+    of the injected factor (``body_axis_value``, :func:`side_force_scale_truth`: the drag's part of the body-axis
+    ``CY_beta`` is not scaled); a finding without a reference value (``model_value`` missing or 0) gets no
+    estimate score. The gain is the finding's own."""
+    if e["cause"] != "scale:CY" or e.get("side_terms") != 1:
+        return None
+    f = next((f for f in findings if f["cause"] == "CY:beta"), None)
+    if f is None:
+        return None
+    gain = float((f.get("gain") or {}).get("percent", f.get("gain_pct")) or 0.0)
+    mv = f.get("model_value")
+    target = float(e.get("body_axis_value", e["value"]))
+    est = float(f["estimate"]) / float(mv) - 1.0 if mv else None
+    se = float(f.get("std_error") or 0.0) / abs(float(mv)) if mv else 0.0
+    return {"via_alias": "CY:beta (one-term side force)", "estimate_alias": est, "gain_pct_alias": gain,
+            "est_alias": est is not None and abs(est - target) <= 0.25 * abs(target), "gain_alias": gain >= 50.0,
+            "cover_alias": est is not None and se > 0 and abs(est - target) <= 2 * se}
 
 
 def score_case(findings: list[dict], truth: dict) -> dict:
@@ -326,6 +387,8 @@ def score_case(findings: list[dict], truth: dict) -> dict:
             row.update(top_alias=True, via_alias=g["cause"], estimate_alias=sa["estimate"],
                        gain_pct_alias=sa["gain_pct"], est_alias=sa["est"], gain_alias=sa["gain"],
                        cover_alias=sa["cover"])
+        elif (t := _one_term_alias(findings[:1] if len(inj) == 1 else findings, e)) is not None:
+            row.update(top_alias=True, **t)
         else:
             row.update(top_alias=False, est_alias=False, gain_alias=False)
         rows.append(row)
@@ -416,7 +479,7 @@ def summarize(paths: list[str]) -> str:
         desc = "; ".join(
             f"s{r['seed']} " + ", ".join(
                 f"{e['cause']} {e['estimate']:.3g} ({e['value']:.3g})" if e["found"] else
-                f"[{e['via_alias']} ~ {e['cause']} {e['estimate_alias']:.3g}] ({e['value']:.3g})" if e.get("via_alias") else
+                f"[{e['via_alias']} ~ {e['cause']} {_g3(e.get('estimate_alias'))}] ({e['value']:.3g})" if e.get("via_alias") else
                 f"[{', '.join(r['score'].get('named', [])[:2]) or 'nothing'}] ({e['value']:.3g})"
                 for e in r["score"].get("effects", []))
             for r in rs)

@@ -113,6 +113,12 @@ DECORRELATED_GP = {"noise_correlation": True, "hyper_stride": 0, "coupling": "of
 #: i8-decnt, for what it gains and loses in eval_jsbsim).
 USE_DECORRELATED_GP = False
 
+#: The replay's ``GPConfig.coupling_test`` (twenty-second session): ``"lr"`` (the default, as ``GPConfig``'s) keeps an
+#: output's coupling only where the deflated likelihood-ratio test on every training row supports it
+#: (:func:`gcs_sysid.gp.joint.lr_coupling`; docs/gp.md, "Coupling the data determine"); ``"none"`` keeps B's
+#: off-diagonals as learned (the default until the twenty-second session; ``eval_jsbsim --gp-fit untested``).
+GP_COUPLING_TEST = "lr"
+
 #: Opt-in (nineteenth session, i8-cyr): the std (CY per unit ``p_hat`` / ``r_hat``) of a zero-mean prior on CY's two
 #: rate slopes, imposed by mixed estimation on the GP's training target (:func:`gcs_sysid.gp.mixed.apply_slope_prior`;
 #: Theil and Goldberger 1961; ``docs/gp.md``, "Prior knowledge on the side-force rate slopes"). None: no prior (the
@@ -407,6 +413,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 else:
                     cfg = GPConfig(**(ALPHA_DOT_GP if use_adot else {}),
                                    **(DECORRELATED_GP if USE_DECORRELATED_GP else {}),
+                                   coupling_test=GP_COUPLING_TEST,
                                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
                     names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
                     prior = side_force_rate_prior(SIDE_FORCE_RATE_PRIOR_STD)

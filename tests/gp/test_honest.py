@@ -199,7 +199,7 @@ def test_noise_start_and_hyper_stride_are_checked():
     assert replace(CFG, coupling_rows="all").coupling_rows == "all" and CFG.coupling_rows == "subset"
     with pytest.raises(InputError, match="coupling_test"):
         replace(CFG, coupling_test="t")
-    assert replace(CFG, coupling_test="lr").coupling_test == "lr" and CFG.coupling_test == "none"
+    assert replace(CFG, coupling_test="none").coupling_test == "none" and CFG.coupling_test == "lr"   # default since s22
 
 
 def test_coupling_off_learns_with_the_coupling_and_keeps_none():

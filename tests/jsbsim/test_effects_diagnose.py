@@ -205,3 +205,31 @@ def test_windy_clean_flights_name_no_cause(tmp_path, ac, seed):
     _, model_path, ref = reference_model(ac, tmp_path)
     findings, truth, _ = diagnose_case(ac, seed, [], tmp_path, model_path, ref)
     assert score_case(findings, truth)["ok"], [f["cause"] for f in findings]
+
+
+def test_one_term_side_force_scale_is_read_by_its_term():
+    """On a model whose side force is one term (``side_terms`` 1: eternity, t6, b737), a ``CY:beta`` finding reads an
+    injected ``CY:scale`` in the with-aliases scores, as the relative change of the derivative against the
+    body-axis factor; the strict scores are untouched, and a side force of several terms gets no such alias."""
+    truth = {"injected": [{"cause": "scale:CY", "value": 0.6, "body_axis_value": 0.55, "side_terms": 1}]}
+    f = [{"cause": "CY:beta", "estimate": -0.35, "model_value": -0.226, "std_error": 0.03, "gain": {"percent": 80}}]
+    sc = score_case(f, truth)
+    row = sc["effects"][0]
+    assert not sc["ok"] and not row["top"]                                     # strict: still not named
+    assert sc["ok_alias"] and row["top_alias"] and row["est_alias"] and row["gain_alias"]
+    assert row["estimate_alias"] == pytest.approx(0.35 / 0.226 - 1)
+    # a factor 1.29 for 1.55 is not within 25 %; no reference value: no estimate score; gain below 50 %: no gain
+    assert not score_case([dict(f[0], estimate=-0.292)], truth)["effects"][0]["est_alias"]
+    assert not score_case([dict(f[0], model_value=None)], truth)["effects"][0]["est_alias"]
+    assert not score_case([dict(f[0], gain={"percent": 40})], truth)["effects"][0]["gain_alias"]
+    # several side-force terms, or another top finding: no alias
+    many = {"injected": [dict(truth["injected"][0], side_terms=5)]}
+    assert not score_case(f, many)["effects"][0]["top_alias"]
+    assert not score_case([{"cause": "Cm:delta_e", "estimate": 0.1, "gain": {"percent": 80}}] + f, truth)["effects"][0]["top_alias"]
+
+
+def test_side_axis_terms_reads_the_flown_model():
+    from benchmarks.eval_jsbsim_diagnose import side_axis_terms
+
+    assert len(side_axis_terms("eternity")) == 1 and len(side_axis_terms("c172x")) == 5
+    assert side_axis_terms("no-such-aircraft") == []
