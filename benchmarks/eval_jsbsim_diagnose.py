@@ -35,9 +35,9 @@ on the flight (the t6's ``scale:CY`` and ``CY:beta``, partial correlation 0.9999
 flight can rank them, and the diagnosis reports both readings; scoring only the first would score a coin
 the data never tossed. A clean flight is still ``ok`` only when nothing is named (aliases name nothing).
 Since the twenty-second session (decided before its freeze) an injected ``CY:scale`` is also read, in the
-with-aliases scores only, by a ``CY:beta`` finding when the flown model's side force is that one term
-(``side_terms`` 1: the eternity, t6 and b737; :func:`side_axis_terms`): a factor on ``CY_beta beta`` is that factor
-on ``CY_beta``, one hypothesis of the aircraft whatever the flight shows, scored as ``estimate / model_value - 1``
+with-aliases scores only, by a ``CY:beta`` finding when the flown model's side force reads beta alone
+(:func:`side_axis_variables`; nine roster aircraft, among them the eternity, t6 and b737): a factor on a side force
+of beta alone is that factor on ``CY_beta``, one hypothesis of the aircraft whatever the flight shows, scored as ``estimate / model_value - 1``
 against ``body_axis_value`` (:func:`_one_term_alias`).
 
 Usage::
@@ -78,7 +78,7 @@ from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "side_force_scale_truth", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
+__all__ = ["reference_model", "diagnose_case", "score_case", "side_force_scale_truth", "side_axis_variables", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -256,18 +256,21 @@ def scoring_truth(truth: dict, truth_npz) -> dict:
             e["value"] = e["wind_axis_value"] = k - 1.0
             if "body_axis_value" not in e:
                 e["body_axis_value"] = side_force_scale_truth(truth_npz, k)
-            if "side_terms" not in e and truth.get("aircraft"):
-                e["side_terms"] = len(side_axis_terms(truth["aircraft"]))
+            if "side_variables" not in e and truth.get("aircraft"):
+                e["side_variables"] = side_axis_variables(truth["aircraft"])
     return out
 
 
-def side_axis_terms(ac: str) -> list[str]:
-    """The names of the functions summed on the SIDE axis of aircraft ``ac``'s flown (stock or derived) JSBSim
-    model, read from its XML in the wheel's aircraft folder; [] when the model cannot be read.
+def side_axis_variables(ac: str) -> list[str]:
+    """The properties aircraft ``ac``'s flown (stock or derived) JSBSim model reads on its SIDE axis, less the
+    scaling ones (``aero/qbar-*``, ``metrics/*``), sorted; read from its XML in the wheel's aircraft folder (every
+    ``<property>`` and table ``<independentVar>`` of the axis); [] when the model cannot be read.
 
-    Used by :func:`score_case`'s one-term alias (twenty-second session): on a model whose side force is one
-    term (eternity, t6, b737: ``CY_beta`` alone), a scale of the whole side force *is* a change of that term's
-    derivative, so a ``CY:beta`` finding reads the injected ``CY:scale``."""
+    Used by :func:`score_case`'s one-term alias (twenty-second session): where the side force reads beta alone
+    (``["aero/beta-rad"]``: the eternity, t6, b737, b747, f4n, rascal, sgs126, iar80 and c684 of the roster), a scale
+    of the whole side force *is* a change of its beta derivative, so a ``CY:beta`` finding reads the injected
+    ``CY:scale``. A side force summed elsewhere (OpenFlight's ``aero/coefficient/CY``: the ultrastick, us25e) or
+    reading rates and surfaces is not one term."""
     import xml.etree.ElementTree as ET
 
     from benchmarks.jsbsim_harness.aircraft import aircraft
@@ -280,9 +283,13 @@ def side_axis_terms(ac: str) -> list[str]:
         return []
     for ax in root.iter("axis"):
         if ax.get("name") == "SIDE":
-            return [f.get("name") or "" for f in ax.findall("function")]
+            names = {(e.text or "").strip() for e in ax.iter() if e.tag in ("property", "independentVar")}
+            return sorted(n for n in names if n and not n.startswith(("aero/qbar", "metrics/")))
     return []
 
+
+#: the side-axis properties that are beta (:func:`side_axis_variables`, :func:`_one_term_alias`)
+BETA_PROPERTIES = frozenset({"aero/beta-rad", "aero/beta-deg"})
 
 def rescore(path: str) -> list[dict]:
     """The records of a ``results.jsonl`` scored again by :func:`score_case` against :func:`scoring_truth`
@@ -334,7 +341,8 @@ def _with_alias(findings: list[dict], cause: str) -> tuple[dict | None, dict | N
 
 def _one_term_alias(findings: list[dict], e: dict) -> dict | None:
     """The with-aliases score of an injected ``scale:CY`` read by a ``CY:beta`` finding, when the flown model's side
-    force is that one term (``e["side_terms"] == 1``, :func:`side_axis_terms`); None otherwise.
+    force reads beta alone (``e["side_variables"]`` within :data:`BETA_PROPERTIES`, :func:`side_axis_variables`);
+    None otherwise.
 
     A factor ``k`` on a side force ``CY_beta beta`` is the factor ``k`` on ``CY_beta``: the two causes are one
     hypothesis of the aircraft, whatever the data (decided in the twenty-second session, before its freeze, after
@@ -343,7 +351,7 @@ def _one_term_alias(findings: list[dict], e: dict) -> dict | None:
     of the injected factor (``body_axis_value``, :func:`side_force_scale_truth`: the drag's part of the body-axis
     ``CY_beta`` is not scaled); a finding without a reference value (``model_value`` missing or 0) gets no
     estimate score. The gain is the finding's own."""
-    if e["cause"] != "scale:CY" or e.get("side_terms") != 1:
+    if e["cause"] != "scale:CY" or not e.get("side_variables") or not set(e["side_variables"]) <= BETA_PROPERTIES:
         return None
     f = next((f for f in findings if f["cause"] == "CY:beta"), None)
     if f is None:

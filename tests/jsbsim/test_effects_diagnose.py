@@ -208,10 +208,10 @@ def test_windy_clean_flights_name_no_cause(tmp_path, ac, seed):
 
 
 def test_one_term_side_force_scale_is_read_by_its_term():
-    """On a model whose side force is one term (``side_terms`` 1: eternity, t6, b737), a ``CY:beta`` finding reads an
+    """On a model whose side force reads beta alone (eternity, t6, b737 ...), a ``CY:beta`` finding reads an
     injected ``CY:scale`` in the with-aliases scores, as the relative change of the derivative against the
     body-axis factor; the strict scores are untouched, and a side force of several terms gets no such alias."""
-    truth = {"injected": [{"cause": "scale:CY", "value": 0.6, "body_axis_value": 0.55, "side_terms": 1}]}
+    truth = {"injected": [{"cause": "scale:CY", "value": 0.6, "body_axis_value": 0.55, "side_variables": ["aero/beta-rad"]}]}
     f = [{"cause": "CY:beta", "estimate": -0.35, "model_value": -0.226, "std_error": 0.03, "gain": {"percent": 80}}]
     sc = score_case(f, truth)
     row = sc["effects"][0]
@@ -223,13 +223,15 @@ def test_one_term_side_force_scale_is_read_by_its_term():
     assert not score_case([dict(f[0], model_value=None)], truth)["effects"][0]["est_alias"]
     assert not score_case([dict(f[0], gain={"percent": 40})], truth)["effects"][0]["gain_alias"]
     # several side-force terms, or another top finding: no alias
-    many = {"injected": [dict(truth["injected"][0], side_terms=5)]}
+    many = {"injected": [dict(truth["injected"][0], side_variables=["aero/beta-rad", "fcs/rudder-pos-rad"])]}
     assert not score_case(f, many)["effects"][0]["top_alias"]
     assert not score_case([{"cause": "Cm:delta_e", "estimate": 0.1, "gain": {"percent": 80}}] + f, truth)["effects"][0]["top_alias"]
 
 
-def test_side_axis_terms_reads_the_flown_model():
-    from benchmarks.eval_jsbsim_diagnose import side_axis_terms
+def test_side_axis_variables_reads_the_flown_model():
+    from benchmarks.eval_jsbsim_diagnose import side_axis_variables
 
-    assert len(side_axis_terms("eternity")) == 1 and len(side_axis_terms("c172x")) == 5
-    assert side_axis_terms("no-such-aircraft") == []
+    assert side_axis_variables("eternity") == ["aero/beta-rad"] == side_axis_variables("t6")
+    assert "fcs/rudder-pos-rad" in side_axis_variables("c172x") and "velocities/r-aero-rad_sec" in side_axis_variables("c172x")
+    assert side_axis_variables("ultrastick") == ["aero/coefficient/CY"]     # summed elsewhere: not one term
+    assert side_axis_variables("no-such-aircraft") == []
