@@ -430,8 +430,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                                            [COEFFICIENTS[i] for i in fit_cols],
                                                            {"Cl": roll_gp_slopes(gust_fit)})
                         notes += [f"{o}: {', '.join(d['inputs'])} slopes fixed at the roll fit's (least squares "
-                                  "on p_hat - p_g -> fixed): " + ", ".join(f"{k} {d['ls'][k]:.3g} -> {d['fixed'][k]:.3g}"
-                                                                            for k in d["inputs"])
+                                  "on p_hat - p_g -> fixed): "
+                                  + ", ".join(f"{k} {d['ls'][k]:.3g} -> {d['fixed'][k]:.3g}" for k in d["inputs"])
                                   for o, d in info.items()]
                     model, _history = fit_gp(X_train, Y_train, cfg, input_names=names,
                                              output_names=[COEFFICIENTS[i] for i in fit_cols])

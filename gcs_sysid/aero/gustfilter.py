@@ -43,7 +43,8 @@ import numpy as np
 
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_GP_SLOPES", "roll_gp_slopes", "INSTRUMENT_DELAYS_S", "LAT_TERMS", "RollGustFit", "fit_roll_gust",
+__all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_GP_SLOPES", "roll_gp_slopes", "INSTRUMENT_DELAYS_S",
+           "LAT_TERMS", "RollGustFit", "fit_roll_gust",
            "instruments",
            "stated_moment_variance", "filter_gust_table"]
 
