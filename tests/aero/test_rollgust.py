@@ -118,7 +118,8 @@ def test_gp_rows_on_p_less_the_gust_alone_lose_the_fits_slopes_and_the_fixed_tar
     Cl_delta_a -0.227..-0.230 on seeds 0-2 where the fit gives -0.46..-0.50 and about -0.25 (truth -0.5, -0.25):
     the gust was estimated for the causal step moment, and the damping step is divided out of the fit's slopes only.
     :func:`gcs_sysid.gp.mixed.apply_fixed_slopes` with :func:`gcs_sysid.aero.gustfilter.roll_gp_slopes` makes least
-    squares of the GP's target return the fit's slopes. A fixed ``R`` is kept (the likelihood's runs to its lower bound, 2e-15)."""
+    squares of the GP's target return the fit's slopes. A fixed ``R`` is kept (the likelihood's runs to its lower
+    bound, 2e-15)."""
     from gcs_sysid.aero.gustfilter import ROLL_GP_SLOPES, roll_gp_slopes
     from gcs_sysid.gp.mixed import apply_fixed_slopes
 
