@@ -383,7 +383,8 @@ def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = 
                    f"1.9 sigma/sqrt(L b) from the reconstructed wind (at least {ROLL_MIN_DRYDEN_RATIO} needed: "
                    "the roll moment does not read the gust); " + G.notes[0])
             return replace(table, notes=list(table.notes) + [why]), None
-        return _take_out(table, G, f"; its SD {ratio:.2f} of the Dryden one from the wind"), G
+        prior = float(np.var(G.g[G.used])) if method == "rollgp" else None
+        return _take_out(table, G, f"; its SD {ratio:.2f} of the Dryden one from the wind", prior), G
     Rs = stated_moment_variance(states, airframe, table.qbar, rows)
     if Rs is None:
         return replace(table, notes=list(table.notes) + ["gust filter not run: no stated p_dot r_dot noise"]), None
@@ -412,8 +413,13 @@ def _dryden_ratio(G: RollGustFit, data: dict, table, dt: float, b: float) -> flo
     return float(G.sigma / exp_g) if exp_g > 0 else float("nan")
 
 
-def _take_out(table, G: RollGustFit, extra: str = ""):
-    """The table with ``G.g`` taken out of ``p_hat`` and ``G.g_var`` added to its ``x_var`` (a new table)."""
+def _take_out(table, G: RollGustFit, extra: str = "", prior_var: float | None = None):
+    """The table with ``G.g`` taken out of ``p_hat`` and ``G.g_var`` added to its ``x_var`` (a new table).
+
+    ``prior_var``: the variance of ``p_hat_g`` stated on the rows the fit did not use (the held-out rows) when it is
+    larger than the fit's process variance ``sigma**2`` (``"rollgp"``: the smoothed gust's own variance over the rows
+    used; the fitted ``sigma`` is about 0.57 of the true gust's SD on the c172p while the smoothed gust's SD is
+    1.0-1.15x it, twenty-second session, i8-rollgp)."""
     from dataclasses import replace
 
     T = len(table.t)
@@ -421,6 +427,7 @@ def _take_out(table, G: RollGustFit, extra: str = ""):
     X = table.X.copy()
     X[:, j] -= G.g
     xv = np.full((T, len(REGRESSORS)), np.nan) if table.x_var is None else table.x_var.copy()
-    xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + G.g_var
+    g_var = G.g_var if prior_var is None else np.where(G.used, G.g_var, np.maximum(G.g_var, prior_var))
+    xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + g_var
     note = G.notes[0] + extra + " (taken out of p_hat on the training rows)"
     return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note])

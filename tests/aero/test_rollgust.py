@@ -146,3 +146,36 @@ def test_gp_rows_on_p_less_the_gust_alone_lose_the_fits_slopes_and_the_fixed_tar
         rg.fit_roll_dynamics(DT, X, Y, p, np.full(n, QBAR), np.ones(n, bool), IXX, S, B, R=0.0)
     with pytest.raises(ValueError, match="not among"):
         roll_gp_slopes(F, ("q_hat",))
+
+
+def test_rollgp_states_the_smoothed_gusts_variance_on_rows_the_fit_did_not_use():
+    """``method="rollgp"`` states ``max(sigma**2, var g_hat)`` for ``p_hat`` on the rows the fit did not use (a
+    held-out block), ``"roll"`` the fitted process variance ``sigma**2``; the rows used carry the smoother's. Here,
+    as on JSBSim's flights, the fitted ``sigma**2`` is short of the gust's variance (0.63 of it on seed 0) and the
+    smoothed gust's variance is the gust's (1.00)."""
+    from types import SimpleNamespace
+
+    from gcs_sysid.aero.gustfilter import filter_gust_table
+    from gcs_sysid.aero.table import CoefficientTable
+
+    X, Y, p, g = _record()
+    n = len(X)
+    rng = np.random.default_rng(1)
+    wind = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)] * 0.5
+    st = SimpleNamespace(data={"p": p, "wn": wind[:, 0], "we": wind[:, 1], "wd": wind[:, 2]})
+    train = np.ones(n, bool)
+    train[3000:3500] = False
+    tab = CoefficientTable(np.arange(n) * DT, X, Y, np.ones(n, bool), np.full(n, QBAR))
+    air = SimpleNamespace(Ixx=IXX, S=S, b=B)
+    j = REGRESSORS.index("p_hat")
+    rolls = {}
+    for m in ("roll", "rollgp"):
+        t, G = filter_gust_table(tab, st, air, train, method=m)
+        assert G is not None, t.notes[-1]
+        rolls[m] = (t.x_var[:, j], G)
+    (v1, G1), (v2, G2) = rolls["roll"], rolls["rollgp"]
+    assert np.allclose(v1[3000:3500], G1.sigma**2)
+    vg = np.var(G2.g[G2.used])
+    assert G2.sigma**2 < 0.8 * vg and abs(vg / np.var(g[G2.used]) - 1) < 0.2
+    assert np.allclose(v2[3000:3500], vg)
+    assert np.allclose(v2[G2.used], G2.g_var[G2.used])
