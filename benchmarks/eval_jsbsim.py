@@ -395,10 +395,11 @@ def main(argv=None) -> int:
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
     ap.add_argument("--duration", type=float, default=120.0, help="logged flight time per flight, s")
-    ap.add_argument("--gust-filter", default=None, choices=("on", "off", "roll"),
+    ap.add_argument("--gust-filter", default=None, choices=("on", "off", "roll", "rollgp"),
                     help="train the GP on p_hat less the filter-error p_g (ReplayOptions.gust_filter; 'on': the "
                          "measured Cl as output, 2SLS slopes; 'roll': p_g a state of the roll dynamics, "
-                         "gcs_sysid.aero.rollgust; default: the replay's default, "
+                         "gcs_sysid.aero.rollgust; 'rollgp': the same with the moment's stated noise and the GP "
+                         "given the fit's Cl slopes; default: the replay's default, "
                          "gcs_sysid.aero.gustfilter.GUST_FILTER)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
@@ -482,7 +483,7 @@ def main(argv=None) -> int:
             for seed in a.seeds:
                 row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates,
                                None if a.gust_filter is None else
-                               {"on": True, "off": False, "roll": "roll"}[a.gust_filter])
+                               {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter])
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"

@@ -73,7 +73,10 @@ class ReplayOptions:
             the held-out rows keep the gyro's hats (``p_g = 0``, its prior mean, with the prior variance stated in
             the band). True or ``"2sls"``: the measured Cl as the filter's output, slopes by two-stage least
             squares; ``"roll"``: the gust a state of the roll dynamics, estimated with the slopes from the causal
-            step moment (:mod:`gcs_sysid.aero.rollgust`). None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
+            step moment (:mod:`gcs_sysid.aero.rollgust`); ``"rollgp"``: the same with the moment's noise at the
+            smoother's stated variance, and the GP's Cl target given the fit's slopes of
+            :data:`gcs_sysid.aero.gustfilter.ROLL_GP_SLOPES` (:func:`gcs_sysid.gp.mixed.apply_fixed_slopes`).
+            None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
     """
 
     rate_hz: float = 50.0
@@ -366,10 +369,11 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         from .aero.gustfilter import GUST_FILTER, filter_gust_table
 
         gust_filter = GUST_FILTER if options.gust_filter is None else options.gust_filter
+        gust_fit = None
         if gust_filter:
             with _stage("gust filter", timings, bar):
-                table = filter_gust_table(table, states, airframe, train,
-                                          method=gust_filter if isinstance(gust_filter, str) else "2sls")[0]
+                table, gust_fit = filter_gust_table(table, states, airframe, train,
+                                                    method=gust_filter if isinstance(gust_filter, str) else "2sls")
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
@@ -424,6 +428,17 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                                           [COEFFICIENTS[i] for i in fit_cols], prior)
                         notes += [f"{o}: prior on its {', '.join(d['inputs'])} slopes (mixed estimation): "
                                   + ", ".join(f"{k} {d['ls'][k]:.3g} -> {d['mixed'][k]:.3g}" for k in d["inputs"])
+                                  for o, d in info.items()]
+                    if gust_fit is not None and gust_filter == "rollgp":   # the roll fit's slopes of Cl (opt-in)
+                        from .aero.gustfilter import roll_gp_slopes
+                        from .gp.mixed import apply_fixed_slopes
+
+                        Y_train, info = apply_fixed_slopes(X_train[:, :len(REGRESSORS)], Y_train, REGRESSORS,
+                                                           [COEFFICIENTS[i] for i in fit_cols],
+                                                           {"Cl": roll_gp_slopes(gust_fit)})
+                        notes += [f"{o}: {', '.join(d['inputs'])} slopes fixed at the roll fit's (least squares "
+                                  "on p_hat - p_g -> fixed): "
+                                  + ", ".join(f"{k} {d['ls'][k]:.3g} -> {d['fixed'][k]:.3g}" for k in d["inputs"])
                                   for o, d in info.items()]
                     model, _history = fit_gp(X_train, Y_train, cfg, input_names=names,
                                              output_names=[COEFFICIENTS[i] for i in fit_cols])

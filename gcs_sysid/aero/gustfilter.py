@@ -43,7 +43,8 @@ import numpy as np
 
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "INSTRUMENT_DELAYS_S", "LAT_TERMS", "RollGustFit", "fit_roll_gust",
+__all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_GP_SLOPES", "roll_gp_slopes", "INSTRUMENT_DELAYS_S",
+           "LAT_TERMS", "RollGustFit", "fit_roll_gust",
            "instruments",
            "stated_moment_variance", "filter_gust_table"]
 
@@ -57,6 +58,13 @@ GUST_FILTER = False
 ROLL_MIN_DRYDEN_RATIO = 0.25
 #: The lateral linear model's regressors (an intercept first).
 LAT_TERMS = ("alpha", "beta", "p_hat", "r_hat", "delta_a", "delta_r")
+#: ``method="rollgp"``: the slopes of Cl the GP is given from the roll fit (:func:`roll_gp_slopes`; the pipeline
+#: fixes them in the GP's training target by :func:`gcs_sysid.gp.mixed.apply_fixed_slopes`). ``alpha`` is left
+#: to the GP: its flight-common offset (the mean vertical wind) moves the level, not the roll dynamics.
+#: Why: trained on ``p_hat - p_g`` alone, the GP's Cl is least squares of the *central* moment on the regressors
+#: the causal *step* moment's gust was made for; that pairing and the step's damping factor give it 86-92 % of
+#: the fit's ``Cl_p`` (twenty-second session, i8-rollgp, docs/benchmarks.md).
+ROLL_GP_SLOPES = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 #: Delays (s) of the aileron and rudder used as instruments for the rates and the sideslip (the controls are set by
 #: the pilot's programme, not by the gust; their delayed values carry the aircraft's response to them).
@@ -282,6 +290,15 @@ def fit_roll_gust(dt: float, X: np.ndarray, Y: np.ndarray, rows: np.ndarray, R: 
                        int(opt.nfev), bool(opt.success), notes)
 
 
+def roll_gp_slopes(G: RollGustFit, names=ROLL_GP_SLOPES) -> dict[str, float]:
+    """``{regressor: slope}`` of Cl from a roll fit's ``theta`` (intercept first, then :data:`LAT_TERMS`) for the
+    regressors ``names`` (each in :data:`LAT_TERMS`; ``ValueError`` otherwise)."""
+    bad = [n for n in names if n not in LAT_TERMS]
+    if bad:
+        raise ValueError(f"roll_gp_slopes: {bad} not among the roll fit's terms {LAT_TERMS}")
+    return {n: float(G.theta[1 + LAT_TERMS.index(n)]) for n in names}
+
+
 def stated_moment_variance(states, airframe, qbar: np.ndarray, rows: np.ndarray) -> np.ndarray | None:
     """Mean over ``rows`` of the measured Cl's and Cn's noise variance that the rate smoother states, ``(2,)``.
 
@@ -325,9 +342,12 @@ def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = 
             :func:`stated_moment_variance`).
         airframe: span, area and inertia.
         train: ``(T,)`` bool training rows.
-        method: ``"2sls"`` (:func:`fit_roll_gust`: the measured Cl as the output, two-stage least squares) or
+        method: ``"2sls"`` (:func:`fit_roll_gust`: the measured Cl as the output, two-stage least squares),
             ``"roll"`` (:func:`gcs_sysid.aero.rollgust.fit_roll_dynamics`: the gust a state of the roll dynamics,
-            the slopes and the gust estimated together from the causal step moment; needs the states' ``p``).
+            the slopes and the gust estimated together from the causal step moment; needs the states' ``p``)
+            or ``"rollgp"`` (the same with the moment's white noise ``R`` fixed at the variance the rate smoother
+            states, :func:`stated_moment_variance`, instead of the likelihood's, which runs to its lower bound;
+            the pipeline then also gives the GP the fit's lateral slopes, :data:`ROLL_GP_SLOPES`).
 
     Returns:
         ``(table, RollGustFit | None)``: a new table (the input is not changed), or the input with a note saying
@@ -340,17 +360,21 @@ def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = 
         return replace(table, notes=list(table.notes) + ["gust filter not run: fewer than 3 rows"]), None
     dt = float(np.median(np.diff(table.t)))
     rows = np.asarray(train, bool) & table.valid
-    if method not in ("2sls", "roll"):
-        raise ValueError(f"filter_gust_table: method must be '2sls' or 'roll', got {method!r}")
-    if method == "roll":
+    if method not in ("2sls", "roll", "rollgp"):
+        raise ValueError(f"filter_gust_table: method must be '2sls', 'roll' or 'rollgp', got {method!r}")
+    if method in ("roll", "rollgp"):
         from .rollgust import fit_roll_dynamics
 
         d = getattr(states, "data", {})
         if "p" not in d or len(d["p"]) != T:
             return replace(table, notes=list(table.notes) + ["gust filter not run: no p on the table's grid"]), None
+        R = None
+        if method == "rollgp":        # the moment's noise where the estimator states it (else the likelihood's)
+            Rs = stated_moment_variance(states, airframe, table.qbar, rows)
+            R = None if Rs is None else float(Rs[0])
         try:
             G = fit_roll_dynamics(dt, table.X, table.Y, d["p"], table.qbar, rows, airframe.Ixx, airframe.S,
-                                  airframe.b)
+                                  airframe.b, R=R)
         except ValueError as e:
             return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
         ratio = _dryden_ratio(G, d, table, dt, airframe.b)
@@ -359,7 +383,8 @@ def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = 
                    f"1.9 sigma/sqrt(L b) from the reconstructed wind (at least {ROLL_MIN_DRYDEN_RATIO} needed: "
                    "the roll moment does not read the gust); " + G.notes[0])
             return replace(table, notes=list(table.notes) + [why]), None
-        return _take_out(table, G, f"; its SD {ratio:.2f} of the Dryden one from the wind"), G
+        prior = float(np.var(G.g[G.used])) if method == "rollgp" else None
+        return _take_out(table, G, f"; its SD {ratio:.2f} of the Dryden one from the wind", prior), G
     Rs = stated_moment_variance(states, airframe, table.qbar, rows)
     if Rs is None:
         return replace(table, notes=list(table.notes) + ["gust filter not run: no stated p_dot r_dot noise"]), None
@@ -388,8 +413,13 @@ def _dryden_ratio(G: RollGustFit, data: dict, table, dt: float, b: float) -> flo
     return float(G.sigma / exp_g) if exp_g > 0 else float("nan")
 
 
-def _take_out(table, G: RollGustFit, extra: str = ""):
-    """The table with ``G.g`` taken out of ``p_hat`` and ``G.g_var`` added to its ``x_var`` (a new table)."""
+def _take_out(table, G: RollGustFit, extra: str = "", prior_var: float | None = None):
+    """The table with ``G.g`` taken out of ``p_hat`` and ``G.g_var`` added to its ``x_var`` (a new table).
+
+    ``prior_var``: the variance of ``p_hat_g`` stated on the rows the fit did not use (the held-out rows) when it is
+    larger than the fit's process variance ``sigma**2`` (``"rollgp"``: the smoothed gust's own variance over the rows
+    used; the fitted ``sigma`` is about 0.57 of the true gust's SD on the c172p while the smoothed gust's SD is
+    1.0-1.15x it, twenty-second session, i8-rollgp)."""
     from dataclasses import replace
 
     T = len(table.t)
@@ -397,6 +427,7 @@ def _take_out(table, G: RollGustFit, extra: str = ""):
     X = table.X.copy()
     X[:, j] -= G.g
     xv = np.full((T, len(REGRESSORS)), np.nan) if table.x_var is None else table.x_var.copy()
-    xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + G.g_var
+    g_var = G.g_var if prior_var is None else np.where(G.used, G.g_var, np.maximum(G.g_var, prior_var))
+    xv[:, j] = np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + g_var
     note = G.notes[0] + extra + " (taken out of p_hat on the training rows)"
     return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note])

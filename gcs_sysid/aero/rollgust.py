@@ -104,7 +104,7 @@ def causal_roll_moment(dt: float, Cl: np.ndarray, p: np.ndarray, qbar: np.ndarra
 
 def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
                       rows: np.ndarray, Ixx: float, S: float, b: float, tau: str = ROLL_TAU,
-                      max_fev: int = 400) -> RollDynamicsFit:
+                      max_fev: int = 400, R: float | None = None) -> RollDynamicsFit:
     """Filter-error slopes of the lateral ``Cl`` and the smoothed rolling gust (module docstring).
 
     Args:
@@ -161,7 +161,13 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
     zv = float(np.var(M[used, 0] - M[used, 1:] @ th_ls))
     n_used = int(used.sum())
 
+    R_fixed = R
+
+    def full(v):                                     # the free parameters -> (log sigma, log R[, log tau])
+        return v if R_fixed is None else np.r_[v[0], np.log(R_fixed), v[1:]]
+
     def nll(v):
+        v = full(v)
         sig, R = np.exp(v[0]), np.exp(v[1])
         tau_ = float(np.exp(v[2])) if tau == "fit" else tau_d
         a = float(np.exp(-dt / tau_))
@@ -178,13 +184,18 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
     bounds = [(v0[0] + 0.5 * np.log(1e-8), v0[0] + 0.5 * np.log(1e4)), (np.log(1e-10 * zv), np.log(zv))]
     if tau == "fit":
         bounds.append((np.log(dt), np.log(span)))
-    opt = minimize(lambda v: nll(v)[0], v0, method="Nelder-Mead", bounds=bounds,
-                   options={"maxfev": max_fev, "xatol": 1e-3, "fatol": 1e-2})
+    if R_fixed is not None:
+        if not R_fixed > 0:
+            raise ValueError(f"fit_roll_dynamics: a fixed R must be positive, got {R_fixed}")
+        del v0[1], bounds[1]
+    opt = minimize(lambda v: nll(v)[0], v0, method="Nelder-Mead" if len(v0) > 1 else "Powell", bounds=bounds,
+                   options={"maxfev": max_fev, "xatol": 1e-3, "fatol": 1e-2} if len(v0) > 1 else {"maxfev": max_fev})
     f, th, a, ss = nll(opt.x)
+    xf = full(opt.x)
     if th is None or not th[_IP] < 0:
         raise ValueError("fit_roll_dynamics: no likelihood optimum with a negative roll damping Cl_p")
-    sig, R = float(np.exp(opt.x[0])), float(np.exp(opt.x[1]))
-    tau_ = float(np.exp(opt.x[2])) if tau == "fit" else tau_d
+    sig, R = float(np.exp(xf[0])), float(np.exp(xf[1]))
+    tau_ = float(np.exp(xf[2])) if tau == "fit" else tau_d
     # divide the step's integration of the damping out: y = (e^{Lp dt} - 1)/(Lp dt) (Lp p + forcing)
     k_h = float(np.mean(np.asarray(qbar, float)[used] * S * b / Ixx * b / (2 * X[used, REGRESSORS.index("V")])))
     Lf = k_h * th[_IP]

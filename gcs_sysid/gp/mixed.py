@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import InputError
 from .colored import variance_inflation
 
-__all__ = ["mixed_estimate", "apply_slope_prior"]
+__all__ = ["mixed_estimate", "apply_slope_prior", "apply_fixed_slopes"]
 
 
 def mixed_estimate(X: np.ndarray, z: np.ndarray, prior_std: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -122,4 +122,55 @@ def apply_slope_prior(X: np.ndarray, Y: np.ndarray, input_names, output_names, p
         named = [ins[d] for d in np.flatnonzero(np.isfinite(sd))]
         info[o] = {"inputs": named, "ls": {k: float(th_ls[1 + ins.index(k)]) for k in named},
                    "mixed": {k: float(th_me[1 + ins.index(k)]) for k in named}}
+    return Y2, info
+
+
+def apply_fixed_slopes(X: np.ndarray, Y: np.ndarray, input_names, output_names, fixed) -> tuple[np.ndarray, dict]:
+    """The GP's training target with some slopes of an output fixed at known values (a prior of zero variance
+    at a non-zero value: Morelli and Klein, *Aircraft System Identification*, 2nd ed., ch. 5, parameters fixed at
+    a priori values; Theil and Goldberger 1961 in the limit).
+
+    Per output ``o`` with fixed slopes ``theta_F`` on the inputs ``F``: the other slopes and the intercept are
+    least squares of ``y - X_F theta_F`` on the other inputs, ``theta_R``; the target becomes
+    ``y' = y - X (theta_LS - theta)`` with ``theta = (theta_F, theta_R)``, so least squares of ``y'`` on all of
+    ``X`` returns ``theta`` exactly and the residual is least squares' own (as :func:`apply_slope_prior`: neither
+    the GP's mean nor its kernel finds a slope the residual does not carry).
+
+    Args:
+        X: ``(N, D)`` training regressors. Y: ``(N, P)`` training outputs (NaN: missing; an output's fit uses its
+            finite rows).
+        input_names: ``D`` names. output_names: ``P`` names.
+        fixed: ``{output: {input: slope}}`` in the data's units; outputs or inputs not in this fit are ignored.
+
+    Returns:
+        ``(Y', info)``: ``Y' (N, P)`` (a copy), and per changed output ``{output: {"inputs": [...],
+        "ls": {input: slope}, "fixed": {input: slope}}}``.
+
+    Raises:
+        InputError: a fixed slope that is not finite.
+    """
+    ins, outs = list(input_names), list(output_names)
+    Y2 = np.array(Y, float, copy=True)
+    X = np.asarray(X, float)
+    info: dict = {}
+    for o, slopes in fixed.items():
+        use = {i: float(v) for i, v in slopes.items() if i in ins}
+        if o not in outs or not use:
+            continue
+        if not all(np.isfinite(v) for v in use.values()):
+            raise InputError(f"apply_fixed_slopes: {o}: fixed slopes must be finite, got {use}")
+        p = outs.index(o)
+        rows = np.isfinite(Y2[:, p]) & np.isfinite(X).all(1)
+        if rows.sum() <= X.shape[1] + 2:
+            continue
+        F = [ins.index(i) for i in use]
+        rest = [j for j in range(X.shape[1]) if j not in F]
+        A = np.c_[np.ones(int(rows.sum())), X[rows]]
+        th_ls = np.linalg.lstsq(A, Y2[rows, p], rcond=None)[0]
+        z = Y2[rows, p] - X[rows][:, F] @ np.array(list(use.values()))
+        b = np.linalg.lstsq(np.c_[np.ones(int(rows.sum())), X[rows][:, rest]], z, rcond=None)[0]
+        th = np.zeros(X.shape[1] + 1)
+        th[0], th[1 + np.array(rest, int)], th[1 + np.array(F)] = b[0], b[1:], list(use.values())
+        Y2[rows, p] -= A @ (th_ls - th)
+        info[o] = {"inputs": list(use), "ls": {i: float(th_ls[1 + ins.index(i)]) for i in use}, "fixed": use}
     return Y2, info

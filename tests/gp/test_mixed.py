@@ -73,3 +73,30 @@ def test_missing_rows_and_bad_input():
         mixed_estimate(X, cy, np.array([1.0, -1.0, 1.0]))
     with pytest.raises(InputError):
         mixed_estimate(X, cy[:-1], np.ones(3))
+
+
+def test_fixed_slopes_are_returned_by_least_squares_of_the_target_and_the_rest_refitted():
+    """``apply_fixed_slopes``: least squares of ``y'`` returns the fixed slope exactly, the others are least
+    squares of ``y - x_F theta_F`` on the rest, the residual is least squares' own; unknown names are ignored and a
+    non-finite slope is refused."""
+    from gcs_sysid.gp.mixed import apply_fixed_slopes
+
+    rng = np.random.default_rng(3)
+    n = 400
+    X = rng.normal(size=(n, 3))
+    X[:, 1] += 0.6 * X[:, 0]
+    Y = np.c_[0.2 + X @ [1.0, -2.0, 0.5] + 0.1 * rng.normal(size=n), rng.normal(size=n)]
+    Y[5, 0] = np.nan
+    Y2, info = apply_fixed_slopes(X, Y, ["a", "b", "c"], ["o", "k"], {"o": {"b": -1.5, "zz": 3.0}, "nope": {"a": 1}})
+    r = np.isfinite(Y[:, 0])
+    A = np.c_[np.ones(r.sum()), X[r]]
+    th = np.linalg.lstsq(A, Y2[r, 0], rcond=None)[0]
+    assert th[2] == pytest.approx(-1.5)
+    rest = np.linalg.lstsq(np.c_[np.ones(r.sum()), X[r][:, [0, 2]]], Y[r, 0] + 1.5 * X[r, 1], rcond=None)[0]
+    assert np.allclose(th[[0, 1, 3]], rest)
+    th_ls = np.linalg.lstsq(A, Y[r, 0], rcond=None)[0]
+    assert np.allclose(Y2[r, 0] - A @ th, Y[r, 0] - A @ th_ls)
+    assert np.isnan(Y2[5, 0]) and np.array_equal(Y2[:, 1], Y[:, 1])
+    assert info == {"o": {"inputs": ["b"], "ls": {"b": pytest.approx(th_ls[2])}, "fixed": {"b": -1.5}}}
+    with pytest.raises(InputError, match="finite"):
+        apply_fixed_slopes(X, Y, ["a", "b", "c"], ["o", "k"], {"o": {"a": np.nan}})
