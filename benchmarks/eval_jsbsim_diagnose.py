@@ -72,7 +72,7 @@ from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "side_force_scale_truth", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
+__all__ = ["reference_model", "level_flights", "diagnose_case", "score_case", "side_force_scale_truth", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
