@@ -78,7 +78,7 @@ from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "diagnose_case", "score_case", "side_force_scale_truth", "side_axis_variables", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
+__all__ = ["reference_model", "level_flights", "diagnose_case", "score_case", "side_force_scale_truth", "side_axis_variables", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -145,17 +145,49 @@ def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: st
     return files, model_path, load_measurements(files.tlog, files.airframe)
 
 
+def _alpha_error_deg(table, tlog: Path) -> dict:
+    """The table's alpha against JSBSim's (the ``-truth.npz`` beside ``tlog``) on its valid rows: mean and RMS, deg
+    ({} without a truth file)."""
+    from benchmarks.jsbsim_harness.truth import load_truth
+
+    npz = tlog.with_name(tlog.stem + "-truth.npz")
+    if not npz.exists():
+        return {}
+    Xt, _ = load_truth(npz).at(table.t)
+    e = np.asarray(table.X, float)[:, 0] - Xt[:, 0]
+    ok = np.asarray(table.valid, bool) & np.isfinite(e)
+    return {"mean_deg": float(np.degrees(e[ok].mean())), "rms_deg": float(np.degrees(np.sqrt(np.mean(e[ok] ** 2)))),
+            "sd_deg": float(np.degrees(e[ok].std()))}
+
+
+def level_flights(ac: str, seeds, out: Path, ref_meas, duration_s: float = DURATION_S, plan: str = PLAN,
+                  turbulence: str = "light") -> list:
+    """Clean flights flown like the reference (``<ac>-level-s<seed>``), loaded as the test flights are (aided with
+    the reference's sideslip estimator): the flights the ``pooled`` alpha level averages over beside the reference.
+    They are never diagnosed."""
+    from gcs_sysid.diagnose.run import load_measurements, shared_angle_models
+
+    out_m = []
+    for s in seeds:
+        files = _flight(FlightConfig(ac, duration_s=duration_s, seed=s, plan=plan, turbulence=turbulence), [], out,
+                        stem=f"{ac}-level-s{s}")
+        out_m.append(load_measurements(files.tlog, files.airframe,
+                                       angle_models=shared_angle_models(ref_meas.states.angle_fits)))
+    return out_m
+
+
 def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_path: Path, ref_meas,
                   duration_s: float = DURATION_S, plan: str = PLAN,
-                  turbulence: str = "light") -> tuple[list[dict], dict, float]:
+                  turbulence: str = "light", level_meas=None) -> tuple[list[dict], dict, float]:
     """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis).
-    ``turbulence`` as in :func:`reference_model`."""
+    ``turbulence`` as in :func:`reference_model`; ``level_meas``: :func:`level_flights` (pooled alpha level)."""
     from gcs_sysid.diagnose import diagnose
     from gcs_sysid.diagnose.run import load_measurements
     from gcs_sysid.sim.model_file import load_model
 
     _LAST_PITOT.clear()
     _LAST_NOT_NAMED.clear()
+    _LAST_LEVEL.clear()
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, turbulence=turbulence), effects, out)
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
@@ -165,18 +197,32 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     from gcs_sysid.diagnose.run import shared_angle_models
 
     meas = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits))
+    from gcs_sysid.diagnose import run as diagnose_run
     from gcs_sysid.diagnose.differential import Reference
 
     # as the CLI does with the flight recorded in <model>.fit.json: the reference carries its decoded
     # flight, so sensor causes are compared with it too (a bias it had is a calibration note)
-    diag = diagnose(meas.table, meas.airframe, load_model(model_path), meas.states, output_error=False,
-                    flight=meas.flight, search=True, search_reference=(ref_meas.table, ref_meas.states),
-                    references=[Reference(ref_meas.table, ref_meas.states, ref_meas.flight, label=f"{ac}-ref")])
+    model = load_model(model_path)
+    kw = {"search_reference": (ref_meas.table, ref_meas.states),
+          "references": [Reference(ref_meas.table, ref_meas.states, ref_meas.flight, label=f"{ac}-ref")]}
+    if diagnose_run.ALPHA_LEVEL:
+        # the alpha level (gcs_sysid.diagnose.alpha_level): this flight, the reference and the model in one frame,
+        # pooled with the level flights' tables (--level-seeds) in "pooled" mode; scored against JSBSim's alpha
+        a_before = _alpha_error_deg(meas.table, files.tlog)
+        model, meas, kw, info = diagnose_run.aligned_alpha(diagnose_run.ALPHA_LEVEL, model, meas, kw,
+                                                           level_tables=[m.table for m in level_meas or ()])
+        _LAST_LEVEL.update(info, alpha_error_before=a_before, alpha_error_after=_alpha_error_deg(meas.table, files.tlog))
+    else:
+        _LAST_LEVEL.update(alpha_error_before=_alpha_error_deg(meas.table, files.tlog))
+    diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=False,
+                    flight=meas.flight, search=True, **kw)
     _LAST_PITOT.update(_pitot_summary(diag.data))
     _LAST_NOT_NAMED[:] = list((diag.data.get("sparse") or {}).get("not_named") or [])
     return diag.findings, truth, time.perf_counter() - t0
 
 
+#: the last diagnosed case's alpha level (``data["alpha_level"]``) and its alpha against JSBSim's before / after
+_LAST_LEVEL: dict = {}
 #: the last diagnosed case's pitot evidence (:func:`_pitot_summary`), recorded with it in ``results.jsonl``
 _LAST_PITOT: dict = {}
 #: the terms the last case's sparse search did not name because their change lay within their expanded uncertainty
@@ -566,7 +612,16 @@ def main(argv=None) -> int:
     p.add_argument("--alpha-profile", nargs="*", default=None, metavar="COLUMN",
                     help="the alpha aiding's columns whose slopes the gust model's likelihood chooses (gcs_sysid."
                          "estimation.airangles.ALPHA_PROFILE_COLUMNS, e.g. delta_e; default: the package's, none)")
+    p.add_argument("--alpha-level", default=None, choices=("reference", "pooled"),
+                   help="move each test flight, the reference and the model into one alpha frame (gcs_sysid.diagnose."
+                        "alpha_level; default off): the reference flight's, or pooled with --level-seeds")
+    p.add_argument("--level-seeds", nargs="*", type=int, default=[101, 102, 103, 104],
+                   help="seeds of the clean level flights pooled with the reference (--alpha-level pooled)")
     a = p.parse_args(argv)
+    if a.alpha_level is not None:
+        from gcs_sysid.diagnose import run as _dr
+
+        _dr.ALPHA_LEVEL = a.alpha_level
     if a.alpha_profile is not None:
         from gcs_sysid.estimation import airangles as _aa
 
@@ -609,7 +664,7 @@ def main(argv=None) -> int:
               file=sys.stderr)
     if a.fly_only:
         return _fly_only(a.aircraft, a.seeds, a.clean_seeds, pairs, a.effects, out, a.plan)
-    refs = {}
+    refs, levels = {}, {}
     lines = []
     with open(out / "results.jsonl", "a") as fh:
         for ac, seed, effects in _cases(a.aircraft, a.seeds, a.clean_seeds, pairs):
@@ -617,14 +672,18 @@ def main(argv=None) -> int:
                 continue
             if ac not in refs:
                 refs[ac] = reference_model(ac, out, plan=a.plan)
+                if a.alpha_level == "pooled":
+                    levels[ac] = level_flights(ac, a.level_seeds, out, refs[ac][2], plan=a.plan)
             _, model_path, ref_meas = refs[ac]
             try:
-                findings, truth, secs = diagnose_case(ac, seed, effects, out, model_path, ref_meas, plan=a.plan)
+                findings, truth, secs = diagnose_case(ac, seed, effects, out, model_path, ref_meas, plan=a.plan,
+                                                      level_meas=levels.get(ac))
                 sc = score_case(findings, truth)
             except RuntimeError as exc:       # the aircraft left the envelope with that effect
                 sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
             rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT), "not_named": list(_LAST_NOT_NAMED),
+                   "alpha_level": dict(_LAST_LEVEL),
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
                                 | {"gain_pct": f.get("gain", {}).get("percent"),
                                    "std_error_decision": f.get("evidence", {}).get("std_error_decision"),

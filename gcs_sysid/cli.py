@@ -105,6 +105,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--reference", action="append", metavar="LOG", help="a reference flight (repeatable; default: "
                    "the flight(s) the model was fitted on, from <model>.fit.json): differential diagnosis")
     d.add_argument("--no-reference", action="store_true", help="no differential diagnosis")
+    d.add_argument("--alpha-level", choices=("reference", "pooled"), default=None,
+                   help="put this flight's alpha in the reference flight's frame, or in the mean frame of every "
+                        "--reference flight (pooled lift curve, docs/diagnose.md 'The alpha level'; default off)")
     _window_args(d)
 
     pr = sub.add_parser("predict", help="evaluate a saved model at given flight conditions (CSV in, CSV out)")
@@ -238,7 +241,8 @@ def _cmd_diagnose(a: argparse.Namespace) -> int:
     from .diagnose import run_diagnose
 
     diag = run_diagnose(a.log, a.airframe, a.model, a.out, t_from=a.t_from, t_to=a.t_to, search=a.search,
-                        notify=_say, references=[] if a.no_reference else a.reference)
+                        notify=_say, references=[] if a.no_reference else a.reference,
+                        alpha_level=a.alpha_level)
     findings = diag.get("findings", []) if isinstance(diag, dict) else getattr(diag, "findings", [])
     print(f"wrote {Path(a.out) / 'diagnosis.json'}: {len(findings)} finding(s)")
     return 0

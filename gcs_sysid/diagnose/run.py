@@ -56,6 +56,13 @@ def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
 SHARE_ALPHA_MODEL = False
 
 
+#: The alpha level (:mod:`gcs_sysid.diagnose.alpha_level`): None (off, the default), ``"reference"`` (the flight
+#: under test moved into the alpha frame of the reference flight the model was fitted on) or ``"pooled"`` (every
+#: flight and the model moved into the frame of the reference flights' mean level). Off: see docs/diagnose.md,
+#: "The alpha level", and docs/benchmarks.md, "Twenty-second session, i9-level".
+ALPHA_LEVEL: str | None = None
+
+
 def shared_angle_models(fits: dict | None) -> dict | None:
     """The reference flight's air-angle fits that the flight under test is aided with.
 
@@ -165,7 +172,7 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
 
 def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None = None,
                  t_to: float | None = None, progress=None, output_error: bool = True, notify=None,
-                 references=None, **kw):
+                 references=None, alpha_level: str | None = None, **kw):
     """``gcs-sysid diagnose``: hold the model against the log; write diagnosis.json, model_extended.toml, report.html.
 
     Args:
@@ -175,6 +182,8 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
         notify: called with one line per damage found in the log (None: not shown).
         references: reference flight logs for the differential diagnosis (``--reference``); None: the
             flight(s) recorded in ``<model>.fit.json`` by ``gcs-sysid fit``, when found; ``[]``: none.
+        alpha_level: ``"reference"`` or ``"pooled"`` (:func:`gcs_sysid.diagnose.alpha_level.align_alpha_levels`;
+            pooled over every reference flight given); None: :data:`ALPHA_LEVEL` (off by default).
         **kw: passed to :func:`gcs_sysid.diagnose.core.diagnose`.
 
     Returns:
@@ -190,9 +199,42 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
         refs = kw.get("references") or []
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=shared_angle_models(
             getattr(refs[0].states, "angle_fits", None)) if refs else None)
+        level = alpha_level if alpha_level is not None else ALPHA_LEVEL
+        level_info = None
+        if level and refs:
+            model, meas, kw, level_info = aligned_alpha(level, model, meas, kw)
+        kw = {**kw, "alpha_level_info": level_info} if level_info is not None else kw
         diag = _diagnose_into(stage.path, diagnose, meas, model, log, airframe_path, model_path, t_from, t_to,
                               output_error, progress, t0, kw)
     return diag
+
+
+def aligned_alpha(mode: str, model, meas: Measurements, kw: dict, level_tables=()):
+    """The model, the flight under test and its reference flights (``kw["references"]``) in one alpha frame.
+
+    :func:`gcs_sysid.diagnose.alpha_level.align_alpha_levels` with the first reference as the flight the model was
+    fitted on; with ``mode="pooled"`` the other references (and ``level_tables``) pool the level.
+
+    Returns:
+        ``(model', meas', kw', info)``: ``model'`` an :class:`~gcs_sysid.sim.model_file.AeroModel`, ``meas'`` a new
+        :class:`Measurements` (the inputs are not changed), ``info`` for ``data["alpha_level"]``.
+    """
+    from dataclasses import replace
+
+    from ..sim.model_file import AeroModel
+    from .alpha_level import align_alpha_levels
+
+    refs = list(kw.get("references") or [])
+    extra = [r.table for r in refs[1:]] + list(level_tables)
+    m1, tab, st, refs1, info = align_alpha_levels(mode, model, meas.table, meas.states, refs[:1], extra)
+    refs1 = refs1 + refs[1:]
+    model1 = AeroModel(m1, getattr(model, "name", "model") or "model",
+                       (getattr(model, "notes", "") or "") + f"; alpha frame moved by {info.get('level_deg', 0.0):.3g} deg "
+                       f"({mode} level)", getattr(model, "source", "") or "")
+    kw1 = dict(kw, references=refs1)
+    if kw.get("search_reference") is not None and refs1:
+        kw1["search_reference"] = (refs1[0].table, refs1[0].states)
+    return model1, replace(meas, table=tab, states=st), kw1, info
 
 
 def _references(model_path, airframe_path, given, progress) -> dict:
@@ -214,8 +256,11 @@ def _diagnose_into(out, diagnose, meas, model, log, airframe_path, model_path, t
     from .report import write_report
 
     notes = kw.pop("reference_notes", [])
+    level_info = kw.pop("alpha_level_info", None)
     diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=output_error,
                     flight=meas.flight, progress=progress, **kw)
+    if level_info is not None:
+        diag.data["alpha_level"] = level_info
     if notes:
         diag.data["reference_notes"] = notes
     diag.data.update({"log": str(log), "airframe": str(airframe_path), "model": str(model_path),
