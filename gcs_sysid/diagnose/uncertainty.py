@@ -114,15 +114,18 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
     branch i9-elev; off).
 
     ``pair_scale`` (with ``reference_fits``; ``sparse.THRESHOLDS["coverage_scale_pair"]``, twenty-second session,
-    branch i9-aiddef): ``"quadrature"`` (the default) takes alpha's scale as the two flights' own in quadrature, as
-    above; ``"slopes"`` takes it as :func:`pair_slope_scale`, the two aidings' lift slopes' ratio (the test flight's
-    alpha scale against the reference's) with both slopes' standard errors in quadrature, and leaves out
+    branch i9-aiddef): ``"quadrature"`` (the default) states only the two flights' own scales in quadrature, as
+    above; ``"slopes"`` adds alpha's ``"scale_null"``, :func:`pair_slope_scale`: the two aidings' lift slopes' ratio
+    (the test flight's alpha scale against the reference's) with both slopes' standard errors in quadrature, without
     ``AxisFit.scale_sigma``, which on a gusty flight is the gust's share of the aided angle, not a scale
-    (``docs/diagnose.md``, item 23). Beta keeps the quadrature.
+    (``docs/diagnose.md``, item 23). Only the naming test under no change reads it (there a scale common to both
+    flights cancels); a named change's estimate is scaled by the common error too, so its type B keeps ``"scale"``.
+    Beta is unchanged.
 
     Returns:
-        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m]}, "beta": {"scale": u_s,
-        "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad; 0 where unknown).
+        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m][, "scale_null": u_p]},
+        "beta": {"scale": u_s, "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad, dimensionless; 0 where
+        unknown).
 
     Raises:
         ValueError: an unknown ``pair_scale``.
@@ -135,7 +138,7 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
         if pair_scale == "slopes":
             ps = pair_slope_scale((angle_fits or {}).get("alpha"), (reference_fits or {}).get("alpha"))
             if ps is not None:
-                out["alpha"]["scale"] = ps
+                out["alpha"]["scale_null"] = ps
         la, lb = a["alpha"].get("loading_delta_e"), b["alpha"].get("loading_delta_e")
         if la is not None and lb is not None:
             # a signed property of how each flight's alpha was built, not an independent error: their difference

@@ -33,16 +33,17 @@ def test_the_pair_scale_is_the_slopes_ratio_not_the_gust_share():
     quad = air_data_uncertainty(fits, rfits)
     assert quad["alpha"]["scale"] > 0.9          # the default: both flights' own statements in quadrature
     new = air_data_uncertainty(fits, rfits, pair_scale="slopes")
-    assert new["alpha"]["scale"] == pytest.approx(want, rel=1e-9)
-    assert new["beta"] == quad["beta"]           # beta keeps the quadrature
+    assert new["alpha"]["scale_null"] == pytest.approx(want, rel=1e-9)     # read under no change only
+    assert new["alpha"]["scale"] == quad["alpha"]["scale"]    # a named change's type B keeps the quadrature
+    assert "scale_null" not in quad["alpha"]
+    assert new["beta"] == quad["beta"]           # beta is unchanged
     assert new["alpha"]["offset_rad"] == quad["alpha"]["offset_rad"]
     # the sign of the slopes' difference does not matter; an unaided axis falls back to the quadrature
     assert pair_slope_scale(ref, flt) == pytest.approx(np.sqrt((4.996 / 4.945 - 1) ** 2 + (0.012 / 4.996) ** 2
                                                                + (0.007 / 4.945) ** 2), rel=1e-9)
     off = AxisFit("alpha", False, "not identified")
     assert pair_slope_scale(off, ref) is None
-    assert air_data_uncertainty({"alpha": off}, rfits, pair_scale="slopes")["alpha"]["scale"] == pytest.approx(
-        air_data_uncertainty({"alpha": off}, rfits)["alpha"]["scale"])
+    assert "scale_null" not in air_data_uncertainty({"alpha": off}, rfits, pair_scale="slopes")["alpha"]
     with pytest.raises(ValueError):
         air_data_uncertainty(fits, rfits, pair_scale="sum")
     assert THRESHOLDS["coverage_scale_pair"] == "quadrature"     # off by default (opt-in)
