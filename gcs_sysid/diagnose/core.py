@@ -432,7 +432,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                        angle_uncertainty=air_data_uncertainty(
                                            getattr(states, "angle_fits", None),
                                            getattr(search_reference[1], "angle_fits", None)
-                                           if isinstance(search_reference, tuple) else None),
+                                           if isinstance(search_reference, tuple) else None,
+                                           pair_scale=str(_SPARSE_TH.get("coverage_scale_pair", "quadrature"))),
                                        model=model0, angle_sigma=_angle_sigma(states, ctx.t))
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)

@@ -187,6 +187,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: nears 1. No new threshold tuned: 0.1 is where ``1 / (1 + s)`` is linear within 1 %, chosen before measuring.
 #: Measured with the alpha aiding profiled (``airangles.ALPHA_PROFILE_COLUMNS``), in ``docs/benchmarks.md``,
 #: *Twenty-first session, i9-aidnull*.
+#: Added 2026-11-24 (twenty-second session, branch i9-aiddef): ``coverage_scale_pair``, **off** (``"quadrature"``):
+#: ``"slopes"`` states alpha's scale uncertainty *under no change* (read only with ``coverage_under_null``) of a flight
+#: against its reference from the two aidings' lift slopes (:func:`gcs_sysid.diagnose.uncertainty.pair_slope_scale`)
+#: instead of the two flights' ``AxisFit.scale_sigma`` in quadrature, which on a gusty flight is the gust's share of
+#: the aided angle (c172p 0.42-0.92 against 0.5-13 % measured); a named change's type B keeps the quadrature. No new
+#: threshold. Measured in ``docs/benchmarks.md``, *Twenty-second session, i9-aiddef*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -203,7 +209,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
-              "coverage_map_delta_e": False, "coverage_scale_step": 0.0}
+              "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
+              "coverage_scale_pair": "quadrature"}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -1409,8 +1416,11 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         for angle, u in (angle_u or {}).items():
             if not (u.get("scale", 0) > 0 or u.get("offset_rad", 0) > 0):
                 continue
+            # under no change a scale common to both flights cancels: the pair's own, where stated
+            # (THRESHOLDS["coverage_scale_pair"], uncertainty.pair_slope_scale)
             sens = angle_null_sensitivity(null["predict"], null["X"], A0, i, j, tr, REGRESSORS.index(angle),
-                                          float(u.get("scale", 0.0)), float(u.get("offset_rad", 0.0)),
+                                          float(u.get("scale_null", u.get("scale", 0.0))),
+                                          float(u.get("offset_rad", 0.0)),
                                           null.get("nuisance"),
                                           float(u.get("curvature", 0.0)) if null.get("curvature") else 0.0,
                                           map_delta_e=float(u.get("map_delta_e", 0.0)) if null.get("map_delta_e")

@@ -39,7 +39,7 @@ from ..jackknife import block_jackknife_cov
 from .regression import ols
 
 __all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "air_data_uncertainty",
-           "elevator_loading", "angle_sensitivity", "combine"]
+           "pair_slope_scale", "elevator_loading", "angle_sensitivity", "combine"]
 
 #: block length of the delete-a-block jackknife, s (the diagnosis's ``alpha_jackknife_s``: longer than the
 #: gusts' correlation times of 1-5 s at light aircraft speeds, short enough to give 5-8 blocks per flight)
@@ -77,7 +77,8 @@ def type_a(res: dict) -> np.ndarray:
     return np.fmax(np.asarray(res["coloured"], float), np.asarray(res["jackknife"], float))
 
 
-def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = None) -> dict:
+def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = None,
+                         pair_scale: str = "quadrature") -> dict:
     """The reconstruction's own standard uncertainty of each air angle's scale and offset.
 
     From the estimator's fits of the specific-force aiding
@@ -112,13 +113,32 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
     the naming test under no change reads, with ``sparse.THRESHOLDS["coverage_map_delta_e"]`` (twentieth session,
     branch i9-elev; off).
 
+    ``pair_scale`` (with ``reference_fits``; ``sparse.THRESHOLDS["coverage_scale_pair"]``, twenty-second session,
+    branch i9-aiddef): ``"quadrature"`` (the default) states only the two flights' own scales in quadrature, as
+    above; ``"slopes"`` adds alpha's ``"scale_null"``, :func:`pair_slope_scale`: the two aidings' lift slopes' ratio
+    (the test flight's alpha scale against the reference's) with both slopes' standard errors in quadrature, without
+    ``AxisFit.scale_sigma``, which on a gusty flight is the gust's share of the aided angle, not a scale
+    (``docs/diagnose.md``, item 23). Only the naming test under no change reads it (there a scale common to both
+    flights cancels); a named change's estimate is scaled by the common error too, so its type B keeps ``"scale"``.
+    Beta is unchanged.
+
     Returns:
-        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m]}, "beta": {"scale": u_s,
-        "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad; 0 where unknown).
+        ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m][, "scale_null": u_p]},
+        "beta": {"scale": u_s, "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad, dimensionless; 0 where
+        unknown).
+
+    Raises:
+        ValueError: an unknown ``pair_scale``.
     """
+    if pair_scale not in ("quadrature", "slopes"):
+        raise ValueError(f"pair_scale must be 'quadrature' or 'slopes', not {pair_scale!r}")
     if reference_fits is not None:
         a, b = air_data_uncertainty(angle_fits), air_data_uncertainty(reference_fits)
         out = {n: {k: float(np.hypot(a[n][k], b[n][k])) for k in a[n] if k != "loading_delta_e"} for n in a}
+        if pair_scale == "slopes":
+            ps = pair_slope_scale((angle_fits or {}).get("alpha"), (reference_fits or {}).get("alpha"))
+            if ps is not None:
+                out["alpha"]["scale_null"] = ps
         la, lb = a["alpha"].get("loading_delta_e"), b["alpha"].get("loading_delta_e")
         if la is not None and lb is not None:
             # a signed property of how each flight's alpha was built, not an independent error: their difference
@@ -144,6 +164,41 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
             if ld is not None:
                 out[name]["loading_delta_e"] = ld
     return out
+
+
+def pair_slope_scale(fit, reference_fit) -> float | None:
+    """Standard uncertainty of a flight's aided-alpha scale *against its reference flight's*, from the two lift slopes.
+
+    The aided angle's excursions are the normal-force coefficient's over the aiding's slope ``CZ_alpha``
+    (:class:`gcs_sysid.estimation.airangles.AxisFit` ``coef[1]``; the later passes refit it on the angle the last one
+    aided, so the flight keeps its first pass's slope), so two flights of one aircraft aided with slopes ``c_f`` and
+    ``c_ref`` read the same true alpha excursion with the relative scale ``c_ref / c_f``. The part of the scale error
+    common to both (the lift-slope floor against the aircraft's true slope, the same on every flight of one aircraft)
+    cancels in a change between the flights and in the naming test under no change; what is left is
+    ``d = c_ref / c_f - 1``, a signed property of the two fits (like :func:`elevator_loading`'s difference, taken
+    whole), with both slopes' standard errors in quadrature (GUM JCGM 100:2008 eq. 10). Measured against JSBSim's
+    alpha (c172p light, the reference and five test flights, alpha profiled): the test flight's scale error less the
+    reference's, from a fit on the true angle with the curvature and the elevator beside it, is -0.042, +0.132,
+    +0.008, +0.005, -0.026; ``d`` is -0.021, +0.128, -0.001, +0.004, -0.010 (``docs/benchmarks.md``,
+    *Twenty-second session, i9-aiddef*). ``AxisFit.scale_sigma`` on the same flights is 0.42-0.92.
+
+    Args:
+        fit, reference_fit: the two flights' alpha ``AxisFit`` (or None).
+
+    Returns:
+        ``sqrt(d^2 + (se_f / c_f)^2 + (se_ref / c_ref)^2)`` (dimensionless), or None where either axis was not aided
+        or a slope is missing (the caller keeps the quadrature).
+    """
+    cs = []
+    for f in (fit, reference_fit):
+        if f is None or not getattr(f, "used", False):
+            return None
+        c, s = np.asarray(f.coef, float), np.asarray(f.coef_sigma, float)
+        if c.size < 2 or not np.isfinite(c[1]) or c[1] == 0.0:
+            return None
+        cs.append((float(c[1]), float(s[1]) if s.size > 1 and np.isfinite(s[1]) else 0.0))
+    (cf, sf), (cr, sr) = cs
+    return float(np.sqrt((cr / cf - 1.0) ** 2 + (sf / cf) ** 2 + (sr / cr) ** 2))
 
 
 def elevator_loading(fit) -> float | None:
