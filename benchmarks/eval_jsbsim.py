@@ -249,6 +249,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         np.fill_diagonal(C, 0.0)
         row["max_corr"] = float(np.nanmax(C)) if C.size else 0.0
         row["gp_coupling_test"] = _pipeline.GP_COUPLING_TEST
+        row["gp_noise_correlation"] = _pipeline.GP_NOISE_CORRELATION
     if model.discrepancy is not None and model.n_outputs == 6:
         # a diagnosis, not a criterion: the coefficient band with its coloured noise share floored at the
         # blocked validation's discrepancy d (as at exact conditions)
@@ -408,6 +409,9 @@ def main(argv=None) -> int:
                          "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); 'untested' sets "
                          "gcs_sysid.pipeline.GP_COUPLING_TEST = 'none' (B's couplings kept as learned, without the "
                          "every-row likelihood-ratio test: the default until the twenty-second session)")
+    ap.add_argument("--gp-noise", default=None, choices=("diagonal", "full"),
+                    help="the replay GP's noise: 'full' sets gcs_sysid.pipeline.GP_NOISE_CORRELATION (a P x P noise "
+                         "covariance, eval_gp_jsbsim's nigp); 'diagonal' one variance per output (the default)")
     ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
                     help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
                          "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
@@ -471,6 +475,10 @@ def main(argv=None) -> int:
 
         pipeline.USE_DECORRELATED_GP = a.gp_fit == "decorrelated"
         pipeline.GP_COUPLING_TEST = "none" if a.gp_fit == "untested" else "lr"
+    if a.gp_noise is not None:
+        import gcs_sysid.pipeline as pipeline
+
+        pipeline.GP_NOISE_CORRELATION = a.gp_noise == "full"
     if a.cy_rate_prior is not None:
         import gcs_sysid.pipeline as pipeline
 

@@ -122,6 +122,13 @@ USE_DECORRELATED_GP = False
 #: off-diagonals as learned (the default until the twenty-second session; ``eval_jsbsim --gp-fit untested``).
 GP_COUPLING_TEST = "lr"
 
+#: The replay's ``GPConfig.noise_correlation`` (twenty-second session, second round): False (the default) learns one
+#: noise variance per output, so an error the gust puts into several coefficients at once can only be explained as
+#: signal coupling (``B``), which the coupling test then keeps (us25e light s1: learned correlation 0.99); True learns
+#: the full ``P x P`` noise covariance (eval_gp_jsbsim's ``nigp``). Opt-in (``eval_jsbsim --gp-noise full``):
+#: docs/benchmarks.md, "Twenty-second session, lead, second round".
+GP_NOISE_CORRELATION = False
+
 #: Opt-in (nineteenth session, i8-cyr): the std (CY per unit ``p_hat`` / ``r_hat``) of a zero-mean prior on CY's two
 #: rate slopes, imposed by mixed estimation on the GP's training target (:func:`gcs_sysid.gp.mixed.apply_slope_prior`;
 #: Theil and Goldberger 1961; ``docs/gp.md``, "Prior knowledge on the side-force rate slopes"). None: no prior (the
@@ -415,8 +422,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
-                    cfg = GPConfig(**(ALPHA_DOT_GP if use_adot else {}),
-                                   **(DECORRELATED_GP if USE_DECORRELATED_GP else {}),
+                    cfg = GPConfig(**{"noise_correlation": GP_NOISE_CORRELATION,
+                                      **(ALPHA_DOT_GP if use_adot else {}),
+                                      **(DECORRELATED_GP if USE_DECORRELATED_GP else {})},
                                    coupling_test=GP_COUPLING_TEST,
                                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
                     names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
