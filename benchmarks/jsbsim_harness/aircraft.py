@@ -91,9 +91,10 @@ _DEG = 57.29577951308232
 #: loop, at 12000 ft) and ``c172p`` (the twentieth session's: JSBSim's stock Cessna 172P, the wheel's ``c172p``,
 #: engine shut down, fixed gear, at 4000 ft) and ``eternity`` (the twenty-first session's: ENAC's Eternity UAV from
 #: Paparazzi, checked into ``data/jsbsim_models/eternity`` and flown as ``Eternity_glide``, motor removed, at
-#: 10000 ft). ``us25e`` (the University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics,
-#: checked into ``data/jsbsim_models/ultrastick25e`` and flown as ``UltraStick25e_glide``; added in the twenty-second
-#: session) is held out and untouched: no part of the method has run on it before its final evaluation.
+#: 10000 ft) and ``us25e`` (the twenty-second session's: the University of Minnesota UAS Lab's Ultra Stick 25e with
+#: its OpenFlight aerodynamics, checked into ``data/jsbsim_models/ultrastick25e`` and flown as
+#: ``UltraStick25e_glide``, no propulsion, direct surfaces, at 10000 ft). No aircraft is held out or untouched until
+#: the next one is added.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -631,9 +632,9 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
-                   "asw20", "iar80", "c684", "ultrastick", "b737", "c172p", "eternity")
-HELD_OUT_AIRCRAFT = ("us25e",)
-UNTOUCHED_AIRCRAFT = ("us25e",)
+                   "asw20", "iar80", "c684", "ultrastick", "b737", "c172p", "eternity", "us25e")
+HELD_OUT_AIRCRAFT = ()
+UNTOUCHED_AIRCRAFT = ()
 
 
 def aircraft(name: str) -> AircraftSpec:

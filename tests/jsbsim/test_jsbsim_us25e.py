@@ -1,4 +1,5 @@
-"""The us25e in the JSBSim harness: the twenty-second session's untouched aircraft (docs/jsbsim.md, "The us25e").
+"""The us25e in the JSBSim harness: the twenty-second session's untouched aircraft, a tuning aircraft since the
+twenty-third session (docs/jsbsim.md, "The us25e").
 
 The model is the University of Minnesota UAS Laboratories' JSBSim Ultra Stick 25e with its OpenFlight aerodynamics
 (UASLab/OpenFlightSim ``Simulation/aircraft/UltraStick25e``, the main file at 06a2b255, its parts at 1650a6e3, MIT),
@@ -14,13 +15,15 @@ turbulence: a mechanism check); none of them flies the harness:
 - the FCS maps the commands straight to the surfaces (+-30 deg, the right aileron the left's mirror), flaps 0;
   no engine, no external force;
 - it is statically stable about the CG, and its elevator, ailerons and rudder act as its constants say;
-- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_eternity.py``).
+- the summaries label it bare, as every tuning aircraft (until the next untouched aircraft is added, no aircraft is
+  labelled "(untouched)").
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
 hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
 are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the us25e: its first evaluation is the final one, after the merge.
+No pipeline fit, GP, diagnosis or scoring ran on the us25e before its final evaluation (twenty-second session); it
+is a tuning aircraft since.
 """
 
 import json
@@ -113,10 +116,10 @@ def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_sa
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0704, abs=3e-4), a
 
 
-def test_summaries_mark_the_us25e_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the us25e "(untouched)" and no other
-    aircraft, the eternity, c172p and ultrastick included (synthetic rows: no us25e result exists before the final
-    evaluation). Moved here from ``test_jsbsim_eternity.py`` (the twenty-first session's untouched aircraft)."""
+def test_summaries_mark_no_aircraft_untouched_the_us25e_included(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the us25e bare, as every other aircraft
+    (synthetic rows): the twenty-third session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
+    until the next one is added."""
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
     from gcs_sysid.aero.table import COEFFICIENTS
 
@@ -130,13 +133,13 @@ def test_summaries_mark_the_us25e_untouched_and_the_others_used(tmp_path):
     p = tmp_path / "r.jsonl"
     p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
     lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| us25e (untouched) | light") for ln in lines)
-    for ac in acs[:18]:
+    for ac in acs:
         assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
+    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
     d = tmp_path / "d.jsonl"
     d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
                          for ac in acs))
     lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| us25e (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| us25e | clean |") for ln in lines)
     assert any(ln.startswith("| eternity | clean |") for ln in lines)
+    assert not any("(untouched)" in ln for ln in lines)
