@@ -92,10 +92,10 @@ Usage::
 ``pa28``, ``j3cub`` (``J3Cub``), ``c182``, ``t37``, ``t6`` (``t6texan2``), ``b747`` (``B747``), ``f16``
 (``f16_direct``), ``f4n`` (``F4N_fcs``), ``rascal`` (``Rascal110_glide``), ``sgs126``, ``asw20`` (``asw20_glide``) and
 ``iar80`` (``IAR80_glide``), ``c684`` (``C684_glide``), ``ultrastick`` (``UltraStick120_glide``), ``b737`` (``737``) and
-``c172p`` and ``eternity`` (``Eternity_glide``) were held out in earlier sessions and have been evaluated: they count as
-used. ``us25e`` (the University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics,
-``UltraStick25e_glide``, without propulsion) is the held-out, untouched one: never in the defaults, made and scored only
-in the final evaluation.
+``c172p``, ``eternity`` (``Eternity_glide``) and ``us25e`` (``UltraStick25e_glide``) were held out in earlier sessions
+and have been evaluated: they count as used. ``ka350`` (a JSBSim Beechcraft King Air 350 twin turboprop from a
+FlightGear package, ``KingAir350_glide``, without its engines) is the held-out, untouched one: never in the defaults,
+made and scored only in the final evaluation.
 """
 
 from __future__ import annotations
@@ -555,11 +555,11 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
     ap.add_argument("--make", action="store_true", help=make_help)
     ap.add_argument("--aircraft", nargs="+", default=aircraft, type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e) or JSBSim model names (J3Cub, T37, t6texan2, B747, "
+                         "c684 ultrastick b737 c172p eternity us25e ka350) or JSBSim model names (J3Cub, T37, t6texan2, B747, "
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
-                         "Eternity_glide, UltraStick25e_glide); "
-                         "us25e is the untouched "
+                         "Eternity_glide, UltraStick25e_glide, KingAir350_glide); "
+                         "ka350 is the untouched "
                          "aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])

@@ -57,9 +57,11 @@ Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV without propulsion at 10000 ft, `
 accepted; the eighteenth session's) and ``b737`` (JSBSim's stock Boeing 737, engines shut down, its own yaw damper in
 the loop, at 12000 ft; ``737`` also accepted; the nineteenth session's) and ``c172p`` (JSBSim's stock Cessna 172P,
 engine shut down, at 4000 ft; the twentieth session's) and ``eternity`` (ENAC's Eternity UAV from Paparazzi's JSBSim
-models without its motor, at 10000 ft; ``Eternity_glide`` also accepted; the twenty-first session's). ``us25e`` (the
-University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics, without propulsion;
-``UltraStick25e_glide`` also accepted) is the held-out, untouched one: never in the default list,
+models without its motor, at 10000 ft; ``Eternity_glide`` also accepted; the twenty-first session's) and ``us25e``
+(the University of Minnesota UAS Lab's Ultra Stick 25e with its OpenFlight aerodynamics, without propulsion;
+``UltraStick25e_glide`` also accepted; the twenty-second session's). ``ka350`` (a JSBSim Beechcraft King Air 350 twin
+turboprop from a FlightGear package, engines removed, gear up, at 8000 ft; ``KingAir350_glide`` also accepted) is
+the held-out, untouched one: never in the default list,
 evaluated once after the thresholds are frozen.
 A flight already in ``--work``, flown by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
 ``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
@@ -386,11 +388,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e) or JSBSim model names (J3Cub, T37, t6texan2, B747, "
+                         "c684 ultrastick b737 c172p eternity us25e ka350) or JSBSim model names (J3Cub, T37, t6texan2, B747, "
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
-                         "Eternity_glide, UltraStick25e_glide); "
-                         "us25e is the untouched "
+                         "Eternity_glide, UltraStick25e_glide, KingAir350_glide); "
+                         "ka350 is the untouched "
                          "aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])

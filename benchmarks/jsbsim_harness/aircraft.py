@@ -630,11 +630,39 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "under data/jsbsim_models/ultrastick25e) without propulsion, direct surfaces (derived model "
               "UltraStick25e_glide, XML sha256 8ea2d4e4a54bfe4f), fixed gear, gliding; untouched by any tuning of the "
               "method"),
+    # ka350: a JSBSim Beechcraft King Air 350 (B300) twin turboprop, the flight model of a FlightGear package
+    # rebuilt in 2026 (itaalh/FlightGear-Beechcraft-350ER Aero/KingAir-350.xml at 0298d965, GPL-2.0-or-later):
+    # 13509 lb as the harness flies it (9650 lb empty, 2888 lb of fuel in two symmetric pairs of tanks, 780 lb of
+    # centre-line point masses; its 190-lb pilot at y = -14.7 in is emptied by the harness), a 57.92-ft (17.65 m)
+    # span, 310 ft^2 (28.8 m^2), T-tail; inertia 30290 / 19681 / 47471 slug ft^2 with the fuel, Ixz 834. Its
+    # aerodynamics are tables in alpha and flaps (CL, CD, Cm_alpha, Cl_beta, Cl_delta_a and Cm_delta_e scheduled in
+    # alpha) and rate and aileron cross terms linear in the basic lift coefficient (Cl_r = 0.06 + 0.22 CL, Cn_p =
+    # 0.01 - 0.08 CL, Cn_delta_a = -0.004 - 0.012 CL), CY_r, an alpha-dot lift and moment. The eighth model from
+    # outside the wheel; checked in (data/jsbsim_models/kingair350/, provenance and licence in its README.md) and
+    # flown as the derived model ``KingAir350_glide`` (derived.py): engines, propellers and systems removed, the
+    # autopilot inputs, rudder boost and feathered-propeller drag that read them removed, its yaw damper off.
+    # Chosen in the twenty-third session (docs/jsbsim.md, "The ka350"). Its FCS: elevator -20 / +14 deg, ailerons
+    # 25 deg up / 15 deg down (differential; the aerodynamics read the mean 0.5 (left - right), 0.349 rad per unit
+    # command, linear), rudder +-25 deg. Signs read from its aerodynamics: Pitch_elevator -1.40 x elevator-pos
+    # (positive = trailing edge down), Roll_aileron +0.100 x 0.5 (left - right) (positive = roll right: delta_a =
+    # -0.5 (left - right), Cl_delta_a -0.100), Yaw_rudder -0.095 x rudder-pos (positive = nose left, Cn_delta_r
+    # -0.095), Yaw_aileron (-0.004 - 0.012 CL) x 0.5 (left - right) (adverse). Set from the harness's truth only
+    # (alpha, beta, rates, excitation per axis, surfaces, sink), never from a method result.
+    "ka350": AircraftSpec(
+        name="ka350", model="KingAir350_glide", airspeed_kts=160.0, altitude_ft=8000.0,
+        elevator_sign=1.0, aileron_sign=-1.0,
+        aileron_props=("fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.3491, 1.0 / 0.34905, 1.0 / 0.4363),
+        amplitude_deg=(4.0, 5.0, 5.0), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
+        notes="Beechcraft King Air 350 twin turboprop (JSBSim flight model of the FlightGear package "
+              "itaalh/FlightGear-Beechcraft-350ER, checked in under data/jsbsim_models/kingair350) without engines, "
+              "propellers, systems, rudder boost or yaw damper (derived model KingAir350_glide, XML sha256 "
+              "1d8b5080db88889e), gear up, gliding; untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
                    "asw20", "iar80", "c684", "ultrastick", "b737", "c172p", "eternity", "us25e")
-HELD_OUT_AIRCRAFT = ()
-UNTOUCHED_AIRCRAFT = ()
+HELD_OUT_AIRCRAFT = ("ka350",)
+UNTOUCHED_AIRCRAFT = ("ka350",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -13,7 +13,9 @@ UAV assembled from its files into one, gliding, with direct surfaces (``UltraSti
 :func:`derive_ultrastick120_glide`; eighteenth session), or ENAC's Eternity UAV from Paparazzi with its motor and
 propeller removed and its elevator moment reading an alias (``Eternity_glide``, :func:`derive_eternity_glide`;
 twenty-first session), or the same lab's Ultra Stick 25e with its OpenFlight aerodynamics, assembled and
-flown as the Ultra Stick 120 (``UltraStick25e_glide``, :func:`derive_ultrastick25e_glide`; twenty-second session).
+flown as the Ultra Stick 120 (``UltraStick25e_glide``, :func:`derive_ultrastick25e_glide`; twenty-second session),
+or a JSBSim Beechcraft King Air 350 twin turboprop gliding, its engines, systems, autopilot inputs, rudder boost
+and yaw damper removed (``KingAir350_glide``, :func:`derive_kingair350_glide`; twenty-third session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -68,7 +70,7 @@ from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
-           "derive_eternity_glide", "derive_ultrastick25e_glide",
+           "derive_eternity_glide", "derive_ultrastick25e_glide", "derive_kingair350_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -583,6 +585,78 @@ def derive_eternity_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+#: The King Air 350's ``<system>`` files, none of them copied (:func:`derive_kingair350_glide`).
+_KA350_SYSTEMS = ["engine-control", "fuel-system", "nws", "autopilot"]
+
+#: The King Air 350's rudder-boost components, which read the removed engines' propeller torque.
+_KA350_BOOST = ["fcs/torque-diff", "fcs/rudder-boost-raw", "fcs/rudder-boost-cmd", "fcs/rudder-boost-lag"]
+
+
+def derive_kingair350_glide(root: ET.Element) -> ET.Element:
+    """A JSBSim Beechcraft King Air 350 (``data/jsbsim_models/kingair350/KingAir-350.xml``:
+    itaalh/FlightGear-Beechcraft-350ER ``Aero/KingAir-350.xml`` at 0298d965, GPL-2.0-or-later) gliding, as
+    JSBSim alone can fly it (twenty-third session).
+
+    The file is the flight model of a FlightGear package rebuilt in 2026 (engines, propellers, systems and an
+    autopilot that runs in JSBSim). Six edits; nothing else changes (a test checks every other element):
+
+    - **Engines removed.** The two ``<engine>`` elements (``PT6A-60A`` turboprops, their feeds and the
+      ``Hartzell-4B-105`` propellers; neither file is copied) are removed, as the rascal's, iar80's, c684's and
+      eternity's: the harness glides every aircraft, so that every non-gravity force is aerodynamic. The four fuel
+      tanks (2888 lb in two symmetric pairs) stay as mass.
+    - **Systems removed.** The four ``<system file=...>`` elements (:data:`_KA350_SYSTEMS`: engine control,
+      fuel, nose-wheel steering, autopilot) name files that are not copied.
+    - **Autopilot inputs removed.** The pitch and roll summers add ``ap/elevator-cmd`` and ``ap/aileron-cmd``,
+      which only the removed autopilot system writes (without it ``run_ic`` raises).
+    - **Rudder boost removed.** Its four components (:data:`_KA350_BOOST`: a rudder command proportional to the
+      two propellers' torque difference, lagged) read ``propulsion/engine[n]/propeller-torque-ftlb``, gone with
+      the engines; the rudder summer's input ``fcs/rudder-boost-lag`` goes with them.
+    - **Yaw damper off.** ``/controls/flight/yaw-damper`` is set to 0 (the file sets 1): its washed-out yaw-rate
+      feedback (2.2 x r, clipped at +-0.35 of the command) would move the rudder with the yaw rate in every flight.
+      The channel stays; its switch then passes 0. The harness's own autopilot damps yaw (``gains``' k_r).
+    - **Feathered-propeller drag removed.** ``Drag_feathered`` (0.003 per feathered propeller) reads the removed
+      engine-control system's ``fcs/feather-pos-norm[n]``; without propellers there is nothing to feather.
+
+    Args:
+        root: the parsed ``KingAir-350.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): two
+            ``<propulsion><engine>``, the four systems, the two autopilot inputs, the four boost components and
+            the boost input, the yaw-damper property, or one ``Drag_feathered`` function.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    systems = root.findall("system")
+    fc = root.find("flight_control")
+    aero = root.find("aerodynamics")
+    if (len(engines) != 2 or [x.get("file") for x in systems] != _KA350_SYSTEMS or fc is None or aero is None):
+        raise ValueError("KingAir-350.xml: expected two <propulsion><engine>, the systems "
+                         f"{_KA350_SYSTEMS}, a <flight_control> and an <aerodynamics>")
+    for e in engines:
+        prop.remove(e)
+    for x in systems:
+        root.remove(x)
+    ap = [(summer, i) for ch in fc.findall("channel") for summer in ch for i in summer.findall("input")
+          if (i.text or "").strip() in ("ap/elevator-cmd", "ap/aileron-cmd", "fcs/rudder-boost-lag")]
+    boost = [(ch, c) for ch in fc.findall("channel") for c in ch if c.get("name") in _KA350_BOOST]
+    damper = [p for p in fc.findall("property") if (p.text or "").strip() == "/controls/flight/yaw-damper"]
+    feathered = [(axis, f) for axis in aero.findall("axis") for f in axis.findall("function")
+                 if f.get("name") == "aero/force/Drag_feathered"]
+    if len(ap) != 3 or len(boost) != 4 or len(damper) != 1 or len(feathered) != 1:
+        raise ValueError("KingAir-350.xml: expected the inputs ap/elevator-cmd, ap/aileron-cmd and "
+                         "fcs/rudder-boost-lag, the four rudder-boost components, the yaw-damper property and "
+                         "one Drag_feathered function")
+    for parent, child in ap + boost + feathered:
+        parent.remove(child)
+    damper[0].set("value", "0")
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -645,6 +719,13 @@ REPO_DERIVED = {
                             "sensors replaced by direct surfaces (+-30 deg); the aerodynamics read "
                             "fcs/elevator-pos-rad and fcs/rudder-pos-rad for the lab's posElev_rad and posRud_rad; "
                             "flaps 0; no number changed."),
+    "KingAir350_glide": ("data/jsbsim_models/kingair350/KingAir-350.xml",
+                         "a JSBSim Beechcraft King Air 350 (itaalh/FlightGear-Beechcraft-350ER Aero/KingAir-350.xml "
+                         "at 0298d965, GPL-2.0-or-later), copied into gcs-sysid's data/jsbsim_models/kingair350/",
+                         derive_kingair350_glide, "engines, propellers and the four systems removed (a glide with "
+                         "no propeller force); the autopilot's inputs, the rudder boost and the feathered-propeller "
+                         "drag (which read them) removed; yaw damper off; the fuel tanks stay as mass; everything "
+                         "else unchanged."),
 }
 
 

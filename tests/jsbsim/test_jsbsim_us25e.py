@@ -14,9 +14,9 @@ turbulence: a mechanism check); none of them flies the harness:
 - the checked-in files are the README's, and the derivation changes no number;
 - the FCS maps the commands straight to the surfaces (+-30 deg, the right aileron the left's mirror), flaps 0;
   no engine, no external force;
-- it is statically stable about the CG, and its elevator, ailerons and rudder act as its constants say;
-- the summaries label it bare, as every tuning aircraft (until the next untouched aircraft is added, no aircraft is
-  labelled "(untouched)").
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its constants say.
+
+The summaries' label test moves on with the untouched aircraft (twenty-third session: ``test_jsbsim_ka350.py``).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
 hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
@@ -25,8 +25,6 @@ are slow.
 No pipeline fit, GP, diagnosis or scoring ran on the us25e before its final evaluation (twenty-second session); it
 is a tuning aircraft since.
 """
-
-import json
 
 import numpy as np
 import pytest
@@ -115,31 +113,3 @@ def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_sa
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.0545, abs=1e-4), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0704, abs=3e-4), a
 
-
-def test_summaries_mark_no_aircraft_untouched_the_us25e_included(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the us25e bare, as every other aircraft
-    (synthetic rows): the twenty-third session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
-    until the next one is added."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    for ac in acs:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| us25e | clean |") for ln in lines)
-    assert any(ln.startswith("| eternity | clean |") for ln in lines)
-    assert not any("(untouched)" in ln for ln in lines)

@@ -1,0 +1,189 @@
+"""The ka350 in the JSBSim harness: the twenty-third session's untouched aircraft (docs/jsbsim.md, "The ka350").
+
+The model is the JSBSim flight model of a FlightGear Beechcraft King Air 350 (B300) package rebuilt in 2026
+(itaalh/FlightGear-Beechcraft-350ER ``Aero/KingAir-350.xml`` at 0298d965, GPL-2.0-or-later), a 13319-lb, 17.65-m-span
+twin turboprop with a T-tail whose aerodynamics are tables in alpha and flaps with rate and aileron cross terms
+linear in the basic lift coefficient. Its XML is checked in under ``data/jsbsim_models/kingair350/`` and flown as the
+derived model ``KingAir350_glide`` (``derived.py``): engines, propellers and systems removed, the autopilot inputs,
+rudder boost and feathered-propeller drag that read them removed, its yaw damper off.
+
+The checks here use the file and JSBSim's own properties (the harness's initial condition, ``run_ic``, no
+turbulence: a mechanism check); none of them flies the harness:
+
+- the checked-in file is the one the README names, and the derivation makes only its six edits;
+- the FCS maps the commands straight to the surfaces (elevator -20 / +14 deg, ailerons 25 up / 15 down with the
+  mean of the two read by the aerodynamics, rudder +-25 deg), the yaw damper off; no engine, no external force;
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
+- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_us25e.py``).
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, gear,
+.tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but
+the names are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the ka350: its first evaluation is the final one, after the merge.
+"""
+
+import copy
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import assert_aero_is_the_only_force, checked_in_model, ic_state, lateral_coefficients
+
+SRC = "data/jsbsim_models/kingair350/KingAir-350.xml"
+SRC_SHA256 = "f89a9376371cbbe4f08060548aee36a25d645620943f5e7273c59e3164c9675d"
+#: The aerodynamics' aileron: 0.5 (left - right), rad (``fcs/aileron-eff-rad``).
+AILERON = "fcs/aileron-eff-rad"
+
+
+def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
+    """:func:`truth_fits.ic_state` for the ka350 (160 kt at 8000 ft; it glides near alpha 0)."""
+    return ic_state(aircraft("ka350"), alpha_deg, beta_deg, cmds)
+
+
+def _same(a, b):
+    """The elements, their text and children, not their own tails."""
+    a, b = map(copy.deepcopy, (a, b))
+    a.tail = b.tail = None
+    return ET.tostring(a) == ET.tostring(b)
+
+
+def test_the_derivation_removes_the_engines_systems_and_what_reads_them():
+    """The checked-in XML is the README's (34611 bytes, its SHA-256). ``KingAir350_glide`` is that XML with its two
+    ``<engine>`` elements and four ``<system>`` elements removed, the pitch and roll summers without
+    ``ap/elevator-cmd`` and ``ap/aileron-cmd``, the yaw channel without its four rudder-boost components and the
+    summer's ``fcs/rudder-boost-lag``, ``/controls/flight/yaw-damper`` 0 and no ``Drag_feathered``; the four tanks
+    and every other element are equal (metrics, mass balance, ground reactions, the flaps and gear channels, every
+    other aerodynamic function, the external reactions). The spec's notes carry the derived XML's hash."""
+    src, der, spec = checked_in_model("ka350", "KingAir350_glide", SRC, 34611, SRC_SHA256)
+    ET.indent(src, space=" ")
+    for tag in ("metrics", "mass_balance", "ground_reactions", "external_reactions"):
+        assert _same(src.find(tag), der.find(tag)), tag
+    assert der.find("propulsion/engine") is None and der.find("system") is None
+    assert [x.get("file") for x in src.findall("system")] == ["engine-control", "fuel-system", "nws", "autopilot"]
+    for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True):
+        assert _same(a, b)
+    fc_s, fc_d = src.find("flight_control"), der.find("flight_control")
+    assert [(p.text.strip(), p.get("value")) for p in fc_d.findall("property")] == [
+        ("/controls/flight/yaw-damper", "0"), ("/controls/flight/rudder-boost", "1")]
+    gone = {"ap/elevator-cmd", "ap/aileron-cmd", "fcs/rudder-boost-lag", "fcs/torque-diff", "fcs/rudder-boost-raw",
+            "fcs/rudder-boost-cmd"}
+    for a, b in zip(fc_s.findall("channel"), fc_d.findall("channel"), strict=True):
+        a = copy.deepcopy(a)
+        for comp in list(a):
+            if comp.get("name") in gone:
+                a.remove(comp)
+                continue
+            for i in comp.findall("input"):
+                if i.text.strip() in gone:
+                    comp.remove(i)
+        assert _same(a, b), a.get("name")
+    s_fun = [f for f in src.find("aerodynamics").iter("function") if f.get("name") != "aero/force/Drag_feathered"]
+    d_fun = list(der.find("aerodynamics").iter("function"))
+    assert len(s_fun) == len(d_fun) == 33
+    for a, b in zip(s_fun, d_fun):
+        assert _same(a, b), a.get("name")
+
+
+def test_the_ka350_flies_its_own_surfaces_without_engine_or_external_force():
+    """The FCS maps each command straight to its surface (``aerosurface_scale``, zero-centred): elevator +14 deg
+    trailing edge down and -20 up; left aileron +15 / -25 deg, the right its mirror (-cmd), so the aerodynamics'
+    aileron 0.5 (left - right) is 0.349 rad per unit command both ways (delta_a = -0.5 (left - right) with
+    ``aileron_sign`` -1); rudder +-25 deg. The yaw damper is off (the rudder is the command alone, a yaw rate moves
+    nothing). No engine; 13319 lb (the pilot emptied); after 50 frames every non-gravity force and moment is
+    aerodynamic."""
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    spec = aircraft("ka350")
+    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(13319.0)
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.2443, rel=1e-9)
+    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.3491, rel=1e-9)
+    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.4363, rel=1e-9)
+    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.2618, rel=1e-9)
+    assert fdm[AILERON] == pytest.approx(-0.4 * 0.34905, rel=1e-9)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363, rel=1e-9)
+    yawing = ic_state(spec, 0.0, 0.0, (0.0, 0.0, 0.2), r_rad_s=0.1)
+    assert yawing["fcs/yaw-damper-cmd"] == 0.0 and yawing["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363)
+    assert spec.cmd_per_rad == pytest.approx((1 / 0.3491, 1 / 0.34905, 1 / 0.4363))
+    de, da, dr = np.radians(-3.0), np.radians(5.0), np.radians(4.0)     # the elevator on its larger (up) side
+    cmd = tuple(d * s * k for d, s, k in zip((de, da, dr), (spec.elevator_sign, spec.aileron_sign, spec.rudder_sign),
+                                             spec.cmd_per_rad))
+    assert _deflections(_state(cmds=cmd), spec) == pytest.approx((de, da, dr), rel=1e-4)
+    assert_aero_is_the_only_force(fdm, 1000.0, external_zero=True)
+
+
+def test_the_ka350_is_statically_stable_and_its_controls_act_as_its_xml_says():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic`` at the harness's initial condition, 160 kt at
+    8000 ft, Mach 0.315) without the ``Pitch_alphadot`` term (``run_ic`` gives an alpha-dot the term reads).
+
+    - **Pitch:** Cm falls with alpha: -0.774 per rad between alpha -4 and 0 deg, -0.805 between 0 and 4, -0.738
+      between 4 and 8 (Pitch_alpha's table, -0.9 per rad near 0, and the lift through the reference point 2.5 in
+      behind and 11 in below the CG); Cm +0.036 at alpha 0; per rad of elevator -1.40 (Pitch_elevator -1.40 and
+      Lift_elevator 0.40 through the arm).
+    - **Roll and yaw:** per rad of 0.5 (left - right) Cl +0.100 (the project's Cl_delta_a -0.100) and Cn -0.0082
+      (adverse: -0.004 - 0.012 CL at CL 0.35; Cn_delta_a +0.0082); per rad of rudder Cn -0.0949 and Cl +0.0161
+      (Roll_rudder 0.018, Side_rudder 0.16 through the arm); Cl_beta -0.0771 at alpha 0 and -0.0976 at 6 deg
+      (Roll_beta's table, -0.085 and -0.106, and the side force -0.60 beta through the 11-in arm); Cn_beta 0.0947.
+    """
+    def cm(alpha, de=0.0):
+        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
+        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
+        return (fdm["moments/m-aero-lbsft"] - fdm["aero/moment/Pitch_alphadot"]) / qsc, fdm
+
+    (c_4, _), (c0, f0), (c4, _), (c8, _) = cm(-4.0), cm(0.0), cm(4.0), cm(8.0)
+    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
+    assert f0["velocities/mach"] == pytest.approx(0.315, abs=0.002)
+    assert slope(c_4, c0) == pytest.approx(-0.774, abs=0.005) and slope(c0, c4) == pytest.approx(-0.805, abs=0.005)
+    assert slope(c4, c8) == pytest.approx(-0.738, abs=0.005) and c0 == pytest.approx(0.036, abs=0.002)
+    for c in (0.3, -0.3):
+        c1, f1 = cm(0.0, c)
+        assert (c1 - c0) / f1["fcs/elevator-pos-rad"] == pytest.approx(-1.398, abs=0.006)
+
+    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
+        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds), aileron=AILERON)
+
+    l0, n0, _, _ = lat()
+    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
+    for c in (0.3, -0.3):
+        l1, n1, a1, _ = lat((0.0, c, 0.0))
+        assert (l1 - l0) / a1 == pytest.approx(0.100, abs=1e-4) and (n1 - n0) / a1 == pytest.approx(-0.0082, abs=1e-4)
+        l2, n2, _, r2 = lat((0.0, 0.0, c))
+        assert (n2 - n0) / r2 == pytest.approx(-0.0949, abs=2e-4) and (l2 - l0) / r2 == pytest.approx(0.0161, abs=2e-4)
+    for a, clb in ((0.0, -0.0771), (6.0, -0.0976)):
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(alpha=a, beta=4.0)
+        assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
+        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0947, abs=5e-4), a
+
+
+def test_summaries_mark_the_ka350_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the ka350 "(untouched)" and no other
+    aircraft, the us25e, eternity and c172p included (synthetic rows: no ka350 result exists before the final
+    evaluation). Moved here from ``test_jsbsim_us25e.py`` (the twenty-second session's untouched aircraft)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
+           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| ka350 (untouched) | light") for ln in lines)
+    for ac in acs[:-1]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| ka350 (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| us25e | clean |") for ln in lines)
