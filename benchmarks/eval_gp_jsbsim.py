@@ -555,7 +555,8 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
     ap.add_argument("--make", action="store_true", help=make_help)
     ap.add_argument("--aircraft", nargs="+", default=aircraft, type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e ka350) or JSBSim model names (J3Cub, T37, t6texan2, B747, "
+                         "c684 ultrastick b737 c172p eternity us25e ka350) or JSBSim model names (J3Cub, T37, "
+                         "t6texan2, B747, "
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide); "

@@ -93,8 +93,10 @@ _DEG = 57.29577951308232
 #: Paparazzi, checked into ``data/jsbsim_models/eternity`` and flown as ``Eternity_glide``, motor removed, at
 #: 10000 ft) and ``us25e`` (the twenty-second session's: the University of Minnesota UAS Lab's Ultra Stick 25e with
 #: its OpenFlight aerodynamics, checked into ``data/jsbsim_models/ultrastick25e`` and flown as
-#: ``UltraStick25e_glide``, no propulsion, direct surfaces, at 10000 ft). No aircraft is held out or untouched until
-#: the next one is added.
+#: ``UltraStick25e_glide``, no propulsion, direct surfaces, at 10000 ft). ``ka350`` (a JSBSim Beechcraft King Air 350
+#: twin turboprop from a FlightGear package, checked into ``data/jsbsim_models/kingair350`` and flown as
+#: ``KingAir350_glide``; added in the twenty-third session) is held out and untouched: no part of the method has run
+#: on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
