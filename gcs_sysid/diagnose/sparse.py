@@ -1392,7 +1392,17 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
     named = f"scale:{coef}" if f["cause"].startswith("scale:") else f["cause"].split(":", 1)[1]
     if named not in terms:
         return
-    if centred:
+    scale_named = centred and centred_scale and named == f"scale:{coef}"
+    if scale_named:
+        # a named scale: the selected monomials in the regressors the model's own terms read (which the scale
+        # column is a function of) are projected on it; no parents
+        model_vars = set().union(*[_term_regressors(t) or set() for t in (model0 or {}).get(coef, {})])
+        missing = []
+        holders = [t for t in terms if t != named and _term_regressors(t) is not None
+                   and _term_regressors(t) <= model_vars]
+        if not holders:
+            return
+    elif centred:
         fac = _factors(named)
         if fac is None or not all(x in LIBRARY_REGRESSORS for x in fac):
             return
@@ -1409,9 +1419,14 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             return
         terms = terms + missing
     i = 1 + terms.index(named)
-    k_scale = terms.index(f"scale:{coef}") if centred and centred_scale and f"scale:{coef}" in terms else None
+    k_scale = terms.index(f"scale:{coef}") if centred and centred_scale and not scale_named \
+        and f"scale:{coef}" in terms else None
 
-    def own_parts(Xp: np.ndarray) -> dict[int, np.ndarray] | None:
+    k_hold = [terms.index(t) for t in holders] if scale_named else []
+
+    def own_parts(Xp: np.ndarray, A: np.ndarray | None = None) -> dict[int, np.ndarray] | None:
+        if scale_named:      # each holder's own column, projected on the scale's
+            return {k: A[:, 1 + k] for k in k_hold}
         if k_scale is None:
             return None
         return {k_scale: _scale_own_part(ctx, Xp, X, tr, model0, j, _term_regressors(named) or set(), wind_axis)}
@@ -1434,11 +1449,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                     lib = ({n: k for k, n in enumerate(nm)}, P)
                 cols.append(lib[1][:, lib[0][t]])
         A = np.nan_to_num(np.column_stack(cols))
-        return _centre_columns(A, terms, named, tr, own_parts(Xp)) if centred and centre else A
+        return _centre_columns(A, terms, named, tr, own_parts(Xp, A)) if centred and centre else A
 
     def raw_weights() -> np.ndarray:
         """The centring weights on the uncentred columns at ``X``."""
-        return _centred_weights(columns(X, centre=False), terms, named, tr, own_parts(X))
+        A = columns(X, centre=False)
+        return _centred_weights(A, terms, named, tr, own_parts(X, A))
 
     rr = np.nan_to_num(r - r[tr].mean())
     try:
@@ -1450,11 +1466,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         rnames, rPhi, Rr, rows, S0r, tref = ref_after
         ridx = {n: k for k, n in enumerate(rnames)}
         if all(t == f"scale:{coef}" or t in ridx for t in terms) and rows.size >= 50 \
-                and (not centred or all(v in ridx for v in _factors(named))):
+                and (not centred or scale_named or all(v in ridx for v in _factors(named))):
             A = np.column_stack([np.ones(rows.size)] + [S0r[rows, j] if t == f"scale:{coef}" else rPhi[rows, ridx[t]]
                                                          for t in terms])
             if centred:       # projected over the reference's own rows (a scale: the flight's weight)
                 A = _centre_columns(A, terms, named, np.arange(rows.size),
+                                    {k: A[:, 1 + k] for k in k_hold} if scale_named else None,
                                     fixed=None if k_scale is None else {k_scale: float(raw_weights()[k_scale])})
             try:
                 ref = fit_standard_errors(tref[rows], np.nan_to_num(A), Rr[rows, j] - Rr[rows, j].mean(),
@@ -1518,6 +1535,7 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             "holders": holders,
             "weights": dict(zip(terms, _centred_weights(columns(X), terms, named, tr).tolist())),
             **({} if k_scale is None else {"scale_weight": float(raw_weights()[k_scale])}),
+            **({"scale_holder_weights": dict(zip(holders, raw_weights()[k_hold].tolist()))} if scale_named else {}),
             "method": "the selected terms plus the named term's parents (marginality principle; Nelder 1977, Peixoto "
                       "1987); the terms in the named term's own regressors projected on it and its parents over the "
                       "training rows (the reference's part over the reference's rows)"}

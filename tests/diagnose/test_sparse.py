@@ -440,3 +440,13 @@ def test_centred_scale_gives_the_named_term_the_scale_share_along_its_regressor(
     assert np.allclose(Ac @ th, y)                                            # the same fitted function
     # a weight given (the reference's fit takes the flight's)
     assert np.allclose(_centre_columns(A, terms, "beta", rows, fixed={1: w[1]}), Ac)
+    # the other way round: scale:CY named, beta selected beside it; beta's own column projected on the scale's
+    terms2 = ["scale:CY", "beta"]
+    A2 = np.column_stack([np.ones(T), S, b])
+    w2 = _centred_weights(A2, terms2, "scale:CY", rows, {1: b})
+    Bs = np.column_stack([np.ones(T), S])
+    assert w2[1] == pytest.approx(np.linalg.lstsq(Bs, b, rcond=None)[0][1], rel=1e-9)
+    y2 = s * S + d * b
+    th2 = np.linalg.lstsq(_centre_columns(A2, terms2, "scale:CY", rows, {1: b}), y2, rcond=None)[0]
+    # the named factor is what a scale fitted alone on the whole correction reads
+    assert th2[1] == pytest.approx(np.linalg.lstsq(Bs, y2, rcond=None)[0][1], rel=1e-6)
