@@ -193,12 +193,14 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: instead of the two flights' ``AxisFit.scale_sigma`` in quadrature, which on a gusty flight is the gust's share of
 #: the aided angle (c172p 0.42-0.92 against 0.5-13 % measured); a named change's type B keeps the quadrature. No new
 #: threshold. Measured in ``docs/benchmarks.md``, *Twenty-second session, i9-aiddef*.
-#: Added 2026-11-24 (twenty-third session, branch i9-cyscale): ``centred_scale``, **off** (opt-in): with
+#: Added 2026-11-24 (twenty-third session, branch i9-cyscale): ``centred_scale``, **on** (rule 8: six of eight
+#: aircraft gain a ``CY:scale`` estimate count, none loses any count; False restores the rule before it): with
 #: ``centred_estimate``, a ``scale:<coef>`` the search selects beside a named monomial of that coefficient gives the
 #: named term its share (:func:`_scale_own_part`): the eternity's ``CY:scale`` flights select ``beta`` and ``scale:CY``
 #: together (the reference's spurious ``r_hat`` column, -0.53, keeps the scale column apart from beta), and the named
 #: ``CY:beta`` read only its own column's part, about half of the change (s2 at 1.6: -0.066 of -0.10). Estimation
-#: only: it names, drops and judges nothing. No threshold. Measured in ``docs/benchmarks.md``, *Twenty-third session,
+#: only: it names, drops and judges nothing. A named ``scale:CY`` likewise takes the share of the monomials selected
+#: beside it in the model's side-force regressors. No threshold. Measured in ``docs/benchmarks.md``, *Twenty-third session,
 #: i9-cyscale*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
@@ -217,7 +219,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
-              "coverage_scale_pair": "quadrature", "centred_scale": False}
+              "coverage_scale_pair": "quadrature", "centred_scale": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
