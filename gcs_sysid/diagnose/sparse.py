@@ -193,6 +193,15 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: instead of the two flights' ``AxisFit.scale_sigma`` in quadrature, which on a gusty flight is the gust's share of
 #: the aided angle (c172p 0.42-0.92 against 0.5-13 % measured); a named change's type B keeps the quadrature. No new
 #: threshold. Measured in ``docs/benchmarks.md``, *Twenty-second session, i9-aiddef*.
+#: Added 2026-11-24 (twenty-third session, branch i9-cyscale): ``centred_scale``, **on** (rule 8: six of eight
+#: aircraft gain a ``CY:scale`` estimate count, none loses any count; False restores the rule before it): with
+#: ``centred_estimate``, a ``scale:<coef>`` the search selects beside a named monomial of that coefficient gives the
+#: named term its share (:func:`_scale_own_part`): the eternity's ``CY:scale`` flights select ``beta`` and ``scale:CY``
+#: together (the reference's spurious ``r_hat`` column, -0.53, keeps the scale column apart from beta), and the named
+#: ``CY:beta`` read only its own column's part, about half of the change (s2 at 1.6: -0.066 of -0.10). Estimation
+#: only: it names, drops and judges nothing. A named ``scale:CY`` likewise takes the share of the monomials selected
+#: beside it in the model's side-force regressors. No threshold. Measured in ``docs/benchmarks.md``, *Twenty-third session,
+#: i9-cyscale*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -210,7 +219,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
-              "coverage_scale_pair": "quadrature"}
+              "coverage_scale_pair": "quadrature", "centred_scale": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -977,7 +986,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
-                                  centred=True, null=null)
+                                  centred=True, null=null, centred_scale=bool(th.get("centred_scale", False)))
     result["findings"] = named
     return result
 
@@ -1238,7 +1247,8 @@ def _term_regressors(term: str) -> set | None:
     return set(fac) if fac is not None and all(x in LIBRARY_REGRESSORS for x in fac) else None
 
 
-def _centred_weights(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray) -> np.ndarray:
+def _centred_weights(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray,
+                     own_parts: dict[int, np.ndarray] | None = None) -> np.ndarray:
     """How much of the named monomial each selected term holds over the flight: a least-squares projection.
 
     A selected term that is a function of the named monomial's regressors only (``alpha^3`` or a hinge in alpha
@@ -1254,6 +1264,9 @@ def _centred_weights(A: np.ndarray, terms: list[str], named: str, rows: np.ndarr
     Args:
         A: (N, 1 + K) the fit's columns, constant first. terms: (K,) their names (the named term's parents among
             them). named: the named monomial. rows: rows of A to project over (the training rows).
+        own_parts: ``{k: (N,) column}``: for a selected term ``k`` that is no function of the named term's regressors
+            alone (``scale:CY``, the model's side force), its part in those regressors (:func:`_scale_own_part`),
+            projected in its place (``THRESHOLDS["centred_scale"]``); None: none.
 
     Returns:
         (K,) weights.
@@ -1270,14 +1283,51 @@ def _centred_weights(A: np.ndarray, terms: list[str], named: str, rows: np.ndarr
         if k == i or t in parents or v is None or not v <= own:
             continue
         w[k] = float(np.linalg.lstsq(B, A[rows, 1 + k], rcond=None)[0][-1])
+    for k, col in (own_parts or {}).items():
+        if k != i and terms[k] not in parents:
+            w[k] = float(np.linalg.lstsq(B, np.nan_to_num(col[rows]), rcond=None)[0][-1])
     return w
 
 
-def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray) -> np.ndarray:
+def _scale_own_part(ctx: DiagContext, Xp: np.ndarray, X: np.ndarray, rows: np.ndarray, model0, j: int,
+                    own_vars: set, wind_axis: bool) -> np.ndarray:
+    """The part of a ``scale:<coef>`` column in a named term's own regressors: the scale column (:func:`scale_columns`
+    of the model's prediction) with every other regressor held at its mean over ``rows`` of ``X``.
+
+    A scale ``k`` of a whole coefficient is ``k - 1`` times each of the model's terms (``scale:CY`` of the eternity's
+    reference model: its ``beta``, ``r_hat``, ``delta_a`` and ``delta_r`` terms, wind axis). When the search selects
+    it beside a named term ``CY:beta``, the fitted correction's slope along ``beta`` is the named term's coefficient
+    plus ``k - 1`` times the scale column's own slope along ``beta``; this column, projected on the named term and
+    its parents (:func:`_centred_weights`), gives that share. For a model linear in the named regressor it is the
+    model's (wind-axis) derivative along it, whatever the other regressors do on the flight.
+
+    Args:
+        ctx: diagnosis context. Xp: (T, 10) the regressors to evaluate at (``X`` or a perturbed copy, type B).
+        X: (T, 10) the library's regressors, whose means over ``rows`` the other regressors are held at.
+        rows: training rows. model0: the model (``{coef: {term: value}}``). j: the coefficient's column.
+        own_vars: the named term's regressors (names in :data:`~gcs_sysid.aero.table.REGRESSORS`).
+        wind_axis: ``scale:CY`` on the wind-axis side force.
+
+    Returns:
+        (T,) the column (0 where the model is not finite).
+    """
+    Xq = np.array(np.nan_to_num(Xp), float, copy=True)
+    mean = np.nan_to_num(X[rows]).mean(axis=0)
+    for c, name in enumerate(REGRESSORS):
+        if name not in own_vars:
+            Xq[:, c] = mean[c]
+    return np.nan_to_num(scale_columns(np.nan_to_num(ctx.model_values(Xq, model0)), Xq, wind_axis)[:, j])
+
+
+def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray,
+                    own_parts: dict[int, np.ndarray] | None = None, fixed: dict[int, float] | None = None) -> np.ndarray:
     """Columns ``[1, terms...]`` (N, 1 + K) reparameterised so that the named term's coefficient is
     :func:`_centred_weights`' ``sum_j w_j theta_j``: column j becomes ``a_j - w_j a_named`` (the same span, so the
-    same fitted function; ``theta'_named = w . theta``)."""
-    w = _centred_weights(A, terms, named, rows)
+    same fitted function; ``theta'_named = w . theta``). ``own_parts``: as :func:`_centred_weights`; ``fixed``:
+    ``{k: w_k}`` weights given (the reference's ``scale:CY`` takes the flight's)."""
+    w = _centred_weights(A, terms, named, rows, own_parts)
+    for k, v in (fixed or {}).items():
+        w[k] = v
     i = 1 + terms.index(named)
     out = np.array(A, float, copy=True)
     for j, wj in enumerate(w):
@@ -1289,7 +1339,7 @@ def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarra
 def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
                       M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
                       inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False,
-                      null: dict | None = None) -> None:
+                      null: dict | None = None, centred_scale: bool = False) -> None:
     """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
 
     The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
@@ -1330,6 +1380,11 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             columns and rows) and their combination with the type-A ones, ``evidence.uncertainty.type_b_under_no_change``
             and ``combined_under_no_change`` (what :func:`beyond_expanded_uncertainty` ``under_null`` reads); the
             reported ``std_error`` is unchanged by it. None: not computed.
+        centred_scale: with ``centred``, a ``scale:<coef>`` selected beside a named monomial of that coefficient is a
+            holder too: its part in the named term's regressors (:func:`_scale_own_part`) is projected on the named
+            term, so a named ``CY:beta`` reads the fitted correction's whole slope along beta, the scale's share
+            included (``THRESHOLDS["centred_scale"]``; twenty-third session, branch i9-cyscale). The reference's
+            fit takes the flight's weight for it.
     """
     from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
@@ -1339,7 +1394,17 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
     named = f"scale:{coef}" if f["cause"].startswith("scale:") else f["cause"].split(":", 1)[1]
     if named not in terms:
         return
-    if centred:
+    scale_named = centred and centred_scale and named == f"scale:{coef}"
+    if scale_named:
+        # a named scale: the selected monomials in the regressors the model's own terms read (which the scale
+        # column is a function of) are projected on it; no parents
+        model_vars = set().union(*[_term_regressors(t) or set() for t in (model0 or {}).get(coef, {})])
+        missing = []
+        holders = [t for t in terms if t != named and _term_regressors(t) is not None
+                   and _term_regressors(t) <= model_vars]
+        if not holders:
+            return
+    elif centred:
         fac = _factors(named)
         if fac is None or not all(x in LIBRARY_REGRESSORS for x in fac):
             return
@@ -1350,13 +1415,26 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         own_vars = _term_regressors(named)
         holders = [t for t in terms if t != named and t not in _parent_terms(named)
                    and (_term_regressors(t) or {"-"}) <= own_vars]
+        if centred_scale and f"scale:{coef}" in terms:
+            holders.append(f"scale:{coef}")
         if not missing and not holders:
             return
         terms = terms + missing
     i = 1 + terms.index(named)
+    k_scale = terms.index(f"scale:{coef}") if centred and centred_scale and not scale_named \
+        and f"scale:{coef}" in terms else None
+
+    k_hold = [terms.index(t) for t in holders] if scale_named else []
+
+    def own_parts(Xp: np.ndarray, A: np.ndarray | None = None) -> dict[int, np.ndarray] | None:
+        if scale_named:      # each holder's own column, projected on the scale's
+            return {k: A[:, 1 + k] for k in k_hold}
+        if k_scale is None:
+            return None
+        return {k_scale: _scale_own_part(ctx, Xp, X, tr, model0, j, _term_regressors(named) or set(), wind_axis)}
 
 
-    def columns(Xp: np.ndarray) -> np.ndarray:
+    def columns(Xp: np.ndarray, centre: bool = True) -> np.ndarray:
         lib = None
         cols = [np.ones(len(Xp))]
         Xn = np.nan_to_num(Xp)
@@ -1373,7 +1451,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                     lib = ({n: k for k, n in enumerate(nm)}, P)
                 cols.append(lib[1][:, lib[0][t]])
         A = np.nan_to_num(np.column_stack(cols))
-        return _centre_columns(A, terms, named, tr) if centred else A
+        return _centre_columns(A, terms, named, tr, own_parts(Xp, A)) if centred and centre else A
+
+    def raw_weights() -> np.ndarray:
+        """The centring weights on the uncentred columns at ``X``."""
+        A = columns(X, centre=False)
+        return _centred_weights(A, terms, named, tr, own_parts(X, A))
 
     rr = np.nan_to_num(r - r[tr].mean())
     try:
@@ -1385,11 +1468,13 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         rnames, rPhi, Rr, rows, S0r, tref = ref_after
         ridx = {n: k for k, n in enumerate(rnames)}
         if all(t == f"scale:{coef}" or t in ridx for t in terms) and rows.size >= 50 \
-                and (not centred or all(v in ridx for v in _factors(named))):
+                and (not centred or scale_named or all(v in ridx for v in _factors(named))):
             A = np.column_stack([np.ones(rows.size)] + [S0r[rows, j] if t == f"scale:{coef}" else rPhi[rows, ridx[t]]
                                                          for t in terms])
-            if centred:       # projected over the reference's own rows
-                A = _centre_columns(A, terms, named, np.arange(rows.size))
+            if centred:       # projected over the reference's own rows (a scale: the flight's weight)
+                A = _centre_columns(A, terms, named, np.arange(rows.size),
+                                    {k: A[:, 1 + k] for k in k_hold} if scale_named else None,
+                                    fixed=None if k_scale is None else {k_scale: float(raw_weights()[k_scale])})
             try:
                 ref = fit_standard_errors(tref[rows], np.nan_to_num(A), Rr[rows, j] - Rr[rows, j].mean(),
                                           ["1"] + terms, block_s)
@@ -1451,6 +1536,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             "std_error_selected_fit": float(f["std_error"]), "terms": terms, "parents_added": missing,
             "holders": holders,
             "weights": dict(zip(terms, _centred_weights(columns(X), terms, named, tr).tolist())),
+            **({} if k_scale is None else {"scale_weight": float(raw_weights()[k_scale])}),
+            **({"scale_holder_weights": dict(zip(holders, raw_weights()[k_hold].tolist()))} if scale_named else {}),
             "method": "the selected terms plus the named term's parents (marginality principle; Nelder 1977, Peixoto "
                       "1987); the terms in the named term's own regressors projected on it and its parents over the "
                       "training rows (the reference's part over the reference's rows)"}

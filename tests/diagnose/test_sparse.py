@@ -383,3 +383,70 @@ def test_centred_estimate_is_the_named_coefficient_whatever_companion_is_selecte
     assert np.linalg.lstsq(Ac, y2, rcond=None)[0][1] == pytest.approx(k, rel=1e-8)
     # the delta_e column is in other regressors: left alone
     assert np.allclose(Ac[:, 5], d)
+
+
+def test_centred_scale_gives_the_named_term_the_scale_share_along_its_regressor():
+    """centred_scale (twenty-third session, branch i9-cyscale): a side-force correction fitted as ``d beta + s S``,
+    ``S`` the model's wind-axis side force (beta and a spurious r_hat column, as the eternity's reference carries),
+    reads along beta ``d + s dS/dbeta`` once the scale's own part in beta is projected on the named term; without it
+    the named coefficient is ``d`` alone (the half of the eternity's scale that was missing). The own part is the
+    model's side force with every other regressor at its mean, so its slope is the model's wind-axis derivative.
+    Mechanism check on synthetic columns (no flight)."""
+    from types import SimpleNamespace
+
+    from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS
+    from gcs_sysid.diagnose.sparse import _centre_columns, _centred_weights, _scale_own_part
+
+    rng = np.random.default_rng(1)
+    T = 4000
+    X = np.zeros((T, len(REGRESSORS)))
+    X[:, REGRESSORS.index("alpha")] = 0.08 + 0.01 * rng.standard_normal(T)
+    X[:, REGRESSORS.index("beta")] = 0.03 * rng.standard_normal(T)
+    X[:, REGRESSORS.index("r_hat")] = 0.02 * rng.standard_normal(T) + 0.3 * X[:, REGRESSORS.index("beta")]
+    X[:, REGRESSORS.index("V")] = 17.0
+    cyb, cyr, cx, cz = -0.226, -0.529, -0.06, -0.5
+
+    def model_values(Xp, model=None):
+        M = np.zeros((len(Xp), 6))
+        M[:, COEFFICIENTS.index("CX")] = cx
+        M[:, COEFFICIENTS.index("CZ")] = cz
+        M[:, COEFFICIENTS.index("CY")] = cyb * Xp[:, REGRESSORS.index("beta")] + cyr * Xp[:, REGRESSORS.index("r_hat")]
+        return M
+
+    ctx = SimpleNamespace(model_values=model_values)
+    rows = np.arange(T)
+    jy = COEFFICIENTS.index("CY")
+    b = X[:, REGRESSORS.index("beta")]
+    a_mean = X[:, REGRESSORS.index("alpha")].mean()
+    part = _scale_own_part(ctx, X, X, rows, None, jy, {"beta"}, wind_axis=False)
+    assert np.polyfit(b, part, 1)[0] == pytest.approx(cyb, rel=1e-9)          # body axis: the model's CY_beta
+    part_w = _scale_own_part(ctx, X, X, rows, None, jy, {"beta"}, wind_axis=True)
+    c_d = -np.cos(a_mean) * cx - np.sin(a_mean) * cz
+    assert np.polyfit(b, part_w, 1)[0] == pytest.approx(cyb + c_d, rel=0.01)   # wind axis: CY_beta + C_D
+    # the fit's columns: 1, beta, the whole scale column (wind axis), p_hat-like noise column
+    S = np.cos(b) * (np.cos(b) * model_values(X)[:, jy] + np.sin(b) * c_d)
+    other = rng.standard_normal(T)
+    terms = ["beta", "scale:CY", "p_hat"]
+    A = np.column_stack([np.ones(T), b, S, other])
+    d, s = -0.066, 0.208
+    y = d * b + s * S + 0.03 * other
+    bare = np.linalg.lstsq(_centre_columns(A, terms, "beta", rows), y, rcond=None)[0][1]
+    assert bare == pytest.approx(d, rel=1e-8)                                 # no holder: the bare coefficient
+    w = _centred_weights(A, terms, "beta", rows, {1: part_w})
+    assert w[1] == pytest.approx(np.polyfit(b, part_w, 1)[0], rel=1e-6) and w[2] == 0.0
+    Ac = _centre_columns(A, terms, "beta", rows, {1: part_w})
+    th = np.linalg.lstsq(Ac, y, rcond=None)[0]
+    assert th[1] == pytest.approx(d + s * w[1], rel=1e-8)                     # the whole slope along beta
+    assert np.allclose(Ac @ th, y)                                            # the same fitted function
+    # a weight given (the reference's fit takes the flight's)
+    assert np.allclose(_centre_columns(A, terms, "beta", rows, fixed={1: w[1]}), Ac)
+    # the other way round: scale:CY named, beta selected beside it; beta's own column projected on the scale's
+    terms2 = ["scale:CY", "beta"]
+    A2 = np.column_stack([np.ones(T), S, b])
+    w2 = _centred_weights(A2, terms2, "scale:CY", rows, {1: b})
+    Bs = np.column_stack([np.ones(T), S])
+    assert w2[1] == pytest.approx(np.linalg.lstsq(Bs, b, rcond=None)[0][1], rel=1e-9)
+    y2 = s * S + d * b
+    th2 = np.linalg.lstsq(_centre_columns(A2, terms2, "scale:CY", rows, {1: b}), y2, rcond=None)[0]
+    # the named factor is what a scale fitted alone on the whole correction reads
+    assert th2[1] == pytest.approx(np.linalg.lstsq(Bs, y2, rcond=None)[0][1], rel=1e-6)
