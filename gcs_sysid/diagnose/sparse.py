@@ -193,6 +193,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: instead of the two flights' ``AxisFit.scale_sigma`` in quadrature, which on a gusty flight is the gust's share of
 #: the aided angle (c172p 0.42-0.92 against 0.5-13 % measured); a named change's type B keeps the quadrature. No new
 #: threshold. Measured in ``docs/benchmarks.md``, *Twenty-second session, i9-aiddef*.
+#: Added 2026-11-24 (twenty-third session, branch i9-level2): ``inadequacy_alpha_centre``, **off**: the reference's
+#: ridge inadequacy on a library in ``alpha - mean(alpha_ref)`` (:func:`_inadequacy_library`), invariant to an alpha
+#: level common to both flights (the alpha level's ``reference`` and ``pooled`` modes then agree). No new threshold.
+#: Mixed on the eternity, c172p, us25e and sgs (``docs/benchmarks.md``, *Twenty-third session, i9-level2*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
