@@ -51,7 +51,7 @@ from ..errors import InputError
 from .context import ModelDict, evaluate_model, model_as_dict
 from .terms import canonical_term, term_factors
 
-__all__ = ["ALPHA_LEVEL_MODES", "level_offset", "pool_levels", "shift_model_alpha", "shift_alpha",
+__all__ = ["ALPHA_LEVEL_MODES", "SHIFT_KEY", "level_offset", "pool_levels", "shift_model_alpha", "shift_alpha",
            "align_alpha_levels"]
 
 #: The accepted modes: ``"reference"`` (the test flight in the first reference flight's alpha frame) and
@@ -176,10 +176,17 @@ def shift_model_alpha(model, level: float) -> ModelDict:
     return out
 
 
+#: The ``FlightStates.data`` key under which :func:`shift_alpha` records the shift it applied, rad, (T,) constant:
+#: a flight reduced again from its log (the pitot's exact re-fit, :func:`gcs_sysid.diagnose.pitot._unit_delta_rereduced`)
+#: comes back in the log's own alpha frame and must be brought into the common one before it is compared.
+SHIFT_KEY = "alpha_level_shift"
+
+
 def shift_alpha(table, states, shift: float):
     """Copies of a flight's coefficient table and states with alpha moved by ``shift`` (rad; new = old + shift).
 
-    Only the alpha column of ``table.X`` and ``states.data["alpha"]`` change; the arrays are copied, the inputs
+    Only the alpha column of ``table.X`` and ``states.data["alpha"]`` change, and the shift is recorded as
+    ``states.data[SHIFT_KEY]`` (T,) (added to what an earlier shift recorded); the arrays are copied, the inputs
     are left as they were. ``states`` may be None.
     """
     X = np.array(table.X, float, copy=True)
@@ -190,6 +197,7 @@ def shift_alpha(table, states, shift: float):
     st = copy.copy(states)
     st.data = dict(states.data)
     st.data["alpha"] = np.asarray(states.data["alpha"], float) + shift
+    st.data[SHIFT_KEY] = np.asarray(states.data.get(SHIFT_KEY, 0.0), float) + np.full(len(st.data["alpha"]), shift)
     return tab, st
 
 

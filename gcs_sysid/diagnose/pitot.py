@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .alpha_level import SHIFT_KEY
 from .candidates import Scorer, fit_sensor_causes
 from .causes import _air_velocity_body, _dcm_nb, transforms
 from .context import DiagContext
@@ -504,11 +505,36 @@ def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float, angle_fits: dict 
         table = compute_coefficients(states, ctx.airframe)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError, KeyError):
         return None
-    X, Y = np.asarray(table.X, float), np.asarray(table.Y, float)
+    X, Y = np.array(table.X, float), np.asarray(table.Y, float)
     if X.shape != ctx.X.shape or not np.allclose(np.asarray(table.t, float), ctx.t):
         return None
+    if SHIFT_KEY in ctx.states:
+        X = _realigned_alpha(ctx, table, X, Y)
     D = (Y - ctx.model_values(X)) - (ctx.Y - ctx.model_values())
     return np.where(np.isfinite(D), D, 0.0) / b0
+
+
+def _realigned_alpha(ctx: DiagContext, table, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """The re-reduced flight's regressors (T, 10) in the common alpha frame of :mod:`gcs_sysid.diagnose.alpha_level`.
+
+    A flight diagnosed with the alpha level on (``ctx.states[SHIFT_KEY]``, the shift applied to it) was moved
+    into one frame with its reference and the model, which ``ctx.model`` already is; its re-reduction with the
+    pitot corrected comes back in the log's own frame. Its offset is found again against ``ctx.model`` (the
+    shifted model: the offset ``d`` found is ``-(shift)`` of the corrected flight) and removed, as the
+    alignment did for the flight as logged. Re-found rather than the recorded shift reused: a pitot bias scales
+    the measured ``CZ`` and so moved the offset the alignment found; the per-m/s effect of the bias must
+    include that move, or the coefficients read the frame's change as the bias's (JSBSim c172p, ``bias:airspeed
+    = 2`` seed 1, pooled level: CZ read -10.0 m/s, the fused estimate 1.36 m/s with the coefficients
+    0.64 +- 1.51, no finding; twenty-third session, branch i9-level2). Where no offset is found the recorded
+    shift is applied.
+    """
+    from ..aero.table import REGRESSORS
+    from .alpha_level import level_offset
+
+    ia = REGRESSORS.index("alpha")
+    off = level_offset(np.asarray(table.t, float), X, Y, np.asarray(table.valid, bool), ctx.model)["offset_rad"]
+    X[:, ia] += -off if np.isfinite(off) else np.asarray(ctx.states[SHIFT_KEY], float)
+    return X
 
 
 def _fit_unit_delta(ctx: DiagContext, R: np.ndarray, D1: np.ndarray,

@@ -202,6 +202,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: only: it names, drops and judges nothing. A named ``scale:CY`` likewise takes the share of the monomials selected
 #: beside it in the model's side-force regressors. No threshold. Measured in ``docs/benchmarks.md``, *Twenty-third session,
 #: i9-cyscale*.
+#: Added 2026-11-24 (twenty-third session, branch i9-level2): ``inadequacy_alpha_centre``, **off**: the reference's
+#: ridge inadequacy on a library in ``alpha - mean(alpha_ref)`` (:func:`_inadequacy_library`), invariant to an alpha
+#: level common to both flights (the alpha level's ``reference`` and ``pooled`` modes then agree). No new threshold.
+#: Mixed on the eternity, c172p, us25e and sgs (``docs/benchmarks.md``, *Twenty-third session, i9-level2*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -219,7 +223,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
-              "coverage_scale_pair": "quadrature", "centred_scale": True}
+              "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -778,20 +782,25 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         # the inadequacy below removes (the JSBSim rascal's Cm:alpha^2 = -8 flight in light turbulence
         # never reaches the reference's top alpha quantile, 7.9 deg, and crashed the search before)
         Phi_r = _aligned(names, Phi, rnames)
+        # the ridge's own library: the same, or (inadequacy_alpha_centre) in alpha less the reference's mean alpha,
+        # so that a level common to both flights does not change the inadequacy (_inadequacy_library)
+        alpha_centre = _reference_alpha_centre(rctx) if th.get("inadequacy_alpha_centre", False) else None
+        inames, iPhi_ref, iPhi = (rnames, rPhi, Phi_r) if alpha_centre is None else \
+            _inadequacy_library(ctx, rctx, knots, alpha_centre)
         rtr, rte = _segments(rctx, segment_frac)
         Rr = np.nan_to_num(np.asarray(Rr, float))
         rows = np.r_[rtr, rte]
-        ridge = _ridge_cv(rPhi[rows], Rr[rows], folds, max_rows) if th.get("inadequacy", "ridge") == "ridge" \
+        ridge = _ridge_cv(iPhi_ref[rows], Rr[rows], folds, max_rows) if th.get("inadequacy", "ridge") == "ridge" \
             and rtr.size >= 20 * folds else None
         for j, coef in enumerate(COEFFICIENTS):
             if not (ctx.active[j] and rctx.active[j]) or rtr.size < 20 * folds:
                 continue
             if ridge is not None:
                 W, mu, sc, lam = ridge
-                base[:, j] = ((Phi_r - mu) / sc) @ W[:, j]
+                base[:, j] = ((iPhi - mu) / sc) @ W[:, j]
                 if ref_ms is None:
                     ref_ms = np.zeros(6)
-                e = Rr[rows, j] - ((rPhi[rows] - mu) / sc) @ W[:, j]
+                e = Rr[rows, j] - ((iPhi_ref[rows] - mu) / sc) @ W[:, j]
                 ref_ms[j] = float(np.mean((e - e.mean()) ** 2))
                 if ref_after is None:
                     ref_after = (rnames, rPhi, np.zeros_like(Rr), rows,
@@ -800,7 +809,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                                  rctx.t)
                 ref_after[2][rows, j] = e
                 result["inadequacy"].append({"coefficient": coef, "model": "ridge", "lambda": float(lam[j]),
-                                             "rms_explained": float(np.std(((rPhi[rows] - mu) / sc) @ W[:, j]))})
+                                             "rms_explained": float(np.std(((iPhi_ref[rows] - mu) / sc) @ W[:, j]))})
             else:
                 idx = {n: i for i, n in enumerate(names)}
                 entry, _ = _fit_coefficient(rnames, rPhi, Rr[:, j], rows, rte[:0], folds, th, max_rows)
@@ -814,9 +823,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             # the inadequacy is itself fitted on the reference flight: its delete-a-block refits, as this
             # flight sees them (the same centring), for the standard uncertainty of a named term
             # (_with_uncertainty)
-            Wb = _ridge_jackknife(rPhi[rows], Rr[rows], rctx.t[rows], ridge, max_rows,
+            Wb = _ridge_jackknife(iPhi_ref[rows], Rr[rows], rctx.t[rows], ridge, max_rows,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0)
-            Ps = (Phi_r - ridge[1]) / ridge[2]
+            Ps = (iPhi - ridge[1]) / ridge[2]
             base_jk = [(Ps @ W_b) * (base != 0).any(axis=0) for W_b in Wb]
             base_jk = [b - b[tr].mean(axis=0) for b in base_jk]
     Rd = R - base
@@ -883,7 +892,11 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 # the reference's inadequacy, predicted on the angles brought to the reference's level
                 # (_inadequacy_at_reference_level): its terms in alpha (the ultrastick's CY and Cn in
                 # alpha*delta_a) read a between-flight alpha offset as a change of their control's slope
-                base_new, base_jk = _inadequacy_at_reference_level(names, Phi, rnames, ridge, Wb, base, tr)
+                if alpha_centre is None:
+                    base_new, base_jk = _inadequacy_at_reference_level(names, Phi, rnames, ridge, Wb, base, tr)
+                else:
+                    cn, cP = _library(_alpha_moved(replace(ctx, X=Xc), -alpha_centre), knots - alpha_centre)
+                    base_new, base_jk = _inadequacy_at_reference_level(cn, cP, inames, ridge, Wb, base, tr)
                 Rd = Rd + base - base_new
                 base = base_new
                 result["inadequacy_prediction"] = base.copy()
@@ -1139,6 +1152,48 @@ def _with_reference_error(f: dict, ref_after) -> None:
         return
     f["evidence"]["std_error_parts"] = {"flight": float(f["std_error"]), "reference": se_ref}
     f["std_error"] = float(np.hypot(f["std_error"], se_ref))
+
+
+def _reference_alpha_centre(rctx: DiagContext) -> float:
+    """The reference flight's mean alpha over its valid rows, rad (0 without any)."""
+    a = np.asarray(rctx.X, float)[:, REGRESSORS.index("alpha")]
+    ok = np.asarray(rctx.valid, bool) & np.isfinite(a)
+    return float(a[ok].mean()) if ok.any() else 0.0
+
+
+def _alpha_moved(ctx: DiagContext, shift: float) -> DiagContext:
+    """A copy of ``ctx`` with alpha moved by ``shift`` (rad; new = old + shift)."""
+    X = np.array(ctx.X, float, copy=True)
+    X[:, REGRESSORS.index("alpha")] += shift
+    return replace(ctx, X=X)
+
+
+def _inadequacy_library(ctx: DiagContext, rctx: DiagContext, knots: np.ndarray,
+                        centre: float) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The reference's ridge inadequacy's library in alpha less ``centre`` (``THRESHOLDS["inadequacy_alpha_centre"]``).
+
+    The ridge of :func:`_ridge_cv` shrinks *standardised* columns, so it is not invariant to alpha's origin: with
+    alpha moved by a constant ``L`` (both flights and the model, as :mod:`gcs_sysid.diagnose.alpha_level` does) a
+    product ``alpha*x`` becomes ``alpha*x + L x``, a different column with a different penalty, and the inadequacy
+    it predicts on the test flight changes although the polynomial space it spans does not. On the JSBSim
+    Eternity's ``Cn:delta_a = -0.03`` seed-3 flight the common frame moved alpha by 2.5 deg and the Cn
+    inadequacy's chosen ridge from 1.0 to 0.1; the search then read ``Cn:delta_a`` -0.019 with a lag beside it
+    instead of -0.029 (twenty-third session, branch i9-level2). With every alpha column formed from
+    ``alpha - centre`` (``centre`` the reference's mean alpha, which moves with the frame) the ridge sees the same
+    columns in any frame. The inadequacy is a nuisance that is never named, so this changes no term's name; the
+    search's own library keeps alpha's origin (an injected ``alpha^2`` or ``alpha*beta`` is one column only there).
+
+    Args:
+        ctx, rctx: the flight under test and the reference. knots: (n_hinges,) the hinges in alpha, rad, in the
+            flights' frame. centre: rad.
+
+    Returns:
+        (names (K',), the reference's columns (T_ref, K'), this flight's columns in the reference's order (T, K')).
+    """
+    k = np.asarray(knots, float) - centre
+    inames, iPhi_ref = _library(_alpha_moved(rctx, -centre), k)
+    names, Phi = _library(_alpha_moved(ctx, -centre), k)
+    return inames, iPhi_ref, _aligned(names, Phi, inames)
 
 
 def _inadequacy_at_reference_level(names: list[str], Phi: np.ndarray, rnames: list[str], ridge, Wb,

@@ -100,3 +100,76 @@ def test_the_alpha_level_is_opt_in_and_checks_its_mode():
     assert run.ALPHA_LEVEL is None                              # off by default (rule 8)
     with pytest.raises(InputError, match="unknown mode"):
         align_alpha_levels("mean", TRUE, _flight(0, 0.0, T=200), None)
+
+
+class _States:
+    """What :func:`shift_alpha` and ``DiagContext.build`` read of a FlightStates."""
+
+    def __init__(self, t, alpha):
+        self.t, self.data = t, {"alpha": np.asarray(alpha, float)}
+
+    def __len__(self):
+        return len(self.t)
+
+
+def test_a_flight_reduced_again_is_brought_into_the_common_frame_before_the_pitot_compares_it():
+    # pitot._realigned_alpha: the pitot's exact re-fit re-reduces the log, which comes back in the log's own alpha
+    # frame; without a pitot change it must come back as the aligned flight, whatever the frame moved by
+    from gcs_sysid.airframe import Airframe
+    from gcs_sysid.diagnose.alpha_level import SHIFT_KEY
+    from gcs_sysid.diagnose.context import DiagContext
+    from gcs_sysid.diagnose.pitot import _realigned_alpha
+
+    levels = np.radians([3.0, -1.5, 0.5, -2.0])
+    model = _reference_model(levels[0])
+    ref, test = _flight(10, levels[0]), _flight(20, np.radians(-3.0))
+    lv = [_flight(11 + k, e) for k, e in enumerate(levels[1:])]
+    st = _States(test.t, test.X[:, 0])
+    m1, tab, st1, _, info = align_alpha_levels("pooled", model, test, st, [Reference(ref)], lv)
+    assert SHIFT_KEY not in st.data and np.allclose(st1.data[SHIFT_KEY], np.radians(info["shift_deg"]))
+    ctx = DiagContext.build(tab, Airframe("test", 1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, ()), m1, st1)
+    X = _realigned_alpha(ctx, test, np.array(test.X, float), test.Y)     # the log's frame, re-aligned
+    assert np.max(np.abs(X[:, 0] - tab.X[:, 0])) < 1e-9
+    assert np.max(np.abs(test.X[:, 0] - tab.X[:, 0])) > np.radians(1.0)  # (without it the frames differ by degrees)
+
+
+def test_the_searchs_inadequacy_with_alpha_centred_does_not_depend_on_alphas_origin():
+    # sparse.THRESHOLDS["inadequacy_alpha_centre"]: the reference's ridge inadequacy predicted on the test flight is
+    # the same when both flights' alpha move by one constant; on the raw library it is not (the ridge shrinks
+    # standardised columns, and alpha*x + L x is another column than alpha*x)
+    from gcs_sysid.airframe import Airframe
+    from gcs_sysid.diagnose import sparse
+    from gcs_sysid.diagnose.context import DiagContext
+
+    af = Airframe("test", 1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, ())
+    rng = np.random.default_rng(7)
+
+    def ctx(seed, shift):
+        T = 1500
+        r = np.random.default_rng(seed)
+        X = np.cumsum(r.standard_normal((T, 10)), axis=0) * 0.002
+        X[:, 0] += 0.06 + shift
+        X[:, 9] = 20.0
+        tab = CoefficientTable(np.arange(T) / 50.0, X, np.zeros((T, 6)), np.ones(T, bool), np.full(T, 200.0))
+        return DiagContext.build(tab, af, {c: {} for c in COEFFICIENTS})
+
+    w, noise = rng.standard_normal(6), 1e-4 * rng.standard_normal((1500, 6))
+    preds = {}
+    for centre in (False, True):
+        for shift in (0.0, np.radians(2.5)):
+            rc, tc = ctx(1, shift), ctx(2, shift)
+            knots = sparse.alpha_quantile_knots(rc)
+            if centre:
+                names, rPhi, Phi = sparse._inadequacy_library(tc, rc, knots, sparse._reference_alpha_centre(rc))
+            else:
+                names, rPhi = sparse._library(rc, knots)
+                Phi = sparse._aligned(*sparse._library(tc, knots), names)
+            a, x = rc.X[:, 0] - 0.06 - shift, rc.X[:, 6]            # an inadequacy in alpha*delta_a on the reference
+            Rr = np.outer(a * x * 40 + x * 0.3, w) + noise
+            W, mu, sc, _ = sparse._ridge_cv(rPhi, Rr, 5, 4000, lambdas=(1.0,))
+            p = ((Phi - mu) / sc) @ W
+            preds[centre, shift] = p - p.mean(axis=0)
+    scale = np.max(np.abs(preds[True, 0.0]))
+    assert np.max(np.abs(preds[True, 0.0] - preds[True, np.radians(2.5)])) < 1e-6 * scale
+    assert np.max(np.abs(preds[False, 0.0] - preds[False, np.radians(2.5)])) > 1e-3 * scale
+    assert sparse.THRESHOLDS["inadequacy_alpha_centre"] is False      # opt-in (rule 8)
