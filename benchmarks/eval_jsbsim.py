@@ -252,6 +252,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         row["max_corr"] = float(np.nanmax(C)) if C.size else 0.0
         row["gp_coupling_test"] = _pipeline.GP_COUPLING_TEST
         row["gp_noise_correlation"] = _pipeline.GP_NOISE_CORRELATION
+        row["gp_noise_posterior"] = _pipeline.GP_NOISE_POSTERIOR
+        row["gp_noise_start"] = _pipeline.GP_NOISE_START
     if model.discrepancy is not None and model.n_outputs == 6:
         # a diagnosis, not a criterion: the coefficient band with its coloured noise share floored at the
         # blocked validation's discrepancy d (as at exact conditions)
@@ -412,9 +414,12 @@ def main(argv=None) -> int:
                          "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); 'untested' sets "
                          "gcs_sysid.pipeline.GP_COUPLING_TEST = 'none' (B's couplings kept as learned, without the "
                          "every-row likelihood-ratio test: the default until the twenty-second session)")
-    ap.add_argument("--gp-noise", default=None, choices=("diagonal", "full"),
+    ap.add_argument("--gp-noise", default=None, choices=("diagonal", "full", "learned", "full-nstart"),
                     help="the replay GP's noise: 'full' sets gcs_sysid.pipeline.GP_NOISE_CORRELATION (a P x P noise "
-                         "covariance, eval_gp_jsbsim's nigp); 'diagonal' one variance per output (the default)")
+                         "covariance, eval_gp_jsbsim's nigp); 'learned' the same covariance learned with the "
+                         "hyperparameters but only its diagonal in the posterior (GP_NOISE_POSTERIOR = 'diagonal'); "
+                         "'full-nstart' full with the shared error started in the noise (GP_NOISE_START = 'noise'); "
+                         "'diagonal' one variance per output (the default)")
     ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
                     help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
                          "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
@@ -481,7 +486,9 @@ def main(argv=None) -> int:
     if a.gp_noise is not None:
         import gcs_sysid.pipeline as pipeline
 
-        pipeline.GP_NOISE_CORRELATION = a.gp_noise == "full"
+        pipeline.GP_NOISE_CORRELATION = a.gp_noise != "diagonal"
+        pipeline.GP_NOISE_POSTERIOR = "diagonal" if a.gp_noise == "learned" else "full"
+        pipeline.GP_NOISE_START = "noise" if a.gp_noise == "full-nstart" else "signal"
     if a.cy_rate_prior is not None:
         import gcs_sysid.pipeline as pipeline
 

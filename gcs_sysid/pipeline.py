@@ -130,6 +130,15 @@ GP_COUPLING_TEST = "lr"
 #: i8-noise) correlations above 0.5 on 29 -> 6 of 87 flights, GP<LS 469 -> 472, but a count lost on 7 aircraft.
 GP_NOISE_CORRELATION = False
 
+#: With :data:`GP_NOISE_CORRELATION`, the noise covariance the replay GP's posterior conditions on
+#: (``GPConfig.noise_posterior``): ``"full"`` (the learned one) or ``"diagonal"`` (the correlation learned with the
+#: hyperparameters, dropped before the posterior: twenty-third session, i8-noise2; ``eval_jsbsim --gp-noise learned``).
+GP_NOISE_POSTERIOR = "full"
+
+#: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or ``"noise"``
+#: (``eval_jsbsim --gp-noise full-nstart``).
+GP_NOISE_START = "signal"
+
 #: Opt-in (nineteenth session, i8-cyr): the std (CY per unit ``p_hat`` / ``r_hat``) of a zero-mean prior on CY's two
 #: rate slopes, imposed by mixed estimation on the GP's training target (:func:`gcs_sysid.gp.mixed.apply_slope_prior`;
 #: Theil and Goldberger 1961; ``docs/gp.md``, "Prior knowledge on the side-force rate slopes"). None: no prior (the
@@ -424,6 +433,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                  f"{len(X_train)} new samples)")
                 else:
                     cfg = GPConfig(**{"noise_correlation": GP_NOISE_CORRELATION,
+                                      "noise_posterior": GP_NOISE_POSTERIOR, "noise_start": GP_NOISE_START,
                                       **(ALPHA_DOT_GP if use_adot else {}),
                                       **(DECORRELATED_GP if USE_DECORRELATED_GP else {})},
                                    coupling_test=GP_COUPLING_TEST,

@@ -85,6 +85,16 @@ class GPConfig:
             bound moves it into ``B`` only as far as it climbs (``docs/gp.md``, "Noise: where the shared
             error starts"). Ignored without ``noise_correlation``, with missing outputs and with the
             per-group kernels of ``output_groups``.
+        noise_posterior: with ``noise_correlation``, the noise covariance the posterior conditions on (and the
+            blocked validation, the coupling test and the predictions with it): ``"full"`` (the default) the learned
+            ``P x P`` one; ``"diagonal"`` (opt-in, twenty-third session, i8-noise2) only its per-output variances:
+            the correlation is learned with the other hyperparameters, so the gusts' shared error is not explained
+            as signal coupling in ``B``, then dropped before the posterior. Why: with a noise correlation the
+            posterior is a seemingly-unrelated-regressions GLS, which moves one output's mean by another's
+            residual wherever their signal priors differ (each output's latent shrunk by its own blocked-validation
+            scale, its own linear terms); sgs126 light s1: a learned CZ-Cm correlation of 0.74 moved Cm's slope
+            from ``q_hat`` to alpha (Cm_q -10.2 -> -0.7; ``docs/gp.md``, "Noise: learned, not conditioned on").
+            Ignored without ``noise_correlation``.
         hyper_stride: learn the global hyperparameters on every ``hyper_stride``-th training row in time
             order (then at most ``n_train_max`` of them at random); 1 (the default): any ``n_train_max`` rows.
             Rows that close in time share the gusts' coloured error, which the bound, counting rows as
@@ -250,6 +260,7 @@ class GPConfig:
     hyper_every: int = 0
     noise_correlation: bool = False
     noise_start: str = "signal"
+    noise_posterior: str = "full"
     hyper_stride: int = 1
     coupling: str = "learned"
     coupling_rows: str = "subset"
@@ -311,6 +322,8 @@ class GPConfig:
             raise InputError(f"GPConfig.coupling_rows must be 'subset' or 'all', got {self.coupling_rows!r}")
         if self.coupling_test not in ("none", "lr"):
             raise InputError(f"GPConfig.coupling_test must be 'none' or 'lr', got {self.coupling_test!r}")
+        if self.noise_posterior not in ("full", "diagonal"):
+            raise InputError(f"GPConfig.noise_posterior must be 'full' or 'diagonal', got {self.noise_posterior!r}")
         if self.noise_start not in ("signal", "noise"):
             raise InputError(f"GPConfig.noise_start must be 'signal' or 'noise', got {self.noise_start!r}")
         if self.inducing not in ("mi", "kmeans", "random"):

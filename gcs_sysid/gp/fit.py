@@ -781,6 +781,12 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         from .joint import decoupled
 
         params = decoupled(params)
+    elif cfg.noise_correlation and cfg.noise_posterior == "diagonal" and params.noise_chol is not None:
+        # learned with the noise correlation, conditioned without it (GPConfig.noise_posterior)
+        R = np.asarray(params.noise_chol)
+        C = R @ R.T
+        history.validation["noise_correlation_learned"] = C.tolist()
+        params = replace(params, noise_chol=None)
     return params
 
 

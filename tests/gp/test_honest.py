@@ -114,6 +114,21 @@ def test_correlated_noise_is_learned_in_the_likelihood_not_the_output_covariance
     assert np.asarray(s["global"]["noise_correlation"]).shape == (3, 3)
 
 
+def test_noise_learned_with_the_hyperparameters_is_dropped_before_the_posterior():
+    """``GPConfig.noise_posterior = "diagonal"`` (twenty-third session, i8-noise2): on the correlated-noise data of the
+    test above the bound still learns the noise correlation (~0.8, kept in ``history.validation``) and so keeps B's
+    correlation below 0.5, but the posterior conditions on the per-output noise variances only (the model's noise
+    correlation is the identity), so one output's residual does not move another's mean (the seemingly-unrelated-
+    regressions GLS transfer of ``docs/gp.md``, "Noise: learned, not conditioned on")."""
+    X, Y, _ = _independent_outputs(400, 0.8, seed=5)
+    model, hist = fit_gp(X, Y, replace(CFG, coupling_validation=False, noise_posterior="diagonal"))
+    assert np.asarray(hist.validation["noise_correlation_learned"])[0, 1] == pytest.approx(0.8, abs=0.12)
+    np.testing.assert_allclose(model.noise_correlation(), np.eye(3), atol=1e-12)
+    assert np.max(np.abs(model.output_correlation() - np.eye(3))) < 0.5
+    with pytest.raises(InputError, match="noise_posterior"):
+        replace(CFG, noise_posterior="mean")
+
+
 @pytest.mark.slow
 def test_coupling_on_all_rows_separates_the_noise_correlation_from_B():
     """``GPConfig.coupling_rows = "all"`` (twentieth session): the stage that learns ``B`` and the noise covariance
