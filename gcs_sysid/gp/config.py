@@ -85,11 +85,13 @@ class GPConfig:
             bound moves it into ``B`` only as far as it climbs (``docs/gp.md``, "Noise: where the shared
             error starts"). Ignored without ``noise_correlation``, with missing outputs and with the
             per-group kernels of ``output_groups``.
-        noise_posterior: with ``noise_correlation``, the noise covariance the posterior conditions on (and the
-            blocked validation, the coupling test and the predictions with it): ``"full"`` (the default) the learned
-            ``P x P`` one; ``"diagonal"`` (opt-in, twenty-third session, i8-noise2) only its per-output variances:
-            the correlation is learned with the other hyperparameters, so the gusts' shared error is not explained
-            as signal coupling in ``B``, then dropped before the posterior. Why: with a noise correlation the
+        noise_posterior: with ``noise_correlation``, the noise covariance the posterior (the predictions' mean and
+            band, the local layer's residuals) conditions on: ``"full"`` (the default) the learned ``P x P`` one;
+            ``"diagonal"`` (opt-in, twenty-third session, i8-noise2) only its per-output variances. The correlation
+            is learned with the other hyperparameters and used by every later decision (the blocked validation's
+            latent scales, the coupling test, the validated terms), so the gusts' shared error is not explained as
+            signal coupling in ``B``; it is dropped just before the posterior (:func:`gcs_sysid.gp.fit.posterior_noise`).
+            Why: with a noise correlation the
             posterior is a seemingly-unrelated-regressions GLS, which moves one output's mean by another's
             residual wherever their signal priors differ (each output's latent shrunk by its own blocked-validation
             scale, its own linear terms); sgs126 light s1: a learned CZ-Cm correlation of 0.74 moved Cm's slope

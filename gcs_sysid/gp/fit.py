@@ -48,7 +48,7 @@ __all__ = ["FitHistory", "fit_gp", "constrain_global", "learn_global", "output_g
            "group_embedding", "group_factors", "output_kernel_mask", "fit_local",
            "noise_correlation_factor",
            "linear_prior_std", "linear_terms_of",
-           "learn_input_noise", "validated_global", "validated_local", "mean_only_masks",
+           "learn_input_noise", "posterior_noise", "validated_global", "validated_local", "mean_only_masks",
            "rows_without_mean_only", "MEAN_ONLY_LENGTHSCALE"]
 
 _NOISE_FLOOR = 1e-6
@@ -781,11 +781,25 @@ def learn_global(Xs: np.ndarray, Ys: np.ndarray, active: np.ndarray, cfg: GPConf
         from .joint import decoupled
 
         params = decoupled(params)
-    elif cfg.noise_correlation and cfg.noise_posterior == "diagonal" and params.noise_chol is not None:
-        # learned with the noise correlation, conditioned without it (GPConfig.noise_posterior)
+    return params
+
+
+def posterior_noise(params: GlobalParams, cfg: GPConfig, history: FitHistory) -> GlobalParams:
+    """``params`` with the noise covariance the posterior conditions on (``GPConfig.noise_posterior``).
+
+    ``"diagonal"`` (with ``noise_correlation``): the learned noise correlation (recorded in
+    ``history.validation["noise_correlation_learned"]``, ``(P, P)`` list) is replaced by the identity, the per-output
+    variances kept. Called after every hyperparameter decision (the bound, the blocked validation's latent scales,
+    the coupling test, the validated linear terms and mean-only inputs), so those are the full model's and only the
+    posterior's mean and band change. Why: with a noise correlation ``Sigma_pq`` the posterior mean is a seemingly-
+    unrelated-regressions GLS (Zellner 1962, JASA 57, eq. 2.8): output ``q``'s residual enters output ``p``'s
+    estimate. With the same regressors and priors in every output that moves nothing (Zellner's sec. 3 equivalence
+    with equation-by-equation least squares); with different ones (alpha_dot_hat a mean-only input of Cm alone, each
+    output its own linear terms and latent scale) it moves ``p``'s slopes by what ``q``'s model leaves out
+    (``docs/gp.md``, "Noise: learned, not conditioned on"). Otherwise ``params`` unchanged."""
+    if cfg.noise_correlation and cfg.noise_posterior == "diagonal" and params.noise_chol is not None:
         R = np.asarray(params.noise_chol)
-        C = R @ R.T
-        history.validation["noise_correlation_learned"] = C.tolist()
+        history.validation["noise_correlation_learned"] = (R @ R.T).tolist()
         params = replace(params, noise_chol=None)
     return params
 
@@ -943,6 +957,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
         params = _validated_terms(params, Xs, Ys, scaler.active, history)
     params = _validated_mean_only(params, Xs, Ys, cfg, kernel, history)
+    params = posterior_noise(params, cfg, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 

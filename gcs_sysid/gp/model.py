@@ -392,7 +392,7 @@ class LocalGlobalGP:
         """
         from ..errors import DataError
         from .fit import (FitHistory, _validated_mean_only, _validated_terms, fit_local, learn_global, mean_only_masks,
-                          output_groups, validated_global, validated_local)
+                          output_groups, posterior_noise, validated_global, validated_local)
 
         enable_x64()
         rows = self.rows
@@ -414,7 +414,7 @@ class LocalGlobalGP:
         params, stats = validated_global(params, rows.X, rows.Y, cfg, history)
         if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
             params = _validated_terms(params, rows.X, rows.Y, self.scaler.active, history)
-        params = _validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history)
+        params = posterior_noise(_validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history), cfg, history)
         evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))
