@@ -789,9 +789,10 @@ def posterior_noise(params: GlobalParams, cfg: GPConfig, history: FitHistory) ->
 
     ``"diagonal"`` (with ``noise_correlation``): the learned noise correlation (recorded in
     ``history.validation["noise_correlation_learned"]``, ``(P, P)`` list) is replaced by the identity, the per-output
-    variances kept. Called after every hyperparameter decision (the bound, the blocked validation's latent scales,
-    the coupling test, the validated linear terms and mean-only inputs), so those are the full model's and only the
-    posterior's mean and band change. Why: with a noise correlation ``Sigma_pq`` the posterior mean is a seemingly-
+    variances kept. Called after the likelihood's decisions (the bound, the coupling test: the full noise covariance keeps the
+    gusts' shared error out of ``B``) and before the choices made by the posterior mean's blocked error (the
+    validated linear terms and mean-only inputs; the latent scales and the coupling gate in :func:`validated_global`
+    drop it themselves), so those see the posterior the model uses. Why: with a noise correlation ``Sigma_pq`` the posterior mean is a seemingly-
     unrelated-regressions GLS (Zellner 1962, JASA 57, eq. 2.8): output ``q``'s residual enters output ``p``'s
     estimate. With the same regressors and priors in every output that moves nothing (Zellner's sec. 3 equivalence
     with equation-by-equation least squares); with different ones (alpha_dot_hat a mean-only input of Cm alone, each
@@ -954,10 +955,10 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
         pool.shutdown(wait=False)                 # the thread ends with its one job
     t2 = time.perf_counter()
     params, stats = validated_global(params, Xs, Ys, cfg, history)
+    params = posterior_noise(params, cfg, history)
     if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
         params = _validated_terms(params, Xs, Ys, scaler.active, history)
     params = _validated_mean_only(params, Xs, Ys, cfg, kernel, history)
-    params = posterior_noise(params, cfg, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
@@ -1062,6 +1063,11 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
     if not _validating(cfg, len(Xs)):
         return params, global_stats(params, Xs, Ys, cfg.batch_size)
     t0 = time.perf_counter()
+    # GPConfig.noise_posterior = "diagonal": the choices made by the posterior mean's blocked error (the latent scales,
+    # the coupling gate) see the posterior the model will use, the likelihood-ratio test the learned likelihood
+    R_noise = params.noise_chol if cfg.noise_correlation and cfg.noise_posterior == "diagonal" else None
+    if R_noise is not None:
+        params = replace(params, noise_chol=None)
     params, stats, s, sse = gate_global(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max,
                                         cfg.seed)
     history.timings["validation_global"] = time.perf_counter() - t0
@@ -1079,6 +1085,8 @@ def validated_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: 
         params, info = gate_coupling(params, Xs, Ys, int(cfg.validation_folds), cfg.batch_size)
         _record_coupling(history, "validation_coupling", t0, info, "coupled", "blocked validation",
                          "the coupling did not lower their blocked error")
+    if R_noise is not None:
+        params = replace(params, noise_chol=R_noise)
     if (cfg.coupling_test == "lr" and cfg.coupling != "off" and Ys.shape[1] > 1
             and cfg.output_groups not in ("kernels", "kernels-free", "output-kernels")):
         params = _tested_coupling(params, stats, Xs, Ys, cfg, history)

@@ -412,9 +412,10 @@ class LocalGlobalGP:
         # the blocked cross-validation of the fit, on the stored rows (arrival order; exact time order
         # while none was thinned): a refresh must not bring back what the fit's check removed
         params, stats = validated_global(params, rows.X, rows.Y, cfg, history)
+        params = posterior_noise(params, cfg, history)
         if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
             params = _validated_terms(params, rows.X, rows.Y, self.scaler.active, history)
-        params = posterior_noise(_validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history), cfg, history)
+        params = _validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history)
         evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))
