@@ -132,7 +132,11 @@ GP_NOISE_CORRELATION = False
 
 #: With :data:`GP_NOISE_CORRELATION`, the noise covariance the replay GP's posterior conditions on
 #: (``GPConfig.noise_posterior``): ``"full"`` (the learned one) or ``"diagonal"`` (the correlation learned with the
-#: hyperparameters, dropped before the posterior: twenty-third session, i8-noise2; ``eval_jsbsim --gp-noise learned``).
+#: hyperparameters and the coupling test, dropped before the posterior and the blocked validation: twenty-third session,
+#: i8-noise2; ``eval_jsbsim --gp-noise learned``). Opt-in: on 87 roster flights it removes full's Cm side effect
+#: (sgs126 light s1, f16 light s2) and keeps its correlations (29 -> 7 above 0.5; GP<LS 469 -> 475), but a count is
+#: lost on 4 aircraft against the default, 3 of them at the 98 % band edge (docs/benchmarks.md, "Twenty-third session,
+#: i8-noise2").
 GP_NOISE_POSTERIOR = "full"
 
 #: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or ``"noise"``
