@@ -93,9 +93,10 @@ class GPConfig:
             signal coupling in ``B``; it is dropped just before the posterior (:func:`gcs_sysid.gp.fit.posterior_noise`).
             Why: with a noise correlation the
             posterior is a seemingly-unrelated-regressions GLS, which moves one output's mean by another's
-            residual wherever their signal priors differ (each output's latent shrunk by its own blocked-validation
-            scale, its own linear terms); sgs126 light s1: a learned CZ-Cm correlation of 0.74 moved Cm's slope
-            from ``q_hat`` to alpha (Cm_q -10.2 -> -0.7; ``docs/gp.md``, "Noise: learned, not conditioned on").
+            residual wherever their regressors or priors differ (``alpha_dot_hat`` in Cm's mean alone, each
+            output's own linear terms and blocked-validation scale; Zellner 1962); sgs126 light s1: a learned CZ-Cm
+            correlation of 0.74 moved Cm's pitch slopes (Cm_q -10.2 -> -0.7, Cm_alpha_dot -4.9 -> -16.4;
+            ``docs/gp.md``, "Noise: learned, not conditioned on"). Opt-in: a count lost on 4 tuning aircraft.
             Ignored without ``noise_correlation``.
         hyper_stride: learn the global hyperparameters on every ``hyper_stride``-th training row in time
             order (then at most ``n_train_max`` of them at random); 1 (the default): any ``n_train_max`` rows.
