@@ -96,7 +96,9 @@ _DEG = 57.29577951308232
 #: ``UltraStick25e_glide``, no propulsion, direct surfaces, at 10000 ft) and ``ka350`` (the twenty-third session's: a
 #: JSBSim Beechcraft King Air 350 twin turboprop from a FlightGear package, checked into
 #: ``data/jsbsim_models/kingair350`` and flown as ``KingAir350_glide``, engines and systems removed, gear up, at
-#: 8000 ft). No aircraft is held out or untouched until the next one is added.
+#: 8000 ft). ``s23`` (JSBSim's Short S.23 "Empire" flying boat, Anders Gidenstam's model with DATCOM+ aerodynamics,
+#: checked into ``data/jsbsim_models/shorts23`` and flown as ``ShortS23_glide``; added in the twenty-fourth session)
+#: is held out and untouched: no part of the method has run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -660,11 +662,39 @@ AIRCRAFT: dict[str, AircraftSpec] = {
               "itaalh/FlightGear-Beechcraft-350ER, checked in under data/jsbsim_models/kingair350) without engines, "
               "propellers, systems, rudder boost or yaw damper (derived model KingAir350_glide, XML sha256 "
               "1d8b5080db88889e), gear up, gliding; untouched by any tuning of the method"),
+    # s23: JSBSim's Short S.23 "Empire" four-engine flying boat of 1936 (Anders Gidenstam 2008-2023,
+    # GPL-2.0-or-later; the jsbsim 1.3.3 wheel's aircraft/Short_S23, checked in under data/jsbsim_models/shorts23
+    # with its DATCOM+ aerodynamics file): 33686 lb as the harness flies it (27528 lb empty, 4704 lb of fuel in
+    # the two inner wing tanks, 1454 lb of centre-line point masses and the four engines' oil in symmetric
+    # pairs, which the harness empties with the crew's off-centre seats), a 114-ft (34.75 m) span, 1510 ft^2
+    # (140.3 m^2), a 16.46-ft (5.02 m) chord; inertia 299666 / 212782 / 501090 slug ft^2 (estimated by Aeromatic,
+    # its documentation says), Ixz -1920 (JSBSim's sign). Its aerodynamics are USAF DATCOM (Datcom+) tables in
+    # alpha from -16 deg: lift, drag, CL_q, CL_alphadot; CY_beta and CY_p; Cl_beta, Cl_p, Cl_r and the aileron's
+    # roll (a table in the left aileron); Cm, Cm_q, Cm_alphadot, Cm_delta_e (a table); Cn_beta, Cn_p, Cn_r, the
+    # aileron's yaw (a table in alpha and aileron) and Cn_delta_r -0.06; no rudder side force or roll, no CY_r
+    # (their DATCOM values are 0). The ninth model from outside the wheel's stock list; flown as the derived
+    # ``ShortS23_glide`` (derived.py): engines, propellers, the hull's water forces and the nine systems removed,
+    # the aerodynamics inlined with an elevator alias. Chosen in the twenty-fourth session (docs/jsbsim.md, "The
+    # s23"). Its FCS: elevator +-18 deg, ailerons +-19.5 deg (both written with the command's sign; the
+    # aerodynamics read the left one), rudder +-22.5 deg. Signs read from its aerodynamics: CmDe -1.07 per rad of
+    # elevator-pos-rad (positive = trailing edge down), ClDs4 +0.122 per rad of left-aileron-pos-rad (positive =
+    # roll right: delta_a = -left, Cl_delta_a -0.122), CnDr -0.06 (positive rudder = nose left, Cn_delta_r
+    # -0.06), CnDa -0.0098 per rad of left aileron at alpha 0 (Cn_delta_a +0.0098, adverse). Set from the
+    # harness's truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never from a method result.
+    "s23": AircraftSpec(
+        name="s23", model="ShortS23_glide", airspeed_kts=130.0, altitude_ft=6000.0,
+        elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.3142, 1.0 / 0.3403, 1.0 / 0.3927),
+        amplitude_deg=(4.0, 5.0, 5.0), pulse_s=(0.7, 0.8, 1.0),
+        notes="Short S.23 Empire four-engine flying boat (JSBSim's model by Anders Gidenstam with DATCOM+ "
+              "aerodynamics, checked in under data/jsbsim_models/shorts23) without engines, propellers, hull forces "
+              "or systems (derived model ShortS23_glide, XML sha256 c1ce083b70c3d424), gliding; untouched by any "
+              "tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
                    "asw20", "iar80", "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350")
-HELD_OUT_AIRCRAFT = ()
-UNTOUCHED_AIRCRAFT = ()
+HELD_OUT_AIRCRAFT = ("s23",)
+UNTOUCHED_AIRCRAFT = ("s23",)
 
 
 def aircraft(name: str) -> AircraftSpec:

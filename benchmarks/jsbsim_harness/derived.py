@@ -15,7 +15,9 @@ propeller removed and its elevator moment reading an alias (``Eternity_glide``, 
 twenty-first session), or the same lab's Ultra Stick 25e with its OpenFlight aerodynamics, assembled and
 flown as the Ultra Stick 120 (``UltraStick25e_glide``, :func:`derive_ultrastick25e_glide`; twenty-second session),
 or a JSBSim Beechcraft King Air 350 twin turboprop gliding, its engines, systems, autopilot inputs, rudder boost
-and yaw damper removed (``KingAir350_glide``, :func:`derive_kingair350_glide`; twenty-third session).
+and yaw damper removed (``KingAir350_glide``, :func:`derive_kingair350_glide`; twenty-third session), or JSBSim's
+Short S.23 flying boat gliding in one file, its engines, hull forces and systems removed (``ShortS23_glide``,
+:func:`derive_shorts23_glide`; twenty-fourth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -70,7 +72,7 @@ from pathlib import Path
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
-           "derive_eternity_glide", "derive_ultrastick25e_glide", "derive_kingair350_glide",
+           "derive_eternity_glide", "derive_ultrastick25e_glide", "derive_kingair350_glide", "derive_shorts23_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -657,6 +659,88 @@ def derive_kingair350_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+#: The checked-in Short S.23 folder (the main file and the DATCOM+ aerodynamics it names).
+_S23_DIR = Path(__file__).resolve().parents[2] / "data" / "jsbsim_models" / "shorts23"
+
+#: The Short S.23's ``<system>`` elements (their ``file`` attributes) in the checked-in version.
+_S23_SYSTEMS = ["hydrodynamics", "hydrodynamic-planing-floats", "Short_S23-hydrodynamics", "sperry-a2-autopilot",
+                "take-off-ap", "engines", "fuel-system", "electrical", "flaps"]
+
+
+def derive_shorts23_glide(root: ET.Element) -> ET.Element:
+    """JSBSim's Short S.23 "Empire" flying boat (``data/jsbsim_models/shorts23/``: the jsbsim 1.3.3 wheel's
+    ``aircraft/Short_S23/Short_S23.xml`` and ``Systems/datcom_aero.xml``, Anders Gidenstam 2008-2023,
+    GPL-2.0-or-later) gliding, in one file, as JSBSim alone can fly it (twenty-fourth session).
+
+    The model is a 1936 four-engine flying boat: Pegasus radials with de Havilland propellers, a planing hull and
+    wing-tip floats modelled by hydrodynamic systems that write external forces, a Sperry A-2 autopilot, engine,
+    fuel, electrical and flap systems, and DATCOM+ aerodynamics in a second file. Five edits; nothing else changes
+    (a test checks every other element, and every aerodynamic function against the checked-in file):
+
+    - **Engines removed.** The four ``<engine>`` elements (``eng_PegasusXc`` with ``prop_deHavilland5000``, their
+      feeds) are removed, as the ka350's and the iar80's: the harness glides every aircraft, so that every
+      non-gravity force is aerodynamic (a stopped engine leaves JSBSim's windmilling propeller). The twelve fuel
+      tanks stay as mass (2 x 2352 lb in the two inner wing tanks, the others empty).
+    - **Hull forces removed.** ``<external_reactions>`` (three forces and three moments at the hull, whose
+      magnitudes only the hydrodynamic systems write: the hull on the water) is removed.
+    - **Systems removed.** The nine ``<system>`` elements (:data:`_S23_SYSTEMS`: the hull's and floats'
+      hydrodynamics, the Sperry autopilot, a take-off autopilot, engines, fuel, electrical and flaps) are removed;
+      the flap stays at JSBSim's ``fcs/flap-pos-deg`` 0 (flaps up). The FCS's summers keep their Sperry and
+      co-pilot inputs, which the FCS itself declares 0 and nothing writes once the systems are gone.
+    - **Aerodynamics in one file.** ``<aerodynamics file="Systems/datcom_aero.xml"/>`` is replaced by the
+      checked-in ``datcom_aero.xml``'s ``<aerodynamics>`` element (the derived model is one file, as the other
+      repository-derived models).
+    - **Elevator alias.** Its tables look the elevator up as an ``independentVar`` (CLDe, CdDe, CmDe and the
+      elevator hinge moment's Ch-delta, four lookups), which ``effects.py``'s ``delay:delta_e`` (it redirects
+      ``<property>`` reads) would not reach; as for the f16 (:func:`derive_f16_direct`) they look it up in the
+      identity function :data:`ELEVATOR_ALIAS` = ``fcs/elevator-pos-rad``, added as the aerodynamics' first
+      child. The numbers are unchanged (a test checks JSBSim's forces and moments against the stock model's).
+
+    Args:
+        root: the parsed ``Short_S23.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): four
+            ``<propulsion><engine>``, one ``<external_reactions>``, the nine systems, and an ``<aerodynamics>``
+            naming ``Systems/datcom_aero.xml``; or the checked-in ``datcom_aero.xml`` has another root.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    ext = root.findall("external_reactions")
+    systems = root.findall("system")
+    aero = root.find("aerodynamics")
+    if (len(engines) != 4 or len(ext) != 1 or [x.get("file") for x in systems] != _S23_SYSTEMS or aero is None
+            or aero.get("file") != "Systems/datcom_aero.xml" or len(aero)):
+        raise ValueError("Short_S23.xml: expected four <propulsion><engine>, one <external_reactions>, the systems "
+                         f"{_S23_SYSTEMS} and <aerodynamics file=\"Systems/datcom_aero.xml\"/>")
+    datcom = ET.parse(_S23_DIR / "datcom_aero.xml").getroot()
+    if datcom.tag != "aerodynamics":
+        raise ValueError(f"datcom_aero.xml: root <{datcom.tag}>, expected <aerodynamics>")
+    for e in engines:
+        prop.remove(e)
+    root.remove(ext[0])
+    for x in systems:
+        root.remove(x)
+    n = 0
+    for iv in datcom.iter("independentVar"):
+        if iv.text and iv.text.strip() == "fcs/elevator-pos-rad":
+            iv.text = ELEVATOR_ALIAS
+            n += 1
+    if n != 4:
+        raise ValueError(f"datcom_aero.xml: {n} table lookups of fcs/elevator-pos-rad, expected 4")
+    alias = ET.Element("function", name=ELEVATOR_ALIAS)
+    _el(alias, "description", "elevator position the tables read (identity; added by the harness's derivation)")
+    _el(alias, "property", "fcs/elevator-pos-rad")
+    datcom.insert(0, alias)
+    root.insert(list(root).index(aero), datcom)
+    root.remove(aero)
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -726,6 +810,15 @@ REPO_DERIVED = {
                          "no propeller force); the autopilot's inputs, the rudder boost and the feathered-propeller "
                          "drag (which read them) removed; yaw damper off; the fuel tanks stay as mass; everything "
                          "else unchanged."),
+    "ShortS23_glide": ("data/jsbsim_models/shorts23/Short_S23.xml",
+                       "JSBSim's Short S.23 flying boat (the jsbsim 1.3.3 wheel's aircraft/Short_S23/Short_S23.xml "
+                       "and Systems/datcom_aero.xml, Anders Gidenstam 2008-2023, GPL-2.0-or-later), copied into "
+                       "gcs-sysid's data/jsbsim_models/shorts23/",
+                       derive_shorts23_glide, "engines and propellers, the hull's external forces and the nine "
+                       "systems (hydrodynamics, autopilots, engines, fuel, electrical, flaps) removed (a glide with "
+                       "no propeller or water force); the DATCOM+ aerodynamics file inlined, its tables reading the "
+                       "elevator through an identity alias; the fuel tanks stay as mass; everything else "
+                       "unchanged."),
 }
 
 

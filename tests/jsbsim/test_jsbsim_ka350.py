@@ -14,9 +14,9 @@ turbulence: a mechanism check); none of them flies the harness:
 - the checked-in file is the one the README names, and the derivation makes only its six edits;
 - the FCS maps the commands straight to the surfaces (elevator -20 / +14 deg, ailerons 25 up / 15 down with the
   mean of the two read by the aerodynamics, rudder +-25 deg), the yaw damper off; no engine, no external force;
-- it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
-- the summaries label it bare, as every tuning aircraft (until the next untouched aircraft is added, no aircraft is
-  labelled "(untouched)").
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says.
+
+The summaries' label test moves on with the untouched aircraft (twenty-fourth session: ``test_jsbsim_s23.py``).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, gear,
 .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but
@@ -27,7 +27,6 @@ is a tuning aircraft since.
 """
 
 import copy
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -162,31 +161,3 @@ def test_the_ka350_is_statically_stable_and_its_controls_act_as_its_xml_says():
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0947, abs=5e-4), a
 
-
-def test_summaries_mark_no_aircraft_untouched_the_ka350_included(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the ka350 bare, as every other aircraft
-    (synthetic rows): the twenty-fourth session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
-    until the next one is added."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    for ac in acs:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| ka350 | clean |") for ln in lines)
-    assert any(ln.startswith("| us25e | clean |") for ln in lines)
-    assert not any("(untouched)" in ln for ln in lines)

@@ -1,0 +1,210 @@
+"""The s23 in the JSBSim harness: the twenty-fourth session's untouched aircraft (docs/jsbsim.md, "The s23").
+
+The model is JSBSim's Short S.23 "Empire" flying boat (Anders Gidenstam 2008-2023, GPL-2.0-or-later; the jsbsim 1.3.3
+wheel's ``aircraft/Short_S23/Short_S23.xml`` and ``Systems/datcom_aero.xml``), a 1936 four-engine flying boat of
+33686 lb as the harness flies it and 114 ft (34.75 m) of span, whose aerodynamics are USAF DATCOM (Datcom+) tables
+in alpha. Both files are checked in under ``data/jsbsim_models/shorts23/`` and flown as the derived model
+``ShortS23_glide`` (``derived.py``): engines, propellers, the hull's water forces and the nine systems removed, the
+aerodynamics inlined, their elevator lookups through an identity alias.
+
+The checks here use the files and JSBSim's own properties (the harness's initial condition, ``run_ic``, no
+turbulence: a mechanism check); none of them flies the harness:
+
+- the checked-in files are the ones the README names, and the derivation makes only its five edits; JSBSim's
+  aerodynamic forces and moments of the derived model equal the stock wheel model's;
+- the FCS maps the commands straight to the surfaces (elevator +-18 deg, ailerons +-19.5 deg, rudder +-22.5 deg);
+  no engine, no external force;
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its tables say;
+- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_ka350.py``).
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
+hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
+are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the s23: its first evaluation is the final one, after the merge.
+"""
+
+import copy
+import dataclasses
+import hashlib
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot, ic_state, \
+    lateral_coefficients
+
+SRC = "data/jsbsim_models/shorts23/Short_S23.xml"
+SRC_SHA256 = "b4ba55cceeaca5057bacfb59b510bf3bdc8e9ea19efbd007904700ab2439282f"
+AERO = "data/jsbsim_models/shorts23/datcom_aero.xml"
+AERO_SHA256 = "f115dfe222b379e3cc78090f760e154be8aa5788ab3580311bedca38715001a6"
+
+
+def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), model=None):
+    """:func:`truth_fits.ic_state` for the s23 (130 kt at 6000 ft; it glides near alpha -1 deg), or for the same
+    spec flying ``model`` (the stock wheel model)."""
+    spec = aircraft("s23")
+    return ic_state(dataclasses.replace(spec, model=model) if model else spec, alpha_deg, beta_deg, cmds)
+
+
+def _same(a, b):
+    """The elements, their text and children, not their own tails."""
+    a, b = map(copy.deepcopy, (a, b))
+    a.tail = b.tail = None
+    return ET.tostring(a) == ET.tostring(b)
+
+
+def _bare(e):
+    """The element's XML with every text and tail stripped of white space (the layout, not the content)."""
+    e = copy.deepcopy(e)
+    for x in e.iter():
+        x.text = x.text.strip() if x.text else x.text
+        x.tail = None
+    return ET.tostring(e)
+
+
+def test_the_derivation_removes_the_engines_water_forces_and_systems_and_inlines_the_aerodynamics():
+    """The checked-in files are the README's (28570 and 58651 bytes, their SHA-256). ``ShortS23_glide`` is the main
+    file without its four ``<engine>`` elements, its ``<external_reactions>`` and its nine ``<system>`` elements, the
+    ``<aerodynamics file=...>`` reference replaced by ``datcom_aero.xml``'s ``<aerodynamics>`` whose four elevator
+    lookups read ``aero/function/elevator-pos-rad``, the identity function of ``fcs/elevator-pos-rad`` added as its
+    first child; the twelve tanks and every other element are equal (metrics, mass balance, ground reactions, the
+    flight control), and so is every aerodynamic function but the alias. The spec's notes carry the derived XML's
+    hash."""
+    from benchmarks.jsbsim_harness.derived import ELEVATOR_ALIAS
+    from benchmarks.jsbsim_harness.logfile import _REPO
+
+    src, der, spec = checked_in_model("s23", "ShortS23_glide", SRC, 28570, SRC_SHA256)
+    raw = (_REPO / AERO).read_bytes()
+    assert len(raw) == 58651 and hashlib.sha256(raw).hexdigest() == AERO_SHA256
+    aero = ET.fromstring(raw)
+    ET.indent(src, space=" ")
+    ET.indent(aero, space=" ")
+    for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control"):
+        assert _same(src.find(tag), der.find(tag)), tag
+    assert der.find("propulsion/engine") is None and der.find("system") is None
+    assert der.find("external_reactions") is None and len(src.findall("propulsion/engine")) == 4
+    assert [x.get("file") for x in src.findall("system")] == [
+        "hydrodynamics", "hydrodynamic-planing-floats", "Short_S23-hydrodynamics", "sperry-a2-autopilot",
+        "take-off-ap", "engines", "fuel-system", "electrical", "flaps"]
+    for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True):
+        assert _same(a, b)
+    assert [c.tag for c in der] == [c.tag for c in src if c.tag not in ("external_reactions", "system")]
+    d_aero = der.find("aerodynamics")
+    assert d_aero.get("file") is None and d_aero[0].get("name") == ELEVATOR_ALIAS
+    assert [p.text for p in d_aero[0].iter("property")] == ["fcs/elevator-pos-rad"]
+    lookups = [iv for iv in aero.iter("independentVar") if iv.text.strip() == "fcs/elevator-pos-rad"]
+    assert len(lookups) == 4
+    for iv in lookups:
+        iv.text = ELEVATOR_ALIAS
+    s_fun, d_fun = list(aero.iter("function")), list(d_aero.iter("function"))[1:]
+    assert len(s_fun) == len(d_fun) == 36
+    for a, b in zip(s_fun, d_fun):
+        assert _bare(a) == _bare(b), a.get("name")
+
+
+def test_the_derived_aerodynamics_are_the_stock_models():
+    """At three states (alpha, sideslip, the three commands), JSBSim's aerodynamic forces and moments of
+    ``ShortS23_glide`` equal those of the wheel's stock ``Short_S23`` (four windmilling engines, its systems idle)
+    to the last bit: the derivation changes no number."""
+    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
+        a, b = _state(alpha, beta, cmds), _state(alpha, beta, cmds, model="Short_S23")
+        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == 4
+        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
+                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
+            assert a[k] == b[k], (alpha, k)
+
+
+def test_the_s23_flies_its_own_surfaces_without_engine_or_external_force():
+    """The FCS maps each command straight to its surface (``aerosurface_scale``): elevator +-0.3142 rad (18 deg),
+    both ailerons +-0.3403 rad (19.5 deg) with the command's sign (the aerodynamics read the left one: delta_a =
+    -left with ``aileron_sign`` -1), rudder +-0.3927 rad (22.5 deg). No engine; 33686 lb (the crew's off-centre
+    seats and the engines' oil emptied); after 50 frames every non-gravity force and moment is aerodynamic and the
+    external forces are 0."""
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    spec = aircraft("s23")
+    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(33685.7, abs=0.1)
+    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.3142, rel=1e-6)
+    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
+    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
+    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.3927, rel=1e-6)
+    assert spec.cmd_per_rad == pytest.approx((1 / 0.3142, 1 / 0.3403, 1 / 0.3927))
+    de, da, dr = np.radians(-3.0), np.radians(5.0), np.radians(4.0)
+    cmd = tuple(d * s * k for d, s, k in zip((de, da, dr), (spec.elevator_sign, spec.aileron_sign, spec.rudder_sign),
+                                             spec.cmd_per_rad))
+    assert _deflections(_state(cmds=cmd), spec) == pytest.approx((de, da, dr), rel=1e-4)
+    assert_aero_is_the_only_force(fdm, 10000.0, external_zero=True)
+
+
+def test_the_s23_is_statically_stable_and_its_controls_act_as_its_tables_say():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic`` at the harness's initial condition, 130 kt at
+    6000 ft, Mach 0.239) without the ``Cmadot`` term (``run_ic`` gives an alpha-dot the term reads).
+
+    - **Pitch:** Cm falls with alpha: -0.530 per rad between alpha -4 and 0 deg, -0.546 between 0 and 4, -0.809
+      between 4 and 8 (Cm_basic's DATCOM table and the lift through the reference point 18 in ahead of and 41 in
+      above the CG); Cm +0.048 at alpha 0; per rad of elevator -1.07 to -1.08 (CmDe's table).
+    - **Roll and yaw:** per rad of the left aileron Cl +0.1216 (ClDs4; the project's Cl_delta_a -0.1216) and Cn
+      -0.0098 (CnDa at alpha 0; Cn_delta_a +0.0098, adverse); per rad of rudder Cn -0.060 (CnDr) and Cl 0 (ClDr and
+      CyDr are 0); Cl_beta -0.128 at alpha 0 and -0.121 at 6 deg (Clb's table and the side force through the
+      reference point's height), Cn_beta 0.069 and 0.068 (Cnb's table).
+    """
+    spec = aircraft("s23")
+    c = {a: cm_without_alpha_dot(spec, a) for a in (-4.0, 0.0, 4.0, 8.0)}
+    slope = lambda a, b: (c[b] - c[a]) / np.radians(4.0)   # noqa: E731
+    assert _state()["velocities/mach"] == pytest.approx(0.2395, abs=0.002)
+    assert slope(-4.0, 0.0) == pytest.approx(-0.530, abs=0.005) and slope(0.0, 4.0) == pytest.approx(-0.546, abs=0.005)
+    assert slope(4.0, 8.0) == pytest.approx(-0.809, abs=0.005) and c[0.0] == pytest.approx(0.048, abs=0.002)
+    for cmd in (0.3, -0.3):
+        de = _state(cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
+        assert (cm_without_alpha_dot(spec, 0.0, cmd) - c[0.0]) / de == pytest.approx(-1.076, abs=0.006)
+
+    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
+        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds))
+
+    l0, n0, _, _ = lat()
+    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
+    for cmd in (0.3, -0.3):
+        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
+        assert (l1 - l0) / a1 == pytest.approx(0.1216, abs=2e-4) and (n1 - n0) / a1 == pytest.approx(-0.0098, abs=2e-4)
+        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
+        assert (n2 - n0) / r2 == pytest.approx(-0.060, abs=1e-6) and abs(l2 - l0) < 1e-9
+    for a, clb, cnb in ((0.0, -0.1281, 0.0692), (6.0, -0.1206, 0.0681)):
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(alpha=a, beta=4.0)
+        assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
+        assert (n3 - nb) / np.radians(4.0) == pytest.approx(cnb, abs=5e-4), a
+
+
+def test_summaries_mark_the_s23_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the s23 "(untouched)" and no other
+    aircraft, the ka350, us25e and eternity included (synthetic rows: no s23 result exists before the final
+    evaluation). Moved here from ``test_jsbsim_ka350.py`` (the twenty-third session's untouched aircraft)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
+           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| s23 (untouched) | light") for ln in lines)
+    for ac in acs[:-1]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| s23 (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| ka350 | clean |") for ln in lines)
+    assert sum("(untouched)" in ln for ln in lines) == 1
