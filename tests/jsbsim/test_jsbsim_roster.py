@@ -396,8 +396,8 @@ CASES = (
     # slug ft^2), five SIDE functions (Cyb, Cyp and the zero-valued Cyr, CyDr, CyDa), the elevator read by the
     # alias and the elevator hinge moment (two <property> reads), no gear. On the 30-s calm flight
     # (derivative_slopes; inertial rates, no alpha-dot) the slopes are the DATCOM tables' at the flight's alpha
-    # (about -1 deg): Cm_alpha -0.13 (the file's static slope is -0.53 per rad near alpha 0; its Cm_alphadot of
-    # about -5 goes into the short fit's Cm_alpha and Cm_q), Cm_delta_e -1.045 (CmDe -1.08); Cl_beta -0.118
+    # (-2.0 deg mean, -4.4..0.8): Cm_alpha -0.13 (the file's static slope is -0.53 per rad near alpha 0; its
+    # Cm_alphadot of about -5 goes into the short fit's Cm_alpha and Cm_q), Cm_delta_e -1.045 (CmDe -1.08); Cl_beta -0.118
     # (Clb -0.128 at alpha 0), Cl_p -0.323, Cl_r 0.112, Cl_delta_a -0.121 (ClDs4 0.122 per rad of the left
     # aileron, delta_a = -left), Cl_delta_r 0 (ClDr 0); Cn_beta 0.066 (Cnb 0.069), Cn_p -0.045, Cn_r -0.153,
     # Cn_delta_a +0.0068 (adverse: CnDa), Cn_delta_r -0.060 (CnDr -0.06). Envelope limits from the six envelope

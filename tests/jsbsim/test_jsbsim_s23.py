@@ -44,7 +44,7 @@ AERO_SHA256 = "f115dfe222b379e3cc78090f760e154be8aa5788ab3580311bedca38715001a6"
 
 
 def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), model=None):
-    """:func:`truth_fits.ic_state` for the s23 (130 kt at 6000 ft; it glides near alpha -1 deg), or for the same
+    """:func:`truth_fits.ic_state` for the s23 (130 kt at 6000 ft; it glides near alpha -2 deg), or for the same
     spec flying ``model`` (the stock wheel model)."""
     spec = aircraft("s23")
     return ic_state(dataclasses.replace(spec, model=model) if model else spec, alpha_deg, beta_deg, cmds)
@@ -146,7 +146,7 @@ def test_the_s23_is_statically_stable_and_its_controls_act_as_its_tables_say():
     6000 ft, Mach 0.239) without the ``Cmadot`` term (``run_ic`` gives an alpha-dot the term reads).
 
     - **Pitch:** Cm falls with alpha: -0.530 per rad between alpha -4 and 0 deg, -0.546 between 0 and 4, -0.809
-      between 4 and 8 (Cm_basic's DATCOM table and the lift through the reference point 18 in ahead of and 41 in
+      between 4 and 8 (Cm_basic's DATCOM table and the lift through the reference point 23 in ahead of and 42 in
       above the CG); Cm +0.048 at alpha 0; per rad of elevator -1.07 to -1.08 (CmDe's table).
     - **Roll and yaw:** per rad of the left aileron Cl +0.1216 (ClDs4; the project's Cl_delta_a -0.1216) and Cn
       -0.0098 (CnDa at alpha 0; Cn_delta_a +0.0098, adverse); per rad of rudder Cn -0.060 (CnDr) and Cl 0 (ClDr and
