@@ -151,18 +151,26 @@ def derive_f16_direct(root: ET.Element) -> ET.Element:
     aero = root.find("aerodynamics")
     if aero is None:
         raise ValueError("f16.xml: no <aerodynamics>")
+    if _alias_elevator_lookups(aero) == 0:
+        raise ValueError("f16.xml: no aerodynamic table looks up fcs/elevator-pos-rad")
+    return root
+
+
+def _alias_elevator_lookups(aero: ET.Element) -> int:
+    """Point every table lookup (``independentVar``) of ``fcs/elevator-pos-rad`` in ``aero`` (an
+    ``<aerodynamics>`` element, modified in place) at :data:`ELEVATOR_ALIAS`, and insert that identity function
+    (``fcs/elevator-pos-rad``) as ``aero``'s first child; the numbers are unchanged (:func:`derive_f16_direct`,
+    :func:`derive_shorts23_glide`). Returns the number of lookups rewritten (the alias is inserted even for 0)."""
     n = 0
     for iv in aero.iter("independentVar"):
         if iv.text and iv.text.strip() == "fcs/elevator-pos-rad":
             iv.text = ELEVATOR_ALIAS
             n += 1
-    if n == 0:
-        raise ValueError("f16.xml: no aerodynamic table looks up fcs/elevator-pos-rad")
     alias = ET.Element("function", name=ELEVATOR_ALIAS)
     _el(alias, "description", "elevator position the tables read (identity; added by the harness's derivation)")
     _el(alias, "property", "fcs/elevator-pos-rad")
     aero.insert(0, alias)
-    return root
+    return n
 
 
 def derive_f4n_fcs(root: ET.Element) -> ET.Element:
@@ -725,17 +733,9 @@ def derive_shorts23_glide(root: ET.Element) -> ET.Element:
     root.remove(ext[0])
     for x in systems:
         root.remove(x)
-    n = 0
-    for iv in datcom.iter("independentVar"):
-        if iv.text and iv.text.strip() == "fcs/elevator-pos-rad":
-            iv.text = ELEVATOR_ALIAS
-            n += 1
+    n = _alias_elevator_lookups(datcom)
     if n != 4:
         raise ValueError(f"datcom_aero.xml: {n} table lookups of fcs/elevator-pos-rad, expected 4")
-    alias = ET.Element("function", name=ELEVATOR_ALIAS)
-    _el(alias, "description", "elevator position the tables read (identity; added by the harness's derivation)")
-    _el(alias, "property", "fcs/elevator-pos-rad")
-    datcom.insert(0, alias)
     root.insert(list(root).index(aero), datcom)
     root.remove(aero)
     return root
