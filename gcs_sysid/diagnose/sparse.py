@@ -225,7 +225,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
-              "pitch_gust_nuisance": False}
+              "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -794,7 +794,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         rows = np.r_[rtr, rte]
         if th.get("pitch_gust_nuisance", False):
             # the reference's own pitch gust moment, its own slope, before its inadequacy is fitted (gust_nuisance)
-            Gr, ginfo_ref = pitch_gust_nuisance(rctx, Rr, rows)
+            Gr, ginfo_ref = pitch_gust_nuisance(rctx, Rr, rows,
+                                                highpass_s=float(th.get("pitch_gust_highpass_s", 0.0) or 0.0))
             Rr = Rr - Gr
         ridge = _ridge_cv(iPhi_ref[rows], Rr[rows], folds, max_rows) if th.get("inadequacy", "ridge") == "ridge" \
             and rtr.size >= 20 * folds else None
@@ -911,7 +912,10 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     if th.get("pitch_gust_nuisance", False):
         # the pitch gust rate's moment (gyro q against the air-relative q the aerodynamics see), fitted on the
         # training rows and removed before the search selects and measures any gain (gust_nuisance)
-        G, ginfo = pitch_gust_nuisance(ctx, Rd, tr)
+        g_slope = None if (reference is None or th["pitch_gust_nuisance"] == "own" or "slope" not in ginfo_ref) \
+            else ginfo_ref["slope"]
+        G, ginfo = pitch_gust_nuisance(ctx, Rd, tr, g_slope,
+                                       highpass_s=float(th.get("pitch_gust_highpass_s", 0.0) or 0.0))
         Rd, Rn, M0 = Rd - G, Rn - G, M0 + G
         result["pitch_gust"] = dict(ginfo, reference=ginfo_ref if reference is not None else None)
     # the scale candidates on the angles the library uses (corrected by the nuisance when it ran)

@@ -66,3 +66,15 @@ def test_without_the_states_or_with_cm_inactive_nothing_is_removed():
     ctx.active[COEFFICIENTS.index("Cm")] = False
     N, info = pitch_gust_nuisance(ctx, R, np.arange(100))
     assert not N.any() and info["skipped"] == "Cm not active"
+
+
+def test_a_given_slope_is_used_as_given_and_the_flight_s_own_is_reported():
+    ctx, _, rng = _ctx()
+    g = pitch_gust_column(ctx)
+    jm = COEFFICIENTS.index("Cm")
+    R = 1e-4 * rng.normal(size=(len(ctx.t), 6))
+    R[:, jm] += 2.0 * g
+    tr = np.arange(2400)
+    N, info = pitch_gust_nuisance(ctx, R, tr, slope=1.5)
+    assert info["slope"] == 1.5 and info["own_slope"] == pytest.approx(2.0, rel=0.02)
+    assert N[:, jm] == pytest.approx(1.5 * (g - g[tr].mean()))
