@@ -207,6 +207,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ridge inadequacy on a library in ``alpha - mean(alpha_ref)`` (:func:`_inadequacy_library`), invariant to an alpha
 #: level common to both flights (the alpha level's ``reference`` and ``pooled`` modes then agree). No new threshold.
 #: Mixed on the eternity, c172p, us25e and sgs (``docs/benchmarks.md``, *Twenty-third session, i9-level2*).
+#: Added 2026-11-24 (twenty-fourth session, branch i9-misses): ``pitch_gust_nuisance``, **off**: the estimated pitch gust
+#: rate's moment (:mod:`gcs_sysid.diagnose.gust_nuisance`; slope from the reference flight, ``"own"``: from the test
+#: flight) removed from both flights' Cm residual before the search; ``pitch_gust_highpass_s`` (0: none; 2.0 measured)
+#: the column less its centred moving mean. ka350 evaluation flights: gain 14 -> 17/20, b737 10 -> 12/12; a
+#: ``Cm:alpha^2`` top count lost on the us25e and the ultrastick (``docs/benchmarks.md``, *Twenty-fourth session,
+#: i9-misses*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
