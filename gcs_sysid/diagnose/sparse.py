@@ -49,6 +49,7 @@ import numpy as np
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from .aliases import ALIAS_CONDITION_INDEX, find_aliases, separation_advice
 from .context import DiagContext
+from .gust_nuisance import pitch_gust_nuisance
 from .lift_alpha import lift_alpha_error
 from .regression import ols
 from .search import LIBRARY_REGRESSORS, alpha_quantile_knots, candidate_library, press_stepwise
@@ -206,6 +207,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ridge inadequacy on a library in ``alpha - mean(alpha_ref)`` (:func:`_inadequacy_library`), invariant to an alpha
 #: level common to both flights (the alpha level's ``reference`` and ``pooled`` modes then agree). No new threshold.
 #: Mixed on the eternity, c172p, us25e and sgs (``docs/benchmarks.md``, *Twenty-third session, i9-level2*).
+#: Added 2026-11-24 (twenty-fourth session, branch i9-misses): ``pitch_gust_nuisance``, **off**: the estimated pitch gust
+#: rate's moment (:mod:`gcs_sysid.diagnose.gust_nuisance`; slope from the reference flight, ``"own"``: from the test
+#: flight) removed from both flights' Cm residual before the search; ``pitch_gust_highpass_s`` (0: none; 2.0 measured)
+#: the column less its centred moving mean. ka350 evaluation flights: gain 14 -> 17/20, b737 10 -> 12/12; a
+#: ``Cm:alpha^2`` top count lost on the us25e and the ultrastick (``docs/benchmarks.md``, *Twenty-fourth session,
+#: i9-misses*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -223,7 +230,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
-              "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False}
+              "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
+              "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -790,6 +798,11 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         rtr, rte = _segments(rctx, segment_frac)
         Rr = np.nan_to_num(np.asarray(Rr, float))
         rows = np.r_[rtr, rte]
+        if th.get("pitch_gust_nuisance", False):
+            # the reference's own pitch gust moment, its own slope, before its inadequacy is fitted (gust_nuisance)
+            Gr, ginfo_ref = pitch_gust_nuisance(rctx, Rr, rows,
+                                                highpass_s=float(th.get("pitch_gust_highpass_s", 0.0) or 0.0))
+            Rr = Rr - Gr
         ridge = _ridge_cv(iPhi_ref[rows], Rr[rows], folds, max_rows) if th.get("inadequacy", "ridge") == "ridge" \
             and rtr.size >= 20 * folds else None
         for j, coef in enumerate(COEFFICIENTS):
@@ -902,6 +915,15 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["inadequacy_prediction"] = base.copy()
                 result["angle_offset_level"] = {"alpha_rad": float(err[tr, 0].mean()) if tr.size else 0.0,
                                                 "beta_rad": float(err[tr, 1].mean()) if tr.size else 0.0}
+    if th.get("pitch_gust_nuisance", False):
+        # the pitch gust rate's moment (gyro q against the air-relative q the aerodynamics see), fitted on the
+        # training rows and removed before the search selects and measures any gain (gust_nuisance)
+        g_slope = None if (reference is None or th["pitch_gust_nuisance"] == "own" or "slope" not in ginfo_ref) \
+            else ginfo_ref["slope"]
+        G, ginfo = pitch_gust_nuisance(ctx, Rd, tr, g_slope,
+                                       highpass_s=float(th.get("pitch_gust_highpass_s", 0.0) or 0.0))
+        Rd, Rn, M0 = Rd - G, Rn - G, M0 + G
+        result["pitch_gust"] = dict(ginfo, reference=ginfo_ref if reference is not None else None)
     # the scale candidates on the angles the library uses (corrected by the nuisance when it ran)
     S0 = np.nan_to_num(scale_columns(M0, np.nan_to_num(Xc if th.get("angle_nuisance", True) else ctx.X),
                                      bool(th.get("side_force_wind_axis", False))))
