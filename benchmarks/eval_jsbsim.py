@@ -314,7 +314,9 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
     ``ls_airp_MODE`` (% errors per coefficient), ``cov_gp_airp_MODE`` (``_each``: per coefficient) and ``airp_MODE`` (``corr`` and ``err_pct``,
     the RMS error of the estimated ``p_hat_g`` in % of JSBSim's ``(p - p_aero) b/(2V)``, on the held-out rows;
     ``sd`` the estimate's SD over the true one's; ``applied`` False when the fit or its Dryden check refused). Mode
-    ``"off"`` reproduces the replay's own ``gp`` line (a check).
+    ``"off"`` reproduces the replay's own ``gp`` line (a check). ``gp_airp_oracle`` / ``ls_airp_oracle``: the same
+    with JSBSim's own ``p_g`` taken out of the held-out rows' ``p_hat`` (reads the truth: what a perfect gust
+    estimate would give; below it, the estimate is taking up the model's own error from the measured moment).
 
     Args:
         res: the replay's result (its table not gust-filtered). model: its GP. airframe: the loaded airframe.
@@ -322,6 +324,8 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
         ls_model: the stepwise least-squares model (``evaluate(X)``). modes: ``"off"`` or
             :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` entries.
     """
+    from dataclasses import replace
+
     from gcs_sysid.aero.gustfilter import heldout_air_roll
     from gcs_sysid.pipeline import gp_inputs
 
@@ -345,6 +349,15 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
         out[f"ls_airp_{mode}"] = _errs(ls_model.evaluate(t2.X[h]), Yt[h])
         if mode != "off":
             g = np.zeros(len(h)) if info is None else info["g"]
+            if mode == modes[-1] or "oracle" not in out:   # once: the model at JSBSim's own p_g (reads the truth)
+                Xo = tab.X.copy()
+                Xo[:, 2] -= np.where(h, np.nan_to_num(g_true), 0.0)
+                to = replace(tab, X=Xo)
+                mo = np.full(Yt.shape, np.nan)
+                mo[np.ix_(rows, fit_cols)] = np.asarray(model.predict(gp_inputs(to, rows, use_adot)[0],
+                                                                      x_var=gp_inputs(to, rows, use_adot)[1])[0])
+                out["gp_airp_oracle"] = _errs(mo[h], Yt[h])
+                out["ls_airp_oracle"] = _errs(ls_model.evaluate(Xo[h]), Yt[h])
             m = h & np.isfinite(g_true)
             gt, ge = g_true[m], g[m]
             out[f"airp_{mode}"] = {"applied": info is not None,
