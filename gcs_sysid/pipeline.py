@@ -411,11 +411,14 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                                     method=gust_filter if isinstance(gust_filter, str) else "2sls")
         if air_roll != "off" and not gust_filter:
             table = table_air
-        elif air_roll != "off":     # the filtered table's held-out x_var already states the gust's prior variance
-            X = table.X.copy()
+        elif air_roll != "off":     # the held-out rows: the estimate and its variance, not the filter's prior
+            X, xv = table.X.copy(), table.x_var
             if air_info is not None:
-                X[:, REGRESSORS.index("p_hat")] -= air_info["g"]
-            table = replace(table, X=X, notes=list(table.notes) + [table_air.notes[-1]])
+                j = REGRESSORS.index("p_hat")
+                X[:, j] -= air_info["g"]
+                xv = np.full(X.shape, np.nan) if table.x_var is None else table.x_var.copy()
+                xv[held, j] = table_air.x_var[held, j]
+            table = replace(table, X=X, x_var=xv, notes=list(table.notes) + [table_air.notes[-1]])
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
