@@ -66,7 +66,10 @@ LAT_TERMS = ("alpha", "beta", "p_hat", "r_hat", "delta_a", "delta_r")
 #: the fit's ``Cl_p`` (twenty-second session, i8-rollgp, docs/benchmarks.md).
 ROLL_GP_SLOPES = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``heldout_air_roll``): the held-out rows'
-#: ``p_hat`` as the gyro's (``"off"``) or less the rolling gust estimated there (:func:`heldout_air_roll`).
+#: ``p_hat`` as the gyro's (``"off"``) or less the rolling gust estimated there (:func:`heldout_air_roll`). Off: on
+#: 93 roster flights it lowers the held-out Cl (median 50.9 -> 27.5 %, ``"predicted"``) but asks CY and Cn at a rate
+#: their slopes were not learned at and loses a count on 15 of 31 groups; with ``GUST_FILTER = "rollgp"`` 14 aircraft
+#: gain a count and 4 lose one (twenty-fourth session, i8-airp, docs/benchmarks.md).
 HELDOUT_AIR_ROLL = "off"
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 #: Delays (s) of the aileron and rudder used as instruments for the rates and the sideslip (the controls are set by
