@@ -182,14 +182,18 @@ def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
-             gust_rates: str | None = None, gust_filter: bool | str | None = None) -> dict:
+             gust_rates: str | None = None, gust_filter: bool | str | None = None,
+             heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = ()) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
     what a simulator using the model would give it). ``gust_filter``: ``ReplayOptions.gust_filter`` (None: the
-    default)."""
+    default). ``heldout_air_roll``: ``ReplayOptions.heldout_air_roll`` (None: the default). ``airp_lines``: modes of
+    :func:`gcs_sysid.aero.gustfilter.heldout_air_roll` scored post hoc on the same replay's model (rows
+    ``gp_airp_MODE``, ``ls_airp_MODE``, ``cov_gp_airp_MODE`` and ``airp_MODE`` with the estimated gust against
+    JSBSim's ``p - p_aero``; a diagnosis: the replay's table must not be gust-filtered)."""
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -200,7 +204,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
     res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False, gust_rates=gust_rates,
-                                                                          gust_filter=gust_filter))
+                                                                          gust_filter=gust_filter,
+                                                                          heldout_air_roll=heldout_air_roll))
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
@@ -214,7 +219,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
-                 "gust_rates": gust_rates, "gust_filter": gust_filter,
+                 "gust_rates": gust_rates, "gust_filter": gust_filter, "heldout_air_roll": heldout_air_roll,
                  "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
@@ -297,7 +302,70 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["alpha_rms_deg"] = float(np.degrees(np.std(Xt[ok, 0])))
     row["beta_rms_deg"] = float(np.degrees(np.sqrt(np.mean(Xt[ok, 1] ** 2))))
     row["cy_diag"] = cy_diagnosis(tab.X[h], Xt_air[h], np.asarray(ma)[:, 1], Yt[h, 1])
+    if airp_lines:
+        g_true = (ip("p") - ip("p_aero")) * cst["b"] / (2 * Xt[:, 9])
+        row.update(airp_scores(res, model, af, h, Yt, g_true, ls_model, airp_lines))
     return row
+
+
+def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.ndarray, ls_model,
+                modes: tuple[str, ...]) -> dict:
+    """The held-out lines with the rows' ``p_hat`` less the rolling gust estimated there
+    (:func:`gcs_sysid.aero.gustfilter.heldout_air_roll`), from one replay's table and model: ``gp_airp_MODE``,
+    ``ls_airp_MODE`` (% errors per coefficient), ``cov_gp_airp_MODE`` (``_each``: per coefficient) and ``airp_MODE`` (``corr`` and ``err_pct``,
+    the RMS error of the estimated ``p_hat_g`` in % of JSBSim's ``(p - p_aero) b/(2V)``, on the held-out rows;
+    ``sd`` the estimate's SD over the true one's; ``applied`` False when the fit or its Dryden check refused). Mode
+    ``"off"`` reproduces the replay's own ``gp`` line (a check). ``gp_airp_oracle`` / ``ls_airp_oracle``: the same
+    with JSBSim's own ``p_g`` taken out of the held-out rows' ``p_hat`` (reads the truth: what a perfect gust
+    estimate would give; below it, the estimate is taking up the model's own error from the measured moment).
+
+    Args:
+        res: the replay's result (its table not gust-filtered). model: its GP. airframe: the loaded airframe.
+        h: ``(T,)`` bool scored held-out rows. Yt: ``(T, 6)`` JSBSim's coefficients. g_true: ``(T,)``.
+        ls_model: the stepwise least-squares model (``evaluate(X)``). modes: ``"off"`` or
+            :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` entries.
+    """
+    from dataclasses import replace
+
+    from gcs_sysid.aero.gustfilter import heldout_air_roll
+    from gcs_sysid.pipeline import gp_inputs
+
+    out: dict = {}
+    tab = res.table
+    fit_cols = [i for i in range(6) if np.isfinite(res.pred_mean[:, i]).any()]
+    use_adot = model.n_inputs == tab.X.shape[1] + 1
+    white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
+    for mode in modes:
+        t2, info = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode)
+        rows = h & np.all(np.isfinite(t2.X), axis=1)
+        Xq, xv = gp_inputs(t2, rows, use_adot)
+        mean, var = model.predict(Xq, x_var=xv)
+        pm = np.full(Yt.shape, np.nan)
+        ps = np.full(Yt.shape, np.nan)
+        pm[np.ix_(rows, fit_cols)] = np.asarray(mean)
+        ps[np.ix_(rows, fit_cols)] = np.sqrt(np.maximum(np.asarray(var) - white[None, :], 0.0))
+        out[f"gp_airp_{mode}"] = _errs(pm[h], Yt[h])
+        out[f"cov_gp_airp_{mode}_each"] = [_coverage(pm[h, i], ps[h, i], Yt[h, i]) for i in range(6)]
+        out[f"cov_gp_airp_{mode}"] = float(np.nanmean(out[f"cov_gp_airp_{mode}_each"]))
+        out[f"ls_airp_{mode}"] = _errs(ls_model.evaluate(t2.X[h]), Yt[h])
+        if mode != "off":
+            g = np.zeros(len(h)) if info is None else info["g"]
+            if mode == modes[-1] or "oracle" not in out:   # once: the model at JSBSim's own p_g (reads the truth)
+                Xo = tab.X.copy()
+                Xo[:, 2] -= np.where(h, np.nan_to_num(g_true), 0.0)
+                to = replace(tab, X=Xo)
+                mo = np.full(Yt.shape, np.nan)
+                mo[np.ix_(rows, fit_cols)] = np.asarray(model.predict(gp_inputs(to, rows, use_adot)[0],
+                                                                      x_var=gp_inputs(to, rows, use_adot)[1])[0])
+                out["gp_airp_oracle"] = _errs(mo[h], Yt[h])
+                out["ls_airp_oracle"] = _errs(ls_model.evaluate(Xo[h]), Yt[h])
+            m = h & np.isfinite(g_true)
+            gt, ge = g_true[m], g[m]
+            out[f"airp_{mode}"] = {"applied": info is not None,
+                                   "corr": float(np.corrcoef(ge, gt)[0, 1]) if np.std(ge) > 0 else 0.0,
+                                   "err_pct": float(100 * np.sqrt(np.mean((ge - gt) ** 2)) / np.std(gt)),
+                                   "sd": float(np.std(ge) / np.std(gt))}
+    return out
 
 
 #: the side-force regressors of :func:`cy_diagnosis`'s local linear fits (a diagnosis only)
@@ -407,6 +475,13 @@ def main(argv=None) -> int:
                          "gcs_sysid.aero.rollgust; 'rollgp': the same with the moment's stated noise and the GP "
                          "given the fit's Cl slopes; default: the replay's default, "
                          "gcs_sysid.aero.gustfilter.GUST_FILTER)")
+    ap.add_argument("--heldout-air-roll", default=None, choices=("off", "smoothed", "filtered", "predicted"),
+                    help="the held-out rows' p_hat less the rolling gust estimated there from their own measured roll "
+                         "moment with the training rows' roll fit (ReplayOptions.heldout_air_roll, "
+                         "gcs_sysid.aero.gustfilter.heldout_air_roll; default: the replay's, HELDOUT_AIR_ROLL)")
+    ap.add_argument("--airp-lines", nargs="*", default=(), choices=("off", "smoothed", "filtered", "predicted"),
+                    help="also score these heldout_air_roll modes post hoc on the same replay's model (rows "
+                         "gp_airp_MODE, ls_airp_MODE, cov_gp_airp_MODE, airp_MODE; a diagnosis)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated", "untested"),
@@ -501,7 +576,8 @@ def main(argv=None) -> int:
             for seed in a.seeds:
                 row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates,
                                None if a.gust_filter is None else
-                               {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter])
+                               {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter],
+                               a.heldout_air_roll, tuple(a.airp_lines))
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
@@ -516,6 +592,11 @@ def main(argv=None) -> int:
                 print(f"{'':32s} tair  {_fmt(row['true_air'])}   {row['cov_true_air']:5.1f}  (at the true regressors "
                       "with the rates JSBSim's aerodynamics reads)")
                 print(f"{'':32s} ls    {_fmt(row['ls'])}", flush=True)
+                for m in a.airp_lines:
+                    extra = "" if m == "off" else (f"  p_g corr {row['airp_' + m]['corr']:.2f} "
+                                                   f"err {row['airp_' + m]['err_pct']:.0f} %")
+                    print(f"{'':32s} {m[:5]:5s} {_fmt(row['gp_airp_' + m])}   {row['cov_gp_airp_' + m]:5.1f}  "
+                          f"(ls {_fmt(row['ls_airp_' + m])}){extra}", flush=True)
                 if a.json:
                     with open(a.json, "a") as f:
                         f.write(json.dumps(row) + "\n")

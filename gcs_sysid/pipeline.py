@@ -8,7 +8,7 @@ from __future__ import annotations
 import importlib
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -77,6 +77,11 @@ class ReplayOptions:
             smoother's stated variance, and the GP's Cl target given the fit's slopes of
             :data:`gcs_sysid.aero.gustfilter.ROLL_GP_SLOPES` (:func:`gcs_sysid.gp.mixed.apply_fixed_slopes`).
             None: :data:`gcs_sysid.aero.gustfilter.GUST_FILTER`.
+        heldout_air_roll: the held-out rows' ``p_hat`` (what the model is asked at there): ``"off"`` the gyro's;
+            ``"smoothed"``, ``"filtered"`` or ``"predicted"``: less the rolling gust estimated on those rows from
+            their own measured roll moment with the training rows' roll fit
+            (:func:`gcs_sysid.aero.gustfilter.heldout_air_roll`; ``"predicted"`` reads only the moments before
+            each row). Training rows unchanged. None: :data:`gcs_sysid.aero.gustfilter.HELDOUT_AIR_ROLL`.
     """
 
     rate_hz: float = 50.0
@@ -95,6 +100,7 @@ class ReplayOptions:
     gust_rates: str | None = None
     alpha_dot_hat: bool = True
     gust_filter: bool | str | None = None
+    heldout_air_roll: str | None = None
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
@@ -181,6 +187,9 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     """
     check_rate(options.rate_hz)
     check_holdout(options.holdout)
+    if options.heldout_air_roll not in (None, "off", "smoothed", "filtered", "predicted"):
+        raise InputError(f"heldout_air_roll: expected off, smoothed, filtered or predicted, got "
+                         f"{options.heldout_air_roll!r}")
     check_window(options.t_from, options.t_to)
     check_positive_int(options.n_inducing, "--inducing")
     if options.targets is not None:
@@ -387,14 +396,29 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
-        from .aero.gustfilter import GUST_FILTER, filter_gust_table
+        from .aero.gustfilter import GUST_FILTER, HELDOUT_AIR_ROLL, filter_gust_table, heldout_air_roll
 
         gust_filter = GUST_FILTER if options.gust_filter is None else options.gust_filter
+        air_roll = HELDOUT_AIR_ROLL if options.heldout_air_roll is None else options.heldout_air_roll
+        air_info = None
+        if air_roll != "off":       # opt-in: the held-out rows at the reconstructed air-relative roll rate
+            with _stage("held-out air roll rate", timings, bar):
+                table_air, air_info = heldout_air_roll(table, states, airframe, train, held, mode=air_roll)
         gust_fit = None
         if gust_filter:
             with _stage("gust filter", timings, bar):
                 table, gust_fit = filter_gust_table(table, states, airframe, train,
                                                     method=gust_filter if isinstance(gust_filter, str) else "2sls")
+        if air_roll != "off" and not gust_filter:
+            table = table_air
+        elif air_roll != "off":     # the held-out rows: the estimate and its variance, not the filter's prior
+            X, xv = table.X.copy(), table.x_var
+            if air_info is not None:
+                j = REGRESSORS.index("p_hat")
+                X[:, j] -= air_info["g"]
+                xv = np.full(X.shape, np.nan) if table.x_var is None else table.x_var.copy()
+                xv[held, j] = table_air.x_var[held, j]
+            table = replace(table, X=X, x_var=xv, notes=list(table.notes) + [table_air.notes[-1]])
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]

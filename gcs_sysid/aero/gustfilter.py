@@ -46,7 +46,7 @@ from .table import COEFFICIENTS, REGRESSORS
 __all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_GP_SLOPES", "roll_gp_slopes", "INSTRUMENT_DELAYS_S",
            "LAT_TERMS", "RollGustFit", "fit_roll_gust",
            "instruments",
-           "stated_moment_variance", "filter_gust_table"]
+           "stated_moment_variance", "filter_gust_table", "HELDOUT_AIR_ROLL", "heldout_air_roll"]
 
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
 #: less the filter-error rolling gust.
@@ -65,6 +65,12 @@ LAT_TERMS = ("alpha", "beta", "p_hat", "r_hat", "delta_a", "delta_r")
 #: the causal *step* moment's gust was made for; that pairing and the step's damping factor give it 86-92 % of
 #: the fit's ``Cl_p`` (twenty-second session, i8-rollgp, docs/benchmarks.md).
 ROLL_GP_SLOPES = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")
+#: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``heldout_air_roll``): the held-out rows'
+#: ``p_hat`` as the gyro's (``"off"``) or less the rolling gust estimated there (:func:`heldout_air_roll`). Off: on
+#: 93 roster flights it lowers the held-out Cl (median 50.9 -> 27.5 %, ``"predicted"``) but asks CY and Cn at a rate
+#: their slopes were not learned at and loses a count on 15 of 31 groups; with ``GUST_FILTER = "rollgp"`` 14 aircraft
+#: gain a count and 4 lose one (twenty-fourth session, i8-airp, docs/benchmarks.md).
+HELDOUT_AIR_ROLL = "off"
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 #: Delays (s) of the aileron and rudder used as instruments for the rates and the sideslip (the controls are set by
 #: the pilot's programme, not by the gust; their delayed values carry the aircraft's response to them).
@@ -363,25 +369,8 @@ def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = 
     if method not in ("2sls", "roll", "rollgp"):
         raise ValueError(f"filter_gust_table: method must be '2sls', 'roll' or 'rollgp', got {method!r}")
     if method in ("roll", "rollgp"):
-        from .rollgust import fit_roll_dynamics
-
-        d = getattr(states, "data", {})
-        if "p" not in d or len(d["p"]) != T:
-            return replace(table, notes=list(table.notes) + ["gust filter not run: no p on the table's grid"]), None
-        R = None
-        if method == "rollgp":        # the moment's noise where the estimator states it (else the likelihood's)
-            Rs = stated_moment_variance(states, airframe, table.qbar, rows)
-            R = None if Rs is None else float(Rs[0])
-        try:
-            G = fit_roll_dynamics(dt, table.X, table.Y, d["p"], table.qbar, rows, airframe.Ixx, airframe.S,
-                                  airframe.b, R=R)
-        except ValueError as e:
-            return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
-        ratio = _dryden_ratio(G, d, table, dt, airframe.b)
-        if not ratio >= ROLL_MIN_DRYDEN_RATIO:
-            why = (f"gust filter not applied: the fitted rolling gust's SD is {ratio:.2f} of MIL-F-8785C's "
-                   f"1.9 sigma/sqrt(L b) from the reconstructed wind (at least {ROLL_MIN_DRYDEN_RATIO} needed: "
-                   "the roll moment does not read the gust); " + G.notes[0])
+        G, ratio, why = _fit_roll(table, states, airframe, rows, method)
+        if G is None:
             return replace(table, notes=list(table.notes) + [why]), None
         prior = float(np.var(G.g[G.used])) if method == "rollgp" else None
         return _take_out(table, G, f"; its SD {ratio:.2f} of the Dryden one from the wind", prior), G
@@ -393,6 +382,90 @@ def filter_gust_table(table, states, airframe, train: np.ndarray, method: str = 
     except ValueError as e:
         return replace(table, notes=list(table.notes) + [f"gust filter not run: {e}"]), None
     return _take_out(table, G), G
+
+
+def _fit_roll(table, states, airframe, rows: np.ndarray, method: str):
+    """:func:`gcs_sysid.aero.rollgust.fit_roll_dynamics` on ``rows`` with ``R`` as ``method`` says (``"rollgp"``:
+    the smoother's stated moment variance, :func:`stated_moment_variance`; ``"roll"``: the likelihood's) and the
+    Dryden check of :data:`ROLL_MIN_DRYDEN_RATIO`. Returns ``(fit, ratio, "")`` or ``(None, ratio, why)``."""
+    from .rollgust import fit_roll_dynamics
+
+    T = len(table.t)
+    dt = float(np.median(np.diff(table.t)))
+    d = getattr(states, "data", {})
+    if "p" not in d or len(d["p"]) != T:
+        return None, float("nan"), "gust filter not run: no p on the table's grid"
+    R = None
+    if method == "rollgp":        # the moment's noise where the estimator states it (else the likelihood's)
+        Rs = stated_moment_variance(states, airframe, table.qbar, rows)
+        R = None if Rs is None else float(Rs[0])
+    try:
+        G = fit_roll_dynamics(dt, table.X, table.Y, d["p"], table.qbar, rows, airframe.Ixx, airframe.S,
+                              airframe.b, R=R)
+    except ValueError as e:
+        return None, float("nan"), f"gust filter not run: {e}"
+    ratio = _dryden_ratio(G, d, table, dt, airframe.b)
+    if not ratio >= ROLL_MIN_DRYDEN_RATIO:
+        return None, ratio, (f"gust filter not applied: the fitted rolling gust's SD is {ratio:.2f} of MIL-F-8785C's "
+                             f"1.9 sigma/sqrt(L b) from the reconstructed wind (at least {ROLL_MIN_DRYDEN_RATIO} "
+                             "needed: the roll moment does not read the gust); " + G.notes[0])
+    return G, ratio, ""
+
+
+def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarray, mode: str = HELDOUT_AIR_ROLL):
+    """The table with the held-out rows' ``p_hat`` relative to the air: less the rolling gust ``p_hat_g`` estimated
+    there from their own measured roll moment (:func:`gcs_sysid.aero.rollgust.roll_gust_on_rows`), with the slopes,
+    gust process and noise of the ``"rollgp"`` roll fit on the training rows (:func:`filter_gust_table`'s).
+
+    JSBSim's roll moment (and the air's) reads ``p - p_g``; the gyro's ``p`` on a held-out row carries the gust, so a
+    model asked there at the gyro's rate answers for a roll rate the aircraft did not have relative to the air
+    (ka350 light: held-out Cl 45-52 % against 26-27 % at the true air rates; twenty-third session). The training rows
+    are not changed. Only the roll moment of the held-out rows is read, never the truth; ``"predicted"`` does not
+    read row ``k``'s own moment for row ``k`` (see :func:`~gcs_sysid.aero.rollgust.roll_gust_on_rows`).
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``X`` ``(T, 10)`` with the gyro's ``p_hat``, ``Y``
+            ``(T, 6)``, ``x_var``; before :func:`filter_gust_table`).
+        states: the smoothed states (``p`` on the table's grid; the stated ``p_dot`` noise for ``R``).
+        airframe: span, area and inertia.
+        train, held: ``(T,)`` bool, the training rows (the fit's) and the rows to change.
+        mode: ``"off"`` (the table returned as it is) or one of
+            :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES`.
+
+    Returns:
+        ``(table, info)``: a new table and a dict (``mode``, ``g`` ``(T,)`` the ``p_hat_g`` taken out (0 off the held-out
+        rows), ``g_var`` (its variance, added to ``x_var``; 0 off them), ``fit``), or the input with a note saying why and None (mode ``"off"``, no fit, the Dryden check failed).
+
+    Raises:
+        ValueError: an unknown ``mode``.
+    """
+    from dataclasses import replace
+
+    from .rollgust import ROW_GUST_MODES, roll_gust_on_rows
+
+    if mode == "off":
+        return table, None
+    if mode not in ROW_GUST_MODES:
+        raise ValueError(f"heldout_air_roll: mode must be 'off' or one of {ROW_GUST_MODES}, got {mode!r}")
+    held = np.asarray(held, bool)
+    if len(table.t) < 3 or not held.any():
+        return replace(table, notes=list(table.notes) + ["held-out air roll rate not estimated: no held-out rows"]), None
+    G, _, why = _fit_roll(table, states, airframe, np.asarray(train, bool) & table.valid, "rollgp")
+    if G is None:
+        return replace(table, notes=list(table.notes) + [why.replace("gust filter", "held-out air roll rate")]), None
+    dt = float(np.median(np.diff(table.t)))
+    g, g_var = roll_gust_on_rows(G, dt, table.X, table.Y, states.data["p"], table.qbar, held & table.valid,
+                                 airframe.Ixx, airframe.S, airframe.b, mode=mode)
+    g, g_var = np.where(held, g, 0.0), np.where(held, g_var, 0.0)
+    j = REGRESSORS.index("p_hat")
+    X = table.X.copy()
+    X[:, j] -= g
+    xv = np.full(X.shape, np.nan) if table.x_var is None else table.x_var.copy()
+    xv[:, j] = np.where(held, np.where(np.isfinite(xv[:, j]), xv[:, j], 0.0) + g_var, xv[:, j])
+    note = (f"held-out rows' p_hat relative to the air: the rolling gust ({mode}, SD {np.std(g[held]):.4f}) of the "
+            "roll fit on the training rows taken out (" + G.notes[0] + ")")
+    return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), {"mode": mode, "g": g, "g_var": g_var,
+                                                                             "fit": G}
 
 
 def _dryden_ratio(G: RollGustFit, data: dict, table, dt: float, b: float) -> float:

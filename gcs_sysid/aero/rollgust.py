@@ -55,7 +55,8 @@ import numpy as np
 from .gustfilter import LAT_TERMS, RollGustFit, _gains, _innovations, _segments, _smooth
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["ROLL_TAU", "RollDynamicsFit", "dryden_roll_tau", "causal_roll_moment", "fit_roll_dynamics"]
+__all__ = ["ROLL_TAU", "ROW_GUST_MODES", "RollDynamicsFit", "dryden_roll_tau", "causal_roll_moment",
+           "fit_roll_dynamics", "roll_gust_on_rows"]
 
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 _MIN_ROWS, _MIN_RUN = 200, 50
@@ -217,3 +218,76 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
              f"Cl_delta_a {theta0[5]:.3f} -> {theta[5]:.3f}; -log L {f:.0f} against {nll_white:.0f} without the gust",)
     return RollDynamicsFit(g, g_var, used, theta, theta0, float(theta[_IP]), tau_, float(np.sqrt(sg2)), R, float(f),
                            float(nll_white), int(opt.nfev), bool(opt.success), notes, L_p=Lp)
+
+
+#: The estimates of the rolling gust on rows the fit did not use (:func:`roll_gust_on_rows`).
+ROW_GUST_MODES = ("smoothed", "filtered", "predicted")
+
+
+def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
+                      rows: np.ndarray, Ixx: float, S: float, b: float, mode: str = "smoothed",
+                      min_run: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """The rolling gust ``p_hat_g`` on ``rows`` (a held-out segment) from their own measured roll moment, with the
+    slopes, gust process and noise of a fit made on other rows (:func:`fit_roll_dynamics`, nothing refitted).
+
+    The step moment's residual on the fit's step slopes, ``z_k = Cl_k+1/2 - theta_step . x_k`` (module docstring),
+    goes through the fit's steady-state Kalman filter (``a = exp(-dt/tau)``, process SD ``sigma |Cl_p_step|``, noise
+    ``R``; Jategaonkar 2015, ch. 5; Simon, *Optimal State Estimation*, 2006, ch. 5 and 9) on each run of usable rows:
+
+    - ``"smoothed"``: the Rauch-Tung-Striebel smoothed state (every moment of the run; offline reconstruction);
+    - ``"filtered"``: the filtered state (the moments up to the step ``[k, k+1]``);
+    - ``"predicted"``: the one-step prediction (the moments before ``k`` only: row ``k``'s own measured moment
+      is not used, so a model asked at ``p_hat - p_hat_g`` there is not given the moment it is scored on).
+
+    ``p_hat_g = -s / Cl_p_step``. The fit's ``theta`` had the step's damping factor divided out; it is put back
+    (``theta (e^{L_p dt} - 1)/(L_p dt)``) so that the residual is the one the fit's filter saw.
+
+    Args:
+        G: the fit (:class:`RollDynamicsFit`, with ``L_p``).
+        dt: grid interval, s. X: ``(T, 10)`` regressors (gyro hats). Y: ``(T, 6)`` measured coefficients.
+        p: ``(T,)`` the smoothed roll rate, rad/s. qbar: ``(T,)`` Pa. rows: ``(T,)`` bool, where to estimate.
+        Ixx, S, b: kg m^2, m^2, m. mode: one of :data:`ROW_GUST_MODES`. min_run: shortest run of usable rows.
+
+    Returns:
+        ``(g, g_var)``, each ``(T,)``: ``p_hat_g`` and its variance on the usable runs of ``rows``; 0 and the fit's
+        stationary variance ``sigma**2`` elsewhere (the prior).
+
+    Raises:
+        ValueError: an unknown ``mode``, shapes that disagree, or a fit without a finite ``L_p``.
+    """
+    from scipy.signal import lfilter
+
+    if mode not in ROW_GUST_MODES:
+        raise ValueError(f"roll_gust_on_rows: mode must be one of {ROW_GUST_MODES}, got {mode!r}")
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
+    T = len(X)
+    if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or any(
+            np.shape(v) != (T,) for v in (p, qbar, rows)):
+        raise ValueError(f"roll_gust_on_rows: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}), p, qbar, rows "
+                         f"(T,) expected, got {X.shape}, {Y.shape}, {[np.shape(v) for v in (p, qbar, rows)]}")
+    if not np.isfinite(G.L_p):
+        raise ValueError("roll_gust_on_rows: the fit has no roll damping L_p")
+    x = G.L_p * dt
+    th = np.asarray(G.theta, float) * (np.expm1(x) / x if x != 0 else 1.0)   # the step slopes the filter used
+    cl_p = float(th[_IP])
+    cols = [REGRESSORS.index(k) for k in LAT_TERMS]
+    A = np.c_[np.ones(T), X[:, cols]]
+    y = causal_roll_moment(dt, Y[:, COEFFICIENTS.index("Cl")], p, qbar, Ixx, S, b)
+    z = y - A @ th
+    use = np.asarray(rows, bool) & np.isfinite(z)
+    a = float(np.exp(-dt / G.tau))
+    ss = _gains(a, (G.sigma * cl_p) ** 2, 1.0, G.R)
+    s = np.zeros(T)
+    var = np.full(T, (G.sigma * cl_p) ** 2)
+    Pf = ss.P * G.R / ss.S
+    for s0, s1 in _segments(use, min_run):
+        zz = z[s0:s1]
+        if mode == "smoothed":
+            s[s0:s1], var[s0:s1] = _smooth(zz, a, ss, 1.0), ss.Ps
+        else:
+            xp = lfilter([0.0, a * ss.K], [1.0, -a * (1 - ss.K)], zz)     # one-step prediction, prior 0 at the start
+            if mode == "predicted":
+                s[s0:s1], var[s0:s1] = xp, ss.P
+            else:
+                s[s0:s1], var[s0:s1] = xp + ss.K * (zz - xp), Pf
+    return -s / cl_p, var / cl_p**2
