@@ -127,3 +127,55 @@ def test_fit_learns_cm_alpha_dot_and_queries_may_leave_it_out():
     m_short, v_short = model.predict(X[:50, :10])
     np.testing.assert_allclose(m_short, m_full)
     np.testing.assert_allclose(v_short, v_full)
+
+
+def test_leader_gives_cz_cm_identical_mean_only_regressors():
+    """``GPConfig.mean_only_leader`` (twenty-fourth session, i8-noise3; the pipeline's opt-in ``ALPHA_DOT_TIED``): CZ
+    carries ``alpha_dot_hat`` exactly where Cm's gates keep it, whatever CZ's own data say, so the two outputs have
+    identical regressors there (Zellner's SUR equivalence: a noise correlation then moves neither output's slopes
+    through the other's residual). The pre-fit gates (Cm's term kept: CZ follows; Cm's term absent: CZ has none
+    although its own slope is large) and the blocked gate's tie (:func:`gcs_sysid.gp.validation.gate_mean_only`)."""
+    from gcs_sysid.gp.validation import gate_mean_only
+    from gcs_sysid.pipeline import ALPHA_DOT_TIED
+
+    cfg = GPConfig(**{**ALPHA_DOT_GP, **ALPHA_DOT_TIED})
+    names = REGRESSORS + ("alpha_dot_hat",)
+    cz = COEFFICIENTS.index("CZ")
+    for cm_alpha_dot, kept in ((-9.0, True), (0.0, False)):
+        table, adh = _flight(cm_alpha_dot=cm_alpha_dot)
+        Y = table.Y.copy()
+        Y[:, cz] += -40.0 * adh                    # CZ's own term, large: its own gate would keep it
+        X, _ = gp_inputs(table, np.ones(len(table.t), bool), True)
+        Xs, Ys = (X - X.mean(0)) / X.std(0), (Y - Y.mean(0)) / Y.std(0)
+        _, allowed, info = mean_only_masks(cfg, names, COEFFICIENTS, Xs, Ys, np.ones(11, bool), X.std(0))
+        assert allowed[:, -1].tolist() == [kept and c in ("CZ", "Cm") for c in COEFFICIENTS], info
+        assert info["outputs"]["CZ"] == info["outputs"]["Cm"] == (["alpha_dot_hat"] if kept else [])
+    with pytest.raises(InputError, match="mean_only_leader"):
+        GPConfig(**{**ALPHA_DOT_GP, "mean_only_leader": "CZ"})
+
+    # the blocked gate: a fake posterior whose weights are the prior std (0: the term out), so the leader's
+    # (output 1) error is lower without the term and the follower's (output 0) lower with it
+    class _P:
+        prior_std = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 1.0]])
+
+    import gcs_sysid.gp.validation as val
+
+    rng = np.random.default_rng(0)
+    Xs = rng.normal(size=(200, 2))
+    Ys = np.stack([Xs[:, 0] + Xs[:, 1], Xs[:, 0]], 1)
+    patch = pytest.MonkeyPatch()
+    patch.setattr(val, "replace", lambda p, prior_std: type("Q", (), {"prior_std": np.asarray(prior_std)})())
+    patch.setattr(val.jax, "device_put", lambda a: a)
+    patch.setattr(val, "global_stats", lambda p, X, Y, b: 0.0)
+    patch.setattr(val, "_add_jit", lambda a, b: a + b)
+    patch.setattr(val, "_sub", lambda a, b: a - b)
+    patch.setattr(val, "_design_u", lambda p, X: np.concatenate([np.ones((len(X), 1)), X], 1))
+    patch.setattr(val, "_mean_weights", lambda p, st: np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]])
+                  * (np.asarray(p.prior_std).T > 0))
+    try:
+        _, keep, ratio = gate_mean_only(_P(), Xs, Ys, [1], 5, 256)
+        assert keep.tolist() == [True, False] and ratio[0] < 1 < ratio[1]
+        out, keep, _ = gate_mean_only(_P(), Xs, Ys, [1], 5, 256, tie=(1, [0]))
+        assert keep.tolist() == [False, False] and not np.asarray(out.prior_std)[:, 2].any()
+    finally:
+        patch.undo()
