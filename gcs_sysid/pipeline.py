@@ -101,14 +101,16 @@ class ReplayOptions:
 #: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md).
 ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("Cm",), "mean_only_sign": -1.0}
 
-#: Opt-in (twenty-fourth session, i8-noise3; ``eval_jsbsim --gp-adot-cz``): ``alpha_dot_hat`` in CZ's mean too, CZ
-#: taking Cm's decision (``GPConfig.mean_only_leader``), so that CZ and Cm have identical regressors there and a
-#: learned CZ-Cm noise correlation no longer moves Cm's slopes through CZ's residual in the posterior mean (Zellner's
-#: SUR equivalence; docs/gp.md, "Noise: learned, not conditioned on").
-ALPHA_DOT_TIED = {"mean_only_outputs": ("CZ", "Cm"), "mean_only_leader": "Cm"}
+#: Opt-in (twenty-fourth session, i8-noise3; ``eval_jsbsim --gp-adot-cz on | all``): ``alpha_dot_hat`` in more outputs'
+#: means, each taking Cm's decision (``GPConfig.mean_only_leader``): ``"cz"`` CZ and Cm, ``"all"`` all six. The outputs
+#: then have identical regressors there, so a learned noise correlation no longer moves Cm's slopes through another
+#: output's residual in the posterior mean (Zellner's SUR equivalence; docs/gp.md, "Noise: learned, not conditioned on").
+ALPHA_DOT_TIED = {"cz": {"mean_only_outputs": ("CZ", "Cm"), "mean_only_leader": "Cm"},
+                  "all": {"mean_only_outputs": COEFFICIENTS, "mean_only_leader": "Cm"}}
 
-#: Whether the replay's fit uses :data:`ALPHA_DOT_TIED` (with ``ReplayOptions.alpha_dot_hat``). Off: opt-in.
-ALPHA_DOT_CZ = False
+#: Which :data:`ALPHA_DOT_TIED` the replay's fit uses (with ``ReplayOptions.alpha_dot_hat``): ``"off"`` (the default,
+#: Cm alone), ``"cz"`` or ``"all"``.
+ALPHA_DOT_TIE = "off"
 
 #: Opt-in (``GPConfig(**ALPHA_DOT_GP, **ALPHA_DOT_PARTNER_RULE)``): ``q_hat`` as alpha_dot_hat's partner, the term
 #: kept only where ``Cm_q < 0`` stays in the same fit and ``|Cm_alpha_dot| <= |Cm_q|``
@@ -448,7 +450,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     cfg = GPConfig(**{"noise_correlation": GP_NOISE_CORRELATION,
                                       "noise_posterior": GP_NOISE_POSTERIOR, "noise_start": GP_NOISE_START,
                                       **(ALPHA_DOT_GP if use_adot else {}),
-                                      **(ALPHA_DOT_TIED if use_adot and ALPHA_DOT_CZ else {}),
+                                      **(ALPHA_DOT_TIED.get(ALPHA_DOT_TIE, {}) if use_adot else {}),
                                       **(DECORRELATED_GP if USE_DECORRELATED_GP else {})},
                                    coupling_test=GP_COUPLING_TEST,
                                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))

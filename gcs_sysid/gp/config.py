@@ -235,7 +235,7 @@ class GPConfig:
             when the outputs have identical regressors (Zellner 1962, "An efficient method of estimating seemingly
             unrelated regressions", JASA 57, sec. 2); with ``alpha_dot_hat`` in Cm's mean alone, CZ's residual
             moved Cm's slopes (``docs/gp.md``, "Noise: learned, not conditioned on"). The pipeline's opt-in
-            :data:`gcs_sysid.pipeline.ALPHA_DOT_TIED`: ``("CZ", "Cm")`` led by ``"Cm"``.
+            :data:`gcs_sysid.pipeline.ALPHA_DOT_TIED`: ``("CZ", "Cm")`` or all six, led by ``"Cm"``.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.

@@ -138,7 +138,7 @@ def test_leader_gives_cz_cm_identical_mean_only_regressors():
     from gcs_sysid.gp.validation import gate_mean_only
     from gcs_sysid.pipeline import ALPHA_DOT_TIED
 
-    cfg = GPConfig(**{**ALPHA_DOT_GP, **ALPHA_DOT_TIED})
+    cfg = GPConfig(**{**ALPHA_DOT_GP, **ALPHA_DOT_TIED["cz"]})
     names = REGRESSORS + ("alpha_dot_hat",)
     cz = COEFFICIENTS.index("CZ")
     for cm_alpha_dot, kept in ((-9.0, True), (0.0, False)):
@@ -150,6 +150,9 @@ def test_leader_gives_cz_cm_identical_mean_only_regressors():
         _, allowed, info = mean_only_masks(cfg, names, COEFFICIENTS, Xs, Ys, np.ones(11, bool), X.std(0))
         assert allowed[:, -1].tolist() == [kept and c in ("CZ", "Cm") for c in COEFFICIENTS], info
         assert info["outputs"]["CZ"] == info["outputs"]["Cm"] == (["alpha_dot_hat"] if kept else [])
+        _, allowed, _ = mean_only_masks(GPConfig(**{**ALPHA_DOT_GP, **ALPHA_DOT_TIED["all"]}), names, COEFFICIENTS,
+                                        Xs, Ys, np.ones(11, bool), X.std(0))
+        assert allowed[:, -1].tolist() == [kept] * 6
     with pytest.raises(InputError, match="mean_only_leader"):
         GPConfig(**{**ALPHA_DOT_GP, "mean_only_leader": "CZ"})
 
