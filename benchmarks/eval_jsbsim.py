@@ -254,7 +254,6 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         row["gp_noise_correlation"] = _pipeline.GP_NOISE_CORRELATION
         row["gp_noise_posterior"] = _pipeline.GP_NOISE_POSTERIOR
         row["gp_noise_start"] = _pipeline.GP_NOISE_START
-        row["gp_adot_tie"] = _pipeline.ALPHA_DOT_TIE
     if model.discrepancy is not None and model.n_outputs == 6:
         # a diagnosis, not a criterion: the coefficient band with its coloured noise share floored at the
         # blocked validation's discrepancy d (as at exact conditions)
@@ -421,10 +420,6 @@ def main(argv=None) -> int:
                          "hyperparameters but only its diagonal in the posterior (GP_NOISE_POSTERIOR = 'diagonal'); "
                          "'full-nstart' full with the shared error started in the noise (GP_NOISE_START = 'noise'); "
                          "'diagonal' one variance per output (the default)")
-    ap.add_argument("--gp-adot-cz", default=None, choices=("on", "all", "off"),
-                    help="'on': alpha_dot_hat in CZ's linear mean too, wherever Cm's gates keep it; 'all': in all six "
-                         "outputs' (gcs_sysid.pipeline.ALPHA_DOT_TIE 'cz' | 'all': identical regressors, so a noise "
-                         "correlation does not move Cm's slopes); default: the package's, off")
     ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
                     help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
                          "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
@@ -494,10 +489,6 @@ def main(argv=None) -> int:
         pipeline.GP_NOISE_CORRELATION = a.gp_noise != "diagonal"
         pipeline.GP_NOISE_POSTERIOR = "diagonal" if a.gp_noise == "learned" else "full"
         pipeline.GP_NOISE_START = "noise" if a.gp_noise == "full-nstart" else "signal"
-    if a.gp_adot_cz is not None:
-        import gcs_sysid.pipeline as pipeline
-
-        pipeline.ALPHA_DOT_TIE = {"on": "cz", "all": "all", "off": "off"}[a.gp_adot_cz]
     if a.cy_rate_prior is not None:
         import gcs_sysid.pipeline as pipeline
 

@@ -98,19 +98,11 @@ class ReplayOptions:
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
-#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md).
+#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md). Never CZ's mean: from the force
+#: equations ``alpha_dot_hat = q_hat cos^2(alpha) + (c rho S / 4m) CZ cos(alpha) + gravity / V^2 terms`` carries the
+#: measured CZ, so CZ with ``q_hat`` and ``alpha_dot_hat`` fits that identity (sgs126 light s1: CZ_alpha_dot +37, CZ_q
+#: -37, 1/k = 38-40; twenty-fourth session, i8-noise3; docs/gp.md, "Identical regressors for Zellner's equivalence").
 ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("Cm",), "mean_only_sign": -1.0}
-
-#: Opt-in (twenty-fourth session, i8-noise3; ``eval_jsbsim --gp-adot-cz on | all``): ``alpha_dot_hat`` in more outputs'
-#: means, each taking Cm's decision (``GPConfig.mean_only_leader``): ``"cz"`` CZ and Cm, ``"all"`` all six. The outputs
-#: then have identical regressors there, so a learned noise correlation no longer moves Cm's slopes through another
-#: output's residual in the posterior mean (Zellner's SUR equivalence; docs/gp.md, "Noise: learned, not conditioned on").
-ALPHA_DOT_TIED = {"cz": {"mean_only_outputs": ("CZ", "Cm"), "mean_only_leader": "Cm"},
-                  "all": {"mean_only_outputs": COEFFICIENTS, "mean_only_leader": "Cm"}}
-
-#: Which :data:`ALPHA_DOT_TIED` the replay's fit uses (with ``ReplayOptions.alpha_dot_hat``): ``"off"`` (the default,
-#: Cm alone), ``"cz"`` or ``"all"``.
-ALPHA_DOT_TIE = "off"
 
 #: Opt-in (``GPConfig(**ALPHA_DOT_GP, **ALPHA_DOT_PARTNER_RULE)``): ``q_hat`` as alpha_dot_hat's partner, the term
 #: kept only where ``Cm_q < 0`` stays in the same fit and ``|Cm_alpha_dot| <= |Cm_q|``
@@ -450,7 +442,6 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     cfg = GPConfig(**{"noise_correlation": GP_NOISE_CORRELATION,
                                       "noise_posterior": GP_NOISE_POSTERIOR, "noise_start": GP_NOISE_START,
                                       **(ALPHA_DOT_GP if use_adot else {}),
-                                      **(ALPHA_DOT_TIED.get(ALPHA_DOT_TIE, {}) if use_adot else {}),
                                       **(DECORRELATED_GP if USE_DECORRELATED_GP else {})},
                                    coupling_test=GP_COUPLING_TEST,
                                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))

@@ -227,15 +227,6 @@ class GPConfig:
             not collinear with the regressors); ``docs/gp.md``, "The partner rule".
         mean_only_ratio: the largest ``|slope(input)| / |slope(partner)|`` (data units), see
             ``mean_only_partners``.
-        mean_only_leader: ``""`` (each of the ``mean_only_outputs`` gated on its own), or one of the
-            ``mean_only_outputs`` whose gates (the coloured-residual test, the sign, the partner rule and the blocked
-            validation) decide for all of them: every output in ``mean_only_outputs`` then carries a mean-only input
-            exactly where the leader does, so they have the same regressors there. Why: with a noise correlation
-            the posterior mean is a seemingly-unrelated-regressions GLS, which equals output-by-output fitting only
-            when the outputs have identical regressors (Zellner 1962, "An efficient method of estimating seemingly
-            unrelated regressions", JASA 57, sec. 2); with ``alpha_dot_hat`` in Cm's mean alone, CZ's residual
-            moved Cm's slopes (``docs/gp.md``, "Noise: learned, not conditioned on"). The pipeline's opt-in
-            :data:`gcs_sysid.pipeline.ALPHA_DOT_TIED`: ``("CZ", "Cm")`` or all six, led by ``"Cm"``.
         hyper_every: rows between automatic hyperparameter refreshes in ``update`` (learned
             again on the stored rows; :meth:`LocalGlobalGP.refresh_hyperparameters`); 0: only
             on request.
@@ -287,7 +278,6 @@ class GPConfig:
     mean_only_sign: float = 0.0
     mean_only_partners: tuple[str, ...] = ()
     mean_only_ratio: float = 1.0
-    mean_only_leader: str = ""
 
     def __post_init__(self):
         for name in ("mean_only_inputs", "mean_only_outputs", "mean_only_partners"):   # JSON gives lists: kept hashable
@@ -298,9 +288,6 @@ class GPConfig:
         if self.mean_only_partners and len(self.mean_only_partners) != len(self.mean_only_inputs):
             raise InputError("GPConfig.mean_only_partners must name one partner (or '') per mean-only input, got "
                              f"{self.mean_only_partners!r} for {self.mean_only_inputs!r}")
-        if self.mean_only_leader and self.mean_only_leader not in self.mean_only_outputs:
-            raise InputError(f"GPConfig.mean_only_leader must be one of mean_only_outputs {self.mean_only_outputs!r}, "
-                             f"got {self.mean_only_leader!r}")
         if not float(self.mean_only_ratio) > 0:
             raise InputError(f"GPConfig.mean_only_ratio must be > 0, got {self.mean_only_ratio!r}")
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:

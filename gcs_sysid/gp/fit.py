@@ -391,9 +391,8 @@ def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys
     info = {"inputs": [names[d] for d in only], "outputs": {}}
     partners = dict(zip([names[d] for d in only], cfg.mean_only_partners))
     scale = np.ones(D) if x_std is None else np.asarray(x_std, float)
-    leader = cfg.mean_only_leader if cfg.mean_only_leader in output_names else ""
     for p, name in enumerate(output_names):
-        if name not in cfg.mean_only_outputs or not cfg.linear_mean or (leader and name != leader):
+        if name not in cfg.mean_only_outputs or not cfg.linear_mean:
             continue
         keep = significant_inputs(Xs, Ys[:, [p]], active)[0]
         if (cfg.mean_only_sign or partners) and keep[only].any():   # the slopes in that least-squares fit
@@ -429,12 +428,6 @@ def mean_only_masks(cfg: GPConfig, input_names, output_names, Xs: np.ndarray, Ys
                     info.setdefault("partner", []).append(f"{name}:{names[d]}: {why}")
         allowed[p, only] = keep[only]
         info["outputs"][name] = [names[d] for d in only if keep[d]]
-    if leader and cfg.linear_mean:                  # GPConfig.mean_only_leader: the others follow the leader
-        lp = list(output_names).index(leader)
-        for p, name in enumerate(output_names):
-            if name in cfg.mean_only_outputs and name != leader:
-                allowed[p, only] = allowed[lp, only]
-                info["outputs"][name] = list(info["outputs"][leader])
     return kernel, allowed, info
 
 
@@ -965,7 +958,7 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     params = posterior_noise(params, cfg, history)
     if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
         params = _validated_terms(params, Xs, Ys, scaler.active, history)
-    params = _validated_mean_only(params, Xs, Ys, cfg, kernel, history, output_names)
+    params = _validated_mean_only(params, Xs, Ys, cfg, kernel, history)
     post = global_posterior(params, stats)
     history.timings["posterior"] = time.perf_counter() - t2
 
@@ -1031,24 +1024,17 @@ def _validated_terms(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, activ
 
 
 def _validated_mean_only(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cfg: GPConfig,
-                         kernel: np.ndarray | None, history: FitHistory, output_names=None) -> GlobalParams:
+                         kernel: np.ndarray | None, history: FitHistory) -> GlobalParams:
     """The mean-only inputs (``kernel`` False) kept in an output's mean only where they lower its blocked
     cross-validation error (:func:`gcs_sysid.gp.validation.gate_mean_only`); unchanged without mean-only inputs
-    or when the blocked validation does not run. Recorded in ``history.validation["mean_only"]``. With
-    ``GPConfig.mean_only_leader`` among ``output_names`` ``(P,)``, the other ``mean_only_outputs`` take the leader's
-    decision."""
+    or when the blocked validation does not run. Recorded in ``history.validation["mean_only"]``."""
     from .validation import gate_mean_only
 
     if kernel is None or np.all(kernel) or not _validating(cfg, len(Xs)):
         return params
     t0 = time.perf_counter()
-    names = list(output_names or ())
-    tie = None
-    if cfg.mean_only_leader and cfg.mean_only_leader in names:
-        tie = (names.index(cfg.mean_only_leader),
-               [p for p, n in enumerate(names) if n in cfg.mean_only_outputs and n != cfg.mean_only_leader])
     params, keep, ratio = gate_mean_only(params, Xs, Ys, np.flatnonzero(~np.asarray(kernel, bool)),
-                                         int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max, cfg.seed, tie=tie)
+                                         int(cfg.validation_folds), cfg.batch_size, cfg.n_train_max, cfg.seed)
     history.timings["validation_mean_only"] = time.perf_counter() - t0
     info = history.validation.setdefault("mean_only", {})
     info["blocked_ratio"] = [None if not np.isfinite(r) else float(r) for r in ratio]

@@ -415,7 +415,7 @@ class LocalGlobalGP:
         params = posterior_noise(params, cfg, history)
         if cfg.linear_terms == "validated" and cfg.linear_mean and "latent_scale" in history.validation:
             params = _validated_terms(params, rows.X, rows.Y, self.scaler.active, history)
-        params = _validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history, self.output_names)
+        params = _validated_mean_only(params, rows.X, rows.Y, cfg, kernel, history)
         evicted = None
         if self.evicted is not None:
             R = _projection_all(self.params, Z_new, np.asarray(new.lengthscales))

@@ -157,8 +157,7 @@ def gate_global(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: int
 
 
 def gate_mean_only(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cols, folds: int, batch: int,
-                   val_max: int = 1000, seed: int = 0, tie: tuple | None = None
-                   ) -> tuple[GlobalParams, np.ndarray, np.ndarray]:
+                   val_max: int = 1000, seed: int = 0) -> tuple[GlobalParams, np.ndarray, np.ndarray]:
     """Keep the mean-only inputs ``cols`` (``GPConfig.mean_only_inputs``) in an output's linear mean only where
     they lower its blocked cross-validation error (``docs/gp.md``, "Mean-only inputs").
 
@@ -176,8 +175,6 @@ def gate_mean_only(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cols, f
         Xs: ``(N, D)``, Ys: ``(N, P)`` standardised training rows in time order.
         cols: indices ``d`` (into ``D``) of the mean-only inputs.
         folds, batch, val_max, seed: as :func:`gate_global`.
-        tie: None, or ``(leader, followers)``: output indices; the followers take the leader's decision
-            (``GPConfig.mean_only_leader``: identical regressors in their means).
 
     Returns:
         ``(params, keep (P,) bool, ratio (P,))``: ``prior_std`` with those weights at 0 for the outputs where the
@@ -212,9 +209,6 @@ def gate_mean_only(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, cols, f
         sse0 += np.nansum((Ys[rows] - U @ np.asarray(_mean_weights(without, rest))) ** 2, 0)
     ratio[carry] = sse1[carry] / np.maximum(sse0[carry], 1e-300)
     keep[carry] = sse1[carry] < sse0[carry]
-    if tie is not None:
-        lead, follow = int(tie[0]), list(tie[1])
-        keep[follow] = keep[lead] | ~carry[follow]
     S[~keep] = S0[~keep]
     return replace(params, prior_std=jax.device_put(S)), keep, ratio
 
