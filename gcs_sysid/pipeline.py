@@ -139,7 +139,8 @@ GP_NOISE_CORRELATION = False
 #: i8-noise2; ``eval_jsbsim --gp-noise learned``). Opt-in: on 87 roster flights it removes full's Cm side effect
 #: (sgs126 light s1, f16 light s2) and keeps its correlations (29 -> 7 above 0.5; GP<LS 469 -> 475), but a count is
 #: lost on 4 aircraft against the default, 3 of them at the 98 % band edge (docs/benchmarks.md, "Twenty-third session,
-#: i8-noise2").
+#: i8-noise2"). Twenty-fourth session (i8-noise3, 93 flights with the ka350): 9 aircraft win, 6 lose a count (iar80
+#: and t6 by a new correlation where JSBSim's own is 0.5-0.67); the default merely reseeded loses one on 12.
 GP_NOISE_POSTERIOR = "full"
 
 #: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or ``"noise"``
