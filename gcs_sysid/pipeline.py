@@ -104,7 +104,10 @@ class ReplayOptions:
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
-#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md).
+#: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md). Never CZ's mean: from the force
+#: equations ``alpha_dot_hat = q_hat cos^2(alpha) + (c rho S / 4m) CZ cos(alpha) + gravity / V^2 terms`` carries the
+#: measured CZ, so CZ with ``q_hat`` and ``alpha_dot_hat`` fits that identity (sgs126 light s1: CZ_alpha_dot +37, CZ_q
+#: -37, 1/k = 38-40; twenty-fourth session, i8-noise3; docs/gp.md, "Identical regressors for Zellner's equivalence").
 ALPHA_DOT_GP = {"mean_only_inputs": ("alpha_dot_hat",), "mean_only_outputs": ("Cm",), "mean_only_sign": -1.0}
 
 #: Opt-in (``GPConfig(**ALPHA_DOT_GP, **ALPHA_DOT_PARTNER_RULE)``): ``q_hat`` as alpha_dot_hat's partner, the term
@@ -142,7 +145,8 @@ GP_NOISE_CORRELATION = False
 #: i8-noise2; ``eval_jsbsim --gp-noise learned``). Opt-in: on 87 roster flights it removes full's Cm side effect
 #: (sgs126 light s1, f16 light s2) and keeps its correlations (29 -> 7 above 0.5; GP<LS 469 -> 475), but a count is
 #: lost on 4 aircraft against the default, 3 of them at the 98 % band edge (docs/benchmarks.md, "Twenty-third session,
-#: i8-noise2").
+#: i8-noise2"). Twenty-fourth session (i8-noise3, 93 flights with the ka350): 9 aircraft win, 6 lose a count (iar80
+#: and t6 by a new correlation where JSBSim's own is 0.5-0.67); the default merely reseeded loses one on 12.
 GP_NOISE_POSTERIOR = "full"
 
 #: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or ``"noise"``
