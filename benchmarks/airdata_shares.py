@@ -112,8 +112,11 @@ def _truth_slopes(Xi: np.ndarray, y: np.ndarray, cols: tuple[str, ...], ctr: flo
     return np.linalg.lstsq(_highpass(A[m], dt, edge), _highpass(y[m][:, None], dt, edge)[:, 0], rcond=None)[0]
 
 
-def shares(tlog: Path, aircraft: str, arp: tuple[float, float] | None = None) -> list[str]:
-    """The lines of one flight (see the module docstring)."""
+def shares(tlog: Path, aircraft: str, arp: tuple[float, float] | None = None,
+           stated: tuple[float, float | None] | None = None) -> list[str]:
+    """The lines of one flight (see the module docstring); ``stated``: ``(CL_alpha, CL_q)`` adds the line ``stated``,
+    the aiding with that stated lift-slope floor (:func:`gcs_sysid.estimation.airangles.aided_air_angles`
+    ``stated_slopes``; its passes fit as the pipeline's, nothing swapped)."""
     import gcs_sysid.estimation.airangles as aa
     from benchmarks.alpha_budget import captured_aiding
     from benchmarks.jsbsim_harness.truth import load_truth
@@ -159,6 +162,9 @@ def shares(tlog: Path, aircraft: str, arp: tuple[float, float] | None = None) ->
             g = aa.AxisFit("alpha", True, "", fa.columns, np.r_[0.0, c], np.zeros(len(fa.columns)))
             r = r0 if name == "main" else aa.aided_air_angles(*args, **dict(kw, models={"alpha": g}))
             out.append(fmt(name, r, c, "alpha"))
+        if stated is not None:
+            r = aa.aided_air_angles(*args, **dict(kw, stated_slopes=tuple(stated)))
+            out.append(fmt("stated", r, r.axes[0].coef[1:], "alpha"))
     if fb.used and len(fb.columns) > 2:
         cols = tuple(fb.columns[1:])
         ct = _truth_slopes(Xi, Y[:, 1], cols, 0.0, m, dt, fb.band_hz or aa.HIGHPASS_HZ)
@@ -187,9 +193,12 @@ def main(argv: list[str] | None = None) -> int:
     ap = work_parser(__doc__.splitlines()[0])
     ap.add_argument("--arp", nargs=2, type=float, default=None, metavar=("AHEAD_M", "ABOVE_M"),
                     help="the aerodynamic reference point's offset from the CG, m (s23: 0.584 1.067)")
+    ap.add_argument("--stated", nargs="+", type=float, default=None, metavar="CL",
+                    help="CL_alpha (1/rad) [CL_q (per q_hat)]: add the aiding with this stated lift-slope floor")
     a = ap.parse_args(argv)
+    st = None if a.stated is None else (a.stated[0], a.stated[1] if len(a.stated) > 1 else None)
     for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
-        print("\n".join(shares(tlog, ac, a.arp)), flush=True)
+        print("\n".join(shares(tlog, ac, a.arp, st)), flush=True)
     return 0
 
 

@@ -181,6 +181,26 @@ def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
     return {ax: f"velocities/{ax}-aero-rad_sec" in xml for ax in "pqr"}
 
 
+#: ``--stated-lift-slope``: ``{aircraft: (CL_alpha, CL_q)}`` written into a copy of the airframe file that the replay and
+#: the least-squares fit read (:func:`stated_airframe`); empty: the harness's airframe file as it is
+STATED_AERO: dict[str, tuple[float, float | None]] = {}
+
+
+def stated_airframe(path: Path, work: Path, stem: str) -> Path:
+    """The airframe file the replay reads: ``path`` itself, or with ``--stated-lift-slope`` a copy
+    ``work/<stem>-airframe-stated.toml`` with ``[aero] CL_alpha`` (and ``CL_q``) appended (the flight's fingerprint
+    reads the harness's own file, so the flights are reused; ``docs/estimation.md``, "The lift-slope floor as a fixed
+    point")."""
+    name = Path(path).stem.removeprefix("jsbsim-")
+    if name not in STATED_AERO:
+        return path
+    cla, clq = STATED_AERO[name]
+    out = Path(work) / f"{stem}-airframe-stated.toml"
+    out.write_text(Path(path).read_text() + f"\n[aero]\nCL_alpha = {cla!r}\n"
+                   + (f"CL_q = {clq!r}\n" if clq is not None else ""))
+    return out
+
+
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None, gust_filter: bool | str | None = None,
              heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = ()) -> dict:
@@ -203,7 +223,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
-    res = run_replay(files.tlog, files.airframe, out, ReplayOptions(progress=False, gust_rates=gust_rates,
+    res = run_replay(files.tlog, stated_airframe(files.airframe, work, files.tlog.stem), out, ReplayOptions(progress=False, gust_rates=gust_rates,
                                                                           gust_filter=gust_filter,
                                                                           heldout_air_roll=heldout_air_roll))
     t_replay = time.perf_counter() - t0 - t_fly
@@ -294,7 +314,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
         row["band_terms"] = band_terms(model, Xg[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
     t_cut = float(tab.t[h][0])
-    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
+    ls_model, _ = run_fit(files.tlog, stated_airframe(files.airframe, work, files.tlog.stem), work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     row["alpha_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 0] - Xt[ok, 0]) ** 2))))
@@ -517,7 +537,18 @@ def main(argv=None) -> int:
     ap.add_argument("--alpha-profile", nargs="*", default=None, metavar="COLUMN",
                     help="the alpha aiding's columns whose slopes the gust model's likelihood chooses (gcs_sysid."
                          "estimation.airangles.ALPHA_PROFILE_COLUMNS, e.g. delta_e; default: the package's, none)")
+    ap.add_argument("--stated-lift-slope", nargs="+", default=None, metavar="AC:CL_ALPHA[:CL_Q]",
+                    help="give the aiding a stated whole-aircraft lift slope (1/rad) and pitch-rate lift (per q_hat) "
+                         "per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero] table; gcs_sysid.estimation.airangles."
+                         "STATED_LIFT_SLOPE on; default: off, the wing's floor)")
     a = ap.parse_args(argv)
+    if a.stated_lift_slope is not None:
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.STATED_LIFT_SLOPE = True
+        for item in a.stated_lift_slope:
+            ac_, *vals = item.split(":")
+            STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
     if a.alpha_profile is not None:
         from gcs_sysid.estimation import airangles as _aa
 

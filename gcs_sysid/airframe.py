@@ -201,6 +201,11 @@ class Airframe:
             lagged estimate from velocity and wind; the default, ArduPilot's AHRS) or ``"vane"``
             (measured by vanes at the CG; the estimator then uses them as alpha and beta).
             ``[air_data] angles`` in the file.
+        CL_alpha: the whole aircraft's stated lift-curve slope (wing, tail and body), 1/rad, > 0, or None
+            (``[aero] CL_alpha``: a wind-tunnel or DATCOM number). CL_q: its stated lift per unit
+            ``q_hat = q c / (2 V)`` (``[aero] CL_q``; the tail's, ``2 a_t V_H eta`` in Etkin 1972 sec. 5.5), or
+            None. Used only with the opt-in :data:`gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE` (the aided
+            alpha's lift-slope floor; ``docs/estimation.md``, "The lift-slope floor as a fixed point").
     """
 
     name: str
@@ -221,6 +226,8 @@ class Airframe:
     limits: Limits | None = None
     air_angles: str = "estimate"
     can_actuators: tuple["CanActuator", ...] = ()
+    CL_alpha: float | None = None
+    CL_q: float | None = None
 
     @property
     def authority(self) -> dict[str, float]:
@@ -322,7 +329,7 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     """
     src = source
     known = {"name", "mass", "inertia", "geometry", "servo", "throttle", "thrust", "imu_lever_arm", "notes",
-             "limits", "air_data", "can_actuator"}
+             "limits", "air_data", "can_actuator", "aero"}
     for k in doc:
         if k not in known:
             raise InputError(f"{src}: unknown top-level field '{k}' (expected one of {sorted(known)})")
@@ -431,8 +438,18 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     if angles not in ("estimate", "vane"):
         raise InputError(f"{src}: [air_data] angles must be \"estimate\" (autopilot's AOA_SSA estimate) or "
                          f"\"vane\" (AOA_SSA/AOA carry vane measurements), got {angles!r}")
+    aero = doc.get("aero", {})
+    if not isinstance(aero, Mapping) or set(aero) - {"CL_alpha", "CL_q"}:
+        raise InputError(f"{src}: [aero] must be a table with only 'CL_alpha' (1/rad) and 'CL_q' (per q_hat)")
+    if "CL_q" in aero and "CL_alpha" not in aero:
+        raise InputError(f"{src}: [aero] CL_q is used only with CL_alpha (the stated lift-slope floor)")
+    cla = _req(aero, "CL_alpha", "[aero]", src, positive=True) if "CL_alpha" in aero else None
+    clq = _req(aero, "CL_q", "[aero]", src) if "CL_q" in aero else None
+    if clq is not None and clq < 0:
+        raise InputError(f"{src}: [aero] field 'CL_q' must be >= 0 (a tail's lift grows with the pitch rate), "
+                         f"got {clq!r}")
     af = Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
-                  tuple(float(x) for x in arm), source, notes, air_angles=angles)
+                  tuple(float(x) for x in arm), source, notes, air_angles=angles, CL_alpha=cla, CL_q=clq)
     if "limits" in doc:
         af = replace(af, limits=_limits(doc["limits"], af, src))
     if "can_actuator" in doc:
@@ -520,6 +537,8 @@ def airframe_to_dict(a: Airframe) -> dict[str, Any]:
         d["limits"] = a.limits.to_dict()
     if a.air_angles != "estimate":
         d["air_data"] = {"angles": a.air_angles}
+    if a.CL_alpha is not None:
+        d["aero"] = {"CL_alpha": a.CL_alpha} | ({"CL_q": a.CL_q} if a.CL_q is not None else {})
     if a.can_actuators:
         d["can_actuator"] = [{"id": c.actuator_id, "servo": c.servo, "sign": c.sign, "scale": c.scale,
                               "zero_deg": math.degrees(c.zero)} for c in a.can_actuators]

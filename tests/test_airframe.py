@@ -94,3 +94,31 @@ def test_load_errors(tmp_path):
     p.write_text("name = [unclosed\n")
     with pytest.raises(InputError, match="not valid TOML"):
         load_airframe(p)
+
+
+def test_stated_lift_derivatives(monkeypatch):
+    """``[aero] CL_alpha``, ``CL_q`` (the aided alpha's stated lift-slope floor) are read, written back, checked, and
+    reach the aiding only with the opt-in ``STATED_LIFT_SLOPE``."""
+    import gcs_sysid.estimation.airangles as aa
+    import gcs_sysid.estimation.estimate as est
+
+    d = _doc()
+    assert airframe_from_dict(d).CL_alpha is None and "aero" not in airframe_to_dict(airframe_from_dict(d))
+    d["aero"] = {"CL_alpha": 5.5, "CL_q": 7.1}
+    a = airframe_from_dict(d)
+    assert (a.CL_alpha, a.CL_q) == (5.5, 7.1)
+    assert airframe_from_dict(airframe_to_dict(a)) == a
+    for bad, frag in (({"CL_alpha": -5.5}, "CL_alpha"), ({"CL_q": 7.0}, "only with CL_alpha"),
+                      ({"CL_alpha": 5.5, "CL_q": -1.0}, "CL_q"), ({"CL_alpha": 5.5, "Cm_q": 1.0}, "[aero]")):
+        d["aero"] = bad
+        with pytest.raises(InputError, match=frag.replace("[", r"\[")):
+            airframe_from_dict(d)
+    seen = []
+    monkeypatch.setattr(est, "aided_air_angles", lambda *x, **k: seen.append(k["stated_slopes"]) or 1 / 0)
+    for on in (False, True):
+        monkeypatch.setattr(aa, "STATED_LIFT_SLOPE", on)
+        with pytest.raises(ZeroDivisionError):
+            z = np.zeros(1)
+            est._aid_angles(0.02, z, z, z + 1.0, 1.2, np.zeros((1, 3)), 0.0, np.zeros((1, 3)),
+                            {"delta_e": 0, "delta_a": 0, "delta_r": 0}, a, np.ones(1, bool), None, None, {}, {}, [])
+    assert seen == [None, (5.5, 7.1)]

@@ -145,6 +145,15 @@ SLOPE_FLOOR = True
 #: or with beta not aided, the fitted slope and the identification check stand as before
 FLOOR_MIN_GUST_SHARE = 0.1
 FLOOR_DROPS = ("q_hat",)   #: columns left out of the first pass when the slope floor holds
+#: Opt-in (default False; twenty-fourth session, lift-floor): the pipeline (:mod:`.estimate`) gives the aiding the
+#: airframe's *stated* whole-aircraft lift derivatives (``[aero] CL_alpha``, ``CL_q`` in the airframe file:
+#: :class:`gcs_sysid.airframe.Airframe`; a wind-tunnel or DATCOM number), :func:`aided_air_angles` ``stated_slopes``.
+#: The floor is then ``CL_alpha`` instead of the wing's Helmbold slope, and where it holds ``q_hat`` is held at
+#: ``-CL_q`` instead of left out. The later passes refit on the angle the floored pass made, so whatever the first
+#: pass holds is where they end (a fixed point: ``docs/estimation.md``, "The lift-slope floor as a fixed point"):
+#: the wing-only floor leaves the whole aircraft's lift slope (the tail's ~10 %) and ``CZ_q`` out (s23: alpha read
+#: 12-13 % too wide). An airframe file without ``[aero]`` changes nothing.
+STATED_LIFT_SLOPE = False
 #: Opt-in (default False; eighteenth session, i8-alpha): keep the aided alpha's flight mean at the kinematic alpha's
 #: (the gust state's mean over the aided rows is removed after every pass). The flight-mean vertical wind is not
 #: observable (it goes into CZ0), so the aiding has no information on alpha's mean; but its force-derived angle,
@@ -468,14 +477,15 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
     return out, sig, tau, float(np.sqrt(ratio * s2)), float(np.sqrt(s2))
 
 
-def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int]
+def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int], held: dict[int, float] | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Least squares ``y ~ A c`` with ``c[0]`` held at ``a1`` and only the columns ``keep`` (indices into ``A``,
-    not 0) refitted; the others are 0.
+    """Least squares ``y ~ A c`` with ``c[0]`` held at ``a1``, the columns ``held`` (index -> slope) held at their
+    slopes, and only the columns ``keep`` (indices into ``A``, not 0) refitted; the others are 0.
 
     Args:
         A: (N, P) band-passed regressors, the angle first. y: (N,) band-passed coefficient.
-        a1: the held slope of column 0. keep: the columns fitted.
+        a1: the held slope of column 0. keep: the columns fitted. held: other held columns (None: none); a column
+        both held and in ``keep`` is held.
 
     Returns:
         ``(c (P,), standard errors (P,) (NaN for the held and dropped ones), residuals (N,), covariance (P, P))``.
@@ -483,8 +493,11 @@ def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int]
     P = A.shape[1]
     c, se, cov = np.zeros(P), np.full(P, np.nan), np.zeros((P, P))
     c[0] = a1
+    for j, v in (held or {}).items():
+        c[j] = v
+    keep = [j for j in keep if j not in (held or {})]
     if keep:
-        co, so, _, cv = _lstsq(A[:, keep], y - a1 * A[:, 0])
+        co, so, _, cv = _lstsq(A[:, keep], y - A @ c)
         c[keep], se[keep] = co, so
         cov[np.ix_(keep, keep)] = cv
     return c, se, y - A @ c, cov
@@ -560,7 +573,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
           V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
-          slope_floor: float | None = None, endog: tuple[str, ...] = (),
+          slope_floor: float | None = None, floor_held: dict[str, float] | None = None, endog: tuple[str, ...] = (),
           min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None
           ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
@@ -578,6 +591,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     :data:`HIGHPASS_HZ`; ``slope_floor``: the least magnitude of the angle's slope in the first pass, 1/rad (alpha: the
     wing's lift slope, :data:`SLOPE_FLOOR`): a flatter or unidentified fitted slope is held there, the other columns
     refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor;
+    ``floor_held``: columns held at a stated slope where the floor holds (``{"q_hat": -CL_q}``, :data:`STATED_LIFT_SLOPE`)
+    instead of refitted or left out (its presence also marks the floor as a stated one in the note);
     ``endog``: the other columns instrumented with the angle (beta: ``p_hat``, ``r_hat``, which answer the gust,
     :data:`INSTRUMENTED_BETA`); ``min_first_stage``: the instruments' least first-stage partial R^2, below which the
     slopes fall back to ordinary least squares; ``weak_test``: ``"f"`` tests the instruments by their first-stage F
@@ -660,7 +675,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                     # then explain badly (JSBSim t6 light s2: first-stage R2 0.12, then 0.07; CY_beta -1.10 against
                     # JSBSim's -1.47 and least squares' -1.46)
                     a_ls, s_ls, refit = _axis(name, dt, kin0, coeff, others, use, passes, sign, quadratic, symmetric,
-                                              moments, None, V, given, band_hz, slope_floor)
+                                              moments, None, V, given, band_hz, slope_floor, floor_held)
                     ols = refit.slope_method
                     refit.slope_method = (f"{ols}; instruments too weak in pass {ipass + 1} ({why}): least squares "
                                           f"in every pass")
@@ -678,11 +693,15 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             free, floored = float(cr[0]), True
             keep = [j for j in range(1, A.shape[1]) if (j < nq and not FLOOR_DROPS_CURVATURE)
                     or (j >= nq and cols[j - nq] not in FLOOR_DROPS)]
-            cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep)
+            hold = {nq + cols.index(k): float(v) for k, v in (floor_held or {}).items() if k in cols}
+            keep = [j for j in keep if j not in hold]
+            cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep, hold)
             dropped = (([names[2]] if quadratic and FLOOR_DROPS_CURVATURE else [])
-                       + [k for k in cols if k in FLOOR_DROPS])
-            floor_note = (f"first pass with CZ_alpha held at the wing's lift slope {sign * abs(slope_floor):+.2f} "
+                       + [k for k in cols if k in FLOOR_DROPS and nq + cols.index(k) not in hold])
+            whose = "the stated lift slope" if floor_held is not None else "the wing's lift slope"
+            floor_note = (f"first pass with CZ_alpha held at {whose} {sign * abs(slope_floor):+.2f} "
                           f"(fitted {free:+.2f}: attenuated by the kinematic angle's gust error)"
+                          + "".join(f", {names[j + 1]} held at the stated {v:+.2f}" for j, v in hold.items())
                           + (f" and {', '.join(dropped)} left out" if dropped else ""))
         prof = ([names.index(k) - 1 for k in ALPHA_PROFILE_COLUMNS if k in names[2:]]
                 if name == "alpha" and fixed is None and not method.startswith("2SLS") else [])
@@ -891,7 +910,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      S: float, b: float, c: float, use: np.ndarray, passes: int = 2,
                      rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None,
                      instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None,
-                     instrument_beta: bool | None = None, beta_band_hz: float | None = None) -> AidedAngles:
+                     instrument_beta: bool | None = None, beta_band_hz: float | None = None,
+                     stated_slopes: tuple[float | None, float | None] | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -931,6 +951,11 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             raising it to the directional (weathercock) corner does not remove the gust's side force from
             ``CY_r_hat`` and worsens the aided sideslip (``docs/estimation.md``, "The sideslip's band and the
             directional mode").
+        stated_slopes: ``(CL_alpha, CL_q)``, the airframe's stated whole-aircraft lift-curve slope, 1/rad, and lift
+            per unit ``q_hat = q c / (2 V)`` (either None: not stated; magnitudes are used): the floor of the first
+            pass is ``CL_alpha`` instead of the wing's Helmbold slope, and where it holds ``q_hat`` is held at
+            ``-CL_q`` instead of left out (:data:`STATED_LIFT_SLOPE`; the witness :data:`FLOOR_MIN_GUST_SHARE` still
+            decides whether the floor holds). None: the wing's floor.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -980,6 +1005,14 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     hg = float(np.nanmedian(hg[u])) if np.isfinite(hg[u]).any() else float("nan")
     floor = lift_slope(b * b / S)          # the wing's lift slope, 1/rad (NaN: no span or area)
     edge = heave_edge_hz(floor, hg)
+    cla, clq = stated_slopes if stated_slopes is not None else (None, None)
+    floor_held = None
+    if cla is not None and np.isfinite(cla) and cla != 0:
+        # the whole aircraft's lift slope (wing, tail and body) as stated for this airframe: the floor's value, and
+        # with it (and only then) the stated pitch-rate lift that the wing-only floor had to leave out
+        floor, floor_held = abs(float(cla)), {}
+        if clq is not None and np.isfinite(clq):
+            floor_held["q_hat"] = -abs(float(clq))
     inst_b = None
     on_b = INSTRUMENTED_BETA if instrument_beta is None else instrument_beta
     min_fs_b, given_b, est_note = BETA_MIN_FIRST_STAGE_R2, (models or {}).get("beta"), ""
@@ -1006,8 +1039,9 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
-                         (models or {}).get("alpha"), band_hz=edge, slope_floor=floor if held else None)
-    if "held at the wing's lift slope" in fa.slope_method:
+                         (models or {}).get("alpha"), band_hz=edge, slope_floor=floor if held else None,
+                         floor_held=floor_held)
+    if "first pass with CZ_alpha held at" in fa.slope_method:
         fa.slope_method += f" (lateral gust witness: {100 * share:.0f} % of the kinematic alpha's in-band variance)"
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "

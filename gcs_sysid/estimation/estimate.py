@@ -18,6 +18,7 @@ from ..airframe import Airframe
 from ..errors import DataError
 from ..parallel import Helper
 from ..telemetry.types import Flight
+from . import airangles
 from .airangles import aided_air_angles, describe
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
@@ -91,7 +92,9 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
     ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
     Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
                           airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia,
-                          models=models)
+                          models=models, stated_slopes=((getattr(airframe, "CL_alpha", None),
+                                                         getattr(airframe, "CL_q", None))
+                                                        if airangles.STATED_LIFT_SLOPE else None))
     notes.extend(describe(Ai))
     if fits is not None:
         fits.update({ax.name: ax for ax in Ai.axes})
