@@ -103,8 +103,20 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
         # files written before the fingerprint was recorded (2026-11-22) carry none and are reused as before
         if doc["config"]["duration_s"] == config.duration_s and doc["config"].get("plan", "standard") == config.plan \
                 and doc.get("harness", harness_fingerprint(config.aircraft)) == harness_fingerprint(config.aircraft):
-            return FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None)
-    return make_effect_flight(config, effects, out, stem=stem)
+            return _stated(FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None),
+                           out, stem)
+    return _stated(make_effect_flight(config, effects, out, stem=stem), out, stem)
+
+
+def _stated(files, out: Path, stem: str):
+    """``files`` with the airframe the pipeline reads replaced by its copy with ``[aero]`` where
+    ``--stated-lift-slope`` names the aircraft (:func:`benchmarks.eval_jsbsim.stated_airframe`)."""
+    from dataclasses import replace
+
+    from benchmarks.eval_jsbsim import stated_airframe
+
+    path = stated_airframe(files.airframe, out, stem)
+    return files if path == files.airframe else replace(files, airframe=path)
 
 
 def _fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, plan: str = PLAN) -> int:
@@ -616,7 +628,18 @@ def main(argv=None) -> int:
                         "alpha_level; default off): the reference flight's, or pooled with --level-seeds")
     p.add_argument("--level-seeds", nargs="*", type=int, default=[101, 102, 103, 104],
                    help="seeds of the clean level flights pooled with the reference (--alpha-level pooled)")
+    p.add_argument("--stated-lift-slope", nargs="+", default=None, metavar="AC:CL_ALPHA[:CL_Q]",
+                   help="the aiding's stated lift-slope floor per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero]; "
+                        "gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE on; as eval_jsbsim's option; default off)")
     a = p.parse_args(argv)
+    if a.stated_lift_slope is not None:
+        from benchmarks.eval_jsbsim import STATED_AERO
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.STATED_LIFT_SLOPE = True
+        for item in a.stated_lift_slope:
+            ac_, *vals = item.split(":")
+            STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
     if a.alpha_level is not None:
         from gcs_sysid.diagnose import run as _dr
 
