@@ -68,3 +68,21 @@ def test_curvature_read_falls_as_one_over_k_squared():
     m = np.ones(T, bool)
     assert ads.curvature_read(X[:, 0], X, Cm, m) == pytest.approx(-8.0, abs=1e-6)
     assert ads.curvature_read(1.12 * X[:, 0], X, Cm, m) == pytest.approx(-8.0 / 1.12**2, abs=1e-6)
+
+
+def test_stated_airframe_copy_for_the_named_aircraft_only(tmp_path, monkeypatch):
+    """``eval_jsbsim --stated-lift-slope``: the replay reads a copy of the airframe file with ``[aero]`` appended for
+    the aircraft named, the harness's own file (the fingerprint's) otherwise."""
+    from benchmarks import eval_jsbsim as ej
+    from benchmarks.jsbsim_harness.aircraft import aircraft
+    from gcs_sysid.airframe import load_airframe
+
+    path = aircraft("s23").airframe_path
+    monkeypatch.setattr(ej, "STATED_AERO", {"s23": (5.5, 7.1)})
+    out = ej.stated_airframe(path, tmp_path, "s23-light-s1-ahrs")
+    assert out == tmp_path / "s23-light-s1-ahrs-airframe-stated.toml"
+    a, b = load_airframe(out), load_airframe(path)
+    assert (a.CL_alpha, a.CL_q) == (5.5, 7.1) and b.CL_alpha is None and (a.S, a.b, a.mass) == (b.S, b.b, b.mass)
+    assert ej.stated_airframe(aircraft("t6").airframe_path, tmp_path, "t6") == aircraft("t6").airframe_path
+    monkeypatch.setattr(ej, "STATED_AERO", {"s23": (5.5, None)})
+    assert load_airframe(ej.stated_airframe(path, tmp_path, "x")).CL_q is None
