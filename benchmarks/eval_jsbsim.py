@@ -181,8 +181,8 @@ def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
     return {ax: f"velocities/{ax}-aero-rad_sec" in xml for ax in "pqr"}
 
 
-#: ``--stated-lift-slope``: ``{aircraft: (CL_alpha, CL_q)}`` written into a copy of the airframe file that the replay and
-#: the least-squares fit read (:func:`stated_airframe`); empty: the harness's airframe file as it is
+#: ``--stated-lift-slope``: ``{aircraft: (CL_alpha, CL_q)}`` written into a copy of the airframe file that the replay
+#: and the least-squares fit read (:func:`stated_airframe`); empty: the harness's airframe file as it is
 STATED_AERO: dict[str, tuple[float, float | None]] = {}
 
 
@@ -223,7 +223,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     t_fly = time.perf_counter() - t0
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
-    res = run_replay(files.tlog, stated_airframe(files.airframe, work, files.tlog.stem), out, ReplayOptions(progress=False, gust_rates=gust_rates,
+    af_path = stated_airframe(files.airframe, work, files.tlog.stem)     # files.airframe unless --stated-lift-slope
+    res = run_replay(files.tlog, af_path, out, ReplayOptions(progress=False, gust_rates=gust_rates,
                                                                           gust_filter=gust_filter,
                                                                           heldout_air_roll=heldout_air_roll))
     t_replay = time.perf_counter() - t0 - t_fly
@@ -314,7 +315,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
         row["band_terms"] = band_terms(model, Xg[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
     t_cut = float(tab.t[h][0])
-    ls_model, _ = run_fit(files.tlog, stated_airframe(files.airframe, work, files.tlog.stem), work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
+    ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     row["alpha_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 0] - Xt[ok, 0]) ** 2))))

@@ -591,8 +591,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     :data:`HIGHPASS_HZ`; ``slope_floor``: the least magnitude of the angle's slope in the first pass, 1/rad (alpha: the
     wing's lift slope, :data:`SLOPE_FLOOR`): a flatter or unidentified fitted slope is held there, the other columns
     refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor;
-    ``floor_held``: columns held at a stated slope where the floor holds (``{"q_hat": -CL_q}``, :data:`STATED_LIFT_SLOPE`)
-    instead of refitted or left out (its presence also marks the floor as a stated one in the note);
+    ``floor_held``: columns held at a stated slope where the floor holds (``{"q_hat": -CL_q}``,
+    :data:`STATED_LIFT_SLOPE`) instead of refitted or left out (its presence also marks the floor as a stated one in the note);
     ``endog``: the other columns instrumented with the angle (beta: ``p_hat``, ``r_hat``, which answer the gust,
     :data:`INSTRUMENTED_BETA`); ``min_first_stage``: the instruments' least first-stage partial R^2, below which the
     slopes fall back to ordinary least squares; ``weak_test``: ``"f"`` tests the instruments by their first-stage F
