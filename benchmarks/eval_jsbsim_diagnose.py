@@ -113,8 +113,10 @@ def _stated(files, out: Path, stem: str):
     ``--stated-lift-slope`` names the aircraft (:func:`benchmarks.eval_jsbsim.stated_airframe`)."""
     from dataclasses import replace
 
-    from benchmarks.eval_jsbsim import stated_airframe
+    from benchmarks.eval_jsbsim import STATED_AERO, stated_airframe
 
+    if not STATED_AERO:         # the option not given: the flight's files exactly as before
+        return files
     path = stated_airframe(files.airframe, out, stem)
     return files if path == files.airframe else replace(files, airframe=path)
 
