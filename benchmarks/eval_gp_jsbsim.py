@@ -92,11 +92,11 @@ Usage::
 ``pa28``, ``j3cub`` (``J3Cub``), ``c182``, ``t37``, ``t6`` (``t6texan2``), ``b747`` (``B747``), ``f16``
 (``f16_direct``), ``f4n`` (``F4N_fcs``), ``rascal`` (``Rascal110_glide``), ``sgs126``, ``asw20`` (``asw20_glide``) and
 ``iar80`` (``IAR80_glide``), ``c684`` (``C684_glide``), ``ultrastick`` (``UltraStick120_glide``), ``b737`` (``737``) and
-``c172p``, ``eternity`` (``Eternity_glide``), ``us25e`` (``UltraStick25e_glide``) and ``ka350``
+``c172p``, ``eternity`` (``Eternity_glide``), ``us25e`` (``UltraStick25e_glide``), ``ka350``
 (``KingAir350_glide``, a JSBSim Beechcraft King Air 350 twin turboprop from a FlightGear package, without its engines)
-were held out in earlier sessions and have been evaluated: they count as used. ``s23`` (JSBSim's Short S.23 flying
-boat, ``ShortS23_glide``, without its engines) is the held-out, untouched one: never in the defaults, made and scored
-only in the final evaluation.
+and ``s23`` (``ShortS23_glide``, JSBSim's Short S.23 flying boat, without its engines) were held out in earlier
+sessions and have been evaluated: they count as used. No aircraft is held out or untouched until the next one is
+added.
 """
 
 from __future__ import annotations
@@ -561,7 +561,7 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide); "
-                         "s23 is the untouched aircraft; default %(default)s")
+                         "none is untouched until the next one is added; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
 
