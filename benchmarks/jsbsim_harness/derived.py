@@ -17,7 +17,9 @@ flown as the Ultra Stick 120 (``UltraStick25e_glide``, :func:`derive_ultrastick2
 or a JSBSim Beechcraft King Air 350 twin turboprop gliding, its engines, systems, autopilot inputs, rudder boost
 and yaw damper removed (``KingAir350_glide``, :func:`derive_kingair350_glide`; twenty-third session), or JSBSim's
 Short S.23 flying boat gliding in one file, its engines, hull forces and systems removed (``ShortS23_glide``,
-:func:`derive_shorts23_glide`; twenty-fourth session).
+:func:`derive_shorts23_glide`; twenty-fourth session), or JSBSim's Fokker Dr.I triplane gliding, its rotary engine,
+propeller and pushback removed and its pitch table reading the elevator through an alias (``Dr1_glide``,
+:func:`derive_dr1_glide`; twenty-fifth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -73,6 +75,7 @@ from pathlib import Path
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
            "derive_eternity_glide", "derive_ultrastick25e_glide", "derive_kingair350_glide", "derive_shorts23_glide",
+           "derive_dr1_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -741,6 +744,61 @@ def derive_shorts23_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def derive_dr1_glide(root: ET.Element) -> ET.Element:
+    """JSBSim's Fokker Dr.I triplane (``data/jsbsim_models/fokkerdr1/dr1.xml``: the jsbsim 1.3.3 wheel's
+    ``aircraft/dr1/dr1.xml``, Ron Jensen and Erik Hofman 2008 from an Aeromatic 0.9 start, LGPL-2.1 with JSBSim)
+    gliding, as JSBSim alone can fly it (twenty-fifth session).
+
+    The model is the 1917 triplane fighter: an Oberursel UR.II rotary engine with its propeller, a FlightGear
+    pushback system that writes an external force at the tail skid (the reason the ninth session could not
+    initialise it: the system reads ``/sim/model/pushback/position-norm``), and its own aerodynamics (a lift table
+    over +-180 deg of alpha, the pitch moment as a table in alpha and a second table in alpha and elevator,
+    constant lateral-directional derivatives that are not Aeromatic's set). Four edits; nothing else changes (a test
+    checks every other element, and that JSBSim's aerodynamic forces and moments equal the stock wheel model's):
+
+    - **Engine removed.** The ``<engine>`` element (``Oberursel-UrII`` with ``Dr1_propeller``, its feed) is
+      removed, as the s23's and the iar80's: the harness glides every aircraft, so that every non-gravity force is
+      aerodynamic (a stopped engine leaves JSBSim's windmilling propeller). The fuel tank (50 lb on the centre
+      line) stays as mass.
+    - **Pushback force removed.** ``<external_reactions>`` (one body-axis force at the tail skid, whose magnitude
+      only the pushback system writes) is removed.
+    - **Pushback system removed.** ``<system file="pushback"/>`` (FlightGear's ground tug) is removed; the chocks
+      system is commented out in the file and stays so.
+    - **Elevator alias.** The ``Cmde`` table looks the elevator up as its column ``independentVar`` (one lookup),
+      which ``effects.py``'s ``delay:delta_e`` (it redirects ``<property>`` reads) would not reach; as for the f16
+      and the s23 it looks it up in the identity function :data:`ELEVATOR_ALIAS` = ``fcs/elevator-pos-rad``, added
+      as the aerodynamics' first child. ``CLde`` reads the elevator as a ``<property>`` (reached directly);
+      ``CDde`` reads JSBSim's ``fcs/mag-elevator-pos-rad`` (not delayed, as on the b747 and c172x).
+
+    Args:
+        root: the parsed ``dr1.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): one
+            ``<propulsion><engine>``, one ``<external_reactions>``, the one ``pushback`` system, an
+            ``<aerodynamics>`` with one table lookup of ``fcs/elevator-pos-rad``.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    ext = root.findall("external_reactions")
+    systems = root.findall("system")
+    aero = root.find("aerodynamics")
+    if len(engines) != 1 or len(ext) != 1 or [x.get("file") for x in systems] != ["pushback"] or aero is None:
+        raise ValueError("dr1.xml: expected one <propulsion><engine>, one <external_reactions>, the system "
+                         "'pushback' and an <aerodynamics>")
+    prop.remove(engines[0])
+    root.remove(ext[0])
+    root.remove(systems[0])
+    n = _alias_elevator_lookups(aero)
+    if n != 1:
+        raise ValueError(f"dr1.xml: {n} table lookups of fcs/elevator-pos-rad, expected 1")
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -819,6 +877,12 @@ REPO_DERIVED = {
                        "no propeller or water force); the DATCOM+ aerodynamics file inlined, its tables reading the "
                        "elevator through an identity alias; the fuel tanks stay as mass; everything else "
                        "unchanged."),
+    "Dr1_glide": ("data/jsbsim_models/fokkerdr1/dr1.xml",
+                  "JSBSim's Fokker Dr.I triplane (the jsbsim 1.3.3 wheel's aircraft/dr1/dr1.xml, Ron Jensen and "
+                  "Erik Hofman 2008, LGPL-2.1 with JSBSim), copied into gcs-sysid's data/jsbsim_models/fokkerdr1/",
+                  derive_dr1_glide, "rotary engine and propeller, the pushback force and the pushback system "
+                  "removed (a glide with no propeller or ground-tug force); the Cmde table reads the elevator "
+                  "through an identity alias; the fuel tank stays as mass; everything else unchanged."),
 }
 
 

@@ -1,6 +1,6 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p, eternity, us25e, ka350 and
-s23;
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p, eternity, us25e, ka350, s23
+and the untouched dr1;
 docs/jsbsim.md, one section each),
 parametrised over the roster.
 
@@ -12,16 +12,16 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); no aircraft is untouched until the next one is added; the s23's own
+default suite, as before the fold); the untouched dr1's are slow too but its names', and its own
 default checks (its model, surfaces, static stability, the summaries' label) are in
-``test_jsbsim_s23.py`` (the ka350's in ``test_jsbsim_ka350.py``, the us25e's in ``test_jsbsim_us25e.py``, the eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+``test_jsbsim_dr1.py`` (the s23's in ``test_jsbsim_s23.py``, the ka350's in ``test_jsbsim_ka350.py``, the us25e's in ``test_jsbsim_us25e.py``, the eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
 the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-fifth sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
 in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
 b737 in the nineteenth, the c172p in the twentieth, the eternity in the twenty-first, the us25e in the
-twenty-second, the ka350 in the twenty-third, the s23 in the twenty-fourth.
+twenty-second, the ka350 in the twenty-third, the s23 in the twenty-fourth, the dr1 in the twenty-fifth.
 """
 
 from dataclasses import dataclass
@@ -413,6 +413,30 @@ CASES = (
          (), 0.3142, 5,
          dict(alpha=(-10.0, 7.0), beta=(10.0, 12.0), bank=(20.0, 25.0), speed=(45.0, 110.0), alt_min=700.0,
               rate_std=1.0, rate_std_held=0.8, sink_min=4.0)),
+    # dr1 (JSBSim's Fokker Dr.I triplane, Ron Jensen and Erik Hofman 2008, the jsbsim 1.3.3 wheel's aircraft/dr1
+    # checked in under data/jsbsim_models/fokkerdr1, LGPL-2.1 with JSBSim; the derived Dr1_glide: rotary engine,
+    # propeller, pushback force and system removed, the Cmde table reading the elevator through an identity alias):
+    # 945 lb (895 empty, 50 of fuel on the centre line, no pilot mass), the project's Ixz +0.115 kg m^2 (the tank's:
+    # JSBSim's -0.085 slug ft^2), five SIDE functions (CYbeta, CYda = 0, CYdr, CYp, CYr), the elevator read by the
+    # alias and CLde (two <property> reads), a fixed gear whose drag is in CDo. On the 30-s calm flight
+    # (derivative_slopes; inertial rates, no alpha-dot) Cm_alpha -0.080 (the static slope is -0.18 to -0.20 per rad
+    # near alpha 0; closure_slopes reads -0.16 with Cm_alphadot -1.00), Cm_delta_e -0.260 (Cmde's table: -0.275 to
+    # -0.283); Cl_beta -0.0287 (Clbeta -0.02 and CYbeta 5.75 in above the CG), Cl_p -0.193, Cl_r -0.043 (Clr
+    # -0.0458), Cl_delta_a -0.087 (Clda 0.087 per rad of the left aileron, delta_a = -left), Cl_delta_r -0.0031;
+    # Cn_beta 0.0964, Cn_p -0.0109, Cn_r -0.082, Cn_delta_a -0.0552 (proverse: Cnda +0.0552 x left), Cn_delta_r
+    # -0.0503. Envelope limits from the six envelope flights flown in the twenty-fifth session (docs/jsbsim.md, "The
+    # dr1"): alpha -4.3..4.7 deg, sideslip 8.6 with the pair and 6.5 with Cl:alpha*beta, bank 15.6 and 16.3, TAS
+    # 32-54 m/s, lowest 1283 m, sink through the air 6.7-8.0 m/s, rate standard deviations at least 3.0 deg/s (3.8
+    # held out), surfaces' at least 1.29 / 1.84 / 1.93 deg.
+    Case("dr1", "Dr1_glide", "dr2", 945.0, 0.115478,
+         (("cm", 0, None, ("in", -0.16, -0.02)), ("cm", 2, -0.2601, ("rel", 0.03)), ("cl", 3, -0.087, ("rel", 0.01)),
+          ("cl", 0, -0.0287, ("rel", 0.05)), ("cl", 1, -0.1933, ("rel", 0.02)), ("cl", 2, -0.0434, ("rel", 0.10)),
+          ("cl", 4, -0.0031, ("abs", 0.001)), ("cn", 4, -0.0503, ("rel", 0.02)), ("cn", 0, 0.0964, ("rel", 0.03)),
+          ("cn", 2, -0.0823, ("rel", 0.05)), ("cn", 3, -0.0552, ("rel", 0.05)), ("cn", 1, -0.0109, ("rel", 0.25))),
+         (), 0.35, 5,
+         dict(alpha=(-8.0, 8.0), beta=(11.0, 12.0), bank=(20.0, 25.0), speed=(28.0, 62.0), alt_min=1000.0,
+              rate_std=2.0, rate_std_held=2.0, sink_min=4.0),
+         untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -586,7 +610,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 @pytest.mark.parametrize("case", [p for p in _params()
                                   if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick",
                                                           "b737", "c172p", "eternity", "us25e", "ka350",
-                                                          "s23")])
+                                                          "s23", "dr1")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse
