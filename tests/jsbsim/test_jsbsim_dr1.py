@@ -27,7 +27,6 @@ are slow.
 No pipeline fit, GP, diagnosis or scoring runs on the dr1: its first evaluation is the final one, after the merge.
 """
 
-import copy
 import dataclasses
 import json
 import xml.etree.ElementTree as ET
@@ -36,8 +35,8 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot, ic_state, \
-    lateral_coefficients
+from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, bare_xml, checked_in_model, \
+    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
 
 SRC = "data/jsbsim_models/fokkerdr1/dr1.xml"
 SRC_SHA256 = "bd394cb162b91e4a11e97e2fbf490e1d5a9ddb0feeed4f5a4c8cf237cedc22f8"
@@ -70,22 +69,6 @@ def _stock_state(alpha_deg, beta_deg, cmds):
     return fdm
 
 
-def _same(a, b):
-    """The elements, their text and children, not their own tails."""
-    a, b = map(copy.deepcopy, (a, b))
-    a.tail = b.tail = None
-    return ET.tostring(a) == ET.tostring(b)
-
-
-def _bare(e):
-    """The element's XML with every text and tail stripped of white space (the layout, not the content)."""
-    e = copy.deepcopy(e)
-    for x in e.iter():
-        x.text = x.text.strip() if x.text else x.text
-        x.tail = None
-    return ET.tostring(e)
-
-
 def test_the_derivation_removes_the_engine_and_pushback_and_aliases_the_elevator_lookup():
     """The checked-in file is the README's (30855 bytes, its SHA-256). ``Dr1_glide`` is that file without its
     ``<engine>``, its ``<external_reactions>`` (the pushback force) and its ``pushback`` system; its ``Cmde`` table
@@ -98,11 +81,11 @@ def test_the_derivation_removes_the_engine_and_pushback_and_aliases_the_elevator
     src, der, spec = checked_in_model("dr1", "Dr1_glide", SRC, 30855, SRC_SHA256)
     ET.indent(src, space=" ")
     for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control"):
-        assert _same(src.find(tag), der.find(tag)), tag
+        assert same_xml(src.find(tag), der.find(tag)), tag
     assert len(src.findall("propulsion/engine")) == 1 and der.find("propulsion/engine") is None
     assert [x.get("file") for x in src.findall("system")] == ["pushback"] and der.find("system") is None
     assert src.find("external_reactions") is not None and der.find("external_reactions") is None
-    assert _same(src.find("propulsion/tank"), der.find("propulsion/tank"))
+    assert same_xml(src.find("propulsion/tank"), der.find("propulsion/tank"))
     assert [c.tag for c in der] == [c.tag for c in src if c.tag not in ("external_reactions", "system")]
     s_aero, d_aero = src.find("aerodynamics"), der.find("aerodynamics")
     assert d_aero[0].get("name") == ELEVATOR_ALIAS and [p.text for p in d_aero[0].iter("property")] == [
@@ -114,7 +97,7 @@ def test_the_derivation_removes_the_engine_and_pushback_and_aliases_the_elevator
     s_fun, d_fun = list(s_aero.iter("function")), list(d_aero.iter("function"))[1:]
     assert len(s_fun) == len(d_fun) == 27
     for a, b in zip(s_fun, d_fun):
-        assert _bare(a) == _bare(b), a.get("name")
+        assert bare_xml(a) == bare_xml(b), a.get("name")
 
 
 def test_the_derived_aerodynamics_are_the_stock_models():
@@ -135,8 +118,6 @@ def test_the_dr1_flies_its_own_surfaces_without_engine_or_external_force():
     ``aileron_sign`` -1), rudder 0.44 rad per unit command with the command clipped at +-0.35 (0.154 rad, 8.8 deg,
     of travel). No engine; 945 lb (895 empty, 50 of fuel); after 50 frames every non-gravity force and moment is
     aerodynamic and the external forces are 0."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("dr1")
     fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(945.0, abs=0.01)
@@ -146,10 +127,7 @@ def test_the_dr1_flies_its_own_surfaces_without_engine_or_external_force():
     assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.44, rel=1e-6)
     assert _state(cmds=(0.0, 0.0, 0.9))["fcs/rudder-pos-rad"] == pytest.approx(0.35 * 0.44, rel=1e-6)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.35, 1 / 0.30, 1 / 0.44))
-    de, da, dr = np.radians(-3.0), np.radians(5.0), np.radians(4.0)
-    cmd = tuple(d * s * k for d, s, k in zip((de, da, dr), (spec.elevator_sign, spec.aileron_sign, spec.rudder_sign),
-                                             spec.cmd_per_rad))
-    assert _deflections(_state(cmds=cmd), spec) == pytest.approx((de, da, dr), rel=1e-4)
+    assert_deflections_map_back(spec)
     assert_aero_is_the_only_force(fdm, 200.0, external_zero=True)
 
 

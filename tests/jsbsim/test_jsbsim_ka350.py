@@ -33,7 +33,8 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, checked_in_model, ic_state, lateral_coefficients
+from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, checked_in_model, ic_state, \
+    lateral_coefficients, same_xml
 
 SRC = "data/jsbsim_models/kingair350/KingAir-350.xml"
 SRC_SHA256 = "f89a9376371cbbe4f08060548aee36a25d645620943f5e7273c59e3164c9675d"
@@ -46,13 +47,6 @@ def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
     return ic_state(aircraft("ka350"), alpha_deg, beta_deg, cmds)
 
 
-def _same(a, b):
-    """The elements, their text and children, not their own tails."""
-    a, b = map(copy.deepcopy, (a, b))
-    a.tail = b.tail = None
-    return ET.tostring(a) == ET.tostring(b)
-
-
 def test_the_derivation_removes_the_engines_systems_and_what_reads_them():
     """The checked-in XML is the README's (34611 bytes, its SHA-256). ``KingAir350_glide`` is that XML with its two
     ``<engine>`` elements and four ``<system>`` elements removed, the pitch and roll summers without
@@ -63,11 +57,11 @@ def test_the_derivation_removes_the_engines_systems_and_what_reads_them():
     src, der, spec = checked_in_model("ka350", "KingAir350_glide", SRC, 34611, SRC_SHA256)
     ET.indent(src, space=" ")
     for tag in ("metrics", "mass_balance", "ground_reactions", "external_reactions"):
-        assert _same(src.find(tag), der.find(tag)), tag
+        assert same_xml(src.find(tag), der.find(tag)), tag
     assert der.find("propulsion/engine") is None and der.find("system") is None
     assert [x.get("file") for x in src.findall("system")] == ["engine-control", "fuel-system", "nws", "autopilot"]
     for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True):
-        assert _same(a, b)
+        assert same_xml(a, b)
     fc_s, fc_d = src.find("flight_control"), der.find("flight_control")
     assert [(p.text.strip(), p.get("value")) for p in fc_d.findall("property")] == [
         ("/controls/flight/yaw-damper", "0"), ("/controls/flight/rudder-boost", "1")]
@@ -82,12 +76,12 @@ def test_the_derivation_removes_the_engines_systems_and_what_reads_them():
             for i in comp.findall("input"):
                 if i.text.strip() in gone:
                     comp.remove(i)
-        assert _same(a, b), a.get("name")
+        assert same_xml(a, b), a.get("name")
     s_fun = [f for f in src.find("aerodynamics").iter("function") if f.get("name") != "aero/force/Drag_feathered"]
     d_fun = list(der.find("aerodynamics").iter("function"))
     assert len(s_fun) == len(d_fun) == 33
     for a, b in zip(s_fun, d_fun):
-        assert _same(a, b), a.get("name")
+        assert same_xml(a, b), a.get("name")
 
 
 def test_the_ka350_flies_its_own_surfaces_without_engine_or_external_force():
@@ -97,8 +91,6 @@ def test_the_ka350_flies_its_own_surfaces_without_engine_or_external_force():
     ``aileron_sign`` -1); rudder +-25 deg. The yaw damper is off (the rudder is the command alone, a yaw rate moves
     nothing). No engine; 13319 lb (the pilot emptied); after 50 frames every non-gravity force and moment is
     aerodynamic."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("ka350")
     fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(13319.0)
@@ -111,10 +103,7 @@ def test_the_ka350_flies_its_own_surfaces_without_engine_or_external_force():
     yawing = ic_state(spec, 0.0, 0.0, (0.0, 0.0, 0.2), r_rad_s=0.1)
     assert yawing["fcs/yaw-damper-cmd"] == 0.0 and yawing["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.3491, 1 / 0.34905, 1 / 0.4363))
-    de, da, dr = np.radians(-3.0), np.radians(5.0), np.radians(4.0)     # the elevator on its larger (up) side
-    cmd = tuple(d * s * k for d, s, k in zip((de, da, dr), (spec.elevator_sign, spec.aileron_sign, spec.rudder_sign),
-                                             spec.cmd_per_rad))
-    assert _deflections(_state(cmds=cmd), spec) == pytest.approx((de, da, dr), rel=1e-4)
+    assert_deflections_map_back(spec)
     assert_aero_is_the_only_force(fdm, 1000.0, external_zero=True)
 
 

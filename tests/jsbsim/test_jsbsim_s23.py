@@ -27,7 +27,6 @@ No pipeline fit, GP, diagnosis or scoring ran on the s23 before its final evalua
 a tuning aircraft since.
 """
 
-import copy
 import dataclasses
 import hashlib
 import json
@@ -37,8 +36,8 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot, ic_state, \
-    lateral_coefficients
+from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, bare_xml, checked_in_model, \
+    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
 
 SRC = "data/jsbsim_models/shorts23/Short_S23.xml"
 SRC_SHA256 = "b4ba55cceeaca5057bacfb59b510bf3bdc8e9ea19efbd007904700ab2439282f"
@@ -51,22 +50,6 @@ def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), model=None):
     spec flying ``model`` (the stock wheel model)."""
     spec = aircraft("s23")
     return ic_state(dataclasses.replace(spec, model=model) if model else spec, alpha_deg, beta_deg, cmds)
-
-
-def _same(a, b):
-    """The elements, their text and children, not their own tails."""
-    a, b = map(copy.deepcopy, (a, b))
-    a.tail = b.tail = None
-    return ET.tostring(a) == ET.tostring(b)
-
-
-def _bare(e):
-    """The element's XML with every text and tail stripped of white space (the layout, not the content)."""
-    e = copy.deepcopy(e)
-    for x in e.iter():
-        x.text = x.text.strip() if x.text else x.text
-        x.tail = None
-    return ET.tostring(e)
 
 
 def test_the_derivation_removes_the_engines_water_forces_and_systems_and_inlines_the_aerodynamics():
@@ -87,14 +70,14 @@ def test_the_derivation_removes_the_engines_water_forces_and_systems_and_inlines
     ET.indent(src, space=" ")
     ET.indent(aero, space=" ")
     for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control"):
-        assert _same(src.find(tag), der.find(tag)), tag
+        assert same_xml(src.find(tag), der.find(tag)), tag
     assert der.find("propulsion/engine") is None and der.find("system") is None
     assert der.find("external_reactions") is None and len(src.findall("propulsion/engine")) == 4
     assert [x.get("file") for x in src.findall("system")] == [
         "hydrodynamics", "hydrodynamic-planing-floats", "Short_S23-hydrodynamics", "sperry-a2-autopilot",
         "take-off-ap", "engines", "fuel-system", "electrical", "flaps"]
     for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True):
-        assert _same(a, b)
+        assert same_xml(a, b)
     assert [c.tag for c in der] == [c.tag for c in src if c.tag not in ("external_reactions", "system")]
     d_aero = der.find("aerodynamics")
     assert d_aero.get("file") is None and d_aero[0].get("name") == ELEVATOR_ALIAS
@@ -106,7 +89,7 @@ def test_the_derivation_removes_the_engines_water_forces_and_systems_and_inlines
     s_fun, d_fun = list(aero.iter("function")), list(d_aero.iter("function"))[1:]
     assert len(s_fun) == len(d_fun) == 36
     for a, b in zip(s_fun, d_fun):
-        assert _bare(a) == _bare(b), a.get("name")
+        assert bare_xml(a) == bare_xml(b), a.get("name")
 
 
 def test_the_derived_aerodynamics_are_the_stock_models():
@@ -127,8 +110,6 @@ def test_the_s23_flies_its_own_surfaces_without_engine_or_external_force():
     -left with ``aileron_sign`` -1), rudder +-0.3927 rad (22.5 deg). No engine; 33686 lb (the crew's off-centre
     seats and the engines' oil emptied); after 50 frames every non-gravity force and moment is aerodynamic and the
     external forces are 0."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("s23")
     fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(33685.7, abs=0.1)
@@ -137,10 +118,7 @@ def test_the_s23_flies_its_own_surfaces_without_engine_or_external_force():
     assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
     assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.3927, rel=1e-6)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.3142, 1 / 0.3403, 1 / 0.3927))
-    de, da, dr = np.radians(-3.0), np.radians(5.0), np.radians(4.0)
-    cmd = tuple(d * s * k for d, s, k in zip((de, da, dr), (spec.elevator_sign, spec.aileron_sign, spec.rudder_sign),
-                                             spec.cmd_per_rad))
-    assert _deflections(_state(cmds=cmd), spec) == pytest.approx((de, da, dr), rel=1e-4)
+    assert_deflections_map_back(spec)
     assert_aero_is_the_only_force(fdm, 10000.0, external_zero=True)
 
 

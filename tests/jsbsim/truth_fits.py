@@ -214,6 +214,24 @@ def check_direct_fcs(spec, min_lift_lbs: float) -> None:
     assert_aero_is_the_only_force(fdm, min_lift_lbs)
 
 
+def assert_deflections_map_back(spec, deltas_deg=(-3.0, 5.0, 4.0)) -> None:
+    """The harness's command for the project's deflections ``deltas_deg`` (delta_e, delta_a, delta_r, deg; the
+    elevator trailing edge up by default, on its larger side for the ka350) through ``spec``'s signs and
+    ``cmd_per_rad``, set at :func:`ic_state`, reads back as those deflections (``flight._deflections``, to 1e-4):
+    the sign map and command scale of the ka350's, s23's and dr1's checks.
+
+    Raises:
+        AssertionError: the deflections differ."""
+    import pytest
+
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    want = tuple(np.radians(deltas_deg))
+    cmd = tuple(d * s * k for d, s, k in zip(want, (spec.elevator_sign, spec.aileron_sign, spec.rudder_sign),
+                                             spec.cmd_per_rad))
+    assert _deflections(ic_state(spec, 0.0, 0.0, cmd), spec) == pytest.approx(want, rel=1e-4)
+
+
 def assert_aero_is_the_only_force(fdm, min_lift_lbs: float, external_zero: bool = False) -> None:
     """Run ``fdm`` 50 frames, then JSBSim's total body forces (lbs) and moments (lbs ft) must equal its
     aerodynamic ones on every axis (no engine, ground or other force), with at least ``min_lift_lbs`` of
@@ -491,6 +509,30 @@ def assert_in_envelope(e: dict, alpha, beta, bank, speed, rate_std: float, rate_
     assert min(e["rate_std"]) > rate_std and min(e["rate_std_held"]) > rate_std_held, e      # deg/s
     assert all(s > m for s, m in zip(e["surface_std"], surface_std_min)), e
     assert e["sink_air_mps"] > sink_min and e["alt_min"] > alt_min, e
+
+
+def same_xml(a, b) -> bool:
+    """Whether two XML elements are equal: their tag, attributes, text and children, not their own tails (the
+    derivation tests of the checked-in models: the ka350's, s23's, dr1's)."""
+    import copy
+    import xml.etree.ElementTree as ET
+
+    a, b = map(copy.deepcopy, (a, b))
+    a.tail = b.tail = None
+    return ET.tostring(a) == ET.tostring(b)
+
+
+def bare_xml(e) -> bytes:
+    """The element's XML with every text and tail stripped of white space: its content, not its layout (to compare
+    a function of a checked-in file with the derived model's, whose indentation ``ET.indent`` rewrote)."""
+    import copy
+    import xml.etree.ElementTree as ET
+
+    e = copy.deepcopy(e)
+    for x in e.iter():
+        x.text = x.text.strip() if x.text else x.text
+        x.tail = None
+    return ET.tostring(e)
 
 
 def checked_in_model(name: str, model: str, src: str, n_bytes: int, sha256: str):
