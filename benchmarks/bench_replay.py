@@ -3,7 +3,7 @@
 Target (issue 2): the whole pipeline within 3x the bare decode time of the same log measured in
 the same run, and peak memory under 1 GiB.
 
-    python benchmarks/bench_replay.py [--repeats 3] [--minutes 10] [--serial] [--cold]
+    python benchmarks/bench_replay.py [--repeats 3] [--minutes 10] [--serial] [--cold] [--gp-noise independent]
 
 It simulates the flight once (cached in benchmarks/out/), then alternates: a bare pymavlink decode
 (``mavutil.mavlink_connection`` + ``recv_match()`` until the end, no processing) and the full
@@ -54,7 +54,8 @@ PIPELINE = """
 import json, resource, sys, time
 t0 = time.perf_counter()
 from gcs_sysid.pipeline import ReplayOptions, run_replay   # as `gcs-sysid replay` does: JAX is set up inside
-r = run_replay(sys.argv[1], sys.argv[2], sys.argv[3], ReplayOptions(progress=False, parallel=sys.argv[4] == "1"))
+r = run_replay(sys.argv[1], sys.argv[2], sys.argv[3], ReplayOptions(progress=False, parallel=sys.argv[4] == "1",
+                                                                  gp_noise=sys.argv[5] if len(sys.argv) > 5 else None))
 wall = time.perf_counter() - t0
 # peak RSS of this process and of its worker (a waited-for child), KiB on Linux; CPU s of each
 me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -143,6 +144,9 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--minutes", type=float, default=10.0)
     ap.add_argument("--serial", action="store_true", help="also time the replay without its worker process")
+    ap.add_argument("--gp-noise", default=None,
+                    help="the replay GP's noise (gcs_sysid.pipeline.GP_NOISE_MODES, e.g. 'independent', the default "
+                         "until the twenty-fifth session); default: the package's (learned)")
     ap.add_argument("--cold", action="store_true",
                     help="give every replay a new empty JAX compilation cache (a fresh machine) instead of the user's")
     a = ap.parse_args()
@@ -175,7 +179,8 @@ def main() -> None:
         decode.append(float(secs))
         env, cdir = cache_for(f"run-{i}")
         before = cache_entries(cdir)
-        out, tree = run_child(PIPELINE, str(log), airframe, str(OUT / f"report-{i}"), "1", env_extra=env)
+        noise = () if a.gp_noise is None else (a.gp_noise,)
+        out, tree = run_child(PIPELINE, str(log), airframe, str(OUT / f"report-{i}"), "1", *noise, env_extra=env)
         added = cache_entries(cdir) - before
         compiled.append(added)
         r = json.loads(out)
@@ -191,7 +196,7 @@ def main() -> None:
                 f"{r['rss_worker']:4.0f} MiB, together {tree:4.0f} MiB")
         if a.serial:
             env, _ = cache_for(f"serial-{i}")
-            s = json.loads(run_child(PIPELINE, str(log), airframe, str(OUT / f"report-serial-{i}"), "0",
+            s = json.loads(run_child(PIPELINE, str(log), airframe, str(OUT / f"report-serial-{i}"), "0", *noise,
                                      env_extra=env)[0])
             serial.append(s["wall"])
             line += f" | serial {s['wall']:6.2f} s"

@@ -511,12 +511,14 @@ def main(argv=None) -> int:
                          "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); 'untested' sets "
                          "gcs_sysid.pipeline.GP_COUPLING_TEST = 'none' (B's couplings kept as learned, without the "
                          "every-row likelihood-ratio test: the default until the twenty-second session)")
-    ap.add_argument("--gp-noise", default=None, choices=("diagonal", "full", "learned", "full-nstart"),
-                    help="the replay GP's noise: 'full' sets gcs_sysid.pipeline.GP_NOISE_CORRELATION (a P x P noise "
-                         "covariance, eval_gp_jsbsim's nigp); 'learned' the same covariance learned with the "
-                         "hyperparameters but only its diagonal in the posterior (GP_NOISE_POSTERIOR = 'diagonal'); "
-                         "'full-nstart' full with the shared error started in the noise (GP_NOISE_START = 'noise'); "
-                         "'diagonal' one variance per output (the default)")
+    ap.add_argument("--gp-noise", default=_pipeline.GP_NOISE, choices=tuple(_pipeline.GP_NOISE_MODES),
+                    help="the replay GP's noise (gcs_sysid.pipeline.GP_NOISE_MODES; sets GP_NOISE_CORRELATION, "
+                         "GP_NOISE_POSTERIOR, GP_NOISE_START): 'learned' (the default since the twenty-fifth session) "
+                         "a P x P noise covariance learned with the hyperparameters, only its diagonal in the posterior; "
+                         "'independent' one variance per output (the default until the twenty-fifth session; "
+                         "'diagonal' is its older name); 'full' the learned covariance in the posterior too "
+                         "(eval_gp_jsbsim's nigp); 'full-nstart' full with the shared error started in the noise; "
+                         "default %(default)s")
     ap.add_argument("--cy-rate-prior", default=None, metavar="STD|off",
                     help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
                          "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
@@ -594,9 +596,8 @@ def main(argv=None) -> int:
     if a.gp_noise is not None:
         import gcs_sysid.pipeline as pipeline
 
-        pipeline.GP_NOISE_CORRELATION = a.gp_noise != "diagonal"
-        pipeline.GP_NOISE_POSTERIOR = "diagonal" if a.gp_noise == "learned" else "full"
-        pipeline.GP_NOISE_START = "noise" if a.gp_noise == "full-nstart" else "signal"
+        (pipeline.GP_NOISE_CORRELATION, pipeline.GP_NOISE_POSTERIOR,
+         pipeline.GP_NOISE_START) = pipeline.GP_NOISE_MODES[a.gp_noise]
     if a.cy_rate_prior is not None:
         import gcs_sysid.pipeline as pipeline
 

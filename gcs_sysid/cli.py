@@ -75,6 +75,11 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                    help="p_hat q_hat r_hat relative to the air: minus the gust rates estimated from the "
                         "reconstructed gusts in this frame (default: the gyro's inertial rates; docs/estimation.md)")
+    r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
+                   help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
+                        "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
+                        "default until the twenty-fifth session; 'diagonal' is its older name) one noise variance per "
+                        "output; 'full' the learned correlation in the predictions too (docs/gp.md, 'The default noise')")
     r.add_argument("--quiet", action="store_true", help="no progress display")
 
     s = sub.add_parser("simulate", help="simulate a flight with the project's 6-DOF model and write a tlog")
@@ -136,7 +141,8 @@ def _replay_options(a: argparse.Namespace):
     return ReplayOptions(rate_hz=a.rate, holdout=a.holdout, t_from=a.t_from, t_to=a.t_to,
                          model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say,
                          targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")),
-                         can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates)
+                         can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates,
+                         gp_noise=a.gp_noise)
 
 
 def _check_replay(a: argparse.Namespace) -> None:

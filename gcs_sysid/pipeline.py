@@ -26,7 +26,7 @@ from .result import ReplayResult
 from .telemetry import cut_window, read_log
 
 __all__ = ["ReplayOptions", "REPLAY_OUTPUTS", "check_replay", "run_replay", "held_out_mask", "error_pct",
-           "identifiability", "training_rows"]
+           "identifiability", "training_rows", "GP_NOISE_MODES", "gp_noise_fields", "replay_gp_config"]
 
 #: What a replay writes into its output folder (an existing folder holding only these may be replaced).
 REPLAY_OUTPUTS = ("report.html", "summary.md", "coefficients.csv", "suggestions.json", "result", "model.npz",
@@ -101,6 +101,7 @@ class ReplayOptions:
     alpha_dot_hat: bool = True
     gust_filter: bool | str | None = None
     heldout_air_roll: str | None = None
+    gp_noise: str | None = None
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
@@ -131,27 +132,93 @@ USE_DECORRELATED_GP = False
 #: off-diagonals as learned (the default until the twenty-second session; ``eval_jsbsim --gp-fit untested``).
 GP_COUPLING_TEST = "lr"
 
-#: The replay's ``GPConfig.noise_correlation`` (twenty-second session, second round): False (the default) learns one
-#: noise variance per output, so an error the gust puts into several coefficients at once can only be explained as
-#: signal coupling (``B``), which the coupling test then keeps (us25e light s1: learned correlation 0.99); True learns
-#: the full ``P x P`` noise covariance (eval_gp_jsbsim's ``nigp``). Opt-in (``eval_jsbsim --gp-noise full``):
-#: docs/benchmarks.md, "Twenty-second session, lead, second round"; on the whole roster (twenty-third session,
-#: i8-noise) correlations above 0.5 on 29 -> 6 of 87 flights, GP<LS 469 -> 472, but a count lost on 7 aircraft.
-GP_NOISE_CORRELATION = False
+#: The replay GP's noise, by name (``ReplayOptions.gp_noise``, ``gcs-sysid replay --gp-noise``, ``eval_jsbsim
+#: --gp-noise``): the :class:`gcs_sysid.gp.GPConfig` fields ``(noise_correlation, noise_posterior, noise_start)``.
+#:   ``learned``      (the default since the twenty-fifth session) the full ``P x P`` noise covariance learned with the
+#:                    hyperparameters and used by every decision before the posterior (the bound, the coupling test, the
+#:                    blocked validation's latent scales), only its diagonal in the posterior (twenty-third session,
+#:                    i8-noise2; docs/gp.md, "Noise: learned, not conditioned on");
+#:   ``independent``  one noise variance per output, no correlation learned (the default until the twenty-fifth
+#:                    session; ``diagonal`` is its older name, kept);
+#:   ``full``         the learned covariance in the posterior too (eval_gp_jsbsim's ``nigp``; twenty-second session);
+#:   ``full-nstart``  ``full`` with the shared error started in the noise (``GPConfig.noise_start = "noise"``).
+GP_NOISE_MODES = {"learned": (True, "diagonal", "signal"), "independent": (False, "full", "signal"),
+                  "diagonal": (False, "full", "signal"), "full": (True, "full", "signal"),
+                  "full-nstart": (True, "full", "noise")}
+
+#: The replay's default noise (a name of :data:`GP_NOISE_MODES`), spelled out in the three constants below, which
+#: :func:`run_replay` reads when ``ReplayOptions.gp_noise`` is None (``eval_jsbsim --gp-noise`` sets them).
+#: ``learned`` since the twenty-fifth session (i8-learned), under the default rule for GP changes (judged at two GP
+#: seeds against the default at the same seed; docs/gp.md, "The default noise"): on 99 tuning flights (22 aircraft)
+#: flight x count flips +38/-8 at GPConfig.seed 0 and +41/-11 at seed 1 (docs/benchmarks.md, "Twenty-fifth session,
+#: i8-learned"), learned output correlations above 0.5 on 32 -> 8 and 39 -> 8 flights; 3 aircraft lose a count at
+#: both seeds, where the default merely reseeded loses one on 12. ``independent`` is the old default.
+GP_NOISE = "learned"
+
+#: The replay's ``GPConfig.noise_correlation``: True (the default since the twenty-fifth session, with
+#: :data:`GP_NOISE_POSTERIOR` ``"diagonal"``: ``learned``) learns the full ``P x P`` noise covariance, so an error the
+#: gust puts into several coefficients at once is explained as noise, not as signal coupling ``B`` (us25e light s1:
+#: a learned output correlation of 0.99 with one variance per output); False (``independent``, the default until the
+#: twenty-fifth session) one noise variance per output. Twenty-second session, lead, second round; twenty-third,
+#: i8-noise (``full`` on the roster: correlations above 0.5 on 29 -> 6 of 87 flights, a count lost on 7 aircraft).
+GP_NOISE_CORRELATION = GP_NOISE_MODES[GP_NOISE][0]
 
 #: With :data:`GP_NOISE_CORRELATION`, the noise covariance the replay GP's posterior conditions on
-#: (``GPConfig.noise_posterior``): ``"full"`` (the learned one) or ``"diagonal"`` (the correlation learned with the
-#: hyperparameters and the coupling test, dropped before the posterior and the blocked validation: twenty-third session,
-#: i8-noise2; ``eval_jsbsim --gp-noise learned``). Opt-in: on 87 roster flights it removes full's Cm side effect
-#: (sgs126 light s1, f16 light s2) and keeps its correlations (29 -> 7 above 0.5; GP<LS 469 -> 475), but a count is
-#: lost on 4 aircraft against the default, 3 of them at the 98 % band edge (docs/benchmarks.md, "Twenty-third session,
-#: i8-noise2"). Twenty-fourth session (i8-noise3, 93 flights with the ka350): 9 aircraft win, 6 lose a count (iar80
-#: and t6 by a new correlation where JSBSim's own is 0.5-0.67); the default merely reseeded loses one on 12.
-GP_NOISE_POSTERIOR = "full"
+#: (``GPConfig.noise_posterior``): ``"diagonal"`` (the default, ``learned``: the correlation learned with the
+#: hyperparameters and the coupling test, dropped before the posterior and the blocked validation: twenty-third
+#: session, i8-noise2) or ``"full"`` (the learned one: its seemingly-unrelated-regressions transfer moved sgs126 light
+#: s1's Cm slopes and f16 light s2's). Twenty-third session (87 flights): correlations above 0.5 29 -> 7, GP<LS
+#: 469 -> 475; twenty-fourth (i8-noise3, 93 flights): 9 aircraft win, 6 lose a count, the default merely reseeded
+#: loses one on 12; twenty-fifth (i8-learned): made the default under the two-seed rule (:data:`GP_NOISE`).
+GP_NOISE_POSTERIOR = GP_NOISE_MODES[GP_NOISE][1]
 
 #: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or ``"noise"``
 #: (``eval_jsbsim --gp-noise full-nstart``).
-GP_NOISE_START = "signal"
+GP_NOISE_START = GP_NOISE_MODES[GP_NOISE][2]
+
+
+def gp_noise_fields(name: str | None = None) -> dict:
+    """The :class:`gcs_sysid.gp.GPConfig` noise fields of the replay's GP.
+
+    Args:
+        name: a key of :data:`GP_NOISE_MODES`, or None for the module's constants (:data:`GP_NOISE_CORRELATION`,
+            :data:`GP_NOISE_POSTERIOR`, :data:`GP_NOISE_START`; by default :data:`GP_NOISE`'s).
+
+    Returns:
+        ``{"noise_correlation": bool, "noise_posterior": str, "noise_start": str}``.
+
+    Raises:
+        InputError: ``name`` is not a key of :data:`GP_NOISE_MODES`.
+    """
+    if name is None:
+        values = (GP_NOISE_CORRELATION, GP_NOISE_POSTERIOR, GP_NOISE_START)
+    elif name in GP_NOISE_MODES:
+        values = GP_NOISE_MODES[name]
+    else:
+        raise InputError(f"--gp-noise: expected one of {', '.join(GP_NOISE_MODES)}, got {name!r}")
+    return dict(zip(("noise_correlation", "noise_posterior", "noise_start"), values))
+
+
+def replay_gp_config(options: ReplayOptions = ReplayOptions(), alpha_dot: bool = False):
+    """The :class:`gcs_sysid.gp.GPConfig` of the replay's GP fit.
+
+    Args:
+        options: the replay's options (``gp_noise``, ``n_inducing`` are read).
+        alpha_dot: ``alpha_dot_hat`` is the 11th input (a mean-only input of Cm, :data:`ALPHA_DOT_GP`).
+
+    Returns:
+        the GPConfig: the noise of :func:`gp_noise_fields` (``learned`` by default), :data:`ALPHA_DOT_GP` when
+        ``alpha_dot``, :data:`DECORRELATED_GP` when :data:`USE_DECORRELATED_GP`, :data:`GP_COUPLING_TEST`.
+
+    Raises:
+        InputError: an unknown ``options.gp_noise``.
+    """
+    from .gp import GPConfig
+
+    return GPConfig(**{**gp_noise_fields(options.gp_noise), **(ALPHA_DOT_GP if alpha_dot else {}),
+                       **(DECORRELATED_GP if USE_DECORRELATED_GP else {})},
+                    coupling_test=GP_COUPLING_TEST,
+                    **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
 
 #: Opt-in (nineteenth session, i8-cyr): the std (CY per unit ``p_hat`` / ``r_hat``) of a zero-mean prior on CY's two
 #: rate slopes, imposed by mixed estimation on the GP's training target (:func:`gcs_sysid.gp.mixed.apply_slope_prior`;
@@ -194,6 +261,8 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.heldout_air_roll not in (None, "off", "smoothed", "filtered", "predicted"):
         raise InputError(f"heldout_air_roll: expected off, smoothed, filtered or predicted, got "
                          f"{options.heldout_air_roll!r}")
+    if options.gp_noise is not None:
+        gp_noise_fields(options.gp_noise)
     check_window(options.t_from, options.t_to)
     check_positive_int(options.n_inducing, "--inducing")
     if options.targets is not None:
@@ -376,7 +445,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             flight = read_log(log, progress=prog, helper=helper, meanwhile=_load_stages)
         from .envelope import confidence_map
         from .estimation import estimate_states
-        from .gp import GPConfig, fit_gp, load_gp
+        from .gp import fit_gp, load_gp
         from .gp.discrepancy import with_offset_covariance
         from .jaxconfig import enable_compilation_cache
         from .maneuvers import ManeuverConfig, suggest_maneuvers
@@ -464,12 +533,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
-                    cfg = GPConfig(**{"noise_correlation": GP_NOISE_CORRELATION,
-                                      "noise_posterior": GP_NOISE_POSTERIOR, "noise_start": GP_NOISE_START,
-                                      **(ALPHA_DOT_GP if use_adot else {}),
-                                      **(DECORRELATED_GP if USE_DECORRELATED_GP else {})},
-                                   coupling_test=GP_COUPLING_TEST,
-                                   **({} if options.n_inducing is None else {"n_inducing": options.n_inducing}))
+                    cfg = replay_gp_config(options, use_adot)
                     names = REGRESSORS + (("alpha_dot_hat",) if use_adot else ())
                     prior = side_force_rate_prior(SIDE_FORCE_RATE_PRIOR_STD)
                     if prior:                    # the target's linear part: the mixed estimate's (opt-in)

@@ -74,9 +74,9 @@ class GPConfig:
         swap_pool: stored rows standing for the unselected set in the exchange criterion.
         noise_correlation: learn a full ``P x P`` noise covariance in the likelihood of the
             global layer (cross-correlated noise: a gust moves several coefficients at once),
-            not only one variance per output; ``docs/gp.md``, "Noise". Off by default: on the
-            JSBSim flights it lowered the errors a little (0.1-1.5 points) but costs ~0.2 s CPU
-            per fit in the replay, which is at its speed limit (``docs/benchmarks.md``).
+            not only one variance per output; ``docs/gp.md``, "Noise". Off in ``GPConfig()``; the
+            replay turns it on, with ``noise_posterior = "diagonal"``, since the twenty-fifth session
+            (``gcs_sysid.pipeline.GP_NOISE = "learned"``; ``docs/gp.md``, "The default noise").
         noise_start: where the residual's cross-output covariance starts, with ``noise_correlation``:
             ``"signal"`` (the default, the start before the seventeenth session): 0.7 of the ridge
             residual's covariance in ``B``, the noise independent (0.3 of each output's variance);
@@ -86,8 +86,8 @@ class GPConfig:
             error starts"). Ignored without ``noise_correlation``, with missing outputs and with the
             per-group kernels of ``output_groups``.
         noise_posterior: with ``noise_correlation``, the noise covariance the posterior (the predictions' mean and
-            band, the local layer's residuals) conditions on: ``"full"`` (the default) the learned ``P x P`` one;
-            ``"diagonal"`` (opt-in, twenty-third session, i8-noise2) only its per-output variances. The correlation
+            band, the local layer's residuals) conditions on: ``"full"`` (``GPConfig``'s default) the learned ``P x P``
+            one; ``"diagonal"`` (twenty-third session, i8-noise2) only its per-output variances. The correlation
             is learned with the other hyperparameters and used by every later decision (the blocked validation's
             latent scales, the coupling test, the validated terms), so the gusts' shared error is not explained as
             signal coupling in ``B``; it is dropped just before the posterior (:func:`gcs_sysid.gp.fit.posterior_noise`).
@@ -96,7 +96,8 @@ class GPConfig:
             residual wherever their regressors or priors differ (``alpha_dot_hat`` in Cm's mean alone, each
             output's own linear terms and blocked-validation scale; Zellner 1962); sgs126 light s1: a learned CZ-Cm
             correlation of 0.74 moved Cm's pitch slopes (Cm_q -10.2 -> -0.7, Cm_alpha_dot -4.9 -> -16.4;
-            ``docs/gp.md``, "Noise: learned, not conditioned on"). Opt-in: a count lost on 4 tuning aircraft.
+            ``docs/gp.md``, "Noise: learned, not conditioned on"). ``GPConfig()`` keeps ``"full"``; the replay uses
+            ``"diagonal"`` with ``noise_correlation`` since the twenty-fifth session (``pipeline.GP_NOISE``).
             Ignored without ``noise_correlation``.
         hyper_stride: learn the global hyperparameters on every ``hyper_stride``-th training row in time
             order (then at most ``n_train_max`` of them at random); 1 (the default): any ``n_train_max`` rows.

@@ -75,3 +75,16 @@ def test_one_flight_is_scored(tmp_path):
     assert np.isfinite(row["beta_rms_deg"])
     # JSBSim's Cl is linear in the air-relative rates: at them the model leaves less than at the gyro's
     assert row["true_air"]["Cl"] < row["true"]["Cl"]
+
+
+def test_gp_noise_defaults_to_learned_and_takes_independent(capsys):
+    """``--gp-noise``: ``learned`` by default (twenty-fifth session, i8-learned), ``independent`` (the old default,
+    one noise variance per output) by name; the choice is what sets the pipeline's three noise constants."""
+    with pytest.raises(SystemExit):
+        eval_jsbsim.main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "default learned" in text and "independent" in text
+    import gcs_sysid.pipeline as pipeline
+
+    assert pipeline.GP_NOISE == "learned"
+    assert pipeline.GP_NOISE_MODES["independent"] == (False, "full", "signal")
