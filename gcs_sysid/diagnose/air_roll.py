@@ -6,9 +6,10 @@ reference model's roll damping ``Cl_p`` and ``Cl_delta_a`` are attenuated (the g
 ``p`` is correlated with the ``Cl_p p_g`` left in the residual; Morelli and Klein, *Aircraft System
 Identification*, 2nd ed., 2016, sec. 5.6 and ch. 10). A hidden rolling moment (``Cl:alpha*beta``) is flown
 against by the roll loop, so ``p`` and ``delta_a`` move with it, and a model that under-predicts that response
-leaves only part of the term in the residual: the s23's ``Cl:alpha*beta = 3`` read 1.5-1.7 against the model
-fitted at the gyro's rate, 2.4-2.8 against the one fitted at the reference's own ``p_hat - p_hat_g``
-(``docs/benchmarks.md``, *Twenty-fifth session, i9-airroll*).
+leaves only part of the term in the residual: on the s23's ``Cl:alpha*beta = 3`` flights the bare residual reads
+1.5-1.7 against the model fitted at the gyro's rate, 2.45-2.79 against the one fitted at the reference's own
+``p_hat - p_hat_g`` (``docs/diagnose.md``, "The air-relative roll rate"; ``docs/benchmarks.md``, *Twenty-fifth
+session, i9-airroll*).
 
 ``p_hat_g`` is the ``"rollgp"`` roll fit's Rauch-Tung-Striebel smoothed rolling gust
 (:func:`gcs_sysid.aero.gustfilter.filter_gust_table`, :mod:`gcs_sysid.aero.rollgust`: the gust a first-order
@@ -23,8 +24,9 @@ moment carries that moment too. Measured on the s23's ``Cl:alpha*beta = 3`` flig
 ``p_hat_g`` regressed on JSBSim's ``p_hat_g`` and the injected moment over ``-Cl_p`` takes 0.63-0.65 of the
 injected term (0.99 at 1.5), and the residual along ``alpha*beta`` falls from 1.5-1.7 to -0.9 .. -0.2; with the
 term itself in the roll fit's design it still takes 0.45-0.47, and a 1-s high-pass of the estimate 0.11-0.15.
-So by default (:data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE` ``"reference"``) only the reference flight, the
-flight the model is fitted on and whose residual the differential search subtracts, is moved to the air rate;
+So the option's mode ``"reference"`` (:data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`; ``"off"`` by default) moves only
+the reference flight, the flight the model is fitted on and whose residual the differential search subtracts, to the
+air rate;
 the flight under test keeps the gyro's ``p_hat`` (its residual then carries the gust's ``-Cl_p p_hat_g``, which is
 independent of the regressors, as noise). ``"both"`` moves the flight under test too (measured, not recommended).
 """
