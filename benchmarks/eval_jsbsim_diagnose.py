@@ -635,9 +635,10 @@ def main(argv=None) -> int:
     p.add_argument("--stated-lift-slope", nargs="+", default=None, metavar="AC:CL_ALPHA[:CL_Q]",
                    help="the aiding's stated lift-slope floor per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero]; "
                         "gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE on; as eval_jsbsim's option; default off)")
-    p.add_argument("--air-roll-rate", default=None, choices=("off", "reference", "both"),
-                   help="the reference flight (and with 'both' the flight under test) at p_hat less its own smoothed "
-                        "rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the package's, off)")
+    p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both"),
+                   help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
+                        "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
+                        "package's, off)")
     a = p.parse_args(argv)
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr

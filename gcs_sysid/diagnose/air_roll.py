@@ -43,8 +43,9 @@ __all__ = ["AIR_ROLL_MODES", "air_roll_table"]
 
 #: The modes of :data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`: ``"off"`` (the gyro's rate everywhere),
 #: ``"reference"`` (the reference flight at its own air-relative rate, the flight under test at the gyro's) and
-#: ``"both"`` (each flight at its own air-relative rate; circular on a flight with a hidden rolling moment).
-AIR_ROLL_MODES = ("off", "reference", "both")
+#: ``"both"`` (each flight at its own air-relative rate; circular on a flight with a hidden rolling moment);
+#: ``"fit"`` (only the model is fitted at the reference's air-relative rate; both flights diagnosed at the gyro's).
+AIR_ROLL_MODES = ("off", "fit", "reference", "both")
 
 
 def air_roll_table(table, states, airframe):

@@ -66,14 +66,18 @@ ALPHA_LEVEL: str | None = None
 #: ``"off"`` (the gyro's ``p_hat`` everywhere, the default), ``"reference"`` (the reference flight, the one ``fit``
 #: fits the model on and the differential diagnosis and search compare with, at ``p_hat`` less its own smoothed
 #: rolling gust; the flight under test at the gyro's) or ``"both"`` (the flight under test at its own air-relative
-#: rate too; measured to take up a hidden rolling moment, docs/diagnose.md). Measured in docs/benchmarks.md,
+#: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
+#: diagnosis compares both flights at the gyro's rate). Measured in docs/benchmarks.md,
 #: "Twenty-fifth session, i9-airroll".
 AIR_ROLL_RATE = "off"
 
 
 def air_roll_for(role: str, mode: str | None = None) -> bool:
-    """Whether a flight of ``role`` (``"reference"`` or ``"flight"``, the one under test) is loaded at the
-    air-relative roll rate under ``mode`` (None: :data:`AIR_ROLL_RATE`).
+    """Whether a flight of ``role`` is loaded at the air-relative roll rate under ``mode`` (None: :data:`AIR_ROLL_RATE`).
+
+    Roles: ``"fit"`` (the reference flight as ``fit`` loads it to fit the model), ``"reference"`` (the reference
+    flight as the diagnosis compares with it) and ``"flight"`` (the flight under test). ``"fit"`` mode moves only the
+    model's fit; ``"reference"`` the fit and the reference; ``"both"`` all three.
 
     Raises:
         ValueError: an unknown ``role`` or ``mode`` (:data:`gcs_sysid.diagnose.air_roll.AIR_ROLL_MODES`).
@@ -83,9 +87,10 @@ def air_roll_for(role: str, mode: str | None = None) -> bool:
     mode = AIR_ROLL_RATE if mode is None else mode
     if mode not in AIR_ROLL_MODES:
         raise ValueError(f"air roll rate: mode must be one of {AIR_ROLL_MODES}, got {mode!r}")
-    if role not in ("reference", "flight"):
-        raise ValueError(f"air roll rate: role must be 'reference' or 'flight', got {role!r}")
-    return mode == "both" or (mode == "reference" and role == "reference")
+    if role not in ("fit", "reference", "flight"):
+        raise ValueError(f"air roll rate: role must be 'fit', 'reference' or 'flight', got {role!r}")
+    moved = {"off": (), "fit": ("fit",), "reference": ("fit", "reference"), "both": ("fit", "reference", "flight")}
+    return role in moved[mode]
 
 
 def shared_angle_models(fits: dict | None) -> dict | None:
@@ -187,7 +192,7 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
-                                 air_roll=air_roll_for("reference"))
+                                 air_roll=air_roll_for("fit"))
         model, report = fit_model(meas.table, name=Path(out_path).stem)
         model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
         save_model(model, stage.path(out), header=report.header())

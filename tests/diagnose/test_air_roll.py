@@ -96,8 +96,10 @@ def test_reference_at_its_air_rate_reads_a_hidden_rolling_moment_that_the_flight
 
 
 def test_air_roll_mode_checked_and_off_by_default():
-    assert run.AIR_ROLL_RATE == "off" and not run.air_roll_for("reference") and not run.air_roll_for("flight")
+    assert run.AIR_ROLL_RATE == "off" and not any(run.air_roll_for(r) for r in ("fit", "reference", "flight"))
     assert run.air_roll_for("flight", "both")
+    assert run.air_roll_for("fit", "fit") and not run.air_roll_for("reference", "fit")
+    assert run.air_roll_for("fit", "reference") and not run.air_roll_for("flight", "reference")
     with pytest.raises(ValueError, match="mode"):
         run.air_roll_for("reference", "gyro")
     with pytest.raises(ValueError, match="role"):
