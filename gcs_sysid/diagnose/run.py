@@ -68,7 +68,7 @@ ALPHA_LEVEL: str | None = None
 #: rolling gust; the flight under test at the gyro's) or ``"both"`` (the flight under test at its own air-relative
 #: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
 #: diagnosis compares both flights at the gyro's rate). Off: the ka350 wins (whole eval 30/26/22/19 -> 31/29/24/22), the
-#: b737 loses a clean flight and the c172p a bias:airspeed estimate and gain (rule 8(a)). Measured in docs/benchmarks.md,
+#: b737 loses a clean flight, the c172p a bias:airspeed estimate and gain, the s23 a Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md,
 #: "Twenty-fifth session, i9-airroll".
 AIR_ROLL_RATE = "off"
 
