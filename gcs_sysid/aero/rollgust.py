@@ -129,7 +129,7 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
         :class:`RollDynamicsFit`; ``g`` (``p_hat_g``) is 0 with the prior variance outside the rows used.
 
     Raises:
-        ValueError: shapes that disagree, ``dt`` not positive, fewer than 200 usable rows in runs of at least 50,
+        ValueError: shapes that disagree (``extra`` included), ``dt`` not positive, fewer than 200 usable rows in runs of at least 50,
             an unknown ``tau``, or a roll damping ``Cl_p`` that is not negative.
     """
     from scipy.optimize import minimize
@@ -137,7 +137,11 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
     X, Y = np.asarray(X, float), np.asarray(Y, float)
     T = len(X)
     shapes = [np.shape(v) for v in (p, qbar, rows)]
-    extra = np.zeros((T, 0)) if extra is None else np.asarray(extra, float).reshape(T, -1)
+    extra = np.zeros((T, 0)) if extra is None else np.asarray(extra, float)
+    if extra.ndim == 1:
+        extra = extra[:, None]
+    if extra.ndim != 2 or len(extra) != T:
+        raise ValueError(f"fit_roll_dynamics: extra columns (T, k) with T = {T} expected, got {extra.shape}")
     if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or any(s != (T,) for s in shapes):
         raise ValueError(f"fit_roll_dynamics: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}) and p, p_dot, "
                          f"qbar, rows (T,) expected, got {X.shape}, {Y.shape}, {shapes}")
