@@ -149,13 +149,13 @@ def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: st
     """Fly the clean reference flight, fit the model; returns (files, model path, measurements).
     ``turbulence``: the harness level (the evaluation flies "light"; tests of a mechanism pass "calm")."""
     from gcs_sysid.diagnose import run_fit
-    from gcs_sysid.diagnose.run import load_measurements
+    from gcs_sysid.diagnose.run import air_roll_for, load_measurements
 
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, turbulence=turbulence), [], out,
                     stem=f"{ac}-ref")
     model_path = out / f"{ac}-ref-{plan}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
-    return files, model_path, load_measurements(files.tlog, files.airframe)
+    return files, model_path, load_measurements(files.tlog, files.airframe, air_roll=air_roll_for("reference"))
 
 
 def _alpha_error_deg(table, tlog: Path) -> dict:
@@ -195,7 +195,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis).
     ``turbulence`` as in :func:`reference_model`; ``level_meas``: :func:`level_flights` (pooled alpha level)."""
     from gcs_sysid.diagnose import diagnose
-    from gcs_sysid.diagnose.run import load_measurements
+    from gcs_sysid.diagnose.run import air_roll_for, load_measurements
     from gcs_sysid.sim.model_file import load_model
 
     _LAST_PITOT.clear()
@@ -209,7 +209,8 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     # SHARE_ALPHA_MODEL its alpha with the reference's force model (one alpha scale for both)
     from gcs_sysid.diagnose.run import shared_angle_models
 
-    meas = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits))
+    meas = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits),
+                             air_roll=air_roll_for("flight"))
     from gcs_sysid.diagnose import run as diagnose_run
     from gcs_sysid.diagnose.differential import Reference
 
@@ -495,7 +496,8 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     est: dict[str, list[float]] = {c: [] for c in _FORCED}
     for cs in clean_seeds:
         files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan), [], out)
-        m = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits))
+        m = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits),
+                              air_roll=air_roll_for("flight"))
         ctx = DiagContext.build(m.table, m.airframe, model, m.states)
         res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, keep_residual=True)
         names, Phi = _library(ctx, knots)
@@ -633,7 +635,15 @@ def main(argv=None) -> int:
     p.add_argument("--stated-lift-slope", nargs="+", default=None, metavar="AC:CL_ALPHA[:CL_Q]",
                    help="the aiding's stated lift-slope floor per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero]; "
                         "gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE on; as eval_jsbsim's option; default off)")
+    p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both"),
+                   help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
+                        "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
+                        "package's, off)")
     a = p.parse_args(argv)
+    if a.air_roll_rate is not None:
+        from gcs_sysid.diagnose import run as _dr
+
+        _dr.AIR_ROLL_RATE = a.air_roll_rate
     if a.stated_lift_slope is not None:
         from benchmarks.eval_jsbsim import STATED_AERO
         from gcs_sysid.estimation import airangles as _aa

@@ -105,7 +105,8 @@ def causal_roll_moment(dt: float, Cl: np.ndarray, p: np.ndarray, qbar: np.ndarra
 
 def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
                       rows: np.ndarray, Ixx: float, S: float, b: float, tau: str = ROLL_TAU,
-                      max_fev: int = 400, R: float | None = None) -> RollDynamicsFit:
+                      max_fev: int = 400, R: float | None = None,
+                      extra: np.ndarray | None = None) -> RollDynamicsFit:
     """Filter-error slopes of the lateral ``Cl`` and the smoothed rolling gust (module docstring).
 
     Args:
@@ -118,12 +119,17 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
         Ixx, S, b: kg m^2, m^2, m.
         tau: ``"dryden"`` (``4 b/(pi V)`` at the rows' mean airspeed) or ``"fit"``.
         max_fev: Nelder-Mead's likelihood evaluations at most.
+        R: the moment's white-noise variance held fixed (None: a likelihood parameter).
+        extra: ``(T, k)`` further columns of the design beside ``(1,) + LAT_TERMS`` (None: none), their slopes
+            estimated with the others by the same GLS, so that a moment they carry is not taken up by the gust
+            state: the diagnosis's candidate terms (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`). Their
+            slopes follow ``theta[7:]`` (the step's damping factor divided out as for the others).
 
     Returns:
         :class:`RollDynamicsFit`; ``g`` (``p_hat_g``) is 0 with the prior variance outside the rows used.
 
     Raises:
-        ValueError: shapes that disagree, ``dt`` not positive, fewer than 200 usable rows in runs of at least 50,
+        ValueError: shapes that disagree (``extra`` included), ``dt`` not positive, fewer than 200 usable rows in runs of at least 50,
             an unknown ``tau``, or a roll damping ``Cl_p`` that is not negative.
     """
     from scipy.optimize import minimize
@@ -131,6 +137,11 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
     X, Y = np.asarray(X, float), np.asarray(Y, float)
     T = len(X)
     shapes = [np.shape(v) for v in (p, qbar, rows)]
+    extra = np.zeros((T, 0)) if extra is None else np.asarray(extra, float)
+    if extra.ndim == 1:
+        extra = extra[:, None]
+    if extra.ndim != 2 or len(extra) != T:
+        raise ValueError(f"fit_roll_dynamics: extra columns (T, k) with T = {T} expected, got {extra.shape}")
     if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or any(s != (T,) for s in shapes):
         raise ValueError(f"fit_roll_dynamics: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}) and p, p_dot, "
                          f"qbar, rows (T,) expected, got {X.shape}, {Y.shape}, {shapes}")
@@ -139,7 +150,7 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
     if tau not in ("dryden", "fit"):
         raise ValueError(f"fit_roll_dynamics: tau must be 'dryden' or 'fit', got {tau!r}")
     cols = [REGRESSORS.index(k) for k in LAT_TERMS]
-    A0 = np.c_[np.ones(T), X[:, cols]]
+    A0 = np.c_[np.ones(T), X[:, cols], extra]
     A = A0.copy()                                    # at k: the state the step starts from, the inputs it holds
     A[-1] = np.nan
     y = causal_roll_moment(dt, Y[:, COEFFICIENTS.index("Cl")], p, qbar, Ixx, S, b)

@@ -62,6 +62,37 @@ SHARE_ALPHA_MODEL = False
 #: "The alpha level", and docs/benchmarks.md, "Twenty-second session, i9-level".
 ALPHA_LEVEL: str | None = None
 
+#: The roll rate the diagnosis reads (:mod:`gcs_sysid.diagnose.air_roll`; twenty-fifth session, branch i9-airroll):
+#: ``"off"`` (the gyro's ``p_hat`` everywhere, the default), ``"reference"`` (the reference flight, the one ``fit``
+#: fits the model on and the differential diagnosis and search compare with, at ``p_hat`` less its own smoothed
+#: rolling gust; the flight under test at the gyro's) or ``"both"`` (the flight under test at its own air-relative
+#: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
+#: diagnosis compares both flights at the gyro's rate). Off: the ka350 wins (whole eval 30/26/22/19 -> 31/29/24/22), the
+#: b737 loses a clean flight, the c172p a bias:airspeed estimate and gain, the s23 a Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md,
+#: "Twenty-fifth session, i9-airroll".
+AIR_ROLL_RATE = "off"
+
+
+def air_roll_for(role: str, mode: str | None = None) -> bool:
+    """Whether a flight of ``role`` is loaded at the air-relative roll rate under ``mode`` (None: :data:`AIR_ROLL_RATE`).
+
+    Roles: ``"fit"`` (the reference flight as ``fit`` loads it to fit the model), ``"reference"`` (the reference
+    flight as the diagnosis compares with it) and ``"flight"`` (the flight under test). ``"fit"`` mode moves only the
+    model's fit; ``"reference"`` the fit and the reference; ``"both"`` all three.
+
+    Raises:
+        ValueError: an unknown ``role`` or ``mode`` (:data:`gcs_sysid.diagnose.air_roll.AIR_ROLL_MODES`).
+    """
+    from .air_roll import AIR_ROLL_MODES
+
+    mode = AIR_ROLL_RATE if mode is None else mode
+    if mode not in AIR_ROLL_MODES:
+        raise ValueError(f"air roll rate: mode must be one of {AIR_ROLL_MODES}, got {mode!r}")
+    if role not in ("fit", "reference", "flight"):
+        raise ValueError(f"air roll rate: role must be 'fit', 'reference' or 'flight', got {role!r}")
+    moved = {"off": (), "fit": ("fit",), "reference": ("fit", "reference"), "both": ("fit", "reference", "flight")}
+    return role in moved[mode]
+
 
 def shared_angle_models(fits: dict | None) -> dict | None:
     """The reference flight's air-angle fits that the flight under test is aided with.
@@ -84,7 +115,7 @@ def shared_angle_models(fits: dict | None) -> dict | None:
 
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
                       progress=None, notify=None, gust_rates: str | None = None,
-                      angle_models: dict | None = None) -> Measurements:
+                      angle_models: dict | None = None, air_roll: bool = False) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
@@ -95,6 +126,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         angle_models: a reference flight's ``states.angle_fits`` (:func:`shared_angle_models`): this flight's alpha
             is aided with its force model (one alpha scale for both) and its sideslip with its side-force estimator
             (:func:`gcs_sysid.estimation.estimate_states`). None: own.
+        air_roll: the table's ``p_hat`` less the flight's own smoothed rolling gust
+            (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`; :func:`air_roll_for` says which flights).
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
@@ -135,6 +168,10 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
+    if air_roll:
+        from .air_roll import air_roll_table
+
+        table, _ = air_roll_table(table, states, airframe)
     tm["coefficients_s"] = time.perf_counter() - t2
     return Measurements(flight, airframe, states, table, tm)
 
@@ -155,7 +192,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
 
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
-        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates)
+        meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
+                                 air_roll=air_roll_for("fit"))
         model, report = fit_model(meas.table, name=Path(out_path).stem)
         model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
         save_model(model, stage.path(out), header=report.header())
@@ -198,7 +236,7 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
         kw = {**kw, **_references(model_path, airframe_path, references, progress)}
         refs = kw.get("references") or []
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=shared_angle_models(
-            getattr(refs[0].states, "angle_fits", None)) if refs else None)
+            getattr(refs[0].states, "angle_fits", None)) if refs else None, air_roll=air_roll_for("flight"))
         level = alpha_level if alpha_level is not None else ALPHA_LEVEL
         level_info = None
         if level and refs:
@@ -244,7 +282,7 @@ def _references(model_path, airframe_path, given, progress) -> dict:
     logs, notes = reference_logs(model_path, given)
     refs = []
     for r in logs:
-        m = load_measurements(r["log"], airframe_path, *r["window_s"], progress)
+        m = load_measurements(r["log"], airframe_path, *r["window_s"], progress, air_roll=air_roll_for("reference"))
         refs.append(Reference(m.table, m.states, m.flight, label=Path(r["log"]).name))
     return {"references": refs, "reference_notes": notes} if (refs or notes) else {}
 

@@ -241,3 +241,20 @@ def test_held_out_rows_at_the_reconstructed_air_relative_roll_rate():
         heldout_air_roll(tab, st, air, ~held, held, mode="causal")
     with pytest.raises(InputError, match="heldout_air_roll"):
         check_replay("x.tlog", "x.toml", None, ReplayOptions(heldout_air_roll="causal"))
+
+
+def test_extra_design_columns_are_fitted_beside_the_gust_state():
+    """``fit_roll_dynamics(extra=)``: a column the moment does not carry (white noise) gets a slope near 0 and leaves the
+    lateral slopes and the gust as they are without it; a column of the wrong length is refused. (The twenty-fifth
+    session's circularity check put a candidate term there, docs/diagnose.md "The air-relative roll rate".)"""
+    X, Y, p, _ = _record(n=3000)
+    n = len(X)
+    q, rows = np.full(n, QBAR), np.ones(n, bool)
+    z = np.random.default_rng(3).normal(0, 0.1, n)
+    F0 = rg.fit_roll_dynamics(DT, X, Y, p, q, rows, IXX, S, B)
+    F = rg.fit_roll_dynamics(DT, X, Y, p, q, rows, IXX, S, B, extra=z)
+    assert F0.theta.shape == (7,) and F.theta.shape == (8,)
+    assert abs(F.theta[7]) < 0.005 and np.allclose(F.theta[:7], F0.theta, atol=0.01)
+    assert np.corrcoef(F.g, F0.g)[0, 1] > 0.99
+    with pytest.raises(ValueError, match="extra"):
+        rg.fit_roll_dynamics(DT, X, Y, p, q, rows, IXX, S, B, extra=z[:-1])
