@@ -633,7 +633,14 @@ def main(argv=None) -> int:
     p.add_argument("--stated-lift-slope", nargs="+", default=None, metavar="AC:CL_ALPHA[:CL_Q]",
                    help="the aiding's stated lift-slope floor per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero]; "
                         "gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE on; as eval_jsbsim's option; default off)")
+    p.add_argument("--beta-profile", default=None, choices=("on", "off"),
+                   help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood (gcs_sysid."
+                        "estimation.airangles.BETA_PROFILE; as eval_jsbsim's option; default: the package's, off)")
     a = p.parse_args(argv)
+    if a.beta_profile is not None:
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.BETA_PROFILE = a.beta_profile == "on"
     if a.stated_lift_slope is not None:
         from benchmarks.eval_jsbsim import STATED_AERO
         from gcs_sysid.estimation import airangles as _aa
