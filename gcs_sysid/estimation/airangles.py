@@ -184,9 +184,12 @@ PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per
 #: the directional mode the kinematic sideslip's gust error correlates positively with it); the likelihood peaks within
 #: a few per cent of JSBSim's slope there (docs/estimation.md, "The side-force slope by the gust model's likelihood").
 BETA_PROFILE = False
-BETA_PROFILE_RANGE = (2.0 / 3.0, 1.5)   #: ``CY_beta`` is searched between these multiples of least squares' slope
-#: (an optimum at either end keeps least squares: with (0.5, 2) the sgs126 s1 went to 0.53x, the us25e s1, s3 to 1.9x,
-#: error SD 0.32 -> 1.85, 0.41 -> 0.73 deg)
+#: ``CY_beta`` is searched between these multiples of least squares' slope; an optimum at either end keeps least
+#: squares. Only flatter (upper end 1): where the likelihood steepens least squares it was wrong on the roster (the jets,
+#: whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5 the
+#: error SD rose on 14 of 60 light roster flights, with 1 on 2 of 66, s23 and ka350 included; chosen after that
+#: measurement). The lower end: with 0.5 the sgs126 s1 went to 0.53x (error SD 0.32 -> 1.85 deg)
+BETA_PROFILE_RANGE = (2.0 / 3.0, 1.0)
 #: the force-derived departure is high-passed here before its likelihood, Hz: below it the kinematic angle's error is the
 #: 30-s wind estimate's drift, which a first-order gust state describes badly (full band: s23 s2, s3 -0.43, -0.31 against
 #: JSBSim's -0.55; with 0.1 Hz -0.52, -0.56)
@@ -586,8 +589,8 @@ def _profile_columns(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray,
 def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray, coeff: np.ndarray,
                          kin: np.ndarray, ang: np.ndarray, m: np.ndarray, segs: list[slice], cr: np.ndarray,
                          sign: float, taus: tuple[float, ...], ratios: tuple[float, ...],
-                         search: tuple[float, float] = BETA_PROFILE_RANGE,
-                         edge_hz: float | None = BETA_PROFILE_EDGE_HZ) -> tuple[np.ndarray, float]:
+                         search: tuple[float, float] | None = None,
+                         edge_hz: float | None = -1.0) -> tuple[np.ndarray, float]:
     """The angle's own slope (column 0, no curvature column) by the gust model's likelihood of the measured coefficient.
 
     The aiding's model is ``C = c0 + a (angle_kin + g) + X_other c_other + e`` with ``g`` a first-order Gauss-Markov gust
@@ -609,8 +612,8 @@ def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndar
         coefficient. A: (T, P) the columns. coeff: (T,) measured coefficient. kin, ang: (T,) kinematic and current angle,
         rad. m: (T,) bool aided rows (N of them). segs: their segments. cr: (P,) least squares' slopes. sign: the slope's
         expected sign. taus, ratios: the gust model's grid. search: the slope is searched (bounded Brent, scipy
-        ``minimize_scalar``) between these multiples of least squares' slope. edge_hz: ``z``'s high-pass edge, Hz (None:
-        the full band).
+        ``minimize_scalar``) between these multiples of least squares' slope (None: :data:`BETA_PROFILE_RANGE`).
+        edge_hz: ``z``'s high-pass edge, Hz (None: the full band; negative: :data:`BETA_PROFILE_EDGE_HZ`).
 
     Returns:
         ``(slopes (P,), least squares' angle slope)``; least squares' slopes unchanged if its slope has the wrong sign.
@@ -622,6 +625,8 @@ def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndar
     if not sign * b > 0:
         return cr, b
     n = int(m.sum())
+    search = BETA_PROFILE_RANGE if search is None else search
+    edge_hz = BETA_PROFILE_EDGE_HZ if edge_hz is not None and edge_hz < 0 else edge_hz
 
     def refit(d: float) -> np.ndarray:
         c = cr.copy()
