@@ -177,22 +177,23 @@ ALPHA_PROFILE_COLUMNS: tuple[str, ...] = ()
 PROFILE_REFIT = False      #: refit the other free columns for each candidate (a profile likelihood; measured: c172p
 #: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
 PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
-#: Opt-in (default False; twenty-fifth session, i8-beta): ``CY_beta`` by the gust model's likelihood, the filter-error
-#: estimate (:func:`_profile_angle_slope`): the change of variables' Jacobian ``-N log|CY_beta|`` included, the other
-#: side-force slopes refitted by least squares for each candidate, in the first pass (the later passes refit on the aided
-#: angle by least squares, a fixed point). Least squares above 0.3 Hz makes ``CY_beta`` 15-18 % steep on the s23 (above
-#: the directional mode the kinematic sideslip's gust error correlates positively with it); the likelihood peaks within
-#: a few per cent of JSBSim's slope there (docs/estimation.md, "The side-force slope by the gust model's likelihood").
+#: Opt-in (default False; twenty-fifth session, i8-beta): ``CY_beta`` by the gust model's likelihood, the
+#: filter-error estimate (:func:`_profile_angle_slope`): the change of variables' Jacobian ``-N log|CY_beta|`` included,
+#: the other side-force slopes refitted by least squares for each candidate, in the first pass (the later passes refit
+#: on the aided angle by least squares, a fixed point). Least squares above 0.3 Hz makes ``CY_beta`` 15-18 % steep on
+#: the s23 (above the directional mode the kinematic sideslip's gust error correlates positively with it); the
+#: likelihood lands within a few per cent of JSBSim's slope there (docs/estimation.md, "The side-force slope by the
+#: gust model's likelihood").
 BETA_PROFILE = False
 #: ``CY_beta`` is searched between these multiples of least squares' slope; an optimum at either end keeps least
-#: squares. Only flatter (upper end 1): where the likelihood steepens least squares it was wrong on the roster (the jets,
-#: whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5 the
-#: error SD rose on 14 of 60 light roster flights, with 1 on 2 of 66, s23 and ka350 included; chosen after that
-#: measurement). The lower end: with 0.5 the sgs126 s1 went to 0.53x (error SD 0.32 -> 1.85 deg)
+#: squares. Only flatter (upper end 1): where the likelihood steepened least squares it was wrong on the roster (the
+#: jets, whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5
+#: the error SD rose on 14 of 60 light roster flights, with 1 on 2 of 66, s23 and ka350 included; chosen after that
+#: measurement). The lower end: with 0.5 the sgs126 s1 went to 0.53 x (error SD 0.32 -> 1.85 deg).
 BETA_PROFILE_RANGE = (2.0 / 3.0, 1.0)
-#: the force-derived departure is high-passed here before its likelihood, Hz: below it the kinematic angle's error is the
-#: 30-s wind estimate's drift, which a first-order gust state describes badly (full band: s23 s2, s3 -0.43, -0.31 against
-#: JSBSim's -0.55; with 0.1 Hz -0.52, -0.56)
+#: the force-derived departure is high-passed here before its likelihood, Hz: below it the kinematic angle's error is
+#: the 30-s wind estimate's drift, which a first-order gust state describes badly (full band: s23 s2, s3 -0.43, -0.31
+#: against JSBSim's -0.55; with 0.1 Hz -0.52, -0.56)
 BETA_PROFILE_EDGE_HZ = 0.1
 
 
@@ -591,29 +592,31 @@ def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndar
                          sign: float, taus: tuple[float, ...], ratios: tuple[float, ...],
                          search: tuple[float, float] | None = None,
                          edge_hz: float | None = -1.0) -> tuple[np.ndarray, float]:
-    """The angle's own slope (column 0, no curvature column) by the gust model's likelihood of the measured coefficient.
+    """The angle's own slope (column 0, no curvature column) by the gust model's likelihood of the coefficient.
 
-    The aiding's model is ``C = c0 + a (angle_kin + g) + X_other c_other + e`` with ``g`` a first-order Gauss-Markov gust
-    angle and ``e`` white. For a candidate slope ``a`` (the other columns refitted by least squares on the band-passed
-    rows, a profile) the force-derived departure ``z = (C - c0 - a angle - X_other c_other) / a + angle - angle_kin`` is
-    ``g + e / a``, and the coefficient's log-likelihood is that of ``z`` under the gust model (:func:`_gm_search`, the
-    correlation time and the variance ratio maximised, the scale profiled out) plus the change of variables' Jacobian
-    ``-N log|a|`` (``z`` scales as ``1 / a``: without it a flatter slope always looks likelier). This is the filter-error
-    method's estimate of the slope with the turbulence as process noise (Jategaonkar, *Flight Vehicle System
-    Identification*, 2nd ed., 2015, ch. 5 and 7; Maine and Iliff, NASA RP-1168, 1986, ch. 6-7). Least squares instead
-    reads the gust's sideslip wherever it correlates with the kinematic one: on the JSBSim flights that correlation is
-    positive above the directional mode, so least squares above 0.3 Hz makes ``CY_beta`` steep (s23 15-18 %), and below
-    it negative (attenuated): no band edge is right on every aircraft, while the likelihood uses the whole record.
-    ``z`` is high-passed at ``edge_hz`` first (the wind estimate's slow drift is no first-order gust). An optimum at
-    either end of the search (the likelihood monotone: not identified) keeps least squares' slopes.
+    The aiding's model is ``C = c0 + a (angle_kin + g) + X_other c_other + e`` with ``g`` a first-order
+    Gauss-Markov gust angle and ``e`` white. For a candidate slope ``a`` (the other columns refitted by least squares
+    on the band-passed rows, a profile) the force-derived departure ``z = (C - c0 - a angle - X_other c_other) / a +
+    angle - angle_kin`` is ``g + e / a``, and the coefficient's log-likelihood is that of ``z`` under the gust model
+    (:func:`_gm_search`: the correlation time and the variance ratio maximised, the scale profiled out) plus the change
+    of variables' Jacobian ``-N log|a|`` (``z`` scales as ``1 / a``: without it a flatter slope always looks likelier).
+    This is the filter-error method's estimate of the slope with the turbulence as process noise (Jategaonkar,
+    *Flight Vehicle System Identification*, 2nd ed., 2015, ch. 5 and 7; Maine and Iliff, NASA RP-1168, 1986, ch. 6-7).
+    Least squares instead reads the gust's sideslip wherever it correlates with the kinematic one: on the JSBSim
+    flights that correlation is positive above the directional mode, so least squares above 0.3 Hz makes ``CY_beta``
+    steep (s23 15-18 %), and negative below it (attenuated): no band edge is right on every aircraft, while the
+    likelihood uses the whole record. ``z`` is high-passed at ``edge_hz`` first (the wind estimate's slow drift is no
+    first-order gust). An optimum at either end of the search (the likelihood monotone: not identified) keeps least
+    squares' slopes.
 
     Args:
-        dt: grid step, s. Ahm: (N, P) band-passed columns on the aided rows (the angle first). yhm: (N,) band-passed
-        coefficient. A: (T, P) the columns. coeff: (T,) measured coefficient. kin, ang: (T,) kinematic and current angle,
-        rad. m: (T,) bool aided rows (N of them). segs: their segments. cr: (P,) least squares' slopes. sign: the slope's
-        expected sign. taus, ratios: the gust model's grid. search: the slope is searched (bounded Brent, scipy
-        ``minimize_scalar``) between these multiples of least squares' slope (None: :data:`BETA_PROFILE_RANGE`).
-        edge_hz: ``z``'s high-pass edge, Hz (None: the full band; negative: :data:`BETA_PROFILE_EDGE_HZ`).
+        dt: grid step, s. Ahm: (N, P) band-passed columns on the aided rows (the angle first). yhm: (N,)
+        band-passed coefficient. A: (T, P) the columns. coeff: (T,) measured coefficient. kin, ang: (T,) kinematic
+        and current angle, rad. m: (T,) bool aided rows (N of them). segs: their segments. cr: (P,) least squares'
+        slopes. sign: the slope's expected sign. taus, ratios: the gust model's grid. search: the slope is searched
+        (bounded Brent, scipy ``minimize_scalar``) between these multiples of least squares' slope (None:
+        :data:`BETA_PROFILE_RANGE`). edge_hz: ``z``'s high-pass edge, Hz (None: the full band; negative:
+        :data:`BETA_PROFILE_EDGE_HZ`).
 
     Returns:
         ``(slopes (P,), least squares' angle slope)``; least squares' slopes unchanged if its slope has the wrong sign.
