@@ -10,7 +10,9 @@ for the one fitted on JSBSim's own regressors and coefficient (the same columns,
   IMU at the CG), so the two must agree; and the angles at the aerodynamic reference point (``--arp X Z``, metres
   ahead of and above the CG, :func:`point_angles`), which differ by ``omega x r / V``;
 * ``alpha``: ``main`` (the pipeline), ``CZa`` (the truth's ``CZ_alpha``), ``CZq`` (the truth's ``CZ_q_hat``), ``CZa+CZq``
-  and ``all`` (every CZ slope the truth's); ``beta``: ``main``, ``CYb`` (the truth's ``CY_beta``), ``all``;
+  and ``all`` (every CZ slope the truth's); ``beta``: ``main``, ``CYb`` (the truth's ``CY_beta``), ``all``, and
+  ``profile`` (nothing swapped: ``CY_beta`` of the first pass by the gust model's likelihood, the opt-in
+  :data:`gcs_sysid.estimation.airangles.BETA_PROFILE`; twenty-fifth session, i8-beta);
 * for each: the error's mean and SD (deg) and its scale ``k``: the aided angle's variations are ``k`` times the true
   ones (:func:`error_stats`; a curvature in the angle then reads ``1 / k^2`` of the truth);
 * ``curv``: the pitching moment's curvature in alpha read by least squares (:func:`curvature_read`, ``Cm`` on ``1,
@@ -184,6 +186,8 @@ def shares(tlog: Path, aircraft: str, arp: tuple[float, float] | None = None,
                 out.append(fmt(name, aa.aided_air_angles(*args, **kw), c, "beta"))
             finally:
                 aa._axis = orig
+        r = aa.aided_air_angles(*args, **dict(kw, profile_beta=True))
+        out.append(fmt("profile", r, r.axes[1].coef[1:], "beta"))
     return out
 
 

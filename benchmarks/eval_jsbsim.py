@@ -531,6 +531,9 @@ def main(argv=None) -> int:
                     help="the side-force slopes: least squares (off), 2SLS with the first-stage R2 floor (r2: "
                          "INSTRUMENTED_BETA), or 2SLS where the effective-sample first-stage F passes (f: "
                          "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
+    ap.add_argument("--beta-profile", default=None, choices=("on", "off"),
+                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood (gcs_sysid."
+                         "estimation.airangles.BETA_PROFILE; default: the package's default, off)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
                     help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."
@@ -565,6 +568,10 @@ def main(argv=None) -> int:
         from gcs_sysid.estimation import airangles
 
         airangles.FLOOR_DROPS_CURVATURE = a.floor_drops_curvature == "on"
+    if a.beta_profile is not None:
+        from gcs_sysid.estimation import airangles
+
+        airangles.BETA_PROFILE = a.beta_profile == "on"
     if a.iv_beta is not None:
         from gcs_sysid.estimation import airangles
 

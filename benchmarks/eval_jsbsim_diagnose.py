@@ -639,11 +639,18 @@ def main(argv=None) -> int:
                    help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
                         "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
                         "package's, off)")
+    p.add_argument("--beta-profile", default=None, choices=("on", "off"),
+                   help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood (gcs_sysid."
+                        "estimation.airangles.BETA_PROFILE; as eval_jsbsim's option; default: the package's, off)")
     a = p.parse_args(argv)
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr
 
         _dr.AIR_ROLL_RATE = a.air_roll_rate
+    if a.beta_profile is not None:
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.BETA_PROFILE = a.beta_profile == "on"
     if a.stated_lift_slope is not None:
         from benchmarks.eval_jsbsim import STATED_AERO
         from gcs_sysid.estimation import airangles as _aa

@@ -177,6 +177,24 @@ ALPHA_PROFILE_COLUMNS: tuple[str, ...] = ()
 PROFILE_REFIT = False      #: refit the other free columns for each candidate (a profile likelihood; measured: c172p
 #: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
 PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
+#: Opt-in (default False; twenty-fifth session, i8-beta): ``CY_beta`` by the gust model's likelihood, the
+#: filter-error estimate (:func:`_profile_angle_slope`): the change of variables' Jacobian ``-N log|CY_beta|`` included,
+#: the other side-force slopes refitted by least squares for each candidate, in the first pass (the later passes refit
+#: on the aided angle by least squares, a fixed point). Least squares above 0.3 Hz makes ``CY_beta`` 15-18 % steep on
+#: the s23 (above the directional mode the kinematic sideslip's gust error correlates positively with it); the
+#: likelihood lands within a few per cent of JSBSim's slope there (docs/estimation.md, "The side-force slope by the
+#: gust model's likelihood").
+BETA_PROFILE = False
+#: ``CY_beta`` is searched between these multiples of least squares' slope; an optimum at either end keeps least
+#: squares. Only flatter (upper end 1): where the likelihood steepened least squares it was wrong on the roster (the
+#: jets, whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5
+#: the error SD rose on 14 of 60 light roster flights, with 1 on 2 of 66, s23 and ka350 included; chosen after that
+#: measurement). The lower end: with 0.5 the sgs126 s1 went to 0.53 x (error SD 0.32 -> 1.85 deg).
+BETA_PROFILE_RANGE = (2.0 / 3.0, 1.0)
+#: the force-derived departure is high-passed here before its likelihood, Hz: below it the kinematic angle's error is
+#: the 30-s wind estimate's drift, which a first-order gust state describes badly (full band: s23 s2, s3 -0.43, -0.31
+#: against JSBSim's -0.55; with 0.1 Hz -0.52, -0.56)
+BETA_PROFILE_EDGE_HZ = 0.1
 
 
 @dataclass
@@ -569,12 +587,80 @@ def _profile_columns(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray,
     return cr, moved
 
 
+def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray, coeff: np.ndarray,
+                         kin: np.ndarray, ang: np.ndarray, m: np.ndarray, segs: list[slice], cr: np.ndarray,
+                         sign: float, taus: tuple[float, ...], ratios: tuple[float, ...],
+                         search: tuple[float, float] | None = None,
+                         edge_hz: float | None = -1.0) -> tuple[np.ndarray, float]:
+    """The angle's own slope (column 0, no curvature column) by the gust model's likelihood of the coefficient.
+
+    The aiding's model is ``C = c0 + a (angle_kin + g) + X_other c_other + e`` with ``g`` a first-order
+    Gauss-Markov gust angle and ``e`` white. For a candidate slope ``a`` (the other columns refitted by least squares
+    on the band-passed rows, a profile) the force-derived departure ``z = (C - c0 - a angle - X_other c_other) / a +
+    angle - angle_kin`` is ``g + e / a``, and the coefficient's log-likelihood is that of ``z`` under the gust model
+    (:func:`_gm_search`: the correlation time and the variance ratio maximised, the scale profiled out) plus the change
+    of variables' Jacobian ``-N log|a|`` (``z`` scales as ``1 / a``: without it a flatter slope always looks likelier).
+    This is the filter-error method's estimate of the slope with the turbulence as process noise (Jategaonkar,
+    *Flight Vehicle System Identification*, 2nd ed., 2015, ch. 5 and 7; Maine and Iliff, NASA RP-1168, 1986, ch. 6-7).
+    Least squares instead reads the gust's sideslip wherever it correlates with the kinematic one: on the JSBSim
+    flights that correlation is positive above the directional mode, so least squares above 0.3 Hz makes ``CY_beta``
+    steep (s23 15-18 %), and negative below it (attenuated): no band edge is right on every aircraft, while the
+    likelihood uses the whole record. ``z`` is high-passed at ``edge_hz`` first (the wind estimate's slow drift is no
+    first-order gust). An optimum at either end of the search (the likelihood monotone: not identified) keeps least
+    squares' slopes.
+
+    Args:
+        dt: grid step, s. Ahm: (N, P) band-passed columns on the aided rows (the angle first). yhm: (N,)
+        band-passed coefficient. A: (T, P) the columns. coeff: (T,) measured coefficient. kin, ang: (T,) kinematic
+        and current angle, rad. m: (T,) bool aided rows (N of them). segs: their segments. cr: (P,) least squares'
+        slopes. sign: the slope's expected sign. taus, ratios: the gust model's grid. search: the slope is searched
+        (bounded Brent, scipy ``minimize_scalar``) between these multiples of least squares' slope (None:
+        :data:`BETA_PROFILE_RANGE`). edge_hz: ``z``'s high-pass edge, Hz (None: the full band; negative:
+        :data:`BETA_PROFILE_EDGE_HZ`).
+
+    Returns:
+        ``(slopes (P,), least squares' angle slope)``; least squares' slopes unchanged if its slope has the wrong sign.
+    """
+    from scipy.optimize import minimize_scalar
+
+    cr = np.asarray(cr, float).copy()
+    b = float(cr[0])
+    if not sign * b > 0:
+        return cr, b
+    n = int(m.sum())
+    search = BETA_PROFILE_RANGE if search is None else search
+    edge_hz = BETA_PROFILE_EDGE_HZ if edge_hz is not None and edge_hz < 0 else edge_hz
+
+    def refit(d: float) -> np.ndarray:
+        c = cr.copy()
+        c[0] = d
+        if Ahm.shape[1] > 1:
+            c[1:] = np.linalg.lstsq(Ahm[:, 1:], yhm - d * Ahm[:, 0], rcond=None)[0]
+        return c
+
+    def nll(d: float) -> float:
+        c = refit(d)
+        model = float(np.mean(coeff[m] - A[m] @ c)) + A[m] @ c
+        z = np.full(len(kin), np.nan)
+        z[m] = ang[m] + (coeff[m] - model) / d - kin[m]
+        if edge_hz is not None:
+            z = _highpass(dt, z[:, None], segs, edge_hz)[:, 0]
+        return -(_gm_search(dt, z, segs, taus, ratios)[0] - n * np.log(abs(d)))
+
+    lo, hi = sorted((search[0] * b, search[1] * b))
+    r = minimize_scalar(nll, bounds=(lo, hi), method="bounded", options={"xatol": 1e-3 * abs(b)})
+    d = float(r.x)
+    if not np.isfinite(r.fun) or min(d - lo, hi - d) < 0.01 * (hi - lo):
+        return cr, b
+    return refit(d), b
+
+
 def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict[str, np.ndarray],
           use: np.ndarray, passes: int, sign: float, quadratic: bool, symmetric: bool,
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
           V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
           slope_floor: float | None = None, floor_held: dict[str, float] | None = None, endog: tuple[str, ...] = (),
-          min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None
+          min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None, profile: bool = False
           ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
@@ -597,7 +683,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     :data:`INSTRUMENTED_BETA`); ``min_first_stage``: the instruments' least first-stage partial R^2, below which the
     slopes fall back to ordinary least squares; ``weak_test``: ``"f"`` tests the instruments by their first-stage F
     on the effective sample size instead (:func:`.angleerrors.first_stage_f`, at least
-    :data:`BETA_MIN_FIRST_STAGE_F`; ``min_first_stage`` 0 skips the test), None: by ``min_first_stage``."""
+    :data:`BETA_MIN_FIRST_STAGE_F`; ``min_first_stage`` 0 skips the test), None: by ``min_first_stage``; ``profile``:
+    the angle's slope of the first least-squares pass by the gust model's likelihood (:func:`_profile_angle_slope`; not
+    with ``quadratic``, a floor, instruments or ``given``; :data:`BETA_PROFILE`)."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -703,6 +791,15 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                           f"(fitted {free:+.2f}: attenuated by the kinematic angle's gust error)"
                           + "".join(f", {names[j + 1]} held at the stated {v:+.2f}" for j, v in hold.items())
                           + (f" and {', '.join(dropped)} left out" if dropped else ""))
+        if (profile and fit is None and fixed is None and not quadratic and slope_floor is None
+                and method.startswith("OLS")):
+            # the filter-error estimate of the angle's slope: least squares reads the gust's part of the angle that
+            # correlates with the kinematic one (steep above the directional mode, flat below it)
+            cr, b_ls = _profile_angle_slope(dt, Ah[m], yh[m], A, coeff, kin, ang, m, segs, cr, sign, TAUS_S, RATIOS)
+            res = yh[m] - Ah[m] @ cr      # the identification check keeps least squares' standard error
+            if cr[0] != b_ls:
+                profile_note = (f"; first pass {names[1] if name == 'alpha' else 'CY_beta'} by the gust model's "
+                                f"likelihood {cr[0]:+.3f} (least squares {b_ls:+.3f})")
         prof = ([names.index(k) - 1 for k in ALPHA_PROFILE_COLUMNS if k in names[2:]]
                 if name == "alpha" and fixed is None and not method.startswith("2SLS") else [])
         if prof:
@@ -911,7 +1008,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      rate_dot: np.ndarray | None = None, inertia: np.ndarray | None = None,
                      instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None,
                      instrument_beta: bool | None = None, beta_band_hz: float | None = None,
-                     stated_slopes: tuple[float | None, float | None] | None = None) -> AidedAngles:
+                     stated_slopes: tuple[float | None, float | None] | None = None,
+                     profile_beta: bool | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -956,6 +1054,9 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             pass is ``CL_alpha`` instead of the wing's Helmbold slope, and where it holds ``q_hat`` is held at
             ``-CL_q`` instead of left out (:data:`STATED_LIFT_SLOPE`; the witness :data:`FLOOR_MIN_GUST_SHARE` still
             decides whether the floor holds). None: the wing's floor.
+        profile_beta: ``CY_beta`` of the first pass by the gust model's likelihood (the filter-error estimate,
+            :func:`_profile_angle_slope`) instead of least squares above the band edge; only where the side-force slopes
+            are fitted by least squares (not with 2SLS or a given model). None: :data:`BETA_PROFILE`.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -1034,7 +1135,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             inst_b = None
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
                           endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=min_fs_b,
-                          weak_test=BETA_WEAK_TEST, band_hz=beta_band_hz)
+                          weak_test=BETA_WEAK_TEST, band_hz=beta_band_hz,
+                          profile=BETA_PROFILE if profile_beta is None else bool(profile_beta))
     fb.slope_method += est_note
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
