@@ -66,3 +66,14 @@ def test_signal_of_the_nominal_form_gets_the_plain_smoother():
     with_gust, _, _ = smooth_specific_force(DT, Z, residual_correction=False)
     plain, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_hz=())
     np.testing.assert_array_equal(with_gust, plain)
+
+
+def test_x_axis_offered_the_state_on_request():
+    # opt-in (estimate_states(gust_force_axes=(0, 1, 2)), eval_jsbsim --gust-force-axes xyz; twenty-fifth session,
+    # i8-meas): the longitudinal gust's drag has the same 1/f^2 tail; x then gets the estimate y and z get
+    f, z = _normal_force()
+    Z = np.stack([z, z, z], 1)
+    xyz, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_axes=(0, 1, 2))
+    plain, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_hz=())
+    np.testing.assert_array_equal(xyz[:, 0], xyz[:, 2])
+    assert _err(xyz[:, 0], f) < 0.6 * _err(plain[:, 0], f)
