@@ -548,7 +548,14 @@ def main(argv=None) -> int:
                     help="give the aiding a stated whole-aircraft lift slope (1/rad) and pitch-rate lift (per q_hat) "
                          "per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero] table; gcs_sysid.estimation.airangles."
                          "STATED_LIFT_SLOPE on; default: off, the wing's floor)")
+    ap.add_argument("--gust-force-axes", default=None, choices=("yz", "xyz"),
+                    help="the specific-force axes offered the turbulence state (gcs_sysid.estimation.rates."
+                         "GUST_FORCE_AXES; default: the package's, y and z; xyz adds x)")
     a = ap.parse_args(argv)
+    if a.gust_force_axes is not None:
+        from gcs_sysid.estimation import rates as _rates
+
+        _rates.GUST_FORCE_AXES = tuple("xyz".index(c) for c in a.gust_force_axes)
     if a.stated_lift_slope is not None:
         from gcs_sysid.estimation import airangles as _aa
 

@@ -19,6 +19,7 @@ from ..errors import DataError
 from ..parallel import Helper
 from ..telemetry.types import Flight
 from . import airangles
+from . import rates as _rates
 from .airangles import aided_air_angles, describe
 from .airdata import air_angles, density, estimate_wind, isa, pressure_altitude, tas_from_eas
 from .align import Aligned, align_flight, events
@@ -129,7 +130,8 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
 def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     progress: Callable[[float], None] | None = None, helper: Helper | None = None,
                     aid_air_angles: bool = True, earth: str = "wgs84", angle_models: dict | None = None,
-                    turbulence_state: bool = True) -> FlightStates:
+                    turbulence_state: bool = True,
+                    gust_force_axes: tuple[int, ...] | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -152,6 +154,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             (:data:`gcs_sysid.estimation.rates.GUST_HZ`; the replay's default). False: the plain smoother, as the
             diagnosis and ``fit`` load their flights (:func:`gcs_sysid.diagnose.run.load_measurements`: on a
             clean JSBSim c172x flight the retained high-frequency CZ was named a zero-size elevator delay).
+        gust_force_axes: the specific-force axes (0 x, 1 y, 2 z) offered that state; None:
+            :data:`gcs_sysid.estimation.rates.GUST_FORCE_AXES` as it stands at the call (y and z; ``(0, 1, 2)``
+            adds x, opt-in, ``eval_jsbsim --gust-force-axes xyz``; docs/estimation.md).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -329,7 +334,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         sf_job = (helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
                                                           f_cg, controls=U, scale=qbar_eas, input_lag=in_lag,
                                                           holds=(Rr.hold,) if in_lag is not None else HOLDS,
-                                                          gust_hz=GUST_HZ if turbulence_state else ())
+                                                          gust_hz=GUST_HZ if turbulence_state else (),
+                                                          gust_axes=tuple(_rates.GUST_FORCE_AXES if gust_force_axes
+                                                                          is None else gust_force_axes))
     vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
         "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
     vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")

@@ -177,7 +177,10 @@ GUST_TAU_S = 2.0
 #: 14.8-16.0 -> 6.5-8.1, sgs126 10.9-14.7 -> 6.3-8.6, c172x 10.0-13.3 -> 9.8-12.8 %; the smoother alone on the f16's
 #: light flights 6.2-7.4 -> 6.7-8.6 % (the one loss; docs/estimation.md, section 5, "The measured coefficients in
 #: MIL-F-8785C light turbulence").
-#: x keeps the residual's Wiener correction alone.
+#: x keeps the residual's Wiener correction alone by default; ``(0, 1, 2)`` (``estimate_states(gust_force_axes=)``,
+#: ``eval_jsbsim --gust-force-axes xyz``) offers x the state too, opt-in: held-out CX sgs126 14.4 -> 12.3, us25e
+#: 3.5 -> 2.7 %, GP band-edge flips elsewhere (docs/estimation.md, "The measured coefficients against their noise
+#: floors"; twenty-fifth session, i8-meas). Read at each :func:`~.estimate.estimate_states` call.
 GUST_FORCE_AXES = (1, 2)
 #: Window of the rate smoother's local bandwidth choice, s (:func:`_local_blend`): the motion's strength changes
 #: along a flight (manoeuvres and quiet legs; turbulence with altitude, MIL-F-8785C sec. 3.7, and in patches), a

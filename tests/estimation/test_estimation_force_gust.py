@@ -4,6 +4,7 @@ up to the Nyquist frequency where the plain smoother took it for noise, and a fl
 plain smoother."""
 
 import numpy as np
+import pytest
 from scipy.signal import butter, lfilter
 
 from gcs_sysid.estimation.rates import GUST_FORCE_AXES, smooth_specific_force
@@ -66,3 +67,54 @@ def test_signal_of_the_nominal_form_gets_the_plain_smoother():
     with_gust, _, _ = smooth_specific_force(DT, Z, residual_correction=False)
     plain, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_hz=())
     np.testing.assert_array_equal(with_gust, plain)
+
+
+def test_x_axis_offered_the_state_on_request():
+    # opt-in (estimate_states(gust_force_axes=(0, 1, 2)), eval_jsbsim --gust-force-axes xyz; twenty-fifth session,
+    # i8-meas): the longitudinal gust's drag has the same 1/f^2 tail; x then gets the estimate y and z get
+    f, z = _normal_force()
+    Z = np.stack([z, z, z], 1)
+    xyz, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_axes=(0, 1, 2))
+    plain, _, _ = smooth_specific_force(DT, Z, residual_correction=False, gust_hz=())
+    np.testing.assert_array_equal(xyz[:, 0], xyz[:, 2])
+    assert _err(xyz[:, 0], f) < 0.6 * _err(plain[:, 0], f)
+
+
+class _Stop(Exception):
+    pass
+
+
+class _RecordingHelper:
+    """Stands in for :class:`gcs_sysid.parallel.Helper`: records the specific-force job's arguments, then stops."""
+
+    def __init__(self):
+        self.kwargs = None
+
+    def submit(self, target, *args, **kwargs):
+        assert target.endswith(":smooth_specific_force")
+        self.kwargs = kwargs
+        raise _Stop
+
+
+def _gust_axes_passed(monkeypatch, axes_constant, **kw):
+    from synthetic_flight import flight_from_truth, truth
+
+    from gcs_sysid.airframe import airframe_from_dict
+    from gcs_sysid.estimation import estimate_states, rates
+
+    monkeypatch.setattr(rates, "GUST_FORCE_AXES", axes_constant)
+    servo = {"name": "elevator", "channel": 2, "pwm_min": 1100, "pwm_trim": 1500, "pwm_max": 1900,
+             "deflection_at_pwm_min_deg": 20.0, "deflection_at_pwm_max_deg": -20.0, "mix": {"delta_e": 1.0}}
+    af = airframe_from_dict({"name": "synthetic", "mass": 3.0, "inertia": {"Ixx": 0.3, "Iyy": 0.35, "Izz": 0.6},
+                             "geometry": {"S": 0.55, "b": 2.0, "c": 0.28}, "servo": [servo]})
+    h = _RecordingHelper()
+    with pytest.raises(_Stop):
+        estimate_states(flight_from_truth(truth(10.0), seed=1), af, helper=h, **kw)
+    return h.kwargs["gust_axes"]
+
+
+def test_estimate_states_passes_the_axes(monkeypatch):
+    # the default path: y and z, read from rates.GUST_FORCE_AXES at the call (eval_jsbsim --gust-force-axes sets it)
+    assert _gust_axes_passed(monkeypatch, (1, 2)) == (1, 2)
+    assert _gust_axes_passed(monkeypatch, (0, 1, 2)) == (0, 1, 2)
+    assert _gust_axes_passed(monkeypatch, (1, 2), gust_force_axes=(0, 1, 2)) == (0, 1, 2)
