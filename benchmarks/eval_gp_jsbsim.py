@@ -94,10 +94,9 @@ Usage::
 ``iar80`` (``IAR80_glide``), ``c684`` (``C684_glide``), ``ultrastick`` (``UltraStick120_glide``), ``b737`` (``737``) and
 ``c172p``, ``eternity`` (``Eternity_glide``), ``us25e`` (``UltraStick25e_glide``), ``ka350``
 (``KingAir350_glide``, a JSBSim Beechcraft King Air 350 twin turboprop from a FlightGear package, without its engines)
-and ``s23`` (``ShortS23_glide``, JSBSim's Short S.23 flying boat, without its engines) were held out in earlier
-sessions and have been evaluated: they count as used. ``dr1`` (JSBSim's Fokker Dr.I triplane, ``Dr1_glide``,
-without its rotary engine) is the held-out, untouched one: never in the defaults, made and scored only in the final
-evaluation.
+``s23`` (``ShortS23_glide``, JSBSim's Short S.23 flying boat, without its engines) and ``dr1`` (``Dr1_glide``,
+JSBSim's Fokker Dr.I triplane, without its rotary engine) were held out in earlier sessions and have been evaluated:
+they count as used. No aircraft is held out or untouched until the next one is added.
 """
 
 from __future__ import annotations
@@ -562,7 +561,7 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide); "
-                         "dr1 is the untouched aircraft; default %(default)s")
+                         "none is untouched until the next one is added; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
 

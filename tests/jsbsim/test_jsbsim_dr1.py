@@ -1,4 +1,5 @@
-"""The dr1 in the JSBSim harness: the twenty-fifth session's untouched aircraft (docs/jsbsim.md, "The dr1").
+"""The dr1 in the JSBSim harness: the twenty-fifth session's untouched aircraft, a tuning aircraft since the
+twenty-sixth session (docs/jsbsim.md, "The dr1").
 
 The model is JSBSim's Fokker Dr.I triplane (Ron Jensen and Erik Hofman 2008, from an Aeromatic 0.9 start; the jsbsim
 1.3.3 wheel's ``aircraft/dr1/dr1.xml``, LGPL-2.1 with JSBSim), a 1917 triplane fighter of 945 lb as the harness flies
@@ -18,13 +19,15 @@ a mechanism check); none of them flies the harness:
 - the FCS maps the commands straight to the surfaces (elevator +-20.1 deg, ailerons +-17.2 deg, rudder +-8.8 deg:
   the command clipped at 0.35 of +-25.2 deg); no engine, no external force;
 - it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_s23.py``).
+- the summaries label it bare, as every tuning aircraft (until the next untouched aircraft is added, no aircraft is
+  labelled "(untouched)").
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
 hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
 are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the dr1: its first evaluation is the final one, after the merge.
+No pipeline fit, GP, diagnosis or scoring ran on the dr1 before its final evaluation (twenty-fifth session); it is a
+tuning aircraft since.
 """
 
 import dataclasses
@@ -170,10 +173,10 @@ def test_the_dr1_is_statically_stable_and_its_controls_act_as_its_xml_says():
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0965, abs=3e-4), a
 
 
-def test_summaries_mark_the_dr1_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the dr1 "(untouched)" and no other
-    aircraft, the s23, ka350 and us25e included (synthetic rows: no dr1 result exists before the final evaluation).
-    Moved here from ``test_jsbsim_s23.py`` (the twenty-fourth session's untouched aircraft)."""
+def test_summaries_mark_no_aircraft_untouched_the_dr1_included(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the dr1 bare, as every other aircraft
+    (synthetic rows): the twenty-sixth session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
+    until the next one is added."""
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
     from gcs_sysid.aero.table import COEFFICIENTS
 
@@ -187,14 +190,13 @@ def test_summaries_mark_the_dr1_untouched_and_the_others_used(tmp_path):
     p = tmp_path / "r.jsonl"
     p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
     lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| dr1 (untouched) | light") for ln in lines)
-    for ac in acs[:-1]:
+    for ac in acs:
         assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
+    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
     d = tmp_path / "d.jsonl"
     d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
                          for ac in acs))
     lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| dr1 (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| dr1 | clean |") for ln in lines)
     assert any(ln.startswith("| s23 | clean |") for ln in lines)
-    assert sum("(untouched)" in ln for ln in lines) == 1
+    assert not any("(untouched)" in ln for ln in lines)
