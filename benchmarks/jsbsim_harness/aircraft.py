@@ -100,8 +100,10 @@ _DEG = 57.29577951308232
 #: model with DATCOM+ aerodynamics, checked into ``data/jsbsim_models/shorts23`` and flown as ``ShortS23_glide``,
 #: engines, hull forces and systems removed, at 6000 ft) and ``dr1`` (the twenty-fifth session's: JSBSim's Fokker
 #: Dr.I triplane, the wheel's ``dr1`` checked into ``data/jsbsim_models/fokkerdr1`` and flown as ``Dr1_glide``, rotary
-#: engine, propeller and pushback removed, at 8000 ft). No aircraft is held out or untouched until the next one is
-#: added.
+#: engine, propeller and pushback removed, at 8000 ft). ``navion`` (JSBSim's Ryan Navion, the wheel's ``L17`` with the
+#: textbook Navion derivatives, checked into ``data/jsbsim_models/navion`` and flown as ``Navion_glide``, engine and
+#: propeller removed, gear up, at 10000 ft; added in the twenty-sixth session) is held out and untouched: no part of
+#: the method has run on it before its final evaluation.
 AIRCRAFT: dict[str, AircraftSpec] = {
     "c172x": AircraftSpec(
         name="c172x", model="c172x", airspeed_kts=80.0, altitude_ft=6000.0,
@@ -725,11 +727,42 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         notes="Fokker Dr.I triplane (JSBSim's model by Ron Jensen and Erik Hofman, checked in under "
               "data/jsbsim_models/fokkerdr1) without its rotary engine, propeller or pushback (derived model "
               "Dr1_glide, XML sha256 6ba46d3a95d9619e), gliding; untouched by any tuning of the method"),
+    # navion: JSBSim's Ryan Navion, the four-seat light aircraft of 1946 (the Army's L-17; the jsbsim 1.3.3 wheel's
+    # aircraft/L17, "Originally from Bruce Jackson (LaRCSim)?", LGPL-2.1 with JSBSim; checked in under
+    # data/jsbsim_models/navion): 2770 lb as the harness flies it (2750 empty, 2 x 10 lb of fuel on the centre line;
+    # no point masses), a 33.42-ft (10.19 m) span, 184 ft^2 (17.09 m^2), a 5.7-ft (1.74 m) chord; inertia 1048 /
+    # 3000 / 3530 slug ft^2, no product of inertia: the Navion's textbook numbers (Teper, NASA CR-96008, 1969;
+    # Nelson, Flight Stability and Automatic Control, 2nd ed., 1998, appendix B), as are its constant derivatives:
+    # Cm_alpha -0.683, Cm_q -9.96, Cm_alphadot -4.36, CL_delta_e 0.355, Cm_delta_e (-0.923 + 0.324 Mach), CY_beta
+    # -0.564 (its only side-force term), Cl_beta -0.074, Cl_p -0.41, Cl_r 0.107, Cl_delta_a (0.134 - 0.0385 Mach),
+    # Cl_delta_r 0.0107, Cn_beta 0.071, Cn_p -0.0575, Cn_r -0.125, Cn_delta_r -0.072, Cn_delta_a -0.0035 per rad of
+    # the left aileron (adverse, small); lift a table in alpha with a kink at 0 (5.0 per rad below, 3.35 above, CL
+    # 0.25 at 0), drag CD0 a table in alpha plus 0.04 CL^2. A stock wheel model the ninth session could not
+    # initialise (its flap normaliser reads fcs/flaps-pos-deg, which nothing writes); flown as the derived
+    # ``Navion_glide`` (derived.py): the engine and propeller removed, the normaliser reading the flap kinematic's
+    # fcs/flap-pos-deg. Chosen in the twenty-sixth session (docs/jsbsim.md, "The navion"). Its FCS: elevator -0.35 /
+    # +0.30 rad (the harness's command scale is the larger, trailing-edge-up side, as the ka350's), ailerons +-0.35
+    # rad (left with the command's sign, right its mirror), rudder +-0.35 rad. Signs read from its aerodynamics: Cmde
+    # negative per rad of elevator-pos-rad (positive = trailing edge down), Clda +0.124 per rad of the left aileron
+    # (positive = roll right: delta_a = -0.5 (left - right), Cl_delta_a -0.124), Cndr -0.072 (positive rudder = nose
+    # left). Gear up (retractable; CDgear 0.03 vanishes with it). Set from the harness's truth only (alpha, beta,
+    # rates, excitation per axis, surfaces, sink), never from a method result: at 90 and 95 kt (6000 ft) the sweep
+    # reached alpha 12-14 deg (CL_max at 13.2) and Cl:alpha*beta 3 knocked off at 45 deg of bank; at 110 kt it banked
+    # 26 deg; 120 kt at 10000 ft flies all eleven trial flights inside the envelope, alpha -4.8..5.3 deg.
+    "navion": AircraftSpec(
+        name="navion", model="Navion_glide", airspeed_kts=120.0, altitude_ft=10000.0,
+        elevator_sign=1.0, aileron_sign=-1.0,
+        aileron_props=("fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"), rudder_sign=1.0,
+        cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
+        amplitude_deg=(4.5, 5.0, 5.0), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
+        notes="Ryan Navion (JSBSim's L17 with LaRCSim's textbook Navion derivatives, checked in under "
+              "data/jsbsim_models/navion) without its engine or propeller (derived model Navion_glide, XML sha256 "
+              "2e075b387ce9a6e4), gear up, gliding; untouched by any tuning of the method"),
 }
 TUNING_AIRCRAFT = ("c172x", "sgs", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126",
                    "asw20", "iar80", "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1")
-HELD_OUT_AIRCRAFT = ()
-UNTOUCHED_AIRCRAFT = ()
+HELD_OUT_AIRCRAFT = ("navion",)
+UNTOUCHED_AIRCRAFT = ("navion",)
 
 
 def aircraft(name: str) -> AircraftSpec:

@@ -19,7 +19,9 @@ and yaw damper removed (``KingAir350_glide``, :func:`derive_kingair350_glide`; t
 Short S.23 flying boat gliding in one file, its engines, hull forces and systems removed (``ShortS23_glide``,
 :func:`derive_shorts23_glide`; twenty-fourth session), or JSBSim's Fokker Dr.I triplane gliding, its rotary engine,
 propeller and pushback removed and its pitch table reading the elevator through an alias (``Dr1_glide``,
-:func:`derive_dr1_glide`; twenty-fifth session).
+:func:`derive_dr1_glide`; twenty-fifth session), or JSBSim's Ryan Navion (the wheel's ``L17``) gliding, its engine
+and propeller removed and its flap normaliser reading the flap kinematic's output (``Navion_glide``,
+:func:`derive_navion_glide`; twenty-sixth session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -75,7 +77,7 @@ from pathlib import Path
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
            "derive_eternity_glide", "derive_ultrastick25e_glide", "derive_kingair350_glide", "derive_shorts23_glide",
-           "derive_dr1_glide",
+           "derive_dr1_glide", "derive_navion_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -799,6 +801,60 @@ def derive_dr1_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+def derive_navion_glide(root: ET.Element) -> ET.Element:
+    """JSBSim's Ryan Navion (``data/jsbsim_models/navion/L17.xml``: the jsbsim 1.3.3 wheel's ``aircraft/L17/L17.xml``,
+    "Originally from Bruce Jackson (LaRCSim)?", LGPL-2.1 with JSBSim) gliding, as JSBSim alone can fly it (twenty-sixth
+    session).
+
+    The model is the Navion four-seat light aircraft (the Army's L-17) with the textbook stability derivatives of
+    the Navion (Teper, NASA CR-96008, 1969; Nelson, *Flight Stability and Automatic Control*, 2nd ed., 1998, appendix
+    B: Cm_alpha -0.683, Cm_q -9.96, Cm_alphadot -4.36, CY_beta -0.564, Cl_beta -0.074, Cl_p -0.410, Cl_r 0.107,
+    Cn_beta 0.071, Cn_p -0.0575, Cn_r -0.125, Cn_delta_r -0.072, CL_delta_e 0.355, Cm_delta_e -0.923 at Mach 0),
+    a Continental IO-470-D with a 75-in propeller, and a flap channel whose normaliser reads
+    ``fcs/flaps-pos-deg``, a property nothing writes (the flap kinematic writes ``fcs/flap-pos-deg``): ``run_ic``
+    raises, the ninth session's reason for setting it aside. Two edits; nothing else changes (a test checks every
+    other element, and that JSBSim's aerodynamic forces and moments equal the stock wheel model's):
+
+    - **Engine removed.** The ``<engine>`` element (``engIO470D`` with ``prop_75in2f``, its feed) is removed, as
+      the dr1's and the iar80's: the harness glides every aircraft, so that every non-gravity force is
+      aerodynamic (a stopped engine leaves JSBSim's windmilling propeller). The two fuel tanks (10 lb each, on
+      the centre line) stay as mass. No aerodynamic function reads the propeller.
+    - **Flap normaliser input.** The ``Flap Position Normalizer``'s ``<input>`` ``fcs/flaps-pos-deg`` reads
+      ``fcs/flap-pos-deg``, the ``Flaps Control`` kinematic's output in the same channel. The harness never
+      commands the flaps: both are 0, so ``fcs/flap-pos-norm`` (read by ``CDflap`` and ``dCLflap``) is 0 as the
+      stock model's is once ``fcs/flaps-pos-deg`` exists at 0.
+
+    The elevator is read as a ``<property>`` only (``CLde``, ``Cmde``), so ``effects.py``'s ``delay:delta_e``
+    reaches it without an alias; ``CDde`` reads JSBSim's ``fcs/mag-elevator-pos-rad`` (not delayed, as on the b747,
+    c172x and dr1).
+
+    Args:
+        root: the parsed ``L17.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): one
+            ``<propulsion><engine>``, one ``Flap Position Normalizer`` reading ``fcs/flaps-pos-deg``, an
+            ``<aerodynamics>``.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    norm = [c for c in root.iterfind("flight_control/channel/aerosurface_scale")
+            if c.get("name") == "Flap Position Normalizer"]
+    if len(engines) != 1 or len(norm) != 1 or root.find("aerodynamics") is None:
+        raise ValueError("L17.xml: expected one <propulsion><engine>, one 'Flap Position Normalizer' and an "
+                         "<aerodynamics>")
+    inp = norm[0].find("input")
+    if inp is None or (inp.text or "").strip() != "fcs/flaps-pos-deg":
+        raise ValueError("L17.xml: the flap normaliser does not read fcs/flaps-pos-deg")
+    prop.remove(engines[0])
+    inp.text = "fcs/flap-pos-deg"
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -883,6 +939,13 @@ REPO_DERIVED = {
                   derive_dr1_glide, "rotary engine and propeller, the pushback force and the pushback system "
                   "removed (a glide with no propeller or ground-tug force); the Cmde table reads the elevator "
                   "through an identity alias; the fuel tank stays as mass; everything else unchanged."),
+    "Navion_glide": ("data/jsbsim_models/navion/L17.xml",
+                     "JSBSim's Ryan Navion (the jsbsim 1.3.3 wheel's aircraft/L17/L17.xml, from LaRCSim's Navion, "
+                     "LGPL-2.1 with JSBSim), copied into gcs-sysid's data/jsbsim_models/navion/",
+                     derive_navion_glide, "engine and propeller removed (a glide with no propeller force); the flap "
+                     "normaliser reads the flap kinematic's output fcs/flap-pos-deg (the file's fcs/flaps-pos-deg "
+                     "exists nowhere, so JSBSim alone could not initialise it); the fuel tanks stay as mass; "
+                     "everything else unchanged."),
 }
 
 

@@ -19,8 +19,8 @@ a mechanism check); none of them flies the harness:
 - the FCS maps the commands straight to the surfaces (elevator +-20.1 deg, ailerons +-17.2 deg, rudder +-8.8 deg:
   the command clipped at 0.35 of +-25.2 deg); no engine, no external force;
 - it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
-- the summaries label it bare, as every tuning aircraft (until the next untouched aircraft is added, no aircraft is
-  labelled "(untouched)").
+- the summaries label it bare, as every tuning aircraft (the untouched navion's label is checked in
+  ``test_jsbsim_navion.py``).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
 hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the names
@@ -174,9 +174,9 @@ def test_the_dr1_is_statically_stable_and_its_controls_act_as_its_xml_says():
 
 
 def test_summaries_mark_no_aircraft_untouched_the_dr1_included(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the dr1 bare, as every other aircraft
-    (synthetic rows): the twenty-sixth session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
-    until the next one is added."""
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the dr1 bare, as every other tuning
+    aircraft (synthetic rows of tuning aircraft only): the twenty-sixth session moved it to tuning, so none of them
+    is "(untouched)" or "(held out)"."""
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
     from gcs_sysid.aero.table import COEFFICIENTS
 

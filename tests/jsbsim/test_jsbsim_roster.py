@@ -1,6 +1,6 @@
 """The harness's checks shared by the aircraft set up from their XML and JSBSim's truth alone (c182,
-t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p, eternity, us25e, ka350, s23
-and dr1;
+t37, t6, b747, f16, f4n, rascal, sgs126, asw20, iar80, c684, ultrastick, b737, c172p, eternity, us25e, ka350, s23,
+dr1 and the untouched navion;
 docs/jsbsim.md, one section each),
 parametrised over the roster.
 
@@ -12,16 +12,17 @@ flights in each aircraft's envelope, and the eval scripts' ``--fly-only``. No pi
 diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) serves its tests.
 
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
-default suite, as before the fold); no aircraft is untouched until the next one is added; the dr1's own
+default suite, as before the fold); the untouched navion's are slow too but its names', and its own
 default checks (its model, surfaces, static stability, the summaries' label) are in
-``test_jsbsim_dr1.py`` (the s23's in ``test_jsbsim_s23.py``, the ka350's in ``test_jsbsim_ka350.py``, the us25e's in ``test_jsbsim_us25e.py``, the eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
+``test_jsbsim_navion.py`` (the dr1's in ``test_jsbsim_dr1.py``, the s23's in ``test_jsbsim_s23.py``, the ka350's in ``test_jsbsim_ka350.py``, the us25e's in ``test_jsbsim_us25e.py``, the eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
 sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
 the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-sixth sessions). Folded in the eleventh session
 from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
 value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
 in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
 b737 in the nineteenth, the c172p in the twentieth, the eternity in the twenty-first, the us25e in the
-twenty-second, the ka350 in the twenty-third, the s23 in the twenty-fourth, the dr1 in the twenty-fifth.
+twenty-second, the ka350 in the twenty-third, the s23 in the twenty-fourth, the dr1 in the twenty-fifth, the navion in
+the twenty-sixth.
 """
 
 from dataclasses import dataclass
@@ -436,6 +437,29 @@ CASES = (
          (), 0.35, 5,
          dict(alpha=(-8.0, 8.0), beta=(11.0, 12.0), bank=(20.0, 25.0), speed=(28.0, 62.0), alt_min=1000.0,
               rate_std=2.0, rate_std_held=2.0, sink_min=4.0)),
+    # navion (JSBSim's Ryan Navion, the jsbsim 1.3.3 wheel's aircraft/L17 checked in under data/jsbsim_models/navion,
+    # LGPL-2.1 with JSBSim; the derived Navion_glide: engine and propeller removed, the flap normaliser reading
+    # fcs/flap-pos-deg): 2770 lb (2750 empty, 2 x 10 lb of fuel on the centre line), no product of inertia (JSBSim's
+    # Ixz reads 0 to 1e-33), one SIDE function (CYb), the elevator read by CLde and Cmde (two <property> reads), a
+    # retractable gear whose CDgear vanishes once up. On the 30-s calm flight (derivative_slopes; inertial rates, no
+    # alpha-dot) Cm_alpha -0.611 (the static slope is -0.68 to -0.72 per rad near alpha 0; closure_slopes reads
+    # -0.716 with Cm_alphadot -4.76), Cm_delta_e -0.828 (Cmde -0.923 + 0.324 Mach); Cl_beta -0.0864 (Clb -0.074 and
+    # CYb 8.3 in below the reference point), Cl_p -0.410, Cl_r 0.107, Cl_delta_a -0.1243 (Clda 0.134 - 0.0385 Mach per
+    # rad of the left aileron, delta_a = -0.5 (left - right)), Cl_delta_r 0.0107; Cn_beta 0.071, Cn_p -0.0575, Cn_r
+    # -0.125, Cn_delta_a +0.0035 (adverse: Cnda -0.0035 x left), Cn_delta_r -0.072: the file's constants. Envelope
+    # limits from the six envelope flights flown in the twenty-sixth session (docs/jsbsim.md, "The navion"): alpha
+    # -4.8..5.3 deg, sideslip 6.8 clean and 6.0 with Cl:alpha*beta, bank 14.5 and 12.8, TAS 56.9-101.8 m/s, lowest
+    # 1288 m, sink through the air 11.1-12.6 m/s (lift-to-drag about 7-8 at the sweep's speeds), rate standard
+    # deviations at least 3.35 deg/s (3.34 held out), surfaces' at least 1.43 / 1.76 / 1.66 deg.
+    Case("navion", "Navion_glide", "navio", 2770.0, 0.0,
+         (("cm", 0, None, ("in", -0.75, -0.45)), ("cm", 2, -0.8283, ("rel", 0.03)), ("cl", 3, -0.1243, ("rel", 0.01)),
+          ("cl", 0, -0.0864, ("rel", 0.03)), ("cl", 1, -0.41, ("rel", 0.02)), ("cl", 2, 0.107, ("rel", 0.05)),
+          ("cl", 4, 0.0107, ("abs", 0.001)), ("cn", 4, -0.072, ("rel", 0.02)), ("cn", 0, 0.071, ("rel", 0.03)),
+          ("cn", 2, -0.125, ("rel", 0.05)), ("cn", 3, 0.0035, ("rel", 0.25)), ("cn", 1, -0.0575, ("rel", 0.10))),
+         ("CDgear",), 0.30, 1,
+         dict(alpha=(-8.0, 8.0), beta=(10.0, 11.0), bank=(20.0, 25.0), speed=(48.0, 115.0), alt_min=900.0,
+              rate_std=2.5, rate_std_held=2.5, sink_min=6.0),
+         untouched=True),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -609,7 +633,7 @@ def test_evaluation_flights_stay_in_the_envelope_with_every_axis_excited(request
 @pytest.mark.parametrize("case", [p for p in _params()
                                   if p.values[0].name in ("rascal", "sgs126", "asw20", "iar80", "c684", "ultrastick",
                                                           "b737", "c172p", "eternity", "us25e", "ka350",
-                                                          "s23", "dr1")])
+                                                          "s23", "dr1", "navion")])
 def test_eval_scripts_fly_it_without_scoring_it(case, tmp_path, capsys, monkeypatch):
     """The JSBSim model name in capitals resolves to the harness name in both scripts; with
     ``--fly-only`` they fly into ``--work`` / ``--out``, say so for the untouched aircraft alone, reuse

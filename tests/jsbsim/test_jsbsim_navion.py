@@ -1,0 +1,181 @@
+"""The navion in the JSBSim harness: the twenty-sixth session's untouched aircraft (docs/jsbsim.md, "The navion").
+
+The model is JSBSim's Ryan Navion (the jsbsim 1.3.3 wheel's ``aircraft/L17/L17.xml``, "Originally from Bruce Jackson
+(LaRCSim)?", LGPL-2.1 with JSBSim), a four-seat light aircraft of 2770 lb as the harness flies it and 33.42 ft
+(10.19 m) of span, whose constant derivatives are the Navion's textbook set (Teper, NASA CR-96008, 1969; Nelson,
+*Flight Stability and Automatic Control*, 2nd ed., 1998, appendix B): Cm_alpha -0.683, Cm_q -9.96, Cm_alphadot
+-4.36, CY_beta -0.564 (the only side-force term), Cl_beta -0.074, Cl_p -0.41, Cl_r 0.107, Cn_beta 0.071, Cn_p
+-0.0575, Cn_r -0.125, Cn_delta_r -0.072, a lift table in alpha with a kink at alpha 0. The file is checked in under
+``data/jsbsim_models/navion/`` and flown as the derived model ``Navion_glide`` (``derived.py``): the engine and
+propeller removed, the flap normaliser reading the flap kinematic's output (the file's ``fcs/flaps-pos-deg`` exists
+nowhere, so JSBSim alone could not initialise it).
+
+The checks here use the file and JSBSim's own properties (the harness's initial condition, ``run_ic``, no turbulence:
+a mechanism check); none of them flies the harness:
+
+- the checked-in file is the one the README names, and the derivation makes only its two edits; JSBSim's
+  aerodynamic forces and moments of the derived model equal the stock wheel model's (which initialises in JSBSim
+  alone once ``fcs/flaps-pos-deg`` exists);
+- the FCS maps the commands straight to the surfaces (elevator -20.1 / +17.2 deg, ailerons +-20.1 deg, rudder
+  +-20.1 deg); no engine, no external force;
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
+- the summaries label it "(untouched)" and nothing else (moved here from ``test_jsbsim_dr1.py``).
+
+The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, gear,
+.tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the
+names are slow.
+
+No pipeline fit, GP, diagnosis or scoring runs on the navion: its first evaluation is the final one, after the merge.
+"""
+
+import dataclasses
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from benchmarks.jsbsim_harness import aircraft
+from truth_fits import assert_deflections_map_back, bare_xml, check_direct_fcs, checked_in_model, \
+    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
+
+SRC = "data/jsbsim_models/navion/L17.xml"
+SRC_SHA256 = "4472cb86623b4fc6529381a270f09d722d52d352428787d93610d349aa23ccbf"
+
+
+def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
+    """:func:`truth_fits.ic_state` for the navion (120 kt at 10000 ft; it glides near alpha 0)."""
+    return ic_state(aircraft("navion"), alpha_deg, beta_deg, cmds)
+
+
+def _stock_state(alpha_deg, beta_deg, cmds):
+    """The wheel's stock ``L17`` at the same initial condition as :func:`_state` (``fcs/flaps-pos-deg``, which its
+    flap normaliser reads and nothing writes, created at 0 before ``run_ic``; its engine present, stopped)."""
+    from benchmarks.jsbsim_harness import FlightConfig
+    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
+
+    spec = dataclasses.replace(aircraft("navion"), model="L17")
+    fdm = load_model(spec, 1 / 200)
+    fdm["fcs/flaps-pos-deg"] = 0.0
+    _set_ic(fdm, spec, FlightConfig("navion", turbulence="none"))
+    fdm["ic/alpha-deg"], fdm["ic/beta-deg"] = alpha_deg, beta_deg
+    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
+    fdm.run_ic()
+    return fdm
+
+
+def test_the_derivation_removes_the_engine_and_repoints_the_flap_normaliser():
+    """The checked-in file is the README's (24580 bytes, its SHA-256). ``Navion_glide`` is that file without its
+    ``<engine>`` (the IO-470-D and its propeller), its ``Flap Position Normalizer`` reading ``fcs/flap-pos-deg``
+    (the flap kinematic's output) for ``fcs/flaps-pos-deg``; the tanks and every other element are equal (metrics,
+    mass balance, ground reactions, every other FCS element, all 27 aerodynamic functions). The spec's notes carry
+    the derived XML's hash."""
+    src, der, spec = checked_in_model("navion", "Navion_glide", SRC, 24580, SRC_SHA256)
+    ET.indent(src, space=" ")
+    for tag in ("metrics", "mass_balance", "ground_reactions", "aerodynamics"):
+        assert same_xml(src.find(tag), der.find(tag)), tag
+    assert len(src.findall("propulsion/engine")) == 1 and der.find("propulsion/engine") is None
+    assert [same_xml(a, b) for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"))] == [True] * 2
+    assert [c.tag for c in der] == [c.tag for c in src]
+    fc_s, fc_d = src.find("flight_control"), der.find("flight_control")
+    norm = [c for c in fc_s.iter("aerosurface_scale") if c.get("name") == "Flap Position Normalizer"]
+    assert len(norm) == 1 and norm[0].find("input").text.strip() == "fcs/flaps-pos-deg"
+    norm[0].find("input").text = "fcs/flap-pos-deg"
+    assert bare_xml(fc_s) == bare_xml(fc_d)
+    assert len(list(src.find("aerodynamics").iter("function"))) == 27
+    assert [p.text.strip() for p in der.find("aerodynamics").iter("property")].count("fcs/elevator-pos-rad") == 2
+
+
+def test_the_derived_aerodynamics_are_the_stock_models():
+    """At three states (alpha, sideslip, the three commands), JSBSim's aerodynamic forces and moments of
+    ``Navion_glide`` equal those of the wheel's stock ``L17`` (its engine stopped, ``fcs/flaps-pos-deg`` at 0) to the
+    last bit: the derivation changes no number."""
+    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
+        a, b = _state(alpha, beta, cmds), _stock_state(alpha, beta, cmds)
+        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == 1
+        assert a["fcs/flap-pos-norm"] == b["fcs/flap-pos-norm"] == 0.0
+        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
+                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
+            assert a[k] == b[k], (alpha, k)
+
+
+def test_the_navion_flies_its_own_surfaces_without_engine_or_external_force():
+    """The FCS maps each command straight to its surface (``aerosurface_scale``): elevator -0.35 rad (trailing
+    edge up) to +0.30 rad, the left aileron +-0.35 rad with the command's sign and the right its mirror (delta_a =
+    -0.5 (left - right) with ``aileron_sign`` -1), rudder +-0.35 rad; the harness's command scale is the elevator's
+    larger, trailing-edge-up side (as the ka350's). No engine; 2770 lb (2750 empty, 2 x 10 lb of fuel); the gear
+    retracts (``gear_up``); after 50 frames every non-gravity force and moment is aerodynamic."""
+    spec = aircraft("navion")
+    assert spec.gear_up and spec.cmd_per_rad == pytest.approx((1 / 0.35, 1 / 0.35, 1 / 0.35))
+    assert _state()["inertia/weight-lbs"] == pytest.approx(2770.0, abs=0.01)
+    check_direct_fcs(spec, min_lift_lbs=1000.0)
+    assert_deflections_map_back(spec)
+
+
+def test_the_navion_is_statically_stable_and_its_controls_act_as_its_xml_says():
+    """JSBSim's moments about the CG at fixed surfaces (``run_ic`` at the harness's initial condition, 120 kt at
+    10000 ft, Mach 0.253) without the ``Cmadot`` term (``run_ic`` gives an alpha-dot the term reads).
+
+    - **Pitch:** Cm falls with alpha: -0.678 per rad between alpha -4 and 0 deg, -0.719 between 0 and 4, -0.768
+      between 4 and 8 (Cmalpha -0.683 and the lift and drag acting 8.3 in below the reference point); Cm +0.0068 at
+      alpha 0; per rad of elevator -0.836 (trailing edge down) and -0.844 (up) (Cmde -0.923 + 0.324 Mach, and CLde).
+    - **Roll and yaw:** per rad of the left aileron Cl +0.1242 (Clda 0.134 - 0.0385 Mach; the project's Cl_delta_a
+      -0.124) and Cn -0.0035 (Cnda: the project's Cn_delta_a +0.0035, adverse); per rad of rudder Cn -0.072 (Cndr)
+      and Cl +0.0107 (Cldr; no rudder side force); Cl_beta -0.0871 (Clb -0.074 and CYb's arm) and Cn_beta 0.071 at
+      alpha 0 and 6 deg (constants).
+    """
+    spec = aircraft("navion")
+    c = {a: cm_without_alpha_dot(spec, a) for a in (-4.0, 0.0, 4.0, 8.0)}
+    slope = lambda a, b: (c[b] - c[a]) / np.radians(4.0)   # noqa: E731
+    assert _state()["velocities/mach"] == pytest.approx(0.2534, abs=0.002)
+    assert slope(-4.0, 0.0) == pytest.approx(-0.678, abs=0.003) and slope(0.0, 4.0) == pytest.approx(-0.719, abs=0.003)
+    assert slope(4.0, 8.0) == pytest.approx(-0.768, abs=0.005) and c[0.0] == pytest.approx(0.0068, abs=0.0005)
+    for cmd, want in ((0.3, -0.836), (-0.3, -0.844)):
+        de = _state(cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
+        assert (cm_without_alpha_dot(spec, 0.0, cmd) - c[0.0]) / de == pytest.approx(want, abs=0.002)
+
+    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
+        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds))
+
+    l0, n0, _, _ = lat()
+    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
+    for cmd in (0.3, -0.3):
+        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
+        assert (l1 - l0) / a1 == pytest.approx(0.1242, abs=2e-4) and (n1 - n0) / a1 == pytest.approx(-0.0035, abs=1e-6)
+        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
+        assert (n2 - n0) / r2 == pytest.approx(-0.072, abs=1e-6) and (l2 - l0) / r2 == pytest.approx(0.0107, abs=1e-6)
+    for a in (0.0, 6.0):
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(alpha=a, beta=4.0)
+        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.0871, abs=5e-4), a
+        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.071, abs=1e-4), a
+
+
+def test_summaries_mark_the_navion_untouched_and_the_others_used(tmp_path):
+    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the navion "(untouched)" and no other
+    aircraft, the dr1, s23 and ka350 included (synthetic rows: no navion result exists before the final
+    evaluation). Moved here from ``test_jsbsim_dr1.py`` (the twenty-fifth session's untouched aircraft)."""
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
+           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion")
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    assert any(ln.startswith("| navion (untouched) | light") for ln in lines)
+    for ac in acs[:-1]:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    assert any(ln.startswith("| navion (untouched) | clean |") for ln in lines)
+    assert any(ln.startswith("| dr1 | clean |") for ln in lines)
+    assert sum("(untouched)" in ln for ln in lines) == 1
