@@ -748,7 +748,7 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # left). Gear up (retractable; CDgear 0.03 vanishes with it). Set from the harness's truth only (alpha, beta,
     # rates, excitation per axis, surfaces, sink), never from a method result: at 90 and 95 kt (6000 ft) the sweep
     # reached alpha 12-14 deg (CL_max at 13.2) and Cl:alpha*beta 3 knocked off at 45 deg of bank; at 110 kt it banked
-    # 26 deg; 120 kt at 10000 ft flies all eleven trial flights inside the envelope, alpha -4.8..5.3 deg.
+    # 26 deg; 120 kt at 10000 ft flies all eleven trial flights inside the envelope, alpha -4.9..5.3 deg.
     "navion": AircraftSpec(
         name="navion", model="Navion_glide", airspeed_kts=120.0, altitude_ft=10000.0,
         elevator_sign=1.0, aileron_sign=-1.0,

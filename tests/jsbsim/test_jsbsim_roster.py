@@ -448,9 +448,9 @@ CASES = (
     # rad of the left aileron, delta_a = -0.5 (left - right)), Cl_delta_r 0.0107; Cn_beta 0.071, Cn_p -0.0575, Cn_r
     # -0.125, Cn_delta_a +0.0035 (adverse: Cnda -0.0035 x left), Cn_delta_r -0.072: the file's constants. Envelope
     # limits from the six envelope flights flown in the twenty-sixth session (docs/jsbsim.md, "The navion"): alpha
-    # -4.8..5.3 deg, sideslip 6.8 clean and 6.0 with Cl:alpha*beta, bank 14.5 and 12.8, TAS 56.9-101.8 m/s, lowest
-    # 1288 m, sink through the air 11.1-12.6 m/s (lift-to-drag about 7-8 at the sweep's speeds), rate standard
-    # deviations at least 3.35 deg/s (3.34 held out), surfaces' at least 1.43 / 1.76 / 1.66 deg.
+    # -4.9..5.3 deg, sideslip 6.8 clean and 6.0 with Cl:alpha*beta, bank 14.5 and 12.8, TAS 56.9-101.8 m/s, lowest
+    # 1288 m, sink through the air 11.3-12.6 m/s (lift-to-drag about 7-8 at the sweep's speeds), rate standard
+    # deviations at least 3.35 deg/s (3.34 held out), surfaces' at least 1.43 / 1.68 / 1.66 deg.
     Case("navion", "Navion_glide", "navio", 2770.0, 0.0,
          (("cm", 0, None, ("in", -0.75, -0.45)), ("cm", 2, -0.8283, ("rel", 0.03)), ("cl", 3, -0.1243, ("rel", 0.01)),
           ("cl", 0, -0.0864, ("rel", 0.03)), ("cl", 1, -0.41, ("rel", 0.02)), ("cl", 2, 0.107, ("rel", 0.05)),
