@@ -25,9 +25,10 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
     p.add_argument("--min-rows", type=int, default=500, help="samples before the GP is first fitted (default 500)")
     p.add_argument("--inducing", type=int, default=None, help="inducing points of the global GP")
     p.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
-                   help="the GP's output noise (default independent, one variance per output; 'learned' is the "
-                        "replay's default: a noise correlation learned with the hyperparameters, so live and replay learn "
-                        "the same noise; docs/live.md, 'The GP's noise')")
+                   help="the GP's output noise: 'learned' (the default, as the replay's) learns the outputs' noise "
+                        "correlation with the hyperparameters and keeps only its diagonal in the predictions; "
+                        "'independent' one variance per output (the default until the twenty-sixth session); "
+                        "docs/live.md, 'The GP's noise'")
     p.add_argument("--silence", type=float, default=30.0, metavar="S",
                    help="report the link as silent after S seconds without a packet (default 30)")
     p.add_argument("--no-learn", action="store_true", help="only log, monitor and request rates")

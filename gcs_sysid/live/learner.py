@@ -36,11 +36,14 @@ from .heap import release_free_heap
 __all__ = ["LearnOptions", "Learner", "learn_from_tlog", "iter_tlog_records", "GP_NOISE", "learner_gp_config"]
 
 #: The live learner's GP noise (a name of :data:`gcs_sysid.pipeline.GP_NOISE_MODES`) when ``LearnOptions.gp_noise``
-#: is None: ``"independent"`` (one noise variance per output, ``GPConfig()``'s own). The replay's default is
-#: ``"learned"`` since the twenty-fifth session (:data:`gcs_sysid.pipeline.GP_NOISE`); ``gcs-sysid listen --gp-noise
-#: learned`` gives the live model the replay's noise. Twenty-sixth session (i8-live): see ``docs/live.md``, "The GP's
-#: noise", for why the live default stays independent.
-GP_NOISE = "independent"
+#: is None: ``"learned"`` since the twenty-sixth session (i8-live), the replay's default too
+#: (:data:`gcs_sysid.pipeline.GP_NOISE`), so ``listen`` and ``replay`` on the same flight learn the same noise model.
+#: Under the default rule for GP changes (two GP seeds against ``"independent"``, the default until then, at the same
+#: seed) on 66 tuning flights (22 aircraft x light s1-3, streamed through the learner; ``benchmarks/eval_live_jsbsim.py``):
+#: flight x count flips +34/-11 at GPConfig.seed 0 and +33/-12 at seed 1, learned output correlations above 0.5 on
+#: 24 -> 8 and 25 -> 7 flights, 5 aircraft losing a count at both seeds where ``"independent"`` merely reseeded loses
+#: one on 10 (docs/benchmarks.md, "Twenty-sixth session, i8-live"; docs/live.md, "The GP's noise").
+GP_NOISE = "learned"
 
 
 @dataclass(frozen=True)
@@ -62,8 +65,10 @@ class LearnOptions:
         n_inducing: inducing points of the global GP (None: the GP's default).
         gp_noise: the GP's output noise, a name of :data:`gcs_sysid.pipeline.GP_NOISE_MODES` (``"learned"``: a
             ``P x P`` noise covariance learned with the hyperparameters, only its variances in the posterior, the
-            replay's default; ``"independent"``: one variance per output; ``"full"``: the learned covariance in
-            the posterior too; ``docs/gp.md``, "Noise"); None: :data:`GP_NOISE`. It sets the first fit's
+            default here and in the replay; ``"independent"``: one variance per output, the default until the
+            twenty-sixth session; ``"full"``: the learned covariance in the posterior too; ``docs/gp.md``, "Noise");
+            None: :data:`GP_NOISE`. Rows that miss an output in the first fit make it ``independent`` (the fit's
+            note: the noise correlation needs complete rows), as in the replay. It sets the first fit's
             ``GPConfig`` (:func:`learner_gp_config`); the incremental updates and the hyperparameter refreshes keep
             that config.
         gp_seed: ``GPConfig.seed`` of the fit (the hyperparameters' row subset, the inducing-point choice).

@@ -1,10 +1,11 @@
 """The live learner's and the campaign's GP noise option (twenty-sixth session, i8-live) reaches the GP.
 
 The replay's GP learns the outputs' noise correlation by default since the twenty-fifth session (``learned``,
-``pipeline.GP_NOISE``); the live learner and the campaign keep ``independent`` (docs/live.md, "The GP's noise")
-but take ``learned`` by name (``LearnOptions.gp_noise``, ``gcs-sysid listen --gp-noise``, ``CampaignConfig.gp_noise``,
-``gcs-sysid campaign --gp-noise``), so a user can make the live model's noise the replay's. Each test fails if the
-option is dropped on its way to ``fit_gp``."""
+``pipeline.GP_NOISE``); the live learner does too since the twenty-sixth (``live.learner.GP_NOISE``; docs/live.md,
+"The GP's noise"), so ``listen`` and ``replay`` on one flight learn the same noise. ``independent`` stays reachable by
+name (``LearnOptions.gp_noise``, ``gcs-sysid listen --gp-noise``), as is the campaign's noise
+(``CampaignConfig.gp_noise``, ``gcs-sysid campaign --gp-noise``). Each test fails if the option is dropped on its way
+to ``fit_gp``."""
 
 from __future__ import annotations
 
@@ -42,10 +43,13 @@ def _table(n: int, seed: int) -> CoefficientTable:
     return CoefficientTable(np.arange(n) * 0.02, X, Y, np.ones(n, bool), np.full(n, 200.0))
 
 
-def test_the_live_default_is_independent_and_learned_is_reachable():
-    assert learner_mod.GP_NOISE == "independent"
-    assert _fields(learner_gp_config(LearnOptions())) == INDEPENDENT
-    assert _fields(learner_gp_config(LearnOptions())) == _fields(gp.GPConfig())   # the default before the option
+def test_the_live_default_is_learned_as_the_replays_and_independent_is_reachable():
+    from gcs_sysid import pipeline
+
+    assert learner_mod.GP_NOISE == "learned" == pipeline.GP_NOISE
+    assert _fields(learner_gp_config(LearnOptions())) == LEARNED
+    assert _fields(learner_gp_config(LearnOptions())) == _fields(pipeline.replay_gp_config())   # live = replay noise
+    assert _fields(learner_gp_config(LearnOptions(gp_noise="independent"))) == _fields(gp.GPConfig())   # the old one
     cfg = learner_gp_config(LearnOptions(gp_noise="learned", gp_seed=1, n_inducing=24))
     assert _fields(cfg) == LEARNED and cfg.seed == 1 and cfg.n_inducing == 24
     assert _fields(learner_gp_config(LearnOptions(gp_noise="full"))) == {**LEARNED, "noise_posterior": "full"}
@@ -62,7 +66,7 @@ def test_the_learner_fits_with_its_noise_option(monkeypatch):
 
     monkeypatch.setattr(gp, "fit_gp", fake_fit)
     af = load_airframe(ROOT / "data" / "airframes" / "sim-trainer.toml")
-    for noise, want in ((None, INDEPENDENT), ("independent", INDEPENDENT), ("learned", LEARNED)):
+    for noise, want in ((None, LEARNED), ("independent", INDEPENDENT), ("learned", LEARNED)):
         lr = Learner(af, LearnOptions(min_rows=50, gp_noise=noise, gp_seed=3))
         with pytest.raises(RuntimeError, match="stop after"):
             lr._learn(_table(60, 1), np.ones(60, bool))
@@ -110,15 +114,18 @@ def test_campaign_fits_with_its_noise_option(monkeypatch, tmp_path):
         assert configs[-1].gp_noise == want
 
 
-@pytest.mark.slow   # two GP fits at the learner's settings (compiles them: ~30-60 s on 2 cores)
-def test_learned_noise_is_learned_in_the_live_fit_and_kept_through_an_update():
+@pytest.mark.slow   # two GP fits and light refreshes at the learner's settings (compiles them: ~1 min on 2 cores)
+def test_learned_noise_is_learned_in_the_live_fit_and_kept_through_updates_and_a_refresh():
     af = load_airframe(ROOT / "data" / "airframes" / "sim-trainer.toml")
     models = {}
     for noise in ("independent", "learned"):
-        lr = Learner(af, LearnOptions(min_rows=300, n_inducing=24, gp_noise=noise))
+        lr = Learner(af, LearnOptions(min_rows=300, n_inducing=24, gp_noise=noise, hyper_every=150))
         lr._learn(_table(400, 1), np.ones(400, bool))
-        lr._learn(_table(100, 2), np.ones(100, bool))          # the incremental update keeps the config
-        assert lr.n_learned == 500
+        partial = _table(160, 2)
+        partial.Y[::3, 3:] = np.nan                             # moments missing on a third of the update's rows
+        lr._learn(partial, np.ones(160, bool))                  # the update, then a light refresh (hyper_every)
+        assert lr.n_learned == 560
+        assert any("refreshed (light)" in n for n in lr.notes), lr.notes
         models[noise] = lr.model
     assert not models["independent"].config.noise_correlation
     assert models["learned"].config.noise_correlation and models["learned"].config.noise_posterior == "diagonal"
