@@ -20,7 +20,8 @@ fresh directory):
   new region's rows (50-row batches), then one hyperparameter refresh, against ``fit_gp`` on all rows
   (the baseline, same run): held-out error in the new region and CPU seconds of each step.
 
-Run: ``python benchmarks/bench_gp_stream.py`` (``--quick``: 36,000 soak rows).
+Run: ``python benchmarks/bench_gp_stream.py`` (``--quick``: 36,000 soak rows; ``--only latency --gp-noise learned``: the
+latency job with the replay's noise, whose cost the twenty-sixth session compared with the default `independent`).
 """
 
 from __future__ import annotations
@@ -50,11 +51,17 @@ def rss_mib() -> float:
     return float("nan")
 
 
-def run_latency(calls: int = 60) -> dict:
+def run_latency(calls: int = 60, gp_noise: str = "independent") -> dict:
+    """The ``latency`` job; ``gp_noise``: the GP's noise by name (:func:`gcs_sysid.pipeline.gp_noise_fields`;
+    ``independent``, ``GPConfig()``'s, is the live learner's default, ``learned`` the replay's)."""
     from gcs_sysid.gp import GPConfig, fit_gp
+    from gcs_sysid.gp.streaming import light_refresh
+    from gcs_sysid.pipeline import gp_noise_fields
 
     X, Y, _ = flight(3000 + 50 * calls + 1000, seed=4)
-    model, _ = fit_gp(X[:3000], Y[:3000], GPConfig(n_inducing=256))
+    t = time.process_time()
+    model, _ = fit_gp(X[:3000], Y[:3000], GPConfig(n_inducing=256, **gp_noise_fields(gp_noise)))
+    fit_cpu = time.process_time() - t
     model.predict(X[:10])
     lat, swaps = [], 0
     Z0 = np.asarray(model.params.Z)
@@ -75,8 +82,14 @@ def run_latency(calls: int = 60) -> dict:
     t = time.perf_counter()
     model.refresh_hyperparameters()
     refresh = time.perf_counter() - t
+    light = []
+    for _ in range(3):      # the live learner's refresh (every LearnOptions.hyper_every rows); the first compiles
+        t = time.perf_counter()
+        light_refresh(model)
+        light.append(time.perf_counter() - t)
     warm = lat[5:]          # the first calls compile the update's programs
-    return {"M": 256, "batch_rows": 50, "calls": calls, "update_median_ms": 1e3 * statistics.median(warm),
+    return {"gp_noise": gp_noise, "fit_3000_cpu_s": fit_cpu, "light_refresh_s": statistics.median(light[1:]),
+            "M": 256, "batch_rows": 50, "calls": calls, "update_median_ms": 1e3 * statistics.median(warm),
             "update_p95_ms": 1e3 * float(np.percentile(warm, 95)), "update_max_ms": 1e3 * max(warm),
             "per_sample_median_ms": 1e3 * statistics.median(warm) / 50,
             "per_sample_mean_ms": 1e3 * float(np.mean(warm)) / 50,
@@ -204,6 +217,8 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--rows", type=int, default=180000)
     ap.add_argument("--only", choices=("latency", "soak", "envelope", "refresh"))
+    ap.add_argument("--gp-noise", default="independent", help="the latency job's GP noise (a name of "
+                    "gcs_sysid.pipeline.GP_NOISE_MODES; default independent, the live learner's)")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
@@ -213,13 +228,13 @@ def main(argv=None):
         limit_blas_threads(1)
         enable_compilation_cache(tempfile.mkdtemp(prefix="gcs-sysid-bench-jax-"))
         kind, value = args.worker.split(":")
-        res = {"latency": lambda: run_latency(), "soak": lambda: run_soak(int(value)),
+        res = {"latency": lambda: run_latency(gp_noise=value or "independent"), "soak": lambda: run_soak(int(value)),
                "envelope": lambda: run_envelope(), "refresh": lambda: run_refresh_grid()}[kind]()
         res["peak_rss_mib"] = __import__("resource").getrusage(__import__("resource").RUSAGE_SELF).ru_maxrss / 1024
         print(json.dumps(res))
         return
     rows = 36000 if args.quick else args.rows
-    jobs = [("latency", 0), ("envelope", 0), ("refresh", 0), ("soak", rows)]
+    jobs = [("latency", args.gp_noise), ("envelope", 0), ("refresh", 0), ("soak", rows)]
     if args.only:
         jobs = [j for j in jobs if j[0] == args.only]
     for kind, value in jobs:
@@ -231,7 +246,8 @@ def main(argv=None):
             print(f"  update of 50 rows at M=256: median {res['update_median_ms']:.1f} ms, p95 {res['update_p95_ms']:.1f} ms"
                   f" -> {res['per_sample_median_ms']:.3f} ms per sample (mean {res['per_sample_mean_ms']:.3f});"
                   f" predict 1000 rows after an update {res['first_predict_1000_s']:.2f} s (posterior + tree), again"
-                  f" {res['next_predict_1000_s']:.2f} s; refresh {res['refresh_s']:.1f} s")
+                  f" {res['next_predict_1000_s']:.2f} s; refresh {res['refresh_s']:.1f} s, light "
+                  f"{res['light_refresh_s']:.1f} s; fit on 3,000 rows {res['fit_3000_cpu_s']:.1f} CPU s ({res['gp_noise']})")
         elif kind == "envelope":
             print(f"  new region: before {res['err_before_pct']}, streamed {res['err_streamed_pct']} (mean ratio to "
                   f"refit {res['ratio_streamed']:.2f}, CPU {res['stream_cpu_s']:.1f} s for {res['rows_new']} rows), + refresh "

@@ -128,6 +128,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--seeds", default="1", help="comma-separated seeds, one campaign each (default 1)")
     c.add_argument("--out", required=True, help="output directory (campaign.json, campaign.md, campaign.png)")
     c.add_argument("--refit", action="store_true", help="re-learn the GP after each flight instead of updating it")
+    c.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
+                   help="the GP's output noise (default independent: one variance per output; 'learned' is the "
+                        "replay's default; docs/gp.md, 'Noise')")
 
     from .live.cli import add_listen_parser
 
@@ -265,7 +268,8 @@ def _cmd_campaign(a: argparse.Namespace) -> int:
     from .outdir import StagedDir
 
     with StagedDir(a.out, "campaign", ("campaign.json", "campaign.md", "campaign.png")) as stage:
-        rc = run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit, write_to=stage.path)
+        rc = run_campaign_cli(a.airframe, a.model, a.flights, a.seeds, a.out, a.refit, write_to=stage.path,
+                              gp_noise=a.gp_noise)
     return rc
 
 

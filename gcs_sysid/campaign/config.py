@@ -31,6 +31,11 @@ class CampaignConfig:
         targets: coefficients to target (None: all, moments first).
         refit: re-learn the GP (hyperparameters, inducing points) on all data after each flight
             instead of the incremental update (for comparison; the product updates incrementally).
+        gp_noise: the GP's output noise, a name of :data:`gcs_sysid.pipeline.GP_NOISE_MODES` (``"independent"``: one
+            variance per output, ``GPConfig()``'s; ``"learned"``: the replay's default, a ``P x P`` noise covariance
+            learned with the hyperparameters, only its variances in the posterior; ``docs/gp.md``, "Noise"). The
+            campaign's coefficient noise ``COEF_NOISE`` is drawn independently per coefficient, so ``learned`` has
+            no cross-correlated noise to find here (``docs/campaign-results.md``).
     """
 
     flights: int = 4
@@ -44,6 +49,7 @@ class CampaignConfig:
     local: bool = True
     targets: tuple[str, ...] | None = None
     refit: bool = False
+    gp_noise: str = "independent"
 
     def __post_init__(self):
         if self.flights < 2:
@@ -52,5 +58,8 @@ class CampaignConfig:
             raise InputError("at least one seed is needed")
         if not self.flight_s >= 82.0:
             raise InputError(f"flight length must be at least 82 s (the validation flight's), got {self.flight_s}")
+        from ..pipeline import gp_noise_fields
+
+        gp_noise_fields(self.gp_noise)      # InputError on an unknown name
 
 

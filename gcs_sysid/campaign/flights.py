@@ -127,10 +127,14 @@ def suggest(model, X: np.ndarray, Y: np.ndarray, airframe: Airframe, cfg: Campai
 
 
 def fit(X: np.ndarray, Y: np.ndarray, cfg: CampaignConfig, seed: int):
+    """The campaign's GP on ``X (N, 10)``, ``Y (N, 6)`` (SI, coefficients), noise ``cfg.gp_noise``
+    (:func:`gcs_sysid.pipeline.gp_noise_fields`), ``GPConfig.seed = seed``; a :class:`~gcs_sysid.gp.LocalGlobalGP`."""
     from ..gp import GPConfig, fit_gp
+    from ..pipeline import gp_noise_fields
 
     gcfg = GPConfig(n_inducing=cfg.n_inducing, n_inducing_hyper=24, n_train_max=600, steps=cfg.gp_steps,
-                    mi_pool=400, local=cfg.local, local_steps=20, batch_size=1024, seed=seed)
+                    mi_pool=400, local=cfg.local, local_steps=20, batch_size=1024, seed=seed,
+                    **gp_noise_fields(cfg.gp_noise))
     model, _ = fit_gp(X, Y, gcfg)
     return model
 

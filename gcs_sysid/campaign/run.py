@@ -179,11 +179,11 @@ def _acceptance(runs: list[dict], lim) -> dict[str, Any]:
 
 
 def run_campaign_cli(airframe: str, model: str, flights: int, seeds: str, out: str, refit: bool = False,
-                     write_to: str | Path | None = None) -> int:
+                     write_to: str | Path | None = None, gp_noise: str | None = None) -> int:
     """``gcs-sysid campaign``: parse the seeds, run, print the acceptance lines; returns the exit code.
 
     ``write_to``: where the files are written (the CLI's staging folder, moved to ``out`` when
-    complete); None writes into ``out``.
+    complete); None writes into ``out``. ``gp_noise``: :attr:`CampaignConfig.gp_noise` (None: its default).
 
     Raises:
         InputError: seeds that are not comma-separated non-negative integers, or see :func:`run_campaign`.
@@ -195,7 +195,8 @@ def run_campaign_cli(airframe: str, model: str, flights: int, seeds: str, out: s
     if not seed_list or min(seed_list) < 0:
         raise InputError(f"--seeds must be comma-separated non-negative integers, got {seeds!r}")
     doc = run_campaign(airframe, model, out if write_to is None else write_to,
-                       CampaignConfig(flights=flights, seeds=seed_list, refit=refit))
+                       CampaignConfig(flights=flights, seeds=seed_list, refit=refit,
+                                      **({} if gp_noise is None else {"gp_noise": gp_noise})))
     acc = doc["acceptance"]
     print(f"wrote {Path(out) / 'campaign.md'}: sigma drop >= 2x standard: {acc['sigma_2x_all']}; "
           f"Cl Cm Cn error below standard: {acc['moments_better_all']}; designed inside limits: "

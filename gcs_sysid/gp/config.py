@@ -76,7 +76,8 @@ class GPConfig:
             global layer (cross-correlated noise: a gust moves several coefficients at once),
             not only one variance per output; ``docs/gp.md``, "Noise". Off in ``GPConfig()``; the
             replay turns it on, with ``noise_posterior = "diagonal"``, since the twenty-fifth session
-            (``gcs_sysid.pipeline.GP_NOISE = "learned"``; ``docs/gp.md``, "The default noise").
+            (``gcs_sysid.pipeline.GP_NOISE = "learned"``; ``docs/gp.md``, "The default noise"), the live learner
+            since the twenty-sixth (``gcs_sysid.live.learner.GP_NOISE``).
         noise_start: where the residual's cross-output covariance starts, with ``noise_correlation``:
             ``"signal"`` (the default, the start before the seventeenth session): 0.7 of the ridge
             residual's covariance in ``B``, the noise independent (0.3 of each output's variance);

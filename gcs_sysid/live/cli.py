@@ -24,6 +24,11 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                    help="newest seconds left for the next step, the smoother's future context (default 3)")
     p.add_argument("--min-rows", type=int, default=500, help="samples before the GP is first fitted (default 500)")
     p.add_argument("--inducing", type=int, default=None, help="inducing points of the global GP")
+    p.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
+                   help="the GP's output noise: 'learned' (the default, as the replay's) learns the outputs' noise "
+                        "correlation with the hyperparameters and keeps only its diagonal in the predictions; "
+                        "'independent' one variance per output (the default until the twenty-sixth session); "
+                        "docs/live.md, 'The GP's noise'")
     p.add_argument("--silence", type=float, default=30.0, metavar="S",
                    help="report the link as silent after S seconds without a packet (default 30)")
     p.add_argument("--no-learn", action="store_true", help="only log, monitor and request rates")
@@ -51,7 +56,8 @@ def cmd_listen(a: argparse.Namespace) -> int:
         if v is not None and not 1 <= v <= 255:
             raise InputError(f"{name} {v}: must lie in 1..255")
     learn = None if a.no_learn else LearnOptions(window_s=a.window, step_s=a.step, lag_s=a.lag,
-                                                 min_rows=a.min_rows, n_inducing=a.inducing)
+                                                 min_rows=a.min_rows, n_inducing=a.inducing,
+                                                 gp_noise=a.gp_noise)
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
                          component=not a.no_component, system_id=a.sysid, component_id=a.compid,
                          duration_s=a.duration, silence_s=a.silence, console=not a.quiet,

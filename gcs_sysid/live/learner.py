@@ -33,7 +33,17 @@ from ..airframe import Airframe
 from ..errors import InputError, SysidError
 from .heap import release_free_heap
 
-__all__ = ["LearnOptions", "Learner", "learn_from_tlog", "iter_tlog_records"]
+__all__ = ["LearnOptions", "Learner", "learn_from_tlog", "iter_tlog_records", "GP_NOISE", "learner_gp_config"]
+
+#: The live learner's GP noise (a name of :data:`gcs_sysid.pipeline.GP_NOISE_MODES`) when ``LearnOptions.gp_noise``
+#: is None: ``"learned"`` since the twenty-sixth session (i8-live), the replay's default too
+#: (:data:`gcs_sysid.pipeline.GP_NOISE`), so ``listen`` and ``replay`` on the same flight learn the same noise model.
+#: Under the default rule for GP changes (two GP seeds against ``"independent"``, the default until then, at the same
+#: seed) on 66 tuning flights (22 aircraft x light s1-3, streamed through the learner; ``benchmarks/eval_live_jsbsim.py``):
+#: flight x count flips +34/-11 at GPConfig.seed 0 and +33/-12 at seed 1, learned output correlations above 0.5 on
+#: 24 -> 8 and 25 -> 7 flights, 5 aircraft losing a count at both seeds where ``"independent"`` merely reseeded loses
+#: one on 10 (docs/benchmarks.md, "Twenty-sixth session, i8-live"; docs/live.md, "The GP's noise").
+GP_NOISE = "learned"
 
 
 @dataclass(frozen=True)
@@ -53,6 +63,15 @@ class LearnOptions:
         refresh_every: steps between refreshes of the confidence map and the suggestions.
         max_rows: learned rows kept for the confidence map (every other one is dropped when full).
         n_inducing: inducing points of the global GP (None: the GP's default).
+        gp_noise: the GP's output noise, a name of :data:`gcs_sysid.pipeline.GP_NOISE_MODES` (``"learned"``: a
+            ``P x P`` noise covariance learned with the hyperparameters, only its variances in the posterior, the
+            default here and in the replay; ``"independent"``: one variance per output, the default until the
+            twenty-sixth session; ``"full"``: the learned covariance in the posterior too; ``docs/gp.md``, "Noise");
+            None: :data:`GP_NOISE`. Rows that miss an output in the first fit make it ``independent`` (the fit's
+            note: the noise correlation needs complete rows), as in the replay. It sets the first fit's
+            ``GPConfig`` (:func:`learner_gp_config`); the incremental updates and the hyperparameter refreshes keep
+            that config.
+        gp_seed: ``GPConfig.seed`` of the fit (the hyperparameters' row subset, the inducing-point choice).
         hyper_every: rows learned between light hyperparameter refreshes of the GP
             (:func:`gcs_sysid.gp.streaming.light_refresh`: warm start, 40 Adam steps on 1,000 stored
             rows; so the length-scales follow an envelope that grows); 0: never.
@@ -72,6 +91,8 @@ class LearnOptions:
     refresh_every: int = 3
     max_rows: int = 20000
     n_inducing: int | None = None
+    gp_noise: str | None = None
+    gp_seed: int = 0
     hyper_every: int = 15000
     max_window_s: float | None = None
     trim_heap: bool = True
@@ -80,6 +101,33 @@ class LearnOptions:
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
             raise InputError(f"--window {self.window_s} s must be longer than --step {self.step_s} s > 0, "
                              f"and --lag {self.lag_s} s >= 0")
+        if self.gp_noise is not None:
+            from ..pipeline import gp_noise_fields
+
+            gp_noise_fields(self.gp_noise)      # InputError on an unknown name, before any record is read
+
+
+def learner_gp_config(options: LearnOptions):
+    """The :class:`gcs_sysid.gp.GPConfig` of the live learner's first fit.
+
+    Args:
+        options: the learner's options (``gp_noise``, ``gp_seed``, ``n_inducing`` are read).
+
+    Returns:
+        ``GPConfig()`` with the noise fields of :func:`gcs_sysid.pipeline.gp_noise_fields` (``options.gp_noise``, or
+        :data:`GP_NOISE` when None), ``seed = options.gp_seed`` and ``n_inducing`` when given. The replay adds its
+        own settings on top (:func:`gcs_sysid.pipeline.replay_gp_config`: the alpha_dot input, the coupling test);
+        with the same noise name the noise fields are the same.
+
+    Raises:
+        InputError: an unknown ``options.gp_noise``.
+    """
+    from ..gp import GPConfig
+    from ..pipeline import gp_noise_fields
+
+    extra = {} if options.n_inducing is None else {"n_inducing": options.n_inducing}
+    return GPConfig(**gp_noise_fields(GP_NOISE if options.gp_noise is None else options.gp_noise),
+                    seed=int(options.gp_seed), **extra)
 
 
 @dataclass
@@ -270,7 +318,7 @@ class Learner:
             return flight
 
     def _learn(self, table: CoefficientTable, rows: np.ndarray) -> None:
-        from ..gp import GPConfig, fit_gp
+        from ..gp import fit_gp
 
         if not rows.any():
             return
@@ -293,8 +341,7 @@ class Learner:
             # others: the joint GP conditions each on the rows that carry it (docs/gp.md, "Missing outputs")
             ok = np.any(np.isfinite(Ya[:, cols]), axis=1)
             self.outputs = tuple(COEFFICIENTS[i] for i in cols)
-            cfg = GPConfig() if self.options.n_inducing is None else GPConfig(n_inducing=self.options.n_inducing)
-            self.model, _ = fit_gp(Xa[ok], Ya[ok][:, cols], cfg)
+            self.model, _ = fit_gp(Xa[ok], Ya[ok][:, cols], learner_gp_config(self.options))
             self.n_learned += int(ok.sum())
             self.notes.append(f"step {self.steps}: GP fitted on {int(ok.sum())} rows "
                               f"({', '.join(self.outputs)})")
