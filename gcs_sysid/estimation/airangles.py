@@ -227,8 +227,9 @@ class AxisFit:
         noise_sigma: 1-sigma of the force-derived angle per sample, rad.
         ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
         r2: share of the measured coefficient's variance above :data:`HIGHPASS_HZ` that the model explains.
-        mean_shift: constant added to the kinematic angle (beta: its mean error, from CY0 ~ 0), rad.
-        shift_note: why the sideslip mean was or was not moved (beta only; empty for alpha).
+        mean_shift: constant added to the angle, rad (beta: the kinematic angle's mean error, from CY0 ~ 0; alpha: the
+            move onto the stated lift line's level, :data:`STATED_LIFT_LEVEL`, else 0).
+        shift_note: why the angle's mean was or was not moved (beta; alpha only with a stated lift line, else empty).
         moment_rss: (kinematic, aided) residual variance of the moment cross-check, each as a share of
             the moment coefficients' variance (NaN: no moments given).
         slope_method: how the slopes were fitted: ``"2SLS"`` (alpha: the elevator and its delayed copies
