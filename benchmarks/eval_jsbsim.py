@@ -186,6 +186,28 @@ def aero_reads_air_rates(aircraft: str) -> dict[str, bool]:
 #: ``--stated-lift-slope``: ``{aircraft: (CL_alpha, CL_q)}`` written into a copy of the airframe file that the replay
 #: and the least-squares fit read (:func:`stated_airframe`); empty: the harness's airframe file as it is
 STATED_AERO: dict[str, tuple[float, float | None]] = {}
+#: ``--stated-lift-level``: ``{aircraft: {"CL_alpha", "CL_q", "CL_delta_e", "CL0", "CL0_sigma"}}`` written into the same
+#: copy (:func:`stated_airframe`; ``CL_alpha`` and ``CL_q`` from :data:`STATED_AERO` where both are given)
+STATED_LINE: dict[str, dict[str, float]] = {}
+
+
+def parse_stated_line(items: list[str]) -> dict[str, dict[str, float]]:
+    """``--stated-lift-level`` items ``AC:CL_ALPHA:CL_Q:CL_DE:CL0[:CL0_SIGMA]`` -> :data:`STATED_LINE` entries.
+
+    Raises:
+        SystemExit: an item without the four numbers after the aircraft, or with a number that does not parse.
+    """
+    out = {}
+    keys = ("CL_alpha", "CL_q", "CL_delta_e", "CL0", "CL0_sigma")
+    for item in items:
+        ac_, *vals = item.split(":")
+        if not 4 <= len(vals) <= 5:
+            raise SystemExit(f"--stated-lift-level {item!r}: needs AC:CL_ALPHA:CL_Q:CL_DE:CL0[:CL0_SIGMA]")
+        try:
+            out[ac_] = {k: float(v) for k, v in zip(keys, vals)}
+        except ValueError as exc:
+            raise SystemExit(f"--stated-lift-level {item!r}: {exc}") from None
+    return out
 
 
 def stated_airframe(path: Path, work: Path, stem: str) -> Path:
@@ -194,12 +216,16 @@ def stated_airframe(path: Path, work: Path, stem: str) -> Path:
     reads the harness's own file, so the flights are reused; ``docs/estimation.md``, "The lift-slope floor as a fixed
     point")."""
     name = Path(path).stem.removeprefix("jsbsim-")
-    if name not in STATED_AERO:
+    if name not in STATED_AERO and name not in STATED_LINE:
         return path
-    cla, clq = STATED_AERO[name]
+    vals = dict(STATED_LINE.get(name, {}))
+    if name in STATED_AERO:
+        vals["CL_alpha"], clq = STATED_AERO[name]
+        vals.pop("CL_q", None)
+        if clq is not None:
+            vals["CL_q"] = clq
     out = Path(work) / f"{stem}-airframe-stated.toml"
-    out.write_text(Path(path).read_text() + f"\n[aero]\nCL_alpha = {cla!r}\n"
-                   + (f"CL_q = {clq!r}\n" if clq is not None else ""))
+    out.write_text(Path(path).read_text() + "\n[aero]\n" + "".join(f"{k} = {v!r}\n" for k, v in vals.items()))
     return out
 
 
@@ -550,6 +576,10 @@ def main(argv=None) -> int:
                     help="give the aiding a stated whole-aircraft lift slope (1/rad) and pitch-rate lift (per q_hat) "
                          "per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero] table; gcs_sysid.estimation.airangles."
                          "STATED_LIFT_SLOPE on; default: off, the wing's floor)")
+    ap.add_argument("--stated-lift-level", nargs="+", default=None, metavar="AC:CL_ALPHA:CL_Q:CL_DE:CL0[:SIGMA]",
+                    help="give the aiding a stated lift line per aircraft (slope 1/rad, per q_hat, per rad of elevator, "
+                         "CL at zero, its 1-sigma), e.g. dr1:3.57:1.05:0.16:0.252:0.01: alpha's flight mean is set "
+                         "on it (gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL on; default: off)")
     ap.add_argument("--gust-force-axes", default=None, choices=("yz", "xyz"),
                     help="the specific-force axes offered the turbulence state (gcs_sysid.estimation.rates."
                          "GUST_FORCE_AXES; default: the package's, y and z; xyz adds x)")
@@ -565,6 +595,11 @@ def main(argv=None) -> int:
         for item in a.stated_lift_slope:
             ac_, *vals = item.split(":")
             STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
+    if a.stated_lift_level is not None:
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.STATED_LIFT_LEVEL = True
+        STATED_LINE.update(parse_stated_line(a.stated_lift_level))
     if a.alpha_profile is not None:
         from gcs_sysid.estimation import airangles as _aa
 

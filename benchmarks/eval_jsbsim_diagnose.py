@@ -110,12 +110,12 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
 
 def _stated(files, out: Path, stem: str):
     """``files`` with the airframe the pipeline reads replaced by its copy with ``[aero]`` where
-    ``--stated-lift-slope`` names the aircraft (:func:`benchmarks.eval_jsbsim.stated_airframe`)."""
+    ``--stated-lift-slope`` or ``--stated-lift-level`` names the aircraft (:func:`benchmarks.eval_jsbsim.stated_airframe`)."""
     from dataclasses import replace
 
-    from benchmarks.eval_jsbsim import STATED_AERO, stated_airframe
+    from benchmarks.eval_jsbsim import STATED_AERO, STATED_LINE, stated_airframe
 
-    if not STATED_AERO:         # the option not given: the flight's files exactly as before
+    if not STATED_AERO and not STATED_LINE:         # the options not given: the flight's files exactly as before
         return files
     path = stated_airframe(files.airframe, out, stem)
     return files if path == files.airframe else replace(files, airframe=path)
@@ -635,6 +635,9 @@ def main(argv=None) -> int:
     p.add_argument("--stated-lift-slope", nargs="+", default=None, metavar="AC:CL_ALPHA[:CL_Q]",
                    help="the aiding's stated lift-slope floor per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero]; "
                         "gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE on; as eval_jsbsim's option; default off)")
+    p.add_argument("--stated-lift-level", nargs="+", default=None, metavar="AC:CL_ALPHA:CL_Q:CL_DE:CL0[:SIGMA]",
+                   help="the aiding's stated lift line per aircraft, alpha's flight mean set on it (gcs_sysid.estimation."
+                        "airangles.STATED_LIFT_LEVEL on; as eval_jsbsim's option; default off)")
     p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both"),
                    help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
                         "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
@@ -659,6 +662,12 @@ def main(argv=None) -> int:
         for item in a.stated_lift_slope:
             ac_, *vals = item.split(":")
             STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
+    if a.stated_lift_level is not None:
+        from benchmarks.eval_jsbsim import STATED_LINE, parse_stated_line
+        from gcs_sysid.estimation import airangles as _aa
+
+        _aa.STATED_LIFT_LEVEL = True
+        STATED_LINE.update(parse_stated_line(a.stated_lift_level))
     if a.alpha_level is not None:
         from gcs_sysid.diagnose import run as _dr
 

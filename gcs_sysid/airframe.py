@@ -206,6 +206,14 @@ class Airframe:
             ``q_hat = q c / (2 V)`` (``[aero] CL_q``; the tail's, ``2 a_t V_H eta`` in Etkin 1972 sec. 5.5), or
             None. Used only with the opt-in :data:`gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE` (the aided
             alpha's lift-slope floor; ``docs/estimation.md``, "The lift-slope floor as a fixed point").
+        CL0: the whole aircraft's stated lift coefficient at ``alpha = 0``, ``q_hat = 0``, ``delta_e = 0``
+            (``[aero] CL0``; ``-CL_alpha alpha_0L``, from a wind tunnel, DATCOM or a glide-polar test), or None.
+            CL_delta_e: its stated lift per radian of elevator (``[aero] CL_delta_e``), or None (taken as 0).
+            CL0_sigma: the stated 1-sigma of the lift line's level at the flight's mean condition, in CL
+            (``[aero] CL0_sigma``; None: :data:`gcs_sysid.estimation.airangles.STATED_CL0_SIGMA`). Used only with the
+            opt-in :data:`gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL` (the aided alpha's flight mean from the
+            stated lift line; ``docs/estimation.md``, "A stated lift line sets alpha's level"); they need
+            ``CL_alpha``.
     """
 
     name: str
@@ -228,6 +236,9 @@ class Airframe:
     can_actuators: tuple["CanActuator", ...] = ()
     CL_alpha: float | None = None
     CL_q: float | None = None
+    CL0: float | None = None
+    CL_delta_e: float | None = None
+    CL0_sigma: float | None = None
 
     @property
     def authority(self) -> dict[str, float]:
@@ -439,17 +450,25 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
         raise InputError(f"{src}: [air_data] angles must be \"estimate\" (autopilot's AOA_SSA estimate) or "
                          f"\"vane\" (AOA_SSA/AOA carry vane measurements), got {angles!r}")
     aero = doc.get("aero", {})
-    if not isinstance(aero, Mapping) or set(aero) - {"CL_alpha", "CL_q"}:
-        raise InputError(f"{src}: [aero] must be a table with only 'CL_alpha' (1/rad) and 'CL_q' (per q_hat)")
-    if "CL_q" in aero and "CL_alpha" not in aero:
-        raise InputError(f"{src}: [aero] CL_q is used only with CL_alpha (the stated lift-slope floor)")
+    if not isinstance(aero, Mapping) or set(aero) - {"CL_alpha", "CL_q", "CL0", "CL_delta_e", "CL0_sigma"}:
+        raise InputError(f"{src}: [aero] must be a table with only 'CL_alpha' (1/rad), 'CL_q' (per q_hat), 'CL0', "
+                         f"'CL_delta_e' (1/rad) and 'CL0_sigma'")
+    for k in ("CL_q", "CL0", "CL_delta_e", "CL0_sigma"):
+        if k in aero and "CL_alpha" not in aero:
+            raise InputError(f"{src}: [aero] {k} is used only with CL_alpha (the stated lift slope and line)")
+    if ("CL_delta_e" in aero or "CL0_sigma" in aero) and "CL0" not in aero:
+        raise InputError(f"{src}: [aero] CL_delta_e and CL0_sigma are used only with CL0 (the stated lift line)")
     cla = _req(aero, "CL_alpha", "[aero]", src, positive=True) if "CL_alpha" in aero else None
     clq = _req(aero, "CL_q", "[aero]", src) if "CL_q" in aero else None
     if clq is not None and clq < 0:
         raise InputError(f"{src}: [aero] field 'CL_q' must be >= 0 (a tail's lift grows with the pitch rate), "
                          f"got {clq!r}")
+    cl0 = _req(aero, "CL0", "[aero]", src) if "CL0" in aero else None
+    clde = _req(aero, "CL_delta_e", "[aero]", src) if "CL_delta_e" in aero else None
+    cl0s = _req(aero, "CL0_sigma", "[aero]", src, positive=True) if "CL0_sigma" in aero else None
     af = Airframe(name, mass, Ixx, Iyy, Izz, Ixz, S, b, c, tuple(servos), throttle, thrust,
-                  tuple(float(x) for x in arm), source, notes, air_angles=angles, CL_alpha=cla, CL_q=clq)
+                  tuple(float(x) for x in arm), source, notes, air_angles=angles, CL_alpha=cla, CL_q=clq,
+                  CL0=cl0, CL_delta_e=clde, CL0_sigma=cl0s)
     if "limits" in doc:
         af = replace(af, limits=_limits(doc["limits"], af, src))
     if "can_actuator" in doc:
@@ -538,7 +557,9 @@ def airframe_to_dict(a: Airframe) -> dict[str, Any]:
     if a.air_angles != "estimate":
         d["air_data"] = {"angles": a.air_angles}
     if a.CL_alpha is not None:
-        d["aero"] = {"CL_alpha": a.CL_alpha} | ({"CL_q": a.CL_q} if a.CL_q is not None else {})
+        d["aero"] = {"CL_alpha": a.CL_alpha} | {k: v for k, v in (("CL_q", a.CL_q), ("CL0", a.CL0),
+                                                                  ("CL_delta_e", a.CL_delta_e),
+                                                                  ("CL0_sigma", a.CL0_sigma)) if v is not None}
     if a.can_actuators:
         d["can_actuator"] = [{"id": c.actuator_id, "servo": c.servo, "sign": c.sign, "scale": c.scale,
                               "zero_deg": math.degrees(c.zero)} for c in a.can_actuators]

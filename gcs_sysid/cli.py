@@ -80,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
                         "default until the twenty-fifth session; 'diagonal' is its older name) one noise variance per "
                         "output; 'full' the learned correlation in the predictions too (docs/gp.md, 'The default noise')")
+    r.add_argument("--stated-lift-level", action="store_true",
+                   help="set the aided alpha's flight mean on the airframe's stated lift line ([aero] CL0 with "
+                        "CL_alpha; docs/estimation.md, 'A stated lift line sets alpha's level'; default off)")
     r.add_argument("--quiet", action="store_true", help="no progress display")
 
     s = sub.add_parser("simulate", help="simulate a flight with the project's 6-DOF model and write a tlog")
@@ -99,6 +102,8 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--out", required=True, help="output model TOML file")
     f.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
                    help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates)")
+    f.add_argument("--stated-lift-level", action="store_true",
+                   help="alpha's flight mean on the airframe's stated lift line (as replay's --stated-lift-level)")
     _window_args(f)
 
     d = sub.add_parser("diagnose", help="compare the simulation model with measured data, name the cause")
@@ -148,6 +153,15 @@ def _replay_options(a: argparse.Namespace):
                          gp_noise=a.gp_noise)
 
 
+def _stated_lift_level(a: argparse.Namespace) -> None:
+    """``--stated-lift-level``: switch on :data:`gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL` for this run (the
+    aiding runs in this process; an airframe without ``[aero] CL0`` is unchanged)."""
+    if getattr(a, "stated_lift_level", False):
+        from .estimation import airangles
+
+        airangles.STATED_LIFT_LEVEL = True
+
+
 def _check_replay(a: argparse.Namespace) -> None:
     from .pipeline import check_replay
 
@@ -157,6 +171,7 @@ def _check_replay(a: argparse.Namespace) -> None:
 def _cmd_replay(a: argparse.Namespace) -> int:
     from .pipeline import MIN_TRAIN_ROWS, run_replay
 
+    _stated_lift_level(a)
     result = run_replay(a.log, a.airframe, a.out, _replay_options(a))
     out = Path(a.out)
     print(f"report: {out / 'report.html'}")
@@ -224,6 +239,7 @@ def _check_fit(a: argparse.Namespace) -> None:
 def _cmd_fit(a: argparse.Namespace) -> int:
     from .diagnose import run_fit
 
+    _stated_lift_level(a)
     run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates)
     print(f"wrote {a.out}")
     return 0

@@ -122,3 +122,32 @@ def test_stated_lift_derivatives(monkeypatch):
             est._aid_angles(0.02, z, z, z + 1.0, 1.2, np.zeros((1, 3)), 0.0, np.zeros((1, 3)),
                             {"delta_e": 0, "delta_a": 0, "delta_r": 0}, a, np.ones(1, bool), None, None, {}, {}, [])
     assert seen == [None, (5.5, 7.1)]
+
+
+def test_stated_lift_line(monkeypatch):
+    """``[aero] CL0``, ``CL_delta_e``, ``CL0_sigma`` (the stated lift line that sets the aided alpha's flight mean) are
+    read, written back, checked, and reach the aiding only with the opt-in ``STATED_LIFT_LEVEL``."""
+    import gcs_sysid.estimation.airangles as aa
+    import gcs_sysid.estimation.estimate as est
+
+    d = _doc()
+    d["aero"] = {"CL_alpha": 3.57, "CL_q": 1.05, "CL0": 0.252, "CL_delta_e": 0.16, "CL0_sigma": 0.01}
+    a = airframe_from_dict(d)
+    assert (a.CL0, a.CL_delta_e, a.CL0_sigma) == (0.252, 0.16, 0.01)
+    assert airframe_from_dict(airframe_to_dict(a)) == a
+    assert airframe_from_dict(_doc()).CL0 is None
+    for bad, frag in (({"CL0": 0.2}, "only with CL_alpha"), ({"CL_alpha": 5.0, "CL_delta_e": 0.3}, "only with CL0"),
+                      ({"CL_alpha": 5.0, "CL0": 0.2, "CL0_sigma": 0.0}, "CL0_sigma"),
+                      ({"CL_alpha": 5.0, "CL0": "x"}, "CL0")):
+        d["aero"] = bad
+        with pytest.raises(InputError, match=frag):
+            airframe_from_dict(d)
+    seen = []
+    monkeypatch.setattr(est, "aided_air_angles", lambda *x, **k: seen.append(k["stated_level"]) or 1 / 0)
+    for on in (False, True):
+        monkeypatch.setattr(aa, "STATED_LIFT_LEVEL", on)
+        with pytest.raises(ZeroDivisionError):
+            z = np.zeros(1)
+            est._aid_angles(0.02, z, z, z + 1.0, 1.2, np.zeros((1, 3)), 0.0, np.zeros((1, 3)),
+                            {"delta_e": 0, "delta_a": 0, "delta_r": 0}, a, np.ones(1, bool), None, None, {}, {}, [])
+    assert seen == [None, {"CL0": 0.252, "CL_alpha": 3.57, "CL_q": 1.05, "CL_delta_e": 0.16, "CL0_sigma": 0.01}]

@@ -20,3 +20,23 @@ def test_unknown_gust_rate_frame_is_a_user_error(capsys):
         main(["replay", "x.tlog", "--airframe", "a.toml", "--out", "o", "--gust-rates", "body"], handle_signals=False)
     assert e.value.code == 2
     assert "--gust-rates" in capsys.readouterr().err
+
+
+def test_stated_lift_level_flag_switches_the_aiding(monkeypatch):
+    """`--stated-lift-level` on replay and fit switches on airangles.STATED_LIFT_LEVEL for the run (off without it)."""
+    import gcs_sysid.cli as cli
+    import gcs_sysid.diagnose as dg
+    import gcs_sysid.estimation.airangles as aa
+    import gcs_sysid.pipeline as pl
+
+    seen = []
+    monkeypatch.setattr(pl, "run_replay", lambda *x, **k: seen.append(aa.STATED_LIFT_LEVEL) or 1 / 0)
+    monkeypatch.setattr(dg, "run_fit", lambda *x, **k: seen.append(aa.STATED_LIFT_LEVEL) or 1 / 0)
+    for argv in (["replay", "x.tlog", "--airframe", "a.toml", "--out", "o"],
+                 ["replay", "x.tlog", "--airframe", "a.toml", "--out", "o", "--stated-lift-level"],
+                 ["fit", "x.tlog", "--airframe", "a.toml", "--out", "m.toml", "--stated-lift-level"]):
+        monkeypatch.setattr(aa, "STATED_LIFT_LEVEL", False)
+        a = build_parser().parse_args(argv)
+        with pytest.raises(ZeroDivisionError):
+            cli.COMMANDS[a.command](a)
+    assert seen == [False, True, True]

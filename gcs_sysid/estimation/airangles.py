@@ -72,7 +72,7 @@ from .angleerrors import MIN_FIRST_STAGE_R2, effective_n, first_stage_f, iv_lsts
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
 
-__all__ = ["TAUS_S", "RATIOS", "AxisFit", "AidedAngles", "aided_air_angles", "describe"]
+__all__ = ["TAUS_S", "RATIOS", "AxisFit", "AidedAngles", "aided_air_angles", "describe", "lift_level"]
 
 TAUS_S = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)     #: candidate gust correlation times, s
 RATIOS = (0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)   #: candidate gust / measurement variance ratios
@@ -162,6 +162,20 @@ STATED_LIFT_SLOPE = False
 #: mean moves away from the kinematic one by 0.3-1.0 deg on the slow aircraft (rascal, sgs126, asw20 in MIL-F-8785C
 #: light turbulence; ``docs/benchmarks.md``, "Eighteenth session, i8-alpha").
 KINEMATIC_MEAN = False
+#: Opt-in (default False; twenty-sixth session, i8-cl0): the aided alpha's flight mean from the airframe's *stated*
+#: lift line (``[aero] CL0``, ``CL_alpha``, ``CL_q``, ``CL_delta_e`` in the airframe file, :class:`gcs_sysid.airframe.
+#: Airframe`; :func:`lift_level`). A constant vertical wind is not observable from one flight's kinematics and goes into
+#: the fitted ``CZ0``; a *stated* zero-lift level is what makes it observable (the level is to alpha's mean what the
+#: stated ``CL_alpha`` is to its scale). The measured lift's flight mean, read through the stated line, gives the true
+#: alpha's mean; it is combined with the aided alpha's mean by their two 1-sigmas (the flight-mean wind's,
+#: ``AxisFit.bias_sigma``, and the stated line's, ``CL0_sigma / CL_alpha`` with the measured lift's block standard
+#: error), and the smaller combined 1-sigma replaces ``bias_sigma``. An airframe without ``CL0`` changes nothing.
+STATED_LIFT_LEVEL = False
+#: the 1-sigma of a stated ``CL0`` when the airframe gives no ``[aero] CL0_sigma`` (a judgement: DATCOM-class estimates
+#: of a conventional aircraft's zero-lift angle are good to about 0.5 deg, 0.02-0.05 in CL; a wind tunnel's to 0.005)
+STATED_CL0_SIGMA = 0.02
+#: block length of the measured lift's flight-mean standard error (:func:`lift_level`: the gusts' lift is correlated), s
+LEVEL_BLOCK_S = 10.0
 #: Opt-in (default False; eighteenth session, i8-alpha): where the lift-slope floor holds, leave the curvature
 #: ``(alpha - alpha0)^2`` out of the first pass too (as :data:`FLOOR_DROPS`); the later passes fit it on the aided angle.
 #: Fitted on the kinematic angle it is that angle's gust error squared (rascal, sgs126, asw20 light: -16..+11 per rad^2
@@ -213,8 +227,9 @@ class AxisFit:
         noise_sigma: 1-sigma of the force-derived angle per sample, rad.
         ratio: the chosen gust / noise variance ratio (one of :data:`RATIOS`).
         r2: share of the measured coefficient's variance above :data:`HIGHPASS_HZ` that the model explains.
-        mean_shift: constant added to the kinematic angle (beta: its mean error, from CY0 ~ 0), rad.
-        shift_note: why the sideslip mean was or was not moved (beta only; empty for alpha).
+        mean_shift: constant added to the angle, rad (beta: the kinematic angle's mean error, from CY0 ~ 0; alpha: the
+            move onto the stated lift line's level, :data:`STATED_LIFT_LEVEL`, else 0).
+        shift_note: why the angle's mean was or was not moved (beta; alpha only with a stated lift line, else empty).
         moment_rss: (kinematic, aided) residual variance of the moment cross-check, each as a share of
             the moment coefficients' variance (NaN: no moments given).
         slope_method: how the slopes were fitted: ``"2SLS"`` (alpha: the elevator and its delayed copies
@@ -357,6 +372,50 @@ def _moment_rss(angle: np.ndarray, X_other: np.ndarray, moments: list[np.ndarray
         c, *_ = np.linalg.lstsq(A, y, rcond=None)
         out.append(float(np.var(y - A @ c)) / max(float(np.var(y)), 1e-300))
     return float(np.mean(out))
+
+
+def lift_level(dt: float, alpha: np.ndarray, CX: np.ndarray, CZ: np.ndarray, q_hat: np.ndarray,
+               delta_e: np.ndarray, m: np.ndarray, CL0: float, CL_alpha: float, CL_q: float = 0.0,
+               CL_delta_e: float = 0.0, CL0_sigma: float = STATED_CL0_SIGMA) -> tuple[float, float]:
+    """The true alpha's flight mean against ``alpha``'s, from a stated lift line (:data:`STATED_LIFT_LEVEL`).
+
+    The lift measured by the accelerometers, ``CL = -CZ cos(alpha) + CX sin(alpha)`` (wind axes; thrust along body x
+    enters through ``sin(alpha)`` only), obeys the stated line ``CL = CL0 + CL_alpha alpha + CL_q q_hat + CL_delta_e
+    delta_e`` at every sample whatever the wind; its flight mean therefore fixes the true angle's flight mean, which
+    kinematics cannot (the flight-mean vertical wind goes into the fitted ``CZ0``; Jategaonkar 2015, flight path
+    reconstruction, ch. 10: a constant air-data offset is observable only against a stated reference; Morelli
+    and Klein 2016 ch. 10, the angle-of-attack bias of data compatibility analysis). The drag is in the rotation; the
+    lift line's curvature is left out: on the JSBSim roster's light flights (alpha within a few degrees of trim) it
+    moves the line's level by 0.00-0.06 deg (j3cub the largest).
+
+    Args:
+        dt: grid step, s.
+        alpha: (T,) the angle whose mean is checked (the aided alpha), rad; the rotation to wind axes uses it.
+        CX, CZ: (T,) body-axis force coefficients from the specific force, ``m f / (qbar S)``.
+        q_hat: (T,) ``q c / (2 V)``. delta_e: (T,) elevator, rad.
+        m: (T,) bool, the rows to average (finite everywhere there).
+        CL0: stated lift at zero alpha, pitch rate and elevator. CL_alpha: stated lift slope, 1/rad (> 0).
+        CL_q, CL_delta_e: stated lift per ``q_hat`` and per radian of elevator.
+        CL0_sigma: stated 1-sigma of the line's level, in CL.
+
+    Returns:
+        ``(offset, sigma)``, rad: the line's mean alpha minus ``alpha``'s over ``m`` (add it to move ``alpha`` onto
+        the line), and its 1-sigma: ``CL0_sigma / CL_alpha`` and the per-sample lift's block standard error
+        (:data:`LEVEL_BLOCK_S` blocks) in quadrature. ``(nan, nan)`` if ``m`` has fewer than two blocks of rows.
+
+    Raises:
+        ValueError: if ``CL_alpha`` is not positive or ``CL0_sigma`` is negative.
+    """
+    if not CL_alpha > 0 or not CL0_sigma >= 0:
+        raise ValueError(f"lift_level needs CL_alpha > 0 and CL0_sigma >= 0, got {CL_alpha!r}, {CL0_sigma!r}")
+    nb = max(int(round(LEVEL_BLOCK_S / dt)), 1)
+    if int(m.sum()) < 2 * nb:
+        return float("nan"), float("nan")
+    a = alpha[m]
+    CL = -CZ[m] * np.cos(a) + CX[m] * np.sin(a)
+    e = (CL - CL0 - CL_q * q_hat[m] - CL_delta_e * delta_e[m]) / CL_alpha - a
+    var = _block_mean_var(e, [slice(0, len(e))], nb)
+    return float(np.mean(e)), float(np.sqrt((CL0_sigma / CL_alpha) ** 2 + var))
 
 
 def _highpass(dt: float, X: np.ndarray, segs: list[slice], edge_hz: float | None = None) -> np.ndarray:
@@ -1009,7 +1068,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None,
                      instrument_beta: bool | None = None, beta_band_hz: float | None = None,
                      stated_slopes: tuple[float | None, float | None] | None = None,
-                     profile_beta: bool | None = None) -> AidedAngles:
+                     profile_beta: bool | None = None, stated_level: dict[str, float | None] | None = None
+                     ) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -1057,6 +1117,12 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         profile_beta: ``CY_beta`` of the first pass by the gust model's likelihood (the filter-error estimate,
             :func:`_profile_angle_slope`) instead of least squares above the band edge; only where the side-force slopes
             are fitted by least squares (not with 2SLS or a given model). None: :data:`BETA_PROFILE`.
+        stated_level: the airframe's stated lift line, ``{"CL0", "CL_alpha", "CL_q", "CL_delta_e", "CL0_sigma"}``
+            (``CL0`` and ``CL_alpha`` required; the others None or missing: 0, 0 and :data:`STATED_CL0_SIGMA`): where
+            alpha is aided, its flight mean is moved onto the line (:func:`lift_level`, :data:`STATED_LIFT_LEVEL`) by
+            the weight ``s_w^2 / (s_w^2 + s_l^2)`` (``s_w`` the flight-mean wind's 1-sigma ``AxisFit.bias_sigma``,
+            ``s_l`` the line's), ``bias_sigma`` becomes ``s_w s_l / sqrt(s_w^2 + s_l^2)`` and the move is said in
+            ``AxisFit.shift_note`` (``mean_shift`` holds it, rad). None: alpha's mean is the aiding's.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -1143,12 +1209,48 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
                          (models or {}).get("alpha"), band_hz=edge, slope_floor=floor if held else None,
                          floor_held=floor_held)
+    if stated_level is not None and fa.used and stated_level.get("CL0") is not None:
+        a, a_sig = _level_onto_line(dt, a, a_sig, fa, k * f_body[:, 0], CZ, q_hat, de, u, stated_level)
     if "first pass with CZ_alpha held at" in fa.slope_method:
         fa.slope_method += f" (lateral gust witness: {100 * share:.0f} % of the kinematic alpha's in-band variance)"
     if powered and fb.used:
         fb.shift_note = ("sideslip mean kept: the throttle varies, and a propeller's side force (slipstream on the "
                          "fin, P-factor) breaks the CY0 ~ 0 prior")
     return AidedAngles(a, be, a_sig, b_sig, (fa, fb))
+
+
+def _level_onto_line(dt: float, a: np.ndarray, a_sig: np.ndarray, fa: AxisFit, CX: np.ndarray, CZ: np.ndarray,
+                     q_hat: np.ndarray, de: np.ndarray, u: np.ndarray, line: dict[str, float | None]
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Move the aided alpha ``a`` (T,) onto the stated lift line's level (:func:`lift_level`) over the rows ``u`` where
+    every input is finite, weighted against the flight-mean wind's prior ``fa.bias_sigma``; updates ``fa``'s
+    ``mean_shift``, ``shift_note`` and ``bias_sigma`` and returns the moved ``(alpha, alpha_sigma)``."""
+    g = lambda k, d: float(line[k]) if line.get(k) is not None else d    # noqa: E731
+    cla = abs(g("CL_alpha", float("nan")))
+    if not np.isfinite(cla) or cla == 0:
+        return a, a_sig
+    s_l0 = g("CL0_sigma", STATED_CL0_SIGMA)
+    m = u & np.isfinite(a) & np.isfinite(CX) & np.isfinite(CZ) & np.isfinite(q_hat) & np.isfinite(de)
+    d, s_l = lift_level(dt, a, CX, CZ, q_hat, de, m, g("CL0", 0.0), cla, abs(g("CL_q", 0.0)), g("CL_delta_e", 0.0),
+                        s_l0)
+    if not np.isfinite(d):
+        return a, a_sig
+    s_w = fa.bias_sigma
+    if np.isfinite(s_w) and s_w > 0:
+        w = s_w**2 / (s_w**2 + s_l**2)
+        post = s_w * s_l / np.sqrt(s_w**2 + s_l**2)
+    else:
+        w, post = 1.0, s_l
+    shift = w * d
+    old = fa.bias_sigma if np.isfinite(fa.bias_sigma) else 0.0
+    a = np.where(u, a + shift, a)
+    a_sig = np.sqrt(np.maximum(a_sig**2 - old**2, 0.0) + post**2)
+    fa.mean_shift = float(shift)
+    fa.bias_sigma = float(post)
+    fa.shift_note = (f"alpha mean moved by {np.degrees(shift):+.2f} deg onto the stated lift line (CL0 "
+                     f"{g('CL0', 0.0):+.3f} +- {s_l0:.3f}: line's level {np.degrees(d):+.2f} +- {np.degrees(s_l):.2f} "
+                     f"deg from the aided mean, weight {w:.2f} against the mean wind's {np.degrees(s_w):.2f} deg)")
+    return a, a_sig
 
 
 def describe(res: AidedAngles) -> list[str]:

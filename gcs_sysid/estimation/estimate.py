@@ -95,7 +95,11 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
                           airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia,
                           models=models, stated_slopes=((getattr(airframe, "CL_alpha", None),
                                                          getattr(airframe, "CL_q", None))
-                                                        if airangles.STATED_LIFT_SLOPE else None))
+                                                        if airangles.STATED_LIFT_SLOPE else None),
+                          stated_level=({k: getattr(airframe, k, None) for k in ("CL0", "CL_alpha", "CL_q",
+                                                                                "CL_delta_e", "CL0_sigma")}
+                                        if airangles.STATED_LIFT_LEVEL and getattr(airframe, "CL0", None) is not None
+                                        else None))
     notes.extend(describe(Ai))
     if fits is not None:
         fits.update({ax.name: ax for ax in Ai.axes})

@@ -605,3 +605,39 @@ def test_stated_lift_slope_moves_the_floor_and_holds_q_hat():
     assert np.std(stated.alpha - alpha) < 0.8 * np.std(wing.alpha - alpha)
     # not stated (None, or CL_alpha None): the wing's floor, bit for bit
     np.testing.assert_array_equal(aided_air_angles(*args, stated_slopes=(None, 7.0)).alpha, wing.alpha)
+
+
+def test_stated_lift_level_sets_alpha_mean():
+    """A constant vertical wind over the flight puts its ``w / V`` on the kinematic alpha, and the aiding keeps it (the
+    Gauss-Markov gust reverts to the kinematic mean; the fitted CZ0 takes the rest). A stated lift line (``CL0``,
+    ``CL_alpha``, ``CL_delta_e``: the opt-in ``STATED_LIFT_LEVEL``) makes that mean observable: the aided alpha's mean
+    moves onto the line, its flight-common 1-sigma falls, the note says so; without the line nothing changes."""
+    from gcs_sysid.estimation.airangles import lift_level
+
+    rec, alpha, _ = _record(seed=5)
+    rec["alpha_kin"] = rec["alpha_kin"] + np.radians(1.0)      # the flight-mean vertical wind: +1 deg on alpha
+    T = len(alpha)
+    args = (DT, rec["alpha_kin"], rec["beta_kin"], rec["V"], rec["qbar"], rec["f_body"], rec["rates"],
+            rec["controls"], MASS, S, B, C, np.ones(T, bool))
+    line = {"CL0": -CZ0, "CL_alpha": -CZ_ALPHA, "CL_q": None, "CL_delta_e": -CZ_DE, "CL0_sigma": 0.005}
+    base, lvl = aided_air_angles(*args), aided_air_angles(*args, stated_level=line)
+    fb, fl = base.axes[0], lvl.axes[0]
+    assert fb.used and fl.used, describe(lvl)
+    off_b, off_l = np.degrees(np.mean(base.alpha - alpha)), np.degrees(np.mean(lvl.alpha - alpha))
+    # measured (seed 5): +0.90 deg -> +0.08 deg (the line's own 1-sigma 0.06 deg against the mean wind's prior 0.17:
+    # weight 0.90), bias_sigma 0.168 -> 0.054 deg
+    assert abs(off_b) > 0.8 and abs(off_l) < 0.12, (off_b, off_l)
+    assert fl.bias_sigma < 0.5 * fb.bias_sigma and fl.bias_sigma > 0, (fb.bias_sigma, fl.bias_sigma)
+    assert abs(np.degrees(fl.mean_shift) + off_b) < 0.15 and "stated lift line" in fl.shift_note
+    assert any("stated lift line" in n for n in describe(lvl))
+    np.testing.assert_allclose(lvl.alpha - base.alpha, fl.mean_shift)      # a constant: the scale and gusts kept
+    assert np.all(lvl.alpha_sigma < base.alpha_sigma)
+    # a loosely stated line moves less (weighted by the two 1-sigmas) and states more
+    loose = aided_air_angles(*args, stated_level=dict(line, CL0_sigma=0.2)).axes[0]
+    assert abs(loose.mean_shift) < 0.8 * abs(fl.mean_shift) and loose.bias_sigma > fl.bias_sigma
+    # not stated: bit for bit the aiding's
+    np.testing.assert_array_equal(aided_air_angles(*args, stated_level=None).alpha, base.alpha)
+    np.testing.assert_array_equal(aided_air_angles(*args, stated_level=dict(line, CL0=None)).alpha, base.alpha)
+    z = np.zeros(T)
+    with pytest.raises(ValueError, match="CL_alpha > 0"):
+        lift_level(DT, alpha, z, z, z, z, np.ones(T, bool), 0.3, 0.0)

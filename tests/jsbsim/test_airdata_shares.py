@@ -86,3 +86,24 @@ def test_stated_airframe_copy_for_the_named_aircraft_only(tmp_path, monkeypatch)
     assert ej.stated_airframe(aircraft("t6").airframe_path, tmp_path, "t6") == aircraft("t6").airframe_path
     monkeypatch.setattr(ej, "STATED_AERO", {"s23": (5.5, None)})
     assert load_airframe(ej.stated_airframe(path, tmp_path, "x")).CL_q is None
+
+
+def test_stated_lift_line_copy(tmp_path, monkeypatch):
+    """``eval_jsbsim --stated-lift-level``: the copy carries the whole stated line; with ``--stated-lift-slope`` too the
+    slope and ``CL_q`` are that option's; a malformed item is refused."""
+    from benchmarks import eval_jsbsim as ej
+    from benchmarks.jsbsim_harness.aircraft import aircraft
+    from gcs_sysid.airframe import load_airframe
+
+    line = ej.parse_stated_line(["s23:5.45:6.3:0.30:0.496:0.01"])
+    assert line == {"s23": {"CL_alpha": 5.45, "CL_q": 6.3, "CL_delta_e": 0.30, "CL0": 0.496, "CL0_sigma": 0.01}}
+    monkeypatch.setattr(ej, "STATED_LINE", line)
+    path = aircraft("s23").airframe_path
+    a = load_airframe(ej.stated_airframe(path, tmp_path, "s23-light-s1-ahrs"))
+    assert (a.CL_alpha, a.CL_q, a.CL0, a.CL_delta_e, a.CL0_sigma) == (5.45, 6.3, 0.496, 0.30, 0.01)
+    monkeypatch.setattr(ej, "STATED_AERO", {"s23": (5.5, None)})
+    a = load_airframe(ej.stated_airframe(path, tmp_path, "x"))
+    assert (a.CL_alpha, a.CL_q, a.CL0) == (5.5, None, 0.496)
+    assert ej.stated_airframe(aircraft("t6").airframe_path, tmp_path, "t6") == aircraft("t6").airframe_path
+    with pytest.raises(SystemExit, match="needs"):
+        ej.parse_stated_line(["s23:5.45:6.3"])
