@@ -645,7 +645,14 @@ def main(argv=None) -> int:
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood (gcs_sysid."
                         "estimation.airangles.BETA_PROFILE; as eval_jsbsim's option; default: the package's, off)")
+    p.add_argument("--library-control-trim", default=None, choices=("on", "off"),
+                   help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
+                        "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
     a = p.parse_args(argv)
+    if a.library_control_trim is not None:
+        from gcs_sysid.diagnose import sparse as _sp
+
+        _sp.THRESHOLDS["library_control_trim"] = a.library_control_trim == "on"
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr
 

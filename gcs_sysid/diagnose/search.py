@@ -36,7 +36,8 @@ LIBRARY_REGRESSORS = ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "de
 
 def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
                       lags_s: tuple[float, ...] = (0.05, 0.1, 0.2),
-                      alpha_knots: np.ndarray | None = None) -> tuple[list[str], np.ndarray]:
+                      alpha_knots: np.ndarray | None = None,
+                      control_trim: dict[str, float] | None = None) -> tuple[list[str], np.ndarray]:
     """The candidate terms, evaluated on every row.
 
     Args:
@@ -45,12 +46,19 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
         lags_s: lags of the surface lag corrections, s.
         alpha_knots: hinge positions in alpha, rad (default: the ``n_hinges`` inner quantiles of
             the training rows' alpha); give another flight's to share one library between flights.
+        control_trim: ``{regressor: value}`` (rad for the surfaces): the monomials' factors in these regressors are
+            measured about the given values, ``delta_e - delta_e0`` (the reference flight's trim, so that a product
+            such as ``alpha^2*delta_e`` is not ``delta_e0`` times ``alpha^2`` at a large trim: Marquardt, JASA 75
+            (1980) 87, nonessential ill-conditioning; Morelli and Klein, *Aircraft System Identification*, sec. 5.4,
+            regressors about the reference condition). A product's own coefficient is unchanged by it; its
+            lower-order parents then read their slopes at the trim. Hinges, ``alpha_dot_hat`` and the lag
+            differences do not depend on it. None (the default): the measured values.
 
     Returns:
         (names, Phi): names (K,) and values (T, K); constant columns left out.
     """
     X = np.nan_to_num(ctx.X)
-    cols = {n: X[:, REGRESSORS.index(n)] for n in LIBRARY_REGRESSORS}
+    cols = {n: X[:, REGRESSORS.index(n)] - float((control_trim or {}).get(n, 0.0)) for n in LIBRARY_REGRESSORS}
     names, out = [], []
     for d in range(1, degree + 1):
         for combo in combinations_with_replacement(LIBRARY_REGRESSORS, d):
@@ -61,7 +69,7 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
                 parts.append(n if k == 1 else f"{n}^{k}")
             names.append("*".join(parts))
             out.append(v)
-    a = cols["alpha"]
+    a = X[:, REGRESSORS.index("alpha")]
     tr = ctx.train
     if alpha_knots is None:
         alpha_knots = alpha_quantile_knots(ctx, n_hinges)
@@ -76,7 +84,7 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
         for u in ("delta_e", "delta_a", "delta_r"):
             for tau in lags_s:
                 names.append(f"{u}(t-{tau:g})-{u}")
-                out.append(np.interp(t - tau, t, cols[u]) - cols[u])
+                out.append(np.interp(t - tau, t, X[:, REGRESSORS.index(u)]) - X[:, REGRESSORS.index(u)])
     Phi = np.column_stack(out)
     keep = np.ptp(Phi[ctx.valid], axis=0) > 0 if ctx.valid.any() else np.zeros(Phi.shape[1], bool)
     return [n for n, k in zip(names, keep) if k], Phi[:, keep]

@@ -213,6 +213,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: the column less its centred moving mean. ka350 evaluation flights: gain 14 -> 17/20, b737 10 -> 12/12; a
 #: ``Cm:alpha^2`` top count lost on the us25e and the ultrastick (``docs/benchmarks.md``, *Twenty-fourth session,
 #: i9-misses*).
+#: Added 2026-11-24 (twenty-sixth session, branch i9-cma2): ``library_control_trim``, **off**: the search library's
+#: monomials measure the surfaces (:data:`TRIM_SURFACES`) about the reference flight's trim (:func:`control_trim`,
+#: :func:`gcs_sysid.diagnose.search.candidate_library` ``control_trim``), so that at a large elevator trim
+#: ``alpha^2*delta_e`` is no longer ``delta_e0 alpha^2`` plus a small part and the search does not split a curvature
+#: between the two (the JSBSim dr1's ``Cm:alpha^2``). The reference's ridge inadequacy keeps the measured surfaces.
+#: No new threshold. Measured in ``docs/benchmarks.md``, *Twenty-sixth session, i9-cma2*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -231,7 +237,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
-              "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0}
+              "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -403,8 +409,33 @@ def _segments(ctx: DiagContext, segment_frac: float) -> tuple[np.ndarray, np.nda
     return v[v < cut - guard], v[v >= cut]
 
 
-def _library(ctx: DiagContext, knots=None) -> tuple[list[str], np.ndarray]:
-    return candidate_library(ctx, lags_s=_LAGS_S, alpha_knots=knots)
+def _library(ctx: DiagContext, knots=None, trim: dict[str, float] | None = None) -> tuple[list[str], np.ndarray]:
+    return candidate_library(ctx, lags_s=_LAGS_S, alpha_knots=knots, control_trim=trim)
+
+
+#: The surfaces whose factors the search's monomials measure about the reference flight's trim with
+#: ``THRESHOLDS["library_control_trim"]`` (the throttle is left as measured: ``alpha*delta_t`` standing in for
+#: ``alpha`` at a near-constant throttle is the hierarchy rule's business, item 3 of docs/diagnose.md).
+TRIM_SURFACES = ("delta_e", "delta_a", "delta_r")
+
+
+def control_trim(rctx: DiagContext, surfaces=TRIM_SURFACES) -> dict[str, float]:
+    """The reference flight's trim of each surface: its mean over the training rows, rad.
+
+    Args:
+        rctx: the reference flight's context (the flight under test's own without a reference).
+        surfaces: regressor names (default :data:`TRIM_SURFACES`).
+
+    Returns:
+        ``{surface: mean}``; 0 for a surface without finite values on those rows.
+    """
+    rows = rctx.train if rctx.train.any() else rctx.valid
+    out = {}
+    for u in surfaces:
+        x = np.asarray(rctx.X, float)[rows, REGRESSORS.index(u)]
+        x = x[np.isfinite(x)]
+        out[u] = float(x.mean()) if x.size else 0.0
+    return out
 
 
 def _aligned(names: list[str], Phi: np.ndarray, to_names: list[str]) -> np.ndarray:
@@ -763,6 +794,10 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         ridge) predicted on this flight, centred on the training rows (an array, not JSON).
     """
     th = dict(THRESHOLDS, **(thresholds or {}))
+    # the search's products with the surfaces measured about the reference's trim (library_control_trim; the
+    # reference's ridge inadequacy keeps the measured surfaces)
+    trim = (control_trim(reference[0] if reference is not None else ctx)
+            if th.get("library_control_trim", False) else None)
     # one library for both flights: the hinges in alpha sit at the reference flight's quantiles
     knots = alpha_quantile_knots(reference[0]) if reference is not None else None
     names, Phi = _library(ctx, knots)
@@ -899,8 +934,10 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 Rd, M0, Xc, err = Rd - N2, M0 + N2, X2, err + np.c_[e2, np.zeros_like(e2)]
                 Rn = Rn - N2
                 result["lift_alpha"] = info2
-        if np.any(err):                    # the library on the corrected angles
-            names, Phi = _library(replace(ctx, X=Xc), knots)
+        if np.any(err) or trim:            # the library on the corrected angles
+            names, Phi = _library(replace(ctx, X=Xc), knots, trim)
+            if offset_level and ridge is not None and trim:
+                names, Phi = _library(replace(ctx, X=Xc), knots)      # the ridge's columns: the measured surfaces
             if offset_level and ridge is not None:
                 # the reference's inadequacy, predicted on the angles brought to the reference's level
                 # (_inadequacy_at_reference_level): its terms in alpha (the ultrastick's CY and Cn in
@@ -915,6 +952,14 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 result["inadequacy_prediction"] = base.copy()
                 result["angle_offset_level"] = {"alpha_rad": float(err[tr, 0].mean()) if tr.size else 0.0,
                                                 "beta_rad": float(err[tr, 1].mean()) if tr.size else 0.0}
+                if trim:
+                    names, Phi = _library(replace(ctx, X=Xc), knots, trim)
+    if trim:
+        if not th.get("angle_nuisance", True):
+            names, Phi = _library(ctx, knots, trim)
+        if ref_after is not None:          # the reference's columns for a named term's error: the same trim
+            ref_after = _library(reference[0], knots, trim) + tuple(ref_after[2:])
+        result["library_control_trim"] = dict(trim)
     if th.get("pitch_gust_nuisance", False):
         # the pitch gust rate's moment (gyro q against the air-relative q the aerodynamics see), fitted on the
         # training rows and removed before the search selects and measures any gain (gust_nuisance)
@@ -997,7 +1042,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
-                                  null=null)
+                                  null=null, trim=trim)
     if th.get("errors_in_variables", False) and angle_sigma:
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         for f in named:
@@ -1021,7 +1066,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
-                                  centred=True, null=null, centred_scale=bool(th.get("centred_scale", False)))
+                                  centred=True, null=null, centred_scale=bool(th.get("centred_scale", False)),
+                                  trim=trim)
     result["findings"] = named
     return result
 
@@ -1416,7 +1462,8 @@ def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarra
 def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
                       M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
                       inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False,
-                      null: dict | None = None, centred_scale: bool = False) -> None:
+                      null: dict | None = None, centred_scale: bool = False,
+                      trim: dict[str, float] | None = None) -> None:
     """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
 
     The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
@@ -1462,6 +1509,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             term, so a named ``CY:beta`` reads the fitted correction's whole slope along beta, the scale's share
             included (``THRESHOLDS["centred_scale"]``; twenty-third session, branch i9-cyscale). The reference's
             fit takes the flight's weight for it.
+        trim: the library's surface trims (:func:`control_trim`, ``THRESHOLDS["library_control_trim"]``): the
+            monomials' surface factors are rebuilt about them, as the search selected them; None: as measured.
     """
     from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
@@ -1515,6 +1564,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         lib = None
         cols = [np.ones(len(Xp))]
         Xn = np.nan_to_num(Xp)
+        if trim:                                                # the library's surfaces about the trim
+            Xn = Xn - np.array([float(trim.get(n, 0.0)) for n in REGRESSORS])
         for t in terms:
             fac = _factors(t)
             if t == f"scale:{coef}":
@@ -1524,7 +1575,7 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                 cols.append(np.prod([Xn[:, REGRESSORS.index(x)] for x in fac], axis=0))
             else:                                               # hinges, lags, alpha_dot_hat: the library
                 if lib is None:
-                    nm, P = _library(replace(ctx, X=Xp), knots)
+                    nm, P = _library(replace(ctx, X=Xp), knots, trim)
                     lib = ({n: k for k, n in enumerate(nm)}, P)
                 cols.append(lib[1][:, lib[0][t]])
         A = np.nan_to_num(np.column_stack(cols))

@@ -450,3 +450,37 @@ def test_centred_scale_gives_the_named_term_the_scale_share_along_its_regressor(
     th2 = np.linalg.lstsq(_centre_columns(A2, terms2, "scale:CY", rows, {1: b}), y2, rcond=None)[0]
     # the named factor is what a scale fitted alone on the whole correction reads
     assert th2[1] == pytest.approx(np.linalg.lstsq(Bs, y2, rcond=None)[0][1], rel=1e-6)
+
+
+def test_library_control_trim_keeps_a_curvature_apart_from_its_elevator_product(airframe):
+    """At a large elevator trim ``alpha^2*delta_e`` is ``delta_e0 alpha^2`` plus a small part (the JSBSim dr1,
+    twenty-sixth session, i9-cma2): the search split a ``Cm:alpha^2`` between the two. With
+    ``library_control_trim`` the library's surfaces are measured about the reference's trim, the product's column
+    is nearly orthogonal to ``alpha^2``, and a flight whose elevator trim is the reference's reads the same
+    product columns whatever that trim. Fails if the trim is not applied."""
+    from gcs_sysid.diagnose.search import candidate_library
+    from gcs_sysid.diagnose.sparse import THRESHOLDS, control_trim
+
+    assert THRESHOLDS["library_control_trim"] is False             # opt-in
+    table, states = measured(BASE, seed=4, hidden=None, duration=90.0)
+    table.X[:, 5] = table.X[:, 5] - 0.18                             # a 10-deg nose-up elevator trim
+    rctx = DiagContext.build(table, airframe, BASE, states)
+    trim = control_trim(rctx)
+    assert trim["delta_e"] == pytest.approx(float(np.mean(rctx.x("delta_e")[rctx.train])), abs=1e-12)
+    assert trim["delta_e"] < -0.15 and abs(trim["delta_a"]) < 0.05
+
+    def corr(names, Phi, a, b):
+        x, y = Phi[rctx.valid, names.index(a)], Phi[rctx.valid, names.index(b)]
+        return abs(np.corrcoef(x, y)[0, 1])
+
+    n0, P0 = candidate_library(rctx)
+    n1, P1 = candidate_library(rctx, control_trim=trim)
+    assert n0 == n1
+    assert corr(n0, P0, "alpha^2", "alpha^2*delta_e") > 0.8          # collinear through the trim
+    assert corr(n1, P1, "alpha^2", "alpha^2*delta_e") < 0.5          # apart about it
+    de = rctx.x("delta_e") - trim["delta_e"]
+    k = n1.index("alpha^2*delta_e")
+    assert np.allclose(P1[:, k], rctx.x("alpha") ** 2 * de)
+    # the lags and hinges do not depend on the trim
+    lag = [i for i, n in enumerate(n0) if n.startswith("delta_e(t-") or n.startswith("max(")]
+    assert lag and np.allclose(P0[:, lag], P1[:, lag])
