@@ -94,10 +94,10 @@ Usage::
 ``iar80`` (``IAR80_glide``), ``c684`` (``C684_glide``), ``ultrastick`` (``UltraStick120_glide``), ``b737`` (``737``) and
 ``c172p``, ``eternity`` (``Eternity_glide``), ``us25e`` (``UltraStick25e_glide``), ``ka350``
 (``KingAir350_glide``, a JSBSim Beechcraft King Air 350 twin turboprop from a FlightGear package, without its engines)
-``s23`` (``ShortS23_glide``, JSBSim's Short S.23 flying boat, without its engines) and ``dr1`` (``Dr1_glide``,
-JSBSim's Fokker Dr.I triplane, without its rotary engine) were held out in earlier sessions and have been evaluated:
-they count as used. ``navion`` (JSBSim's Ryan Navion, the wheel's ``L17``, ``Navion_glide``, without its engine) is
-the held-out, untouched one: never in the defaults, made and scored only in the final evaluation.
+``s23`` (``ShortS23_glide``, JSBSim's Short S.23 flying boat, without its engines), ``dr1`` (``Dr1_glide``,
+JSBSim's Fokker Dr.I triplane, without its rotary engine) and ``navion`` (``Navion_glide``, JSBSim's Ryan Navion, the
+wheel's ``L17``, without its engine) were held out in earlier sessions and have been evaluated: they count as used.
+No aircraft is held out or untouched until the next one is added.
 """
 
 from __future__ import annotations
@@ -563,7 +563,7 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                         "Navion_glide); navion is the untouched aircraft; default %(default)s")
+                         "Navion_glide); none is untouched until the next one is added; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
 

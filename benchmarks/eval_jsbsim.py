@@ -63,9 +63,10 @@ models without its motor, at 10000 ft; ``Eternity_glide`` also accepted; the twe
 twin turboprop from a FlightGear package, engines removed, gear up, at 8000 ft; ``KingAir350_glide`` also accepted;
 the twenty-third session's) and ``s23`` (JSBSim's Short S.23 flying boat, engines removed, at 6000 ft;
 ``ShortS23_glide`` also accepted; the twenty-fourth session's) and ``dr1`` (JSBSim's Fokker Dr.I triplane, rotary
-engine removed, at 8000 ft; ``Dr1_glide`` also accepted; the twenty-fifth session's). ``navion`` (JSBSim's Ryan
-Navion, the wheel's ``L17``, engine removed, gear up, at 10000 ft; ``Navion_glide`` also accepted) is the held-out,
-untouched one: never in the default list, evaluated once after the thresholds are frozen.
+engine removed, at 8000 ft; ``Dr1_glide`` also accepted; the twenty-fifth session's) and ``navion`` (JSBSim's Ryan
+Navion, the wheel's ``L17``, engine removed, gear up, at 10000 ft; ``Navion_glide`` also accepted; the twenty-sixth
+session's). No aircraft is held out or untouched until the next one is added; that one is never in the default
+list, evaluated once after the thresholds are frozen.
 A flight already in ``--work``, flown by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
 ``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
 (or finds) the flights there and stops. Results are appended as JSON lines to ``--json`` when given.
@@ -514,7 +515,7 @@ def main(argv=None) -> int:
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                         "Navion_glide); navion is the untouched aircraft; default %(default)s")
+                         "Navion_glide); none is untouched until the next one is added; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))

@@ -19,7 +19,7 @@ a mechanism check); none of them flies the harness:
 - the FCS maps the commands straight to the surfaces (elevator +-20.1 deg, ailerons +-17.2 deg, rudder +-8.8 deg:
   the command clipped at 0.35 of +-25.2 deg); no engine, no external force;
 - it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
-- the summaries label it bare, as every tuning aircraft (the untouched navion's label is checked in
+- the summaries label it bare, as every tuning aircraft (the navion's label is checked in
   ``test_jsbsim_navion.py``).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, .tlog,
