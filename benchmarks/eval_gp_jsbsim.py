@@ -97,7 +97,8 @@ Usage::
 ``s23`` (``ShortS23_glide``, JSBSim's Short S.23 flying boat, without its engines), ``dr1`` (``Dr1_glide``,
 JSBSim's Fokker Dr.I triplane, without its rotary engine) and ``navion`` (``Navion_glide``, JSBSim's Ryan Navion, the
 wheel's ``L17``, without its engine) were held out in earlier sessions and have been evaluated: they count as used.
-No aircraft is held out or untouched until the next one is added.
+``fokker50`` (JSBSim's Fokker 50, ``Fokker50_glide``, without its engines, propwash terms or yaw damper) is the
+held-out, untouched one: never in the defaults, made and scored only in the final evaluation.
 """
 
 from __future__ import annotations
@@ -557,13 +558,13 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
     ap.add_argument("--make", action="store_true", help=make_help)
     ap.add_argument("--aircraft", nargs="+", default=aircraft, type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion) or JSBSim model names (J3Cub, "
+                         "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim model names (J3Cub, "
                          "T37, "
                          "t6texan2, B747, "
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                         "Navion_glide); none is untouched until the next one is added; default %(default)s")
+                         "Navion_glide, Fokker50_glide); fokker50 is the untouched aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
 

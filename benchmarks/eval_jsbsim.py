@@ -65,7 +65,8 @@ the twenty-third session's) and ``s23`` (JSBSim's Short S.23 flying boat, engine
 ``ShortS23_glide`` also accepted; the twenty-fourth session's) and ``dr1`` (JSBSim's Fokker Dr.I triplane, rotary
 engine removed, at 8000 ft; ``Dr1_glide`` also accepted; the twenty-fifth session's) and ``navion`` (JSBSim's Ryan
 Navion, the wheel's ``L17``, engine removed, gear up, at 10000 ft; ``Navion_glide`` also accepted; the twenty-sixth
-session's). No aircraft is held out or untouched until the next one is added; that one is never in the default
+session's). ``fokker50`` (JSBSim's Fokker 50 twin-turboprop airliner, engines, propwash terms and yaw damper
+removed, gear up, at 10000 ft; ``Fokker50_glide`` also accepted) is the held-out, untouched one: never in the default
 list, evaluated once after the thresholds are frozen.
 A flight already in ``--work``, flown by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
 ``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
@@ -509,13 +510,13 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion) or JSBSim model names (J3Cub, "
+                         "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim model names (J3Cub, "
                          "T37, "
                          "t6texan2, B747, "
                          "f16_direct, "
                          "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                          "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                         "Navion_glide); none is untouched until the next one is added; default %(default)s")
+                         "Navion_glide, Fokker50_glide); fokker50 is the untouched aircraft; default %(default)s")
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))

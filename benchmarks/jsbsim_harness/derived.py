@@ -21,7 +21,9 @@ Short S.23 flying boat gliding in one file, its engines, hull forces and systems
 propeller and pushback removed and its pitch table reading the elevator through an alias (``Dr1_glide``,
 :func:`derive_dr1_glide`; twenty-fifth session), or JSBSim's Ryan Navion (the wheel's ``L17``) gliding, its engine
 and propeller removed and its flap normaliser reading the flap kinematic's output (``Navion_glide``,
-:func:`derive_navion_glide`; twenty-sixth session).
+:func:`derive_navion_glide`; twenty-sixth session), or JSBSim's Fokker 50 gliding, its engines and propellers, the
+channels and propwash terms that read them, and its yaw damper removed (``Fokker50_glide``,
+:func:`derive_fokker50_glide`; twenty-seventh session).
 
 The harness flies stock models whose surfaces follow the normalised commands
 (``fcs/{elevator,aileron,rudder}-cmd-norm``). JSBSim's F-16 (``f16.xml``, Erik Hofman 2001) puts a
@@ -77,7 +79,7 @@ from pathlib import Path
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
            "derive_eternity_glide", "derive_ultrastick25e_glide", "derive_kingair350_glide", "derive_shorts23_glide",
-           "derive_dr1_glide", "derive_navion_glide",
+           "derive_dr1_glide", "derive_navion_glide", "derive_fokker50_glide",
            "US120_SURFACE_RAD", "derived_xml", "derived_sha",
            "install_derived_models", "ELEVATOR_ALIAS",
            "ELEVATOR_DEG_ALIAS"]
@@ -855,6 +857,91 @@ def derive_navion_glide(root: ET.Element) -> ET.Element:
     return root
 
 
+#: The Fokker 50's propwash functions (axis, name): each a product with a propeller thrust coefficient.
+_F50_PROPWASH = [("LIFT", "aero/force/Lift_propwash"), ("ROLL", "aero/moment/Roll_differential_propwash"),
+                 ("PITCH", "aero/moment/Pitch_propwash")]
+
+#: The Fokker 50's yaw-damper components (the ``Yaw`` channel's), removed with the rudder summer's input.
+_F50_DAMPER = ["Yaw Damper Rate", "Yaw Damper Beta", "Yaw Damper Sum", "Yaw Damper Final"]
+
+
+def derive_fokker50_glide(root: ET.Element) -> ET.Element:
+    """JSBSim's Fokker 50 (``data/jsbsim_models/fokker50/fokker50.xml``: the jsbsim 1.3.3 wheel's
+    ``aircraft/fokker50/fokker50.xml``, Erik Hofman 2002, LGPL-2.1 with JSBSim) gliding, as JSBSim alone can fly it
+    (twenty-seventh session).
+
+    The model is the Fokker 50 twin-turboprop regional airliner: two PW125B engines with Dowty Rotol propellers, an
+    engine-control channel (``EEC``) that reads FlightGear's ``/controls/engines/engine[n]/throttle`` (so ``run_ic``
+    raises in JSBSim alone: the ninth session's reason for setting it aside), a ``Thruster`` channel that sums the
+    propellers' thrust coefficients, three propwash terms that multiply them, and a yaw damper. Five edits; nothing
+    else changes (a test checks every other element, and that JSBSim's aerodynamic forces and moments equal the stock
+    model's less its three propwash terms):
+
+    - **Engines removed.** The two ``<engine>`` elements (``PW125BX`` with ``dowty-rotol-aero``, their feeds) are
+      removed, as the navion's, dr1's and ka350's: the harness glides every aircraft, so that every non-gravity force
+      is aerodynamic (a stopped engine leaves JSBSim's windmilling propeller). The two fuel tanks (1100 lb each,
+      3 in either side of the centre line) stay as mass.
+    - **Engine control removed.** The ``EEC`` channel (throttle and propeller-speed commands from FlightGear's
+      throttle and ``/systems/fokker50/erp/*`` settings) and the two ``<property>`` declarations of those settings;
+      they drive the engines only.
+    - **Thrust coefficients removed.** The ``Thruster`` channel (four summers of
+      ``propulsion/engine[n]/thrust-coefficient``), gone with the engines.
+    - **Propwash terms removed.** ``Lift_propwash``, ``Roll_differential_propwash`` and ``Pitch_propwash``
+      (:data:`_F50_PROPWASH`) are products with the total or the left-less-right thrust coefficient: without
+      propellers the coefficient is 0 and so is each term. No other aerodynamic function reads the propellers.
+    - **Yaw damper removed.** Its four components (:data:`_F50_DAMPER`: 2 x r above 11 psf of dynamic pressure,
+      clipped at +-0.2 of the command) and the rudder summer's input ``fcs/yaw-damper-final``: it would move the
+      rudder with the yaw rate in every flight (the ka350's damper is off for the same reason). The rudder then
+      follows the command, as the elevator and ailerons do.
+
+    The elevator is read as a ``<property>`` only (``CLde``, ``Cmde``), so ``effects.py``'s ``delay:delta_e``
+    reaches it without an alias; ``CDde`` reads JSBSim's ``fcs/mag-elevator-pos-rad`` (not delayed, as on the
+    navion).
+
+    Args:
+        root: the parsed ``fokker50.xml`` (not modified).
+
+    Returns:
+        a new root element.
+
+    Raises:
+        ValueError: the XML lacks an element the derivation expects (another version of the file): two
+            ``<propulsion><engine>``, the ``EEC``, ``Thruster`` and ``Yaw`` channels, the two ERP properties, the
+            three propwash functions, the four damper components and the rudder summer's damper input.
+    """
+    root = copy.deepcopy(root)
+    prop = root.find("propulsion")
+    engines = prop.findall("engine") if prop is not None else []
+    fc = root.find("flight_control")
+    aero = root.find("aerodynamics")
+    if len(engines) != 2 or fc is None or aero is None:
+        raise ValueError("fokker50.xml: expected two <propulsion><engine>, a <flight_control> and an <aerodynamics>")
+    channels = {ch.get("name"): ch for ch in fc.findall("channel")}
+    erp = [p for p in fc.findall("property") if (p.text or "").strip().startswith("/systems/fokker50/erp/")]
+    axes = {a.get("name"): a for a in aero.findall("axis")}
+    wash = [(axes[ax], f) for ax, name in _F50_PROPWASH if ax in axes
+            for f in axes[ax].findall("function") if f.get("name") == name]
+    yaw = channels.get("Yaw")
+    damper = [c for c in yaw if c.get("name") in _F50_DAMPER] if yaw is not None else []
+    rsum = [c for c in yaw if c.get("name") == "Rudder Sum"] if yaw is not None else []
+    dinp = [i for i in rsum[0].findall("input") if (i.text or "").strip() == "fcs/yaw-damper-final"] if rsum else []
+    if ("EEC" not in channels or "Thruster" not in channels or len(erp) != 2 or len(wash) != 3
+            or len(damper) != 4 or len(dinp) != 1):
+        raise ValueError("fokker50.xml: expected the EEC, Thruster and Yaw channels, two /systems/fokker50/erp "
+                         "properties, the three propwash functions, the four yaw-damper components and the rudder "
+                         "summer's fcs/yaw-damper-final input")
+    for e in engines:
+        prop.remove(e)
+    for x in [channels["EEC"], channels["Thruster"]] + erp:
+        fc.remove(x)
+    for axis, f in wash:
+        axis.remove(f)
+    for c in damper:
+        yaw.remove(c)
+    rsum[0].remove(dinp[0])
+    return root
+
+
 #: Derived model name -> (stock model it comes from, derivation, what the derivation did: the
 #: derived XML's header comment).
 DERIVED = {
@@ -946,6 +1033,13 @@ REPO_DERIVED = {
                      "normaliser reads the flap kinematic's output fcs/flap-pos-deg (the file's fcs/flaps-pos-deg "
                      "exists nowhere, so JSBSim alone could not initialise it); the fuel tanks stay as mass; "
                      "everything else unchanged."),
+    "Fokker50_glide": ("data/jsbsim_models/fokker50/fokker50.xml",
+                       "JSBSim's Fokker 50 (the jsbsim 1.3.3 wheel's aircraft/fokker50/fokker50.xml, Erik Hofman "
+                       "2002, LGPL-2.1 with JSBSim), copied into gcs-sysid's data/jsbsim_models/fokker50/",
+                       derive_fokker50_glide, "engines and propellers removed (a glide with no propeller force), "
+                       "with the engine-control and thrust-coefficient channels that read them and the three "
+                       "propwash terms that multiply the thrust coefficients (0 without propellers); yaw damper "
+                       "removed; the fuel tanks stay as mass; everything else unchanged."),
 }
 
 
