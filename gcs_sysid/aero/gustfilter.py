@@ -70,7 +70,10 @@ ROLL_GP_SLOPES = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")
 #: ``p_hat`` as the gyro's (``"off"``) or less the rolling gust estimated there (:func:`heldout_air_roll`). Off: on
 #: 93 roster flights it lowers the held-out Cl (median 50.9 -> 27.5 %, ``"predicted"``) but asks CY and Cn at a rate
 #: their slopes were not learned at and loses a count on 15 of 31 groups; with ``GUST_FILTER = "rollgp"`` 14 aircraft
-#: gain a count and 4 lose one (twenty-fourth session, i8-airp, docs/benchmarks.md).
+#: gain a count and 4 lose one (twenty-fourth session, i8-airp, docs/benchmarks.md). Per output (``"predicted:Cl"``,
+#: the other outputs at the gyro's rate, unchanged) on 24 aircraft light s1-3 at GP seeds 0 and 1: held-out Cl median
+#: 48.7 -> 26.9 % but +11/-17 and +8/-18 counts (GP < LS with LS at the same rate; Cl's band covers 99.6 %, its
+#: learned noise still holds the gust; twenty-seventh session, i8-airpcl).
 HELDOUT_AIR_ROLL = "off"
 #: Every value ``heldout_air_roll`` takes (:func:`air_roll_mode`): ``"off"``; a gust mode of
 #: :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` (every output asked at the air rate, the twenty-fourth session's);
