@@ -373,12 +373,13 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
     Args:
         res: the replay's result (its table not gust-filtered). model: its GP. airframe: the loaded airframe.
         h: ``(T,)`` bool scored held-out rows. Yt: ``(T, 6)`` JSBSim's coefficients. g_true: ``(T,)``.
-        ls_model: the stepwise least-squares model (``evaluate(X)``). modes: ``"off"`` or
-            :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` entries.
+        ls_model: the stepwise least-squares model (``evaluate(X)``). modes: entries of
+            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_MODES` (``"predicted:Cl"``: Cl at the air rate, the other
+            outputs' lines at the gyro's, as the replay's per-output mode asks them).
     """
     from dataclasses import replace
 
-    from gcs_sysid.aero.gustfilter import heldout_air_roll
+    from gcs_sysid.aero.gustfilter import air_roll_mode, heldout_air_roll
     from gcs_sysid.pipeline import gp_inputs
 
     out: dict = {}
@@ -386,8 +387,7 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
     fit_cols = [i for i in range(6) if np.isfinite(res.pred_mean[:, i]).any()]
     use_adot = model.n_inputs == tab.X.shape[1] + 1
     white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
-    for mode in modes:
-        t2, info = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode)
+    def at(t2):
         rows = h & np.all(np.isfinite(t2.X), axis=1)
         Xq, xv = gp_inputs(t2, rows, use_adot)
         mean, var = model.predict(Xq, x_var=xv)
@@ -395,10 +395,20 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
         ps = np.full(Yt.shape, np.nan)
         pm[np.ix_(rows, fit_cols)] = np.asarray(mean)
         ps[np.ix_(rows, fit_cols)] = np.sqrt(np.maximum(np.asarray(var) - white[None, :], 0.0))
+        return rows, pm, ps, ls_model.evaluate(t2.X[h])
+
+    for mode in modes:
+        t2, info = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode)
+        rows, pm, ps, pl = at(t2)
+        outs = air_roll_mode(mode)[1]
+        if outs is not None:    # per output ("MODE:Cl"): the others at the gyro's p_hat, as the replay asks them
+            keep = [i for i, c in enumerate(COEFFICIENTS) if c not in outs]
+            _, pm0, ps0, pl0 = at(tab)
+            pm[:, keep], ps[:, keep], pl[:, keep] = pm0[:, keep], ps0[:, keep], pl0[:, keep]
         out[f"gp_airp_{mode}"] = _errs(pm[h], Yt[h])
         out[f"cov_gp_airp_{mode}_each"] = [_coverage(pm[h, i], ps[h, i], Yt[h, i]) for i in range(6)]
         out[f"cov_gp_airp_{mode}"] = float(np.nanmean(out[f"cov_gp_airp_{mode}_each"]))
-        out[f"ls_airp_{mode}"] = _errs(ls_model.evaluate(t2.X[h]), Yt[h])
+        out[f"ls_airp_{mode}"] = _errs(pl, Yt[h])
         if mode != "off":
             g = np.zeros(len(h)) if info is None else info["g"]
             if mode == modes[-1] or "oracle" not in out:   # once: the model at JSBSim's own p_g (reads the truth)
@@ -507,6 +517,8 @@ def summarize(paths: list[str]) -> str:
 
 
 def main(argv=None) -> int:
+    from gcs_sysid.aero.gustfilter import AIR_ROLL_MODES
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
                     help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
@@ -527,11 +539,11 @@ def main(argv=None) -> int:
                          "gcs_sysid.aero.rollgust; 'rollgp': the same with the moment's stated noise and the GP "
                          "given the fit's Cl slopes; default: the replay's default, "
                          "gcs_sysid.aero.gustfilter.GUST_FILTER)")
-    ap.add_argument("--heldout-air-roll", default=None, choices=("off", "smoothed", "filtered", "predicted"),
+    ap.add_argument("--heldout-air-roll", default=None, choices=AIR_ROLL_MODES,
                     help="the held-out rows' p_hat less the rolling gust estimated there from their own measured roll "
                          "moment with the training rows' roll fit (ReplayOptions.heldout_air_roll, "
                          "gcs_sysid.aero.gustfilter.heldout_air_roll; default: the replay's, HELDOUT_AIR_ROLL)")
-    ap.add_argument("--airp-lines", nargs="*", default=(), choices=("off", "smoothed", "filtered", "predicted"),
+    ap.add_argument("--airp-lines", nargs="*", default=(), choices=AIR_ROLL_MODES,
                     help="also score these heldout_air_roll modes post hoc on the same replay's model (rows "
                          "gp_airp_MODE, ls_airp_MODE, cov_gp_airp_MODE, airp_MODE; a diagnosis)")
     ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),

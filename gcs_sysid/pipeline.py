@@ -81,7 +81,10 @@ class ReplayOptions:
             ``"smoothed"``, ``"filtered"`` or ``"predicted"``: less the rolling gust estimated on those rows from
             their own measured roll moment with the training rows' roll fit
             (:func:`gcs_sysid.aero.gustfilter.heldout_air_roll`; ``"predicted"`` reads only the moments before
-            each row). Training rows unchanged. None: :data:`gcs_sysid.aero.gustfilter.HELDOUT_AIR_ROLL`.
+            each row). ``"smoothed:Cl"``, ``"filtered:Cl"``, ``"predicted:Cl"``: per output, only Cl is asked at
+            that rate, the other outputs at the gyro's (their slopes were learned there;
+            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_MODES`). Training rows unchanged. None:
+            :data:`gcs_sysid.aero.gustfilter.HELDOUT_AIR_ROLL`.
     """
 
     rate_hz: float = 50.0
@@ -258,8 +261,10 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     """
     check_rate(options.rate_hz)
     check_holdout(options.holdout)
-    if options.heldout_air_roll not in (None, "off", "smoothed", "filtered", "predicted"):
-        raise InputError(f"heldout_air_roll: expected off, smoothed, filtered or predicted, got "
+    from .aero.gustfilter import AIR_ROLL_MODES
+
+    if options.heldout_air_roll is not None and options.heldout_air_roll not in AIR_ROLL_MODES:
+        raise InputError(f"heldout_air_roll: expected one of {', '.join(AIR_ROLL_MODES)}, got "
                          f"{options.heldout_air_roll!r}")
     if options.gp_noise is not None:
         gp_noise_fields(options.gp_noise)
@@ -482,16 +487,20 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             with _stage("gust filter", timings, bar):
                 table, gust_fit = filter_gust_table(table, states, airframe, train,
                                                     method=gust_filter if isinstance(gust_filter, str) else "2sls")
-        if air_roll != "off" and not gust_filter:
-            table = table_air
-        elif air_roll != "off":     # the held-out rows: the estimate and its variance, not the filter's prior
+        if air_roll != "off" and gust_filter:   # the held-out rows: the estimate and its variance, not the prior
             X, xv = table.X.copy(), table.x_var
             if air_info is not None:
                 j = REGRESSORS.index("p_hat")
                 X[:, j] -= air_info["g"]
                 xv = np.full(X.shape, np.nan) if table.x_var is None else table.x_var.copy()
                 xv[held, j] = table_air.x_var[held, j]
-            table = replace(table, X=X, x_var=xv, notes=list(table.notes) + [table_air.notes[-1]])
+            table_air = replace(table, X=X, x_var=xv, notes=list(table.notes) + [table_air.notes[-1]])
+        air_outputs = None          # per output ("MODE:Cl"): these outputs asked at table_air's held-out rows
+        if air_roll != "off" and (air_info is None or air_info["outputs"] is None):
+            table = table_air       # every output at the air rate (or no estimate: the table and its note)
+        elif air_roll != "off":
+            air_outputs = air_info["outputs"]
+            table = replace(table, notes=list(table.notes) + [table_air.notes[-1]])
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
@@ -565,6 +574,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                                    map_cov=table.x_map_cov)
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
+                white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
                 if rows.any():
                     # the estimator's stated per-row air-angle variance: errors the residuals cannot show
                     Xq, xv = gp_inputs(table, rows, use_adot)
@@ -572,8 +582,16 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
                     pred_sigma_obs[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
                     # the coefficient's band: the same less the white measurement noise (docs/gp.md, "Two bands")
-                    white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
                     pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.maximum(np.asarray(var) - white[None, :], 0.0))
+                rows_air = held & table_air.valid & np.all(np.isfinite(table_air.X), axis=1) if air_outputs else None
+                if air_outputs and rows_air.any():   # per output: these at the air-relative roll rate (opt-in)
+                    cols = [k for k, i in enumerate(fit_cols) if COEFFICIENTS[i] in air_outputs]
+                    Xq, xv = gp_inputs(table_air, rows_air, use_adot)
+                    mean, var = (np.asarray(v)[:, cols] for v in model.predict(Xq, x_var=xv))
+                    at = np.ix_(rows_air, [fit_cols[k] for k in cols])
+                    pred_mean[at] = mean
+                    pred_sigma_obs[at] = np.sqrt(var)
+                    pred_sigma[at] = np.sqrt(np.maximum(var - white[None, cols], 0.0))
             gp_summary = model.summary()
             gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
             # the measurements are drawn against the band for a measurement

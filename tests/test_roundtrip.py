@@ -111,3 +111,45 @@ def test_replay_model_takes_alpha_dot_hat_for_cm_only(roundtrip):
     assert float(np.asarray(model.params.lengthscale)[-1]) == MEAN_ONLY_LENGTHSCALE
     prior = np.broadcast_to(np.asarray(model.params.prior_std), (model.n_outputs, model.n_inputs + 1))
     assert np.all(prior[np.arange(6) != COEFFICIENTS.index("Cm"), -1] == 0.0)
+
+
+def test_heldout_air_roll_per_output_asks_only_cl_at_the_air_rate(roundtrip, tmp_path, monkeypatch):
+    """``ReplayOptions.heldout_air_roll="MODE:Cl"`` (twenty-seventh session, i8-airpcl): only Cl's held-out
+    predictions are asked at the table whose held-out ``p_hat`` has the rolling gust taken out; every other output
+    and every training row is the ``"off"`` replay's, and the training table is the gyro's. ``"MODE"`` alone asks
+    every output there. The gust estimate is replaced by a known shift of the held-out rows' ``p_hat`` (calm air:
+    the roll fit's Dryden check refuses a real one), so the test reads the replay's bookkeeping alone."""
+    from dataclasses import replace
+
+    import gcs_sysid.aero.gustfilter as gf
+    from gcs_sysid.aero.table import REGRESSORS
+
+    _, result, out = roundtrip
+    j = REGRESSORS.index("p_hat")
+
+    def shifted(table, states, airframe, train, held, mode="off"):
+        base, outputs = gf.air_roll_mode(mode)
+        g = np.where(held, 0.05, 0.0)
+        X = table.X.copy()
+        X[:, j] -= g
+        return (replace(table, X=X, notes=list(table.notes) + ["shifted"]),
+                {"mode": base, "outputs": outputs, "g": g, "g_var": np.zeros(len(g)), "fit": None})
+
+    monkeypatch.setattr(gf, "heldout_air_roll", shifted)
+    opts = dict(progress=False, model_in=result.model_path, write=False)
+    run = {m: run_replay(out / "flight.tlog", DATA / "airframes" / "sim-trainer.toml", tmp_path / m.replace(":", "-"),
+                         ReplayOptions(heldout_air_roll=m, **opts)) for m in ("off", "predicted:Cl", "predicted")}
+    held, il = run["off"].held_out, COEFFICIENTS.index("Cl")
+    h = held & np.isfinite(run["off"].pred_mean[:, il])
+    assert h.sum() > 100
+    per, every, off = run["predicted:Cl"], run["predicted"], run["off"]
+    assert np.array_equal(per.table.X, off.table.X) and "shifted" in per.notes
+    assert not np.allclose(every.table.X[h, j], off.table.X[h, j])
+    for name in ("pred_mean", "pred_sigma", "pred_sigma_obs"):
+        a, b, c = getattr(per, name), getattr(off, name), getattr(every, name)
+        others = [i for i in range(6) if i != il]
+        np.testing.assert_array_equal(a[:, others], b[:, others])
+        np.testing.assert_array_equal(a[~held], b[~held])
+        np.testing.assert_allclose(a[h, il], c[h, il], rtol=1e-6, atol=1e-9)   # Cl as the every-output mode asks it
+    assert np.max(np.abs(per.pred_mean[h, il] - off.pred_mean[h, il])) > 1e-4
+    assert not np.allclose(every.pred_mean[h, COEFFICIENTS.index("CY")], off.pred_mean[h, COEFFICIENTS.index("CY")])

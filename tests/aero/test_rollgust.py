@@ -241,6 +241,19 @@ def test_held_out_rows_at_the_reconstructed_air_relative_roll_rate():
         heldout_air_roll(tab, st, air, ~held, held, mode="causal")
     with pytest.raises(InputError, match="heldout_air_roll"):
         check_replay("x.tlog", "x.toml", None, ReplayOptions(heldout_air_roll="causal"))
+    # per output ("MODE:Cl", twenty-seventh session): the same table; which outputs are asked at it is the caller's
+    from gcs_sysid.aero.gustfilter import AIR_ROLL_MODES, air_roll_mode
+
+    assert air_roll_mode("predicted:Cl") == ("predicted", ("Cl",)) and air_roll_mode("smoothed") == ("smoothed", None)
+    assert air_roll_mode("off") == ("off", None) and "filtered:Cl" in AIR_ROLL_MODES
+    with pytest.raises(ValueError, match="mode"):
+        air_roll_mode("predicted:CY")
+    t1, i1 = heldout_air_roll(tab, st, air, ~held, held, mode="predicted")
+    t2, i2 = heldout_air_roll(tab, st, air, ~held, held, mode="predicted:Cl")
+    assert np.array_equal(t1.X, t2.X) and i1["outputs"] is None and i2["outputs"] == ("Cl",)
+    assert "(for Cl)" in t2.notes[-1] and "(for Cl)" not in t1.notes[-1]
+    with pytest.raises(InputError, match="heldout_air_roll"):
+        check_replay("x.tlog", "x.toml", None, ReplayOptions(heldout_air_roll="predicted:Cn"))
 
 
 def test_extra_design_columns_are_fitted_beside_the_gust_state():
