@@ -219,6 +219,15 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ``alpha^2*delta_e`` is no longer ``delta_e0 alpha^2`` plus a small part and the search does not split a curvature
 #: between the two (the JSBSim dr1's ``Cm:alpha^2``). The reference's ridge inadequacy keeps the measured surfaces.
 #: No new threshold. Measured in ``docs/benchmarks.md``, *Twenty-sixth session, i9-cma2*.
+#: Added 2026-11-24 (twenty-seventh session, branch i9-a2pair): ``power_with_parent`` (the regressors whose square may
+#: enter the forward search in one step with its first parent, ``(alpha^2, alpha)``: :func:`power_parent_blocks`,
+#: :func:`gcs_sysid.diagnose.search.press_stepwise` ``blocks``; ``()`` off). A curvature about a zero that is off by
+#: ``e`` (the measured alpha against the air's) is ``k x^2 - 2 k e x``, and its square alone was beaten by whatever
+#: single term correlated (the JSBSim dr1's ``Cm:alpha^2``). The pair's PRESS drop is the score, its untouched gain the
+#: finding's gain; the finding's ``evidence.entered_with`` names the parent, and ``diagnose``'s differential step
+#: judges the term beyond the offset, the alpha scale and the jackknife with the parent beside it
+#: (:func:`gcs_sysid.diagnose.differential.offset_allowance` ``parents``). No new threshold. Measured in
+#: ``docs/benchmarks.md``, *Twenty-seventh session, i9-a2pair*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
