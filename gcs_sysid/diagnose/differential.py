@@ -130,8 +130,16 @@ def _refit_other(ctx: DiagContext, R: np.ndarray, finding: dict, ref: Reference,
     return float(hit[0].estimate), float(hit[0].std_error)
 
 
+def _parent_columns(X: np.ndarray, parents) -> np.ndarray:
+    """(T, k) the columns of the terms a finding entered the search with (``evidence.entered_with``); (T, 0) none."""
+    if not parents:
+        return np.zeros((len(X), 0))
+    return np.asarray(term_matrix(X, list(parents)), float).reshape(len(X), -1)
+
+
 def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, coef: str, term: str,
-                     min_t: float = 3.0, min_gain_pct: float = 10.0, column: np.ndarray | None = None) -> dict:
+                     min_t: float = 3.0, min_gain_pct: float = 10.0, column: np.ndarray | None = None,
+                     parents=()) -> dict:
     """Is an aero finding more than a between-flight offset of its coefficient?
 
     Flights of one aircraft differ by near-constant coefficient offsets that are no cause (the
@@ -148,6 +156,11 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
         min_t, min_gain_pct: the tests above.
         column: (T,) the finding's own column where ``term`` is no vocabulary monomial (``scale:CY``: the model's
             side force, :func:`_scale_column`); None: ``term_matrix(X, [term])``.
+        parents: vocabulary terms the finding entered the sparse search with (its ``evidence.entered_with``:
+            ``alpha`` beside ``alpha^2``, ``sparse.THRESHOLDS["power_with_parent"]``): fitted beside the term, the
+            gain beyond the offset is the term's and theirs together (a curvature about a shifted zero is
+            ``k x^2 - 2 k e x``; without its parent the term alone reads a fraction of ``k``). () (the default): the
+            term alone.
 
     Returns:
         ``{"offset_only": bool, "estimate", "std_error", "t", "gain_beyond_offset_percent", "why"}``.
@@ -159,20 +172,22 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
         phi = np.asarray(column, float) if column is not None else term_matrix(X, [term])[:, 0]
     except SysidError:                  # a term outside the vocabulary: the search fitted its own constant
         return {"offset_only": False, "why": "term outside the vocabulary (the sparse search's own constant)"}
+    P = _parent_columns(X, parents)
     r = R[:, j]
-    ok = np.isfinite(r) & np.isfinite(phi)
+    ok = np.isfinite(r) & np.isfinite(phi) & np.isfinite(P).all(axis=1)
     tr, te = train & ok, test & ok
     if tr.sum() < 50 or te.sum() < 20 or np.std(phi[tr]) == 0:
         return {"offset_only": True, "why": f"{term} does not vary on these rows: an offset of {coef}"}
-    res = ols(np.column_stack([np.ones(tr.sum()), phi[tr]]), r[tr], terms=["1", term])
+    res = ols(np.column_stack([np.ones(tr.sum()), phi[tr], P[tr]]), r[tr], terms=["1", term, *parents])
     c, th, se = float(res.theta[0]), float(res.theta[1]), float(res.std_error[1])
     b = float(np.sqrt(np.mean((r[te] - np.mean(r[tr])) ** 2)))
-    a = float(np.sqrt(np.mean((r[te] - c - th * phi[te]) ** 2)))
+    a = float(np.sqrt(np.mean((r[te] - c - th * phi[te] - P[te] @ res.theta[2:]) ** 2)))
     gain = 100.0 * (1.0 - a / b) if b > 0 else 0.0
     t = th / se if se > 0 else 0.0
     only = abs(t) < min_t or gain < min_gain_pct
-    why = (f"with {coef}'s between-flight offset free, {coef}:{term} is {th:+.4g} +- {se:.2g} (t {t:.1f}) and "
-           f"gains {gain:.0f} % on the held-out rows beyond the offset")
+    with_p = f" (with {', '.join(parents)} beside it, which it entered the search with)" if parents else ""
+    why = (f"with {coef}'s between-flight offset free, {coef}:{term}{with_p} is {th:+.4g} +- {se:.2g} (t {t:.1f}) "
+           f"and gains {gain:.0f} % on the held-out rows beyond the offset")
     return {"offset_only": bool(only), "estimate": th, "std_error": se, "t": float(t),
             "gain_beyond_offset_percent": float(gain), "why": why}
 
@@ -191,7 +206,8 @@ def _angle_factors(term: str) -> list[str]:
     return [part.partition("^")[0] for part in term.replace(" ", "").split("*")]
 
 
-def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.ndarray, block_s: float) -> float:
+def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.ndarray, block_s: float,
+                       beside: np.ndarray | None = None) -> float:
     """Block-jackknife standard error of the slope of ``r`` on ``phi`` (a free constant beside it).
 
     The rows are cut into contiguous blocks of ``block_s`` seconds; the slope is refitted with each block
@@ -204,16 +220,19 @@ def block_jackknife_se(t: np.ndarray, phi: np.ndarray, r: np.ndarray, rows: np.n
 
     Args:
         t: (T,) time, s. phi: (T,) regressor. r: (T,) response. rows: (T,) bool rows to use.
-        block_s: block length, s.
+        block_s: block length, s. beside: (T, k) columns fitted beside ``phi`` (a finding's parents,
+            :func:`offset_allowance` ``parents``); None: the constant only.
 
     Returns:
         the standard error (same units as the slope); NaN with fewer than 3 blocks of 50 rows or more
         (:func:`gcs_sysid.diagnose.uncertainty.block_jackknife_cov`, whose slope entry it is).
     """
-    rows = np.asarray(rows, bool) & np.isfinite(phi) & np.isfinite(r)
+    B = np.zeros((len(phi), 0)) if beside is None else np.asarray(beside, float).reshape(len(phi), -1)
+    rows = np.asarray(rows, bool) & np.isfinite(phi) & np.isfinite(r) & np.isfinite(B).all(axis=1)
     # the slope's entry of the general delete-a-block covariance (a constant column beside the regressor:
     # the same blocks, thresholds and leave-one-out fits; agrees with the centred-slope form to 1e-13)
-    cov = block_jackknife_cov(t[rows], np.column_stack([np.ones(int(rows.sum())), phi[rows]]), r[rows], block_s)
+    cov = block_jackknife_cov(t[rows], np.column_stack([np.ones(int(rows.sum())), phi[rows], B[rows]]), r[rows],
+                              block_s)
     return float(np.sqrt(cov[1, 1])) if cov is not None else float("nan")
 
 
@@ -221,7 +240,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
                           scale_se: bool = True, jackknife: dict | None = None,
                           along_term: bool = False, column: np.ndarray | None = None,
-                          beside: dict | None = None) -> dict | None:
+                          beside: dict | None = None, parents=()) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -271,6 +290,8 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
             value is the reference's estimate, so a change carries both), in quadrature; the larger of that
             and the standard error above is used (added 2026-11-22, branch i9-delay:
             ``sparse.THRESHOLDS["alpha_jackknife_s"]``).
+        parents: the terms the finding entered the search with, fitted beside it in the judgement beyond the
+            scale (:func:`offset_allowance`), its scale share and its jackknife. (): the term alone.
 
     Returns:
         None when the finding is not such a term or no other coefficient has a contribution of the
@@ -329,15 +350,17 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     R_adj = np.array(R, float, copy=True)
     R_adj[:, j] = R[:, j] - s_hat * N[:, j]
     beyond = offset_allowance(X, R_adj, train, test, coef, term, min_t=min_t, min_gain_pct=min_gain_pct,
-                              column=column)
+                              column=column, parents=parents)
     if scale_se and "std_error" in beyond and np.isfinite(se_s):
         try:
             phi = np.asarray(column, float) if column is not None else term_matrix(X, [term])[:, 0]
         except SysidError:
             phi = None
-        m = ok & np.isfinite(phi) if phi is not None else ok[:0]
+        P = _parent_columns(X, parents)
+        m = ok & np.isfinite(phi) & np.isfinite(P).all(axis=1) if phi is not None else ok[:0]
         if phi is not None and m.sum() >= 50 and np.std(phi[m]) > 0:
-            k = float(np.linalg.lstsq(np.column_stack([np.ones(m.sum()), phi[m]]), N[m, j], rcond=None)[0][1])
+            k = float(np.linalg.lstsq(np.column_stack([np.ones(m.sum()), phi[m], P[m]]), N[m, j],
+                                      rcond=None)[0][1])
             share = abs(k) * se_s
             se = float(np.hypot(beyond["std_error"], share))
             t = beyond["estimate"] / se if se > 0 else 0.0
@@ -347,7 +370,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                                f"+- {se:.2g} (the scale's uncertainty {share:.2g} included; t {t:.1f}) and gains "
                                f"{beyond['gain_beyond_offset_percent']:.0f} % on the held-out rows beyond the offset"))
     if jackknife and "std_error" in beyond:
-        beyond = _with_jackknife(beyond, X, R_adj[:, j], ok, term, jackknife, min_t)
+        beyond = _with_jackknife(beyond, X, R_adj[:, j], ok, term, jackknife, min_t, parents)
     if along_term:
         return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
                 "error_along_term": float(s_hat), "term": term,
@@ -557,19 +580,21 @@ def _note_allowance(doc: dict, f: dict, allowance: dict, summary: str) -> None:
 
 
 def _with_jackknife(beyond: dict, X: np.ndarray, r: np.ndarray, rows: np.ndarray, term: str, jk: dict,
-                    min_t: float) -> dict:
-    """``beyond`` (an :func:`offset_allowance` document) judged with the block-jackknife standard error too."""
+                    min_t: float, parents=()) -> dict:
+    """``beyond`` (an :func:`offset_allowance` document) judged with the block-jackknife standard error too
+    (``parents``: fitted beside the term, in both flights)."""
     try:
         phi = term_matrix(X, [term])[:, 0]
     except SysidError:
         return beyond
-    se_f = block_jackknife_se(np.asarray(jk["t"], float), phi, r, rows, float(jk["block_s"]))
+    se_f = block_jackknife_se(np.asarray(jk["t"], float), phi, r, rows, float(jk["block_s"]),
+                              _parent_columns(X, parents))
     se_r = 0.0
     if jk.get("reference") is not None:
         t_r, X_r, r_r, rows_r = jk["reference"]
         try:
             se_r = block_jackknife_se(np.asarray(t_r, float), term_matrix(X_r, [term])[:, 0], r_r, rows_r,
-                                      float(jk["block_s"]))
+                                      float(jk["block_s"]), _parent_columns(X_r, parents))
         except SysidError:
             se_r = float("nan")
     if not (np.isfinite(se_f) and np.isfinite(se_r)):
@@ -912,8 +937,10 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             R_wo = (diag.residual_after - fitted[cause].delta) if cause in fitted else diag.residual_before
             if search_residual is not None and f.get("source") == "sparse search":
                 R_wo = np.where(valid0[:, None], search_residual, np.nan)
+            # a curvature that entered the search with its parent is judged with it (sparse.power_parent_blocks)
+            parents = tuple(f.get("evidence", {}).get("entered_with") or ())
             allow = offset_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
-                                     min_t=min_t, min_gain_pct=min_gain_pct)
+                                     min_t=min_t, min_gain_pct=min_gain_pct, parents=parents)
             if allow["offset_only"]:
                 f["evidence"]["differential"] = {"verdict": "allowance", "allowance": allow}
                 doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
@@ -931,7 +958,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                           (r_ctx.t, r_ctx.X, r_R[:, COEFFICIENTS.index(coef)], r_ctx.valid)}
                 scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                               coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                              scale_se=angle_scale_se, jackknife=jk)
+                                              scale_se=angle_scale_se, jackknife=jk, parents=parents)
                 if scale is not None and scale["scale_only"]:
                     scaled = scale
                     break

@@ -98,17 +98,22 @@ def alpha_quantile_knots(ctx: DiagContext, n_hinges: int = 4) -> np.ndarray:
 
 
 def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: int = 6,
-                   min_press_gain: float = 0.02) -> dict:
+                   min_press_gain: float = 0.02, blocks: list[tuple[int, ...]] | None = None) -> dict:
     """Forward stepwise selection by block PRESS on the training rows.
 
     Args:
         Phi: candidates on the training rows (N, K). r: residual on the same rows (N,).
         fold: (N,) fold index 0..F-1 of each row (contiguous time blocks).
         max_terms: most terms selected. min_press_gain: smallest relative PRESS decrease to go on.
+        blocks: column groups that may also enter together in one step, as one candidate, when none of
+            their columns is selected yet and they fit within ``max_terms`` (e.g. ``(alpha^2, alpha)``, a
+            curvature with its first parent: :func:`gcs_sysid.diagnose.sparse.power_parent_blocks`). A block
+            is compared with the single columns by the same block PRESS; when it wins, its columns are
+            appended in the given order and the PRESS path gets one entry for the step. None: singles only.
 
     Returns:
-        ``{"selected": [k...], "press": [PRESS after 0, 1, ... terms], "scale": (K,)}``; columns are
-        standardised internally (``scale``: their training RMS).
+        ``{"selected": [k...], "press": [PRESS after 0, 1, ... steps], "scale": (K,), "steps": [[k...] per
+        step]}``; columns are standardised internally (``scale``: their training RMS).
     """
     scale = np.sqrt(np.mean(Phi**2, axis=0))
     scale = np.where(scale > 0, scale, 1.0)
@@ -121,7 +126,19 @@ def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: 
     ridge = 1e-9 * np.trace(G) / G.shape[0]
     sel: list[int] = []
     press = [float(rk.sum())]
+    steps: list[list[int]] = []
     K = A.shape[1]
+    eye = np.eye(K)
+
+    def set_press(S: list[int]) -> float:
+        # the same fold-out arithmetic for one column set
+        Sa = np.asarray(S, dtype=int)
+        Gks = Gk[:, Sa[:, None], Sa[None, :]]                                             # (F, s, s)
+        bks = bk[:, Sa]
+        Gm = G[Sa[:, None], Sa[None, :]][None] - Gks + ridge * eye[:Sa.size, :Sa.size]
+        th = np.linalg.solve(Gm, (b[Sa][None] - bks)[..., None])[..., 0]                 # (F, s)
+        return float((rk - 2 * np.einsum("fs,fs->f", th, bks) + np.einsum("fs,fst,ft->f", th, Gks, th)).sum())
+
     while len(sel) < max_terms:
         # every candidate c and fold k of this step at once: the fold-out normal equations of sel + [c]
         # (Gm = G_S - Gk_S, stacked (F, C, s, s)) solved in one batched call, then the fold's PRESS term
@@ -138,11 +155,19 @@ def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: 
         p = (rk[:, None] - 2 * np.einsum("fcs,fcs->fc", th, bks)
              + np.einsum("fcs,fcst,fct->fc", th, Gks, th)).sum(0)                           # (C,)
         i = int(np.argmin(p))                                  # the first of equal minima, as the loop did
-        if not p[i] < press[-1] or press[-1] - p[i] < min_press_gain * press[-1]:
+        step, best = [int(cand[i])], float(p[i])
+        for blk in blocks or ():
+            if len(sel) + len(blk) > max_terms or any(c in sel for c in blk):
+                continue
+            pb = set_press(sel + list(blk))
+            if pb < best:
+                step, best = [int(c) for c in blk], pb
+        if not best < press[-1] or press[-1] - best < min_press_gain * press[-1]:
             break
-        sel.append(int(cand[i]))
-        press.append(float(p[i]))
-    return {"selected": sel, "press": press, "scale": scale}
+        sel += step
+        steps.append(step)
+        press.append(best)
+    return {"selected": sel, "press": press, "scale": scale, "steps": steps}
 
 
 def search_residual(ctx: DiagContext, R: np.ndarray, coefficients=None, folds: int = 5, max_terms: int = 6,

@@ -219,6 +219,15 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ``alpha^2*delta_e`` is no longer ``delta_e0 alpha^2`` plus a small part and the search does not split a curvature
 #: between the two (the JSBSim dr1's ``Cm:alpha^2``). The reference's ridge inadequacy keeps the measured surfaces.
 #: No new threshold. Measured in ``docs/benchmarks.md``, *Twenty-sixth session, i9-cma2*.
+#: Added 2026-11-24 (twenty-seventh session, branch i9-a2pair): ``power_with_parent`` (the regressors whose square may
+#: enter the forward search in one step with its first parent, ``(alpha^2, alpha)``: :func:`power_parent_blocks`,
+#: :func:`gcs_sysid.diagnose.search.press_stepwise` ``blocks``; ``()`` off). A curvature about a zero that is off by
+#: ``e`` (the measured alpha against the air's) is ``k x^2 - 2 k e x``, and its square alone was beaten by whatever
+#: single term correlated (the JSBSim dr1's ``Cm:alpha^2``). The pair's PRESS drop is the score, its untouched gain the
+#: finding's gain; the finding's ``evidence.entered_with`` names the parent, and ``diagnose``'s differential step
+#: judges the term beyond the offset, the alpha scale and the jackknife with the parent beside it
+#: (:func:`gcs_sysid.diagnose.differential.offset_allowance` ``parents``). No new threshold. Measured in
+#: ``docs/benchmarks.md``, *Twenty-seventh session, i9-a2pair*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -237,7 +246,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
-              "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False}
+              "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
+              "power_with_parent": ()}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -275,22 +285,45 @@ def stlsq(A: np.ndarray, y: np.ndarray, threshold: float, max_iter: int = 10, ri
 
 
 def select_terms(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: int, min_step_gain: float,
-                 threshold: float) -> tuple[list[int], list[float]]:
+                 threshold: float, blocks: list[tuple[int, ...]] | None = None) -> tuple[list[int], list[float]]:
     """Forward stepwise by block PRESS on training folds, then STLSQ pruning of the selected set.
 
     Args:
         Phi: candidates on the training rows (N, K). r: residual there (N,). fold: (N,) block index.
+        blocks: column groups that may enter together in one step (:func:`power_parent_blocks`;
+            :func:`gcs_sysid.diagnose.search.press_stepwise`). None: one column a step.
 
     Returns:
-        (selected column indices, PRESS path of the stepwise part).
+        (selected column indices, PRESS path of the stepwise part: one entry per step).
     """
-    res = press_stepwise(Phi, r, fold, max_terms, min_step_gain)
+    res = press_stepwise(Phi, r, fold, max_terms, min_step_gain, blocks=blocks)
     sel = res["selected"]
     if len(sel) > 1:
         A = Phi[:, sel] / res["scale"][sel]
         th = stlsq(A, r, threshold)
         sel = [k for k, v in zip(sel, th) if v != 0.0]
     return sel, res["press"]
+
+
+def power_parent_blocks(names: list[str], regressors=("alpha",)) -> list[tuple[int, int]]:
+    """The joint candidates ``(x^2, x)``: each listed regressor's square with its first parent, as column indices.
+
+    Why: a curvature about an origin that is off by ``e`` (the measured alpha of a flight against the air's,
+    the flight-mean vertical wind of a JSBSim dr1 flight: 1-1.5 deg on a manoeuvre of 1.1 deg SD) is
+    ``k (x - e)^2 = k x^2 - 2 k e x + const``; its linear part can exceed its own, and ``x^2`` entering alone
+    is then beaten by whatever single term correlates (``docs/benchmarks.md``, *Twenty-sixth session,
+    i9-cma2*). A polynomial model is well formulated only with the lower-order terms of each term it holds
+    (marginality: Peixoto, *The American Statistician* 41(4) (1987) 311; Nelder, *J. Appl. Stat.* 27 (2000)
+    109), so the square enters with its parent; the curvature's coefficient is the same whatever ``e`` is.
+
+    Args:
+        names: the library's term names (K,). regressors: the regressors whose squares enter with their parent.
+
+    Returns:
+        ``[(index of x^2, index of x), ...]`` for the regressors whose two columns are both in ``names``.
+    """
+    idx = {n: i for i, n in enumerate(names)}
+    return [(idx[f"{x}^2"], idx[x]) for x in regressors if f"{x}^2" in idx and x in idx]
 
 
 def _fold_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]) -> np.ndarray:
@@ -494,7 +527,9 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
     sub = tr[:: max(1, int(np.ceil(tr.size / max_rows)))]
     fold = np.minimum((np.arange(sub.size) * folds) // sub.size, folds - 1)
     Pc = Phi[sub] - Phi[tr].mean(axis=0)
-    sel, press = select_terms(Pc, r[sub], fold, th["max_terms"], th["min_step_gain"], th["stlsq_threshold"])
+    blocks = power_parent_blocks(names, tuple(th.get("power_with_parent", ()) or ()))
+    sel, press = select_terms(Pc, r[sub], fold, th["max_terms"], th["min_step_gain"], th["stlsq_threshold"],
+                              blocks=blocks or None)
     if sel and th.get("hierarchy_tol", 0.0) > 0:
         sel = _prefer_lower_degree(Pc, r[sub], fold, sel, names, th["hierarchy_tol"])
     if sel and th.get("smooth_se", 0.0) > 0:
@@ -517,6 +552,11 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
     out["terms"] = [{"term": names[k], "estimate": float(v), "std_error": float(s), "std_error_naming": float(sb)}
                     for k, v, s, sb in zip(sel, fit.theta[1:], fit_mk.std_error[1:], fit.std_error[1:])]
     out["score"] = float(1 - press[1] / press[0]) if len(press) > 1 and press[0] > 0 else 0.0
+    first = names[sel[0]]
+    parent = next((names[b[1]] for b in blocks if names[b[0]] == first and b[1] in sel), None)
+    if parent is not None and len(sel) > 1 and names[sel[1]] == parent:
+        # the curvature entered with its parent (power_with_parent): the score and gain are the pair's
+        out["entered_with"] = [parent]
     out["held_out"] = {"rms_before": before, "rms_after": after,
                        "percent": float(100 * (1 - after / before)) if before > 0 else 0.0,
                        "confirmation": untouched_confirmation(r[te], pred[te])}
@@ -1814,6 +1854,7 @@ def _name_term(coef: str, entry: dict, model: dict) -> dict:
     t = entry["terms"][0]
     term = t["term"]
     ev = {"domain": "sparse search", "score": entry["score"], "terms": entry["terms"],
+          **({"entered_with": list(entry["entered_with"])} if entry.get("entered_with") else {}),
           "t_statistic": t["estimate"] / t["std_error_naming"] if t.get("std_error_naming", 0) > 0 else None,
           "std_error_method": "Morelli and Klein sec. 5.3, all lags (t_statistic: Bartlett window)"}
     if "(t-" in term:                       # "delta_e(t-0.1)-delta_e": a delay of that surface

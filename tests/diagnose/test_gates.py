@@ -135,3 +135,25 @@ def test_a_wind_correction_the_reference_needs_too_is_a_calibration(monkeypatch)
     monkeypatch.setattr(differential, "_wind_fit", lambda c, R: (np.array([0.0, 0.05]), np.eye(2) * 0.01))
     changed = differential._wind_differential(f, fitted, refs)
     assert changed["verdict"] == "changed" and "estimator" in changed["why"]
+
+
+def test_a_curvature_about_a_shifted_zero_is_judged_with_the_parent_it_entered_with():
+    """``-8 (alpha_m - e)^2`` with the measured alpha 1.2 deg off the air's (the JSBSim dr1, twenty-sixth session):
+    refitted alone beside a free constant, the linear part ``16 e alpha`` stays in its residual and ``alpha^2``
+    is not beyond its standard error nor gains much beyond the offset (an allowance); with ``alpha`` beside it
+    (``parents``, the search's ``entered_with``) it reads -8 and is more than an offset."""
+    rng = np.random.default_rng(5)
+    n = 6000
+    X = np.zeros((n, 10))
+    t = np.arange(n) * 0.02
+    X[:, 0] = 0.02 * np.sin(t / 2.1) + 0.01 * np.sin(t / 0.7) + 0.002 * rng.normal(size=n)
+    X[:, 9] = 30.0
+    test = (np.floor(t / 8.0).astype(int) % 3) == 2
+    R = np.zeros((n, 6))
+    e = np.radians(1.2)
+    R[:, 4] = -8.0 * (X[:, 0] - e) ** 2 + 2e-4 * rng.normal(size=n)
+    alone = offset_allowance(X, R, ~test, test, "Cm", "alpha^2")
+    both = offset_allowance(X, R, ~test, test, "Cm", "alpha^2", parents=("alpha",))
+    assert alone["offset_only"] and alone["gain_beyond_offset_percent"] < 20.0, alone
+    assert not both["offset_only"] and both["estimate"] == pytest.approx(-8.0, rel=0.05), both
+    assert both["gain_beyond_offset_percent"] > 90.0 and "beside it" in both["why"]

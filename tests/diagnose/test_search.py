@@ -131,3 +131,29 @@ def test_diagnose_reports_the_search(airframe):
     cm = next(e for e in d.data["search"] if e["coefficient"] == "Cm")
     assert "alpha^3" in [t["term"] for t in cm["terms"]]
     assert "search_s" in d.data["timings"]
+
+
+def test_a_block_enters_in_one_step_when_its_columns_alone_lose():
+    """``k (x - e)^2`` about a shifted origin: its linear part is larger than its curvature, so ``x`` alone enters
+    first; offered as a block, ``(x^2, x)`` enters in one step, with the block PRESS of a direct refit."""
+    rng = np.random.default_rng(2)
+    N = 900
+    x = rng.normal(size=N)
+    Phi = np.column_stack([x, x**2, x**3, rng.normal(size=(N, 5))])
+    r = (x - 1.5) ** 2
+    r = r - r.mean() + 0.05 * rng.normal(size=N)
+    Phi = Phi - Phi.mean(axis=0)
+    fold = np.minimum((np.arange(N) * 5) // N, 4)
+    single = press_stepwise(Phi, r, fold, max_terms=2)
+    assert single["selected"][0] == 0 and single["steps"] == [[c] for c in single["selected"]]
+    res = press_stepwise(Phi, r, fold, max_terms=3, blocks=[(1, 0)])
+    assert res["steps"][0] == [1, 0] and res["selected"][:2] == [1, 0]
+    direct = 0.0
+    for k in range(5):
+        m = fold == k
+        th = np.linalg.lstsq(Phi[~m][:, [1, 0]], r[~m], rcond=None)[0]
+        direct += np.sum((r[m] - Phi[m][:, [1, 0]] @ th) ** 2)
+    assert res["press"][1] == pytest.approx(direct, rel=1e-6)
+    assert res["press"][1] < 0.05 * single["press"][1]
+    # a block that does not fit within max_terms is not offered
+    assert press_stepwise(Phi, r, fold, max_terms=1, blocks=[(1, 0)])["selected"] == [0]

@@ -484,3 +484,31 @@ def test_library_control_trim_keeps_a_curvature_apart_from_its_elevator_product(
     # the lags and hinges do not depend on the trim
     lag = [i for i, n in enumerate(n0) if n.startswith("delta_e(t-") or n.startswith("max(")]
     assert lag and np.allclose(P0[:, lag], P1[:, lag])
+
+
+def test_power_with_parent_names_a_curvature_about_a_shifted_alpha(airframe):
+    """A ``Cm:alpha^2`` of -3 on a flight whose measured alpha is 3 deg off the air's (the JSBSim dr1's
+    flight-mean vertical wind, twenty-sixth session, i9-cma2): ``-3 (alpha_m - e)^2`` has a linear part larger
+    than its curvature, and with one term a step the search names ``Cm:alpha^3``. With ``power_with_parent``
+    ``alpha^2`` enters with ``alpha`` and is named, its change within 25 % and the pair's untouched gain
+    reported as the finding's."""
+    from gcs_sysid.diagnose.sparse import THRESHOLDS, power_parent_blocks
+
+    assert power_parent_blocks(["alpha", "beta", "alpha^2", "beta^2", "alpha^3"], ("alpha", "q_hat")) == [(2, 0)]
+    ref = _ctx(airframe, seed=4)
+    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
+    a = table.X[:, 0].copy()
+    table.Y[:, 4] += -3.0 * a**2
+    table.X[:, 0] = a + np.radians(3.0)
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    R = ctx.Y - ctx.model_values()
+    off = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ()})
+    on = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ("alpha",)})
+    assert [f["cause"] for f in off["findings"]] != ["Cm:alpha^2"]
+    assert [f["cause"] for f in on["findings"]] == ["Cm:alpha^2"], on["findings"]
+    f = on["findings"][0]
+    assert f["evidence"]["entered_with"] == ["alpha"]
+    assert [t["term"] for t in f["evidence"]["terms"][:2]] == ["alpha^2", "alpha"]
+    assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
+    assert f["gain"]["percent"] >= 50.0
+    assert THRESHOLDS["power_with_parent"] in ((), ("alpha",))
