@@ -24,7 +24,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["enable_x64", "enable_compilation_cache", "default_cache_dir", "limit_blas_threads"]
+__all__ = ["enable_x64", "enable_compilation_cache", "default_cache_dir", "limit_blas_threads", "stored_program",
+           "stored_jit"]
 
 #: Environment variable that overrides the cache directory; set it to ``"off"`` to disable the cache.
 CACHE_ENV = "GCS_SYSID_JAX_CACHE"
@@ -115,3 +116,141 @@ def limit_blas_threads(n: int = 1) -> int:
     global _BLAS_LIMIT
     _BLAS_LIMIT = threadpool_limits(limits=max(int(n), 1), user_api="blas")
     return sum(1 for lib in threadpool_info() if lib.get("user_api") == "blas")
+
+
+#: Bumped when the layout of :func:`stored_program`'s files or its key changes.
+_STORED_FORMAT = 1
+_SOURCE_HASH: str | None = None
+_PROGRAMS: dict[str, object] = {}
+
+
+def _source_hash() -> str:
+    """SHA-256 of every ``.py`` file of the installed gcs_sysid package (path and bytes), once per process."""
+    global _SOURCE_HASH
+    if _SOURCE_HASH is None:
+        import hashlib
+
+        root = Path(__file__).resolve().parent
+        h = hashlib.sha256()
+        for f in sorted(root.rglob("*.py")):
+            h.update(str(f.relative_to(root)).encode())
+            h.update(f.read_bytes())
+        _SOURCE_HASH = h.hexdigest()
+    return _SOURCE_HASH
+
+
+def stored_program(fn, args: tuple, static: tuple = ()):
+    """``fn`` traced and lowered once per machine: the traced program kept on disk, beside the compilation cache.
+
+    JAX's persistent compilation cache (:func:`enable_compilation_cache`) skips XLA's compilation, but each process
+    still traces the Python function and lowers it to StableHLO before it can look the program up; for the GP's
+    Adam step (the gradient of the bound) that is about 1.3 s per replay on the 2-core benchmark box
+    (``docs/benchmarks.md``, "Twenty-seventh session, speed27"). Here the lowered program is serialised with
+    :func:`jax.export.export` into ``<cache>/traced/`` and later processes deserialise it instead of tracing
+    (the JAX manual, "Exporting and serializing staged-out computations"). The program is the same StableHLO, so
+    XLA compiles (or loads) the same computation and the results are identical.
+
+    The file's key is the module and name of ``fn`` and of each ``static`` function, the tree structure and the shape, dtype and weak type of every leaf of ``args``,
+    the SHA-256 of the gcs_sysid package's source, the JAX, jaxlib, optax and NumPy versions, the backend and the
+    64-bit and matmul-precision flags; any change of the code gives a new key (old files are left, unused).
+
+    Args:
+        fn: a module-level function, called as ``fn(*static, *args)`` (no closure: what it computes must follow
+            from its code and ``args``' structure alone).
+        args: the positional arguments of one call (arrays, Python scalars, None, tuples, lists and dicts of them).
+        static: module-level functions passed first (e.g. the loss of an optimiser step), each part of the key.
+
+    Returns:
+        A callable ``program(*args)`` (arguments of the same structure, shapes and dtypes) returning what
+        ``fn(*static, *args)`` returns; None when the compilation cache is off (no directory: the caller calls
+        its jitted function as before), ``fn`` has a closure, or the export or the file fails (then this process
+        keeps using the caller's path for that key).
+
+    Raises:
+        nothing: every failure returns None.
+    """
+    import dataclasses
+    import pickle
+
+    import jax
+
+    cache = jax.config.jax_compilation_cache_dir
+    funcs = (fn, *static)
+    if not cache or any(getattr(f, "__closure__", True) is not None or "<locals>" in f.__qualname__ for f in funcs):
+        return None
+    try:
+        import hashlib
+
+        import jaxlib
+        import numpy
+        import optax
+
+        leaves, tree = jax.tree_util.tree_flatten(args)
+        avals = [jax.typeof(x) for x in leaves]
+        parts = [str(_STORED_FORMAT), *(f"{f.__module__}.{f.__qualname__}" for f in funcs), str(tree),
+                 ";".join(f"{a.shape}:{a.dtype}:{a.weak_type}" for a in avals), _source_hash(), jax.__version__,
+                 jaxlib.__version__, optax.__version__, numpy.__version__, jax.default_backend(),
+                 str(jax.config.jax_enable_x64), str(jax.config.jax_default_matmul_precision)]
+        key = hashlib.sha256("\n".join(parts).encode()).hexdigest()
+    except Exception:
+        return None
+    if key in _PROGRAMS:
+        return _PROGRAMS[key]
+    path = Path(cache) / "traced" / f"{key}.pkl"
+    exported = None
+    try:
+        if path.exists():
+            exported = pickle.loads(path.read_bytes())
+    except Exception:          # unreadable or foreign: exported again below
+        exported = None
+    try:
+        if exported is None:
+            def staged(*xs):
+                return fn(*static, *xs)
+
+            specs = jax.tree_util.tree_unflatten(tree, [jax.ShapeDtypeStruct(a.shape, a.dtype, weak_type=a.weak_type)
+                                                        for a in avals])
+            # without its VJP closure (not picklable, not needed: the stored program is only called)
+            exported = dataclasses.replace(jax.export.export(jax.jit(staged))(*specs), _get_vjp=None)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_bytes(pickle.dumps(exported, protocol=pickle.HIGHEST_PROTOCOL))
+            os.replace(tmp, path)
+        program = jax.jit(exported.call)
+    except Exception:
+        program = None
+    _PROGRAMS[key] = program
+    return program
+
+
+class _StoredJit:
+    """:func:`stored_jit`'s wrapper."""
+
+    def __init__(self, fn):
+        import functools
+
+        import jax
+
+        functools.update_wrapper(self, fn)
+        self._fn, self._jit = fn, jax.jit(fn)
+
+    def __call__(self, *args, **kwargs):
+        program = None if kwargs else stored_program(self._fn, args)
+        return self._jit(*args, **kwargs) if program is None else program(*args)
+
+
+def stored_jit(fn):
+    """``jax.jit(fn)`` whose traced program is kept on disk (:func:`stored_program`) when the compilation cache is on.
+
+    Args:
+        fn: a module-level function of arrays (and pytrees of them), no closure.
+
+    Returns:
+        A callable with ``fn``'s signature: positional calls use the stored program (traced once per machine and
+        argument structure), keyword calls and calls without a cache directory the plain ``jax.jit(fn)``. The results
+        are the same either way.
+
+    Raises:
+        what ``fn`` raises when traced.
+    """
+    return _StoredJit(fn)
