@@ -122,6 +122,8 @@ def limit_blas_threads(n: int = 1) -> int:
 _STORED_FORMAT = 1
 _SOURCE_HASH: str | None = None
 _PROGRAMS: dict[str, object] = {}
+#: This process's programs by (functions, tree structure, avals): a repeated call skips the key's hashing.
+_MEMO: dict[tuple, object] = {}
 
 
 def _source_hash() -> str:
@@ -143,16 +145,18 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     """``fn`` traced and lowered once per machine: the traced program kept on disk, beside the compilation cache.
 
     JAX's persistent compilation cache (:func:`enable_compilation_cache`) skips XLA's compilation, but each process
-    still traces the Python function and lowers it to StableHLO before it can look the program up; for the GP's
-    Adam step (the gradient of the bound) that is about 1.3 s per replay on the 2-core benchmark box
-    (``docs/benchmarks.md``, "Twenty-seventh session, speed27"). Here the lowered program is serialised with
-    :func:`jax.export.export` into ``<cache>/traced/`` and later processes deserialise it instead of tracing
-    (the JAX manual, "Exporting and serializing staged-out computations"). The program is the same StableHLO, so
-    XLA compiles (or loads) the same computation and the results are identical.
+    still traces the Python function and lowers it to StableHLO before it can look the program up: in a loaded
+    profile of the replay, 4.5 of its main process's 27.6 busy seconds, 2.8 of them the GP's Adam steps (the gradient
+    of the bound; ``docs/benchmarks.md``, "Twenty-seventh session, speed27"). Here the lowered program is
+    serialised with :func:`jax.export.export` into ``<cache>/traced/`` and later processes deserialise it instead
+    of tracing (the JAX manual, "Exporting and serializing staged-out computations"). The program is the same
+    StableHLO, so XLA compiles (or loads) the same computation and the results are identical.
 
-    The file's key is the module and name of ``fn`` and of each ``static`` function, the tree structure and the shape, dtype and weak type of every leaf of ``args``,
-    the SHA-256 of the gcs_sysid package's source, the JAX, jaxlib, optax and NumPy versions, the backend and the
-    64-bit and matmul-precision flags; any change of the code gives a new key (old files are left, unused).
+    The file's key is the module and name of ``fn`` and of each ``static`` function, the tree structure and the
+    shape, dtype and weak type of every leaf of ``args``, the SHA-256 of the gcs_sysid package's source, the JAX,
+    jaxlib, optax and NumPy versions, the backend and the 64-bit and matmul-precision flags; any change of the code
+    gives a new key (old files are left, unused). The files are trusted as the compilation cache's are (written by
+    this package on this machine).
 
     Args:
         fn: a module-level function, called as ``fn(*static, *args)`` (no closure: what it computes must follow
@@ -186,7 +190,10 @@ def stored_program(fn, args: tuple, static: tuple = ()):
         import optax
 
         leaves, tree = jax.tree_util.tree_flatten(args)
-        avals = [jax.typeof(x) for x in leaves]
+        avals = tuple(jax.typeof(x) for x in leaves)
+        memo = (funcs, tree, avals)
+        if memo in _MEMO:
+            return _MEMO[memo]
         parts = [str(_STORED_FORMAT), *(f"{f.__module__}.{f.__qualname__}" for f in funcs), str(tree),
                  ";".join(f"{a.shape}:{a.dtype}:{a.weak_type}" for a in avals), _source_hash(), jax.__version__,
                  jaxlib.__version__, optax.__version__, numpy.__version__, jax.default_backend(),
@@ -195,6 +202,7 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     except Exception:
         return None
     if key in _PROGRAMS:
+        _MEMO[memo] = _PROGRAMS[key]
         return _PROGRAMS[key]
     path = Path(cache) / "traced" / f"{key}.pkl"
     exported = None
@@ -219,7 +227,7 @@ def stored_program(fn, args: tuple, static: tuple = ()):
         program = jax.jit(exported.call)
     except Exception:
         program = None
-    _PROGRAMS[key] = program
+    _PROGRAMS[key] = _MEMO[memo] = program
     return program
 
 

@@ -97,7 +97,8 @@ def test_stored_gp_programs_give_the_jitted_results_and_are_loaded_by_the_next_p
     assert first["stored"] >= 2 and len(files) == first["stored"]
     again = json.loads(_child(STORED.replace("sys.argv[1]", "'load'"), cache).splitlines()[-1])
     assert sorted((tmp_path / "jax" / "traced").glob("*.pkl")) == files
-    plain = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), {"GCS_SYSID_JAX_CACHE": "off"}).splitlines()[-1])
+    off = {"GCS_SYSID_JAX_CACHE": "off"}
+    plain = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), off).splitlines()[-1])
     assert plain["stored"] == 0
     for k in ("elbo", "local", "mean", "var"):                # bit for bit: the same program either way
         assert first[k] == plain[k] and again[k] == plain[k], k
