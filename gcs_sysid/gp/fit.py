@@ -30,7 +30,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from ..jaxconfig import enable_x64, stored_program
+from ..jaxconfig import enable_x64, stored_jit, stored_program
 from .batching import global_mean, global_posterior, global_predict, global_stats
 from .config import GPConfig
 from .inputnoise import fit_input_noise, mean_gradient
@@ -142,7 +142,7 @@ def noise_correlation_factor(off: jax.Array) -> jax.Array:
     return U / jnp.sqrt(jnp.sum(U * U, axis=1, keepdims=True))
 
 
-_constrain_global_jit = jax.jit(constrain_global)
+_constrain_global_jit = stored_jit(constrain_global)
 
 
 #: Adam's initial state (zero moments; it does not depend on the step size), built by one compiled
@@ -166,7 +166,7 @@ def _constrain_local(raw) -> LocalParams:
                        amp=jnp.exp(raw["log_amp"]) + _NOISE_FLOOR, noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR)
 
 
-_constrain_local_jit = jax.jit(_constrain_local)
+_constrain_local_jit = stored_jit(_constrain_local)
 
 
 def _adam_step_body(loss, raw, opt_state, lr, args):
