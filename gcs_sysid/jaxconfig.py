@@ -141,6 +141,69 @@ def _source_hash() -> str:
     return _SOURCE_HASH
 
 
+_NAMED: set[type] = set()
+
+
+def _register_type(cls, empty) -> None:
+    """Register one node type for ``jax.export``'s serialisation under ``module.qualname``: a NamedTuple as such, any
+    other registered node with ``empty`` (``()`` or None) as its auxiliary data."""
+    import jax
+
+    if cls in _NAMED:
+        return
+    name = f"{cls.__module__}.{cls.__qualname__}"
+    try:
+        if issubclass(cls, tuple) and hasattr(cls, "_fields"):
+            jax.export.register_namedtuple_serialization(cls, serialized_name=name)
+        else:
+            jax.export.register_pytree_node_serialization(
+                cls, serialized_name=name, serialize_auxdata=lambda aux: b"",
+                deserialize_auxdata=lambda b, empty=empty: empty)
+    except ValueError:          # already registered (by another package, or an earlier call)
+        pass
+    _NAMED.add(cls)
+
+
+def _node_types(tree) -> dict | None:
+    """The custom node types of a PyTreeDef, ``{cls: its auxiliary data}``; None if one carries auxiliary data other
+    than ``()`` or None (the serialisation could not restore it) and is not a NamedTuple."""
+    found, todo = {}, [tree]
+    while todo:
+        node = todo.pop()
+        data = node.node_data()
+        if data is not None and data[0] not in (tuple, list, dict, type(None)):
+            cls = data[0]
+            if not (issubclass(cls, tuple) and hasattr(cls, "_fields")) and data[1] not in ((), None):
+                return None
+            found[cls] = data[1]
+        todo.extend(node.children())
+    return found
+
+
+def _register_tree(tree) -> bool:
+    """Register every custom node type of ``tree`` (:func:`_register_type`); False if one cannot be (:func:`_node_types`)."""
+    types = _node_types(tree)
+    if types is None:
+        return False
+    for cls, empty in types.items():
+        _register_type(cls, empty)
+    return True
+
+
+def _register_listed(path: Path) -> None:
+    """Register the node types named in a stored program's ``.types`` file (``module:qualname:tuple|none`` lines,
+    written beside it) before it is read: :func:`jax.export.deserialize` must know every node type of the program's
+    input and output trees."""
+    import importlib
+
+    for line in path.read_text().split():
+        module, qualname, empty = line.split(":")
+        cls = importlib.import_module(module)
+        for part in qualname.split("."):
+            cls = getattr(cls, part)
+        _register_type(cls, () if empty == "tuple" else None)
+
+
 def stored_program(fn, args: tuple, static: tuple = ()):
     """``fn`` traced and lowered once per machine: the traced program kept on disk, beside the compilation cache.
 
@@ -148,7 +211,7 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     still traces the Python function and lowers it to StableHLO before it can look the program up: in a loaded
     profile of the replay, 4.5 of its main process's 27.6 busy seconds, 2.8 of them the GP's Adam steps (the gradient
     of the bound; ``docs/benchmarks.md``, "Twenty-seventh session, speed27"). Here the lowered program is
-    serialised with :func:`jax.export.export` into ``<cache>/traced/`` and later processes deserialise it instead
+    exported with :func:`jax.export.export` and serialised (``Exported.serialize``, flatbuffers) into ``<cache>/traced/`` and later processes deserialise it instead
     of tracing (the JAX manual, "Exporting and serializing staged-out computations"). The program is the same
     StableHLO, so XLA compiles (or loads) the same computation and the results are identical.
 
@@ -173,9 +236,6 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     Raises:
         nothing: every failure returns None.
     """
-    import dataclasses
-    import pickle
-
     import jax
 
     cache = jax.config.jax_compilation_cache_dir
@@ -204,11 +264,15 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     if key in _PROGRAMS:
         _MEMO[memo] = _PROGRAMS[key]
         return _PROGRAMS[key]
-    path = Path(cache) / "traced" / f"{key}.pkl"
+    if not _register_tree(tree):     # a node type JAX's serialisation cannot restore: the caller's jit
+        _PROGRAMS[key] = _MEMO[memo] = None
+        return None
+    path = Path(cache) / "traced" / f"{key}.jaxexport"
     exported = None
     try:
         if path.exists():
-            exported = pickle.loads(path.read_bytes())
+            _register_listed(path.with_suffix(".types"))
+            exported = jax.export.deserialize(bytearray(path.read_bytes()))
     except Exception:          # unreadable or foreign: exported again below
         exported = None
     try:
@@ -218,11 +282,21 @@ def stored_program(fn, args: tuple, static: tuple = ()):
 
             specs = jax.tree_util.tree_unflatten(tree, [jax.ShapeDtypeStruct(a.shape, a.dtype, weak_type=a.weak_type)
                                                         for a in avals])
-            # without its VJP closure (not picklable, not needed: the stored program is only called)
-            exported = dataclasses.replace(jax.export.export(jax.jit(staged))(*specs), _get_vjp=None)
+            # JAX's own serialisation (flatbuffers; no VJP: the stored program is only called, never differentiated)
+            exported = jax.export.export(jax.jit(staged))(*specs)
+            types = _node_types(exported.out_tree)
+            if types is None or not _register_tree(exported.out_tree):
+                raise ValueError("an output node with auxiliary data")
+            types.update(_node_types(exported.in_tree))
+            blob = exported.serialize()
             path.parent.mkdir(parents=True, exist_ok=True)
+            listed = path.with_suffix(f".{os.getpid()}.types.tmp")    # the node types a later process registers first
+            listed.write_text("\n".join(sorted(f"{c.__module__}:{c.__qualname__}:{'none' if e is None else 'tuple'}"
+                                                for c, e in types.items())))
+            os.replace(listed, path.with_suffix(".types"))
+            exported = jax.export.deserialize(blob)
             tmp = path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_bytes(pickle.dumps(exported, protocol=pickle.HIGHEST_PROTOCOL))
+            tmp.write_bytes(bytes(blob))
             os.replace(tmp, path)
         program = jax.jit(exported.call)
     except Exception:

@@ -92,11 +92,11 @@ def test_stored_gp_programs_give_the_jitted_results_and_are_loaded_by_the_next_p
 
     cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
     first = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), cache).splitlines()[-1])
-    files = sorted((tmp_path / "jax" / "traced").glob("*.pkl"))
+    files = sorted((tmp_path / "jax" / "traced").glob("*.jaxexport"))
     # the Adam steps of both layers and the other stored GP programs, each written once
     assert first["stored"] >= 2 and len(files) == first["stored"]
     again = json.loads(_child(STORED.replace("sys.argv[1]", "'load'"), cache).splitlines()[-1])
-    assert sorted((tmp_path / "jax" / "traced").glob("*.pkl")) == files
+    assert sorted((tmp_path / "jax" / "traced").glob("*.jaxexport")) == files
     off = {"GCS_SYSID_JAX_CACHE": "off"}
     plain = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), off).splitlines()[-1])
     assert plain["stored"] == 0
