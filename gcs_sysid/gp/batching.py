@@ -9,6 +9,7 @@ from __future__ import annotations
 import jax
 import numpy as np
 
+from ..jaxconfig import stored_jit
 from .local import LocalParams, LocalStore, local_predict_chunk, neighbours
 from .sparse import (GlobalParams, GlobalPosterior, Stats, add_stats, mean_global_chunk, posterior,
                      predict_global_chunk, stats_of)
@@ -20,11 +21,11 @@ __all__ = ["global_stats", "global_predict", "global_mean", "local_predict", "gl
 #: rows (``docs/benchmarks.md``, soak memory), and 512-row chunks are no slower.
 LOCAL_CHUNK = 512
 
-_stats_jit = jax.jit(stats_of)
-_predict_jit = jax.jit(predict_global_chunk)
-_mean_jit = jax.jit(mean_global_chunk)
-global_posterior = jax.jit(posterior)
-_add_jit = jax.jit(add_stats)
+_stats_jit = stored_jit(stats_of)
+_predict_jit = stored_jit(predict_global_chunk)
+_mean_jit = stored_jit(mean_global_chunk)
+global_posterior = stored_jit(posterior)
+_add_jit = stored_jit(add_stats)
 
 
 def _chunks(n: int, size: int):

@@ -30,7 +30,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from ..jaxconfig import enable_x64
+from ..jaxconfig import enable_x64, stored_jit, stored_program
 from .batching import global_mean, global_posterior, global_predict, global_stats
 from .config import GPConfig
 from .inputnoise import fit_input_noise, mean_gradient
@@ -142,7 +142,7 @@ def noise_correlation_factor(off: jax.Array) -> jax.Array:
     return U / jnp.sqrt(jnp.sum(U * U, axis=1, keepdims=True))
 
 
-_constrain_global_jit = jax.jit(constrain_global)
+_constrain_global_jit = stored_jit(constrain_global)
 
 
 #: Adam's initial state (zero moments; it does not depend on the step size), built by one compiled
@@ -166,11 +166,10 @@ def _constrain_local(raw) -> LocalParams:
                        amp=jnp.exp(raw["log_amp"]) + _NOISE_FLOOR, noise=jnp.exp(raw["log_noise"]) + _NOISE_FLOOR)
 
 
-_constrain_local_jit = jax.jit(_constrain_local)
+_constrain_local_jit = stored_jit(_constrain_local)
 
 
-@partial(jax.jit, static_argnames=("loss",))
-def _adam_step(loss, raw, opt_state, lr, args):
+def _adam_step_body(loss, raw, opt_state, lr, args):
     """One Adam step on ``loss(raw, *args)``; a step with a non-finite loss or gradient is skipped."""
     value, grads = jax.value_and_grad(loss)(raw, *args)
     updates, new_state = optax.adam(lr).update(grads, opt_state, raw)
@@ -180,6 +179,17 @@ def _adam_step(loss, raw, opt_state, lr, args):
         good = good & jnp.all(jnp.isfinite(g))
     keep = lambda new, old: jax.tree_util.tree_map(lambda a, b: jnp.where(good, a, b), new, old)  # noqa: E731
     return keep(new_raw, raw), keep(new_state, opt_state), value
+
+
+_adam_step = partial(jax.jit, static_argnames=("loss",))(_adam_step_body)
+
+
+def _adam_stepper(loss, raw, opt_state, lr, args):
+    """The Adam step of :func:`_adam` as ``step(raw, opt_state, lr, args)``: the program stored on disk beside the
+    compilation cache (:func:`gcs_sysid.jaxconfig.stored_program`: no tracing after the first run on a machine), else
+    the jitted :func:`_adam_step`. Same computation either way."""
+    program = stored_program(_adam_step_body, (raw, opt_state, lr, args), static=(loss,))
+    return partial(_adam_step, loss) if program is None else program
 
 
 def _adam(loss, raw, opt_state, lr, args, n_steps: int, tol: float = 0.0, window: int = 10):
@@ -193,8 +203,9 @@ def _adam(loss, raw, opt_state, lr, args, n_steps: int, tol: float = 0.0, window
     values = []
     lr = np.float64(lr)   # one strongly typed scalar: the compiled step is reused, never re-traced
     prev = np.inf
+    step = _adam_stepper(loss, raw, opt_state, lr, args) if n_steps > 0 else None
     for k in range(n_steps):
-        raw, opt_state, value = _adam_step(loss, raw, opt_state, lr, args)
+        raw, opt_state, value = step(raw, opt_state, lr, args)
         values.append(value)
         if tol > 0 and (k + 1) % window == 0 and k + 1 < n_steps:
             cur = float(np.mean(np.asarray(jax.device_get(values[-window:]))))

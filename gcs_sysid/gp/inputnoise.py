@@ -30,6 +30,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 import numpy as np
+
+from ..jaxconfig import stored_jit
 from jax.scipy.linalg import solve_triangular
 from scipy.optimize import minimize
 
@@ -39,7 +41,7 @@ from .sparse import GlobalParams, GlobalPosterior
 __all__ = ["mean_gradient", "slope_variance", "fit_input_noise"]
 
 
-@jax.jit
+@stored_jit
 def _gradient_chunk(params: GlobalParams, post: GlobalPosterior, Xs: jax.Array) -> jax.Array:
     M, D = params.Z.shape
     Lms = post.Lm[None] if post.Lm.ndim == 2 else post.Lm                       # (J, M, M)

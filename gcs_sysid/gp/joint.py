@@ -39,6 +39,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..jaxconfig import stored_jit
 from .batching import global_stats
 from .model import LocalGlobalGP
 from .sparse import GlobalParams, elbo
@@ -242,7 +243,7 @@ def gate_coupling(params: GlobalParams, Xs: np.ndarray, Ys: np.ndarray, folds: i
 #: its coupling to the others only when removing it lowers the deflated bound beyond the chi-square quantile.
 LR_LEVEL = 0.05
 
-_elbo_jit = jax.jit(elbo)
+_elbo_jit = stored_jit(elbo)
 
 
 def lr_coupling(params: GlobalParams, stats, share: float = 1.0, level: float = LR_LEVEL, df_max: int | None = None

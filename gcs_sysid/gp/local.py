@@ -25,6 +25,8 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..jaxconfig import stored_jit
+
 from .kernels import GibbsKernel
 
 __all__ = ["LocalParams", "LocalStore", "build_store", "neighbours", "local_predict_chunk",
@@ -172,7 +174,7 @@ def _one_query(params: LocalParams, xq, zq, Xn, zn, rn):
     return mean, jnp.maximum(var, 1e-12 * params.amp)
 
 
-@jax.jit
+@stored_jit
 def local_predict_chunk(params: LocalParams, Xq, zq, Xn, zn, rn):
     """Local residual mean and variance ``(Q, P)``, latent (noise not included).
 

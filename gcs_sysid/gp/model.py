@@ -10,7 +10,7 @@ import numpy as np
 from scipy.linalg import block_diag, cho_solve
 
 from ..errors import InputError
-from ..jaxconfig import enable_x64
+from ..jaxconfig import enable_x64, stored_jit
 from .batching import global_mean, global_posterior, global_predict, global_stats, local_predict
 from .config import GPConfig
 from .local import LocalParams, LocalStore, build_store
@@ -21,8 +21,8 @@ from .streaming import chol_kmm, exchange_inducing, project_stats, projection
 
 __all__ = ["LocalGlobalGP"]
 
-_elbo_jit = jax.jit(elbo)
-_add_jit = jax.jit(add_stats)
+_elbo_jit = stored_jit(elbo)
+_add_jit = stored_jit(add_stats)
 
 
 def _projection_all(old: GlobalParams, Z_new: np.ndarray, lengthscales_new: np.ndarray) -> np.ndarray:

@@ -41,6 +41,8 @@ from dataclasses import dataclass, replace
 import jax
 import jax.numpy as jnp
 import numpy as np
+
+from ..jaxconfig import stored_jit
 from jax.scipy.linalg import cho_solve
 
 from .batching import _add_jit, global_stats, local_predict
@@ -86,7 +88,7 @@ def scale_latent(params: GlobalParams, s) -> GlobalParams:
     return replace(params, A=params.A * s[:, None], lmc_A=lmc)
 
 
-@jax.jit
+@stored_jit
 def _mean_weights(params: GlobalParams, st: Stats) -> jax.Array:
     """Predictive-mean weights ``(J*M+D+1, P)`` on ``u = [phi; xa]`` (as :func:`sparse.posterior`,
     without the covariance)."""
@@ -96,7 +98,7 @@ def _mean_weights(params: GlobalParams, st: Stats) -> jax.Array:
     return jnp.einsum("pkj,k->jp", _selectors(params, params.Z.shape[0]), mu)
 
 
-@jax.jit
+@stored_jit
 def _design_u(params: GlobalParams, Xs: jax.Array) -> jax.Array:
     """``u = [phi(x); xa(x)]`` of shape ``(N, J*M+D+1)``; independent of ``A`` (the features use
     only the length-scales and the inducing inputs)."""
@@ -104,7 +106,7 @@ def _design_u(params: GlobalParams, Xs: jax.Array) -> jax.Array:
     return jnp.concatenate([features(params, Lm, Xs), design(Xs).T], axis=0).T
 
 
-@jax.jit
+@stored_jit
 def _sub(a: Stats, b: Stats) -> Stats:
     """``a - b`` leaf by leaf, as one compiled program (eager, each leaf's shape compiles its own)."""
     return jax.tree_util.tree_map(jnp.subtract, a, b)

@@ -59,3 +59,57 @@ def test_limit_blas_threads_sets_every_loaded_openblas_to_one_thread():
             "print(n, len(libs), float(np.abs(np.linalg.solve(a, a) - np.eye(50)).max()) < 1e-8)\n")
     n, n_libs, ok = _child(code, {}).split()
     assert int(n) == int(n_libs) and ok == "True"     # each loaded OpenBLAS was found and set; results unchanged
+
+
+STORED = r"""
+import json, sys
+import numpy as np
+from dataclasses import replace
+import jax
+from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64
+import gcs_sysid.jaxconfig as jc
+enable_x64()
+enable_compilation_cache()
+if sys.argv[1] == "load":                          # this process must find the program on disk, never export it
+    def refuse(*a, **k):
+        raise AssertionError("exported again")
+    jax.export.export = refuse
+from gcs_sysid.gp import GPConfig, fit_gp
+rng = np.random.default_rng(5)
+X = rng.uniform(-1, 1, (300, 10))
+Y = X[:, :6] * np.array([1.0, -0.5, 0.3, 0.8, -1.2, 0.4]) + 0.05 * rng.standard_normal((300, 6))
+model, hist = fit_gp(X, Y, GPConfig(n_inducing=12, steps=30, local_steps=10, seed=1))
+mean, var = model.predict(X[:7])
+used = sum(p is not None for p in jc._PROGRAMS.values())
+print(json.dumps({"elbo": [float(v).hex() for v in hist.elbo], "local": [float(v).hex() for v in hist.local_loss],
+                  "mean": [float(v).hex() for v in np.ravel(mean)], "var": [float(v).hex() for v in np.ravel(var)],
+                  "stored": used}))
+"""
+
+
+def test_stored_gp_programs_give_the_jitted_results_and_are_loaded_by_the_next_process(tmp_path):
+    import json
+
+    cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
+    first = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), cache).splitlines()[-1])
+    files = sorted((tmp_path / "jax" / "traced").glob("*.jaxexport"))
+    # the Adam steps of both layers and the other stored GP programs, each written once
+    assert first["stored"] >= 2 and len(files) == first["stored"]
+    again = json.loads(_child(STORED.replace("sys.argv[1]", "'load'"), cache).splitlines()[-1])
+    assert sorted((tmp_path / "jax" / "traced").glob("*.jaxexport")) == files
+    off = {"GCS_SYSID_JAX_CACHE": "off"}
+    plain = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), off).splitlines()[-1])
+    assert plain["stored"] == 0
+    for k in ("elbo", "local", "mean", "var"):                # bit for bit: the same program either way
+        assert first[k] == plain[k] and again[k] == plain[k], k
+    assert again["stored"] == first["stored"]                 # every one loaded (exporting again raises there)
+
+
+def test_stored_program_refuses_a_closure():
+    import jax.numpy as jnp
+
+    from gcs_sysid.jaxconfig import stored_program
+
+    k = 2.0
+    closure = lambda x: (x * k,)                             # noqa: E731  (what it computes is not in its code)
+    assert stored_program(closure, (jnp.ones(3),)) is None
