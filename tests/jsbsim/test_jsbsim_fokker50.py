@@ -1,5 +1,5 @@
-"""The fokker50 in the JSBSim harness: the twenty-seventh session's untouched aircraft (docs/jsbsim.md, "The
-fokker50").
+"""The fokker50 in the JSBSim harness: the twenty-seventh session's untouched aircraft, a tuning aircraft since the
+twenty-eighth (docs/jsbsim.md, "The fokker50").
 
 The model is JSBSim's Fokker 50 (the jsbsim 1.3.3 wheel's ``aircraft/fokker50/fokker50.xml``, Erik Hofman 2002,
 LGPL-2.1 with JSBSim), the twin-turboprop regional airliner, 31900 lb as the harness flies it and 95.15 ft (29.0 m)
@@ -21,19 +21,19 @@ a mechanism check); none of them flies the harness:
   and where the propwash tables are 0 the forces and moments are the stock model's bit for bit;
 - the FCS maps the commands straight to the surfaces (elevator -20.1 / +17.2 deg, ailerons +-20.1 deg, rudder
   +-20.1 deg, no yaw damper); no engine, no external force;
-- it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says;
-- the summaries label it "(untouched)" and nothing else.
+- it is statically stable about the CG, and its elevator, ailerons and rudder act as its XML says.
+
+That the summaries label it bare, as every tuning aircraft, is checked in ``test_jsbsim_navion.py``.
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign map, gear,
 .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``. All of them but the
 names are slow.
 
-No pipeline fit, GP, diagnosis or scoring runs on the fokker50: its first evaluation is the final one, after the
-merge.
+No pipeline fit, GP, diagnosis or scoring ran on the fokker50 before its final evaluation (twenty-seventh session); it
+is a tuning aircraft since.
 """
 
 import dataclasses
-import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -203,33 +203,3 @@ def test_the_fokker50_is_statically_stable_and_its_controls_act_as_its_xml_says(
         l3, n3, _, _ = lat(alpha=a, beta=4.0)
         assert (l3 - lb) / np.radians(4.0) == pytest.approx(want, abs=5e-4), a
         assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.1809, abs=1e-4), a
-
-
-def test_summaries_mark_the_fokker50_untouched_and_the_others_used(tmp_path):
-    """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the fokker50 "(untouched)" and no other
-    aircraft, the navion, dr1 and s23 included (synthetic rows: no fokker50 result exists before the final
-    evaluation)."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion", "fokker50")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    assert any(ln.startswith("| fokker50 (untouched) | light") for ln in lines)
-    for ac in acs[:-1]:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| fokker50 (untouched) | clean |") for ln in lines)
-    assert any(ln.startswith("| navion | clean |") for ln in lines)
-    assert sum("(untouched)" in ln for ln in lines) == 1

@@ -173,12 +173,12 @@ def test_fingerprint_is_per_aircraft():
     assert harness_fingerprint("c172x") == fingerprint(spec, src, spec.airframe_path.read_bytes(),
                                                        __import__("jsbsim").__version__)
     text = src[rel_ac]
-    assert '"f16": AircraftSpec(' in text and 'UNTOUCHED_AIRCRAFT = ("fokker50",)' in text
+    assert '"f16": AircraftSpec(' in text and 'UNTOUCHED_AIRCRAFT: tuple[str, ...] = ()' in text
     roster = (text.replace('"f16": AircraftSpec(', '"t6b": AircraftSpec(name="t6b", model="x", airspeed_kts=1.0, '
                            'altitude_ft=1.0, elevator_sign=1.0, aileron_sign=1.0, aileron_props=("a", None), '
                            'rudder_sign=1.0, cmd_per_rad=(1, 1, 1), amplitude_deg=(1, 1, 1), pulse_s=(1, 1, 1)),\n'
                            '    "f16": AircraftSpec(')
-              .replace('UNTOUCHED_AIRCRAFT = ("fokker50",)', 'UNTOUCHED_AIRCRAFT = ("t6b",)') + "\n# a comment\n")
+              .replace('UNTOUCHED_AIRCRAFT: tuple[str, ...] = ()', 'UNTOUCHED_AIRCRAFT = ("t6b",)') + "\n# a comment\n")
     assert fp(texts=src | {rel_ac: roster}) == fp()
     assert fp(s=dataclasses.replace(spec, amplitude_deg=(3.0, 5.0, 6.5))) != fp()
     assert fp(texts=src | {rel_ac: text + "\n_DEG = 1.0\n"}) != fp()

@@ -156,8 +156,8 @@ def test_the_navion_is_statically_stable_and_its_controls_act_as_its_xml_says():
 
 def test_summaries_mark_no_aircraft_untouched_the_navion_included(tmp_path):
     """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the navion bare, as every other aircraft
-    (synthetic rows): the twenty-seventh session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
-    until the next one is added."""
+    (synthetic rows): the twenty-seventh session moved it to tuning, the twenty-eighth the fokker50, and no aircraft is
+    "(untouched)" or "(held out)" until the next one is added."""
     from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
     from gcs_sysid.aero.table import COEFFICIENTS
 
@@ -167,7 +167,7 @@ def test_summaries_mark_no_aircraft_untouched_the_navion_included(tmp_path):
                 "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
 
     acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion")
+           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion", "fokker50")
     p = tmp_path / "r.jsonl"
     p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
     lines = eval_jsbsim.summarize([str(p)]).splitlines()
@@ -180,4 +180,5 @@ def test_summaries_mark_no_aircraft_untouched_the_navion_included(tmp_path):
     lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
     assert any(ln.startswith("| navion | clean |") for ln in lines)
     assert any(ln.startswith("| dr1 | clean |") for ln in lines)
+    assert any(ln.startswith("| fokker50 | clean |") for ln in lines)
     assert not any("(untouched)" in ln for ln in lines)

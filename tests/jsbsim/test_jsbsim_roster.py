@@ -485,8 +485,7 @@ CASES = (
           ("cn", 2, -0.1739, ("rel", 0.05)), ("cn", 3, 0.008, ("rel", 0.25)), ("cn", 1, None, ("in", -0.11, -0.06))),
          ("CDgear",), 0.30, 4,
          dict(alpha=(-11.0, 5.0), beta=(10.0, 11.0), bank=(20.0, 25.0), speed=(70.0, 175.0), alt_min=250.0,
-              rate_std=1.5, rate_std_held=1.2, sink_min=12.0),
-         untouched=True),
+              rate_std=1.5, rate_std_held=1.2, sink_min=12.0)),
 )
 BY_NAME = {c.name: c for c in CASES}
 
@@ -527,7 +526,7 @@ def test_names_resolve_and_roles(case):
         assert case.name in TUNING_AIRCRAFT and case.name not in HELD_OUT_AIRCRAFT
         assert summary_label(case.name) == case.name
     used = {"pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80", "c684",
-            "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion"}
+            "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion", "fokker50"}
     assert used <= set(TUNING_AIRCRAFT)
 
 
