@@ -153,15 +153,19 @@ def rigid_body_residual(truth: dict, inertia: np.ndarray) -> np.ndarray:
     return np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
 
 
-def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0, props=()):
     """JSBSim (``FGFDMExec``) at the harness's initial condition for ``spec`` with the given alpha and
     sideslip (deg), yaw rate (rad/s) and fixed normalised commands ``cmds`` (elevator, aileron,
-    rudder), after ``run_ic``: the FCS evaluated once, nothing integrated (the f4n's and rascal's
-    checks of their FCS and static stability)."""
+    rudder), after ``run_ic``: the FCS evaluated once, nothing integrated (the per-aircraft tests'
+    checks of their FCS and static stability). ``props``: properties created at 0 before the initial
+    condition (the FlightGear properties a stock wheel model reads and nothing writes, without which
+    ``run_ic`` fails: the navion's, dr1's and fokker50's stock models)."""
     from benchmarks.jsbsim_harness import FlightConfig
     from benchmarks.jsbsim_harness.flight import _set_ic, load_model
 
     fdm = load_model(spec, 1 / 200)
+    for k in props:
+        fdm[k] = 0.0
     _set_ic(fdm, spec, FlightConfig(spec.name, turbulence="none"))
     fdm["ic/alpha-deg"], fdm["ic/beta-deg"], fdm["ic/r-rad_sec"] = alpha_deg, beta_deg, r_rad_s
     fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
@@ -185,13 +189,97 @@ def lateral_coefficients(fdm, aileron: str = "fcs/left-aileron-pos-rad",
     return fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb, fdm[aileron], fdm[rudder]
 
 
-def cm_without_alpha_dot(spec, alpha_deg: float, elevator_cmd: float = 0.0) -> float:
+def cm_without_alpha_dot(spec, alpha_deg: float, elevator_cmd: float = 0.0,
+                         term: str | None = "aero/coefficient/Cmadot") -> float:
     """JSBSim's pitching-moment coefficient about the CG at :func:`ic_state` (``alpha_deg`` of alpha, the
-    normalised elevator command ``elevator_cmd``) less its ``Cmadot`` term (``run_ic`` gives an alpha-dot the
-    term reads): the static Cm the rascal's and sgs126's stability checks difference over alpha and elevator."""
+    normalised elevator command ``elevator_cmd``) less its alpha-dot term ``term`` (``run_ic`` gives an alpha-dot
+    the term reads; ``aero/moment/Pitch_alphadot`` in Aeromatic's models, None where the model has none): the
+    static Cm the stability checks (:func:`assert_pitch_derivatives`) difference over alpha and elevator."""
     fdm = ic_state(spec, alpha_deg=alpha_deg, cmds=(elevator_cmd, 0.0, 0.0))
     qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-    return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc
+    m = fdm["moments/m-aero-lbsft"]
+    if term is not None:
+        m -= fdm[term]
+    return m / qsc
+
+
+def assert_pitch_derivatives(spec, slopes, elevator, *, cm_at=None, alpha_e: float = 0.0, travel=None,
+                             term: str | None = "aero/coefficient/Cmadot") -> None:
+    """``spec``'s static pitch from JSBSim at fixed surfaces (:func:`cm_without_alpha_dot`, no turbulence): the
+    stability and elevator checks of the per-aircraft tests (``test_jsbsim_<name>.py``).
+
+    Args:
+        spec: the harness ``AircraftSpec``.
+        slopes: ``((alpha_a, alpha_b, want), ...)``, deg and 1/rad: ``(Cm(alpha_b) - Cm(alpha_a)) /
+            (alpha_b - alpha_a)`` must equal ``want`` (a ``pytest.approx``: its tolerance is the test's).
+        elevator: ``((cmd, want), ...)``: at alpha ``alpha_e`` (deg), ``(Cm(cmd) - Cm(0)) / delta_e`` per rad
+            of the elevator must equal ``want``, ``delta_e`` the FCS's ``fcs/elevator-pos-rad`` at that command
+            or, with ``travel = (up, down)`` (rad per unit command), ``cmd * up`` for a negative command and
+            ``cmd * down`` otherwise (the surface's end as the model's XML gives it).
+        cm_at: ``{alpha_deg: want}``: Cm at those alphas.
+        term: the alpha-dot term left out (:func:`cm_without_alpha_dot`).
+
+    Raises:
+        AssertionError: the first check that fails, with the alphas or command in its message.
+    """
+    memo = {}
+
+    def cm(alpha, cmd=0.0):
+        if (alpha, cmd) not in memo:
+            memo[alpha, cmd] = cm_without_alpha_dot(spec, alpha, cmd, term)
+        return memo[alpha, cmd]
+
+    for a, b, want in slopes:
+        assert (cm(b) - cm(a)) / np.radians(b - a) == want, (a, b)
+    for a, want in (cm_at or {}).items():
+        assert cm(a) == want, a
+    for cmd, want in elevator:
+        if travel is None:
+            de = ic_state(spec, alpha_e, cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
+        else:
+            de = cmd * (travel[0] if cmd < 0 else travel[1])
+        assert (cm(alpha_e, cmd) - cm(alpha_e)) / de == want, cmd
+
+
+def assert_lateral_derivatives(spec, aileron, rudder, beta, *, alpha_deg: float = 0.0, rest: float = 1e-9,
+                               aileron_cmds=(0.3, -0.3), rudder_cmds=(0.3, -0.3),
+                               aileron_prop: str = "fcs/left-aileron-pos-rad") -> None:
+    """``spec``'s rolling and yawing moments from JSBSim at fixed surfaces (:func:`ic_state`,
+    :func:`lateral_coefficients`, no turbulence): the roll and yaw checks of the per-aircraft tests.
+
+    At rest (``alpha_deg`` of alpha, no sideslip, zero commands) abs(Cl) and abs(Cn) are under ``rest``; the
+    derivatives are the differences from rest per rad of the deflection (or of the sideslip). Each ``want`` is a
+    ``pytest.approx`` (its tolerance is the test's), or None where the test checks nothing.
+
+    Args:
+        spec: the harness ``AircraftSpec``.
+        aileron: ``(Cl_per_rad, Cn_per_rad)`` of the aileron property ``aileron_prop`` (JSBSim's sign: the
+            project's Cl_delta_a and Cn_delta_a have the other), at each command of ``aileron_cmds``.
+        rudder: ``(Cn_per_rad, Cl_per_rad)`` of ``fcs/rudder-pos-rad``, at each command of ``rudder_cmds``.
+        beta: ``{alpha_deg: (Cl_beta, Cn_beta)}``: per rad of 4 deg of sideslip at that alpha, from that alpha's
+            own rest.
+
+    Raises:
+        AssertionError: the first check that fails, with the command or alpha in its message.
+    """
+    def lat(cmds=(0.0, 0.0, 0.0), alpha=alpha_deg, beta_deg=0.0):
+        return lateral_coefficients(ic_state(spec, alpha, beta_deg, cmds), aileron=aileron_prop)
+
+    l0, n0, a0, r0 = lat()
+    assert abs(l0) < rest and abs(n0) < rest, (l0, n0)
+    for cmd in aileron_cmds:
+        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
+        for got, want in zip(((l1 - l0) / (a1 - a0), (n1 - n0) / (a1 - a0)), aileron):
+            assert want is None or got == want, ("aileron", cmd)
+    for cmd in rudder_cmds:
+        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
+        for got, want in zip(((n2 - n0) / (r2 - r0), (l2 - l0) / (r2 - r0)), rudder):
+            assert want is None or got == want, ("rudder", cmd)
+    for a, wants in beta.items():
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(alpha=a, beta_deg=4.0)
+        for got, want in zip(((l3 - lb) / np.radians(4.0), (n3 - nb) / np.radians(4.0)), wants):
+            assert want is None or got == want, ("beta", a)
 
 
 def check_direct_fcs(spec, min_lift_lbs: float) -> None:
@@ -636,3 +724,68 @@ def assert_openflightsim_direct_surfaces(name: str, surface_rad: float, min_lift
     cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
     assert _deflections(ic_state(spec, 2.0, 0.0, (0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
     assert_aero_is_the_only_force(fdm, min_lift_lbs, external_zero=True)
+
+
+#: The roster in the order the aircraft were added, the fokker50 last (the summaries' label tests take prefixes).
+ROSTER_ORDER = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20",
+                "iar80", "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion",
+                "fokker50")
+
+
+def assert_summaries_label_bare(tmp_path, last: str, clean: tuple[str, ...]) -> None:
+    """The markdown summaries of ``eval_jsbsim`` and ``eval_jsbsim_diagnose`` label every aircraft of
+    :data:`ROSTER_ORDER` up to ``last`` bare (synthetic rows of those aircraft alone): no row reads
+    "(untouched)" or "(held out)", every aircraft has its ``| NAME | light`` row in the first, and each of ``clean``
+    its ``| NAME | clean |`` row in the second.
+
+    Args:
+        tmp_path: a folder for the two synthetic .jsonl files.
+        last: the last aircraft of the roster's prefix written.
+        clean: the aircraft whose clean rows the diagnosis summary must show.
+
+    Raises:
+        AssertionError: a label or row differs.
+    """
+    import json
+
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ROSTER_ORDER[:ROSTER_ORDER.index(last) + 1]
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    for ac in acs:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    for ac in clean:
+        assert any(ln.startswith(f"| {ac} | clean |") for ln in lines), ac
+    assert not any("(untouched)" in ln for ln in lines)
+
+
+def assert_same_aero_as_stock(state, stock_state, n_engines: int, zero=()) -> None:
+    """At three states (alpha 4, -3, 0 deg; sideslip 4, -2, 0 deg; the commands (0.3, -0.4, 0.2), (-0.2, 0.3, -0.5),
+    0), JSBSim's aerodynamic forces and moments of a derived model (``state(alpha, beta, cmds)``, no engine) equal
+    those of the wheel's stock model (``stock_state``, its ``n_engines`` engines stopped) to the last bit (the
+    navion's, s23's and dr1's derivation checks: the derivation changes no number). The properties ``zero`` read 0
+    in both.
+
+    Raises:
+        AssertionError: an engine count, a ``zero`` property or a force or moment differs."""
+    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
+        a, b = state(alpha, beta, cmds), stock_state(alpha, beta, cmds)
+        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == n_engines
+        for k in zero:
+            assert a[k] == b[k] == 0.0, (alpha, k)
+        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
+                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
+            assert a[k] == b[k], (alpha, k)
