@@ -31,8 +31,8 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, \
-    checked_in_model, ic_state
+from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, checked_in_model, ic_state, surface_state
 
 SRC = "data/jsbsim_models/asw20/asw20-JSBSim.xml"
 SRC_SHA256 = "c3a7877a124d79fcc82340614703cc07795993a06552ad6df9f05b10d1bdbc48"
@@ -117,20 +117,13 @@ def test_the_asw20_flies_its_own_surfaces_without_engine_or_external_force():
     No engine; the external forces (winch, aerotow, FlightGear's generic engine) are 0, and after 50 frames
     every non-gravity force and moment is aerodynamic. A yaw rate does not move the rudder (no yaw damper),
     so the harness's own damper flies it (k_r 0.4)."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("asw20")
     assert spec.gains[5] == 0.4 and spec.gear_up and spec.aileron_props == ("fcs/left-aileron-pos-rad", None)
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.38397), "fcs/left-aileron-pos-rad": (1, -0.43633),
+                               "fcs/right-aileron-pos-rad": (1, -0.43633), "fcs/rudder-pos-rad": (2, 31 * 0.01745)},
+                        up=0.43633, alpha_deg=-2.0, r_rad_s=0.2)
     assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.38397, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(0.4 * 0.43633, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.43633, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 31 * 0.01745, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.43633, rel=1e-9)
-    da = np.radians(5.0)
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, -2.0)
     assert_aero_is_the_only_force(fdm, 300.0, external_zero=True)
 
 

@@ -25,12 +25,12 @@ are slow.
 No pipeline fit, GP, diagnosis or scoring ran on the c172p before the twentieth session's final evaluation.
 """
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, ic_state
+from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 RAD_PER_DEG_FCS = 0.01745     # the c172p's FCS gain (deg -> rad)
 
@@ -49,24 +49,21 @@ def test_the_c172p_flies_its_stock_fcs_and_no_engine_force():
     gives no induced velocity, so the elevator's and rudder's wash dynamic pressure is 0.5 rho u^2 (body-axis u), and
     after 50 frames every non-gravity force and moment is aerodynamic."""
     from benchmarks.jsbsim_harness.derived import DERIVED, REPO_DERIVED
-    from benchmarks.jsbsim_harness.flight import _deflections
 
     spec = aircraft("c172p")
     assert spec.model == "c172p" and spec.model not in DERIVED and spec.model not in REPO_DERIVED
     assert not spec.gear_up and spec.gains == (1.0, 0.3, 0.01, 0.4, 0.1, 0.4)
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    # the trailing-edge-up elevator to 1e-9 (was pytest's default 1e-6)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 23.0 * RAD_PER_DEG_FCS),
+                               "fcs/left-aileron-pos-rad": (1, 20.0 * RAD_PER_DEG_FCS),
+                               "fcs/rudder-pos-rad": (2, 16.0 * RAD_PER_DEG_FCS)},
+                        up=28.0 * RAD_PER_DEG_FCS, alpha_deg=2.0)
     assert fdm.get_propulsion().get_num_engines() == 1 and fdm["inertia/weight-lbs"] == pytest.approx(1700.0)
     assert fdm["fcs/flap-pos-deg"] == 0.0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 23.0 * RAD_PER_DEG_FCS, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 28.0 * RAD_PER_DEG_FCS)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 20.0 * RAD_PER_DEG_FCS, rel=1e-9)
     assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-fdm["fcs/left-aileron-pos-rad"], rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 16.0 * RAD_PER_DEG_FCS, rel=1e-9)
     assert spec.cmd_per_rad == pytest.approx((1 / (28 * RAD_PER_DEG_FCS), 1 / (20 * RAD_PER_DEG_FCS),
                                               1 / (16 * RAD_PER_DEG_FCS)))
-    da = np.radians(5.0)      # trailing edge down on the right
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, 2.0)
     wash = _state()
     u_over_v = wash["velocities/u-aero-fps"] / wash["velocities/vt-fps"]
     assert wash["aero/function/qbar-induced-psf"] == pytest.approx(wash["aero/qbar-psf"] * u_over_v ** 2, rel=1e-9)

@@ -39,7 +39,7 @@ from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
 from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_lateral_derivatives, \
     assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, checked_in_model, \
-    ic_state, same_xml
+    ic_state, same_xml, surface_state
 
 SRC = "data/jsbsim_models/fokkerdr1/dr1.xml"
 SRC_SHA256 = "bd394cb162b91e4a11e97e2fbf490e1d5a9ddb0feeed4f5a4c8cf237cedc22f8"
@@ -107,12 +107,10 @@ def test_the_dr1_flies_its_own_surfaces_without_engine_or_external_force():
     of travel). No engine; 945 lb (895 empty, 50 of fuel); after 50 frames every non-gravity force and moment is
     aerodynamic and the external forces are 0."""
     spec = aircraft("dr1")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.35), "fcs/left-aileron-pos-rad": (1, 0.30),
+                               "fcs/right-aileron-pos-rad": (1, 0.30), "fcs/rudder-pos-rad": (2, 0.44)},
+                        alpha_deg=0.0, rel=1e-6)
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(945.0, abs=0.01)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.35, rel=1e-6)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.30, rel=1e-6)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.30, rel=1e-6)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.44, rel=1e-6)
     assert _state(cmds=(0.0, 0.0, 0.9))["fcs/rudder-pos-rad"] == pytest.approx(0.35 * 0.44, rel=1e-6)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.35, 1 / 0.30, 1 / 0.44))
     assert_deflections_map_back(spec)

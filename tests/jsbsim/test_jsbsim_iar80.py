@@ -25,13 +25,10 @@ No pipeline fit, GP, diagnosis or scoring runs in these tests.
 
 import xml.etree.ElementTree as ET
 
-import numpy as np
-import pytest
-
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, \
-    checked_in_model, ic_state
+from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, checked_in_model, ic_state, surface_state
 
 SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
 SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
@@ -64,20 +61,13 @@ def test_the_iar80_flies_its_own_surfaces_without_engine_or_external_force():
     Aeromatic FCS; only the left is read by the aerodynamics), so the harness reads the left alone
     (``aileron_props``) with delta_a = -left. No engine; after 50 frames every non-gravity force and moment
     is aerodynamic. A yaw rate does not move the rudder (no yaw damper), so the harness's own damper flies it."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("iar80")
     assert spec.gains[5] == 0.4 and spec.gear_up and spec.aileron_props == ("fcs/left-aileron-pos-rad", None)
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.35), "fcs/left-aileron-pos-rad": (1, 0.35),
+                               "fcs/right-aileron-pos-rad": (1, 0.35), "fcs/rudder-pos-rad": (2, 0.35)},
+                        up=0.35, alpha_deg=2.0, r_rad_s=0.2)
     assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.35, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
-    da = np.radians(5.0)
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, 2.0)
     assert_aero_is_the_only_force(fdm, 3000.0, external_zero=True)
 
 

@@ -34,7 +34,7 @@ import pytest
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
 from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_lateral_derivatives, \
-    assert_pitch_derivatives, checked_in_model, ic_state, same_xml
+    assert_pitch_derivatives, checked_in_model, ic_state, same_xml, surface_state
 
 SRC = "data/jsbsim_models/kingair350/KingAir-350.xml"
 SRC_SHA256 = "f89a9376371cbbe4f08060548aee36a25d645620943f5e7273c59e3164c9675d"
@@ -92,14 +92,10 @@ def test_the_ka350_flies_its_own_surfaces_without_engine_or_external_force():
     nothing). No engine; 13319 lb (the pilot emptied); after 50 frames every non-gravity force and moment is
     aerodynamic."""
     spec = aircraft("ka350")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.2443), "fcs/left-aileron-pos-rad": (1, 0.4363),
+                               "fcs/right-aileron-pos-rad": (1, -0.2618), AILERON: (1, 0.34905),
+                               "fcs/rudder-pos-rad": (2, 0.4363)}, up=0.3491, alpha_deg=0.0)
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(13319.0)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.2443, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.3491, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.4363, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.2618, rel=1e-9)
-    assert fdm[AILERON] == pytest.approx(-0.4 * 0.34905, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363, rel=1e-9)
     yawing = ic_state(spec, 0.0, 0.0, (0.0, 0.0, 0.2), r_rad_s=0.1)
     assert yawing["fcs/yaw-damper-cmd"] == 0.0 and yawing["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.3491, 1 / 0.34905, 1 / 0.4363))

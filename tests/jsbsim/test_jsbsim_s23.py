@@ -37,7 +37,7 @@ from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
 from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_lateral_derivatives, \
     assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, checked_in_model, \
-    ic_state, same_xml
+    ic_state, same_xml, surface_state
 
 SRC = "data/jsbsim_models/shorts23/Short_S23.xml"
 SRC_SHA256 = "b4ba55cceeaca5057bacfb59b510bf3bdc8e9ea19efbd007904700ab2439282f"
@@ -106,12 +106,10 @@ def test_the_s23_flies_its_own_surfaces_without_engine_or_external_force():
     seats and the engines' oil emptied); after 50 frames every non-gravity force and moment is aerodynamic and the
     external forces are 0."""
     spec = aircraft("s23")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.3142), "fcs/left-aileron-pos-rad": (1, 0.3403),
+                               "fcs/right-aileron-pos-rad": (1, 0.3403), "fcs/rudder-pos-rad": (2, 0.3927)},
+                        alpha_deg=0.0, rel=1e-6)
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(33685.7, abs=0.1)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.3142, rel=1e-6)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.3927, rel=1e-6)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.3142, 1 / 0.3403, 1 / 0.3927))
     assert_deflections_map_back(spec)
     assert_aero_is_the_only_force(fdm, 10000.0, external_zero=True)

@@ -282,24 +282,71 @@ def assert_lateral_derivatives(spec, aileron, rudder, beta, *, alpha_deg: float 
             assert want is None or got == want, ("beta", a)
 
 
+#: The normalised commands (elevator, aileron, rudder) of the surface checks (:func:`surface_state`).
+SURFACE_CMDS = (0.3, -0.4, 0.2)
+
+
+def surface_state(spec, gains: dict, *, up: float | None = None, alpha_deg: float = 4.0, r_rad_s: float = 0.0,
+                  rel: float = 1e-9):
+    """JSBSim at :func:`ic_state` (``alpha_deg`` of alpha, 4 deg of sideslip, the commands :data:`SURFACE_CMDS`, the
+    yaw rate ``r_rad_s``, rad/s), once its FCS is checked to map each command straight to the surfaces: the
+    per-aircraft tests' FCS checks.
+
+    Args:
+        spec: the harness ``AircraftSpec``.
+        gains: ``{property: (channel, rad per unit command)}``, channel 0 elevator, 1 aileron, 2 rudder: the
+            property must read the channel's command times the gain (to ``rel``; a mirrored surface has a
+            negative gain).
+        up: the elevator's rad per unit command on its trailing-edge-up side, or None: at the command (-0.3, 0, 0)
+            (same alpha, no sideslip, no yaw rate) ``fcs/elevator-pos-rad`` must read -0.3 ``up``.
+
+    Returns:
+        The ``FGFDMExec`` at the commands (:func:`assert_aero_is_the_only_force` runs it on).
+
+    Raises:
+        AssertionError: a surface differs (its property in the message).
+    """
+    import pytest
+
+    fdm = ic_state(spec, alpha_deg, 4.0, SURFACE_CMDS, r_rad_s)
+    for prop, (channel, gain) in gains.items():
+        assert fdm[prop] == pytest.approx(SURFACE_CMDS[channel] * gain, rel=rel), prop
+    if up is not None:
+        assert ic_state(spec, alpha_deg, cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * up,
+                                                                                                         rel=rel)
+    return fdm
+
+
 def check_direct_fcs(spec, min_lift_lbs: float) -> None:
     """Assert that ``spec``'s FCS maps the normalised commands straight to the surfaces its aerodynamics
-    read (elevator -0.35..+0.30 rad, left aileron +-0.35 rad with the right its mirror, rudder +-0.35 rad),
-    that JSBSim has no engine, and that after 50 frames every non-gravity force and moment is aerodynamic
-    with at least ``min_lift_lbs`` of body-z force (the rascal's and sgs126's checks: both fly such an FCS).
+    read (elevator -0.35..+0.30 rad, left aileron +-0.35 rad with the right its mirror, rudder +-0.35 rad,
+    a yaw rate moving nothing: :func:`surface_state`), that JSBSim has no engine, and that after 50 frames
+    every non-gravity force and moment is aerodynamic with at least ``min_lift_lbs`` of body-z force (the
+    rascal's, sgs126's, navion's and fokker50's checks: all fly such an FCS).
 
     Raises:
         AssertionError: the first check that fails."""
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.30), "fcs/left-aileron-pos-rad": (1, 0.35),
+                               "fcs/right-aileron-pos-rad": (1, -0.35), "fcs/rudder-pos-rad": (2, 0.35)},
+                        up=0.35, r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert_aero_is_the_only_force(fdm, min_lift_lbs)
+
+
+def assert_aileron_maps_back(spec, alpha_deg: float) -> None:
+    """The harness's aileron command for 5 deg of the project's delta_a (trailing edge down on the right) through
+    ``spec``'s ``aileron_sign`` and ``cmd_per_rad``, set at :func:`ic_state` (``alpha_deg``), reads back as 5 deg
+    (``flight._deflections``, to 1e-9).
+
+    Raises:
+        AssertionError: the deflection differs."""
     import pytest
 
-    fdm = ic_state(spec, beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
-    assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.30, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
-    assert ic_state(spec, cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
-    assert_aero_is_the_only_force(fdm, min_lift_lbs)
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    da = np.radians(5.0)
+    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
+    assert _deflections(ic_state(spec, alpha_deg, 0.0, (0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
 
 
 def assert_deflections_map_back(spec, deltas_deg=(-3.0, 5.0, 4.0)) -> None:
@@ -706,23 +753,16 @@ def assert_openflightsim_direct_surfaces(name: str, surface_rad: float, min_lift
     Raises:
         AssertionError: the first check that fails.
     """
-    import pytest
-
     from benchmarks.jsbsim_harness import aircraft
-    from benchmarks.jsbsim_harness.flight import _deflections
 
     spec = aircraft(name)
     assert not spec.gear_up and spec.aileron_props == ("fcs/posAilL_rad", "fcs/posAilR_rad")
-    fdm = ic_state(spec, 2.0, 4.0, (0.3, -0.4, 0.2), 0.2)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, surface_rad), "fcs/posAilL_rad": (1, surface_rad),
+                               "fcs/posAilR_rad": (1, -surface_rad), "fcs/rudder-pos-rad": (2, surface_rad)},
+                        alpha_deg=2.0, r_rad_s=0.2)
     assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * surface_rad, rel=1e-9)
-    assert fdm["fcs/posAilL_rad"] == pytest.approx(-0.4 * surface_rad, rel=1e-9)
-    assert fdm["fcs/posAilR_rad"] == pytest.approx(0.4 * surface_rad, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * surface_rad, rel=1e-9)
     assert fdm["fcs/posFlapL_rad"] == 0.0 and fdm["fcs/posFlapR_rad"] == 0.0
-    da = np.radians(5.0)      # trailing edge down on the right
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(ic_state(spec, 2.0, 0.0, (0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, 2.0)
     assert_aero_is_the_only_force(fdm, min_lift_lbs, external_zero=True)
 
 
