@@ -28,7 +28,7 @@ No pipeline fit, GP, diagnosis or scoring ran on the ultrastick before the eight
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
 from truth_fits import assert_lateral_derivatives, assert_openflightsim_assembly, \
-    assert_openflightsim_direct_surfaces, assert_pitch_derivatives, ic_state
+    assert_openflightsim_direct_surfaces, assert_pitch_derivatives
 
 DIR = "data/jsbsim_models/ultrastick120"
 #: file -> (bytes, SHA-256), as the README lists them.
@@ -40,11 +40,6 @@ FILES = {
     "Gear.xml": (1702, "fbfa16e648947d212bbcbd28e1ebb94a3d8bab3d4fc9b88d52455bf134b02c7b"),
 }
 SURFACE = 0.5235987755982988      # every surface's end, rad (the lab's actuator clip, 30 deg)
-
-
-def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the ultrastick (45 kt at 10000 ft)."""
-    return ic_state(aircraft("ultrastick"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 
 def test_the_derivation_assembles_the_files_and_changes_no_number():

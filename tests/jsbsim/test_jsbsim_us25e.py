@@ -45,11 +45,6 @@ FILES = {
 SURFACE = 0.5235987755982988      # every surface's end, rad (the lab's actuator clip, 30 deg)
 
 
-def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the us25e."""
-    return ic_state(aircraft("us25e"), alpha_deg, beta_deg, cmds, r_rad_s)
-
-
 def test_the_derivation_assembles_the_files_and_changes_no_number():
     """The checked-in files are the README's (bytes and SHA-256). ``UltraStick25e_glide`` holds
     ``MetricsOpenFlight.xml``, ``MassOpenFlight.xml`` and ``Gear.xml`` as they are, an empty ``<propulsion>``, a
@@ -69,7 +64,7 @@ def test_the_us25e_flies_direct_surfaces_without_engine_or_external_force():
     -left); the flaps stay 0. No engine; after 50 frames every non-gravity force and moment is aerodynamic (1.959
     kg: 4.32 lb). A yaw rate does not move the rudder."""
     assert_openflightsim_direct_surfaces("us25e", SURFACE, 1.0)
-    assert _state()["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
+    assert ic_state(aircraft("us25e"), 2.0)["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
 
 
 def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_say():
@@ -90,7 +85,7 @@ def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_sa
     assert_pitch_derivatives(spec, ((-4.0, 0.0, per_rad), (0.0, 4.0, per_rad), (4.0, 8.0, per_rad)),
                              ((-0.3, approx(-0.847, abs=0.002)), (0.3, approx(-0.847, abs=0.002))), alpha_e=2.0,
                              travel=(SURFACE, SURFACE), term=None)
-    assert _state(alpha_deg=0.0)["aero/coefficient/CMm"] == pytest.approx(-0.0278, abs=1e-9)
+    assert ic_state(spec, 0.0)["aero/coefficient/CMm"] == pytest.approx(-0.0278, abs=1e-9)
     beta = (approx(-0.0545, abs=1e-4), approx(0.0704, abs=3e-4))
     assert_lateral_derivatives(spec, (approx(0.1646, abs=1e-4), approx(-0.0574, abs=1e-4)),
                                (approx(-0.1804, abs=2e-4), approx(0.0115, abs=1e-4)),
