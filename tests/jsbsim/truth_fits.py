@@ -666,6 +666,22 @@ def same_xml(a, b) -> bool:
     return ET.tostring(a) == ET.tostring(b)
 
 
+def assert_kept_but_engines(src, der, tags, n_engines: int, n_tanks: int) -> None:
+    """The derived model ``der`` keeps the checked-in ``src``'s elements ``tags`` (:func:`same_xml`; ``src`` indented
+    as the derived XML first, ``ET.indent(src, space=" ")``) and its ``n_tanks`` fuel tanks one for one, and has none
+    of ``src``'s ``n_engines`` ``<propulsion><engine>`` (the glide derivations' checks: the fokker50's, navion's,
+    dr1's, s23's and ka350's).
+
+    Raises:
+        AssertionError: an element, an engine count or a tank differs. ValueError: the two have another number of
+            tanks (``zip(strict=True)``)."""
+    for tag in tags:
+        assert same_xml(src.find(tag), der.find(tag)), tag
+    assert len(src.findall("propulsion/engine")) == n_engines and der.find("propulsion/engine") is None
+    tanks = list(zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True))
+    assert len(tanks) == n_tanks and all(same_xml(a, b) for a, b in tanks), len(tanks)
+
+
 def bare_xml(e) -> bytes:
     """The element's XML with every text and tail stripped of white space: its content, not its layout (to compare
     a function of a checked-in file with the derived model's, whose indentation ``ET.indent`` rewrote)."""
