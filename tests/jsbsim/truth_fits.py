@@ -4,10 +4,10 @@ the rigid body, the decoded log, the hidden effects in JSBSim's own properties, 
 The per-aircraft tests (``test_jsbsim_<name>.py``) share the checks of JSBSim's own properties at the harness's
 initial condition (:func:`ic_state`, no turbulence, nothing flown): the FCS (:func:`surface_state`,
 :func:`check_direct_fcs`, :func:`assert_aileron_maps_back`, :func:`assert_deflections_map_back`), static stability
-and control (:func:`assert_pitch_derivatives`, :func:`assert_lateral_derivatives`: each test passes its own
-numbers and tolerances as ``pytest.approx``), the derivation (:func:`assert_kept_but_engines`,
-against the stock model :func:`assert_same_aero_as_stock`) and the summaries' labels (:func:`assert_summaries_label_bare`); twenty-eighth
-session, folded from twelve files' copies with every assertion and tolerance kept.
+and control (:func:`assert_pitch_derivatives`, :func:`assert_lateral_derivatives`: each test passes its own numbers
+and tolerances as ``pytest.approx``), the derivation (:func:`assert_kept_but_engines`, against the stock model
+:func:`assert_same_aero_as_stock`) and the summaries' labels (:func:`assert_summaries_label_bare`); twenty-eighth
+session, folded from sixteen files' copies with every assertion and tolerance kept.
 """
 
 import numpy as np
