@@ -40,7 +40,6 @@ Usage::
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -52,6 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import gcs_sysid.estimation.airangles as aa  # noqa: E402
 import gcs_sysid.estimation.estimate as est  # noqa: E402
 from benchmarks.alpha_budget import _highpass, flown_logs, work_parser  # noqa: E402
+from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.jsbsim_harness.truth import load_truth  # noqa: E402
 from gcs_sysid.airframe import load_airframe  # noqa: E402
 from gcs_sysid.telemetry import read_log  # noqa: E402
@@ -195,9 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     for tlog, ac, _ in flown_logs(a.work, a.aircraft, a.turbulence):
         r = stages(tlog, ac)
         print(show(r), flush=True)
-        if a.json:
-            with open(a.json, "a") as fh:
-                fh.write(json.dumps(r) + "\n")
+        append_jsonl(a.json, [r])
     return 0
 
 

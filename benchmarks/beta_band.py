@@ -30,7 +30,6 @@ Usage::
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -41,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import gcs_sysid.estimation.airangles as aa  # noqa: E402
 from benchmarks.alpha_budget import captured_aiding, flown_logs, work_parser  # noqa: E402
+from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.jsbsim_harness.truth import load_truth  # noqa: E402
 
 COLUMNS = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")     #: the side-force model's columns (airangles)
@@ -164,9 +164,7 @@ def main(argv: list[str] | None = None) -> int:
         e, g = show(r)
         print(e, flush=True)
         gust.append(g)
-        if a.json:
-            with open(a.json, "a") as fh:
-                fh.write(json.dumps(r) + "\n")
+        append_jsonl(a.json, [r])
     print("\n| flight | " + " | ".join(f"{lo}-{hi or ''} Hz: g on beta_kin / r_hat" for lo, hi in BANDS) + " |")
     print("|---" * (1 + len(BANDS)) + "|")
     print("\n".join(gust))

@@ -34,6 +34,8 @@ from scipy.signal import welch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from benchmarks.eval_common import append_jsonl  # noqa: E402
+
 FIR_TAPS = 60
 
 
@@ -158,9 +160,7 @@ def main(argv=None) -> int:
                     continue
                 print(ac, turb, seed, "  ".join(f"{k}: {r[k]['ratio']:.2f}" for k in ("p_dot", "q_dot", "r_dot")),
                       flush=True)
-                if a.json:
-                    with open(a.json, "a") as fh:
-                        fh.write(json.dumps(r) + "\n")
+                append_jsonl(a.json, [r])
     return 0
 
 

@@ -81,6 +81,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.eval_gp_jsbsim import (CARRIES, MOMENTS, TRUTH_NONE, _correlations, add_flight_args, errors,  # noqa: E402
                                        make, missing_rows)
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
@@ -353,9 +354,7 @@ def main(argv=None) -> int:
                           + ("" if "err_gap" not in r else "  gap " + " ".join(
                               f"{r['err_gap'][COEFFICIENTS[i]]:6.2f}" for i in MOMENTS))
                           + f"  ({r['n_train']} rows, {r['t_fit_s']:.1f} s)", flush=True)
-                    if a.json:
-                        with open(a.json, "a") as f:
-                            f.write(json.dumps(r) + "\n")
+                    append_jsonl(a.json, [r])
     return 0
 
 

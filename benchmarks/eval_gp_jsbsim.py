@@ -114,6 +114,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.eval_common import AIRCRAFT_HELP, append_jsonl  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
@@ -557,14 +558,7 @@ def add_flight_args(ap: argparse.ArgumentParser, aircraft: list[str],
     ap.add_argument("--cache", default="/tmp/gcs-sysid-gp-eval", help="folder of the cached flights (.npz)")
     ap.add_argument("--make", action="store_true", help=make_help)
     ap.add_argument("--aircraft", nargs="+", default=aircraft, type=aircraft_argument,
-                    help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim model names (J3Cub, "
-                         "T37, "
-                         "t6texan2, B747, "
-                         "f16_direct, "
-                         "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
-                         "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                         "Navion_glide, Fokker50_glide); fokker50 is the untouched aircraft; default %(default)s")
+                    help=AIRCRAFT_HELP)
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light"])
 
@@ -609,9 +603,7 @@ def main(argv=None) -> int:
                                   + " ".join(f"{r['err_gap'][c]:6.2f}" for i, c in enumerate(COEFFICIENTS) if i in MOMENTS)
                                   + f"  ({r['n_missing']} of {r['n_train']} missing, {r['n_region']} held-out "
                                   f"rows in region)  {r['t_fit_s']:.1f} s", flush=True)
-                            if a.json:
-                                with open(a.json, "a") as f:
-                                    f.write(json.dumps(r) + "\n")
+                            append_jsonl(a.json, [r])
                         continue
                     for r in score(path, a.variants, thin=a.thin):
                         print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
@@ -621,9 +613,7 @@ def main(argv=None) -> int:
                             if r.get(k):
                                 print(f"{'':33s} {k:15s} " + " ".join(f"{r[k][c]:6.1f}" for c in COEFFICIENTS)
                                       + f"   mean {np.nanmean(list(r[k].values())):5.1f}", flush=True)
-                        if a.json:
-                            with open(a.json, "a") as f:
-                                f.write(json.dumps(r) + "\n")
+                        append_jsonl(a.json, [r])
     return 0
 
 

@@ -86,6 +86,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.eval_common import AIRCRAFT_HELP, append_jsonl  # noqa: E402
 from benchmarks.jsbsim_harness import (UNTOUCHED_AIRCRAFT, FlightConfig, coefficient_errors,  # noqa: E402
                                        load_truth, make_flight)
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
@@ -210,6 +211,40 @@ def parse_stated_line(items: list[str]) -> dict[str, dict[str, float]]:
         except ValueError as exc:
             raise SystemExit(f"--stated-lift-level {item!r}: {exc}") from None
     return out
+
+
+def apply_aiding_options(a: argparse.Namespace) -> None:
+    """Set the air-angle aiding's module switches from the options this script and ``eval_jsbsim_diagnose.py`` share
+    (each only where given; the package's defaults otherwise).
+
+    Args:
+        a: the parsed command line: ``stated_lift_slope`` (items ``AC:CL_ALPHA[:CL_Q]``: :data:`STATED_AERO` and
+            ``airangles.STATED_LIFT_SLOPE`` on), ``stated_lift_level`` (:func:`parse_stated_line` items:
+            :data:`STATED_LINE` and ``airangles.STATED_LIFT_LEVEL`` on), ``alpha_profile`` (column names:
+            ``airangles.ALPHA_PROFILE_COLUMNS``) and the ``on``/``off`` switches ``beta_profile``, and where the
+            script has them ``kinematic_mean`` and ``floor_drops_curvature`` (``airangles.BETA_PROFILE``,
+            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``).
+
+    Raises:
+        SystemExit: a ``--stated-lift-level`` item does not parse. ValueError: a ``--stated-lift-slope`` value is
+            not a number.
+    """
+    from gcs_sysid.estimation import airangles as _aa
+
+    if a.stated_lift_slope is not None:
+        _aa.STATED_LIFT_SLOPE = True
+        for item in a.stated_lift_slope:
+            ac_, *vals = item.split(":")
+            STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
+    if a.stated_lift_level is not None:
+        _aa.STATED_LIFT_LEVEL = True
+        STATED_LINE.update(parse_stated_line(a.stated_lift_level))
+    if a.alpha_profile is not None:
+        _aa.ALPHA_PROFILE_COLUMNS = tuple(a.alpha_profile)
+    for option, flag in (("kinematic_mean", "KINEMATIC_MEAN"), ("floor_drops_curvature", "FLOOR_DROPS_CURVATURE"),
+                         ("beta_profile", "BETA_PROFILE")):
+        if getattr(a, option, None) is not None:
+            setattr(_aa, flag, getattr(a, option) == "on")
 
 
 def stated_airframe(path: Path, work: Path, stem: str) -> Path:
@@ -521,14 +556,7 @@ def main(argv=None) -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--aircraft", nargs="+", default=["c172x", "sgs", "pa28"], type=aircraft_argument,
-                    help="harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                         "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim model names (J3Cub, "
-                         "T37, "
-                         "t6texan2, B747, "
-                         "f16_direct, "
-                         "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
-                         "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                         "Navion_glide, Fokker50_glide); fokker50 is the untouched aircraft; default %(default)s")
+                    help=AIRCRAFT_HELP)
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate"])
     ap.add_argument("--aoa", default="ahrs", choices=("ahrs", "vane"))
@@ -602,34 +630,7 @@ def main(argv=None) -> int:
         from gcs_sysid.estimation import rates as _rates
 
         _rates.GUST_FORCE_AXES = tuple("xyz".index(c) for c in a.gust_force_axes)
-    if a.stated_lift_slope is not None:
-        from gcs_sysid.estimation import airangles as _aa
-
-        _aa.STATED_LIFT_SLOPE = True
-        for item in a.stated_lift_slope:
-            ac_, *vals = item.split(":")
-            STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
-    if a.stated_lift_level is not None:
-        from gcs_sysid.estimation import airangles as _aa
-
-        _aa.STATED_LIFT_LEVEL = True
-        STATED_LINE.update(parse_stated_line(a.stated_lift_level))
-    if a.alpha_profile is not None:
-        from gcs_sysid.estimation import airangles as _aa
-
-        _aa.ALPHA_PROFILE_COLUMNS = tuple(a.alpha_profile)
-    if a.kinematic_mean is not None:
-        from gcs_sysid.estimation import airangles
-
-        airangles.KINEMATIC_MEAN = a.kinematic_mean == "on"
-    if a.floor_drops_curvature is not None:
-        from gcs_sysid.estimation import airangles
-
-        airangles.FLOOR_DROPS_CURVATURE = a.floor_drops_curvature == "on"
-    if a.beta_profile is not None:
-        from gcs_sysid.estimation import airangles
-
-        airangles.BETA_PROFILE = a.beta_profile == "on"
+    apply_aiding_options(a)
     if a.iv_beta is not None:
         from gcs_sysid.estimation import airangles
 
@@ -696,9 +697,7 @@ def main(argv=None) -> int:
                                                    f"err {row['airp_' + m]['err_pct']:.0f} %")
                     print(f"{'':32s} {m[:5]:5s} {_fmt(row['gp_airp_' + m])}   {row['cov_gp_airp_' + m]:5.1f}  "
                           f"(ls {_fmt(row['ls_airp_' + m])}){extra}", flush=True)
-                if a.json:
-                    with open(a.json, "a") as f:
-                        f.write(json.dumps(row) + "\n")
+                append_jsonl(a.json, [row])
     forces = [r[k][c] for r in rows for k in ("gp",) for c in COEFFICIENTS[:3]]
     moments = [r[k][c] for r in rows for k in ("gp",) for c in COEFFICIENTS[3:]]
     print(f"median held-out model error: forces {np.nanmedian(forces):.1f} % (thesis real flight {THESIS_FORCES}), "

@@ -657,32 +657,13 @@ def main(argv=None) -> int:
         from gcs_sysid.diagnose import run as _dr
 
         _dr.AIR_ROLL_RATE = a.air_roll_rate
-    if a.beta_profile is not None:
-        from gcs_sysid.estimation import airangles as _aa
+    from benchmarks.eval_jsbsim import apply_aiding_options
 
-        _aa.BETA_PROFILE = a.beta_profile == "on"
-    if a.stated_lift_slope is not None:
-        from benchmarks.eval_jsbsim import STATED_AERO
-        from gcs_sysid.estimation import airangles as _aa
-
-        _aa.STATED_LIFT_SLOPE = True
-        for item in a.stated_lift_slope:
-            ac_, *vals = item.split(":")
-            STATED_AERO[ac_] = (float(vals[0]), float(vals[1]) if len(vals) > 1 else None)
-    if a.stated_lift_level is not None:
-        from benchmarks.eval_jsbsim import STATED_LINE, parse_stated_line
-        from gcs_sysid.estimation import airangles as _aa
-
-        _aa.STATED_LIFT_LEVEL = True
-        STATED_LINE.update(parse_stated_line(a.stated_lift_level))
+    apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile
     if a.alpha_level is not None:
         from gcs_sysid.diagnose import run as _dr
 
         _dr.ALPHA_LEVEL = a.alpha_level
-    if a.alpha_profile is not None:
-        from gcs_sysid.estimation import airangles as _aa
-
-        _aa.ALPHA_PROFILE_COLUMNS = tuple(a.alpha_profile)
     if a.share_alpha_model:
         from gcs_sysid.diagnose import run as diagnose_run
 

@@ -38,6 +38,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.eval_jsbsim import _coverage, _errs, aero_reads_air_rates  # noqa: E402
 from benchmarks.jsbsim_harness import UNTOUCHED_AIRCRAFT, FlightConfig, load_truth, make_flight  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
@@ -230,10 +231,7 @@ def main(argv=None) -> int:
         for turb in a.turbulence:
             for seed in a.seeds:
                 rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds)
-                if a.json:
-                    with open(a.json, "a") as f:
-                        for r in rows:
-                            f.write(json.dumps(r) + "\n")
+                append_jsonl(a.json, rows)
     return 0
 
 

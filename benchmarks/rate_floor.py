@@ -27,7 +27,6 @@ Columns: ``gyro`` and ``air`` the held-out errors ``100 RMS(fit - truth) / RMS(t
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -35,6 +34,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.eval_jsbsim import true_alpha_dot  # noqa: E402
 from benchmarks.jsbsim_harness import load_truth  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
@@ -103,9 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         ai = " ".join(f"{r['air'][k]:5.1f}" for k in COEFFICIENTS)
         gr = " ".join(f"{t:.3f}/{s:.3f}" for t, s in zip(r["gust_rms"], r["dryden"]))
         print(f"{r['file'][:-10]:28s} gyro: {g} | air: {ai} | {gr}")
-        if a.json:
-            with open(a.json, "a") as fh:
-                fh.write(json.dumps(r) + "\n")
+        append_jsonl(a.json, [r])
     return 0
 
 

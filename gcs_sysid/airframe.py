@@ -316,6 +316,12 @@ def _req(d: Mapping[str, Any], key: str, where: str, src: str, positive: bool = 
     return float(v)
 
 
+def _positives(d: Mapping[str, Any], keys: tuple[str, ...], where: str, src: str) -> list[float]:
+    """The required positive numbers ``keys`` of the table ``d`` (:func:`_req`), in order; the first that is missing
+    or not a positive finite number raises its :class:`InputError`."""
+    return [_req(d, k, where, src, positive=True) for k in keys]
+
+
 def _opt(d: Mapping[str, Any], key: str, default: float, where: str, src: str) -> float:
     return _req(d, key, where, src) if key in d else default
 
@@ -351,9 +357,7 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     inertia = doc.get("inertia")
     if not isinstance(inertia, Mapping):
         raise InputError(f"{src}: missing table [inertia] with Ixx, Iyy, Izz (kg m^2) and optional Ixz")
-    Ixx = _req(inertia, "Ixx", "[inertia]", src, positive=True)
-    Iyy = _req(inertia, "Iyy", "[inertia]", src, positive=True)
-    Izz = _req(inertia, "Izz", "[inertia]", src, positive=True)
+    Ixx, Iyy, Izz = _positives(inertia, ("Ixx", "Iyy", "Izz"), "[inertia]", src)
     Ixz = _opt(inertia, "Ixz", 0.0, "[inertia]", src)
     if Ixx * Izz - Ixz**2 <= 0:
         raise InputError(f"{src}: [inertia] tensor is not positive definite (Ixx*Izz must exceed Ixz^2)")
@@ -362,9 +366,7 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
     geom = doc.get("geometry")
     if not isinstance(geom, Mapping):
         raise InputError(f"{src}: missing table [geometry] with S (m^2), b (m), c (m)")
-    S = _req(geom, "S", "[geometry]", src, positive=True)
-    b = _req(geom, "b", "[geometry]", src, positive=True)
-    c = _req(geom, "c", "[geometry]", src, positive=True)
+    S, b, c = _positives(geom, ("S", "b", "c"), "[geometry]", src)
 
     servos_doc = doc.get("servo")
     if not isinstance(servos_doc, list) or not servos_doc:

@@ -75,6 +75,7 @@ import tempfile
 import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import NamedTuple
 
 __all__ = ["DERIVED", "REPO_DERIVED", "derive_f16_direct", "derive_f4n_fcs", "derive_rascal_glide",
            "derive_asw20_glide", "derive_iar80_glide", "derive_c684_glide", "derive_ultrastick120_glide",
@@ -105,6 +106,26 @@ def _el(parent: ET.Element, tag: str, text: str | None = None, **attrib) -> ET.E
     if text is not None:
         e.text = text
     return e
+
+
+class _Parts(NamedTuple):
+    """The elements of a JSBSim model that the glide derivations remove or edit (:func:`_parts`)."""
+
+    prop: ET.Element | None
+    engines: list[ET.Element]
+    systems: list[ET.Element]
+    external: list[ET.Element]
+    fc: ET.Element | None
+    aero: ET.Element | None
+
+
+def _parts(root: ET.Element) -> _Parts:
+    """``root``'s ``<propulsion>`` and its ``<engine>`` children (none where it has no propulsion), its ``<system>``
+    and ``<external_reactions>`` children, its ``<flight_control>`` and its ``<aerodynamics>`` (None where missing):
+    what each derivation checks before it edits the copy (twenty-eighth session: one lookup for nine copies)."""
+    prop = root.find("propulsion")
+    return _Parts(prop, prop.findall("engine") if prop is not None else [], root.findall("system"),
+                  root.findall("external_reactions"), root.find("flight_control"), root.find("aerodynamics"))
 
 
 def _scale(channel: ET.Element, name: str, cmd: str, half_range: float, out: str) -> None:
@@ -236,8 +257,7 @@ def derive_rascal_glide(root: ET.Element) -> ET.Element:
         ValueError: the XML has no ``<propulsion>`` with an ``<engine>`` or no ``<aerodynamics>``.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
+    prop, engines, *_ = _parts(root)
     if not engines or root.find("aerodynamics") is None:
         raise ValueError("Rascal110-JSBSim.xml: no <propulsion><engine> to remove or no <aerodynamics>")
     for e in engines:
@@ -337,8 +357,7 @@ def derive_iar80_glide(root: ET.Element) -> ET.Element:
             (another version of the file).
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
+    prop, engines, *_ = _parts(root)
     if len(engines) != 1 or root.find("aerodynamics") is None:
         raise ValueError("IAR80-Jsb.xml: expected one <propulsion><engine> to remove and an <aerodynamics>")
     prop.remove(engines[0])
@@ -377,9 +396,7 @@ def derive_c684_glide(root: ET.Element) -> ET.Element:
             or ``<aerodynamics>``.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
-    systems = root.findall("system")
+    prop, engines, systems, *_ = _parts(root)
     flags = list(root.iter("retractable"))
     if (len(engines) != 1 or [s.get("file") for s in systems] != ["engine"] or root.find("aerodynamics") is None
             or len(flags) != 3 or any((f.text or "").strip() != "FIXED" for f in flags)):
@@ -585,11 +602,8 @@ def derive_eternity_glide(root: ET.Element) -> ET.Element:
             ``fcs/elevator-pos-deg``.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
-    fc = root.find("flight_control")
+    prop, engines, _, _, fc, aero = _parts(root)
     throttle = [ch for ch in fc.findall("channel") if ch.get("name") == "Throttle"] if fc is not None else []
-    aero = root.find("aerodynamics")
     reads = [p for p in aero.iter("property") if (p.text or "").strip() == "fcs/elevator-pos-deg"] \
         if aero is not None else []
     if len(engines) != 1 or len(throttle) != 1 or len(reads) != 1:
@@ -646,11 +660,7 @@ def derive_kingair350_glide(root: ET.Element) -> ET.Element:
             the boost input, the yaw-damper property, or one ``Drag_feathered`` function.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
-    systems = root.findall("system")
-    fc = root.find("flight_control")
-    aero = root.find("aerodynamics")
+    prop, engines, systems, _, fc, aero = _parts(root)
     if (len(engines) != 2 or [x.get("file") for x in systems] != _KA350_SYSTEMS or fc is None or aero is None):
         raise ValueError("KingAir-350.xml: expected two <propulsion><engine>, the systems "
                          f"{_KA350_SYSTEMS}, a <flight_control> and an <aerodynamics>")
@@ -723,11 +733,7 @@ def derive_shorts23_glide(root: ET.Element) -> ET.Element:
             naming ``Systems/datcom_aero.xml``; or the checked-in ``datcom_aero.xml`` has another root.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
-    ext = root.findall("external_reactions")
-    systems = root.findall("system")
-    aero = root.find("aerodynamics")
+    prop, engines, systems, ext, _, aero = _parts(root)
     if (len(engines) != 4 or len(ext) != 1 or [x.get("file") for x in systems] != _S23_SYSTEMS or aero is None
             or aero.get("file") != "Systems/datcom_aero.xml" or len(aero)):
         raise ValueError("Short_S23.xml: expected four <propulsion><engine>, one <external_reactions>, the systems "
@@ -786,11 +792,7 @@ def derive_dr1_glide(root: ET.Element) -> ET.Element:
             ``<aerodynamics>`` with one table lookup of ``fcs/elevator-pos-rad``.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
-    ext = root.findall("external_reactions")
-    systems = root.findall("system")
-    aero = root.find("aerodynamics")
+    prop, engines, systems, ext, _, aero = _parts(root)
     if len(engines) != 1 or len(ext) != 1 or [x.get("file") for x in systems] != ["pushback"] or aero is None:
         raise ValueError("dr1.xml: expected one <propulsion><engine>, one <external_reactions>, the system "
                          "'pushback' and an <aerodynamics>")
@@ -842,8 +844,7 @@ def derive_navion_glide(root: ET.Element) -> ET.Element:
             ``<aerodynamics>``.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
+    prop, engines, *_ = _parts(root)
     norm = [c for c in root.iterfind("flight_control/channel/aerosurface_scale")
             if c.get("name") == "Flap Position Normalizer"]
     if len(engines) != 1 or len(norm) != 1 or root.find("aerodynamics") is None:
@@ -910,10 +911,7 @@ def derive_fokker50_glide(root: ET.Element) -> ET.Element:
             three propwash functions, the four damper components and the rudder summer's damper input.
     """
     root = copy.deepcopy(root)
-    prop = root.find("propulsion")
-    engines = prop.findall("engine") if prop is not None else []
-    fc = root.find("flight_control")
-    aero = root.find("aerodynamics")
+    prop, engines, _, _, fc, aero = _parts(root)
     if len(engines) != 2 or fc is None or aero is None:
         raise ValueError("fokker50.xml: expected two <propulsion><engine>, a <flight_control> and an <aerodynamics>")
     channels = {ch.get("name"): ch for ch in fc.findall("channel")}

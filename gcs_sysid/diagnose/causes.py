@@ -118,34 +118,16 @@ def _gyro(ctx, axis, b):
     return X, Y
 
 
-def t_gyro_x(ctx, p):
-    return _gyro(ctx, 0, p[0])
-
-
-def t_gyro_y(ctx, p):
-    return _gyro(ctx, 1, p[0])
-
-
-def t_gyro_z(ctx, p):
-    return _gyro(ctx, 2, p[0])
-
-
 def _accel(ctx, axis, b):
     Y = ctx.Y.copy()
     Y[:, axis] -= ctx.airframe.mass * b / (ctx.qbar * ctx.airframe.S)
     return ctx.X, Y
 
 
-def t_accel_x(ctx, p):
-    return _accel(ctx, 0, p[0])
-
-
-def t_accel_y(ctx, p):
-    return _accel(ctx, 1, p[0])
-
-
-def t_accel_z(ctx, p):
-    return _accel(ctx, 2, p[0])
+def _axis_bias(transform, axis: int):
+    """The cause transform ``(ctx, p) -> transform(ctx, axis, p[0])``: a bias ``p[0]`` on one axis (0 x, 1 y, 2 z)
+    of the gyro (:func:`_gyro`, rad/s) or the accelerometer (:func:`_accel`, m/s^2)."""
+    return lambda ctx, p: transform(ctx, axis, p[0])
 
 
 def _dcm_nb(phi, theta, psi):
@@ -251,12 +233,8 @@ def transforms(ctx: DiagContext) -> list[SensorCause]:
         SensorCause("scale:airspeed", t_scale_airspeed, [1.0], scale=[0.05]),
         SensorCause("bias:alpha", t_bias_alpha, [0.0], scale=[0.02]),
         SensorCause("bias:beta", t_bias_beta, [0.0], scale=[0.02]),
-        SensorCause("bias:gyro_x", t_gyro_x, [0.0], scale=[0.02]),
-        SensorCause("bias:gyro_y", t_gyro_y, [0.0], scale=[0.02]),
-        SensorCause("bias:gyro_z", t_gyro_z, [0.0], scale=[0.02]),
-        SensorCause("bias:accel_x", t_accel_x, [0.0], scale=[0.3]),
-        SensorCause("bias:accel_y", t_accel_y, [0.0], scale=[0.3]),
-        SensorCause("bias:accel_z", t_accel_z, [0.0], scale=[0.3]),
+        *(SensorCause(f"bias:gyro_{ax}", _axis_bias(_gyro, i), [0.0], scale=[0.02]) for i, ax in enumerate("xyz")),
+        *(SensorCause(f"bias:accel_{ax}", _axis_bias(_accel, i), [0.0], scale=[0.3]) for i, ax in enumerate("xyz")),
         SensorCause("mass", t_mass, [a.mass], scale=[0.1 * a.mass]),
         SensorCause("cg_offset", t_cg, [0.0, 0.0, 0.0], scale=[0.02, 0.02, 0.02],
                     labels=["dx", "dy", "dz"]),

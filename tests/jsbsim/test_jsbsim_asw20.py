@@ -30,8 +30,9 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import (assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot,
-                         ic_state, lateral_coefficients)
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, checked_in_model, ic_state, surface_state
 
 SRC = "data/jsbsim_models/asw20/asw20-JSBSim.xml"
 SRC_SHA256 = "c3a7877a124d79fcc82340614703cc07795993a06552ad6df9f05b10d1bdbc48"
@@ -116,20 +117,13 @@ def test_the_asw20_flies_its_own_surfaces_without_engine_or_external_force():
     No engine; the external forces (winch, aerotow, FlightGear's generic engine) are 0, and after 50 frames
     every non-gravity force and moment is aerodynamic. A yaw rate does not move the rudder (no yaw damper),
     so the harness's own damper flies it (k_r 0.4)."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("asw20")
     assert spec.gains[5] == 0.4 and spec.gear_up and spec.aileron_props == ("fcs/left-aileron-pos-rad", None)
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.38397), "fcs/left-aileron-pos-rad": (1, -0.43633),
+                               "fcs/right-aileron-pos-rad": (1, -0.43633), "fcs/rudder-pos-rad": (2, 31 * 0.01745)},
+                        up=0.43633, alpha_deg=-2.0, r_rad_s=0.2)
     assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.38397, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(0.4 * 0.43633, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.43633, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 31 * 0.01745, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.43633, rel=1e-9)
-    da = np.radians(5.0)
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, -2.0)
     assert_aero_is_the_only_force(fdm, 300.0, external_zero=True)
 
 
@@ -147,26 +141,11 @@ def test_the_asw20_is_statically_stable_and_its_controls_act_as_its_xml_says():
       (Clb), Cn_beta 0.1007 (Cnb). Cl and Cn at rest are 0.
     """
     spec = aircraft("asw20")
-
-    def cm(alpha, de=0.0):
-        return cm_without_alpha_dot(spec, alpha, de)
-
-    cm_4, c0, c4 = cm(-4.0), cm(0.0), cm(4.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(cm_4, c0) == pytest.approx(-1.14, abs=0.02) and slope(c0, c4) == pytest.approx(-1.38, abs=0.02)
-    assert abs(cm(-2.0)) < 0.01
-    assert (cm(-2.0, -0.5) - cm(-2.0)) / (-0.5 * 0.43633) == pytest.approx(-0.786, abs=0.005)
-    assert (cm(-2.0, 0.5) - cm(-2.0)) / (0.5 * 0.38397) == pytest.approx(-0.786, abs=0.005)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
-        fdm = _state(beta_deg=beta, cmds=cmds)
-        return lateral_coefficients(fdm)
-
-    (l0, n0, _, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
-    assert abs(l0) < 1e-12 and abs(n0) < 1e-12
-    assert l1 / a1 == pytest.approx(-0.214, rel=1e-6) and n1 / a1 == pytest.approx(-0.017, rel=1e-6)
-    l2, n2, _, r2 = lat((0.0, 0.0, 0.4))
-    assert l2 / r2 == pytest.approx(0.0065, rel=1e-6) and n2 / r2 == pytest.approx(-0.041, rel=1e-6)
-    l3, n3, _, _ = lat(beta=4.0)
-    assert l3 / np.radians(4.0) == pytest.approx(-0.0693, rel=1e-6)
-    assert n3 / np.radians(4.0) == pytest.approx(0.1007, rel=1e-6)
+    # Cm at alpha -2 within 0.01 (was < 0.01: the same but for Cm exactly 0.01)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-1.14, abs=0.02)), (0.0, 4.0, approx(-1.38, abs=0.02))),
+                             ((-0.5, approx(-0.786, abs=0.005)), (0.5, approx(-0.786, abs=0.005))),
+                             cm_at={-2.0: approx(0.0, abs=0.01)}, alpha_e=-2.0, travel=(0.43633, 0.38397))
+    assert_lateral_derivatives(spec, (approx(-0.214, rel=1e-6), approx(-0.017, rel=1e-6)),
+                               (approx(-0.041, rel=1e-6), approx(0.0065, rel=1e-6)),
+                               {-2.0: (approx(-0.0693, rel=1e-6), approx(0.1007, rel=1e-6))},
+                               alpha_deg=-2.0, rest=1e-12, aileron_cmds=(0.4,), rudder_cmds=(0.4,))

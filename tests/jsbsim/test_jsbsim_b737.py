@@ -28,7 +28,8 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, ic_state
 
 
 def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
@@ -79,30 +80,13 @@ def test_the_b737_is_statically_stable_and_its_controls_act_as_its_xml_says():
       -0.081), Cn 0 (no aileron yaw); per rad of rudder Cn -0.200 and Cl +0.010; Cl_beta -0.145 (Clb -0.09 and
       the side force, CYb -1, acting 64 in above the CG), Cn_beta 0.273 (Cnb 0.26 and the side force aft of it).
     """
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc, fdm["velocities/mach"]
-
-    (cm_4, _), (c0, mach), (c4, _) = cm(-4.0), cm(0.0), cm(4.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert mach == pytest.approx(0.556, abs=0.005)
-    assert slope(cm_4, c0) == pytest.approx(-1.008, abs=0.01) and slope(c0, c4) == pytest.approx(-1.138, abs=0.01)
-    for c, want in ((-0.3, -0.993), (0.3, -0.946)):
-        assert (cm(2.0, c)[0] - cm(2.0)[0]) / (c * 0.3) == pytest.approx(want, abs=0.005)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
-        fdm = _state(beta_deg=beta, cmds=cmds)
-        return lateral_coefficients(fdm)
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-5 and abs(n0) < 1e-5
-    for c in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, c, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.0814, abs=5e-4) and abs(n1 - n0) < 1e-9
-    l2, n2, _, r2 = lat((0.0, 0.0, 0.3))
-    assert (n2 - n0) / r2 == pytest.approx(-0.200, abs=2e-3) and (l2 - l0) / r2 == pytest.approx(0.010, abs=1e-3)
-    l3, n3, _, _ = lat(beta=4.0)
-    assert (l3 - l0) / np.radians(4.0) == pytest.approx(-0.145, abs=2e-3)
-    assert (n3 - n0) / np.radians(4.0) == pytest.approx(0.273, abs=3e-3)
-
+    spec = aircraft("b737")
+    assert _state(alpha_deg=0.0)["velocities/mach"] == pytest.approx(0.556, abs=0.005)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-1.008, abs=0.01)), (0.0, 4.0, approx(-1.138, abs=0.01))),
+                             ((-0.3, approx(-0.993, abs=0.005)), (0.3, approx(-0.946, abs=0.005))), alpha_e=2.0,
+                             travel=(0.3, 0.3))
+    # no aileron yaw: |dCn / da| <= 1e-9 (was |dCn| < 1e-9; |da| < 1 rad: stronger); dCn is exactly 0
+    assert_lateral_derivatives(spec, (approx(0.0814, abs=5e-4), approx(0.0, abs=1e-9)),
+                               (approx(-0.200, abs=2e-3), approx(0.010, abs=1e-3)),
+                               {2.0: (approx(-0.145, abs=2e-3), approx(0.273, abs=3e-3))},
+                               alpha_deg=2.0, rest=1e-5, rudder_cmds=(0.3,))

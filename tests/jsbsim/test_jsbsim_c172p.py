@@ -25,11 +25,12 @@ are slow.
 No pipeline fit, GP, diagnosis or scoring ran on the c172p before the twentieth session's final evaluation.
 """
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, ic_state, lateral_coefficients
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 RAD_PER_DEG_FCS = 0.01745     # the c172p's FCS gain (deg -> rad)
 
@@ -48,24 +49,21 @@ def test_the_c172p_flies_its_stock_fcs_and_no_engine_force():
     gives no induced velocity, so the elevator's and rudder's wash dynamic pressure is 0.5 rho u^2 (body-axis u), and
     after 50 frames every non-gravity force and moment is aerodynamic."""
     from benchmarks.jsbsim_harness.derived import DERIVED, REPO_DERIVED
-    from benchmarks.jsbsim_harness.flight import _deflections
 
     spec = aircraft("c172p")
     assert spec.model == "c172p" and spec.model not in DERIVED and spec.model not in REPO_DERIVED
     assert not spec.gear_up and spec.gains == (1.0, 0.3, 0.01, 0.4, 0.1, 0.4)
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    # the trailing-edge-up elevator to 1e-9 (was pytest's default 1e-6)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 23.0 * RAD_PER_DEG_FCS),
+                               "fcs/left-aileron-pos-rad": (1, 20.0 * RAD_PER_DEG_FCS),
+                               "fcs/rudder-pos-rad": (2, 16.0 * RAD_PER_DEG_FCS)},
+                        up=28.0 * RAD_PER_DEG_FCS, alpha_deg=2.0)
     assert fdm.get_propulsion().get_num_engines() == 1 and fdm["inertia/weight-lbs"] == pytest.approx(1700.0)
     assert fdm["fcs/flap-pos-deg"] == 0.0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 23.0 * RAD_PER_DEG_FCS, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 28.0 * RAD_PER_DEG_FCS)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 20.0 * RAD_PER_DEG_FCS, rel=1e-9)
     assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-fdm["fcs/left-aileron-pos-rad"], rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 16.0 * RAD_PER_DEG_FCS, rel=1e-9)
     assert spec.cmd_per_rad == pytest.approx((1 / (28 * RAD_PER_DEG_FCS), 1 / (20 * RAD_PER_DEG_FCS),
                                               1 / (16 * RAD_PER_DEG_FCS)))
-    da = np.radians(5.0)      # trailing edge down on the right
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, 2.0)
     wash = _state()
     u_over_v = wash["velocities/u-aero-fps"] / wash["velocities/vt-fps"]
     assert wash["aero/function/qbar-induced-psf"] == pytest.approx(wash["aero/qbar-psf"] * u_over_v ** 2, rel=1e-9)
@@ -86,33 +84,12 @@ def test_the_c172p_is_statically_stable_and_its_controls_act_as_its_xml_says():
       +0.0235 (Cldr 0.0147 and CYdr 0.187 through the arm); Cl_beta -0.113 (Clb -0.092 and the side force) and
       Cn_beta 0.059, nearly constant in alpha.
     """
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc, fdm
-
-    (cm_4, _), (c0, f0), (c4, _), (c8, _) = cm(-4.0), cm(0.0), cm(4.0), cm(8.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert f0["velocities/mach"] == pytest.approx(0.138, abs=0.003)
-    assert slope(cm_4, c0) == pytest.approx(-1.782, abs=0.01) and slope(c0, c4) == pytest.approx(-1.914, abs=0.01)
-    assert slope(c4, c8) == pytest.approx(-2.066, abs=0.01)
-    for c, want in ((0.3, -1.108), (-0.3, -1.149)):
-        c1, f1 = cm(2.0, c)
-        assert (c1 - cm(2.0)[0]) / f1["fcs/elevator-pos-rad"] == pytest.approx(want, abs=0.005)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
-        fdm = _state(alpha_deg=alpha, beta_deg=beta, cmds=cmds)
-        return lateral_coefficients(fdm)
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for c in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, c, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.229, abs=5e-4) and (n1 - n0) / a1 == pytest.approx(-0.0053, abs=2e-4)
-        l2, n2, _, r2 = lat((0.0, 0.0, c))
-        assert (n2 - n0) / r2 == pytest.approx(-0.0431, abs=5e-4) and (l2 - l0) / r2 == pytest.approx(0.0235, abs=5e-4)
-    for a in (0.0, 6.0):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(beta=4.0, alpha=a)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.113, abs=3e-3), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0592, abs=1e-3), a
+    spec = aircraft("c172p")
+    assert _state(alpha_deg=0.0)["velocities/mach"] == pytest.approx(0.138, abs=0.003)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-1.782, abs=0.01)), (0.0, 4.0, approx(-1.914, abs=0.01)),
+                                    (4.0, 8.0, approx(-2.066, abs=0.01))),
+                             ((0.3, approx(-1.108, abs=0.005)), (-0.3, approx(-1.149, abs=0.005))), alpha_e=2.0)
+    beta = (approx(-0.113, abs=3e-3), approx(0.0592, abs=1e-3))
+    assert_lateral_derivatives(spec, (approx(0.229, abs=5e-4), approx(-0.0053, abs=2e-4)),
+                               (approx(-0.0431, abs=5e-4), approx(0.0235, abs=5e-4)), {0.0: beta, 6.0: beta},
+                               alpha_deg=2.0)

@@ -31,8 +31,9 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import (assert_aero_is_the_only_force, checked_in_model, cm_without_alpha_dot,
-                         ic_state, lateral_coefficients)
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_pitch_derivatives, checked_in_model, ic_state, \
+    lateral_coefficients
 
 SRC = "data/jsbsim_models/c684/C684.xml"
 SRC_SHA256 = "fb02bd7d563c8877ebcaaffe81e17ab62efd456ec65027436349e696765e826d"
@@ -114,13 +115,9 @@ def test_the_c684_is_statically_stable_and_its_controls_act_as_its_xml_says():
       the side force ahead of the CG).
     """
     spec = aircraft("c684")
-    cm = lambda a, de=0.0: cm_without_alpha_dot(spec, a, de)   # noqa: E731
-    cm_4, c0, c4 = cm(-4.0), cm(0.0), cm(4.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(cm_4, c0) == pytest.approx(-0.863, abs=0.01) and slope(c0, c4) == pytest.approx(-0.807, abs=0.01)
-    assert c0 == pytest.approx(-0.0113, abs=0.002)
-    assert (cm(2.0, -0.5) - cm(2.0)) / (-0.5 * 0.35) == pytest.approx(-1.234, abs=0.005)
-    assert (cm(2.0, 0.5) - cm(2.0)) / (0.5 * 0.30) == pytest.approx(-1.272, abs=0.005)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.863, abs=0.01)), (0.0, 4.0, approx(-0.807, abs=0.01))),
+                             ((-0.5, approx(-1.234, abs=0.005)), (0.5, approx(-1.272, abs=0.005))),
+                             cm_at={0.0: approx(-0.0113, abs=0.002)}, alpha_e=2.0, travel=(0.35, 0.30))
 
     def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
         fdm = _state(alpha_deg=alpha, beta_deg=beta, cmds=cmds)

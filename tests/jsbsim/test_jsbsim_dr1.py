@@ -31,15 +31,15 @@ tuning aircraft since.
 """
 
 import dataclasses
-import json
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, bare_xml, checked_in_model, \
-    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_kept_but_engines, \
+    assert_lateral_derivatives, assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, \
+    bare_xml, checked_in_model, ic_state, surface_state
 
 SRC = "data/jsbsim_models/fokkerdr1/dr1.xml"
 SRC_SHA256 = "bd394cb162b91e4a11e97e2fbf490e1d5a9ddb0feeed4f5a4c8cf237cedc22f8"
@@ -58,18 +58,8 @@ def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
 def _stock_state(alpha_deg, beta_deg, cmds):
     """The wheel's stock ``dr1`` at the same initial condition as :func:`_state` (its pushback system's FlightGear
     properties created at 0 before ``run_ic``; its engine present, stopped)."""
-    from benchmarks.jsbsim_harness import FlightConfig
-    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
-
-    spec = dataclasses.replace(aircraft("dr1"), model="dr1")
-    fdm = load_model(spec, 1 / 200)
-    for k in _PUSHBACK_PROPS:
-        fdm[k] = 0.0
-    _set_ic(fdm, spec, FlightConfig("dr1", turbulence="none"))
-    fdm["ic/alpha-deg"], fdm["ic/beta-deg"] = alpha_deg, beta_deg
-    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
-    fdm.run_ic()
-    return fdm
+    return ic_state(dataclasses.replace(aircraft("dr1"), model="dr1"), alpha_deg, beta_deg, cmds,
+                    props=_PUSHBACK_PROPS)
 
 
 def test_the_derivation_removes_the_engine_and_pushback_and_aliases_the_elevator_lookup():
@@ -83,12 +73,9 @@ def test_the_derivation_removes_the_engine_and_pushback_and_aliases_the_elevator
 
     src, der, spec = checked_in_model("dr1", "Dr1_glide", SRC, 30855, SRC_SHA256)
     ET.indent(src, space=" ")
-    for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control"):
-        assert same_xml(src.find(tag), der.find(tag)), tag
-    assert len(src.findall("propulsion/engine")) == 1 and der.find("propulsion/engine") is None
+    assert_kept_but_engines(src, der, ("metrics", "mass_balance", "ground_reactions", "flight_control"), 1, 1)
     assert [x.get("file") for x in src.findall("system")] == ["pushback"] and der.find("system") is None
     assert src.find("external_reactions") is not None and der.find("external_reactions") is None
-    assert same_xml(src.find("propulsion/tank"), der.find("propulsion/tank"))
     assert [c.tag for c in der] == [c.tag for c in src if c.tag not in ("external_reactions", "system")]
     s_aero, d_aero = src.find("aerodynamics"), der.find("aerodynamics")
     assert d_aero[0].get("name") == ELEVATOR_ALIAS and [p.text for p in d_aero[0].iter("property")] == [
@@ -107,12 +94,7 @@ def test_the_derived_aerodynamics_are_the_stock_models():
     """At three states (alpha, sideslip, the three commands), JSBSim's aerodynamic forces and moments of
     ``Dr1_glide`` equal those of the wheel's stock ``dr1`` (its rotary engine stopped, its pushback idle) to the last
     bit: the derivation changes no number."""
-    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
-        a, b = _state(alpha, beta, cmds), _stock_state(alpha, beta, cmds)
-        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == 1
-        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
-                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
-            assert a[k] == b[k], (alpha, k)
+    assert_same_aero_as_stock(_state, _stock_state, 1)
 
 
 def test_the_dr1_flies_its_own_surfaces_without_engine_or_external_force():
@@ -122,12 +104,10 @@ def test_the_dr1_flies_its_own_surfaces_without_engine_or_external_force():
     of travel). No engine; 945 lb (895 empty, 50 of fuel); after 50 frames every non-gravity force and moment is
     aerodynamic and the external forces are 0."""
     spec = aircraft("dr1")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.35), "fcs/left-aileron-pos-rad": (1, 0.30),
+                               "fcs/right-aileron-pos-rad": (1, 0.30), "fcs/rudder-pos-rad": (2, 0.44)},
+                        alpha_deg=0.0, rel=1e-6)
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(945.0, abs=0.01)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.35, rel=1e-6)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.30, rel=1e-6)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.30, rel=1e-6)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.44, rel=1e-6)
     assert _state(cmds=(0.0, 0.0, 0.9))["fcs/rudder-pos-rad"] == pytest.approx(0.35 * 0.44, rel=1e-6)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.35, 1 / 0.30, 1 / 0.44))
     assert_deflections_map_back(spec)
@@ -147,56 +127,18 @@ def test_the_dr1_is_statically_stable_and_its_controls_act_as_its_xml_says():
       CYbeta's arm) and Cn_beta 0.0965 at alpha 0 and 6 deg (constants).
     """
     spec = aircraft("dr1")
-    c = {a: cm_without_alpha_dot(spec, a) for a in (-4.0, 0.0, 4.0, 8.0)}
-    slope = lambda a, b: (c[b] - c[a]) / np.radians(4.0)   # noqa: E731
     assert _state()["velocities/mach"] == pytest.approx(0.1383, abs=0.002)
-    assert slope(-4.0, 0.0) == pytest.approx(-0.175, abs=0.003) and slope(0.0, 4.0) == pytest.approx(-0.202, abs=0.003)
-    assert slope(4.0, 8.0) == pytest.approx(-0.408, abs=0.005) and c[0.0] == pytest.approx(-0.0131, abs=0.0005)
-    for cmd, want in ((0.3, -0.283), (-0.3, -0.275)):
-        de = _state(cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
-        assert (cm_without_alpha_dot(spec, 0.0, cmd) - c[0.0]) / de == pytest.approx(want, abs=0.002)
-
-    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
-        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds))
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for cmd in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.087, abs=1e-6) and (n1 - n0) / a1 == pytest.approx(0.0552, abs=1e-6)
-        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
-        assert (n2 - n0) / r2 == pytest.approx(-0.0503, abs=2e-4) and (l2 - l0) / r2 == pytest.approx(-0.0031, abs=2e-4)
-    for a in (0.0, 6.0):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(alpha=a, beta=4.0)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.0287, abs=3e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0965, abs=3e-4), a
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.175, abs=0.003)), (0.0, 4.0, approx(-0.202, abs=0.003)),
+                                    (4.0, 8.0, approx(-0.408, abs=0.005))),
+                             ((0.3, approx(-0.283, abs=0.002)), (-0.3, approx(-0.275, abs=0.002))),
+                             cm_at={0.0: approx(-0.0131, abs=0.0005)})
+    beta = (approx(-0.0287, abs=3e-4), approx(0.0965, abs=3e-4))
+    assert_lateral_derivatives(spec, (approx(0.087, abs=1e-6), approx(0.0552, abs=1e-6)),
+                               (approx(-0.0503, abs=2e-4), approx(-0.0031, abs=2e-4)), {0.0: beta, 6.0: beta})
 
 
 def test_summaries_mark_no_aircraft_untouched_the_dr1_included(tmp_path):
     """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the dr1 bare, as every other tuning
     aircraft (synthetic rows of tuning aircraft only): the twenty-sixth session moved it to tuning, so none of them
     is "(untouched)" or "(held out)"."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    for ac in acs:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| dr1 | clean |") for ln in lines)
-    assert any(ln.startswith("| s23 | clean |") for ln in lines)
-    assert not any("(untouched)" in ln for ln in lines)
+    assert_summaries_label_bare(tmp_path, "dr1", ("dr1", "s23"))

@@ -32,7 +32,9 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, checked_in_model, ic_state, lateral_coefficients
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, \
+    checked_in_model, ic_state
 
 SRC = "data/jsbsim_models/eternity/Eternity.xml"
 SRC_SHA256 = "2341802f2ba31fea2d561a94a66957f88fa478ffcdc8fedb45f70f4772fa4bc7"
@@ -115,28 +117,13 @@ def test_the_eternity_is_statically_stable_and_its_controls_act_as_its_xml_says(
       Cn_delta_a +0.021); per rad of rudder position Cn +0.043 and Cl +0.00166 (the project's delta_r is minus the
       position: Cn_delta_r -0.043); Cl_beta -0.094 and Cn_beta 0.065 (Yaw_beta 0.0517 and the side force's arm).
     """
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/moment/Pitch_alphadot"]) / qsc, fdm
-
-    (c_8, _), (c_4, _), (c0, f0), (c4, _) = cm(-8.0), cm(-4.0), cm(0.0), cm(4.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert f0["velocities/mach"] == pytest.approx(0.072, abs=0.002)
-    assert slope(c_8, c_4) == pytest.approx(-1.552, abs=0.01) and slope(c_4, c0) == pytest.approx(-1.938, abs=0.01)
-    assert slope(c0, c4) == pytest.approx(-1.741, abs=0.01) and c0 == pytest.approx(-0.175, abs=0.002)
-    for c in (0.3, -0.3):
-        c1, f1 = cm(-2.0, c)
-        assert (c1 - cm(-2.0)[0]) / f1["fcs/elevator-pos-rad"] == pytest.approx(-0.761, abs=0.005)
-    l0, n0, _, _ = lateral_coefficients(_state())
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for c in (0.3, -0.3):
-        l1, n1, a1, _ = lateral_coefficients(_state(cmds=(0.0, c, 0.0)))
-        assert (l1 - l0) / a1 == pytest.approx(0.2966, abs=1e-4) and (n1 - n0) / a1 == pytest.approx(-0.021, abs=1e-4)
-        l2, n2, _, r2 = lateral_coefficients(_state(cmds=(0.0, 0.0, c)))
-        assert (n2 - n0) / r2 == pytest.approx(0.043, abs=1e-4) and (l2 - l0) / r2 == pytest.approx(0.00166, abs=1e-5)
-    for a in (-4.0, 0.0):
-        lb, nb, _, _ = lateral_coefficients(_state(alpha_deg=a))
-        l3, n3, _, _ = lateral_coefficients(_state(alpha_deg=a, beta_deg=4.0))
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.094, abs=1e-3), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.065, abs=1e-3), a
+    spec = aircraft("eternity")
+    assert _state(alpha_deg=0.0)["velocities/mach"] == pytest.approx(0.072, abs=0.002)
+    assert_pitch_derivatives(spec, ((-8.0, -4.0, approx(-1.552, abs=0.01)), (-4.0, 0.0, approx(-1.938, abs=0.01)),
+                                    (0.0, 4.0, approx(-1.741, abs=0.01))),
+                             ((0.3, approx(-0.761, abs=0.005)), (-0.3, approx(-0.761, abs=0.005))),
+                             cm_at={0.0: approx(-0.175, abs=0.002)}, alpha_e=-2.0, term="aero/moment/Pitch_alphadot")
+    beta = (approx(-0.094, abs=1e-3), approx(0.065, abs=1e-3))
+    assert_lateral_derivatives(spec, (approx(0.2966, abs=1e-4), approx(-0.021, abs=1e-4)),
+                               (approx(0.043, abs=1e-4), approx(0.00166, abs=1e-5)), {-4.0: beta, 0.0: beta},
+                               alpha_deg=-2.0)

@@ -25,7 +25,8 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import ic_state
+from pytest import approx
+from truth_fits import assert_pitch_derivatives, ic_state
 
 
 def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0, spec=None):
@@ -92,11 +93,6 @@ def test_the_f4n_is_statically_stable_about_its_cg():
     condition, sideslip 0) falls with alpha: Cm_alpha -0.23 per rad between 0 and 4 deg and between 4
     and 8 deg (its Cmalpha -0.3, the CG and the aerodynamic reference point 4 in apart vertically);
     Cm per rad of elevator about -0.54 (its Cmde, -0.70 + 0.25 Mach, at the initial Mach 0.61)."""
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        return fdm["moments/m-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"])
-
-    c0, c4, c8 = cm(0.0), cm(4.0), cm(8.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(c0, c4) == pytest.approx(-0.23, abs=0.01) and slope(c4, c8) == pytest.approx(-0.23, abs=0.01)
-    assert (cm(4.0, -0.5) - c4) / (-0.5 * 0.35) == pytest.approx(-0.54, abs=0.02)
+    per_rad = approx(-0.23, abs=0.01)
+    assert_pitch_derivatives(aircraft("f4n"), ((0.0, 4.0, per_rad), (4.0, 8.0, per_rad)),
+                             ((-0.5, approx(-0.54, abs=0.02)),), alpha_e=4.0, travel=(0.35, 0.35), term=None)

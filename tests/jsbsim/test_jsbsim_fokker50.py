@@ -36,12 +36,12 @@ is a tuning aircraft since.
 import dataclasses
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_deflections_map_back, bare_xml, check_direct_fcs, checked_in_model, \
-    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
+from pytest import approx
+from truth_fits import assert_deflections_map_back, assert_kept_but_engines, assert_lateral_derivatives, \
+    assert_pitch_derivatives, bare_xml, check_direct_fcs, checked_in_model, ic_state, same_xml
 
 SRC = "data/jsbsim_models/fokker50/fokker50.xml"
 SRC_SHA256 = "dd6507d48e51e27423c89af29a036ae7e8c797add03df115bdbc2e4132932a89"
@@ -58,18 +58,8 @@ def _stock_state(alpha_deg, beta_deg, cmds):
     """The wheel's stock ``fokker50`` at the same initial condition as :func:`_state` (FlightGear's
     ``/controls/engines/engine[n]/throttle``, which its engine control reads and nothing writes, created at 0 before
     ``run_ic``; its engines present, stopped, their propellers windmilling)."""
-    from benchmarks.jsbsim_harness import FlightConfig
-    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
-
-    spec = dataclasses.replace(aircraft("fokker50"), model="fokker50")
-    fdm = load_model(spec, 1 / 200)
-    fdm["/controls/engines/engine/throttle"] = 0.0
-    fdm["/controls/engines/engine[1]/throttle"] = 0.0
-    _set_ic(fdm, spec, FlightConfig("fokker50", turbulence="none"))
-    fdm["ic/alpha-deg"], fdm["ic/beta-deg"] = alpha_deg, beta_deg
-    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
-    fdm.run_ic()
-    return fdm
+    return ic_state(dataclasses.replace(aircraft("fokker50"), model="fokker50"), alpha_deg, beta_deg, cmds,
+                    props=("/controls/engines/engine/throttle", "/controls/engines/engine[1]/throttle"))
 
 
 def _functions(root):
@@ -85,10 +75,7 @@ def test_the_derivation_removes_the_engines_their_channels_the_propwash_and_the_
     the derived XML's hash."""
     src, der, spec = checked_in_model("fokker50", "Fokker50_glide", SRC, 43202, SRC_SHA256)
     ET.indent(src, space=" ")
-    for tag in ("metrics", "mass_balance", "ground_reactions", "system"):
-        assert same_xml(src.find(tag), der.find(tag)), tag
-    assert len(src.findall("propulsion/engine")) == 2 and der.find("propulsion/engine") is None
-    assert [same_xml(a, b) for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"))] == [True] * 2
+    assert_kept_but_engines(src, der, ("metrics", "mass_balance", "ground_reactions", "system"), 2, 2)
     assert [c.tag for c in der] == [c.tag for c in src]
     fc_s = src.find("flight_control")
     for ch in [c for c in fc_s.findall("channel") if c.get("name") in ("EEC", "Thruster")]:
@@ -178,28 +165,14 @@ def test_the_fokker50_is_statically_stable_and_its_controls_act_as_its_xml_says(
       -0.0445 at 6 deg (Clb a table in alpha and Reynolds number, and CYb's arm), Cn_beta 0.1809 (a constant).
     """
     spec = aircraft("fokker50")
-    c = {a: cm_without_alpha_dot(spec, a) for a in (-4.0, 0.0, 4.0, 8.0)}
-    slope = lambda a, b: (c[b] - c[a]) / np.radians(4.0)   # noqa: E731
     s0 = _state()
-    assert s0["velocities/mach"] == pytest.approx(0.3782, abs=0.002) and s0["aero/Re"] == pytest.approx(16.03e6, rel=0.01)
-    assert slope(-4.0, 0.0) == pytest.approx(-1.911, abs=0.005) and slope(0.0, 4.0) == pytest.approx(-2.001, abs=0.005)
-    assert slope(4.0, 8.0) == pytest.approx(-2.179, abs=0.005) and c[0.0] == pytest.approx(0.0201, abs=0.0005)
-    for cmd, want in ((0.3, -1.385), (-0.3, -1.406)):
-        de = _state(cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
-        assert (cm_without_alpha_dot(spec, 0.0, cmd) - c[0.0]) / de == pytest.approx(want, abs=0.003)
-
-    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
-        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds))
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for cmd in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.1287, abs=2e-4) and (n1 - n0) / a1 == pytest.approx(-0.008, abs=1e-6)
-        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
-        assert (n2 - n0) / r2 == pytest.approx(-0.1102, abs=1e-4) and (l2 - l0) / r2 == pytest.approx(0.0155, abs=1e-4)
-    for a, want in ((0.0, -0.0403), (6.0, -0.0445)):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(alpha=a, beta=4.0)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(want, abs=5e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.1809, abs=1e-4), a
+    assert s0["velocities/mach"] == pytest.approx(0.3782, abs=0.002)
+    assert s0["aero/Re"] == pytest.approx(16.03e6, rel=0.01)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-1.911, abs=0.005)), (0.0, 4.0, approx(-2.001, abs=0.005)),
+                                    (4.0, 8.0, approx(-2.179, abs=0.005))),
+                             ((0.3, approx(-1.385, abs=0.003)), (-0.3, approx(-1.406, abs=0.003))),
+                             cm_at={0.0: approx(0.0201, abs=0.0005)})
+    assert_lateral_derivatives(spec, (approx(0.1287, abs=2e-4), approx(-0.008, abs=1e-6)),
+                               (approx(-0.1102, abs=1e-4), approx(0.0155, abs=1e-4)),
+                               {0.0: (approx(-0.0403, abs=5e-4), approx(0.1809, abs=1e-4)),
+                                6.0: (approx(-0.0445, abs=5e-4), approx(0.1809, abs=1e-4))})

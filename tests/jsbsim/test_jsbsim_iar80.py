@@ -25,11 +25,10 @@ No pipeline fit, GP, diagnosis or scoring runs in these tests.
 
 import xml.etree.ElementTree as ET
 
-import numpy as np
-import pytest
-
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, checked_in_model, ic_state, lateral_coefficients
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, checked_in_model, ic_state, surface_state
 
 SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
 SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
@@ -62,20 +61,13 @@ def test_the_iar80_flies_its_own_surfaces_without_engine_or_external_force():
     Aeromatic FCS; only the left is read by the aerodynamics), so the harness reads the left alone
     (``aileron_props``) with delta_a = -left. No engine; after 50 frames every non-gravity force and moment
     is aerodynamic. A yaw rate does not move the rudder (no yaw damper), so the harness's own damper flies it."""
-    from benchmarks.jsbsim_harness.flight import _deflections
-
     spec = aircraft("iar80")
     assert spec.gains[5] == 0.4 and spec.gear_up and spec.aileron_props == ("fcs/left-aileron-pos-rad", None)
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.35), "fcs/left-aileron-pos-rad": (1, 0.35),
+                               "fcs/right-aileron-pos-rad": (1, 0.35), "fcs/rudder-pos-rad": (2, 0.35)},
+                        up=0.35, alpha_deg=2.0, r_rad_s=0.2)
     assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.35, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
-    da = np.radians(5.0)
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(_state(cmds=(0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, 2.0)
     assert_aero_is_the_only_force(fdm, 3000.0, external_zero=True)
 
 
@@ -93,29 +85,11 @@ def test_the_iar80_is_statically_stable_and_its_controls_act_as_its_xml_says():
       (``Roll_beta`` -0.1 and ``Side_beta`` -1 acting 8.7 in above the CG), Cn_beta 0.12. Cl and Cn at rest are 0.
     """
     spec = aircraft("iar80")
-
-    def cm(alpha, de=0.0):
-        fdm = ic_state(spec, alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/moment/Pitch_alphadot"]) / qsc
-
-    cm_4, c0, c4 = cm(-4.0), cm(0.0), cm(4.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(cm_4, c0) == pytest.approx(-0.479, abs=0.01) and slope(c0, c4) == pytest.approx(-0.548, abs=0.01)
-    assert c0 == pytest.approx(0.0077, abs=0.002)
-    assert (cm(2.0, -0.5) - cm(2.0)) / (-0.5 * 0.35) == pytest.approx(-0.897, abs=0.005)
-    assert (cm(2.0, 0.5) - cm(2.0)) / (0.5 * 0.35) == pytest.approx(-0.865, abs=0.005)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
-        fdm = _state(beta_deg=beta, cmds=cmds)
-        return lateral_coefficients(fdm)
-
-    (l0, n0, _, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
-    assert abs(l0) < 1e-12 and abs(n0) < 1e-12
-    assert l1 / a1 == pytest.approx(0.18, rel=1e-6) and n1 / a1 == pytest.approx(-0.003, rel=1e-6)
-    l2, n2, _, r2 = lat((0.0, 0.0, 0.4))
-    assert l2 / r2 == pytest.approx(0.01, rel=1e-6) and n2 / r2 == pytest.approx(-0.1, rel=1e-6)
-    l3, n3, _, _ = lat(beta=4.0)
-    assert l3 / np.radians(4.0) == pytest.approx(-0.1216, abs=5e-4)
-    assert n3 / np.radians(4.0) == pytest.approx(0.12, rel=1e-6)
-
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.479, abs=0.01)), (0.0, 4.0, approx(-0.548, abs=0.01))),
+                             ((-0.5, approx(-0.897, abs=0.005)), (0.5, approx(-0.865, abs=0.005))),
+                             cm_at={0.0: approx(0.0077, abs=0.002)}, alpha_e=2.0, travel=(0.35, 0.35),
+                             term="aero/moment/Pitch_alphadot")
+    assert_lateral_derivatives(spec, (approx(0.18, rel=1e-6), approx(-0.003, rel=1e-6)),
+                               (approx(-0.1, rel=1e-6), approx(0.01, rel=1e-6)),
+                               {2.0: (approx(-0.1216, abs=5e-4), approx(0.12, rel=1e-6))},
+                               alpha_deg=2.0, rest=1e-12, aileron_cmds=(0.4,), rudder_cmds=(0.4,))

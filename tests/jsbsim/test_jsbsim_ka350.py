@@ -29,12 +29,12 @@ is a tuning aircraft since.
 import copy
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, checked_in_model, ic_state, \
-    lateral_coefficients, same_xml
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_kept_but_engines, \
+    assert_lateral_derivatives, assert_pitch_derivatives, checked_in_model, ic_state, same_xml, surface_state
 
 SRC = "data/jsbsim_models/kingair350/KingAir-350.xml"
 SRC_SHA256 = "f89a9376371cbbe4f08060548aee36a25d645620943f5e7273c59e3164c9675d"
@@ -56,12 +56,9 @@ def test_the_derivation_removes_the_engines_systems_and_what_reads_them():
     other aerodynamic function, the external reactions). The spec's notes carry the derived XML's hash."""
     src, der, spec = checked_in_model("ka350", "KingAir350_glide", SRC, 34611, SRC_SHA256)
     ET.indent(src, space=" ")
-    for tag in ("metrics", "mass_balance", "ground_reactions", "external_reactions"):
-        assert same_xml(src.find(tag), der.find(tag)), tag
-    assert der.find("propulsion/engine") is None and der.find("system") is None
+    assert_kept_but_engines(src, der, ("metrics", "mass_balance", "ground_reactions", "external_reactions"), 2, 4)
+    assert der.find("system") is None
     assert [x.get("file") for x in src.findall("system")] == ["engine-control", "fuel-system", "nws", "autopilot"]
-    for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True):
-        assert same_xml(a, b)
     fc_s, fc_d = src.find("flight_control"), der.find("flight_control")
     assert [(p.text.strip(), p.get("value")) for p in fc_d.findall("property")] == [
         ("/controls/flight/yaw-damper", "0"), ("/controls/flight/rudder-boost", "1")]
@@ -92,14 +89,10 @@ def test_the_ka350_flies_its_own_surfaces_without_engine_or_external_force():
     nothing). No engine; 13319 lb (the pilot emptied); after 50 frames every non-gravity force and moment is
     aerodynamic."""
     spec = aircraft("ka350")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.2443), "fcs/left-aileron-pos-rad": (1, 0.4363),
+                               "fcs/right-aileron-pos-rad": (1, -0.2618), AILERON: (1, 0.34905),
+                               "fcs/rudder-pos-rad": (2, 0.4363)}, up=0.3491, alpha_deg=0.0)
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(13319.0)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.2443, rel=1e-9)
-    assert _state(cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.3491, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.4363, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.2618, rel=1e-9)
-    assert fdm[AILERON] == pytest.approx(-0.4 * 0.34905, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363, rel=1e-9)
     yawing = ic_state(spec, 0.0, 0.0, (0.0, 0.0, 0.2), r_rad_s=0.1)
     assert yawing["fcs/yaw-damper-cmd"] == 0.0 and yawing["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.4363)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.3491, 1 / 0.34905, 1 / 0.4363))
@@ -120,33 +113,13 @@ def test_the_ka350_is_statically_stable_and_its_controls_act_as_its_xml_says():
       (Roll_rudder 0.018, Side_rudder 0.16 through the arm); Cl_beta -0.0771 at alpha 0 and -0.0976 at 6 deg
       (Roll_beta's table, -0.085 and -0.106, and the side force -0.60 beta through the 11-in arm); Cn_beta 0.0947.
     """
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-        return (fdm["moments/m-aero-lbsft"] - fdm["aero/moment/Pitch_alphadot"]) / qsc, fdm
-
-    (c_4, _), (c0, f0), (c4, _), (c8, _) = cm(-4.0), cm(0.0), cm(4.0), cm(8.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert f0["velocities/mach"] == pytest.approx(0.315, abs=0.002)
-    assert slope(c_4, c0) == pytest.approx(-0.774, abs=0.005) and slope(c0, c4) == pytest.approx(-0.805, abs=0.005)
-    assert slope(c4, c8) == pytest.approx(-0.738, abs=0.005) and c0 == pytest.approx(0.036, abs=0.002)
-    for c in (0.3, -0.3):
-        c1, f1 = cm(0.0, c)
-        assert (c1 - c0) / f1["fcs/elevator-pos-rad"] == pytest.approx(-1.398, abs=0.006)
-
-    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
-        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds), aileron=AILERON)
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for c in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, c, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.100, abs=1e-4) and (n1 - n0) / a1 == pytest.approx(-0.0082, abs=1e-4)
-        l2, n2, _, r2 = lat((0.0, 0.0, c))
-        assert (n2 - n0) / r2 == pytest.approx(-0.0949, abs=2e-4) and (l2 - l0) / r2 == pytest.approx(0.0161, abs=2e-4)
-    for a, clb in ((0.0, -0.0771), (6.0, -0.0976)):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(alpha=a, beta=4.0)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0947, abs=5e-4), a
-
+    spec = aircraft("ka350")
+    assert _state()["velocities/mach"] == pytest.approx(0.315, abs=0.002)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.774, abs=0.005)), (0.0, 4.0, approx(-0.805, abs=0.005)),
+                                    (4.0, 8.0, approx(-0.738, abs=0.005))),
+                             ((0.3, approx(-1.398, abs=0.006)), (-0.3, approx(-1.398, abs=0.006))),
+                             cm_at={0.0: approx(0.036, abs=0.002)}, term="aero/moment/Pitch_alphadot")
+    assert_lateral_derivatives(spec, (approx(0.100, abs=1e-4), approx(-0.0082, abs=1e-4)),
+                               (approx(-0.0949, abs=2e-4), approx(0.0161, abs=2e-4)),
+                               {0.0: (approx(-0.0771, abs=5e-4), approx(0.0947, abs=5e-4)),
+                                6.0: (approx(-0.0976, abs=5e-4), approx(0.0947, abs=5e-4))}, aileron_prop=AILERON)

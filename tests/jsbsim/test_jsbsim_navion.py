@@ -32,15 +32,15 @@ is a tuning aircraft since.
 """
 
 import dataclasses
-import json
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_deflections_map_back, bare_xml, check_direct_fcs, checked_in_model, \
-    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
+from pytest import approx
+from truth_fits import assert_deflections_map_back, assert_kept_but_engines, assert_lateral_derivatives, \
+    assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, check_direct_fcs, \
+    checked_in_model, ic_state
 
 SRC = "data/jsbsim_models/navion/L17.xml"
 SRC_SHA256 = "4472cb86623b4fc6529381a270f09d722d52d352428787d93610d349aa23ccbf"
@@ -54,17 +54,8 @@ def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
 def _stock_state(alpha_deg, beta_deg, cmds):
     """The wheel's stock ``L17`` at the same initial condition as :func:`_state` (``fcs/flaps-pos-deg``, which its
     flap normaliser reads and nothing writes, created at 0 before ``run_ic``; its engine present, stopped)."""
-    from benchmarks.jsbsim_harness import FlightConfig
-    from benchmarks.jsbsim_harness.flight import _set_ic, load_model
-
-    spec = dataclasses.replace(aircraft("navion"), model="L17")
-    fdm = load_model(spec, 1 / 200)
-    fdm["fcs/flaps-pos-deg"] = 0.0
-    _set_ic(fdm, spec, FlightConfig("navion", turbulence="none"))
-    fdm["ic/alpha-deg"], fdm["ic/beta-deg"] = alpha_deg, beta_deg
-    fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
-    fdm.run_ic()
-    return fdm
+    return ic_state(dataclasses.replace(aircraft("navion"), model="L17"), alpha_deg, beta_deg, cmds,
+                    props=("fcs/flaps-pos-deg",))
 
 
 def test_the_derivation_removes_the_engine_and_repoints_the_flap_normaliser():
@@ -75,10 +66,7 @@ def test_the_derivation_removes_the_engine_and_repoints_the_flap_normaliser():
     the derived XML's hash."""
     src, der, spec = checked_in_model("navion", "Navion_glide", SRC, 24580, SRC_SHA256)
     ET.indent(src, space=" ")
-    for tag in ("metrics", "mass_balance", "ground_reactions", "aerodynamics"):
-        assert same_xml(src.find(tag), der.find(tag)), tag
-    assert len(src.findall("propulsion/engine")) == 1 and der.find("propulsion/engine") is None
-    assert [same_xml(a, b) for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"))] == [True] * 2
+    assert_kept_but_engines(src, der, ("metrics", "mass_balance", "ground_reactions", "aerodynamics"), 1, 2)
     assert [c.tag for c in der] == [c.tag for c in src]
     fc_s, fc_d = src.find("flight_control"), der.find("flight_control")
     norm = [c for c in fc_s.iter("aerosurface_scale") if c.get("name") == "Flap Position Normalizer"]
@@ -93,13 +81,7 @@ def test_the_derived_aerodynamics_are_the_stock_models():
     """At three states (alpha, sideslip, the three commands), JSBSim's aerodynamic forces and moments of
     ``Navion_glide`` equal those of the wheel's stock ``L17`` (its engine stopped, ``fcs/flaps-pos-deg`` at 0) to the
     last bit: the derivation changes no number."""
-    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
-        a, b = _state(alpha, beta, cmds), _stock_state(alpha, beta, cmds)
-        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == 1
-        assert a["fcs/flap-pos-norm"] == b["fcs/flap-pos-norm"] == 0.0
-        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
-                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
-            assert a[k] == b[k], (alpha, k)
+    assert_same_aero_as_stock(_state, _stock_state, 1, zero=("fcs/flap-pos-norm",))
 
 
 def test_the_navion_flies_its_own_surfaces_without_engine_or_external_force():
@@ -128,57 +110,18 @@ def test_the_navion_is_statically_stable_and_its_controls_act_as_its_xml_says():
       alpha 0 and 6 deg (constants).
     """
     spec = aircraft("navion")
-    c = {a: cm_without_alpha_dot(spec, a) for a in (-4.0, 0.0, 4.0, 8.0)}
-    slope = lambda a, b: (c[b] - c[a]) / np.radians(4.0)   # noqa: E731
     assert _state()["velocities/mach"] == pytest.approx(0.2534, abs=0.002)
-    assert slope(-4.0, 0.0) == pytest.approx(-0.678, abs=0.003) and slope(0.0, 4.0) == pytest.approx(-0.719, abs=0.003)
-    assert slope(4.0, 8.0) == pytest.approx(-0.768, abs=0.005) and c[0.0] == pytest.approx(0.0068, abs=0.0005)
-    for cmd, want in ((0.3, -0.836), (-0.3, -0.844)):
-        de = _state(cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
-        assert (cm_without_alpha_dot(spec, 0.0, cmd) - c[0.0]) / de == pytest.approx(want, abs=0.002)
-
-    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
-        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds))
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for cmd in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.1242, abs=2e-4) and (n1 - n0) / a1 == pytest.approx(-0.0035, abs=1e-6)
-        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
-        assert (n2 - n0) / r2 == pytest.approx(-0.072, abs=1e-6) and (l2 - l0) / r2 == pytest.approx(0.0107, abs=1e-6)
-    for a in (0.0, 6.0):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(alpha=a, beta=4.0)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.0871, abs=5e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.071, abs=1e-4), a
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.678, abs=0.003)), (0.0, 4.0, approx(-0.719, abs=0.003)),
+                                    (4.0, 8.0, approx(-0.768, abs=0.005))),
+                             ((0.3, approx(-0.836, abs=0.002)), (-0.3, approx(-0.844, abs=0.002))),
+                             cm_at={0.0: approx(0.0068, abs=0.0005)})
+    beta = (approx(-0.0871, abs=5e-4), approx(0.071, abs=1e-4))
+    assert_lateral_derivatives(spec, (approx(0.1242, abs=2e-4), approx(-0.0035, abs=1e-6)),
+                               (approx(-0.072, abs=1e-6), approx(0.0107, abs=1e-6)), {0.0: beta, 6.0: beta})
 
 
 def test_summaries_mark_no_aircraft_untouched_the_navion_included(tmp_path):
     """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the navion bare, as every other aircraft
     (synthetic rows): the twenty-seventh session moved it to tuning, the twenty-eighth the fokker50, and no aircraft is
     "(untouched)" or "(held out)" until the next one is added."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion", "fokker50")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    for ac in acs:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| navion | clean |") for ln in lines)
-    assert any(ln.startswith("| dr1 | clean |") for ln in lines)
-    assert any(ln.startswith("| fokker50 | clean |") for ln in lines)
-    assert not any("(untouched)" in ln for ln in lines)
+    assert_summaries_label_bare(tmp_path, "fokker50", ("navion", "dr1", "fokker50"))

@@ -28,12 +28,12 @@ No pipeline fit, GP, diagnosis or scoring runs here.
 import hashlib
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from benchmarks.jsbsim_harness.logfile import _REPO
-from truth_fits import check_direct_fcs, cm_without_alpha_dot, ic_state
+from pytest import approx
+from truth_fits import assert_pitch_derivatives, check_direct_fcs, ic_state, lateral_coefficients
 
 SOURCE = _REPO / "data" / "jsbsim_models" / "rascal" / "Rascal110-JSBSim.xml"
 SOURCE_SHA256 = "d5b9e7435e3a04d7f8c4d3e37b6ecb9ca4865f98e17d38a50177e5a86d41dd20"   # README.md's
@@ -97,19 +97,10 @@ def test_the_rascal_is_statically_stable_and_yaws_adversely():
     - **Yaw:** Cn per rad of left aileron -0.030 (its Cnda: adverse yaw, Cn_delta_a +0.03 in the
       project's sign). Cn at rest is its Cndi, +0.0007.
     """
-    def cm(alpha, de=0.0):
-        return cm_without_alpha_dot(aircraft("rascal"), alpha, de)
+    assert_pitch_derivatives(aircraft("rascal"), ((0.0, 4.0, approx(-0.79, abs=0.02)),
+                                                  (4.0, 8.0, approx(-0.65, abs=0.02))),
+                             ((-0.5, approx(-0.53, abs=0.01)),), alpha_e=4.0, travel=(0.35, 0.30))
 
-    c0, c4, c8 = cm(0.0), cm(4.0), cm(8.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(c0, c4) == pytest.approx(-0.79, abs=0.02) and slope(c4, c8) == pytest.approx(-0.65, abs=0.02)
-    assert (cm(4.0, -0.5) - c4) / (-0.5 * 0.35) == pytest.approx(-0.53, abs=0.01)
-
-    def cn(cmd):
-        fdm = _state(alpha_deg=2.0, cmds=(0.0, cmd, 0.0))
-        return fdm["moments/n-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/bw-ft"]), \
-            fdm["fcs/left-aileron-pos-rad"]
-
-    (n0, l0), (n1, l1) = cn(0.0), cn(0.4)
-    assert (n1 - n0) / (l1 - l0) == pytest.approx(-0.03, rel=1e-6) and n0 == pytest.approx(0.0007, rel=1e-6)
-
+    (_, n0, a0, _), (_, n1, a1, _) = (lateral_coefficients(_state(alpha_deg=2.0, cmds=(0.0, c, 0.0)))
+                                      for c in (0.0, 0.4))
+    assert (n1 - n0) / (a1 - a0) == pytest.approx(-0.03, rel=1e-6) and n0 == pytest.approx(0.0007, rel=1e-6)

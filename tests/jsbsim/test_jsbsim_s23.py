@@ -29,15 +29,15 @@ a tuning aircraft since.
 
 import dataclasses
 import hashlib
-import json
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, bare_xml, checked_in_model, \
-    cm_without_alpha_dot, ic_state, lateral_coefficients, same_xml
+from pytest import approx
+from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_kept_but_engines, \
+    assert_lateral_derivatives, assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, \
+    bare_xml, checked_in_model, ic_state, surface_state
 
 SRC = "data/jsbsim_models/shorts23/Short_S23.xml"
 SRC_SHA256 = "b4ba55cceeaca5057bacfb59b510bf3bdc8e9ea19efbd007904700ab2439282f"
@@ -69,15 +69,11 @@ def test_the_derivation_removes_the_engines_water_forces_and_systems_and_inlines
     aero = ET.fromstring(raw)
     ET.indent(src, space=" ")
     ET.indent(aero, space=" ")
-    for tag in ("metrics", "mass_balance", "ground_reactions", "flight_control"):
-        assert same_xml(src.find(tag), der.find(tag)), tag
-    assert der.find("propulsion/engine") is None and der.find("system") is None
-    assert der.find("external_reactions") is None and len(src.findall("propulsion/engine")) == 4
+    assert_kept_but_engines(src, der, ("metrics", "mass_balance", "ground_reactions", "flight_control"), 4, 12)
+    assert der.find("system") is None and der.find("external_reactions") is None
     assert [x.get("file") for x in src.findall("system")] == [
         "hydrodynamics", "hydrodynamic-planing-floats", "Short_S23-hydrodynamics", "sperry-a2-autopilot",
         "take-off-ap", "engines", "fuel-system", "electrical", "flaps"]
-    for a, b in zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True):
-        assert same_xml(a, b)
     assert [c.tag for c in der] == [c.tag for c in src if c.tag not in ("external_reactions", "system")]
     d_aero = der.find("aerodynamics")
     assert d_aero.get("file") is None and d_aero[0].get("name") == ELEVATOR_ALIAS
@@ -96,12 +92,7 @@ def test_the_derived_aerodynamics_are_the_stock_models():
     """At three states (alpha, sideslip, the three commands), JSBSim's aerodynamic forces and moments of
     ``ShortS23_glide`` equal those of the wheel's stock ``Short_S23`` (four windmilling engines, its systems idle)
     to the last bit: the derivation changes no number."""
-    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
-        a, b = _state(alpha, beta, cmds), _state(alpha, beta, cmds, model="Short_S23")
-        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == 4
-        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
-                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
-            assert a[k] == b[k], (alpha, k)
+    assert_same_aero_as_stock(_state, lambda *a: _state(*a, model="Short_S23"), 4)
 
 
 def test_the_s23_flies_its_own_surfaces_without_engine_or_external_force():
@@ -111,12 +102,10 @@ def test_the_s23_flies_its_own_surfaces_without_engine_or_external_force():
     seats and the engines' oil emptied); after 50 frames every non-gravity force and moment is aerodynamic and the
     external forces are 0."""
     spec = aircraft("s23")
-    fdm = _state(beta_deg=4.0, cmds=(0.3, -0.4, 0.2))
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.3142), "fcs/left-aileron-pos-rad": (1, 0.3403),
+                               "fcs/right-aileron-pos-rad": (1, 0.3403), "fcs/rudder-pos-rad": (2, 0.3927)},
+                        alpha_deg=0.0, rel=1e-6)
     assert fdm.get_propulsion().get_num_engines() == 0 and fdm["inertia/weight-lbs"] == pytest.approx(33685.7, abs=0.1)
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.3142, rel=1e-6)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(-0.4 * 0.3403, rel=1e-6)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.3927, rel=1e-6)
     assert spec.cmd_per_rad == pytest.approx((1 / 0.3142, 1 / 0.3403, 1 / 0.3927))
     assert_deflections_map_back(spec)
     assert_aero_is_the_only_force(fdm, 10000.0, external_zero=True)
@@ -135,56 +124,20 @@ def test_the_s23_is_statically_stable_and_its_controls_act_as_its_tables_say():
       reference point's height), Cn_beta 0.069 and 0.068 (Cnb's table).
     """
     spec = aircraft("s23")
-    c = {a: cm_without_alpha_dot(spec, a) for a in (-4.0, 0.0, 4.0, 8.0)}
-    slope = lambda a, b: (c[b] - c[a]) / np.radians(4.0)   # noqa: E731
     assert _state()["velocities/mach"] == pytest.approx(0.2395, abs=0.002)
-    assert slope(-4.0, 0.0) == pytest.approx(-0.530, abs=0.005) and slope(0.0, 4.0) == pytest.approx(-0.546, abs=0.005)
-    assert slope(4.0, 8.0) == pytest.approx(-0.809, abs=0.005) and c[0.0] == pytest.approx(0.048, abs=0.002)
-    for cmd in (0.3, -0.3):
-        de = _state(cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
-        assert (cm_without_alpha_dot(spec, 0.0, cmd) - c[0.0]) / de == pytest.approx(-1.076, abs=0.006)
-
-    def lat(cmds=(0.0, 0.0, 0.0), alpha=0.0, beta=0.0):
-        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds))
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for cmd in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.1216, abs=2e-4) and (n1 - n0) / a1 == pytest.approx(-0.0098, abs=2e-4)
-        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
-        assert (n2 - n0) / r2 == pytest.approx(-0.060, abs=1e-6) and abs(l2 - l0) < 1e-9
-    for a, clb, cnb in ((0.0, -0.1281, 0.0692), (6.0, -0.1206, 0.0681)):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(alpha=a, beta=4.0)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(cnb, abs=5e-4), a
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.530, abs=0.005)), (0.0, 4.0, approx(-0.546, abs=0.005)),
+                                    (4.0, 8.0, approx(-0.809, abs=0.005))),
+                             ((0.3, approx(-1.076, abs=0.006)), (-0.3, approx(-1.076, abs=0.006))),
+                             cm_at={0.0: approx(0.048, abs=0.002)})
+    # ClDr and CyDr are 0: the rudder's Cl per rad within 1e-9 (|dCl| < 1.2e-10; the check was |dCl| < 1e-9)
+    assert_lateral_derivatives(spec, (approx(0.1216, abs=2e-4), approx(-0.0098, abs=2e-4)),
+                               (approx(-0.060, abs=1e-6), approx(0.0, abs=1e-9)),
+                               {0.0: (approx(-0.1281, abs=5e-4), approx(0.0692, abs=5e-4)),
+                                6.0: (approx(-0.1206, abs=5e-4), approx(0.0681, abs=5e-4))})
 
 
 def test_summaries_mark_no_aircraft_untouched_the_s23_included(tmp_path):
     """The markdown summaries of eval_jsbsim and eval_jsbsim_diagnose label the s23 bare, as every other aircraft
     (synthetic rows): the twenty-fifth session moved it to tuning, and no aircraft is "(untouched)" or "(held out)"
     until the next one is added."""
-    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
-    from gcs_sysid.aero.table import COEFFICIENTS
-
-    def row(ac):
-        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
-        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
-                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
-
-    acs = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20", "iar80",
-           "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23")
-    p = tmp_path / "r.jsonl"
-    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
-    lines = eval_jsbsim.summarize([str(p)]).splitlines()
-    for ac in acs:
-        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
-    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
-    d = tmp_path / "d.jsonl"
-    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
-                         for ac in acs))
-    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
-    assert any(ln.startswith("| s23 | clean |") for ln in lines)
-    assert any(ln.startswith("| ka350 | clean |") for ln in lines)
-    assert not any("(untouched)" in ln for ln in lines)
+    assert_summaries_label_bare(tmp_path, "s23", ("s23", "ka350"))

@@ -25,10 +25,10 @@ import dataclasses
 import xml.etree.ElementTree as ET
 
 import numpy as np
-import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft
-from truth_fits import check_direct_fcs, cm_without_alpha_dot, ic_state, lateral_coefficients
+from pytest import approx
+from truth_fits import assert_lateral_derivatives, assert_pitch_derivatives, check_direct_fcs, ic_state
 
 FT = 0.3048
 
@@ -71,28 +71,14 @@ def test_the_sgs126_is_statically_stable_and_yaws_adversely():
       -0.03 (Cndr); Cn_beta 0.12; Cl_beta -0.1137 (Clb -0.1 plus the side force, CYb -1, acting 6.4 in
       above the CG). Cn and Cl at rest are 0.
     """
-    def cm(alpha, de=0.0):
-        return cm_without_alpha_dot(aircraft("sgs126"), alpha, de)
-
-    c0, c4, c8 = cm(0.0), cm(4.0), cm(8.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(c0, c4) == pytest.approx(-0.56, abs=0.02) and slope(c4, c8) == pytest.approx(-0.65, abs=0.02)
-    assert (cm(4.0, -0.5) - c4) / (-0.5 * 0.35) == pytest.approx(-0.78, abs=0.01)
-    assert (cm(4.0, 0.5) - c4) / (0.5 * 0.30) == pytest.approx(-0.78, abs=0.01)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0):
-        fdm = _state(alpha_deg=2.0, beta_deg=beta, cmds=cmds)
-        return lateral_coefficients(fdm)
-
-    (l0, n0, a0, _), (l1, n1, a1, _) = lat(), lat((0.0, 0.4, 0.0))
-    assert abs(l0) < 1e-12 and abs(n0) < 1e-12
-    assert (l1 - l0) / (a1 - a0) == pytest.approx(0.0585, rel=0.01)
-    assert (n1 - n0) / (a1 - a0) == pytest.approx(-0.02, rel=1e-6)
-    l2, n2, _, r2 = lat((0.0, 0.0, 0.4))
-    assert (n2 - n0) / r2 == pytest.approx(-0.03, rel=1e-6)
-    l3, n3, _, _ = lat(beta=4.0)
-    assert (n3 - n0) / np.radians(4.0) == pytest.approx(0.12, rel=1e-3)
-    assert (l3 - l0) / np.radians(4.0) == pytest.approx(-0.1137, rel=0.01)
+    spec = aircraft("sgs126")
+    assert_pitch_derivatives(spec, ((0.0, 4.0, approx(-0.56, abs=0.02)), (4.0, 8.0, approx(-0.65, abs=0.02))),
+                             ((-0.5, approx(-0.78, abs=0.01)), (0.5, approx(-0.78, abs=0.01))), alpha_e=4.0,
+                             travel=(0.35, 0.30))
+    assert_lateral_derivatives(spec, (approx(0.0585, rel=0.01), approx(-0.02, rel=1e-6)),
+                               (approx(-0.03, rel=1e-6), None),
+                               {2.0: (approx(-0.1137, rel=0.01), approx(0.12, rel=1e-3))},
+                               alpha_deg=2.0, rest=1e-12, aileron_cmds=(0.4,), rudder_cmds=(0.4,))
 
 
 def test_turbulence_levels_at_its_altitude():

@@ -25,12 +25,10 @@ All of them but the names are slow.
 No pipeline fit, GP, diagnosis or scoring ran on the ultrastick before the eighteenth session's final evaluation.
 """
 
-import numpy as np
-import pytest
-
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import (assert_openflightsim_assembly, assert_openflightsim_direct_surfaces, ic_state,
-                        lateral_coefficients)
+from pytest import approx
+from truth_fits import assert_lateral_derivatives, assert_openflightsim_assembly, \
+    assert_openflightsim_direct_surfaces, assert_pitch_derivatives
 
 DIR = "data/jsbsim_models/ultrastick120"
 #: file -> (bytes, SHA-256), as the README lists them.
@@ -42,11 +40,6 @@ FILES = {
     "Gear.xml": (1702, "fbfa16e648947d212bbcbd28e1ebb94a3d8bab3d4fc9b88d52455bf134b02c7b"),
 }
 SURFACE = 0.5235987755982988      # every surface's end, rad (the lab's actuator clip, 30 deg)
-
-
-def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the ultrastick (45 kt at 10000 ft)."""
-    return ic_state(aircraft("ultrastick"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 
 def test_the_derivation_assembles_the_files_and_changes_no_number():
@@ -86,30 +79,12 @@ def test_the_ultrastick_is_statically_stable_and_its_controls_act_as_its_tables_
       its ``dCMl__beta_rad`` table), Cn_beta 0.068-0.075.
     """
     spec = aircraft("ultrastick")
-
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        return fdm["moments/m-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"])
-
-    cm_4, c0, c4 = cm(-4.0), cm(0.0), cm(4.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    assert slope(cm_4, c0) == pytest.approx(-0.930, abs=0.01) and slope(c0, c4) == pytest.approx(-0.695, abs=0.01)
-    for c in (-0.3, 0.3):
-        assert (cm(2.0, c) - cm(2.0)) / (c * SURFACE) == pytest.approx(-1.196, abs=0.005)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
-        fdm = _state(alpha_deg=alpha, beta_deg=beta, cmds=cmds)
-        return lateral_coefficients(fdm, aileron="fcs/posAilL_rad")
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-5 and abs(n0) < 1e-5
-    for c in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, c, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.2172, abs=1e-3) and (n1 - n0) / a1 == pytest.approx(-0.0038, abs=3e-4)
-    l2, n2, _, r2 = lat((0.0, 0.0, 0.3))
-    assert (n2 - n0) / r2 == pytest.approx(-0.0392, abs=5e-4) and (l2 - l0) / r2 == pytest.approx(-0.0037, abs=5e-4)
-    for a, clb, cnb in ((-2.0, 0.0213, 0.0680), (2.0, -0.0164, 0.0683), (6.0, -0.0374, 0.0745)):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(beta=4.0, alpha=a)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(clb, abs=5e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(cnb, abs=5e-4), a
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, approx(-0.930, abs=0.01)), (0.0, 4.0, approx(-0.695, abs=0.01))),
+                             ((-0.3, approx(-1.196, abs=0.005)), (0.3, approx(-1.196, abs=0.005))), alpha_e=2.0,
+                             travel=(SURFACE, SURFACE), term=None)
+    assert_lateral_derivatives(spec, (approx(0.2172, abs=1e-3), approx(-0.0038, abs=3e-4)),
+                               (approx(-0.0392, abs=5e-4), approx(-0.0037, abs=5e-4)),
+                               {-2.0: (approx(0.0213, abs=5e-4), approx(0.0680, abs=5e-4)),
+                                2.0: (approx(-0.0164, abs=5e-4), approx(0.0683, abs=5e-4)),
+                                6.0: (approx(-0.0374, abs=5e-4), approx(0.0745, abs=5e-4))},
+                               alpha_deg=2.0, rest=1e-5, rudder_cmds=(0.3,), aileron_prop="fcs/posAilL_rad")

@@ -26,12 +26,12 @@ No pipeline fit, GP, diagnosis or scoring ran on the us25e before its final eval
 is a tuning aircraft since.
 """
 
-import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import aircraft
-from truth_fits import (assert_openflightsim_assembly, assert_openflightsim_direct_surfaces, ic_state,
-                        lateral_coefficients)
+from pytest import approx
+from truth_fits import assert_lateral_derivatives, assert_openflightsim_assembly, \
+    assert_openflightsim_direct_surfaces, assert_pitch_derivatives, ic_state
 
 DIR = "data/jsbsim_models/ultrastick25e"
 #: file -> (bytes, SHA-256), as the README lists them.
@@ -43,11 +43,6 @@ FILES = {
     "Gear.xml": (1677, "7330a6bf1a1fca3f33c260eeb334cd094700c2c65fd4c8caf928526c61cefc9d"),
 }
 SURFACE = 0.5235987755982988      # every surface's end, rad (the lab's actuator clip, 30 deg)
-
-
-def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the us25e."""
-    return ic_state(aircraft("us25e"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 
 def test_the_derivation_assembles_the_files_and_changes_no_number():
@@ -69,7 +64,7 @@ def test_the_us25e_flies_direct_surfaces_without_engine_or_external_force():
     -left); the flaps stay 0. No engine; after 50 frames every non-gravity force and moment is aerodynamic (1.959
     kg: 4.32 lb). A yaw rate does not move the rudder."""
     assert_openflightsim_direct_surfaces("us25e", SURFACE, 1.0)
-    assert _state()["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
+    assert ic_state(aircraft("us25e"), 2.0)["inertia/weight-lbs"] == pytest.approx(1.959 / 0.45359237, rel=1e-6)
 
 
 def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_say():
@@ -85,31 +80,14 @@ def test_the_us25e_is_statically_stable_and_its_controls_act_as_its_constants_sa
       -0.1811 and the rudder's side force through the arm) and Cl +0.0115; Cl_beta -0.0545 and Cn_beta 0.0704
       (``dCMn__beta`` 0.0723 less the side force's arm), the same at every alpha (constants).
     """
-    def cm(alpha, de=0.0):
-        fdm = _state(alpha_deg=alpha, cmds=(de, 0.0, 0.0))
-        return fdm["moments/m-aero-lbsft"] / (fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"])
-
-    c_4, c0, c4, c8 = cm(-4.0), cm(0.0), cm(4.0), cm(8.0)
-    slope = lambda a, b: (b - a) / np.radians(4.0)   # noqa: E731
-    for a, b in ((c_4, c0), (c0, c4), (c4, c8)):
-        assert slope(a, b) == pytest.approx(-0.641, abs=0.003)
-    assert _state(alpha_deg=0.0)["aero/coefficient/CMm"] == pytest.approx(-0.0278, abs=1e-9)
-    for c in (-0.3, 0.3):
-        assert (cm(2.0, c) - cm(2.0)) / (c * SURFACE) == pytest.approx(-0.847, abs=0.002)
-
-    def lat(cmds=(0.0, 0.0, 0.0), beta=0.0, alpha=2.0):
-        return lateral_coefficients(_state(alpha_deg=alpha, beta_deg=beta, cmds=cmds), aileron="fcs/posAilL_rad")
-
-    l0, n0, _, _ = lat()
-    assert abs(l0) < 1e-9 and abs(n0) < 1e-9
-    for c in (0.3, -0.3):
-        l1, n1, a1, _ = lat((0.0, c, 0.0))
-        assert (l1 - l0) / a1 == pytest.approx(0.1646, abs=1e-4) and (n1 - n0) / a1 == pytest.approx(-0.0574, abs=1e-4)
-        l2, n2, _, r2 = lat((0.0, 0.0, c))
-        assert (n2 - n0) / r2 == pytest.approx(-0.1804, abs=2e-4) and (l2 - l0) / r2 == pytest.approx(0.0115, abs=1e-4)
-    for a in (-2.0, 2.0, 6.0):
-        lb, nb, _, _ = lat(alpha=a)
-        l3, n3, _, _ = lat(beta=4.0, alpha=a)
-        assert (l3 - lb) / np.radians(4.0) == pytest.approx(-0.0545, abs=1e-4), a
-        assert (n3 - nb) / np.radians(4.0) == pytest.approx(0.0704, abs=3e-4), a
-
+    spec = aircraft("us25e")
+    per_rad = approx(-0.641, abs=0.003)
+    assert_pitch_derivatives(spec, ((-4.0, 0.0, per_rad), (0.0, 4.0, per_rad), (4.0, 8.0, per_rad)),
+                             ((-0.3, approx(-0.847, abs=0.002)), (0.3, approx(-0.847, abs=0.002))), alpha_e=2.0,
+                             travel=(SURFACE, SURFACE), term=None)
+    assert ic_state(spec, 0.0)["aero/coefficient/CMm"] == pytest.approx(-0.0278, abs=1e-9)
+    beta = (approx(-0.0545, abs=1e-4), approx(0.0704, abs=3e-4))
+    assert_lateral_derivatives(spec, (approx(0.1646, abs=1e-4), approx(-0.0574, abs=1e-4)),
+                               (approx(-0.1804, abs=2e-4), approx(0.0115, abs=1e-4)),
+                               {-2.0: beta, 2.0: beta, 6.0: beta},
+                               alpha_deg=2.0, aileron_prop="fcs/posAilL_rad")

@@ -1,5 +1,14 @@
 """Checks of a JSBSim flight's exact truth shared by the harness tests: least-squares derivatives,
-the rigid body, the decoded log, the hidden effects in JSBSim's own properties, the evaluation's flights."""
+the rigid body, the decoded log, the hidden effects in JSBSim's own properties, the evaluation's flights.
+
+The per-aircraft tests (``test_jsbsim_<name>.py``) share the checks of JSBSim's own properties at the harness's
+initial condition (:func:`ic_state`, no turbulence, nothing flown): the FCS (:func:`surface_state`,
+:func:`check_direct_fcs`, :func:`assert_aileron_maps_back`, :func:`assert_deflections_map_back`), static stability
+and control (:func:`assert_pitch_derivatives`, :func:`assert_lateral_derivatives`: each test passes its own numbers
+and tolerances as ``pytest.approx``), the derivation (:func:`assert_kept_but_engines`, against the stock model
+:func:`assert_same_aero_as_stock`) and the summaries' labels (:func:`assert_summaries_label_bare`); twenty-eighth
+session, folded from sixteen files' copies with every assertion and tolerance kept.
+"""
 
 import numpy as np
 
@@ -153,15 +162,19 @@ def rigid_body_residual(truth: dict, inertia: np.ndarray) -> np.ndarray:
     return np.sqrt(np.mean((rhs - M) ** 2, 0)) / np.sqrt(np.mean(M ** 2, 0))
 
 
-def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
+def ic_state(spec, alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0, props=()):
     """JSBSim (``FGFDMExec``) at the harness's initial condition for ``spec`` with the given alpha and
     sideslip (deg), yaw rate (rad/s) and fixed normalised commands ``cmds`` (elevator, aileron,
-    rudder), after ``run_ic``: the FCS evaluated once, nothing integrated (the f4n's and rascal's
-    checks of their FCS and static stability)."""
+    rudder), after ``run_ic``: the FCS evaluated once, nothing integrated (the per-aircraft tests'
+    checks of their FCS and static stability). ``props``: properties created at 0 before the initial
+    condition (the FlightGear properties a stock wheel model reads and nothing writes, without which
+    ``run_ic`` fails: the navion's, dr1's and fokker50's stock models)."""
     from benchmarks.jsbsim_harness import FlightConfig
     from benchmarks.jsbsim_harness.flight import _set_ic, load_model
 
     fdm = load_model(spec, 1 / 200)
+    for k in props:
+        fdm[k] = 0.0
     _set_ic(fdm, spec, FlightConfig(spec.name, turbulence="none"))
     fdm["ic/alpha-deg"], fdm["ic/beta-deg"], fdm["ic/r-rad_sec"] = alpha_deg, beta_deg, r_rad_s
     fdm["fcs/elevator-cmd-norm"], fdm["fcs/aileron-cmd-norm"], fdm["fcs/rudder-cmd-norm"] = cmds
@@ -185,33 +198,164 @@ def lateral_coefficients(fdm, aileron: str = "fcs/left-aileron-pos-rad",
     return fdm["moments/l-aero-lbsft"] / qsb, fdm["moments/n-aero-lbsft"] / qsb, fdm[aileron], fdm[rudder]
 
 
-def cm_without_alpha_dot(spec, alpha_deg: float, elevator_cmd: float = 0.0) -> float:
+def cm_without_alpha_dot(spec, alpha_deg: float, elevator_cmd: float = 0.0,
+                         term: str | None = "aero/coefficient/Cmadot") -> float:
     """JSBSim's pitching-moment coefficient about the CG at :func:`ic_state` (``alpha_deg`` of alpha, the
-    normalised elevator command ``elevator_cmd``) less its ``Cmadot`` term (``run_ic`` gives an alpha-dot the
-    term reads): the static Cm the rascal's and sgs126's stability checks difference over alpha and elevator."""
+    normalised elevator command ``elevator_cmd``) less its alpha-dot term ``term`` (``run_ic`` gives an alpha-dot
+    the term reads; ``aero/moment/Pitch_alphadot`` in Aeromatic's models, None where the model has none): the
+    static Cm the stability checks (:func:`assert_pitch_derivatives`) difference over alpha and elevator."""
     fdm = ic_state(spec, alpha_deg=alpha_deg, cmds=(elevator_cmd, 0.0, 0.0))
     qsc = fdm["aero/qbar-psf"] * fdm["metrics/Sw-sqft"] * fdm["metrics/cbarw-ft"]
-    return (fdm["moments/m-aero-lbsft"] - fdm["aero/coefficient/Cmadot"]) / qsc
+    m = fdm["moments/m-aero-lbsft"]
+    if term is not None:
+        m -= fdm[term]
+    return m / qsc
+
+
+def assert_pitch_derivatives(spec, slopes, elevator, *, cm_at=None, alpha_e: float = 0.0, travel=None,
+                             term: str | None = "aero/coefficient/Cmadot") -> None:
+    """``spec``'s static pitch from JSBSim at fixed surfaces (:func:`cm_without_alpha_dot`, no turbulence): the
+    stability and elevator checks of the per-aircraft tests (``test_jsbsim_<name>.py``).
+
+    Args:
+        spec: the harness ``AircraftSpec``.
+        slopes: ``((alpha_a, alpha_b, want), ...)``, deg and 1/rad: ``(Cm(alpha_b) - Cm(alpha_a)) /
+            (alpha_b - alpha_a)`` must equal ``want`` (a ``pytest.approx``: its tolerance is the test's).
+        elevator: ``((cmd, want), ...)``: at alpha ``alpha_e`` (deg), ``(Cm(cmd) - Cm(0)) / delta_e`` per rad
+            of the elevator must equal ``want``, ``delta_e`` the FCS's ``fcs/elevator-pos-rad`` at that command
+            or, with ``travel = (up, down)`` (rad per unit command), ``cmd * up`` for a negative command and
+            ``cmd * down`` otherwise (the surface's end as the model's XML gives it).
+        cm_at: ``{alpha_deg: want}``: Cm at those alphas.
+        term: the alpha-dot term left out (:func:`cm_without_alpha_dot`).
+
+    Raises:
+        AssertionError: the first check that fails, with the alphas or command in its message.
+    """
+    memo = {}
+
+    def cm(alpha, cmd=0.0):
+        if (alpha, cmd) not in memo:
+            memo[alpha, cmd] = cm_without_alpha_dot(spec, alpha, cmd, term)
+        return memo[alpha, cmd]
+
+    for a, b, want in slopes:
+        assert (cm(b) - cm(a)) / np.radians(b - a) == want, (a, b)
+    for a, want in (cm_at or {}).items():
+        assert cm(a) == want, a
+    for cmd, want in elevator:
+        if travel is None:
+            de = ic_state(spec, alpha_e, cmds=(cmd, 0.0, 0.0))["fcs/elevator-pos-rad"]
+        else:
+            de = cmd * (travel[0] if cmd < 0 else travel[1])
+        assert (cm(alpha_e, cmd) - cm(alpha_e)) / de == want, cmd
+
+
+def assert_lateral_derivatives(spec, aileron, rudder, beta, *, alpha_deg: float = 0.0, rest: float = 1e-9,
+                               aileron_cmds=(0.3, -0.3), rudder_cmds=(0.3, -0.3),
+                               aileron_prop: str = "fcs/left-aileron-pos-rad") -> None:
+    """``spec``'s rolling and yawing moments from JSBSim at fixed surfaces (:func:`ic_state`,
+    :func:`lateral_coefficients`, no turbulence): the roll and yaw checks of the per-aircraft tests.
+
+    At rest (``alpha_deg`` of alpha, no sideslip, zero commands) abs(Cl) and abs(Cn) are under ``rest``; the
+    derivatives are the differences from rest per rad of the deflection (or of the sideslip). Each ``want`` is a
+    ``pytest.approx`` (its tolerance is the test's), or None where the test checks nothing.
+
+    Args:
+        spec: the harness ``AircraftSpec``.
+        aileron: ``(Cl_per_rad, Cn_per_rad)`` of the aileron property ``aileron_prop`` (JSBSim's sign: the
+            project's Cl_delta_a and Cn_delta_a have the other), at each command of ``aileron_cmds``.
+        rudder: ``(Cn_per_rad, Cl_per_rad)`` of ``fcs/rudder-pos-rad``, at each command of ``rudder_cmds``.
+        beta: ``{alpha_deg: (Cl_beta, Cn_beta)}``: per rad of 4 deg of sideslip at that alpha, from that alpha's
+            own rest.
+
+    Raises:
+        AssertionError: the first check that fails, with the command or alpha in its message.
+    """
+    def lat(cmds=(0.0, 0.0, 0.0), alpha=alpha_deg, beta_deg=0.0):
+        return lateral_coefficients(ic_state(spec, alpha, beta_deg, cmds), aileron=aileron_prop)
+
+    l0, n0, a0, r0 = lat()
+    assert abs(l0) < rest and abs(n0) < rest, (l0, n0)
+    for cmd in aileron_cmds:
+        l1, n1, a1, _ = lat((0.0, cmd, 0.0))
+        for got, want in zip(((l1 - l0) / (a1 - a0), (n1 - n0) / (a1 - a0)), aileron):
+            assert want is None or got == want, ("aileron", cmd)
+    for cmd in rudder_cmds:
+        l2, n2, _, r2 = lat((0.0, 0.0, cmd))
+        for got, want in zip(((n2 - n0) / (r2 - r0), (l2 - l0) / (r2 - r0)), rudder):
+            assert want is None or got == want, ("rudder", cmd)
+    for a, wants in beta.items():
+        lb, nb, _, _ = lat(alpha=a)
+        l3, n3, _, _ = lat(alpha=a, beta_deg=4.0)
+        for got, want in zip(((l3 - lb) / np.radians(4.0), (n3 - nb) / np.radians(4.0)), wants):
+            assert want is None or got == want, ("beta", a)
+
+
+#: The normalised commands (elevator, aileron, rudder) of the surface checks (:func:`surface_state`).
+SURFACE_CMDS = (0.3, -0.4, 0.2)
+
+
+def surface_state(spec, gains: dict, *, up: float | None = None, alpha_deg: float = 4.0, r_rad_s: float = 0.0,
+                  rel: float = 1e-9):
+    """JSBSim at :func:`ic_state` (``alpha_deg`` of alpha, 4 deg of sideslip, the commands :data:`SURFACE_CMDS`, the
+    yaw rate ``r_rad_s``, rad/s), once its FCS is checked to map each command straight to the surfaces: the
+    per-aircraft tests' FCS checks.
+
+    Args:
+        spec: the harness ``AircraftSpec``.
+        gains: ``{property: (channel, rad per unit command)}``, channel 0 elevator, 1 aileron, 2 rudder: the
+            property must read the channel's command times the gain (to ``rel``; a mirrored surface has a
+            negative gain).
+        up: the elevator's rad per unit command on its trailing-edge-up side, or None: at the command (-0.3, 0, 0)
+            (same alpha, no sideslip, no yaw rate) ``fcs/elevator-pos-rad`` must read -0.3 ``up``.
+
+    Returns:
+        The ``FGFDMExec`` at the commands (:func:`assert_aero_is_the_only_force` runs it on).
+
+    Raises:
+        AssertionError: a surface differs (its property in the message).
+    """
+    import pytest
+
+    fdm = ic_state(spec, alpha_deg, 4.0, SURFACE_CMDS, r_rad_s)
+    for prop, (channel, gain) in gains.items():
+        assert fdm[prop] == pytest.approx(SURFACE_CMDS[channel] * gain, rel=rel), prop
+    if up is not None:
+        assert ic_state(spec, alpha_deg, cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * up,
+                                                                                                         rel=rel)
+    return fdm
 
 
 def check_direct_fcs(spec, min_lift_lbs: float) -> None:
     """Assert that ``spec``'s FCS maps the normalised commands straight to the surfaces its aerodynamics
-    read (elevator -0.35..+0.30 rad, left aileron +-0.35 rad with the right its mirror, rudder +-0.35 rad),
-    that JSBSim has no engine, and that after 50 frames every non-gravity force and moment is aerodynamic
-    with at least ``min_lift_lbs`` of body-z force (the rascal's and sgs126's checks: both fly such an FCS).
+    read (elevator -0.35..+0.30 rad, left aileron +-0.35 rad with the right its mirror, rudder +-0.35 rad,
+    a yaw rate moving nothing: :func:`surface_state`), that JSBSim has no engine, and that after 50 frames
+    every non-gravity force and moment is aerodynamic with at least ``min_lift_lbs`` of body-z force (the
+    rascal's, sgs126's, navion's and fokker50's checks: all fly such an FCS).
 
     Raises:
         AssertionError: the first check that fails."""
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, 0.30), "fcs/left-aileron-pos-rad": (1, 0.35),
+                               "fcs/right-aileron-pos-rad": (1, -0.35), "fcs/rudder-pos-rad": (2, 0.35)},
+                        up=0.35, r_rad_s=0.2)
+    assert fdm.get_propulsion().get_num_engines() == 0
+    assert_aero_is_the_only_force(fdm, min_lift_lbs)
+
+
+def assert_aileron_maps_back(spec, alpha_deg: float) -> None:
+    """The harness's aileron command for 5 deg of the project's delta_a (trailing edge down on the right) through
+    ``spec``'s ``aileron_sign`` and ``cmd_per_rad``, set at :func:`ic_state` (``alpha_deg``), reads back as 5 deg
+    (``flight._deflections``, to 1e-9).
+
+    Raises:
+        AssertionError: the deflection differs."""
     import pytest
 
-    fdm = ic_state(spec, beta_deg=4.0, cmds=(0.3, -0.4, 0.2), r_rad_s=0.2)
-    assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * 0.30, rel=1e-9)
-    assert fdm["fcs/left-aileron-pos-rad"] == pytest.approx(-0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/right-aileron-pos-rad"] == pytest.approx(0.4 * 0.35, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * 0.35, rel=1e-9)
-    assert ic_state(spec, cmds=(-0.3, 0.0, 0.0))["fcs/elevator-pos-rad"] == pytest.approx(-0.3 * 0.35, rel=1e-9)
-    assert_aero_is_the_only_force(fdm, min_lift_lbs)
+    from benchmarks.jsbsim_harness.flight import _deflections
+
+    da = np.radians(5.0)
+    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
+    assert _deflections(ic_state(spec, alpha_deg, 0.0, (0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
 
 
 def assert_deflections_map_back(spec, deltas_deg=(-3.0, 5.0, 4.0)) -> None:
@@ -522,6 +666,22 @@ def same_xml(a, b) -> bool:
     return ET.tostring(a) == ET.tostring(b)
 
 
+def assert_kept_but_engines(src, der, tags, n_engines: int, n_tanks: int) -> None:
+    """The derived model ``der`` keeps the checked-in ``src``'s elements ``tags`` (:func:`same_xml`; ``src`` indented
+    as the derived XML first, ``ET.indent(src, space=" ")``) and its ``n_tanks`` fuel tanks one for one, and has none
+    of ``src``'s ``n_engines`` ``<propulsion><engine>`` (the glide derivations' checks: the fokker50's, navion's,
+    dr1's, s23's and ka350's).
+
+    Raises:
+        AssertionError: an element, an engine count or a tank differs. ValueError: the two have another number of
+            tanks (``zip(strict=True)``)."""
+    for tag in tags:
+        assert same_xml(src.find(tag), der.find(tag)), tag
+    assert len(src.findall("propulsion/engine")) == n_engines and der.find("propulsion/engine") is None
+    tanks = list(zip(src.findall("propulsion/tank"), der.findall("propulsion/tank"), strict=True))
+    assert len(tanks) == n_tanks and all(same_xml(a, b) for a, b in tanks), len(tanks)
+
+
 def bare_xml(e) -> bytes:
     """The element's XML with every text and tail stripped of white space: its content, not its layout (to compare
     a function of a checked-in file with the derived model's, whose indentation ``ET.indent`` rewrote)."""
@@ -618,21 +778,79 @@ def assert_openflightsim_direct_surfaces(name: str, surface_rad: float, min_lift
     Raises:
         AssertionError: the first check that fails.
     """
-    import pytest
-
     from benchmarks.jsbsim_harness import aircraft
-    from benchmarks.jsbsim_harness.flight import _deflections
 
     spec = aircraft(name)
     assert not spec.gear_up and spec.aileron_props == ("fcs/posAilL_rad", "fcs/posAilR_rad")
-    fdm = ic_state(spec, 2.0, 4.0, (0.3, -0.4, 0.2), 0.2)
+    fdm = surface_state(spec, {"fcs/elevator-pos-rad": (0, surface_rad), "fcs/posAilL_rad": (1, surface_rad),
+                               "fcs/posAilR_rad": (1, -surface_rad), "fcs/rudder-pos-rad": (2, surface_rad)},
+                        alpha_deg=2.0, r_rad_s=0.2)
     assert fdm.get_propulsion().get_num_engines() == 0
-    assert fdm["fcs/elevator-pos-rad"] == pytest.approx(0.3 * surface_rad, rel=1e-9)
-    assert fdm["fcs/posAilL_rad"] == pytest.approx(-0.4 * surface_rad, rel=1e-9)
-    assert fdm["fcs/posAilR_rad"] == pytest.approx(0.4 * surface_rad, rel=1e-9)
-    assert fdm["fcs/rudder-pos-rad"] == pytest.approx(0.2 * surface_rad, rel=1e-9)
     assert fdm["fcs/posFlapL_rad"] == 0.0 and fdm["fcs/posFlapR_rad"] == 0.0
-    da = np.radians(5.0)      # trailing edge down on the right
-    cmd = da * spec.aileron_sign * spec.cmd_per_rad[1]
-    assert _deflections(ic_state(spec, 2.0, 0.0, (0.0, cmd, 0.0)), spec)[1] == pytest.approx(da, rel=1e-9)
+    assert_aileron_maps_back(spec, 2.0)
     assert_aero_is_the_only_force(fdm, min_lift_lbs, external_zero=True)
+
+
+#: The roster in the order the aircraft were added, the fokker50 last (the summaries' label tests take prefixes).
+ROSTER_ORDER = ("c172x", "pa28", "j3cub", "c182", "t37", "t6", "b747", "f16", "f4n", "rascal", "sgs126", "asw20",
+                "iar80", "c684", "ultrastick", "b737", "c172p", "eternity", "us25e", "ka350", "s23", "dr1", "navion",
+                "fokker50")
+
+
+def assert_summaries_label_bare(tmp_path, last: str, clean: tuple[str, ...]) -> None:
+    """The markdown summaries of ``eval_jsbsim`` and ``eval_jsbsim_diagnose`` label every aircraft of
+    :data:`ROSTER_ORDER` up to ``last`` bare (synthetic rows of those aircraft alone): no row reads
+    "(untouched)" or "(held out)", every aircraft has its ``| NAME | light`` row in the first, and each of ``clean``
+    its ``| NAME | clean |`` row in the second.
+
+    Args:
+        tmp_path: a folder for the two synthetic .jsonl files.
+        last: the last aircraft of the roster's prefix written.
+        clean: the aircraft whose clean rows the diagnosis summary must show.
+
+    Raises:
+        AssertionError: a label or row differs.
+    """
+    import json
+
+    from benchmarks import eval_jsbsim, eval_jsbsim_diagnose
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    def row(ac):
+        errs = {k: {c: 10.0 for c in COEFFICIENTS} for k in ("meas", "gp", "true", "ls")}
+        return {"aircraft": ac, "turbulence": "light", "aoa": "ahrs", "seed": 1, **errs, "cov_gp": 90.0,
+                "cov_true": 90.0, "alpha_deg": 0.1, "beta_deg": 0.1, "alpha_rms_deg": 1.0, "beta_rms_deg": 1.0}
+
+    acs = ROSTER_ORDER[:ROSTER_ORDER.index(last) + 1]
+    p = tmp_path / "r.jsonl"
+    p.write_text("".join(json.dumps(row(ac)) + "\n" for ac in acs))
+    lines = eval_jsbsim.summarize([str(p)]).splitlines()
+    for ac in acs:
+        assert any(ln.startswith(f"| {ac} | light") for ln in lines), ac
+    assert not any("(held out)" in ln or "(untouched)" in ln for ln in lines)
+    d = tmp_path / "d.jsonl"
+    d.write_text("".join(json.dumps({"aircraft": ac, "seed": 11, "effects": [], "score": {"ok": True}}) + "\n"
+                         for ac in acs))
+    lines = eval_jsbsim_diagnose.summarize([str(d)]).splitlines()
+    for ac in clean:
+        assert any(ln.startswith(f"| {ac} | clean |") for ln in lines), ac
+    assert not any("(untouched)" in ln for ln in lines)
+
+
+def assert_same_aero_as_stock(state, stock_state, n_engines: int, zero=()) -> None:
+    """At three states (alpha 4, -3, 0 deg; sideslip 4, -2, 0 deg; the commands (0.3, -0.4, 0.2), (-0.2, 0.3, -0.5),
+    0), JSBSim's aerodynamic forces and moments of a derived model (``state(alpha, beta, cmds)``, no engine) equal
+    those of the wheel's stock model (``stock_state``, its ``n_engines`` engines stopped) to the last bit (the
+    navion's, s23's and dr1's derivation checks: the derivation changes no number). The properties ``zero`` read 0
+    in both.
+
+    Raises:
+        AssertionError: an engine count, a ``zero`` property or a force or moment differs."""
+    for alpha, beta, cmds in ((4.0, 4.0, (0.3, -0.4, 0.2)), (-3.0, -2.0, (-0.2, 0.3, -0.5)), (0.0, 0.0, (0, 0, 0))):
+        a, b = state(alpha, beta, cmds), stock_state(alpha, beta, cmds)
+        assert a.get_propulsion().get_num_engines() == 0 and b.get_propulsion().get_num_engines() == n_engines
+        for k in zero:
+            assert a[k] == b[k] == 0.0, (alpha, k)
+        for k in ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs", "moments/l-aero-lbsft",
+                  "moments/m-aero-lbsft", "moments/n-aero-lbsft"):
+            assert a[k] == b[k], (alpha, k)
