@@ -21,7 +21,7 @@ AIRCRAFT_HELP = ("harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n r
                  "f16_direct, "
                  "F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, "
                  "Eternity_glide, UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, "
-                 "Navion_glide, Fokker50_glide); fokker50 is the untouched aircraft; default %(default)s")
+                 "Navion_glide, Fokker50_glide); no aircraft is untouched now (docs/jsbsim.md); default %(default)s")
 
 
 def append_jsonl(path: str | None, rows: Iterable[dict]) -> None:

@@ -49,10 +49,11 @@ Usage::
 ``--aircraft`` takes the harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 c684
 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim's model names (J3Cub, T37, t6texan2, B747, f16_direct,
 F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, Eternity_glide,
-UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, Navion_glide, Fokker50_glide); ``fokker50`` is the
-untouched aircraft, never in the defaults (``j3cub``, ``c182``, ``t37``, ``t6``, ``b747``, ``f16``, ``f4n``, ``rascal``, ``sgs126``, ``asw20``, ``iar80``,
-``c684``, ``ultrastick``, ``b737``, ``c172p``, ``eternity``, ``us25e``, ``ka350``, ``s23``, ``dr1`` and ``navion``,
-untouched until the sixth to twenty-sixth sessions' final evaluations, now count as used; none of them is in the defaults). The flights of ``--out`` are reused when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
+UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, Navion_glide, Fokker50_glide); no aircraft is
+untouched now (``j3cub``, ``c182``, ``t37``, ``t6``, ``b747``, ``f16``, ``f4n``, ``rascal``, ``sgs126``, ``asw20``,
+``iar80``, ``c684``, ``ultrastick``, ``b737``, ``c172p``, ``eternity``, ``us25e``, ``ka350``, ``s23``, ``dr1``,
+``navion`` and ``fokker50``, untouched until the sixth to twenty-seventh sessions' final evaluations, count as used;
+none of them is in the defaults; docs/jsbsim.md, "No untouched aircraft"). The flights of ``--out`` are reused when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
 duration and plan; ``--fly-only`` flies (or finds) the reference and every case and stops,
 without fitting or diagnosing anything.
 
