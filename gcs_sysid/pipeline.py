@@ -91,7 +91,7 @@ class ReplayOptions:
             (:func:`gcs_sysid.aero.gustfilter.air_roll_target`). Pair it with ``heldout_air_roll="predicted:Cl"``
             (Cl asked at ``p_hat - p_hat_g`` on the held-out rows); with ``"off"`` the held-out Cl is the model's at
             ``p_g = 0``. Not with ``gust_filter`` (that moves every output's ``p_hat`` instead). None:
-            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_TRAIN`.
+            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_TRAIN` (off), off when ``gust_filter`` is on.
     """
 
     rate_hz: float = 50.0
@@ -490,7 +490,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
 
         gust_filter = GUST_FILTER if options.gust_filter is None else options.gust_filter
         air_roll = HELDOUT_AIR_ROLL if options.heldout_air_roll is None else options.heldout_air_roll
-        air_train = AIR_ROLL_TRAIN if options.air_roll_train is None else options.air_roll_train
+        # the default gives way to an explicit gust_filter (both would take the gust out of Cl's training rows)
+        air_train = (AIR_ROLL_TRAIN and not gust_filter) if options.air_roll_train is None else options.air_roll_train
         if air_train and gust_filter:
             raise InputError("air_roll_train: not with gust_filter (both take the rolling gust out of Cl's training "
                              "rows)")
