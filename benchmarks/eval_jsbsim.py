@@ -268,14 +268,16 @@ def stated_airframe(path: Path, work: Path, stem: str) -> Path:
 
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None, gust_filter: bool | str | None = None,
-             heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = ()) -> dict:
+             heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = (),
+             air_roll_train: bool | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
     what a simulator using the model would give it). ``gust_filter``: ``ReplayOptions.gust_filter`` (None: the
-    default). ``heldout_air_roll``: ``ReplayOptions.heldout_air_roll`` (None: the default). ``airp_lines``: modes of
+    default). ``heldout_air_roll``: ``ReplayOptions.heldout_air_roll`` (None: the default). ``air_roll_train``:
+    ``ReplayOptions.air_roll_train`` (None: the default). ``airp_lines``: modes of
     :func:`gcs_sysid.aero.gustfilter.heldout_air_roll` scored post hoc on the same replay's model (rows
     ``gp_airp_MODE``, ``ls_airp_MODE``, ``cov_gp_airp_MODE`` and ``airp_MODE`` with the estimated gust against
     JSBSim's ``p - p_aero``; a diagnosis: the replay's table must not be gust-filtered)."""
@@ -291,7 +293,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     af_path = stated_airframe(files.airframe, work, files.tlog.stem)     # files.airframe unless --stated-lift-slope
     res = run_replay(files.tlog, af_path, out, ReplayOptions(progress=False, gust_rates=gust_rates,
                                                                           gust_filter=gust_filter,
-                                                                          heldout_air_roll=heldout_air_roll))
+                                                                          heldout_air_roll=heldout_air_roll,
+                                                                          air_roll_train=air_roll_train))
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
@@ -306,6 +309,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
                  "gust_rates": gust_rates, "gust_filter": gust_filter, "heldout_air_roll": heldout_air_roll,
+                 "air_roll_train": air_roll_train,
                  "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
@@ -571,6 +575,11 @@ def main(argv=None) -> int:
                     help="the held-out rows' p_hat less the rolling gust estimated there from their own measured roll "
                          "moment with the training rows' roll fit (ReplayOptions.heldout_air_roll, "
                          "gcs_sysid.aero.gustfilter.heldout_air_roll; default: the replay's, HELDOUT_AIR_ROLL)")
+    ap.add_argument("--air-roll-train", default=None, choices=("on", "off"),
+                    help="train the GP's Cl on the measured Cl less the roll fit's rolling-gust moment, Cl at the "
+                         "air-relative roll rate (ReplayOptions.air_roll_train, gcs_sysid.aero.gustfilter."
+                         "air_roll_target; pair with --heldout-air-roll predicted:Cl; default: the replay's, "
+                         "AIR_ROLL_TRAIN)")
     ap.add_argument("--airp-lines", nargs="*", default=(), choices=AIR_ROLL_MODES,
                     help="also score these heldout_air_roll modes post hoc on the same replay's model (rows "
                          "gp_airp_MODE, ls_airp_MODE, cov_gp_airp_MODE, airp_MODE; a diagnosis)")
@@ -677,7 +686,8 @@ def main(argv=None) -> int:
                 row = evaluate(ac, seed, turb, a.aoa, a.duration, work, a.gust_rates,
                                None if a.gust_filter is None else
                                {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter],
-                               a.heldout_air_roll, tuple(a.airp_lines))
+                               a.heldout_air_roll, tuple(a.airp_lines),
+                               None if a.air_roll_train is None else a.air_roll_train == "on")
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"

@@ -85,6 +85,13 @@ class ReplayOptions:
             that rate, the other outputs at the gyro's (their slopes were learned there;
             :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_MODES`). Training rows unchanged. None:
             :data:`gcs_sysid.aero.gustfilter.HELDOUT_AIR_ROLL`.
+        air_roll_train: train the GP's Cl on the measured Cl less the roll fit's rolling-gust moment
+            (``Cl + Cl_p p_hat_g``, the gust smoothed on the training rows; the inputs, the gyro's ``p_hat``, and
+            CX..CZ, Cm, Cn unchanged), so that Cl is learned at the air-relative roll rate
+            (:func:`gcs_sysid.aero.gustfilter.air_roll_target`). Pair it with ``heldout_air_roll="predicted:Cl"``
+            (Cl asked at ``p_hat - p_hat_g`` on the held-out rows); with ``"off"`` the held-out Cl is the model's at
+            ``p_g = 0``. Not with ``gust_filter`` (that moves every output's ``p_hat`` instead). None:
+            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_TRAIN` (off), off when ``gust_filter`` is on.
     """
 
     rate_hz: float = 50.0
@@ -104,6 +111,7 @@ class ReplayOptions:
     alpha_dot_hat: bool = True
     gust_filter: bool | str | None = None
     heldout_air_roll: str | None = None
+    air_roll_train: bool | None = None
     gp_noise: str | None = None
 
 
@@ -266,6 +274,9 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.heldout_air_roll is not None and options.heldout_air_roll not in AIR_ROLL_MODES:
         raise InputError(f"heldout_air_roll: expected one of {', '.join(AIR_ROLL_MODES)}, got "
                          f"{options.heldout_air_roll!r}")
+    if options.air_roll_train and options.gust_filter:
+        raise InputError("air_roll_train: not with gust_filter (both take the rolling gust out of Cl's training "
+                         "rows: gust_filter through every output's p_hat, air_roll_train through Cl's target)")
     if options.gp_noise is not None:
         gp_noise_fields(options.gp_noise)
     check_window(options.t_from, options.t_to)
@@ -474,14 +485,26 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
-        from .aero.gustfilter import GUST_FILTER, HELDOUT_AIR_ROLL, filter_gust_table, heldout_air_roll
+        from .aero.gustfilter import (AIR_ROLL_TRAIN, GUST_FILTER, HELDOUT_AIR_ROLL, air_roll_target,
+                                      filter_gust_table, heldout_air_roll)
 
         gust_filter = GUST_FILTER if options.gust_filter is None else options.gust_filter
         air_roll = HELDOUT_AIR_ROLL if options.heldout_air_roll is None else options.heldout_air_roll
+        # the default gives way to an explicit gust_filter (both would take the gust out of Cl's training rows)
+        air_train = (AIR_ROLL_TRAIN and not gust_filter) if options.air_roll_train is None else options.air_roll_train
+        if air_train and gust_filter:
+            raise InputError("air_roll_train: not with gust_filter (both take the rolling gust out of Cl's training "
+                             "rows)")
         air_info = None
         if air_roll != "off":       # opt-in: the held-out rows at the reconstructed air-relative roll rate
             with _stage("held-out air roll rate", timings, bar):
                 table_air, air_info = heldout_air_roll(table, states, airframe, train, held, mode=air_roll)
+        Y_fit = table.Y             # the GP's training target (air_roll_train: Cl's moved to the air roll rate)
+        if air_train:               # opt-in: Cl's target less the training rows' smoothed gust moment
+            with _stage("air roll training target", timings, bar):
+                Y_fit, target_info = air_roll_target(table, states, airframe, train,
+                                                     fit=None if air_info is None else air_info["fit"])
+            notes.append(target_info["note"])
         gust_fit = None
         if gust_filter:
             with _stage("gust filter", timings, bar):
@@ -523,7 +546,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 X_all[~np.isfinite(table.alpha_dot_hat), -1] = np.nan
                 if options.model_in:             # a saved model's update needs every value
                     X_all[~np.isfinite(X_all[:, -1])] = np.nan
-            X_train, Y_train, partial = training_rows(X_all[train], table.Y[train][:, fit_cols],
+            X_train, Y_train, partial = training_rows(X_all[train], Y_fit[train][:, fit_cols],
                                                       [COEFFICIENTS[i] for i in fit_cols],
                                                       optional=int(use_adot and not options.model_in))
             if partial:

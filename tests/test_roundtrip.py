@@ -153,3 +153,48 @@ def test_heldout_air_roll_per_output_asks_only_cl_at_the_air_rate(roundtrip, tmp
         np.testing.assert_allclose(a[h, il], c[h, il], rtol=1e-6, atol=1e-9)   # Cl as the every-output mode asks it
     assert np.max(np.abs(per.pred_mean[h, il] - off.pred_mean[h, il])) > 1e-4
     assert not np.allclose(every.pred_mean[h, COEFFICIENTS.index("CY")], off.pred_mean[h, COEFFICIENTS.index("CY")])
+
+
+def test_air_roll_train_moves_only_cls_training_target(roundtrip, tmp_path, monkeypatch):
+    """``ReplayOptions.air_roll_train`` (twenty-eighth session, i8-clair): the GP is given the same inputs and the
+    same targets as without it, except Cl's, which is the measured Cl plus ``Cl_p p_hat_g`` of the roll fit on the
+    training rows (:func:`gcs_sysid.aero.gustfilter.air_roll_target`). The roll fit is replaced by a known one
+    (calm air: the Dryden check refuses a real one) and the GP's fit is stopped at its call, so the test reads what
+    the replay hands the GP."""
+    import gcs_sysid.aero.gustfilter as gf
+    import gcs_sysid.gp as gp
+    from gcs_sysid.aero.table import REGRESSORS
+
+    _, _, out = roundtrip
+    j = REGRESSORS.index("p_hat")
+    CLP = -0.5
+
+    def fake_fit(table, states, airframe, rows, method):
+        n = len(table.t)
+        g = np.where(rows, 0.3 * np.nan_to_num(table.X[:, j]) + 0.001, 0.0)
+        G = gf.RollGustFit(g, np.full(n, 1e-6), np.asarray(rows, bool), np.zeros(7), np.zeros(7), CLP, 0.5, 0.01,
+                           1e-8, 0.0, 0.0, 1, True, ("a known roll fit",))
+        return G, 1.0, ""
+
+    class Stop(Exception):
+        pass
+
+    seen = {}
+
+    def capture(X, Y, cfg, input_names=None, output_names=None):
+        seen[key] = (np.array(X), np.array(Y), list(output_names))
+        raise Stop
+
+    monkeypatch.setattr(gf, "_fit_roll", fake_fit)
+    monkeypatch.setattr(gp, "fit_gp", capture)
+    for key in (False, True):
+        with pytest.raises(Stop):
+            run_replay(out / "flight.tlog", DATA / "airframes" / "sim-trainer.toml", tmp_path / str(key),
+                       ReplayOptions(progress=False, write=False, air_roll_train=key, heldout_air_roll="off"))
+    (X0, Y0, names), (X1, Y1, names1) = seen[False], seen[True]
+    assert names == names1 and "Cl" in names and len(X0) > 1000
+    il = names.index("Cl")
+    np.testing.assert_array_equal(X1, X0)
+    others = [i for i in range(len(names)) if i != il]
+    np.testing.assert_array_equal(Y1[:, others], Y0[:, others])
+    np.testing.assert_allclose(Y1[:, il] - Y0[:, il], CLP * (0.3 * X0[:, j] + 0.001), rtol=1e-9, atol=1e-12)

@@ -47,7 +47,7 @@ __all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_GP_SLOPES", "roll_gp_sl
            "LAT_TERMS", "RollGustFit", "fit_roll_gust",
            "instruments",
            "stated_moment_variance", "filter_gust_table", "HELDOUT_AIR_ROLL", "AIR_ROLL_MODES", "air_roll_mode",
-           "heldout_air_roll"]
+           "heldout_air_roll", "AIR_ROLL_TRAIN", "air_roll_target"]
 
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
 #: less the filter-error rolling gust.
@@ -74,6 +74,8 @@ ROLL_GP_SLOPES = ("beta", "p_hat", "r_hat", "delta_a", "delta_r")
 #: the other outputs at the gyro's rate, unchanged) on 24 aircraft light s1-3 at GP seeds 0 and 1: held-out Cl median
 #: 48.7 -> 26.9 % but +11/-17 and +8/-18 counts (GP < LS with LS at the same rate; Cl's band covers 99.6 %, its
 #: learned noise still holds the gust; twenty-seventh session, i8-airpcl).
+#: With :data:`AIR_ROLL_TRAIN` (Cl learned at the air rate too, its noise no longer holding the gust's moment) the
+#: pair meets rule 8(b) (twenty-eighth session, i8-clair; see there for why it is still opt-in).
 HELDOUT_AIR_ROLL = "off"
 #: Every value ``heldout_air_roll`` takes (:func:`air_roll_mode`): ``"off"``; a gust mode of
 #: :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` (every output asked at the air rate, the twenty-fourth session's);
@@ -82,6 +84,18 @@ HELDOUT_AIR_ROLL = "off"
 #: score: ``"predicted"``/``"predicted:Cl"`` only (``"smoothed"`` and ``"filtered"`` read row ``k``'s own moment,
 #: the quantity scored there).
 AIR_ROLL_MODES = ("off", "smoothed", "filtered", "predicted", "smoothed:Cl", "filtered:Cl", "predicted:Cl")
+#: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``air_roll_train``): train the GP's Cl on the
+#: measured Cl less the roll fit's gust moment, ``Cl + Cl_p p_hat_g`` (:func:`air_roll_target`; the training rows'
+#: smoothed gust), so that Cl is learned as a function of the air-relative roll rate with the gyro's ``p_hat``
+#: shared by every output; paired with ``heldout_air_roll="predicted:Cl"``. Twenty-eighth session, i8-clair (24
+#: aircraft light s1-3 at GP seeds 0 and 1, LS at the same held-out rate): counts +32/-5 and +34/-0 against the
+#: default, no aircraft losing at both seeds (the reseeded default: 10); held-out Cl median 48.7 -> 17.9 %, true-air
+#: Cl 28.5 -> 20.9 %; Cl's band covers 88.9 % (median; 90.8 before), too narrow on some (fokker50 60-74 %). Rule
+#: 8(b) met, but left off: as the default (with ``HELDOUT_AIR_ROLL = "predicted:Cl"``) issue 2's calm-air round
+#: trip (tests/test_roundtrip.py, sim-trainer) gave held-out Cl 57 % against its 10 % limit (this alone: 98.6 %): in
+#: calm air the Dryden check lets a roll fit through whose gust takes up other error (Cl_p -0.45 -> -1.30).
+#: Not used (the target unchanged) when ``gust_filter`` is on and ``air_roll_train`` is not set.
+AIR_ROLL_TRAIN = False
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 #: Delays (s) of the aileron and rudder used as instruments for the rates and the sideslip (the controls are set by
 #: the pilot's programme, not by the gust; their delayed values carry the aircraft's response to them).
@@ -498,6 +512,63 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
             + G.notes[0] + ")")
     return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), {"mode": mode, "outputs": outputs, "g": g,
                                                                              "g_var": g_var, "fit": G}
+
+
+def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit | None = None):
+    """The measured coefficients with the training rows' Cl at the air-relative roll rate: Cl less the rolling
+    gust's moment of the roll fit, ``Cl + Cl_p p_hat_g`` (``p_hat_g`` smoothed on the training rows), every other
+    output and every other row as measured.
+
+    The roll fit's output model is ``Cl_k = theta . x_k - Cl_p p_hat_g,k + e_k`` with the gyro's ``p_hat`` in
+    ``x_k`` (module docstring; :mod:`gcs_sysid.aero.rollgust`): the moment the gust causes is ``-Cl_p p_hat_g``.
+    Taken out of the target, Cl on a training row is what the aircraft's moment would be with its air-relative roll
+    rate equal to the gyro's ``p_hat``, so a model trained on the gyro's ``p_hat`` with this target is a model of Cl
+    at the air-relative rate, and is asked at ``p_hat - p_hat_g`` where it predicts (the held-out rows:
+    ``heldout_air_roll="predicted:Cl"``, :func:`heldout_air_roll`). The inputs stay shared by every output (the other
+    outputs' slopes were learned at the gyro's rate and asking them at the air rate lost counts, twenty-fourth
+    session, i8-airp); only Cl's target moves. The filter-error treatment of turbulence as a process-noise state
+    whose smoothed estimate is used offline (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA
+    2015, ch. 5); like :func:`gcs_sysid.gp.mixed.apply_fixed_slopes`, a change of the training target only.
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``X`` ``(T, 10)`` with the gyro's ``p_hat``, ``Y``
+            ``(T, 6)``; before :func:`filter_gust_table`).
+        states: the smoothed states (``p`` on the table's grid; the stated ``p_dot`` noise for ``R``).
+        airframe: span, area and inertia.
+        train: ``(T,)`` bool, the training rows (the only rows whose moment the fit reads or whose target changes).
+        fit: a ``"rollgp"`` roll fit on those rows already made (:func:`heldout_air_roll`'s ``info["fit"]``);
+            None: fitted here (:func:`filter_gust_table`'s, with its Dryden check).
+
+    Returns:
+        ``(Y, info)``: ``Y`` ``(T, 6)`` a copy with Cl's column changed on the fit's rows, and a dict (``Cl_p``,
+        ``g`` ``(T,)`` the ``p_hat_g`` used (0 off the rows), ``rows`` ``(T,)`` bool, ``sd`` the correction's SD in
+        Cl units, ``note``); with no fit (fewer than 3 rows, no ``p``, the Dryden check failed) ``(table.Y,
+        {"note": why})``, the target unchanged.
+
+    Raises:
+        ValueError: ``train`` not ``(T,)``.
+    """
+    train = np.asarray(train, bool)
+    T = len(table.t)
+    if train.shape != (T,):
+        raise ValueError(f"air_roll_target: train must be ({T},), got {train.shape}")
+    rows = train & np.asarray(table.valid, bool)
+    if fit is None:
+        if T < 3:
+            return table.Y, {"note": "Cl's training target not moved to the air roll rate: fewer than 3 rows"}
+        fit, _, why = _fit_roll(table, states, airframe, rows, "rollgp")
+        if fit is None:
+            return table.Y, {"note": why.replace("gust filter", "Cl's air-rate training target")}
+    use = rows & np.asarray(fit.used, bool) & np.isfinite(fit.g)
+    g = np.where(use, fit.g, 0.0)
+    i = COEFFICIENTS.index("Cl")
+    Y = np.array(table.Y, float, copy=True)
+    corr = fit.Cl_p * g
+    Y[:, i] = Y[:, i] + corr
+    sd = float(np.std(corr[use])) if use.any() else 0.0
+    note = (f"Cl's training target at the air-relative roll rate: Cl + Cl_p p_hat_g on {int(use.sum())} training rows "
+            f"(Cl_p {fit.Cl_p:.3g}, the correction's SD {sd:.3g}; " + fit.notes[0] + ")")
+    return Y, {"Cl_p": float(fit.Cl_p), "g": g, "rows": use, "sd": sd, "note": note}
 
 
 def _dryden_ratio(G: RollGustFit, data: dict, table, dt: float, b: float) -> float:
