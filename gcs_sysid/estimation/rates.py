@@ -343,6 +343,7 @@ def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray,
             num, den = ss2tf(Cg, M[:, i:i + 1], Cg[j:j + 1], M[j:j + 1, i:i + 1])
             xst[j] += lfilter(num[0], den, xri, axis=-1)
     v = F @ np.ascontiguousarray(xt[:, :, -1])   # zero-input response of the end condition, until it has decayed
+    del xt, Zt                                   # (freed before the result's copy: the worker's peak memory)
     scale = max(float(np.abs(v).max()), 1e-300)
     # the powers C^(k+1) until they have decayed (small matrices), then all rows at once
     pw, Ck = [], Cg.copy()
