@@ -306,43 +306,59 @@ def _solve(GG: np.ndarray, Ge: np.ndarray) -> tuple[np.ndarray, np.ndarray, floa
     return Minv @ Ge, Minv, 2.0 * float(np.log(np.diag(L)).sum())
 
 
-def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray) -> np.ndarray:
+def _smooth_columns(F: np.ndarray, g: SteadyState, H: np.ndarray, Z: np.ndarray,
+                    states: tuple[int, ...] | None = None) -> np.ndarray:
     """Constant-gain RTS smoother of many scalar records at once, from a zero prior mean.
 
     The same passes as :func:`~gcs_sysid.estimation.kalman.steady_state_smoother` (with
-    ``x0 = 0``) for each column of ``Z`` (n, m), vectorised over the columns.
+    ``x0 = 0``) for each column of ``Z`` (n, m), vectorised over the columns. The passes run on
+    time-contiguous copies (``(state, column, time)``): each input is transposed once, not once per
+    filter, and the sums build up contiguously; every value is that of the same ``lfilter`` calls
+    on the same inputs, added in the same order.
+
+    Args:
+        F, g, H: the nominal model and its steady-state gains.
+        Z: (n, m) records.
+        states: the smoothed states wanted (None: all); the others are returned as 0 (the backward
+            pass filters ``len(states)`` of them instead of ``Nx``).
 
     Returns:
         Smoothed states (n, Nx, m).
     """
     n, m = Z.shape
     nx = F.shape[0]
+    want = tuple(range(nx)) if states is None else tuple(states)
     A = (np.eye(nx) - g.K @ H) @ F
-    x = np.empty((n, nx, m))
+    Zt = np.ascontiguousarray(Z.T)
+    xt = np.empty((nx, m, n))
     for j in range(nx):      # forward: x_k = A x_{k-1} + K z_k, zero initial state
         num, den = ss2tf(A, g.K, A[j:j + 1], g.K[j:j + 1])
-        x[:, j] = _lfilter_columns(num[0], den, Z)
+        xt[j] = lfilter(num[0], den, Zt, axis=-1)
     Cg = g.C
     M = np.eye(nx) - Cg @ F
-    xr = x[::-1]
-    xs = np.zeros((n, nx, m))
+    xst = np.zeros((nx, m, n))      # time reversed
     for i in range(nx):      # backward: xs_k = C xs_{k+1} + M x_k, from xs_T = F x_{T-1}
-        for j in range(nx):
+        xri = np.ascontiguousarray(xt[i, :, ::-1])
+        for j in want:
             num, den = ss2tf(Cg, M[:, i:i + 1], Cg[j:j + 1], M[j:j + 1, i:i + 1])
-            xs[:, j] += _lfilter_columns(num[0], den, xr[:, i])
-    v = F @ x[-1]            # zero-input response of the end condition, until it has decayed
+            xst[j] += lfilter(num[0], den, xri, axis=-1)
+    v = F @ np.ascontiguousarray(xt[:, :, -1])   # zero-input response of the end condition, until it has decayed
+    del xt, Zt                                   # (freed before the result's copy: the worker's peak memory)
     scale = max(float(np.abs(v).max()), 1e-300)
     # the powers C^(k+1) until they have decayed (small matrices), then all rows at once
     pw, Ck = [], Cg.copy()
     norm_c = max(float(np.abs(Cg).max()), 1e-300)
+    v_max, floor = float(np.abs(v).max()), 1e-15 * scale * min(norm_c, 1.0)
     for _ in range(n):
-        if not np.abs(Ck).max() * float(np.abs(v).max()) > 1e-15 * scale * min(norm_c, 1.0):
+        if not np.abs(Ck).max() * v_max > floor:
             break
         pw.append(Ck)
         Ck = Cg @ Ck
     if pw:
-        xs[:len(pw)] += np.einsum("kij,jm->kim", np.array(pw), v)
-    return xs[::-1]
+        tail = np.einsum("kij,jm->kim", np.array(pw), v)
+        for j in want:
+            xst[j, :, :len(pw)] += tail[:, j].T
+    return np.ascontiguousarray(xst.transpose(2, 0, 1))[::-1]
 
 
 def _long_run_cov(S: np.ndarray, max_lag: int) -> np.ndarray:
@@ -547,15 +563,18 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                         A, W = np.concatenate([A, Ax], 1), np.concatenate([W, Wx], 1)
                     # measured part, and the parts of the signal and of its derivative (undelayed)
                     cols.append((W, W, A) if order == 1 else (A, A, np.gradient(A, dt, axis=0)))
-                colcache[key] = (cols, {}, {})
-            cols, Gs, GG = colcache[key]
+                # the measured part's columns transposed once (time contiguous) for every candidate's filter
+                colcache[key] = (cols, {}, {}, [np.ascontiguousarray(X[0].T) for X in cols] if m else None)
+            cols, Gs, GG, cols_t = colcache[key]
 
-            def gram(c, cols=cols, Gs=Gs, GG=GG, m=m):
+            def gram(c, cols=cols, Gs=Gs, GG=GG, m=m, cols_t=cols_t):
                 """Per segment the column innovations of candidate ``c`` and their lagged Gram matrix
                 (computed once per candidate, shared by the axes)."""
                 if c not in Gs:
                     num, den = tfs[c]
-                    Gs[c] = [(_lfilter_columns(num, den, X[0]) if m else X[0]) / math.sqrt(S[c]) for X in cols]
+                    # = _lfilter_columns(num, den, X[0]) on the transposed copy made once
+                    Gs[c] = [(lfilter(num, den, Xt, axis=-1).T if m else X[0]) / math.sqrt(S[c])
+                             for X, Xt in zip(cols, cols_t or [None] * len(cols))]
                     GG[c] = sum(lagged(G, nd, lag).T @ lagged(G, nd, lag) for G in Gs[c]) if Gs[c] else \
                         np.zeros((m, m))
                 return Gs[c], GG[c]
@@ -686,7 +705,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
                 # states by (X - smoother(Mz)) db
                 kk = (sg.start, sg.stop, c)   # the same for axes with the same segment and bandwidth
                 if kk not in xjcache:
-                    xjcache[kk] = _smooth_columns(F, g, H, Mz)
+                    # only the states read below: the signal (H) and its derivative (1)
+                    xjcache[kk] = _smooth_columns(F, g, H, Mz, tuple(sorted({1, *np.flatnonzero(H[0])})))
                 xj = xjcache[kk]
                 D0, D1 = X0 - np.einsum("j,njm->nm", H[0], xj), X1 - xj[:, 1]
                 C = s2 * Minv

@@ -186,3 +186,25 @@ def test_a_servo_delay_is_found_and_the_jump_follows_it(roll):
     # without the search (delay fixed at 0) the jumps land 3 samples early
     R0 = smooth_rates(DT, np.repeat(z[:, None], 3, 1), controls=cmd[:, None], max_delay_s=0.0)
     assert _rms(R0.accel[steps, 0] - pd[steps]) > 5 * _rms(R.accel[steps, 0] - pd[steps])
+
+
+@pytest.mark.parametrize("gust_hz", [0.0, 8.0])
+def test_smooth_columns_matches_the_smoother_per_column(gust_hz):
+    """The vectorised column smoother gives, per column, the steady-state RTS smoother's states (zero prior),
+    and asking for only some states leaves those bit for bit the same and the others 0."""
+    from gcs_sysid.estimation.kalman import steady_state_smoother
+    from gcs_sysid.estimation.rates import _nominal_model, _smooth_columns
+
+    F, Q, H = _nominal_model(0.02, 2.5, gust_hz)
+    g = steady_state(F, Q, H, np.eye(1))
+    rng = np.random.default_rng(3)
+    Z = np.cumsum(rng.standard_normal((600, 5)), axis=0)
+    full = _smooth_columns(F, g, H, Z)
+    for k in range(Z.shape[1]):
+        ref, _ = steady_state_smoother(F, g, H, Z[:, k:k + 1], np.zeros(len(F)))
+        np.testing.assert_allclose(full[:, :, k], ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+    want = tuple(sorted({1, *np.flatnonzero(H[0])}))
+    part = _smooth_columns(F, g, H, Z, want)
+    assert np.array_equal(part[:, list(want)], full[:, list(want)])
+    others = [j for j in range(len(F)) if j not in want]
+    assert others and not part[:, others].any()
