@@ -231,7 +231,7 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: offered only at a step where the square is not the best single column (a square that wins alone enters alone, its
 #: parent on its own PRESS), and ``entered_with`` only when the first step was the block; that removed the t6's and
 #: s23's losses and kept the four wins (*Twenty-eighth session, i9-pwp2*). Still off: the other effects are measured
-#: on seven of the nine aircraft (not the s23 and ka350).
+#: on eight of the nine aircraft (not the ka350).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
