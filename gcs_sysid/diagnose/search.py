@@ -108,8 +108,11 @@ def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: 
         blocks: column groups that may also enter together in one step, as one candidate, when none of
             their columns is selected yet and they fit within ``max_terms`` (e.g. ``(alpha^2, alpha)``, a
             curvature with its first parent: :func:`gcs_sysid.diagnose.sparse.power_parent_blocks`). A block
-            is compared with the single columns by the same block PRESS; when it wins, its columns are
-            appended in the given order and the PRESS path gets one entry for the step. None: singles only.
+            is offered at a step only when its first column is not that step's best single column (the block
+            rescues a square that a correlated single beats; a square that wins alone enters alone, as
+            without blocks); it is then compared with the single columns by the same block PRESS, and when it
+            wins its columns are appended in the given order and the PRESS path gets one entry for the step.
+            None: singles only.
 
     Returns:
         ``{"selected": [k...], "press": [PRESS after 0, 1, ... steps], "scale": (K,), "steps": [[k...] per
@@ -157,7 +160,10 @@ def press_stepwise(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: 
         i = int(np.argmin(p))                                  # the first of equal minima, as the loop did
         step, best = [int(cand[i])], float(p[i])
         for blk in blocks or ():
-            if len(sel) + len(blk) > max_terms or any(c in sel for c in blk):
+            # a block is offered only in lieu of its first column: when that column is not this step's best
+            # single (the square that a correlated single beats); a square that wins alone enters alone and
+            # its parent follows on its own PRESS, one term a step (Morelli and Klein sec. 5.4)
+            if len(sel) + len(blk) > max_terms or any(c in sel for c in blk) or blk[0] == int(cand[i]):
                 continue
             pb = set_press(sel + list(blk))
             if pb < best:

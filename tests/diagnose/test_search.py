@@ -157,3 +157,23 @@ def test_a_block_enters_in_one_step_when_its_columns_alone_lose():
     assert res["press"][1] < 0.05 * single["press"][1]
     # a block that does not fit within max_terms is not offered
     assert press_stepwise(Phi, r, fold, max_terms=1, blocks=[(1, 0)])["selected"] == [0]
+
+
+def test_a_square_that_wins_alone_enters_alone_and_its_parent_on_its_own_press():
+    """The block rescues a square that a correlated single beats; where the square is the step's best single it
+    enters alone (the path without blocks), and the parent follows only on its own PRESS (twenty-eighth session,
+    i9-pwp2: before, the block took the first step of the s23's and t6's ``Cm:alpha^2`` flights where the square
+    won alone, and the parent beside it halved the curvature)."""
+    rng = np.random.default_rng(3)
+    N = 900
+    x = rng.normal(size=N)
+    Phi = np.column_stack([x, x**2, x**3, rng.normal(size=(N, 5))])
+    r = (x - 0.2) ** 2                      # the curvature dominates; its linear part, -0.4 x, is real but smaller
+    r = r - r.mean() + 0.05 * rng.normal(size=N)
+    Phi = Phi - Phi.mean(axis=0)
+    fold = np.minimum((np.arange(N) * 5) // N, 4)
+    single = press_stepwise(Phi, r, fold, max_terms=3)
+    assert single["steps"][:2] == [[1], [0]]
+    # offered the block, the search takes the same path, one column a step (before: the block, [[1, 0]])
+    res = press_stepwise(Phi, r, fold, max_terms=3, blocks=[(1, 0)])
+    assert res["steps"] == single["steps"] and res["press"] == pytest.approx(single["press"])

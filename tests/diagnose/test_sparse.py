@@ -512,3 +512,25 @@ def test_power_with_parent_names_a_curvature_about_a_shifted_alpha(airframe):
     assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
     assert f["gain"]["percent"] >= 50.0
     assert THRESHOLDS["power_with_parent"] in ((), ("alpha",))
+
+
+def test_power_with_parent_leaves_a_curvature_that_wins_alone_to_the_search_without_blocks(airframe):
+    """A ``Cm:alpha^2`` of -3 with alpha 1 deg off the air's: the square is the best single term, so it enters
+    alone and ``alpha`` follows on its own PRESS, as with the option off; the finding carries no ``entered_with``
+    and the differential step judges the term alone (twenty-eighth session, i9-pwp2: before, the block took the
+    first step and the finding was judged with ``alpha`` beside it, which lost the s23's and t6's flights)."""
+    ref = _ctx(airframe, seed=4)
+    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
+    a = table.X[:, 0].copy()
+    table.Y[:, 4] += -3.0 * a**2
+    table.X[:, 0] = a + np.radians(1.0)
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    R = ctx.Y - ctx.model_values()
+    off = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ()})
+    on = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ("alpha",)})
+    cm = [next(c for c in res["coefficients"] if c["coefficient"] == "Cm") for res in (off, on)]
+    assert [t["term"] for t in cm[1]["terms"]][:2] == ["alpha^2", "alpha"] == [t["term"] for t in cm[0]["terms"]][:2]
+    assert "entered_with" not in cm[1]
+    assert [f["cause"] for f in on["findings"]] == [f["cause"] for f in off["findings"]] == ["Cm:alpha^2"]
+    assert "entered_with" not in on["findings"][0]["evidence"]
+    assert on["findings"][0]["estimate"] == pytest.approx(off["findings"][0]["estimate"])
