@@ -486,6 +486,20 @@ def test_library_control_trim_keeps_a_curvature_apart_from_its_elevator_product(
     assert lag and np.allclose(P0[:, lag], P1[:, lag])
 
 
+def _shifted_curvature_searches(airframe, offset_deg):
+    """The sparse search without and with ``power_with_parent = ("alpha",)`` on a flight with a hidden
+    ``Cm:alpha^2`` of -3 whose measured alpha is ``offset_deg`` off the air's, against a clean reference."""
+    ref = _ctx(airframe, seed=4)
+    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
+    a = table.X[:, 0].copy()
+    table.Y[:, 4] += -3.0 * a**2
+    table.X[:, 0] = a + np.radians(offset_deg)
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    R = ctx.Y - ctx.model_values()
+    return tuple(sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": blocks})
+                 for blocks in ((), ("alpha",)))
+
+
 def test_power_with_parent_names_a_curvature_about_a_shifted_alpha(airframe):
     """A ``Cm:alpha^2`` of -3 on a flight whose measured alpha is 3 deg off the air's (the JSBSim dr1's
     flight-mean vertical wind, twenty-sixth session, i9-cma2): ``-3 (alpha_m - e)^2`` has a linear part larger
@@ -495,15 +509,7 @@ def test_power_with_parent_names_a_curvature_about_a_shifted_alpha(airframe):
     from gcs_sysid.diagnose.sparse import THRESHOLDS, power_parent_blocks
 
     assert power_parent_blocks(["alpha", "beta", "alpha^2", "beta^2", "alpha^3"], ("alpha", "q_hat")) == [(2, 0)]
-    ref = _ctx(airframe, seed=4)
-    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
-    a = table.X[:, 0].copy()
-    table.Y[:, 4] += -3.0 * a**2
-    table.X[:, 0] = a + np.radians(3.0)
-    ctx = DiagContext.build(table, airframe, BASE, states)
-    R = ctx.Y - ctx.model_values()
-    off = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ()})
-    on = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ("alpha",)})
+    off, on = _shifted_curvature_searches(airframe, 3.0)
     assert [f["cause"] for f in off["findings"]] != ["Cm:alpha^2"]
     assert [f["cause"] for f in on["findings"]] == ["Cm:alpha^2"], on["findings"]
     f = on["findings"][0]
@@ -519,15 +525,7 @@ def test_power_with_parent_leaves_a_curvature_that_wins_alone_to_the_search_with
     alone and ``alpha`` follows on its own PRESS, as with the option off; the finding carries no ``entered_with``
     and the differential step judges the term alone (twenty-eighth session, i9-pwp2: before, the block took the
     first step and the finding was judged with ``alpha`` beside it, which lost the s23's and t6's flights)."""
-    ref = _ctx(airframe, seed=4)
-    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
-    a = table.X[:, 0].copy()
-    table.Y[:, 4] += -3.0 * a**2
-    table.X[:, 0] = a + np.radians(1.0)
-    ctx = DiagContext.build(table, airframe, BASE, states)
-    R = ctx.Y - ctx.model_values()
-    off = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ()})
-    on = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": ("alpha",)})
+    off, on = _shifted_curvature_searches(airframe, 1.0)
     cm = [next(c for c in res["coefficients"] if c["coefficient"] == "Cm") for res in (off, on)]
     assert [t["term"] for t in cm[1]["terms"]][:2] == ["alpha^2", "alpha"] == [t["term"] for t in cm[0]["terms"]][:2]
     assert "entered_with" not in cm[1]
