@@ -31,15 +31,16 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
-    assert_pitch_derivatives, checked_in_model, ic_state, surface_state
+from model_checks import checked_in_model
+from static_checks import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 SRC = "data/jsbsim_models/asw20/asw20-JSBSim.xml"
 SRC_SHA256 = "c3a7877a124d79fcc82340614703cc07795993a06552ad6df9f05b10d1bdbc48"
 
 
 def _state(alpha_deg=-2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the asw20 (65 kt at 3000 ft, Mach 0.108)."""
+    """:func:`static_checks.ic_state` for the asw20 (65 kt at 3000 ft, Mach 0.108)."""
     return ic_state(aircraft("asw20"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

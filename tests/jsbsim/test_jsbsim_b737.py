@@ -29,11 +29,11 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, ic_state
+from static_checks import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, ic_state
 
 
 def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the b737 (250 kt at 12000 ft, engines stopped, gear command up)."""
+    """:func:`static_checks.ic_state` for the b737 (250 kt at 12000 ft, engines stopped, gear command up)."""
     return ic_state(aircraft("b737"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

@@ -29,14 +29,14 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+from static_checks import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
     assert_pitch_derivatives, ic_state, surface_state
 
 RAD_PER_DEG_FCS = 0.01745     # the c172p's FCS gain (deg -> rad)
 
 
 def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
-    """:func:`truth_fits.ic_state` for the c172p (80 kt at 4000 ft, engine stopped)."""
+    """:func:`static_checks.ic_state` for the c172p (80 kt at 4000 ft, engine stopped)."""
     return ic_state(aircraft("c172p"), alpha_deg, beta_deg, cmds)
 
 

@@ -32,8 +32,8 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_pitch_derivatives, checked_in_model, ic_state, \
-    lateral_coefficients
+from model_checks import checked_in_model
+from static_checks import assert_aero_is_the_only_force, assert_pitch_derivatives, ic_state, lateral_coefficients
 
 SRC = "data/jsbsim_models/c684/C684.xml"
 SRC_SHA256 = "fb02bd7d563c8877ebcaaffe81e17ab62efd456ec65027436349e696765e826d"
@@ -41,7 +41,7 @@ DEG = np.pi / 180.0
 
 
 def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the c684 (125 kt at 6000 ft)."""
+    """:func:`static_checks.ic_state` for the c684 (125 kt at 6000 ft)."""
     return ic_state(aircraft("c684"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

@@ -37,9 +37,10 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_kept_but_engines, \
-    assert_lateral_derivatives, assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, \
-    bare_xml, checked_in_model, ic_state, surface_state
+from model_checks import assert_kept_but_engines, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, \
+    checked_in_model
+from static_checks import assert_aero_is_the_only_force, assert_deflections_map_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 SRC = "data/jsbsim_models/fokkerdr1/dr1.xml"
 SRC_SHA256 = "bd394cb162b91e4a11e97e2fbf490e1d5a9ddb0feeed4f5a4c8cf237cedc22f8"
@@ -51,7 +52,7 @@ _PUSHBACK_PROPS = ("/sim/model/pushback/position-norm", "/sim/model/pushback/tar
 
 
 def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
-    """:func:`truth_fits.ic_state` for the dr1 (70 kt at 8000 ft; it glides near alpha 0)."""
+    """:func:`static_checks.ic_state` for the dr1 (70 kt at 8000 ft; it glides near alpha 0)."""
     return ic_state(aircraft("dr1"), alpha_deg, beta_deg, cmds)
 
 

@@ -33,8 +33,8 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, \
-    checked_in_model, ic_state
+from model_checks import checked_in_model
+from static_checks import assert_aero_is_the_only_force, assert_lateral_derivatives, assert_pitch_derivatives, ic_state
 
 SRC = "data/jsbsim_models/eternity/Eternity.xml"
 SRC_SHA256 = "2341802f2ba31fea2d561a94a66957f88fa478ffcdc8fedb45f70f4772fa4bc7"
@@ -42,7 +42,7 @@ RAD_PER_DEG_FCS = 0.01745     # the model's FCS gain (deg -> rad)
 
 
 def _state(alpha_deg=-2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
-    """:func:`truth_fits.ic_state` for the eternity (34 kt at 10000 ft; it trims near alpha -2 deg)."""
+    """:func:`static_checks.ic_state` for the eternity (34 kt at 10000 ft; it trims near alpha -2 deg)."""
     return ic_state(aircraft("eternity"), alpha_deg, beta_deg, cmds)
 
 

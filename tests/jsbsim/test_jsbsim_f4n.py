@@ -26,11 +26,11 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_pitch_derivatives, ic_state
+from static_checks import assert_pitch_derivatives, ic_state
 
 
 def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0, spec=None):
-    """:func:`truth_fits.ic_state` for the f4n (or ``spec``)."""
+    """:func:`static_checks.ic_state` for the f4n (or ``spec``)."""
     return ic_state(spec or aircraft("f4n"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

@@ -40,8 +40,9 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_deflections_map_back, assert_kept_but_engines, assert_lateral_derivatives, \
-    assert_pitch_derivatives, bare_xml, check_direct_fcs, checked_in_model, ic_state, same_xml
+from model_checks import assert_kept_but_engines, bare_xml, checked_in_model, same_xml
+from static_checks import assert_deflections_map_back, assert_lateral_derivatives, assert_pitch_derivatives, \
+    check_direct_fcs, ic_state
 
 SRC = "data/jsbsim_models/fokker50/fokker50.xml"
 SRC_SHA256 = "dd6507d48e51e27423c89af29a036ae7e8c797add03df115bdbc2e4132932a89"
@@ -50,7 +51,7 @@ OWN_STATE = ("aero/coefficient/CDi", "aero/force/Lift_alpha_rate", "aero/coeffic
 
 
 def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
-    """:func:`truth_fits.ic_state` for the fokker50 (180 kt at 10000 ft; it glides near alpha -1 deg)."""
+    """:func:`static_checks.ic_state` for the fokker50 (180 kt at 10000 ft; it glides near alpha -1 deg)."""
     return ic_state(aircraft("fokker50"), alpha_deg, beta_deg, cmds)
 
 

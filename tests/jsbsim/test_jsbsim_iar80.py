@@ -27,15 +27,16 @@ import xml.etree.ElementTree as ET
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
-    assert_pitch_derivatives, checked_in_model, ic_state, surface_state
+from model_checks import checked_in_model
+from static_checks import assert_aero_is_the_only_force, assert_aileron_maps_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 SRC = "data/jsbsim_models/iar80/IAR80-Jsb.xml"
 SRC_SHA256 = "ce95df946a1a617e340005fbe28a7b02dc65877bf5d622f92224c165b517b207"
 
 
 def _state(alpha_deg=2.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the iar80 (150 kt at 10000 ft)."""
+    """:func:`static_checks.ic_state` for the iar80 (150 kt at 10000 ft)."""
     return ic_state(aircraft("iar80"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

@@ -5,7 +5,8 @@ Only the harness is checked here, on JSBSim's exact truth: the rigid-body consis
 with the checked-in airframe file, the sign map, the .tlog as the pipeline decodes it, the XML
 edits of every hidden effect, and (slow) that the evaluation's flights stay in the envelope with
 enough excitation on every axis. No pipeline fit, GP or diagnosis is run on the J3Cub in the
-test suite. The shared checks are in ``truth_fits.py`` (also used by ``test_jsbsim_roster.py``).
+test suite. The shared checks are in ``truth_fits.py`` and ``static_checks.py``
+(also used by ``test_jsbsim_roster.py``).
 """
 
 from types import SimpleNamespace
@@ -15,8 +16,9 @@ import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft, canonical_name, fly, make_flight
 from benchmarks.jsbsim_harness.effects import EFFECTS, Effect, _write_model
-from truth_fits import (EVALUATION_FLIGHTS, decoded_servo_errors, delay_trace, derivative_slopes, effect_state,
-                        injected_moment, non_aero_residual, rigid_body_residual)
+from static_checks import delay_trace, effect_state, injected_moment
+from truth_fits import (EVALUATION_FLIGHTS, decoded_servo_errors, derivative_slopes, non_aero_residual,
+                        rigid_body_residual)
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 

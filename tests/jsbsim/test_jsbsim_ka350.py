@@ -33,8 +33,9 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_kept_but_engines, \
-    assert_lateral_derivatives, assert_pitch_derivatives, checked_in_model, ic_state, same_xml, surface_state
+from model_checks import assert_kept_but_engines, checked_in_model, same_xml
+from static_checks import assert_aero_is_the_only_force, assert_deflections_map_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 SRC = "data/jsbsim_models/kingair350/KingAir-350.xml"
 SRC_SHA256 = "f89a9376371cbbe4f08060548aee36a25d645620943f5e7273c59e3164c9675d"
@@ -43,7 +44,7 @@ AILERON = "fcs/aileron-eff-rad"
 
 
 def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
-    """:func:`truth_fits.ic_state` for the ka350 (160 kt at 8000 ft; it glides near alpha 0)."""
+    """:func:`static_checks.ic_state` for the ka350 (160 kt at 8000 ft; it glides near alpha 0)."""
     return ic_state(aircraft("ka350"), alpha_deg, beta_deg, cmds)
 
 

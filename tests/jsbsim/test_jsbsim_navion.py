@@ -38,16 +38,17 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_deflections_map_back, assert_kept_but_engines, assert_lateral_derivatives, \
-    assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, check_direct_fcs, \
-    checked_in_model, ic_state
+from model_checks import assert_kept_but_engines, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, \
+    checked_in_model
+from static_checks import assert_deflections_map_back, assert_lateral_derivatives, assert_pitch_derivatives, \
+    check_direct_fcs, ic_state
 
 SRC = "data/jsbsim_models/navion/L17.xml"
 SRC_SHA256 = "4472cb86623b4fc6529381a270f09d722d52d352428787d93610d349aa23ccbf"
 
 
 def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0)):
-    """:func:`truth_fits.ic_state` for the navion (120 kt at 10000 ft; it glides near alpha 0)."""
+    """:func:`static_checks.ic_state` for the navion (120 kt at 10000 ft; it glides near alpha 0)."""
     return ic_state(aircraft("navion"), alpha_deg, beta_deg, cmds)
 
 

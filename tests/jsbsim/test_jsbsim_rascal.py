@@ -33,14 +33,14 @@ import pytest
 from benchmarks.jsbsim_harness import aircraft
 from benchmarks.jsbsim_harness.logfile import _REPO
 from pytest import approx
-from truth_fits import assert_pitch_derivatives, check_direct_fcs, ic_state, lateral_coefficients
+from static_checks import assert_pitch_derivatives, check_direct_fcs, ic_state, lateral_coefficients
 
 SOURCE = _REPO / "data" / "jsbsim_models" / "rascal" / "Rascal110-JSBSim.xml"
 SOURCE_SHA256 = "d5b9e7435e3a04d7f8c4d3e37b6ecb9ca4865f98e17d38a50177e5a86d41dd20"   # README.md's
 
 
 def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the rascal."""
+    """:func:`static_checks.ic_state` for the rascal."""
     return ic_state(aircraft("rascal"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

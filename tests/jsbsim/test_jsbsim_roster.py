@@ -31,9 +31,10 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft, make_flight
-from truth_fits import (ENVELOPE_FLIGHTS, assert_airspeed_bias_in_log, assert_hidden_effects_in_jsbsim,
-                        assert_in_envelope, assert_names_resolve, assert_rigid_body_glide, assert_servos_map_back,
-                        closure_slopes, derivative_slopes, evaluation_envelope)
+from model_checks import assert_names_resolve
+from static_checks import assert_hidden_effects_in_jsbsim
+from truth_fits import (ENVELOPE_FLIGHTS, assert_airspeed_bias_in_log, assert_in_envelope, assert_rigid_body_glide,
+                        assert_servos_map_back, closure_slopes, derivative_slopes, evaluation_envelope)
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.telemetry import read_log
 
@@ -613,7 +614,7 @@ def test_every_hidden_effect_shows_in_jsbsims_own_forces_and_moments(case):
     moment is k alpha^2, k alpha beta or k delta_a times qbar S c|b and exactly the change of JSBSim's
     total aerodynamic moment; CY:scale multiplies the sum of its SIDE functions (and the wind-axis
     side force) by k; the delay holds the elevator the aerodynamics read 24 frames (0.12 s at 200 Hz)
-    behind the surface (``truth_fits.assert_hidden_effects_in_jsbsim``)."""
+    behind the surface (``static_checks.assert_hidden_effects_in_jsbsim``)."""
     assert_hidden_effects_in_jsbsim(aircraft(case.name), case.elevator_end, n_side=case.n_side,
                                     n_elevator_reads=case.n_elevator_reads, min_lbf=case.min_lbf)
 

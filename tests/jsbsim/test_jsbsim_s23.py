@@ -35,9 +35,10 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_aero_is_the_only_force, assert_deflections_map_back, assert_kept_but_engines, \
-    assert_lateral_derivatives, assert_pitch_derivatives, assert_same_aero_as_stock, assert_summaries_label_bare, \
-    bare_xml, checked_in_model, ic_state, surface_state
+from model_checks import assert_kept_but_engines, assert_same_aero_as_stock, assert_summaries_label_bare, bare_xml, \
+    checked_in_model
+from static_checks import assert_aero_is_the_only_force, assert_deflections_map_back, assert_lateral_derivatives, \
+    assert_pitch_derivatives, ic_state, surface_state
 
 SRC = "data/jsbsim_models/shorts23/Short_S23.xml"
 SRC_SHA256 = "b4ba55cceeaca5057bacfb59b510bf3bdc8e9ea19efbd007904700ab2439282f"
@@ -46,7 +47,7 @@ AERO_SHA256 = "f115dfe222b379e3cc78090f760e154be8aa5788ab3580311bedca38715001a6"
 
 
 def _state(alpha_deg=0.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), model=None):
-    """:func:`truth_fits.ic_state` for the s23 (130 kt at 6000 ft; it glides near alpha -2 deg), or for the same
+    """:func:`static_checks.ic_state` for the s23 (130 kt at 6000 ft; it glides near alpha -2 deg), or for the same
     spec flying ``model`` (the stock wheel model)."""
     spec = aircraft("s23")
     return ic_state(dataclasses.replace(spec, model=model) if model else spec, alpha_deg, beta_deg, cmds)

@@ -28,13 +28,13 @@ import numpy as np
 
 from benchmarks.jsbsim_harness import FlightConfig, aircraft
 from pytest import approx
-from truth_fits import assert_lateral_derivatives, assert_pitch_derivatives, check_direct_fcs, ic_state
+from static_checks import assert_lateral_derivatives, assert_pitch_derivatives, check_direct_fcs, ic_state
 
 FT = 0.3048
 
 
 def _state(alpha_deg=4.0, beta_deg=0.0, cmds=(0.0, 0.0, 0.0), r_rad_s=0.0):
-    """:func:`truth_fits.ic_state` for the sgs126."""
+    """:func:`static_checks.ic_state` for the sgs126."""
     return ic_state(aircraft("sgs126"), alpha_deg, beta_deg, cmds, r_rad_s)
 
 

@@ -27,8 +27,8 @@ No pipeline fit, GP, diagnosis or scoring ran on the ultrastick before the eight
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_lateral_derivatives, assert_openflightsim_assembly, \
-    assert_openflightsim_direct_surfaces, assert_pitch_derivatives
+from model_checks import assert_openflightsim_assembly, assert_openflightsim_direct_surfaces
+from static_checks import assert_lateral_derivatives, assert_pitch_derivatives
 
 DIR = "data/jsbsim_models/ultrastick120"
 #: file -> (bytes, SHA-256), as the README lists them.

@@ -30,8 +30,8 @@ import pytest
 
 from benchmarks.jsbsim_harness import aircraft
 from pytest import approx
-from truth_fits import assert_lateral_derivatives, assert_openflightsim_assembly, \
-    assert_openflightsim_direct_surfaces, assert_pitch_derivatives, ic_state
+from model_checks import assert_openflightsim_assembly, assert_openflightsim_direct_surfaces
+from static_checks import assert_lateral_derivatives, assert_pitch_derivatives, ic_state
 
 DIR = "data/jsbsim_models/ultrastick25e"
 #: file -> (bytes, SHA-256), as the README lists them.
