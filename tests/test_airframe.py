@@ -96,12 +96,26 @@ def test_load_errors(tmp_path):
         load_airframe(p)
 
 
-def test_stated_lift_derivatives(monkeypatch):
-    """``[aero] CL_alpha``, ``CL_q`` (the aided alpha's stated lift-slope floor) are read, written back, checked, and
-    reach the aiding only with the opt-in ``STATED_LIFT_SLOPE``."""
+def _aiding_sees(monkeypatch, a, flag: str, key: str) -> list:
+    """What the aiding (``aided_air_angles``) is handed as its keyword ``key`` when ``est._aid_angles`` runs on the
+    airframe ``a`` with the opt-in ``airangles.<flag>`` off, then on (the aiding is stubbed to record and raise)."""
     import gcs_sysid.estimation.airangles as aa
     import gcs_sysid.estimation.estimate as est
 
+    seen = []
+    monkeypatch.setattr(est, "aided_air_angles", lambda *x, **k: seen.append(k[key]) or 1 / 0)
+    for on in (False, True):
+        monkeypatch.setattr(aa, flag, on)
+        with pytest.raises(ZeroDivisionError):
+            z = np.zeros(1)
+            est._aid_angles(0.02, z, z, z + 1.0, 1.2, np.zeros((1, 3)), 0.0, np.zeros((1, 3)),
+                            {"delta_e": 0, "delta_a": 0, "delta_r": 0}, a, np.ones(1, bool), None, None, {}, {}, [])
+    return seen
+
+
+def test_stated_lift_derivatives(monkeypatch):
+    """``[aero] CL_alpha``, ``CL_q`` (the aided alpha's stated lift-slope floor) are read, written back, checked, and
+    reach the aiding only with the opt-in ``STATED_LIFT_SLOPE``."""
     d = _doc()
     assert airframe_from_dict(d).CL_alpha is None and "aero" not in airframe_to_dict(airframe_from_dict(d))
     d["aero"] = {"CL_alpha": 5.5, "CL_q": 7.1}
@@ -113,23 +127,12 @@ def test_stated_lift_derivatives(monkeypatch):
         d["aero"] = bad
         with pytest.raises(InputError, match=frag.replace("[", r"\[")):
             airframe_from_dict(d)
-    seen = []
-    monkeypatch.setattr(est, "aided_air_angles", lambda *x, **k: seen.append(k["stated_slopes"]) or 1 / 0)
-    for on in (False, True):
-        monkeypatch.setattr(aa, "STATED_LIFT_SLOPE", on)
-        with pytest.raises(ZeroDivisionError):
-            z = np.zeros(1)
-            est._aid_angles(0.02, z, z, z + 1.0, 1.2, np.zeros((1, 3)), 0.0, np.zeros((1, 3)),
-                            {"delta_e": 0, "delta_a": 0, "delta_r": 0}, a, np.ones(1, bool), None, None, {}, {}, [])
-    assert seen == [None, (5.5, 7.1)]
+    assert _aiding_sees(monkeypatch, a, "STATED_LIFT_SLOPE", "stated_slopes") == [None, (5.5, 7.1)]
 
 
 def test_stated_lift_line(monkeypatch):
     """``[aero] CL0``, ``CL_delta_e``, ``CL0_sigma`` (the stated lift line that sets the aided alpha's flight mean) are
     read, written back, checked, and reach the aiding only with the opt-in ``STATED_LIFT_LEVEL``."""
-    import gcs_sysid.estimation.airangles as aa
-    import gcs_sysid.estimation.estimate as est
-
     d = _doc()
     d["aero"] = {"CL_alpha": 3.57, "CL_q": 1.05, "CL0": 0.252, "CL_delta_e": 0.16, "CL0_sigma": 0.01}
     a = airframe_from_dict(d)
@@ -142,12 +145,5 @@ def test_stated_lift_line(monkeypatch):
         d["aero"] = bad
         with pytest.raises(InputError, match=frag):
             airframe_from_dict(d)
-    seen = []
-    monkeypatch.setattr(est, "aided_air_angles", lambda *x, **k: seen.append(k["stated_level"]) or 1 / 0)
-    for on in (False, True):
-        monkeypatch.setattr(aa, "STATED_LIFT_LEVEL", on)
-        with pytest.raises(ZeroDivisionError):
-            z = np.zeros(1)
-            est._aid_angles(0.02, z, z, z + 1.0, 1.2, np.zeros((1, 3)), 0.0, np.zeros((1, 3)),
-                            {"delta_e": 0, "delta_a": 0, "delta_r": 0}, a, np.ones(1, bool), None, None, {}, {}, [])
-    assert seen == [None, {"CL0": 0.252, "CL_alpha": 3.57, "CL_q": 1.05, "CL_delta_e": 0.16, "CL0_sigma": 0.01}]
+    assert _aiding_sees(monkeypatch, a, "STATED_LIFT_LEVEL", "stated_level") == [
+        None, {"CL0": 0.252, "CL_alpha": 3.57, "CL_q": 1.05, "CL_delta_e": 0.16, "CL0_sigma": 0.01}]
