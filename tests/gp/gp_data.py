@@ -65,3 +65,18 @@ def envelope_expansion_case(seed: int = 41):
     new = np.flatnonzero(~flown)
     test = new[::4]
     return X, Yt, Y, flown, test, np.setdiff1d(new, test)
+
+
+def exact_gp_data():
+    """The small data set of the tests of the sparse global layer against the exact dense GP (test_kernels_exact,
+    test_heterotopic): 25 rows of two inputs uniform on [-2, 2], three correlated outputs of one smooth function plus
+    0.1 Gaussian noise, and 7 query rows uniform on [-2.5, 2.5] (seed 3).
+
+    Returns:
+        ``(X, Y, Xq)``: (25, 2), (25, 3), (7, 2).
+    """
+    rng = np.random.default_rng(3)
+    X = rng.uniform(-2, 2, (25, 2))
+    f = np.sin(2 * X[:, 0]) + 0.5 * X[:, 1]
+    Y = np.column_stack([f, 0.7 * f + 0.2 * X[:, 0], -0.3 * f + np.cos(X[:, 1])]) + 0.1 * rng.standard_normal((25, 3))
+    return X, Y, rng.uniform(-2.5, 2.5, (7, 2))

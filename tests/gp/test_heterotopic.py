@@ -11,6 +11,7 @@ import pytest
 from gcs_sysid.gp import exact, sparse
 from gcs_sysid.gp.kernels import coregionalisation
 from gcs_sysid.gp.sparse import GlobalParams, add_stats
+from gp_data import exact_gp_data
 
 elbo, posterior = jax.jit(sparse.elbo), jax.jit(sparse.posterior)
 stats_of = jax.jit(sparse.stats_of)
@@ -30,14 +31,10 @@ def _params(Z, lmc=False):
 
 @pytest.fixture(scope="module")
 def data():
-    rng = np.random.default_rng(3)
-    X = rng.uniform(-2, 2, (25, 2))
-    f = np.sin(2 * X[:, 0]) + 0.5 * X[:, 1]
-    Y = np.column_stack([f, 0.7 * f + 0.2 * X[:, 0], -0.3 * f + np.cos(X[:, 1])]) + 0.1 * rng.standard_normal((25, 3))
+    X, Y, Xq = exact_gp_data()
     mask = np.ones_like(Y, bool)
     mask[X[:, 0] > 0.5, 1] = False          # output 1 missing over part of the envelope
     mask[::4, 2] = False
-    Xq = rng.uniform(-2.5, 2.5, (7, 2))
     return X, Y, mask, Xq
 
 

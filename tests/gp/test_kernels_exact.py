@@ -9,6 +9,7 @@ import jax
 from gcs_sysid.gp import exact, sparse
 from gcs_sysid.gp.kernels import ARDSquaredExponential, GibbsKernel, coregionalisation, pairwise
 from gcs_sysid.gp.sparse import GlobalParams, add_stats
+from gp_data import exact_gp_data
 
 # compiled once per shape: far cheaper than op-by-op dispatch
 elbo, posterior, stats_of = jax.jit(sparse.elbo), jax.jit(sparse.posterior), jax.jit(sparse.stats_of)
@@ -25,12 +26,7 @@ def _params(X, Z, jitter=1e-10, prior_std=1.0):
 
 @pytest.fixture(scope="module")
 def data():
-    rng = np.random.default_rng(3)
-    X = rng.uniform(-2, 2, (25, 2))
-    f = np.sin(2 * X[:, 0]) + 0.5 * X[:, 1]
-    Y = np.column_stack([f, 0.7 * f + 0.2 * X[:, 0], -0.3 * f + np.cos(X[:, 1])]) + 0.1 * rng.standard_normal((25, 3))
-    Xq = rng.uniform(-2.5, 2.5, (7, 2))
-    return X, Y, Xq
+    return exact_gp_data()
 
 
 def test_kernel_matrices_equal_pairwise_definitions():
