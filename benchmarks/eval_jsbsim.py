@@ -16,7 +16,8 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
   tair   the same with the rates the aircraft's JSBSim aerodynamics reads in ``p_hat q_hat r_hat``
          (c172x, sgs, c182, t37, t6, b747: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
          so ``tair`` = ``true``; ``true`` has the inertial rates a gyro measures)
-  ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
+  ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors (with ``air_roll_train``
+         also ``ls_airtrain`` in the JSON: Cl trained on the GP's air-rate target, :func:`ls_air_target_scores`)
   cov    share of the truth inside the model's 95 % band, averaged over the six coefficients
          (``cov_gp_each`` etc. in the JSON: per coefficient). The truth is noise-free, so both scored bands
          are bands for the coefficient itself (``docs/gp.md``, "Two bands"; ``docs/jsbsim.md``, "What the
