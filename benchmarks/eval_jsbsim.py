@@ -16,7 +16,8 @@ against the truth (``100 * RMS(est - truth) / RMS(truth)`` per coefficient, on t
   tair   the same with the rates the aircraft's JSBSim aerodynamics reads in ``p_hat q_hat r_hat``
          (c172x, sgs, c182, t37, t6, b747: air-relative ``p-aero q-aero r-aero``; pa28: its XML reads the body rates,
          so ``tair`` = ``true``; ``true`` has the inertial rates a gyro measures)
-  ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors
+  ls     the stepwise least-squares model (``gcs-sysid fit``) at the measured regressors (with ``air_roll_train``
+         also ``ls_airtrain`` in the JSON: Cl trained on the GP's air-rate target, :func:`ls_air_target_scores`)
   cov    share of the truth inside the model's 95 % band, averaged over the six coefficients
          (``cov_gp_each`` etc. in the JSON: per coefficient). The truth is noise-free, so both scored bands
          are bands for the coefficient itself (``docs/gp.md``, "Two bands"; ``docs/jsbsim.md``, "What the
@@ -387,6 +388,11 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
+    from gcs_sysid.aero.gustfilter import AIR_ROLL_TRAIN, HELDOUT_AIR_ROLL
+
+    if (AIR_ROLL_TRAIN and not gust_filter) if air_roll_train is None else air_roll_train:
+        row.update(ls_air_target_scores(res, af, h, Yt, ls_model,
+                                        HELDOUT_AIR_ROLL if heldout_air_roll is None else heldout_air_roll))
     row["alpha_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 0] - Xt[ok, 0]) ** 2))))
     row["beta_deg"] = float(np.degrees(np.sqrt(np.mean((tab.X[ok, 1] - Xt[ok, 1]) ** 2))))
     row["alpha_rms_deg"] = float(np.degrees(np.std(Xt[ok, 0])))
@@ -396,6 +402,42 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         g_true = (ip("p") - ip("p_aero")) * cst["b"] / (2 * Xt[:, 9])
         row.update(airp_scores(res, model, af, h, Yt, g_true, ls_model, airp_lines))
     return row
+
+
+def ls_air_target_scores(res, airframe, h: np.ndarray, Yt: np.ndarray, ls_model, mode: str) -> dict:
+    """The least-squares line with Cl trained on the target the replay's GP was given with ``air_roll_train``
+    (:func:`gcs_sysid.aero.gustfilter.air_roll_target`: the measured Cl less the training rows' smoothed gust
+    moment) and asked, as the GP's Cl is, at the held-out rows' air-relative roll rate of ``mode``
+    (:func:`gcs_sysid.aero.gustfilter.heldout_air_roll`; ``"off"``: the gyro's). A fair GP < LS for Cl: the
+    ``ls`` line (``gcs-sysid fit``) is trained on the measured Cl at the gyro's rate, whose gust moment the GP's
+    target no longer holds. The stepwise fit is :func:`gcs_sysid.diagnose.fit.fit_model` (``gcs-sysid fit``'s pool
+    and thresholds) on the replay's own table and training rows; the other coefficients keep ``ls_model``'s.
+
+    Returns:
+        ``ls_airtrain`` (the fair line) and ``ls_airtab`` (the same fit on the measured Cl, asked at the same rate:
+        what the replay's table rather than ``gcs-sysid fit``'s own changes), % errors per coefficient on ``h``;
+        ``ls_airtrain_applied`` False when the roll fit was refused (the target is then the measured Cl).
+    """
+    from dataclasses import replace
+
+    from gcs_sysid.aero.gustfilter import air_roll_mode, air_roll_target, heldout_air_roll
+    from gcs_sysid.diagnose.fit import fit_model
+
+    tab, i = res.table, COEFFICIENTS.index("Cl")
+    info = None
+    X_air = tab.X
+    if air_roll_mode(mode)[0] != "off":
+        t2, info = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode)
+        X_air = t2.X
+    Y2, tinfo = air_roll_target(tab, res.states, airframe, res.train, fit=None if info is None else info["fit"])
+    base = ls_model.evaluate(tab.X[h])
+    out: dict = {"ls_airtrain_applied": "Cl_p" in tinfo}
+    for key, Y in (("ls_airtrain", Y2), ("ls_airtab", tab.Y)):
+        m, _ = fit_model(replace(tab, Y=Y), mask=res.train)
+        est = base.copy()
+        est[:, i] = m.evaluate(X_air[h])[:, i]
+        out[key] = _errs(est, Yt[h])
+    return out
 
 
 def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.ndarray, ls_model,

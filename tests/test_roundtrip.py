@@ -159,8 +159,8 @@ def test_air_roll_train_moves_only_cls_training_target(roundtrip, tmp_path, monk
     """``ReplayOptions.air_roll_train`` (twenty-eighth session, i8-clair): the GP is given the same inputs and the
     same targets as without it, except Cl's, which is the measured Cl plus ``Cl_p p_hat_g`` of the roll fit on the
     training rows (:func:`gcs_sysid.aero.gustfilter.air_roll_target`). The roll fit is replaced by a known one
-    (calm air: the Dryden check refuses a real one) and the GP's fit is stopped at its call, so the test reads what
-    the replay hands the GP."""
+    (calm air: the instruments' check refuses a real one) and the GP's fit is stopped at its call, so the test reads
+    what the replay hands the GP."""
     import gcs_sysid.aero.gustfilter as gf
     import gcs_sysid.gp as gp
     from gcs_sysid.aero.table import REGRESSORS
@@ -169,7 +169,7 @@ def test_air_roll_train_moves_only_cls_training_target(roundtrip, tmp_path, monk
     j = REGRESSORS.index("p_hat")
     CLP = -0.5
 
-    def fake_fit(table, states, airframe, rows, method):
+    def fake_fit(table, states, airframe, rows, method, iv_check=False):
         n = len(table.t)
         g = np.where(rows, 0.3 * np.nan_to_num(table.X[:, j]) + 0.001, 0.0)
         G = gf.RollGustFit(g, np.full(n, 1e-6), np.asarray(rows, bool), np.zeros(7), np.zeros(7), CLP, 0.5, 0.01,
@@ -198,3 +198,28 @@ def test_air_roll_train_moves_only_cls_training_target(roundtrip, tmp_path, monk
     others = [i for i in range(len(names)) if i != il]
     np.testing.assert_array_equal(Y1[:, others], Y0[:, others])
     np.testing.assert_allclose(Y1[:, il] - Y0[:, il], CLP * (0.3 * X0[:, j] + 0.001), rtol=1e-9, atol=1e-12)
+
+
+def test_calm_air_roll_fit_refused_by_the_instruments_check(roundtrip):
+    """Issue 2's calm air (twenty-ninth session, i8-guard): the roll fit passes the Dryden check (the reconstructed
+    wind's noise gives an expected gust), but with no rolling gust in the moment its state takes up the regressors'
+    own variation and its ``Cl_p`` runs to -1.30 (sim-trainer: -0.45); two-stage least squares on the controls gives
+    -0.45, so the air-rate pair's check (:data:`gcs_sysid.aero.gustfilter.ROLL_MAX_IV_RATIO`) refuses the fit, and
+    ``heldout_air_roll`` and ``air_roll_target`` leave the table and the target as they are, with a note."""
+    import gcs_sysid.aero.gustfilter as gf
+    from gcs_sysid.airframe import load_airframe
+
+    _, result, _ = roundtrip
+    tab, st = result.table, result.states
+    af = load_airframe(DATA / "airframes" / "sim-trainer.toml")
+    rows = result.train & tab.valid
+    G, ratio, why = gf._fit_roll(tab, st, af, rows, "rollgp")
+    assert G is not None and ratio >= gf.ROLL_MIN_DRYDEN_RATIO and G.Cl_p < -1.0, why
+    clp_iv, se = gf.instrumented_roll_damping(float(np.median(np.diff(tab.t))), tab.X, tab.Y, rows & G.used)
+    assert abs(clp_iv + 0.45) < 0.02 and abs(G.Cl_p) > 2 * abs(clp_iv)
+    G2, _, why = gf._fit_roll(tab, st, af, rows, "rollgp", iv_check=True)
+    assert G2 is None and "instrumented" in why
+    t2, info = gf.heldout_air_roll(tab, st, af, result.train, result.held_out, mode="predicted:Cl")
+    assert info is None and np.array_equal(t2.X, tab.X) and "instrumented" in t2.notes[-1]
+    Y, tinfo = gf.air_roll_target(tab, st, af, result.train)
+    assert Y is tab.Y and "instrumented" in tinfo["note"]

@@ -237,7 +237,7 @@ ROW_GUST_MODES = ("smoothed", "filtered", "predicted")
 
 def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
                       rows: np.ndarray, Ixx: float, S: float, b: float, mode: str = "smoothed",
-                      min_run: int = 10) -> tuple[np.ndarray, np.ndarray]:
+                      min_run: int = 10, gust_var: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The rolling gust ``p_hat_g`` on ``rows`` (a held-out segment) from their own measured roll moment, with the
     slopes, gust process and noise of a fit made on other rows (:func:`fit_roll_dynamics`, nothing refitted).
 
@@ -258,6 +258,11 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
         dt: grid interval, s. X: ``(T, 10)`` regressors (gyro hats). Y: ``(T, 6)`` measured coefficients.
         p: ``(T,)`` the smoothed roll rate, rad/s. qbar: ``(T,)`` Pa. rows: ``(T,)`` bool, where to estimate.
         Ixx, S, b: kg m^2, m^2, m. mode: one of :data:`ROW_GUST_MODES`. min_run: shortest run of usable rows.
+        gust_var: the variance of ``p_hat_g`` (dimensionless) under which the ``"predicted"`` and ``"filtered"``
+            estimates' error variance is stated (None: the fit's ``sigma**2``). The filter keeps the fit's gain;
+            with a larger process variance ``q`` its error variance is that of a suboptimal filter, the stationary
+            solution of ``P = a^2 (1 - K)^2 P + a^2 K^2 R + q`` (predicted; filtered ``(1 - K)^2 P + K^2 R``;
+            Gelb, *Applied Optimal Estimation*, 1974, sec. 7.2). ``"smoothed"`` states the fit's ``Ps``.
 
     Returns:
         ``(g, g_var)``, each ``(T,)``: ``p_hat_g`` and its variance on the usable runs of ``rows``; 0 and the fit's
@@ -291,6 +296,11 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
     s = np.zeros(T)
     var = np.full(T, (G.sigma * cl_p) ** 2)
     Pf = ss.P * G.R / ss.S
+    Pp = ss.P
+    if gust_var is not None and gust_var > G.sigma**2:   # the fit's gain under a larger gust (a suboptimal filter)
+        q = gust_var * cl_p**2 * (1 - a * a)
+        Pp = (q + (a * ss.K) ** 2 * G.R) / (1 - (a * (1 - ss.K)) ** 2)
+        Pf = (1 - ss.K) ** 2 * Pp + ss.K**2 * G.R
     for s0, s1 in _segments(use, min_run):
         zz = z[s0:s1]
         if mode == "smoothed":
@@ -298,7 +308,7 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
         else:
             xp = lfilter([0.0, a * ss.K], [1.0, -a * (1 - ss.K)], zz)     # one-step prediction, prior 0 at the start
             if mode == "predicted":
-                s[s0:s1], var[s0:s1] = xp, ss.P
+                s[s0:s1], var[s0:s1] = xp, Pp
             else:
                 s[s0:s1], var[s0:s1] = xp + ss.K * (zz - xp), Pf
     return -s / cl_p, var / cl_p**2

@@ -88,3 +88,43 @@ def test_gp_noise_defaults_to_learned_and_takes_independent(capsys):
 
     assert pipeline.GP_NOISE == "learned"
     assert pipeline.GP_NOISE_MODES["independent"] == (False, "full", "signal")
+
+
+def test_fair_least_squares_line_trains_cl_on_the_gps_air_rate_target():
+    """``ls_air_target_scores`` (twenty-ninth session, i8-guard): the LS line with Cl trained on the target the GP
+    gets with ``air_roll_train`` and asked at the held-out air rate. On the simulated roll axis of
+    ``tests/aero/test_rollgust.py`` (gust in the moment) it is closer to the air-rate Cl than the same stepwise fit
+    of the measured Cl asked at the same rate; the other coefficients are the given LS model's."""
+    import sys
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "aero"))
+    from test_rollgust import B, CLB, CLDA, CLP, DT, IXX, QBAR, S, V, _record
+
+    from benchmarks.eval_jsbsim import ls_air_target_scores
+    from gcs_sysid.aero.table import CoefficientTable, REGRESSORS
+    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
+
+    X, Y, p, g = _record(seed=1)
+    n = len(X)
+    rng = np.random.default_rng(3)
+    il = 3
+    Y[:, [0, 1, 2, 4, 5]] = 0.01 * rng.normal(size=(n, 5))
+    held = np.zeros(n, bool)
+    held[4000:] = True
+    w = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)]
+    w *= np.std(g) / (dryden_rate_sigma(gust_intensity(DT, w, np.full(n, V)), B)[0] * B / (2 * V))
+    st = SimpleNamespace(data={"p": p, "wn": w[:, 0], "we": w[:, 1], "wd": w[:, 2]})
+    tab = CoefficientTable(np.arange(n) * DT, X, Y, np.ones(n, bool), np.full(n, QBAR))
+    res = SimpleNamespace(table=tab, states=st, train=~held, held_out=held)
+    j, cb, cd = (REGRESSORS.index(k) for k in ("p_hat", "beta", "delta_a"))
+    Yt = np.zeros_like(Y)
+    Yt[:, il] = CLB * X[:, cb] + CLP * (X[:, j] - g) + CLDA * X[:, cd]      # Cl at the air rate
+    Yt[:, [0, 1, 2, 4, 5]] = 1.0
+    ls = SimpleNamespace(evaluate=lambda Xq: np.zeros((len(Xq), 6)))
+    out = ls_air_target_scores(res, SimpleNamespace(Ixx=IXX, S=S, b=B), held, Yt, ls, "predicted:Cl")
+    assert out["ls_airtrain_applied"]
+    assert out["ls_airtrain"]["Cl"] < 0.7 * out["ls_airtab"]["Cl"]
+    for c in ("CX", "CY", "CZ", "Cm", "Cn"):
+        assert out["ls_airtrain"][c] == out["ls_airtab"][c] == 100.0
