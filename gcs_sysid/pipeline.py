@@ -91,7 +91,7 @@ class ReplayOptions:
             (:func:`gcs_sysid.aero.gustfilter.air_roll_target`). Pair it with ``heldout_air_roll="predicted:Cl"``
             (Cl asked at ``p_hat - p_hat_g`` on the held-out rows); with ``"off"`` the held-out Cl is the model's at
             ``p_g = 0``. Not with ``gust_filter`` (that moves every output's ``p_hat`` instead). None:
-            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_TRAIN` (off), off when ``gust_filter`` is on.
+            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_TRAIN` (on), off when ``gust_filter`` is on.
     """
 
     rate_hz: float = 50.0
