@@ -27,9 +27,10 @@ __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_
 HEAD_FRACTION = 0.55
 #: The same when the caller has its own work to do first (``meanwhile``: the replay's estimation imports, ~0.8
 #: CPU s since the twenty-ninth session, which moved JAX's to the estimation stage; ~1.6 CPU s before, when 10 %
-#: was kept here). A whole scan of the benchmark flight is ~1.4 CPU s and the worker starts ~0.3 s late, so 30 %
-#: here evens the two processes out (``docs/benchmarks.md``, "Twenty-ninth session, speed29").
-HEAD_FRACTION_BUSY = 0.3
+#: was kept here). With 30 % the decode stage cost the main process 1.56 CPU s and the worker (its start-up
+#: included) 1.23 on the benchmark flight; 20 % evens the two out (``docs/benchmarks.md``, "Twenty-ninth session,
+#: speed29").
+HEAD_FRACTION_BUSY = 0.2
 #: Files smaller than this are scanned in one piece (the hand-over would cost more than it saves).
 MIN_SPLIT_BYTES = 1 << 20
 
