@@ -465,7 +465,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     ok = False
     try:
         with _stage("decode log", timings, bar) as prog:
-            # the stages' imports (about a second) run here while the worker decodes most of the log
+            # the estimation stage's imports (about 0.8 CPU s) run here while the worker decodes most of the log
             flight = read_log(log, progress=prog, helper=helper, meanwhile=_load_stages)
         from .estimation import estimate_states
 
