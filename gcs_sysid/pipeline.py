@@ -395,15 +395,23 @@ def _stage(name: str, timings: dict[str, float], bar) -> Iterator[Callable[[floa
 
 
 def _load_stages() -> None:
-    """Import the modules of the stages after decoding (JAX, optax, SciPy, filterpy: about a second)
-    and set up JAX (64-bit) and BLAS (one thread: the many small factorisations of the smoothers and
-    the GP run faster without hand-offs, and the worker has the other core; ``docs/gp.md``)."""
-    from .jaxconfig import enable_x64, limit_blas_threads
+    """Import the estimation stage's modules (SciPy, filterpy: about 0.8 CPU s) and set up BLAS (one
+    thread: the many small factorisations of the smoothers and the GP run faster without hand-offs, and
+    the worker has the other core; ``docs/gp.md``). Run while the worker decodes most of the log."""
+    from .jaxconfig import limit_blas_threads
+
+    limit_blas_threads(1)
+    importlib.import_module("gcs_sysid.estimation.estimate")
+
+
+def _load_model_stages() -> None:
+    """Import the modules of the stages after estimation (JAX, optax: about 0.6 CPU s) and set up JAX
+    (64-bit; idempotent). Run while the worker smooths the specific force (the estimation stage's wait,
+    :func:`gcs_sysid.estimation.estimate_states`' ``meanwhile``), and before the coefficients in any case."""
+    from .jaxconfig import enable_x64
 
     enable_x64()
-    limit_blas_threads(1)
-    for m in ("gcs_sysid.estimation.estimate", "gcs_sysid.gp", "gcs_sysid.envelope", "gcs_sysid.maneuvers",
-              "gcs_sysid.report"):
+    for m in ("gcs_sysid.gp", "gcs_sysid.envelope", "gcs_sysid.maneuvers", "gcs_sysid.report"):
         importlib.import_module(m)
 
 
@@ -457,16 +465,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     ok = False
     try:
         with _stage("decode log", timings, bar) as prog:
-            # the stages' imports (about a second) run here while the worker decodes most of the log
+            # the estimation stage's imports (about 0.8 CPU s) run here while the worker decodes most of the log
             flight = read_log(log, progress=prog, helper=helper, meanwhile=_load_stages)
-        from .envelope import confidence_map
         from .estimation import estimate_states
-        from .gp import fit_gp, load_gp
-        from .gp.discrepancy import with_offset_covariance
-        from .jaxconfig import enable_compilation_cache
-        from .maneuvers import ManeuverConfig, suggest_maneuvers
-        from .report import write_report
-        from .report.tables import correlation_of
 
         helper.preload(["gcs_sysid.estimation.rates"])   # for the specific-force smoother, next
         if options.notify is not None:
@@ -478,7 +479,18 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             flight = merge_can_log(flight, log, options.can_log, options.can_offset)
         flight = cut_window(flight, options.t_from, options.t_to)
         with _stage("estimate states", timings, bar) as prog:
-            states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper)
+            # the later stages' imports (JAX) run here while the worker smooths the specific force
+            states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper,
+                                     meanwhile=_load_model_stages)
+        _load_model_stages()   # idempotent: done already unless estimation had no specific force to hand over
+        from .envelope import confidence_map
+        from .gp import fit_gp, load_gp
+        from .gp.discrepancy import with_offset_covariance
+        from .jaxconfig import enable_compilation_cache
+        from .maneuvers import ManeuverConfig, suggest_maneuvers
+        from .report import write_report
+        from .report.tables import correlation_of
+
         helper.preload(["gcs_sysid.report.plots"])   # matplotlib for the figures, while the GP is fitted
         with _stage("coefficients", timings, bar):
             table = compute_coefficients(states, airframe, gust_rates=options.gust_rates)

@@ -135,7 +135,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     progress: Callable[[float], None] | None = None, helper: Helper | None = None,
                     aid_air_angles: bool = True, earth: str = "wgs84", angle_models: dict | None = None,
                     turbulence_state: bool = True,
-                    gust_force_axes: tuple[int, ...] | None = None) -> FlightStates:
+                    gust_force_axes: tuple[int, ...] | None = None,
+                    meanwhile: Callable[[], None] | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -161,6 +162,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         gust_force_axes: the specific-force axes (0 x, 1 y, 2 z) offered that state; None:
             :data:`gcs_sysid.estimation.rates.GUST_FORCE_AXES` as it stands at the call (y and z; ``(0, 1, 2)``
             adds x, opt-in, ``eval_jsbsim --gust-force-axes xyz``; docs/estimation.md).
+        meanwhile: optional callable run once, in this process, after the velocity filter and the air data and
+            before the specific-force smoother's result is collected: the caller's own preparation (the replay's
+            later imports) overlaps the worker's smoother instead of waiting for it. Not run when the flight has
+            no accelerometer (no smoother to wait for). It must not change what this function computes.
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -514,6 +519,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         data["alpha"], data["beta"] = alpha, beta
     if f_cg is not None:
         # the velocity filter needs the raw samples (white noise); the coefficients get the smoothed ones
+        if meanwhile is not None:
+            meanwhile()
         f_s, f_sig, f_noise = sf_job.result()
         f_corr = f_s - abias
         for i, k in enumerate(("ax", "ay", "az")):

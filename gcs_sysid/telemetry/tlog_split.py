@@ -25,10 +25,12 @@ __all__ = ["HEAD_FRACTION", "HEAD_FRACTION_BUSY", "MIN_SPLIT_BYTES", "scan_tlog_
 
 #: Share of the file this process scans; the worker starts about 0.1 s later and hands back its rows.
 HEAD_FRACTION = 0.55
-#: The same when the caller has its own work to do first (``meanwhile``: the replay's imports, ~1.6 CPU s).
-#: The imports outlast the worker's scan of 90 % of the benchmark flight (~1.2 CPU s), so the head is kept
-#: small: 20 % cost this process 0.27-0.32 CPU s, 10 % about half that (``docs/benchmarks.md``).
-HEAD_FRACTION_BUSY = 0.1
+#: The same when the caller has its own work to do first (``meanwhile``: the replay's estimation imports, ~0.8
+#: CPU s since the twenty-ninth session, which moved JAX's to the estimation stage; ~1.6 CPU s before, when 10 %
+#: was kept here). With 30 % the decode stage cost the main process 1.56 CPU s and the worker (its start-up
+#: included) 1.23 on the benchmark flight; 20 % evens the two out (``docs/benchmarks.md``, "Twenty-ninth session,
+#: speed29").
+HEAD_FRACTION_BUSY = 0.2
 #: Files smaller than this are scanned in one piece (the hand-over would cost more than it saves).
 MIN_SPLIT_BYTES = 1 << 20
 

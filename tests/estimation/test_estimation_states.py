@@ -1,5 +1,7 @@
 """estimate_states on synthetic flights with known truth: accuracy, partial logs, low rates."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from synthetic_flight import flight_from_truth, truth
@@ -130,3 +132,39 @@ def test_low_rate_log_says_what_is_not_identifiable(tr, airframe):
     assert not st.identifiability["Cm"][0] and st.identifiability["CZ"][0]
     assert any("not identifiable" in n for n in st.notes)
     assert fracs == sorted(fracs) and fracs[-1] == 1.0
+
+
+def test_meanwhile_runs_once_while_the_force_smoother_is_pending_and_changes_nothing(tr, airframe, full):
+    """``estimate_states(meanwhile=)`` (the replay's later imports overlap the worker's specific-force smoother):
+    called once, after the force smoother was handed over and before its result is collected; the states are
+    the same bit for bit as without it."""
+    from gcs_sysid.parallel import Helper
+
+    calls = []
+
+    class Recording(Helper):
+        def submit(self, target, *args, **kwargs):
+            job = super().submit(target, *args, **kwargs)
+            calls.append(("submit", target))
+            result = job.result
+
+            def collected():
+                calls.append(("result", target))
+                return result()
+            job.result = collected
+            return job
+
+    st = estimate_states(flight_from_truth(tr, seed=1), airframe, helper=Recording(enabled=False),
+                         meanwhile=lambda: calls.append(("meanwhile", None)))
+    sf = "gcs_sysid.estimation.rates:smooth_specific_force"
+    assert calls == [("submit", sf), ("meanwhile", None), ("result", sf)]
+    assert st.data.keys() == full.data.keys()
+    for k in full.data:
+        np.testing.assert_array_equal(st.data[k], full.data[k], err_msg=k)
+    # no accelerometer: no smoother to wait for, and meanwhile is not run
+    flight = flight_from_truth(tr, seed=1)
+    imu = flight.streams["imu"]
+    flight.streams["imu"] = replace(imu, fields={k: v for k, v in imu.fields.items() if k not in ("ax", "ay", "az")})
+    calls.clear()
+    estimate_states(flight, airframe, meanwhile=lambda: calls.append(("meanwhile", None)))
+    assert calls == []
