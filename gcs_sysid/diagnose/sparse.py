@@ -230,8 +230,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: ``docs/benchmarks.md``, *Twenty-seventh session, i9-a2pair*. Twenty-eighth session (branch i9-pwp2): the block is
 #: offered only at a step where the square is not the best single column (a square that wins alone enters alone, its
 #: parent on its own PRESS), and ``entered_with`` only when the first step was the block; that removed the t6's and
-#: s23's losses and kept the four wins (*Twenty-eighth session, i9-pwp2*). Still off: measured on nine of the 25
-#: tuning aircraft (no count lost there); the other sixteen were not run.
+#: s23's losses and kept the four wins (*Twenty-eighth session, i9-pwp2*). Still off after the twenty-ninth session
+#: (branch i9-pwp3): ``Cm:alpha^2`` and clean flights on all 25 tuning aircraft win on seven and lose nothing, but an
+#: other effect's count is lost: the sgs126's ``Cn:delta_a`` estimate (4 -> 3/6), where the block entered ``Cn``'s own
+#: search at its third step and took ``p_hat``'s place (*Twenty-ninth session, i9-pwp3*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
