@@ -83,6 +83,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--stated-lift-level", action="store_true",
                    help="set the aided alpha's flight mean on the airframe's stated lift line ([aero] CL0 with "
                         "CL_alpha; docs/estimation.md, 'A stated lift line sets alpha's level'; default off)")
+    r.add_argument("--air-roll", default=None, choices=("on", "off"),
+                   help="Cl learned and asked at the air-relative roll rate (the rolling gust's moment taken out "
+                        "of Cl's training target, the held-out Cl asked at the gyro's p_hat less the predicted "
+                        "gust; refused, with a note, where the roll fit finds no gust): 'on' the default, 'off' "
+                        "Cl at the gyro's rate as every other coefficient (docs/estimation.md, 'The pair is the "
+                        "default')")
     r.add_argument("--quiet", action="store_true", help="no progress display")
 
     s = sub.add_parser("simulate", help="simulate a flight with the project's 6-DOF model and write a tlog")
@@ -150,7 +156,15 @@ def _replay_options(a: argparse.Namespace):
                          model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say,
                          targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")),
                          can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates,
-                         gp_noise=a.gp_noise)
+                         gp_noise=a.gp_noise, **_air_roll_options(getattr(a, "air_roll", None)))
+
+
+def _air_roll_options(flag: str | None) -> dict:
+    """``--air-roll on|off`` as :class:`gcs_sysid.pipeline.ReplayOptions` fields (``air_roll_train`` and
+    ``heldout_air_roll``, the pair :mod:`gcs_sysid.aero.gustfilter` makes the default); None: the defaults."""
+    if flag is None:
+        return {}
+    return {"air_roll_train": flag == "on", "heldout_air_roll": "predicted:Cl" if flag == "on" else "off"}
 
 
 def _stated_lift_level(a: argparse.Namespace) -> None:

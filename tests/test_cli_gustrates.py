@@ -1,4 +1,4 @@
-"""`--gust-rates` on replay and fit: parsed into the options, a wrong frame is a user error."""
+"""`--gust-rates` on replay and fit: parsed into the options, a wrong frame is a user error; `--air-roll` on replay."""
 
 import pytest
 
@@ -40,3 +40,18 @@ def test_stated_lift_level_flag_switches_the_aiding(monkeypatch):
         with pytest.raises(ZeroDivisionError):
             cli.COMMANDS[a.command](a)
     assert seen == [False, True, True]
+
+
+def test_replay_air_roll_flag_sets_both_halves_of_the_pair(capsys):
+    """`--air-roll off` turns off Cl's air-rate target and its held-out rate together, `on` asks for both, no flag leaves
+    the replay's defaults (None); another value is a user error (exit 2)."""
+    base = ["replay", "x.tlog", "--airframe", "a.toml", "--out", "o"]
+    o = _replay_options(build_parser().parse_args(base + ["--air-roll", "off"]))
+    assert (o.air_roll_train, o.heldout_air_roll) == (False, "off")
+    o = _replay_options(build_parser().parse_args(base + ["--air-roll", "on"]))
+    assert (o.air_roll_train, o.heldout_air_roll) == (True, "predicted:Cl")
+    o = _replay_options(build_parser().parse_args(base))
+    assert (o.air_roll_train, o.heldout_air_roll) == (None, None)
+    with pytest.raises(SystemExit) as e:
+        main(base + ["--air-roll", "maybe"], handle_signals=False)
+    assert e.value.code == 2 and "--air-roll" in capsys.readouterr().err
