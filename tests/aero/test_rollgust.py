@@ -52,6 +52,32 @@ def _record(n=5000, seed=0, gust_in_moment=True):
     return X, Y, p[j], pg[j] * h
 
 
+def _dryden_wind(g, rng):
+    """``(n, 3)`` NED wind, m/s: a random walk in north and east scaled so that the rolling gust MIL-F-8785C's
+    Dryden form expects from its intensity has the SD of the simulated ``p_hat_g`` ``g`` (what the Dryden check of
+    :func:`gcs_sysid.aero.gustfilter._fit_roll` compares the fitted gust with)."""
+    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
+
+    n = len(g)
+    w = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)]
+    return w * np.std(g) / (dryden_rate_sigma(gust_intensity(DT, w, np.full(n, V)), B)[0] * B / (2 * V))
+
+
+def _roll_case(X, Y, p, g, rng):
+    """A :func:`_record` as the replay hands it to the air-rate pair: ``(held, states, table)``, the held-out block
+    rows 4000 on, states with ``p`` and a :func:`_dryden_wind`, the coefficient table (every row valid)."""
+    from types import SimpleNamespace
+
+    from gcs_sysid.aero.table import CoefficientTable
+
+    n = len(X)
+    held = np.zeros(n, bool)
+    held[4000:] = True
+    w = _dryden_wind(g, rng)
+    st = SimpleNamespace(data={"p": p, "wn": w[:, 0], "we": w[:, 1], "wd": w[:, 2]})
+    return held, st, CoefficientTable(np.arange(n) * DT, X, Y, np.ones(n, bool), np.full(n, QBAR))
+
+
 def test_gust_state_recovers_roll_damping_where_least_squares_is_biased():
     """100 s at 50 Hz, the gust term ~70 % of the Cl signal's SD: least squares on the gyro's ``p_hat`` gives
     Cl_p -0.30..-0.34 on seeds 0-4 (the attenuation seen on JSBSim); the filter-error fit -0.47..-0.51, Cl_delta_a
@@ -210,11 +236,7 @@ def test_held_out_rows_at_the_reconstructed_air_relative_roll_rate():
         cl_true)  # noqa: E731
     assert err(X[held, j]) > 0.5
     # the Dryden check needs a wind: scale one so that its expected rolling gust is the simulated one's
-    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
-
-    rng = np.random.default_rng(7)
-    w = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)]
-    w *= np.std(g) / (dryden_rate_sigma(gust_intensity(DT, w, np.full(n, V)), B)[0] * B / (2 * V))
+    w = _dryden_wind(g, np.random.default_rng(7))
     st.data.update(wn=w[:, 0], we=w[:, 1], wd=w[:, 2])
     corr = {}
     for mode in ("smoothed", "filtered", "predicted"):
@@ -284,9 +306,7 @@ def test_cl_training_target_at_the_air_relative_roll_rate():
     from types import SimpleNamespace
 
     from gcs_sysid.aero.gustfilter import _fit_roll, air_roll_target
-    from gcs_sysid.aero.table import CoefficientTable
     from gcs_sysid.errors import InputError
-    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
     from gcs_sysid.pipeline import ReplayOptions, check_replay
 
     air = SimpleNamespace(Ixx=IXX, S=S, b=B)
@@ -296,12 +316,7 @@ def test_cl_training_target_at_the_air_relative_roll_rate():
     for reads in (True, False):
         X, Y, p, g = _record(gust_in_moment=reads)
         n = len(X)
-        held = np.zeros(n, bool)
-        held[4000:] = True
-        w = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)]
-        w *= np.std(g) / (dryden_rate_sigma(gust_intensity(DT, w, np.full(n, V)), B)[0] * B / (2 * V))
-        st = SimpleNamespace(data={"p": p, "wn": w[:, 0], "we": w[:, 1], "wd": w[:, 2]})
-        tab = CoefficientTable(np.arange(n) * DT, X, Y, np.ones(n, bool), np.full(n, QBAR))
+        held, st, tab = _roll_case(X, Y, p, g, rng)
         Y2, info = air_roll_target(tab, st, air, ~held)
         if not reads:
             assert Y2 is tab.Y and "Cl_p" not in info and "air-rate training target" in info["note"]
@@ -337,18 +352,10 @@ def test_instrumented_roll_damping_and_the_moment_gust_variance():
     from types import SimpleNamespace
 
     from gcs_sysid.aero import gustfilter as gf
-    from gcs_sysid.aero.table import CoefficientTable
-    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
 
     X, Y, p, g = _record(seed=1)
     n = len(X)
-    held = np.zeros(n, bool)
-    held[4000:] = True
-    rng = np.random.default_rng(7)
-    w = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)]
-    w *= np.std(g) / (dryden_rate_sigma(gust_intensity(DT, w, np.full(n, V)), B)[0] * B / (2 * V))
-    st = SimpleNamespace(data={"p": p, "wn": w[:, 0], "we": w[:, 1], "wd": w[:, 2]})
-    tab = CoefficientTable(np.arange(n) * DT, X, Y, np.ones(n, bool), np.full(n, QBAR))
+    held, st, tab = _roll_case(X, Y, p, g, np.random.default_rng(7))
     air = SimpleNamespace(Ixx=IXX, S=S, b=B)
     F, _, why = gf._fit_roll(tab, st, air, ~held, "rollgp", iv_check=True)
     assert F is not None, why

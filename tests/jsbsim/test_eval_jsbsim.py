@@ -100,23 +100,17 @@ def test_fair_least_squares_line_trains_cl_on_the_gps_air_rate_target():
     from types import SimpleNamespace
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "aero"))
-    from test_rollgust import B, CLB, CLDA, CLP, DT, IXX, QBAR, S, V, _record
+    from test_rollgust import B, CLB, CLDA, CLP, IXX, S, _record, _roll_case
 
     from benchmarks.eval_jsbsim import ls_air_target_scores
-    from gcs_sysid.aero.table import CoefficientTable, REGRESSORS
-    from gcs_sysid.estimation.gustrates import dryden_rate_sigma, gust_intensity
+    from gcs_sysid.aero.table import REGRESSORS
 
     X, Y, p, g = _record(seed=1)
     n = len(X)
     rng = np.random.default_rng(3)
     il = 3
     Y[:, [0, 1, 2, 4, 5]] = 0.01 * rng.normal(size=(n, 5))
-    held = np.zeros(n, bool)
-    held[4000:] = True
-    w = np.c_[np.cumsum(rng.normal(size=(n, 2)), 0), np.zeros(n)]
-    w *= np.std(g) / (dryden_rate_sigma(gust_intensity(DT, w, np.full(n, V)), B)[0] * B / (2 * V))
-    st = SimpleNamespace(data={"p": p, "wn": w[:, 0], "we": w[:, 1], "wd": w[:, 2]})
-    tab = CoefficientTable(np.arange(n) * DT, X, Y, np.ones(n, bool), np.full(n, QBAR))
+    held, st, tab = _roll_case(X, Y, p, g, rng)
     res = SimpleNamespace(table=tab, states=st, train=~held, held_out=held)
     j, cb, cd = (REGRESSORS.index(k) for k in ("p_hat", "beta", "delta_a"))
     Yt = np.zeros_like(Y)
