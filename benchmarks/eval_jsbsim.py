@@ -420,16 +420,15 @@ def ls_air_target_scores(res, airframe, h: np.ndarray, Yt: np.ndarray, ls_model,
     """
     from dataclasses import replace
 
-    from gcs_sysid.aero.gustfilter import air_roll_mode, air_roll_target, heldout_air_roll
+    from gcs_sysid.aero.gustfilter import air_roll_fit, air_roll_mode, air_roll_target, heldout_air_roll
     from gcs_sysid.diagnose.fit import fit_model
 
     tab, i = res.table, COEFFICIENTS.index("Cl")
-    info = None
+    fit = air_roll_fit(tab, res.states, airframe, res.train)
     X_air = tab.X
     if air_roll_mode(mode)[0] != "off":
-        t2, info = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode)
-        X_air = t2.X
-    Y2, tinfo = air_roll_target(tab, res.states, airframe, res.train, fit=None if info is None else info["fit"])
+        X_air = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode, fit=fit)[0].X
+    Y2, tinfo = air_roll_target(tab, res.states, airframe, res.train, fit=fit)
     base = ls_model.evaluate(tab.X[h])
     out: dict = {"ls_airtrain_applied": "Cl_p" in tinfo}
     for key, Y in (("ls_airtrain", Y2), ("ls_airtab", tab.Y)):

@@ -497,7 +497,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
-        from .aero.gustfilter import (AIR_ROLL_TRAIN, GUST_FILTER, HELDOUT_AIR_ROLL, air_roll_target,
+        from .aero.gustfilter import (AIR_ROLL_TRAIN, GUST_FILTER, HELDOUT_AIR_ROLL, air_roll_fit, air_roll_target,
                                       filter_gust_table, heldout_air_roll)
 
         gust_filter = GUST_FILTER if options.gust_filter is None else options.gust_filter
@@ -508,14 +508,17 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             raise InputError("air_roll_train: not with gust_filter (both take the rolling gust out of Cl's training "
                              "rows)")
         air_info = None
-        if air_roll != "off":       # opt-in: the held-out rows at the reconstructed air-relative roll rate
+        pair_fit = None             # both halves of the pair on: one roll fit (or why it was refused) for the two
+        if air_roll != "off":       # the held-out rows at the reconstructed air-relative roll rate
             with _stage("held-out air roll rate", timings, bar):
-                table_air, air_info = heldout_air_roll(table, states, airframe, train, held, mode=air_roll)
+                if air_train:
+                    pair_fit = air_roll_fit(table, states, airframe, train)
+                table_air, air_info = heldout_air_roll(table, states, airframe, train, held, mode=air_roll,
+                                                       fit=pair_fit)
         Y_fit = table.Y             # the GP's training target (air_roll_train: Cl's moved to the air roll rate)
-        if air_train:               # opt-in: Cl's target less the training rows' smoothed gust moment
+        if air_train:               # Cl's target less the training rows' smoothed gust moment
             with _stage("air roll training target", timings, bar):
-                Y_fit, target_info = air_roll_target(table, states, airframe, train,
-                                                     fit=None if air_info is None else air_info["fit"])
+                Y_fit, target_info = air_roll_target(table, states, airframe, train, fit=pair_fit)
             notes.append(target_info["note"])
         gust_fit = None
         if gust_filter:

@@ -127,7 +127,7 @@ def test_heldout_air_roll_per_output_asks_only_cl_at_the_air_rate(roundtrip, tmp
     _, result, out = roundtrip
     j = REGRESSORS.index("p_hat")
 
-    def shifted(table, states, airframe, train, held, mode="off"):
+    def shifted(table, states, airframe, train, held, mode="off", fit=None):
         base, outputs = gf.air_roll_mode(mode)
         g = np.where(held, 0.05, 0.0)
         X = table.X.copy()

@@ -49,7 +49,7 @@ __all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_MAX_IV_RATIO", "instrum
            "instruments",
            "stated_moment_variance", "filter_gust_table", "HELDOUT_AIR_ROLL", "AIR_ROLL_MODES", "air_roll_mode",
            "heldout_air_roll", "HELDOUT_GUST_VAR", "gust_moment_variance", "AIR_ROLL_TRAIN",
-           "air_roll_target"]
+           "air_roll_fit", "air_roll_target"]
 
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
 #: less the filter-error rolling gust.
@@ -542,7 +542,8 @@ def air_roll_mode(mode: str) -> tuple[str, tuple[str, ...] | None]:
     return base, (tuple(outs.split(",")) if outs else None)
 
 
-def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarray, mode: str = HELDOUT_AIR_ROLL):
+def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarray, mode: str = HELDOUT_AIR_ROLL,
+                     fit: RollGustFit | str | None = None):
     """The table with the held-out rows' ``p_hat`` relative to the air: less the rolling gust ``p_hat_g`` estimated
     there from their own measured roll moment (:func:`gcs_sysid.aero.rollgust.roll_gust_on_rows`), with the slopes,
     gust process and noise of the ``"rollgp"`` roll fit on the training rows (:func:`filter_gust_table`'s).
@@ -561,6 +562,7 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
         train, held: ``(T,)`` bool, the training rows (the fit's) and the rows to change.
         mode: ``"off"`` (the table returned as it is) or one of :data:`AIR_ROLL_MODES` (a per-output mode
             ``"MODE:Cl"`` makes the same table: which outputs are asked at it is the caller's, ``info["outputs"]``).
+        fit: :func:`air_roll_fit` on ``train`` already made (the fit, or why it was refused); None: made here.
 
     Returns:
         ``(table, info)``: a new table and a dict (``mode`` the gust mode, ``outputs`` (None: every output; else the
@@ -583,9 +585,9 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
     held = np.asarray(held, bool)
     if len(table.t) < 3 or not held.any():
         return replace(table, notes=list(table.notes) + ["held-out air roll rate not estimated: no held-out rows"]), None
-    G, _, why = _fit_roll(table, states, airframe, np.asarray(train, bool) & table.valid, "rollgp", iv_check=True)
-    if G is None:
-        return replace(table, notes=list(table.notes) + [why.replace("gust filter", "held-out air roll rate")]), None
+    G = air_roll_fit(table, states, airframe, train) if fit is None else fit
+    if isinstance(G, str):
+        return replace(table, notes=list(table.notes) + [G.replace("gust filter", "held-out air roll rate")]), None
     dt = float(np.median(np.diff(table.t)))
     g, g_var = roll_gust_on_rows(G, dt, table.X, table.Y, states.data["p"], table.qbar, held & table.valid,
                                  airframe.Ixx, airframe.S, airframe.b, mode=mode,
@@ -618,7 +620,25 @@ def gust_moment_variance(fit: RollGustFit) -> float:
     return float(max(np.var(fit.g[u]) + np.mean(fit.g_var[u]), fit.sigma**2))
 
 
-def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit | None = None):
+def air_roll_fit(table, states, airframe, train: np.ndarray) -> RollGustFit | str:
+    """The air-rate pair's roll fit on the valid training rows: :func:`filter_gust_table`'s ``"rollgp"`` fit with its
+    Dryden check and the instruments' check of :data:`ROLL_MAX_IV_RATIO`. Made once, it serves both halves of the
+    pair (:func:`heldout_air_roll`, :func:`air_roll_target`; their ``fit``), so the replay fits the roll once.
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (gyro's ``p_hat``). states: ``p`` on the table's grid.
+        airframe: span, area and inertia. train: ``(T,)`` bool, the training rows.
+
+    Returns:
+        the fit, or why there is none (a note in the gust filter's words, ``"gust filter not ..."``, which each half
+        restates under its own name).
+    """
+    G, _, why = _fit_roll(table, states, airframe, np.asarray(train, bool) & np.asarray(table.valid, bool), "rollgp",
+                          iv_check=True)
+    return why if G is None else G
+
+
+def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit | str | None = None):
     """The measured coefficients with the training rows' Cl at the air-relative roll rate: Cl less the rolling
     gust's moment of the roll fit, ``Cl + Cl_p p_hat_g`` (``p_hat_g`` smoothed on the training rows), every other
     output and every other row as measured.
@@ -640,9 +660,8 @@ def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit
         states: the smoothed states (``p`` on the table's grid; the stated ``p_dot`` noise for ``R``).
         airframe: span, area and inertia.
         train: ``(T,)`` bool, the training rows (the only rows whose moment the fit reads or whose target changes).
-        fit: a ``"rollgp"`` roll fit on those rows already made (:func:`heldout_air_roll`'s ``info["fit"]``);
-            None: fitted here (:func:`filter_gust_table`'s, with its Dryden check, and the instruments' check of
-            :data:`ROLL_MAX_IV_RATIO`).
+        fit: :func:`air_roll_fit` on those rows already made (the fit, or why it was refused; also
+            :func:`heldout_air_roll`'s ``info["fit"]``); None: made here.
 
     Returns:
         ``(Y, info)``: ``Y`` ``(T, 6)`` a copy with Cl's column changed on the fit's rows, and a dict (``Cl_p``,
@@ -661,9 +680,9 @@ def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit
     if fit is None:
         if T < 3:
             return table.Y, {"note": "Cl's training target not moved to the air roll rate: fewer than 3 rows"}
-        fit, _, why = _fit_roll(table, states, airframe, rows, "rollgp", iv_check=True)
-        if fit is None:
-            return table.Y, {"note": why.replace("gust filter", "Cl's air-rate training target")}
+        fit = air_roll_fit(table, states, airframe, train)
+    if isinstance(fit, str):
+        return table.Y, {"note": fit.replace("gust filter", "Cl's air-rate training target")}
     use = rows & np.asarray(fit.used, bool) & np.isfinite(fit.g)
     g = np.where(use, fit.g, 0.0)
     i = COEFFICIENTS.index("Cl")
