@@ -8,11 +8,17 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-# Compiled JAX programs go to a cache private to this test session (inherited by the CLI
-# subprocesses), so the suite neither reads nor fills the user's cache.
+# Compiled JAX programs go to a cache private to this test session (inherited by the xdist
+# workers and the CLI subprocesses), so the suite neither reads nor fills the user's cache. The
+# process that made the folder removes it at exit (the workers and subprocesses have ended by then);
+# a folder given by the caller is left alone.
+import atexit  # noqa: E402
+import shutil  # noqa: E402
 import tempfile  # noqa: E402
 
-os.environ.setdefault("GCS_SYSID_JAX_CACHE", tempfile.mkdtemp(prefix="gcs-sysid-jax-"))
+if not os.environ.get("GCS_SYSID_JAX_CACHE", "").strip():
+    os.environ["GCS_SYSID_JAX_CACHE"] = tempfile.mkdtemp(prefix="gcs-sysid-jax-")
+    atexit.register(shutil.rmtree, os.environ["GCS_SYSID_JAX_CACHE"], ignore_errors=True)
 
 from pathlib import Path
 
