@@ -69,7 +69,7 @@ measured Cl and the gyro's rate, as the replay); ``ls`` is then ``eval_jsbsim``'
 stepwise fit on the replay's table and the same target, asked at the same rate); ``err_true`` asks Cl at JSBSim's
 air-relative rates (``eval_jsbsim``'s ``true_air``, :func:`true_air_regressors`), the other outputs at the truth's
 body rates as before. ``--make`` caches the pair's arrays (:func:`air_rate_arrays`); ``--air-roll off`` gives the tables before (``aoa`` tagged ``/gyro-Cl``). The
-``--missing`` models and ``--diagnose`` stay on the measured Cl.
+``--missing`` models, ``--diagnose`` and ``eval_gp_joint.py`` (its own scoring) stay on the measured Cl.
 
 Missing outputs (heterotopic data, ``--missing PATTERN ...``; issue 8 item 3, the case where the
 coupling of the outputs can move the predictions): the moment coefficients (Cl Cm Cn) of a share of
