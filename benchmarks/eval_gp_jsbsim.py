@@ -68,7 +68,8 @@ variant's Cl is trained on the replay's target (the measured Cl less the trainin
 measured Cl and the gyro's rate, as the replay); ``ls`` is then ``eval_jsbsim``'s fair line ``ls_airtrain`` (Cl by the
 stepwise fit on the replay's table and the same target, asked at the same rate); ``err_true`` asks Cl at JSBSim's
 air-relative rates (``eval_jsbsim``'s ``true_air``, :func:`true_air_regressors`), the other outputs at the truth's
-body rates as before. ``--make`` caches the pair's arrays (:func:`air_rate_arrays`); ``--air-roll off`` gives the tables before (``aoa`` tagged ``/gyro-Cl``). The
+body rates as before. ``--make`` caches the pair's arrays (:func:`air_rate_arrays`); ``--air-roll off`` gives the
+tables before (``aoa`` tagged ``/gyro-Cl``). The
 ``--missing`` models, ``--diagnose`` and ``eval_gp_joint.py`` (its own scoring) stay on the measured Cl.
 
 Missing outputs (heterotopic data, ``--missing PATTERN ...``; issue 8 item 3, the case where the
@@ -172,7 +173,8 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
 def true_air_regressors(aircraft: str, truth, t: np.ndarray, Xt: np.ndarray) -> np.ndarray:
     """The true regressors ``Xt`` ``(T, 10)`` with the rate hats JSBSim's aerodynamics reads: ``p_aero q_aero r_aero``
     on the axes whose XML reads them (:func:`benchmarks.eval_jsbsim.aero_reads_air_rates`), as ``eval_jsbsim``'s
-    ``true_air`` line; the others as ``Xt``. ``t``: ``(T,)`` s; ``truth``: :func:`~benchmarks.jsbsim_harness.load_truth`."""
+    ``true_air`` line; the others as ``Xt``. ``t``: ``(T,)`` s; ``truth``:
+    :func:`~benchmarks.jsbsim_harness.load_truth`."""
     from benchmarks.eval_jsbsim import aero_reads_air_rates
 
     out = np.array(Xt, float, copy=True)

@@ -223,8 +223,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             from .differential import fit_record
 
             doc["reference_flights"] = [fit_record(log, t_from, t_to)]
-            doc["air_roll"] = {"target": "gyro", "applied": False, "note": "off (--air-roll off)"} if air is None \
-                else {k: air[k] for k in ("target", "applied", "note", "Cl_p")}
+            off = {"target": "gyro", "applied": False, "Cl_p": None, "note": "off (--air-roll off)"}
+            doc["air_roll"] = off if air is None else {k: air[k] for k in ("target", "applied", "Cl_p", "note")}
         if meas.flight.damage and isinstance(doc, dict):
             doc["log_damage"] = list(meas.flight.damage)
         stage.path(out.with_suffix(".fit.json")).write_text(json.dumps(doc, indent=1, default=float))

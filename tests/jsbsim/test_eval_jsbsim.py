@@ -126,8 +126,8 @@ def test_fair_least_squares_line_trains_cl_on_the_gps_air_rate_target():
 
 def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
     """``eval_gp_jsbsim`` (thirtieth session, i8-airfit): the cache holds the replay's air-rate pair
-    (:func:`benchmarks.eval_gp_jsbsim.air_rate_arrays`) and ``score`` trains Cl on its target and asks it at the held-out
-    air rate by default. On the simulated roll axis of ``tests/aero/test_rollgust.py`` the independent GPs' Cl is closer
+    (:func:`benchmarks.eval_gp_jsbsim.air_rate_arrays`) and ``score`` trains Cl on its target and asks it at the
+    held-out air rate by default. On the simulated roll axis of ``tests/aero/test_rollgust.py`` the independent GPs' Cl is closer
     to the air-rate Cl with the pair than without (``air_roll=False``, the old tables); the other outputs' GPs see the
     same rows and targets either way (identical errors); ``ls`` is the fair line; a cache made before the pair's
     arrays is refused unless ``air_roll=False``."""
@@ -159,7 +159,8 @@ def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
     np.testing.assert_array_equal(air["X_air"][~held], X[~held])
     np.testing.assert_array_equal(air["Y_air"][:, others], Y[:, others])
     base = dict(t=tab.t, X=X, Y=Y, valid=np.ones(n, bool), held=held, train=~held, Xt=X, Yt=Yt,
-                gp_mean=np.zeros_like(Y), gp_sigma=np.zeros_like(Y), ls=ls.evaluate(X), x_offset_cov=np.full((10, 10), np.nan))
+                gp_mean=np.zeros_like(Y), gp_sigma=np.zeros_like(Y), ls=ls.evaluate(X),
+                x_offset_cov=np.full((10, 10), np.nan))
     old, new = tmp_path / "sim-1-light-ahrs.npz", tmp_path / "new" / "sim-1-light-ahrs.npz"
     new.parent.mkdir()
     np.savez(old, **base)
