@@ -61,6 +61,17 @@ lists the pairs with a learned correlation above 0.5 where the truth's is below 
 (``CARRIES``). ``--diagnose`` prints, per
 flight, least squares per output against seemingly-unrelated-regressions GLS (Zellner 1962).
 
+The replay's air-rate pair (``--air-roll``, on by default since the thirtieth session, as ``gcs-sysid replay``): every
+variant's Cl is trained on the replay's target (the measured Cl less the training rows' smoothed rolling-gust moment,
+:func:`gcs_sysid.aero.gustfilter.air_roll_target`) and asked at the held-out rows' air-relative roll rate
+(``HELDOUT_AIR_ROLL = "predicted:Cl"``), from the one roll fit ``air_roll_fit`` with its calm-air guard (refused: the
+measured Cl and the gyro's rate, as the replay); ``ls`` is then ``eval_jsbsim``'s fair line ``ls_airtrain`` (Cl by the
+stepwise fit on the replay's table and the same target, asked at the same rate); ``err_true`` asks Cl at JSBSim's
+air-relative rates (``eval_jsbsim``'s ``true_air``, :func:`true_air_regressors`), the other outputs at the truth's
+body rates as before. ``--make`` caches the pair's arrays (:func:`air_rate_arrays`); ``--air-roll off`` gives the
+tables before (``aoa`` tagged ``/gyro-Cl``). The
+``--missing`` models, ``--diagnose`` and ``eval_gp_joint.py`` (its own scoring) stay on the measured Cl.
+
 Missing outputs (heterotopic data, ``--missing PATTERN ...``; issue 8 item 3, the case where the
 coupling of the outputs can move the predictions): the moment coefficients (Cl Cm Cn) of a share of
 the training rows are removed (NaN) by a pattern fixed before any run (:data:`MISSING_PATTERNS`):
@@ -133,6 +144,7 @@ CARRIES = 0.1
 def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, cache: Path) -> Path:
     """Fly, replay and fit least squares once; save the table, truth and LS predictions (``.npz``)."""
     from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight
+    from gcs_sysid.airframe import load_airframe
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.pipeline import ReplayOptions, run_replay
 
@@ -148,11 +160,68 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     Xt, Yt = truth.at(tab.t)
     t_cut = float(tab.t[held & tab.valid][0])
     ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut)
+    air = air_rate_arrays(res, load_airframe(files.airframe), ls_model)
+    air["Xt_air"] = true_air_regressors(aircraft, truth, tab.t, Xt)
     out = cache / f"{name}.npz"
     np.savez(out, t=tab.t, X=tab.X, Y=tab.Y, valid=tab.valid, held=held, train=res.train, Xt=Xt, Yt=Yt,
              gp_mean=res.pred_mean, gp_sigma=res.pred_sigma, ls=ls_model.evaluate(tab.X),
-             x_offset_cov=np.full((tab.X.shape[1],) * 2, np.nan) if tab.x_offset_cov is None else tab.x_offset_cov)
+             x_offset_cov=np.full((tab.X.shape[1],) * 2, np.nan) if tab.x_offset_cov is None else tab.x_offset_cov,
+             **air)
     return out
+
+
+def true_air_regressors(aircraft: str, truth, t: np.ndarray, Xt: np.ndarray) -> np.ndarray:
+    """The true regressors ``Xt`` ``(T, 10)`` with the rate hats JSBSim's aerodynamics reads: ``p_aero q_aero r_aero``
+    on the axes whose XML reads them (:func:`benchmarks.eval_jsbsim.aero_reads_air_rates`), as ``eval_jsbsim``'s
+    ``true_air`` line; the others as ``Xt``. ``t``: ``(T,)`` s; ``truth``:
+    :func:`~benchmarks.jsbsim_harness.load_truth`."""
+    from benchmarks.eval_jsbsim import aero_reads_air_rates
+
+    out = np.array(Xt, float, copy=True)
+    cst = truth.meta["constants"]
+    axes = aero_reads_air_rates(aircraft)
+    for j, (ax, ref) in enumerate(zip("pqr", ("b", "c", "b"))):
+        if axes[ax]:
+            out[:, 2 + j] = np.interp(t, truth.t, truth.fields[f"{ax}_aero"], left=np.nan, right=np.nan) * cst[ref] \
+                / (2 * Xt[:, 9])
+    return out
+
+
+def air_rate_arrays(res, airframe, ls_model) -> dict:
+    """The replay's air-rate pair on one replay's table, for :func:`score` (arrays for the cache ``.npz``).
+
+    The one roll fit of the pair (:func:`gcs_sysid.aero.gustfilter.air_roll_fit` on the replay's training rows, with
+    its Dryden and instruments' checks), the GP's Cl training target it gives
+    (:func:`~gcs_sysid.aero.gustfilter.air_roll_target`: the measured Cl less the training rows' smoothed gust
+    moment) and the held-out rows at the air-relative roll rate of
+    :data:`~gcs_sysid.aero.gustfilter.HELDOUT_AIR_ROLL` (:func:`~gcs_sysid.aero.gustfilter.heldout_air_roll`), as
+    ``run_replay`` makes them with ``AIR_ROLL_TRAIN``; and the fair least-squares line of ``eval_jsbsim``
+    (``ls_airtrain``, :func:`benchmarks.eval_jsbsim.ls_air_target_scores`): Cl by ``gcs-sysid fit``'s stepwise
+    regression (:func:`gcs_sysid.diagnose.fit.fit_model`) on the replay's training rows and that target, asked at the
+    same held-out air rate; the other coefficients ``ls_model``'s.
+
+    Args:
+        res: :class:`gcs_sysid.pipeline.ReplayResult` (its table at the gyro's ``p_hat``, states, rows).
+        airframe: the flight's :class:`~gcs_sysid.airframe.Airframe`.
+        ls_model: ``gcs-sysid fit``'s model on the training window (``evaluate(X) -> (T, 6)``).
+
+    Returns:
+        ``Y_air`` ``(T, 6)`` (the measured coefficients with Cl's training rows moved; equal to ``Y`` where the roll
+        fit was refused), ``X_air`` ``(T, 10)`` (``X`` with the held-out rows' ``p_hat`` less the gust; equal to
+        ``X`` where refused or ``HELDOUT_AIR_ROLL`` is ``"off"``), ``ls_air`` ``(T, 6)``, ``air_applied`` (bool:
+        the roll fit was accepted), ``air_note`` (the target's note: what was done, or why not).
+    """
+    from gcs_sysid.aero.gustfilter import HELDOUT_AIR_ROLL, air_roll_fit, air_roll_target, heldout_air_roll
+    from gcs_sysid.diagnose.fit import fit_model
+
+    tab = res.table
+    fit = air_roll_fit(tab, res.states, airframe, res.train)
+    X_air = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=HELDOUT_AIR_ROLL, fit=fit)[0].X
+    Y_air, info = air_roll_target(tab, res.states, airframe, res.train, fit=fit)
+    i = COEFFICIENTS.index("Cl")
+    ls_air = np.array(ls_model.evaluate(tab.X), float)
+    ls_air[:, i] = fit_model(replace(tab, Y=Y_air), mask=res.train)[0].evaluate(X_air)[:, i]
+    return dict(Y_air=Y_air, X_air=X_air, ls_air=ls_air, air_applied=not isinstance(fit, str), air_note=info["note"])
 
 
 def errors(est: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -206,16 +275,44 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
     raise ValueError(variant)
 
 
-def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = None):
+def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = None, air_roll: bool = True):
     """Every variant on one cached flight; yields one JSON-able dict per variant.
 
     ``thin``: fit on every ``thin``-th training row only (few samples over the whole flown envelope:
     where pooling the outputs in one joint model should matter most); None: all of them.
+    ``air_roll``: the replay's air-rate pair (:func:`air_rate_arrays`, cached by ``--make``): every variant's Cl
+    trained on the air-rate target and asked at the held-out rows' air roll rate (the other outputs at the gyro's
+    rate, as the replay's ``"predicted:Cl"``), and ``ls`` the fair least-squares line on the same target; where the
+    roll fit was refused the target and rates are the measured ones. False: Cl trained on the measured Cl at the
+    gyro's rate (the tables before the thirtieth session; the lines' ``aoa`` gets ``/gyro-Cl``).
+
+    Raises:
+        ValueError: ``air_roll`` on a cache made before the air-rate arrays (remake it with ``--make``).
     """
     from gcs_sysid.gp.discrepancy import with_offset_covariance
 
     d = np.load(path)
     X, Y, Xt, Yt = d["X"], d["Y"], d["Xt"], d["Yt"]
+    if air_roll and "Y_air" not in d.files:
+        raise ValueError(f"{path}: cached without the air-rate pair's arrays; remake it with --make, or score it "
+                         "with --air-roll off")
+    Ym = Y                                  # the measured coefficients (meas); Y: the training target
+    Y, Xa = (d["Y_air"], d["X_air"]) if air_roll else (Y, X)
+    ls_line = d["ls_air"] if air_roll else d["ls"]
+    ci = COEFFICIENTS.index("Cl")
+
+    # the true regressors Cl is asked at (err_true): JSBSim's air-relative rates for a model of Cl at the air rate
+    Xt_cl = d["Xt_air"] if air_roll and "Xt_air" in d.files else Xt
+
+    def held(predict, at=None, at_cl=None, **kw):
+        """``predict(Xq, **kw) -> (mean, var)`` on the held-out rows of ``at`` (``X``), Cl's column at ``at_cl``
+        (the air rate ``Xa``)."""
+        at, at_cl = (X, Xa) if at is None else (at, at_cl)
+        m, v = (np.array(a, float) for a in predict(at[h], **kw))
+        if at_cl is not at:
+            ma, va = predict(at_cl[h], **kw)
+            m[:, ci], v[:, ci] = np.asarray(ma)[:, ci], np.asarray(va)[:, ci]
+        return m, v
     # the estimator's flight-common regressor offset (tables cached before it was carried have none)
     off = d["x_offset_cov"] if "x_offset_cov" in d.files and np.isfinite(d["x_offset_cov"]).all() else None
     ok = d["valid"] & np.isfinite(Yt).all(1) & np.isfinite(X).all(1)
@@ -226,6 +323,9 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
     meta = dict(zip(("aircraft", "seed", "turbulence", "aoa"), path.stem.split("-")))
     if thin is not None:
         meta["aoa"] += f"/thin{int(thin)}"            # a separate group in --summarize
+    if not air_roll:
+        meta["aoa"] += "/gyro-Cl"
+    meta["air_roll"] = bool(air_roll) and bool(d["air_applied"])   # the pair applied (not refused) on this flight
     memo: dict = {}
 
     def joint_fit():          # nigp, shared by nigp, dec and sel (fitted once per flight)
@@ -249,28 +349,30 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
         true_latent = true_noise = None
         extra: dict = {}
         if v == "ls":
-            mean, sig = d["ls"][h], np.full((int(h.sum()), Y.shape[1]), np.nan)
+            mean, sig = ls_line[h], np.full((int(h.sum()), Y.shape[1]), np.nan)
             sig_n = sig_g = sig
         elif v == "sel":
             sel = select_outputs(joint_fit()[0], indep_fit(), X[tr], Y[tr])
-            m, var = sel.predict(X[h], include_noise=False)
+            m, var = held(sel.predict, include_noise=False)
             mean, sig = m, np.sqrt(var)
-            sig_n = np.sqrt(sel.predict(X[h])[1])
+            sig_n = np.sqrt(held(sel.predict)[1])
             sig_g = sig * np.nan
-            mt, vt = sel.predict(Xt[h], include_noise=False, input_noise=False)
+            mt, vt = held(sel.predict, Xt, Xt_cl, include_noise=False, input_noise=False)
             true = mt, np.sqrt(vt)
             extra = {"use_joint": sel.use_joint.tolist(), "cv_joint": sel.err_joint.tolist(),
                      "cv_indep": sel.err_indep.tolist()}
         elif v == "indep":
             models = indep_fit()
-            parts = [m.predict(X[h], False) for m in models]
+            Xq = [Xa[h] if p == ci else X[h] for p in range(len(models))]
+            parts = [m.predict(x, False) for m, x in zip(models, Xq)]
             mean = np.column_stack([m for m, _ in parts])
             sig = np.sqrt(np.column_stack([s for _, s in parts]))
-            tp = [m.predict(Xt[h], include_noise=False, input_noise=False) for m in models]
+            tp = [m.predict((Xt_cl if p == ci else Xt)[h], include_noise=False, input_noise=False)
+                  for p, m in enumerate(models)]
             true = np.column_stack([m for m, _ in tp]), np.sqrt(np.column_stack([s for _, s in tp]))
             sig_n = sig_g = sig * np.nan
         else:
-            prior = d["ls"] if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
+            prior = ls_line if v == "lsres" else np.zeros_like(Y)      # lsres: the GP on the residual of LS
             if v in ("nigp", "dec"):
                 model, hist = joint_fit()
                 if v == "dec":
@@ -282,27 +384,27 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
                 if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "nigpu"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
-            m, var = model.predict(X[h], include_noise=False)
+            m, var = held(model.predict, include_noise=False)
             mean, sig = m + prior[h], np.sqrt(var)
-            sig_n = np.sqrt(model.predict(X[h])[1])                         # with the observation noise (the replay's band)
+            sig_n = np.sqrt(held(model.predict)[1])                         # with the observation noise (the replay's band)
             # with the global layer's noise variance sigma_p^2 (the likelihood's) instead of the local nugget
             sig_g = np.sqrt(var + np.asarray(model.params.noise)[None, :] * model.scaler.y_std**2)
             c = model.output_correlation()
             corr = float(np.max(np.abs(c - np.diag(np.diag(c)))))
-            mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)     # exact regressors
+            mt, vt = held(model.predict, Xt, Xt_cl, include_noise=False, input_noise=False)     # exact regressors
             true = mt + prior[h], np.sqrt(vt)
             # before the model-error term (docs/gp.md, "The band at exact conditions"): latent alone, and
             # the latent band widened by the offset term alone / the discrepancy alone
-            _, vl = model.predict(Xt[h], include_noise=False, input_noise=False, model_error=False)
+            _, vl = held(model.predict, Xt, Xt_cl, include_noise=False, input_noise=False, model_error=False)
             true_latent = coverage(mt + prior[h], np.sqrt(vl), Yt[h])
-            true_noise = coverage(mt + prior[h], np.sqrt(model.predict(Xt[h], input_noise=False)[1]), Yt[h])
+            true_noise = coverage(mt + prior[h], np.sqrt(held(model.predict, Xt, Xt_cl, input_noise=False)[1]), Yt[h])
         e, cv, cvn = errors(mean, Yt[h]), coverage(mean, sig, Yt[h]), coverage(mean, sig_n, Yt[h])
         yield (dict(meta, variant=v, err=dict(zip(COEFFICIENTS, e.round(2).tolist())),
                          cov=dict(zip(COEFFICIENTS, cv.round(1).tolist())),
                          cov_noise=dict(zip(COEFFICIENTS, cvn.round(1).tolist())),
                          cov_gnoise=dict(zip(COEFFICIENTS, coverage(mean, sig_g, Yt[h]).round(1).tolist())),
                          max_corr=corr, validation=validation,
-                         meas=dict(zip(COEFFICIENTS, errors(Y[h], Yt[h]).round(2).tolist())),
+                         meas=dict(zip(COEFFICIENTS, errors(Ym[h], Yt[h]).round(2).tolist())),
                          **({} if true is None else {
                              "err_true": dict(zip(COEFFICIENTS, errors(true[0], Yt[h]).round(2).tolist())),
                              "cov_true": dict(zip(COEFFICIENTS, coverage(*true, Yt[h]).round(1).tolist()))}),
@@ -577,6 +679,10 @@ def main(argv=None) -> int:
                     help="remove the moments of part of the training rows by these patterns and score hjoint, "
                          "hindep, hdrop, hdec, hjointv instead of --variants")
     ap.add_argument("--missing-models", nargs="+", default=list(MISSING_MODELS), choices=MISSING_MODELS)
+    ap.add_argument("--air-roll", choices=("on", "off"), default="on",
+                    help="Cl trained on the replay's air-rate target and asked at the held-out air roll rate, the "
+                         "LS line on the same target (the replay's air-rate pair, AIR_ROLL_TRAIN; default on); "
+                         "'off': the measured Cl at the gyro's rate (the tables before the thirtieth session)")
     ap.add_argument("--diagnose", action="store_true",
                     help="print least squares vs SUR/GLS per cached flight instead of fitting GPs")
     a = ap.parse_args(argv)
@@ -605,7 +711,7 @@ def main(argv=None) -> int:
                                   f"rows in region)  {r['t_fit_s']:.1f} s", flush=True)
                             append_jsonl(a.json, [r])
                         continue
-                    for r in score(path, a.variants, thin=a.thin):
+                    for r in score(path, a.variants, thin=a.thin, air_roll=a.air_roll == "on"):
                         print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
                               + "  cov " + " ".join(f"{r['cov'][c]:5.1f}" for c in COEFFICIENTS)
                               + f"  corr {r['max_corr']:.2f}  {r['t_fit_s']:.1f} s", flush=True)

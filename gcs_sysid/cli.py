@@ -110,6 +110,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates)")
     f.add_argument("--stated-lift-level", action="store_true",
                    help="alpha's flight mean on the airframe's stated lift line (as replay's --stated-lift-level)")
+    f.add_argument("--air-roll", default="off", choices=("on", "off"),
+                   help="Cl fitted on the replay's air-rate target (the measured Cl less the window's smoothed "
+                        "rolling-gust moment, so the model's Cl terms read the air-relative roll rate; refused, "
+                        "with a note in the model's header and <out>.fit.json, where the roll fit finds no gust): "
+                        "'off' the default (the measured Cl at the gyro's rate), 'on' (docs/estimation.md, "
+                        "'Where the pair applies')")
     _window_args(f)
 
     d = sub.add_parser("diagnose", help="compare the simulation model with measured data, name the cause")
@@ -254,7 +260,8 @@ def _cmd_fit(a: argparse.Namespace) -> int:
     from .diagnose import run_fit
 
     _stated_lift_level(a)
-    run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates)
+    run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates,
+            air_roll_train=a.air_roll == "on")
     print(f"wrote {a.out}")
     return 0
 

@@ -18,7 +18,7 @@ DIAGNOSE_OUTPUTS = ("diagnosis.json", "model_extended.toml", "report.html")
 #: Logs at least this large (a 10-minute 50 Hz flight is ~7 MB) are decoded with the spare worker process.
 SPLIT_MIN_BYTES = 4 << 20
 
-__all__ = ["Measurements", "load_measurements", "run_fit", "run_diagnose"]
+__all__ = ["Measurements", "load_measurements", "run_fit", "air_rate_target", "run_diagnose"]
 
 
 @dataclass
@@ -177,35 +177,92 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
 
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
-            progress=None, notify=None, gust_rates: str | None = None):
+            progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool = False):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
     Also writes ``<out>.fit.json`` with the per-coefficient statistics (and the damage found in the
     log, ``log_damage``). Both files are written under temporary names and renamed into place at
     the end (:class:`gcs_sysid.outdir.StagedFiles`); ``--out`` is checked before the log is decoded.
 
+    Args:
+        air_roll_train: Cl fitted on the replay's air-rate target (``--air-roll on``; off by default, the
+            diagnosis's reference models are fitted through here): the measured Cl less the window's smoothed
+            rolling-gust moment, from the replay's one roll fit with its checks (:func:`air_rate_target`), so the
+            model's ``Cl`` terms read the air-relative roll rate; every other coefficient as measured. Refused
+            (the measured Cl) where the roll fit is refused; ``<out>.fit.json``'s ``air_roll`` and the model
+            file's header say which and why.
+
     Returns:
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
+
+    Raises:
+        InputError: ``air_roll_train`` with :data:`AIR_ROLL_RATE` moving the fit's flight already (the gust would
+            be taken out twice); from the stages.
     """
     from ..sim.model_file import save_model
     from .fit import fit_model
 
+    if air_roll_train and air_roll_for("fit"):
+        raise InputError(f"fit --air-roll on: not with the diagnosis's air roll rate {AIR_ROLL_RATE!r} (the fit's "
+                         "table is at the air rate already)")
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
                                  air_roll=air_roll_for("fit"))
-        model, report = fit_model(meas.table, name=Path(out_path).stem)
+        table, air = meas.table, None
+        if air_roll_train:
+            table, air = air_rate_target(meas)
+        model, report = fit_model(table, name=Path(out_path).stem)
+        if air is not None:
+            report.notes.append(air["note"])
         model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
-        save_model(model, stage.path(out), header=report.header())
+        header = report.header() + ("" if air is None else "\n" + air["note"])
+        save_model(model, stage.path(out), header=header)
         doc = report.to_json()
         if isinstance(doc, dict):                 # which flight: diagnose finds it again (differential diagnosis)
             from .differential import fit_record
 
             doc["reference_flights"] = [fit_record(log, t_from, t_to)]
+            off = {"target": "gyro", "applied": False, "Cl_p": None, "note": "off (--air-roll off)"}
+            doc["air_roll"] = off if air is None else {k: air[k] for k in ("target", "applied", "Cl_p", "note")}
         if meas.flight.damage and isinstance(doc, dict):
             doc["log_damage"] = list(meas.flight.damage)
         stage.path(out.with_suffix(".fit.json")).write_text(json.dumps(doc, indent=1, default=float))
     return model, report
+
+
+def air_rate_target(meas: Measurements):
+    """The fit's table with Cl at the air-relative roll rate: the replay's air-rate pair, training half, on every valid
+    row of the window (``gcs-sysid fit`` holds nothing out).
+
+    The one roll fit of the pair (:func:`gcs_sysid.aero.gustfilter.air_roll_fit`: the ``"rollgp"`` filter-error fit
+    with the Dryden check and the instruments' check of :data:`~gcs_sysid.aero.gustfilter.ROLL_MAX_IV_RATIO`) and
+    the target it gives (:func:`~gcs_sysid.aero.gustfilter.air_roll_target`: ``Cl + Cl_p p_hat_g``, the measured Cl
+    less the smoothed gust moment); Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5
+    (the filter-error method). The regressors are not changed (the gyro's ``p_hat``): a model fitted on this target
+    is a model of Cl at the air-relative rate.
+
+    Args:
+        meas: :func:`load_measurements`' flight (table at the gyro's rate, states, airframe).
+
+    Returns:
+        ``(table, info)``: a new table (Cl's column moved; ``meas.table`` itself where the fit was refused) and a dict
+        (``target`` ``"air"`` or ``"gyro"``, ``applied`` bool, ``Cl_p`` (None when refused), ``note``: what was done
+        or why it was refused).
+    """
+    from dataclasses import replace
+
+    from ..aero.gustfilter import air_roll_fit, air_roll_target
+
+    table = meas.table
+    rows = np.asarray(table.valid, bool)
+    fit = air_roll_fit(table, meas.states, meas.airframe, rows) if len(table.t) >= 3 else \
+        "gust filter not run: fewer than 3 rows"
+    Y, info = air_roll_target(table, meas.states, meas.airframe, rows, fit=fit)
+    applied = not isinstance(fit, str)
+    out = {"target": "air" if applied else "gyro", "applied": applied,
+           "Cl_p": float(info["Cl_p"]) if applied else None, "note": info["note"]}
+    return (replace(table, Y=Y) if applied else table), out
 
 
 def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None = None,

@@ -122,3 +122,56 @@ def test_fair_least_squares_line_trains_cl_on_the_gps_air_rate_target():
     assert out["ls_airtrain"]["Cl"] < 0.7 * out["ls_airtab"]["Cl"]
     for c in ("CX", "CY", "CZ", "Cm", "Cn"):
         assert out["ls_airtrain"][c] == out["ls_airtab"][c] == 100.0
+
+
+def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
+    """``eval_gp_jsbsim`` (thirtieth session, i8-airfit): the cache holds the replay's air-rate pair
+    (:func:`benchmarks.eval_gp_jsbsim.air_rate_arrays`) and ``score`` trains Cl on its target and asks it at the
+    held-out air rate by default. On the simulated roll axis of ``tests/aero/test_rollgust.py`` the independent GPs' Cl is closer
+    to the air-rate Cl with the pair than without (``air_roll=False``, the old tables); the other outputs' GPs see the
+    same rows and targets either way (identical errors); ``ls`` is the fair line; a cache made before the pair's
+    arrays is refused unless ``air_roll=False``."""
+    import sys
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "aero"))
+    from test_rollgust import B, CLB, CLDA, CLP, IXX, S, _record, _roll_case
+
+    from benchmarks.eval_gp_jsbsim import air_rate_arrays, score
+    from gcs_sysid.aero.table import REGRESSORS
+
+    X, Y, p, g = _record(seed=1)
+    n = len(X)
+    rng = np.random.default_rng(3)
+    il, others = 3, [0, 1, 2, 4, 5]
+    Y[:, others] = 0.01 * rng.normal(size=(n, 5))
+    held, st, tab = _roll_case(X, Y, p, g, rng)
+    res = SimpleNamespace(table=tab, states=st, train=~held, held_out=held)
+    j, cb, cd = (REGRESSORS.index(k) for k in ("p_hat", "beta", "delta_a"))
+    Xt_air = X.copy()
+    Xt_air[:, j] = X[:, j] - g
+    Yt = np.ones_like(Y)
+    Yt[:, il] = CLB * X[:, cb] + CLP * (X[:, j] - g) + CLDA * X[:, cd]      # Cl at the air rate
+    ls = SimpleNamespace(evaluate=lambda Xq: np.zeros((len(Xq), 6)))
+    air = air_rate_arrays(res, SimpleNamespace(Ixx=IXX, S=S, b=B), ls)
+    assert air["air_applied"] and not np.array_equal(air["X_air"][held], X[held])
+    np.testing.assert_array_equal(air["X_air"][~held], X[~held])
+    np.testing.assert_array_equal(air["Y_air"][:, others], Y[:, others])
+    base = dict(t=tab.t, X=X, Y=Y, valid=np.ones(n, bool), held=held, train=~held, Xt=X, Yt=Yt,
+                gp_mean=np.zeros_like(Y), gp_sigma=np.zeros_like(Y), ls=ls.evaluate(X),
+                x_offset_cov=np.full((10, 10), np.nan))
+    old, new = tmp_path / "sim-1-light-ahrs.npz", tmp_path / "new" / "sim-1-light-ahrs.npz"
+    new.parent.mkdir()
+    np.savez(old, **base)
+    np.savez(new, **base, **air, Xt_air=Xt_air)
+    with pytest.raises(ValueError, match="air-rate"):
+        list(score(old, ["ls"]))
+    on = {r["variant"]: r for r in score(new, ["ls", "indep"], thin=4)}
+    off = {r["variant"]: r for r in score(new, ["ls", "indep"], thin=4, air_roll=False)}
+    assert on["indep"]["air_roll"] and not off["indep"]["air_roll"] and off["indep"]["aoa"].endswith("/gyro-Cl")
+    assert on["indep"]["err"]["Cl"] < 0.8 * off["indep"]["err"]["Cl"]
+    assert on["indep"]["err_true"]["Cl"] < off["indep"]["err_true"]["Cl"]
+    assert on["ls"]["err"]["Cl"] < 100.0 == off["ls"]["err"]["Cl"]                     # the fair line's Cl fitted
+    for c in ("CX", "CY", "CZ", "Cm", "Cn"):
+        assert on["indep"]["err"][c] == off["indep"]["err"][c]
