@@ -122,8 +122,12 @@ def limit_blas_threads(n: int = 1) -> int:
 _STORED_FORMAT = 1
 _SOURCE_HASH: str | None = None
 _PROGRAMS: dict[str, object] = {}
-#: This process's programs by (functions, tree structure, avals): a repeated call skips the key's hashing.
+#: This process's compiled executables by the same key (:func:`_load_executable`, :func:`_store_executable`).
+_EXECUTABLES: dict[str, object] = {}
+#: This process's programs by (functions, tree structure, avals, concrete): a repeated call skips the key's hashing.
 _MEMO: dict[tuple, object] = {}
+#: Bumped when the layout of the compiled executables' files (:func:`_store_executable`) changes.
+_EXECUTABLE_FORMAT = 1
 
 
 def _source_hash() -> str:
@@ -204,8 +208,167 @@ def _register_listed(path: Path) -> None:
         _register_type(cls, () if empty == "tuple" else None)
 
 
+def _ensure_lapack() -> None:
+    """Register jaxlib's LAPACK kernels (the custom calls of the CPU executables' Cholesky factors and triangular
+    solves), as lowering a linear-algebra operation (or calling an exported program) does.
+
+    An executable loaded from disk is never lowered in this process, and calling its LAPACK custom calls before they
+    are registered crashed the process (a segmentation fault, jax 0.10.2, CPU). This is JAX's private
+    ``jax._src.lax.linalg.initialize_lapack`` (what ``jax.export``'s call lowering runs); if it is missing the caller
+    does not load executables.
+
+    Raises:
+        AttributeError, ImportError: this JAX has no such function.
+    """
+    from jax._src.lax import linalg
+
+    linalg.initialize_lapack()
+
+
+def _executable_header(key: str) -> dict:
+    """What a stored executable must match to be loaded: the program's key (:func:`stored_program`: its code, the
+    argument structure and avals, the package source, the versions, the backend, the 64-bit flag) and, beside it,
+    the format, the JAX and jaxlib versions, the backend and its platform version, the first device's kind, the
+    device count, the 64-bit flag and ``XLA_FLAGS`` (an executable is machine code for one backend and device)."""
+    import jax
+    import jaxlib
+
+    device = jax.devices()[0]
+    return {"format": _EXECUTABLE_FORMAT, "key": key, "jax": jax.__version__, "jaxlib": jaxlib.__version__,
+            "backend": jax.default_backend(), "platform_version": str(device.client.platform_version),
+            "device_kind": str(device.device_kind), "devices": jax.device_count(),
+            "x64": bool(jax.config.jax_enable_x64), "xla_flags": os.environ.get("XLA_FLAGS", "")}
+
+
+def _executable_path(cache: str | os.PathLike, header: dict) -> Path:
+    """``<cache>/compiled/<sha256 of the header>.jaxexe``: a different JAX, device or flag gives another file."""
+    import hashlib
+    import json
+
+    name = hashlib.sha256(json.dumps(header, sort_keys=True).encode()).hexdigest()
+    return Path(cache) / "compiled" / f"{name}.jaxexe"
+
+
+def _load_executable(cache: str | os.PathLike, key: str):
+    """The compiled executable stored for ``key`` by an earlier process (:func:`_store_executable`), loaded.
+
+    The file is a pickle of ``(header, sha256 of the payload, payload, input tree, output tree)``; it is used only
+    if its header equals this process's (:func:`_executable_header`) and the payload's hash matches (a truncated or
+    altered file is never handed to XLA). The payload is :func:`jax.experimental.serialize_executable.serialize`'s:
+    the executable XLA compiled, which ``deserialize_and_load`` loads without tracing, lowering or looking the
+    program up in the compilation cache.
+
+    Returns:
+        ``(compiled, path)``: the :class:`jax.stages.Compiled` and its file; None when there is no file or it cannot
+        be used (no error is raised: the caller compiles as before).
+    """
+    import hashlib
+    import pickle
+
+    try:
+        header = _executable_header(key)
+        path = _executable_path(cache, header)
+        if not path.exists():
+            return None
+        from jax.experimental import serialize_executable
+
+        stored, digest, payload, in_tree, out_tree = pickle.loads(path.read_bytes())
+        if stored != header or hashlib.sha256(payload).hexdigest() != digest:
+            return None
+        _ensure_lapack()
+        return serialize_executable.deserialize_and_load(payload, in_tree, out_tree), path
+    except Exception:
+        return None
+
+
+_CACHE_HITS = [0]          # persistent-cache hits seen by :func:`_count_hit` (registered once)
+_COUNTING: list = []
+
+
+def _count_hit(event: str, **_) -> None:
+    """A :mod:`jax.monitoring` listener: counts the compilation cache's hits (``/jax/compilation_cache/cache_hits``)."""
+    if event == "/jax/compilation_cache/cache_hits":
+        _CACHE_HITS[0] += 1
+
+
+def _store_executable(cache: str | os.PathLike, key: str, program, args: tuple):
+    """Compile ``program`` (a jitted function) for ``args`` as its call would, and write the executable atomically
+    (a temporary file renamed) for :func:`_load_executable`.
+
+    ``program.lower(*args).compile()`` is the path ``program(*args)`` takes (trace, lower, compile or load from the
+    compilation cache), so the executable is the one the call would run. Only an executable XLA compiled in this
+    call is written: one that the compilation cache loaded serialises without its code (jax 0.10.2, CPU: a later
+    process's call failed with "NOT_FOUND: Function convert_copy_fusion not found"), so a cache hit writes nothing.
+    Writing is best effort.
+
+    Returns:
+        The :class:`jax.stages.Compiled` (also when nothing was written), or None when this program cannot be
+        compiled ahead (the caller keeps ``program``).
+    """
+    import hashlib
+    import pickle
+
+    import jax
+
+    try:
+        if not _COUNTING:
+            jax.monitoring.register_event_listener(_count_hit)
+            _COUNTING.append(True)
+        hits = _CACHE_HITS[0]
+        compiled = program.lower(*args).compile()
+    except Exception:
+        return None
+    if _CACHE_HITS[0] != hits:
+        return compiled
+    try:
+        from jax.experimental import serialize_executable
+
+        payload, in_tree, out_tree = serialize_executable.serialize(compiled)
+        header = _executable_header(key)
+        blob = pickle.dumps((header, hashlib.sha256(payload).hexdigest(), payload, in_tree, out_tree),
+                            protocol=pickle.HIGHEST_PROTOCOL)
+        path = _executable_path(cache, header)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_bytes(blob)
+        os.replace(tmp, path)
+    except Exception:
+        pass
+    return compiled
+
+
+class _Loaded:
+    """A loaded executable (:func:`_load_executable`) that gives way to ``fallback()`` (a zero-argument callable
+    returning the exported program, or ``jax.jit`` of the function) if its first call raises: the file is then removed
+    and the call made again by the fallback, so a stored executable that loads but cannot run costs one failed call,
+    never a missing result."""
+
+    __slots__ = ("_call", "_compiled", "_fallback", "_path")
+
+    def __init__(self, compiled, fallback, path: Path):
+        self._compiled, self._fallback, self._path = compiled, fallback, path
+        self._call = self._first
+
+    def __call__(self, *args):
+        return self._call(*args)
+
+    def _first(self, *args):
+        try:
+            out = self._compiled(*args)
+        except Exception:
+            try:
+                self._path.unlink()
+            except OSError:
+                pass
+            self._call = self._fallback()
+            return self._call(*args)
+        self._call = self._compiled
+        return out
+
+
 def stored_program(fn, args: tuple, static: tuple = ()):
-    """``fn`` traced and lowered once per machine: the traced program kept on disk, beside the compilation cache.
+    """``fn`` traced, lowered and compiled once per machine: the traced program and the compiled executable kept on
+    disk, beside the compilation cache.
 
     JAX's persistent compilation cache (:func:`enable_compilation_cache`) skips XLA's compilation, but each process
     still traces the Python function and lowers it to StableHLO before it can look the program up: in a loaded
@@ -215,11 +378,20 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     of tracing (the JAX manual, "Exporting and serializing staged-out computations"). The program is the same
     StableHLO, so XLA compiles (or loads) the same computation and the results are identical.
 
+    Calling the exported program still traces and lowers a wrapper of it and looks it up in the compilation cache
+    (about 0.9 s for the replay's 23 stored programs; ``docs/benchmarks.md``, "Thirtieth session, speed30"). So
+    the executable compiled for a concrete call is also serialised
+    (:func:`jax.experimental.serialize_executable.serialize`) into ``<cache>/compiled/`` (:func:`_store_executable`),
+    and later processes load it (:func:`_load_executable`; 0.35 s for the same programs): the same executable, so the
+    same bits. Calls with tracers (``fn`` called inside another traced function) and other backends than the CPU use
+    the exported program.
+
     The file's key is the module and name of ``fn`` and of each ``static`` function, the tree structure and the
     shape, dtype and weak type of every leaf of ``args``, the SHA-256 of the gcs_sysid package's source, the JAX,
     jaxlib, optax and NumPy versions, the backend and the 64-bit and matmul-precision flags; any change of the code
-    gives a new key (old files are left, unused). The files are trusted as the compilation cache's are (written by
-    this package on this machine).
+    gives a new key (old files are left, unused). An executable's file is keyed by that key and the device
+    (:func:`_executable_header`). The files are trusted as the compilation cache's are (written by this package on
+    this machine; an executable's loader runs what it loads).
 
     Args:
         fn: a module-level function, called as ``fn(*static, *args)`` (no closure: what it computes must follow
@@ -230,8 +402,9 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     Returns:
         A callable ``program(*args)`` (arguments of the same structure, shapes and dtypes) returning what
         ``fn(*static, *args)`` returns; None when the compilation cache is off (no directory: the caller calls
-        its jitted function as before), ``fn`` has a closure, or the export or the file fails (then this process
-        keeps using the caller's path for that key).
+        its jitted function as before, and nothing is stored), ``fn`` has a closure, or the export or the file fails
+        (then this process keeps using the caller's path for that key). An executable that cannot be loaded, compiled
+        or written is skipped silently (the exported program is returned).
 
     Raises:
         nothing: every failure returns None.
@@ -251,7 +424,9 @@ def stored_program(fn, args: tuple, static: tuple = ()):
 
         leaves, tree = jax.tree_util.tree_flatten(args)
         avals = tuple(jax.typeof(x) for x in leaves)
-        memo = (funcs, tree, avals)
+        # executables only for concrete calls on the CPU (the backend whose custom calls _ensure_lapack registers)
+        concrete = jax.default_backend() == "cpu" and not any(isinstance(x, jax.core.Tracer) for x in leaves)
+        memo = (funcs, tree, avals, concrete)
         if memo in _MEMO:
             return _MEMO[memo]
         parts = [str(_STORED_FORMAT), *(f"{f.__module__}.{f.__qualname__}" for f in funcs), str(tree),
@@ -261,11 +436,39 @@ def stored_program(fn, args: tuple, static: tuple = ()):
         key = hashlib.sha256("\n".join(parts).encode()).hexdigest()
     except Exception:
         return None
-    if key in _PROGRAMS:
-        _MEMO[memo] = _PROGRAMS[key]
+    def exported():
+        if key not in _PROGRAMS:
+            _PROGRAMS[key] = _exported_program(fn, static, tree, avals, cache, key)
         return _PROGRAMS[key]
+
+    def fallback():             # a stored executable failed on its first call: the exported program, else a plain jit
+        import functools
+
+        return exported() or jax.jit(functools.partial(fn, *static))
+
+    if concrete:
+        if key not in _EXECUTABLES:
+            loaded = _load_executable(cache, key)
+            _EXECUTABLES[key] = None if loaded is None else _Loaded(loaded[0], fallback, loaded[1])
+        if _EXECUTABLES[key] is not None:
+            _MEMO[memo] = _EXECUTABLES[key]
+            return _EXECUTABLES[key]
+    program = exported()
+    if concrete and program is not None:
+        _EXECUTABLES[key] = _store_executable(cache, key, program, args)
+        if _EXECUTABLES[key] is not None:
+            program = _EXECUTABLES[key]
+    _MEMO[memo] = program
+    return program
+
+
+def _exported_program(fn, static: tuple, tree, avals: tuple, cache: str, key: str):
+    """:func:`stored_program`'s traced program for ``key``: ``jax.jit`` of the exported program read from
+    ``<cache>/traced/``, or exported and written there; None when ``tree`` or the output cannot be serialised or the
+    export fails."""
+    import jax
+
     if not _register_tree(tree):     # a node type JAX's serialisation cannot restore: the caller's jit
-        _PROGRAMS[key] = _MEMO[memo] = None
         return None
     path = Path(cache) / "traced" / f"{key}.jaxexport"
     exported = None
@@ -298,11 +501,9 @@ def stored_program(fn, args: tuple, static: tuple = ()):
             tmp = path.with_suffix(f".{os.getpid()}.tmp")
             tmp.write_bytes(bytes(blob))
             os.replace(tmp, path)
-        program = jax.jit(exported.call)
+        return jax.jit(exported.call)
     except Exception:
-        program = None
-    _PROGRAMS[key] = _MEMO[memo] = program
-    return program
+        return None
 
 
 class _StoredJit:

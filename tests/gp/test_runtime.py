@@ -80,7 +80,7 @@ X = rng.uniform(-1, 1, (300, 10))
 Y = X[:, :6] * np.array([1.0, -0.5, 0.3, 0.8, -1.2, 0.4]) + 0.05 * rng.standard_normal((300, 6))
 model, hist = fit_gp(X, Y, GPConfig(n_inducing=12, steps=30, local_steps=10, seed=1))
 mean, var = model.predict(X[:7])
-used = sum(p is not None for p in jc._PROGRAMS.values())
+used = len({k for k, p in {**jc._PROGRAMS, **jc._EXECUTABLES}.items() if p is not None})
 print(json.dumps({"elbo": [float(v).hex() for v in hist.elbo], "local": [float(v).hex() for v in hist.local_loss],
                   "mean": [float(v).hex() for v in np.ravel(mean)], "var": [float(v).hex() for v in np.ravel(var)],
                   "stored": used}))
@@ -93,10 +93,12 @@ def test_stored_gp_programs_give_the_jitted_results_and_are_loaded_by_the_next_p
     cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
     first = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), cache).splitlines()[-1])
     files = sorted((tmp_path / "jax" / "traced").glob("*.jaxexport"))
-    # the Adam steps of both layers and the other stored GP programs, each written once
-    assert first["stored"] >= 2 and len(files) == first["stored"]
+    compiled = sorted((tmp_path / "jax" / "compiled").glob("*.jaxexe"))
+    # the Adam steps of both layers and the other stored GP programs, each written once (traced and compiled)
+    assert first["stored"] >= 2 and len(files) == first["stored"] == len(compiled)
     again = json.loads(_child(STORED.replace("sys.argv[1]", "'load'"), cache).splitlines()[-1])
     assert sorted((tmp_path / "jax" / "traced").glob("*.jaxexport")) == files
+    assert sorted((tmp_path / "jax" / "compiled").glob("*.jaxexe")) == compiled
     off = {"GCS_SYSID_JAX_CACHE": "off"}
     plain = json.loads(_child(STORED.replace("sys.argv[1]", "'export'"), off).splitlines()[-1])
     assert plain["stored"] == 0
@@ -113,3 +115,79 @@ def test_stored_program_refuses_a_closure():
     k = 2.0
     closure = lambda x: (x * k,)                             # noqa: E731  (what it computes is not in its code)
     assert stored_program(closure, (jnp.ones(3),)) is None
+
+
+EXE = r"""
+import json
+import numpy as np
+import jax, jax.numpy as jnp
+from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64, stored_jit
+import gcs_sysid.jaxconfig as jc
+enable_x64()
+enable_compilation_cache()
+
+def solve(a, b):                                   # LAPACK custom calls (Cholesky, triangular solve) and a fusion
+    l = jnp.linalg.cholesky(a @ a.T + 3.0 * jnp.eye(a.shape[0]))
+    return jax.scipy.linalg.solve_triangular(l, b, lower=True), jnp.tanh(b).sum()
+
+rng = np.random.default_rng(0)
+x, s = stored_jit(solve)(rng.standard_normal((5, 5)), rng.standard_normal((5, 2)))
+print(json.dumps({"bits": [float(v).hex() for v in np.ravel(x)] + [float(s).hex()],
+                  "loaded": sum(isinstance(p, jc._Loaded) and p._call is p._compiled for p in jc._EXECUTABLES.values()),
+                  "exported": sum(p is not None for p in jc._PROGRAMS.values())}))
+"""
+
+
+def _exe_run(env: dict) -> dict:
+    import json
+
+    return json.loads(_child(EXE, env).splitlines()[-1])
+
+
+def test_stored_executable_is_loaded_by_the_next_process_and_gives_the_same_bits(tmp_path):
+    cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
+    first = _exe_run(cache)
+    files = sorted((tmp_path / "jax" / "compiled").glob("*.jaxexe"))
+    assert len(files) == 1 and first["loaded"] == 0 and first["exported"] == 1
+    again = _exe_run(cache)
+    assert again["loaded"] == 1 and again["exported"] == 0       # neither traced, lowered nor exported
+    assert sorted((tmp_path / "jax" / "compiled").glob("*.jaxexe")) == files
+    off = _exe_run({"GCS_SYSID_JAX_CACHE": "off", "XDG_CACHE_HOME": str(tmp_path / "xdg")})
+    assert off["loaded"] == 0 and off["exported"] == 0 and not (tmp_path / "xdg").exists()   # cache off: no store
+    assert first["bits"] == again["bits"] == off["bits"]
+
+
+def test_corrupt_or_foreign_executable_falls_back_and_a_cache_hit_is_not_stored(tmp_path):
+    import pickle
+
+    cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
+    first = _exe_run(cache)
+    (path,) = (tmp_path / "jax" / "compiled").glob("*.jaxexe")
+    good = path.read_bytes()
+    header, digest, payload, in_tree, out_tree = pickle.loads(good)
+    foreign = dict(header, jax="0.0.0")                          # written by another JAX (same file name)
+    flipped = bytes([payload[0] ^ 1]) + payload[1:]              # one bit changed, the recorded hash kept
+    for bad in (good[: len(good) // 2], pickle.dumps((foreign, digest, payload, in_tree, out_tree)),
+                pickle.dumps((header, digest, flipped, in_tree, out_tree))):
+        path.write_bytes(bad)
+        run = _exe_run(cache)
+        assert run["loaded"] == 0 and run["exported"] == 1 and run["bits"] == first["bits"]
+    # the program is in JAX's compilation cache: what it loads is not written again (it would lack its code)
+    path.unlink()
+    run = _exe_run(cache)
+    assert run["bits"] == first["bits"] and not list((tmp_path / "jax" / "compiled").glob("*.jaxexe"))
+
+
+def test_loaded_executable_that_fails_on_its_first_call_gives_way_and_is_removed(tmp_path):
+    from gcs_sysid.jaxconfig import _Loaded
+
+    path = tmp_path / "x.jaxexe"
+    path.write_bytes(b"x")
+
+    def broken(*args):
+        raise RuntimeError("NOT_FOUND: Function fusion not found")
+
+    loaded = _Loaded(broken, lambda: (lambda a, b: a + b), path)
+    assert loaded(2, 3) == 5 and loaded(1, 1) == 2 and not path.exists()
+    working = _Loaded(lambda a: a * 2, lambda: None, tmp_path / "y.jaxexe")
+    assert working(4) == 8 and working._call is working._compiled
