@@ -233,7 +233,9 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: s23's losses and kept the four wins (*Twenty-eighth session, i9-pwp2*). Still off after the twenty-ninth session
 #: (branch i9-pwp3): ``Cm:alpha^2`` and clean flights on all 25 tuning aircraft win on seven and lose nothing, but an
 #: other effect's count is lost: the sgs126's ``Cn:delta_a`` estimate (4 -> 3/6), where the block entered ``Cn``'s own
-#: search at its third step and took ``p_hat``'s place (*Twenty-ninth session, i9-pwp3*).
+#: search at its third step and took ``p_hat``'s place (*Twenty-ninth session, i9-pwp3*). Thirtieth session (branch
+#: i9-pwpcm): an entry may name its coefficient, ``("Cm:alpha",)``: the block only in ``Cm``'s search. That gives the
+#: sgs126's ``Cn:delta_a`` back and keeps the seven wins (*Thirtieth session, i9-pwpcm*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
