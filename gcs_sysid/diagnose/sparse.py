@@ -233,7 +233,9 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: s23's losses and kept the four wins (*Twenty-eighth session, i9-pwp2*). Still off after the twenty-ninth session
 #: (branch i9-pwp3): ``Cm:alpha^2`` and clean flights on all 25 tuning aircraft win on seven and lose nothing, but an
 #: other effect's count is lost: the sgs126's ``Cn:delta_a`` estimate (4 -> 3/6), where the block entered ``Cn``'s own
-#: search at its third step and took ``p_hat``'s place (*Twenty-ninth session, i9-pwp3*).
+#: search at its third step and took ``p_hat``'s place (*Twenty-ninth session, i9-pwp3*). Thirtieth session (branch
+#: i9-pwpcm): an entry may name its coefficient, ``("Cm:alpha",)``: the block only in ``Cm``'s search. That gives the
+#: sgs126's ``Cn:delta_a`` back and keeps the seven wins (*Thirtieth session, i9-pwpcm*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -316,7 +318,8 @@ def select_terms(Phi: np.ndarray, r: np.ndarray, fold: np.ndarray, max_terms: in
     return sel, res["press"]
 
 
-def power_parent_blocks(names: list[str], regressors=("alpha",)) -> list[tuple[int, int]]:
+def power_parent_blocks(names: list[str], regressors=("alpha",),
+                        coefficient: str | None = None) -> list[tuple[int, int]]:
     """The joint candidates ``(x^2, x)``: each listed regressor's square with its first parent, as column indices.
 
     Why: a curvature about an origin that is off by ``e`` (the measured alpha of a flight against the air's,
@@ -327,14 +330,24 @@ def power_parent_blocks(names: list[str], regressors=("alpha",)) -> list[tuple[i
     (marginality: Peixoto, *The American Statistician* 41(4) (1987) 311; Nelder, *J. Appl. Stat.* 27 (2000)
     109), so the square enters with its parent; the curvature's coefficient is the same whatever ``e`` is.
 
+    An entry may name the coefficient whose search it is for, ``"Cm:alpha"``: the block is then offered only in
+    that coefficient's forward search (the stepwise regression of Morelli and Klein, *Aircraft System
+    Identification*, 2nd ed. (2016), ch. 5, sec. 5.4: one search per coefficient). The block was built for a ``Cm``
+    curvature about a shifted alpha; offered in every coefficient whose library holds ``alpha^2`` and ``alpha``
+    it entered the sgs126's ``Cn`` search at its third step, filled the last places and kept ``p_hat`` out, and
+    ``Cn:delta_a`` was read without it (``docs/benchmarks.md``, *Twenty-ninth session, i9-pwp3*).
+
     Args:
-        names: the library's term names (K,). regressors: the regressors whose squares enter with their parent.
+        names: the library's term names (K,). regressors: the regressors whose squares enter with their parent,
+            each ``"x"`` (every coefficient's search) or ``"C:x"`` (only coefficient ``C``'s).
+        coefficient: the coefficient whose search this is (``"Cm"``); None: only the bare ``"x"`` entries apply.
 
     Returns:
-        ``[(index of x^2, index of x), ...]`` for the regressors whose two columns are both in ``names``.
+        ``[(index of x^2, index of x), ...]`` for the regressors that apply whose two columns are both in ``names``.
     """
     idx = {n: i for i, n in enumerate(names)}
-    return [(idx[f"{x}^2"], idx[x]) for x in regressors if f"{x}^2" in idx and x in idx]
+    xs = [e.rpartition(":")[2] for e in regressors if e.rpartition(":")[0] in ("", coefficient)]
+    return [(idx[f"{x}^2"], idx[x]) for x in xs if f"{x}^2" in idx and x in idx]
 
 
 def _fold_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]) -> np.ndarray:
@@ -531,14 +544,14 @@ def _ridge_cv(Phi: np.ndarray, Y: np.ndarray, folds: int, max_rows: int,
     return W, mu, sc, best
 
 
-def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows):
+def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=None):
     # the intercept is a nuisance, always in and never named: flights differ by constant offsets
     # (trim, wind estimate) that are no term-level cause
     r = r - r[tr].mean()
     sub = tr[:: max(1, int(np.ceil(tr.size / max_rows)))]
     fold = np.minimum((np.arange(sub.size) * folds) // sub.size, folds - 1)
     Pc = Phi[sub] - Phi[tr].mean(axis=0)
-    blocks = power_parent_blocks(names, tuple(th.get("power_with_parent", ()) or ()))
+    blocks = power_parent_blocks(names, tuple(th.get("power_with_parent", ()) or ()), coefficient)
     steps: list = []
     sel, press = select_terms(Pc, r[sub], fold, th["max_terms"], th["min_step_gain"], th["stlsq_threshold"],
                               blocks=blocks or None, steps=steps)
@@ -915,7 +928,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                                              "rms_explained": float(np.std(((iPhi_ref[rows] - mu) / sc) @ W[:, j]))})
             else:
                 idx = {n: i for i, n in enumerate(names)}
-                entry, _ = _fit_coefficient(rnames, rPhi, Rr[:, j], rows, rte[:0], folds, th, max_rows)
+                entry, _ = _fit_coefficient(rnames, rPhi, Rr[:, j], rows, rte[:0], folds, th, max_rows, coef)
                 terms = [t for t in entry["terms"] if t["term"] in idx]
                 if terms:
                     base[:, j] = Phi[:, [idx[t["term"]] for t in terms]] @ np.array([t["estimate"] for t in terms])
@@ -1042,7 +1055,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             # (CY: the model's wind-axis side force, scale_columns)
             cnames, cPhi = (names + [f"scale:{coef}"], np.column_stack([Phi, S0[:, j]])) \
                 if coef in th.get("scale_coefficients", ()) else (names, Phi)
-            entry, _ = _fit_coefficient(cnames, cPhi, Rd[:, j], tr, te, folds, th, max_rows)
+            entry, _ = _fit_coefficient(cnames, cPhi, Rd[:, j], tr, te, folds, th, max_rows, coef)
             entry["coefficient"] = coef
             entries.append(entry)
             t0 = entry["terms"][0] if entry["terms"] else None

@@ -517,7 +517,7 @@ def test_power_with_parent_names_a_curvature_about_a_shifted_alpha(airframe):
     assert [t["term"] for t in f["evidence"]["terms"][:2]] == ["alpha^2", "alpha"]
     assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
     assert f["gain"]["percent"] >= 50.0
-    assert THRESHOLDS["power_with_parent"] in ((), ("alpha",))
+    assert THRESHOLDS["power_with_parent"] in ((), ("alpha",), ("Cm:alpha",))
 
 
 def test_power_with_parent_leaves_a_curvature_that_wins_alone_to_the_search_without_blocks(airframe):
@@ -532,3 +532,56 @@ def test_power_with_parent_leaves_a_curvature_that_wins_alone_to_the_search_with
     assert [f["cause"] for f in on["findings"]] == [f["cause"] for f in off["findings"]] == ["Cm:alpha^2"]
     assert "entered_with" not in on["findings"][0]["evidence"]
     assert on["findings"][0]["estimate"] == pytest.approx(off["findings"][0]["estimate"])
+
+
+def _coefficients_a_block_entered(monkeypatch, ctx, R, ref, blocks):
+    """The sparse search with ``power_with_parent = blocks``, and the coefficients in whose forward search a
+    block (more than one column in one step) entered."""
+    from gcs_sysid.diagnose import sparse
+
+    entered, current = [], [None]
+    fit, select = sparse._fit_coefficient, sparse.select_terms
+
+    def fit_logged(*a, **kw):
+        current[0] = kw.get("coefficient", a[8] if len(a) > 8 else None)
+        return fit(*a, **kw)
+
+    def select_logged(*a, steps=None, **kw):
+        steps = [] if steps is None else steps
+        out = select(*a, steps=steps, **kw)
+        entered.extend(current[0] for st in steps if len(st) > 1)
+        return out
+
+    monkeypatch.setattr(sparse, "_fit_coefficient", fit_logged)
+    monkeypatch.setattr(sparse, "select_terms", select_logged)
+    res = sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": blocks})
+    monkeypatch.undo()
+    return res, set(entered)
+
+
+def test_power_with_parent_named_for_cm_offers_the_block_only_in_cms_search(airframe, monkeypatch):
+    """``power_with_parent = ("Cm:alpha",)``: the block ``(alpha^2, alpha)`` is offered in ``Cm``'s search only
+    (twenty-ninth session, i9-pwp3: offered to every coefficient, it entered the sgs126's ``Cn`` search and kept
+    ``p_hat`` out). A flight with the same curvature about a 3-deg-shifted alpha hidden in ``Cm`` and in ``CZ``:
+    with ``("alpha",)`` the block enters both searches; named for ``Cm`` it enters ``Cm``'s alone, and ``Cm``'s
+    curvature is still named with its parent."""
+    from gcs_sysid.diagnose.sparse import power_parent_blocks
+
+    names = ["alpha", "beta", "alpha^2", "beta^2"]
+    assert power_parent_blocks(names, ("Cm:alpha",), "Cm") == [(2, 0)]
+    assert power_parent_blocks(names, ("Cm:alpha",), "Cn") == power_parent_blocks(names, ("Cm:alpha",)) == []
+    assert power_parent_blocks(names, ("alpha",), "Cn") == [(2, 0)]
+    ref = _ctx(airframe, seed=4)
+    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
+    a = table.X[:, 0].copy()
+    table.Y[:, 4] += -3.0 * a**2
+    table.Y[:, 2] += -3.0 * a**2
+    table.X[:, 0] = a + np.radians(3.0)
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    R = ctx.Y - ctx.model_values()
+    _, every = _coefficients_a_block_entered(monkeypatch, ctx, R, ref, ("alpha",))
+    assert "Cm" in every and every - {"Cm"}, every
+    res, only = _coefficients_a_block_entered(monkeypatch, ctx, R, ref, ("Cm:alpha",))
+    assert only == {"Cm"}, only
+    cm = next(f for f in res["findings"] if f["coefficient"] == "Cm")
+    assert cm["cause"] == "Cm:alpha^2" and cm["evidence"]["entered_with"] == ["alpha"]
