@@ -235,7 +235,8 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: other effect's count is lost: the sgs126's ``Cn:delta_a`` estimate (4 -> 3/6), where the block entered ``Cn``'s own
 #: search at its third step and took ``p_hat``'s place (*Twenty-ninth session, i9-pwp3*). Thirtieth session (branch
 #: i9-pwpcm): an entry may name its coefficient, ``("Cm:alpha",)``: the block only in ``Cm``'s search. That gives the
-#: sgs126's ``Cn:delta_a`` back and keeps the seven wins (*Thirtieth session, i9-pwpcm*).
+#: sgs126's ``Cn:delta_a`` back and keeps the seven wins (*Thirtieth session, i9-pwpcm*). **On** since then,
+#: ``("Cm:alpha",)``; ``()`` turns it off.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -255,7 +256,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
-              "power_with_parent": ()}
+              "power_with_parent": ("Cm:alpha",)}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
