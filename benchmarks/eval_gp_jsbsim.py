@@ -211,17 +211,13 @@ def air_rate_arrays(res, airframe, ls_model) -> dict:
         ``X`` where refused or ``HELDOUT_AIR_ROLL`` is ``"off"``), ``ls_air`` ``(T, 6)``, ``air_applied`` (bool:
         the roll fit was accepted), ``air_note`` (the target's note: what was done, or why not).
     """
-    from gcs_sysid.aero.gustfilter import HELDOUT_AIR_ROLL, air_roll_fit, air_roll_target, heldout_air_roll
-    from gcs_sysid.diagnose.fit import fit_model
+    from benchmarks.eval_jsbsim import air_rate_pair, ls_cl_on
+    from gcs_sysid.aero.gustfilter import HELDOUT_AIR_ROLL
 
-    tab = res.table
-    fit = air_roll_fit(tab, res.states, airframe, res.train)
-    X_air = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=HELDOUT_AIR_ROLL, fit=fit)[0].X
-    Y_air, info = air_roll_target(tab, res.states, airframe, res.train, fit=fit)
-    i = COEFFICIENTS.index("Cl")
-    ls_air = np.array(ls_model.evaluate(tab.X), float)
-    ls_air[:, i] = fit_model(replace(tab, Y=Y_air), mask=res.train)[0].evaluate(X_air)[:, i]
-    return dict(Y_air=Y_air, X_air=X_air, ls_air=ls_air, air_applied=not isinstance(fit, str), air_note=info["note"])
+    X_air, Y_air, info = air_rate_pair(res, airframe, HELDOUT_AIR_ROLL)
+    ls_air = np.array(ls_model.evaluate(res.table.X), float)
+    ls_air[:, COEFFICIENTS.index("Cl")] = ls_cl_on(res, Y_air, X_air)
+    return dict(Y_air=Y_air, X_air=X_air, ls_air=ls_air, air_applied="Cl_p" in info, air_note=info["note"])
 
 
 def errors(est: np.ndarray, ref: np.ndarray) -> np.ndarray:

@@ -418,25 +418,54 @@ def ls_air_target_scores(res, airframe, h: np.ndarray, Yt: np.ndarray, ls_model,
         what the replay's table rather than ``gcs-sysid fit``'s own changes), % errors per coefficient on ``h``;
         ``ls_airtrain_applied`` False when the roll fit was refused (the target is then the measured Cl).
     """
-    from dataclasses import replace
-
-    from gcs_sysid.aero.gustfilter import air_roll_fit, air_roll_mode, air_roll_target, heldout_air_roll
-    from gcs_sysid.diagnose.fit import fit_model
-
     tab, i = res.table, COEFFICIENTS.index("Cl")
+    X_air, Y2, tinfo = air_rate_pair(res, airframe, mode)
+    base = ls_model.evaluate(tab.X[h])
+    out: dict = {"ls_airtrain_applied": "Cl_p" in tinfo}
+    for key, Y in (("ls_airtrain", Y2), ("ls_airtab", tab.Y)):
+        est = base.copy()
+        est[:, i] = ls_cl_on(res, Y, X_air[h])
+        out[key] = _errs(est, Yt[h])
+    return out
+
+
+def air_rate_pair(res, airframe, mode: str):
+    """The replay's air-rate pair on one replay's table, as ``run_replay`` makes it with ``air_roll_train``: the one
+    roll fit (:func:`gcs_sysid.aero.gustfilter.air_roll_fit` on the training rows, with its Dryden and instruments'
+    checks), the held-out rows at the air-relative roll rate of ``mode``
+    (:func:`~gcs_sysid.aero.gustfilter.heldout_air_roll`; ``"off"``: the gyro's) and the Cl training target
+    (:func:`~gcs_sysid.aero.gustfilter.air_roll_target`: the measured Cl less the training rows' smoothed gust
+    moment).
+
+    Args:
+        res: :class:`gcs_sysid.pipeline.ReplayResult` (table at the gyro's ``p_hat``, states, rows).
+        airframe: the flight's airframe (``Ixx``, ``S``, ``b`` ...). mode: a ``HELDOUT_AIR_ROLL`` value.
+
+    Returns:
+        ``(X_air (T, 10), Y_air (T, 6), info)``: ``X_air`` and ``Y_air`` equal the table's where the fit was refused;
+        ``info`` is ``air_roll_target``'s (``"Cl_p"`` in it when the fit was applied, ``"note"``).
+    """
+    from gcs_sysid.aero.gustfilter import air_roll_fit, air_roll_mode, air_roll_target, heldout_air_roll
+
+    tab = res.table
     fit = air_roll_fit(tab, res.states, airframe, res.train)
     X_air = tab.X
     if air_roll_mode(mode)[0] != "off":
         X_air = heldout_air_roll(tab, res.states, airframe, res.train, res.held_out, mode=mode, fit=fit)[0].X
-    Y2, tinfo = air_roll_target(tab, res.states, airframe, res.train, fit=fit)
-    base = ls_model.evaluate(tab.X[h])
-    out: dict = {"ls_airtrain_applied": "Cl_p" in tinfo}
-    for key, Y in (("ls_airtrain", Y2), ("ls_airtab", tab.Y)):
-        m, _ = fit_model(replace(tab, Y=Y), mask=res.train)
-        est = base.copy()
-        est[:, i] = m.evaluate(X_air[h])[:, i]
-        out[key] = _errs(est, Yt[h])
-    return out
+    Y_air, info = air_roll_target(tab, res.states, airframe, res.train, fit=fit)
+    return X_air, Y_air, info
+
+
+def ls_cl_on(res, Y: np.ndarray, Xq: np.ndarray) -> np.ndarray:
+    """Cl ``(Q,)`` at ``Xq`` ``(Q, 10)`` from ``gcs-sysid fit``'s stepwise regression
+    (:func:`gcs_sysid.diagnose.fit.fit_model`, its pool and thresholds) on the replay's table with the coefficients
+    ``Y`` ``(T, 6)`` and its training rows."""
+    from dataclasses import replace
+
+    from gcs_sysid.diagnose.fit import fit_model
+
+    m, _ = fit_model(replace(res.table, Y=Y), mask=res.train)
+    return m.evaluate(Xq)[:, COEFFICIENTS.index("Cl")]
 
 
 def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.ndarray, ls_model,
