@@ -1,13 +1,16 @@
 """Ask the vehicle for the messages system identification needs, and say what is missing.
 
 Per required message one ``MAV_CMD_SET_MESSAGE_INTERVAL`` (one at a time, as the ``COMMAND_ACK``
-does not name the message; two tries of :data:`ACK_TIMEOUT_S`). A message whose request is
+does not name the message; :data:`ACK_TRIES` tries of :data:`ACK_TIMEOUT_S` each, the ``confirmation``
+field counting the retries, as the MAVLink command protocol asks). A message whose request is
 denied, unsupported or unanswered falls back to ``REQUEST_DATA_STREAM`` for its ArduPilot stream
 group. After :data:`SETTLE_S` the received rates are compared with the asked ones; a shortfall is
 reported with what it costs the identification (:func:`shortfall_costs`).
 
 References:
-    https://mavlink.io/en/services/message_interval.html; ArduPilot ``SRx_`` stream groups.
+    https://mavlink.io/en/services/message_interval.html; https://mavlink.io/en/services/command.html
+    (retries, ``confirmation``); MAVSDK's command sender retries three times
+    (``MavlinkCommandSender::DEFAULT_RETRIES``); ArduPilot ``SRx_`` stream groups.
 """
 
 from __future__ import annotations
@@ -16,9 +19,13 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
-__all__ = ["REQUIRED_RATES", "rates_from_params", "RateRequester", "shortfall_costs", "ACK_TIMEOUT_S", "SETTLE_S"]
+__all__ = ["REQUIRED_RATES", "rates_from_params", "RateRequester", "shortfall_costs", "ACK_TIMEOUT_S", "ACK_TRIES",
+           "SETTLE_S"]
 
 ACK_TIMEOUT_S = 1.0
+#: tries per request before it is "no answer" (a radio link or a busy router can hold an answer past one
+#: timeout; two tries were too few behind MAVProxy on a loaded machine).
+ACK_TRIES = 3
 SETTLE_S = 5.0
 _CMD = 511          # MAV_CMD_SET_MESSAGE_INTERVAL
 _ACCEPTED = 0
@@ -150,7 +157,7 @@ class RateRequester:
             return
         now = self.clock()
         if self._current is not None and now - self._sent_at > ACK_TIMEOUT_S:
-            if self._tries < 2:
+            if self._tries < ACK_TRIES:
                 self._request(self._current)
             else:
                 self.result[self._current] = "no answer"
