@@ -149,7 +149,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:],
                "air_roll": dict(lr.air_roll) if pair else None}
         if pair:
-            row["gp_air_cl"] = dict(row["gp"])
+            row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
                 from gcs_sysid.aero.gustfilter import heldout_air_roll
 
@@ -158,10 +158,16 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                                                  fit=lr._roll_fit)
                 if info is not None:
                     xva = None if tab_air.x_var is None else tab_air.x_var[h]
-                    mc, _ = model.predict(tab_air.X[h], x_var=xva)
+                    mc, vc = model.predict(tab_air.X[h], x_var=xva)
+                    i, k = COEFFICIENTS.index("Cl"), outputs.index("Cl")
                     mean_a = mean.copy()
-                    mean_a[:, COEFFICIENTS.index("Cl")] = np.asarray(mc)[:, outputs.index("Cl")]
+                    mean_a[:, i] = np.asarray(mc)[:, k]
                     row["gp_air_cl"] = _errs(mean_a, Yt[h])
+                    row["cov_gp_air_cl"] = _coverage(mean_a[:, i], np.sqrt(np.maximum(np.asarray(vc)[:, k] - white[k],
+                                                                                      0.0)), Yt[h, i])
+                    ls_a = np.array(ls_model.evaluate(tab.X[h]), float)
+                    ls_a[:, i] = ls_model.evaluate(tab_air.X[h])[:, i]      # LS asked at the same held-out rate
+                    row["ls_air_cl"] = _errs(ls_a, Yt[h])
         row["cov_gp"] = float(np.nanmean(row["cov_gp_each"]))
         row["cov_true_air"] = float(np.nanmean(row["cov_true_air_each"]))
         out.append(row)
@@ -182,9 +188,14 @@ def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
     """Issue 8's counts of one row: coefficients within / better than LS, bands in 90-98 %, correlation flag.
 
     ``heldout_cl="air"``: a row with the air-rate pair on has its held-out Cl asked at the reconstructed air rate
-    (``gp_air_cl``), as the replay asks it; ``"gyro"``: at the gyro's rate, as the learner's model is asked."""
+    (``gp_air_cl``), as the replay asks it, and so has its LS line (``ls_air_cl``: least squares on the measured Cl
+    asked at the same held-out rate); ``"gyro"``: at the gyro's rate, as the learner's model is asked."""
     if heldout_cl == "air" and row.get("gp_air_cl") is not None:
-        row = {**row, "gp": row["gp_air_cl"]}
+        row = {**row, "gp": row["gp_air_cl"], "ls": row.get("ls_air_cl", row["ls"])}
+        if row.get("cov_gp_air_cl") is not None:        # Cl's band at the same question
+            each = list(row["cov_gp_each"])
+            each[COEFFICIENTS.index("Cl")] = row["cov_gp_air_cl"]
+            row["cov_gp"] = float(np.nanmean(each))
     th = {c: 5.0 if c in FORCES else 10.0 for c in COEFFICIENTS}
     fin = lambda d, c: d.get(c) is not None and np.isfinite(d[c])  # noqa: E731
     return {"gp_within": sum(fin(row["gp"], c) and row["gp"][c] <= th[c] for c in COEFFICIENTS),
