@@ -16,14 +16,22 @@ For each JSBSim flight (``benchmarks.jsbsim_harness``, as ``eval_jsbsim.py``; fl
    (the largest learned output correlation, ``model.output_correlation()``) and ``ls`` (``run_fit`` on the
    training window, once per flight).
 
+``--air-roll off on`` also runs each noise x GP seed with the learner's air-rate pair (``LearnOptions.air_roll``;
+thirty-first session, live-pair31): such rows add the learner's ``air_roll`` status, ``gp_air_cl`` (the held-out Cl
+asked at ``p_hat - p_hat_g``, ``heldout_air_roll`` ``"predicted:Cl"`` with the learner's own roll fit: the replay's
+question, post hoc), ``ls_air_cl`` (least squares asked there too) and ``cov_gp_air_cl`` (Cl's band there).
+
 Counts (:func:`counts`; thresholds as issue 8: held-out / true-air within 5 % forces, 10 % moments; GP better than
-LS; bands 90-98 %; a learned output correlation above 0.5) and flips of each noise against ``independent`` at the
-same seed are printed by ``--summarize``.
+LS; bands 90-98 %; a learned output correlation above 0.5) and flips of each variant (:func:`variant`: the noise,
+``+air-roll``) against ``--base`` (``independent``) at the same seed are printed by ``--summarize``
+(``--heldout-cl air``: the pair's Cl at the air-rate question).
 
 Usage::
 
     python benchmarks/eval_live_jsbsim.py --aircraft c172x sgs --seeds 1 --work DIR --json live.jsonl
     python benchmarks/eval_live_jsbsim.py --summarize live.jsonl
+    python benchmarks/eval_live_jsbsim.py --aircraft c172x --gp-noise learned --air-roll off on --json pair.jsonl
+    python benchmarks/eval_live_jsbsim.py --summarize pair.jsonl --base learned --heldout-cl gyro
 """
 
 from __future__ import annotations
@@ -141,7 +149,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
         C = np.abs(np.asarray(model.output_correlation(), float))
         np.fill_diagonal(C, 0.0)
         row = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "duration_s": duration,
-               "gp_noise": noise, "gp_seed": gs, "outputs": list(outputs), "n_learned": int(n_learned), "n_heldout": int(h.sum()), "t_record_s": round(t_rec, 1),
+               "gp_noise": noise, "gp_seed": gs, "outputs": list(outputs), "n_learned": int(n_learned),
+               "n_heldout": int(h.sum()), "t_record_s": round(t_rec, 1),
                "cpu_learn_s": round(cpu, 2), "noise_correlation": bool(model.config.noise_correlation),
                "gp": _errs(mean, Yt[h]), "true_air": _errs(mta, Yt[h]), "ls": ls,
                "cov_gp_each": [_coverage(mean[:, i], sig[:, i], Yt[h, i]) for i in range(6)],
