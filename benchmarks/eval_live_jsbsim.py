@@ -16,14 +16,22 @@ For each JSBSim flight (``benchmarks.jsbsim_harness``, as ``eval_jsbsim.py``; fl
    (the largest learned output correlation, ``model.output_correlation()``) and ``ls`` (``run_fit`` on the
    training window, once per flight).
 
+``--air-roll off on`` also runs each noise x GP seed with the learner's air-rate pair (``LearnOptions.air_roll``;
+thirty-first session, live-pair31): such rows add the learner's ``air_roll`` status, ``gp_air_cl`` (the held-out Cl
+asked at ``p_hat - p_hat_g``, ``heldout_air_roll`` ``"predicted:Cl"`` with the learner's own roll fit: the replay's
+question, post hoc), ``ls_air_cl`` (least squares asked there too) and ``cov_gp_air_cl`` (Cl's band there).
+
 Counts (:func:`counts`; thresholds as issue 8: held-out / true-air within 5 % forces, 10 % moments; GP better than
-LS; bands 90-98 %; a learned output correlation above 0.5) and flips of each noise against ``independent`` at the
-same seed are printed by ``--summarize``.
+LS; bands 90-98 %; a learned output correlation above 0.5) and flips of each variant (:func:`variant`: the noise,
+``+air-roll``) against ``--base`` (``independent``) at the same seed are printed by ``--summarize``
+(``--heldout-cl air``: the pair's Cl at the air-rate question).
 
 Usage::
 
     python benchmarks/eval_live_jsbsim.py --aircraft c172x sgs --seeds 1 --work DIR --json live.jsonl
     python benchmarks/eval_live_jsbsim.py --summarize live.jsonl
+    python benchmarks/eval_live_jsbsim.py --aircraft c172x --gp-noise learned --air-roll off on --json pair.jsonl
+    python benchmarks/eval_live_jsbsim.py --summarize pair.jsonl --base learned --heldout-cl gyro
 """
 
 from __future__ import annotations
@@ -47,33 +55,54 @@ from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 FORCES = ("CX", "CY", "CZ")
 
 
+def _pair_states(states):
+    """The part of a window's states the air-rate pair reads (:data:`gcs_sysid.aero.gustfilter.AIR_ROLL_STATE_KEYS`)."""
+    from gcs_sysid.aero.gustfilter import AIR_ROLL_STATE_KEYS
+    from gcs_sysid.estimation.states import FlightStates
+
+    if states is None:
+        return None
+    return FlightStates(states.t, states.rate_hz, {k: states.data[k] for k in AIR_ROLL_STATE_KEYS["data"]
+                                                   if k in states.data},
+                        {k: states.sigma[k] for k in AIR_ROLL_STATE_KEYS["sigma"] if k in states.sigma})
+
+
 def record_steps(tlog: Path, airframe) -> list[tuple]:
-    """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows)`` of every GP step."""
+    """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states)`` of every GP step
+    (``states``: the part the air-rate pair reads)."""
     from gcs_sysid.live.learner import Learner, LearnOptions, iter_tlog_records
 
     steps: list[tuple] = []
     rec = Learner(airframe, LearnOptions())
-    rec._learn = lambda table, rows: steps.append((dict(rec.identifiable), table, rows.copy()))   # no GP here
+    rec._learn = lambda table, rows, states=None: steps.append((dict(rec.identifiable), table, rows.copy(),
+                                                                _pair_states(states)))   # no GP here
     for stamp, packet in iter_tlog_records(tlog):
         rec.feed(stamp, packet)
     rec.finish()
     return steps
 
 
-def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int):
-    """The model of a learner fed ``steps`` up to vehicle time ``t_cut`` (s); (model, outputs, rows learned, CPU s)."""
+def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = False):
+    """The learner fed ``steps`` up to vehicle time ``t_cut`` (s) and its CPU s (its ``model``, ``outputs``,
+    ``n_learned``, ``air_roll``)."""
     from gcs_sysid.live.learner import Learner, LearnOptions
 
-    lr = Learner(airframe, LearnOptions(gp_noise=gp_noise, gp_seed=gp_seed))
+    lr = Learner(airframe, LearnOptions(gp_noise=gp_noise, gp_seed=gp_seed, air_roll=air_roll))
     t0 = time.process_time()
-    for k, (ident, table, rows) in enumerate(steps):
+    for k, (ident, table, rows, states) in enumerate(steps):
         lr.steps, lr.identifiable = k + 1, ident
-        lr._learn(table, rows & (table.t < t_cut))
-    return lr.model, lr.outputs, lr.n_learned, time.process_time() - t0
+        lr._learn(table, rows & (table.t < t_cut), states)
+    return lr, time.process_time() - t0
 
 
-def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds) -> list[dict]:
-    """One flight's rows (one per noise x GP seed), JSON-able."""
+def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
+             air_rolls=(False,)) -> list[dict]:
+    """One flight's rows (one per noise x GP seed x air-rate pair off/on), JSON-able.
+
+    With the pair on (``LearnOptions.air_roll``) the row also has ``gp_air_cl``: ``gp`` with Cl asked at the
+    held-out rows' ``p_hat - p_hat_g`` (``heldout_air_roll`` ``"predicted:Cl"`` with the learner's own roll fit: the
+    replay's held-out question; a post hoc line, the live learner asks nowhere at the air rate), and
+    ``air_roll`` the learner's status."""
     from gcs_sysid.aero import compute_coefficients
     from gcs_sysid.airframe import load_airframe
     from gcs_sysid.diagnose import run_fit
@@ -87,7 +116,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                         reuse=True)
     truth = load_truth(files.truth)
     af = load_airframe(files.airframe)
-    tab = compute_coefficients(estimate_states(read_log(files.tlog), af), af)
+    states_all = estimate_states(read_log(files.tlog), af)
+    tab = compute_coefficients(states_all, af)
     held = held_out_mask(tab.t, tab.valid, 0.2)
     t_cut = float(tab.t[held][0])
     Xt, Yt = truth.at(tab.t)
@@ -103,40 +133,78 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     steps = record_steps(files.tlog, af)
     t_rec = time.perf_counter() - t0
     out = []
-    for noise in noises:
-        for gs in gp_seeds:
-            model, outputs, n_learned, cpu = learn(steps, af, t_cut, noise, gs)
-            cols = [COEFFICIENTS.index(c) for c in outputs]
-            mean = np.full((int(h.sum()), 6), np.nan)
-            sig, mta, sta = mean.copy(), mean.copy(), mean.copy()
-            xv = None if tab.x_var is None else tab.x_var[h]
-            m, v = model.predict(tab.X[h], x_var=xv)
-            white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
-            mean[:, cols] = np.asarray(m)
-            sig[:, cols] = np.sqrt(np.maximum(np.asarray(v) - white[None, :], 0.0))
-            ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
-            mta[:, cols], sta[:, cols] = np.asarray(ma), np.sqrt(np.asarray(va))
-            C = np.abs(np.asarray(model.output_correlation(), float))
-            np.fill_diagonal(C, 0.0)
-            row = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "duration_s": duration,
-                   "gp_noise": noise, "gp_seed": gs, "outputs": list(outputs), "n_learned": int(n_learned), "n_heldout": int(h.sum()), "t_record_s": round(t_rec, 1),
-                   "cpu_learn_s": round(cpu, 2), "noise_correlation": bool(model.config.noise_correlation),
-                   "gp": _errs(mean, Yt[h]), "true_air": _errs(mta, Yt[h]), "ls": ls,
-                   "cov_gp_each": [_coverage(mean[:, i], sig[:, i], Yt[h, i]) for i in range(6)],
-                   "cov_true_air_each": [_coverage(mta[:, i], sta[:, i], Yt[h, i]) for i in range(6)],
-                   "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:]}
-            row["cov_gp"] = float(np.nanmean(row["cov_gp_each"]))
-            row["cov_true_air"] = float(np.nanmean(row["cov_true_air_each"]))
-            out.append(row)
-            print(f"{aircraft} {turbulence} s{seed} {noise} gs{gs}: gp " +
-                  " ".join(f"{c} {row['gp'][c]:.1f}" for c in COEFFICIENTS) +
-                  f" | cov {row['cov_gp']:.1f} / {row['cov_true_air']:.1f} corr {row['max_corr']:.2f} "
-                  f"cpu {cpu:.1f} s", flush=True)
+    for noise, gs, pair in ((n, g, p) for n in noises for g in gp_seeds for p in air_rolls):
+        lr, cpu = learn(steps, af, t_cut, noise, gs, pair)
+        model, outputs, n_learned = lr.model, lr.outputs, lr.n_learned
+        cols = [COEFFICIENTS.index(c) for c in outputs]
+        mean = np.full((int(h.sum()), 6), np.nan)
+        sig, mta, sta = mean.copy(), mean.copy(), mean.copy()
+        xv = None if tab.x_var is None else tab.x_var[h]
+        m, v = model.predict(tab.X[h], x_var=xv)
+        white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
+        mean[:, cols] = np.asarray(m)
+        sig[:, cols] = np.sqrt(np.maximum(np.asarray(v) - white[None, :], 0.0))
+        ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
+        mta[:, cols], sta[:, cols] = np.asarray(ma), np.sqrt(np.asarray(va))
+        C = np.abs(np.asarray(model.output_correlation(), float))
+        np.fill_diagonal(C, 0.0)
+        row = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "duration_s": duration,
+               "gp_noise": noise, "gp_seed": gs, "outputs": list(outputs), "n_learned": int(n_learned),
+               "n_heldout": int(h.sum()), "t_record_s": round(t_rec, 1),
+               "cpu_learn_s": round(cpu, 2), "noise_correlation": bool(model.config.noise_correlation),
+               "gp": _errs(mean, Yt[h]), "true_air": _errs(mta, Yt[h]), "ls": ls,
+               "cov_gp_each": [_coverage(mean[:, i], sig[:, i], Yt[h, i]) for i in range(6)],
+               "cov_true_air_each": [_coverage(mta[:, i], sta[:, i], Yt[h, i]) for i in range(6)],
+               "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:],
+               "air_roll": dict(lr.air_roll) if pair else None}
+        if pair:
+            row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
+            if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
+                from gcs_sysid.aero.gustfilter import heldout_air_roll
+
+                train = tab.valid & (tab.t < t_cut)
+                tab_air, info = heldout_air_roll(tab, states_all, af, train, held, mode="predicted:Cl",
+                                                 fit=lr._roll_fit)
+                if info is not None:
+                    xva = None if tab_air.x_var is None else tab_air.x_var[h]
+                    mc, vc = model.predict(tab_air.X[h], x_var=xva)
+                    i, k = COEFFICIENTS.index("Cl"), outputs.index("Cl")
+                    mean_a = mean.copy()
+                    mean_a[:, i] = np.asarray(mc)[:, k]
+                    row["gp_air_cl"] = _errs(mean_a, Yt[h])
+                    row["cov_gp_air_cl"] = _coverage(mean_a[:, i], np.sqrt(np.maximum(np.asarray(vc)[:, k] - white[k],
+                                                                                      0.0)), Yt[h, i])
+                    ls_a = np.array(ls_model.evaluate(tab.X[h]), float)
+                    ls_a[:, i] = ls_model.evaluate(tab_air.X[h])[:, i]      # LS asked at the same held-out rate
+                    row["ls_air_cl"] = _errs(ls_a, Yt[h])
+        row["cov_gp"] = float(np.nanmean(row["cov_gp_each"]))
+        row["cov_true_air"] = float(np.nanmean(row["cov_true_air_each"]))
+        out.append(row)
+        print(f"{aircraft} {turbulence} s{seed} {noise} gs{gs} pair {'on' if pair else 'off'}: gp " +
+              " ".join(f"{c} {row['gp'][c]:.1f}" for c in COEFFICIENTS) +
+              f" | cov {row['cov_gp']:.1f} / {row['cov_true_air']:.1f} corr {row['max_corr']:.2f} "
+              f"cpu {cpu:.1f} s" + (f" | pair {lr.air_roll['state']}, Cl at the air rate "
+                                     f"{row['gp_air_cl']['Cl']:.1f}" if pair else ""), flush=True)
     return out
 
 
-def counts(row: dict) -> dict[str, int]:
-    """Issue 8's counts of one row: coefficients within / better than LS, bands in 90-98 %, correlation flag."""
+def variant(row: dict) -> str:
+    """A row's learner variant: its GP noise, ``+air-roll`` with the air-rate pair on."""
+    return row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
+
+
+def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
+    """Issue 8's counts of one row: coefficients within / better than LS, bands in 90-98 %, correlation flag.
+
+    ``heldout_cl="air"``: a row with the air-rate pair on has its held-out Cl asked at the reconstructed air rate
+    (``gp_air_cl``), as the replay asks it, and so has its LS line (``ls_air_cl``: least squares on the measured Cl
+    asked at the same held-out rate); ``"gyro"``: at the gyro's rate, as the learner's model is asked."""
+    if heldout_cl == "air" and row.get("gp_air_cl") is not None:
+        row = {**row, "gp": row["gp_air_cl"], "ls": row.get("ls_air_cl", row["ls"])}
+        if row.get("cov_gp_air_cl") is not None:        # Cl's band at the same question
+            each = list(row["cov_gp_each"])
+            each[COEFFICIENTS.index("Cl")] = row["cov_gp_air_cl"]
+            row["cov_gp"] = float(np.nanmean(each))
     th = {c: 5.0 if c in FORCES else 10.0 for c in COEFFICIENTS}
     fin = lambda d, c: d.get(c) is not None and np.isfinite(d[c])  # noqa: E731
     return {"gp_within": sum(fin(row["gp"], c) and row["gp"][c] <= th[c] for c in COEFFICIENTS),
@@ -148,22 +216,24 @@ def counts(row: dict) -> dict[str, int]:
             "no_corr": int(row["max_corr"] <= 0.5)}
 
 
-def summarize(paths: list[str], base: str = "independent") -> str:
-    """Totals per noise and GP seed, flips against ``base`` at the same seed, aircraft losing a count."""
+def summarize(paths: list[str], base: str = "independent", heldout_cl: str = "gyro") -> str:
+    """Totals per variant (:func:`variant`) and GP seed, flips against ``base`` at the same seed, aircraft losing a
+    count (:func:`counts` with ``heldout_cl``)."""
     rows = [json.loads(line) for p in paths for line in Path(p).read_text().splitlines() if line.strip()]
     key = lambda r: (r["aircraft"], r["turbulence"], r["seed"])  # noqa: E731
-    by = {(key(r), r["gp_noise"], r["gp_seed"]): r for r in rows}
-    noises = sorted({r["gp_noise"] for r in rows})
+    by = {(key(r), variant(r), r["gp_seed"]): r for r in rows}
+    cnt = lambda r: counts(r, heldout_cl)  # noqa: E731
+    noises = sorted({variant(r) for r in rows})
     gseeds = sorted({r["gp_seed"] for r in rows})
     flights = sorted({key(r) for r in rows})
     lines = [f"{len(flights)} flights; noises {noises}; GP seeds {gseeds}", ""]
-    items = list(counts(rows[0]))
+    items = list(cnt(rows[0]))
     lines.append("| noise, GP seed | " + " | ".join(items) + " | median gp F / M % | median cpu s |")
     lines.append("|---" * (len(items) + 3) + "|")
     for n in noises:
         for s in gseeds:
             rs = [by[(f, n, s)] for f in flights if (f, n, s) in by]
-            tot = {i: sum(counts(r)[i] for r in rs) for i in items}
+            tot = {i: sum(cnt(r)[i] for r in rs) for i in items}
             gf = np.nanmedian([r["gp"][c] for r in rs for c in FORCES])
             gm = np.nanmedian([r["gp"][c] for r in rs for c in COEFFICIENTS if c not in FORCES])
             cpu = np.median([r["cpu_learn_s"] for r in rs])
@@ -179,7 +249,7 @@ def summarize(paths: list[str], base: str = "independent") -> str:
             for f in flights:
                 if (f, n, s) not in by or (f, base, s) not in by:
                     continue
-                a, b = counts(by[(f, n, s)]), counts(by[(f, base, s)])
+                a, b = cnt(by[(f, n, s)]), cnt(by[(f, base, s)])
                 for i in items:
                     win += max(a[i] - b[i], 0)
                     loss += max(b[i] - a[i], 0)
@@ -197,7 +267,7 @@ def summarize(paths: list[str], base: str = "independent") -> str:
         lost = set()
         for f in flights:
             if (f, base, s0) in by and (f, base, s1) in by:
-                a, b = counts(by[(f, base, s1)]), counts(by[(f, base, s0)])
+                a, b = cnt(by[(f, base, s1)]), cnt(by[(f, base, s0)])
                 for i in items:
                     win += max(a[i] - b[i], 0)
                     loss += max(b[i] - a[i], 0)
@@ -216,12 +286,17 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=90.0)
     ap.add_argument("--gp-noise", nargs="+", default=["independent", "learned"])
     ap.add_argument("--gp-seeds", nargs="+", type=int, default=[0, 1])
+    ap.add_argument("--air-roll", nargs="+", default=["off"], choices=("off", "on"),
+                    help="the learner's air-rate pair (LearnOptions.air_roll) off and/or on")
+    ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
+    ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
+                    help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")
     ap.add_argument("--work", default=None)
     ap.add_argument("--json", default=None, help="append one JSON line per flight x noise x GP seed")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL")
     a = ap.parse_args(argv)
     if a.summarize:
-        print(summarize(a.summarize))
+        print(summarize(a.summarize, a.base, a.heldout_cl))
         return 0
     import tempfile
 
@@ -230,7 +305,8 @@ def main(argv=None) -> int:
     for ac in a.aircraft:
         for turb in a.turbulence:
             for seed in a.seeds:
-                rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds)
+                rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds,
+                                tuple(x == "on" for x in a.air_roll))
                 append_jsonl(a.json, rows)
     return 0
 

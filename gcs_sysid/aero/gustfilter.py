@@ -49,7 +49,7 @@ __all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_MAX_IV_RATIO", "instrum
            "instruments",
            "stated_moment_variance", "filter_gust_table", "HELDOUT_AIR_ROLL", "AIR_ROLL_MODES", "air_roll_mode",
            "heldout_air_roll", "HELDOUT_GUST_VAR", "gust_moment_variance", "AIR_ROLL_TRAIN",
-           "air_roll_fit", "air_roll_target"]
+           "air_roll_fit", "air_roll_target", "AIR_ROLL_STATE_KEYS", "air_roll_target_on_rows"]
 
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
 #: less the filter-error rolling gust.
@@ -692,6 +692,72 @@ def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit
     sd = float(np.std(corr[use])) if use.any() else 0.0
     note = (f"Cl's training target at the air-relative roll rate: Cl + Cl_p p_hat_g on {int(use.sum())} training rows "
             f"(Cl_p {fit.Cl_p:.3g}, the correction's SD {sd:.3g}; " + fit.notes[0] + ")")
+    return Y, {"Cl_p": float(fit.Cl_p), "g": g, "rows": use, "sd": sd, "note": note}
+
+
+#: What the air-rate pair reads of the smoothed states (:class:`gcs_sysid.estimation.states.FlightStates`): ``data``
+#: keys (the roll rate for the step moment, the wind for the Dryden check) and ``sigma`` keys (the stated ``p_dot``
+#: and ``r_dot`` noise for the moment's ``R``, :func:`stated_moment_variance`). A caller that keeps only part of a
+#: flight's states for a later fit (the live learner) keeps these.
+AIR_ROLL_STATE_KEYS = {"data": ("p", "wn", "we", "wd"), "sigma": ("p_dot", "r_dot")}
+
+
+def air_roll_target_on_rows(fit, table, states, airframe, rows: np.ndarray, context: np.ndarray | None = None):
+    """The measured coefficients with Cl on ``rows`` at the air-relative roll rate, the rolling gust smoothed there
+    with a roll fit made on other rows (nothing refitted): ``Cl + Cl_p p_hat_g`` as :func:`air_roll_target`, with
+    ``p_hat_g`` from :func:`gcs_sysid.aero.rollgust.roll_gust_on_rows` (``"smoothed"``: the fit's steady-state
+    filter and Rauch-Tung-Striebel smoother over the measured step moments of ``context``).
+
+    The live learner's later steps (:mod:`gcs_sysid.live.learner`, ``LearnOptions.air_roll``): the pair's roll fit
+    is made once on the first fit's rows (:func:`air_roll_fit`, :func:`air_roll_target`) and each later window's new
+    rows get their target from that fit's fixed slopes, gust process and noise, so that every row the GP learns
+    carries a target of one fit (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5:
+    the filter-error model's state estimate with its parameters fixed).
+
+    Args:
+        fit: the fit (:class:`~gcs_sysid.aero.rollgust.RollDynamicsFit`, :func:`air_roll_fit`'s), or why there is
+            none (a string: the target is returned unchanged with that reason restated).
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` of the window (``X`` ``(T, 10)`` with the gyro's
+            ``p_hat``, ``Y`` ``(T, 6)``, ``qbar``, ``valid``; ``t`` on a uniform grid).
+        states: the window's smoothed states (``data["p"]`` on the table's grid, rad/s).
+        airframe: ``S`` m^2, ``b`` m, ``Ixx`` kg m^2.
+        rows: ``(T,)`` bool, the rows whose Cl moves (e.g. the window's new rows).
+        context: ``(T,)`` bool, the rows whose measured moments the smoother reads (None: ``rows``); each run of at
+            least 10 usable rows is smoothed on its own. A row of ``rows`` outside the runs keeps its Cl.
+
+    Returns:
+        ``(Y, info)``: ``Y`` ``(T, 6)`` a copy with Cl's column changed on the rows moved, and a dict (``Cl_p``,
+        ``g`` ``(T,)`` the ``p_hat_g`` used (0 off the rows moved), ``rows`` ``(T,)`` bool the rows moved, ``sd``
+        the correction's SD in Cl units, ``note``); with no fit ``(table.Y, {"note": why})``.
+
+    Raises:
+        ValueError: ``rows`` or ``context`` not ``(T,)``, or fewer than 3 rows; :func:`roll_gust_on_rows`'s errors.
+    """
+    from .rollgust import roll_gust_on_rows
+
+    T = len(table.t)
+    rows = np.asarray(rows, bool)
+    context = rows if context is None else np.asarray(context, bool)
+    if rows.shape != (T,) or context.shape != (T,):
+        raise ValueError(f"air_roll_target_on_rows: rows and context must be ({T},), got {rows.shape}, "
+                         f"{context.shape}")
+    if isinstance(fit, str):
+        return table.Y, {"note": fit.replace("gust filter", "Cl's air-rate training target")}
+    if T < 3:
+        raise ValueError(f"air_roll_target_on_rows: {T} rows, at least 3 needed")
+    dt = float(np.median(np.diff(table.t)))
+    g, _ = roll_gust_on_rows(fit, dt, table.X, table.Y, states.data["p"], table.qbar,
+                             context & np.asarray(table.valid, bool), airframe.Ixx, airframe.S, airframe.b,
+                             mode="smoothed")
+    use = rows & (g != 0.0) & np.isfinite(g)      # outside the smoothed runs the estimate is the prior mean, 0
+    g = np.where(use, g, 0.0)
+    i = COEFFICIENTS.index("Cl")
+    Y = np.array(table.Y, float, copy=True)
+    corr = fit.Cl_p * g
+    Y[:, i] = Y[:, i] + corr
+    sd = float(np.std(corr[use])) if use.any() else 0.0
+    note = (f"Cl's training target at the air-relative roll rate: Cl + Cl_p p_hat_g on {int(use.sum())} rows, the "
+            f"gust smoothed with the fixed roll fit (Cl_p {fit.Cl_p:.3g}, the correction's SD {sd:.3g})")
     return Y, {"Cl_p": float(fit.Cl_p), "g": g, "rows": use, "sd": sd, "note": note}
 
 

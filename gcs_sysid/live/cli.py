@@ -29,6 +29,11 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "correlation with the hyperparameters and keeps only its diagonal in the predictions; "
                         "'independent' one variance per output (the default until the twenty-sixth session); "
                         "docs/live.md, 'The GP's noise'")
+    p.add_argument("--air-roll", default="off", choices=("on", "off"),
+                   help="the air-rate pair in the learner: 'on' moves Cl's training target to the air-relative roll "
+                        "rate with the replay's roll fit (made once on the first fit's rows, with its Dryden and "
+                        "instruments' checks; refused: the gyro's rate for the whole session); default off; "
+                        "docs/live.md, 'The air-rate pair'")
     p.add_argument("--silence", type=float, default=30.0, metavar="S",
                    help="report the link as silent after S seconds without a packet (default 30)")
     p.add_argument("--no-learn", action="store_true", help="only log, monitor and request rates")
@@ -57,7 +62,7 @@ def cmd_listen(a: argparse.Namespace) -> int:
             raise InputError(f"{name} {v}: must lie in 1..255")
     learn = None if a.no_learn else LearnOptions(window_s=a.window, step_s=a.step, lag_s=a.lag,
                                                  min_rows=a.min_rows, n_inducing=a.inducing,
-                                                 gp_noise=a.gp_noise)
+                                                 gp_noise=a.gp_noise, air_roll=a.air_roll == "on")
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
                          component=not a.no_component, system_id=a.sysid, component_id=a.compid,
                          duration_s=a.duration, silence_s=a.silence, console=not a.quiet,

@@ -10,7 +10,10 @@ The same stages as the replay (:mod:`gcs_sysid.pipeline`), run causally on a lag
    coefficients computed (:func:`gcs_sysid.aero.compute_coefficients`);
 3. the rows between the last learned vehicle time and ``lag_s`` before the window's end (the
    smoother has had its future context for them) are new: the first ``min_rows`` of them fit the GP
-   (:func:`gcs_sysid.gp.fit_gp`), later ones go to its incremental update (``model.update``);
+   (:func:`gcs_sysid.gp.fit_gp`), later ones go to its incremental update (``model.update``); with
+   ``LearnOptions.air_roll`` Cl's target is first moved to the air-relative roll rate (the air-rate pair's
+   roll fit made once on the first fit's rows, its fixed parameters on every later window; ``docs/live.md``,
+   "The air-rate pair");
 4. every ``refresh_every`` steps the confidence map and the maneuver suggestions are refreshed.
 
 The schedule is driven by the records' stamps, never by the processing's wall clock, so feeding the
@@ -81,6 +84,15 @@ class LearnOptions:
             heap's free pages back to the system (:func:`gcs_sysid.live.heap.release_free_heap`), so
             the resident size follows what is held, not the high-water mark of the longest window or
             refresh so far, and one stage's freed temporaries do not stack under the next one's.
+        air_roll: the air-rate pair's training half (``gcs-sysid listen --air-roll on``; off by default,
+            ``docs/live.md``, "The air-rate pair"): the replay's roll fit with its two checks
+            (:func:`gcs_sysid.aero.gustfilter.air_roll_fit`: the Dryden check and the instruments' check) made once
+            on the rows of the GP's first fit, their Cl moved to the air-relative roll rate
+            (:func:`~gcs_sysid.aero.gustfilter.air_roll_target`), and every later window's new rows' Cl moved with
+            that fit's fixed parameters (:func:`~gcs_sysid.aero.gustfilter.air_roll_target_on_rows`, the gust
+            smoothed over the window) before ``model.update``. A refused fit leaves Cl at the gyro's rate for the
+            whole session (the learner's notes and ``air_roll`` status say why). The inputs stay the gyro's for
+            every output; the learner asks its model nowhere at the air rate.
     """
 
     window_s: float = 30.0
@@ -96,6 +108,7 @@ class LearnOptions:
     hyper_every: int = 15000
     max_window_s: float | None = None
     trim_heap: bool = True
+    air_roll: bool = False
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -165,6 +178,10 @@ class Learner:
             what the session learned.
         coalesced, refreshes_deferred: steps merged and map refreshes put off while behind.
         coalesced_at: stamps (us) of the records at which a due step was merged into the next.
+        air_roll: the air-rate pair's status (``LearnOptions.air_roll``): ``state`` (``"off"``, ``"waiting"`` for
+            the first fit, ``"applied"`` or ``"refused"``), ``note`` (the replay's wording: what was fitted, or why
+            not), and once applied ``Cl_p``, ``tau_s``, ``sigma`` (the roll fit's), ``rows_moved`` (rows learned
+            with a moved Cl so far) and ``sd_first`` (the first fit's correction SD, Cl units).
     """
 
     airframe: Airframe
@@ -184,6 +201,7 @@ class Learner:
     coalesced: int = 0
     refreshes_deferred: int = 0
     coalesced_at: list = field(default_factory=list)
+    air_roll: dict = field(default_factory=dict)
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -204,6 +222,9 @@ class Learner:
         self._since_hyper = 0
         self._due_us = 0
         self._replayed: set | None = None     # coalesced stamps of a session being replayed
+        self._roll_fit = None                 # the air-rate pair's roll fit (LearnOptions.air_roll), once applied
+        self._pending_roll: dict | None = None   # the pending rows' grid slices for that fit
+        self.air_roll = {"state": "waiting" if self.options.air_roll else "off", "note": ""}
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -279,7 +300,7 @@ class Learner:
         if start is not None:
             rows &= table.t > start
         self._t_done = max(end, start) if start is not None else end
-        self._learn(table, rows)
+        self._learn(table, rows, states)
         t2 = time.perf_counter()
         if self.model is not None and (final or self._refresh_due or self.steps % self.options.refresh_every == 0):
             if not final and self.behind is not None and self._replayed is None and self.behind():
@@ -317,15 +338,24 @@ class Learner:
                 self.notes.append(f"CAN not merged (step {self.steps}): {exc}")
             return flight
 
-    def _learn(self, table: CoefficientTable, rows: np.ndarray) -> None:
+    def _learn(self, table: CoefficientTable, rows: np.ndarray, states=None) -> None:
+        """Learn ``table``'s ``rows`` ((T,) bool): pending until the first fit, then ``model.update``.
+
+        ``states``: the window's smoothed states (:class:`gcs_sysid.estimation.states.FlightStates` on the table's
+        grid); read only with ``LearnOptions.air_roll`` (the roll fit's rate, wind and stated noise).
+        """
         from ..gp import fit_gp
 
         if not rows.any():
             return
         X, Y, t = table.X[rows], table.Y[rows], table.t[rows]
+        if self.model is not None and self._roll_fit is not None:
+            Y = self._air_roll_later(table, rows, states)
         self._keep(X, Y, t)
         if self.model is None:
             self._pending.append((X, Y))
+            if self.options.air_roll:
+                self._hold_roll_rows(table, rows, states)
             n = sum(len(x) for x, _ in self._pending)
             if n < self.options.min_rows:
                 return
@@ -335,8 +365,12 @@ class Learner:
                     and np.isfinite(Ya[:, i]).mean() > 0.5]
             if not cols:   # nothing identifiable yet: keep only the newest min_rows rows waiting
                 self._pending = [(Xa[-self.options.min_rows:], Ya[-self.options.min_rows:])]
+                if self._pending_roll is not None:
+                    self._trim_roll_rows(self.options.min_rows)
                 return
             self._pending = []
+            if self.options.air_roll:
+                Ya = self._air_roll_first(Ya)
             # a row that misses some coefficients (an angular-acceleration estimate rejected) is kept for the
             # others: the joint GP conditions each on the rows that carry it (docs/gp.md, "Missing outputs")
             ok = np.any(np.isfinite(Ya[:, cols]), axis=1)
@@ -354,6 +388,105 @@ class Learner:
             self._since_hyper += int(ok.sum())
             if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
                 self._refresh_hyper()
+
+    # --- the air-rate pair (LearnOptions.air_roll) ---------------------------------------------
+
+    def _hold_roll_rows(self, table: CoefficientTable, rows: np.ndarray, states) -> None:
+        """Keep the grid slice of ``table`` and ``states`` from the first to the last of ``rows`` for the roll fit
+        (every grid row in between: the fit needs contiguous rows), ``rows`` within it as its training rows."""
+        from ..aero.gustfilter import AIR_ROLL_STATE_KEYS
+
+        if self._pending_roll is not None and self._pending_roll.get("missing"):
+            return
+        if states is None or any(k not in states.data for k in AIR_ROLL_STATE_KEYS["data"]):
+            self._pending_roll = {"missing": "gust filter not run: the window's states carry no roll rate and wind"}
+            return
+        i = np.flatnonzero(rows)
+        sl = slice(int(i[0]), int(i[-1]) + 1)
+        part = {"t": table.t[sl], "X": table.X[sl], "Y": table.Y[sl], "valid": np.asarray(table.valid[sl], bool),
+                "qbar": table.qbar[sl], "train": np.asarray(rows[sl], bool)}
+        # a join to the previous slice off the grid (another window's grid, a reboot) starts a new run for the fit
+        brk = np.zeros(len(part["t"]), bool)
+        prev = self._pending_roll
+        if prev is not None and len(prev["t"]):
+            dt = 1.0 / self.options.rate_hz
+            brk[0] = not (0.5 * dt <= part["t"][0] - prev["t"][-1] <= 1.5 * dt)
+        part["brk"] = brk
+        for k in AIR_ROLL_STATE_KEYS["data"]:
+            part["d_" + k] = np.asarray(states.data[k])[sl]
+        for k in AIR_ROLL_STATE_KEYS["sigma"]:
+            if k in states.sigma:
+                part["s_" + k] = np.asarray(states.sigma[k])[sl]
+        if prev is None:
+            self._pending_roll = part
+        else:
+            self._pending_roll = {k: np.concatenate([prev[k], part[k]]) for k in part if k in prev}
+
+    def _trim_roll_rows(self, n: int) -> None:
+        """Keep the held grid rows from the ``n``-th last training row on (as the pending rows are trimmed)."""
+        P = self._pending_roll
+        if P.get("missing"):
+            return
+        i = np.flatnonzero(P["train"])
+        cut = int(i[-n]) if len(i) >= n else 0
+        self._pending_roll = {k: v[cut:] for k, v in P.items()}
+        self._pending_roll["brk"][0] = True
+
+    def _roll_table_states(self, P: dict):
+        """The held grid rows as a coefficient table and the states the pair reads."""
+        from ..aero.gustfilter import AIR_ROLL_STATE_KEYS
+        from ..estimation.states import FlightStates
+
+        table = CoefficientTable(P["t"], P["X"], P["Y"], P["valid"], P["qbar"])
+        states = FlightStates(P["t"], self.options.rate_hz, {k: P["d_" + k] for k in AIR_ROLL_STATE_KEYS["data"]},
+                              {k: P["s_" + k] for k in AIR_ROLL_STATE_KEYS["sigma"] if "s_" + k in P})
+        return table, states
+
+    def _air_roll_first(self, Ya: np.ndarray) -> np.ndarray:
+        """The pair's roll fit on the first fit's rows (made once, with its two checks); their Cl moved when it
+        is accepted. Returns the first fit's targets (``Ya`` itself when refused)."""
+        from ..aero.gustfilter import air_roll_fit, air_roll_target
+
+        P, self._pending_roll = self._pending_roll, None
+        if P is None or P.get("missing"):
+            why = (P or {}).get("missing", "gust filter not run: no rows held for the roll fit")
+        else:
+            table, states = self._roll_table_states(P)
+            train = P["train"]
+            if int(train.sum()) != len(Ya):
+                raise SysidError(f"air roll: {int(train.sum())} held rows against {len(Ya)} pending")
+            why = air_roll_fit(table, states, self.airframe, train & ~P["brk"]) if len(table.t) >= 3 else \
+                "gust filter not run: fewer than 3 rows"
+        if isinstance(why, str):
+            self.air_roll = {"state": "refused",
+                             "note": why.replace("gust filter", "Cl's air-rate training target") +
+                             " (Cl learned at the gyro's roll rate for the whole session)"}
+            self.notes.append(f"step {self.steps}: {self.air_roll['note']}")
+            return Ya
+        G = why
+        Y, info = air_roll_target(table, states, self.airframe, train, fit=G)
+        self._roll_fit = G
+        self.air_roll = {"state": "applied", "note": info["note"], "Cl_p": float(G.Cl_p), "tau_s": float(G.tau),
+                         "sigma": float(G.sigma), "rows_moved": int(info["rows"].sum()), "sd_first": info["sd"]}
+        self.notes.append(f"step {self.steps}: {info['note']}")
+        i = COEFFICIENTS.index("Cl")
+        tp, cl = table.t[train], Y[train, i]
+        order = np.argsort(tp, kind="stable")
+        k = np.clip(np.searchsorted(tp[order], self.t), 0, len(tp) - 1)
+        hit = tp[order][k] == self.t                 # the kept rows of the first fit take the learned target
+        self.Y[hit, i] = cl[order][k[hit]]
+        return Y[train]
+
+    def _air_roll_later(self, table: CoefficientTable, rows: np.ndarray, states) -> np.ndarray:
+        """``rows``' targets with Cl moved by the stored roll fit, the gust smoothed over the window's valid rows."""
+        from ..aero.gustfilter import air_roll_target_on_rows
+
+        if states is None or "p" not in states.data:
+            raise SysidError("air roll: the window's states are needed to move Cl's target")
+        context = np.asarray(table.valid, bool) & np.all(np.isfinite(table.X), axis=1)
+        Y, info = air_roll_target_on_rows(self._roll_fit, table, states, self.airframe, rows, context=context)
+        self.air_roll["rows_moved"] = self.air_roll.get("rows_moved", 0) + int(info["rows"].sum())
+        return Y[rows]
 
     def _refresh_hyper(self) -> None:
         """A light hyperparameter refresh of the GP (warm start, few steps; ``docs/live.md``)."""

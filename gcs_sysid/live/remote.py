@@ -84,6 +84,7 @@ def _status(learner) -> dict:
             "identifiable": dict(learner.identifiable), "confidence": learner.confidence(),
             "suggestions": [SuggestionText(str(s.reason)) for s in learner.suggestions[:5]],
             "has_model": model is not None, "rows_stored": len(rows) if rows is not None else 0,
+            "air_roll": dict(learner.air_roll),
             "pid": os.getpid(), "rss_mib": _rss_mib()}
 
 
@@ -205,7 +206,7 @@ class RemoteLearner:
     Holds a copy of the learner's status for the console and the report (the attributes the session
     reads from a ``Learner``: ``steps``, ``n_learned``, ``outputs``, ``notes``, ``timings``,
     ``control_sources``, ``coalesced``, ``refreshes_deferred``, ``coalesced_at``, ``identifiable``,
-    ``suggestions``, :meth:`confidence`); ``model`` is None until :meth:`finish` brings the learner back.
+    ``suggestions``, ``air_roll``, :meth:`confidence`); ``model`` is None until :meth:`finish` brings the learner back.
 
     Args:
         airframe: the airframe.
@@ -236,6 +237,7 @@ class RemoteLearner:
         self.coalesced_at: list = []
         self.identifiable: dict = {}
         self.suggestions: list = []
+        self.air_roll: dict = {}
         self._confidence: dict = {}
         self._extra_notes: list[str] = []
         self.queued = 0
@@ -270,7 +272,7 @@ class RemoteLearner:
 
     def _update(self, st: dict) -> None:
         for k in ("steps", "n_learned", "outputs", "timings", "control_sources", "coalesced", "refreshes_deferred",
-                  "coalesced_at", "identifiable", "suggestions", "has_model", "rows_stored", "rss_mib"):
+                  "coalesced_at", "identifiable", "suggestions", "has_model", "rows_stored", "rss_mib", "air_roll"):
             setattr(self, k, st[k])
         self.notes = st["notes"] + self._extra_notes
         self._confidence = st["confidence"]

@@ -38,6 +38,12 @@ def render_markdown(snap: dict) -> str:
     if "samples_learned" in snap:
         lines.append(f"- samples learned: {snap['samples_learned']} in {snap['steps']} steps; "
                      f"model: `{snap.get('model', 'none (too few samples)')}`")
+        ar = snap.get("air_roll") or {}
+        if ar.get("state", "off") != "off":
+            lines.append(f"- the air-rate pair (Cl's target at the air-relative roll rate, `--air-roll on`): "
+                         f"{ar['state']}" + (f"; {ar['rows_moved']} rows learned with a moved Cl"
+                                            if ar.get("rows_moved") is not None else "")
+                         + (f" ({ar['note']})" if ar.get("note") else ""))
         if snap.get("steps_coalesced") or snap.get("map_refreshes_deferred"):
             lines.append(f"- the learner fell behind: {snap.get('steps_coalesced', 0)} steps coalesced, "
                          f"{snap.get('map_refreshes_deferred', 0)} map refreshes deferred (to replay `raw.tlog` on the "

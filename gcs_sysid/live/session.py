@@ -340,6 +340,7 @@ class LiveSession:
                 "control_sources": dict(learner.control_sources), "steps_coalesced": learner.coalesced,
                 "map_refreshes_deferred": learner.refreshes_deferred,
                 "coalesced_at_us": list(learner.coalesced_at),
+                "air_roll": dict(getattr(learner, "air_roll", {})),
                 "learner_in": "worker process" if self._remote else "this process",
             })
         return snap
