@@ -199,6 +199,15 @@ PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per
 #: likelihood lands within a few per cent of JSBSim's slope there (docs/estimation.md, "The side-force slope by the
 #: gust model's likelihood").
 BETA_PROFILE = False
+#: Opt-in (default False; thirty-first session, i8-truereg; only with :data:`BETA_PROFILE`): the later passes keep the
+#: first pass's profiled ``CY_beta`` (the other side-force slopes refitted by least squares with it held) instead of
+#: refitting it by least squares on the aided sideslip. That refit is circular: the aided sideslip is built from the
+#: measured side force with the last pass's slope, so least squares on it returns about that slope plus the share of
+#: the gust the aided angle still misses, and the passes drift back towards least squares' steep slope (fokker50 light
+#: s1: profiled -0.480, least squares -0.538, after the passes -0.496; JSBSim's -0.445). A model learned on a sideslip
+#: read ``k`` times the true one has ``CY_beta`` and ``Cn_beta`` ``1 / k`` times JSBSim's and misses at the true
+#: sideslip (``docs/benchmarks.md``, "Thirty-first session, i8-truereg").
+BETA_PROFILE_HOLD = False
 #: ``CY_beta`` is searched between these multiples of least squares' slope; an optimum at either end keeps least
 #: squares. Only flatter (upper end 1): where the likelihood steepened least squares it was wrong on the roster (the
 #: jets, whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5
@@ -776,6 +785,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     nq = 2 if quadratic else 1
     fit = None
     floor_note = profile_note = ""
+    held_slope = None      # BETA_PROFILE_HOLD: the first pass's profiled slope, kept in the later passes
     keep: list[int] = []
     edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
@@ -830,6 +840,13 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                     return a_ls, s_ls, refit
         if not method.startswith(("2SLS", "given")):
             cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
+            if held_slope is not None and fit is not None:
+                # BETA_PROFILE_HOLD: the first pass's profiled slope kept (least squares on the aided angle is
+                # circular); the other columns refitted with it held, the slope's standard error least squares'
+                se0 = float(csr[0])
+                cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], held_slope, list(range(1, Ah.shape[1])))
+                csr[0] = se0
+                method = "OLS with the first pass's profiled slope held"
         floored = False
         if slope_floor is not None and fixed is None and fit is None and not sign * cr[0] >= abs(slope_floor):
             # errors in variables only attenuate the fitted slope (the kinematic angle's gust error), and the wing's
@@ -859,6 +876,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             if cr[0] != b_ls:
                 profile_note = (f"; first pass {names[1] if name == 'alpha' else 'CY_beta'} by the gust model's "
                                 f"likelihood {cr[0]:+.3f} (least squares {b_ls:+.3f})")
+                if BETA_PROFILE_HOLD:
+                    held_slope = float(cr[0])
+                    profile_note += ", held in the later passes"
         prof = ([names.index(k) - 1 for k in ALPHA_PROFILE_COLUMNS if k in names[2:]]
                 if name == "alpha" and fixed is None and not method.startswith("2SLS") else [])
         if prof:

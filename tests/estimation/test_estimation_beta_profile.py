@@ -50,3 +50,26 @@ def test_cy_beta_by_the_gust_likelihood_is_not_steep():
     # the filter-error estimate: within 10 % on average, and nearer than least squares on every record
     assert abs(np.mean(prof) / CY_BETA - 1) < 0.10
     assert np.all(np.abs(prof - CY_BETA) < np.abs(ls - CY_BETA))
+
+
+def test_the_held_profiled_slope_survives_the_later_passes(monkeypatch):
+    # BETA_PROFILE_HOLD (thirty-first session, i8-truereg): the later passes refit on the aided sideslip, built from
+    # the side force with the last slope (circular); with the option the first pass's profiled slope is the final one
+    import re
+
+    from gcs_sysid.estimation import airangles
+
+    kin, cy, others = _record(1)
+    use = np.ones(T, bool)
+    free = _axis("beta", DT, kin, cy, others, use, 3, -1.0, False, False, profile=True)[2]
+    monkeypatch.setattr(airangles, "BETA_PROFILE_HOLD", True)
+    held = _axis("beta", DT, kin, cy, others, use, 3, -1.0, False, False, profile=True)[2]
+    first = float(re.search(r"likelihood ([-+0-9.]+)", held.slope_method).group(1))
+    assert "held in the later passes" in held.slope_method
+    assert abs(held.coef[1] - first) < 5e-4      # the note rounds to 3 decimals
+    assert "held in the later passes" not in free.slope_method
+    # without the option the passes move the slope away from the first pass's (what the option stops)
+    first_free = float(re.search(r"likelihood ([-+0-9.]+)", free.slope_method).group(1))
+    assert abs(free.coef[1] - first_free) > 2e-3
+    # the rudder's slope is still refitted with the sideslip's held, and both fits aid the angle
+    assert np.isfinite(held.coef[2]) and held.used and free.used
