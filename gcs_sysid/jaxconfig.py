@@ -380,7 +380,8 @@ def prefetch_executables(name: str) -> int:
         path = _order_path(name)
         if path is None or jax.default_backend() != "cpu":
             return 0
-        names = [n for n in path.read_text().split() if _ORDER_NAME.match(n) and n not in _AHEAD and n not in _USED]
+        names = [n for n in dict.fromkeys(path.read_text().split())
+                 if _ORDER_NAME.match(n) and n not in _AHEAD and n not in _USED]
         if not names:
             return 0
         _executable_header("")          # the backend started here, not in the thread
@@ -394,7 +395,9 @@ def prefetch_executables(name: str) -> int:
         for job in jobs:
             job.run()
 
-    threading.Thread(target=run, name="gcs-sysid-executables", daemon=True).start()
+    # not a daemon: a process that ends while the thread is inside XLA's loader waits for it (a daemon thread stopped
+    # there at exit aborts the process: "FATAL: exception not rethrown"); the list bounds its work
+    threading.Thread(target=run, name="gcs-sysid-executables", daemon=False).start()
     return len(jobs)
 
 

@@ -231,3 +231,17 @@ def test_an_executable_not_yet_started_ahead_is_the_callers():
     late = _Ahead(Path("/nonexistent/y.jaxexe"))
     late.run()                                                     # the thread tried (and failed): nothing to load
     assert late.claim_or_wait() is True and late.result is None
+
+
+def test_listed_executables_are_queued_once_and_a_process_ending_while_they_load_exits_with_status_0(tmp_path):
+    cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
+    _exe_run(cache)
+    (path,) = (tmp_path / "jax" / "compiled").glob("*.jaxexe")
+    names = [f"{k:064x}.jaxexe" for k in range(1, 41)]             # forty copies: the thread is still loading at exit
+    for n in names:
+        path.with_name(n).write_bytes(path.read_bytes())
+    (tmp_path / "jax" / "compiled" / "t.order").write_text("\n".join(names * 2) + "\n")
+    code = ("from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64, prefetch_executables\n"
+            "enable_x64(); enable_compilation_cache()\n"
+            "print(prefetch_executables('t'))\n")
+    assert _child(code, cache).split()[-1] == "40"                 # listed twice, queued once; exit status 0
