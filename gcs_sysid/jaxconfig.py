@@ -403,7 +403,14 @@ def prefetch_executables(name: str) -> int:
 
 def record_executables(name: str) -> None:
     """Write the stored executables this process used so far, first use first, as ``name``'s list for the next
-    process's :func:`prefetch_executables` (atomically; unchanged lists are not rewritten; best effort)."""
+    process's :func:`prefetch_executables` (atomically; unchanged lists are not rewritten; best effort).
+
+    Args:
+        name: the caller's list (``"replay"``), letters, digits, ``-`` and ``_``.
+
+    Raises:
+        nothing: without a compilation cache, an executable used or a writable folder nothing is written.
+    """
     try:
         path = _order_path(name)
         if path is None or not _USED:
