@@ -145,9 +145,14 @@ def noise_correlation_factor(off: jax.Array) -> jax.Array:
 _constrain_global_jit = stored_jit(constrain_global)
 
 
-#: Adam's initial state (zero moments; it does not depend on the step size), built by one compiled
-#: call: in a fresh process every eager JAX operation first compiles a small program of its own.
-_adam_init = jax.jit(optax.adam(1.0).init)
+def _adam_init_body(raw):
+    """Adam's initial state for ``raw`` (zero moments, step count 0; it does not depend on the step size)."""
+    return optax.adam(1.0).init(raw)
+
+
+#: Adam's initial state built by one compiled call (in a fresh process every eager JAX operation first compiles
+#: a small program of its own), kept on disk as a stored program (:func:`gcs_sysid.jaxconfig.stored_jit`).
+_adam_init = stored_jit(_adam_init_body)
 
 
 def _global_loss(raw, fixed, Xs, Ys, mask=None):

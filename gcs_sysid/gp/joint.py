@@ -136,8 +136,9 @@ def couple_only(params: GlobalParams, coupled, noise_coupled=None) -> GlobalPara
     R = None
     if params.noise_chol is not None and noise_coupled.any():
         Rn = np.asarray(params.noise_chol)
-        R = jnp.asarray(np.linalg.cholesky((Rn @ Rn.T) * (np.outer(noise_coupled, noise_coupled) | eye)))
-    return replace(params, A=jnp.asarray(A[0]), lmc_A=None if params.lmc_A is None else jnp.asarray(A[1:]),
+        R = jax.device_put(np.linalg.cholesky((Rn @ Rn.T) * (np.outer(noise_coupled, noise_coupled) | eye)))
+    # device_put, not jnp.asarray: the same array without an identity program compiled for each shape
+    return replace(params, A=jax.device_put(A[0]), lmc_A=None if params.lmc_A is None else jax.device_put(A[1:]),
                    noise_chol=R)
 
 

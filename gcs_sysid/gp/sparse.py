@@ -58,14 +58,38 @@ from dataclasses import dataclass
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax.scipy.linalg import cho_solve, solve_triangular
 
+from ..jaxconfig import stored_jit
 from .kernels import ARDSquaredExponential
 
 __all__ = ["GlobalParams", "Stats", "GlobalPosterior", "stats_of", "add_stats", "elbo", "logdet_quad", "posterior",
            "mean_global_chunk", "predict_global_chunk", "design", "features", "prior_scales"]
 
 _LOG2PI = math.log(2.0 * math.pi)
+
+
+def _concrete(*arrays) -> bool:
+    """Whether every array given (None skipped) holds values, none is a tracer: :class:`GlobalParams`' derived
+    quantities are then formed on the host (stacking, a minimum, a diagonal: exact, the same values) or by a stored
+    program (:func:`gcs_sysid.jaxconfig.stored_jit`), so that an eager JAX operation does not trace, lower and look
+    up a program of its own in each process (``docs/benchmarks.md``, "Thirty-first session, speed31")."""
+    return not any(isinstance(a, jax.core.Tracer) for a in arrays if a is not None)
+
+
+def _coregionalisation_body(F: jax.Array, G: jax.Array) -> jax.Array:
+    """``sum_j F_j G_j^T``, ``(P, Q)``, of factors ``F (J, P, R)``, ``G (J, Q, R)`` (:attr:`GlobalParams.B`)."""
+    return jnp.einsum("jpr,jqr->pq", F, G)
+
+
+def _coregionalisation_parts_body(F: jax.Array, G: jax.Array) -> jax.Array:
+    """``F_j G_j^T`` per ``j``, ``(J, P, Q)`` (:attr:`GlobalParams.B_parts`)."""
+    return jnp.einsum("jpr,jqr->jpq", F, G)
+
+
+_coregionalisation = stored_jit(_coregionalisation_body)
+_coregionalisation_parts = stored_jit(_coregionalisation_parts_body)
 
 
 @jax.tree_util.register_dataclass
@@ -109,14 +133,23 @@ class GlobalParams:
 
     @property
     def lengthscales(self) -> jax.Array:
-        """Length-scales of every latent kernel, ``(J, D)`` (row 0: ``lengthscale``)."""
+        """Length-scales of every latent kernel, ``(J, D)`` (row 0: ``lengthscale``); a NumPy array when the
+        parameters hold values (:func:`_concrete`: stacking copies, no program is compiled for it)."""
+        if _concrete(self.lengthscale, self.lmc_lengthscale):
+            first = np.asarray(self.lengthscale)[None, :]
+            return first if self.lmc_lengthscale is None else np.concatenate(
+                [first, np.asarray(self.lmc_lengthscale)], axis=0)
         if self.lmc_lengthscale is None:
             return self.lengthscale[None, :]
         return jnp.concatenate([self.lengthscale[None, :], self.lmc_lengthscale], axis=0)
 
     @property
     def factors(self) -> jax.Array:
-        """Coregionalisation factors of every latent kernel, ``(J, P, R)`` (``[0]``: ``A``)."""
+        """Coregionalisation factors of every latent kernel, ``(J, P, R)`` (``[0]``: ``A``); a NumPy array when
+        the parameters hold values (:func:`_concrete`)."""
+        if _concrete(self.A, self.lmc_A):
+            first = np.asarray(self.A)[None]
+            return first if self.lmc_A is None else np.concatenate([first, np.asarray(self.lmc_A)], axis=0)
         if self.lmc_A is None:
             return self.A[None]
         return jnp.concatenate([self.A[None], self.lmc_A], axis=0)
@@ -124,25 +157,31 @@ class GlobalParams:
     @property
     def B(self) -> jax.Array:
         """Coregionalisation matrix ``(P, P)`` of the latent part at one input, ``sum_j B_j``
-        (``cov(f(x), f(x)) = sum_j B_j k_j(x, x)``, ``k_j(x, x) = 1``)."""
+        (``cov(f(x), f(x)) = sum_j B_j k_j(x, x)``, ``k_j(x, x) = 1``). With values (:func:`_concrete`) the same
+        einsum runs as a stored program (:func:`gcs_sysid.jaxconfig.stored_jit`: not traced and lowered again in
+        every process)."""
         F = self.factors
-        return jnp.einsum("jpr,jqr->pq", F, F)
+        return _coregionalisation(F, F) if isinstance(F, np.ndarray) else _coregionalisation_body(F, F)
 
     @property
     def B_parts(self) -> jax.Array:
-        """Per-kernel coregionalisation matrices ``B_j = A_j A_j^T``, ``(J, P, P)``."""
+        """Per-kernel coregionalisation matrices ``B_j = A_j A_j^T``, ``(J, P, P)`` (a stored program with values,
+        as :attr:`B`)."""
         F = self.factors
-        return jnp.einsum("jpr,jqr->jpq", F, F)
+        return _coregionalisation_parts(F, F) if isinstance(F, np.ndarray) else _coregionalisation_parts_body(F, F)
 
     def metric_lengthscale(self) -> jax.Array:
         """``(D,)`` the shortest length-scale of any kernel per input (for distances: inducing-point
-        selection, the row store's grid, the local layer's neighbours); ``lengthscale`` for ICM."""
-        return jnp.min(self.lengthscales, axis=0)
+        selection, the row store's grid, the local layer's neighbours); ``lengthscale`` for ICM. A NumPy array
+        when the parameters hold values (:func:`_concrete`; a minimum is exact either way)."""
+        ls = self.lengthscales
+        return np.min(ls, axis=0) if isinstance(ls, np.ndarray) else jnp.min(ls, axis=0)
 
     def noise_cov(self) -> jax.Array:
-        """Noise covariance ``Sigma (P, P)`` (diagonal ``noise`` when ``noise_chol`` is None)."""
+        """Noise covariance ``Sigma (P, P)`` (diagonal ``noise`` when ``noise_chol`` is None; then a NumPy array
+        when the parameters hold values, :func:`_concrete`)."""
         if self.noise_chol is None:
-            return jnp.diag(self.noise)
+            return np.diag(np.asarray(self.noise)) if _concrete(self.noise) else jnp.diag(self.noise)
         s = jnp.sqrt(self.noise)
         return (s[:, None] * self.noise_chol) @ (s[:, None] * self.noise_chol).T
 
@@ -183,7 +222,7 @@ class Stats:
 
     def rows(self) -> float:
         """Rows conditioned on (per-output form: the largest count of one output's entries)."""
-        return float(jnp.max(self.n))
+        return float(np.max(np.asarray(self.n)) if _concrete(self.n) else jnp.max(self.n))
 
 
 @jax.tree_util.register_dataclass

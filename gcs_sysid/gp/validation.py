@@ -83,6 +83,11 @@ def scale_latent(params: GlobalParams, s) -> GlobalParams:
     Rows of every coregionalisation factor are scaled (``A_j -> diag(s) A_j``, so
     ``B_j -> S B_j S``); a lower-triangular factor stays lower-triangular.
     """
+    if not isinstance(params.A, jax.core.Tracer) and not isinstance(params.lmc_A, jax.core.Tracer):
+        # values: the products on the host (one rounding each, as XLA's), moved back; no eager program compiled
+        s = np.asarray(s, np.asarray(params.A).dtype)
+        lmc = None if params.lmc_A is None else jax.device_put(np.asarray(params.lmc_A) * s[None, :, None])
+        return replace(params, A=jax.device_put(np.asarray(params.A) * s[:, None]), lmc_A=lmc)
     s = jnp.asarray(s, params.A.dtype)
     lmc = None if params.lmc_A is None else params.lmc_A * s[None, :, None]
     return replace(params, A=params.A * s[:, None], lmc_A=lmc)
@@ -247,7 +252,7 @@ def gate_local(local: LocalParams, Xs: np.ndarray, resid: np.ndarray, metric: np
     ratio = with_l / np.maximum(without, 1e-300)
     keep = ratio < LOCAL_MARGIN
     amp = np.where(keep, np.asarray(local.amp), np.asarray(local.amp) * LOCAL_OFF)
-    return replace(local, amp=jnp.asarray(amp)), keep, ratio
+    return replace(local, amp=jax.device_put(amp)), keep, ratio   # device_put: jnp.asarray compiles a copy
 
 
 @dataclass(frozen=True)
