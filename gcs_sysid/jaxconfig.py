@@ -22,11 +22,10 @@ running). :func:`limit_blas_threads` sets the OpenBLAS thread count at run time.
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 
 __all__ = ["enable_x64", "enable_compilation_cache", "default_cache_dir", "limit_blas_threads", "stored_program",
-           "stored_jit", "prefetch_executables", "record_executables"]
+           "stored_jit"]
 
 #: Environment variable that overrides the cache directory; set it to ``"off"`` to disable the cache.
 CACHE_ENV = "GCS_SYSID_JAX_CACHE"
@@ -263,167 +262,23 @@ def _load_executable(cache: str | os.PathLike, key: str):
         ``(compiled, path)``: the :class:`jax.stages.Compiled` and its file; None when there is no file or it cannot
         be used (no error is raised: the caller compiles as before).
     """
-    try:
-        header = _executable_header(key)
-        path = _executable_path(cache, header)
-        ahead = _AHEAD.pop(path.name, None)
-        if ahead is not None and ahead.claim_or_wait() and ahead.result is not None:
-            _USED.append(path.name)     # loaded by prefetch_executables' thread (the same file, the same checks)
-            return ahead.result, path
-        if not path.exists():
-            return None
-        compiled = _read_executable(path, header)
-        if compiled is not None:
-            _USED.append(path.name)
-        return None if compiled is None else (compiled, path)
-    except Exception:
-        return None
-
-
-def _read_executable(path: Path, header: dict | None = None):
-    """The executable in ``path`` (:func:`_store_executable`'s file), loaded, if its header equals ``header`` (None:
-    this process's header for the key the file names, :func:`_executable_header`) and its payload's SHA-256
-    matches; else None. Raises what reading or loading raises."""
     import hashlib
     import pickle
 
-    from jax.experimental import serialize_executable
-
-    stored, digest, payload, in_tree, out_tree = pickle.loads(path.read_bytes())
-    if header is None:
-        header = _executable_header(stored["key"])
-    if stored != header or hashlib.sha256(payload).hexdigest() != digest:
-        return None
-    _ensure_lapack()
-    return serialize_executable.deserialize_and_load(payload, in_tree, out_tree)
-
-
-class _Ahead:
-    """One executable file queued by :func:`prefetch_executables`: its thread loads it unless the caller claimed it
-    first (then :func:`_load_executable` loads it itself and the thread skips it)."""
-
-    __slots__ = ("path", "result", "_lock", "_started", "_claimed", "_done")
-
-    def __init__(self, path: Path):
-        import threading
-
-        self.path, self.result = path, None
-        self._lock, self._done = threading.Lock(), threading.Event()
-        self._started = self._claimed = False
-
-    def claim_or_wait(self) -> bool:
-        """True once the thread's load is finished (``result`` set, or None when it failed); False when the thread
-        had not started it: it is the caller's to load now."""
-        with self._lock:
-            if not self._started:
-                self._claimed = True
-                return False
-        self._done.wait()
-        return True
-
-    def run(self) -> None:
-        with self._lock:
-            if self._claimed:
-                return
-            self._started = True
-        try:
-            self.result = _read_executable(self.path)
-        except Exception:
-            self.result = None
-        finally:
-            self._done.set()
-
-
-#: Executable files queued by :func:`prefetch_executables`, by file name, until :func:`_load_executable` takes them.
-_AHEAD: dict[str, _Ahead] = {}
-#: The executable files this process loaded or wrote, first use first (:func:`record_executables`).
-_USED: list[str] = []
-_ORDER_NAME = re.compile(r"^[0-9a-f]{64}\.jaxexe$")
-
-
-def _order_path(name: str) -> Path | None:
-    """``<cache>/compiled/<name>.order`` (None without a compilation cache or for a name with other characters
-    than letters, digits, ``-`` and ``_``)."""
-    import jax
-
-    cache = jax.config.jax_compilation_cache_dir
-    if not cache or not re.fullmatch(r"[A-Za-z0-9_-]+", name):
-        return None
-    return Path(cache) / "compiled" / f"{name}.order"
-
-
-def prefetch_executables(name: str) -> int:
-    """Start loading, in a background thread, the stored executables that the last process which called
-    :func:`record_executables` with ``name`` used, in the order it first used them.
-
-    Loading a stored executable (:func:`_load_executable`) takes about 15 ms of XLA's own threads per program, and
-    each is loaded on its program's first call: on the replay's critical path, where the main process otherwise
-    waits for the worker or for XLA. A program whose file this thread has loaded is taken from it (the same file,
-    header and SHA-256 checks, so the same executable and the same results); one it has not started is loaded by the
-    caller as before; a listed file that this run does not use (another flight's shapes, a changed package) costs
-    its load and nothing else. Only on the CPU backend with the compilation cache on.
-
-    Args:
-        name: the caller's list (``"replay"``), letters, digits, ``-`` and ``_``.
-
-    Returns:
-        The number of files queued (0: no list, no cache, another backend, or nothing new).
-
-    Raises:
-        nothing: a list or file that cannot be read or loaded is skipped.
-    """
-    import threading
-
-    import jax
-
     try:
-        path = _order_path(name)
-        if path is None or jax.default_backend() != "cpu":
-            return 0
-        names = [n for n in dict.fromkeys(path.read_text().split())
-                 if _ORDER_NAME.match(n) and n not in _AHEAD and n not in _USED]
-        if not names:
-            return 0
-        _executable_header("")          # the backend started here, not in the thread
+        header = _executable_header(key)
+        path = _executable_path(cache, header)
+        if not path.exists():
+            return None
+        from jax.experimental import serialize_executable
+
+        stored, digest, payload, in_tree, out_tree = pickle.loads(path.read_bytes())
+        if stored != header or hashlib.sha256(payload).hexdigest() != digest:
+            return None
         _ensure_lapack()
+        return serialize_executable.deserialize_and_load(payload, in_tree, out_tree), path
     except Exception:
-        return 0
-    jobs = [_Ahead(path.parent / n) for n in names]
-    _AHEAD.update((j.path.name, j) for j in jobs)
-
-    def run() -> None:
-        for job in jobs:
-            job.run()
-
-    # not a daemon: a process that ends while the thread is inside XLA's loader waits for it (a daemon thread stopped
-    # there at exit aborts the process: "FATAL: exception not rethrown"); the list bounds its work
-    threading.Thread(target=run, name="gcs-sysid-executables", daemon=False).start()
-    return len(jobs)
-
-
-def record_executables(name: str) -> None:
-    """Write the stored executables this process used so far, first use first, as ``name``'s list for the next
-    process's :func:`prefetch_executables` (atomically; unchanged lists are not rewritten; best effort).
-
-    Args:
-        name: the caller's list (``"replay"``), letters, digits, ``-`` and ``_``.
-
-    Raises:
-        nothing: without a compilation cache, an executable used or a writable folder nothing is written.
-    """
-    try:
-        path = _order_path(name)
-        if path is None or not _USED:
-            return
-        text = "\n".join(dict.fromkeys(_USED)) + "\n"
-        if path.exists() and path.read_text() == text:
-            return
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(text)
-        os.replace(tmp, path)
-    except Exception:
-        pass
+        return None
 
 
 _CACHE_HITS = [0]          # persistent-cache hits seen by :func:`_count_hit` (registered once)
@@ -477,7 +332,6 @@ def _store_executable(cache: str | os.PathLike, key: str, program, args: tuple):
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_bytes(blob)
         os.replace(tmp, path)
-        _USED.append(path.name)
     except Exception:
         pass
     return compiled

@@ -32,10 +32,6 @@ __all__ = ["ReplayOptions", "REPLAY_OUTPUTS", "check_replay", "run_replay", "hel
 REPLAY_OUTPUTS = ("report.html", "summary.md", "coefficients.csv", "suggestions.json", "result", "model.npz",
                   "model.json")
 
-#: The list of stored executables a replay records for the next one to load ahead
-#: (:func:`gcs_sysid.jaxconfig.prefetch_executables`).
-REPLAY_EXECUTABLES = "replay"
-
 #: Fewest valid rows the GP is fitted on.
 MIN_TRAIN_ROWS = 50
 #: Held-out error (%) above which the report warns that a coefficient's model does not generalise.
@@ -409,19 +405,14 @@ def _load_stages() -> None:
 
 
 def _load_model_stages() -> None:
-    """Import the modules of the stages after estimation (JAX, optax: about 0.6 CPU s), set up JAX (64-bit, the
-    compilation cache; idempotent) and start loading the GP's stored executables that the last replay used
-    (:func:`gcs_sysid.jaxconfig.prefetch_executables`, a background thread). Run while the worker smooths the
-    specific force (the estimation stage's wait, :func:`gcs_sysid.estimation.estimate_states`' ``meanwhile``), and
-    before the coefficients in any case."""
-    from .jaxconfig import enable_compilation_cache, enable_x64, prefetch_executables
+    """Import the modules of the stages after estimation (JAX, optax: about 0.6 CPU s) and set up JAX
+    (64-bit; idempotent). Run while the worker smooths the specific force (the estimation stage's wait,
+    :func:`gcs_sysid.estimation.estimate_states`' ``meanwhile``), and before the coefficients in any case."""
+    from .jaxconfig import enable_x64
 
     enable_x64()
     for m in ("gcs_sysid.gp", "gcs_sysid.envelope", "gcs_sysid.maneuvers", "gcs_sysid.report"):
         importlib.import_module(m)
-    # compiled GP programs are cached on disk (only the first run on a machine compiles)
-    if enable_compilation_cache() is not None:
-        prefetch_executables(REPLAY_EXECUTABLES)
 
 
 def _progress_bar(enabled: bool):
@@ -662,9 +653,6 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     notes.append(f"no manoeuvre suggestions: {e}")
             if suggestions:
                 draw("suggestions", "suggestions_figure", list(suggestions))
-            from .jaxconfig import record_executables
-
-            record_executables(REPLAY_EXECUTABLES)     # for the next replay's prefetch_executables
         metrics: dict[str, dict[str, float]] = {}
         for i, name in enumerate(COEFFICIENTS):
             y = table.Y[:, i]

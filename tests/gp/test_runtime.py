@@ -130,22 +130,11 @@ def solve(a, b):                                   # LAPACK custom calls (Choles
     l = jnp.linalg.cholesky(a @ a.T + 3.0 * jnp.eye(a.shape[0]))
     return jax.scipy.linalg.solve_triangular(l, b, lower=True), jnp.tanh(b).sum()
 
-import os
-ahead = 0
-if os.environ.get("PREFETCH"):                     # load the listed executables ahead, then forbid loading here
-    ahead = jc.prefetch_executables("t")
-    for job in list(jc._AHEAD.values()):
-        job._done.wait(60)
-    def refuse(*a, **k):
-        raise AssertionError("loaded by the caller")
-    jc._read_executable = refuse
 rng = np.random.default_rng(0)
 x, s = stored_jit(solve)(rng.standard_normal((5, 5)), rng.standard_normal((5, 2)))
-jc.record_executables("t")
 print(json.dumps({"bits": [float(v).hex() for v in np.ravel(x)] + [float(s).hex()],
                   "loaded": sum(isinstance(p, jc._Loaded) and p._call is p._compiled for p in jc._EXECUTABLES.values()),
-                  "exported": sum(p is not None for p in jc._PROGRAMS.values()), "ahead": ahead,
-                  "left": sorted(jc._AHEAD)}))
+                  "exported": sum(p is not None for p in jc._PROGRAMS.values())}))
 """
 
 
@@ -202,46 +191,3 @@ def test_loaded_executable_that_fails_on_its_first_call_gives_way_and_is_removed
     assert loaded(2, 3) == 5 and loaded(1, 1) == 2 and not path.exists()
     working = _Loaded(lambda a: a * 2, lambda: None, tmp_path / "y.jaxexe")
     assert working(4) == 8 and working._call is working._compiled
-
-
-def test_recorded_executables_are_loaded_ahead_by_the_next_process_and_give_the_same_bits(tmp_path):
-    cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
-    first = _exe_run(cache)                                       # compiles, stores and records its executable
-    (path,) = (tmp_path / "jax" / "compiled").glob("*.jaxexe")
-    order = tmp_path / "jax" / "compiled" / "t.order"
-    assert order.read_text().split() == [path.name]
-    # the list also names a file this run does not use and lines that are no executable's name: the first is
-    # loaded and left unused, the others ignored
-    other = path.with_name("0" * 64 + ".jaxexe")
-    other.write_bytes(path.read_bytes())
-    order.write_text(f"{other.name}\n../{path.name}\nnot-a-file\n{path.name}\n")
-    again = _exe_run(dict(cache, PREFETCH="1"))                  # loading in this process raises
-    assert again["ahead"] == 2 and again["left"] == [other.name]
-    assert again["loaded"] == 1 and again["exported"] == 0 and again["bits"] == first["bits"]
-    assert order.read_text().split() == [path.name]               # what this run used, rewritten
-
-
-def test_an_executable_not_yet_started_ahead_is_the_callers():
-    from gcs_sysid.jaxconfig import _Ahead
-
-    job = _Ahead(Path("/nonexistent/x.jaxexe"))
-    assert job.claim_or_wait() is False                            # the caller loads it
-    job.run()                                                      # the thread then skips it
-    assert job.result is None and not job._done.is_set()
-    late = _Ahead(Path("/nonexistent/y.jaxexe"))
-    late.run()                                                     # the thread tried (and failed): nothing to load
-    assert late.claim_or_wait() is True and late.result is None
-
-
-def test_listed_executables_are_queued_once_and_a_process_ending_while_they_load_exits_with_status_0(tmp_path):
-    cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
-    _exe_run(cache)
-    (path,) = (tmp_path / "jax" / "compiled").glob("*.jaxexe")
-    names = [f"{k:064x}.jaxexe" for k in range(1, 41)]             # forty copies: the thread is still loading at exit
-    for n in names:
-        path.with_name(n).write_bytes(path.read_bytes())
-    (tmp_path / "jax" / "compiled" / "t.order").write_text("\n".join(names * 2) + "\n")
-    code = ("from gcs_sysid.jaxconfig import enable_compilation_cache, enable_x64, prefetch_executables\n"
-            "enable_x64(); enable_compilation_cache()\n"
-            "print(prefetch_executables('t'))\n")
-    assert _child(code, cache).split()[-1] == "40"                 # listed twice, queued once; exit status 0
