@@ -638,6 +638,18 @@ def air_roll_fit(table, states, airframe, train: np.ndarray) -> RollGustFit | st
     return why if G is None else G
 
 
+def _cl_at_air_rate(Y: np.ndarray, Cl_p: float, g: np.ndarray, use: np.ndarray):
+    """``Y`` ``(T, 6)`` copied with Cl moved to the air-relative roll rate on ``use`` (``Cl + Cl_p p_hat_g``; the
+    output model of :func:`air_roll_target`). Returns the copy, ``p_hat_g`` ``(T,)`` zeroed off ``use``, and the
+    correction's SD over ``use`` (Cl units; 0 when no row is used)."""
+    g = np.where(use, g, 0.0)
+    i = COEFFICIENTS.index("Cl")
+    Y = np.array(Y, float, copy=True)
+    corr = Cl_p * g
+    Y[:, i] = Y[:, i] + corr
+    return Y, g, (float(np.std(corr[use])) if use.any() else 0.0)
+
+
 def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit | str | None = None):
     """The measured coefficients with the training rows' Cl at the air-relative roll rate: Cl less the rolling
     gust's moment of the roll fit, ``Cl + Cl_p p_hat_g`` (``p_hat_g`` smoothed on the training rows), every other
@@ -684,12 +696,7 @@ def air_roll_target(table, states, airframe, train: np.ndarray, fit: RollGustFit
     if isinstance(fit, str):
         return table.Y, {"note": fit.replace("gust filter", "Cl's air-rate training target")}
     use = rows & np.asarray(fit.used, bool) & np.isfinite(fit.g)
-    g = np.where(use, fit.g, 0.0)
-    i = COEFFICIENTS.index("Cl")
-    Y = np.array(table.Y, float, copy=True)
-    corr = fit.Cl_p * g
-    Y[:, i] = Y[:, i] + corr
-    sd = float(np.std(corr[use])) if use.any() else 0.0
+    Y, g, sd = _cl_at_air_rate(table.Y, fit.Cl_p, fit.g, use)
     note = (f"Cl's training target at the air-relative roll rate: Cl + Cl_p p_hat_g on {int(use.sum())} training rows "
             f"(Cl_p {fit.Cl_p:.3g}, the correction's SD {sd:.3g}; " + fit.notes[0] + ")")
     return Y, {"Cl_p": float(fit.Cl_p), "g": g, "rows": use, "sd": sd, "note": note}
@@ -750,12 +757,7 @@ def air_roll_target_on_rows(fit, table, states, airframe, rows: np.ndarray, cont
                              context & np.asarray(table.valid, bool), airframe.Ixx, airframe.S, airframe.b,
                              mode="smoothed")
     use = rows & (g != 0.0) & np.isfinite(g)      # outside the smoothed runs the estimate is the prior mean, 0
-    g = np.where(use, g, 0.0)
-    i = COEFFICIENTS.index("Cl")
-    Y = np.array(table.Y, float, copy=True)
-    corr = fit.Cl_p * g
-    Y[:, i] = Y[:, i] + corr
-    sd = float(np.std(corr[use])) if use.any() else 0.0
+    Y, g, sd = _cl_at_air_rate(table.Y, fit.Cl_p, g, use)
     note = (f"Cl's training target at the air-relative roll rate: Cl + Cl_p p_hat_g on {int(use.sum())} rows, the "
             f"gust smoothed with the fixed roll fit (Cl_p {fit.Cl_p:.3g}, the correction's SD {sd:.3g})")
     return Y, {"Cl_p": float(fit.Cl_p), "g": g, "rows": use, "sd": sd, "note": note}
