@@ -47,7 +47,7 @@ from jax.scipy.linalg import cho_solve
 
 from .batching import _add_jit, global_stats, local_predict
 from .local import LocalParams, LocalStore
-from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _selectors, design, features
+from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _concrete, _selectors, design, features
 
 __all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "SHARED_NEIGHBOURS", "block_folds", "scale_latent",
            "gate_global", "gate_local", "gate_mean_only",
@@ -83,7 +83,7 @@ def scale_latent(params: GlobalParams, s) -> GlobalParams:
     Rows of every coregionalisation factor are scaled (``A_j -> diag(s) A_j``, so
     ``B_j -> S B_j S``); a lower-triangular factor stays lower-triangular.
     """
-    if not isinstance(params.A, jax.core.Tracer) and not isinstance(params.lmc_A, jax.core.Tracer):
+    if _concrete(params.A, params.lmc_A):
         # values: the products on the host (one rounding each, as XLA's), moved back; no eager program compiled
         s = np.asarray(s, np.asarray(params.A).dtype)
         lmc = None if params.lmc_A is None else jax.device_put(np.asarray(params.lmc_A) * s[None, :, None])
