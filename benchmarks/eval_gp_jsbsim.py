@@ -146,6 +146,7 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     from benchmarks.jsbsim_harness import FlightConfig, load_truth, make_flight
     from gcs_sysid.airframe import load_airframe
     from gcs_sysid.diagnose import run_fit
+    from gcs_sysid.estimation import airangles
     from gcs_sysid.pipeline import ReplayOptions, run_replay
 
     name = f"{aircraft}-{seed}-{turbulence}-{aoa}"
@@ -159,7 +160,8 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
     t_cut = float(tab.t[held & tab.valid][0])
-    ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut)
+    ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut,
+                          profile_beta=airangles.BETA_PROFILE)      # the replay's sideslip estimator
     air = air_rate_arrays(res, load_airframe(files.airframe), ls_model)
     air["Xt_air"] = true_air_regressors(aircraft, truth, tab.t, Xt)
     out = cache / f"{name}.npz"

@@ -385,8 +385,12 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
         row["band_terms"] = band_terms(model, Xg[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
     t_cut = float(tab.t[h][0])
+    # the LS line on the replay's own sideslip estimator (the two models are scored at the replay's regressors;
+    # `gcs-sysid fit` alone keeps least squares' CY_beta by default, gcs_sysid.diagnose.run.BETA_PROFILE)
+    from gcs_sysid.estimation import airangles as _aa
+
     ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
-                          gust_rates=gust_rates)
+                          gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     from gcs_sysid.aero.gustfilter import AIR_ROLL_TRAIN, HELDOUT_AIR_ROLL
 
@@ -681,8 +685,9 @@ def main(argv=None) -> int:
                          "INSTRUMENTED_BETA), or 2SLS where the effective-sample first-stage F passes (f: "
                          "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
     ap.add_argument("--beta-profile", default=None, choices=("on", "off"),
-                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood (gcs_sysid."
-                         "estimation.airangles.BETA_PROFILE; default: the package's default, off)")
+                    help="CY_beta of the replay's sideslip aiding by the gust model's likelihood, held in the later "
+                         "passes (gcs_sysid.estimation.airangles.BETA_PROFILE; default: the package's, on; the LS "
+                         "line is fitted with the same estimator)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
                     help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."

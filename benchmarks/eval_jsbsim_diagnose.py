@@ -644,8 +644,9 @@ def main(argv=None) -> int:
                         "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
                         "package's, off)")
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
-                   help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood (gcs_sysid."
-                        "estimation.airangles.BETA_PROFILE; as eval_jsbsim's option; default: the package's, off)")
+                   help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
+                        "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
+                        "package's, off: the replay's estimator, gcs_sysid.estimation.airangles.BETA_PROFILE, is on)")
     p.add_argument("--library-control-trim", default=None, choices=("on", "off"),
                    help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
                         "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
@@ -661,6 +662,10 @@ def main(argv=None) -> int:
     from benchmarks.eval_jsbsim import apply_aiding_options
 
     apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile
+    if a.beta_profile is not None:      # the diagnosis loads its flights with its own switch (load_measurements)
+        from gcs_sysid.diagnose import run as _dr
+
+        _dr.BETA_PROFILE = a.beta_profile == "on"
     if a.alpha_level is not None:
         from gcs_sysid.diagnose import run as _dr
 

@@ -106,7 +106,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     from gcs_sysid.aero import compute_coefficients
     from gcs_sysid.airframe import load_airframe
     from gcs_sysid.diagnose import run_fit
-    from gcs_sysid.estimation import estimate_states
+    from gcs_sysid.estimation import airangles, estimate_states
     from gcs_sysid.pipeline import held_out_mask
     from gcs_sysid.telemetry import read_log
 
@@ -127,7 +127,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
         if aero_reads_air_rates(aircraft)[ax]:
             Xt_air[:, 2 + j] = np.interp(tab.t, truth.t, truth.fields[f"{ax}_aero"]) * cst[ref] / (2 * Xt[:, 9])
     h = held & tab.valid & np.isfinite(Yt).all(1) & np.all(np.isfinite(tab.X), axis=1)
-    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-livefit.toml", t_to=t_cut)
+    ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-livefit.toml", t_to=t_cut,
+                          profile_beta=airangles.BETA_PROFILE)      # the learner's sideslip estimator
     ls = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     t0 = time.perf_counter()
     steps = record_steps(files.tlog, af)

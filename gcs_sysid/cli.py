@@ -116,6 +116,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "with a note in the model's header and <out>.fit.json, where the roll fit finds no gust): "
                         "'off' the default (the measured Cl at the gyro's rate), 'on' (docs/estimation.md, "
                         "'Where the pair applies')")
+    f.add_argument("--beta-profile", default="off", choices=("on", "off"),
+                   help="the aided sideslip's CY_beta by the gust model's likelihood, held in the later passes (the "
+                        "replay's estimator): 'off' the default (least squares, as the diagnosis loads its flights), "
+                        "'on' (docs/estimation.md, 'The side-force slope by the gust model's likelihood')")
     _window_args(f)
 
     d = sub.add_parser("diagnose", help="compare the simulation model with measured data, name the cause")
@@ -261,7 +265,7 @@ def _cmd_fit(a: argparse.Namespace) -> int:
 
     _stated_lift_level(a)
     run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates,
-            air_roll_train=a.air_roll == "on")
+            air_roll_train=a.air_roll == "on", profile_beta=a.beta_profile == "on")
     print(f"wrote {a.out}")
     return 0
 

@@ -72,6 +72,15 @@ ALPHA_LEVEL: str | None = None
 #: "Twenty-fifth session, i9-airroll".
 AIR_ROLL_RATE = "off"
 
+#: The sideslip aiding's ``CY_beta`` estimator for every flight the diagnosis and ``fit`` load
+#: (:func:`load_measurements`, and the pitot-bias re-run of :mod:`gcs_sysid.diagnose.pitot`): False, least squares
+#: (the estimator issue 9's roster counts were measured with); True, the gust model's likelihood with the slope held
+#: (:data:`gcs_sysid.estimation.airangles.BETA_PROFILE` and ``BETA_PROFILE_HOLD``, the replay's default since the
+#: thirty-second session). Off here: the diagnosis compares flights through their aided sideslips, issue 9's counts
+#: with the profile are not measured, and the twenty-fifth session's run of the profile alone lost the s23's
+#: ``CY:scale`` (docs/benchmarks.md, "Twenty-fifth session, i8-beta" and "Thirty-second session, lead").
+BETA_PROFILE = False
+
 
 def air_roll_for(role: str, mode: str | None = None) -> bool:
     """Whether a flight of ``role`` is loaded at the air-relative roll rate under ``mode`` (None: :data:`AIR_ROLL_RATE`).
@@ -115,7 +124,8 @@ def shared_angle_models(fits: dict | None) -> dict | None:
 
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
                       progress=None, notify=None, gust_rates: str | None = None,
-                      angle_models: dict | None = None, air_roll: bool = False) -> Measurements:
+                      angle_models: dict | None = None, air_roll: bool = False,
+                      profile_beta: bool | None = None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
@@ -128,6 +138,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
             (:func:`gcs_sysid.estimation.estimate_states`). None: own.
         air_roll: the table's ``p_hat`` less the flight's own smoothed rolling gust
             (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`; :func:`air_roll_for` says which flights).
+        profile_beta: the sideslip aiding's ``CY_beta`` estimator (``estimate_states(profile_beta=)``); None:
+            :data:`BETA_PROFILE` as it stands at the call (least squares).
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
@@ -164,7 +176,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         # flight (tests/jsbsim/test_effects_diagnose.py; docs/estimation.md, "Moderate turbulence")
         states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
                                  if progress is not None else None, helper=helper, angle_models=angle_models,
-                                 turbulence_state=False)
+                                 turbulence_state=False,
+                                 profile_beta=BETA_PROFILE if profile_beta is None else bool(profile_beta))
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
@@ -177,7 +190,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
 
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
-            progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool = False):
+            progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool = False,
+            profile_beta: bool | None = None):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
     Also writes ``<out>.fit.json`` with the per-coefficient statistics (and the damage found in the
@@ -191,6 +205,9 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             model's ``Cl`` terms read the air-relative roll rate; every other coefficient as measured. Refused
             (the measured Cl) where the roll fit is refused; ``<out>.fit.json``'s ``air_roll`` and the model
             file's header say which and why.
+        profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the replay's estimator,
+            ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least squares: the
+            diagnosis's reference models are fitted through here).
 
     Returns:
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
@@ -208,7 +225,7 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
-                                 air_roll=air_roll_for("fit"))
+                                 air_roll=air_roll_for("fit"), profile_beta=profile_beta)
         table, air = meas.table, None
         if air_roll_train:
             table, air = air_rate_target(meas)

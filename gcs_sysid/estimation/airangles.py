@@ -191,15 +191,23 @@ ALPHA_PROFILE_COLUMNS: tuple[str, ...] = ()
 PROFILE_REFIT = False      #: refit the other free columns for each candidate (a profile likelihood; measured: c172p
 #: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
 PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
-#: Opt-in (default False; twenty-fifth session, i8-beta): ``CY_beta`` by the gust model's likelihood, the
+#: Default on for the replay, ``predict`` and ``listen`` since the thirty-second session (twenty-fifth session, i8-beta,
+#: opt-in until then): ``CY_beta`` by the gust model's likelihood, the
 #: filter-error estimate (:func:`_profile_angle_slope`): the change of variables' Jacobian ``-N log|CY_beta|`` included,
 #: the other side-force slopes refitted by least squares for each candidate, in the first pass (the later passes refit
 #: on the aided angle by least squares, a fixed point). Least squares above 0.3 Hz makes ``CY_beta`` 15-18 % steep on
 #: the s23 (above the directional mode the kinematic sideslip's gust error correlates positively with it); the
 #: likelihood lands within a few per cent of JSBSim's slope there (docs/estimation.md, "The side-force slope by the
-#: gust model's likelihood").
-BETA_PROFILE = False
-#: Opt-in (default False; thirty-first session, i8-truereg; only with :data:`BETA_PROFILE`): the later passes keep the
+#: gust model's likelihood"). With :data:`BETA_PROFILE_HOLD`, on the 75 light flights of the 25 JSBSim tuning aircraft
+#: issue 8's counts went +11/-2 (GP seed 0) and +15/-3 (seed 1), only the s23 losing a count at both seeds, and the
+#: median error of the model at JSBSim's true regressors fell for CY 24.7 -> 21.2 % and Cn 21.4 -> 18.6 % (rule 8(b);
+#: ``docs/benchmarks.md``, "Thirty-first session, lead" and "Thirty-second session, lead"). The diagnosis and
+#: ``gcs-sysid fit`` load their flights with least squares instead (:data:`gcs_sysid.diagnose.run.BETA_PROFILE`):
+#: issue 9's counts with the profile are not measured, and the twenty-fifth session's run of the profile alone lost a
+#: count there (the s23's ``CY:scale``). :func:`aided_air_angles` ``profile_beta`` and
+#: :func:`gcs_sysid.estimation.estimate_states` ``profile_beta`` choose per call.
+BETA_PROFILE = True
+#: Default on with :data:`BETA_PROFILE` (thirty-first session, i8-truereg; only with the profile): the later passes keep the
 #: first pass's profiled ``CY_beta`` (the other side-force slopes refitted by least squares with it held) instead of
 #: refitting it by least squares on the aided sideslip. That refit is circular: the aided sideslip is built from the
 #: measured side force with the last pass's slope, so least squares on it returns about that slope plus the share of
@@ -207,7 +215,7 @@ BETA_PROFILE = False
 #: s1: profiled -0.480, least squares -0.538, after the passes -0.496; JSBSim's -0.445). A model learned on a sideslip
 #: read ``k`` times the true one has ``CY_beta`` and ``Cn_beta`` ``1 / k`` times JSBSim's and misses at the true
 #: sideslip (``docs/benchmarks.md``, "Thirty-first session, i8-truereg").
-BETA_PROFILE_HOLD = False
+BETA_PROFILE_HOLD = True
 #: ``CY_beta`` is searched between these multiples of least squares' slope; an optimum at either end keeps least
 #: squares. Only flatter (upper end 1): where the likelihood steepened least squares it was wrong on the roster (the
 #: jets, whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5

@@ -81,11 +81,11 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
 
 
 def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
-                Wd=None, offsets=None, models=None, fits=None):
+                Wd=None, offsets=None, models=None, fits=None, profile_beta=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
     records sources, sigma, notes and the flight-common offsets' 1-sigma (``offsets``, rad; and the
     gusts in the wind) and the axes' fits (``fits``); ``models``: another flight's fits to take the alpha
-    model's slopes from; returns ``(alpha, beta)``."""
+    model's slopes from; ``profile_beta``: as :func:`estimate_states`; returns ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
         notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
                      "control outputs)")
@@ -93,7 +93,7 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
     ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
     Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
                           airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia,
-                          models=models, stated_slopes=((getattr(airframe, "CL_alpha", None),
+                          models=models, profile_beta=profile_beta, stated_slopes=((getattr(airframe, "CL_alpha", None),
                                                          getattr(airframe, "CL_q", None))
                                                         if airangles.STATED_LIFT_SLOPE else None),
                           stated_level=({k: getattr(airframe, k, None) for k in ("CL0", "CL_alpha", "CL_q",
@@ -136,7 +136,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     aid_air_angles: bool = True, earth: str = "wgs84", angle_models: dict | None = None,
                     turbulence_state: bool = True,
                     gust_force_axes: tuple[int, ...] | None = None,
-                    meanwhile: Callable[[], None] | None = None) -> FlightStates:
+                    meanwhile: Callable[[], None] | None = None,
+                    profile_beta: bool | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -166,6 +167,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             before the specific-force smoother's result is collected: the caller's own preparation (the replay's
             later imports) overlaps the worker's smoother instead of waiting for it. Not run when the flight has
             no accelerometer (no smoother to wait for). It must not change what this function computes.
+        profile_beta: the sideslip aiding's ``CY_beta`` by the gust model's likelihood (True) or by least squares
+            (False); None: :data:`gcs_sysid.estimation.airangles.BETA_PROFILE` as it stands at the call (on; the
+            diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_PROFILE`, off).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -491,7 +495,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             alpha, beta = _take_vanes(vanes, sources, ident, notes)
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
-                                      fly, C, v_ned, sources, sigma, notes, Wd, offsets, angle_models, fits)
+                                      fly, C, v_ned, sources, sigma, notes, Wd, offsets, angle_models, fits,
+                                      profile_beta)
     else:
         if have_tas:
             V = tas

@@ -61,6 +61,7 @@ def test_the_held_profiled_slope_survives_the_later_passes(monkeypatch):
 
     kin, cy, others = _record(1)
     use = np.ones(T, bool)
+    monkeypatch.setattr(airangles, "BETA_PROFILE_HOLD", False)
     free = _axis("beta", DT, kin, cy, others, use, 3, -1.0, False, False, profile=True)[2]
     monkeypatch.setattr(airangles, "BETA_PROFILE_HOLD", True)
     held = _axis("beta", DT, kin, cy, others, use, 3, -1.0, False, False, profile=True)[2]
