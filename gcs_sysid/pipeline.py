@@ -610,6 +610,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     # and the aided angles' common scale and linear error (docs/gp.md, "The band at exact conditions")
                     model = with_offset_covariance(model, table.x_offset_cov, scale_var=table.x_scale_var,
                                                    map_cov=table.x_map_cov)
+            # the map first: its figures (the worker's longest) are drawn while the rows are predicted
+            with _stage("confidence map", timings, bar):
+                envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
+            draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
@@ -637,9 +641,6 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             corr = correlation_of(gp_summary, gp_summary["outputs"])
             if corr is not None:
                 draw("correlation", "correlation_figure", *corr)
-            with _stage("confidence map", timings, bar):
-                envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
-            draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
                 cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
