@@ -15,7 +15,7 @@ from ..result import ReplayResult
 from .store import jsonable
 
 __all__ = ["THESIS_FLOOR_PCT", "CSV_COLUMNS", "fmt", "fmt_axis", "facts", "stream_rows", "error_rows",
-           "score_rows", "region_rows", "suggestion_rows", "gp_rows", "lengthscale_rows", "write_csv",
+           "score_rows", "region_rows", "suggestion_rows", "gp_rows", "lengthscale_rows", "write_csv", "csv_data", "write_csv_data",
            "write_suggestions_json", "correlation_of", "ANGLES"]
 
 #: Held-out error floor reported by the thesis this project follows (forces, moments), %.
@@ -181,10 +181,25 @@ def lengthscale_rows(r: ReplayResult) -> list[dict[str, str]]:
     return rows
 
 
+def csv_data(t: np.ndarray, X: np.ndarray, Y: np.ndarray, pred_mean: np.ndarray, pred_sigma: np.ndarray,
+             pred_sigma_obs: np.ndarray, held_out: np.ndarray) -> np.ndarray:
+    """The values of coefficients.csv, ``(N, len(CSV_COLUMNS))``: ``t (N,)`` [s], the regressors ``X (N, 10)``,
+    the measured coefficients ``Y (N, 6)``, the model's mean, sigma and sigma_obs ``(N, 6)`` each and the
+    held-out mask ``(N,)`` as 0/1, side by side (a :class:`~gcs_sysid.result.ReplayResult`'s arrays)."""
+    return np.column_stack([t, X, Y, pred_mean, pred_sigma, pred_sigma_obs, np.asarray(held_out).astype(float)])
+
+
 def write_csv(r: ReplayResult, path: Path) -> Path:
     """coefficients.csv: one row per grid time (columns :data:`CSV_COLUMNS`; NaN written as ``nan``)."""
     tb = r.table
-    data = np.column_stack([tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.pred_sigma_obs, r.held_out.astype(float)])
+    return write_csv_data(csv_data(tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.pred_sigma_obs, r.held_out), path)
+
+
+def write_csv_data(data: np.ndarray, path: str | Path) -> Path:
+    """Write coefficients.csv from :func:`csv_data`'s ``(N, len(CSV_COLUMNS))`` array to ``path``; the same
+    file as :func:`write_csv` (the pipeline has its worker process write it while the suggestions are
+    ranked)."""
+    path = Path(path)
     # one %-format per row (as numpy.savetxt does) is several times faster than csv.writer with
     # per-value f-strings; same text, same "\r\n" line ends as csv.writer
     fmt = ",".join(["%.4f"] + ["%.7g"] * (data.shape[1] - 2) + ["%d"])
