@@ -19,7 +19,10 @@ and both ``T_p`` and ``Psi^T Lambda^{-1} Psi`` are products of the candidate's f
 ``(J, J)``, ``J = K M + D + 1`` for ``K`` latent kernels (1 for the ICM; a linear model of
 coregionalisation stacks each kernel's features), computed once per model. A candidate then costs
 ``O(P^2 E J^2 + (P E)^2 P J + (P E)^3)`` instead of ``O((P M)^3)``: the query variance is
-``var_p(x) - |R_p u(x)|^2`` with ``R_p = chol(C)^{-1} T_p``.
+``var_p(x) - |R_p u(x)|^2`` with ``R_p = chol(C)^{-1} T_p``. The rows enter only through
+``U_e U_e^T``, so ``U_e`` is first replaced by its thin SVD's leading columns ``U_r diag(s_r)``
+(``r <= min(E, J)``; directions that move no variance by more than machine epsilon left out:
+:func:`_compressed`), and ``E`` above is ``r``.
 
 The result equals ``model.update(X_e, any Y, exchange=False).predict_global(X_query)`` (a test).
 """
@@ -104,7 +107,7 @@ def _compressed(Ue: np.ndarray, drop: float) -> np.ndarray:
     few independent features. Source: Golub and Van Loan (2013), sec. 2.4 (SVD, low-rank
     approximation); Rasmussen and Williams (2006), eq. A.9 (Woodbury).
     """
-    U, s, _ = np.linalg.svd(Ue, full_matrices=False)
+    U, s, _ = np.linalg.svd(Ue, full_matrices=False)      # min(J, E) columns: more rows than J is exact
     tail = np.cumsum((s * s)[::-1])[::-1]                  # tail[i] = sum_{j >= i} s_j^2
     r = max(int(np.count_nonzero(tail > drop)), 1)
     return U[:, :r] * s[None, :r]
