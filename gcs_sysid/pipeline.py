@@ -542,6 +542,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             table = replace(table, notes=list(table.notes) + [table_air.notes[-1]])
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
+        measured_csv = None                      # coefficients.csv's measured fields, formatted while the GP is fitted
+        if stage is not None:
+            measured_csv = helper.submit("gcs_sysid.report.tables:csv_measured_text", table.t, table.X, table.Y)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
         pred_mean = np.full(table.Y.shape, np.nan)
         pred_sigma = np.full(table.Y.shape, np.nan)        # the coefficient itself (no white measurement noise)
@@ -646,7 +649,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             if stage is not None:   # coefficients.csv written by the worker while the suggestions are ranked
                 csv_job = helper.submit("gcs_sysid.report.tables:write_csv_data",
                                         csv_data(table.t, table.X, table.Y, pred_mean, pred_sigma, pred_sigma_obs,
-                                                 held), stage.path / "coefficients.csv")
+                                                 held), stage.path / "coefficients.csv", measured_csv.result())
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
                 cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
