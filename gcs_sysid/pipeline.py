@@ -454,6 +454,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     # the worker decodes part of the log, smooths the specific force, then draws the figures
     helper = Helper(enabled=None if options.parallel else False, warm=("gcs_sysid.telemetry.tlog_scan",))
     figures: dict[str, Job] = {}
+    csv_job: Job | None = None   # coefficients.csv, when the worker writes it
 
     def draw(name: str, function: str, *args) -> None:
         if options.write:
@@ -489,7 +490,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         from .jaxconfig import enable_compilation_cache
         from .maneuvers import ManeuverConfig, suggest_maneuvers
         from .report import write_report
-        from .report.tables import correlation_of
+        from .report.tables import correlation_of, csv_data
 
         helper.preload(["gcs_sysid.report.plots"])   # matplotlib for the figures, while the GP is fitted
         with _stage("coefficients", timings, bar):
@@ -541,6 +542,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             table = replace(table, notes=list(table.notes) + [table_air.notes[-1]])
         draw("streams", "streams_figure", flight.summaries)   # drawn while the GP is fitted
         draw("states", "states_figure", states, held)
+        measured_csv = None                      # coefficients.csv's measured fields, formatted while the GP is fitted
+        if stage is not None:
+            measured_csv = helper.submit("gcs_sysid.report.tables:csv_measured_text", table.t, table.X, table.Y)
         fit_cols = [i for i, c in enumerate(COEFFICIENTS) if ident[c][0]]
         pred_mean = np.full(table.Y.shape, np.nan)
         pred_sigma = np.full(table.Y.shape, np.nan)        # the coefficient itself (no white measurement noise)
@@ -610,6 +614,16 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     # and the aided angles' common scale and linear error (docs/gp.md, "The band at exact conditions")
                     model = with_offset_covariance(model, table.x_offset_cov, scale_var=table.x_scale_var,
                                                    map_cov=table.x_map_cov)
+            gp_summary = model.summary()
+            gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
+            corr = correlation_of(gp_summary, gp_summary["outputs"])
+            if corr is not None:                 # drawn while the envelope is mapped
+                draw("correlation", "correlation_figure", *corr)
+            # the map before the predictions: its figures (the worker's longest) are drawn while the rows
+            # are predicted
+            with _stage("confidence map", timings, bar):
+                envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
+            draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("predict", timings, bar):
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
@@ -630,16 +644,12 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, cols], 0.0))
-            gp_summary = model.summary()
-            gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
             # the measurements are drawn against the band for a measurement
             draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma_obs, held, ident)
-            corr = correlation_of(gp_summary, gp_summary["outputs"])
-            if corr is not None:
-                draw("correlation", "correlation_figure", *corr)
-            with _stage("confidence map", timings, bar):
-                envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
-            draw("envelope", "envelope_figures", envelope, table.X[train])
+            if stage is not None:   # coefficients.csv written by the worker while the suggestions are ranked
+                csv_job = helper.submit("gcs_sysid.report.tables:write_csv_data",
+                                        csv_data(table.t, table.X, table.Y, pred_mean, pred_sigma, pred_sigma_obs,
+                                                 held), stage.path / "coefficients.csv", measured_csv.result())
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
                 cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
@@ -689,12 +699,13 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         )
         if stage is not None:
             with _stage("write report", timings, bar):
-                write_report(result, stage.path, figures=figures)
+                write_report(result, stage.path, figures=figures, csv=csv_job)
                 stage.commit()
         ok = True
         return result
     finally:
         if stage is not None and not ok:
+            helper.close(wait=False)   # stopped first: it may be writing coefficients.csv into the staged folder
             stage.abort()
         helper.close(wait=ok)
         if bar is not None:

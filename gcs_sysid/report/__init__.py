@@ -8,6 +8,7 @@ recomputing. Contents and file formats: ``docs/report.md``.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from ..result import ReplayResult
 from .cards import render_testcards_html, render_testcards_md, write_flynext_plan
@@ -20,7 +21,7 @@ __all__ = ["write_report", "save_result", "load_result", "CSV_COLUMNS"]
 
 
 def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
-                 figures: dict | None = None) -> dict[str, Path]:
+                 figures: dict | None = None, csv: Any = None) -> dict[str, Path]:
     """Write the report files into ``out_dir`` (created).
 
     Args:
@@ -28,6 +29,9 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
         out_dir: output directory.
         save: also save the result itself (``out_dir/result/result.{json,npz}``) for re-rendering.
         figures: figures drawn elsewhere, or jobs drawing them (see :func:`~gcs_sysid.report.html.render_html`).
+        csv: None, or a job already writing ``out_dir/coefficients.csv`` (its ``result()`` gives the path:
+            :func:`~gcs_sysid.report.tables.write_csv_data` in the pipeline's worker process); waited for
+            before the HTML.
 
     Returns:
         name -> path for ``report.html``, ``summary.md``, ``coefficients.csv``, ``suggestions.json``,
@@ -38,7 +42,7 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files = {
-        "csv": write_csv(result, out / "coefficients.csv"),
+        "csv": write_csv(result, out / "coefficients.csv") if csv is None else None,
         "suggestions": write_suggestions_json(result, out / "suggestions.json"),
         "markdown": render_markdown(result, out / "summary.md"),
         "testcards_md": render_testcards_md(result, out / "testcards.md"),
@@ -49,5 +53,7 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
         files["plan"] = plan
     if save:
         files.update(save_result(result, out / "result"))
+    if csv is not None:
+        files["csv"] = Path(csv.result())
     files["html"] = render_html(result, out / "report.html", figures)   # last: figures may still be drawing
     return files

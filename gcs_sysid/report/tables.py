@@ -11,12 +11,13 @@ from typing import Any
 import numpy as np
 
 from ..aero.table import COEFFICIENTS, FORCE_COEFFICIENTS, REGRESSORS
+from ..errors import InputError
 from ..result import ReplayResult
 from .store import jsonable
 
 __all__ = ["THESIS_FLOOR_PCT", "CSV_COLUMNS", "fmt", "fmt_axis", "facts", "stream_rows", "error_rows",
-           "score_rows", "region_rows", "suggestion_rows", "gp_rows", "lengthscale_rows", "write_csv",
-           "write_suggestions_json", "correlation_of", "ANGLES"]
+           "score_rows", "region_rows", "suggestion_rows", "gp_rows", "lengthscale_rows", "write_csv", "csv_data",
+           "write_csv_data", "csv_measured_text", "write_suggestions_json", "correlation_of", "ANGLES", "CSV_MEASURED"]
 
 #: Held-out error floor reported by the thesis this project follows (forces, moments), %.
 THESIS_FLOOR_PCT = {"forces": 19.8, "moments": 23.8}
@@ -28,6 +29,8 @@ CSV_COLUMNS = (["time_s", *REGRESSORS, *COEFFICIENTS] + [f"{c}_pred" for c in CO
 #: latter and there was no ``<C>_sigma_obs``. docs/gp.md, "Two bands".
 #: Regressors shown in degrees.
 ANGLES = ("alpha", "beta", "delta_e", "delta_a", "delta_r")
+#: coefficients.csv's leading columns that exist before the model: time, regressors, measured coefficients
+CSV_MEASURED = 1 + len(REGRESSORS) + len(COEFFICIENTS)
 
 
 def fmt(v: Any, nd: int = 3) -> str:
@@ -181,17 +184,58 @@ def lengthscale_rows(r: ReplayResult) -> list[dict[str, str]]:
     return rows
 
 
+def csv_data(t: np.ndarray, X: np.ndarray, Y: np.ndarray, pred_mean: np.ndarray, pred_sigma: np.ndarray,
+             pred_sigma_obs: np.ndarray, held_out: np.ndarray) -> np.ndarray:
+    """The values of coefficients.csv, ``(N, len(CSV_COLUMNS))``: ``t (N,)`` [s], the regressors ``X (N, 10)``,
+    the measured coefficients ``Y (N, 6)``, the model's mean, sigma and sigma_obs ``(N, 6)`` each and the
+    held-out mask ``(N,)`` as 0/1, side by side (a :class:`~gcs_sysid.result.ReplayResult`'s arrays)."""
+    return np.column_stack([t, X, Y, pred_mean, pred_sigma, pred_sigma_obs, np.asarray(held_out).astype(float)])
+
+
 def write_csv(r: ReplayResult, path: Path) -> Path:
     """coefficients.csv: one row per grid time (columns :data:`CSV_COLUMNS`; NaN written as ``nan``)."""
     tb = r.table
-    data = np.column_stack([tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.pred_sigma_obs, r.held_out.astype(float)])
+    return write_csv_data(csv_data(tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.pred_sigma_obs, r.held_out), path)
+
+
+def csv_measured_text(t: np.ndarray, X: np.ndarray, Y: np.ndarray) -> list[str]:
+    """Each row's first :data:`CSV_MEASURED` fields of coefficients.csv as :func:`write_csv` writes them
+    (time, the regressors ``X (N, 10)``, the measured coefficients ``Y (N, 6)``; ``t (N,)`` [s]): they
+    exist before the model, so the pipeline's worker formats them while the GP is fitted."""
+    fmt = ",".join(["%.4f"] + ["%.7g"] * (CSV_MEASURED - 1))
+    return [fmt % tuple(row) for row in np.column_stack([t, X, Y]).tolist()]
+
+
+def write_csv_data(data: np.ndarray, path: str | Path, measured: list[str] | None = None) -> Path:
+    """Write coefficients.csv from :func:`csv_data`'s ``(N, len(CSV_COLUMNS))`` array to ``path``; the same
+    file as :func:`write_csv` (the pipeline has its worker process write it while the suggestions are
+    ranked).
+
+    Args:
+        data: :func:`csv_data`'s array.
+        path: the file written.
+        measured: :func:`csv_measured_text` of the same rows (their first :data:`CSV_MEASURED` fields,
+            already formatted), or None to format every field here.
+
+    Raises:
+        InputError: ``measured`` not one string per row.
+    """
+    path = Path(path)
     # one %-format per row (as numpy.savetxt does) is several times faster than csv.writer with
-    # per-value f-strings; same text, same "\r\n" line ends as csv.writer
-    fmt = ",".join(["%.4f"] + ["%.7g"] * (data.shape[1] - 2) + ["%d"])
+    # per-value f-strings; same text, same "\r\n" line ends as csv.writer. %-formatting is field by
+    # field, so a row formatted in two parts joined by "," is the same text
+    if measured is None:
+        fmt = ",".join(["%.4f"] + ["%.7g"] * (data.shape[1] - 2) + ["%d"])
+        lines = [fmt % tuple(row) + "\r\n" for row in data.tolist()]
+    else:
+        if len(measured) != len(data):
+            raise InputError(f"write_csv_data: {len(measured)} formatted rows for {len(data)} rows")
+        fmt = ",".join(["%.7g"] * (data.shape[1] - CSV_MEASURED - 1) + ["%d"])
+        lines = [m + "," + fmt % tuple(row) + "\r\n" for m, row in zip(measured, data[:, CSV_MEASURED:].tolist())]
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(CSV_COLUMNS)
-        f.write("".join([fmt % tuple(row) + "\r\n" for row in data.tolist()]))
+        f.write("".join(lines))
     return path
 
 

@@ -122,6 +122,38 @@ def test_batched_variance_after_square_root_fallback_gives_the_same_numbers(flig
     assert np.all(np.isfinite(far[1])) and np.all(far[1] <= far[0] * (1 + 1e-9))
 
 
+def test_batched_variance_after_compresses_a_candidate_without_moving_the_numbers(flight, fitted, monkeypatch):
+    """A candidate's rows enter only through U_e U_e^T: its SVD's leading columns give the same variances
+    (rotation only: to round-off; the left-out directions: below machine epsilon), and rows that repeat a
+    few points keep only as many directions as there are distinct points."""
+    import gcs_sysid.gp.ranking as ranking
+
+    X, _, _ = flight
+    model, _ = fitted
+    queries = np.vstack([X[:5] + 6 * X.std(0), X[:40]])
+    extras = [X[200:264], np.repeat(X[300:304], 16, axis=0), np.repeat(X[:5] + 6 * X.std(0), 3, axis=0)]
+    got = model.global_variance_after_many(extras, [queries] * 3)
+    kept = []
+    real = ranking._compressed
+
+    def whole(Ue, drop):                     # every column kept, unrotated: the product form as it was
+        kept.append((real(Ue, drop).shape[1], Ue, drop))
+        return Ue
+
+    monkeypatch.setattr(ranking, "_compressed", whole)
+    ref = model.global_variance_after_many(extras, [queries] * 3)
+    for (b0, a0), (b1, a1) in zip(ref, got):
+        np.testing.assert_array_equal(b1, b0)
+        np.testing.assert_allclose(a1, a0, rtol=1e-10)
+        assert np.all(a1 <= b1 * (1 + 1e-9)) and np.any(a1 < 0.99 * b1)
+    assert kept[1][0] == 4                    # 64 rows of 4 distinct points: 4 directions
+    _, Ue, drop = kept[1]
+    Uc = real(Ue, drop)
+    assert Uc.shape == (Ue.shape[0], 4) and 0 < drop < 1e-12
+    np.testing.assert_allclose(Uc @ Uc.T, Ue @ Ue.T, atol=1e-10 * np.abs(Ue @ Ue.T).max())
+    assert real(Ue, 0.0).shape == (Ue.shape[0], min(Ue.shape))   # nothing left out: the thin SVD only
+
+
 def test_save_and_load_round_trip(tmp_path, flight, fitted):
     from gcs_sysid.gp import load_gp
 

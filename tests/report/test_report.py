@@ -105,6 +105,30 @@ def test_save_load_rerender(partial_result, tmp_path):
         load_result(tmp_path)
 
 
+def test_csv_written_by_a_job_is_the_same_file(written, tmp_path):
+    """write_report(csv=job): the pipeline's worker writes coefficients.csv from csv_data (write_csv_data),
+    its measured fields formatted earlier (csv_measured_text); the report waits for it and the file is the
+    one write_csv writes, byte for byte, with or without the measured fields given."""
+    from gcs_sysid.report.tables import csv_data, csv_measured_text, write_csv_data
+
+    r, files = written
+    tb = r.table
+    data = csv_data(tb.t, tb.X, tb.Y, r.pred_mean, r.pred_sigma, r.pred_sigma_obs, r.held_out)
+    calls = []
+
+    class Job:                                # what gcs_sysid.parallel.Job gives: result() -> the path
+        def result(self):
+            calls.append(1)
+            return write_csv_data(data, tmp_path / "coefficients.csv", csv_measured_text(tb.t, tb.X, tb.Y))
+
+    again = write_report(r, tmp_path, save=False, csv=Job())
+    assert calls == [1] and again["csv"] == tmp_path / "coefficients.csv"
+    assert again["csv"].read_bytes() == files["csv"].read_bytes()
+    assert write_csv_data(data, tmp_path / "whole.csv").read_bytes() == files["csv"].read_bytes()
+    with pytest.raises(InputError, match="formatted rows"):
+        write_csv_data(data, tmp_path / "bad.csv", csv_measured_text(tb.t, tb.X, tb.Y)[1:])
+
+
 def test_partial_result_says_what_is_missing(partial_result, tmp_path):
     from gcs_sysid.report.html import render_html
     from gcs_sysid.report.markdown import render_markdown
