@@ -48,7 +48,7 @@ __all__ = ["GUST_FILTER", "ROLL_MIN_DRYDEN_RATIO", "ROLL_MAX_IV_RATIO", "instrum
            "LAT_TERMS", "RollGustFit", "fit_roll_gust",
            "instruments",
            "stated_moment_variance", "filter_gust_table", "HELDOUT_AIR_ROLL", "AIR_ROLL_MODES", "air_roll_mode",
-           "heldout_air_roll", "HELDOUT_GUST_VAR", "gust_moment_variance", "AIR_ROLL_TRAIN",
+           "heldout_air_roll", "HELDOUT_GUST_VAR", "gust_moment_variance", "heldout_gust_pred_var", "AIR_ROLL_TRAIN",
            "air_roll_fit", "air_roll_target", "AIR_ROLL_STATE_KEYS", "air_roll_target_on_rows"]
 
 #: The replay's default (:class:`gcs_sysid.pipeline.ReplayOptions` ``gust_filter``): train the GP on ``p_hat``
@@ -591,7 +591,8 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
     dt = float(np.median(np.diff(table.t)))
     g, g_var = roll_gust_on_rows(G, dt, table.X, table.Y, states.data["p"], table.qbar, held & table.valid,
                                  airframe.Ixx, airframe.S, airframe.b, mode=mode,
-                                 gust_var=gust_moment_variance(G) if HELDOUT_GUST_VAR == "moment" else None)
+                                 gust_var=gust_moment_variance(G) if HELDOUT_GUST_VAR == "moment" else None,
+                                 pred_var=heldout_gust_pred_var(G, table, states, airframe, dt))
     g, g_var = np.where(held, g, 0.0), np.where(held, g_var, 0.0)
     j = REGRESSORS.index("p_hat")
     X = table.X.copy()
@@ -603,6 +604,32 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
             + G.notes[0] + ")")
     return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), {"mode": mode, "outputs": outputs, "g": g,
                                                                              "g_var": g_var, "fit": G}
+
+
+def heldout_gust_pred_var(fit, table, states, airframe, dt: float, how: str | None = None) -> float | None:
+    """The held-out prediction's error variance of ``p_hat_g`` (dimensionless) that :data:`HELDOUT_GUST_VAR`
+    (``how``; None: it) measures on the fit's own rows, or None where it states none (``"fit"``, ``"moment"``).
+
+    ``"rts"``, ``"nis"`` and ``"innov"``: :func:`gcs_sysid.aero.rollgust.predicted_gust_variance` by that method on
+    ``fit.used`` (the training rows the roll fit read; the log's own moment only, no truth).
+
+    Args:
+        fit: the air-rate pair's roll fit (:func:`air_roll_fit`). table: the coefficient table it was made on
+            (``X`` ``(T, 10)``, ``Y`` ``(T, 6)``, ``qbar`` ``(T,)`` Pa). states: ``data["p"]`` ``(T,)`` rad/s.
+            airframe: ``Ixx`` kg m^2, ``S`` m^2, ``b`` m. dt: grid interval, s.
+
+    Raises:
+        ValueError: an unknown ``how``.
+    """
+    from .rollgust import PRED_VAR_METHODS, predicted_gust_variance
+
+    how = HELDOUT_GUST_VAR if how is None else how
+    if how in ("fit", "moment"):
+        return None
+    if how not in PRED_VAR_METHODS:
+        raise ValueError(f"heldout_gust_pred_var: one of ('fit', 'moment') + {PRED_VAR_METHODS} expected, got {how!r}")
+    return predicted_gust_variance(fit, dt, table.X, table.Y, states.data["p"], table.qbar, np.asarray(fit.used, bool),
+                                   airframe.Ixx, airframe.S, airframe.b, method=how)
 
 
 def gust_moment_variance(fit: RollGustFit) -> float:
