@@ -100,6 +100,12 @@ HELDOUT_AIR_ROLL = "predicted:Cl"
 #: session, i8-guard): ``"fit"`` Cl's band covers 88.9 % (median; 41-45 flights below 90 %), the issue's coverage
 #: count 64 -> 66 and 65 -> 67; ``"moment"`` 98.0 % (5 below 90, 35 above 98), the count 64 -> 57 and 65 -> 60 (the
 #: six outputs' mean band goes above 98 %). ``"fit"`` kept: the truth lies between.
+#: Measured on the training rows, no truth read (:func:`heldout_gust_pred_var`,
+#: :func:`gcs_sysid.aero.rollgust.predicted_gust_variance`): ``"rts"`` (the prediction against the smoothed gust),
+#: ``"nis"`` (the innovations' mean square less ``R``) and ``"innov"`` (plus ``R``: the prediction follows the
+#: measured moment's slow error). On JSBSim's flights ``"rts"`` and ``"nis"`` state the fit's ``P`` (the filter is
+#: consistent by its own innovations); the band misses the measured Cl's slow error, 2-6 times the stated ``R``,
+#: which the one-step prediction carries (thirty-second session, i8-clband, docs/benchmarks.md).
 HELDOUT_GUST_VAR = "fit"
 #: Every value ``heldout_air_roll`` takes (:func:`air_roll_mode`): ``"off"``; a gust mode of
 #: :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` (every output asked at the air rate, the twenty-fourth session's);

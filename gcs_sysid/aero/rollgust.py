@@ -364,11 +364,13 @@ def predicted_gust_variance(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.
       the prediction has not seen (Bar-Shalom, Li and Kirubarajan, *Estimation with Applications to Tracking and
       Navigation*, 2001, sec. 5.4: the normalised innovation squared; its mean ``mean(nu^2)/S`` is 1 for a
       consistent filter). Holds whatever the process variance, given the noise ``R``, if that noise is white.
-    - ``"innov"``: ``mean(nu^2) + R``. The prediction is made from the *measured* moments before ``k``; where the
-      measured moment's error ``e`` is slow (the rate smoother's ``p_dot`` error is correlated over many grid
-      steps) the prediction has followed it, so against the true moment its error is ``-nu + e`` with ``nu``
-      holding little of ``e``: variance ``mean(nu^2) + var e``, ``var e`` the stated ``R``. (With white ``e`` the
-      same error is ``mean(nu^2) - R``, ``"nis"``; the two bracket it.)
+    - ``"innov"``: ``mean(nu^2) + R``. The prediction is made from the *measured* moments before ``k``, so against
+      the true moment its error is ``e - nu`` (``e`` the measured moment's error): variance
+      ``mean(nu^2) + var e - 2 cov(nu, e)``. With white ``e`` the covariance is ``var e`` (``"nis"``); where ``e``
+      is slow (the rate smoother's ``p_dot`` error, correlated over many grid steps) the prediction has followed
+      it and ``nu`` holds little of it, the covariance goes to 0, and the error to ``mean(nu^2) + var e``, ``var e``
+      the stated ``R``: the upper end of the bracket ``"nis"`` .. ``"innov"``
+      (tests/aero/test_rollgust.py: a slow ``e`` lies inside it, 1.4-1.7 times short of ``"innov"``).
 
     On JSBSim's flights (72 light flights, thirty-second session, i8-clband, docs/benchmarks.md) the filter is
     consistent by its own innovations: ``"rts"`` gives the fit's ``P`` (ratio 1.00) and ``mean(nu^2)/S`` is
