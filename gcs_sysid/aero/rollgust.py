@@ -56,7 +56,7 @@ from .gustfilter import LAT_TERMS, RollGustFit, _gains, _innovations, _segments,
 from .table import COEFFICIENTS, REGRESSORS
 
 __all__ = ["ROLL_TAU", "ROW_GUST_MODES", "RollDynamicsFit", "dryden_roll_tau", "causal_roll_moment",
-           "fit_roll_dynamics", "roll_gust_on_rows"]
+           "fit_roll_dynamics", "roll_gust_on_rows", "PRED_VAR_METHODS", "predicted_gust_variance"]
 
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 _MIN_ROWS, _MIN_RUN = 200, 50
@@ -237,7 +237,8 @@ ROW_GUST_MODES = ("smoothed", "filtered", "predicted")
 
 def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
                       rows: np.ndarray, Ixx: float, S: float, b: float, mode: str = "smoothed",
-                      min_run: int = 10, gust_var: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+                      min_run: int = 10, gust_var: float | None = None,
+                      pred_var: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The rolling gust ``p_hat_g`` on ``rows`` (a held-out segment) from their own measured roll moment, with the
     slopes, gust process and noise of a fit made on other rows (:func:`fit_roll_dynamics`, nothing refitted).
 
@@ -263,6 +264,10 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
             with a larger process variance ``q`` its error variance is that of a suboptimal filter, the stationary
             solution of ``P = a^2 (1 - K)^2 P + a^2 K^2 R + q`` (predicted; filtered ``(1 - K)^2 P + K^2 R``;
             Gelb, *Applied Optimal Estimation*, 1974, sec. 7.2). ``"smoothed"`` states the fit's ``Ps``.
+        pred_var: the ``"predicted"`` estimate's error variance of ``p_hat_g`` (dimensionless) measured elsewhere
+            (:func:`predicted_gust_variance` on the training rows; None: not given). Used in place of the fit's
+            (and of ``gust_var``'s) when larger; the ``"filtered"`` one follows as ``(1 - K)^2 P + K^2 R`` (the fit's
+            gain ``K``; Gelb 1974, sec. 7.2).
 
     Returns:
         ``(g, g_var)``, each ``(T,)``: ``p_hat_g`` and its variance on the usable runs of ``rows``; 0 and the fit's
@@ -281,23 +286,16 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
             np.shape(v) != (T,) for v in (p, qbar, rows)):
         raise ValueError(f"roll_gust_on_rows: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}), p, qbar, rows "
                          f"(T,) expected, got {X.shape}, {Y.shape}, {[np.shape(v) for v in (p, qbar, rows)]}")
-    if not np.isfinite(G.L_p):
-        raise ValueError("roll_gust_on_rows: the fit has no roll damping L_p")
-    x = G.L_p * dt
-    th = np.asarray(G.theta, float) * (np.expm1(x) / x if x != 0 else 1.0)   # the step slopes the filter used
-    cl_p = float(th[_IP])
-    cols = [REGRESSORS.index(k) for k in LAT_TERMS]
-    A = np.c_[np.ones(T), X[:, cols]]
-    y = causal_roll_moment(dt, Y[:, COEFFICIENTS.index("Cl")], p, qbar, Ixx, S, b)
-    z = y - A @ th
+    z, cl_p, a, ss = _step_residual(G, dt, X, Y, p, qbar, Ixx, S, b, "roll_gust_on_rows")
     use = np.asarray(rows, bool) & np.isfinite(z)
-    a = float(np.exp(-dt / G.tau))
-    ss = _gains(a, (G.sigma * cl_p) ** 2, 1.0, G.R)
     s = np.zeros(T)
     var = np.full(T, (G.sigma * cl_p) ** 2)
     Pf = ss.P * G.R / ss.S
     Pp = ss.P
-    if gust_var is not None and gust_var > G.sigma**2:   # the fit's gain under a larger gust (a suboptimal filter)
+    if pred_var is not None and pred_var * cl_p**2 > Pp:  # a stated prediction error (predicted_gust_variance)
+        Pp = pred_var * cl_p**2
+        Pf = (1 - ss.K) ** 2 * Pp + ss.K**2 * G.R
+    elif gust_var is not None and gust_var > G.sigma**2:   # the fit's gain under a larger gust (a suboptimal filter)
         q = gust_var * cl_p**2 * (1 - a * a)
         Pp = (q + (a * ss.K) ** 2 * G.R) / (1 - (a * (1 - ss.K)) ** 2)
         Pf = (1 - ss.K) ** 2 * Pp + ss.K**2 * G.R
@@ -312,3 +310,104 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
             else:
                 s[s0:s1], var[s0:s1] = xp + ss.K * (zz - xp), Pf
     return -s / cl_p, var / cl_p**2
+
+
+def _step_residual(G: RollDynamicsFit, dt: float, X, Y, p, qbar, Ixx: float, S: float, b: float, who: str):
+    """The step moment's residual on the fit's step slopes and the fit's steady-state filter: ``(z, cl_p, a, ss)``,
+    ``z`` ``(T,)`` (NaN where the step moment is not defined), ``cl_p`` the step's ``Cl_p``, ``a = exp(-dt/tau)``,
+    ``ss`` the :func:`~gcs_sysid.aero.gustfilter._gains` for the gust term ``s = -cl_p p_hat_g`` (Cl units).
+
+    Raises:
+        ValueError: shapes that disagree, or a fit without a finite ``L_p`` (the message starts with ``who``).
+    """
+    X, Y = np.asarray(X, float), np.asarray(Y, float)
+    T = len(X)
+    if X.shape != (T, len(REGRESSORS)) or Y.shape != (T, len(COEFFICIENTS)) or any(
+            np.shape(v) != (T,) for v in (p, qbar)):
+        raise ValueError(f"{who}: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}), p, qbar (T,) expected, got "
+                         f"{X.shape}, {Y.shape}, {[np.shape(v) for v in (p, qbar)]}")
+    if not np.isfinite(G.L_p):
+        raise ValueError(f"{who}: the fit has no roll damping L_p")
+    x = G.L_p * dt
+    th = np.asarray(G.theta, float) * (np.expm1(x) / x if x != 0 else 1.0)   # the step slopes the filter used
+    cl_p = float(th[_IP])
+    cols = [REGRESSORS.index(k) for k in LAT_TERMS]
+    A = np.c_[np.ones(T), X[:, cols]]
+    y = causal_roll_moment(dt, Y[:, COEFFICIENTS.index("Cl")], p, qbar, Ixx, S, b)
+    a = float(np.exp(-dt / G.tau))
+    return y - A @ th, cl_p, a, _gains(a, (G.sigma * cl_p) ** 2, 1.0, G.R)
+
+
+#: How :func:`predicted_gust_variance` reads the training rows: ``"rts"`` (the one-step prediction against the
+#: smoothed gust), ``"nis"`` (the innovations' mean square less the moment's noise) or ``"innov"`` (the
+#: innovations' mean square plus the moment's noise: the prediction carries the measured moment's slow error).
+PRED_VAR_METHODS = ("rts", "nis", "innov")
+
+
+def predicted_gust_variance(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray,
+                            qbar: np.ndarray, rows: np.ndarray, Ixx: float, S: float, b: float, method: str = "rts",
+                            min_run: int = 10) -> float:
+    """The one-step-ahead estimate's error variance of ``p_hat_g`` (dimensionless), measured on rows where the
+    gust's moment is known to the fit (its training rows), not stated by the fit's likelihood: what
+    :func:`roll_gust_on_rows` ``"predicted"`` should state on a held-out segment (its ``pred_var``). Nothing but
+    the log's own moment enters (no true gust).
+
+    On each run of usable ``rows`` the step moment's residual ``z`` goes through the fit's steady-state filter
+    (prediction ``xp``, the innovations ``nu = z - xp``) and its Rauch-Tung-Striebel smoother (``xs``), the same
+    filter as :func:`roll_gust_on_rows` on the held-out rows (``s = -Cl_p,step p_hat_g``, Cl units):
+
+    - ``"rts"``: ``mean((xp - xs)^2) + Ps``. For a linear-Gaussian model the smoothed error is orthogonal to the
+      smoother's correction, so the prediction's error variance is the correction's variance plus the smoothed one
+      (Rauch, Tung and Striebel, AIAA J. 3(8), 1965; Gelb, *Applied Optimal Estimation*, 1974, sec. 5.2). The
+      correction is measured; ``Ps`` is the fit's.
+    - ``"nis"``: ``mean(nu^2) - R``. The innovation is the prediction's error plus the moment's white noise, which
+      the prediction has not seen (Bar-Shalom, Li and Kirubarajan, *Estimation with Applications to Tracking and
+      Navigation*, 2001, sec. 5.4: the normalised innovation squared; its mean ``mean(nu^2)/S`` is 1 for a
+      consistent filter). Holds whatever the process variance, given the noise ``R``, if that noise is white.
+    - ``"innov"``: ``mean(nu^2) + R``. The prediction is made from the *measured* moments before ``k``, so against
+      the true moment its error is ``e - nu`` (``e`` the measured moment's error): variance
+      ``mean(nu^2) + var e - 2 cov(nu, e)``. With white ``e`` the covariance is ``var e`` (``"nis"``); where ``e``
+      is slow (the rate smoother's ``p_dot`` error, correlated over many grid steps) the prediction has followed
+      it and ``nu`` holds little of it, the covariance goes to 0, and the error to ``mean(nu^2) + var e``, ``var e``
+      the stated ``R``: the upper end of the bracket ``"nis"`` .. ``"innov"``
+      (tests/aero/test_rollgust.py: a slow ``e`` lies inside it, 1.4-1.7 times short of ``"innov"``).
+
+    On JSBSim's flights (72 light flights, thirty-second session, i8-clband, docs/benchmarks.md) the filter is
+    consistent by its own innovations: ``"rts"`` gives the fit's ``P`` (ratio 1.00) and ``mean(nu^2)/S`` is
+    0.36-0.94, so ``"rts"`` and ``"nis"`` state the fit's ``P``; the measured Cl's error against JSBSim's is
+    2.0-6.0 times ``R`` and slow, and the GP's held-out Cl error against the truth is close to ``mean(nu^2)`` plus
+    it, which only ``"innov"`` reads (with ``R``, still short of it).
+
+    Each is floored at the fit's own ``P`` (the variance :func:`roll_gust_on_rows` states without it).
+
+    Args:
+        G: the fit (:class:`RollDynamicsFit`, with ``L_p``). dt: grid interval, s.
+        X: ``(T, 10)`` regressors (gyro hats). Y: ``(T, 6)`` measured coefficients. p: ``(T,)`` the smoothed roll
+            rate, rad/s. qbar: ``(T,)`` Pa. rows: ``(T,)`` bool, where to measure (the fit's rows, ``G.used``).
+        Ixx, S, b: kg m^2, m^2, m. method: one of :data:`PRED_VAR_METHODS`. min_run: shortest run of usable rows.
+
+    Returns:
+        the variance of ``p_hat_g``'s one-step prediction error (dimensionless); the fit's ``P / Cl_p,step^2``
+        when no run is usable.
+
+    Raises:
+        ValueError: an unknown ``method``, shapes that disagree, or a fit without a finite ``L_p``.
+    """
+    from scipy.signal import lfilter
+
+    if method not in PRED_VAR_METHODS:
+        raise ValueError(f"predicted_gust_variance: method must be one of {PRED_VAR_METHODS}, got {method!r}")
+    z, cl_p, a, ss = _step_residual(G, dt, X, Y, p, qbar, Ixx, S, b, "predicted_gust_variance")
+    if np.shape(rows) != z.shape:
+        raise ValueError(f"predicted_gust_variance: rows must be {z.shape}, got {np.shape(rows)}")
+    use = np.asarray(rows, bool) & np.isfinite(z)
+    sq, n = 0.0, 0
+    for s0, s1 in _segments(use, min_run):
+        zz = z[s0:s1]
+        xp = lfilter([0.0, a * ss.K], [1.0, -a * (1 - ss.K)], zz)
+        d = xp - _smooth(zz, a, ss, 1.0) if method == "rts" else zz - xp
+        sq, n = sq + float(d @ d), n + len(d)
+    if n == 0:
+        return float(ss.P / cl_p**2)
+    P = sq / n + {"rts": ss.Ps, "nis": -G.R, "innov": G.R}[method]
+    return float(max(P, ss.P) / cl_p**2)
