@@ -486,7 +486,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     """
     from gcs_sysid.aero.table import COEFFICIENTS
     from gcs_sysid.diagnose.context import DiagContext, model_as_dict
-    from gcs_sysid.diagnose.run import load_measurements
+    from gcs_sysid.diagnose.run import air_roll_for, load_measurements
     from gcs_sysid.diagnose.run import shared_angle_models
     from gcs_sysid.diagnose.sparse import _library, alpha_quantile_knots, reference_context, sparse_search
     from gcs_sysid.sim.model_file import load_model
