@@ -270,7 +270,7 @@ def stated_airframe(path: Path, work: Path, stem: str) -> Path:
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None, gust_filter: bool | str | None = None,
              heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = (),
-             air_roll_train: bool | None = None) -> dict:
+             air_roll_train: bool | None = None, gp_seed: int = 0) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
@@ -278,7 +278,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
     what a simulator using the model would give it). ``gust_filter``: ``ReplayOptions.gust_filter`` (None: the
     default). ``heldout_air_roll``: ``ReplayOptions.heldout_air_roll`` (None: the default). ``air_roll_train``:
-    ``ReplayOptions.air_roll_train`` (None: the default). ``airp_lines``: modes of
+    ``ReplayOptions.air_roll_train`` (None: the default). ``gp_seed``: ``ReplayOptions.gp_seed`` (the GP fit's
+    ``GPConfig.seed``; 0, the default, as before the option existed). ``airp_lines``: modes of
     :func:`gcs_sysid.aero.gustfilter.heldout_air_roll` scored post hoc on the same replay's model (rows
     ``gp_airp_MODE``, ``ls_airp_MODE``, ``cov_gp_airp_MODE`` and ``airp_MODE`` with the estimated gust against
     JSBSim's ``p - p_aero``; a diagnosis: the replay's table must not be gust-filtered)."""
@@ -295,7 +296,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     res = run_replay(files.tlog, af_path, out, ReplayOptions(progress=False, gust_rates=gust_rates,
                                                                           gust_filter=gust_filter,
                                                                           heldout_air_roll=heldout_air_roll,
-                                                                          air_roll_train=air_roll_train))
+                                                                          air_roll_train=air_roll_train,
+                                                                          gp_seed=gp_seed))
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
@@ -310,7 +312,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
                  "gust_rates": gust_rates, "gust_filter": gust_filter, "heldout_air_roll": heldout_air_roll,
-                 "air_roll_train": air_roll_train,
+                 "air_roll_train": air_roll_train, "gp_seed": gp_seed,
                  "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
@@ -676,6 +678,10 @@ def main(argv=None) -> int:
                     help="a zero-mean prior of this std (0: the slopes fixed at 0) on CY's p_hat and r_hat slopes, by "
                          "mixed estimation on the GP's target (gcs_sysid.pipeline.SIDE_FORCE_RATE_PRIOR_STD); 'off': "
                          "none; default: the package's default")
+    ap.add_argument("--gp-seed", type=int, default=0,
+                    help="the replay GP's seed (ReplayOptions.gp_seed, GPConfig.seed: the hyperparameters' row subset "
+                         "and the inducing points); issue 8's counts are judged at seeds 0 and 1 "
+                         "(benchmarks/issue8_counts.py); default %(default)s")
     ap.add_argument("--json", default=None, help="append one JSON line per flight to this file")
     ap.add_argument("--work", default=None, help="keep the flights and replays here (default: a temp dir)")
     ap.add_argument("--summarize", nargs="+", default=None, metavar="JSONL",
@@ -762,7 +768,7 @@ def main(argv=None) -> int:
                                None if a.gust_filter is None else
                                {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter],
                                a.heldout_air_roll, tuple(a.airp_lines),
-                               None if a.air_roll_train is None else a.air_roll_train == "on")
+                               None if a.air_roll_train is None else a.air_roll_train == "on", a.gp_seed)
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
