@@ -175,3 +175,22 @@ def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
     assert on["ls"]["err"]["Cl"] < 100.0 == off["ls"]["err"]["Cl"]                     # the fair line's Cl fitted
     for c in ("CX", "CY", "CZ", "Cm", "Cn"):
         assert on["indep"]["err"][c] == off["indep"]["err"][c]
+
+
+def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
+    """``--gp-seed N`` is handed to :func:`eval_jsbsim.evaluate` (which passes it as ``ReplayOptions.gp_seed``);
+    0 by default, as before the option existed."""
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def fake_evaluate(*args):
+        seen.append(args[-1])
+        raise Stop               # stop before the printing, which needs a scored row
+
+    monkeypatch.setattr(eval_jsbsim, "evaluate", fake_evaluate)
+    for argv, want in (([], 0), (["--gp-seed", "1"], 1)):
+        with pytest.raises(Stop):
+            eval_jsbsim.main(["--aircraft", "sgs", "--turbulence", "light", "--work", str(tmp_path), *argv])
+        assert seen[-1] == want

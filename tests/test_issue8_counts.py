@@ -1,0 +1,101 @@
+"""benchmarks/issue8_counts.py: issue 8's counts and rule 8(b)'s flips on small hand-made ``eval_jsbsim`` lines."""
+
+import json
+
+import pytest
+
+from benchmarks import issue8_counts as ic
+
+C = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
+
+
+def _row(ac="sgs", seed=1, gp_seed=0, meas=(1, 1, 1, 1, 1, 1), gp=(1, 1, 1, 1, 1, 1), tair=(1, 1, 1, 1, 1, 1),
+         ls=(2, 2, 2, 2, 2, 2), fair=None, cov_gp=95.0, cov_tair=95.0, corr=0.1):
+    r = {"aircraft": ac, "turbulence": "light", "seed": seed, "aoa": "ahrs", "gp_seed": gp_seed,
+         "meas": dict(zip(C, meas)), "gp": dict(zip(C, gp)), "true_air": dict(zip(C, tair)),
+         "ls": dict(zip(C, ls)), "cov_gp": cov_gp, "cov_true_air": cov_tair, "max_corr": corr}
+    if fair is not None:
+        r["ls_airtrain"] = dict(zip(C, fair))
+    return r
+
+
+def _write(path, rows):
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    return str(path)
+
+
+def test_the_lines_split_forces_from_moments_inclusive():
+    # measured: 3 % forces, 8 % moments; GP and true-air: 5 / 10 %
+    v = ic.item_values(_row(meas=(3.0, 3.01, 0.5, 8.0, 8.01, 2.9), gp=(5.0, 5.1, 9.0, 10.0, 10.5, 4.0),
+                            tair=(4.9, 6.0, 1.0, 11.0, 9.9, float("nan"))))
+    assert [v[("meas", c)] for c in C] == [True, False, True, True, False, True]
+    assert [v[("gp", c)] for c in C] == [True, False, False, True, False, True]
+    assert [v[("true_air", c)] for c in C] == [True, False, True, False, True, False]   # NaN satisfies nothing
+
+
+def test_gp_against_both_least_squares_lines_and_the_flight_counts():
+    v = ic.item_values(_row(gp=(1, 2, 3, 4, 5, 6), ls=(2, 2, 2, 9, 9, 9), fair=(0.5, 3, 3, 5, 5, 5),
+                            cov_gp=98.0, cov_tair=89.99, corr=0.51))
+    assert [v[("gp<ls", c)] for c in C] == [True, False, False, True, True, True]      # strict: a tie is no win
+    assert [v[("gp<fair", c)] for c in C] == [False, True, False, True, False, False]
+    assert v[("cov_gp", "")] is True and v[("cov_tair", "")] is False
+    assert v[("corr", "")] is True
+    w = ic.item_values(_row())                        # no ls_airtrain: the fair line is not scored at all
+    assert all(w[("gp<fair", c)] is None for c in C)
+
+
+def test_counts_per_aircraft_and_total():
+    rows = {ic.flight_key(r): r for r in (_row("sgs", 1), _row("sgs", 2, gp=(9,) * 6, cov_gp=99.0),
+                                          _row("t6", 1, corr=0.7))}
+    t = ic.tally(rows)
+    assert t["sgs"]["gp"] == [6 + 3, 12]              # flight 2: only the three moments within 10 %
+    assert t["sgs"]["cov_gp"] == [1, 2] and t["t6"]["corr"] == [1, 1]
+    assert t["total"]["gp<ls"] == [6 + 0 + 6, 18]
+    text = ic.format_counts(rows, "x")
+    assert "| sgs | 2 | 12 | 9 |" in text and "| **total** | 3 |" in text
+
+
+def test_flips_and_rule_8b_at_two_gp_seeds(tmp_path, capsys):
+    base, cand = [], []
+    LS = (9, 2, 2, 2, 2, 2)        # sgs's CX: GP < LS either way
+    for gs in (0, 1):
+        base += [_row("sgs", 1, gs, gp=(6, 1, 1, 1, 1, 1), ls=LS), _row("t6", 1, gs), _row("s23", 1, gs, corr=0.8)]
+    # seed 0: sgs wins CX held out, s23's correlation drops (a win), t6 loses its band -> +2/-1
+    cand += [_row("sgs", 1, 0, ls=LS), _row("t6", 1, 0, cov_gp=99.0), _row("s23", 1, 0, corr=0.2)]
+    # seed 1: sgs wins CX, t6 loses CY true-air and Cl's GP < LS, s23 unchanged -> +1/-2
+    cand += [_row("sgs", 1, 1, ls=LS), _row("t6", 1, 1, tair=(1, 7, 1, 1, 1, 1), gp=(1, 1, 1, 3, 1, 1)),
+             _row("s23", 1, 1, corr=0.8)]
+    ch0, un0 = ic.flips({ic.flight_key(r): r for r in base[:3]}, {ic.flight_key(r): r for r in cand[:3]})
+    assert un0 == [] and sorted((c["aircraft"], c["count"], c["win"]) for c in ch0) == [
+        ("s23", "corr", True), ("sgs", "gp", True), ("t6", "cov_gp", False)]
+    holds, both, text = ic.verdict({0: ch0, 1: ic.flips({ic.flight_key(r): r for r in base[3:]},
+                                                        {ic.flight_key(r): r for r in cand[3:]})[0]})
+    assert not holds and both == ["t6"]
+    assert "seed 0 +2/-1" in text and "seed 1 +1/-2" in text
+    # the same through the command line: the rows' own gp_seed pairs the files
+    b = _write(tmp_path / "b.jsonl", base)
+    c = _write(tmp_path / "c.jsonl", cand)
+    assert ic.main([c, "--against", b]) == 0
+    out = capsys.readouterr().out
+    assert "rule 8(b) FAILS" in out and "aircraft losing a count at every seed: t6" in out
+    assert "lost: t6 light s1 ahrs cov_gp" in out
+
+
+def test_rule_8b_needs_a_win_and_twice_the_losses():
+    win = {"aircraft": "a", "count": "gp", "win": True}
+    loss = {"aircraft": "b", "count": "gp", "win": False}
+    assert ic.verdict({0: [win, win, loss], 1: [win, win]})[0]
+    assert not ic.verdict({0: [win, loss], 1: [win, win]})[0]
+    assert not ic.verdict({0: [], 1: []})[0]                 # nothing won: no case for a change
+    with pytest.raises(ValueError):
+        ic.verdict({0: [win]})
+
+
+def test_a_file_can_state_its_gp_seed_and_a_flight_twice_is_refused(tmp_path):
+    old = dict(_row("sgs", 1))
+    del old["gp_seed"]
+    p = _write(tmp_path / "old.jsonl", [old])
+    assert set(ic.load_runs([p])) == {0} and set(ic.load_runs([p + "@1"])) == {1}
+    q = _write(tmp_path / "dup.jsonl", [_row("sgs", 1), _row("sgs", 1)])
+    with pytest.raises(SystemExit, match="twice"):
+        ic.load_runs([q])
