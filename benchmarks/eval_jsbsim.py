@@ -222,7 +222,8 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
         a: the parsed command line: ``stated_lift_slope`` (items ``AC:CL_ALPHA[:CL_Q]``: :data:`STATED_AERO` and
             ``airangles.STATED_LIFT_SLOPE`` on), ``stated_lift_level`` (:func:`parse_stated_line` items:
             :data:`STATED_LINE` and ``airangles.STATED_LIFT_LEVEL`` on), ``alpha_profile`` (column names:
-            ``airangles.ALPHA_PROFILE_COLUMNS``) and the ``on``/``off`` switches ``beta_profile``, and where the
+            ``airangles.ALPHA_PROFILE_COLUMNS``), ``beta_profile_min_lr`` where the script has it
+            (``airangles.BETA_PROFILE_MIN_LR``) and the ``on``/``off`` switches ``beta_profile``, and where the
             script has them ``kinematic_mean`` and ``floor_drops_curvature`` (``airangles.BETA_PROFILE``,
             ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``).
 
@@ -246,6 +247,8 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
                          ("beta_profile", "BETA_PROFILE")):
         if getattr(a, option, None) is not None:
             setattr(_aa, flag, getattr(a, option) == "on")
+    if getattr(a, "beta_profile_min_lr", None) is not None:
+        _aa.BETA_PROFILE_MIN_LR = a.beta_profile_min_lr
 
 
 def stated_airframe(path: Path, work: Path, stem: str) -> Path:
@@ -694,6 +697,10 @@ def main(argv=None) -> int:
                     help="CY_beta of the replay's sideslip aiding by the gust model's likelihood, held in the later "
                          "passes (gcs_sysid.estimation.airangles.BETA_PROFILE; default: the package's, on; the LS "
                          "line is fitted with the same estimator)")
+    ap.add_argument("--beta-profile-min-lr", default=None, type=float, metavar="LR",
+                    help="take the profiled CY_beta only where its likelihood-ratio statistic against least squares' "
+                         "slope reaches LR (3.84: the chi-squared 95 %% point; gcs_sysid.estimation.airangles."
+                         "BETA_PROFILE_MIN_LR; default: the package's, no test)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
                     help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."

@@ -226,6 +226,17 @@ BETA_PROFILE_RANGE = (2.0 / 3.0, 1.0)
 #: the 30-s wind estimate's drift, which a first-order gust state describes badly (full band: s23 s2, s3 -0.43, -0.31
 #: against JSBSim's -0.55; with 0.1 Hz -0.52, -0.56)
 BETA_PROFILE_EDGE_HZ = 0.1
+#: Opt-in (thirty-third session, i8-counts33; None: off, the default): the profiled ``CY_beta`` is taken only where
+#: the gust model's likelihood prefers it to least squares' significantly, i.e. the likelihood-ratio statistic
+#: ``2 (nll(least squares) - nll(profiled))`` (:func:`_angle_profile_objective`) reaches this value; below it least
+#: squares' slope is kept (and nothing is held). The statistic is chi-squared with one degree of freedom under least
+#: squares' slope (Wilks 1938; Pawitan, *In All Likelihood*, 2001, sec. 9.3): 3.84 is the 95 % level
+#: (:data:`BETA_PROFILE_LR_95`). On the s23's light flights the profile moved the slope by 1-1.5 curvature standard
+#: errors with a ratio of 0.3-2.1, and the model's Cl and Cn at the true regressors got worse
+#: (``docs/benchmarks.md``, "Thirty-third session, i8-counts33").
+BETA_PROFILE_MIN_LR: float | None = None
+#: the chi-squared 95 % point with one degree of freedom (``scipy.stats.chi2.ppf(0.95, 1)``)
+BETA_PROFILE_LR_95 = 3.841458820694124
 
 
 @dataclass
@@ -663,11 +674,46 @@ def _profile_columns(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray,
     return cr, moved
 
 
+def _angle_profile_objective(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray, coeff: np.ndarray,
+                             kin: np.ndarray, ang: np.ndarray, m: np.ndarray, segs: list[slice], cr: np.ndarray,
+                             taus: tuple[float, ...], ratios: tuple[float, ...], edge_hz: float | None = -1.0):
+    """The profile of :func:`_profile_angle_slope`: the other slopes for a candidate angle slope, and the
+    coefficient's negative log-likelihood under the gust model there (the arguments are that function's).
+
+    Returns:
+        ``(refit, nll)``: ``refit(d)`` the slopes ``(P,)`` with the angle's at ``d`` and the others refitted by least
+        squares on the band-passed rows; ``nll(d)`` the negative concentrated log-likelihood of ``z = g + e / d``
+        under the Gauss-Markov gust model (:func:`_gm_search`) plus the Jacobian ``N log|d|``, ``z`` high-passed at
+        ``edge_hz`` (None: the full band; negative: :data:`BETA_PROFILE_EDGE_HZ`).
+    """
+    cr = np.asarray(cr, float).copy()
+    n = int(m.sum())
+    edge_hz = BETA_PROFILE_EDGE_HZ if edge_hz is not None and edge_hz < 0 else edge_hz
+
+    def refit(d: float) -> np.ndarray:
+        c = cr.copy()
+        c[0] = d
+        if Ahm.shape[1] > 1:
+            c[1:] = np.linalg.lstsq(Ahm[:, 1:], yhm - d * Ahm[:, 0], rcond=None)[0]
+        return c
+
+    def nll(d: float) -> float:
+        c = refit(d)
+        model = float(np.mean(coeff[m] - A[m] @ c)) + A[m] @ c
+        z = np.full(len(kin), np.nan)
+        z[m] = ang[m] + (coeff[m] - model) / d - kin[m]
+        if edge_hz is not None:
+            z = _highpass(dt, z[:, None], segs, edge_hz)[:, 0]
+        return -(_gm_search(dt, z, segs, taus, ratios)[0] - n * np.log(abs(d)))
+
+    return refit, nll
+
+
 def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray, coeff: np.ndarray,
                          kin: np.ndarray, ang: np.ndarray, m: np.ndarray, segs: list[slice], cr: np.ndarray,
                          sign: float, taus: tuple[float, ...], ratios: tuple[float, ...],
                          search: tuple[float, float] | None = None,
-                         edge_hz: float | None = -1.0) -> tuple[np.ndarray, float]:
+                         edge_hz: float | None = -1.0, min_lr: float | None = None) -> tuple[np.ndarray, float]:
     """The angle's own slope (column 0, no curvature column) by the gust model's likelihood of the coefficient.
 
     The aiding's model is ``C = c0 + a (angle_kin + g) + X_other c_other + e`` with ``g`` a first-order
@@ -692,7 +738,8 @@ def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndar
         slopes. sign: the slope's expected sign. taus, ratios: the gust model's grid. search: the slope is searched
         (bounded Brent, scipy ``minimize_scalar``) between these multiples of least squares' slope (None:
         :data:`BETA_PROFILE_RANGE`). edge_hz: ``z``'s high-pass edge, Hz (None: the full band; negative:
-        :data:`BETA_PROFILE_EDGE_HZ`).
+        :data:`BETA_PROFILE_EDGE_HZ`). min_lr: least squares' slopes are kept unless the likelihood-ratio statistic
+        ``2 (nll(least squares) - nll(profiled))`` reaches it (None: no test; :data:`BETA_PROFILE_MIN_LR`).
 
     Returns:
         ``(slopes (P,), least squares' angle slope)``; least squares' slopes unchanged if its slope has the wrong sign.
@@ -703,31 +750,15 @@ def _profile_angle_slope(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndar
     b = float(cr[0])
     if not sign * b > 0:
         return cr, b
-    n = int(m.sum())
     search = BETA_PROFILE_RANGE if search is None else search
-    edge_hz = BETA_PROFILE_EDGE_HZ if edge_hz is not None and edge_hz < 0 else edge_hz
-
-    def refit(d: float) -> np.ndarray:
-        c = cr.copy()
-        c[0] = d
-        if Ahm.shape[1] > 1:
-            c[1:] = np.linalg.lstsq(Ahm[:, 1:], yhm - d * Ahm[:, 0], rcond=None)[0]
-        return c
-
-    def nll(d: float) -> float:
-        c = refit(d)
-        model = float(np.mean(coeff[m] - A[m] @ c)) + A[m] @ c
-        z = np.full(len(kin), np.nan)
-        z[m] = ang[m] + (coeff[m] - model) / d - kin[m]
-        if edge_hz is not None:
-            z = _highpass(dt, z[:, None], segs, edge_hz)[:, 0]
-        return -(_gm_search(dt, z, segs, taus, ratios)[0] - n * np.log(abs(d)))
-
+    refit, nll = _angle_profile_objective(dt, Ahm, yhm, A, coeff, kin, ang, m, segs, cr, taus, ratios, edge_hz)
     lo, hi = sorted((search[0] * b, search[1] * b))
     r = minimize_scalar(nll, bounds=(lo, hi), method="bounded", options={"xatol": 1e-3 * abs(b)})
     d = float(r.x)
     if not np.isfinite(r.fun) or min(d - lo, hi - d) < 0.01 * (hi - lo):
         return cr, b
+    if min_lr is not None and not 2.0 * (nll(b) - float(r.fun)) >= min_lr:
+        return cr, b         # the likelihood does not prefer the profiled slope significantly: least squares'
     return refit(d), b
 
 
@@ -879,7 +910,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                 and method.startswith("OLS")):
             # the filter-error estimate of the angle's slope: least squares reads the gust's part of the angle that
             # correlates with the kinematic one (steep above the directional mode, flat below it)
-            cr, b_ls = _profile_angle_slope(dt, Ah[m], yh[m], A, coeff, kin, ang, m, segs, cr, sign, TAUS_S, RATIOS)
+            cr, b_ls = _profile_angle_slope(dt, Ah[m], yh[m], A, coeff, kin, ang, m, segs, cr, sign, TAUS_S, RATIOS,
+                                            min_lr=BETA_PROFILE_MIN_LR)
             res = yh[m] - Ah[m] @ cr      # the identification check keeps least squares' standard error
             if cr[0] != b_ls:
                 profile_note = (f"; first pass {names[1] if name == 'alpha' else 'CY_beta'} by the gust model's "
