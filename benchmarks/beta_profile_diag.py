@@ -9,10 +9,14 @@ and on, and prints (a diagnosis: it reads JSBSim's truth, and only to score):
              ``2 (nll(b_ls) - nll(b_prof))`` of the two, the curvature's standard error of the profiled slope
              (``se``: ``1 / sqrt(nll'')`` at the optimum, by a parabola through the grid) and the curve
              ``nll(d) - nll(b_prof)`` over ``d / b_ls`` in :data:`GRID` (``curve`` in the JSON)
-  scale      the aided sideslip regressed on JSBSim's (``eval_jsbsim.cy_diagnosis``'s ``beta_scale``) on the held-out rows
+  scale      the aided sideslip regressed on JSBSim's (``eval_jsbsim.cy_diagnosis``'s ``beta_scale``) on the held-out rows;
+             ``beta_read``: JSBSim's sideslip regressed on the replay's with the replay's other lateral regressors
+             beside it (``factor``: what a moment's sideslip slope on the replay's regressors is multiplied by), and
+             the SD of the replay's sideslip beside those regressors (``partial_sd_deg``) and in all (``sd_deg``)
   slopes     the GP's and JSBSim's local slopes of CY, Cl and Cn on the true regressors with the aero rates
              (``beta p_hat r_hat delta_a delta_r``, least squares with a constant on the held-out rows), and the GP's
-             % error there (``eval_jsbsim``'s ``true_air``)
+             % error there (``eval_jsbsim``'s ``true_air``); ``meas_on_est`` / ``meas_on_true``: the measured
+             coefficient's slopes on the replay's / on JSBSim's regressors (all valid rows)
 
 Usage::
 
@@ -117,9 +121,24 @@ def diagnose(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     row = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "profile": profile, "gp_seed": gp_seed,
            "cpu_replay_s": round(cpu, 1), "true_air": _errs(ma, Yt[h]), "gp": _errs(res.pred_mean[h], Yt[h])}
     row["cy_diag"] = cy_diagnosis(tab.X[h], Xa[h], ma[:, 1], Yt[h, 1])
+    ok = tab.valid & np.isfinite(tab.Y).all(1) & np.isfinite(tab.X).all(1) & np.isfinite(Xa).all(1)
     for c in LATERAL:
         i = COEFFICIENTS.index(c)
-        row[f"slopes_{c}"] = {"model": local_slopes(Xa[h], ma[:, i]), "true": local_slopes(Xa[h], Yt[h, i])}
+        row[f"slopes_{c}"] = {"model": local_slopes(Xa[h], ma[:, i]), "true": local_slopes(Xa[h], Yt[h, i]),
+                              # the measured coefficient itself, all valid rows, on the replay's and on JSBSim's
+                              # regressors: whether a flat slope is in the data at the aided sideslip or in the model
+                              "meas_on_est": local_slopes(tab.X[ok], tab.Y[ok, i]),
+                              "meas_on_true": local_slopes(Xa[ok], tab.Y[ok, i])}
+    # the sideslip a moment slope reads: JSBSim's sideslip regressed on the replay's one with the replay's other lateral
+    # regressors beside it (all valid rows). A moment linear in the true sideslip then has its slope on the replay's
+    # regressors times this factor; the aided angle's error hurts more where the rates explain most of the sideslip
+    idx = [REGRESSORS.index(k) for k in CY_DIAG_COLUMNS]
+    G = np.c_[np.ones(ok.sum()), tab.X[ok][:, idx]]
+    lam, *_ = np.linalg.lstsq(G, Xa[ok, 1], rcond=None)
+    other = np.c_[np.ones(ok.sum()), tab.X[ok][:, idx[1:]]]
+    part = tab.X[ok, 1] - other @ np.linalg.lstsq(other, tab.X[ok, 1], rcond=None)[0]
+    row["beta_read"] = {"factor": float(lam[1]), "partial_sd_deg": float(np.degrees(np.std(part))),
+                        "sd_deg": float(np.degrees(np.std(tab.X[ok, 1])))}
     if calls:
         args, kwargs, b_prof = calls[0]
         row["profile_first_pass"] = profile_curve(args, kwargs, b_prof)
@@ -142,12 +161,16 @@ def main(argv=None) -> int:
                 r = diagnose(ac, seed, a.turbulence, a.duration, Path(a.work), profile, a.gp_seed)
                 append_jsonl(a.json, [r])
                 d = r["cy_diag"]
+                br = r["beta_read"]
                 print(f"{ac} {a.turbulence} s{seed} profile {'on ' if profile else 'off'}: beta scale "
-                      f"{d['beta_scale']:.3f}; true-air " + " ".join(f"{c} {r['true_air'][c]:.1f}" for c in COEFFICIENTS))
+                      f"{d['beta_scale']:.3f}, read by the moments x{br['factor']:.3f} (partial SD "
+                      f"{br['partial_sd_deg']:.2f} of {br['sd_deg']:.2f} deg); true-air " + " ".join(f"{c} {r['true_air'][c]:.1f}" for c in COEFFICIENTS))
                 for c in LATERAL:
                     s = r[f"slopes_{c}"]
                     print(f"    {c}: " + "  ".join(f"{k} {s['model'][k]:+.4f}/{s['true'][k]:+.4f}"
-                                                   for k in CY_DIAG_COLUMNS) + "  (GP / JSBSim)")
+                                                   for k in CY_DIAG_COLUMNS) + "  (GP / JSBSim); measured on the "
+                          f"replay's / JSBSim's regressors: beta {s['meas_on_est']['beta']:+.4f} / "
+                          f"{s['meas_on_true']['beta']:+.4f}")
                 p = r.get("profile_first_pass")
                 if p:
                     print(f"    first pass CY_beta: LS {p['b_ls']:+.4f} profiled {p['b_prof']:+.4f} "

@@ -8,6 +8,8 @@ the heading answers in anti-phase. As on the JSBSim s23 (least squares above 0.3
 the kinematic sideslip makes ``CY_beta`` steep; the filter-error estimate does not.
 """
 
+import re
+
 import numpy as np
 from scipy.signal import lfilter
 
@@ -74,3 +76,35 @@ def test_the_held_profiled_slope_survives_the_later_passes(monkeypatch):
     assert abs(free.coef[1] - first_free) > 2e-3
     # the rudder's slope is still refitted with the sideslip's held, and both fits aid the angle
     assert np.isfinite(held.coef[2]) and held.used and free.used
+
+
+def test_the_likelihood_ratio_test_keeps_least_squares_where_the_profile_is_not_preferred(monkeypatch):
+    # BETA_PROFILE_MIN_LR (thirty-third session, i8-counts33; opt-in): the profiled slope only where the likelihood
+    # ratio against least squares' slope reaches the threshold. The same record's statistic, from the objective the
+    # profile maximises, decides: above it the profile is taken as without the test, below it least squares' is kept
+    from gcs_sysid.estimation import airangles
+
+    kin, cy, others = _record(2)
+    use = np.ones(T, bool)
+    ls = _axis("beta", DT, kin, cy, others, use, 2, -1.0, False, False)[2]
+    free = _axis("beta", DT, kin, cy, others, use, 2, -1.0, False, False, profile=True)[2]
+    assert "by the gust model's likelihood" in free.slope_method
+    captured = []
+    orig = airangles._profile_angle_slope
+    monkeypatch.setattr(airangles, "_profile_angle_slope",
+                        lambda *a, **k: captured.append((a, k)) or orig(*a, **k))
+    _axis("beta", DT, kin, cy, others, use, 2, -1.0, False, False, profile=True)
+    a = captured[0][0]
+    _, nll = airangles._angle_profile_objective(*a[:10], *a[11:13])
+    b_ls = float(a[9][0])
+    d = float(re.search(r"likelihood ([-+0-9.]+)", free.slope_method).group(1))
+    lr = 2 * (nll(b_ls) - nll(d))
+    assert lr > 1.0                               # this record's profile is preferred
+    monkeypatch.setattr(airangles, "_profile_angle_slope", orig)
+    monkeypatch.setattr(airangles, "BETA_PROFILE_MIN_LR", 0.5 * lr)
+    passed = _axis("beta", DT, kin, cy, others, use, 2, -1.0, False, False, profile=True)[2]
+    assert passed.coef[1] == free.coef[1] and passed.slope_method == free.slope_method
+    monkeypatch.setattr(airangles, "BETA_PROFILE_MIN_LR", 2.0 * lr)
+    kept = _axis("beta", DT, kin, cy, others, use, 2, -1.0, False, False, profile=True)[2]
+    assert "likelihood" not in kept.slope_method        # least squares' slope, nothing held
+    assert kept.coef[1] == ls.coef[1]
