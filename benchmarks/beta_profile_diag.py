@@ -9,7 +9,7 @@ and on, and prints (a diagnosis: it reads JSBSim's truth, and only to score):
              ``2 (nll(b_ls) - nll(b_prof))`` of the two, the curvature's standard error of the profiled slope
              (``se``: ``1 / sqrt(nll'')`` at the optimum, by a parabola through the grid) and the curve
              ``nll(d) - nll(b_prof)`` over ``d / b_ls`` in :data:`GRID` (``curve`` in the JSON)
-  scale      the aided sideslip regressed on JSBSim's (``eval_jsbsim.cy_diagnosis``'s ``beta_scale``) on the held-out rows;
+  scale      the aided sideslip regressed on JSBSim's (``eval_jsbsim.cy_diagnosis``'s ``beta_scale``), held-out rows;
              ``beta_read``: JSBSim's sideslip regressed on the replay's with the replay's other lateral regressors
              beside it (``factor``: what a moment's sideslip slope on the replay's regressors is multiplied by), and
              the SD of the replay's sideslip beside those regressors (``partial_sd_deg``) and in all (``sd_deg``)
@@ -164,7 +164,8 @@ def main(argv=None) -> int:
                 br = r["beta_read"]
                 print(f"{ac} {a.turbulence} s{seed} profile {'on ' if profile else 'off'}: beta scale "
                       f"{d['beta_scale']:.3f}, read by the moments x{br['factor']:.3f} (partial SD "
-                      f"{br['partial_sd_deg']:.2f} of {br['sd_deg']:.2f} deg); true-air " + " ".join(f"{c} {r['true_air'][c]:.1f}" for c in COEFFICIENTS))
+                      f"{br['partial_sd_deg']:.2f} of {br['sd_deg']:.2f} deg); true-air "
+                      + " ".join(f"{c} {r['true_air'][c]:.1f}" for c in COEFFICIENTS))
                 for c in LATERAL:
                     s = r[f"slopes_{c}"]
                     print(f"    {c}: " + "  ".join(f"{k} {s['model'][k]:+.4f}/{s['true'][k]:+.4f}"

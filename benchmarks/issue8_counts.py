@@ -291,8 +291,9 @@ def main(argv=None) -> int:
                          "8(b)'s verdict where two or more GP seeds are paired")
     a = ap.parse_args(argv)
     cand = load_runs(a.files)
+    print(f"runs: {' '.join(a.files)}" + (f" against {' '.join(a.against)}" if a.against else ""), end="\n\n")
     for gs, rows in sorted(cand.items()):
-        print(format_counts(rows, f"counts, GP seed {gs} ({', '.join(a.files)})"), end="\n\n")
+        print(format_counts(rows, f"counts, GP seed {gs}"), end="\n\n")
     if a.against is None:
         return 0
     base = load_runs(a.against)

@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-SCRIPTS = ("benchmarks/eval_jsbsim_diagnose.py", "benchmarks/eval_jsbsim.py")
+SCRIPTS = ("benchmarks/eval_jsbsim_diagnose.py", "benchmarks/eval_jsbsim.py", "benchmarks/issue8_counts.py",
+           "benchmarks/beta_profile_diag.py")
 
 
 def unbound_globals(source: str, filename: str) -> list[str]:

@@ -99,3 +99,20 @@ def test_a_file_can_state_its_gp_seed_and_a_flight_twice_is_refused(tmp_path):
     q = _write(tmp_path / "dup.jsonl", [_row("sgs", 1), _row("sgs", 1)])
     with pytest.raises(SystemExit, match="twice"):
         ic.load_runs([q])
+
+
+def test_beta_profile_diag_local_slopes_recover_a_linear_moment():
+    # benchmarks/beta_profile_diag.py reads the lateral slopes by least squares on the CY_DIAG_COLUMNS
+    import numpy as np
+
+    from benchmarks import beta_profile_diag as bpd
+    from gcs_sysid.aero.table import REGRESSORS
+
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((400, len(REGRESSORS)))
+    want = {"beta": 0.07, "p_hat": -0.04, "r_hat": -0.15, "delta_a": 0.006, "delta_r": -0.06}
+    y = 0.01 + sum(v * X[:, REGRESSORS.index(k)] for k, v in want.items()) + 0.3 * X[:, REGRESSORS.index("alpha")]
+    y[5] = np.nan                                     # a row without a value is left out
+    got = bpd.local_slopes(X, y)
+    assert set(got) == set(want)
+    assert all(abs(got[k] - v) < 0.05 for k, v in want.items())

@@ -231,9 +231,11 @@ BETA_PROFILE_EDGE_HZ = 0.1
 #: ``2 (nll(least squares) - nll(profiled))`` (:func:`_angle_profile_objective`) reaches this value; below it least
 #: squares' slope is kept (and nothing is held). The statistic is chi-squared with one degree of freedom under least
 #: squares' slope (Wilks 1938; Pawitan, *In All Likelihood*, 2001, sec. 9.3): 3.84 is the 95 % level
-#: (:data:`BETA_PROFILE_LR_95`). On the s23's light flights the profile moved the slope by 1-1.5 curvature standard
-#: errors with a ratio of 0.3-2.1, and the model's Cl and Cn at the true regressors got worse
-#: (``docs/benchmarks.md``, "Thirty-third session, i8-counts33").
+#: (:data:`BETA_PROFILE_LR_95`). On the s23's light flights the profile moved the slope by 0.6-1.5 curvature standard
+#: errors with a ratio of 0.3-2.1, and the model's Cl and Cn at the true regressors got worse. At 3.84 on the 75 light
+#: roster flights it refused the profile on 23 of the 41 it moves (12 aircraft) and lost rule 8(b) on issue 8's
+#: counts (+4/-5 at GP seed 0, +4/-9 at seed 1; ``docs/benchmarks.md``, "Thirty-third session, i8-counts33";
+#: ``docs/estimation.md``, "Why the s23 loses counts with it").
 BETA_PROFILE_MIN_LR: float | None = None
 #: the chi-squared 95 % point with one degree of freedom (``scipy.stats.chi2.ppf(0.95, 1)``)
 BETA_PROFILE_LR_95 = 3.841458820694124
