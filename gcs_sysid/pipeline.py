@@ -406,8 +406,8 @@ def _load_stages() -> None:
 
 def _load_model_stages() -> None:
     """Import the modules of the stages after estimation (JAX, optax: about 0.6 CPU s) and set up JAX
-    (64-bit; idempotent). Run while the worker runs the velocity filter and smooths the specific force
-    (:func:`gcs_sysid.estimation.estimate_states`' ``meanwhile``), and before the coefficients in any case."""
+    (64-bit; idempotent). Run while the worker smooths the specific force (the estimation stage's wait,
+    :func:`gcs_sysid.estimation.estimate_states`' ``meanwhile``), and before the coefficients in any case."""
     from .jaxconfig import enable_x64
 
     enable_x64()
@@ -451,7 +451,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     stage = StagedDir(out, "replay", REPLAY_OUTPUTS) if options.write else None
     timings: dict[str, float] = {}
     notes: list[str] = []
-    # the worker decodes part of the log, runs the velocity filter, smooths the specific force, then draws the figures
+    # the worker decodes part of the log, smooths the specific force, then draws the figures
     helper = Helper(enabled=None if options.parallel else False, warm=("gcs_sysid.telemetry.tlog_scan",))
     figures: dict[str, Job] = {}
     csv_job: Job | None = None   # coefficients.csv from the worker's measured fields, written by write_report
@@ -470,8 +470,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             flight = read_log(log, progress=prog, helper=helper, meanwhile=_load_stages)
         from .estimation import estimate_states
 
-        # for the velocity filter and the specific-force smoother, next
-        helper.preload(["gcs_sysid.estimation.smoothers", "gcs_sysid.estimation.rates"])
+        helper.preload(["gcs_sysid.estimation.rates"])   # for the specific-force smoother, next
         if options.notify is not None:
             for note in flight.damage:
                 options.notify(f"damaged log: {note}")
@@ -481,8 +480,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             flight = merge_can_log(flight, log, options.can_log, options.can_offset)
         flight = cut_window(flight, options.t_from, options.t_to)
         with _stage("estimate states", timings, bar) as prog:
-            # the later stages' imports (JAX) run here while the worker runs the velocity filter and smooths the
-            # specific force
+            # the later stages' imports (JAX) run here while the worker smooths the specific force
             states = estimate_states(flight, airframe, rate_hz=options.rate_hz, progress=prog, helper=helper,
                                      meanwhile=_load_model_stages)
         _load_model_stages()   # idempotent: done already unless estimation had no specific force to hand over

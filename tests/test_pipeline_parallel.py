@@ -1,5 +1,4 @@
-"""The replay with its worker process (decode split, velocity filter, specific force, figures) equals the replay
-without."""
+"""The replay with its worker process (decode split, specific force, figures) equals the replay without."""
 
 from pathlib import Path
 

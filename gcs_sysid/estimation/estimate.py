@@ -26,7 +26,7 @@ from .align import Aligned, align_flight, events
 from .alpharate import kinematic_alpha_rate
 from .ekf import dcm, smooth_attitude
 from .rates import CONTROL_AXES, COUPLED, GUST_HZ, HOLDS, normal_force_input, smooth_rates
-from .smoothers import normal_gravity, smooth_level
+from .smoothers import normal_gravity, smooth_level, smooth_velocity
 from .kalman import noise_std
 from .measured import surface_controls
 from .states import FlightStates
@@ -145,9 +145,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         airframe: mass properties, servo maps and IMU lever arm.
         rate_hz: grid rate, Hz (capped at the IMU rate).
         progress: optional ``callable(fraction)`` called as stages finish.
-        helper: a :class:`~gcs_sysid.parallel.Helper` whose worker runs the velocity filter and then smooths
-            the specific force while this process runs ``meanwhile`` and the air data (None: all here; same
-            results).
+        helper: a :class:`~gcs_sysid.parallel.Helper` whose worker smooths the specific force while
+            this process runs the velocity filter and the air data (None: all here; same results).
         aid_air_angles: aid the kinematic alpha and beta with the specific force
             (:mod:`gcs_sysid.estimation.airangles`; False: kinematic only, for comparisons).
         earth: the velocity filter's Earth: ``"wgs84"`` (WGS-84 normal gravity, Coriolis and transport
@@ -164,11 +163,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         gust_force_axes: the specific-force axes (0 x, 1 y, 2 z) offered that state; None:
             :data:`gcs_sysid.estimation.rates.GUST_FORCE_AXES` as it stands at the call (y and z; ``(0, 1, 2)``
             adds x, opt-in, ``eval_jsbsim --gust-force-axes xyz``; docs/estimation.md).
-        meanwhile: optional callable run once, in this process, once the velocity filter and the specific-force
-            smoother are handed to ``helper`` and before their results are collected: the caller's own preparation
-            (the replay's later imports) overlaps the worker's smoothers instead of waiting for them. Not run when
-            the flight has no accelerometer (no smoother to wait for). It must not change what this function
-            computes.
+        meanwhile: optional callable run once, in this process, after the velocity filter and the air data and
+            before the specific-force smoother's result is collected: the caller's own preparation (the replay's
+            later imports) overlaps the worker's smoother instead of waiting for it. Not run when the flight has
+            no accelerometer (no smoother to wait for). It must not change what this function computes.
         profile_beta: the sideslip aiding's ``CY_beta`` by the gust model's likelihood (True) or by least squares
             (False); None: :data:`gcs_sysid.estimation.airangles.BETA_PROFILE` as it stands at the call (on; the
             diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_PROFILE`, off).
@@ -344,39 +342,30 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             notes.append("accelerometers moved to the CG (lever arm " + ", ".join(f"{x:g}" for x in r_arm) + " m)")
     else:
         missing.append("ax ay az: no accelerometer (IMU) stream")
+    if f_cg is not None:   # needs nothing from the velocity filter and the air data below: in the helper's
+        # worker (when there is one) while this process runs them; collected at the end
+        sf_job = (helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
+                                                          f_cg, controls=U, scale=qbar_eas, input_lag=in_lag,
+                                                          holds=(Rr.hold,) if in_lag is not None else HOLDS,
+                                                          gust_hz=GUST_HZ if turbulence_state else (),
+                                                          gust_axes=tuple(_rates.GUST_FORCE_AXES if gust_force_axes
+                                                                          is None else gust_force_axes))
     vsrc = "gps" if _stack(al, "gps", ("vn", "ve", "vd")) is not None else (
         "local_position" if _stack(al, "local_position", ("vx", "vy", "vz")) is not None else None)
     vfields = ("vn", "ve", "vd") if vsrc == "gps" else ("vx", "vy", "vz")
     v_ned = None
     C = dcm(*euler.T) if euler is not None else None
-    # Two smoothers go to the helper's worker (when there is one; else each runs here when collected, with the
-    # same results): the velocity filter first, then the specific-force smoother, which needs nothing from the
-    # velocity filter and the air data below. Meanwhile this process runs the caller's ``meanwhile`` (the replay's
-    # later imports); it collects the velocity for the air data and the smoothed specific force at the end.
-    pool = helper or Helper(enabled=False)
-    vel_job = None
+    abias = np.zeros((T, 3))
     if vsrc is not None:
+        if vsrc == "local_position":
+            notes.append("no GPS velocity: using LOCAL_POSITION_NED (the autopilot's EKF velocity)")
         vmeas = events(flight[vsrc], vfields, t)
         if f_cg is not None and C is not None:
             sa = float(np.median([noise_std(f_cg[:, i], 1e-3) for i in range(3)]))
             lat = al.get("gps", "lat") if earth == "wgs84" else np.full(T, np.nan)
             round_earth = bool(np.isfinite(lat).any())
-            vel_job = pool.submit("gcs_sysid.estimation.smoothers:smooth_velocity", dt, C, f_cg, vmeas, sa,
-                                  lat=lat if round_earth else None, alt=al.get("gps", "alt"))
-    if f_cg is not None:
-        sf_job = pool.submit("gcs_sysid.estimation.rates:smooth_specific_force", dt,
-                             f_cg, controls=U, scale=qbar_eas, input_lag=in_lag,
-                             holds=(Rr.hold,) if in_lag is not None else HOLDS,
-                             gust_hz=GUST_HZ if turbulence_state else (),
-                             gust_axes=tuple(_rates.GUST_FORCE_AXES if gust_force_axes is None else gust_force_axes))
-        if meanwhile is not None:
-            meanwhile()
-    abias = np.zeros((T, 3))
-    if vsrc is not None:
-        if vsrc == "local_position":
-            notes.append("no GPS velocity: using LOCAL_POSITION_NED (the autopilot's EKF velocity)")
-        if vel_job is not None:
-            Vel = vel_job.result()
+            Vel = smooth_velocity(dt, C, f_cg, vmeas, sa, lat=lat if round_earth else None,
+                                  alt=al.get("gps", "alt"))
             v_ned, vsig, abias = Vel.v_ned, Vel.v_sigma, Vel.accel_bias
             vs = f"KF + RTS: accelerometers (attitude-rotated) integrated, updated by {vsrc} velocity"
             if round_earth:
@@ -535,6 +524,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         data["alpha"], data["beta"] = alpha, beta
     if f_cg is not None:
         # the velocity filter needs the raw samples (white noise); the coefficients get the smoothed ones
+        if meanwhile is not None:
+            meanwhile()
         f_s, f_sig, f_noise = sf_job.result()
         f_corr = f_s - abias
         for i, k in enumerate(("ax", "ay", "az")):

@@ -85,17 +85,12 @@ class _Stop(Exception):
 
 
 class _RecordingHelper:
-    """Stands in for :class:`gcs_sysid.parallel.Helper`: records the specific-force job's arguments, then stops
-    (the velocity filter, handed over first, runs in this process when collected)."""
+    """Stands in for :class:`gcs_sysid.parallel.Helper`: records the specific-force job's arguments, then stops."""
 
     def __init__(self):
         self.kwargs = None
 
     def submit(self, target, *args, **kwargs):
-        from gcs_sysid.parallel import Helper
-
-        if target.endswith(":smooth_velocity"):
-            return Helper(enabled=False).submit(target, *args, **kwargs)
         assert target.endswith(":smooth_specific_force")
         self.kwargs = kwargs
         raise _Stop
