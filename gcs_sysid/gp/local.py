@@ -44,7 +44,7 @@ MISSING_NOISE = 1e8
 #: stored points at exactly the same distance from a query, i.e. duplicated rows, could come in another order).
 #: The rows of a flight lie along a trajectory in the 10-D regressor space, where median cuts make many thin
 #: cells: on the 10-minute benchmark flight (24,000 stored rows, 16 neighbours) the confidence map's 4,096
-#: queries take 0.34 -> 0.12 CPU s, the 30,000 predictions 0.35 -> 0.17 and the validation's shared search (49
+#: queries take 0.32 -> 0.12 CPU s, the 30,000 predictions 0.34 -> 0.17 and the validation's shared search (49
 #: neighbours of every row) 0.67 -> 0.38 (``docs/benchmarks.md``, "Thirty-third session, speed33").
 NEIGHBOUR_TREE = {"leafsize": 64, "balanced_tree": False}
 
