@@ -297,9 +297,12 @@ def _store_executable(cache: str | os.PathLike, key: str, program, args: tuple):
 
     ``program.lower(*args).compile()`` is the path ``program(*args)`` takes (trace, lower, compile or load from the
     compilation cache), so the executable is the one the call would run. Only an executable XLA compiled in this
-    call is written: one that the compilation cache loaded serialises without its code (jax 0.10.2, CPU: a later
-    process's call failed with "NOT_FOUND: Function convert_copy_fusion not found"), so a cache hit writes nothing.
-    Writing is best effort.
+    process is written: one that the compilation cache loaded serialises without its code (jax 0.10.2, CPU: a later
+    process's call failed with "NOT_FOUND: Function convert_copy_fusion not found"). A cache hit (the same program
+    under a new key: the package's source changed, the program did not) is therefore compiled once more without the
+    cache (:func:`_compile_uncached`) and that executable is written; without it every later process traced, lowered
+    and looked the program up again (about 0.5 s of the benchmark replay's main process, thirty-third session,
+    speed33). Writing is best effort.
 
     Returns:
         The :class:`jax.stages.Compiled` (also when nothing was written), or None when this program cannot be
@@ -319,7 +322,10 @@ def _store_executable(cache: str | os.PathLike, key: str, program, args: tuple):
     except Exception:
         return None
     if _CACHE_HITS[0] != hits:
-        return compiled
+        fresh = _compile_uncached(program, args)
+        if fresh is None:
+            return compiled                   # as loaded from the cache: nothing to write
+        compiled = fresh
     try:
         from jax.experimental import serialize_executable
 
@@ -335,6 +341,40 @@ def _store_executable(cache: str | os.PathLike, key: str, program, args: tuple):
     except Exception:
         pass
     return compiled
+
+
+def _compile_uncached(program, args: tuple):
+    """``program`` (a jitted function) compiled for ``args`` by XLA in this process, not loaded from JAX's
+    persistent compilation cache: for this one compilation the cache is off (``jax_enable_compilation_cache``; JAX
+    decides once per process whether it uses the cache, so its private ``compilation_cache.reset_cache`` makes it
+    decide again, before and after) and JAX's in-memory caches are cleared (:func:`jax.clear_caches`: else the
+    lowering and the executable just loaded would be handed back). The same program compiled by the same XLA: the
+    executable that a run with an empty cache compiles and writes.
+
+    Returns:
+        The :class:`jax.stages.Compiled`, or None when this JAX lacks ``reset_cache`` or the compilation fails
+        (nothing is raised; the cache is on again either way).
+    """
+    import jax
+
+    try:
+        from jax._src import compilation_cache
+    except ImportError:
+        return None
+    reset = getattr(compilation_cache, "reset_cache", None)
+    if reset is None:
+        return None
+    was = jax.config.jax_enable_compilation_cache
+    try:
+        jax.config.update("jax_enable_compilation_cache", False)
+        reset()
+        jax.clear_caches()
+        return program.lower(*args).compile()
+    except Exception:
+        return None
+    finally:
+        jax.config.update("jax_enable_compilation_cache", was)
+        reset()
 
 
 class _Loaded:

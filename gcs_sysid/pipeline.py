@@ -458,7 +458,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
     # the worker decodes part of the log, smooths the specific force, then draws the figures
     helper = Helper(enabled=None if options.parallel else False, warm=("gcs_sysid.telemetry.tlog_scan",))
     figures: dict[str, Job] = {}
-    csv_job: Job | None = None   # coefficients.csv, when the worker writes it
+    csv_job: Job | None = None   # coefficients.csv from the worker's measured fields, written by write_report
 
     def draw(name: str, function: str, *args) -> None:
         if options.write:
@@ -650,10 +650,15 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, cols], 0.0))
             # the measurements are drawn against the band for a measurement
             draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma_obs, held, ident)
-            if stage is not None:   # coefficients.csv written by the worker while the suggestions are ranked
-                csv_job = helper.submit("gcs_sysid.report.tables:write_csv_data",
-                                        csv_data(table.t, table.X, table.Y, pred_mean, pred_sigma, pred_sigma_obs,
-                                                 held), stage.path / "coefficients.csv", measured_csv.result())
+            if stage is not None:
+                # coefficients.csv: its measured fields were formatted by the worker while the GP was fitted; the
+                # model's fields are formatted and the file written here, by write_report while the worker draws
+                # the last figures (after the predictions the worker's figures are the longer chain; a job without
+                # a worker runs when collected)
+                csv_job = Helper(enabled=False).submit(
+                    "gcs_sysid.report.tables:write_csv_data",
+                    csv_data(table.t, table.X, table.Y, pred_mean, pred_sigma, pred_sigma_obs, held),
+                    stage.path / "coefficients.csv", measured_csv.result())
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
                 cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
@@ -709,7 +714,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         return result
     finally:
         if stage is not None and not ok:
-            helper.close(wait=False)   # stopped first: it may be writing coefficients.csv into the staged folder
+            helper.close(wait=False)   # stopped first, before its staged folder is removed
             stage.abort()
         helper.close(wait=ok)
         if bar is not None:

@@ -12,8 +12,9 @@ local layer ("local GP with a non-stationary covariance for fast variations"), s
 with the global layer.
 
 Neighbours are searched with a k-d tree in the global layer's metric (standardised
-inputs divided by the global length-scales). Local hyperparameters maximise a composite
-likelihood: the sum of exact log marginal likelihoods over random neighbourhoods.
+inputs divided by the global length-scales), built by :func:`neighbour_tree`. Local
+hyperparameters maximise a composite likelihood: the sum of exact log marginal
+likelihoods over random neighbourhoods.
 """
 
 from __future__ import annotations
@@ -29,11 +30,29 @@ from ..jaxconfig import stored_jit
 
 from .kernels import GibbsKernel
 
-__all__ = ["LocalParams", "LocalStore", "build_store", "neighbours", "local_predict_chunk",
-           "local_objective", "shared_nll", "MISSING_NOISE"]
+__all__ = ["LocalParams", "LocalStore", "build_store", "neighbours", "neighbour_tree", "NEIGHBOUR_TREE",
+           "local_predict_chunk", "local_objective", "shared_nll", "MISSING_NOISE"]
 
 #: Noise variance of a neighbour's missing output, in units of that output's ``amp + noise``.
 MISSING_NOISE = 1e8
+
+#: How the neighbour search's k-d trees are built (``scipy.spatial.cKDTree`` keyword arguments): cells cut at the
+#: sliding midpoint of their longest side instead of at the median (``balanced_tree=False``; Maneewongvatana and
+#: Mount 1999, "It's okay to be skinny, if your friends are fat"), 64 points per leaf instead of 16. The tree only
+#: decides which cells are visited: every returned distance is computed from the same two points by the same
+#: arithmetic, so a query returns the same neighbours and the same distances bit for bit, in the same order (two
+#: stored points at exactly the same distance from a query, i.e. duplicated rows, could come in another order).
+#: The rows of a flight lie along a trajectory in the 10-D regressor space, where median cuts make many thin
+#: cells: on the 10-minute benchmark flight (24,000 stored rows, 16 neighbours) the confidence map's 4,096
+#: queries take 0.32 -> 0.12 CPU s, the 30,000 predictions 0.34 -> 0.17 and the validation's shared search (49
+#: neighbours of every row) 0.67 -> 0.38 (``docs/benchmarks.md``, "Thirty-third session, speed33").
+NEIGHBOUR_TREE = {"leafsize": 64, "balanced_tree": False}
+
+
+def neighbour_tree(pts: np.ndarray) -> cKDTree:
+    """The k-d tree of the local layer's neighbour searches on ``pts (N, D)`` (the rows in the neighbour metric),
+    built with :data:`NEIGHBOUR_TREE`."""
+    return cKDTree(pts, **NEIGHBOUR_TREE)
 
 
 @jax.tree_util.register_dataclass
@@ -78,7 +97,7 @@ def build_store(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int) -
     """Index the points ``Xs (N, D)`` with residuals ``resid (N, P)`` for ``k``-neighbour queries."""
     k = int(max(1, min(k, len(Xs))))
     pts = Xs * metric
-    tree = cKDTree(pts)
+    tree = neighbour_tree(pts)
     kk = min(k + 1, len(Xs))
     dist, _ = tree.query(pts, k=kk, workers=-1)
     dist = np.asarray(dist).reshape(len(Xs), kk)

@@ -46,7 +46,7 @@ from ..jaxconfig import stored_jit
 from jax.scipy.linalg import cho_solve
 
 from .batching import _add_jit, global_stats, local_predict
-from .local import LocalParams, LocalStore
+from .local import LocalParams, LocalStore, neighbour_tree
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _concrete, _selectors, design, features
 
 __all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "SHARED_NEIGHBOURS", "block_folds", "scale_latent",
@@ -277,11 +277,9 @@ class NeighbourSearch:
 def shared_search(Xs: np.ndarray, metric: np.ndarray, k: int) -> NeighbourSearch:
     """The ``min(N, SHARED_NEIGHBOURS * k + 1)`` nearest rows of every row of ``Xs (N, D)`` in the
     metric ``metric (D,)`` (one k-d tree query; :func:`store_without` builds stores from it)."""
-    from scipy.spatial import cKDTree
-
     n = len(Xs)
     pts = Xs * metric
-    tree = cKDTree(pts)
+    tree = neighbour_tree(pts)
     wide = min(n, SHARED_NEIGHBOURS * int(k) + 1)
     dist, idx = tree.query(pts, k=wide, workers=-1)
     return NeighbourSearch(pts, tree, np.asarray(dist).reshape(n, wide), np.asarray(idx).reshape(n, wide),
@@ -304,15 +302,13 @@ def store_without(search: NeighbourSearch, Xs: np.ndarray, resid: np.ndarray, a:
         search: :func:`shared_search` of ``Xs``. Xs: ``(N, D)`` standardised rows; resid: ``(N, P)``.
         a, b: the held-back rows ``[a, b)``; at least 2 rows must lie outside.
     """
-    from scipy.spatial import cKDTree
-
     n = len(Xs)
     keep_rows = np.r_[0:a, b:n]
     m = len(keep_rows)
     kb = int(max(1, min(search.k, m)))
     kk = min(kb + 1, m)                                       # <= the shared width: m <= N, kb <= k
     p_keep = search.pts[keep_rows]
-    tree = search.tree if m == n else cKDTree(p_keep)
+    tree = search.tree if m == n else neighbour_tree(p_keep)
     ii = search.idx[keep_rows]
     outside = (ii < a) | (ii >= b)
     # the first kk neighbours outside the block, in distance order (stable: the query's order)

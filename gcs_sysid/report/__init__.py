@@ -29,9 +29,9 @@ def write_report(result: ReplayResult, out_dir: str | Path, save: bool = True,
         out_dir: output directory.
         save: also save the result itself (``out_dir/result/result.{json,npz}``) for re-rendering.
         figures: figures drawn elsewhere, or jobs drawing them (see :func:`~gcs_sysid.report.html.render_html`).
-        csv: None, or a job already writing ``out_dir/coefficients.csv`` (its ``result()`` gives the path:
-            :func:`~gcs_sysid.report.tables.write_csv_data` in the pipeline's worker process); waited for
-            before the HTML.
+        csv: None, or a job writing ``out_dir/coefficients.csv`` (its ``result()`` gives the path:
+            :func:`~gcs_sysid.report.tables.write_csv_data`, which the pipeline runs here, from the measured
+            fields its worker formatted); collected before the HTML.
 
     Returns:
         name -> path for ``report.html``, ``summary.md``, ``coefficients.csv``, ``suggestions.json``,

@@ -208,8 +208,8 @@ def csv_measured_text(t: np.ndarray, X: np.ndarray, Y: np.ndarray) -> list[str]:
 
 def write_csv_data(data: np.ndarray, path: str | Path, measured: list[str] | None = None) -> Path:
     """Write coefficients.csv from :func:`csv_data`'s ``(N, len(CSV_COLUMNS))`` array to ``path``; the same
-    file as :func:`write_csv` (the pipeline has its worker process write it while the suggestions are
-    ranked).
+    file as :func:`write_csv` (the pipeline writes it with the measured fields its worker process formatted while
+    the GP was fitted, while the worker draws the last figures).
 
     Args:
         data: :func:`csv_data`'s array.

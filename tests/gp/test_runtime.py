@@ -157,7 +157,7 @@ def test_stored_executable_is_loaded_by_the_next_process_and_gives_the_same_bits
     assert first["bits"] == again["bits"] == off["bits"]
 
 
-def test_corrupt_or_foreign_executable_falls_back_and_a_cache_hit_is_not_stored(tmp_path):
+def test_corrupt_or_foreign_executable_falls_back_and_a_cache_hit_is_compiled_and_stored(tmp_path):
     import pickle
 
     cache = {"GCS_SYSID_JAX_CACHE": str(tmp_path / "jax")}
@@ -172,10 +172,15 @@ def test_corrupt_or_foreign_executable_falls_back_and_a_cache_hit_is_not_stored(
         path.write_bytes(bad)
         run = _exe_run(cache)
         assert run["loaded"] == 0 and run["exported"] == 1 and run["bits"] == first["bits"]
-    # the program is in JAX's compilation cache: what it loads is not written again (it would lack its code)
+    # the program is in JAX's compilation cache but its executable's file is gone (as after a change of the package's
+    # source: a new key). What the cache loads lacks its code, so the program is compiled once more without the
+    # cache and that executable is written; the next process loads it and runs it, with the same bits
     path.unlink()
     run = _exe_run(cache)
-    assert run["bits"] == first["bits"] and not list((tmp_path / "jax" / "compiled").glob("*.jaxexe"))
+    assert run["bits"] == first["bits"] and run["loaded"] == 0 and run["exported"] == 1
+    assert [p.name for p in (tmp_path / "jax" / "compiled").glob("*.jaxexe")] == [path.name]
+    again = _exe_run(cache)
+    assert again["loaded"] == 1 and again["exported"] == 0 and again["bits"] == first["bits"]
 
 
 def test_loaded_executable_that_fails_on_its_first_call_gives_way_and_is_removed(tmp_path):

@@ -106,8 +106,8 @@ def test_save_load_rerender(partial_result, tmp_path):
 
 
 def test_csv_written_by_a_job_is_the_same_file(written, tmp_path):
-    """write_report(csv=job): the pipeline's worker writes coefficients.csv from csv_data (write_csv_data),
-    its measured fields formatted earlier (csv_measured_text); the report waits for it and the file is the
+    """write_report(csv=job): the pipeline writes coefficients.csv from csv_data (write_csv_data), its
+    measured fields formatted earlier by its worker (csv_measured_text); the report collects it and the file is the
     one write_csv writes, byte for byte, with or without the measured fields given."""
     from gcs_sysid.report.tables import csv_data, csv_measured_text, write_csv_data
 
