@@ -39,6 +39,13 @@ Usage::
     python benchmarks/issue8_counts.py base-g0.jsonl                     # one run's counts
     python benchmarks/issue8_counts.py cand-g0.jsonl cand-g1.jsonl --against base-g0.jsonl base-g1.jsonl
     python benchmarks/issue8_counts.py old-s1.jsonl@1 --against main-s1.jsonl@1   # rows without gp_seed
+    python benchmarks/issue8_counts.py cand-g0.jsonl cand-g1.jsonl --against base-g0.jsonl base-g1.jsonl \
+        --counts meas gp true_air "gp<ls" "gp<fair"     # the flips and the verdict on these counts only
+
+``--counts`` restricts the flips and the verdict to the named counts (the tables keep them all). The thirty-first
+and thirty-second sessions decided with the bands and the correlation left out ("coverage not counted"); the
+thirty-third session found that the sideslip profile's verdict depends on that choice (``docs/benchmarks.md``,
+"Thirty-third session, lead").
 """
 
 from __future__ import annotations
@@ -289,6 +296,9 @@ def main(argv=None) -> int:
     ap.add_argument("--against", nargs="+", default=None, metavar="JSONL[@GP_SEED]",
                     help="the base run's files: print the flips of the candidate against it per GP seed, and rule "
                          "8(b)'s verdict where two or more GP seeds are paired")
+    ap.add_argument("--counts", nargs="+", default=list(COUNTS), choices=list(COUNTS), metavar="COUNT",
+                    help="judge the flips and the verdict on these counts only (default: all of "
+                         + ", ".join(COUNTS) + ")")
     a = ap.parse_args(argv)
     cand = load_runs(a.files)
     print(f"runs: {' '.join(a.files)}" + (f" against {' '.join(a.against)}" if a.against else ""), end="\n\n")
@@ -300,11 +310,14 @@ def main(argv=None) -> int:
     per_seed = {}
     for gs in sorted(set(base) & set(cand)):
         changes, unmatched = flips(base[gs], cand[gs])
+        changes = [ch for ch in changes if ch["count"] in a.counts]
         per_seed[gs] = changes
         print(format_flips(changes, unmatched, gs), end="\n\n")
     missing = sorted(set(base) ^ set(cand))
     if missing:
         print(f"GP seeds in one run only (not compared): {missing}")
+    if set(a.counts) != set(COUNTS):
+        print(f"flips and verdict on the counts {', '.join(a.counts)} only")
     if len(per_seed) >= 2:
         print(verdict(per_seed)[2])
     elif per_seed:

@@ -116,3 +116,18 @@ def test_beta_profile_diag_local_slopes_recover_a_linear_moment():
     got = bpd.local_slopes(X, y)
     assert set(got) == set(want)
     assert all(abs(got[k] - v) < 0.05 for k, v in want.items())
+
+
+def test_counts_option_restricts_the_flips_and_the_verdict(tmp_path, capsys):
+    # a candidate that wins a held-out error and loses a band at each GP seed: +1/-1 with every count,
+    # +1/-0 when the bands are left out of the judgement
+    base = [_row("sgs", 1, gs, gp=(6, 1, 1, 1, 1, 1), ls=(9,) * 6) for gs in (0, 1)]
+    cand = [_row("sgs", 1, gs, ls=(9,) * 6, cov_tair=99.0) for gs in (0, 1)]
+    b, c = _write(tmp_path / "b.jsonl", base), _write(tmp_path / "c.jsonl", cand)
+    assert ic.main([c, "--against", b]) == 0
+    assert "rule 8(b) FAILS (seed 0 +1/-1, seed 1 +1/-1" in capsys.readouterr().out
+    assert ic.main([c, "--against", b, "--counts", "meas", "gp", "true_air", "gp<ls", "gp<fair"]) == 0
+    out = capsys.readouterr().out
+    assert "rule 8(b) HOLDS (seed 0 +1/-0, seed 1 +1/-0" in out
+    assert "on the counts meas, gp, true_air, gp<ls, gp<fair only" in out
+    assert "| cov_tair |" in out                     # the tables keep every count
