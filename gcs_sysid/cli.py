@@ -117,8 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "'off' the default (the measured Cl at the gyro's rate), 'on' (docs/estimation.md, "
                         "'Where the pair applies')")
     f.add_argument("--beta-profile", default="off", choices=("on", "off"),
-                   help="the aided sideslip's CY_beta by the gust model's likelihood, held in the later passes (the "
-                        "replay's estimator): 'off' the default (least squares, as the diagnosis loads its flights), "
+                   help="the aided sideslip's CY_beta by the gust model's likelihood, held in the later passes (opt-in "
+                        "everywhere since the thirty-third session): 'off' the default (least squares, as the diagnosis loads its flights), "
                         "'on' (docs/estimation.md, 'The side-force slope by the gust model's likelihood')")
     _window_args(f)
 

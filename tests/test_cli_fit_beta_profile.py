@@ -1,7 +1,8 @@
-"""The sideslip aiding's ``CY_beta`` estimator per path (thirty-second session): the replay's default is the gust model's
-likelihood with the slope held (``airangles.BETA_PROFILE``, ``BETA_PROFILE_HOLD``); the diagnosis and ``gcs-sysid fit``
-load their flights with least squares (``gcs_sysid.diagnose.run.BETA_PROFILE``), and ``fit --beta-profile on`` asks for
-the replay's estimator (docs/estimation.md, "The side-force slope by the gust model's likelihood")."""
+"""The sideslip aiding's ``CY_beta`` estimator per path: least squares everywhere by default (the gust model's likelihood
+with the slope held, ``airangles.BETA_PROFILE`` and ``BETA_PROFILE_HOLD``, was the replay's default in the
+thirty-second session only); the diagnosis and ``gcs-sysid fit`` load their flights with least squares
+(``gcs_sysid.diagnose.run.BETA_PROFILE``), and ``fit --beta-profile on`` asks for the profile (docs/estimation.md, "The
+side-force slope by the gust model's likelihood")."""
 
 from pathlib import Path
 
@@ -32,23 +33,24 @@ def test_fit_beta_profile_flag_reaches_run_fit_and_is_off_by_default(monkeypatch
     assert e.value.code == 2
 
 
-def test_the_replay_profiles_the_sideslip_slope_and_the_diagnosis_does_not(monkeypatch):
-    """On the project's sample flight: the estimator's default (the replay's ``estimate_states``) runs the likelihood
-    search of ``CY_beta``; ``load_measurements`` (the diagnosis's and ``fit``'s loader) does not, unless asked."""
+def test_least_squares_is_every_paths_default_and_the_profile_is_asked_for(monkeypatch):
+    """On the project's sample flight: the estimator's default (the replay's ``estimate_states``) and
+    ``load_measurements`` (the diagnosis's and ``fit``'s loader) run no likelihood search of ``CY_beta`` (opt-in again
+    since the thirty-third session); ``profile_beta=True`` runs it on either path."""
     from gcs_sysid.airframe import load_airframe
     from gcs_sysid.diagnose.run import load_measurements
     from gcs_sysid.estimation import airangles, estimate_states
     from gcs_sysid.telemetry import read_log
 
-    assert airangles.BETA_PROFILE and airangles.BETA_PROFILE_HOLD
+    assert not airangles.BETA_PROFILE and not airangles.BETA_PROFILE_HOLD
     calls = []
     real = airangles._profile_angle_slope
     monkeypatch.setattr(airangles, "_profile_angle_slope", lambda *a, **k: calls.append(1) or real(*a, **k))
     replay = estimate_states(read_log(LOG), load_airframe(AIRFRAME))
-    assert replay.angle_fits["beta"].used and len(calls) == 1
+    assert replay.angle_fits["beta"].used and calls == []
     load_measurements(LOG, AIRFRAME)
-    assert len(calls) == 1                               # least squares: no search
+    assert calls == []                                   # least squares: no search
     load_measurements(LOG, AIRFRAME, profile_beta=True)
-    assert len(calls) == 2
-    estimate_states(read_log(LOG), load_airframe(AIRFRAME), profile_beta=False)
+    assert len(calls) == 1
+    estimate_states(read_log(LOG), load_airframe(AIRFRAME), profile_beta=True)
     assert len(calls) == 2

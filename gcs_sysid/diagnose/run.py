@@ -75,8 +75,8 @@ AIR_ROLL_RATE = "off"
 #: The sideslip aiding's ``CY_beta`` estimator for every flight the diagnosis and ``fit`` load
 #: (:func:`load_measurements`, and the pitot-bias re-run of :mod:`gcs_sysid.diagnose.pitot`): False, least squares
 #: (the estimator issue 9's roster counts were measured with); True, the gust model's likelihood with the slope held
-#: (:data:`gcs_sysid.estimation.airangles.BETA_PROFILE` and ``BETA_PROFILE_HOLD``, the replay's default since the
-#: thirty-second session). Off here: the diagnosis compares flights through their aided sideslips, issue 9's counts
+#: (:data:`gcs_sysid.estimation.airangles.BETA_PROFILE` and ``BETA_PROFILE_HOLD``, the replay's default in the
+#: thirty-second session only, opt-in again since the thirty-third). Off here: the diagnosis compares flights through their aided sideslips, issue 9's counts
 #: with the profile are not measured, and the twenty-fifth session's run of the profile alone lost the s23's
 #: ``CY:scale`` (docs/benchmarks.md, "Twenty-fifth session, i8-beta" and "Thirty-second session, lead").
 BETA_PROFILE = False
@@ -205,8 +205,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             model's ``Cl`` terms read the air-relative roll rate; every other coefficient as measured. Refused
             (the measured Cl) where the roll fit is refused; ``<out>.fit.json``'s ``air_roll`` and the model
             file's header say which and why.
-        profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the replay's estimator,
-            ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least squares: the
+        profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the thirty-second session's replay
+            estimator, ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least squares: the
             diagnosis's reference models are fitted through here).
 
     Returns:

@@ -168,8 +168,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             later imports) overlaps the worker's smoother instead of waiting for it. Not run when the flight has
             no accelerometer (no smoother to wait for). It must not change what this function computes.
         profile_beta: the sideslip aiding's ``CY_beta`` by the gust model's likelihood (True) or by least squares
-            (False); None: :data:`gcs_sysid.estimation.airangles.BETA_PROFILE` as it stands at the call (on; the
-            diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_PROFILE`, off).
+            (False); None: :data:`gcs_sysid.estimation.airangles.BETA_PROFILE` as it stands at the call (off since the
+            thirty-third session; the diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_PROFILE`, off).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from

@@ -82,13 +82,16 @@ def test_gusts_are_recovered_from_the_specific_force():
     assert 0.5 < np.degrees(np.nanmean(res.beta_sigma)) / aid_b < 2.0
 
 
-def test_the_held_likelihood_slope_keeps_an_attenuated_first_pass():
-    """A known limit of the replay's default (``BETA_PROFILE`` with ``BETA_PROFILE_HOLD``, docs/estimation.md): where
+def test_the_held_likelihood_slope_keeps_an_attenuated_first_pass(monkeypatch):
+    """A known limit of the opt-in profile (``BETA_PROFILE`` with ``BETA_PROFILE_HOLD``, docs/estimation.md): where
     the kinematic sideslip's error is independent of it, least squares' first pass is attenuated (here 0.90 of
     ``CY_BETA``), the likelihood, searched only flatter, keeps about it, and the hold stops the later passes from
     undoing the attenuation (they reach 1.06 without it). The aided sideslip is still most of the way there."""
+    from gcs_sysid.estimation import airangles
+
+    monkeypatch.setattr(airangles, "BETA_PROFILE_HOLD", True)
     rec, alpha, beta = _record()
-    res = _run(rec)
+    res = _run(rec, profile_beta=True)
     fb = res.axes[1]
     assert "held in the later passes" in fb.slope_method
     assert 0.8 < fb.coef[1] / CY_BETA < 0.95, fb.coef
