@@ -209,10 +209,11 @@ PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per
 #: **Why it is off again** (thirty-third session, lead; ``docs/benchmarks.md``, "Thirty-third session, lead"): those
 #: counts left out the bands and the correlation. With all of issue 8's counts (``benchmarks/issue8_counts.py``) the
 #: same 90-s flights give +13/-10 and +14/-6; 120-s flights of the same aircraft +12/-9 and +15/-9; and a third set
-#: fixed in advance (seeds 4-6, 90 s) **+6/-11** at GP seed 0, net negative, which the session's pre-registered rule
-#: made the end of the default. The medians at the true regressors still favour it on CY and Cn on every set.
+#: fixed in advance (seeds 4-6, 90 s) **+6/-11** and **+8/-14**, net negative at both GP seeds, which the session's
+#: pre-registered rule made the end of the default. The medians at the true regressors still favour it on CY and Cn on every set.
 BETA_PROFILE = False
-#: On with :data:`BETA_PROFILE` (thirty-first session, i8-truereg; only with the profile, and off with it): the later passes keep the
+#: On (thirty-first session, i8-truereg; it acts only with the profile, :data:`BETA_PROFILE` or ``profile_beta=True``,
+#: so the profile, when asked for, comes with its hold): the later passes keep the
 #: first pass's profiled ``CY_beta`` (the other side-force slopes refitted by least squares with it held) instead of
 #: refitting it by least squares on the aided sideslip. That refit is circular: the aided sideslip is built from the
 #: measured side force with the last pass's slope, so least squares on it returns about that slope plus the share of
@@ -220,7 +221,7 @@ BETA_PROFILE = False
 #: s1: profiled -0.480, least squares -0.538, after the passes -0.496; JSBSim's -0.445). A model learned on a sideslip
 #: read ``k`` times the true one has ``CY_beta`` and ``Cn_beta`` ``1 / k`` times JSBSim's and misses at the true
 #: sideslip (``docs/benchmarks.md``, "Thirty-first session, i8-truereg").
-BETA_PROFILE_HOLD = False
+BETA_PROFILE_HOLD = True
 #: ``CY_beta`` is searched between these multiples of least squares' slope; an optimum at either end keeps least
 #: squares. Only flatter (upper end 1): where the likelihood steepened least squares it was wrong on the roster (the
 #: jets, whose gust is fast against the manoeuvre: b737 -1.07..-1.13 -> -1.33..-1.43 against JSBSim's -1.03; with 1.5
