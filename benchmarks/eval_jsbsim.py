@@ -695,8 +695,8 @@ def main(argv=None) -> int:
                          "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
     ap.add_argument("--beta-profile", default=None, choices=("on", "off"),
                     help="CY_beta of the replay's sideslip aiding by the gust model's likelihood, held in the later "
-                         "passes (gcs_sysid.estimation.airangles.BETA_PROFILE; default: the package's, on; the LS "
-                         "line is fitted with the same estimator)")
+                         "passes (gcs_sysid.estimation.airangles.BETA_PROFILE; default: the package's, off since the "
+                         "thirty-third session; the LS line is fitted with the same estimator)")
     ap.add_argument("--beta-profile-min-lr", default=None, type=float, metavar="LR",
                     help="take the profiled CY_beta only where its likelihood-ratio statistic against least squares' "
                          "slope reaches LR (3.84: the chi-squared 95 %% point; gcs_sysid.estimation.airangles."

@@ -646,7 +646,7 @@ def main(argv=None) -> int:
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
-                        "package's, off: the replay's estimator, gcs_sysid.estimation.airangles.BETA_PROFILE, is on)")
+                        "package's, off, as the replay's since the thirty-third session)")
     p.add_argument("--library-control-trim", default=None, choices=("on", "off"),
                    help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
                         "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
