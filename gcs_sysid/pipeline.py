@@ -653,12 +653,11 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             if stage is not None:
                 # coefficients.csv: its measured fields were formatted by the worker while the GP was fitted; the
                 # model's fields are formatted and the file written here, by write_report while the worker draws
-                # the last figures (after the predictions the worker's figures are the longer chain; a job without
-                # a worker runs when collected)
-                csv_job = Helper(enabled=False).submit(
-                    "gcs_sysid.report.tables:write_csv_data",
-                    csv_data(table.t, table.X, table.Y, pred_mean, pred_sigma, pred_sigma_obs, held),
-                    stage.path / "coefficients.csv", measured_csv.result())
+                # the last figures (after the predictions the worker's figures are the longer chain): a deferred
+                # call, a Job with no worker behind it, run when write_report collects it
+                csv_job = Job("gcs_sysid.report.tables:write_csv_data",
+                              (csv_data(table.t, table.X, table.Y, pred_mean, pred_sigma, pred_sigma_obs, held),
+                               stage.path / "coefficients.csv", measured_csv.result()), {}, None)
             with _stage("suggest maneuvers", timings, bar):
                 gate = {c: error_pct(pred_mean[held, i], table.Y[held, i]) for i, c in enumerate(COEFFICIENTS)}
                 cfg = None if options.targets is None else ManeuverConfig(targets=options.targets)
