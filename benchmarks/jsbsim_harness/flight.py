@@ -57,8 +57,18 @@ TURBULENCE = {"none": (0, 0.0), "calm": (1, 15.0), "light": (3, 15.0), "moderate
 #: Flight plans: ``"standard"`` holds one trim airspeed; ``"sweep"`` adds a speed sweep (several
 #: trim airspeeds, reached by slow pull-ups and push-overs) and steady-heading sideslips at each of
 #: them, so that alpha spans several degrees and sideslip happens at different alpha
-#: (:func:`speed_schedule`, :func:`sideslip_holds`).
-PLANS = ("standard", "sweep")
+#: (:func:`speed_schedule`, :func:`sideslip_holds`); ``"sweep_turn"`` flies the sweep in a steady
+#: turn that carries the heading through up to :data:`TURN_HEADING_DEG` (:func:`turn_rate`), so that
+#: the wind triangle separates the wind from a pitot error (the heading-sweep form of the cloverleaf
+#: calibration: USNTPS FTM 108, ch. 9; Lewis 2003).
+PLANS = ("standard", "sweep", "sweep_turn")
+#: Plans that fly the speed sweep and its sideslips.
+SWEEP_PLANS = ("sweep", "sweep_turn")
+#: Sensor noise draws (``FlightConfig.sensor_draw``): ``"shared"`` seeds the noise from the flight's seed
+#: alone, so every aircraft's flight of one seed carries the same noise sequences (among them the
+#: autopilot wind estimate's wander); ``"per_aircraft"`` mixes the aircraft's name into the seed, so that
+#: a roster of aircraft is a roster of independent draws (thirty-fourth session, issue 9).
+SENSOR_DRAWS = ("shared", "per_aircraft")
 
 #: The sweep's trim airspeeds: (start as a fraction of the logged duration, airspeed / initial
 #: airspeed). The last 20 % of the flight (the held-out segment) holds two levels of its own.
@@ -93,6 +103,11 @@ ABORT_BANK_DEG = 45.0
 RECOVER_S = 6.0
 RECOVER_FADE_S = 1.5
 RECOVER_K_BETA = 0.5
+#: ``"sweep_turn"``: the heading turned through over the logged flight (deg), the largest bank the turn
+#: may need (deg; a faster aircraft turns through less), and the roll-in time at the start (s).
+TURN_HEADING_DEG = 300.0
+TURN_MAX_BANK_DEG = 25.0
+TURN_ROLL_IN_S = 5.0
 
 
 @dataclass(frozen=True)
@@ -113,8 +128,11 @@ class FlightConfig:
             maneuvers) through a first-order lag with a rate limit of ``servo_rate_deg_s`` (JSBSim's
             stock models move their surfaces instantly). 0 = ideal servos.
         servo_rate_deg_s: servo rate limit, deg/s of the project's deflection.
-        plan: ``"standard"`` (one trim airspeed) or ``"sweep"`` (:data:`PLANS`): the same
-            maneuvers plus a speed sweep and steady-heading sideslips that span alpha.
+        plan: ``"standard"`` (one trim airspeed), ``"sweep"`` (:data:`PLANS`): the same
+            maneuvers plus a speed sweep and steady-heading sideslips that span alpha, or
+            ``"sweep_turn"``: the sweep flown in a steady turn (:func:`turn_rate`).
+        sensor_draw: ``"shared"`` or ``"per_aircraft"`` (:data:`SENSOR_DRAWS`): whether the sensor
+            noise is seeded by ``seed`` alone or by ``seed`` and the aircraft's name.
     """
 
     aircraft: str = "c172x"
@@ -129,10 +147,13 @@ class FlightConfig:
     servo_tau_s: float = 0.04
     servo_rate_deg_s: float = 300.0
     plan: str = "standard"
+    sensor_draw: str = "shared"
 
     def __post_init__(self):
         if self.plan not in PLANS:
             raise ValueError(f"plan must be one of {', '.join(PLANS)}, got '{self.plan}'")
+        if self.sensor_draw not in SENSOR_DRAWS:
+            raise ValueError(f"sensor_draw must be one of {', '.join(SENSOR_DRAWS)}, got '{self.sensor_draw}'")
         if self.turbulence not in TURBULENCE:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}, got '{self.turbulence}'")
         if abs(self.sim_rate_hz / self.log_rate_hz - round(self.sim_rate_hz / self.log_rate_hz)) > 1e-9:
@@ -255,7 +276,7 @@ def speed_schedule(t: np.ndarray, duration: float, plan: str = "standard") -> tu
     """
     t = np.asarray(t, float)
     f, df = np.ones_like(t), np.zeros_like(t)
-    if plan != "sweep":
+    if plan not in SWEEP_PLANS:
         return f, df
     for (_, prev), (frac, lev) in zip(SWEEP_LEVELS[:-1], SWEEP_LEVELS[1:]):
         t0 = frac * duration
@@ -275,7 +296,7 @@ def sideslip_holds(spec: AircraftSpec, duration: float, plan: str = "standard") 
     The autopilot's roll and heading loops supply the opposite aileron and the bank, as a pilot
     flying a steady-heading sideslip does. Levels too short to hold one are skipped.
     """
-    if plan != "sweep":
+    if plan not in SWEEP_PLANS:
         return []
     ar = SWEEP_SLIP_RUDDER * np.radians(spec.amplitude_deg[2])
     starts = [frac * duration for frac, _ in SWEEP_LEVELS] + [duration]
@@ -296,6 +317,21 @@ def slip_scale(level: float) -> float:
     """
     x = (float(level) - SLIP_SLOW_FROM) / (1.0 - SLIP_SLOW_FROM)
     return float(np.clip(x, SLIP_SLOW_MIN, 1.0))
+
+
+def turn_rate(plan: str, v_ref: float, duration: float) -> float:
+    """Heading rate of the plan's steady turn, rad/s (0 unless ``plan == "sweep_turn"``).
+
+    :data:`TURN_HEADING_DEG` over ``duration``, or the rate a coordinated turn reaches at
+    :data:`TURN_MAX_BANK_DEG` at ``v_ref`` (``g tan(phi) / V``) when that is less.
+
+    Args:
+        plan: one of :data:`PLANS`. v_ref: the initial true airspeed, m/s. duration: logged time, s.
+    """
+    if plan != "sweep_turn":
+        return 0.0
+    return float(min(np.radians(TURN_HEADING_DEG) / duration,
+                     9.80665 * np.tan(np.radians(TURN_MAX_BANK_DEG)) / max(v_ref, 1.0)))
 
 
 _SLIP_S = 4.0        # ramp in 0.75 s, hold 2.5 s, ramp out 0.75 s
@@ -418,7 +454,8 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
     k_th, k_q, k_v, k_phi, k_p, k_r = spec.gains
     v_ref = fdm["velocities/vt-fps"] * FT
     theta_ref0 = fdm["attitude/theta-rad"]
-    psi_ref = fdm["attitude/psi-rad"]
+    psi_ref0 = fdm["attitude/psi-rad"]
+    omega_turn = turn_rate(config.plan, v_ref, config.duration_s)
     de_int = 0.0
     servo = np.zeros(3)          # surface positions the servos hold (project deltas), rad
     first = True
@@ -457,10 +494,17 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
         e_th = theta - theta_ref
         de_int += 0.5 * k_th * e_th * dt
         de = de_int + k_th * e_th + k_q * q + man[0]
+        # the heading reference: fixed, or turning at omega_turn after a roll-in (``"sweep_turn"``)
+        t_turn = max(t_now, 0.0)
+        w_in = min(t_turn / TURN_ROLL_IN_S, 1.0)
+        psi_ref = psi_ref0 + omega_turn * (0.5 * TURN_ROLL_IN_S * w_in * w_in if w_in < 1.0
+                                           else t_turn - 0.5 * TURN_ROLL_IN_S)
         psi_err = (fdm["attitude/psi-rad"] - psi_ref + np.pi) % (2 * np.pi) - np.pi
-        phi_ref = float(np.clip(-0.5 * psi_err, -0.2, 0.2))     # weak heading hold
+        phi_ff = float(np.arctan(V * omega_turn * w_in / 9.80665))   # coordinated-turn bank
+        phi_ref = phi_ff + float(np.clip(-0.5 * psi_err, -0.2, 0.2))     # weak heading hold
         da = k_phi * (phi - phi_ref) + k_p * p + man[1]
-        dr = k_r * r + man[2] - (1.0 - w_man) * RECOVER_K_BETA * fdm["aero/beta-rad"]   # + recovery rudder
+        r_turn = omega_turn * w_in * np.cos(phi) * np.cos(theta)          # the turn's own yaw rate
+        dr = k_r * (r - r_turn) + man[2] - (1.0 - w_man) * RECOVER_K_BETA * fdm["aero/beta-rad"]   # + recovery
         cmd = np.array([de, da, dr])
         if first:
             servo, first = cmd.copy(), False

@@ -30,6 +30,8 @@ References:
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 from scipy.signal import lfilter
 
@@ -75,6 +77,8 @@ def make_sensors(rec: Recording, aoa: str = "ahrs", seed: int | None = None,
         rec: the flight (truth at ``rec.config.log_rate_hz``, which must be 50 Hz).
         aoa: ``"ahrs"`` (ArduPilot's estimate) or ``"vane"`` (exact angles + noise).
         seed: noise seed (default ``rec.config.seed``); the noise does not depend on ``imu_offset``.
+            With ``rec.config.sensor_draw == "per_aircraft"`` the aircraft's name is mixed into it
+            (CRC-32), so that each aircraft draws its own noise for the same seed.
         imu_offset: IMU position from the CG, body axes, m: the accelerometers measure
             ``f_cg + omega_dot x r + omega x (omega x r)`` (rigid body; Stevens, Lewis and Johnson
             2016, sec. 1.9). A log written with an offset needs an airframe file whose
@@ -91,7 +95,11 @@ def make_sensors(rec: Recording, aoa: str = "ahrs", seed: int | None = None,
     rate = rec.config.log_rate_hz
     if abs(rate - 50.0) > 1e-9:
         raise ValueError(f"the harness logs at 50 Hz, got {rate}")
-    rng = np.random.default_rng(1000 + (rec.config.seed if seed is None else seed))
+    base = 1000 + (rec.config.seed if seed is None else seed)
+    # "per_aircraft": the aircraft's name enters the seed, so that flights of one seed on different
+    # aircraft draw independent noise (FlightConfig.sensor_draw); "shared" keeps the older draws
+    draw = getattr(rec.config, "sensor_draw", "shared")
+    rng = np.random.default_rng([base, zlib.crc32(rec.config.aircraft.encode())] if draw == "per_aircraft" else base)
     tr, t = rec.truth, rec.t
     T, dt = len(t), 1.0 / rate
     m = rec.constants["mass"]

@@ -135,6 +135,48 @@ def test_sideslips_are_smaller_at_the_slow_levels():
     assert min(abs(a) for _, a in holds) < 0.6 * full < max(abs(a) for _, a in holds)
 
 
+def test_turn_plan_carries_the_heading_round_at_a_limited_bank():
+    """``"sweep_turn"`` flies the sweep in a steady turn: the c172x turns through most of
+    TURN_HEADING_DEG at a modest bank, inside the envelope; a fast aircraft's rate is set by the bank
+    limit; the other plans do not turn (turn_rate 0, so their flights are the same as before)."""
+    from benchmarks.jsbsim_harness.flight import TURN_HEADING_DEG, TURN_MAX_BANK_DEG, turn_rate
+
+    assert turn_rate("sweep", 40.0, 120.0) == 0.0 and turn_rate("standard", 40.0, 120.0) == 0.0
+    assert turn_rate("sweep_turn", 20.0, 120.0) == pytest.approx(np.radians(TURN_HEADING_DEG) / 120.0)
+    assert turn_rate("sweep_turn", 134.0, 120.0) == pytest.approx(9.80665 * np.tan(np.radians(TURN_MAX_BANK_DEG))
+                                                                  / 134.0)
+    rec = fly(FlightConfig("c172x", duration_s=120.0, seed=1, plan="sweep_turn"))
+    psi = np.unwrap(rec.truth["psi"])
+    assert 250.0 < np.degrees(psi[-1] - psi[0]) < TURN_HEADING_DEG + 10.0
+    phi = np.degrees(rec.truth["phi"])
+    assert 5.0 < np.median(np.abs(phi)) < TURN_MAX_BANK_DEG and np.abs(phi).max() < 40.0
+    assert rec.meta["aborts"] == []
+    with pytest.raises(ValueError, match="plan must be one of"):
+        FlightConfig("c172x", plan="cloverleaf")
+
+
+def test_sensor_draw_per_aircraft_gives_each_aircraft_its_own_noise():
+    """``sensor_draw="shared"`` seeds the sensor noise from the seed alone (every aircraft of a seed
+    shares the autopilot wind's wander); ``"per_aircraft"`` mixes the aircraft's name in, so that the
+    same flight under two names draws different noise, and the same name the same noise."""
+    import dataclasses
+
+    from benchmarks.jsbsim_harness.sensors import make_sensors
+
+    rec = fly(FlightConfig("c172x", duration_s=20.0, seed=1, turbulence="none"))
+
+    def wind(name, draw):
+        cfg = dataclasses.replace(rec.config, aircraft=name, sensor_draw=draw)
+        return make_sensors(dataclasses.replace(rec, config=cfg))["wind"]["wn"]
+
+    np.testing.assert_array_equal(wind("c172x", "shared"), wind("sgs", "shared"))
+    np.testing.assert_array_equal(wind("c172x", "shared"), make_sensors(rec)["wind"]["wn"])
+    np.testing.assert_array_equal(wind("c172x", "per_aircraft"), wind("c172x", "per_aircraft"))
+    assert np.abs(wind("c172x", "per_aircraft") - wind("sgs", "per_aircraft")).max() > 0.01
+    with pytest.raises(ValueError, match="sensor_draw must be one of"):
+        FlightConfig("c172x", sensor_draw="independent")
+
+
 @pytest.mark.slow
 def test_a_departing_maneuver_is_knocked_off_and_the_flight_survives(tmp_path):
     """With Cl:alpha*beta = 3 the SGS's dihedral reverses at the slow level and a sideslip departs
