@@ -86,6 +86,18 @@ REF_SEED = 100
 #: ``"sweep"`` spans alpha with a speed sweep and steady-heading sideslips; ``"standard"`` was the
 #: plan of the 2026-11-21 runs).
 PLAN = "sweep"
+#: Sensor noise draws of every flight (``FlightConfig.sensor_draw``) for the library's functions
+#: (:func:`reference_model`, :func:`diagnose_case` ...): ``"shared"`` (every aircraft's flight of one seed
+#: carries the same noise: the records until the thirty-fourth session, and the tests written on them).
+#: The script's runs draw ``"per_aircraft"`` by default since the thirty-fourth session (``--sensor-draw``;
+#: decided before its data: with shared draws a roster's ``bias:airspeed`` counts rest on one wind-wander
+#: draw per seed).
+SENSOR_DRAW = "shared"
+
+
+def _stem_suffix(plan: str, sensor_draw: str) -> str:
+    """The file-name suffix of a flight's plan and noise draw (none for the standard plan's shared draw)."""
+    return (f"-{plan}" if plan != "standard" else "") + ("-pa" if sensor_draw == "per_aircraft" else "")
 
 
 def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | None = None):
@@ -95,14 +107,14 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
 
     tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
     stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
-    if config.plan != "standard":
-        stem += f"-{config.plan}"
+    stem += _stem_suffix(config.plan, config.sensor_draw)
     tlog = out / f"{stem}.tlog"
     done = tlog.with_name(stem + "-effects.json")
     if tlog.exists() and done.exists():
         doc = json.loads(done.read_text())
         # files written before the fingerprint was recorded (2026-11-22) carry none and are reused as before
         if doc["config"]["duration_s"] == config.duration_s and doc["config"].get("plan", "standard") == config.plan \
+                and doc["config"].get("sensor_draw", "shared") == config.sensor_draw \
                 and doc.get("harness", harness_fingerprint(config.aircraft)) == harness_fingerprint(config.aircraft):
             return _stated(FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None),
                            out, stem)
@@ -130,9 +142,10 @@ def _fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, pla
     for ac, seed, effs in _cases(aircraft_names, seeds, clean_seeds, pairs):
         if effects and effs and not all(e.name in effects for e in effs):
             continue
-        jobs = [] if ac in done else [(FlightConfig(ac, duration_s=DURATION_S, seed=REF_SEED, plan=plan), [], f"{ac}-ref")]
+        jobs = [] if ac in done else [(FlightConfig(ac, duration_s=DURATION_S, seed=REF_SEED, plan=plan,
+                                                    sensor_draw=SENSOR_DRAW), [], f"{ac}-ref")]
         done.add(ac)
-        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan), effs, None))
+        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan, sensor_draw=SENSOR_DRAW), effs, None))
         for cfg, es, stem in jobs:
             t0 = time.perf_counter()
             tag = "+".join(f"{e.name}={e.value:g}" for e in es) or ("reference" if stem else "clean")
@@ -152,9 +165,10 @@ def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: st
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.diagnose.run import air_roll_for, load_measurements
 
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, turbulence=turbulence), [], out,
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, sensor_draw=SENSOR_DRAW,
+                                 turbulence=turbulence), [], out,
                     stem=f"{ac}-ref")
-    model_path = out / f"{ac}-ref-{plan}-model.toml"
+    model_path = out / f"{ac}-ref-{plan}{'-pa' if SENSOR_DRAW == 'per_aircraft' else ''}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
     return files, model_path, load_measurements(files.tlog, files.airframe, air_roll=air_roll_for("reference"))
 
@@ -183,7 +197,8 @@ def level_flights(ac: str, seeds, out: Path, ref_meas, duration_s: float = DURAT
 
     out_m = []
     for s in seeds:
-        files = _flight(FlightConfig(ac, duration_s=duration_s, seed=s, plan=plan, turbulence=turbulence), [], out,
+        files = _flight(FlightConfig(ac, duration_s=duration_s, seed=s, plan=plan, sensor_draw=SENSOR_DRAW,
+                                     turbulence=turbulence), [], out,
                         stem=f"{ac}-level-s{s}")
         out_m.append(load_measurements(files.tlog, files.airframe,
                                        angle_models=shared_angle_models(ref_meas.states.angle_fits)))
@@ -202,7 +217,8 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     _LAST_PITOT.clear()
     _LAST_NOT_NAMED.clear()
     _LAST_LEVEL.clear()
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, turbulence=turbulence), effects, out)
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, sensor_draw=SENSOR_DRAW,
+                                 turbulence=turbulence), effects, out)
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
     t0 = time.perf_counter()
@@ -364,7 +380,7 @@ def rescore(path: str) -> list[dict]:
         if r["effects"] and "error" not in r["score"]:
             tag = "+".join(f"{n}={v:g}" for n, v in r["effects"])
             stem = f"{r['aircraft']}-s{r['seed']}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
-            stem += f"-{r.get('plan', PLAN)}" if r.get("plan", PLAN) != "standard" else ""
+            stem += _stem_suffix(r.get("plan", PLAN), r.get("sensor_draw", "shared"))
             truth = json.loads((folder / f"{stem}-effects.json").read_text())
             findings = [dict(f, gain={"percent": f.get("gain_pct") or 0.0}) for f in r["findings"]]
             r["score"] = score_case(findings, scoring_truth(truth, folder / f"{stem}-truth.npz"))
@@ -496,7 +512,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     knots = alpha_quantile_knots(reference[0])
     est: dict[str, list[float]] = {c: [] for c in _FORCED}
     for cs in clean_seeds:
-        files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan), [], out)
+        files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan, sensor_draw=SENSOR_DRAW), [], out)
         m = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits),
                               air_roll=air_roll_for("flight"))
         ctx = DiagContext.build(m.table, m.airframe, model, m.states)
@@ -600,6 +616,7 @@ def coverage_with_scatter(results: list[str], scatter: list[str]) -> str:
 
 
 def main(argv=None) -> int:
+    global SENSOR_DRAW
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
     p.add_argument("--seeds", nargs="*", type=int, default=[1, 2, 3],
@@ -610,8 +627,11 @@ def main(argv=None) -> int:
     p.add_argument("--fly-only", action="store_true",
                    help="only fly (or find in --out) the reference and every case; no fit, no diagnosis")
     p.add_argument("--out", default=str(REPO / "benchmarks" / "out" / "diag-effects"))
-    p.add_argument("--plan", default=PLAN, choices=("standard", "sweep"),
-                   help="flight plan of every flight (default %(default)s)")
+    p.add_argument("--plan", default=PLAN, choices=("standard", "sweep", "sweep_turn"),
+                   help="flight plan of every flight (default %(default)s; sweep_turn: the sweep in a steady turn)")
+    p.add_argument("--sensor-draw", default="per_aircraft", choices=("shared", "per_aircraft"),
+                   help="sensor noise seeded by the seed and the aircraft, or by the seed alone as every record before "
+                        "the thirty-fourth session (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
     p.add_argument("--rescore", action="store_true",
                    help="with --summary: score the records again against today's scoring truth (scoring_truth: "
@@ -651,6 +671,15 @@ def main(argv=None) -> int:
                    help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
                         "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
     a = p.parse_args(argv)
+    prev, SENSOR_DRAW = SENSOR_DRAW, a.sensor_draw
+    try:
+        return _run(p, a)
+    finally:                    # the library's functions keep their own default after a run
+        SENSOR_DRAW = prev
+
+
+def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
+    """:func:`main` after its arguments are parsed (``SENSOR_DRAW`` set from ``--sensor-draw``)."""
     if a.library_control_trim is not None:
         from gcs_sysid.diagnose import sparse as _sp
 
@@ -725,7 +754,8 @@ def main(argv=None) -> int:
                 sc = score_case(findings, truth)
             except RuntimeError as exc:       # the aircraft left the envelope with that effect
                 sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
-            rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "effects": [[e.name, e.value] for e in effects],
+            rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "sensor_draw": SENSOR_DRAW,
+                   "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT), "not_named": list(_LAST_NOT_NAMED),
                    "alpha_level": dict(_LAST_LEVEL),
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
