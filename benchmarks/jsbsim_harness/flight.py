@@ -66,8 +66,9 @@ PLANS = ("standard", "sweep", "sweep_turn")
 SWEEP_PLANS = ("sweep", "sweep_turn")
 #: Sensor noise draws (``FlightConfig.sensor_draw``): ``"shared"`` seeds the noise from the flight's seed
 #: alone, so every aircraft's flight of one seed carries the same noise sequences (among them the
-#: autopilot wind estimate's wander); ``"per_aircraft"`` mixes the aircraft's name into the seed, so that
-#: a roster of aircraft is a roster of independent draws (thirty-fourth session, issue 9).
+#: autopilot wind estimate's wander); ``"per_aircraft"`` mixes the aircraft's name into the sensor seed, so
+#: that a roster's sensor noise is independent draws (thirty-fourth session, issue 9). JSBSim's turbulence
+#: (``simulation/randomseed`` = ``seed``) is still one draw per seed across aircraft.
 SENSOR_DRAWS = ("shared", "per_aircraft")
 
 #: The sweep's trim airspeeds: (start as a fraction of the logged duration, airspeed / initial
