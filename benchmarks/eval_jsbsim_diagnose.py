@@ -54,8 +54,10 @@ untouched now (``j3cub``, ``c182``, ``t37``, ``t6``, ``b747``, ``f16``, ``f4n``,
 ``iar80``, ``c684``, ``ultrastick``, ``b737``, ``c172p``, ``eternity``, ``us25e``, ``ka350``, ``s23``, ``dr1``,
 ``navion`` and ``fokker50``, untouched until the sixth to twenty-seventh sessions' final evaluations, count as used;
 none of them is in the defaults; docs/jsbsim.md, "No untouched aircraft"). The flights of ``--out`` are reused when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
-duration and plan; ``--fly-only`` flies (or finds) the reference and every case and stops,
-without fitting or diagnosing anything.
+duration, plan and sensor draw; ``--fly-only`` flies (or finds) the reference and every case and stops,
+without fitting or diagnosing anything. ``--sensor-draw`` is ``per_aircraft`` by default since the thirty-fourth
+session (each aircraft its own sensor noise; the records before drew ``shared``), and ``--plan sweep_turn`` flies
+the sweep in a steady turn (``benchmarks/jsbsim_harness/flight.py``).
 
 Prints a table and writes one JSON line per case to ``<out>/results.jsonl``.
 """
