@@ -97,9 +97,14 @@ PLAN = "sweep"
 SENSOR_DRAW = "shared"
 
 
+def _draw_suffix(sensor_draw: str) -> str:
+    """The file-name suffix of a noise draw: ``-pa`` for per-aircraft draws, none for shared ones."""
+    return "-pa" if sensor_draw == "per_aircraft" else ""
+
+
 def _stem_suffix(plan: str, sensor_draw: str) -> str:
     """The file-name suffix of a flight's plan and noise draw (none for the standard plan's shared draw)."""
-    return (f"-{plan}" if plan != "standard" else "") + ("-pa" if sensor_draw == "per_aircraft" else "")
+    return (f"-{plan}" if plan != "standard" else "") + _draw_suffix(sensor_draw)
 
 
 def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | None = None):
@@ -170,7 +175,7 @@ def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: st
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, sensor_draw=SENSOR_DRAW,
                                  turbulence=turbulence), [], out,
                     stem=f"{ac}-ref")
-    model_path = out / f"{ac}-ref-{plan}{'-pa' if SENSOR_DRAW == 'per_aircraft' else ''}-model.toml"
+    model_path = out / f"{ac}-ref-{plan}{_draw_suffix(SENSOR_DRAW)}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
     return files, model_path, load_measurements(files.tlog, files.airframe, air_roll=air_roll_for("reference"))
 

@@ -98,8 +98,8 @@ def make_sensors(rec: Recording, aoa: str = "ahrs", seed: int | None = None,
     base = 1000 + (rec.config.seed if seed is None else seed)
     # "per_aircraft": the aircraft's name enters the seed, so that flights of one seed on different
     # aircraft draw independent noise (FlightConfig.sensor_draw); "shared" keeps the older draws
-    draw = getattr(rec.config, "sensor_draw", "shared")
-    rng = np.random.default_rng([base, zlib.crc32(rec.config.aircraft.encode())] if draw == "per_aircraft" else base)
+    per_aircraft = rec.config.sensor_draw == "per_aircraft"
+    rng = np.random.default_rng([base, zlib.crc32(rec.config.aircraft.encode())] if per_aircraft else base)
     tr, t = rec.truth, rec.t
     T, dt = len(t), 1.0 / rate
     m = rec.constants["mass"]

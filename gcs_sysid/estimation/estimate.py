@@ -458,10 +458,13 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                 sources["wind"] = ("least squares over 30 s windows: |v_gps - w| = k V_tas" +
                                    ("" if PITOT_SCALE_FROM_TURNS else " (k = 1)") + ", beta ~ 0 on average" +
                                    (" (autopilot WIND/XKF2 only as a weak prior)" if wind_ap is not None else ""))
-                kn = (f"pitot scale k = {We.scale:.3f} +- {We.scale_sigma:.3f}" if np.isfinite(We.scale_sigma)
-                      else "pitot scale kept at 1 (too few turns to separate it from the wind)"
-                      if PITOT_SCALE_FROM_TURNS else "pitot scale taken as 1 (the pitot is trusted; its "
-                      "calibration is the diagnosis's wind triangle)")
+                if not PITOT_SCALE_FROM_TURNS:
+                    kn = ("pitot scale taken as 1 (the pitot is trusted; its calibration is the diagnosis's wind "
+                          "triangle)")
+                elif np.isfinite(We.scale_sigma):
+                    kn = f"pitot scale k = {We.scale:.3f} +- {We.scale_sigma:.3f}"
+                else:
+                    kn = "pitot scale kept at 1 (too few turns to separate it from the wind)"
                 notes.append(f"{kn}; mean wind N E = {wind[:, 0].mean():+.2f}, {wind[:, 1].mean():+.2f} m/s")
                 k_pitot = We.scale
             except ValueError:
