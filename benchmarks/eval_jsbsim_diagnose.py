@@ -54,9 +54,10 @@ untouched now (``j3cub``, ``c182``, ``t37``, ``t6``, ``b747``, ``f16``, ``f4n``,
 ``iar80``, ``c684``, ``ultrastick``, ``b737``, ``c172p``, ``eternity``, ``us25e``, ``ka350``, ``s23``, ``dr1``,
 ``navion`` and ``fokker50``, untouched until the sixth to twenty-seventh sessions' final evaluations, count as used;
 none of them is in the defaults; docs/jsbsim.md, "No untouched aircraft"). The flights of ``--out`` are reused when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
-duration, plan and sensor draw; ``--fly-only`` flies (or finds) the reference and every case and stops,
+duration, plan and draws; ``--fly-only`` flies (or finds) the reference and every case and stops,
 without fitting or diagnosing anything. ``--sensor-draw`` is ``per_aircraft`` by default since the thirty-fourth
-session (each aircraft its own sensor noise; the records before drew ``shared``), and ``--plan sweep_turn`` flies
+session (each aircraft its own sensor noise; the records before drew ``shared``), ``--turbulence-draw`` is
+``per_aircraft`` since the thirty-fifth (each aircraft its own JSBSim turbulence), and ``--plan sweep_turn`` flies
 the sweep in a steady turn (``benchmarks/jsbsim_harness/flight.py``).
 
 Prints a table and writes one JSON line per case to ``<out>/results.jsonl``.
@@ -95,16 +96,27 @@ PLAN = "sweep"
 #: decided before its data: with shared draws a roster's ``bias:airspeed`` counts rest on one wind-wander
 #: draw per seed).
 SENSOR_DRAW = "shared"
+#: JSBSim's turbulence draws of every flight (``FlightConfig.turbulence_draw``) for the library's functions:
+#: ``"shared"`` (every aircraft's flight of one seed flies the same random sequence: the records until the
+#: thirty-fifth session). The script's runs draw ``"per_aircraft"`` by default since the thirty-fifth session
+#: (``--turbulence-draw``; decided before its data, for the reason of ``SENSOR_DRAW``'s default).
+TURBULENCE_DRAW = "shared"
 
 
-def _draw_suffix(sensor_draw: str) -> str:
-    """The file-name suffix of a noise draw: ``-pa`` for per-aircraft draws, none for shared ones."""
-    return "-pa" if sensor_draw == "per_aircraft" else ""
+def _draws() -> dict[str, str]:
+    """The draws of every flight, as :class:`FlightConfig` keyword arguments."""
+    return {"sensor_draw": SENSOR_DRAW, "turbulence_draw": TURBULENCE_DRAW}
 
 
-def _stem_suffix(plan: str, sensor_draw: str) -> str:
-    """The file-name suffix of a flight's plan and noise draw (none for the standard plan's shared draw)."""
-    return (f"-{plan}" if plan != "standard" else "") + _draw_suffix(sensor_draw)
+def _draw_suffix(sensor_draw: str, turbulence_draw: str = "shared") -> str:
+    """The file-name suffix of the draws: ``-pa`` for per-aircraft sensor noise, ``-pt`` for per-aircraft
+    turbulence, none for shared ones."""
+    return ("-pa" if sensor_draw == "per_aircraft" else "") + ("-pt" if turbulence_draw == "per_aircraft" else "")
+
+
+def _stem_suffix(plan: str, sensor_draw: str, turbulence_draw: str = "shared") -> str:
+    """The file-name suffix of a flight's plan and draws (none for the standard plan's shared draws)."""
+    return (f"-{plan}" if plan != "standard" else "") + _draw_suffix(sensor_draw, turbulence_draw)
 
 
 def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | None = None):
@@ -114,7 +126,7 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
 
     tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
     stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
-    stem += _stem_suffix(config.plan, config.sensor_draw)
+    stem += _stem_suffix(config.plan, config.sensor_draw, config.turbulence_draw)
     tlog = out / f"{stem}.tlog"
     done = tlog.with_name(stem + "-effects.json")
     if tlog.exists() and done.exists():
@@ -122,6 +134,7 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
         # files written before the fingerprint was recorded (2026-11-22) carry none and are reused as before
         if doc["config"]["duration_s"] == config.duration_s and doc["config"].get("plan", "standard") == config.plan \
                 and doc["config"].get("sensor_draw", "shared") == config.sensor_draw \
+                and doc["config"].get("turbulence_draw", "shared") == config.turbulence_draw \
                 and doc.get("harness", harness_fingerprint(config.aircraft)) == harness_fingerprint(config.aircraft):
             return _stated(FlightFiles(tlog, out / f"{stem}-truth.npz", aircraft(config.aircraft).airframe_path, None),
                            out, stem)
@@ -150,9 +163,9 @@ def _fly_only(aircraft_names, seeds, clean_seeds, pairs, effects, out: Path, pla
         if effects and effs and not all(e.name in effects for e in effs):
             continue
         jobs = [] if ac in done else [(FlightConfig(ac, duration_s=DURATION_S, seed=REF_SEED, plan=plan,
-                                                    sensor_draw=SENSOR_DRAW), [], f"{ac}-ref")]
+                                                    **_draws()), [], f"{ac}-ref")]
         done.add(ac)
-        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan, sensor_draw=SENSOR_DRAW), effs, None))
+        jobs.append((FlightConfig(ac, duration_s=DURATION_S, seed=seed, plan=plan, **_draws()), effs, None))
         for cfg, es, stem in jobs:
             t0 = time.perf_counter()
             tag = "+".join(f"{e.name}={e.value:g}" for e in es) or ("reference" if stem else "clean")
@@ -172,10 +185,10 @@ def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: st
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.diagnose.run import air_roll_for, load_measurements
 
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, sensor_draw=SENSOR_DRAW,
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, **_draws(),
                                  turbulence=turbulence), [], out,
                     stem=f"{ac}-ref")
-    model_path = out / f"{ac}-ref-{plan}{_draw_suffix(SENSOR_DRAW)}-model.toml"
+    model_path = out / f"{ac}-ref-{plan}{_draw_suffix(SENSOR_DRAW, TURBULENCE_DRAW)}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
     return files, model_path, load_measurements(files.tlog, files.airframe, air_roll=air_roll_for("reference"))
 
@@ -204,7 +217,7 @@ def level_flights(ac: str, seeds, out: Path, ref_meas, duration_s: float = DURAT
 
     out_m = []
     for s in seeds:
-        files = _flight(FlightConfig(ac, duration_s=duration_s, seed=s, plan=plan, sensor_draw=SENSOR_DRAW,
+        files = _flight(FlightConfig(ac, duration_s=duration_s, seed=s, plan=plan, **_draws(),
                                      turbulence=turbulence), [], out,
                         stem=f"{ac}-level-s{s}")
         out_m.append(load_measurements(files.tlog, files.airframe,
@@ -224,7 +237,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     _LAST_PITOT.clear()
     _LAST_NOT_NAMED.clear()
     _LAST_LEVEL.clear()
-    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, sensor_draw=SENSOR_DRAW,
+    files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, **_draws(),
                                  turbulence=turbulence), effects, out)
     truth = scoring_truth(json.loads(files.tlog.with_name(files.tlog.stem + "-effects.json").read_text()),
                           files.tlog.with_name(files.tlog.stem + "-truth.npz"))
@@ -387,7 +400,8 @@ def rescore(path: str) -> list[dict]:
         if r["effects"] and "error" not in r["score"]:
             tag = "+".join(f"{n}={v:g}" for n, v in r["effects"])
             stem = f"{r['aircraft']}-s{r['seed']}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
-            stem += _stem_suffix(r.get("plan", PLAN), r.get("sensor_draw", "shared"))
+            stem += _stem_suffix(r.get("plan", PLAN), r.get("sensor_draw", "shared"),
+                                 r.get("turbulence_draw", "shared"))
             truth = json.loads((folder / f"{stem}-effects.json").read_text())
             findings = [dict(f, gain={"percent": f.get("gain_pct") or 0.0}) for f in r["findings"]]
             r["score"] = score_case(findings, scoring_truth(truth, folder / f"{stem}-truth.npz"))
@@ -519,7 +533,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     knots = alpha_quantile_knots(reference[0])
     est: dict[str, list[float]] = {c: [] for c in _FORCED}
     for cs in clean_seeds:
-        files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan, sensor_draw=SENSOR_DRAW), [], out)
+        files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan, **_draws()), [], out)
         m = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits),
                               air_roll=air_roll_for("flight"))
         ctx = DiagContext.build(m.table, m.airframe, model, m.states)
@@ -623,7 +637,7 @@ def coverage_with_scatter(results: list[str], scatter: list[str]) -> str:
 
 
 def main(argv=None) -> int:
-    global SENSOR_DRAW
+    global SENSOR_DRAW, TURBULENCE_DRAW
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--aircraft", nargs="+", default=["c172x", "sgs"])
     p.add_argument("--seeds", nargs="*", type=int, default=[1, 2, 3],
@@ -639,6 +653,9 @@ def main(argv=None) -> int:
     p.add_argument("--sensor-draw", default="per_aircraft", choices=("shared", "per_aircraft"),
                    help="sensor noise seeded by the seed and the aircraft, or by the seed alone as every record before "
                         "the thirty-fourth session (default %(default)s)")
+    p.add_argument("--turbulence-draw", default="per_aircraft", choices=("shared", "per_aircraft"),
+                   help="JSBSim's turbulence seeded by the seed and the aircraft, or by the seed alone as every record "
+                        "before the thirty-fifth session (default %(default)s)")
     p.add_argument("--summary", nargs="+", metavar="JSONL", help="only print the markdown table of these results")
     p.add_argument("--rescore", action="store_true",
                    help="with --summary: score the records again against today's scoring truth (scoring_truth: "
@@ -678,15 +695,17 @@ def main(argv=None) -> int:
                    help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
                         "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
     a = p.parse_args(argv)
-    prev, SENSOR_DRAW = SENSOR_DRAW, a.sensor_draw
+    prev = SENSOR_DRAW, TURBULENCE_DRAW
+    SENSOR_DRAW, TURBULENCE_DRAW = a.sensor_draw, a.turbulence_draw
     try:
         return _run(p, a)
-    finally:                    # the library's functions keep their own default after a run
-        SENSOR_DRAW = prev
+    finally:                    # the library's functions keep their own defaults after a run
+        SENSOR_DRAW, TURBULENCE_DRAW = prev
 
 
 def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
-    """:func:`main` after its arguments are parsed (``SENSOR_DRAW`` set from ``--sensor-draw``)."""
+    """:func:`main` after its arguments are parsed (``SENSOR_DRAW`` and ``TURBULENCE_DRAW`` set from
+    ``--sensor-draw`` and ``--turbulence-draw``)."""
     if a.library_control_trim is not None:
         from gcs_sysid.diagnose import sparse as _sp
 
@@ -762,6 +781,7 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
             except RuntimeError as exc:       # the aircraft left the envelope with that effect
                 sc, findings, secs = {"ok": False, "error": str(exc)}, [], 0.0
             rec = {"aircraft": ac, "seed": seed, "plan": a.plan, "sensor_draw": SENSOR_DRAW,
+                   "turbulence_draw": TURBULENCE_DRAW,
                    "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT), "not_named": list(_LAST_NOT_NAMED),
                    "alpha_level": dict(_LAST_LEVEL),

@@ -25,6 +25,7 @@ References:
 from __future__ import annotations
 
 import os
+import zlib
 from dataclasses import asdict, dataclass, field
 from typing import Mapping
 
@@ -35,7 +36,7 @@ from gcs_sysid.signals import doublet, multisine, three_two_one_one
 
 from .aircraft import AircraftSpec, aircraft
 
-__all__ = ["FlightConfig", "Recording", "fly", "load_model", "maneuver_inputs", "speed_schedule",
+__all__ = ["FlightConfig", "Recording", "fly", "load_model", "turbulence_seed", "maneuver_inputs", "speed_schedule",
            "sideslip_holds", "slip_scale", "PLANS", "TURBULENCE", "LBF", "FT", "SLUG", "SLUG_FT2"]
 
 LBF = 4.4482216152605      # N per lbf
@@ -67,9 +68,13 @@ SWEEP_PLANS = ("sweep", "sweep_turn")
 #: Sensor noise draws (``FlightConfig.sensor_draw``): ``"shared"`` seeds the noise from the flight's seed
 #: alone, so every aircraft's flight of one seed carries the same noise sequences (among them the
 #: autopilot wind estimate's wander); ``"per_aircraft"`` mixes the aircraft's name into the sensor seed, so
-#: that a roster's sensor noise is independent draws (thirty-fourth session, issue 9). JSBSim's turbulence
-#: (``simulation/randomseed`` = ``seed``) is still one draw per seed across aircraft.
+#: that a roster's sensor noise is independent draws (thirty-fourth session, issue 9).
 SENSOR_DRAWS = ("shared", "per_aircraft")
+#: JSBSim's turbulence draws (``FlightConfig.turbulence_draw``, the same two values): ``"shared"`` sets
+#: ``simulation/randomseed`` to the flight's seed, so every aircraft's flight of one seed flies the same
+#: random sequence (the slow aircraft's seed-100 references shared their gusts: thirty-fourth session,
+#: pitot_scale_gate); ``"per_aircraft"`` mixes the aircraft's name in (:func:`turbulence_seed`).
+TURBULENCE_DRAWS = SENSOR_DRAWS
 
 #: The sweep's trim airspeeds: (start as a fraction of the logged duration, airspeed / initial
 #: airspeed). The last 20 % of the flight (the held-out segment) holds two levels of its own.
@@ -134,6 +139,8 @@ class FlightConfig:
             ``"sweep_turn"``: the sweep flown in a steady turn (:func:`turn_rate`).
         sensor_draw: ``"shared"`` or ``"per_aircraft"`` (:data:`SENSOR_DRAWS`): whether the sensor
             noise is seeded by ``seed`` alone or by ``seed`` and the aircraft's name.
+        turbulence_draw: ``"shared"`` or ``"per_aircraft"`` (:data:`TURBULENCE_DRAWS`): the same
+            for JSBSim's turbulence (:func:`turbulence_seed`).
     """
 
     aircraft: str = "c172x"
@@ -149,12 +156,16 @@ class FlightConfig:
     servo_rate_deg_s: float = 300.0
     plan: str = "standard"
     sensor_draw: str = "shared"
+    turbulence_draw: str = "shared"
 
     def __post_init__(self):
         if self.plan not in PLANS:
             raise ValueError(f"plan must be one of {', '.join(PLANS)}, got '{self.plan}'")
         if self.sensor_draw not in SENSOR_DRAWS:
             raise ValueError(f"sensor_draw must be one of {', '.join(SENSOR_DRAWS)}, got '{self.sensor_draw}'")
+        if self.turbulence_draw not in TURBULENCE_DRAWS:
+            raise ValueError(f"turbulence_draw must be one of {', '.join(TURBULENCE_DRAWS)}, "
+                             f"got '{self.turbulence_draw}'")
         if self.turbulence not in TURBULENCE:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}, got '{self.turbulence}'")
         if abs(self.sim_rate_hz / self.log_rate_hz - round(self.sim_rate_hz / self.log_rate_hz)) > 1e-9:
@@ -180,6 +191,16 @@ class Recording:
     constants: dict[str, float]
     config: FlightConfig
     meta: dict = field(default_factory=dict)
+
+
+def turbulence_seed(config: FlightConfig) -> int:
+    """JSBSim's ``simulation/randomseed`` for ``config``: the flight's seed with
+    ``turbulence_draw="shared"``; with ``"per_aircraft"`` a CRC-32 of the aircraft's name and the seed,
+    kept to 31 bits (JSBSim's property is a C int), so that a roster's turbulence is independent
+    draws and each aircraft's flight of a seed is still the same every time."""
+    if config.turbulence_draw == "shared":
+        return int(config.seed)
+    return zlib.crc32(f"{config.aircraft}/{config.seed}".encode()) & 0x7FFFFFFF
 
 
 def load_model(spec: AircraftSpec, dt: float, seed: int = 0, aircraft_path: str | None = None) -> jsbsim.FGFDMExec:
@@ -450,7 +471,7 @@ def fly(config: FlightConfig, aircraft_path: str | None = None) -> Recording:
     spec = aircraft(config.aircraft)
     dt = 1.0 / config.sim_rate_hz
     dec = int(round(config.sim_rate_hz / config.log_rate_hz))
-    fdm = load_model(spec, dt, config.seed, aircraft_path)
+    fdm = load_model(spec, dt, turbulence_seed(config), aircraft_path)
     _set_ic(fdm, spec, config)
     k_th, k_q, k_v, k_phi, k_p, k_r = spec.gains
     v_ref = fdm["velocities/vt-fps"] * FT

@@ -1,6 +1,8 @@
 """The JSBSim harness itself: exact truth consistent with rigid-body dynamics, sign conventions,
 generated airframe files, the .tlog as the pipeline decodes it."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -159,8 +161,6 @@ def test_sensor_draw_per_aircraft_gives_each_aircraft_its_own_noise():
     """``sensor_draw="shared"`` seeds the sensor noise from the seed alone (every aircraft of a seed
     shares the autopilot wind's wander); ``"per_aircraft"`` mixes the aircraft's name in, so that the
     same flight under two names draws different noise, and the same name the same noise."""
-    import dataclasses
-
     from benchmarks.jsbsim_harness.sensors import make_sensors
 
     rec = fly(FlightConfig("c172x", duration_s=20.0, seed=1, turbulence="none"))
@@ -175,6 +175,26 @@ def test_sensor_draw_per_aircraft_gives_each_aircraft_its_own_noise():
     assert np.abs(wind("c172x", "per_aircraft") - wind("sgs", "per_aircraft")).max() > 0.01
     with pytest.raises(ValueError, match="sensor_draw must be one of"):
         FlightConfig("c172x", sensor_draw="independent")
+
+
+def test_turbulence_draw_per_aircraft_gives_each_aircraft_its_own_gusts():
+    """``turbulence_draw="shared"`` sets JSBSim's random seed to the flight's seed (the older flights);
+    ``"per_aircraft"`` mixes the aircraft's name in: another gust sequence for the same seed, the same
+    one each time it is flown, and a seed JSBSim's C int holds."""
+    from benchmarks.jsbsim_harness.flight import turbulence_seed
+
+    shared = FlightConfig("c172x", duration_s=8.0, seed=1)
+    own = dataclasses.replace(shared, turbulence_draw="per_aircraft")
+    assert turbulence_seed(shared) == 1
+    assert turbulence_seed(own) != turbulence_seed(dataclasses.replace(own, aircraft="sgs"))
+    assert turbulence_seed(own) != turbulence_seed(dataclasses.replace(own, seed=2))
+    assert all(0 <= turbulence_seed(dataclasses.replace(own, seed=s)) < 2**31 for s in range(50))
+    a, b, c = fly(shared), fly(own), fly(own)
+    np.testing.assert_array_equal(b.truth["wn"], c.truth["wn"])
+    gust = a.truth["wn"] - np.mean(a.truth["wn"])
+    assert np.abs(a.truth["wn"] - b.truth["wn"]).max() > 0.2 * np.abs(gust).max() > 0.0
+    with pytest.raises(ValueError, match="turbulence_draw must be one of"):
+        FlightConfig("c172x", turbulence_draw="independent")
 
 
 @pytest.mark.slow

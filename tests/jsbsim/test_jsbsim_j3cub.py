@@ -139,7 +139,7 @@ def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, mon
     assert eval_jsbsim_diagnose.main(diag) == 0
     first = capsys.readouterr().out.splitlines()
     assert len(first) == 3 and all(ln.split()[-3] == "flown" for ln in first), first    # reference + 2 sizes
-    doc = tmp_path / "d" / "j3cub-s1-bias_airspeed=1-sweep-pa-effects.json"
+    doc = tmp_path / "d" / "j3cub-s1-bias_airspeed=1-sweep-pa-pt-effects.json"
     stale = json.loads(doc.read_text()) | {"harness": "0" * 16}
     doc.write_text(json.dumps(stale))
     flown = []
@@ -148,7 +148,7 @@ def test_eval_scripts_take_the_j3cub_and_reuse_its_flights(tmp_path, capsys, mon
     assert eval_jsbsim_diagnose.main(diag) == 0
     second = capsys.readouterr().out.splitlines()
     assert [ln.split()[-3] for ln in second] == ["reused", "reused", "flown"], second
-    assert flown == ["j3cub-s1-bias_airspeed=1-sweep-pa"]                   # only the stale one is flown again
+    assert flown == ["j3cub-s1-bias_airspeed=1-sweep-pa-pt"]                # only the stale one is flown again
     assert not (tmp_path / "d" / "results.jsonl").exists() or not (tmp_path / "d" / "results.jsonl").read_text()
 
 
