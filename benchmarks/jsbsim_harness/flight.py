@@ -124,7 +124,8 @@ class FlightConfig:
         aircraft: harness aircraft name (:data:`benchmarks.jsbsim_harness.aircraft.AIRCRAFT`).
         duration_s: logged flight time after the settling phase, s.
         turbulence: ``"none"``, ``"calm"``, ``"light"`` or ``"moderate"`` (:data:`TURBULENCE`).
-        seed: seeds JSBSim's turbulence (``simulation/randomseed``) and, in ``sensors``, the noise.
+        seed: seeds JSBSim's turbulence (``simulation/randomseed``, :func:`turbulence_seed`) and, in
+            ``sensors``, the noise.
         wind_ned: steady wind, the air's velocity over the ground, NED, m/s.
         sim_rate_hz: JSBSim integration rate, Hz.
         log_rate_hz: truth and fast-stream rate, Hz (a whole divisor of ``sim_rate_hz``).
