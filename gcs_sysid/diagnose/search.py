@@ -37,7 +37,8 @@ LIBRARY_REGRESSORS = ("alpha", "beta", "p_hat", "q_hat", "r_hat", "delta_e", "de
 def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
                       lags_s: tuple[float, ...] = (0.05, 0.1, 0.2),
                       alpha_knots: np.ndarray | None = None,
-                      control_trim: dict[str, float] | None = None) -> tuple[list[str], np.ndarray]:
+                      control_trim: dict[str, float] | None = None,
+                      drop_constant: bool = True) -> tuple[list[str], np.ndarray]:
     """The candidate terms, evaluated on every row.
 
     Args:
@@ -53,9 +54,12 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
             regressors about the reference condition). A product's own coefficient is unchanged by it; its
             lower-order parents then read their slopes at the trim. Hinges, ``alpha_dot_hat`` and the lag
             differences do not depend on it. None (the default): the measured values.
+        drop_constant: leave out the columns that are constant on the valid rows (the search's library).
+            False keeps every candidate: for a library rebuilt at perturbed regressors to re-evaluate terms
+            already selected (a hinge whose knot the perturbed alpha no longer crosses is all zeros there).
 
     Returns:
-        (names, Phi): names (K,) and values (T, K); constant columns left out.
+        (names, Phi): names (K,) and values (T, K); constant columns left out unless ``drop_constant`` is False.
     """
     X = np.nan_to_num(ctx.X)
     cols = {n: X[:, REGRESSORS.index(n)] - float((control_trim or {}).get(n, 0.0)) for n in LIBRARY_REGRESSORS}
@@ -86,6 +90,8 @@ def candidate_library(ctx: DiagContext, degree: int = 3, n_hinges: int = 4,
                 names.append(f"{u}(t-{tau:g})-{u}")
                 out.append(np.interp(t - tau, t, X[:, REGRESSORS.index(u)]) - X[:, REGRESSORS.index(u)])
     Phi = np.column_stack(out)
+    if not drop_constant:
+        return names, Phi
     keep = np.ptp(Phi[ctx.valid], axis=0) > 0 if ctx.valid.any() else np.zeros(Phi.shape[1], bool)
     return [n for n, k in zip(names, keep) if k], Phi[:, keep]
 

@@ -467,8 +467,9 @@ def _segments(ctx: DiagContext, segment_frac: float) -> tuple[np.ndarray, np.nda
     return v[v < cut - guard], v[v >= cut]
 
 
-def _library(ctx: DiagContext, knots=None, trim: dict[str, float] | None = None) -> tuple[list[str], np.ndarray]:
-    return candidate_library(ctx, lags_s=_LAGS_S, alpha_knots=knots, control_trim=trim)
+def _library(ctx: DiagContext, knots=None, trim: dict[str, float] | None = None,
+             drop_constant: bool = True) -> tuple[list[str], np.ndarray]:
+    return candidate_library(ctx, lags_s=_LAGS_S, alpha_knots=knots, control_trim=trim, drop_constant=drop_constant)
 
 
 #: The surfaces whose factors the search's monomials measure about the reference flight's trim with
@@ -1643,8 +1644,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             elif fac and all(x in REGRESSORS for x in fac):     # a monomial, as the library forms it
                 cols.append(np.prod([Xn[:, REGRESSORS.index(x)] for x in fac], axis=0))
             else:                                               # hinges, lags, alpha_dot_hat: the library
-                if lib is None:
-                    nm, P = _library(replace(ctx, X=Xp), knots, trim)
+                if lib is None:       # every candidate: a hinge the perturbed alpha no longer crosses is zeros
+                    nm, P = _library(replace(ctx, X=Xp), knots, trim, drop_constant=False)
                     lib = ({n: k for k, n in enumerate(nm)}, P)
                 cols.append(lib[1][:, lib[0][t]])
         A = np.nan_to_num(np.column_stack(cols))

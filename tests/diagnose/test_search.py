@@ -36,6 +36,24 @@ def test_library_spans_cubics_hinges_lags(airframe):
     assert np.allclose(Phi[:, i], ctx.x("alpha") ** 2 * ctx.x("beta"))
 
 
+def test_library_keeps_a_constant_hinge_when_asked(airframe):
+    """A hinge whose knot alpha never crosses is all zeros: the search's library leaves it out, while the
+    library rebuilt at perturbed angles to re-evaluate selected terms keeps every candidate (the
+    thirty-fifth session's roster crashed with KeyError 'max(0,alpha-2.4deg)' on an ultrastick flight when
+    the alpha-scale sensitivity moved alpha below a knot)."""
+    ctx, _ = _ctx(airframe)
+    top = float(np.nanmax(ctx.x("alpha")))
+    knots = np.array([top - 0.02, top + 0.01])
+    names, Phi = candidate_library(ctx, alpha_knots=knots)
+    every, Phi_all = candidate_library(ctx, alpha_knots=knots, drop_constant=False)
+    inside, beyond = (f"max(0,alpha-{np.degrees(k):.1f}deg)" for k in knots)
+    assert inside in names and beyond not in names
+    assert beyond in every and not Phi_all[:, every.index(beyond)].any()
+    assert set(names) <= set(every)
+    for n in names:
+        assert np.array_equal(Phi[:, names.index(n)], Phi_all[:, every.index(n)])
+
+
 def test_press_stepwise_against_brute_force():
     """Block PRESS of the chosen first term equals a direct leave-one-block-out refit."""
     rng = np.random.default_rng(0)
