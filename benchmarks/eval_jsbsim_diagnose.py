@@ -79,7 +79,7 @@ if str(REPO) not in sys.path:
 
 from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
-from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, make_effect_flight  # noqa: E402
+from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, case_stem, make_effect_flight  # noqa: E402
 
 __all__ = ["reference_model", "level_flights", "diagnose_case", "score_case", "side_force_scale_truth", "side_axis_variables", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
 
@@ -124,8 +124,7 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
     from benchmarks.jsbsim_harness.aircraft import aircraft
     from benchmarks.jsbsim_harness.logfile import FlightFiles, harness_fingerprint
 
-    tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
-    stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
+    stem = stem or case_stem(config.aircraft, config.seed, [(e.name, e.value) for e in effects])
     stem += _stem_suffix(config.plan, config.sensor_draw, config.turbulence_draw)
     tlog = out / f"{stem}.tlog"
     done = tlog.with_name(stem + "-effects.json")
@@ -398,10 +397,8 @@ def rescore(path: str) -> list[dict]:
             continue
         r = json.loads(ln)
         if r["effects"] and "error" not in r["score"]:
-            tag = "+".join(f"{n}={v:g}" for n, v in r["effects"])
-            stem = f"{r['aircraft']}-s{r['seed']}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
-            stem += _stem_suffix(r.get("plan", PLAN), r.get("sensor_draw", "shared"),
-                                 r.get("turbulence_draw", "shared"))
+            stem = case_stem(r["aircraft"], r["seed"], r["effects"]) + _stem_suffix(
+                r.get("plan", PLAN), r.get("sensor_draw", "shared"), r.get("turbulence_draw", "shared"))
             truth = json.loads((folder / f"{stem}-effects.json").read_text())
             findings = [dict(f, gain={"percent": f.get("gain_pct") or 0.0}) for f in r["findings"]]
             r["score"] = score_case(findings, scoring_truth(truth, folder / f"{stem}-truth.npz"))

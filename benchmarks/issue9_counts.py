@@ -52,6 +52,8 @@ CLASSES = {
     "transports": ("b737", "b747", "ka350", "fokker50", "s23"),
 }
 COUNTS = ("top", "est", "gain", "all")
+#: The classes in the tables' order, the unlisted aircraft last.
+_CLASS_ORDER = (*CLASSES, "other")
 
 
 def aircraft_class(name: str) -> str:
@@ -75,7 +77,8 @@ def load(paths) -> dict[tuple, dict]:
             try:
                 r = json.loads(ln)
                 key = (r["aircraft"], int(r["seed"]), tuple((e[0], float(e[1])) for e in r["effects"]))
-                r["score"]
+                if not isinstance(r["score"], dict):
+                    raise TypeError("score is not an object")
             except (json.JSONDecodeError, KeyError, TypeError, IndexError, ValueError) as exc:
                 raise ValueError(f"{p}:{n}: not an eval_jsbsim_diagnose record (aircraft, seed, effects, "
                                  f"score expected): {exc}") from None
@@ -105,7 +108,7 @@ def tally(recs: dict[tuple, dict]) -> dict:
     clean: dict = defaultdict(lambda: [0, 0])
     named_clean: dict = defaultdict(list)
     pairs = [0, 0]
-    for (ac, seed, effs), r in sorted(recs.items(), key=lambda kv: (kv[0][0], kv[0][1], kv[0][2])):
+    for (ac, seed, effs), r in sorted(recs.items()):
         if not effs:
             clean[ac][1] += 1
             if r["score"].get("ok"):
@@ -155,8 +158,7 @@ def _pct(k: int, n: int) -> str:
 
 def roster_table(t: dict) -> str:
     """The markdown table: per aircraft, top/estimate/gain/all three per effect, the clean flights, the row sums."""
-    acs = sorted({a for a, _ in t["cells"]} | set(t["clean"]),
-                 key=lambda a: (list(CLASSES).index(aircraft_class(a)) if aircraft_class(a) in CLASSES else 99, a))
+    acs = sorted({a for a, _ in t["cells"]} | set(t["clean"]), key=lambda a: (_CLASS_ORDER.index(aircraft_class(a)), a))
     lines = ["| class | aircraft | " + " | ".join(f"`{e}`" for e in EFFECTS) + " | clean | top | all three |",
              "|" + "---|" * (len(EFFECTS) + 5)]
     for a in acs:
@@ -183,7 +185,7 @@ def totals_table(t: dict) -> str:
     for e in EFFECTS:
         v = tot[e]
         lines.append(f"| `{e}` | {v['n']} | " + " | ".join(_pct(v[k], v["n"]) for k in COUNTS) + " | |")
-    for cls in list(CLASSES) + ["other"]:
+    for cls in _CLASS_ORDER:
         acs = {a for a, _ in t["cells"] if aircraft_class(a) == cls} | {a for a in t["clean"] if aircraft_class(a) == cls}
         if not acs:
             continue

@@ -43,7 +43,7 @@ from .logfile import FlightFiles, harness_fingerprint, write_log
 from .sensors import make_sensors
 from .truth import save_truth, truth_coefficients, truth_regressors
 
-__all__ = ["Effect", "EFFECTS", "SIZES", "inject_xml", "make_effect_flight", "stock_model_dir",
+__all__ = ["Effect", "EFFECTS", "SIZES", "case_stem", "inject_xml", "make_effect_flight", "stock_model_dir",
            "side_force_beta"]
 
 RHO0 = 1.225
@@ -209,6 +209,17 @@ def _bias_airspeed(sensors: dict, rec: Recording, bias: float) -> dict:
     return sensors
 
 
+def case_stem(aircraft_name: str, seed: int, effects) -> str:
+    """The file stem of a case, ``<aircraft>-s<seed>-<name>=<value>[+...]`` or ``...-clean``, with the
+    characters a file name should not carry replaced (``:`` -> ``_``, ``*`` -> ``x``, ``^`` dropped).
+
+    Args:
+        aircraft_name: harness aircraft name. seed: the flight's seed. effects: ``(name, value)`` pairs.
+    """
+    tag = "+".join(f"{n}={v:g}" for n, v in effects) or "clean"
+    return f"{aircraft_name}-s{seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
+
+
 def make_effect_flight(config: FlightConfig, effects: list[Effect], out_dir: str | Path, aoa: str = "ahrs",
                        stem: str | None = None) -> FlightFiles:
     """Fly ``config`` with ``effects`` injected; write ``<stem>.tlog``, ``-truth.npz`` and ``-effects.json``.
@@ -228,8 +239,7 @@ def make_effect_flight(config: FlightConfig, effects: list[Effect], out_dir: str
     spec = aircraft(config.aircraft)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    tag = "+".join(f"{e.name}={e.value:g}" for e in effects) or "clean"
-    stem = stem or f"{config.aircraft}-s{config.seed}-{tag}".replace(":", "_").replace("*", "x").replace("^", "")
+    stem = stem or case_stem(config.aircraft, config.seed, [(e.name, e.value) for e in effects])
     xml_effects = [e for e in effects if e.name != "bias:airspeed"]
     if xml_effects:
         with tempfile.TemporaryDirectory(prefix="jsbsim-effect-") as tmp:
