@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["block_jackknife_cov"]
+__all__ = ["block_jackknife_cov", "block_jackknife_var", "block_labels"]
 
 
 def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: float = 15.0,
@@ -35,10 +35,7 @@ def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: fl
     t, A, r = np.asarray(t, float), np.asarray(A, float), np.asarray(r, float)
     ok = np.isfinite(t) & np.all(np.isfinite(A), axis=1) & np.isfinite(r)
     t, A, r = t[ok], A[ok], r[ok]
-    if t.size < 3 * min_rows or block_s <= 0:
-        return None
-    k = np.floor((t - t[0]) / block_s).astype(int)
-    labels = [b for b in np.unique(k) if np.sum(k == b) >= min_rows]
+    k, labels = block_labels(t, block_s, min_rows)
     if len(labels) < 3:
         return None
     G, g = A.T @ A, A.T @ r
@@ -53,3 +50,47 @@ def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: fl
     B = th.shape[0]
     d = th - th.mean(axis=0)
     return (B - 1) / B * (d.T @ d)
+
+
+def block_labels(t: np.ndarray, block_s: float, min_rows: int = 50) -> tuple[np.ndarray, list[int]]:
+    """The delete-a-block jackknife's blocks: contiguous ``block_s``-second blocks counted from ``t[0]``.
+
+    Args:
+        t: (N,) time of the rows in time order, s (finite).
+        block_s: block length, s. min_rows: blocks with fewer rows are never left out on their own.
+
+    Returns:
+        (k, labels): (N,) block index of each row, and the indices of the blocks that may be left out
+        (empty with fewer than ``3 * min_rows`` rows or ``block_s <= 0``).
+    """
+    t = np.asarray(t, float)
+    if t.size < 3 * min_rows or block_s <= 0:
+        return np.zeros(t.size, int), []
+    k = np.floor((t - t[0]) / block_s).astype(int)
+    return k, [int(b) for b in np.unique(k) if np.sum(k == b) >= min_rows]
+
+
+def block_jackknife_var(t: np.ndarray, statistic, block_s: float = 15.0, min_rows: int = 50) -> float:
+    """Delete-a-block jackknife variance of a scalar statistic of time-ordered, dependent rows.
+
+    The statistic is recomputed with each block left out, ``s_i``, and
+    ``Var = (B - 1)/B sum (s_i - mean s)^2`` (Kuensch 1989, the same blocks as :func:`block_jackknife_cov`;
+    Efron and Tibshirani 1993 sec. 11.5). For smooth statistics of the rows (a difference of two
+    least-squares residual shares, :func:`gcs_sysid.estimation.airangles._moment_check`).
+
+    Args:
+        t: (N,) time of the rows in time order, s (finite).
+        statistic: callable taking an (N,) bool mask of the rows kept and returning a float.
+        block_s: block length, s. min_rows: as :func:`block_labels`.
+
+    Returns:
+        the variance, or NaN with fewer than 3 blocks or a non-finite leave-one-out value.
+    """
+    k, labels = block_labels(t, block_s, min_rows)
+    if len(labels) < 3:
+        return float("nan")
+    s = np.array([float(statistic(k != b)) for b in labels])
+    if not np.all(np.isfinite(s)):
+        return float("nan")
+    B = s.size
+    return float((B - 1) / B * np.sum((s - s.mean()) ** 2))

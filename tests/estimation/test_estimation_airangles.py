@@ -663,3 +663,68 @@ def test_stated_lift_level_sets_alpha_mean():
     z = np.zeros(T)
     with pytest.raises(ValueError, match="CL_alpha > 0"):
         lift_level(DT, alpha, z, z, z, z, np.ones(T, bool), 0.3, 0.0)
+
+
+def _angles(rng, T, sigma_kin, sigma_ang, C=-1.0):
+    """A true angle, two estimates with independent slow errors, and one moment coefficient that depends on the
+    true angle with slope ``C`` beside another regressor and a slow unexplained part (gusts)."""
+    true = _gauss_markov(rng, T, 3.0, 0.05)
+    kin = true + _gauss_markov(rng, T, 1.0, sigma_kin)
+    ang = true + _gauss_markov(rng, T, 1.0, sigma_ang)
+    X_other = rng.normal(size=(T, 2))
+    moments = [C * true + 0.5 * X_other[:, 0] + _gauss_markov(rng, T, 2.0, 0.02) + 0.01 * rng.normal(size=T)]
+    return true, kin, ang, X_other, moments
+
+
+def test_moment_lambda_standard_error_is_the_leave_one_block_out_scatter():
+    """lambda and its standard error (from the blocks' normal equations) equal a brute-force delete-a-block
+    jackknife of the encompassing regression refitted by lstsq on the rows left."""
+    from gcs_sysid.estimation.airangles import moment_lambda
+    from gcs_sysid.jackknife import block_labels
+
+    rng = np.random.default_rng(0)
+    T = 6000
+    _, kin, ang, X_other, moments = _angles(rng, T, 0.02, 0.01)
+    moments.append(0.3 * kin + 0.02 * rng.normal(size=T))
+    m = np.ones(T, bool)
+    m[:100] = False
+
+    def brute(keep):
+        Y = np.column_stack([Mo[m] for Mo in moments])
+        Y = (Y - Y.mean(axis=0)) / Y.std(axis=0)           # scaled on all rows of m, as the function does
+        A = np.column_stack([np.ones(m.sum()), kin[m], (ang - kin)[m], X_other[m]])
+        c, *_ = np.linalg.lstsq(A[keep], Y[keep], rcond=None)
+        return np.sum(c[2] * c[1]) / np.sum(c[1] ** 2)
+
+    lam, se = moment_lambda(DT, kin, ang, X_other, moments, m)
+    idx = np.nonzero(m)[0]
+    k, labels = block_labels(idx * DT, 15.0)
+    assert lam == pytest.approx(brute(np.ones(idx.size, bool)), rel=1e-9)
+    d = np.array([brute(k != b) for b in labels])
+    assert se == pytest.approx(np.sqrt((len(d) - 1) / len(d) * np.sum((d - d.mean()) ** 2)), rel=1e-9)
+
+
+@pytest.mark.parametrize("sigma_kin, sigma_ang, C, closer", [
+    (0.03, 0.01, -1.0, "ang"),        # the aided angle three times better: the moments follow it
+    (0.01, 0.03, -1.0, "kin"),        # the misled aiding: they follow the kinematic angle, beyond their scatter
+    (0.03, 0.01, 0.0, None),          # moments that do not depend on the angle: no evidence either way
+])
+def test_moment_lambda_reads_which_angle_the_moments_follow(sigma_kin, sigma_ang, C, closer):
+    """lambda ~ var(e_kin) / (var(e_kin) + var(e_ang)): above 0.5 where the aided angle is the closer to the
+    true one, below 0.5 by more than MOMENT_Z standard errors where the kinematic one is (the cross-check then
+    drops the aiding), and wide where the moments carry no information on the angle."""
+    from gcs_sysid.estimation.airangles import MOMENT_Z, moment_lambda
+
+    rng = np.random.default_rng(7)
+    T = 6000
+    true, kin, ang, X_other, moments = _angles(rng, T, sigma_kin, sigma_ang, C)
+    lam, se = moment_lambda(DT, kin, ang, X_other, moments, np.ones(T, bool))
+    ek, ea = np.var(kin - true), np.var(ang - true)
+    if closer == "ang":
+        assert lam > 0.5 and lam + MOMENT_Z * se > 0.5, (lam, se)
+        assert lam == pytest.approx(ek / (ek + ea), abs=0.15)
+    elif closer == "kin":
+        assert lam + MOMENT_Z * se < 0.5, (lam, se)
+        assert lam == pytest.approx(ek / (ek + ea), abs=0.15)
+    else:
+        assert lam + MOMENT_Z * se > 0.5, (lam, se)
