@@ -75,8 +75,8 @@ def block_jackknife_var(t: np.ndarray, statistic, block_s: float = 15.0, min_row
 
     The statistic is recomputed with each block left out, ``s_i``, and
     ``Var = (B - 1)/B sum (s_i - mean s)^2`` (Kuensch 1989, the same blocks as :func:`block_jackknife_cov`;
-    Efron and Tibshirani 1993 sec. 11.5). For smooth statistics of the rows (a difference of two
-    least-squares residual shares, :func:`gcs_sysid.estimation.airangles._moment_check`).
+    Efron and Tibshirani 1993 sec. 11.5). For smooth statistics of the rows (a ratio of least-squares
+    coefficients, :func:`gcs_sysid.estimation.airangles.moment_lambda`).
 
     Args:
         t: (N,) time of the rows in time order, s (finite).

@@ -99,12 +99,12 @@ MEAN_BLOCK_S = 5.0    #: block length for the standard error of the CY constant 
 #: variance, 0.3 in sigma, and follows a turbulent stretch of a flight that is calm elsewhere)
 MOMENT_WINDOW_TAUS = 5.0
 #: the moment cross-check drops the aiding only when, beside the larger residual, the moments follow the kinematic
-#: angle by more than this many block-jackknife standard errors (``lambda + MOMENT_Z se < 0.5``, :func:`_moment_check`;
+#: angle by more than this many block-jackknife standard errors (``lambda + MOMENT_Z se < 0.5``, :func:`moment_lambda`;
 #: thirty-sixth session). None: the older rule (a larger residual alone drops it), which fell back on a knife edge on
 #: the JSBSim gliders' flights (sgs126: 41.7 against 41.5 %) and kept a kinematic alpha 20-50 times further from the
 #: true one
 MOMENT_Z: float | None = 2.0
-MOMENT_BLOCK_S = 15.0  #: block length of :func:`_moment_check`'s jackknife, s (the gusts are slow; as the scale check)
+MOMENT_BLOCK_S = 15.0  #: block length of :func:`moment_lambda`'s jackknife, s (the gusts are slow; as the scale check)
 #: Default of ``aided_air_angles(instrument_slopes=None)``: fit CZ_alpha by two-stage least squares with the
 #: elevator as instrument (:mod:`.angleerrors`). Off by default for now: measured better on JSBSim (c172x
 #: light: alpha scale error 8 -> 5 %, 7 -> 3 %) and on the project's sim trainer (alpha RMS 0.114 -> 0.047
@@ -1115,7 +1115,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         if ra > rk and (MOMENT_Z is None or not np.isfinite(se) or lam + MOMENT_Z * se < 0.5):
             mname = "Cm" if name == "alpha" else "Cl, Cn"
             fit.used = False
-            lam_note = f"; they follow it, lambda = {lam:.2f} +- {se:.2f}" if np.isfinite(se) else ""
+            lam_note = f"; the moments follow the kinematic one: lambda = {lam:.2f} +- {se:.2f}" if np.isfinite(se) else ""
             fit.reason = (f"the aided {name} fits {mname} worse than the kinematic one (residual {100 * ra:.1f} % "
                           f"vs {100 * rk:.1f} % of the variance{lam_note}): the force model is not trusted")
             return kin0, kinematic_sigma(ang, kin0, gust_sig, m, int(round(MOMENT_WINDOW_TAUS * fit.tau_s / dt))), fit
