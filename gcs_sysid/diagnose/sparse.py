@@ -237,6 +237,16 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: i9-pwpcm): an entry may name its coefficient, ``("Cm:alpha",)``: the block only in ``Cm``'s search. That gives the
 #: sgs126's ``Cn:delta_a`` back and keeps the seven wins (*Thirtieth session, i9-pwpcm*). **On** since then,
 #: ``("Cm:alpha",)``; ``()`` turns it off.
+#: Changed 2026-11-25 (thirty-sixth session): ``angle_error_beside_named`` (nineteenth session, branch i9-ultra) **on**.
+#: The sideslip's error along a search finding's term is fitted on the search's differential residual (after the
+#: reference's inadequacy), not on the residual against the model: the JSBSim t37's reference model has no ``r_hat`` in
+#: CY, Cl or Cn, so on the raw residual the other coefficients' own ``r_hat`` derivatives (common to both flights) were
+#: read as the angle's error (-0.08 +- 0.06 rad per unit, where the two flights' Cl and Cn slopes differ by what an
+#: error of +0.4..+0.6 makes, and JSBSim's truth says the aided sideslip's ``r_hat`` loading moved by 0.7), and two
+#: clean flights named ``CY:r_hat``. On the whole roster (25 aircraft x 6 effects x 2 sizes, seed 1, clean 11-15;
+#: the rule fixed before the run): clean 116 -> 118 of 125, top 180 -> 182 of 300 (``Cn:delta_a`` +3 on the asw20,
+#: pa28 and sgs126; ``Cl:alpha*beta`` -1 on the c684, which now names nothing), all three 111 -> 112
+#: (*Thirty-sixth session, lead*). False restores the rule before it.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -252,7 +262,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
               "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
-              "angle_offset_level": False, "angle_error_beside_named": False, "coverage_curvature": True,
+              "angle_offset_level": False, "angle_error_beside_named": True, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
