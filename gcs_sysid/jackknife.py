@@ -5,6 +5,9 @@ A low-level helper with no project imports, so that both the estimation layer
 kinematic one) and the diagnosis (:mod:`gcs_sysid.diagnose.uncertainty`,
 :func:`gcs_sysid.diagnose.differential.block_jackknife_se`) use the same estimator. Moved here from
 ``gcs_sysid/diagnose/uncertainty.py`` in the tenth session (branch i9-alias); the diagnosis re-exports it.
+The same blocks (:func:`block_labels`) serve the scalar form, :func:`block_jackknife_var`, for a statistic that is
+not a least-squares coefficient (thirty-sixth session: the moment cross-check's ``lambda``,
+:func:`gcs_sysid.estimation.airangles.moment_lambda`).
 """
 
 from __future__ import annotations
