@@ -225,7 +225,7 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
             ``airangles.ALPHA_PROFILE_COLUMNS``), ``beta_profile_min_lr`` where the script has it
             (``airangles.BETA_PROFILE_MIN_LR``) and the ``on``/``off`` switches ``beta_profile``, and where the
             script has them ``kinematic_mean`` and ``floor_drops_curvature`` (``airangles.BETA_PROFILE``,
-            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``).
+            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``), and ``wind_window`` (s: ``estimate.WIND_WINDOW_S``).
 
     Raises:
         SystemExit: a ``--stated-lift-level`` item does not parse. ValueError: a ``--stated-lift-slope`` value is
@@ -249,6 +249,10 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
             setattr(_aa, flag, getattr(a, option) == "on")
     if getattr(a, "beta_profile_min_lr", None) is not None:
         _aa.BETA_PROFILE_MIN_LR = a.beta_profile_min_lr
+    if getattr(a, "wind_window", None) is not None:
+        from gcs_sysid.estimation import estimate as _est
+
+        _est.WIND_WINDOW_S = float(a.wind_window)
 
 
 def stated_airframe(path: Path, work: Path, stem: str) -> Path:
@@ -702,6 +706,8 @@ def main(argv=None) -> int:
                          "slope reaches LR (3.84: the chi-squared 95 %% point; gcs_sysid.estimation.airangles."
                          "BETA_PROFILE_MIN_LR; default: the package's, no test)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
+    ap.add_argument("--wind-window", default=None, type=float, metavar="S",
+                    help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
                     help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."
                          "KINEMATIC_MEAN; default: the package's default, off)")

@@ -684,6 +684,8 @@ def main(argv=None) -> int:
                    help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
                         "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
                         "package's, off)")
+    p.add_argument("--wind-window", default=None, type=float, metavar="S",
+                   help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
@@ -713,7 +715,7 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         _dr.AIR_ROLL_RATE = a.air_roll_rate
     from benchmarks.eval_jsbsim import apply_aiding_options
 
-    apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile
+    apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile, --wind-window
     if a.beta_profile is not None:      # the diagnosis loads its flights with its own switch (load_measurements)
         from gcs_sysid.diagnose import run as _dr
 

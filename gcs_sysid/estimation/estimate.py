@@ -41,6 +41,9 @@ V_FLOOR = 8.0        #: airspeed (m/s) above which the aircraft counts as flying
 #: gave V within 0.03 m/s on average (docs/estimation.md, "Wind"). The pitot's calibration is the diagnosis's (the
 #: wind triangle and the data-compatibility check, one steady wind and coloured standard errors).
 PITOT_SCALE_FROM_TURNS = False
+#: Length (s) of the wind fit's windows (``estimate_wind(window_s=...)``): one horizontal wind per window, linearly
+#: interpolated between the window centres.
+WIND_WINDOW_S = 30.0
 RATE_OK_HZ = 20.0    #: gyro rate from which angular accelerations are trusted
 RATE_MIN_HZ = 10.0   #: below this rate they are not identifiable at all
 _STREAM_ADVICE = ("raise the telemetry stream rates to 50 Hz (ArduPilot SRx_RAW_SENS for RAW_IMU, SRx_EXTRA1 for "
@@ -452,10 +455,10 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             if have_tas else None
         if fly is not None and fly.sum() >= 10:
             try:
-                We = estimate_wind(t, v_ned, tas, fly, prior=wind_ap, C=C,
+                We = estimate_wind(t, v_ned, tas, fly, prior=wind_ap, C=C, window_s=WIND_WINDOW_S,
                                    min_turn=0.5 if PITOT_SCALE_FROM_TURNS else 0.0)
                 wind, wsig = We.wind, We.sigma
-                sources["wind"] = ("least squares over 30 s windows: |v_gps - w| = k V_tas" +
+                sources["wind"] = (f"least squares over {WIND_WINDOW_S:g} s windows: |v_gps - w| = k V_tas" +
                                    ("" if PITOT_SCALE_FROM_TURNS else " (k = 1)") + ", beta ~ 0 on average" +
                                    (" (autopilot WIND/XKF2 only as a weak prior)" if wind_ap is not None else ""))
                 if not PITOT_SCALE_FROM_TURNS:
