@@ -34,6 +34,8 @@ there is a win (the thirty-second session's i8-clband reading: no wins, no case)
 seed when one of its counts, summed over its flights, goes down (the twenty-fifth session's table); aircraft with
 a lost flip whose count does not go down are listed apart.
 
+Files may be gzip-compressed (``.jsonl.gz``: the committed record sets in ``benchmarks/records/``).
+
 Usage::
 
     python benchmarks/issue8_counts.py base-g0.jsonl                     # one run's counts
@@ -56,6 +58,10 @@ import math
 import sys
 from collections import defaultdict
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.eval_common import read_lines  # noqa: E402
 
 COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 FORCES = COEFFICIENTS[:3]
@@ -148,8 +154,8 @@ def load_runs(specs: list[str]) -> dict[int, dict[tuple, dict]]:
             except ValueError:
                 raise SystemExit(f"{spec}: expected FILE or FILE@GP_SEED") from None
         try:
-            lines = Path(path).read_text().splitlines()
-        except OSError as exc:
+            lines = read_lines(path)
+        except (OSError, UnicodeDecodeError) as exc:
             raise SystemExit(f"{path}: {exc}") from None
         for i, line in enumerate(lines, 1):
             if not line.strip():

@@ -24,10 +24,19 @@ two-sigma band for two independent binomial samples, ``2 sqrt(p (1 - p) (1/n1 + 
 a difference inside the band is "within draw scatter" (thirty-fifth session's rule: the rosters' draws differ, so
 the question is whether a difference is larger than a change of draws alone would give).
 
+Where the two rosters share cases flown alike (the same aircraft, seed and effects, and the same ``plan``,
+``sensor_draw`` and ``turbulence_draw`` fields), ``--against`` also pairs them case by case (:func:`flips`; the
+thirty-sixth and thirty-seventh sessions' rule for a change of method on the same flights): each count that a case
+gains is a win, each it loses a loss, a clean flight that stops naming a cause a win of ``clean``, and a pair whose
+both effects become found a win of ``pair``. The flights are the same, so every flip is the method's doing.
+
+Records may be gzip-compressed (``.jsonl.gz``: the committed record sets in ``benchmarks/records/``).
+
 Usage::
 
     python benchmarks/issue9_counts.py A/results.jsonl B/results.jsonl           # the table and the totals
     python benchmarks/issue9_counts.py new/*.jsonl --against old/*.jsonl       # and the rates against another roster
+    python benchmarks/issue9_counts.py new/*.jsonl --against benchmarks/records/issue9-roster-*.jsonl.gz   # paired
 """
 
 from __future__ import annotations
@@ -38,6 +47,10 @@ import math
 import sys
 from collections import defaultdict
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.eval_common import read_lines  # noqa: E402
 
 #: The six effects of issue 9's roster, in the table's column order (``benchmarks/jsbsim_harness/effects.py``).
 EFFECTS = ("Cm:alpha^2", "Cl:alpha*beta", "Cn:delta_a", "CY:scale", "delay:delta_e", "bias:airspeed")
@@ -71,7 +84,7 @@ def load(paths) -> dict[tuple, dict]:
     """
     out: dict[tuple, dict] = {}
     for p in paths:
-        for n, ln in enumerate(Path(p).read_text().splitlines(), 1):
+        for n, ln in enumerate(read_lines(p), 1):
             if not ln.strip():
                 continue
             try:
@@ -212,14 +225,77 @@ def against_table(t: dict, base: dict) -> str:
     return "\n".join(lines)
 
 
+#: The record fields that say how a case was flown; two records pair only where they agree (absent counts as
+#: a value of its own).
+FLOWN_AS = ("plan", "sensor_draw", "turbulence_draw")
+
+
+def _label(key: tuple) -> str:
+    ac, seed, effs = key
+    return f"{ac} s{seed} " + (" + ".join(f"{e}={v:g}" for e, v in effs) if effs else "clean")
+
+
+def _pair_found(r: dict) -> bool:
+    rows = r["score"].get("effects") or []
+    return bool(rows) and "error" not in r["score"] and all(e.get("found") for e in rows)
+
+
+def flips(recs: dict[tuple, dict], base: dict[tuple, dict]) -> dict:
+    """The cases of ``recs`` against the same cases of ``base``, flown alike (:data:`FLOWN_AS`), count by count.
+
+    Args:
+        recs, base: :func:`load` results (the candidate and the base roster).
+
+    Returns:
+        ``{"paired": n, "unpaired": n, "counts": {count: {"wins": [label...], "losses": [label...]}}}`` with the
+        counts :data:`COUNTS` (single-effect cases), ``"clean"`` (a clean flight names nothing) and ``"pair"``
+        (both effects of a two-effect case found); a label reads ``"sgs s1 Cn:delta_a=-0.06"``. A case in only one
+        roster, or flown differently, is unpaired.
+    """
+    out = {k: {"wins": [], "losses": []} for k in (*COUNTS, "clean", "pair")}
+    paired = unpaired = 0
+    for key in sorted(set(recs) | set(base)):
+        r, b = recs.get(key), base.get(key)
+        if r is None or b is None or any(r.get(f) != b.get(f) for f in FLOWN_AS):
+            unpaired += 1
+            continue
+        paired += 1
+        effs = key[2]
+        if not effs:
+            now, was = {"clean": bool(r["score"].get("ok"))}, {"clean": bool(b["score"].get("ok"))}
+        elif len(effs) == 1:
+            now, was = case_counts(r), case_counts(b)
+        else:
+            now, was = {"pair": _pair_found(r)}, {"pair": _pair_found(b)}
+        for k in now:
+            if now[k] != was[k]:
+                out[k]["wins" if now[k] else "losses"].append(_label(key))
+    return {"paired": paired, "unpaired": unpaired, "counts": out}
+
+
+def flips_table(f: dict) -> str:
+    """The markdown table of :func:`flips`, and each flipped case."""
+    lines = [f"Paired case by case: {f['paired']} cases ({f['unpaired']} unpaired).", "",
+             "| count | wins | losses | net |", "|---|---|---|---|"]
+    for k, v in f["counts"].items():
+        lines.append(f"| {k} | {len(v['wins'])} | {len(v['losses'])} | {len(v['wins']) - len(v['losses']):+d} |")
+    for k, v in f["counts"].items():
+        for side, word in (("wins", "win"), ("losses", "loss")):
+            if v[side]:
+                lines.append(f"- {k} {word}: " + "; ".join(v[side]))
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("results", nargs="+", metavar="JSONL", help="eval_jsbsim_diagnose results.jsonl files (later wins)")
     p.add_argument("--against", nargs="+", metavar="JSONL", default=None, help="the base roster's results files")
     a = p.parse_args(argv)
     try:
-        t = tally(load(a.results))
-        base = tally(load(a.against)) if a.against else None
+        recs = load(a.results)
+        base_recs = load(a.against) if a.against else None
+        t = tally(recs)
+        base = tally(base_recs) if base_recs is not None else None
     except (OSError, ValueError) as exc:
         print(f"issue9_counts: {exc}", file=sys.stderr)
         return 2
@@ -229,6 +305,9 @@ def main(argv=None) -> int:
         print("\nClean flights that named a cause: " + "; ".join(named) + ".")
     if base is not None:
         print("\n" + against_table(t, base))
+        f = flips(recs, base_recs)
+        if f["paired"]:
+            print("\n" + flips_table(f))
     return 0
 
 

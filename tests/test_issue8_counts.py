@@ -131,3 +131,17 @@ def test_counts_option_restricts_the_flips_and_the_verdict(tmp_path, capsys):
     assert "rule 8(b) HOLDS (seed 0 +1/-0, seed 1 +1/-0" in out
     assert "on the counts meas, gp, true_air, gp<ls, gp<fair only" in out
     assert "| cov_tair |" in out                     # the tables keep every count
+
+
+def test_a_gzip_record_set_reads_as_the_plain_one(tmp_path):
+    import gzip
+
+    rows = [_row(), _row(seed=2, gp_seed=1)]
+    plain = _write(tmp_path / "r.jsonl", rows)
+    gz = tmp_path / "r.jsonl.gz"
+    with gzip.open(gz, "wt") as f:
+        f.write(open(plain).read())
+    assert ic.load_runs([str(gz)]) == ic.load_runs([plain])
+    (tmp_path / "bad.jsonl.gz").write_text("not gzip")
+    with pytest.raises(SystemExit, match="bad.jsonl.gz"):
+        ic.load_runs([str(tmp_path / "bad.jsonl.gz")])

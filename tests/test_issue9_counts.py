@@ -72,3 +72,35 @@ def test_cli_prints_the_tables_and_names_a_bad_line(tmp_path, capsys):
     bad.write_text(json.dumps(_case()) + "\n{\"aircraft\": \"sgs\"}\n")
     assert ic.main([str(bad)]) == 2
     assert f"{bad}:2: not an eval_jsbsim_diagnose record" in capsys.readouterr().err
+
+
+def test_flips_pair_cases_flown_alike_and_read_gzip(tmp_path):
+    import gzip
+
+    flown = {"plan": "sweep", "sensor_draw": "per_aircraft", "turbulence_draw": "per_aircraft"}
+    base = [dict(_case(seed=1), **flown), dict(_case(seed=2, top=False, est=False, gain=False, named=[]), **flown),
+            dict(_clean(seed=11, named=["CX:beta"]), **flown), dict(_clean(seed=12), **flown),
+            dict(_case(seed=3), plan="standard")]
+    new = [dict(_case(seed=1, gain=False), **flown), dict(_case(seed=2), **flown),
+           dict(_clean(seed=11), **flown), dict(_clean(seed=12, named=["scale:CY"]), **flown),
+           dict(_case(seed=3), **flown)]                      # seed 3 flown with another plan: not paired
+    gz = tmp_path / "base.jsonl.gz"
+    with gzip.open(gz, "wt") as f:
+        f.write("".join(json.dumps(r) + "\n" for r in base))
+    f = ic.flips(ic.load([_write(tmp_path / "new.jsonl", new)]), ic.load([str(gz)]))
+    assert f["paired"] == 4 and f["unpaired"] == 1
+    c = f["counts"]
+    assert c["top"] == {"wins": ["sgs s2 Cn:delta_a=-0.06"], "losses": []}
+    assert c["gain"] == {"wins": ["sgs s2 Cn:delta_a=-0.06"], "losses": ["sgs s1 Cn:delta_a=-0.06"]}
+    assert c["all"]["losses"] == ["sgs s1 Cn:delta_a=-0.06"] and c["all"]["wins"] == ["sgs s2 Cn:delta_a=-0.06"]
+    assert c["clean"] == {"wins": ["sgs s11 clean"], "losses": ["sgs s12 clean"]}
+    table = ic.flips_table(f)
+    assert "Paired case by case: 4 cases (1 unpaired)." in table and "| top | 1 | 0 | +1 |" in table
+    assert "- clean loss: sgs s12 clean" in table
+
+
+def test_a_bad_gzip_file_is_named(tmp_path, capsys):
+    bad = tmp_path / "r.jsonl.gz"
+    bad.write_text("not gzip\n")
+    assert ic.main([str(bad)]) == 2
+    assert "issue9_counts:" in capsys.readouterr().err
