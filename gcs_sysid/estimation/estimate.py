@@ -42,7 +42,9 @@ V_FLOOR = 8.0        #: airspeed (m/s) above which the aircraft counts as flying
 #: wind triangle and the data-compatibility check, one steady wind and coloured standard errors).
 PITOT_SCALE_FROM_TURNS = False
 #: Length (s) of the wind fit's windows (``estimate_wind(window_s=...)``): one horizontal wind per window, linearly
-#: interpolated between the window centres.
+#: interpolated between the window centres. 15 s was measured in the thirty-seventh session and not adopted: closer
+#: to JSBSim's wind and 5 more tops on issue 9's roster, but 2 fewer clean flights naming nothing and issue 8's rule
+#: 8(b) failed (docs/benchmarks.md, "Thirty-seventh session, lead").
 WIND_WINDOW_S = 30.0
 RATE_OK_HZ = 20.0    #: gyro rate from which angular accelerations are trusted
 RATE_MIN_HZ = 10.0   #: below this rate they are not identifiable at all
