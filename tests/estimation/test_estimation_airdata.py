@@ -69,3 +69,39 @@ def test_cross_wind_on_a_straight_leg_from_the_crab_angle():
     we = estimate_wind(t, v_ned, tas, np.ones(len(t), bool), C=C)
     np.testing.assert_allclose(we.wind[:, :2].mean(0), wind[:2], atol=0.1)
     assert we.scale == 1.0 and np.isnan(we.scale_sigma)   # no turns: the pitot scale is not estimated
+
+
+def test_residual_scale_leaves_a_fit_within_pitot_noise_alone():
+    """Residuals within the pitot's noise: one solve, the same wind as without ``residual_scale``."""
+    rng = np.random.default_rng(6)
+    t = np.arange(0, 90, 0.02)
+    wind = np.array([0.0, 4.0, 0.0])
+    V = 20.0 + 2.0 * np.sin(0.05 * t)
+    crab = -np.arcsin(wind[1] / V)
+    C = dcm(np.zeros_like(t), np.full_like(t, 0.05), crab)
+    v_ned = np.einsum("tij,tj->ti", C, np.stack([V * np.cos(0.05), 0 * t, V * np.sin(0.05)], 1)) + wind
+    tas = V + rng.normal(0, 0.3, len(t))
+    a = estimate_wind(t, v_ned, tas, np.ones(len(t), bool), C=C)
+    b = estimate_wind(t, v_ned, tas, np.ones(len(t), bool), C=C, residual_scale=True)
+    assert b.fits == 1 and b.sigma_airspeed == 0.5
+    np.testing.assert_array_equal(a.wind, b.wind)
+
+
+def test_residual_scale_weights_gusty_airspeed_residuals_with_their_rms():
+    """A gust along the flight path the wind model cannot hold (2 m/s, 3-s correlation): the airspeed residuals'
+    weight becomes their RMS, and the refit settles within a few solves."""
+    rng = np.random.default_rng(7)
+    t = np.arange(0, 120, 0.02)
+    wind = np.array([2.0, -3.0, 0.0])
+    V = 30.0 + 3.0 * np.sin(0.07 * t)
+    crab = -np.arcsin(wind[1] / V)
+    C = dcm(np.zeros_like(t), np.zeros_like(t), crab)
+    v_ned = np.einsum("tij,tj->ti", C, np.stack([V, 0 * t, 0 * t], 1)) + wind
+    g = np.zeros(len(t))
+    a = np.exp(-0.02 / 3.0)
+    for i in range(1, len(t)):
+        g[i] = a * g[i - 1] + np.sqrt(1 - a * a) * 2.0 * rng.normal()
+    tas = V + g + rng.normal(0, 0.3, len(t))
+    we = estimate_wind(t, v_ned, tas, np.ones(len(t), bool), C=C, residual_scale=True)
+    assert 1.2 < we.sigma_airspeed < 2.5 and 2 <= we.fits <= 4
+    np.testing.assert_allclose(we.wind[:, :2].mean(0), wind[:2], atol=0.6)
