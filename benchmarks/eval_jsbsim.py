@@ -225,7 +225,8 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
             ``airangles.ALPHA_PROFILE_COLUMNS``), ``beta_profile_min_lr`` where the script has it
             (``airangles.BETA_PROFILE_MIN_LR``) and the ``on``/``off`` switches ``beta_profile``, and where the
             script has them ``kinematic_mean`` and ``floor_drops_curvature`` (``airangles.BETA_PROFILE``,
-            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``), and ``wind_window`` (s: ``estimate.WIND_WINDOW_S``).
+            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``), ``wind_window`` (s: ``estimate.WIND_WINDOW_S``) and the
+            ``on``/``off`` switch ``wind_residual_scale`` (``estimate.WIND_RESIDUAL_SCALE``).
 
     Raises:
         SystemExit: a ``--stated-lift-level`` item does not parse. ValueError: a ``--stated-lift-slope`` value is
@@ -253,6 +254,10 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
         from gcs_sysid.estimation import estimate as _est
 
         _est.WIND_WINDOW_S = float(a.wind_window)
+    if getattr(a, "wind_residual_scale", None) is not None:
+        from gcs_sysid.estimation import estimate as _est
+
+        _est.WIND_RESIDUAL_SCALE = a.wind_residual_scale == "on"
 
 
 def stated_airframe(path: Path, work: Path, stem: str) -> Path:
@@ -708,6 +713,9 @@ def main(argv=None) -> int:
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
+    ap.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),
+                    help="weight the wind fit's airspeed residuals with their own RMS (gcs_sysid.estimation.estimate."
+                         "WIND_RESIDUAL_SCALE; default: the package's, off)")
     ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
                     help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."
                          "KINEMATIC_MEAN; default: the package's default, off)")

@@ -686,6 +686,9 @@ def main(argv=None) -> int:
                         "package's, off)")
     p.add_argument("--wind-window", default=None, type=float, metavar="S",
                    help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
+    p.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),
+                   help="weight the wind fit's airspeed residuals with their own RMS (gcs_sysid.estimation.estimate."
+                        "WIND_RESIDUAL_SCALE; default: the package's, off)")
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
@@ -715,7 +718,8 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         _dr.AIR_ROLL_RATE = a.air_roll_rate
     from benchmarks.eval_jsbsim import apply_aiding_options
 
-    apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile, --wind-window
+    apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile, --wind-window,
+    #                              --wind-residual-scale
     if a.beta_profile is not None:      # the diagnosis loads its flights with its own switch (load_measurements)
         from gcs_sysid.diagnose import run as _dr
 
