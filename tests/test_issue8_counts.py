@@ -145,3 +145,22 @@ def test_a_gzip_record_set_reads_as_the_plain_one(tmp_path):
     (tmp_path / "bad.jsonl.gz").write_text("not gzip")
     with pytest.raises(SystemExit, match="bad.jsonl.gz"):
         ic.load_runs([str(tmp_path / "bad.jsonl.gz")])
+
+
+def test_a_lost_gp_ls_flip_where_least_squares_got_better_can_be_set_aside(tmp_path, capsys):
+    # seed 0: least squares improves on CY (GP unchanged) -> a gp<ls loss set aside; seed 1: the GP worsens on Cn
+    # (1 -> 3 %, past LS's 2) -> a loss that stays; a held-out win on CX at each seed
+    base = [_row("sgs", 1, gs, gp=(6, 1, 1, 1, 1, 1), ls=(9, 2, 2, 2, 2, 2)) for gs in (0, 1)]
+    cand = [_row("sgs", 1, 0, ls=(9, 0.5, 2, 2, 2, 2)), _row("sgs", 1, 1, gp=(1, 1, 1, 1, 1, 3), ls=(9, 2, 2, 2, 2, 2))]
+    ch0, _ = ic.flips({ic.flight_key(base[0]): base[0]}, {ic.flight_key(cand[0]): cand[0]})
+    kept, aside = ic.set_aside_ls_gains(ch0, {ic.flight_key(base[0]): base[0]}, {ic.flight_key(cand[0]): cand[0]},
+                                        0.1)
+    assert [(c["count"], c["coef"], c["win"]) for c in kept] == [("gp", "CX", True)]
+    assert [(c["coef"], c["ls_base"], c["ls_cand"], c["gp_cand"]) for c in aside] == [("CY", 2.0, 0.5, 1.0)]
+    b, c = _write(tmp_path / "b.jsonl", base), _write(tmp_path / "c.jsonl", cand)
+    assert ic.main([c, "--against", b]) == 0
+    assert "rule 8(b) FAILS (seed 0 +1/-1, seed 1 +1/-1" in capsys.readouterr().out
+    assert ic.main([c, "--against", b, "--ls-loss-needs-gp-worse", "0.1"]) == 0
+    out = capsys.readouterr().out
+    assert "rule 8(b) FAILS (seed 0 +1/-0, seed 1 +1/-1" in out             # the GP's own loss still counts
+    assert "GP seed 0: 1 lost gp<ls flips set aside" in out and "sgs light s1 ahrs CY: gp 1.00 -> 1.00 %" in out
