@@ -153,7 +153,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: :func:`gcs_sysid.diagnose.differential.angle_scale_allowance` ``column``; no new threshold) and
 #: ``coverage_type_a`` (the naming's coverage test reads the combined uncertainty without its type-B air-angle
 #: components, which are proportional to the change itself: :func:`beyond_expanded_uncertainty`). Measured in
-#: ``docs/benchmarks.md``, *Eighteenth session, i9-c684*.
+#: ``docs/benchmarks.md``, *Eighteenth session, i9-c684*. ``scale_beta_allowance`` **on** since the thirty-ninth
+#: session, by a rule written before its run: every clean flight of a fresh set that named ``scale:CY`` (s23 s16/s20,
+#: iar80 s17, sgs126 s19/s20) named the ratio of the two flights' aided-sideslip scales against JSBSim's (s23: 0.774
+#: on the reference, 0.893 on s16, 0.864 named for 0.867), with the measured CY within 1-2 % of JSBSim's. Re-run on
+#: every case that mentions ``scale:CY`` and all 50 roster ``CY:scale`` cases (83): clean +7 (roster b747 s11 and
+#: iar80 s15, the five fresh), no other count moved; ALFA unchanged (*Thirty-ninth session, lead*).
 #: Added 2026-11-23 (nineteenth session, branch i9-null), off until the twentieth: ``coverage_under_null`` (the naming's
 #: coverage test reads the combined uncertainty *under no change*: the type-A components with the air angles'
 #: stated scale and offset uncertainty carried through the *unchanged model's* prediction, nuisance and fit, not
@@ -272,7 +277,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "alias_condition_index": ALIAS_CONDITION_INDEX, "angle_error_along_term": ("beta",),
               "force_moment_arm_max": 0.1, "errors_in_variables": False,
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
-              "scale_beta_allowance": False, "coverage_type_a": False, "coverage_under_null": "alpha",
+              "scale_beta_allowance": True, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": True, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,

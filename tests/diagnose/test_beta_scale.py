@@ -231,3 +231,27 @@ def test_a_side_force_scale_finding_is_judged_against_the_sideslip_scale():
     b = angle_scale_allowance(X, R2, train, test, MODEL, "CY", "scale:CY", "beta", column=col)
     assert b is not None and not b["scale_only"], b
     assert abs(b["scale"]) < 0.02
+
+
+def test_a_side_force_scale_finding_is_judged_against_the_sideslip_scale_by_default():
+    """``scale_beta_allowance`` (on since the thirty-ninth session): a ``scale:CY`` "change" between two flights whose
+    aided sideslips differ in scale (JSBSim's S23 clean flights: 0.77 of the true sideslip on the reference, 0.89 on
+    s16, named ``scale:CY`` 0.864 where 0.77 / 0.89 = 0.867) moves Cl and Cn by their beta terms too, so it is that
+    scale; a side-force scale alone (CY 30 % larger, Cl and Cn untouched) stays a finding."""
+    from gcs_sysid.diagnose.differential import _scale_column, angle_scale_allowance
+    from gcs_sysid.diagnose.sparse import THRESHOLDS
+
+    assert THRESHOLDS["scale_beta_allowance"] is True
+    X, noise, train, test = _flight(5)
+    ib = REGRESSORS.index("beta")
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / 0.87                    # this flight's sideslip 13 % small against the reference's
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    col = _scale_column(MODEL, X, "CY")
+    a = angle_scale_allowance(X, R, train, test, MODEL, "CY", "scale:CY", "beta", column=col)
+    assert a is not None and a["scale_only"], a
+    assert set(a["from"]) == {"Cl", "Cn"}
+    R2 = noise.copy()
+    R2[:, COEFFICIENTS.index("CY")] += 0.3 * evaluate_model(MODEL, X)[:, COEFFICIENTS.index("CY")]
+    b = angle_scale_allowance(X, R2, train, test, MODEL, "CY", "scale:CY", "beta", column=col)
+    assert b is not None and not b["scale_only"], b
