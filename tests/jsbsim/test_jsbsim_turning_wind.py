@@ -11,19 +11,17 @@ import numpy as np
 import pytest
 
 from benchmarks.jsbsim_harness import FlightConfig
-from benchmarks.jsbsim_harness.logfile import make_flight
-from gcs_sysid.airframe import load_airframe
 from gcs_sysid.estimation import estimate as estimate_mod
 from gcs_sysid.estimation import estimate_states
-from gcs_sysid.telemetry import read_log
+
+from truth_fits import flown_flight
 
 
 @pytest.fixture(scope="module")
 def turning(tmp_path_factory):
     cfg = FlightConfig("c172x", duration_s=120.0, seed=11, plan="sweep_turn", turbulence="light",
                        sensor_draw="per_aircraft")
-    files = make_flight(cfg, tmp_path_factory.mktemp("turning"))
-    return read_log(files.tlog), load_airframe(files.airframe), np.load(files.truth)
+    return flown_flight(cfg, tmp_path_factory.mktemp("turning"))
 
 
 def _errors(states, truth):

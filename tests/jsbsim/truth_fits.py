@@ -17,9 +17,19 @@ from benchmarks.jsbsim_harness.truth import truth_coefficients, truth_regressors
 __all__ = ["LB", "assert_rigid_body_glide", "assert_servos_map_back", "derivative_slopes", "closure_slopes",
            "servo_against_truth", "rigid_body_residual", "LOG_STREAMS", "decoded_servo_errors", "non_aero_residual",
            "EVALUATION_FLIGHTS", "ENVELOPE_FLIGHTS", "assert_airspeed_bias_in_log", "evaluation_envelope",
-           "assert_in_envelope"]
+           "assert_in_envelope", "flown_flight"]
 
 LB = 0.45359237          # kg per lb
+
+
+def flown_flight(cfg, folder):
+    """Fly ``cfg`` (a harness ``FlightConfig``) into ``folder`` and return ``(decoded log, airframe, truth npz)``."""
+    from benchmarks.jsbsim_harness.logfile import make_flight
+    from gcs_sysid.airframe import load_airframe
+    from gcs_sysid.telemetry import read_log
+
+    files = make_flight(cfg, folder)
+    return read_log(files.tlog), load_airframe(files.airframe), np.load(files.truth)
 
 
 def assert_rigid_body_glide(files, mass_lb: float) -> None:
