@@ -103,5 +103,8 @@ def test_residual_scale_weights_gusty_airspeed_residuals_with_their_rms():
         g[i] = a * g[i - 1] + np.sqrt(1 - a * a) * 2.0 * rng.normal()
     tas = V + g + rng.normal(0, 0.3, len(t))
     we = estimate_wind(t, v_ned, tas, np.ones(len(t), bool), C=C, residual_scale=True)
-    assert 1.2 < we.sigma_airspeed < 2.5 and 2 <= we.fits <= 4
+    # the weight is the residuals' RMS after the fit: the gust and the noise of this draw less the share the 30-s
+    # windows' wind absorbs (0.89-0.95 of it over seeds 7-11); one refit from 0.5 m/s settles it within 5 %
+    drawn = float(np.sqrt(np.mean(g ** 2) + 0.3 ** 2))
+    assert 0.85 * drawn < we.sigma_airspeed <= drawn and we.fits == 2
     np.testing.assert_allclose(we.wind[:, :2].mean(0), wind[:2], atol=0.6)
