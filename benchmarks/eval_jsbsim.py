@@ -715,7 +715,7 @@ def main(argv=None) -> int:
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     ap.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),
                     help="weight the wind fit's airspeed residuals with their own RMS (gcs_sysid.estimation.estimate."
-                         "WIND_RESIDUAL_SCALE; default: the package's, off)")
+                         "WIND_RESIDUAL_SCALE; default: the package's, on since the fortieth session)")
     ap.add_argument("--kinematic-mean", default=None, choices=("on", "off"),
                     help="keep the aided alpha's flight mean at the kinematic one (gcs_sysid.estimation.airangles."
                          "KINEMATIC_MEAN; default: the package's default, off)")

@@ -688,7 +688,7 @@ def main(argv=None) -> int:
                    help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     p.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),
                    help="weight the wind fit's airspeed residuals with their own RMS (gcs_sysid.estimation.estimate."
-                        "WIND_RESIDUAL_SCALE; default: the package's, off)")
+                        "WIND_RESIDUAL_SCALE; default: the package's, on since the fortieth session)")
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "

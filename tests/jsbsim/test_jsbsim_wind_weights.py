@@ -5,8 +5,8 @@ per-aircraft draws). Its dives reach 33 m/s down at 96 m/s airspeed, where JSBSi
 put 1-3 m/s between the pitot and ``|v_gps - w|`` for any horizontal wind. Weighted as 0.5-m/s pitot noise those
 residuals outweighed the sideslip residuals, and the fit bought them down with a crosswind 9-23 m/s off from 20 to 60
 s (4.6 m/s off on average; thirty-sixth session's lead). Weighted with their own RMS (``estimate.WIND_RESIDUAL_SCALE``,
-thirty-eighth session, opt-in: issue 8's rule 8(b) failed with it, docs/benchmarks.md) the wind is within a metre per
-second of JSBSim's on average.
+thirty-eighth session; the default since the fortieth, when the rule written before fresh flights passed,
+docs/benchmarks.md) the wind is within a metre per second of JSBSim's on average.
 """
 
 import numpy as np
@@ -47,9 +47,9 @@ def _model_class_scatter(truth, window_s: float = estimate_mod.WIND_WINDOW_S, si
     return float(np.sqrt(np.mean(r ** 2) + sigma_tas ** 2))
 
 
-def test_the_navion_dive_keeps_its_wind_with_residual_weights(navion, monkeypatch):
+def test_the_navion_dive_keeps_its_wind_with_residual_weights(navion):
+    """The default weighting (the residuals' own RMS) keeps the wind through the dive."""
     flight, af, truth = navion
-    monkeypatch.setattr(estimate_mod, "WIND_RESIDUAL_SCALE", True)
     st = estimate_states(flight, af)
     assert _mean_wind_error(st, truth) < 1.0                     # measured 0.07 m/s
     note = next(n for n in st.notes if "airspeed residuals weighted with their own RMS" in n)
@@ -60,10 +60,11 @@ def test_the_navion_dive_keeps_its_wind_with_residual_weights(navion, monkeypatc
     assert sigma == pytest.approx(_model_class_scatter(truth), rel=0.15)
 
 
-def test_pitot_noise_weights_lose_the_wind_in_the_dive(navion):
-    """The default weighting (the pitot's noise), on the same flight: the crosswind several m/s off."""
+def test_pitot_noise_weights_lose_the_wind_in_the_dive(navion, monkeypatch):
+    """The weighting before the fortieth session (the pitot's noise), on the same flight: the crosswind several m/s
+    off. This is what the default guards against."""
     flight, af, truth = navion
-    assert estimate_mod.WIND_RESIDUAL_SCALE is False
+    monkeypatch.setattr(estimate_mod, "WIND_RESIDUAL_SCALE", False)
     st = estimate_states(flight, af)
     assert _mean_wind_error(st, truth) > 3.0                     # measured 4.6 m/s
     assert not any("own RMS" in n for n in st.notes)
