@@ -68,7 +68,7 @@ def parse_arms(specs: list[str]) -> list[tuple[str, list[str]]]:
             raise ValueError(f"arm {name!r} given twice")
         names.add(name)
         arms.append((name, shlex.split(rest)))
-    keys = {name: sorted(t for t in toks if t.startswith("--")) for name, toks in arms}
+    keys = {name: sorted(t.split("=", 1)[0] for t in toks if t.startswith("--")) for name, toks in arms}
     if len({tuple(k) for k in keys.values()}) > 1:
         raise ValueError("every arm must name the same options (a worker keeps the switches an earlier job set): "
                          + "; ".join(f"{n}: {' '.join(k) or '(none)'}" for n, k in keys.items()))
@@ -226,6 +226,9 @@ def main(argv=None) -> int:
         arms = parse_arms(a.arm)
     except ValueError as exc:
         ap.error(str(exc))
+    unknown = sorted(set(getattr(a, "clean_only_arms", [])) - {n for n, _ in arms})
+    if unknown:
+        ap.error(f"--clean-only-arms {' '.join(unknown)}: no such --arm")
     from benchmarks import jsbsim_harness  # noqa: F401  (installs the derived JSBSim models once, before the fork)
 
     work, out = Path(a.work), Path(a.out)

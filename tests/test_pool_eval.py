@@ -11,6 +11,7 @@ def test_arms_that_name_the_same_options_parse():
     arms = parse_arms(["base:--wind-residual-scale off", "ws: --wind-residual-scale on"])
     assert arms == [("base", ["--wind-residual-scale", "off"]), ("ws", ["--wind-residual-scale", "on"])]
     assert parse_arms(["a:", "b:"]) == [("a", []), ("b", [])]
+    assert [n for n, _ in parse_arms(["a:--x=on", "b:--x off"])] == ["a", "b"]       # --opt=value names --opt
     assert parse_arms(["x:--sparse-thresholds '{\"a\": 1}'"]) == [("x", ["--sparse-thresholds", '{"a": 1}'])]
 
 
@@ -23,6 +24,14 @@ def test_arms_that_name_the_same_options_parse():
 def test_arms_that_would_leak_a_switch_are_refused(specs, words):
     with pytest.raises(ValueError, match=words):
         parse_arms(specs)
+
+
+def test_a_clean_only_arm_must_be_an_arm(capsys):
+    from benchmarks.pool_eval import main
+
+    with pytest.raises(SystemExit):
+        main(["issue9", "--seed", "3", "--arm", "a:", "--clean-only-arms", "b", "--work", "W", "--out", "O"])
+    assert "--clean-only-arms b: no such --arm" in capsys.readouterr().err
 
 
 def test_the_effect_groups_cover_issue_9s_six_effects_once():
