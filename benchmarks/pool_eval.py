@@ -99,8 +99,9 @@ def _quiet(module: str, args: list[str]):
     return rc, buf.getvalue()
 
 
-def _link_flights(src: Path, dst: Path, prefix: str = "") -> None:
-    """Hard links of ``src``'s files (starting with ``prefix``) in ``dst``, the runs' ``results.jsonl`` left out."""
+def _link_flights(src: Path, dst: Path, prefix: str | tuple[str, ...] = "") -> None:
+    """Hard links of ``src``'s files (starting with ``prefix``, or one of them) in ``dst``, the runs'
+    ``results.jsonl`` left out."""
     dst.mkdir(parents=True, exist_ok=True)
     for f in src.iterdir():
         if f.is_file() and f.name.startswith(prefix) and f.name != "results.jsonl" and not (dst / f.name).exists():
@@ -125,8 +126,7 @@ def _eval8(job):
     t = time.time()
     stem = f"{ac}-light-s{seed}-ahrs"
     d = work / f"{arm}-g{gp_seed}"
-    _link_flights(work / "FLY", d, stem + "-")
-    _link_flights(work / "FLY", d, stem + ".")
+    _link_flights(work / "FLY", d, (stem + "-", stem + "."))
     js = work / "json" / f"{arm}-g{gp_seed}-{stem}.jsonl"
     js.parent.mkdir(parents=True, exist_ok=True)
     js.unlink(missing_ok=True)
