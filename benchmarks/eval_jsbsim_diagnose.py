@@ -302,7 +302,8 @@ def _pitot_summary(data: dict) -> dict:
             "fused_mps": fused.get("estimate"), "fused_t": fused.get("t_statistic"), "agree": fused.get("agree"),
             "screen": (wt.get("screen") or {}).get("passes"), "rereduced_mps": re.get("estimate"),
             "checks": wt.get("checks"), "why": wt.get("why"),
-            "gain_untouched": wt.get("gain_untouched"), "gain_sensor": wt.get("gain_sensor")}
+            "gain_untouched": wt.get("gain_untouched"), "gain_sensor": wt.get("gain_sensor"),
+            "coefficients_witness": wt.get("coefficients_witness")}
 
 
 def side_force_scale_truth(truth_npz, k: float) -> float:
@@ -693,6 +694,10 @@ def main(argv=None) -> int:
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
                         "package's, off, as the replay's since the thirty-third session)")
+    p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off",
+                   help="the coefficients confirm a wind-triangle pitot bias only where their standard error is at most "
+                        "this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; default: the "
+                        "package's)")
     p.add_argument("--library-control-trim", default=None, choices=("on", "off"),
                    help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
                         "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
@@ -712,6 +717,10 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         from gcs_sysid.diagnose import sparse as _sp
 
         _sp.THRESHOLDS["library_control_trim"] = a.library_control_trim == "on"
+    if a.pitot_witness_max_se is not None:
+        from gcs_sysid.diagnose import pitot as _pt
+
+        _pt.COEF_WITNESS_MAX_SE_MPS = None if a.pitot_witness_max_se == "off" else float(a.pitot_witness_max_se)
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr
 

@@ -113,6 +113,31 @@ def test_the_coefficients_must_see_the_bias_not_only_agree_with_it():
     assert not coefficients_confirm(fuse_pitot_evidence({"change_mps": -1.07, "std_error": 0.42}, -0.9, 1.0))
 
 
+def test_coefficients_without_the_power_to_confirm_are_not_asked_to(monkeypatch):
+    """``pitot.COEF_WITNESS_MAX_SE_MPS``: a coefficient estimate of the bias with a standard error above the cap is no
+    witness, so the confirmation is waived; agreement and the fused t still decide, and below the cap (the sim
+    trainer's false pitot, 0.41 m/s) the rule stands. The JSBSim rascal's seed-1 2 m/s bias (forty-first session):
+    triangle 2.13 +- 0.51, coefficients 0.23 +- 1.33 m/s."""
+    from gcs_sysid.diagnose import pitot
+
+    rascal = fuse_pitot_evidence({"change_mps": 2.13, "std_error": 0.51}, 0.23, 1.33)
+    false = fuse_pitot_evidence({"change_mps": 0.498, "std_error": 0.127}, -0.136, 0.414)
+    weak = fuse_pitot_evidence({"change_mps": 1.0, "std_error": 0.5}, 0.2, 1.5)          # fused t < 3
+    against = fuse_pitot_evidence({"change_mps": 2.0, "std_error": 0.3}, -4.0, 1.5)      # they disagree
+    monkeypatch.setattr(pitot, "COEF_WITNESS_MAX_SE_MPS", None)
+    checks, witness = pitot._acceptance_checks(rascal)
+    assert witness["witness"] and checks["significant"] and not checks["coefficients_confirm"]
+    monkeypatch.setattr(pitot, "COEF_WITNESS_MAX_SE_MPS", 1.0)
+    checks, witness = pitot._acceptance_checks(rascal)
+    assert all(checks.values()) and not witness["witness"] and "1.33 m/s" in witness["why"]
+    checks, witness = pitot._acceptance_checks(false)
+    assert witness["witness"] and not checks["coefficients_confirm"]
+    checks, _ = pitot._acceptance_checks(weak)
+    assert checks["coefficients_confirm"] and not checks["significant"]
+    checks, _ = pitot._acceptance_checks(against)
+    assert not checks["measurements_agree"]
+
+
 @pytest.mark.parametrize("bias", [0.0, 2.0])
 def test_bias_sign_and_size(bias):
     t, st, valid, fl = _flight(bias, turn=True, with_ap_wind=False, seed=3)
