@@ -199,6 +199,14 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: instead of the two flights' ``AxisFit.scale_sigma`` in quadrature, which on a gusty flight is the gust's share of
 #: the aided angle (c172p 0.42-0.92 against 0.5-13 % measured); a named change's type B keeps the quadrature. No new
 #: threshold. Measured in ``docs/benchmarks.md``, *Twenty-second session, i9-aiddef*.
+#: Changed 2026-11-26 (forty-first session, lead): ``coverage_scale_pair`` **on** (``"slopes"``), by a rule written
+#: before its run (wins > losses on top, no clean flight lost, no net loss on estimate, gain or all three, ALFA as
+#: before): on the seed-1 roster record's 425 cases, paired, top +6/-0, estimate +6/-0, gain +4/-0, all three +4/-0,
+#: clean 0/0 (the ultrastick's and us25e's ``Cm:alpha^2``, stated alpha scales of 0.7-1.3 that swamped their
+#: curvature changes). The thirty-first and thirty-second sessions had lost clean flights with it (b737, b747 s13;
+#: c182 s15) at the defaults of then; at today's (the wind fit's residual scale among them) none is lost. Wrong
+#: causes it adds where nothing or only the injected one was named: four (``docs/benchmarks.md``, *Forty-first
+#: session, lead*). ``"quadrature"`` restores the rule before.
 #: Added 2026-11-24 (twenty-third session, branch i9-cyscale): ``centred_scale``, **on** (rule 8: six of eight
 #: aircraft gain a ``CY:scale`` estimate count, none loses any count; False restores the rule before it): with
 #: ``centred_estimate``, a ``scale:<coef>`` the search selects beside a named monomial of that coefficient gives the
@@ -280,7 +288,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "scale_beta_allowance": True, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": True, "coverage_curvature": True,
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
-              "coverage_scale_pair": "quadrature", "centred_scale": True, "inadequacy_alpha_centre": False,
+              "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha",), "delay_primary_agreement": 3.0}
 

@@ -114,7 +114,8 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
     branch i9-elev; off).
 
     ``pair_scale`` (with ``reference_fits``; ``sparse.THRESHOLDS["coverage_scale_pair"]``, twenty-second session,
-    branch i9-aiddef): ``"quadrature"`` (the default) states only the two flights' own scales in quadrature, as
+    branch i9-aiddef; the diagnosis passes ``"slopes"`` since the forty-first session): ``"quadrature"`` (this
+    function's default) states only the two flights' own scales in quadrature, as
     above; ``"slopes"`` adds alpha's ``"scale_null"``, :func:`pair_slope_scale`: the two aidings' lift slopes' ratio
     (the test flight's alpha scale against the reference's) with both slopes' standard errors in quadrature, without
     ``AxisFit.scale_sigma``, which on a gusty flight is the gust's share of the aided angle, not a scale

@@ -31,7 +31,7 @@ def test_the_pair_scale_is_the_slopes_ratio_not_the_gust_share():
     assert 0.005 < want < 0.02
     fits, rfits = {"alpha": flt, "beta": beta}, {"alpha": ref, "beta": beta}
     quad = air_data_uncertainty(fits, rfits)
-    assert quad["alpha"]["scale"] > 0.9          # the default: both flights' own statements in quadrature
+    assert quad["alpha"]["scale"] > 0.9          # the function's default: both flights' own statements in quadrature
     new = air_data_uncertainty(fits, rfits, pair_scale="slopes")
     assert new["alpha"]["scale_null"] == pytest.approx(want, rel=1e-9)     # read under no change only
     assert new["alpha"]["scale"] == quad["alpha"]["scale"]    # a named change's type B keeps the quadrature
@@ -46,4 +46,5 @@ def test_the_pair_scale_is_the_slopes_ratio_not_the_gust_share():
     assert "scale_null" not in air_data_uncertainty({"alpha": off}, rfits, pair_scale="slopes")["alpha"]
     with pytest.raises(ValueError):
         air_data_uncertainty(fits, rfits, pair_scale="sum")
-    assert THRESHOLDS["coverage_scale_pair"] == "quadrature"     # off by default (opt-in)
+    # the diagnosis's default since the forty-first session (the function's own default stays the quadrature)
+    assert THRESHOLDS["coverage_scale_pair"] == "slopes"
