@@ -203,10 +203,10 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: before its run (wins > losses on top, no clean flight lost, no net loss on estimate, gain or all three, ALFA as
 #: before): on the seed-1 roster record's 425 cases, paired, top +6/-0, estimate +6/-0, gain +4/-0, all three +4/-0,
 #: clean 0/0 (``Cm:alpha^2`` on the ultrastick, us25e and asw20 and the ultrastick's ``Cn:delta_a``: stated alpha scales
-#: of 0.86-1.26 had swamped their changes). The thirty-first and thirty-second sessions had lost clean flights with it (b737, b747 s13;
-#: c182 s15) at the defaults of then; at today's (the wind fit's residual scale among them) none is lost. Wrong
-#: causes it adds where nothing or only the injected one was named: five (``docs/benchmarks.md``, *Forty-first
-#: session, lead*). ``"quadrature"`` restores the rule before.
+#: of 0.86-1.26 had swamped their changes). The thirty-first and thirty-second sessions had lost clean flights with it
+#: (b737, b747 s13; c182 s15) at the defaults of then; at today's (the wind fit's residual scale among them) none is
+#: lost. Wrong causes it adds where nothing or only the injected one was named: five (``docs/benchmarks.md``,
+#: *Forty-first session, lead*). ``"quadrature"`` restores the rule before.
 #: Added 2026-11-24 (twenty-third session, branch i9-cyscale): ``centred_scale``, **on** (rule 8: six of eight
 #: aircraft gain a ``CY:scale`` estimate count, none loses any count; False restores the rule before it): with
 #: ``centred_estimate``, a ``scale:<coef>`` the search selects beside a named monomial of that coefficient gives the
