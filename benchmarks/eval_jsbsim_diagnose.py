@@ -695,6 +695,7 @@ def main(argv=None) -> int:
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
                         "package's, off, as the replay's since the thirty-third session)")
     p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off",
+                   type=lambda v: v if v == "off" else float(v),
                    help="the coefficients confirm a wind-triangle pitot bias only where their standard error is at most "
                         "this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; default: the "
                         "package's)")
@@ -720,7 +721,7 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
     if a.pitot_witness_max_se is not None:
         from gcs_sysid.diagnose import pitot as _pt
 
-        _pt.COEF_WITNESS_MAX_SE_MPS = None if a.pitot_witness_max_se == "off" else float(a.pitot_witness_max_se)
+        _pt.COEF_WITNESS_MAX_SE_MPS = None if a.pitot_witness_max_se == "off" else a.pitot_witness_max_se
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr
 
