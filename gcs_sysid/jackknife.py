@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["block_jackknife_cov", "block_jackknife_var", "block_labels"]
+__all__ = ["block_jackknife_cov", "block_jackknife_var", "block_jackknife_vars", "block_labels"]
 
 
 def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: float = 15.0,
@@ -89,11 +89,30 @@ def block_jackknife_var(t: np.ndarray, statistic, block_s: float = 15.0, min_row
     Returns:
         the variance, or NaN with fewer than 3 blocks or a non-finite leave-one-out value.
     """
+    v = block_jackknife_vars(t, lambda keep: [float(statistic(keep))], block_s, min_rows)
+    return float(v[0]) if v is not None else float("nan")
+
+
+def block_jackknife_vars(t: np.ndarray, statistic, block_s: float = 15.0, min_rows: int = 50) -> np.ndarray | None:
+    """Delete-a-block jackknife variances of a vector statistic of time-ordered, dependent rows.
+
+    As :func:`block_jackknife_var`, element by element (the same blocks): for the coefficients of a fit that is not
+    plain least squares, or is refitted whole (the sideslip aiding's first pass, two-stage or least squares:
+    :attr:`gcs_sysid.estimation.airangles.AxisFit.slope_jackknife`).
+
+    Args:
+        t: (N,) time of the rows in time order, s (finite).
+        statistic: callable taking an (N,) bool mask of the rows kept and returning a (P,) array.
+        block_s: block length, s. min_rows: as :func:`block_labels`.
+
+    Returns:
+        (P,) variances, or None with fewer than 3 blocks or a non-finite leave-one-out value.
+    """
     k, labels = block_labels(t, block_s, min_rows)
     if len(labels) < 3:
-        return float("nan")
-    s = np.array([float(statistic(k != b)) for b in labels])
+        return None
+    s = np.array([np.asarray(statistic(k != b), float) for b in labels])
     if not np.all(np.isfinite(s)):
-        return float("nan")
-    B = s.size
-    return float((B - 1) / B * np.sum((s - s.mean()) ** 2))
+        return None
+    B = s.shape[0]
+    return (B - 1) / B * np.sum((s - s.mean(axis=0)) ** 2, axis=0)

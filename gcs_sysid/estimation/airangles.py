@@ -67,7 +67,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import butter, lfilter, sosfiltfilt
 
-from ..jackknife import block_jackknife_cov
+from ..jackknife import block_jackknife_cov, block_jackknife_vars
 from .angleerrors import MIN_FIRST_STAGE_R2, effective_n, first_stage_f, iv_lstsq, lagged_instruments, mean_wind_sigma
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
@@ -78,6 +78,9 @@ TAUS_S = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)     #: candidate gust correlation
 RATIOS = (0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)   #: candidate gust / measurement variance ratios
 MIN_T_STAT = 8.0      #: |CY_beta|, |CZ_alpha| must exceed this many standard errors
 MIN_SEGMENT_S = 5.0   #: shortest contiguous record that is aided, s
+#: block length of the first pass's delete-a-block jackknife (:attr:`AxisFit.slope_jackknife`), s: the diagnosis's
+#: (:data:`gcs_sysid.diagnose.uncertainty.BLOCK_S`), longer than the gusts' correlation times
+SLOPE_JACKKNIFE_S = 15.0
 MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
 MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, Hz
 HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz (at least; see HEAVE_EDGE)
@@ -306,6 +309,16 @@ class AxisFit:
             not aided.
         band_hz: the edge, Hz, above which the slopes were fitted (:data:`HIGHPASS_HZ`, or for alpha the heave
             mode's corner where higher: :func:`heave_edge_hz`).
+        slope_jackknife: (P,) delete-a-block jackknife standard errors of the *first* pass's coefficients (on the
+            kinematic angle; :data:`SLOPE_JACKKNIFE_S`-second blocks, Kuensch 1989), NaN for the constant; all NaN
+            where the first pass was not a plain least-squares or two-stage fit (a floored, profiled or given slope).
+            The later passes refit the model on the angle the last one aided, which the force model itself built,
+            so their standard errors (:attr:`coef_sigma`) say how well the aided angle reproduces the force, not
+            how well the slopes are known: on the JSBSim SGS 1-26 (light turbulence) the side-force model's
+            ``CY_r_hat`` is -0.539 +- 0.007 on the reference flight and -1.071 +- 0.011 on a clean flight of the
+            same aircraft, while the first pass's jackknife gives +- 0.30 and +- 0.49 (``docs/benchmarks.md``,
+            *Forty-second session, lead*). Read by the diagnosis as the aided angle's uncertain loading on the
+            model's other columns (:func:`gcs_sysid.diagnose.uncertainty.air_data_uncertainty`, ``along_*``).
     """
 
     name: str
@@ -330,6 +343,7 @@ class AxisFit:
     map_columns: tuple[str, ...] = ()
     map_cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     band_hz: float = HIGHPASS_HZ
+    slope_jackknife: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def curvature_sigma(self) -> float:
@@ -399,6 +413,24 @@ def _lstsq(A: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     except np.linalg.LinAlgError:
         cov = np.linalg.pinv(A.T @ A) * s2
     return c, np.sqrt(np.maximum(np.diag(cov), 0.0)), e, cov
+
+
+def _slope_jackknife(dt: float, n: int, refit) -> np.ndarray | None:
+    """Delete-a-block jackknife standard errors of a fit's coefficients on ``n`` time-ordered rows.
+
+    Args:
+        dt: row spacing, s (the rows of the aiding's fit are its valid segments end to end).
+        n: number of rows. refit: ``keep (n,) bool -> (P,) coefficients`` fitted on the kept rows.
+
+    Returns:
+        (P,) standard errors over the :data:`SLOPE_JACKKNIFE_S`-second blocks (Kuensch 1989;
+        :func:`gcs_sysid.jackknife.block_jackknife_vars`), or None with fewer than 3 blocks or a failed refit.
+    """
+    try:
+        v = block_jackknife_vars(np.arange(n) * dt, refit, SLOPE_JACKKNIFE_S)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    return None if v is None else np.sqrt(v)
 
 
 def _block_mean_var(e: np.ndarray, segs: list[slice], n: int) -> float:
@@ -923,6 +955,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     fit = None
     floor_note = profile_note = ""
     held_slope = None      # BETA_PROFILE_HOLD: the first pass's profiled slope, kept in the later passes
+    jk_first = None        # AxisFit.slope_jackknife: the first pass's block-jackknife standard errors
     keep: list[int] = []
     edge = HIGHPASS_HZ if band_hz is None else max(float(band_hz), HIGHPASS_HZ)
     ctr = float(np.mean(kin[m]))
@@ -984,6 +1017,16 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                 cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], held_slope, list(range(1, Ah.shape[1])))
                 csr[0] = se0
                 method = "OLS with the first pass's profiled slope held"
+        if fit is None and fixed is None and held_slope is None:
+            # the first pass's coefficients as a second flight would scatter them (AxisFit.slope_jackknife): the
+            # later passes fit on the aided angle, so their own standard errors cannot say it
+            Am, ym = Ah[m], yh[m]
+            if method.startswith("2SLS"):
+                Zm = Zh[m]
+                jk_first = _slope_jackknife(dt, len(ym), lambda k: iv_lstsq(Am[k], ym[k], en, Zm[k],
+                                                                             fuller_n=n_full)[0])
+            else:
+                jk_first = _slope_jackknife(dt, len(ym), lambda k: np.linalg.lstsq(Am[k], ym[k], rcond=None)[0])
         floored = False
         if slope_floor is not None and fixed is None and fit is None and not sign * cr[0] >= abs(slope_floor):
             # errors in variables only attenuate the fitted slope (the kinematic angle's gust error), and the wing's
@@ -997,6 +1040,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             hold = {nq + cols.index(k): float(v) for k, v in (floor_held or {}).items() if k in cols}
             keep = [j for j in keep if j not in hold]
             cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], sign * abs(slope_floor), keep, hold)
+            jk_first = None       # a held slope: no sampling scatter of the first pass to state
             dropped = (([names[2]] if quadratic and FLOOR_DROPS_CURVATURE else [])
                        + [k for k in cols if k in FLOOR_DROPS and nq + cols.index(k) not in hold])
             whose = "the stated lift slope" if floor_held is not None else "the wing's lift slope"
@@ -1010,6 +1054,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             # correlates with the kinematic one (steep above the directional mode, flat below it)
             cr, b_ls = _profile_angle_slope(dt, Ah[m], yh[m], A, coeff, kin, ang, m, segs, cr, sign, TAUS_S, RATIOS,
                                             min_lr=BETA_PROFILE_MIN_LR)
+            if cr[0] != b_ls:
+                jk_first = None   # the slope is the likelihood's, not the least-squares fit the jackknife repeats
             res = yh[m] - Ah[m] @ cr      # the identification check keeps least squares' standard error
             if cr[0] != b_ls:
                 profile_note = (f"; first pass {names[1] if name == 'alpha' else 'CY_beta'} by the gust model's "
@@ -1030,6 +1076,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             free_p = (keep if floored else list(range(A.shape[1]))) if PROFILE_REFIT else []
             cr, moved = _profile_columns(dt, Ah[m], yh[m], A, coeff, kin, ang, m, segs, cr, free_p, prof, quadratic,
                                          ctr, sign, taus_p, ratios_p)
+            if fit is None:
+                jk_first = None
             res = yh[m] - Ah[m] @ cr
             csr = csr.copy()
             csr[prof] = np.nan
@@ -1084,6 +1132,9 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
             np.log(RATIOS) - np.log((s_g / s_v) ** 2))))], r2, shift if fit is None else fit.mean_shift,
             shift_note if fit is None else fit.shift_note, slope_method=method, first_stage_r2=fs_r2,
             band_hz=edge)
+    if fit is not None:
+        fit.slope_jackknife = (np.r_[np.nan, jk_first] if jk_first is not None and len(jk_first) == len(fit.coef) - 1
+                               else np.full(len(fit.coef), np.nan))
     if fit is not None and given_note:
         fit.slope_method = f"{fit.slope_method}: {given_note}"
     if fit is not None and floor_note:
