@@ -103,7 +103,7 @@ def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.nd
                            j: int, rows: np.ndarray, k_angle: int, scale: float, offset: float,
                            nuisance: Callable[[np.ndarray], np.ndarray] | None = None,
                            curvature: float = 0.0, map_delta_e: float = 0.0, k_delta_e: int | None = None,
-                           scale_step: float = 0.0) -> dict:
+                           scale_step: float = 0.0, along: dict[str, tuple[int, float]] | None = None) -> dict:
     """Type-B standard uncertainty of one fitted coefficient under no change, from an angle's scale, offset and
     curvature.
 
@@ -130,21 +130,32 @@ def angle_null_sensitivity(predict: Callable[[np.ndarray], np.ndarray], X: np.nd
             -> alpha's excursions 42 times the measured, ``Cn:delta_a`` +- 0.104 under no change against 0.0017
             from the fits). 0: the step is ``scale`` (as before).
 
+        along: ``{name: (column, u)}``: the angle's error along regressor ``column`` of ``X``, ``u`` rad per unit (the
+            aided sideslip's loadings on its side-force model's other columns,
+            :func:`gcs_sysid.diagnose.uncertainty.sideslip_loadings`; ``sparse.THRESHOLDS["coverage_beta_along"]``,
+            forty-second session), each carried as ``map_delta_e`` is; None: none.
+
     Returns:
         ``{"scale": u, "offset": u}`` and, with ``curvature > 0``, ``"curvature": u``, with ``map_delta_e > 0``,
-        ``"map_delta_e": u`` (units of the coefficient; 0 where the input uncertainty is 0).
+        ``"map_delta_e": u``, and ``"along_<name>": u`` for each entry of ``along`` (units of the coefficient; 0 where
+        the input uncertainty is 0).
     """
     out = {}
     An = np.nan_to_num(np.asarray(A, float)[rows])
     parts = (("scale", scale), ("offset", offset)) + ((("curvature", curvature),) if curvature > 0 else ())
+    cols_along = {}
     if map_delta_e > 0 and k_delta_e is not None:
         parts = parts + (("map_delta_e", map_delta_e),)
+        cols_along["map_delta_e"] = k_delta_e
+    for name, (col, u) in (along or {}).items():
+        parts = parts + ((f"along_{name}", u),)
+        cols_along[f"along_{name}"] = col
     for what, u in parts:
         if not u > 0:
             out[what] = 0.0
             continue
-        if what == "map_delta_e":
-            d = null_residual(predict, X, rows, k_angle, "along", float(u), along=k_delta_e)
+        if what in cols_along:
+            d = null_residual(predict, X, rows, k_angle, "along", float(u), along=cols_along[what])
         elif what == "scale" and 0.0 < scale_step < u:
             # first order: the difference at a step where 1 / (1 + s) is linear, times u over the step
             d = null_residual(predict, X, rows, k_angle, what, float(scale_step)) * (float(u) / float(scale_step))

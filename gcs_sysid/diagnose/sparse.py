@@ -53,6 +53,7 @@ from .gust_nuisance import pitch_gust_nuisance
 from .lift_alpha import lift_alpha_error
 from .regression import ols
 from .search import LIBRARY_REGRESSORS, alpha_quantile_knots, candidate_library, press_stepwise
+from .uncertainty import SIDESLIP_ALONG
 
 __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
            "angle_nuisance", "untouched_confirmation", "scale_columns", "NAMING_COVERAGE_FACTOR",
@@ -271,6 +272,18 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: eternity s15 (clean 118 -> 119 of 125); a fresh set (seed 2 ``delay:delta_e`` at both sizes and clean seeds 16-20,
 #: 25 aircraft, 175 cases) refuses nothing; ALFA 9 of 9 located, 5 of 5 clean (``docs/benchmarks.md``,
 #: *Thirty-ninth session, lead*). 0 restores the rule before it.
+#: Added 2026-11-26 (forty-second session): ``coverage_beta_along`` (read only with ``coverage_under_null``): the aided
+#: sideslip's loadings on its side-force model's other columns (``p_hat``, ``r_hat``, ``delta_a``, ``delta_r``), each
+#: the first aiding pass's block-jackknife standard error of ``CY_k`` over ``|CY_beta|``, both flights in quadrature
+#: (:func:`gcs_sysid.diagnose.uncertainty.sideslip_loadings`), carried under no change as sideslip errors along those
+#: columns through the unchanged model (:func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity` ``along``)
+#: and read by the ``"alpha"`` variant as ``beta_along_<column>``. A side-force term fitted on the aided sideslip
+#: gives the aiding's own coefficient back, and the aiding's later passes state it circularly (the JSBSim SGS 1-26's
+#: clean seed 12: ``CY:r_hat`` -1.07 against the reference's -0.54, each +- 0.01; first-pass jackknife +- 0.49 and
+#: +- 0.30). ``True``: for every named term; ``"columns"``: only for a named term that is itself one of those columns
+#: (the aiding's own coefficient read back; a ``scale:CY`` selected beside ``beta`` and the surfaces is identified
+#: through the model's yaw- and roll-rate content alone, which the ``r_hat`` loading then swamps). No new threshold.
+#: Measured in ``docs/benchmarks.md``, *Forty-second session, lead*.
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -290,7 +303,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
-              "power_with_parent": ("Cm:alpha",), "delay_primary_agreement": 3.0}
+              "power_with_parent": ("Cm:alpha",), "delay_primary_agreement": 3.0, "coverage_beta_along": "columns"}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -1155,6 +1168,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 "X": np.nan_to_num(ctx.X), "nuisance": null_nuisance,
                 "curvature": bool(th.get("coverage_curvature", False)),
                 "map_delta_e": bool(th.get("coverage_map_delta_e", False)),
+                "beta_along": th.get("coverage_beta_along", False),
                 "scale_step": float(th.get("coverage_scale_step", 0.0) or 0.0)}
     if th.get("honest_std_error", True):
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
@@ -1761,7 +1775,12 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                                           float(u.get("curvature", 0.0)) if null.get("curvature") else 0.0,
                                           map_delta_e=float(u.get("map_delta_e", 0.0)) if null.get("map_delta_e")
                                           else 0.0, k_delta_e=REGRESSORS.index("delta_e"),
-                                          scale_step=float(null.get("scale_step", 0.0)))
+                                          scale_step=float(null.get("scale_step", 0.0)),
+                                          along={k[6:]: (REGRESSORS.index(k[6:]), float(v)) for k, v in u.items()
+                                                 if k.startswith("along_") and k[6:] in REGRESSORS}
+                                          if angle == "beta" and (null.get("beta_along") is True or (
+                                              null.get("beta_along") == "columns" and named in SIDESLIP_ALONG))
+                                          else None)
             typeb_null.update({f"{angle}_{k}": v for k, v in sens.items()})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
@@ -1771,8 +1790,10 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                       **typeb_null}) if null is not None else None
     # the variant "alpha": the alpha components under no change, the sideslip's as before (its own column): a
     # sideslip scale error along CY is what the differential step judges from Cl and Cn (angle_scale_allowance)
+    # (and the sideslip's loadings on its aiding's other columns, which only exist under no change:
+    # THRESHOLDS["coverage_beta_along"])
     typeb_alpha = {**{k: v for k, v in typeb.items() if not k.startswith("alpha_")},
-                   **{k: v for k, v in typeb_null.items() if k.startswith("alpha_")}}
+                   **{k: v for k, v in typeb_null.items() if k.startswith(("alpha_", "beta_along_"))}}
     u_null_alpha = combine({"flight": flight, "reference": reference, "inadequacy": parts.get("inadequacy_jackknife"),
                             **typeb_alpha}) if null is not None else None
     if not np.isfinite(u_c) or u_c <= 0:

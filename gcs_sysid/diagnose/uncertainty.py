@@ -39,7 +39,7 @@ from ..jackknife import block_jackknife_cov
 from .regression import ols
 
 __all__ = ["BLOCK_S", "block_jackknife_cov", "fit_standard_errors", "type_a", "air_data_uncertainty",
-           "pair_slope_scale", "elevator_loading", "angle_sensitivity", "combine"]
+           "pair_slope_scale", "elevator_loading", "sideslip_loadings", "angle_sensitivity", "combine"]
 
 #: block length of the delete-a-block jackknife, s (the diagnosis's ``alpha_jackknife_s``: longer than the
 #: gusts' correlation times of 1-5 s at light aircraft speeds, short enough to give 5-8 blocks per flight)
@@ -123,10 +123,16 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
     flights cancels); a named change's estimate is scaled by the common error too, so its type B keeps ``"scale"``.
     Beta is unchanged.
 
+    Beta also gets ``"along_<column>"`` for each column of the side-force model the sideslip was aided with besides
+    the angle (``p_hat``, ``r_hat``, ``delta_a``, ``delta_r``; :func:`sideslip_loadings`): the standard uncertainty of
+    the aided sideslip's loading on that column, rad per unit, with ``reference_fits`` the two flights' in quadrature
+    (independent flights). Only the naming test under no change reads it, with
+    ``sparse.THRESHOLDS["coverage_beta_along"]`` (forty-second session).
+
     Returns:
         ``{"alpha": {"scale": u_s, "offset_rad": u_o, "curvature": u_c[, "map_delta_e": u_m][, "scale_null": u_p]},
-        "beta": {"scale": u_s, "offset_rad": u_o}}`` (dimensionless, rad, 1/rad, rad/rad, dimensionless; 0 where
-        unknown).
+        "beta": {"scale": u_s, "offset_rad": u_o[, "along_<column>": u_l ...]}}`` (dimensionless, rad, 1/rad, rad/rad,
+        dimensionless, rad per unit; 0 where unknown).
 
     Raises:
         ValueError: an unknown ``pair_scale``.
@@ -135,7 +141,9 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
         raise ValueError(f"pair_scale must be 'quadrature' or 'slopes', not {pair_scale!r}")
     if reference_fits is not None:
         a, b = air_data_uncertainty(angle_fits), air_data_uncertainty(reference_fits)
-        out = {n: {k: float(np.hypot(a[n][k], b[n][k])) for k in a[n] if k != "loading_delta_e"} for n in a}
+        # a loading one flight's aiding had and the other's not (a column that did not vary) counts 0 there
+        out = {n: {k: float(np.hypot(a[n].get(k, 0.0), b[n].get(k, 0.0))) for k in {**a[n], **b[n]}
+                   if k != "loading_delta_e"} for n in a}
         if pair_scale == "slopes":
             ps = pair_slope_scale((angle_fits or {}).get("alpha"), (reference_fits or {}).get("alpha"))
             if ps is not None:
@@ -164,7 +172,47 @@ def air_data_uncertainty(angle_fits: dict | None, reference_fits: dict | None = 
             ld = elevator_loading(fit)
             if ld is not None:
                 out[name]["loading_delta_e"] = ld
+        else:
+            out[name].update({f"along_{k}": v for k, v in sideslip_loadings(fit).items()})
     return out
+
+
+#: the side-force model's columns besides the angle whose loading on the aided sideslip :func:`sideslip_loadings` states
+SIDESLIP_ALONG = ("p_hat", "r_hat", "delta_a", "delta_r")
+
+
+def sideslip_loadings(fit) -> dict[str, float]:
+    """Standard uncertainty of the aided sideslip's loading on each other column of its side-force model.
+
+    The aided sideslip is the side force's excursion less the model's other terms, over the slope
+    (:class:`gcs_sysid.estimation.airangles.AxisFit`: ``beta = (CY - CY_0 - sum_k CY_k x_k) / CY_beta`` where the
+    force-derived angle leads), so an error ``e_k`` of a fitted ``CY_k`` is a sideslip error ``-e_k / CY_beta x_k``.
+    A side-force coefficient then fitted on that sideslip gives ``CY_k`` back whatever the air did: the diagnosis's
+    ``CY:r_hat`` on a clean JSBSim SGS 1-26 flight (s12) was the two flights' aiding fits' ``CY_r_hat``, -1.07
+    against -0.54, where JSBSim's side force has no yaw-rate term and each fit states +- 0.01
+    (``docs/benchmarks.md``, *Forty-second session, lead*). The aiding's later passes refit on the aided angle, so
+    their standard errors are circular; the first pass's block jackknife (:attr:`AxisFit.slope_jackknife`, on the
+    kinematic angle) is the scatter a second flight shows: there +- 0.30 and +- 0.49.
+
+    Args:
+        fit: the sideslip's ``AxisFit`` (or None).
+
+    Returns:
+        ``{column: slope_jackknife_k / |CY_beta|}`` (rad per unit of the column) for the columns of
+        :data:`SIDESLIP_ALONG` in the fit with a finite jackknife; {} where the axis was not aided or has none.
+    """
+    if fit is None or not getattr(fit, "used", False):
+        return {}
+    cols = list(getattr(fit, "columns", ()) or ())
+    c = np.asarray(getattr(fit, "coef", ()), float)
+    jk = np.asarray(getattr(fit, "slope_jackknife", ()), float)
+    if "beta" not in cols or c.size != len(cols) or jk.size != len(cols):
+        return {}
+    slope = abs(float(c[cols.index("beta")]))
+    if not (np.isfinite(slope) and slope > 0):
+        return {}
+    return {k: float(jk[cols.index(k)] / slope) for k in SIDESLIP_ALONG
+            if k in cols and np.isfinite(jk[cols.index(k)])}
 
 
 def pair_slope_scale(fit, reference_fit) -> float | None:
