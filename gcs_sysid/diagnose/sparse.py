@@ -1596,6 +1596,24 @@ def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarra
     return out
 
 
+def _sideslip_along(u: dict, mode, named: str) -> dict[str, tuple[int, float]] | None:
+    """The aided sideslip's loadings a named term carries under no change (``THRESHOLDS["coverage_beta_along"]``).
+
+    Args:
+        u: the sideslip's ``air_data_uncertainty`` entry (``"along_<column>"``: rad per unit of the column).
+        mode: ``True`` (every term), ``"columns"`` (only a term that is itself one of :data:`SIDESLIP_ALONG`), else
+            none. named: the named term.
+
+    Returns:
+        ``{column: (index in REGRESSORS, u)}`` for :func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity`
+        ``along``, or None.
+    """
+    if not (mode is True or (mode == "columns" and named in SIDESLIP_ALONG)):
+        return None
+    return {k[6:]: (REGRESSORS.index(k[6:]), float(v)) for k, v in u.items()
+            if k.startswith("along_") and k[6:] in REGRESSORS}
+
+
 def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.ndarray, tr: np.ndarray, ref_after,
                       M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
                       inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False,
@@ -1776,11 +1794,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                                           map_delta_e=float(u.get("map_delta_e", 0.0)) if null.get("map_delta_e")
                                           else 0.0, k_delta_e=REGRESSORS.index("delta_e"),
                                           scale_step=float(null.get("scale_step", 0.0)),
-                                          along={k[6:]: (REGRESSORS.index(k[6:]), float(v)) for k, v in u.items()
-                                                 if k.startswith("along_") and k[6:] in REGRESSORS}
-                                          if angle == "beta" and (null.get("beta_along") is True or (
-                                              null.get("beta_along") == "columns" and named in SIDESLIP_ALONG))
-                                          else None)
+                                          along=_sideslip_along(u, null.get("beta_along"), named)
+                                          if angle == "beta" else None)
             typeb_null.update({f"{angle}_{k}": v for k, v in sens.items()})
     flight = float(type_a(own)[i])
     reference = float(type_a(ref)[i]) if "reference_coloured" in parts else None
