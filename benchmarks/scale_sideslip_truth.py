@@ -34,6 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks import eval_jsbsim_diagnose as E  # noqa: E402
 from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.jsbsim_harness.truth import load_truth  # noqa: E402
+from gcs_sysid.aero.table import REGRESSORS  # noqa: E402
 
 SIZES = (1.6, 1.3)                  #: the roster's ``CY:scale`` sizes
 TOLERANCE = 0.25                    #: issue 9's estimate line: within 25 % of the injected change
@@ -66,7 +67,7 @@ def scale_case(ac: str, seed: int, k: float, out: Path, model_path: Path, ref_me
     d = captured["d"]
     tlog = out / (E.case_stem(ac, seed, [("CY:scale", k)]) + E._stem_suffix(E.PLAN, E.SENSOR_DRAW, E.TURBULENCE_DRAW)
                   + ".tlog")
-    ib = 1                                                   # REGRESSORS: alpha, beta, ...
+    ib = REGRESSORS.index("beta")
     rec = {"aircraft": ac, "seed": seed, "k": k, "named": [f["cause"] for f in findings],
            "s_true": g_ref / aided_gain(d.t, d.X[:, ib], d.train | d.test, tlog) - 1.0}
     for f in d.data["sparse"].get("findings", []):
@@ -112,8 +113,8 @@ def main(argv=None) -> int:
     records = []
     for ac in a.aircraft:
         files, model_path, ref_meas = E.reference_model(ac, out)
-        g_ref = aided_gain(ref_meas.table.t, np.asarray(ref_meas.table.X, float)[:, 1], ref_meas.table.valid,
-                           files.tlog)
+        beta_ref = np.asarray(ref_meas.table.X, float)[:, REGRESSORS.index("beta")]
+        g_ref = aided_gain(ref_meas.table.t, beta_ref, ref_meas.table.valid, files.tlog)
         for k in a.sizes:
             r = scale_case(ac, a.seed, k, out, model_path, ref_meas, g_ref)
             records.append(r)
