@@ -30,7 +30,7 @@ slopes free beside the scale, a band of frequencies), and scores each against ``
 Usage::
 
     python benchmarks/scale_sideslip_truth.py --aircraft t6 c684 --seed 1 --out DIR [--sizes 1.6 1.3] [--json F]
-        [--variants]
+        [--variants] [--clean-seeds 11 12 13 14 15] [--beta-profile]
 """
 
 from __future__ import annotations
@@ -220,6 +220,24 @@ def variant_errors(records: list[dict]) -> dict:
     return out
 
 
+def clean_scale(ac: str, seed: int, out: Path, ref_meas, g_ref: float) -> dict | None:
+    """The true between-flight sideslip scale of a clean flight (no effect) of ``ac`` at ``seed`` in ``out`` (flown
+    there before; None where it is not): the flight loaded as the diagnosis loads it (the reference's angle fits,
+    the flight's air-roll table), no diagnosis run."""
+    from gcs_sysid.diagnose.run import air_roll_for, load_measurements, shared_angle_models
+
+    tlog = out / (E.case_stem(ac, seed, []) + E._stem_suffix(E.PLAN, E.SENSOR_DRAW, E.TURBULENCE_DRAW) + ".tlog")
+    if not tlog.exists():
+        return None
+    from benchmarks.jsbsim_harness.aircraft import aircraft
+
+    m = load_measurements(tlog, aircraft(ac).airframe_path, angle_models=shared_angle_models(
+        ref_meas.states.angle_fits), air_roll=air_roll_for("flight"))
+    beta = np.asarray(m.table.X, float)[:, REGRESSORS.index("beta")]
+    return {"aircraft": ac, "seed": seed, "k": 1.0, "clean": True,
+            "s_true": g_ref / aided_gain(m.table.t, beta, m.table.valid, tlog) - 1.0}
+
+
 def size_pairs(records: list[dict]) -> dict | None:
     """Over the aircraft flown at two sizes: the true sideslip scale ``s_true`` at each size (mean), the pairs'
     correlation and the mean, median and SD of the difference (larger size minus smaller). A scale that the side
@@ -246,17 +264,27 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--aircraft", nargs="+", required=True)
     p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--sizes", nargs="+", type=float, default=list(SIZES))
+    p.add_argument("--sizes", nargs="*", type=float, default=list(SIZES),
+                   help="CY:scale sizes to diagnose (none: only --clean-seeds)")
     p.add_argument("--out", required=True, help="flight folder (eval_jsbsim_diagnose's --out; reused flights)")
     p.add_argument("--json", default=None, help="append one JSON line per case here")
     p.add_argument("--draws", default="per_aircraft", choices=("shared", "per_aircraft"),
                    help="sensor noise and turbulence draws, as eval_jsbsim_diagnose's (default %(default)s)")
     p.add_argument("--variants", action="store_true", help="also refit the sideslip scale by VARIANTS (see above)")
+    p.add_argument("--clean-seeds", nargs="*", type=int, default=[],
+                   help="also the true sideslip scale of these clean flights already in --out (no diagnosis)")
+    p.add_argument("--beta-profile", action="store_true",
+                   help="aid every flight's sideslip (reference and test) with the profiled CY_beta "
+                        "(gcs_sysid.diagnose.run.BETA_PROFILE = True; opt-in, off in the diagnosis)")
     a = p.parse_args(argv)
     E.SENSOR_DRAW = E.TURBULENCE_DRAW = a.draws
+    if a.beta_profile:
+        from gcs_sysid.diagnose import run as diagnose_run
+
+        diagnose_run.BETA_PROFILE = True
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    records = []
+    records, clean = [], []
     for ac in a.aircraft:
         files, model_path, ref_meas = E.reference_model(ac, out)
         beta_ref = np.asarray(ref_meas.table.X, float)[:, REGRESSORS.index("beta")]
@@ -269,7 +297,19 @@ def main(argv=None) -> int:
             ratio = "" if r.get("search") is None else f" search/(k-1) {r['search'] / (k - 1):.2f}"
             s = "" if r.get("s") is None else f" s {r['s']:+.3f}"
             print(f"{ac:10s} s{a.seed} k {k:g} named {r['named']}{ratio}{s} s_true {r['s_true']:+.3f}", flush=True)
+        for seed in a.clean_seeds:
+            r = clean_scale(ac, seed, out, ref_meas, g_ref)
+            if r is None:
+                continue
+            clean.append(r)
+            if a.json:
+                append_jsonl(a.json, [r])
+            print(f"{ac:10s} s{seed} clean s_true {r['s_true']:+.3f}", flush=True)
     print(counts(records))
+    if clean:
+        c = np.array([r["s_true"] for r in clean])
+        print(f"clean flights: {len(c)}, s_true mean {c.mean():+.3f}, SD {c.std():.3f}, median |s| "
+              f"{np.median(np.abs(c)):.3f}")
     pairs = size_pairs(records)
     if pairs:
         print(f"s_true at k {pairs['sizes'][0]:g} / {pairs['sizes'][1]:g}: mean {pairs['mean'][0]:+.3f} / "
