@@ -234,8 +234,17 @@ def clean_scale(ac: str, seed: int, out: Path, ref_meas, g_ref: float) -> dict |
     m = load_measurements(tlog, aircraft(ac).airframe_path, angle_models=shared_angle_models(
         ref_meas.states.angle_fits), air_roll=air_roll_for("flight"))
     beta = np.asarray(m.table.X, float)[:, REGRESSORS.index("beta")]
-    return {"aircraft": ac, "seed": seed, "k": 1.0, "clean": True,
-            "s_true": g_ref / aided_gain(m.table.t, beta, m.table.valid, tlog) - 1.0}
+    rec = {"aircraft": ac, "seed": seed, "k": 1.0, "clean": True,
+           "s_true": g_ref / aided_gain(m.table.t, beta, m.table.valid, tlog) - 1.0}
+    fr, ff = ref_meas.states.angle_fits.get("beta"), m.states.angle_fits.get("beta")
+    if fr is not None and ff is not None and fr.used and ff.used:
+        # the two flights' fitted side-force slopes and the first pass's block jackknife of each (the aiding's own
+        # statement of how well this flight knows CY_beta)
+        jk = [float(np.asarray(f.slope_jackknife, float)[1]) if np.size(f.slope_jackknife) > 1 else np.nan
+              for f in (ff, fr)]
+        rec.update(CY_beta_ratio=float(ff.coef[1] / fr.coef[1] - 1.0),
+                   CY_beta_ratio_se=float(np.hypot(*jk) / abs(fr.coef[1])))
+    return rec
 
 
 def size_pairs(records: list[dict]) -> dict | None:
@@ -310,6 +319,14 @@ def main(argv=None) -> int:
         c = np.array([r["s_true"] for r in clean])
         print(f"clean flights: {len(c)}, s_true mean {c.mean():+.3f}, SD {c.std():.3f}, median |s| "
               f"{np.median(np.abs(c)):.3f}")
+        P = np.array([(r["s_true"], r["CY_beta_ratio"], r["CY_beta_ratio_se"]) for r in clean if "CY_beta_ratio" in r])
+        if len(P) >= 3:
+            b = np.polyfit(P[:, 1], P[:, 0], 1)
+            z = P[:, 1] / P[:, 2]
+            print(f"  against CY_beta(flight) / CY_beta(reference) - 1 ({len(P)} flights): correlation "
+                  f"{np.corrcoef(P[:, 0], P[:, 1])[0, 1]:.2f}, slope {b[0]:.2f}, s_true's SD after it "
+                  f"{np.std(P[:, 0] - np.polyval(b, P[:, 1])):.3f}; the ratio's jackknife standard error median "
+                  f"{np.nanmedian(P[:, 2]):.3f}, SD of ratio / se {np.nanstd(z[np.isfinite(z)]):.2f}")
     pairs = size_pairs(records)
     if pairs:
         print(f"s_true at k {pairs['sizes'][0]:g} / {pairs['sizes'][1]:g}: mean {pairs['mean'][0]:+.3f} / "
