@@ -67,23 +67,22 @@ VARIANTS = {
 }
 
 
-def _band(x: np.ndarray, rows: np.ndarray, dt: float, band) -> np.ndarray:
-    """``x`` (T,) band-passed within each contiguous run of ``rows`` (second-order Butterworth, forward and back);
-    NaN outside the runs and in runs shorter than 60 samples."""
+def _band(X: np.ndarray, rows: np.ndarray, dt: float, band) -> np.ndarray:
+    """The columns of ``X`` (T, P) band-passed within each contiguous run of ``rows`` at least 60 samples long
+    (:func:`gcs_sysid.estimation.nodes.segments`; each run's mean removed, second-order Butterworth, forward and back);
+    NaN elsewhere."""
     from scipy.signal import butter, sosfiltfilt
 
-    y = np.full(len(x), np.nan)
-    edges = np.diff(np.r_[0, rows.astype(int), 0])
-    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-        v = x[a:b] - x[a:b].mean()
-        if b - a < 60:
-            continue
-        if band[0]:
-            v = sosfiltfilt(butter(2, band[0], "high", fs=1.0 / dt, output="sos"), v)
-        if band[1]:
-            v = sosfiltfilt(butter(2, band[1], "low", fs=1.0 / dt, output="sos"), v)
-        y[a:b] = v
-    return y
+    from gcs_sysid.estimation.nodes import segments
+
+    filters = [butter(2, edge, kind, fs=1.0 / dt, output="sos") for edge, kind in zip(band, ("high", "low")) if edge]
+    Y = np.full(X.shape, np.nan)
+    for sg in segments(rows, 60):
+        v = X[sg] - X[sg].mean(axis=0)
+        for sos in filters:
+            v = sosfiltfilt(sos, v, axis=0)
+        Y[sg] = v
+    return Y
 
 
 def refit_scale(t: np.ndarray, X: np.ndarray, R: np.ndarray, N: np.ndarray, rows: np.ndarray, coefs=("Cl", "Cn"),
@@ -102,12 +101,11 @@ def refit_scale(t: np.ndarray, X: np.ndarray, R: np.ndarray, N: np.ndarray, rows
     from gcs_sysid.aero.table import COEFFICIENTS
 
     ok = rows & np.isfinite(R).all(axis=1) & np.isfinite(N).all(axis=1)
-    dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.02
     F = np.column_stack([np.nan_to_num(X[:, REGRESSORS.index(x)]) for x in free]) if free else np.zeros((len(X), 0))
     if band is not None:
-        cols = [_band(np.where(ok, c, 0.0), ok, dt, band) for c in (*R.T, *N.T, *F.T)]
-        R, N = np.column_stack(cols[:6]), np.column_stack(cols[6:12])
-        F = np.column_stack(cols[12:]) if free else F
+        dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.02
+        Y = _band(np.where(ok[:, None], np.column_stack([R, N, F]), 0.0), ok, dt, band)
+        R, N, F = Y[:, :6], Y[:, 6:12], Y[:, 12:]
         ok = ok & np.isfinite(R).all(axis=1) & np.isfinite(N).all(axis=1)
     num = den = 0.0
     for c in coefs:
@@ -122,6 +120,12 @@ def refit_scale(t: np.ndarray, X: np.ndarray, R: np.ndarray, N: np.ndarray, rows
         w = 1.0 / max(float(np.var(r)), 1e-30)
         num, den = num + w * float(n @ r), den + w * float(n @ n)
     return num / den if den > 0 else float("nan")
+
+
+def _tlog(out: Path, ac: str, seed: int, effects: list) -> Path:
+    """The .tlog that ``eval_jsbsim_diagnose`` flies for ``ac`` at ``seed`` with ``effects`` (``[(name, value)]``;
+    empty: the clean flight) in ``out``, at its plan and draws."""
+    return out / (E.case_stem(ac, seed, effects) + E._stem_suffix(E.PLAN, E.SENSOR_DRAW, E.TURBULENCE_DRAW) + ".tlog")
 
 
 def aided_gain(t: np.ndarray, beta: np.ndarray, valid: np.ndarray, tlog: Path) -> float:
@@ -166,8 +170,7 @@ def scale_case(ac: str, seed: int, k: float, out: Path, model_path: Path, ref_me
     finally:
         D.diagnose, DF.angle_scale_allowance = original, original_asa
     d = captured["d"]
-    tlog = out / (E.case_stem(ac, seed, [("CY:scale", k)]) + E._stem_suffix(E.PLAN, E.SENSOR_DRAW, E.TURBULENCE_DRAW)
-                  + ".tlog")
+    tlog = _tlog(out, ac, seed, [("CY:scale", k)])
     ib = REGRESSORS.index("beta")
     rec = {"aircraft": ac, "seed": seed, "k": k, "named": [f["cause"] for f in findings],
            "s_true": g_ref / aided_gain(d.t, d.X[:, ib], d.train | d.test, tlog) - 1.0}
@@ -224,13 +227,12 @@ def clean_scale(ac: str, seed: int, out: Path, ref_meas, g_ref: float) -> dict |
     """The true between-flight sideslip scale of a clean flight (no effect) of ``ac`` at ``seed`` in ``out`` (flown
     there before; None where it is not): the flight loaded as the diagnosis loads it (the reference's angle fits,
     the flight's air-roll table), no diagnosis run."""
+    from benchmarks.jsbsim_harness.aircraft import aircraft
     from gcs_sysid.diagnose.run import air_roll_for, load_measurements, shared_angle_models
 
-    tlog = out / (E.case_stem(ac, seed, []) + E._stem_suffix(E.PLAN, E.SENSOR_DRAW, E.TURBULENCE_DRAW) + ".tlog")
+    tlog = _tlog(out, ac, seed, [])
     if not tlog.exists():
         return None
-    from benchmarks.jsbsim_harness.aircraft import aircraft
-
     m = load_measurements(tlog, aircraft(ac).airframe_path, angle_models=shared_angle_models(
         ref_meas.states.angle_fits), air_roll=air_roll_for("flight"))
     beta = np.asarray(m.table.X, float)[:, REGRESSORS.index("beta")]

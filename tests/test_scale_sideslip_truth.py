@@ -13,7 +13,7 @@ def _flight(s: float, yaw_change: float = 0.0, seed: int = 0, n: int = 6000, dt:
     t = np.arange(n) * dt
     X = np.zeros((n, len(REGRESSORS)))
     f = np.fft.rfftfreq(n, dt)
-    for k, name in enumerate(("beta", "p_hat", "r_hat", "delta_a", "delta_r")):
+    for name in ("beta", "p_hat", "r_hat", "delta_a", "delta_r"):
         spec = (rng.normal(size=f.size) + 1j * rng.normal(size=f.size)) * (f < 1.5)
         x = np.fft.irfft(spec, n)
         X[:, REGRESSORS.index(name)] = 0.05 * x / x.std()
