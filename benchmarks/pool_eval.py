@@ -35,6 +35,13 @@ import time
 import traceback
 from pathlib import Path
 
+# One BLAS thread per worker, set before anything imports NumPy: the parent imports the harness (and NumPy, whose
+# OpenBLAS sizes its thread pool at import from every core) before the workers fork and pin themselves to one core.
+# A 16-core machine then ran 16 BLAS threads inside each pinned worker: no case finished in nine minutes (forty-fifth
+# session); on this 2-core box a case took 40 s against 7-8 s with one thread.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
@@ -76,12 +83,15 @@ def parse_arms(specs: list[str]) -> list[tuple[str, list[str]]]:
 
 
 def _pin(counter) -> None:
-    """Pool initializer: one core per worker (JAX's and BLAS's thread pools size themselves by the affinity)."""
+    """Pool initializer: one core per worker (JAX's thread pool sizes itself by the affinity; BLAS gets one thread)."""
     with counter.get_lock():
         i = counter.value
         counter.value += 1
     cpus = sorted(os.sched_getaffinity(0))
     os.sched_setaffinity(0, {cpus[i % len(cpus)]})
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")   # the environment's limit holds only where BLAS loads after it
 
 
 def _quiet(module: str, args: list[str]):
