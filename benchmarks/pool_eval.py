@@ -35,13 +35,6 @@ import time
 import traceback
 from pathlib import Path
 
-# One BLAS thread per worker, set before anything imports NumPy: the parent imports the harness (and NumPy, whose
-# OpenBLAS sizes its thread pool at import from every core) before the workers fork and pin themselves to one core.
-# A 16-core machine then ran 16 BLAS threads inside each pinned worker: no case finished in nine minutes (forty-fifth
-# session); on this 2-core box a case took 40 s against 7-8 s with one thread.
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
-
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
@@ -239,6 +232,13 @@ def main(argv=None) -> int:
     unknown = sorted(set(getattr(a, "clean_only_arms", [])) - {n for n, _ in arms})
     if unknown:
         ap.error(f"--clean-only-arms {' '.join(unknown)}: no such --arm")
+    # One BLAS thread per worker, set before NumPy loads: the parent imports the harness (and NumPy, whose OpenBLAS
+    # sizes its thread pool from every core at import) before the workers fork and pin themselves to one core. A
+    # 16-core machine then ran 16 BLAS threads inside each pinned worker and no case finished in nine minutes
+    # (forty-fifth session); on a 2-core box a case took 40 s against 7-8 s with one thread. :func:`_pin` also
+    # limits BLAS in each worker, for a NumPy loaded before this line.
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
     from benchmarks import jsbsim_harness  # noqa: F401  (installs the derived JSBSim models once, before the fork)
 
     work, out = Path(a.work), Path(a.out)

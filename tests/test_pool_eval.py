@@ -39,3 +39,28 @@ def test_the_effect_groups_cover_issue_9s_six_effects_once():
 
     names = [e for g in EFFECT_GROUPS for e in g]
     assert sorted(names) == sorted(EFFECTS) and len(set(names)) == len(names)
+
+
+def _blas_threads(job):
+    """A pool job: the most threads any loaded BLAS would use in this worker (the pool's result tuple)."""
+    from threadpoolctl import threadpool_info
+
+    n = max((lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas"), default=0)
+    return f"blas {job}", 0, 0.0, f"{n}\n", ""
+
+
+def test_a_pinned_worker_runs_one_blas_thread_though_numpy_loaded_before_the_fork(tmp_path):
+    # NumPy (loaded in this process long before) sized its BLAS from every core; a worker pinned to one core must
+    # not keep that pool (16 BLAS threads on one core stalled a 16-core run).
+    import numpy  # noqa: F401
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    from benchmarks.pool_eval import _run_pool
+
+    assert any(lib.get("user_api") == "blas" for lib in threadpool_info())
+    with threadpool_limits(limits=2, user_api="blas"):     # as on a 2-core box without tests/conftest.py's limit
+        if max(lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas") < 2:
+            pytest.skip("this BLAS runs one thread at most here")
+        failed = _run_pool(1, [(_blas_threads, [0, 1])], tmp_path, lambda job: "blas.txt")
+    assert failed == 0
+    assert (tmp_path / "blas.txt").read_text().split() == ["1", "1"]
