@@ -699,6 +699,12 @@ def main(argv=None) -> int:
                    help="the coefficients confirm a wind-triangle pitot bias only where their standard error is at most "
                         "this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; default: the "
                         "package's)")
+    p.add_argument("--pitot-signature-triangle", default=None, choices=("on", "off"),
+                   help="a pitot cause named on the coefficients' signature must agree with the wind triangle's change "
+                        "(gcs_sysid.diagnose.pitot.SIGNATURE_TRIANGLE_AGREE; default: the package's)")
+    p.add_argument("--pitot-signature-systematic", default=None, choices=("on", "off"),
+                   help="the signature path's pitot significance counts the coefficient fit's between-flight "
+                        "systematic (gcs_sysid.diagnose.pitot.SIGNATURE_SYSTEMATIC; default: the package's)")
     p.add_argument("--library-control-trim", default=None, choices=("on", "off"),
                    help="the sparse search's monomials with the surfaces measured about the reference flight's trim "
                         "(gcs_sysid.diagnose.sparse.THRESHOLDS['library_control_trim']; default: the package's, off)")
@@ -718,6 +724,14 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         from gcs_sysid.diagnose import sparse as _sp
 
         _sp.THRESHOLDS["library_control_trim"] = a.library_control_trim == "on"
+    if a.pitot_signature_triangle is not None:
+        from gcs_sysid.diagnose import pitot as _pt
+
+        _pt.SIGNATURE_TRIANGLE_AGREE = a.pitot_signature_triangle == "on"
+    if a.pitot_signature_systematic is not None:
+        from gcs_sysid.diagnose import pitot as _pt
+
+        _pt.SIGNATURE_SYSTEMATIC = a.pitot_signature_systematic == "on"
     if a.pitot_witness_max_se is not None:
         from gcs_sysid.diagnose import pitot as _pt
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gcs_sysid.diagnose.pitot import (COEF_SYSTEMATIC_MPS, MIN_T_COEF_CONFIRM, MIN_T_FUSED, coefficients_confirm,
-                                      fuse_pitot_evidence)
+                                      fuse_pitot_evidence, signature_agrees_with_triangle)
 from gcs_sysid.diagnose.wind_triangle import (WIND_SYSTEMATIC_MPS, change_since_references, triangle_gain,
                                               wind_triangle)
 from gcs_sysid.telemetry.types import Flight, Stream
@@ -230,3 +230,20 @@ def test_an_offset_made_by_the_fitted_wind_correction_earns_no_gain():
     assert len(spurious) >= 2, spurious                          # the joint fit's trade, "significant"
     assert max(spurious) < 10.0, spurious
     assert np.median(real) > 50.0 and min(real) > 20.0, real
+
+
+def test_the_signature_path_must_agree_with_the_triangle():
+    # the b737's clean s23 (JSBSim, seed 3): the signature read -1.59 +- 0.28 m/s, the triangle +0.53 +- 0.51
+    # since the reference (whose own signature fit reads 0): over three combined standard errors apart
+    tri = {"change_mps": 0.53, "std_error": 0.51}
+    assert not signature_agrees_with_triangle(tri, -1.59, (0.0, 0.0), 0.28)
+    # the same reading with the reference's own fit at -1.0 +- 0.1: a change of -0.59, which agrees
+    assert signature_agrees_with_triangle(tri, -1.59, (-1.0, 0.1), 0.28)
+    # a real 1 m/s bias read 1.08 +- 0.07 by the signature and 0.48 +- 0.55 by the triangle (c172p, seed 3)
+    assert signature_agrees_with_triangle({"change_mps": 0.48, "std_error": 0.55}, 1.08, (0.0, 0.0), 0.07)
+    # the boundary is fuse_pitot_evidence's: 3 x hypot(triangle se, coefficient se with the systematic term)
+    edge = 3.0 * np.hypot(0.5, np.hypot(0.1, COEF_SYSTEMATIC_MPS))
+    assert signature_agrees_with_triangle({"change_mps": 0.0, "std_error": 0.5}, edge * 0.999, (0.0, 0.0), 0.1)
+    assert not signature_agrees_with_triangle({"change_mps": 0.0, "std_error": 0.5}, edge * 1.001, (0.0, 0.0), 0.1)
+    # no usable triangle: nothing to test
+    assert signature_agrees_with_triangle({"change_mps": 0.0, "std_error": 0.0}, 5.0, (0.0, 0.0), 0.1)
