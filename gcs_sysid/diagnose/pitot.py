@@ -141,15 +141,16 @@ MIN_T_COEF_CONFIRM = 1.0
 COEF_WITNESS_MAX_SE_MPS: float | None = 1.0
 #: The signature path (a pitot cause named on the coefficients' signature when the wind-triangle path names nothing)
 #: must agree with the wind triangle's change since the reference flight(s), by the three combined standard errors of
-#: :func:`fuse_pitot_evidence` (:func:`signature_agrees_with_triangle`; forty-fifth session, candidate). Before, only
+#: :func:`fuse_pitot_evidence` (:func:`signature_agrees_with_triangle`; on since the forty-fifth session, by a rule written
+#: before its fresh runs: ``docs/benchmarks.md``, "Forty-fifth session, lead"). Before, only
 #: the flight's own wind shift was asked of it, within 3 standard errors plus 25 %: the b737's clean s23 (seed 3)
 #: was named -1.59 +- 0.28 m/s where the triangle read +0.53 +- 0.51.
-SIGNATURE_TRIANGLE_AGREE = False
+SIGNATURE_TRIANGLE_AGREE = True
 #: The signature path's significance (:data:`MIN_T`) counts :data:`COEF_SYSTEMATIC_MPS` in quadrature with the fit's
-#: coloured standard error, as the wind-triangle path does for the same coefficient fit (forty-fifth session,
-#: candidate). Before, the coloured error alone: the ultrastick's clean s26 (seed 4) was named -0.26 +- 0.033 m/s
+#: coloured standard error, as the wind-triangle path does for the same coefficient fit (on since the forty-fifth
+#: session, with :data:`SIGNATURE_TRIANGLE_AGREE`). Before, the coloured error alone: the ultrastick's clean s26 (seed 4) was named -0.26 +- 0.033 m/s
 #: (t 8; with the term 1.3).
-SIGNATURE_SYSTEMATIC = False
+SIGNATURE_SYSTEMATIC = True
 #: True: an accepted pitot finding takes its place among the findings by its held-out gain, like the catalogue's and
 #: the search's causes (:func:`with_pitot`; tried 2026-11-23, branch i9-heave2). False (kept): first, as
 #: :func:`gcs_sysid.diagnose.sparse.merge_findings` keeps every data-compatibility cause first. Measured with True at
