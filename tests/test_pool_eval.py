@@ -60,6 +60,8 @@ def test_a_pinned_worker_runs_one_blas_thread_though_numpy_loaded_before_the_for
     assert any(lib.get("user_api") == "blas" for lib in threadpool_info())
     with threadpool_limits(limits=2, user_api="blas"):     # as on a 2-core box without tests/conftest.py's limit
         if max(lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas") < 2:
+            # a BLAS capped at one thread cannot give a worker more than one either: the stall this test
+            # guards against cannot occur, and the test's premise (a two-thread parent) cannot be built
             pytest.skip("this BLAS runs one thread at most here")
         failed = _run_pool(1, [(_blas_threads, [0, 1])], tmp_path, lambda job: "blas.txt")
     assert failed == 0

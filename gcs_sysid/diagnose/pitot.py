@@ -283,13 +283,10 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
                              min_gain_pct, angle_fits)
     for f, cand, gate in passed:
         if SIGNATURE_TRIANGLE_AGREE and fused is not None and fused.get("change") is not None:
-            k = _mps_per_unit(ctx, f.cause)
-            refs = cand["references"]
-            w = np.array([1.0 / max(r["std_error"], 1e-9) ** 2 for r in refs])
-            ref = (float(np.sum(w * [r["estimate"] for r in refs]) / w.sum() - _null(f.cause)) * k,
-                   float(k / np.sqrt(w.sum()))) if refs else (0.0, 0.0)
-            agree = signature_agrees_with_triangle(fused["change"], (f.estimate - _null(f.cause)) * k, ref,
-                                                   f.std_error * k)
+            k, null = _mps_per_unit(ctx, f.cause), _null(f.cause)
+            ref_mean, ref_se = _references_mean(cand["references"])
+            ref = ((ref_mean - null) * k, ref_se * k) if cand["references"] else (0.0, 0.0)
+            agree = signature_agrees_with_triangle(fused["change"], (f.estimate - null) * k, ref, f.std_error * k)
             cand["checks"]["triangle_agrees"] = agree
             cand["accepted"] = bool(cand["accepted"] and agree)
         if cand["accepted"] and (best is None or f.score > best[0].score):
@@ -320,6 +317,15 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
                          "summary": f"{f.cause} {f.estimate:.3g} +- {f.std_error:.2g}: every implied coefficient "
                                     f"({', '.join(gate['signature']['implied'])}) sees it"}}
     return out
+
+
+def _references_mean(refs: list[dict]) -> tuple[float, float]:
+    """Inverse-variance mean of the references' fits of one cause (:func:`_reference_values`) and its standard error,
+    in the cause's units; ``(0, 0)`` without any."""
+    if not refs:
+        return 0.0, 0.0
+    w = np.array([1.0 / max(r["std_error"], 1e-9) ** 2 for r in refs])
+    return float(np.sum(w * [r["estimate"] for r in refs]) / w.sum()), float(1.0 / np.sqrt(w.sum()))
 
 
 def _mps_per_unit(ctx: DiagContext, cause: str) -> float:
@@ -466,12 +472,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
     ref_tri = _reference_triangles(references, airframe, model)
     change = change_since_references(tri, ref_tri)
     refs = cand.get("references") or []
-    if refs:
-        w = np.array([1.0 / max(r["std_error"], 1e-9) ** 2 for r in refs])
-        ref_b = float(np.sum(w * [r["estimate"] for r in refs]) / w.sum())
-        ref_se = float(1.0 / np.sqrt(w.sum()))
-    else:
-        ref_b, ref_se = 0.0, 0.0
+    ref_b, ref_se = _references_mean(refs)
     coef_change = cand["estimate"] - ref_b
     coef_se = float(np.sqrt(cand["std_error"] ** 2 + ref_se ** 2 + COEF_SYSTEMATIC_MPS ** 2))
     fused = fuse_pitot_evidence(change, coef_change, coef_se)
