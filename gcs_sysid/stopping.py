@@ -23,7 +23,9 @@ only if the main thread is not inside one; a main thread inside an import writes
 ends with the process. Clean-ups are
 registered by what creates something to clean (:mod:`gcs_sysid.outdir`,
 :mod:`gcs_sysid.parallel`); :func:`critical` marks a short section that must not be cut in half
-(moving finished outputs into place): a stop waits for it to end.
+(moving finished outputs into place): a stop waits for it to end. A forked child (a ``multiprocessing``
+worker) starts with none of this: default handlers, no wakeup pipe (which it would share with the
+parent, so that a SIGTERM sent to the child stopped the parent), no clean-ups.
 
 References:
     Python documentation, ``signal.set_wakeup_fd`` and "Note on Signal Handlers and Exceptions",
@@ -203,6 +205,8 @@ def _python_handler(signum, frame) -> None:
 
 
 _watcher: threading.Thread | None = None
+_fds: tuple[int, int] | None = None      # the wakeup pipe (read end, write end)
+_fork_hook_registered = False
 
 
 def _watcher_alive() -> bool:
@@ -211,7 +215,7 @@ def _watcher_alive() -> bool:
 
 def install() -> None:
     """Handle SIGINT and SIGTERM as described above (main thread only; idempotent)."""
-    global _installed, _watcher
+    global _installed, _watcher, _fds, _fork_hook_registered
     if _installed:
         return
     r, w = os.pipe()
@@ -222,3 +226,37 @@ def install() -> None:
         signal.signal(sig, _python_handler)
     signal.set_wakeup_fd(w, warn_on_full_buffer=False)
     _installed = True
+    _fds = (r, w)
+    if not _fork_hook_registered:
+        os.register_at_fork(after_in_child=_forget_in_child)
+        _fork_hook_registered = True
+
+
+def _forget_in_child() -> None:
+    """After a fork: the child is not the command and must not share its stop.
+
+    A forked child (a ``multiprocessing`` worker) inherits the wakeup pipe: a SIGTERM sent to the child
+    (``Pool.terminate``) would write the signal number into the pipe that the parent's watcher reads, and
+    the parent would stop itself (seen 2026-11-26: a test's pool ended the pytest worker that had run a
+    command in-process). The child also inherits the parent's clean-ups, which remove the parent's
+    outputs. So the child gets the default handlers back, no wakeup fd and no clean-ups.
+    """
+    global _installed, _watcher, _fds
+    if not _installed:
+        return
+    try:
+        signal.set_wakeup_fd(-1)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    except ValueError:   # not the main thread (cannot happen after a fork: the forking thread is the main one)
+        pass
+    if _fds is not None:
+        for fd in _fds:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+    _fds = None
+    _cleanups.clear()
+    _watcher = None
+    _installed = False

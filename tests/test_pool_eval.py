@@ -2,6 +2,11 @@
 from their options, so every arm must name the same options, or a switch one arm set leaks into the next arm's job.
 (The pool's runs themselves fly JSBSim and take minutes; they are measured in docs/benchmarks.md, fortieth session.)"""
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
 
 from benchmarks.pool_eval import EFFECT_GROUPS, parse_arms
@@ -49,20 +54,37 @@ def _blas_threads(job):
     return f"blas {job}", 0, 0.0, f"{n}\n", ""
 
 
+POOL_SCRIPT = r'''
+import pathlib, sys
+import numpy  # noqa: F401  (NumPy loaded before the fork, as the harness loads it in pool_eval's parent)
+from threadpoolctl import threadpool_info, threadpool_limits
+from benchmarks.pool_eval import _run_pool
+from tests.test_pool_eval import _blas_threads
+
+blas = [lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas"]
+assert blas, "no BLAS loaded"
+with threadpool_limits(limits=2, user_api="blas"):     # as on a 2-core box without tests/conftest.py's limit
+    if max(lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas") < 2:
+        print("one-thread BLAS")
+        sys.exit(0)
+    print("failed", _run_pool(1, [(_blas_threads, [0, 1])], pathlib.Path(sys.argv[1]), lambda job: "blas.txt"))
+'''
+
+
 def test_a_pinned_worker_runs_one_blas_thread_though_numpy_loaded_before_the_fork(tmp_path):
-    # NumPy (loaded in this process long before) sized its BLAS from every core; a worker pinned to one core must
-    # not keep that pool (16 BLAS threads on one core stalled a 16-core run).
-    import numpy  # noqa: F401
-    from threadpoolctl import threadpool_info, threadpool_limits
-
-    from benchmarks.pool_eval import _run_pool
-
-    assert any(lib.get("user_api") == "blas" for lib in threadpool_info())
-    with threadpool_limits(limits=2, user_api="blas"):     # as on a 2-core box without tests/conftest.py's limit
-        if max(lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas") < 2:
-            # a BLAS capped at one thread cannot give a worker more than one either: the stall this test
-            # guards against cannot occur, and the test's premise (a two-thread parent) cannot be built
-            pytest.skip("this BLAS runs one thread at most here")
-        failed = _run_pool(1, [(_blas_threads, [0, 1])], tmp_path, lambda job: "blas.txt")
-    assert failed == 0
+    # NumPy (loaded in the parent long before) sized its BLAS from every core; a worker pinned to one core must
+    # not keep that pool (16 BLAS threads on one core stalled a 16-core run). The pool runs in a fresh interpreter,
+    # as pool_eval does: a fork of this pytest worker would copy its threads and its signal set-up.
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")]))}
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env.pop(var, None)
+    proc = subprocess.run([sys.executable, "-c", POOL_SCRIPT, str(tmp_path)], capture_output=True, text=True,
+                          timeout=120, cwd=root, env=env)
+    assert proc.returncode == 0, proc.stderr
+    if proc.stdout.strip() == "one-thread BLAS":
+        # a BLAS capped at one thread cannot give a worker more than one either: the stall this test
+        # guards against cannot occur, and the test's premise (a two-thread parent) cannot be built
+        pytest.skip("this BLAS runs one thread at most here")
+    assert proc.stdout.split() == ["failed", "0"], proc.stdout
     assert (tmp_path / "blas.txt").read_text().split() == ["1", "1"]

@@ -49,3 +49,32 @@ def test_signal_inside_an_import_is_not_raised_into_it(tmp_path):
     assert proc.returncode == 128 + signal.SIGTERM, (proc.returncode, stderr)
     assert stderr.strip() == "gcs-sysid: stopped by SIGTERM", stderr
     assert took < 3.0, took
+
+
+FORK_SCRIPT = r'''
+import multiprocessing as mp, os, pathlib, signal, sys, time
+from gcs_sysid import stopping
+tmp = pathlib.Path(sys.argv[1])
+stopping.install()
+stopping.register(lambda: (tmp / "cleaned").write_text(str(os.getpid())) and None)
+ctx = mp.get_context("fork")
+child = ctx.Process(target=time.sleep, args=(30,))
+child.start()
+time.sleep(0.3)
+child.terminate()            # SIGTERM, as Pool.terminate sends its workers
+child.join(10)
+time.sleep(0.5)              # a byte in the shared wakeup pipe would have stopped this process by now
+print("parent alive", child.exitcode, flush=True)
+'''
+
+
+def test_a_forked_child_does_not_share_the_parents_stop(tmp_path):
+    # A forked child inherited the wakeup pipe: the SIGTERM a multiprocessing pool sends its workers at the end
+    # reached the parent's watcher and ended the parent (a pytest worker that had run a command in-process and
+    # then a pool: CI's run of 2026-11-25 lost the worker and hung). The child also ran the parent's clean-ups.
+    proc = subprocess.run([sys.executable, "-c", FORK_SCRIPT, str(tmp_path)], capture_output=True, text=True,
+                          timeout=60)
+    assert proc.returncode == 0, (proc.returncode, proc.stderr)
+    assert proc.stdout.split() == ["parent", "alive", str(-signal.SIGTERM)], proc.stdout   # default SIGTERM
+    assert "stopped by" not in proc.stderr, proc.stderr
+    assert not (tmp_path / "cleaned").exists(), "the child ran the parent's clean-up"
