@@ -44,8 +44,8 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator
 
-__all__ = ["install", "installed", "register", "unregister", "critical", "park", "Stopped", "EXIT_SIGINT",
-           "EXIT_SIGTERM"]
+__all__ = ["install", "uninstall", "installed", "register", "unregister", "critical", "park", "Stopped",
+           "EXIT_SIGINT", "EXIT_SIGTERM"]
 
 EXIT_SIGINT = 128 + signal.SIGINT     # 130
 EXIT_SIGTERM = 128 + signal.SIGTERM   # 143
@@ -195,6 +195,8 @@ def _watch(fd: int) -> None:
         for b in data:
             if b in (signal.SIGINT, signal.SIGTERM):
                 _stop(b)
+            elif b == _QUIT:   # :func:`uninstall`
+                return
 
 
 def _python_handler(signum, frame) -> None:
@@ -206,7 +208,9 @@ def _python_handler(signum, frame) -> None:
 
 _watcher: threading.Thread | None = None
 _fds: tuple[int, int] | None = None      # the wakeup pipe (read end, write end)
+_previous: dict | None = None            # what install() replaced: the two handlers and the wakeup fd
 _fork_hook_registered = False
+_QUIT = 0                                # the byte that ends the watcher (no signal has number 0)
 
 
 def _watcher_alive() -> bool:
@@ -215,21 +219,58 @@ def _watcher_alive() -> bool:
 
 def install() -> None:
     """Handle SIGINT and SIGTERM as described above (main thread only; idempotent)."""
-    global _installed, _watcher, _fds, _fork_hook_registered
+    global _installed, _watcher, _fds, _fork_hook_registered, _previous
     if _installed:
         return
     r, w = os.pipe()
     os.set_blocking(w, False)
     _watcher = threading.Thread(target=_watch, args=(r,), name="gcs-sysid-signals", daemon=True)
     _watcher.start()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, _python_handler)
-    signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+    previous = {sig: signal.signal(sig, _python_handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    previous["wakeup_fd"] = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
     _installed = True
     _fds = (r, w)
+    _previous = previous
     if not _fork_hook_registered:
         os.register_at_fork(after_in_child=_forget_in_child)
         _fork_hook_registered = True
+
+
+def uninstall() -> None:
+    """Undo :func:`install` in this process (a no-op when not installed): the handlers and the wakeup fd it
+    replaced are put back, the watcher ends and the registered clean-ups are forgotten.
+
+    For callers that run a command in-process and carry on (the test suite runs CLI commands inside its
+    worker processes, which later tests fork or signal). Main thread only.
+
+    Raises:
+        ValueError: called from another thread (as :func:`signal.signal`).
+    """
+    global _installed, _watcher, _fds, _previous
+    if not _installed:
+        return
+    prev = _previous or {}
+    signal.set_wakeup_fd(prev.get("wakeup_fd", -1))
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        handler = prev.get(sig)
+        signal.signal(sig, signal.SIG_DFL if handler is None else handler)   # None: not set from Python
+    if _fds is not None:
+        r, w = _fds
+        try:
+            os.write(w, bytes([_QUIT]))
+        except OSError:
+            pass
+        if _watcher is not None:
+            _watcher.join(timeout=5.0)
+        for fd in (r, w):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+    with _lock:
+        _cleanups.clear()
+    _fds = _previous = _watcher = None
+    _installed = False
 
 
 def _forget_in_child() -> None:
@@ -241,7 +282,7 @@ def _forget_in_child() -> None:
     command in-process). The child also inherits the parent's clean-ups, which remove the parent's
     outputs. So the child gets the default handlers back, no wakeup fd and no clean-ups.
     """
-    global _installed, _watcher, _fds
+    global _installed, _watcher, _fds, _previous
     if not _installed:
         return
     try:
@@ -256,7 +297,6 @@ def _forget_in_child() -> None:
                 os.close(fd)
             except OSError:
                 pass
-    _fds = None
+    _fds = _previous = _watcher = None
     _cleanups.clear()
-    _watcher = None
     _installed = False

@@ -37,6 +37,24 @@ REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
 
 
+@pytest.fixture(autouse=True)
+def _signal_handling_restored():
+    """Each test leaves SIGINT/SIGTERM as it found them: a CLI command run in-process installs
+    :mod:`gcs_sysid.stopping` (or, for ``listen``, its own SIGTERM handler) in this worker, and a later
+    test's signal or fork then reached that watcher and ended the worker (nineteenth session; CI of
+    2026-11-25, which lost a worker and hung)."""
+    import signal
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    from gcs_sysid import stopping
+
+    stopping.uninstall()
+    for s, h in before.items():
+        if signal.getsignal(s) is not h and h is not None:
+            signal.signal(s, h)
+
+
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
     """The repository's data/ directory."""

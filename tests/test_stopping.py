@@ -78,3 +78,36 @@ def test_a_forked_child_does_not_share_the_parents_stop(tmp_path):
     assert proc.stdout.split() == ["parent", "alive", str(-signal.SIGTERM)], proc.stdout   # default SIGTERM
     assert "stopped by" not in proc.stderr, proc.stderr
     assert not (tmp_path / "cleaned").exists(), "the child ran the parent's clean-up"
+
+
+UNINSTALL_SCRIPT = r'''
+import os, signal, threading
+from gcs_sysid import stopping
+before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+stopping.install()
+stopping.register(lambda: "never")
+assert any(t.name == "gcs-sysid-signals" for t in threading.enumerate())
+stopping.uninstall()
+stopping.uninstall()                      # a no-op the second time
+assert not stopping.installed()
+assert all(signal.getsignal(s) is h for s, h in before.items())
+assert signal.set_wakeup_fd(-1) == -1     # no wakeup pipe left
+assert not any(t.name == "gcs-sysid-signals" for t in threading.enumerate())
+try:
+    os.kill(os.getpid(), signal.SIGINT)   # Python's own handling again
+    for _ in range(100):
+        threading.Event().wait(0.01)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+stopping.install()                        # and it can be installed again
+assert stopping.installed()
+'''
+
+
+def test_uninstall_gives_back_what_install_took():
+    # The test suite runs CLI commands in its worker processes (tests/conftest.py uninstalls after each test):
+    # a watcher left behind ended the worker at a later test's signal (nineteenth session) or fork (2026-11-26).
+    proc = subprocess.run([sys.executable, "-c", UNINSTALL_SCRIPT], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, (proc.returncode, proc.stderr)
+    assert proc.stdout.split() == ["KeyboardInterrupt"], proc.stdout
+    assert "stopped by" not in proc.stderr and "interrupted" not in proc.stderr, proc.stderr
