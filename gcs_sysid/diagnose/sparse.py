@@ -181,11 +181,14 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: 0.12-s delay no longer named as ``CZ:delta_e``; one sgs ``Cm:alpha^2 = -4`` flight names ``Cm:alpha*delta_e^2``
 #: where main named nothing). Not measured: the other 10 tuning aircraft.
 #: Added 2026-11-23 (twentieth session, branch i9-elev): ``coverage_map_delta_e`` (read only with
-#: ``coverage_under_null``), **off**: the difference of the two flights' aided-alpha loadings on the elevator
+#: ``coverage_under_null``), on (below): the difference of the two flights' aided-alpha loadings on the elevator
 #: (:func:`gcs_sysid.diagnose.uncertainty.elevator_loading`, ``-CZ_delta_e / CZ_alpha`` of each aiding fit) carried
 #: under no change as a fourth alpha component (the angle's error along ``delta_e``). No new threshold. Measured
 #: post hoc on the c172p's final-evaluation flights and the c172x's (``docs/benchmarks.md``, *Twentieth session,
-#: i9-elev*).
+#: i9-elev*). **On by default since the forty-sixth session** (2026-11-26), by a rule written before its runs: fresh
+#: clean seeds 26-35 (250 flights, never run with it) 242 -> 247 with nothing named, no flight newly naming a cause
+#: (the ``CZ:delta_e`` / ``Cm:delta_e`` of the asw20, sgs, eternity and pa28); seed 3 every one of its 300 effect
+#: decisions unchanged, clean 123 -> 125 of 125 (the sgs's ``CZ:delta_e``); ALFA 9/9, 5/5 (*Forty-sixth session*).
 #: Added 2026-11-24 (twenty-first session, branch i9-aidnull): ``coverage_scale_step`` (read only with
 #: ``coverage_under_null``), **off** (0.0): the largest relative step of the angle scale's central difference under
 #: no change; a stated scale uncertainty above it is carried as the first-order sensitivity at this step times the
@@ -300,7 +303,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "naming_coverage_factor": NAMING_COVERAGE_FACTOR, "centred_estimate": True,
               "scale_beta_allowance": True, "coverage_type_a": False, "coverage_under_null": "alpha",
               "angle_offset_level": False, "angle_error_beside_named": True, "coverage_curvature": True,
-              "coverage_map_delta_e": False, "coverage_scale_step": 0.0,
+              "coverage_map_delta_e": True, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha",), "delay_primary_agreement": 3.0, "coverage_beta_along": "columns"}

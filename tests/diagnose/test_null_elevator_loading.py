@@ -1,4 +1,5 @@
-"""The aided alpha's elevator loading under no change (``sparse.THRESHOLDS["coverage_map_delta_e"]``, opt-in).
+"""The aided alpha's elevator loading under no change (``sparse.THRESHOLDS["coverage_map_delta_e"]``, on since
+the forty-sixth session).
 
 The alpha aiding's force model ``CZ = c0 + CZ_alpha alpha + ... + CZ_delta_e delta_e`` is fitted per flight; an error
 ``e`` in its ``CZ_delta_e`` is an aided-alpha error ``-e / CZ_alpha * delta_e``
@@ -48,7 +49,7 @@ def _cm_delta_e(cm, x, de):
 
 
 def test_the_aidings_elevator_loading_and_the_pairs_difference():
-    assert THRESHOLDS["coverage_map_delta_e"] is False              # opt-in
+    assert THRESHOLDS["coverage_map_delta_e"] is True               # the default since the forty-sixth session
     assert elevator_loading(_fit(0.277)) == pytest.approx(0.277)
     assert elevator_loading(AxisFit("alpha", False, "not aided", ("1", "alpha", "delta_e"), np.zeros(3),
                                     np.zeros(3))) is None
