@@ -46,20 +46,18 @@ def test_the_effect_groups_cover_issue_9s_six_effects_once():
     assert sorted(names) == sorted(EFFECTS) and len(set(names)) == len(names)
 
 
-def _blas_threads(job):
-    """A pool job: the most threads any loaded BLAS would use in this worker (the pool's result tuple)."""
-    from threadpoolctl import threadpool_info
-
-    n = max((lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas"), default=0)
-    return f"blas {job}", 0, 0.0, f"{n}\n", ""
-
-
 POOL_SCRIPT = r'''
 import pathlib, sys
 import numpy  # noqa: F401  (NumPy loaded before the fork, as the harness loads it in pool_eval's parent)
 from threadpoolctl import threadpool_info, threadpool_limits
 from benchmarks.pool_eval import _run_pool
-from tests.test_pool_eval import _blas_threads
+
+
+def _blas_threads(job):
+    """A pool job: the most threads any loaded BLAS would use in this worker (the pool's result tuple)."""
+    n = max((lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas"), default=0)
+    return f"blas {job}", 0, 0.0, f"{n}\n", ""
+
 
 blas = [lib["num_threads"] for lib in threadpool_info() if lib.get("user_api") == "blas"]
 assert blas, "no BLAS loaded"
