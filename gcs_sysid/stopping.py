@@ -262,15 +262,20 @@ def uninstall() -> None:
             pass
         if _watcher is not None:
             _watcher.join(timeout=5.0)
-        for fd in (r, w):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
+        _close_pipe()
     with _lock:
         _cleanups.clear()
     _fds = _previous = _watcher = None
     _installed = False
+
+
+def _close_pipe() -> None:
+    """Close both ends of the wakeup pipe (already closed ends are ignored)."""
+    for fd in _fds or ():
+        try:
+            os.close(fd)
+        except OSError:
+            pass
 
 
 def _forget_in_child() -> None:
@@ -291,12 +296,7 @@ def _forget_in_child() -> None:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
     except ValueError:   # not the main thread (cannot happen after a fork: the forking thread is the main one)
         pass
-    if _fds is not None:
-        for fd in _fds:
-            try:
-                os.close(fd)
-            except OSError:
-                pass
+    _close_pipe()
     _fds = _previous = _watcher = None
     _cleanups.clear()
     _installed = False
