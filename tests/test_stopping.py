@@ -83,6 +83,9 @@ def test_a_forked_child_does_not_share_the_parents_stop(tmp_path):
 UNINSTALL_SCRIPT = r'''
 import os, signal, threading
 from gcs_sysid import stopping
+# Python's own SIGINT handler, whatever this process inherited: a shell starts background jobs with SIGINT
+# ignored, and Python then keeps SIG_IGN (CI run from `.ci/run &`, 2026-11-26: no KeyboardInterrupt below)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
 stopping.install()
 stopping.register(lambda: "never")
