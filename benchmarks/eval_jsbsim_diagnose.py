@@ -699,6 +699,9 @@ def main(argv=None) -> int:
                    help="the coefficients confirm a wind-triangle pitot bias only where their standard error is at most "
                         "this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; default: the "
                         "package's)")
+    p.add_argument("--pitot-refit-systematic", default=None, type=float, metavar="MPS",
+                   help="the exact pitot re-fit's between-flight systematic error, m/s, in quadrature with its "
+                        "standard error (gcs_sysid.diagnose.pitot.REFIT_SYSTEMATIC_MPS; default: the package's)")
     p.add_argument("--pitot-signature-triangle", default=None, choices=("on", "off"),
                    help="a pitot cause named on the coefficients' signature must agree with the wind triangle's change "
                         "(gcs_sysid.diagnose.pitot.SIGNATURE_TRIANGLE_AGREE; default: the package's)")
@@ -732,6 +735,10 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         from gcs_sysid.diagnose import pitot as _pt
 
         _pt.SIGNATURE_SYSTEMATIC = a.pitot_signature_systematic == "on"
+    if a.pitot_refit_systematic is not None:
+        from gcs_sysid.diagnose import pitot as _pt
+
+        _pt.REFIT_SYSTEMATIC_MPS = a.pitot_refit_systematic
     if a.pitot_witness_max_se is not None:
         from gcs_sysid.diagnose import pitot as _pt
 
