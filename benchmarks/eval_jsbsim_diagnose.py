@@ -702,6 +702,10 @@ def main(argv=None) -> int:
     p.add_argument("--pitot-refit-systematic", default=None, type=float, metavar="MPS",
                    help="the exact pitot re-fit's between-flight systematic error, m/s, in quadrature with its "
                         "standard error (gcs_sysid.diagnose.pitot.REFIT_SYSTEMATIC_MPS; default: the package's)")
+    p.add_argument("--pitot-refit-relative", default=None, type=float, metavar="FRACTION",
+                   help="the exact pitot re-fit's systematic error relative to the median airspeed, in quadrature "
+                        "(gcs_sysid.diagnose.pitot.REFIT_SYSTEMATIC_REL; default: the package's, 0.005 since the "
+                        "forty-seventh session; 0 to compare with the committed records)")
     p.add_argument("--pitot-signature-triangle", default=None, choices=("on", "off"),
                    help="a pitot cause named on the coefficients' signature must agree with the wind triangle's change "
                         "(gcs_sysid.diagnose.pitot.SIGNATURE_TRIANGLE_AGREE; default: the package's)")
@@ -739,6 +743,10 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         from gcs_sysid.diagnose import pitot as _pt
 
         _pt.REFIT_SYSTEMATIC_MPS = a.pitot_refit_systematic
+    if a.pitot_refit_relative is not None:
+        from gcs_sysid.diagnose import pitot as _pt
+
+        _pt.REFIT_SYSTEMATIC_REL = a.pitot_refit_relative
     if a.pitot_witness_max_se is not None:
         from gcs_sysid.diagnose import pitot as _pt
 

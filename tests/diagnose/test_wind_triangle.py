@@ -249,9 +249,11 @@ def test_the_signature_path_must_agree_with_the_triangle():
     assert signature_agrees_with_triangle({"change_mps": 0.0, "std_error": 0.0}, 5.0, (0.0, 0.0), 0.1)
 
 
-def test_the_exact_refit_carries_its_own_systematic_term(monkeypatch):
+@pytest.mark.parametrize("relative", [0.0, 0.005])
+def test_the_exact_refit_carries_its_own_systematic_term(monkeypatch, relative):
     """The closed-form fit (the screen) counts COEF_SYSTEMATIC_MPS, the exact re-fit that decides counts
-    REFIT_SYSTEMATIC_MPS (forty-seventh session: separate constants, measured apart)."""
+    REFIT_SYSTEMATIC_MPS and REFIT_SYSTEMATIC_REL times the flight's median airspeed (forty-seventh session: separate
+    constants, measured apart)."""
     from types import SimpleNamespace
 
     from gcs_sysid.diagnose import pitot, wind_triangle as wt
@@ -269,6 +271,7 @@ def test_the_exact_refit_carries_its_own_systematic_term(monkeypatch):
         return real(change, coef_change, coef_se)
 
     monkeypatch.setattr(pitot, "REFIT_SYSTEMATIC_MPS", 0.45)
+    monkeypatch.setattr(pitot, "REFIT_SYSTEMATIC_REL", relative)
     monkeypatch.setattr(pitot, "fuse_pitot_evidence", spy)
     monkeypatch.setattr(wt, "wind_triangle", lambda *a, **k: {"bias_mps": 1.5})
     monkeypatch.setattr(wt, "change_since_references",
@@ -277,11 +280,12 @@ def test_the_exact_refit_carries_its_own_systematic_term(monkeypatch):
     monkeypatch.setattr(pitot, "_rereduced_baseline", lambda *a: None)
     monkeypatch.setattr(pitot, "_unit_delta_rereduced", lambda ctx, flight, b, angle_fits=None: np.zeros((10, 6)))
     monkeypatch.setattr(pitot, "_fit_unit_delta", lambda ctx, R, D1, base=None: (1.2, 0.1, {}))
-    ctx = SimpleNamespace(t=np.arange(10.0), states=None, valid=np.ones(10, bool))
+    V = np.array([30.0, 40.0, 50.0, 60.0, 200.0, 40.0, 40.0, 45.0, 35.0, 40.0])       # median 40 m/s (valid rows)
+    ctx = SimpleNamespace(t=np.arange(10.0), states=None, valid=np.ones(10, bool), x=lambda name: V)
     with pytest.raises(Seen):
         pitot._fused_candidate(ctx, None, None, None, [], None, None,
                                [{"cause": "bias:airspeed", "estimate": 1.0, "std_error": 0.2}], None, 25.0)
     (c0, se0), (c1, se1) = seen
     assert (c0, c1) == (1.0, 1.2)
     assert se0 == pytest.approx(np.hypot(0.2, pitot.COEF_SYSTEMATIC_MPS))
-    assert se1 == pytest.approx(np.hypot(0.1, 0.45))
+    assert se1 == pytest.approx(np.sqrt(0.1 ** 2 + 0.45 ** 2 + (relative * 40.0) ** 2))
