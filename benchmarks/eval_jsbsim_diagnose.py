@@ -731,25 +731,15 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         from gcs_sysid.diagnose import sparse as _sp
 
         _sp.THRESHOLDS["library_control_trim"] = a.library_control_trim == "on"
-    if a.pitot_signature_triangle is not None:
-        from gcs_sysid.diagnose import pitot as _pt
+    from gcs_sysid.diagnose import pitot as _pt
 
-        _pt.SIGNATURE_TRIANGLE_AGREE = a.pitot_signature_triangle == "on"
-    if a.pitot_signature_systematic is not None:
-        from gcs_sysid.diagnose import pitot as _pt
-
-        _pt.SIGNATURE_SYSTEMATIC = a.pitot_signature_systematic == "on"
-    if a.pitot_refit_systematic is not None:
-        from gcs_sysid.diagnose import pitot as _pt
-
-        _pt.REFIT_SYSTEMATIC_MPS = a.pitot_refit_systematic
-    if a.pitot_refit_relative is not None:
-        from gcs_sysid.diagnose import pitot as _pt
-
-        _pt.REFIT_SYSTEMATIC_REL = a.pitot_refit_relative
+    for name, value in (("SIGNATURE_TRIANGLE_AGREE", a.pitot_signature_triangle),
+                        ("SIGNATURE_SYSTEMATIC", a.pitot_signature_systematic),
+                        ("REFIT_SYSTEMATIC_MPS", a.pitot_refit_systematic),
+                        ("REFIT_SYSTEMATIC_REL", a.pitot_refit_relative)):
+        if value is not None:                    # given: "on"/"off" switches, numbers as they are
+            setattr(_pt, name, value == "on" if isinstance(value, str) else value)
     if a.pitot_witness_max_se is not None:
-        from gcs_sysid.diagnose import pitot as _pt
-
         _pt.COEF_WITNESS_MAX_SE_MPS = None if a.pitot_witness_max_se == "off" else a.pitot_witness_max_se
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr

@@ -275,7 +275,7 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
             continue
         # the autopilot's own wind estimate independently confirms a pitot error along the heading: then the
         # coefficient offsets the bias makes are part of its evidence, not a between-flight allowance
-        b_est = f.estimate if cause == "bias:airspeed" else (f.estimate - 1.0) * float(np.median(ctx.x("V")[ctx.valid]))
+        b_est = f.estimate if cause == "bias:airspeed" else (f.estimate - 1.0) * _median_airspeed(ctx)
         confirmed = wind is not None and abs(wind["bias_mps"]) >= MIN_T_WIND * wind["std_error"] and \
             abs(wind["bias_mps"] - b_est) <= 3.0 * np.hypot(wind["std_error"], f.std_error) + 0.25 * abs(b_est)
         gate = physical_gate(ctx, np.nan_to_num(R), f.delta, 1, proj, acc, gain_rows,
@@ -285,7 +285,7 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         checks["beats_terms"] = bool(gate["versus_terms"]["beats"])
         cand["gate"] = gate
         if wind is not None:
-            b = f.estimate if cause == "bias:airspeed" else (f.estimate - 1.0) * float(np.median(ctx.x("V")[ctx.valid]))
+            b = f.estimate if cause == "bias:airspeed" else (f.estimate - 1.0) * _median_airspeed(ctx)
             checks["wind_shift"] = bool(abs(wind["bias_mps"] - b) <= 3.0 * np.hypot(wind["std_error"], f.std_error)
                                         + 0.25 * abs(b))
             cand["wind_shift"] = wind
@@ -350,9 +350,14 @@ def _references_mean(refs: list[dict]) -> tuple[float, float]:
     return float(np.sum(w * [r["estimate"] for r in refs]) / w.sum()), float(1.0 / np.sqrt(w.sum()))
 
 
+def _median_airspeed(ctx: DiagContext) -> float:
+    """The flight's median airspeed over its valid rows, m/s."""
+    return float(np.median(ctx.x("V")[ctx.valid]))
+
+
 def _mps_per_unit(ctx: DiagContext, cause: str) -> float:
     """m/s of airspeed per unit of a pitot cause: 1 for a bias, the flight's median V for a scale (``(s - 1) V``)."""
-    return float(np.median(ctx.x("V")[ctx.valid])) if cause == "scale:airspeed" else 1.0
+    return _median_airspeed(ctx) if cause == "scale:airspeed" else 1.0
 
 
 def signature_agrees_with_triangle(change: dict, estimate_mps: float, reference: tuple[float, float],
@@ -522,7 +527,7 @@ def _fused_candidate(ctx, R, proj, flight, references, airframe, model, candidat
             if DIFFERENTIAL_REREDUCED else None
         b_c, se_c, per_coef = _fit_unit_delta(ctx, R, D1, base)
         coef_change = b_c - (0.0 if base else ref_b)
-        v_med = float(np.median(ctx.x("V")[ctx.valid])) if REFIT_SYSTEMATIC_REL and np.isfinite(b_c) else 0.0
+        v_med = _median_airspeed(ctx) if REFIT_SYSTEMATIC_REL and np.isfinite(b_c) else 0.0
         coef_se = float(np.sqrt(se_c ** 2 + (0.0 if base else ref_se ** 2) + REFIT_SYSTEMATIC_MPS ** 2
                                 + (REFIT_SYSTEMATIC_REL * v_med) ** 2))
         fused = fuse_pitot_evidence(change, coef_change, coef_se)
