@@ -706,6 +706,11 @@ def main(argv=None) -> int:
                    help="the exact pitot re-fit's systematic error relative to the median airspeed, in quadrature "
                         "(gcs_sysid.diagnose.pitot.REFIT_SYSTEMATIC_REL; default: the package's, 0.005 since the "
                         "forty-seventh session; 0 to compare with the committed records)")
+    p.add_argument("--pitot-triangle-confirm", default=None, metavar="T|off",
+                   type=lambda v: v if v == "off" else float(v),
+                   help="the wind triangle must see a fused pitot bias on its own, at least T of its standard errors on "
+                        "the estimate's side; 'off': not asked (gcs_sysid.diagnose.pitot.MIN_T_TRIANGLE_CONFIRM; default: "
+                        "the package's)")
     p.add_argument("--pitot-signature-triangle", default=None, choices=("on", "off"),
                    help="a pitot cause named on the coefficients' signature must agree with the wind triangle's change "
                         "(gcs_sysid.diagnose.pitot.SIGNATURE_TRIANGLE_AGREE; default: the package's)")
@@ -741,6 +746,8 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
             setattr(_pt, name, value == "on" if isinstance(value, str) else value)
     if a.pitot_witness_max_se is not None:
         _pt.COEF_WITNESS_MAX_SE_MPS = None if a.pitot_witness_max_se == "off" else a.pitot_witness_max_se
+    if a.pitot_triangle_confirm is not None:
+        _pt.MIN_T_TRIANGLE_CONFIRM = None if a.pitot_triangle_confirm == "off" else a.pitot_triangle_confirm
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr
 

@@ -113,6 +113,28 @@ def test_the_coefficients_must_see_the_bias_not_only_agree_with_it():
     assert not coefficients_confirm(fuse_pitot_evidence({"change_mps": -1.07, "std_error": 0.42}, -0.9, 1.0))
 
 
+def test_the_triangle_must_see_the_bias_when_asked_to(monkeypatch):
+    """``pitot.MIN_T_TRIANGLE_CONFIRM``: the wind triangle must confirm a fused finding as the coefficients must. JSBSim
+    numbers (forty-seventh and forty-eighth sessions): the navion's clean s50, named -1.29 m/s on the coefficients
+    (-2.10 +- 0.53) with the triangle at -0.29 +- 0.59; the j3cub's 2 m/s bias of seed 3 (triangle 2.13 +- 0.52,
+    coefficients 1.16 +- 0.41)."""
+    from gcs_sysid.diagnose import pitot
+
+    navion = fuse_pitot_evidence({"change_mps": -0.285, "std_error": 0.591}, -2.096, 0.53)
+    j3cub = fuse_pitot_evidence({"change_mps": 2.125, "std_error": 0.518}, 1.157, 0.411)
+    monkeypatch.setattr(pitot, "MIN_T_TRIANGLE_CONFIRM", None)
+    checks, _ = pitot._acceptance_checks(navion)
+    assert all(checks.values()) and "triangle_confirms" not in checks          # what named it
+    monkeypatch.setattr(pitot, "MIN_T_TRIANGLE_CONFIRM", 1.0)
+    checks, _ = pitot._acceptance_checks(navion)
+    assert checks["significant"] and checks["coefficients_confirm"] and not checks["triangle_confirms"]
+    checks, _ = pitot._acceptance_checks(j3cub)
+    assert all(checks.values()) and checks["triangle_confirms"]
+    # the side is the fused estimate's: a triangle as large on the other side does not confirm
+    assert not pitot.triangle_confirms(fuse_pitot_evidence({"change_mps": -0.6, "std_error": 0.5}, 2.5, 0.3))
+    assert pitot.triangle_confirms(fuse_pitot_evidence({"change_mps": 0.55, "std_error": 0.5}, 2.5, 0.3))
+
+
 def test_coefficients_without_the_power_to_confirm_are_not_asked_to(monkeypatch):
     """``pitot.COEF_WITNESS_MAX_SE_MPS``: a coefficient estimate of the bias with a standard error above the cap is no
     witness, so the confirmation is waived; agreement and the fused t still decide, and below the cap (the sim
