@@ -710,7 +710,7 @@ def main(argv=None) -> int:
                    type=lambda v: v if v == "off" else float(v),
                    help="the wind triangle must see a fused pitot bias on its own, at least T of its standard errors on "
                         "the estimate's side; 'off': not asked (gcs_sysid.diagnose.pitot.MIN_T_TRIANGLE_CONFIRM; default: "
-                        "the package's)")
+                        "the package's, 1.0 since the forty-eighth session)")
     p.add_argument("--pitot-signature-triangle", default=None, choices=("on", "off"),
                    help="a pitot cause named on the coefficients' signature must agree with the wind triangle's change "
                         "(gcs_sysid.diagnose.pitot.SIGNATURE_TRIANGLE_AGREE; default: the package's)")
