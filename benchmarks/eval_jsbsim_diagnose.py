@@ -708,9 +708,10 @@ def main(argv=None) -> int:
                         "forty-seventh session; 0 to compare with the committed records)")
     p.add_argument("--pitot-triangle-confirm", default=None, metavar="T|off",
                    type=lambda v: v if v == "off" else float(v),
-                   help="the wind triangle must see a fused pitot bias on its own, at least T of its standard errors on "
-                        "the estimate's side; 'off': not asked (gcs_sysid.diagnose.pitot.MIN_T_TRIANGLE_CONFIRM; default: "
-                        "the package's, 1.0 since the forty-eighth session)")
+                   help="the wind triangle must see a fused pitot bias on its own, at least T of its standard "
+                        "errors on the estimate's side; 'off': not asked "
+                        "(gcs_sysid.diagnose.pitot.MIN_T_TRIANGLE_CONFIRM; default: the package's, 1.0 since the "
+                        "forty-eighth session)")
     p.add_argument("--pitot-signature-triangle", default=None, choices=("on", "off"),
                    help="a pitot cause named on the coefficients' signature must agree with the wind triangle's change "
                         "(gcs_sysid.diagnose.pitot.SIGNATURE_TRIANGLE_AGREE; default: the package's)")

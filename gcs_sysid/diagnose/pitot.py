@@ -62,8 +62,8 @@ __all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", 
            "REFIT_SYSTEMATIC_REL", "SENSOR_GAIN", "MIN_T_SCREEN", "MIN_T_SCREEN_TRIANGLE", "MAX_SE_COEF_MPS",
            "MIN_T_COEF_CONFIRM", "COEF_WITNESS_MAX_SE_MPS", "MIN_T_TRIANGLE_CONFIRM", "SIGNATURE_TRIANGLE_AGREE",
            "SIGNATURE_SYSTEMATIC", "RANK_BY_GAIN",
-           "signature_agrees_with_triangle", "airspeed_cause", "coefficients_confirm", "triangle_confirms", "wind_shift",
-           "fuse_pitot_evidence", "screen", "with_pitot"]
+           "signature_agrees_with_triangle", "airspeed_cause", "coefficients_confirm", "triangle_confirms",
+           "wind_shift", "fuse_pitot_evidence", "screen", "with_pitot"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
@@ -161,18 +161,18 @@ MIN_T_COEF_CONFIRM = 1.0
 #: 0.41 m/s and keeps the rule. See ``docs/diagnose.md``, "Both measurements must see it", and ``docs/benchmarks.md``,
 #: "Forty-first session, lead".
 COEF_WITNESS_MAX_SE_MPS: float | None = 1.0
-#: The wind triangle must *confirm* a fused finding too (on since the forty-eighth session, by a rule written before its
-#: fresh runs; None: not asked, the rule before): its
-#: own change since the reference flight(s) must lie at least this many of its standard errors from 0 on the fused
-#: estimate's side, as :data:`MIN_T_COEF_CONFIRM` asks of the coefficients. Without it the coefficients carry the
-#: finding alone when the triangle reads nothing, and their exact re-fit's stated error is the weaker of the two
-#: (against JSBSim's the robust SD of its standardised error is 1.15 after the median over the coefficients and about 5
-#: per coefficient: ``docs/benchmarks.md``, "Forty-seventh session, lead" and "Forty-eighth session, lead"). Two of the three false fused findings of the
-#: forty-seventh session's fresh clean flights read the triangle at 0.35 and 0.48 of its standard errors (c684 s38,
-#: navion s50); of the 101 real biases accepted in the records and on seeds 6 and 7, all read it at 1 or more but one
-#: (c172p 1 m/s, seed 6: 0.78). On fresh flights (effect seed 8's 50 biases, clean seeds 51-55) it changed no decision:
-#: no clean flight was named there, and the 22 accepted biases read the triangle at 2.2 or more. See
-#: ``docs/benchmarks.md``, "Forty-eighth session, lead".
+#: The wind triangle must *confirm* a fused finding too (on since the forty-eighth session, by a rule written before
+#: its fresh runs; None: not asked, the rule before): its own change since the reference flight(s) must lie at least
+#: this many of its standard errors from 0 on the fused estimate's side, as :data:`MIN_T_COEF_CONFIRM` asks of the
+#: coefficients. Without it the coefficients carry the finding alone when the triangle reads nothing, and their exact
+#: re-fit's stated error is the weaker of the two (against JSBSim's truth the robust SD of its standardised error is
+#: 1.15 after the median over the coefficients and about 5 per coefficient: ``docs/benchmarks.md``, "Forty-seventh
+#: session, lead" and "Forty-eighth session, lead"). Two of the three false fused findings of the forty-seventh
+#: session's fresh clean flights read the triangle at 0.35 and 0.48 of its standard errors (c684 s38, navion s50); of
+#: the 101 real biases accepted in the records and on seeds 6 and 7, all read it at 1 or more but one (c172p 1 m/s,
+#: seed 6: 0.78). On fresh flights (effect seed 8's 50 biases, clean seeds 51-55) it changed no decision: no clean
+#: flight was named there, and the 22 accepted biases read the triangle at 2.2 or more. See ``docs/benchmarks.md``,
+#: "Forty-eighth session, lead".
 MIN_T_TRIANGLE_CONFIRM: float | None = 1.0
 #: The signature path (a pitot cause named on the coefficients' signature when the wind-triangle path names nothing)
 #: must agree with the wind triangle's change since the reference flight(s), by the three combined standard errors of
