@@ -694,8 +694,7 @@ def main(argv=None) -> int:
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
                         "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
                         "package's, off, as the replay's since the thirty-third session)")
-    p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off",
-                   type=lambda v: v if v == "off" else float(v),
+    p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off", type=_number_or_off,
                    help="the coefficients confirm a wind-triangle pitot bias only where their standard error is at most "
                         "this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; default: the "
                         "package's)")
@@ -706,8 +705,7 @@ def main(argv=None) -> int:
                    help="the exact pitot re-fit's systematic error relative to the median airspeed, in quadrature "
                         "(gcs_sysid.diagnose.pitot.REFIT_SYSTEMATIC_REL; default: the package's, 0.005 since the "
                         "forty-seventh session; 0 to compare with the committed records)")
-    p.add_argument("--pitot-triangle-confirm", default=None, metavar="T|off",
-                   type=lambda v: v if v == "off" else float(v),
+    p.add_argument("--pitot-triangle-confirm", default=None, metavar="T|off", type=_number_or_off,
                    help="the wind triangle must see a fused pitot bias on its own, at least T of its standard "
                         "errors on the estimate's side; 'off': not asked "
                         "(gcs_sysid.diagnose.pitot.MIN_T_TRIANGLE_CONFIRM; default: the package's, 1.0 since the "
@@ -730,6 +728,11 @@ def main(argv=None) -> int:
         SENSOR_DRAW, TURBULENCE_DRAW = prev
 
 
+def _number_or_off(v: str) -> float | str:
+    """An option's value: ``"off"`` as it is, anything else as a float (argparse reports a ValueError)."""
+    return v if v == "off" else float(v)
+
+
 def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
     """:func:`main` after its arguments are parsed (``SENSOR_DRAW`` and ``TURBULENCE_DRAW`` set from
     ``--sensor-draw`` and ``--turbulence-draw``)."""
@@ -745,10 +748,10 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
                         ("REFIT_SYSTEMATIC_REL", a.pitot_refit_relative)):
         if value is not None:                    # given: "on"/"off" switches, numbers as they are
             setattr(_pt, name, value == "on" if isinstance(value, str) else value)
-    if a.pitot_witness_max_se is not None:
-        _pt.COEF_WITNESS_MAX_SE_MPS = None if a.pitot_witness_max_se == "off" else a.pitot_witness_max_se
-    if a.pitot_triangle_confirm is not None:
-        _pt.MIN_T_TRIANGLE_CONFIRM = None if a.pitot_triangle_confirm == "off" else a.pitot_triangle_confirm
+    for name, value in (("COEF_WITNESS_MAX_SE_MPS", a.pitot_witness_max_se),
+                        ("MIN_T_TRIANGLE_CONFIRM", a.pitot_triangle_confirm)):
+        if value is not None:                    # given: a number, or "off" (None: the check not asked)
+            setattr(_pt, name, None if value == "off" else value)
     if a.air_roll_rate is not None:
         from gcs_sysid.diagnose import run as _dr
 

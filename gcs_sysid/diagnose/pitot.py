@@ -434,10 +434,16 @@ def coefficients_confirm(fused: dict) -> bool:
     Returns:
         True when ``sign(estimate) * coefficients_mps / coefficients_se >= MIN_T_COEF_CONFIRM``.
     """
-    se = fused["coefficients_se"]
-    if not (se > 0) or not np.isfinite(fused["coefficients_mps"]):
+    return _sees_it(fused, "coefficients", MIN_T_COEF_CONFIRM)
+
+
+def _sees_it(fused: dict, which: str, min_t: float) -> bool:
+    """One measurement's own change (``which``: ``"coefficients"`` or ``"triangle"``) lies at least ``min_t`` of its
+    standard errors from 0 on the fused estimate's side; False without a finite change and a positive error."""
+    se = fused[f"{which}_se"]
+    if not (se > 0) or not np.isfinite(fused[f"{which}_mps"]):
         return False
-    return bool(np.sign(fused["estimate"]) * fused["coefficients_mps"] / se >= MIN_T_COEF_CONFIRM)
+    return bool(np.sign(fused["estimate"]) * fused[f"{which}_mps"] / se >= min_t)
 
 
 def triangle_confirms(fused: dict) -> bool:
@@ -450,12 +456,7 @@ def triangle_confirms(fused: dict) -> bool:
         True when ``sign(estimate) * triangle_mps / triangle_se >= MIN_T_TRIANGLE_CONFIRM`` (always True while it is
         None).
     """
-    if MIN_T_TRIANGLE_CONFIRM is None:
-        return True
-    se = fused["triangle_se"]
-    if not (se > 0) or not np.isfinite(fused["triangle_mps"]):
-        return False
-    return bool(np.sign(fused["estimate"]) * fused["triangle_mps"] / se >= MIN_T_TRIANGLE_CONFIRM)
+    return MIN_T_TRIANGLE_CONFIRM is None or _sees_it(fused, "triangle", MIN_T_TRIANGLE_CONFIRM)
 
 
 def _acceptance_checks(fused: dict) -> tuple[dict, dict]:
