@@ -681,10 +681,10 @@ def main(argv=None) -> int:
     p.add_argument("--stated-lift-level", nargs="+", default=None, metavar="AC:CL_ALPHA:CL_Q:CL_DE:CL0[:SIGMA]",
                    help="the aiding's stated lift line per aircraft, alpha's flight mean set on it (gcs_sysid.estimation."
                         "airangles.STATED_LIFT_LEVEL on; as eval_jsbsim's option; default off)")
-    p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both"),
+    p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both", "reference:Cl"),
                    help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
-                        "p_hat less its own smoothed rolling gust (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the "
-                        "package's, off)")
+                        "p_hat less its own smoothed rolling gust; 'reference:Cl': the reference's Cl target only "
+                        "(gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the package's, off)")
     p.add_argument("--wind-window", default=None, type=float, metavar="S",
                    help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     p.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),

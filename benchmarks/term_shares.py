@@ -131,7 +131,7 @@ def main(argv=None) -> int:
     p.add_argument("--effect", required=True, choices=sorted(TERMS))
     p.add_argument("--aircraft", nargs="+", default=None, help="default: every aircraft with the effect's files")
     p.add_argument("--out", type=Path, default=None, help="append one JSON line per case")
-    p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both"),
+    p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both", "reference:Cl"),
                    help="gcs_sysid.diagnose.run.AIR_ROLL_RATE for the run (default: the package's)")
     a = p.parse_args(argv)
     if a.air_roll_rate is not None:

@@ -39,13 +39,15 @@ import numpy as np
 
 from ..aero.table import REGRESSORS
 
-__all__ = ["AIR_ROLL_MODES", "air_roll_table"]
+__all__ = ["AIR_ROLL_MODES", "air_roll_table", "air_roll_cl_table"]
 
 #: The modes of :data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`: ``"off"`` (the gyro's rate everywhere),
 #: ``"reference"`` (the reference flight at its own air-relative rate, the flight under test at the gyro's) and
 #: ``"both"`` (each flight at its own air-relative rate; circular on a flight with a hidden rolling moment);
-#: ``"fit"`` (only the model is fitted at the reference's air-relative rate; both flights diagnosed at the gyro's).
-AIR_ROLL_MODES = ("off", "fit", "reference", "both")
+#: ``"fit"`` (only the model is fitted at the reference's air-relative rate; both flights diagnosed at the gyro's);
+#: ``"reference:Cl"`` (as ``"reference"``, but only the reference's Cl moves, by its target: :func:`air_roll_cl_table`;
+#: every ``p_hat`` column stays the gyro's, so Cn and CY see the same rate on both flights).
+AIR_ROLL_MODES = ("off", "fit", "reference", "both", "reference:Cl")
 
 
 def air_roll_table(table, states, airframe):
@@ -74,3 +76,38 @@ def air_roll_table(table, states, airframe):
     j = REGRESSORS.index("p_hat")
     g = np.asarray(table.X, float)[:, j] - np.asarray(out.X, float)[:, j]
     return out, {"applied": True, "note": out.notes[-1], "g_sd": float(np.std(g[G.used])), "Cl_p": float(G.Cl_p)}
+
+
+def air_roll_cl_table(table, states, airframe):
+    """The table with Cl's target at the air-relative roll rate on its valid rows, every regressor the gyro's.
+
+    ``Cl + Cl_p p_hat_g`` (:func:`gcs_sysid.aero.gustfilter.air_roll_target`, the roll fit of :func:`air_roll_table`
+    on the flight's own valid rows): the moment the rolling gust caused is taken out of Cl, so a model fitted on it
+    with the gyro's ``p_hat`` is not attenuated by the gust, and a residual against it carries no gust moment. Unlike
+    :func:`air_roll_table` nothing else moves: Cn's and CY's ``p_hat`` terms read the gyro's rate on the reference as
+    on the flight under test (forty-ninth session: moving the regressor for every coefficient lost ``Cn:delta_a``,
+    ``CY:scale`` and ``bias:airspeed`` tops where Cl's ``alpha*beta`` gained; ``docs/diagnose.md``, "The air-relative
+    roll rate").
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``X`` ``(T, 10)`` with the gyro's ``p_hat``, ``Y``
+            ``(T, 6)``, ``valid`` ``(T,)``).
+        states: the smoothed states (``data["p"]`` ``(T,)`` rad/s; the stated ``p_dot`` noise).
+        airframe: span ``b`` m, area ``S`` m^2, inertia ``Ixx`` kg m^2.
+
+    Returns:
+        ``(table', info)``: a new table (``Y``'s Cl column changed on the valid rows, a note added) and
+        ``{"applied": bool, "note": str, "g_sd": float, "Cl_p": float}``; where the roll fit is refused the table is
+        returned with only the note and ``applied`` False.
+    """
+    from ..aero.gustfilter import air_roll_target
+
+    Y, info = air_roll_target(table, states, airframe, np.asarray(table.valid, bool))
+    note = str(info.get("note", ""))
+    if "Cl_p" not in info:
+        return replace(table, notes=list(table.notes) + [f"air roll rate (Cl): {note}"]), \
+            {"applied": False, "note": note, "g_sd": 0.0, "Cl_p": float("nan")}
+    g = np.asarray(info["g"], float)
+    return replace(table, Y=Y, notes=list(table.notes) + [f"air roll rate (Cl target): {note}"]), \
+        {"applied": True, "note": note, "g_sd": float(np.std(g[np.asarray(info["rows"], bool)])),
+         "Cl_p": float(info["Cl_p"])}

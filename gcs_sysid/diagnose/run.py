@@ -69,7 +69,9 @@ ALPHA_LEVEL: str | None = None
 #: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
 #: diagnosis compares both flights at the gyro's rate). Off: the ka350 wins (whole eval 30/26/22/19 -> 31/29/24/22), the
 #: b737 loses a clean flight, the c172p a bias:airspeed estimate and gain, the s23 a Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md,
-#: "Twenty-fifth session, i9-airroll".
+#: "Twenty-fifth session, i9-airroll". ``"reference:Cl"`` (forty-ninth session): the reference flight's Cl *target* at its
+#: air-relative rate and every ``p_hat`` the gyro's (:func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`), so that
+#: Cn and CY are not moved with Cl; opt-in ("Forty-ninth session, lead").
 AIR_ROLL_RATE = "off"
 
 #: The sideslip aiding's ``CY_beta`` estimator for every flight the diagnosis and ``fit`` load
@@ -99,7 +101,8 @@ def air_roll_for(role: str, mode: str | None = None) -> bool:
         raise ValueError(f"air roll rate: mode must be one of {AIR_ROLL_MODES}, got {mode!r}")
     if role not in ("fit", "reference", "flight"):
         raise ValueError(f"air roll rate: role must be 'fit', 'reference' or 'flight', got {role!r}")
-    moved = {"off": (), "fit": ("fit",), "reference": ("fit", "reference"), "both": ("fit", "reference", "flight")}
+    moved = {"off": (), "fit": ("fit",), "reference": ("fit", "reference"), "both": ("fit", "reference", "flight"),
+             "reference:Cl": ("fit", "reference")}
     return role in moved[mode]
 
 
@@ -182,9 +185,10 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
     if air_roll:
-        from .air_roll import air_roll_table
+        from .air_roll import air_roll_cl_table, air_roll_table
 
-        table, _ = air_roll_table(table, states, airframe)
+        # "reference:Cl" moves Cl's target only (air_roll_cl_table); the other modes the p_hat regressor
+        table, _ = (air_roll_cl_table if AIR_ROLL_RATE == "reference:Cl" else air_roll_table)(table, states, airframe)
     tm["coefficients_s"] = time.perf_counter() - t2
     return Measurements(flight, airframe, states, table, tm)
 

@@ -104,3 +104,28 @@ def test_air_roll_mode_checked_and_off_by_default():
         run.air_roll_for("reference", "gyro")
     with pytest.raises(ValueError, match="role"):
         run.air_roll_for("test", "both")
+
+
+def test_reference_cl_target_moves_only_cl_and_reads_the_hidden_moment():
+    """``"reference:Cl"``: the reference's Cl target at its air rate, every regressor (``p_hat`` too) the gyro's.
+    Fitted on it, the model's ``Cl_p`` is not attenuated and the flight under test (at the gyro's rate) reads the
+    hidden ``3 alpha beta`` as the ``"reference"`` mode does."""
+    from gcs_sysid.diagnose.air_roll import air_roll_cl_table
+
+    air = SimpleNamespace(Ixx=IXX, S=S, b=B)
+    ref, ref_st, _ = _flight(1)
+    ref_cl, info = air_roll_cl_table(ref, ref_st, air)
+    assert info["applied"] and np.isfinite(info["Cl_p"])
+    assert np.array_equal(ref_cl.X, ref.X)                                   # no regressor moves
+    moved = np.flatnonzero(np.any(ref_cl.Y != ref.Y, axis=0))
+    assert list(moved) == [JL]                                               # only Cl's target
+    th_gyro, th_cl = _cl_fit(ref.X, ref.Y[:, JL]), _cl_fit(ref_cl.X, ref_cl.Y[:, JL])
+    assert abs(th_cl[2] - CLP) < abs(th_gyro[2] - CLP) / 2                   # Cl_p no longer attenuated
+    k = 3.0
+    fl, _, _ = _flight(2, k_ab=k)
+    term = fl.X[:, COL("alpha")] * fl.X[:, COL("beta")]
+    read_gyro = _term_read(th_gyro, fl.X, fl.Y[:, JL], term)
+    read_cl = _term_read(th_cl, fl.X, fl.Y[:, JL], term)
+    assert abs(read_cl - k) < 0.2 * k < abs(read_gyro - k)
+    assert run.air_roll_for("fit", "reference:Cl") and run.air_roll_for("reference", "reference:Cl")
+    assert not run.air_roll_for("flight", "reference:Cl")
