@@ -81,8 +81,10 @@ def air_roll_table(table, states, airframe):
 def air_roll_cl_table(table, states, airframe):
     """The table with Cl's target at the air-relative roll rate on its valid rows, every regressor the gyro's.
 
-    ``Cl + Cl_p p_hat_g`` (:func:`gcs_sysid.aero.gustfilter.air_roll_target`, the roll fit of :func:`air_roll_table`
-    on the flight's own valid rows): the moment the rolling gust caused is taken out of Cl, so a model fitted on it
+    ``Cl + Cl_p p_hat_g`` (:func:`gcs_sysid.aero.gustfilter.air_roll_target` with its own ``"rollgp"`` roll fit,
+    :func:`~gcs_sysid.aero.gustfilter.air_roll_fit`, on the flight's valid rows; the filter-error method, Jategaonkar,
+    *Flight Vehicle System Identification*, 2nd ed., 2015, ch. 5): the moment the rolling gust caused is taken out
+    of Cl, so a model fitted on it
     with the gyro's ``p_hat`` is not attenuated by the gust, and a residual against it carries no gust moment. Unlike
     :func:`air_roll_table` nothing else moves: Cn's and CY's ``p_hat`` terms read the gyro's rate on the reference as
     on the flight under test (forty-ninth session: moving the regressor for every coefficient lost ``Cn:delta_a``,

@@ -69,9 +69,9 @@ ALPHA_LEVEL: str | None = None
 #: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
 #: diagnosis compares both flights at the gyro's rate). Off: the ka350 wins (whole eval 30/26/22/19 -> 31/29/24/22), the
 #: b737 loses a clean flight, the c172p a bias:airspeed estimate and gain, the s23 a Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md,
-#: "Twenty-fifth session, i9-airroll". ``"reference:Cl"`` (forty-ninth session): the reference flight's Cl *target* at its
-#: air-relative rate and every ``p_hat`` the gyro's (:func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`), so that
-#: Cn and CY are not moved with Cl; opt-in ("Forty-ninth session, lead").
+#: "Twenty-fifth session, i9-airroll". ``"reference:Cl"`` (forty-ninth session): the reference flight's Cl *target*
+#: at its air-relative rate and every ``p_hat`` the gyro's (:func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`), so
+#: that Cn and CY are not moved with Cl; opt-in ("Forty-ninth session, lead").
 AIR_ROLL_RATE = "off"
 
 #: The sideslip aiding's ``CY_beta`` estimator for every flight the diagnosis and ``fit`` load
@@ -140,7 +140,9 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
             is aided with its force model (one alpha scale for both) and its sideslip with its side-force estimator
             (:func:`gcs_sysid.estimation.estimate_states`). None: own.
         air_roll: the table's ``p_hat`` less the flight's own smoothed rolling gust
-            (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`; :func:`air_roll_for` says which flights).
+            (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`; with :data:`AIR_ROLL_RATE` ``"reference:Cl"`` its Cl
+            target instead, :func:`~gcs_sysid.diagnose.air_roll.air_roll_cl_table`; :func:`air_roll_for` says which
+            flights).
         profile_beta: the sideslip aiding's ``CY_beta`` estimator (``estimate_states(profile_beta=)``); None:
             :data:`BETA_PROFILE` as it stands at the call (least squares).
 
