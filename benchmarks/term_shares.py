@@ -82,8 +82,11 @@ def _capture():
     return cap
 
 
-def case_shares(work: Path, ac: str, seed: int, effect: str, value: float, cap: dict) -> dict | None:
+def case_shares(work: Path, ac: str, seed: int, effect: str, value: float, cap: dict,
+                refs: dict | None = None) -> dict | None:
     """Diagnose one case as the evaluation does and read the injected term's shares.
+
+    ``refs``: the reference fits already made, by folder (filled here; both sizes of an aircraft share one).
 
     Returns:
         ``{"aircraft", "value", "top", "R", "base", "Rd", "ideal", "base_rms", "ref_explained"}`` (shares of
@@ -99,7 +102,10 @@ def case_shares(work: Path, ac: str, seed: int, effect: str, value: float, cap: 
         return None
     # a folder whose reference model is already fitted, else the first
     d = next((h.parent for h in hits if any(h.parent.glob(f"{ac}-ref-*-model.toml"))), hits[0].parent)
-    _, model_path, ref = E.reference_model(ac, d, plan=E.PLAN)
+    refs = {} if refs is None else refs
+    if d not in refs:                            # fitted once per folder, not once per case
+        refs[d] = E.reference_model(ac, d, plan=E.PLAN)[1:]
+    model_path, ref = refs[d]
     findings, _, _ = E.diagnose_case(ac, seed, [Effect(effect, value)], d, model_path, ref, plan=E.PLAN)
     coef, term_fn, lower_fn = TERMS[effect]
     j = _COEFS.index(coef)
@@ -140,13 +146,13 @@ def main(argv=None) -> int:
         diagnose_run.AIR_ROLL_RATE = a.air_roll_rate
     E.SENSOR_DRAW, E.TURBULENCE_DRAW = "per_aircraft", "per_aircraft"
     names = a.aircraft or sorted({f.name.split("-s")[0] for f in a.work.glob(f"**/*-s{a.seed}-*.tlog")})
-    cap = _capture()
+    cap, refs = _capture(), {}
     rows = []
     print("| aircraft | value | top | R | base | Rd | ideal | base RMS / reference's |")
     print("|---|---|---|---|---|---|---|---|")
     for ac in names:
         for value in SIZES[a.effect]:
-            r = case_shares(a.work, ac, a.seed, a.effect, value, cap)
+            r = case_shares(a.work, ac, a.seed, a.effect, value, cap, refs)
             if r is None:
                 continue
             rows.append(r)
