@@ -39,7 +39,7 @@ import numpy as np
 
 from ..aero.table import REGRESSORS
 
-__all__ = ["AIR_ROLL_MODES", "air_roll_table", "air_roll_cl_table"]
+__all__ = ["AIR_ROLL_MODES", "CL_TARGET_NOTE", "air_roll_table", "air_roll_cl_table", "moved_targets"]
 
 #: The modes of :data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`: ``"off"`` (the gyro's rate everywhere),
 #: ``"reference"`` (the reference flight at its own air-relative rate, the flight under test at the gyro's) and
@@ -48,6 +48,9 @@ __all__ = ["AIR_ROLL_MODES", "air_roll_table", "air_roll_cl_table"]
 #: ``"reference:Cl"`` (as ``"reference"``, but only the reference's Cl moves, by its target: :func:`air_roll_cl_table`;
 #: every ``p_hat`` column stays the gyro's, so Cn and CY see the same rate on both flights).
 AIR_ROLL_MODES = ("off", "fit", "reference", "both", "reference:Cl")
+
+#: How a table's note begins where :func:`air_roll_cl_table` moved its Cl target (read by :func:`moved_targets`).
+CL_TARGET_NOTE = "air roll rate (Cl target)"
 
 
 def air_roll_table(table, states, airframe):
@@ -110,6 +113,24 @@ def air_roll_cl_table(table, states, airframe):
         return replace(table, notes=list(table.notes) + [f"air roll rate (Cl): {note}"]), \
             {"applied": False, "note": note, "g_sd": 0.0, "Cl_p": float("nan")}
     g = np.asarray(info["g"], float)
-    return replace(table, Y=Y, notes=list(table.notes) + [f"air roll rate (Cl target): {note}"]), \
+    return replace(table, Y=Y, notes=list(table.notes) + [f"{CL_TARGET_NOTE}: {note}"]), \
         {"applied": True, "note": note, "g_sd": float(np.std(g[np.asarray(info["rows"], bool)])),
          "Cl_p": float(info["Cl_p"])}
+
+
+def moved_targets(table) -> frozenset:
+    """The coefficients whose measured target :func:`air_roll_cl_table` moved on ``table`` (by its note).
+
+    A residual of such a coefficient against a model is not comparable with the same coefficient's residual on a
+    flight whose target did not move (the one carries the rolling gust's moment, the other not), so the
+    differential diagnosis does not fit an air angle's between-flight scale on it
+    (:func:`gcs_sysid.diagnose.differential.angle_scale_allowance`'s ``witness_exclude``).
+
+    Args:
+        table: a :class:`~gcs_sysid.aero.table.CoefficientTable` (its ``notes``), or anything with ``notes``.
+
+    Returns:
+        ``frozenset({"Cl"})`` where the Cl target was moved, else an empty set.
+    """
+    notes = getattr(table, "notes", None) or ()
+    return frozenset({"Cl"}) if any(str(n).startswith(CL_TARGET_NOTE) for n in notes) else frozenset()

@@ -465,8 +465,14 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["output_error"] = {k: v for k, v in diag.output_error.items() if k != "windows_plot"}
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
     if references:
+        from .air_roll import moved_targets
         from .differential import differential
         from .sparse import THRESHOLDS as _SPARSE_TH
+
+        # a coefficient whose target was moved on one side only witnesses no air angle's scale (air_roll.moved_targets)
+        moved = moved_targets(table)
+        unlike = tuple(c for c in COEFFICIENTS
+                       if any((c in moved_targets(r.table)) != (c in moved) for r in references))
 
         say("diagnose: differential against the reference flight(s)")
         t1 = time.perf_counter()
@@ -485,7 +491,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                             scale_wind_axis=bool(_SPARSE_TH.get("side_force_wind_axis", False)),
                                             angle_error_beside_named=bool(_SPARSE_TH.get("angle_error_beside_named",
                                                                                          False)),
-                                            beside_residual=search_residual if search else None)
+                                            beside_residual=search_residual if search else None,
+                                            angle_witness_exclude=unlike)
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

@@ -240,7 +240,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
                           scale_se: bool = True, jackknife: dict | None = None,
                           along_term: bool = False, column: np.ndarray | None = None,
-                          beside: dict | None = None, parents=()) -> dict | None:
+                          beside: dict | None = None, parents=(), witness_exclude=()) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -292,6 +292,14 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
             ``sparse.THRESHOLDS["alpha_jackknife_s"]``).
         parents: the terms the finding entered the search with, fitted beside it in the judgement beyond the
             scale (:func:`offset_allowance`), its scale share and its jackknife. (): the term alone.
+        witness_exclude: coefficients the angle's scale is *not* fitted on although in its group: those whose
+            measured target differs in kind between this flight and the reference (the reference's Cl at the
+            air-relative roll rate, the flight's at the gyro's: :func:`gcs_sysid.diagnose.air_roll.moved_targets`),
+            whose residual then carries the rolling gust's moment, which follows the sideslip through the lateral
+            dynamics (fiftieth session: on the JSBSim SGS 1-23's clean seed 21 Cl and Cn read a sideslip scale
+            1.035 +- 0.047 that way, 0.885 +- 0.04 with both flights at the gyro's rate, so ``scale:CY`` 0.865 was
+            named; Cn alone reads 0.955 +- 0.048 either way).
+            (): every coefficient of the group with a contribution.
 
     Returns:
         None when the finding is not such a term or no other coefficient has a contribution of the
@@ -324,7 +332,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
         X1[:, ia] *= 1.0 + eps
         N = (evaluate_model(model, X1) - evaluate_model(model, X)) / eps    # (T, 6): x dC/dx
     ok = train & np.isfinite(R).all(axis=1) & np.isfinite(N).all(axis=1)
-    others = [c for c in group if c != coef and np.std(N[ok, COEFFICIENTS.index(c)]) > 0]
+    others = [c for c in group if c != coef and c not in witness_exclude and np.std(N[ok, COEFFICIENTS.index(c)]) > 0]
     if ok.sum() < 50 or not others:
         return None
     num = den = 0.0
@@ -387,7 +395,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
 
 def angle_error_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
-                          scale_se: bool = True) -> dict | None:
+                          scale_se: bool = True, witness_exclude=()) -> dict | None:
     """Is a finding more than an error of the measured air angle that moves with the finding's own term?
 
     The scale allowance (:func:`angle_scale_allowance`) covers an angle error proportional to the angle.
@@ -408,7 +416,7 @@ def angle_error_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     angle's group, the term is not a vocabulary monomial, or no other coefficient depends on the angle.
     """
     return angle_scale_allowance(X, R, train, test, model, coef, term, angle, min_t, min_gain_pct, scale_se,
-                                 along_term=True)
+                                 along_term=True, witness_exclude=witness_exclude)
 
 
 #: The force coefficients whose moment about the CG each moment coefficient carries when the aerodynamic force
@@ -811,7 +819,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
                  force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
                  scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
-                 beside_residual: np.ndarray | None = None) -> dict:
+                 beside_residual: np.ndarray | None = None, angle_witness_exclude=()) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -872,6 +880,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             nuisance; ``sparse_search(keep_residual=True)``), on which ``angle_error_beside_named`` fits a search
             finding's angle error and judges it: on the raw residual the reference's own inadequacy (the ultrastick's
             Cn ridge) stays in the other coefficients and the error along ``p_hat`` was not found. None: the raw one.
+        angle_witness_exclude: coefficients no air angle's scale or error is fitted on (``witness_exclude`` of
+            :func:`angle_scale_allowance`): those whose measured target differs in kind between this flight and the
+            references (:func:`gcs_sysid.diagnose.air_roll.moved_targets`). (): none.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -958,7 +969,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                           (r_ctx.t, r_ctx.X, r_R[:, COEFFICIENTS.index(coef)], r_ctx.valid)}
                 scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                               coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                              scale_se=angle_scale_se, jackknife=jk, parents=parents)
+                                              scale_se=angle_scale_se, jackknife=jk, parents=parents,
+                                              witness_exclude=angle_witness_exclude)
                 if scale is not None and scale["scale_only"]:
                     scaled = scale
                     break
@@ -971,11 +983,12 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                         if beside_residual is not None and f.get("source") == "sparse search" else R_wo
                     err = angle_scale_allowance(diag.X, R_e, diag.train & valid0, diag.test & valid0, diag.model,
                                                 coef, term, angle, min_t, min_gain_pct, angle_scale_se,
-                                                along_term=True, beside=_named_columns(diag, cause))
+                                                along_term=True, beside=_named_columns(diag, cause),
+                                                witness_exclude=angle_witness_exclude)
                 else:
                     err = angle_error_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                                 coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                                scale_se=angle_scale_se)
+                                                scale_se=angle_scale_se, witness_exclude=angle_witness_exclude)
                 if err is not None and err["scale_only"]:
                     scaled = err
                     break
@@ -1010,7 +1023,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             col = _scale_column(diag.model, diag.X, coef, scale_wind_axis)
             scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model, coef,
                                           cause, "beta", min_t=min_t, min_gain_pct=min_gain_pct,
-                                          scale_se=angle_scale_se, column=col)
+                                          scale_se=angle_scale_se, column=col, witness_exclude=angle_witness_exclude)
             if scale is not None and scale["scale_only"]:
                 _note_allowance(doc, f, scale, f"{cause}: a between-flight scale of the measured sideslip, not a cause")
                 continue

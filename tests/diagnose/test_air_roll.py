@@ -129,3 +129,7 @@ def test_reference_cl_target_moves_only_cl_and_reads_the_hidden_moment():
     assert abs(read_cl - k) < 0.2 * k < abs(read_gyro - k)
     assert run.air_roll_for("fit", "reference:Cl") and run.air_roll_for("reference", "reference:Cl")
     assert not run.air_roll_for("flight", "reference:Cl")
+    # the moved target is told apart by the table, so the differential fits no air angle's scale on it
+    from gcs_sysid.diagnose.air_roll import moved_targets
+
+    assert moved_targets(ref_cl) == {"Cl"} and moved_targets(ref) == frozenset() and moved_targets(fl) == frozenset()

@@ -255,3 +255,29 @@ def test_a_side_force_scale_finding_is_judged_against_the_sideslip_scale_by_defa
     R2[:, COEFFICIENTS.index("CY")] += 0.3 * evaluate_model(MODEL, X)[:, COEFFICIENTS.index("CY")]
     b = angle_scale_allowance(X, R2, train, test, MODEL, "CY", "scale:CY", "beta", column=col)
     assert b is not None and not b["scale_only"], b
+
+
+def test_a_coefficient_whose_target_moved_on_one_flight_only_witnesses_no_sideslip_scale():
+    """Fiftieth session (``--air-roll-rate reference:Cl``): the reference's Cl target is moved to its air-relative
+    roll rate, the flight's is not, so the flight's Cl residual carries the rolling gust's moment, which follows the
+    sideslip through the lateral dynamics. Read from Cl and Cn, the JSBSim SGS 1-23's clean seed 21 had a sideslip
+    scale of 1.035 (0.885 with both flights at the gyro's rate) and named ``scale:CY``. Here the measured sideslip
+    is 0.8 of the true one and Cl's residual carries a moment that cancels the scale's share in Cl: with Cl a
+    witness the scale is under-read and CY's share stands as a change; without it Cn alone reads the scale."""
+    X, noise, train, test = _flight(5)
+    ib, jl = REGRESSORS.index("beta"), COEFFICIENTS.index("Cl")
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / 0.8
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    R[:, jl] -= 0.25 * MODEL["Cl"]["beta"] * X[:, ib]       # the moment that moved with Cl's target, not the scale
+    mixed = beta_scale_allowance(X, R, train, test, MODEL, "CY", "beta")
+    assert mixed is not None and not mixed["scale_only"], mixed
+    assert set(mixed["from"]) == {"Cl", "Cn"} and mixed["beta_scale"] < 0.2
+    from gcs_sysid.diagnose.differential import angle_scale_allowance
+
+    alone = angle_scale_allowance(X, R, train, test, MODEL, "CY", "beta", "beta", witness_exclude=("Cl",))
+    assert alone is not None and alone["scale_only"], alone
+    assert alone["from"] == ["Cn"] and abs(alone["beta_scale"] - 0.25) < 0.03
+    # the same exclusion through the sideslip error along a term
+    err = angle_error_allowance(X, R, train, test, MODEL, "CY", "r_hat", witness_exclude=("Cl",))
+    assert err is None or err["from"] == ["Cn"]
