@@ -684,7 +684,7 @@ def main(argv=None) -> int:
     p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both", "reference:Cl"),
                    help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
                         "p_hat less its own smoothed rolling gust; 'reference:Cl': the reference's Cl target only "
-                        "(gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the package's, off)")
+                        "(gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the package's, reference:Cl)")
     p.add_argument("--wind-window", default=None, type=float, metavar="S",
                    help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     p.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),

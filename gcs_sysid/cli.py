@@ -110,12 +110,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates)")
     f.add_argument("--stated-lift-level", action="store_true",
                    help="alpha's flight mean on the airframe's stated lift line (as replay's --stated-lift-level)")
-    f.add_argument("--air-roll", default="off", choices=("on", "off"),
+    f.add_argument("--air-roll", default=None, choices=("on", "off"),
                    help="Cl fitted on the replay's air-rate target (the measured Cl less the window's smoothed "
                         "rolling-gust moment, so the model's Cl terms read the air-relative roll rate; refused, "
                         "with a note in the model's header and <out>.fit.json, where the roll fit finds no gust): "
-                        "'off' the default (the measured Cl at the gyro's rate), 'on' (docs/estimation.md, "
-                        "'Where the pair applies')")
+                        "'on', or 'off' (the measured Cl at the gyro's rate); not given: as diagnose reads its "
+                        "reference flight (Cl's air-rate target, docs/diagnose.md, 'The air-relative roll rate'; "
+                        "docs/estimation.md, 'Where the pair applies')")
     f.add_argument("--beta-profile", default="off", choices=("on", "off"),
                    help="the aided sideslip's CY_beta by the gust model's likelihood, held in the later passes (opt-in "
                         "everywhere since the thirty-third session): 'off' the default (least squares, as the diagnosis loads its flights), "
@@ -265,7 +266,7 @@ def _cmd_fit(a: argparse.Namespace) -> int:
 
     _stated_lift_level(a)
     run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates,
-            air_roll_train=a.air_roll == "on", profile_beta=a.beta_profile == "on")
+            air_roll_train=None if a.air_roll is None else a.air_roll == "on", profile_beta=a.beta_profile == "on")
     print(f"wrote {a.out}")
     return 0
 

@@ -16,8 +16,9 @@ LOG = DATA / "flights" / "sim-trainer-sysid.tlog"
 AIRFRAME = DATA / "airframes" / "sim-trainer.toml"
 
 
-def test_fit_air_roll_flag_reaches_run_fit_and_is_off_by_default(monkeypatch):
-    """No flag: ``air_roll_train=False``; ``on``: True; another value is a user error (exit 2)."""
+def test_fit_air_roll_flag_reaches_run_fit_and_follows_the_diagnosis_by_default(monkeypatch):
+    """No flag: ``air_roll_train=None`` (the diagnosis's own mode); ``off``: False; ``on``: True; another value is a
+    user error (exit 2)."""
     import gcs_sysid.cli as cli
     import gcs_sysid.diagnose as dg
 
@@ -28,7 +29,7 @@ def test_fit_air_roll_flag_reaches_run_fit_and_is_off_by_default(monkeypatch):
         a = build_parser().parse_args(base + extra)
         with pytest.raises(ZeroDivisionError):
             cli.COMMANDS[a.command](a)
-    assert seen == [False, False, True]
+    assert seen == [None, False, True]
     with pytest.raises(SystemExit) as e:
         main(base + ["--air-roll", "maybe"], handle_signals=False)
     assert e.value.code == 2

@@ -24,7 +24,8 @@ moment carries that moment too. Measured on the s23's ``Cl:alpha*beta = 3`` flig
 ``p_hat_g`` regressed on JSBSim's ``p_hat_g`` and the injected moment over ``-Cl_p`` takes 0.63-0.65 of the
 injected term (0.99 at 1.5), and the residual along ``alpha*beta`` falls from 1.5-1.7 to -0.9 .. -0.2; with the
 term itself in the roll fit's design it still takes 0.45-0.47, and a 1-s high-pass of the estimate 0.11-0.15.
-So the option's mode ``"reference"`` (:data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`; ``"off"`` by default) moves only
+So the option's mode ``"reference"`` (:data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`; ``"reference:Cl"`` by default
+since the fiftieth session, ``"off"`` before) moves only
 the reference flight, the flight the model is fitted on and whose residual the differential search subtracts, to the
 air rate;
 the flight under test keeps the gyro's ``p_hat`` (its residual then carries the gust's ``-Cl_p p_hat_g``, which is

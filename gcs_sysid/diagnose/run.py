@@ -71,8 +71,11 @@ ALPHA_LEVEL: str | None = None
 #: b737 loses a clean flight, the c172p a bias:airspeed estimate and gain, the s23 a Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md,
 #: "Twenty-fifth session, i9-airroll". ``"reference:Cl"`` (forty-ninth session): the reference flight's Cl *target*
 #: at its air-relative rate and every ``p_hat`` the gyro's (:func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`), so
-#: that Cn and CY are not moved with Cl; opt-in ("Forty-ninth session, lead").
-AIR_ROLL_RATE = "off"
+#: that Cn and CY are not moved with Cl; the default since the fiftieth session, by the rule written before its fresh
+#: test (effect seed 9 and clean seeds 56-60, paired with ``"off"``: top +8/-3, all three +6/-2, clean not worse;
+#: docs/benchmarks.md, "Fiftieth session, lead"). A coefficient whose target moved on one flight only witnesses no air
+#: angle's scale (:func:`gcs_sysid.diagnose.air_roll.moved_targets`).
+AIR_ROLL_RATE = "reference:Cl"
 
 #: The sideslip aiding's ``CY_beta`` estimator for every flight the diagnosis and ``fit`` load
 #: (:func:`load_measurements`, and the pitot-bias re-run of :mod:`gcs_sysid.diagnose.pitot`): False, least squares
@@ -196,7 +199,7 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
 
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
-            progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool = False,
+            progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool | None = None,
             profile_beta: bool | None = None):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
@@ -205,12 +208,15 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     the end (:class:`gcs_sysid.outdir.StagedFiles`); ``--out`` is checked before the log is decoded.
 
     Args:
-        air_roll_train: Cl fitted on the replay's air-rate target (``--air-roll on``; off by default, the
-            diagnosis's reference models are fitted through here): the measured Cl less the window's smoothed
-            rolling-gust moment, from the replay's one roll fit with its checks (:func:`air_rate_target`), so the
-            model's ``Cl`` terms read the air-relative roll rate; every other coefficient as measured. Refused
-            (the measured Cl) where the roll fit is refused; ``<out>.fit.json``'s ``air_roll`` and the model
-            file's header say which and why.
+        air_roll_train: True: Cl fitted on the replay's air-rate target (``--air-roll on``): the measured Cl less
+            the window's smoothed rolling-gust moment, from the replay's one roll fit with its checks
+            (:func:`air_rate_target`), so the model's ``Cl`` terms read the air-relative roll rate; every other
+            coefficient as measured. Refused (the measured Cl) where the roll fit is refused; ``<out>.fit.json``'s
+            ``air_roll`` and the model file's header say which and why. False (``--air-roll off``): the measured Cl
+            (a mode of :data:`AIR_ROLL_RATE` that moves the fit's ``p_hat`` regressor still moves it). None (the
+            default): as the diagnosis loads its reference flight, :data:`AIR_ROLL_RATE` (``"reference:Cl"``
+            since the fiftieth session: Cl's air-rate target, :func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`;
+            the diagnosis's reference models are fitted through here).
         profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the thirty-second session's replay
             estimator, ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least squares: the
             diagnosis's reference models are fitted through here).
@@ -219,19 +225,22 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
 
     Raises:
-        InputError: ``air_roll_train`` with :data:`AIR_ROLL_RATE` moving the fit's flight already (the gust would
-            be taken out twice); from the stages.
+        InputError: ``air_roll_train`` True with :data:`AIR_ROLL_RATE` moving the fit's ``p_hat`` regressor already
+            (the gust would be taken out twice); from the stages.
     """
     from ..sim.model_file import save_model
     from .fit import fit_model
 
-    if air_roll_train and air_roll_for("fit"):
+    target_only = AIR_ROLL_RATE == "reference:Cl"          # the mode moves Cl's target, not a regressor
+    if air_roll_train and air_roll_for("fit") and not target_only:
         raise InputError(f"fit --air-roll on: not with the diagnosis's air roll rate {AIR_ROLL_RATE!r} (the fit's "
                          "table is at the air rate already)")
+    # explicit on/off: the replay's pair or the measured Cl; None: the diagnosis's own mode (air_roll_for)
+    moved = air_roll_for("fit") and (air_roll_train is None or not target_only)
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
-                                 air_roll=air_roll_for("fit"), profile_beta=profile_beta)
+                                 air_roll=moved, profile_beta=profile_beta)
         table, air = meas.table, None
         if air_roll_train:
             table, air = air_rate_target(meas)

@@ -95,8 +95,12 @@ def test_reference_at_its_air_rate_reads_a_hidden_rolling_moment_that_the_flight
     assert read_both < read_air - 0.03 * k                       # 2.43
 
 
-def test_air_roll_mode_checked_and_off_by_default():
-    assert run.AIR_ROLL_RATE == "off" and not any(run.air_roll_for(r) for r in ("fit", "reference", "flight"))
+def test_air_roll_mode_checked_and_the_reference_cl_target_by_default():
+    """The default since the fiftieth session: the fit's and the reference's Cl target at the air rate, the flight
+    under test as measured; ``"off"`` moves nothing."""
+    assert run.AIR_ROLL_RATE == "reference:Cl"
+    assert run.air_roll_for("fit") and run.air_roll_for("reference") and not run.air_roll_for("flight")
+    assert not any(run.air_roll_for(r, "off") for r in ("fit", "reference", "flight"))
     assert run.air_roll_for("flight", "both")
     assert run.air_roll_for("fit", "fit") and not run.air_roll_for("reference", "fit")
     assert run.air_roll_for("fit", "reference") and not run.air_roll_for("flight", "reference")
