@@ -39,7 +39,8 @@ def test_fit_air_roll_is_refused_in_calm_air_with_the_reason_recorded(tmp_path, 
     """The project's sample flight (the simulation's turbulence moves the air, not the roll moment: no rolling gust):
     the pair's roll fit is refused by its instruments' check (twenty-ninth session, i8-guard), so ``--air-roll on``
     fits the measured Cl, the same model as ``off``; ``<out>.fit.json`` says ``target = "gyro"``, ``applied = false``
-    and why, and so does the model file's header. The diagnosis's own air roll rate (``AIR_ROLL_RATE`` moving the
+    and why, and so does the model file's header; without the flag (the diagnosis's ``"reference:Cl"``) the same
+    refusal is recorded with the mode's name. The diagnosis's own air roll rate (``AIR_ROLL_RATE`` moving the
     fit's flight) and ``--air-roll on`` together are a user error (exit 2), before anything is written."""
     import gcs_sysid.diagnose.run as dr
 
@@ -58,6 +59,14 @@ def test_fit_air_roll_is_refused_in_calm_air_with_the_reason_recorded(tmp_path, 
     on, off = tomllib.loads(models["on"]), tomllib.loads(models["off"])
     assert on.pop("name") == "on" and off.pop("name") == "off"
     assert on == off                                                          # the measured Cl: the same model
+    # no flag: as the diagnosis loads its reference ("reference:Cl", the default): the same refusal, recorded as such
+    out = tmp_path / "default.toml"
+    assert main(["fit", str(LOG), "--airframe", str(AIRFRAME), "--out", str(out)], handle_signals=False) == 0
+    air = json.loads(out.with_suffix(".fit.json").read_text())["air_roll"]
+    assert air["target"] == "gyro" and not air["applied"] and air["Cl_p"] is None
+    assert "'reference:Cl'" in air["note"] and "instrumented" in air["note"]
+    default = tomllib.loads(out.read_text())
+    assert default.pop("name") == "default" and default == off
     monkeypatch.setattr(dr, "AIR_ROLL_RATE", "fit")
     capsys.readouterr()
     out = tmp_path / "both.toml"

@@ -235,8 +235,10 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     if air_roll_train and air_roll_for("fit") and not target_only:
         raise InputError(f"fit --air-roll on: not with the diagnosis's air roll rate {AIR_ROLL_RATE!r} (the fit's "
                          "table is at the air rate already)")
-    # explicit on/off: the replay's pair or the measured Cl; None: the diagnosis's own mode (air_roll_for)
-    moved = air_roll_for("fit") and (air_roll_train is None or not target_only)
+    # explicit on/off: the replay's pair or the measured Cl; None: the diagnosis's own mode (air_roll_for): Cl's
+    # target below (recorded), or the p_hat regressor moved by load_measurements
+    cl_target = air_roll_train is None and target_only and air_roll_for("fit")
+    moved = air_roll_for("fit") and not target_only
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
@@ -244,6 +246,14 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
         table, air = meas.table, None
         if air_roll_train:
             table, air = air_rate_target(meas)
+        elif cl_target:                         # as load_measurements moves the diagnosis's reference flight
+            from .air_roll import air_roll_cl_table
+
+            table, info = air_roll_cl_table(meas.table, meas.states, meas.airframe)
+            air = {"target": "air" if info["applied"] else "gyro", "applied": bool(info["applied"]),
+                   "Cl_p": float(info["Cl_p"]) if info["applied"] else None,
+                   "note": f"{info['note']} (the diagnosis's air roll rate {AIR_ROLL_RATE!r}; --air-roll off: "
+                           "the measured Cl)"}
         model, report = fit_model(table, name=Path(out_path).stem)
         if air is not None:
             report.notes.append(air["note"])
