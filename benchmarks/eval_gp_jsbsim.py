@@ -162,7 +162,8 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     Xt, Yt = truth.at(tab.t)
     t_cut = float(tab.t[held & tab.valid][0])
     ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut,
-                          profile_beta=airangles.BETA_PROFILE)      # the replay's sideslip estimator
+                          profile_beta=airangles.BETA_PROFILE,      # the replay's sideslip estimator
+                          air_roll_train=False)     # the measured Cl (the air-rate line is air_rate_arrays')
     air = air_rate_arrays(res, load_airframe(files.airframe), ls_model)
     air["Xt_air"] = true_air_regressors(aircraft, truth, tab.t, Xt)
     out = cache / f"{name}.npz"

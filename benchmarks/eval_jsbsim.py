@@ -404,7 +404,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     from gcs_sysid.estimation import airangles as _aa
 
     ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
-                          gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE)
+                          gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE,
+                          air_roll_train=False)     # the measured Cl, as issue 8's records were (not the diagnosis's)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     from gcs_sysid.aero.gustfilter import AIR_ROLL_TRAIN, HELDOUT_AIR_ROLL
 

@@ -128,7 +128,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
             Xt_air[:, 2 + j] = np.interp(tab.t, truth.t, truth.fields[f"{ax}_aero"]) * cst[ref] / (2 * Xt[:, 9])
     h = held & tab.valid & np.isfinite(Yt).all(1) & np.all(np.isfinite(tab.X), axis=1)
     ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-livefit.toml", t_to=t_cut,
-                          profile_beta=airangles.BETA_PROFILE)      # the learner's sideslip estimator
+                          profile_beta=airangles.BETA_PROFILE,      # the learner's sideslip estimator
+                          air_roll_train=False)     # the measured Cl (not the diagnosis's reference target)
     ls = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     t0 = time.perf_counter()
     steps = record_steps(files.tlog, af)
