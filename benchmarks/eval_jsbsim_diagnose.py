@@ -182,14 +182,14 @@ def reference_model(ac: str, out: Path, duration_s: float = DURATION_S, plan: st
     """Fly the clean reference flight, fit the model; returns (files, model path, measurements).
     ``turbulence``: the harness level (the evaluation flies "light"; tests of a mechanism pass "calm")."""
     from gcs_sysid.diagnose import run_fit
-    from gcs_sysid.diagnose.run import air_roll_for, load_measurements
+    from gcs_sysid.diagnose.run import air_roll_kind, load_measurements
 
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=REF_SEED, plan=plan, **_draws(),
                                  turbulence=turbulence), [], out,
                     stem=f"{ac}-ref")
     model_path = out / f"{ac}-ref-{plan}{_draw_suffix(SENSOR_DRAW, TURBULENCE_DRAW)}-model.toml"
     run_fit(files.tlog, files.airframe, model_path)
-    return files, model_path, load_measurements(files.tlog, files.airframe, air_roll=air_roll_for("reference"))
+    return files, model_path, load_measurements(files.tlog, files.airframe, air_roll=air_roll_kind("reference"))
 
 
 def _alpha_error_deg(table, tlog: Path) -> dict:
@@ -230,7 +230,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     """Fly one case and diagnose it; returns (findings, injected truth doc, seconds of diagnosis).
     ``turbulence`` as in :func:`reference_model`; ``level_meas``: :func:`level_flights` (pooled alpha level)."""
     from gcs_sysid.diagnose import diagnose
-    from gcs_sysid.diagnose.run import air_roll_for, load_measurements
+    from gcs_sysid.diagnose.run import air_roll_kind, load_measurements
     from gcs_sysid.sim.model_file import load_model
 
     _LAST_PITOT.clear()
@@ -246,7 +246,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     from gcs_sysid.diagnose.run import shared_angle_models
 
     meas = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits),
-                             air_roll=air_roll_for("flight"))
+                             air_roll=air_roll_kind("flight"))
     from gcs_sysid.diagnose import run as diagnose_run
     from gcs_sysid.diagnose.differential import Reference
 
@@ -521,7 +521,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     """
     from gcs_sysid.aero.table import COEFFICIENTS
     from gcs_sysid.diagnose.context import DiagContext, model_as_dict
-    from gcs_sysid.diagnose.run import air_roll_for, load_measurements
+    from gcs_sysid.diagnose.run import air_roll_kind, load_measurements
     from gcs_sysid.diagnose.run import shared_angle_models
     from gcs_sysid.diagnose.sparse import _library, alpha_quantile_knots, reference_context, sparse_search
     from gcs_sysid.sim.model_file import load_model
@@ -533,7 +533,7 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
     for cs in clean_seeds:
         files = _flight(FlightConfig(ac, duration_s=DURATION_S, seed=cs, plan=plan, **_draws()), [], out)
         m = load_measurements(files.tlog, files.airframe, angle_models=shared_angle_models(ref_meas.states.angle_fits),
-                              air_roll=air_roll_for("flight"))
+                              air_roll=air_roll_kind("flight"))
         ctx = DiagContext.build(m.table, m.airframe, model, m.states)
         res = sparse_search(ctx, ctx.Y - ctx.model_values(), reference, keep_residual=True)
         names, Phi = _library(ctx, knots)

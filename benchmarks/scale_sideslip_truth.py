@@ -228,13 +228,13 @@ def clean_scale(ac: str, seed: int, out: Path, ref_meas, g_ref: float) -> dict |
     there before; None where it is not): the flight loaded as the diagnosis loads it (the reference's angle fits,
     the flight's air-roll table), no diagnosis run."""
     from benchmarks.jsbsim_harness.aircraft import aircraft
-    from gcs_sysid.diagnose.run import air_roll_for, load_measurements, shared_angle_models
+    from gcs_sysid.diagnose.run import air_roll_kind, load_measurements, shared_angle_models
 
     tlog = _tlog(out, ac, seed, [])
     if not tlog.exists():
         return None
     m = load_measurements(tlog, aircraft(ac).airframe_path, angle_models=shared_angle_models(
-        ref_meas.states.angle_fits), air_roll=air_roll_for("flight"))
+        ref_meas.states.angle_fits), air_roll=air_roll_kind("flight"))
     beta = np.asarray(m.table.X, float)[:, REGRESSORS.index("beta")]
     rec = {"aircraft": ac, "seed": seed, "k": 1.0, "clean": True,
            "s_true": g_ref / aided_gain(m.table.t, beta, m.table.valid, tlog) - 1.0}

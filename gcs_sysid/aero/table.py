@@ -48,6 +48,10 @@ class CoefficientTable:
         alpha_dot_hat: ``(T,)`` ``alpha_dot c / (2 V)`` (dimensionless; ``alpha_dot`` the estimator's state from the
             force equations, ``gcs_sysid.estimation.alpharate``), or None. Not a column of ``X``: the pipeline's GP
             takes it as a mean-only input of Cm (``docs/gp.md``, "Mean-only inputs").
+        corrected_targets: the coefficients (names of :data:`COEFFICIENTS`) whose column of ``Y`` is no longer the
+            measured coefficient but a corrected target (e.g. ``("Cl",)``: Cl less the rolling gust's moment,
+            :func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`); () for a table as measured. A residual of such a
+            coefficient is not comparable with one of a table where it was not corrected.
     """
 
     t: np.ndarray
@@ -61,6 +65,7 @@ class CoefficientTable:
     x_scale_var: np.ndarray | None = None
     x_map_cov: np.ndarray | None = None
     alpha_dot_hat: np.ndarray | None = None
+    corrected_targets: tuple[str, ...] = ()
 
     def x(self, name: str) -> np.ndarray:
         """Regressor column by name, shape (T,)."""
@@ -75,4 +80,5 @@ class CoefficientTable:
         return CoefficientTable(self.t[mask], self.X[mask], self.Y[mask], self.valid[mask], self.qbar[mask],
                                 list(self.notes), self.x_offset_cov, None if self.x_var is None else self.x_var[mask],
                                 self.x_scale_var, self.x_map_cov,
-                                None if self.alpha_dot_hat is None else self.alpha_dot_hat[mask])
+                                None if self.alpha_dot_hat is None else self.alpha_dot_hat[mask],
+                                tuple(self.corrected_targets))

@@ -38,9 +38,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..aero.table import REGRESSORS
+from ..aero.table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["AIR_ROLL_MODES", "CL_TARGET_NOTE", "air_roll_table", "air_roll_cl_table", "moved_targets"]
+__all__ = ["AIR_ROLL_MODES", "CL_TARGET_NOTE", "air_roll_table", "air_roll_cl_table", "moved_targets",
+           "unlike_targets"]
 
 #: The modes of :data:`gcs_sysid.diagnose.run.AIR_ROLL_RATE`: ``"off"`` (the gyro's rate everywhere),
 #: ``"reference"`` (the reference flight at its own air-relative rate, the flight under test at the gyro's) and
@@ -50,7 +51,8 @@ __all__ = ["AIR_ROLL_MODES", "CL_TARGET_NOTE", "air_roll_table", "air_roll_cl_ta
 #: every ``p_hat`` column stays the gyro's, so Cn and CY see the same rate on both flights).
 AIR_ROLL_MODES = ("off", "fit", "reference", "both", "reference:Cl")
 
-#: How a table's note begins where :func:`air_roll_cl_table` moved its Cl target (read by :func:`moved_targets`).
+#: How a table's note begins where :func:`air_roll_cl_table` moved its Cl target (for the reader; the table's
+#: ``corrected_targets`` says it to the code, :func:`moved_targets`).
 CL_TARGET_NOTE = "air roll rate (Cl target)"
 
 
@@ -102,7 +104,8 @@ def air_roll_cl_table(table, states, airframe):
         airframe: span ``b`` m, area ``S`` m^2, inertia ``Ixx`` kg m^2.
 
     Returns:
-        ``(table', info)``: a new table (``Y``'s Cl column changed on the valid rows, a note added) and
+        ``(table', info)``: a new table (``Y``'s Cl column changed on the valid rows, ``"Cl"`` in its
+        ``corrected_targets``, a note added) and
         ``{"applied": bool, "note": str, "g_sd": float, "Cl_p": float}``; where the roll fit is refused the table is
         returned with only the note and ``applied`` False.
     """
@@ -114,24 +117,41 @@ def air_roll_cl_table(table, states, airframe):
         return replace(table, notes=list(table.notes) + [f"air roll rate (Cl): {note}"]), \
             {"applied": False, "note": note, "g_sd": 0.0, "Cl_p": float("nan")}
     g = np.asarray(info["g"], float)
-    return replace(table, Y=Y, notes=list(table.notes) + [f"{CL_TARGET_NOTE}: {note}"]), \
+    moved = tuple(dict.fromkeys([*table.corrected_targets, "Cl"]))
+    return replace(table, Y=Y, notes=list(table.notes) + [f"{CL_TARGET_NOTE}: {note}"], corrected_targets=moved), \
         {"applied": True, "note": note, "g_sd": float(np.std(g[np.asarray(info["rows"], bool)])),
          "Cl_p": float(info["Cl_p"])}
 
 
 def moved_targets(table) -> frozenset:
-    """The coefficients whose measured target :func:`air_roll_cl_table` moved on ``table`` (by its note).
+    """The coefficients whose measured target was corrected on ``table`` (its ``corrected_targets``; today only Cl,
+    by :func:`air_roll_cl_table`).
 
     A residual of such a coefficient against a model is not comparable with the same coefficient's residual on a
     flight whose target did not move (the one carries the rolling gust's moment, the other not), so the
     differential diagnosis does not fit an air angle's between-flight scale on it
-    (:func:`gcs_sysid.diagnose.differential.angle_scale_allowance`'s ``witness_exclude``).
+    (:func:`gcs_sysid.diagnose.differential.angle_scale_allowance`'s ``witness_exclude``; :func:`unlike_targets`).
 
     Args:
-        table: a :class:`~gcs_sysid.aero.table.CoefficientTable` (its ``notes``), or anything with ``notes``.
+        table: a :class:`~gcs_sysid.aero.table.CoefficientTable`, or anything with ``corrected_targets`` (a table
+            without the attribute counts as measured).
 
     Returns:
         ``frozenset({"Cl"})`` where the Cl target was moved, else an empty set.
     """
-    notes = getattr(table, "notes", None) or ()
-    return frozenset({"Cl"}) if any(str(n).startswith(CL_TARGET_NOTE) for n in notes) else frozenset()
+    return frozenset(getattr(table, "corrected_targets", None) or ())
+
+
+def unlike_targets(table, references) -> tuple[str, ...]:
+    """The coefficients whose target was corrected on ``table`` or on some reference but not on both.
+
+    Args:
+        table: the flight under test's :class:`~gcs_sysid.aero.table.CoefficientTable`.
+        references: the reference flights (each with a ``table``).
+
+    Returns:
+        the coefficients, in :data:`~gcs_sysid.aero.table.COEFFICIENTS` order ( () when every target is alike).
+    """
+    mine = moved_targets(table)
+    differ = set().union(*(moved_targets(r.table) ^ mine for r in references))
+    return tuple(c for c in COEFFICIENTS if c in differ)

@@ -465,14 +465,12 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["output_error"] = {k: v for k, v in diag.output_error.items() if k != "windows_plot"}
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
     if references:
-        from .air_roll import moved_targets
+        from .air_roll import unlike_targets
         from .differential import differential
         from .sparse import THRESHOLDS as _SPARSE_TH
 
         # a coefficient whose target was moved on one side only witnesses no air angle's scale (air_roll.moved_targets)
-        moved = moved_targets(table)
-        unlike = tuple(c for c in COEFFICIENTS
-                       if any((c in moved_targets(r.table)) != (c in moved) for r in references))
+        unlike = unlike_targets(table, references)
 
         say("diagnose: differential against the reference flight(s)")
         t1 = time.perf_counter()

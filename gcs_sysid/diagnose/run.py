@@ -63,7 +63,7 @@ SHARE_ALPHA_MODEL = False
 ALPHA_LEVEL: str | None = None
 
 #: The roll rate the diagnosis reads (:mod:`gcs_sysid.diagnose.air_roll`; twenty-fifth session, branch i9-airroll):
-#: ``"off"`` (the gyro's ``p_hat`` everywhere, the default), ``"reference"`` (the reference flight, the one ``fit``
+#: ``"off"`` (the gyro's ``p_hat`` everywhere; the default until the fiftieth session), ``"reference"`` (the reference flight, the one ``fit``
 #: fits the model on and the differential diagnosis and search compare with, at ``p_hat`` less its own smoothed
 #: rolling gust; the flight under test at the gyro's) or ``"both"`` (the flight under test at its own air-relative
 #: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
@@ -87,12 +87,20 @@ AIR_ROLL_RATE = "reference:Cl"
 BETA_PROFILE = False
 
 
-def air_roll_for(role: str, mode: str | None = None) -> bool:
-    """Whether a flight of ``role`` is loaded at the air-relative roll rate under ``mode`` (None: :data:`AIR_ROLL_RATE`).
+#: What :func:`load_measurements`' ``air_roll`` moves to the air-relative roll rate: ``"off"`` nothing, ``"p_hat"`` the
+#: ``p_hat`` regressor (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`), ``"Cl"`` Cl's target only
+#: (:func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`).
+AIR_ROLL_KINDS = ("off", "p_hat", "Cl")
+
+
+def air_roll_kind(role: str, mode: str | None = None) -> str:
+    """What a flight of ``role`` is loaded with under ``mode`` (None: :data:`AIR_ROLL_RATE`): one of
+    :data:`AIR_ROLL_KINDS`, for :func:`load_measurements`' ``air_roll``.
 
     Roles: ``"fit"`` (the reference flight as ``fit`` loads it to fit the model), ``"reference"`` (the reference
     flight as the diagnosis compares with it) and ``"flight"`` (the flight under test). ``"fit"`` mode moves only the
-    model's fit; ``"reference"`` the fit and the reference; ``"both"`` all three.
+    model's fit; ``"reference"`` the fit and the reference; ``"both"`` all three; each by its ``p_hat`` regressor.
+    ``"reference:Cl"`` moves the fit and the reference by Cl's target.
 
     Raises:
         ValueError: an unknown ``role`` or ``mode`` (:data:`gcs_sysid.diagnose.air_roll.AIR_ROLL_MODES`).
@@ -106,7 +114,19 @@ def air_roll_for(role: str, mode: str | None = None) -> bool:
         raise ValueError(f"air roll rate: role must be 'fit', 'reference' or 'flight', got {role!r}")
     moved = {"off": (), "fit": ("fit",), "reference": ("fit", "reference"), "both": ("fit", "reference", "flight"),
              "reference:Cl": ("fit", "reference")}
-    return role in moved[mode]
+    if role not in moved[mode]:
+        return "off"
+    return "Cl" if mode == "reference:Cl" else "p_hat"
+
+
+def air_roll_for(role: str, mode: str | None = None) -> bool:
+    """Whether a flight of ``role`` is moved to the air-relative roll rate at all under ``mode`` (None:
+    :data:`AIR_ROLL_RATE`): :func:`air_roll_kind` is not ``"off"``.
+
+    Raises:
+        ValueError: an unknown ``role`` or ``mode``.
+    """
+    return air_roll_kind(role, mode) != "off"
 
 
 def shared_angle_models(fits: dict | None) -> dict | None:
@@ -130,7 +150,7 @@ def shared_angle_models(fits: dict | None) -> dict | None:
 
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
                       progress=None, notify=None, gust_rates: str | None = None,
-                      angle_models: dict | None = None, air_roll: bool = False,
+                      angle_models: dict | None = None, air_roll: str = "off",
                       profile_beta: bool | None = None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
@@ -142,16 +162,17 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         angle_models: a reference flight's ``states.angle_fits`` (:func:`shared_angle_models`): this flight's alpha
             is aided with its force model (one alpha scale for both) and its sideslip with its side-force estimator
             (:func:`gcs_sysid.estimation.estimate_states`). None: own.
-        air_roll: the table's ``p_hat`` less the flight's own smoothed rolling gust
-            (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`; with :data:`AIR_ROLL_RATE` ``"reference:Cl"`` its Cl
-            target instead, :func:`~gcs_sysid.diagnose.air_roll.air_roll_cl_table`; :func:`air_roll_for` says which
-            flights).
+        air_roll: one of :data:`AIR_ROLL_KINDS` (:func:`air_roll_kind` says which for a role under the diagnosis's
+            mode): ``"off"`` as measured; ``"p_hat"`` the table's ``p_hat`` less the flight's own smoothed rolling
+            gust (:func:`gcs_sysid.diagnose.air_roll.air_roll_table`); ``"Cl"`` Cl's target at the air-relative rate,
+            every regressor the gyro's (:func:`~gcs_sysid.diagnose.air_roll.air_roll_cl_table`).
         profile_beta: the sideslip aiding's ``CY_beta`` estimator (``estimate_states(profile_beta=)``); None:
             :data:`BETA_PROFILE` as it stands at the call (least squares).
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
             are absent from the log, or a window outside the log.
+        ValueError: ``air_roll`` not one of :data:`AIR_ROLL_KINDS` (checked before the log is read).
     """
     from ..aero import compute_coefficients
     from ..estimation import estimate_states
@@ -159,6 +180,9 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
     from ..parallel import Helper
     from ..telemetry import cut_window, read_log
 
+    if isinstance(air_roll, bool) or air_roll not in AIR_ROLL_KINDS:
+        raise ValueError(f"load_measurements: air_roll must be one of {AIR_ROLL_KINDS} (air_roll_kind), "
+                         f"got {air_roll!r}")
     tm: dict[str, float] = {}
     t0 = time.perf_counter()
     check_window(t_from, t_to)
@@ -189,11 +213,10 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
-    if air_roll:
+    if air_roll != "off":
         from .air_roll import air_roll_cl_table, air_roll_table
 
-        # "reference:Cl" moves Cl's target only (air_roll_cl_table); the other modes the p_hat regressor
-        table, _ = (air_roll_cl_table if AIR_ROLL_RATE == "reference:Cl" else air_roll_table)(table, states, airframe)
+        table, _ = (air_roll_cl_table if air_roll == "Cl" else air_roll_table)(table, states, airframe)
     tm["coefficients_s"] = time.perf_counter() - t2
     return Measurements(flight, airframe, states, table, tm)
 
@@ -231,14 +254,14 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     from ..sim.model_file import save_model
     from .fit import fit_model
 
-    target_only = AIR_ROLL_RATE == "reference:Cl"          # the mode moves Cl's target, not a regressor
-    if air_roll_train and air_roll_for("fit") and not target_only:
+    kind = air_roll_kind("fit")
+    if air_roll_train and kind == "p_hat":
         raise InputError(f"fit --air-roll on: not with the diagnosis's air roll rate {AIR_ROLL_RATE!r} (the fit's "
                          "table is at the air rate already)")
-    # explicit on/off: the replay's pair or the measured Cl; None: the diagnosis's own mode (air_roll_for): Cl's
+    # explicit on/off: the replay's pair or the measured Cl; None: the diagnosis's own mode (air_roll_kind): Cl's
     # target below (recorded), or the p_hat regressor moved by load_measurements
-    cl_target = air_roll_train is None and target_only and air_roll_for("fit")
-    moved = air_roll_for("fit") and not target_only
+    cl_target = air_roll_train is None and kind == "Cl"
+    moved = "p_hat" if kind == "p_hat" else "off"
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
@@ -335,7 +358,7 @@ def run_diagnose(log, airframe_path, model_path, out_dir, t_from: float | None =
         kw = {**kw, **_references(model_path, airframe_path, references, progress)}
         refs = kw.get("references") or []
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, angle_models=shared_angle_models(
-            getattr(refs[0].states, "angle_fits", None)) if refs else None, air_roll=air_roll_for("flight"))
+            getattr(refs[0].states, "angle_fits", None)) if refs else None, air_roll=air_roll_kind("flight"))
         level = alpha_level if alpha_level is not None else ALPHA_LEVEL
         level_info = None
         if level and refs:
@@ -381,7 +404,7 @@ def _references(model_path, airframe_path, given, progress) -> dict:
     logs, notes = reference_logs(model_path, given)
     refs = []
     for r in logs:
-        m = load_measurements(r["log"], airframe_path, *r["window_s"], progress, air_roll=air_roll_for("reference"))
+        m = load_measurements(r["log"], airframe_path, *r["window_s"], progress, air_roll=air_roll_kind("reference"))
         refs.append(Reference(m.table, m.states, m.flight, label=Path(r["log"]).name))
     return {"references": refs, "reference_notes": notes} if (refs or notes) else {}
 

@@ -108,6 +108,18 @@ def test_air_roll_mode_checked_and_the_reference_cl_target_by_default():
         run.air_roll_for("reference", "gyro")
     with pytest.raises(ValueError, match="role"):
         run.air_roll_for("test", "both")
+    # what load_measurements moves, per role: the kind, not the module's mode read again at load time
+    assert [run.air_roll_kind(r) for r in ("fit", "reference", "flight")] == ["Cl", "Cl", "off"]
+    assert [run.air_roll_kind(r, "reference") for r in ("fit", "reference", "flight")] == ["p_hat", "p_hat", "off"]
+    assert run.air_roll_kind("flight", "both") == "p_hat" and run.air_roll_kind("reference", "off") == "off"
+
+
+@pytest.mark.parametrize("kind", [True, False, "on", "reference:Cl"])
+def test_load_measurements_refuses_an_air_roll_that_is_not_a_kind(kind):
+    """``load_measurements(air_roll=)`` takes one of ``AIR_ROLL_KINDS``; a bool (which meant "whatever the module's
+    mode says" before the fifty-first session) or a mode's name is refused before the log is read."""
+    with pytest.raises(ValueError, match="air_roll must be one of"):
+        run.load_measurements("no-such.tlog", "no-such.toml", air_roll=kind)
 
 
 def test_reference_cl_target_moves_only_cl_and_reads_the_hidden_moment():
@@ -137,3 +149,13 @@ def test_reference_cl_target_moves_only_cl_and_reads_the_hidden_moment():
     from gcs_sysid.diagnose.air_roll import moved_targets
 
     assert moved_targets(ref_cl) == {"Cl"} and moved_targets(ref) == frozenset() and moved_targets(fl) == frozenset()
+    assert ref_cl.corrected_targets == ("Cl",) and ref_cl.select(ref_cl.valid).corrected_targets == ("Cl",)
+    # the field, not the note, says it: a note alone moves nothing
+    from dataclasses import replace
+
+    from gcs_sysid.diagnose.air_roll import unlike_targets
+
+    assert moved_targets(replace(ref, notes=list(ref_cl.notes))) == frozenset()
+    refs = [SimpleNamespace(table=ref_cl), SimpleNamespace(table=ref)]
+    assert unlike_targets(fl, refs) == ("Cl",) and unlike_targets(ref_cl, refs[:1]) == ()
+    assert unlike_targets(fl, refs[1:]) == ()
