@@ -150,7 +150,7 @@ def unlike_targets(table, references) -> tuple[str, ...]:
         references: the reference flights (each with a ``table``).
 
     Returns:
-        the coefficients, in :data:`~gcs_sysid.aero.table.COEFFICIENTS` order ( () when every target is alike).
+        the coefficients, in :data:`~gcs_sysid.aero.table.COEFFICIENTS` order (empty when every target is alike).
     """
     mine = moved_targets(table)
     differ = set().union(*(moved_targets(r.table) ^ mine for r in references))

@@ -63,8 +63,9 @@ SHARE_ALPHA_MODEL = False
 ALPHA_LEVEL: str | None = None
 
 #: The roll rate the diagnosis reads (:mod:`gcs_sysid.diagnose.air_roll`; twenty-fifth session, branch i9-airroll):
-#: ``"off"`` (the gyro's ``p_hat`` everywhere; the default until the fiftieth session), ``"reference"`` (the reference flight, the one ``fit``
-#: fits the model on and the differential diagnosis and search compare with, at ``p_hat`` less its own smoothed
+#: ``"off"`` (the gyro's ``p_hat`` everywhere; the default until the fiftieth session), ``"reference"`` (the
+#: reference flight, the one ``fit`` fits the model on and the differential diagnosis and search compare with, at
+#: ``p_hat`` less its own smoothed
 #: rolling gust; the flight under test at the gyro's) or ``"both"`` (the flight under test at its own air-relative
 #: rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``: only the model's fit (the
 #: diagnosis compares both flights at the gyro's rate). Off: the ka350 wins (whole eval 30/26/22/19 -> 31/29/24/22), the
