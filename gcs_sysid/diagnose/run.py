@@ -23,13 +23,18 @@ __all__ = ["Measurements", "load_measurements", "run_fit", "air_rate_target", "r
 
 @dataclass
 class Measurements:
-    """A log taken through the replay front end: the flight, airframe, states and coefficients."""
+    """A log taken through the replay front end: the flight, airframe, states and coefficients.
+
+    ``air_roll``: what :func:`load_measurements`' ``air_roll`` did (the info of
+    :func:`gcs_sysid.diagnose.air_roll.air_roll_table` / :func:`~gcs_sysid.diagnose.air_roll.air_roll_cl_table`:
+    ``applied``, ``note``, ``g_sd``, ``Cl_p``), or None where it moved nothing."""
 
     flight: object
     airframe: Airframe
     states: object
     table: object
     timings: dict
+    air_roll: dict | None = None
 
 
 def _check_airframe_matches(flight, airframe: Airframe, log: str) -> None:
@@ -217,9 +222,11 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
     if air_roll != "off":
         from .air_roll import air_roll_cl_table, air_roll_table
 
-        table, _ = (air_roll_cl_table if air_roll == "Cl" else air_roll_table)(table, states, airframe)
+        table, air_info = (air_roll_cl_table if air_roll == "Cl" else air_roll_table)(table, states, airframe)
+    else:
+        air_info = None
     tm["coefficients_s"] = time.perf_counter() - t2
-    return Measurements(flight, airframe, states, table, tm)
+    return Measurements(flight, airframe, states, table, tm, air_info)
 
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
@@ -259,21 +266,18 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     if air_roll_train and kind == "p_hat":
         raise InputError(f"fit --air-roll on: not with the diagnosis's air roll rate {AIR_ROLL_RATE!r} (the fit's "
                          "table is at the air rate already)")
-    # explicit on/off: the replay's pair or the measured Cl; None: the diagnosis's own mode (air_roll_kind): Cl's
-    # target below (recorded), or the p_hat regressor moved by load_measurements
-    cl_target = air_roll_train is None and kind == "Cl"
-    moved = "p_hat" if kind == "p_hat" else "off"
+    # explicit on/off: the replay's pair or the measured Cl (a p_hat mode still moves the regressor); None: the
+    # diagnosis's own mode, as load_measurements loads its reference flight (air_roll_kind)
+    load_kind = "off" if air_roll_train is not None and kind == "Cl" else kind
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
-                                 air_roll=moved, profile_beta=profile_beta)
+                                 air_roll=load_kind, profile_beta=profile_beta)
         table, air = meas.table, None
         if air_roll_train:
             table, air = air_rate_target(meas)
-        elif cl_target:                         # as load_measurements moves the diagnosis's reference flight
-            from .air_roll import air_roll_cl_table
-
-            table, info = air_roll_cl_table(meas.table, meas.states, meas.airframe)
+        elif load_kind == "Cl":                 # Cl's target moved by load_measurements: recorded
+            info = meas.air_roll
             air = {"target": "air" if info["applied"] else "gyro", "applied": bool(info["applied"]),
                    "Cl_p": float(info["Cl_p"]) if info["applied"] else None,
                    "note": f"{info['note']} (the diagnosis's air roll rate {AIR_ROLL_RATE!r}; --air-roll off: "
