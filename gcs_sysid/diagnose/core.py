@@ -490,7 +490,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                             angle_error_beside_named=bool(_SPARSE_TH.get("angle_error_beside_named",
                                                                                          False)),
                                             beside_residual=search_residual if search else None,
-                                            angle_witness_exclude=unlike)
+                                            angle_witness_exclude=unlike,
+                                            angle_scale_type_b={"beta": float(_SPARSE_TH.get("beta_scale_type_b",
+                                                                                             0.0))})
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

@@ -240,7 +240,8 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
                           scale_se: bool = True, jackknife: dict | None = None,
                           along_term: bool = False, column: np.ndarray | None = None,
-                          beside: dict | None = None, parents=(), witness_exclude=()) -> dict | None:
+                          beside: dict | None = None, parents=(), witness_exclude=(),
+                          scale_type_b: float = 0.0) -> dict | None:
     """Is a finding in an air angle more than a between-flight *scale* of that measured angle?
 
     The log's air angles are estimates whose scale differs from flight to flight: the reconstruction
@@ -300,6 +301,13 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
             1.035 +- 0.047 that way, 0.885 +- 0.04 with both flights at the gyro's rate, so ``scale:CY`` 0.865 was
             named; Cn alone reads 0.955 +- 0.048 either way).
             (): every coefficient of the group with a contribution.
+        scale_type_b: a type-B standard uncertainty of the fitted scale ``s`` (dimensionless), added in quadrature
+            to its fitted standard error (JCGM 100:2008 sec. 4.3 and eq. 10) before ``scale_se`` carries it; the
+            scale's fit treats the witnesses' residual as noise, while what moves ``s`` is the part of that residual
+            which follows the angle (gusts, a witness's own inadequacy), common to the whole flight: on the JSBSim
+            roster's ``CY:scale`` flights the fitted sideslip scale lies 0.039-0.044 RMS from JSBSim's, against a
+            median stated 0.012 (``docs/benchmarks.md``, *Forty-fourth session, lead*). Not applied ``along_term``
+            (whose ``s`` is in radians per unit of the term). 0: the fit's standard error alone.
 
     Returns:
         None when the finding is not such a term or no other coefficient has a contribution of the
@@ -353,7 +361,8 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
         return None
     s_hat = num / den
     res = ols(np.concatenate([n for _, n in cols])[:, None], np.concatenate([r for r, _ in cols]), terms=["s"])
-    se_s = float(res.std_error[0])
+    se_s_fit = float(res.std_error[0])
+    se_s = float(np.hypot(se_s_fit, scale_type_b)) if scale_type_b > 0 and not along_term else se_s_fit
     j = COEFFICIENTS.index(coef)
     R_adj = np.array(R, float, copy=True)
     R_adj[:, j] = R[:, j] - s_hat * N[:, j]
@@ -388,7 +397,8 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
                        f"{beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
     return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
             "beta_scale" if angle == "beta" else "alpha_scale": float(s_hat),
-            "std_error": se_s, "from": others, "beyond_scale": beyond,
+            "std_error": se_s, "std_error_fit": se_s_fit, "std_error_type_b": float(scale_type_b),
+            "from": others, "beyond_scale": beyond,
             "why": f"a common {angle} scale {1 + s_hat:.3f} +- {se_s:.2g} (fitted on {', '.join(others)}) and {coef}'s "
                    f"offset free: {beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}
 
@@ -819,7 +829,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
                  force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
                  scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
-                 beside_residual: np.ndarray | None = None, angle_witness_exclude=()) -> dict:
+                 beside_residual: np.ndarray | None = None, angle_witness_exclude=(),
+                 angle_scale_type_b: dict | None = None) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -883,6 +894,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         angle_witness_exclude: coefficients no air angle's scale or error is fitted on (``witness_exclude`` of
             :func:`angle_scale_allowance`): those whose measured target differs in kind between this flight and the
             references (:func:`gcs_sysid.diagnose.air_roll.moved_targets`). (): none.
+        angle_scale_type_b: ``{angle: u}``, the type-B standard uncertainty of that angle's between-flight scale
+            (``scale_type_b`` of :func:`angle_scale_allowance`; ``sparse.THRESHOLDS["beta_scale_type_b"]`` for
+            ``"beta"``). None or an absent angle: 0.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -894,6 +908,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
     Raises:
         DataError: a reference with too few valid rows (from the table checks).
     """
+    type_b = {k: float(v) for k, v in (angle_scale_type_b or {}).items()}
     refs = []
     for ref in references:
         ctx = DiagContext.build(ref.table, airframe, diag.model, ref.states, None, None)
@@ -970,7 +985,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                               coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
                                               scale_se=angle_scale_se, jackknife=jk, parents=parents,
-                                              witness_exclude=angle_witness_exclude)
+                                              witness_exclude=angle_witness_exclude,
+                                              scale_type_b=type_b.get(angle, 0.0))
                 if scale is not None and scale["scale_only"]:
                     scaled = scale
                     break
@@ -1023,7 +1039,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             col = _scale_column(diag.model, diag.X, coef, scale_wind_axis)
             scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model, coef,
                                           cause, "beta", min_t=min_t, min_gain_pct=min_gain_pct,
-                                          scale_se=angle_scale_se, column=col, witness_exclude=angle_witness_exclude)
+                                          scale_se=angle_scale_se, column=col, witness_exclude=angle_witness_exclude,
+                                          scale_type_b=type_b.get("beta", 0.0))
             if scale is not None and scale["scale_only"]:
                 _note_allowance(doc, f, scale, f"{cause}: a between-flight scale of the measured sideslip, not a cause")
                 continue
