@@ -391,7 +391,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     if along_term:
         return {"scale_only": bool(beyond["offset_only"]), "angle": angle, "scale": float(s_hat),
                 "error_along_term": float(s_hat), "term": term,
-                "std_error": se_s, "from": others, "beyond_scale": beyond,
+                "std_error": se_s, "std_error_fit": se_s_fit, "from": others, "beyond_scale": beyond,
                 "why": f"a common {angle} error {s_hat:+.3g} +- {se_s:.2g} rad per unit of {term} (fitted on "
                        f"{', '.join(others)}) and {coef}'s offset free: "
                        f"{beyond['why'].split(': ', 1)[-1] if 'why' in beyond else ''}"}

@@ -281,3 +281,37 @@ def test_a_coefficient_whose_target_moved_on_one_flight_only_witnesses_no_sidesl
     # the same exclusion through the sideslip error along a term
     err = angle_error_allowance(X, R, train, test, MODEL, "CY", "r_hat", witness_exclude=("Cl",))
     assert err is None or err["from"] == ["Cn"]
+
+
+def test_a_type_b_uncertainty_of_the_sideslip_scale_is_carried_into_the_finding():
+    """``beta_scale_type_b`` (fifty-second session): the witnesses' fit of the sideslip scale treats their residual as
+    noise, but a moment in that residual which follows the sideslip moves the fitted scale on the whole flight (the
+    forty-fourth session measured the fit 0.04 RMS from JSBSim's scale against a stated 0.012). Here the measured
+    sideslip is 0.9 of the true one (``s`` 0.111) and Cl's and Cn's residuals carry a further moment along their beta
+    terms that makes them read 0.061: with the fitted standard error alone CY's share beyond that scale is a "change";
+    with a type-B 0.04 on ``s`` it is an allowance, and a real side-force change of 30 % still stands."""
+    X, noise, train, test = _flight(6)
+    noise[:, COEFFICIENTS.index("CY")] *= 0.1                   # a quiet side force
+    ib, j = REGRESSORS.index("beta"), COEFFICIENTS.index("CY")
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / 0.9
+    R = evaluate_model(MODEL, X_true) - evaluate_model(MODEL, X) + noise
+    for c in ("Cl", "Cn"):                                     # the witnesses read the scale 0.05 low
+        R[:, COEFFICIENTS.index(c)] -= 0.05 * MODEL[c]["beta"] * X[:, ib]
+    fit_only = beta_scale_allowance(X, R, train, test, MODEL, "CY", "beta")
+    assert fit_only is not None and not fit_only["scale_only"], fit_only
+    assert abs(fit_only["beta_scale"] - 0.061) < 0.01 and fit_only["std_error"] < 0.01
+    from gcs_sysid.diagnose.differential import angle_scale_allowance
+
+    typed = angle_scale_allowance(X, R, train, test, MODEL, "CY", "beta", "beta", scale_type_b=0.04)
+    assert typed is not None and typed["scale_only"], typed
+    assert typed["std_error"] == np.hypot(typed["std_error_fit"], 0.04) and typed["std_error_type_b"] == 0.04
+    assert typed["beta_scale"] == fit_only["beta_scale"]       # the term widens the scale's error, not its value
+    R2 = R.copy()
+    R2[:, j] += 0.3 * MODEL["CY"]["beta"] * X[:, ib]
+    real = angle_scale_allowance(X, R2, train, test, MODEL, "CY", "beta", "beta", scale_type_b=0.04)
+    assert real is not None and not real["scale_only"], real
+    # the error along a term is in radians per unit of the term: the scale's type-B term does not apply there
+    along = angle_scale_allowance(X, R, train, test, MODEL, "CY", "r_hat", "beta", along_term=True, scale_type_b=0.04)
+    plain = angle_scale_allowance(X, R, train, test, MODEL, "CY", "r_hat", "beta", along_term=True)
+    assert along is not None and along["std_error"] == plain["std_error"] == along["std_error_fit"]
