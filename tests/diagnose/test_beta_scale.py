@@ -303,6 +303,9 @@ def test_a_type_b_uncertainty_of_the_sideslip_scale_is_carried_into_the_finding(
     assert abs(fit_only["beta_scale"] - 0.061) < 0.01 and fit_only["std_error"] < 0.01
     from gcs_sysid.diagnose.differential import angle_scale_allowance
 
+    from gcs_sysid.diagnose.sparse import THRESHOLDS
+
+    assert THRESHOLDS["beta_scale_type_b"] == 0.04                # on since the fifty-second session
     typed = angle_scale_allowance(X, R, train, test, MODEL, "CY", "beta", "beta", scale_type_b=0.04)
     assert typed is not None and typed["scale_only"], typed
     assert typed["std_error"] == np.hypot(typed["std_error_fit"], 0.04) and typed["std_error_type_b"] == 0.04
