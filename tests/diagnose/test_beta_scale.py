@@ -290,6 +290,10 @@ def test_a_type_b_uncertainty_of_the_sideslip_scale_is_carried_into_the_finding(
     sideslip is 0.9 of the true one (``s`` 0.111) and Cl's and Cn's residuals carry a further moment along their beta
     terms that makes them read 0.061: with the fitted standard error alone CY's share beyond that scale is a "change";
     with a type-B 0.04 on ``s`` it is an allowance, and a real side-force change of 30 % still stands."""
+    from gcs_sysid.diagnose.differential import angle_scale_allowance
+    from gcs_sysid.diagnose.sparse import THRESHOLDS
+
+    assert THRESHOLDS["beta_scale_type_b"] == 0.04                # on since the fifty-second session
     X, noise, train, test = _flight(6)
     noise[:, COEFFICIENTS.index("CY")] *= 0.1                   # a quiet side force
     ib, j = REGRESSORS.index("beta"), COEFFICIENTS.index("CY")
@@ -301,11 +305,6 @@ def test_a_type_b_uncertainty_of_the_sideslip_scale_is_carried_into_the_finding(
     fit_only = beta_scale_allowance(X, R, train, test, MODEL, "CY", "beta")
     assert fit_only is not None and not fit_only["scale_only"], fit_only
     assert abs(fit_only["beta_scale"] - 0.061) < 0.01 and fit_only["std_error"] < 0.01
-    from gcs_sysid.diagnose.differential import angle_scale_allowance
-
-    from gcs_sysid.diagnose.sparse import THRESHOLDS
-
-    assert THRESHOLDS["beta_scale_type_b"] == 0.04                # on since the fifty-second session
     typed = angle_scale_allowance(X, R, train, test, MODEL, "CY", "beta", "beta", scale_type_b=0.04)
     assert typed is not None and typed["scale_only"], typed
     assert typed["std_error"] == np.hypot(typed["std_error_fit"], 0.04) and typed["std_error_type_b"] == 0.04
