@@ -303,7 +303,7 @@ def _pitot_summary(data: dict) -> dict:
             "screen": (wt.get("screen") or {}).get("passes"), "rereduced_mps": re.get("estimate"),
             "checks": wt.get("checks"), "why": wt.get("why"),
             "gain_untouched": wt.get("gain_untouched"), "gain_sensor": wt.get("gain_sensor"),
-            "coefficients_witness": wt.get("coefficients_witness")}
+            "coefficients_witness": wt.get("coefficients_witness"), "resolution": wt.get("resolution")}
 
 
 def side_force_scale_truth(truth_npz, k: float) -> float:

@@ -63,7 +63,7 @@ __all__ = ["MIN_T", "WIND_SYSTEMATIC_MPS", "MIN_T_WIND", "COEF_SYSTEMATIC_MPS", 
            "MIN_T_COEF_CONFIRM", "COEF_WITNESS_MAX_SE_MPS", "MIN_T_TRIANGLE_CONFIRM", "SIGNATURE_TRIANGLE_AGREE",
            "SIGNATURE_SYSTEMATIC", "RANK_BY_GAIN",
            "signature_agrees_with_triangle", "airspeed_cause", "coefficients_confirm", "triangle_confirms",
-           "wind_shift", "fuse_pitot_evidence", "screen", "with_pitot"]
+           "wind_shift", "fuse_pitot_evidence", "screen", "with_pitot", "LIMITING_SHARE", "pitot_resolution"]
 
 #: |estimate - null| / coloured standard error a pitot cause needs (as the sparse search's terms).
 MIN_T = 5.0
@@ -193,6 +193,11 @@ SIGNATURE_SYSTEMATIC = True
 #: flights where it was named (``scale:CY`` first, 62-84 %), one of them otherwise found; with :data:`MIN_T_COEF_CONFIRM` the false
 #: pitot it guarded against is no longer accepted (``docs/benchmarks.md``, *Fifteenth session, i9-heave2*).
 RANK_BY_GAIN = False
+#: The share of the wind triangle's variance (of the change since the reference flight(s)) above which
+#: :func:`pitot_resolution` names a component as what limits the flight: the autopilot wind's error (advice: a heading
+#: reversal or a cloverleaf) or the scatter of the pitot against GPS in gusts (advice: longer steady legs). A report
+#: figure; no decision reads it.
+LIMITING_SHARE = 0.5
 
 
 def wind_shift(ctx: DiagContext, flight) -> dict | None:
@@ -327,6 +332,8 @@ def airspeed_cause(ctx: DiagContext, R: np.ndarray, proj=None, flight=None, refe
         if cand["accepted"] and (best is None or f.score > best[0].score):
             best = (f, cand, gate)
     out["wind_triangle"] = fused
+    if fused is not None:
+        fused["resolution"] = pitot_resolution(fused)
     delta = fused.pop("_delta", None) if fused is not None else None
     if fused is not None and fused["accepted"]:
         out["finding"] = fused.pop("finding")
@@ -457,6 +464,93 @@ def triangle_confirms(fused: dict) -> bool:
         None).
     """
     return MIN_T_TRIANGLE_CONFIRM is None or _sees_it(fused, "triangle", MIN_T_TRIANGLE_CONFIRM)
+
+
+def _scatter_se(tri: dict) -> float:
+    """A :func:`~gcs_sysid.diagnose.wind_triangle.wind_triangle`'s bias standard error with the wind known: its
+    residual's RMS over the square root of its effective samples (m/s; NaN without them)."""
+    n_eff, rms = tri.get("n_eff"), tri.get("residual_rms_mps")
+    if not n_eff or rms is None or not n_eff > 0:
+        return float("nan")
+    return float(rms / np.sqrt(n_eff))
+
+
+def pitot_resolution(wt: dict) -> dict | None:
+    """What a flight resolves of a pitot bias change, what limits it, and what would resolve more (a report figure;
+    no decision reads it).
+
+    The smallest change since the reference flight(s) the diagnosis could name is :data:`MIN_T_FUSED` standard errors
+    of the measurement that names it: the wind triangle's change fused with the coefficients' exact re-fit where the
+    re-fit ran (:func:`_fused_candidate`), else the triangle's change alone (the closed-form screen does not name;
+    its stated error is too small, ``docs/diagnose.md``). The other checks (agreement, both measurements confirming,
+    the gain) can only raise it. The triangle's variance (this flight's and the references' mean, as
+    :func:`~gcs_sysid.diagnose.wind_triangle.change_since_references` adds them) is split into its *scatter*, the
+    pitot against GPS in gusts the wind estimate cannot follow (``residual_rms_mps^2 / n_eff`` per flight: it falls
+    as one over the steady flight time), and the rest, the *wind estimate's* error (along a steady track the wind
+    and a pitot bias are one unknown, told apart only by the autopilot's wind, prior :data:`WIND_SYSTEMATIC_MPS` per
+    component: a heading reversal or a cloverleaf removes it; USNTPS FTM 108, ch. 9; Lewis, "A Flight Test
+    Technique Using GPS for Position Error Correction Testing", SETP Cockpit, 2003). A share of at least
+    :data:`LIMITING_SHARE` names what limits the flight and what to fly.
+
+    Args:
+        wt: ``data["pitot"]["wind_triangle"]`` (:func:`_fused_candidate`'s document): ``flight`` and ``references``
+            (:func:`~gcs_sysid.diagnose.wind_triangle.wind_triangle` each), ``change``
+            (:func:`~gcs_sysid.diagnose.wind_triangle.change_since_references`), ``fused`` (or None) and
+            ``coefficients_rereduced`` (present where the exact re-fit ran).
+
+    Returns:
+        None without the flight's triangle change; else ``{"min_named_mps", "std_error_mps", "by",
+        "triangle_std_error_mps", "wind_share", "scatter_share", "limited_by" ("wind estimate" | "scatter" | None),
+        "heading_span_deg", "reference_heading_span_deg" (list), "summary", "advice"}`` (m/s, deg, shares 0-1;
+        shares None where a flight's scatter is not known; ``advice`` None when neither share reaches
+        :data:`LIMITING_SHARE`).
+    """
+    change, tri = wt.get("change"), wt.get("flight")
+    if not change or not tri or not change.get("std_error", 0) > 0:
+        return None
+    fused = wt.get("fused") if wt.get("coefficients_rereduced") else None
+    by = ("the wind triangle and the coefficients' exact re-fit, fused" if fused
+          else "the wind triangle alone (the coefficients' exact re-fit runs only past the screen)")
+    se = float(fused["std_error"]) if fused else float(change["std_error"])
+    refs = [r for r in (wt.get("references") or []) if r and r.get("std_error", 0) > 0]
+    # the change's variance: this flight's plus the references' inverse-variance mean's, each split in two
+    w = np.array([1.0 / r["std_error"] ** 2 for r in refs])
+    parts = [(1.0, tri)] + [(float(wi / w.sum()), r) for wi, r in zip(w, refs)]
+    total = float(sum(a * a * c["std_error"] ** 2 for a, c in parts))
+    scatter = float(sum(a * a * min(_scatter_se(c), c["std_error"]) ** 2 for a, c in parts))
+    shares = (1.0 - scatter / total, scatter / total) if np.isfinite(scatter) and total > 0 else (None, None)
+    limited = None
+    if shares[0] is not None and shares[0] >= LIMITING_SHARE:
+        limited = "wind estimate"
+    elif shares[1] is not None and shares[1] >= LIMITING_SHARE:
+        limited = "scatter"
+    span = tri.get("heading_span_deg")
+    out = {"min_named_mps": float(MIN_T_FUSED * se), "std_error_mps": se, "by": by,
+           "triangle_std_error_mps": float(change["std_error"]), "wind_share": shares[0], "scatter_share": shares[1],
+           "limited_by": limited, "heading_span_deg": span,
+           "reference_heading_span_deg": [r.get("heading_span_deg") for r in refs]}
+    since = "since the reference flight(s)" if refs else "against none (no reference flight)"
+    out["summary"] = (f"the pitot's bias change {since} is measured to +- {se:.2g} m/s (stated standard error) by "
+                      f"{by}: a change smaller than about {MIN_T_FUSED * se:.2g} m/s ({MIN_T_FUSED:g} standard "
+                      "errors) is not named on this flight")
+    if shares[0] is not None:
+        out["summary"] += (f"; of the wind triangle's variance {100 * shares[0]:.0f} % is the autopilot wind "
+                           f"estimate's error, {100 * shares[1]:.0f} % the pitot's scatter against GPS in gusts")
+    where = "on the reference flight and on this one" if refs else "on this flight"
+    spans = ", ".join(f"{lbl} {c['heading_span_deg']:.0f} deg" for lbl, c in
+                      [("this flight", tri)] + [(r.get("label", "reference"), r) for r in refs]
+                      if c.get("heading_span_deg") is not None)
+    out["advice"] = {
+        "wind estimate": (f"limited by the wind estimate (heading spans: {spans}): along a steady track the wind and a "
+                          f"pitot bias are one unknown, told apart only by the autopilot's wind (taken as good to "
+                          f"{WIND_SYSTEMATIC_MPS:g} m/s per component). To resolve a smaller bias, fly a heading "
+                          f"reversal or a cloverleaf (three steady legs about 120 deg apart) {where}: the wind is "
+                          "then solved from the flight itself (USNTPS FTM 108, ch. 9; Lewis 2003)"),
+        "scatter": ("limited by the pitot's scatter against GPS in gusts the wind estimate cannot follow: its share "
+                    "falls as one over the steady flight time, so four times the steady time halves it; fly longer "
+                    f"steady legs, or in calmer air, {where}"),
+        None: None}[limited]
+    return out
 
 
 def _acceptance_checks(fused: dict) -> tuple[dict, dict]:

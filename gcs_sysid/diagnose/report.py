@@ -140,6 +140,46 @@ def _faults_section(findings: list[dict], summary: dict | None) -> str:
     return "\n".join(out)
 
 
+def _pm(x, se, fmt="{:+.2f}") -> str:
+    return "" if x is None else fmt.format(x) + ("" if se is None else f" +- {se:.2f}")
+
+
+def _pitot_section(pitot: dict | None) -> str:
+    """The airspeed check: the wind triangle and the coefficients' qbar signature against the reference flight(s),
+    what was decided and why, and the smallest change this flight resolves (:func:`gcs_sysid.diagnose.pitot.
+    pitot_resolution`) with the flight that would resolve more."""
+    head = "<h2>Airspeed (pitot) check: wind triangle and coefficients against the reference flight(s)</h2>"
+    wt = (pitot or {}).get("wind_triangle")
+    if not wt:
+        return head + "<p>Not judged (no pitot bias candidate was fitted).</p>"
+    ch, fl, fu = wt.get("change") or {}, wt.get("flight") or {}, wt.get("fused") or {}
+    if not ch:
+        return head + f"<p>Not judged: {html.escape(str(wt.get('why', 'no wind triangle')))}.</p>"
+    refs = wt.get("references") or []
+    rows = [["wind triangle, this flight", _pm(ch.get("flight_mps"), fl.get("std_error")),
+             _f(fl.get("heading_span_deg"), "{:.0f}"), fl.get("wind", "")]]
+    rows += [[f"wind triangle, {r.get('label', 'reference')}", _pm(r.get("bias_mps"), r.get("std_error")),
+              _f(r.get("heading_span_deg"), "{:.0f}"), r.get("wind", "")] for r in refs]
+    rows.append(["change since the reference(s)", _pm(ch.get("change_mps"), ch.get("std_error")), "", ""])
+    if fu:
+        rows.append(["coefficients' qbar signature (change)",
+                     _pm(fu.get("coefficients_mps"), fu.get("coefficients_se")), "",
+                     "exact re-fit" if wt.get("coefficients_rereduced") else "closed form"])
+        rows.append(["fused", _pm(fu.get("estimate"), fu.get("std_error")), "",
+                     f"t = {fu['t_statistic']:.1f}, {'agree' if fu.get('agree') else 'disagree'}"])
+    out = [head, _table(rows, ["measurement", "pitot bias (m/s)", "heading span (deg)", "note"])]
+    if wt.get("accepted"):
+        out.append("<p class='warn'>Named: bias:airspeed (see Findings).</p>")
+    else:
+        out.append(f"<p class='ok'>Not named: {html.escape(str(wt.get('why', '')))}.</p>")
+    res = wt.get("resolution")
+    if res:
+        out.append(f"<p>Resolution: {html.escape(res['summary'])}.</p>")
+        if res.get("advice"):
+            out.append(f"<p class='warn'>{html.escape(res['advice'])}.</p>")
+    return "\n".join(out)
+
+
 def _search_section(search: list[dict]) -> str:
     """What the wide-library search adds to each coefficient (terms by block PRESS, gain held out)."""
     out = ["<h2>Beyond the catalogue: wide-library search (block PRESS on training rows, gain held out)</h2>"]
@@ -201,6 +241,7 @@ def render_html(d) -> str:
     for s in data.get("separation", []):
         parts.append(f"<p class='warn'>{html.escape(s)}</p>")
     parts.append(_faults_section(d.findings, data.get("faults")))
+    parts.append(_pitot_section(data.get("pitot")))
     if "coefficient_diagnosis" in data:
         parts.append(f"<p class='warn'>Coefficient-level diagnosis {html.escape(data['coefficient_diagnosis'])}</p>"
                      "<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])

@@ -109,6 +109,11 @@ def test_no_hidden_effect_no_finding(make_log, tmp_path):
     assert doc["findings"] == [], [f["cause"] for f in doc["findings"]]
     assert not any(u["above_threshold"] for u in doc["unexplained"])
     assert doc["data"]["turbulence"]["active"]           # the gusts the reconstruction misses were seen
+    # the airspeed check says what it could have named (pitot.pitot_resolution) and the report shows it
+    res = doc["data"]["pitot"]["wind_triangle"]["resolution"]
+    assert res["min_named_mps"] == pytest.approx(3.0 * res["std_error_mps"]) and 0 < res["std_error_mps"] < 1.0
+    page = (tmp_path / "diag" / "report.html").read_text()
+    assert "Airspeed (pitot) check" in page and f"smaller than about {res['min_named_mps']:.2g} m/s" in page
 
 
 @pytest.mark.parametrize("cause,value,truth", E2E)

@@ -311,3 +311,61 @@ def test_the_exact_refit_carries_its_own_systematic_term(monkeypatch, relative):
     assert (c0, c1) == (1.0, 1.2)
     assert se0 == pytest.approx(np.hypot(0.2, pitot.COEF_SYSTEMATIC_MPS))
     assert se1 == pytest.approx(np.sqrt(0.1 ** 2 + 0.45 ** 2 + (relative * 40.0) ** 2))
+
+
+def _resolution(turn: bool, with_reference: bool = True, refit: bool = True):
+    from gcs_sysid.diagnose.pitot import pitot_resolution
+
+    t, st, valid, fl = _flight(1.0, turn=turn, seed=1)
+    tri = wind_triangle(t, st, valid, fl)
+    refs = []
+    if with_reference:
+        t0, st0, valid0, fl0 = _flight(0.0, turn=turn, seed=2)
+        refs = [wind_triangle(t0, st0, valid0, fl0) | {"label": "reference 1"}]
+    change = change_since_references(tri, refs)
+    fused = fuse_pitot_evidence(change, 0.8, 0.5)
+    wt = {"flight": tri, "references": refs, "change": change, "fused": fused}
+    if refit:
+        wt["coefficients_rereduced"] = {"estimate": 0.8, "std_error": 0.5}
+    return pitot_resolution(wt), change, fused
+
+
+def test_the_resolution_says_what_a_flight_cannot_name_what_limits_it_and_what_to_fly():
+    """A steady track is limited by the autopilot wind's prior (the report advises a heading reversal); turns are
+    limited by the pitot's own scatter, far smaller; without the exact re-fit the triangle alone sizes it."""
+    straight, change, fused = _resolution(turn=False)
+    assert straight["limited_by"] == "wind estimate" and straight["wind_share"] > 0.9
+    assert straight["wind_share"] + straight["scatter_share"] == pytest.approx(1.0)
+    assert straight["min_named_mps"] == pytest.approx(MIN_T_FUSED * fused["std_error"])
+    assert straight["triangle_std_error_mps"] == pytest.approx(change["std_error"])
+    assert 0.5 < straight["min_named_mps"] < 2.0         # the straight flights' 1 m/s sits at the resolution
+    assert "heading reversal" in straight["advice"] and "on the reference flight and on this one" in straight["advice"]
+    assert f"{straight['min_named_mps']:.2g} m/s" in straight["summary"]
+    turning, _, _ = _resolution(turn=True)
+    assert turning["limited_by"] == "scatter" and "longer steady legs" in turning["advice"]
+    assert turning["min_named_mps"] < 0.2 * straight["min_named_mps"]
+    screened, change, _ = _resolution(turn=False, refit=False)
+    assert screened["min_named_mps"] == pytest.approx(MIN_T_FUSED * change["std_error"])
+    assert "triangle alone" in screened["by"]
+    alone, _, _ = _resolution(turn=False, with_reference=False)
+    assert "on this flight" in alone["advice"] and "no reference flight" in alone["summary"]
+    from gcs_sysid.diagnose.pitot import pitot_resolution
+
+    assert pitot_resolution({"flight": None, "references": [], "change": None, "fused": None}) is None
+    nothing_known = pitot_resolution({"flight": {"std_error": 0.3}, "references": [], "fused": None,
+                                      "change": {"change_mps": 0.1, "std_error": 0.3}})
+    assert nothing_known["wind_share"] is None and nothing_known["advice"] is None
+
+
+def test_the_report_shows_the_airspeed_check_with_its_resolution():
+    from gcs_sysid.diagnose.report import _pitot_section
+
+    res, change, fused = _resolution(turn=False)
+    wt = {"flight": {"std_error": 0.3, "heading_span_deg": 1.0, "wind": "autopilot prior"},
+          "references": [{"label": "reference 1", "bias_mps": 0.0, "std_error": 0.3, "heading_span_deg": 1.0}],
+          "change": change, "fused": fused, "accepted": False, "why": "significant failed", "resolution": res}
+    page = _pitot_section({"wind_triangle": wt})
+    assert "Airspeed (pitot) check" in page and "Not named: significant failed" in page
+    assert f"{change['change_mps']:+.2f} +- {change['std_error']:.2f}" in page
+    assert "heading reversal" in page and "Resolution: the pitot" in page
+    assert "Not judged" in _pitot_section(None)
