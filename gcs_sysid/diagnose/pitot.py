@@ -546,9 +546,9 @@ def pitot_resolution(wt: dict) -> dict | None:
                           f"{WIND_SYSTEMATIC_MPS:g} m/s per component). To resolve a smaller bias, fly a heading "
                           f"reversal or a cloverleaf (three steady legs about 120 deg apart) {where}: the wind is "
                           "then solved from the flight itself (USNTPS FTM 108, ch. 9; Lewis 2003)"),
-        "scatter": ("limited by the pitot's scatter against GPS in gusts the wind estimate cannot follow: its share "
-                    "falls as one over the steady flight time, so four times the steady time halves it; fly longer "
-                    f"steady legs, or in calmer air, {where}"),
+        "scatter": ("limited by the pitot's scatter against GPS in gusts the wind estimate cannot follow: its "
+                    "variance falls as one over the steady flight time (four times the time halves its standard "
+                    f"error); fly longer steady legs, or in calmer air, {where}"),
         None: None}[limited]
     return out
 
