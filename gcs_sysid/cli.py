@@ -296,6 +296,11 @@ def _cmd_diagnose(a: argparse.Namespace) -> int:
                         alpha_level=a.alpha_level)
     findings = diag.get("findings", []) if isinstance(diag, dict) else getattr(diag, "findings", [])
     print(f"wrote {Path(a.out) / 'diagnosis.json'}: {len(findings)} finding(s)")
+    from .diagnose.report import pitot_console_lines
+
+    for line in pitot_console_lines(diag.get("data", {}) if isinstance(diag, dict) else getattr(diag, "data", {}),
+                                    findings):
+        print(line)
     return 0
 
 

@@ -197,3 +197,6 @@ def test_simulate_diagnose_chain(simulated, tmp_path):
     assert [f["cause"] for f in diag["findings"]] == ["wind"], diag["findings"]
     assert 3.0 < diag["findings"][0]["estimate"] < 5.0
     assert (out / "model_extended.toml").exists() and (out / "report.html").exists()
+    # the airspeed check's resolution is printed (diagnose.report.pitot_console_lines)
+    res = diag["data"]["pitot"]["wind_triangle"]["resolution"]
+    assert f"airspeed (pitot) check: {res['summary']}" in p.stdout

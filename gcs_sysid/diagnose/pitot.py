@@ -529,14 +529,14 @@ def pitot_resolution(wt: dict) -> dict | None:
            "triangle_std_error_mps": float(change["std_error"]), "wind_share": shares[0], "scatter_share": shares[1],
            "limited_by": limited, "heading_span_deg": span,
            "reference_heading_span_deg": [r.get("heading_span_deg") for r in refs]}
-    since = "since the reference flight(s)" if refs else "against none (no reference flight)"
+    since = "since the reference flight(s)" if refs else "(no reference flight, so against zero)"
     out["summary"] = (f"the pitot's bias change {since} is measured to +- {se:.2g} m/s (stated standard error) by "
                       f"{by}: a change smaller than about {MIN_T_FUSED * se:.2g} m/s ({MIN_T_FUSED:g} standard "
                       "errors) is not named on this flight")
     if shares[0] is not None:
         out["summary"] += (f"; of the wind triangle's variance {100 * shares[0]:.0f} % is the autopilot wind "
                            f"estimate's error, {100 * shares[1]:.0f} % the pitot's scatter against GPS in gusts")
-    where = "on the reference flight and on this one" if refs else "on this flight"
+    where = "on the reference flight and on this one" if refs else "in the next flight"
     spans = ", ".join(f"{lbl} {c['heading_span_deg']:.0f} deg" for lbl, c in
                       [("this flight", tri)] + [(r.get("label", "reference"), r) for r in refs]
                       if c.get("heading_span_deg") is not None)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..aero.table import COEFFICIENTS
 
-__all__ = ["write_report", "render_html"]
+__all__ = ["write_report", "render_html", "pitot_console_lines"]
 
 _CSS = """body{font-family:sans-serif;max-width:1100px;margin:1em auto;color:#222}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}
@@ -144,7 +144,15 @@ def _pm(x, se, fmt="{:+.2f}") -> str:
     return "" if x is None else fmt.format(x) + ("" if se is None else f" +- {se:.2f}")
 
 
-def _pitot_section(pitot: dict | None) -> str:
+_PITOT_CAUSES = ("bias:airspeed", "scale:airspeed")
+
+
+def _pitot_named(findings) -> str | None:
+    """The pitot cause among the findings (either path: the wind triangle's or the coefficients' signature), or None."""
+    return next((f["cause"] for f in findings or () if f.get("cause") in _PITOT_CAUSES), None)
+
+
+def _pitot_section(pitot: dict | None, findings=()) -> str:
     """The airspeed check: the wind triangle and the coefficients' qbar signature against the reference flight(s),
     what was decided and why, and the smallest change this flight resolves (:func:`gcs_sysid.diagnose.pitot.
     pitot_resolution`) with the flight that would resolve more."""
@@ -168,8 +176,9 @@ def _pitot_section(pitot: dict | None) -> str:
         rows.append(["fused", _pm(fu.get("estimate"), fu.get("std_error")), "",
                      f"t = {fu['t_statistic']:.1f}, {'agree' if fu.get('agree') else 'disagree'}"])
     out = [head, _table(rows, ["measurement", "pitot bias (m/s)", "heading span (deg)", "note"])]
-    if wt.get("accepted"):
-        out.append("<p class='warn'>Named: bias:airspeed (see Findings).</p>")
+    named = _pitot_named(findings)
+    if named:
+        out.append(f"<p class='warn'>Named: {named} (see Findings).</p>")
     else:
         out.append(f"<p class='ok'>Not named: {html.escape(str(wt.get('why', '')))}.</p>")
     res = wt.get("resolution")
@@ -178,6 +187,23 @@ def _pitot_section(pitot: dict | None) -> str:
         if res.get("advice"):
             out.append(f"<p class='warn'>{html.escape(res['advice'])}.</p>")
     return "\n".join(out)
+
+
+def pitot_console_lines(data: dict, findings=()) -> list[str]:
+    """The airspeed check's resolution as the CLI prints it after a diagnosis: ``[]`` without one, else the summary
+    and, where one share limits the flight, the advice (:func:`gcs_sysid.diagnose.pitot.pitot_resolution`).
+
+    Args:
+        data: ``Diagnosis.data`` (reads ``data["pitot"]["wind_triangle"]["resolution"]``).
+        findings: the diagnosis's findings (a pitot cause among them is said first).
+    """
+    wt = (data.get("pitot") or {}).get("wind_triangle") or {}
+    res = wt.get("resolution")
+    if not res:
+        return []
+    named = _pitot_named(findings)
+    head = f"airspeed (pitot) check: {named} named; " if named else "airspeed (pitot) check: "
+    return [head + res["summary"]] + ([f"airspeed (pitot) check: {res['advice']}"] if res.get("advice") else [])
 
 
 def _search_section(search: list[dict]) -> str:
@@ -241,7 +267,7 @@ def render_html(d) -> str:
     for s in data.get("separation", []):
         parts.append(f"<p class='warn'>{html.escape(s)}</p>")
     parts.append(_faults_section(d.findings, data.get("faults")))
-    parts.append(_pitot_section(data.get("pitot")))
+    parts.append(_pitot_section(data.get("pitot"), d.findings))
     if "coefficient_diagnosis" in data:
         parts.append(f"<p class='warn'>Coefficient-level diagnosis {html.escape(data['coefficient_diagnosis'])}</p>"
                      "<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])

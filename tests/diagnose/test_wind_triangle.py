@@ -348,7 +348,7 @@ def test_the_resolution_says_what_a_flight_cannot_name_what_limits_it_and_what_t
     assert screened["min_named_mps"] == pytest.approx(MIN_T_FUSED * change["std_error"])
     assert "triangle alone" in screened["by"]
     alone, _, _ = _resolution(turn=False, with_reference=False)
-    assert "on this flight" in alone["advice"] and "no reference flight" in alone["summary"]
+    assert "in the next flight" in alone["advice"] and "no reference flight" in alone["summary"]
     from gcs_sysid.diagnose.pitot import pitot_resolution
 
     assert pitot_resolution({"flight": None, "references": [], "change": None, "fused": None}) is None
@@ -366,6 +366,20 @@ def test_the_report_shows_the_airspeed_check_with_its_resolution():
           "change": change, "fused": fused, "accepted": False, "why": "significant failed", "resolution": res}
     page = _pitot_section({"wind_triangle": wt})
     assert "Airspeed (pitot) check" in page and "Not named: significant failed" in page
+    # named by the coefficients' signature path (the triangle's own path not accepted): said so
+    assert "Named: bias:airspeed" in _pitot_section({"wind_triangle": wt}, [{"cause": "bias:airspeed"}])
     assert f"{change['change_mps']:+.2f} +- {change['std_error']:.2f}" in page
     assert "heading reversal" in page and "Resolution: the pitot" in page
     assert "Not judged" in _pitot_section(None)
+
+
+def test_the_cli_prints_the_airspeed_checks_resolution_and_advice():
+    from gcs_sysid.diagnose.report import pitot_console_lines
+
+    res, _, _ = _resolution(turn=False)
+    lines = pitot_console_lines({"pitot": {"wind_triangle": {"accepted": False, "resolution": res}}})
+    assert len(lines) == 2 and lines[0].endswith(res["summary"]) and "heading reversal" in lines[1]
+    named = pitot_console_lines({"pitot": {"wind_triangle": {"accepted": True, "resolution": res}}},
+                                [{"cause": "bias:airspeed"}])
+    assert "bias:airspeed named" in named[0]
+    assert pitot_console_lines({}) == [] and pitot_console_lines({"pitot": {"wind_triangle": {}}}) == []
