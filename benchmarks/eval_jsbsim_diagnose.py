@@ -235,6 +235,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
 
     _LAST_PITOT.clear()
     _LAST_NOT_NAMED.clear()
+    _LAST_FLOOR.clear()
     _LAST_LEVEL.clear()
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, **_draws(),
                                  turbulence=turbulence), effects, out)
@@ -268,6 +269,8 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
                     flight=meas.flight, search=True, **kw)
     _LAST_PITOT.update(_pitot_summary(diag.data))
     _LAST_NOT_NAMED[:] = list((diag.data.get("sparse") or {}).get("not_named") or [])
+    _LAST_FLOOR.update({e["coefficient"]: e.get("naming_floor") for e in (diag.data.get("sparse") or {}).get(
+        "coefficients") or [] if "coefficient" in e})
     return diag.findings, truth, time.perf_counter() - t0
 
 
@@ -278,6 +281,9 @@ _LAST_PITOT: dict = {}
 #: the terms the last case's sparse search did not name because their change lay within their expanded uncertainty
 #: (``sparse.beyond_expanded_uncertainty``; sixteenth session), recorded as ``not_named``
 _LAST_NOT_NAMED: list = []
+#: the last case's sparse-search naming floor per coefficient (``sparse.naming_floor``: the smallest term the share
+#: gates let it name), recorded as ``naming_floor``
+_LAST_FLOOR: dict = {}
 
 
 def _pitot_summary(data: dict) -> dict:
@@ -827,6 +833,7 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
                    "turbulence_draw": TURBULENCE_DRAW,
                    "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT), "not_named": list(_LAST_NOT_NAMED),
+                   "naming_floor": dict(_LAST_FLOOR),
                    "alpha_level": dict(_LAST_LEVEL),
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
                                 | {"gain_pct": f.get("gain", {}).get("percent"),

@@ -57,7 +57,7 @@ from .uncertainty import SIDESLIP_ALONG
 
 __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findings", "reference_context",
            "angle_nuisance", "untouched_confirmation", "scale_columns", "NAMING_COVERAGE_FACTOR",
-           "beyond_expanded_uncertainty"]
+           "beyond_expanded_uncertainty", "FLOOR_TERMS", "naming_floor"]
 
 #: Acceptance thresholds of a named term, frozen on 2026-11-21 (before the final evaluation in
 #: ``benchmarks/eval_jsbsim_diagnose.py``; tuned on c172x and sgs only, pa28 held out). Added and
@@ -607,6 +607,53 @@ def _ridge_cv(Phi: np.ndarray, Y: np.ndarray, folds: int, max_rows: int,
     return W, mu, sc, best
 
 
+#: Library columns whose smallest nameable change :func:`naming_floor` states per coefficient: the hidden effects a
+#: flight-test engineer asks about first (the air angles, their curvature and cross term, the three surfaces).
+FLOOR_TERMS = ("alpha", "beta", "alpha^2", "alpha*beta", "beta^2", "delta_e", "delta_a", "delta_r")
+
+
+def naming_floor(names: list[str], Phi: np.ndarray, resid: np.ndarray, rows: np.ndarray, th: dict) -> dict | None:
+    """The smallest term the search's share gates let it name in one coefficient (a report figure; no decision).
+
+    A first term is named only if it takes at least ``min_press_drop`` of the residual's block PRESS and gains at
+    least ``min_gain_pct`` (or, with the untouched segment confirming it, ``confirm_min_gain_pct``) on the untouched
+    rows (:func:`_held_out_passes`). A term of RMS ``a`` on a residual of RMS ``n`` it does not explain takes the
+    share ``a^2 / (a^2 + n^2)`` and gains ``1 - n / sqrt(a^2 + n^2)``, so no term with
+    ``a < f n``, ``f = max(sqrt(p / (1 - p)), sqrt(1 / (1 - g)^2 - 1))`` (``p`` the PRESS drop, ``g`` the lower gain
+    gate) is named, however significant. These share gates are what keeps clean flights clean (their between-flight
+    differences are as significant as a hidden term and as small a share: ``docs/benchmarks.md``, "Thirty-first
+    session"); a term above the floor must still pass ``min_abs_t`` and the differential checks. ``n`` is the
+    residual left on the untouched rows after the terms the search selected (all of it where none was): on a flight
+    that carries an unnamed term the floor is read high by ``sqrt(1 + (a / n)^2)``.
+
+    Args:
+        names: the K library column names. Phi: (T, K) the library. resid: (T,) the residual after the selected
+            terms (the search's differential target). rows: the untouched rows (indices). th: the thresholds.
+
+    Returns:
+        None with fewer than 2 rows; else ``{"residual_rms", "factor", "term_rms_min", "min_change": {term: value}}``:
+        the residual's RMS, ``f``, ``f n`` (coefficient units) and, for each of :data:`FLOOR_TERMS` in the library with
+        a moving column, the smallest change of its coefficient named (``f n / RMS(column)``, the column centred on
+        ``rows``).
+    """
+    rows = np.asarray(rows)
+    if rows.size < 2:
+        return None
+    p = float(th["min_press_drop"])
+    g = min(float(th["min_gain_pct"]), float(th.get("confirm_min_gain_pct", th["min_gain_pct"]))) / 100.0
+    f = float(max(np.sqrt(p / (1.0 - p)), np.sqrt(1.0 / (1.0 - g) ** 2 - 1.0)))
+    e = np.asarray(resid, float)[rows]
+    n = float(np.sqrt(np.mean((e - e.mean()) ** 2)))
+    idx = {c: i for i, c in enumerate(names)}
+    out = {}
+    for term in FLOOR_TERMS:
+        if term in idx:
+            sd = float(np.std(Phi[rows, idx[term]]))
+            if sd > 0:
+                out[term] = f * n / sd
+    return {"residual_rms": n, "factor": f, "term_rms_min": f * n, "min_change": out}
+
+
 def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=None):
     # the intercept is a nuisance, always in and never named: flights differ by constant offsets
     # (trim, wind estimate) that are no term-level cause
@@ -626,6 +673,7 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=Non
     out = {"terms": [], "press": press, "score": 0.0,
            "held_out": {"rms_before": before, "rms_after": before, "percent": 0.0}}
     if not sel:
+        out["naming_floor"] = naming_floor(names, Phi, r, te, th)
         return out, np.zeros(len(r))
     one = np.ones((len(r), 1))
     A = np.hstack([one[tr], Phi[tr][:, sel]])
@@ -651,6 +699,7 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=Non
     out["held_out"] = {"rms_before": before, "rms_after": after,
                        "percent": float(100 * (1 - after / before)) if before > 0 else 0.0,
                        "confirmation": untouched_confirmation(r[te], pred[te])}
+    out["naming_floor"] = naming_floor(names, Phi, r - pred, te, th)
     if th.get("name_control_parent", False):
         out["terms"] = _control_parent_first(out["terms"], th["min_abs_t"])
     if th.get("alias_condition_index", 0) > 0:

@@ -585,3 +585,33 @@ def test_power_with_parent_named_for_cm_offers_the_block_only_in_cms_search(airf
     assert only == {"Cm"}, only
     cm = next(f for f in res["findings"] if f["coefficient"] == "Cm")
     assert cm["cause"] == "Cm:alpha^2" and cm["evidence"]["entered_with"] == ["alpha"]
+
+
+def test_the_naming_floor_is_where_the_share_gates_stop_a_term():
+    """sparse.naming_floor: a term below ``f n`` takes less than ``min_press_drop`` of the PRESS (not named however
+    significant); one well above it takes more. Synthetic: white noise n = 1 and one curvature term in alpha."""
+    from gcs_sysid.diagnose.sparse import THRESHOLDS, _fit_coefficient, naming_floor
+
+    rng = np.random.default_rng(3)
+    T = 4000
+    alpha = 0.05 + 0.03 * np.sin(np.linspace(0, 40 * np.pi, T)) + 0.01 * rng.standard_normal(T)
+    beta = 0.02 * rng.standard_normal(T)
+    names = ["alpha", "alpha^2", "beta", "alpha*beta"]
+    Phi = np.column_stack([alpha, alpha ** 2, beta, alpha * beta])
+    tr, te = np.arange(0, 3200), np.arange(3200, T)
+    th = dict(THRESHOLDS)
+    noise = rng.standard_normal(T)
+    floor = naming_floor(names, Phi, noise, te, th)
+    f = np.sqrt(th["min_press_drop"] / (1 - th["min_press_drop"]))       # the PRESS gate binds at today's gates
+    assert floor["factor"] == pytest.approx(max(f, np.sqrt(1 / 0.9 ** 2 - 1)))
+    assert floor["term_rms_min"] == pytest.approx(floor["factor"] * np.std(noise[te]))
+    k_min = floor["min_change"]["alpha^2"]
+    assert k_min == pytest.approx(floor["term_rms_min"] / np.std(alpha[te] ** 2))
+    # a curvature at 0.5 and 1.6 of the floor: the first's PRESS drop stays under the gate, the second's is over
+    drops = []
+    for size in (0.5, 1.6):
+        r = size * k_min * (alpha ** 2 - np.mean(alpha ** 2)) + noise
+        entry, _ = _fit_coefficient(names, Phi, r, tr, te, 5, th, 4000, "Cm")
+        drops.append(entry["score"])
+        assert entry["naming_floor"]["residual_rms"] < 1.1          # the residual after the selected terms
+    assert drops[0] < th["min_press_drop"] < drops[1], drops
