@@ -206,6 +206,27 @@ def pitot_console_lines(data: dict, findings=()) -> list[str]:
     return [head + res["summary"]] + ([f"airspeed (pitot) check: {res['advice']}"] if res.get("advice") else [])
 
 
+def _floor_section(sparse: dict | None) -> str:
+    """The sparse search's naming floor per coefficient (:func:`gcs_sysid.diagnose.sparse.naming_floor`): the
+    smallest term its share gates let it name, in coefficient units and as the change of common terms."""
+    from .sparse import FLOOR_TERMS
+
+    rows = [(e["coefficient"], e["naming_floor"]) for e in (sparse or {}).get("coefficients") or []
+            if e.get("naming_floor")]
+    if not rows:
+        return ""
+    terms = [t for t in FLOOR_TERMS if any(t in fl["min_change"] for _, fl in rows)]
+    out = ["<h2>What this flight could name: the sparse search's floor per coefficient</h2>",
+           "<p>A term is named only if it takes a large enough share of the residual (block PRESS drop and held-out "
+           f"gain), however significant: no term whose RMS is below {rows[0][1]['factor']:.2f} times the residual "
+           "left on the untouched rows is named. Below, that floor and the smallest change of common terms it means "
+           "on this flight (a term above it must still pass the other checks).</p>",
+           _table([[c, _f(fl["residual_rms"]), _f(fl["term_rms_min"])] + [_f(fl["min_change"].get(t)) for t in terms]
+                   for c, fl in rows], ["coefficient", "residual RMS (untouched)", "smallest term named (RMS)"]
+                  + [f"smallest {t} change" for t in terms])]
+    return "\n".join(out)
+
+
 def _search_section(search: list[dict]) -> str:
     """What the wide-library search adds to each coefficient (terms by block PRESS, gain held out)."""
     out = ["<h2>Beyond the catalogue: wide-library search (block PRESS on training rows, gain held out)</h2>"]
@@ -277,6 +298,7 @@ def render_html(d) -> str:
         parts.append(_differential_section(data["differential"]))
     if data.get("search") is not None:
         parts.append(_search_section(data["search"]))
+    parts.append(_floor_section(data.get("sparse")))
     parts.append("<h2>Equation error on held-out data (per coefficient)</h2>")
     ee = data["equation_error"]
     parts.append(_table([[c, _f(ee[c]["rms_before"]), _f(ee[c]["rms_after"]), _f(ee[c]["percent"], "{:.0f} %")]

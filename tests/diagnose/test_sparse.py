@@ -615,3 +615,13 @@ def test_the_naming_floor_is_where_the_share_gates_stop_a_term():
         drops.append(entry["score"])
         assert entry["naming_floor"]["residual_rms"] < 1.1          # the residual after the selected terms
     assert drops[0] < th["min_press_drop"] < drops[1], drops
+
+
+def test_the_report_shows_the_naming_floor():
+    from gcs_sysid.diagnose.report import _floor_section
+
+    fl = {"residual_rms": 0.002, "factor": 0.816, "term_rms_min": 0.00163, "min_change": {"alpha*beta": 4.1}}
+    page = _floor_section({"coefficients": [{"coefficient": "Cl", "naming_floor": fl}]})
+    assert "What this flight could name" in page and "smallest alpha*beta change" in page and "4.1" in page
+    assert "0.82 times the residual" in page
+    assert _floor_section(None) == "" and _floor_section({"coefficients": [{"coefficient": "Cl"}]}) == ""
