@@ -967,8 +967,9 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
 
     Returns:
         ``{"coefficients": [...], "inadequacy": [...], "findings": [...], "segment": {...}}``:
-        per coefficient the selected terms (estimate, std_error), PRESS path, score and the
-        untouched-segment gain; ``findings`` the named terms, best first, each
+        per coefficient the selected terms (estimate, std_error), PRESS path, score, the
+        untouched-segment gain and ``naming_floor`` (:func:`naming_floor`: the smallest term the share
+        gates let it name); ``findings`` the named terms, best first, each
         ``{"cause", "coefficient", "estimate", "std_error", "gain": {"percent", ...}, "evidence"}``.
         With a reference also ``"inadequacy_prediction"``, (T, 6): the reference flight's inadequacy (its
         ridge) predicted on this flight, centred on the training rows (an array, not JSON).
