@@ -513,6 +513,7 @@ def pitot_resolution(wt: dict) -> dict | None:
           else "the wind triangle alone (the coefficients' exact re-fit runs only past the screen)")
     se = float(fused["std_error"]) if fused else float(change["std_error"])
     refs = [r for r in (wt.get("references") or []) if r and r.get("std_error", 0) > 0]
+    flights = [("this flight", tri)] + [(r.get("label", "reference"), r) for r in refs]
     # the change's variance: this flight's plus the references' inverse-variance mean's, each split in two
     w = np.array([1.0 / r["std_error"] ** 2 for r in refs])
     parts = [(1.0, tri)] + [(float(wi / w.sum()), r) for wi, r in zip(w, refs)]
@@ -537,8 +538,7 @@ def pitot_resolution(wt: dict) -> dict | None:
         out["summary"] += (f"; of the wind triangle's variance {100 * shares[0]:.0f} % is the autopilot wind "
                            f"estimate's error, {100 * shares[1]:.0f} % the pitot's scatter against GPS in gusts")
     where = "on the reference flight and on this one" if refs else "in the next flight"
-    spans = ", ".join(f"{lbl} {c['heading_span_deg']:.0f} deg" for lbl, c in
-                      [("this flight", tri)] + [(r.get("label", "reference"), r) for r in refs]
+    spans = ", ".join(f"{lbl} {c['heading_span_deg']:.0f} deg" for lbl, c in flights
                       if c.get("heading_span_deg") is not None)
     out["advice"] = {
         "wind estimate": (f"limited by the wind estimate (heading spans: {spans}): along a steady track the wind and a "

@@ -144,12 +144,11 @@ def _pm(x, se, fmt="{:+.2f}") -> str:
     return "" if x is None else fmt.format(x) + ("" if se is None else f" +- {se:.2f}")
 
 
-_PITOT_CAUSES = ("bias:airspeed", "scale:airspeed")
-
-
 def _pitot_named(findings) -> str | None:
     """The pitot cause among the findings (either path: the wind triangle's or the coefficients' signature), or None."""
-    return next((f["cause"] for f in findings or () if f.get("cause") in _PITOT_CAUSES), None)
+    from .pitot import PITOT_CAUSES
+
+    return next((f["cause"] for f in findings or () if f.get("cause") in PITOT_CAUSES), None)
 
 
 def _pitot_section(pitot: dict | None, findings=()) -> str:

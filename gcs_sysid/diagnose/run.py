@@ -74,7 +74,8 @@ ALPHA_LEVEL: str | None = None
 #: test at its own air-relative rate too; measured to take up a hidden rolling moment, docs/diagnose.md); ``"fit"``:
 #: only the model's fit (the diagnosis compares both flights at the gyro's rate). Off: the ka350 wins (whole eval
 #: 30/26/22/19 -> 31/29/24/22), the b737 loses a clean flight, the c172p a bias:airspeed estimate and gain, the s23 a
-#: Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md, "Twenty-fifth session, i9-airroll". ``"reference:Cl"`` (forty-ninth session): the reference flight's Cl *target*
+#: Cn:delta_a top (rule 8(a)). Measured in docs/benchmarks.md, "Twenty-fifth session, i9-airroll".
+#: ``"reference:Cl"`` (forty-ninth session): the reference flight's Cl *target*
 #: at its air-relative rate and every ``p_hat`` the gyro's (:func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`), so
 #: that Cn and CY are not moved with Cl; the default since the fiftieth session, by the rule written before its fresh
 #: test (effect seed 9 and clean seeds 56-60, paired with ``"off"``: top +8/-3, all three +6/-2, clean not worse;

@@ -291,8 +291,9 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: standard uncertainty of the sideslip's between-flight scale ``s`` that the differential step fits on the witness
 #: coefficients (:func:`gcs_sysid.diagnose.differential.angle_scale_allowance` ``scale_type_b``), added in quadrature to
 #: its fitted standard error before that error is carried into a ``CY:beta``, ``Cn:beta`` or ``scale:CY`` finding's
-#: judgement beyond the scale. The forty-fourth session measured the fitted ``s`` against JSBSim's on the roster's ``CY:scale``
-#: flights: 0.044 and 0.039 RMS (seeds 1, 3) against a median stated 0.012; 0.04 is that figure, not tuned. Adopted by
+#: judgement beyond the scale. The forty-fourth session measured the fitted ``s`` against JSBSim's on the roster's
+#: ``CY:scale`` flights: 0.044 and 0.039 RMS (seeds 1, 3) against a median stated 0.012; 0.04 is that figure, not
+#: tuned. Adopted by
 #: a rule written before its runs: fresh effect seed 71 and clean seeds 66-70 (and the semi-fresh effect seed 11), both
 #: arms on the same flights: every top, estimate and gain the same, clean 124 -> 125 of 125 (the j3cub s66's
 #: ``CY:beta``), eight wrong findings gone beside or instead of the injected cause (``docs/benchmarks.md``,
