@@ -318,7 +318,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha",), "delay_primary_agreement": 3.0, "coverage_beta_along": "columns",
-              "beta_scale_type_b": 0.04}
+              "beta_scale_type_b": 0.04, "hierarchy_se": 0.0, "hierarchy_se_degree": 3}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -448,14 +448,48 @@ def _parents(name: str, index: dict[str, int]) -> list[int]:
     return out
 
 
-def _prefer_lower_degree(A, r, fold, sel, names, tol):
+def _degree(name: str) -> int:
+    """How many regressor factors monomial ``name`` has (``alpha^2*beta`` -> 3); 0 for a lag, hinge or scale."""
+    if "(" in name or ":" in name or name == "alpha_dot_hat":
+        return 0
+    return sum(int(pw) if pw else 1 for pw in (part.partition("^")[2] for part in name.split("*")))
+
+
+def _prefer_lower_degree(A, r, fold, sel, names, tol, n_se: float = 0.0, min_degree: int = 3,
+                         blocks: list[tuple[int, int]] | None = None) -> tuple[list[int], list[str]]:
     """Replace a selected monomial by a term one factor lower when the block PRESS rises by less than ``tol``.
 
     A product stands in for its factor when the other factor hardly moves (``alpha*delta_t`` for
     ``alpha`` at near-constant throttle); as in the fit's stepwise rule, the simpler term wins.
+
+    With ``n_se > 0`` a selected monomial of degree ``min_degree`` or more is also replaced by a parent when the
+    parent's block PRESS lies within ``n_se`` standard errors of the *selected* set's (the one-standard-error rule
+    of :func:`_prefer_smooth`: Hastie, Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed.,
+    sec. 7.10; the bound is the selected set's, fixed, so replacements do not drift). The parent is offered as the
+    forward search offers it: alone, and, where it is the square of a ``power_with_parent`` block, with the block's
+    parent beside it. Why: ``x^3`` over a flown range of ``x`` away from zero is a parabola about ``x0 / 2`` (``x0``
+    the range's centre), so a curvature ``k (x - e)^2`` about an origin that is off by ``e`` (the measured alpha
+    against the air's) reads as ``x^3`` about as well as ``k x^2 - 2 k e x`` does, with one column fewer; by
+    marginality (Peixoto, *The American Statistician* 41(4) (1987) 311) the lower polynomial is named unless the
+    data ask for the cubic.
+
+    Args:
+        A: (N, K) candidates. r: (N,) residual. fold: (N,) block index. sel: selected columns. names: the K names.
+        tol: relative PRESS rise a parent may cost (any degree). n_se: standard errors a parent may cost (degree
+            ``min_degree`` and up; 0: off). blocks: :func:`power_parent_blocks` of this coefficient's search.
+
+    Returns:
+        (the selected columns, the parents brought in beside a square by the standard-error rule: its
+        ``entered_with``).
     """
     index = {n: i for i, n in enumerate(names)}
     sel = list(sel)
+    brought: list[str] = []
+    bound = None
+    if n_se > 0 and sel:
+        p = _fold_press(A, r, fold, sel)
+        bound = p.sum() + n_se * np.sqrt(p.size) * np.std(p, ddof=1)
+    block_parent = {sq: par for sq, par in (blocks or ())}
     changed = True
     while changed:
         changed = False
@@ -470,7 +504,27 @@ def _prefer_lower_degree(A, r, fold, sel, names, tol):
                     break
             if changed:
                 break
-    return sel
+        if changed or bound is None:
+            continue
+        best = None
+        for i, k in enumerate(sel):
+            if _degree(names[k]) < min_degree:
+                continue
+            for par in _parents(names[k], index):
+                if par in sel:
+                    continue
+                trials = [(sel[:i] + [par] + sel[i + 1:], [])]
+                x = block_parent.get(par)
+                if x is not None and x not in sel:
+                    trials.append((sel[:i] + [par, x] + sel[i + 1:], [names[x]]))
+                for trial, extra in trials:
+                    pt = _block_press(A, r, fold, trial)
+                    if pt <= bound and (best is None or pt < best[0]):
+                        best = (pt, trial, extra)
+        if best is not None:
+            sel, changed = best[1], True
+            brought += best[2]
+    return sel, brought
 
 
 _HINGE = re.compile(r"^max\(0,([a-z_]+)-")
@@ -666,8 +720,11 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=Non
     steps: list = []
     sel, press = select_terms(Pc, r[sub], fold, th["max_terms"], th["min_step_gain"], th["stlsq_threshold"],
                               blocks=blocks or None, steps=steps)
+    brought: list[str] = []
     if sel and th.get("hierarchy_tol", 0.0) > 0:
-        sel = _prefer_lower_degree(Pc, r[sub], fold, sel, names, th["hierarchy_tol"])
+        sel, brought = _prefer_lower_degree(Pc, r[sub], fold, sel, names, th["hierarchy_tol"],
+                                            n_se=float(th.get("hierarchy_se", 0.0)),
+                                            min_degree=int(th.get("hierarchy_se_degree", 3)), blocks=blocks)
     if sel and th.get("smooth_se", 0.0) > 0:
         sel = _prefer_smooth(Pc, r[sub], fold, sel, names, th["smooth_se"])
     before = float(np.sqrt(np.mean(r[te] ** 2))) if te.size else 0.0
@@ -697,6 +754,12 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=Non
         # the block, not the square alone followed by its parent on its own PRESS): the score and gain are
         # the pair's
         out["entered_with"] = [parent]
+    elif brought and len(sel) > 1 and names[sel[1]] in brought:
+        # the lower-degree rule replaced a cubic by the square and its parent (hierarchy_se): the pair stands where
+        # the cubic stood, as if it had entered as the block, and the score is the pair's own PRESS drop
+        out["entered_with"] = [names[sel[1]]]
+        if press and press[0] > 0:
+            out["score"] = float(1 - _block_press(Pc, r[sub], fold, sel[:2]) / press[0])
     out["held_out"] = {"rms_before": before, "rms_after": after,
                        "percent": float(100 * (1 - after / before)) if before > 0 else 0.0,
                        "confirmation": untouched_confirmation(r[te], pred[te])}
