@@ -298,6 +298,17 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: arms on the same flights: every top, estimate and gain the same, clean 124 -> 125 of 125 (the j3cub s66's
 #: ``CY:beta``), eight wrong findings gone beside or instead of the injected cause (``docs/benchmarks.md``,
 #: *Fifty-second session, lead*).
+#: Added 2026-11-27 (fifty-fourth session), **on** (2.0; 0.0 restores the rule before): ``hierarchy_se`` with
+#: ``hierarchy_se_degree`` = 3. A selected monomial of degree 3 or more gives way to a parent (alone, or a
+#: ``power_with_parent`` square with its parent, as the forward search offers it) when that set's block PRESS lies
+#: within ``hierarchy_se`` standard errors of the selected set's (:func:`_prefer_lower_degree`; the one-standard-error
+#: rule ``smooth_se`` already uses, same 2). Over a flown range of alpha away from zero ``alpha^3`` is a parabola about
+#: half the range's centre, so a curvature about a shifted alpha read as ``Cm:alpha^3`` (the ultrastick's -4, seed 72:
+#: ``alpha^3`` -19.0; the c182's and sgs126's on seed 71). Degree 2 is left to ``hierarchy_tol``: ``alpha*beta`` and
+#: ``beta``, ``alpha^2`` and ``alpha`` are near aliases at trim. Adopted by a rule written before its run: fresh effect
+#: seed 72 (300 cases) and clean seeds 73-77 (125 flights), both arms on the same flights: top +1/-0, estimate +2/-0,
+#: gain +1/-0, all three +1/-0, clean 124 = 124; three wrong findings gone beside or instead of the injected cause
+#: (``docs/benchmarks.md``, *Fifty-fourth session, lead*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -318,7 +329,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha",), "delay_primary_agreement": 3.0, "coverage_beta_along": "columns",
-              "beta_scale_type_b": 0.04, "hierarchy_se": 0.0, "hierarchy_se_degree": 3}
+              "beta_scale_type_b": 0.04, "hierarchy_se": 2.0, "hierarchy_se_degree": 3}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

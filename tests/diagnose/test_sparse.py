@@ -625,3 +625,26 @@ def test_the_report_shows_the_naming_floor():
     assert "What this flight could name" in page and "smallest alpha*beta change" in page and "4.1" in page
     assert "0.82 times the residual" in page
     assert _floor_section(None) == "" and _floor_section({"coefficients": [{"coefficient": "Cl"}]}) == ""
+
+
+def test_hierarchy_se_names_the_square_where_the_flight_cannot_tell_it_from_a_cubic():
+    """sparse ``hierarchy_se``: a cubic selected over a narrow range of alpha away from zero is replaced by the
+    square with its parent when their block PRESS lies within 2 standard errors (the pair stands as the block,
+    ``entered_with``); over a range through zero the cubic is told apart and stays; 0 leaves the cubic."""
+    from gcs_sysid.diagnose.sparse import THRESHOLDS, _fit_coefficient
+
+    names = ["alpha", "alpha^2", "alpha^3", "beta"]
+    tr, te = np.arange(0, 3200), np.arange(3200, 4000)
+
+    def selected(centre, amplitude, hse, seed=5):
+        rng = np.random.default_rng(seed)
+        alpha = centre + amplitude * np.sin(np.linspace(0, 40 * np.pi, 4000)) + 0.005 * rng.standard_normal(4000)
+        Phi = np.column_stack([alpha, alpha ** 2, alpha ** 3, 0.02 * rng.standard_normal(4000)])
+        r = -40 * alpha ** 3 + 0.002 * rng.standard_normal(4000)
+        entry, _ = _fit_coefficient(names, Phi, r, tr, te, 5, dict(THRESHOLDS, hierarchy_se=hse), 4000, "Cm")
+        return [t["term"] for t in entry["terms"]], entry.get("entered_with"), entry["score"]
+
+    assert selected(0.07, 0.025, 0.0)[:2] == (["alpha^3"], None)
+    terms, parents, score = selected(0.07, 0.025, 2.0)
+    assert terms == ["alpha^2", "alpha"] and parents == ["alpha"] and score > 0.9
+    assert selected(0.0, 0.08, 2.0)[:2] == (["alpha^3"], None)
