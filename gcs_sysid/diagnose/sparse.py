@@ -459,11 +459,11 @@ def _parents(name: str, index: dict[str, int]) -> list[int]:
     return out
 
 
-def _degree(name: str) -> int:
-    """How many regressor factors monomial ``name`` has (``alpha^2*beta`` -> 3); 0 for a lag, hinge or scale."""
-    if "(" in name or ":" in name or name == "alpha_dot_hat":
-        return 0
-    return sum(int(pw) if pw else 1 for pw in (part.partition("^")[2] for part in name.split("*")))
+def _se_bound(A, r, fold, sel, n_se: float) -> float:
+    """Block PRESS of columns ``sel`` plus ``n_se`` standard errors of it (``sqrt(F)`` times the standard deviation of
+    the F fold terms): the one-standard-error rule's bound (:func:`_prefer_smooth`, :func:`_prefer_lower_degree`)."""
+    p = _fold_press(A, r, fold, sel)
+    return float(p.sum() + n_se * np.sqrt(p.size) * np.std(p, ddof=1))
 
 
 def _prefer_lower_degree(A, r, fold, sel, names, tol, n_se: float = 0.0, min_degree: int = 3,
@@ -498,8 +498,7 @@ def _prefer_lower_degree(A, r, fold, sel, names, tol, n_se: float = 0.0, min_deg
     brought: list[str] = []
     bound = None
     if n_se > 0 and sel:
-        p = _fold_press(A, r, fold, sel)
-        bound = p.sum() + n_se * np.sqrt(p.size) * np.std(p, ddof=1)
+        bound = _se_bound(A, r, fold, sel, n_se)
     block_parent = {sq: par for sq, par in (blocks or ())}
     changed = True
     while changed:
@@ -519,7 +518,7 @@ def _prefer_lower_degree(A, r, fold, sel, names, tol, n_se: float = 0.0, min_deg
             continue
         best = None
         for i, k in enumerate(sel):
-            if _degree(names[k]) < min_degree:
+            if len(_factors(names[k]) or ()) < min_degree:
                 continue
             for par in _parents(names[k], index):
                 if par in sel:
@@ -568,8 +567,7 @@ def _prefer_smooth(A, r, fold, sel, names, n_se):
         if not m:
             continue
         x = m.group(1)
-        p = _fold_press(A, r, fold, sel)
-        bound = p.sum() + n_se * np.sqrt(p.size) * np.std(p, ddof=1)
+        bound = _se_bound(A, r, fold, sel, n_se)
         best = None
         for cand in (x, f"{x}^2", f"{x}^3"):
             c = index.get(cand)
