@@ -411,17 +411,24 @@ def power_parent_blocks(names: list[str], regressors=("alpha",),
     it entered the sgs126's ``Cn`` search at its third step, filled the last places and kept ``p_hat`` out, and
     ``Cn:delta_a`` was read without it (``docs/benchmarks.md``, *Twenty-ninth session, i9-pwp3*).
 
+    An entry may also be a product ``"x*y"`` (``"Cl:alpha*beta"``): the product then enters with ``y``, the term
+    it turns into where ``x`` is off by ``e``: ``k (x - e) y = k x y - k e y`` (the rolling moment in ``alpha*beta``
+    about the measured alpha, whose level the flight does not fix, reads as ``beta`` and ``alpha*beta`` together).
+
     Args:
         names: the library's term names (K,). regressors: the regressors whose squares enter with their parent,
-            each ``"x"`` (every coefficient's search) or ``"C:x"`` (only coefficient ``C``'s).
+            each ``"x"`` (every coefficient's search) or ``"C:x"`` (only coefficient ``C``'s), or products
+            ``"x*y"`` / ``"C:x*y"`` that enter with ``y``.
         coefficient: the coefficient whose search this is (``"Cm"``); None: only the bare ``"x"`` entries apply.
 
     Returns:
-        ``[(index of x^2, index of x), ...]`` for the regressors that apply whose two columns are both in ``names``.
+        ``[(index of x^2, index of x), ...]`` (``(index of x*y, index of y)`` for a product) for the entries that
+        apply whose two columns are both in ``names``.
     """
     idx = {n: i for i, n in enumerate(names)}
     xs = [e.rpartition(":")[2] for e in regressors if e.rpartition(":")[0] in ("", coefficient)]
-    return [(idx[f"{x}^2"], idx[x]) for x in xs if f"{x}^2" in idx and x in idx]
+    pairs = [(x, x.partition("*")[2]) if "*" in x else (f"{x}^2", x) for x in xs]
+    return [(idx[t], idx[p]) for t, p in pairs if t in idx and p in idx]
 
 
 def _fold_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]) -> np.ndarray:
