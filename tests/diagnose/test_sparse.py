@@ -648,3 +648,36 @@ def test_hierarchy_se_names_the_square_where_the_flight_cannot_tell_it_from_a_cu
     terms, parents, score = selected(0.07, 0.025, 2.0)
     assert terms == ["alpha^2", "alpha"] and parents == ["alpha"] and score > 0.9
     assert selected(0.0, 0.08, 2.0)[:2] == (["alpha^3"], None)
+
+
+def _shifted_product_searches(airframe, offset_deg, k=3.0):
+    """The sparse search without and with ``power_with_parent = ("Cl:alpha*beta",)`` on a flight with a hidden
+    ``Cl:alpha*beta`` of ``k`` whose measured alpha is ``offset_deg`` off the air's, against a clean reference."""
+    ref = _ctx(airframe, seed=4)
+    table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
+    a = table.X[:, 0].copy()
+    table.Y[:, 3] += k * a * table.X[:, 1]
+    table.X[:, 0] = a + np.radians(offset_deg)
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    R = ctx.Y - ctx.model_values()
+    return tuple(sparse_search(ctx, R, reference=ref, thresholds={"power_with_parent": blocks})
+                 for blocks in (("Cm:alpha",), ("Cm:alpha", "Cl:alpha*beta")))
+
+
+def test_power_with_parent_names_a_product_about_a_shifted_alpha(airframe):
+    """A ``Cl:alpha*beta`` of 3 on a flight whose measured alpha is 4 deg off the air's (the alpha level a flight
+    does not fix: the JSBSim Eternity's, fifty-fifth session): ``3 (alpha_m - e) beta`` is ``3 alpha_m beta`` less
+    ``3 e beta``, and with one term a step the search takes ``beta`` first and names ``Cl:beta``. With the product
+    as a ``power_with_parent`` entry, ``alpha*beta`` enters with ``beta`` and is named, its change within 25 %."""
+    from gcs_sysid.diagnose.sparse import power_parent_blocks
+
+    names = ["alpha", "beta", "alpha^2", "alpha*beta", "beta*delta_e"]
+    assert power_parent_blocks(names, ("Cl:alpha*beta",), "Cl") == [(3, 1)]
+    assert power_parent_blocks(names, ("Cl:alpha*beta",), "Cn") == []
+    assert power_parent_blocks(names, ("Cm:alpha", "Cl:alpha*beta"), "Cm") == [(2, 0)]
+    off, on = _shifted_product_searches(airframe, 4.0)
+    assert [f["cause"] for f in off["findings"] if f["coefficient"] == "Cl"] != ["Cl:alpha*beta"], off["findings"]
+    cl = [f for f in on["findings"] if f["coefficient"] == "Cl"]
+    assert [f["cause"] for f in cl] == ["Cl:alpha*beta"], on["findings"]
+    assert cl[0]["evidence"]["entered_with"] == ["beta"]
+    assert cl[0]["estimate"] - cl[0]["model_value"] == pytest.approx(3.0, rel=0.25)
