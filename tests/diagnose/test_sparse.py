@@ -517,7 +517,7 @@ def test_power_with_parent_names_a_curvature_about_a_shifted_alpha(airframe):
     assert [t["term"] for t in f["evidence"]["terms"][:2]] == ["alpha^2", "alpha"]
     assert f["estimate"] - f["model_value"] == pytest.approx(-3.0, rel=0.25)
     assert f["gain"]["percent"] >= 50.0
-    assert THRESHOLDS["power_with_parent"] in ((), ("alpha",), ("Cm:alpha",))
+    assert THRESHOLDS["power_with_parent"] in ((), ("alpha",), ("Cm:alpha",), ("Cm:alpha", "Cl:alpha*beta"))
 
 
 def test_power_with_parent_leaves_a_curvature_that_wins_alone_to_the_search_without_blocks(airframe):
