@@ -314,9 +314,9 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: rule before. A rolling moment ``k alpha beta`` read in a measured alpha that is off the air's by ``e`` is
 #: ``k alpha_m beta - k e beta``, so ``beta`` could win the first step and ``Cl:beta`` was named (the JSBSim
 #: Eternity's 3 and 1.5 on seed 72), or ``alpha^2*beta`` stood for the pair. Adopted by a rule written before its run:
-#: fresh effect seed 78
-#: (300 cases) and clean seeds 79-83 (125 flights), both arms on the same flights: top +3/-1 (209 of 300), estimate
-#: +2/-1, gain +1/-0, all three +1/-0, clean 125 = 125 (``docs/benchmarks.md``, *Fifty-fifth session, lead*).
+#: fresh effect seed 78 (300 cases) and clean seeds 79-83 (125 flights), both arms on the same flights: top +3/-1
+#: (209 of 300), estimate +2/-1, gain +1/-0, all three +1/-0, clean 125 = 125 (``docs/benchmarks.md``, *Fifty-fifth
+#: session, lead*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -336,8 +336,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_map_delta_e": True, "coverage_scale_step": 0.0,
               "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
-              "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0, "coverage_beta_along": "columns",
-              "beta_scale_type_b": 0.04, "hierarchy_se": 2.0, "hierarchy_se_degree": 3}
+              "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0,
+              "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0, "hierarchy_se_degree": 3}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

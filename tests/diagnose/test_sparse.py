@@ -651,8 +651,9 @@ def test_hierarchy_se_names_the_square_where_the_flight_cannot_tell_it_from_a_cu
 
 
 def _shifted_product_searches(airframe, offset_deg, k=3.0):
-    """The sparse search without and with ``power_with_parent = ("Cl:alpha*beta",)`` on a flight with a hidden
-    ``Cl:alpha*beta`` of ``k`` whose measured alpha is ``offset_deg`` off the air's, against a clean reference."""
+    """The sparse search with ``power_with_parent`` ``("Cm:alpha",)`` and ``("Cm:alpha", "Cl:alpha*beta")`` on a
+    flight with a hidden ``Cl:alpha*beta`` of ``k`` whose measured alpha is ``offset_deg`` off the air's, against a
+    clean reference."""
     ref = _ctx(airframe, seed=4)
     table, states = measured(BASE, seed=9, hidden=None, duration=90.0)
     a = table.X[:, 0].copy()
@@ -667,8 +668,9 @@ def _shifted_product_searches(airframe, offset_deg, k=3.0):
 def test_power_with_parent_names_a_product_about_a_shifted_alpha(airframe):
     """A ``Cl:alpha*beta`` of 3 on a flight whose measured alpha is 4 deg off the air's (the alpha level a flight
     does not fix: the JSBSim Eternity's, fifty-fifth session): ``3 (alpha_m - e) beta`` is ``3 alpha_m beta`` less
-    ``3 e beta``, and with one term a step the search takes ``beta`` first and names ``Cl:beta``. With the product
-    as a ``power_with_parent`` entry, ``alpha*beta`` enters with ``beta`` and is named, its change within 25 %."""
+    ``3 e beta``, and with one term a step the search names something else (here ``Cl:alpha^2*beta`` 0.34, the cubic
+    standing for the pair; on the Eternity ``Cl:beta``). With the product as a ``power_with_parent`` entry,
+    ``alpha*beta`` enters with ``beta`` and is named, its change within 25 %."""
     from gcs_sysid.diagnose.sparse import power_parent_blocks
 
     names = ["alpha", "beta", "alpha^2", "alpha*beta", "beta*delta_e"]
