@@ -337,7 +337,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_scale_pair": "slopes", "centred_scale": True, "inadequacy_alpha_centre": False,
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0,
-              "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0, "hierarchy_se_degree": 3}
+              "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
+              "hierarchy_se_degree": 3}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -455,13 +456,11 @@ def _block_press(A: np.ndarray, r: np.ndarray, fold: np.ndarray, cols: list[int]
 
 
 def _parents(name: str, index: dict[str, int]) -> list[int]:
-    """Library columns of the terms one factor lower than monomial ``name`` (``alpha*delta_t`` -> ``alpha``, ``delta_t``)."""
-    if "(" in name or name == "alpha_dot_hat":
+    """Library columns of the terms one factor lower than monomial ``name`` (``alpha*delta_t`` -> ``alpha``,
+    ``delta_t``); none for a lag, hinge, scale or ``alpha_dot_hat`` (:func:`_factors`)."""
+    factors = _factors(name)
+    if factors is None:
         return []
-    factors = []
-    for part in name.split("*"):
-        base, _, pw = part.partition("^")
-        factors += [base] * (int(pw) if pw else 1)
     out = []
     for i in range(len(factors)):
         rest = factors[:i] + factors[i + 1:]
