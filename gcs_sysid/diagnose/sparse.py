@@ -49,7 +49,6 @@ import numpy as np
 from ..aero.table import COEFFICIENTS, REGRESSORS
 from .aliases import ALIAS_CONDITION_INDEX, find_aliases, separation_advice
 from .context import DiagContext
-from .differential import offset_allowance
 from .gust_nuisance import pitch_gust_nuisance
 from .lift_alpha import lift_alpha_error
 from .regression import ols
@@ -339,7 +338,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0,
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
-              "hierarchy_se_degree": 3, "offset_gives_way": False, "simpler_catalogue_powers": True}
+              "hierarchy_se_degree": 3, "simpler_catalogue_powers": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -733,7 +732,7 @@ def naming_floor(names: list[str], Phi: np.ndarray, resid: np.ndarray, rows: np.
     return {"residual_rms": n, "factor": f, "term_rms_min": f * n, "min_change": out}
 
 
-def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=None, offset_test=None):
+def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=None):
     # the intercept is a nuisance, always in and never named: flights differ by constant offsets
     # (trim, wind estimate) that are no term-level cause
     r = r - r[tr].mean()
@@ -790,65 +789,10 @@ def _fit_coefficient(names, Phi, r, tr, te, folds, th, max_rows, coefficient=Non
     out["naming_floor"] = naming_floor(names, Phi, r - pred, te, th)
     if th.get("name_control_parent", False):
         out["terms"] = _control_parent_first(out["terms"], th["min_abs_t"])
-    if offset_test is not None:
-        out = _offset_gives_way(out, offset_test, [(names[b[0]], names[b[1]]) for b in blocks], th["min_abs_t"])
     if th.get("alias_condition_index", 0) > 0:
         k0 = names.index(out["terms"][0]["term"])
         out["aliases"] = _aliases(names, Phi, r, tr, te, Pc, k0, [k for k in sel if k != k0], before, th)
     return out, pred
-
-
-def _offset_gives_way(out: dict, offset_test, pairs: list[tuple[str, str]], min_abs_t: float) -> dict:
-    """A first term that is only a between-flight offset gives way to the next selected term that is more.
-
-    The differential step judges a searched finding against a free constant of its coefficient
-    (:func:`gcs_sysid.diagnose.differential.offset_allowance`) and withdraws it when the term adds less than its
-    threshold on the held-out rows beyond the constant; the coefficient then names nothing, although the selection
-    may hold a term that is more than an offset. A surface that trims with alpha is the case met: the JSBSim
-    Rascal's ``Cm:alpha^2 = -8`` (seed 3) selects ``delta_e`` first (the trim elevator follows the level the
-    curvature moves), then ``alpha^2`` -7.91 +- 0.37 with ``alpha``; ``Cm:delta_e`` gains 5 % beyond the offset and
-    was withdrawn, and nothing was named. Here the first term is judged by the same test before naming; when it is
-    only an offset, the first later term (in selection order) that is a vocabulary monomial, at least ``min_abs_t``
-    of its naming standard errors from zero and more than an offset (with its ``power_with_parent`` parent beside
-    it where the parent was selected too) is put first, its parent second (``entered_with``). The fit, its
-    estimates, the PRESS path, score and untouched-segment gain are the selection's, unchanged; the term the
-    offset test withdrew stays in the fit beside the named one. (Morelli and Klein, *Aircraft System
-    Identification*, 2nd ed., sec. 5.4: the selected model is judged as a whole; which of its terms is the change
-    is the naming's question.)
-
-    Args:
-        out: a coefficient's entry (:func:`_fit_coefficient`). offset_test: ``(term, parents) -> dict`` returning
-            :func:`~gcs_sysid.diagnose.differential.offset_allowance`'s result. pairs: ``(power, parent)`` names of
-            the coefficient's ``power_with_parent`` blocks. min_abs_t: the naming's ``|estimate| / se`` floor.
-
-    Returns:
-        ``out`` unchanged, or a copy with ``terms`` reordered, ``entered_with`` set or removed and
-        ``offset_gave_way`` (``{"term", "why"}``: the term that gave way and the offset test's reason).
-    """
-    terms = out["terms"]
-    first_parents = tuple(out.get("entered_with") or ())
-    if not terms or _factors(terms[0]["term"]) is None:
-        return out
-    a0 = offset_test(terms[0]["term"], first_parents)
-    if not a0.get("offset_only"):
-        return out
-    sel = [t["term"] for t in terms]
-    for t in terms[1:]:
-        if t["term"] in first_parents or _factors(t["term"]) is None or not (
-                t["std_error_naming"] > 0 and abs(t["estimate"]) >= min_abs_t * t["std_error_naming"]):
-            continue
-        parents = tuple(p for c, p in pairs if c == t["term"] and p in sel)
-        if offset_test(t["term"], parents).get("offset_only", True):
-            continue
-        lead = [t] + [terms[sel.index(p)] for p in parents]
-        new = dict(out, terms=lead + [u for u in terms if u not in lead],
-                   offset_gave_way={"term": terms[0]["term"], "why": a0.get("why", "")})
-        if parents:
-            new["entered_with"] = list(parents)
-        else:
-            new.pop("entered_with", None)
-        return new
-    return out
 
 
 def _aliases(names, Phi, r, tr, te, Pc, k0: int, others: list[int], before: float, th: dict) -> list[dict]:
@@ -1126,9 +1070,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
     knots = alpha_quantile_knots(reference[0]) if reference is not None else None
     names, Phi = _library(ctx, knots)
     tr, te = _segments(ctx, segment_frac)
-    R_raw = np.asarray(R, float)
-    valid0 = np.isfinite(R_raw).all(axis=1)
-    R = np.nan_to_num(R_raw)
+    R = np.nan_to_num(np.asarray(R, float))
     result = {"coefficients": [], "inadequacy": [], "findings": [], "n_candidates": len(names),
               "segment": {"train_rows": int(tr.size), "untouched_rows": int(te.size),
                           "untouched_from_s": float(ctx.t[te[0]]) if te.size else None},
@@ -1313,15 +1255,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
             # (CY: the model's wind-axis side force, scale_columns)
             cnames, cPhi = (names + [f"scale:{coef}"], np.column_stack([Phi, S0[:, j]])) \
                 if coef in th.get("scale_coefficients", ()) else (names, Phi)
-            offset_test = None
-            if reference is not None and th.get("offset_gives_way", False):
-                # the differential step's between-flight offset test, as it will judge the finding
-                # (differential.offset_allowance on the residual before any cause, its rows and defaults)
-                def offset_test(term, parents, _coef=coef):
-                    return offset_allowance(ctx.X, R_raw, ctx.train & valid0, ctx.test & valid0, _coef, term,
-                                            parents=parents)
-            entry, _ = _fit_coefficient(cnames, cPhi, Rd[:, j], tr, te, folds, th, max_rows, coef,
-                                        offset_test=offset_test)
+            entry, _ = _fit_coefficient(cnames, cPhi, Rd[:, j], tr, te, folds, th, max_rows, coef)
             entry["coefficient"] = coef
             entries.append(entry)
             t0 = entry["terms"][0] if entry["terms"] else None

@@ -107,37 +107,6 @@ def test_merge_keeps_the_searched_power_without_simpler_catalogue_powers():
     assert [f["cause"] for f in merge_findings([cat], {"findings": [product], "thresholds": off})] == ["Cm:alpha"]
 
 
-def _term(name, estimate, se):
-    return {"term": name, "estimate": estimate, "std_error": se, "std_error_naming": se}
-
-
-def test_offset_first_term_gives_way_to_the_next_term_that_is_more():
-    """``_offset_gives_way``: the first term judged only an offset gives way to the next selected monomial that is
-    more (with its ``power_with_parent`` parent second); a lag is never promoted; a first term that is more than an
-    offset keeps its place; the fit's numbers are untouched."""
-    from gcs_sysid.diagnose.sparse import _offset_gives_way
-
-    entry = {"terms": [_term("delta_e", 0.076, 0.004), _term("delta_e(t-0.24)-delta_e", 0.08, 0.005),
-                       _term("alpha^2", -7.9, 0.37), _term("alpha", 0.76, 0.05)],
-             "score": 0.66, "held_out": {"percent": 40.0}}
-    asked = []
-
-    def offset_test(term, parents):
-        asked.append((term, parents))
-        return {"offset_only": term == "delta_e", "why": f"{term} is an offset"}
-
-    out = _offset_gives_way(entry, offset_test, [("alpha^2", "alpha")], 5.0)
-    assert [t["term"] for t in out["terms"]] == ["alpha^2", "alpha", "delta_e", "delta_e(t-0.24)-delta_e"]
-    assert out["entered_with"] == ["alpha"] and out["offset_gave_way"]["term"] == "delta_e"
-    assert out["score"] == 0.66 and out["terms"][0]["estimate"] == -7.9 and entry["terms"][0]["term"] == "delta_e"
-    assert asked == [("delta_e", ()), ("alpha^2", ("alpha",))]           # the lag was never tested
-    # a later term under min_abs_t standard errors is passed over; none left: unchanged
-    weak = dict(entry, terms=[entry["terms"][0], _term("alpha^2", -1.0, 0.37)])
-    assert _offset_gives_way(weak, offset_test, [], 5.0) is weak
-    # the first term more than an offset: unchanged
-    assert _offset_gives_way(entry, lambda term, parents: {"offset_only": False}, [], 5.0) is entry
-
-
 def test_side_force_scale_is_named_as_scale_of_cy(airframe):
     """CY k times the model's: the residual is (k - 1) times the model's CY, the ``scale:CY`` candidate."""
     ref = _ctx(airframe, seed=4)
