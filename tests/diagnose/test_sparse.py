@@ -95,16 +95,18 @@ def test_merge_keeps_the_simpler_catalogue_term():
 
 
 def test_merge_keeps_the_searched_power_without_simpler_catalogue_powers():
-    """``simpler_catalogue_powers`` False: a catalogue ``x`` does not replace the search's ``x^2`` (the regressor itself
-    is the left-out factor), and still replaces a product with another regressor (``alpha*delta_t``)."""
+    """``simpler_catalogue_powers`` False (the default): a catalogue ``x`` does not replace the search's ``x^2`` (the
+    regressor itself is the left-out factor), and still replaces a product with another regressor (``alpha*delta_t``);
+    True restores the rule before (the catalogue's ``x`` replaces the power too)."""
     cat = {"cause": "Cm:alpha", "coefficient": "Cm", "evidence": {}}
     power = {"cause": "Cm:alpha^2", "coefficient": "Cm", "evidence": {}}
     product = {"cause": "Cm:alpha*delta_t", "coefficient": "Cm", "evidence": {}}
-    assert [f["cause"] for f in merge_findings([cat], {"findings": [power]})] == ["Cm:alpha"]
-    off = {"simpler_catalogue_powers": False}
-    out = merge_findings([cat], {"findings": [power], "thresholds": off})
-    assert [f["cause"] for f in out] == ["Cm:alpha^2"] and out[0]["source"] == "sparse search"
-    assert [f["cause"] for f in merge_findings([cat], {"findings": [product], "thresholds": off})] == ["Cm:alpha"]
+    for sparse in ({"findings": [power]}, {"findings": [power], "thresholds": {"simpler_catalogue_powers": False}}):
+        out = merge_findings([cat], sparse)
+        assert [f["cause"] for f in out] == ["Cm:alpha^2"] and out[0]["source"] == "sparse search"
+    assert [f["cause"] for f in merge_findings([cat], {"findings": [product]})] == ["Cm:alpha"]
+    before = {"findings": [power], "thresholds": {"simpler_catalogue_powers": True}}
+    assert [f["cause"] for f in merge_findings([cat], before)] == ["Cm:alpha"]
 
 
 def test_side_force_scale_is_named_as_scale_of_cy(airframe):
