@@ -317,8 +317,7 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: fresh effect seed 78 (300 cases) and clean seeds 79-83 (125 flights), both arms on the same flights: top +3/-1
 #: (209 of 300), estimate +2/-1, gain +1/-0, all three +1/-0, clean 125 = 125 (``docs/benchmarks.md``, *Fifty-fifth
 #: session, lead*).
-#: Added 2026-11-27 (fifty-sixth session), **on** (``simpler_catalogue_powers`` False; True restores the rule
-#: before):
+#: Added 2026-11-27 (fifty-sixth session), **on** (``simpler_catalogue_powers`` False; True restores the rule before):
 #: in :func:`merge_findings` a catalogue term ``x`` no longer replaces the search's power ``x^k`` of the same
 #: coefficient (a product with another regressor, ``Cm:alpha`` for ``Cm:alpha*delta_t``, still is). The left-out
 #: factor of a power is the varying regressor itself, and the search's library held ``x`` and its PRESS chose ``x^k``;
