@@ -2262,8 +2262,8 @@ def merge_findings(findings: list[dict], sparse: dict) -> list[dict]:
     """
     keep_first = [f for f in findings if f.get("evidence", {}).get("domain") == "data compatibility"
                   or f["cause"].startswith(("stuck:", "thrust_loss", "wind"))]
-    th = dict(THRESHOLDS, **(sparse.get("thresholds") or {}))
-    powers = bool(th["simpler_catalogue_powers"])
+    powers = bool((sparse.get("thresholds") or THRESHOLDS).get("simpler_catalogue_powers",
+                                                               THRESHOLDS["simpler_catalogue_powers"]))
     named = []
     for f in sparse.get("findings", []):
         # hierarchy: a catalogue term of the same coefficient made of a subset of this product's
