@@ -56,13 +56,6 @@ WIND_WINDOW_S = 30.0
 #: fortieth (docs/benchmarks.md, "Fortieth session, lead"). Where the residuals are within the pitot's noise (the
 #: project's own simulation) it changes nothing.
 WIND_RESIDUAL_SCALE = True
-#: Whether the rate smoother (:func:`gcs_sysid.estimation.rates.smooth_rates`) smooths the raw gyro, with the
-#: attitude filter's gyro bias taken out of its rate (and the bias's derivative out of its acceleration) afterwards,
-#: instead of smoothing the gyro minus that bias. The smoother is linear in the measurements and passes a slowly
-#: varying offset unchanged, so the two agree to the smoother's error on the bias's curvature; smoothing first lets a
-#: helper's worker run the rate smoother while this process runs the attitude filter (the replay's critical path,
-#: ``docs/benchmarks.md``, "Fifty-seventh session").
-RATES_BEFORE_BIAS = True
 RATE_OK_HZ = 20.0    #: gyro rate from which angular accelerations are trusted
 RATE_MIN_HZ = 10.0   #: below this rate they are not identifiable at all
 _STREAM_ADVICE = ("raise the telemetry stream rates to 50 Hz (ArduPilot SRx_RAW_SENS for RAW_IMU, SRx_EXTRA1 for "
@@ -174,9 +167,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         airframe: mass properties, servo maps and IMU lever arm.
         rate_hz: grid rate, Hz (capped at the IMU rate).
         progress: optional ``callable(fraction)`` called as stages finish.
-        helper: a :class:`~gcs_sysid.parallel.Helper` whose worker smooths the rates while this process
-            runs the attitude filter (:data:`RATES_BEFORE_BIAS`), then the specific force while this process
-            runs the velocity filter and the air data (None: all here; same results).
+        helper: a :class:`~gcs_sysid.parallel.Helper` whose worker smooths the specific force while
+            this process runs the velocity filter and the air data (None: all here; same results).
         aid_air_angles: aid the kinematic alpha and beta with the specific force
             (:mod:`gcs_sysid.estimation.airangles`; False: kinematic only, for comparisons).
         earth: the velocity filter's Earth: ``"wgs84"`` (WGS-84 normal gravity, Coriolis and transport
@@ -232,7 +224,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     ident: dict[str, tuple[bool, str]] = {}
     prog(0.1)
 
-    # --- gyro and attitude streams --------------------------------------------------------------
+    # --- gyro and attitude ------------------------------------------------------------------
     gyro = _stack(al, "imu", ("p", "q", "r"))
     gyro_src, gyro_rate = "imu", al.rates.get("imu", 0.0)
     if gyro is None:
@@ -247,67 +239,6 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         att = events(flight[att_stream], ("roll", "pitch", "yaw"), t, angles=("roll", "pitch", "yaw"))
         if not np.isfinite(att).all(axis=1).any():
             att = None
-    # the controls first (nothing in them needs the attitude), so that the rate smoother can start in the
-    # helper's worker while this process runs the attitude filter (RATES_BEFORE_BIAS); their notes keep
-    # their place after the attitude's
-    notes_b: list[str] = []
-    missing_b: list[str] = []
-    # --- controls -------------------------------------------------------------------------------
-    servo_rate = al.rates.get("servo", 0.0)
-    if al.has("servo") or airframe.can_actuators:   # measured surface positions (DroneCAN) beat PWM
-        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels
-               if al.has("servo") and f"pwm{ch}" in al.values["servo"]}
-        ctrl, csrc, cnotes = surface_controls(al, airframe, pwm)
-        for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
-            if k in ctrl:
-                data[k], sources[k] = ctrl[k], csrc[k]
-        notes_b.extend(cnotes)
-    mix = airframe.mixing
-    for i, k in enumerate(("delta_e", "delta_a", "delta_r")):
-        if k in data:
-            continue
-        if not np.any(mix[i] != 0.0):  # the aircraft has no such surface (a flying wing has no rudder)
-            data[k], sources[k] = np.zeros(T), f"0: the {airframe.name} airframe has no servo driving {k}"
-            notes_b.append(f"{k} = 0: the airframe has no servo mixed into it")
-        else:
-            missing_b.append(f"{k}: no servo output (SERVO_OUTPUT_RAW / RCOU) for its channel(s)")
-    if "delta_t" not in data:
-        thr = al.get("vfr_hud", "throttle")
-        if airframe.throttle is None:
-            data["delta_t"], sources["delta_t"] = np.zeros(T), "0: the airframe has no throttle (glider)"
-        elif np.isfinite(thr).any():
-            data["delta_t"], sources["delta_t"] = thr, "VFR_HUD throttle (no throttle servo output)"
-        else:
-            missing_b.append("delta_t: no throttle servo output and no VFR_HUD throttle")
-    if servo_rate and servo_rate < 0.95 * RATE_MIN_HZ:
-        ident["controls"] = (False, f"servo outputs at {servo_rate:.1f} Hz: control steps are smeared; "
-                                    f"{_STREAM_ADVICE}")
-        notes_b.append(ident["controls"][1])
-    else:
-        ident["controls"] = (al.has("servo"), f"servo outputs at {servo_rate:.0f} Hz" if servo_rate else "no servo")
-
-    # --- rates and angular accelerations ------------------------------------------------------
-    W = Wd = None
-    in_lag = None
-    # control commands as known inputs: angular accelerations and forces jump where they step; their
-    # effectiveness scales with the dynamic pressure, here from the pitot's EAS (0.5 rho0 EAS^2)
-    cnames = [k for k in ("delta_e", "delta_a", "delta_r", "delta_t")
-              if k in data and ident["controls"][0] and sources[k].startswith("servo")]
-    U = np.stack([data[k] for k in cnames], axis=1) if cnames else None
-    eas_q = al.get("airspeed", "eas")
-    if not np.isfinite(eas_q).any():
-        eas_q = al.get("vfr_hud", "airspeed")
-    qbar_eas = 0.5 * 1.225 * eas_q**2 if np.isfinite(eas_q).sum() >= 10 else None
-    acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
-    rate_kw = dict(controls=U, scale=qbar_eas,
-                   aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,),
-                   control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None,
-                   coupled={cnames.index(k): v for k, v in COUPLED.items() if k in cnames})
-    early = RATES_BEFORE_BIAS and gyro is not None and gyro_src == "imu"
-    rates_job = ((helper or Helper(enabled=False)).submit("gcs_sysid.estimation.rates:smooth_rates", dt, gyro,
-                                                           **rate_kw) if early else None)
-
-    # --- attitude (EKF + RTS) and the gyro bias -----------------------------------------------
     bias = np.zeros((T, 3))
     euler = None
     if gyro is not None:
@@ -329,20 +260,61 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     else:
         missing.append("phi theta psi: no attitude stream (ATTITUDE / ATT / EKF); the IMU alone cannot level")
     prog(0.35)
-    notes.extend(notes_b)
-    missing.extend(missing_b)
 
-    # --- rates and angular accelerations (the smoother's result) ------------------------------
-    if gyro is not None:
-        if rates_job is not None:
-            # smoothed from the raw gyro in the worker, the EKF's slowly varying bias taken out afterwards: the
-            # smoother is linear and passes a slowly varying offset unchanged (RATES_BEFORE_BIAS)
-            Rr = rates_job.result()
-            W, Wd = Rr.rate - bias, Rr.accel - np.gradient(bias, dt, axis=0)
+    # --- controls -------------------------------------------------------------------------------
+    servo_rate = al.rates.get("servo", 0.0)
+    if al.has("servo") or airframe.can_actuators:   # measured surface positions (DroneCAN) beat PWM
+        pwm = {ch: al.values["servo"][f"pwm{ch}"] for ch in airframe.channels
+               if al.has("servo") and f"pwm{ch}" in al.values["servo"]}
+        ctrl, csrc, cnotes = surface_controls(al, airframe, pwm)
+        for k in ("delta_e", "delta_a", "delta_r", "delta_t"):
+            if k in ctrl:
+                data[k], sources[k] = ctrl[k], csrc[k]
+        notes.extend(cnotes)
+    mix = airframe.mixing
+    for i, k in enumerate(("delta_e", "delta_a", "delta_r")):
+        if k in data:
+            continue
+        if not np.any(mix[i] != 0.0):  # the aircraft has no such surface (a flying wing has no rudder)
+            data[k], sources[k] = np.zeros(T), f"0: the {airframe.name} airframe has no servo driving {k}"
+            notes.append(f"{k} = 0: the airframe has no servo mixed into it")
         else:
-            Rr = smooth_rates(dt, gyro - bias, **rate_kw)
-            W, Wd = Rr.rate, Rr.accel
+            missing.append(f"{k}: no servo output (SERVO_OUTPUT_RAW / RCOU) for its channel(s)")
+    if "delta_t" not in data:
+        thr = al.get("vfr_hud", "throttle")
+        if airframe.throttle is None:
+            data["delta_t"], sources["delta_t"] = np.zeros(T), "0: the airframe has no throttle (glider)"
+        elif np.isfinite(thr).any():
+            data["delta_t"], sources["delta_t"] = thr, "VFR_HUD throttle (no throttle servo output)"
+        else:
+            missing.append("delta_t: no throttle servo output and no VFR_HUD throttle")
+    if servo_rate and servo_rate < 0.95 * RATE_MIN_HZ:
+        ident["controls"] = (False, f"servo outputs at {servo_rate:.1f} Hz: control steps are smeared; "
+                                    f"{_STREAM_ADVICE}")
+        notes.append(ident["controls"][1])
+    else:
+        ident["controls"] = (al.has("servo"), f"servo outputs at {servo_rate:.0f} Hz" if servo_rate else "no servo")
+
+    # --- rates and angular accelerations ------------------------------------------------------
+    W = Wd = None
+    in_lag = None
+    # control commands as known inputs: angular accelerations and forces jump where they step; their
+    # effectiveness scales with the dynamic pressure, here from the pitot's EAS (0.5 rho0 EAS^2)
+    cnames = [k for k in ("delta_e", "delta_a", "delta_r", "delta_t")
+              if k in data and ident["controls"][0] and sources[k].startswith("servo")]
+    U = np.stack([data[k] for k in cnames], axis=1) if cnames else None
+    eas_q = al.get("airspeed", "eas")
+    if not np.isfinite(eas_q).any():
+        eas_q = al.get("vfr_hud", "airspeed")
+    qbar_eas = 0.5 * 1.225 * eas_q**2 if np.isfinite(eas_q).sum() >= 10 else None
+    if gyro is not None:
+        acc0 = _stack(al, "imu", ("ax", "ay", "az"))   # the gust-driven pitching moment shows in az at once
+        Rr = smooth_rates(dt, gyro - bias, controls=U, scale=qbar_eas,
+                          aux=None if acc0 is None else normal_force_input(dt, acc0[:, 2]), aux_axes=(1,),
+                          control_axes=[CONTROL_AXES[k] for k in cnames] if cnames else None,
+                          coupled={cnames.index(k): v for k, v in COUPLED.items() if k in cnames})
         in_lag = Rr.input_lag if cnames else None
+        W, Wd = Rr.rate, Rr.accel
         for i, k in enumerate(("p", "q", "r")):
             data[k], sigma[k] = W[:, i], Rr.rate_sigma[:, i]
             data[k + "_dot"], sigma[k + "_dot"] = Wd[:, i], Rr.accel_sigma[:, i]

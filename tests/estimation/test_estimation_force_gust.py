@@ -85,17 +85,12 @@ class _Stop(Exception):
 
 
 class _RecordingHelper:
-    """Stands in for :class:`gcs_sysid.parallel.Helper`: runs the rate smoother's job here (estimate.RATES_BEFORE_BIAS),
-    records the specific-force job's arguments, then stops."""
+    """Stands in for :class:`gcs_sysid.parallel.Helper`: records the specific-force job's arguments, then stops."""
 
     def __init__(self):
         self.kwargs = None
 
     def submit(self, target, *args, **kwargs):
-        if target.endswith(":smooth_rates"):
-            from gcs_sysid.parallel import Job
-
-            return Job(target, args, kwargs, None)
         assert target.endswith(":smooth_specific_force")
         self.kwargs = kwargs
         raise _Stop

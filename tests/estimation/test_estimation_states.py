@@ -137,8 +137,7 @@ def test_low_rate_log_says_what_is_not_identifiable(tr, airframe):
 def test_meanwhile_runs_once_while_the_force_smoother_is_pending_and_changes_nothing(tr, airframe, full):
     """``estimate_states(meanwhile=)`` (the replay's later imports overlap the worker's specific-force smoother):
     called once, after the force smoother was handed over and before its result is collected; the states are
-    the same bit for bit as without it. The rate smoother's job (``RATES_BEFORE_BIAS``) is handed over before the
-    attitude filter runs and collected after it, before the force smoother (which needs its input delays)."""
+    the same bit for bit as without it."""
     from gcs_sysid.parallel import Helper
 
     calls = []
@@ -158,8 +157,7 @@ def test_meanwhile_runs_once_while_the_force_smoother_is_pending_and_changes_not
     st = estimate_states(flight_from_truth(tr, seed=1), airframe, helper=Recording(enabled=False),
                          meanwhile=lambda: calls.append(("meanwhile", None)))
     sf = "gcs_sysid.estimation.rates:smooth_specific_force"
-    rr = "gcs_sysid.estimation.rates:smooth_rates"
-    assert calls == [("submit", rr), ("result", rr), ("submit", sf), ("meanwhile", None), ("result", sf)]
+    assert calls == [("submit", sf), ("meanwhile", None), ("result", sf)]
     assert st.data.keys() == full.data.keys()
     for k in full.data:
         np.testing.assert_array_equal(st.data[k], full.data[k], err_msg=k)
@@ -170,21 +168,3 @@ def test_meanwhile_runs_once_while_the_force_smoother_is_pending_and_changes_not
     calls.clear()
     estimate_states(flight, airframe, meanwhile=lambda: calls.append(("meanwhile", None)))
     assert calls == []
-
-
-def test_rates_smoothed_before_the_bias_agree_with_the_bias_taken_out_first(tr, airframe, full, monkeypatch):
-    """``estimate.RATES_BEFORE_BIAS`` (the default): the rate smoother runs on the raw gyro (in a worker, beside the
-    attitude filter) and the EKF's gyro bias is taken out of its rate and acceleration afterwards. The smoother is
-    linear and passes the slowly varying bias unchanged, so the states agree with smoothing the gyro minus the bias
-    to far below the gyro's noise (0.003 rad/s here; the flight's gyro bias is 0.01-0.02 rad/s, so leaving it in
-    fails), with the same notes (the smoother's discrete choices: bandwidths, delays, hold)."""
-    import gcs_sysid.estimation.estimate as est
-
-    assert est.RATES_BEFORE_BIAS
-    monkeypatch.setattr(est, "RATES_BEFORE_BIAS", False)
-    first = estimate_states(flight_from_truth(tr, seed=1), airframe)
-    assert first.notes == full.notes and first.data.keys() == full.data.keys()
-    for k, tol in (("p", 1e-6), ("q", 1e-6), ("r", 1e-6), ("p_dot", 1e-4), ("q_dot", 1e-4), ("r_dot", 1e-4)):
-        np.testing.assert_allclose(full.data[k], first.data[k], rtol=0, atol=tol, err_msg=k)
-    for k in ("phi", "theta", "psi", "alpha", "beta", "V"):
-        np.testing.assert_allclose(full.data[k], first.data[k], rtol=0, atol=1e-7, err_msg=k)
