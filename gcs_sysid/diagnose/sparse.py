@@ -347,7 +347,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "pitch_gust_nuisance": False, "pitch_gust_highpass_s": 0.0, "library_control_trim": False,
               "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0,
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
-              "hierarchy_se_degree": 3, "simpler_catalogue_powers": False}
+              "hierarchy_se_degree": 3, "simpler_catalogue_powers": False,
+              "delay_se_central": True}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -2129,10 +2130,15 @@ def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j:
         if sse < best_s:
             best, best_s, best_D = float(tau), sse, D
     h = 0.005
+    # the response's slope in tau by a central difference about the best tau (delay_se_central, the default since
+    # the fifty-seventh session); before, the lower point was clipped at 0, which for a best tau at or below -h (a
+    # grid that reaches below zero: a reference without a delay reads -0.005 s) put both points at about 0 and
+    # divided their float noise by ~1e-16: the reference's standard error came out 0 or anything
+    lo = best - h if THRESHOLDS.get("delay_se_central", True) else max(best - h, 0.0)
     Xp, Xm = ctx.X.copy(), ctx.X.copy()
     Xp[:, k] = np.interp(ctx.t - best - h, ctx.t, np.nan_to_num(ctx.X[:, k]))
-    Xm[:, k] = np.interp(ctx.t - max(best - h, 0.0), ctx.t, np.nan_to_num(ctx.X[:, k]))
-    g = np.nan_to_num(ctx.model_values(Xp) - ctx.model_values(Xm))[:, j] / (best + h - max(best - h, 0.0))
+    Xm[:, k] = np.interp(ctx.t - lo, ctx.t, np.nan_to_num(ctx.X[:, k]))
+    g = np.nan_to_num(ctx.model_values(Xp) - ctx.model_values(Xm))[:, j] / (best + h - lo)
     e = R[tr, j] - best_D[tr, j]
     try:
         fit = ols(np.column_stack([np.ones(tr.size), g[tr]]), e - e.mean(), ["1", "dtau"])
