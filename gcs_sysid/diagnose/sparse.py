@@ -326,6 +326,12 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: no clean flight. Adopted by a rule written before its run: fresh effect seed 84 (300 cases) and clean seeds 85-89
 #: (125 flights), both arms on the same flights: top +2/-0 (212 of 300; the us25e's -8 and -4), estimate +0/-0, gain
 #: +2/-0, all three +0/-0, clean 124 = 124 (``docs/benchmarks.md``, *Fifty-sixth session, lead*).
+#: Added 2026-11-28 (fifty-seventh session), a bug fix: ``delay_se_central`` (a delay's linearised standard error takes
+#: the response's slope in tau by a central difference about the best tau; False: the lower point clipped at 0, which
+#: gave a reference reading -0.005 s on the differential grid a standard error of 0 or anything, :func:`_refine_delay`).
+#: Kept by a rule written before its fresh run: fresh effect seed 90 and clean seeds 91-95, both arms on the same
+#: flights: top +1/-0 (208 of 300), all three +1/-0, clean 124 = 124 (``docs/benchmarks.md``, *Fifty-seventh session,
+#: lead*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -2131,9 +2137,9 @@ def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j:
             best, best_s, best_D = float(tau), sse, D
     h = 0.005
     # the response's slope in tau by a central difference about the best tau (delay_se_central, the default since
-    # the fifty-seventh session); before, the lower point was clipped at 0, which for a best tau at or below -h (a
-    # grid that reaches below zero: a reference without a delay reads -0.005 s) put both points at about 0 and
-    # divided their float noise by ~1e-16: the reference's standard error came out 0 or anything
+    # the fifty-seventh session); before, the lower point was clipped at 0, which for a best tau of -h (a grid that
+    # reaches below zero: a reference without a delay reads -0.005 s) put both points at about 0 and divided their
+    # float noise by ~1e-16: the reference's standard error came out 0 or anything; at a best of 0 it was one-sided
     lo = best - h if THRESHOLDS.get("delay_se_central", True) else max(best - h, 0.0)
     Xp, Xm = ctx.X.copy(), ctx.X.copy()
     Xp[:, k] = np.interp(ctx.t - best - h, ctx.t, np.nan_to_num(ctx.X[:, k]))
