@@ -89,7 +89,7 @@ def test_a_delay_read_below_zero_keeps_its_standard_error(monkeypatch, central):
     about 0 and their float noise was divided by ~1e-16: the standard error came out 0 or anything (the JSBSim
     c172x's seed-3 reference: 0.018 s on one run, 0 on another whose states differed by 1e-6). Here the log's clock
     starts at 100 s, where a shift of 1e-16 s moves no sample: the clipped slope is all zeros and the fit has no
-    standard error (0). Central (the default): about the standard error of the same flight read at +0.005 s."""
+    standard error (0). Central (the default): the standard error of the same flight read at +0.005 s, within 5 %."""
     from dataclasses import replace
 
     from gcs_sysid.diagnose import sparse
@@ -109,6 +109,7 @@ def test_a_delay_read_below_zero_keeps_its_standard_error(monkeypatch, central):
         se_at[d] = se
     if central:
         assert np.isfinite(se_at[-0.005]) and se_at[-0.005] > 0
-        assert 1 / 3 < se_at[-0.005] / se_at[0.005] < 3, se_at
+        # the same flight's slope a 0.01-s shift of its delay apart: measured equal to 5e-4 on seeds 4-7
+        assert se_at[-0.005] == pytest.approx(se_at[0.005], rel=0.05), se_at
     else:                                   # the clipped difference: no standard error at all (0 here)
         assert not (np.isfinite(se_at[-0.005]) and se_at[-0.005] > 0) and se_at[0.005] > 0, se_at
