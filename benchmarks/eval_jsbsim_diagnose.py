@@ -236,6 +236,7 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     _LAST_PITOT.clear()
     _LAST_NOT_NAMED.clear()
     _LAST_FLOOR.clear()
+    _LAST_FIRST.clear()
     _LAST_LEVEL.clear()
     files = _flight(FlightConfig(ac, duration_s=duration_s, seed=seed, plan=plan, **_draws(),
                                  turbulence=turbulence), effects, out)
@@ -271,7 +272,27 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
     _LAST_NOT_NAMED[:] = list((diag.data.get("sparse") or {}).get("not_named") or [])
     _LAST_FLOOR.update({e["coefficient"]: e.get("naming_floor") for e in (diag.data.get("sparse") or {}).get(
         "coefficients") or [] if "coefficient" in e})
+    _LAST_FIRST.update({e["coefficient"]: first_term_gates(e) for e in (diag.data.get("sparse") or {}).get(
+        "coefficients") or [] if "coefficient" in e})
     return diag.findings, truth, time.perf_counter() - t0
+
+
+def first_term_gates(entry: dict) -> dict | None:
+    """What the sparse search's naming gates read of one coefficient's first selected term (round 0 of
+    :func:`gcs_sysid.diagnose.sparse.sparse_search`): the term and its estimate, ``t`` (the estimate over its
+    Bartlett standard error, against ``min_abs_t``), ``score`` (its PRESS drop, against ``min_press_drop``), the
+    untouched segment's gain (percent, against ``min_gain_pct``) and its confirmation slope and t. None where the
+    search selected no term. Recorded per case so that a gate's trade-off can be read from the records."""
+    terms = entry.get("terms") or []
+    if not terms:
+        return None
+    t0, held = terms[0], entry.get("held_out") or {}
+    se = float(t0.get("std_error_naming") or 0.0)
+    conf = held.get("confirmation") or {}
+    return {"term": t0["term"], "estimate": float(t0["estimate"]),
+            "t": abs(float(t0["estimate"])) / se if se > 0 else None, "score": float(entry.get("score", 0.0)),
+            "gain_pct": held.get("percent"), "confirm_slope": conf.get("slope"),
+            "confirm_t": conf.get("t_statistic"), "entered_with": entry.get("entered_with")}
 
 
 #: the last diagnosed case's alpha level (``data["alpha_level"]``) and its alpha against JSBSim's before / after
@@ -284,6 +305,9 @@ _LAST_NOT_NAMED: list = []
 #: the last case's sparse-search naming floor per coefficient (``sparse.naming_floor``: the smallest term the share
 #: gates let it name), recorded as ``naming_floor``
 _LAST_FLOOR: dict = {}
+#: the last case's first selected term per coefficient with what the naming gates read of it (:func:`first_term_gates`),
+#: recorded as ``first_terms``
+_LAST_FIRST: dict = {}
 
 
 def _pitot_summary(data: dict) -> dict:
@@ -833,7 +857,7 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
                    "turbulence_draw": TURBULENCE_DRAW,
                    "effects": [[e.name, e.value] for e in effects],
                    "score": sc, "diagnose_s": secs, "pitot": dict(_LAST_PITOT), "not_named": list(_LAST_NOT_NAMED),
-                   "naming_floor": dict(_LAST_FLOOR),
+                   "naming_floor": dict(_LAST_FLOOR), "first_terms": dict(_LAST_FIRST),
                    "alpha_level": dict(_LAST_LEVEL),
                    "findings": [{k: f.get(k) for k in ("cause", "estimate", "std_error", "model_value")}
                                 | {"gain_pct": f.get("gain", {}).get("percent"),

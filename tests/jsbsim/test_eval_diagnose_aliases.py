@@ -60,3 +60,18 @@ def test_the_pitot_record_keeps_each_flights_own_wind_triangle_and_the_refit_by_
     assert s["triangle_mps"] == 0.330 and s["triangle_heading_span_deg"] == 26.4
     assert s["rereduced_by_coefficient"] == {"CY": {"estimate": 1.37, "std_error": 0.16, "used": True}}
     assert _pitot_summary({}) == {}
+
+
+def test_the_first_terms_record_reads_what_the_naming_gates_read():
+    """first_term_gates: the navion's seed-90 Cm entry of the fifty-eighth session's probe (t 17, PRESS drop 0.389
+    against 0.4, untouched gain 23 % confirmed at slope 1.05, t 9.4), and None where nothing was selected."""
+    from benchmarks.eval_jsbsim_diagnose import first_term_gates
+
+    entry = {"terms": [{"term": "alpha^2", "estimate": -4.114, "std_error": 0.3, "std_error_naming": 0.2392},
+                       {"term": "delta_e", "estimate": -0.025, "std_error": 0.01, "std_error_naming": 0.01}],
+             "score": 0.389, "held_out": {"percent": 23.3, "confirmation": {"slope": 1.05, "t_statistic": 9.4}}}
+    g = first_term_gates(entry)
+    assert g["term"] == "alpha^2" and g["estimate"] == -4.114 and abs(g["t"] - 17.2) < 0.05
+    assert (g["score"], g["gain_pct"], g["confirm_slope"], g["confirm_t"]) == (0.389, 23.3, 1.05, 9.4)
+    assert g["entered_with"] is None
+    assert first_term_gates({"terms": [], "score": 0.0, "held_out": {"percent": 0.0}}) is None
