@@ -492,7 +492,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
                                             beside_residual=search_residual if search else None,
                                             angle_witness_exclude=unlike,
                                             angle_scale_type_b={"beta": float(_SPARSE_TH.get("beta_scale_type_b",
-                                                                                             0.0))})
+                                                                                             0.0))},
+                                            estimate_beyond_scale=tuple(_SPARSE_TH.get("estimate_beyond_angle_scale",
+                                                                                       ()) or ()))
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

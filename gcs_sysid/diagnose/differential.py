@@ -830,7 +830,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
                  scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
                  beside_residual: np.ndarray | None = None, angle_witness_exclude=(),
-                 angle_scale_type_b: dict | None = None) -> dict:
+                 angle_scale_type_b: dict | None = None, estimate_beyond_scale: tuple = ()) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -897,6 +897,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         angle_scale_type_b: ``{angle: u}``, the type-B standard uncertainty of that angle's between-flight scale
             (``scale_type_b`` of :func:`angle_scale_allowance`; ``sparse.THRESHOLDS["beta_scale_type_b"]`` for
             ``"beta"``). None or an absent angle: 0.
+        estimate_beyond_scale: causes (``"scale:CY"``) whose kept finding reports its change beyond the air angle's
+            between-flight scale, the estimate its naming was judged on (:func:`report_beyond_scale`;
+            ``sparse.THRESHOLDS["estimate_beyond_angle_scale"]``). (): every finding keeps its selected estimate.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -1148,6 +1151,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"),
                                "reference_corrections": [c.get("correction") for c in compared]})
         keep.append(f)
+    for f in keep:                             # every decision is made: only what a finding reports changes
+        if f["cause"] in estimate_beyond_scale:
+            report_beyond_scale(f)
     diag.findings[:] = keep
     # structure no term explains: in the references too, or only here
     ref_gp = [residual_structure(ctx, np.nan_to_num(R), threshold_pct=threshold_pct) for _, ctx, R in refs]
@@ -1163,6 +1169,46 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         doc["unexplained"][coef] = {"verdict": verdict, "references_with_it": also, "region": g["region"],
                                     "structured_percent": g["structured_percent"], "rms_gp_mean": g["rms_gp_mean"]}
     return doc
+
+
+def report_beyond_scale(f: dict) -> bool:
+    """Report a kept finding's change beyond the between-flight scale of its air angle (in place).
+
+    A finding in a sideslip coefficient is named only when it stands beyond a common scale ``1 + s`` of the measured
+    sideslip fitted on the other coefficients (:func:`angle_scale_allowance`: the residual less ``s x dC/dx``, refitted
+    with the coefficient's offset free). The selected estimate is read against the flight's own measured angle, and
+    that angle is not the reference's when the change itself enters its reconstruction: the aided sideslip is built
+    from the side force (``gcs_sysid.estimation.airangles``) with the reference's side-force model, so a side force
+    ``k`` times the model's also scales the measured sideslip by about ``1 + w (k - 1)`` (``w``: the side force's
+    weight in the aided angle), and against that angle the side force reads only ``(1 - w)(k - 1) / (1 + w (k - 1))``
+    of its change. With ``s`` taken out, what is left is the change per unit of the model's side force at the
+    measured angle, ``(k - 1) / (1 + w (k - 1))`` (``tests/diagnose/test_beta_scale.py``: 0.417 for 0.5 at ``w`` 0.4,
+    0.23 as selected). Measured on the JSBSim roster's seed-90 ``CY:scale`` flights (fifty-eighth session,
+    ``docs/benchmarks.md``): 37 named, within 25 % of JSBSim's scale 27 as selected and 34 beyond the sideslip scale
+    (median 0.87 and 0.95 of the change).
+
+    The finding's ``estimate`` becomes ``model_value + beyond_scale.estimate`` and its ``std_error`` the selected
+    combined standard uncertainty with the scale's share added in quadrature (``beyond_scale.std_error_scale_share``,
+    JCGM 100:2008 eq. 10); what it reported before is kept in ``evidence.estimate_as_selected``. Nothing is changed
+    where the finding carries no scale allowance with a finite estimate beyond it (the angle's scale was not fitted,
+    or an error along the term, whose ``s`` is in other units).
+
+    Returns:
+        Whether the finding was changed.
+    """
+    ev = f.setdefault("evidence", {})
+    for key in ("beta_scale_allowance", "alpha_scale_allowance"):
+        a = ev.get(key) or {}
+        b = a.get("beyond_scale") or {}
+        est, share = b.get("estimate"), b.get("std_error_scale_share", 0.0)
+        if "error_along_term" in a or est is None or not np.isfinite(est) or not np.isfinite(share):
+            continue
+        mv = f.get("model_value", ev.get("model_value", 0.0))
+        ev["estimate_as_selected"] = {"estimate": f["estimate"], "std_error": f["std_error"], "beyond": key}
+        f["estimate"] = float(mv + est)
+        f["std_error"] = float(np.hypot(f["std_error"], share))
+        return True
+    return False
 
 
 def fit_record(log, t_from: float | None, t_to: float | None) -> dict:

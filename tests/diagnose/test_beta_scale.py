@@ -317,3 +317,57 @@ def test_a_type_b_uncertainty_of_the_sideslip_scale_is_carried_into_the_finding(
     along = angle_scale_allowance(X, R, train, test, MODEL, "CY", "r_hat", "beta", along_term=True, scale_type_b=0.04)
     plain = angle_scale_allowance(X, R, train, test, MODEL, "CY", "r_hat", "beta", along_term=True)
     assert along is not None and along["std_error"] == plain["std_error"] == along["std_error_fit"]
+
+
+def _side_force_flight(seed: int, k: float, w: float):
+    """A side force ``k`` times the model's (JSBSim's wind-axis scale: ``(k - 1)`` times the scale column at the true
+    sideslip added to CY), read on a sideslip aided from that side force: the measured angle ``1 + w (k - 1)`` times
+    the true one (``w``: the side force's weight in the aided angle), Cl and Cn the model's at the true angle."""
+    from gcs_sysid.diagnose.differential import _scale_column
+
+    X, noise, train, test = _flight(seed)
+    ib, j = REGRESSORS.index("beta"), COEFFICIENTS.index("CY")
+    X_true = X.copy()
+    X_true[:, ib] = X[:, ib] / (1.0 + w * (k - 1.0))
+    Y = evaluate_model(MODEL, X_true)
+    Y[:, j] += (k - 1.0) * _scale_column(MODEL, X_true, "CY")
+    return X, Y - evaluate_model(MODEL, X) + noise, train, test
+
+
+def test_a_side_force_scale_reports_its_change_beyond_the_sideslip_scale_it_caused():
+    """``report_beyond_scale`` (``sparse.THRESHOLDS["estimate_beyond_angle_scale"]``): a side force 1.5 times the
+    model's that also scales the aided sideslip by 1.2 (w = 0.4) reads 0.23 as selected, 46 % of its change, and 0.417
+    beyond the sideslip scale (0.5 / 1.2: per unit of the model's side force at the measured angle); with the angle
+    untouched (w = 0) both read 0.5. The finding then reports 1 + the change beyond the scale, its standard error with
+    the scale's share in quadrature, and keeps what it selected."""
+    from gcs_sysid.diagnose.differential import _scale_column, angle_scale_allowance, offset_allowance, report_beyond_scale
+
+    for w, sel_lo, sel_hi, beyond in ((0.4, 0.20, 0.26, 0.5 / 1.2), (0.0, 0.49, 0.51, 0.5)):
+        X, R, train, test = _side_force_flight(3, 1.5, w)
+        col = _scale_column(MODEL, X, "CY")
+        sel = offset_allowance(X, R, train, test, "CY", "scale:CY", column=col)
+        a = angle_scale_allowance(X, R, train, test, MODEL, "CY", "scale:CY", "beta", column=col, scale_type_b=0.04)
+        assert a is not None and not a["scale_only"], a
+        assert sel_lo <= sel["estimate"] <= sel_hi, sel
+        assert abs(a["beyond_scale"]["estimate"] - beyond) < 0.01, a["beyond_scale"]
+        f = {"cause": "scale:CY", "estimate": 1.0 + sel["estimate"], "std_error": 0.03, "model_value": 1.0,
+             "evidence": {"beta_scale_allowance": a}}
+        assert report_beyond_scale(f)
+        share = a["beyond_scale"]["std_error_scale_share"]
+        assert abs(share - 0.045) < 0.005                     # the type-B 0.04 and the fit, through the column
+        assert f["estimate"] == 1.0 + a["beyond_scale"]["estimate"] and f["std_error"] == np.hypot(0.03, share)
+        assert f["evidence"]["estimate_as_selected"] == {"estimate": 1.0 + sel["estimate"], "std_error": 0.03,
+                                                         "beyond": "beta_scale_allowance"}
+
+
+def test_a_finding_without_a_scale_beyond_it_keeps_its_estimate():
+    from gcs_sysid.diagnose.differential import report_beyond_scale
+
+    plain = {"cause": "scale:CY", "estimate": 1.3, "std_error": 0.02, "model_value": 1.0, "evidence": {}}
+    along = {"cause": "CY:r_hat", "estimate": 0.1, "std_error": 0.01, "model_value": 0.0,
+             "evidence": {"beta_scale_allowance": {"error_along_term": 0.1, "beyond_scale": {"estimate": 0.05}}}}
+    for f in (plain, along):
+        before = dict(f)
+        assert not report_beyond_scale(f)
+        assert f["estimate"] == before["estimate"] and f["std_error"] == before["std_error"]
+        assert "estimate_as_selected" not in f["evidence"]
