@@ -332,6 +332,14 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: Kept by a rule written before its fresh run: fresh effect seed 90 and clean seeds 91-95, both arms on the same
 #: flights: top +1/-0 (208 of 300), all three +1/-0, clean 124 = 124 (``docs/benchmarks.md``, *Fifty-seventh session,
 #: lead*).
+#: Added 2026-11-28 (fifty-eighth session), **on**: ``estimate_beyond_angle_scale`` (the causes whose kept finding
+#: reports its change beyond the air angle's between-flight scale, :func:`gcs_sysid.diagnose.differential.
+#: report_beyond_scale`; (): the selected estimate). Only what a kept ``scale:CY`` reports changes, never what is named:
+#: the aided sideslip is built from the side force, so a side-force change also scales the measured sideslip and reads
+#: low against it. Adopted by a rule written before its run: fresh effect seed 96, the 50 ``CY:scale`` cases, both arms
+#: on the same flights: named causes identical in every case, estimate +5/-1, all three +5/-1, the +-2 standard error
+#: interval covering JSBSim's scale on 18 -> 22 of the 24 ``scale:CY`` findings (``docs/benchmarks.md``,
+#: *Fifty-eighth session, lead*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -354,7 +362,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0,
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
               "hierarchy_se_degree": 3, "simpler_catalogue_powers": False,
-              "delay_se_central": True, "estimate_beyond_angle_scale": ()}
+              "delay_se_central": True, "estimate_beyond_angle_scale": ("scale:CY",)}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

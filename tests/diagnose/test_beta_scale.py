@@ -371,3 +371,11 @@ def test_a_finding_without_a_scale_beyond_it_keeps_its_estimate():
         assert not report_beyond_scale(f)
         assert f["estimate"] == before["estimate"] and f["std_error"] == before["std_error"]
         assert "estimate_as_selected" not in f["evidence"]
+
+
+def test_a_side_force_scale_reports_beyond_the_sideslip_scale_by_default():
+    """On since the fifty-eighth session (fresh seed 96: estimate +5/-1 on the 50 ``CY:scale`` cases, named causes
+    identical); the term findings keep their selected (centred) estimate."""
+    from gcs_sysid.diagnose.sparse import THRESHOLDS
+
+    assert tuple(THRESHOLDS["estimate_beyond_angle_scale"]) == ("scale:CY",)
