@@ -1180,12 +1180,12 @@ def report_beyond_scale(f: dict) -> bool:
     that angle is not the reference's when the change itself enters its reconstruction: the aided sideslip is built
     from the side force (``gcs_sysid.estimation.airangles``) with the reference's side-force model, so a side force
     ``k`` times the model's also scales the measured sideslip by about ``1 + w (k - 1)`` (``w``: the side force's
-    weight in the aided angle), and against that angle the side force reads only ``(1 - w)(k - 1) / (1 + w (k - 1))``
-    of its change. With ``s`` taken out, what is left is the change per unit of the model's side force at the
-    measured angle, ``(k - 1) / (1 + w (k - 1))`` (``tests/diagnose/test_beta_scale.py``: 0.417 for 0.5 at ``w`` 0.4,
-    0.23 as selected). Measured on the JSBSim roster's seed-90 ``CY:scale`` flights (fifty-eighth session,
-    ``docs/benchmarks.md``): 37 named, within 25 % of JSBSim's scale 27 as selected and 34 beyond the sideslip scale
-    (median 0.87 and 0.95 of the change).
+    weight in the aided angle), and against that angle the side force's change reads
+    ``(1 - w)(k - 1) / (1 + w (k - 1))`` where it is ``k - 1``. With ``s`` taken out, what is left is the change per
+    unit of the model's side force at the measured angle, ``(k - 1) / (1 + w (k - 1))``
+    (``tests/diagnose/test_beta_scale.py``: 0.417 for 0.5 at ``w`` 0.4, 0.23 as selected). Measured on the JSBSim
+    roster's seed-90 ``CY:scale`` flights (fifty-eighth session, ``docs/benchmarks.md``): 37 named, within 25 % of
+    JSBSim's scale 27 as selected and 34 beyond the sideslip scale (median 0.87 and 0.95 of the change).
 
     The finding's ``estimate`` becomes ``model_value + beyond_scale.estimate`` and its ``std_error`` the selected
     combined standard uncertainty with the scale's share added in quadrature (``beyond_scale.std_error_scale_share``,

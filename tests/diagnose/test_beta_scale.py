@@ -340,7 +340,8 @@ def test_a_side_force_scale_reports_its_change_beyond_the_sideslip_scale_it_caus
     beyond the sideslip scale (0.5 / 1.2: per unit of the model's side force at the measured angle); with the angle
     untouched (w = 0) both read 0.5. The finding then reports 1 + the change beyond the scale, its standard error with
     the scale's share in quadrature, and keeps what it selected."""
-    from gcs_sysid.diagnose.differential import _scale_column, angle_scale_allowance, offset_allowance, report_beyond_scale
+    from gcs_sysid.diagnose.differential import (_scale_column, angle_scale_allowance, offset_allowance,
+                                                 report_beyond_scale)
 
     for w, sel_lo, sel_hi, beyond in ((0.4, 0.20, 0.26, 0.5 / 1.2), (0.0, 0.49, 0.51, 0.5)):
         X, R, train, test = _side_force_flight(3, 1.5, w)
@@ -361,6 +362,7 @@ def test_a_side_force_scale_reports_its_change_beyond_the_sideslip_scale_it_caus
 
 
 def test_a_finding_without_a_scale_beyond_it_keeps_its_estimate():
+    """No scale allowance, or an error along the term (its ``s`` in radians per unit of the term): nothing changes."""
     from gcs_sysid.diagnose.differential import report_beyond_scale
 
     plain = {"cause": "scale:CY", "estimate": 1.3, "std_error": 0.02, "model_value": 1.0, "evidence": {}}
