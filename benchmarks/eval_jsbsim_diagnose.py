@@ -270,10 +270,9 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
                     flight=meas.flight, search=True, **kw)
     _LAST_PITOT.update(_pitot_summary(diag.data))
     _LAST_NOT_NAMED[:] = list((diag.data.get("sparse") or {}).get("not_named") or [])
-    _LAST_FLOOR.update({e["coefficient"]: e.get("naming_floor") for e in (diag.data.get("sparse") or {}).get(
-        "coefficients") or [] if "coefficient" in e})
-    _LAST_FIRST.update({e["coefficient"]: first_term_gates(e) for e in (diag.data.get("sparse") or {}).get(
-        "coefficients") or [] if "coefficient" in e})
+    entries = [e for e in (diag.data.get("sparse") or {}).get("coefficients") or [] if "coefficient" in e]
+    _LAST_FLOOR.update({e["coefficient"]: e.get("naming_floor") for e in entries})
+    _LAST_FIRST.update({e["coefficient"]: first_term_gates(e) for e in entries})
     return diag.findings, truth, time.perf_counter() - t0
 
 
