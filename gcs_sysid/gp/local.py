@@ -19,7 +19,7 @@ likelihoods over random neighbourhoods.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import jax
 import jax.numpy as jnp
@@ -30,8 +30,8 @@ from ..jaxconfig import stored_jit
 
 from .kernels import GibbsKernel
 
-__all__ = ["LocalParams", "LocalStore", "build_store", "neighbours", "neighbour_tree", "NEIGHBOUR_TREE",
-           "local_predict_chunk", "local_objective", "shared_nll", "MISSING_NOISE"]
+__all__ = ["LocalParams", "LocalStore", "build_store", "neighbours", "neighbour_tree", "own_neighbours",
+           "NEIGHBOUR_TREE", "local_predict_chunk", "local_objective", "shared_nll", "MISSING_NOISE"]
 
 #: Noise variance of a neighbour's missing output, in units of that output's ``amp + noise``.
 MISSING_NOISE = 1e8
@@ -82,6 +82,12 @@ class LocalStore:
         metric: ``(D,)`` scale dividing ``X`` for the neighbour search.
         z: ``(N,)`` centred log local spacing. z_mean: the centring constant.
         k: neighbours per query. tree: the k-d tree on ``X * metric``.
+        own_idx, own_dist: ``(N, k)`` each stored row's ``k`` nearest stored rows (itself first) and their
+            distances, as ``tree.query`` returns them, or None: kept from the query that gave ``z`` so that
+            :func:`neighbours` need not search again for a query that is a stored row (e.g. the predictions
+            at the training rows). own_unique: ``(N,)`` bool, where the row's ``k + 1`` nearest distances
+            rise strictly (no ties, e.g. no repeated row): only there are its ``k`` nearest and their order
+            the same from any k-query, so only those rows' own neighbours are used.
     """
 
     X: np.ndarray
@@ -91,6 +97,27 @@ class LocalStore:
     z_mean: float
     k: int
     tree: cKDTree
+    own_idx: np.ndarray | None = field(default=None, repr=False)
+    own_dist: np.ndarray | None = field(default=None, repr=False)
+    own_unique: np.ndarray | None = field(default=None, repr=False)
+
+    def own_rows(self, Xq: np.ndarray) -> np.ndarray | None:
+        """``(Q,)`` the stored row equal bit for bit to each row of ``Xq (Q, D)``, -1 where none; None when the
+        store kept no neighbours of its own rows (``own_idx``) or ``Xq`` is not of the stored rows' dtype."""
+        if self.own_idx is None or self.own_unique is None or Xq.dtype != self.X.dtype or Xq.ndim != 2 or len(Xq) == 0:
+            return None
+        lookup = self.__dict__.get("_row_lookup")
+        if lookup is None:        # built on first use: the row's bytes -> its index (rows without ties)
+            rows = np.flatnonzero(self.own_unique)
+            lookup = dict(zip(_row_keys(self.X[rows]), rows.tolist()))
+            object.__setattr__(self, "_row_lookup", lookup)
+        return np.fromiter((lookup.get(b, -1) for b in _row_keys(Xq)), dtype=np.intp, count=len(Xq))
+
+
+def _row_keys(X: np.ndarray) -> list[bytes]:
+    """Each row of ``X (N, D)`` as bytes (a dictionary key)."""
+    X = np.ascontiguousarray(X)
+    return X.view(np.dtype((np.void, X.shape[1] * X.itemsize))).ravel().tolist()
 
 
 def build_store(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int) -> LocalStore:
@@ -99,18 +126,40 @@ def build_store(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int) -
     pts = Xs * metric
     tree = neighbour_tree(pts)
     kk = min(k + 1, len(Xs))
-    dist, _ = tree.query(pts, k=kk, workers=-1)
-    dist = np.asarray(dist).reshape(len(Xs), kk)
+    dist, idx = tree.query(pts, k=kk, workers=-1)
+    dist, idx = np.asarray(dist).reshape(len(Xs), kk), np.asarray(idx).reshape(len(Xs), kk)
     logrho = np.log(np.maximum(dist[:, 1:].mean(1) if kk > 1 else np.ones(len(Xs)), 1e-12))
     z_mean = float(logrho.mean())
-    return LocalStore(Xs, resid, metric, logrho - z_mean, z_mean, k, tree)
+    # the first k of each row's k + 1 nearest are what a k-query of that row returns (itself first)
+    return LocalStore(Xs, resid, metric, logrho - z_mean, z_mean, k, tree, *own_neighbours(idx, dist, k))
+
+
+def own_neighbours(idx: np.ndarray, dist: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``LocalStore``'s ``(own_idx (N, k), own_dist (N, k), own_unique (N,))`` from each stored row's query of its
+    ``min(k + 1, N)`` nearest stored rows, ``idx`` and ``dist`` ``(N, >= min(k + 1, N))`` in distance order."""
+    kk = min(k + 1, idx.shape[1])
+    unique = np.all(np.diff(dist[:, :kk], axis=1) > 0, axis=1)
+    return np.ascontiguousarray(idx[:, :k]), np.ascontiguousarray(dist[:, :k]), unique
 
 
 def neighbours(store: LocalStore, Xq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Indices ``(Q, k)`` of the stored neighbours of ``Xq (Q, D)`` and the queries' ``z (Q,)``."""
-    dist, idx = store.tree.query(Xq * store.metric, k=store.k, workers=-1)
-    dist = np.asarray(dist).reshape(len(Xq), store.k)
-    idx = np.asarray(idx).reshape(len(Xq), store.k)
+    """Indices ``(Q, k)`` of the stored neighbours of ``Xq (Q, D)`` and the queries' ``z (Q,)``.
+
+    A query equal bit for bit to a stored row takes that row's own neighbours (``LocalStore.own_idx``,
+    from the store's own search, the same neighbours and distances a k-query returns); the others are
+    searched in the k-d tree."""
+    own = store.own_rows(Xq)
+    if own is None or not (hit := own >= 0).any():
+        dist, idx = store.tree.query(Xq * store.metric, k=store.k, workers=-1)
+        dist = np.asarray(dist).reshape(len(Xq), store.k)
+        idx = np.asarray(idx).reshape(len(Xq), store.k)
+    else:
+        idx, dist = store.own_idx[np.maximum(own, 0)], store.own_dist[np.maximum(own, 0)]
+        if not hit.all():
+            miss = ~hit
+            d, i = store.tree.query(Xq[miss] * store.metric, k=store.k, workers=-1)
+            dist[miss] = np.asarray(d).reshape(-1, store.k)
+            idx[miss] = np.asarray(i).reshape(-1, store.k)
     z = np.log(np.maximum(dist.mean(1), 1e-12)) - store.z_mean
     return idx, z
 

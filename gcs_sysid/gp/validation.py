@@ -46,7 +46,7 @@ from ..jaxconfig import stored_jit
 from jax.scipy.linalg import cho_solve
 
 from .batching import _add_jit, global_stats, local_predict
-from .local import LocalParams, LocalStore, neighbour_tree
+from .local import LocalParams, LocalStore, neighbour_tree, own_neighbours
 from .sparse import GlobalParams, Stats, _assemble, _chol_kmm, _concrete, _selectors, design, features
 
 __all__ = ["GLOBAL_GRID", "LOCAL_OFF", "LOCAL_MARGIN", "SHARED_NEIGHBOURS", "block_folds", "scale_latent",
@@ -320,7 +320,10 @@ def store_without(search: NeighbourSearch, Xs: np.ndarray, resid: np.ndarray, a:
         dist[short] = np.asarray(again).reshape(len(short), kk)
     logrho = np.log(np.maximum(dist[:, 1:].mean(1) if kk > 1 else np.ones(m), 1e-12))
     z_mean = float(logrho.mean())
-    return LocalStore(Xs[keep_rows], resid[keep_rows], search.metric, logrho - z_mean, z_mean, kb, tree)
+    # the store of every row (the model's) keeps each row's own kb nearest rows (itself first), as a kb-query of
+    # its tree returns them (``LocalStore.own_idx``); a block's store is queried at the block's rows, none stored
+    own = own_neighbours(search.idx, dist, kb) if m == n else (None, None, None)
+    return LocalStore(Xs[keep_rows], resid[keep_rows], search.metric, logrho - z_mean, z_mean, kb, tree, *own)
 
 
 def block_stores(Xs: np.ndarray, resid: np.ndarray, metric: np.ndarray, k: int, blocks: list[tuple[int, int]],
