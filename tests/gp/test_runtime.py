@@ -33,7 +33,9 @@ def test_negative_tol_is_rejected():
 
 
 def _child(code: str, env: dict) -> str:
-    full = dict(os.environ, PYTHONPATH=str(REPO), **env)
+    # on the CPU backend wherever the suite runs: stored executables are the CPU backend's (gcs_sysid.jaxconfig's
+    # stored_jit), and with a CUDA jaxlib installed JAX would otherwise pick the GPU, where none is written
+    full = dict(os.environ, PYTHONPATH=str(REPO), JAX_PLATFORMS="cpu", **env)
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=full, check=True,
                           timeout=120).stdout
 
