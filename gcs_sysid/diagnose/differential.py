@@ -794,7 +794,8 @@ def _where(ctx_X: np.ndarray, valid: np.ndarray, term: str, contribution: np.nda
     return out
 
 
-def _reference_delay(ctx: DiagContext, R: np.ndarray, surf: str, coef: str) -> tuple[float, float] | None:
+def _reference_delay(ctx: DiagContext, R: np.ndarray, surf: str, coef: str, central: bool = True
+                     ) -> tuple[float, float] | None:
     """A reference flight's own delay of ``surf`` by the fit that sized the flight's (``sparse._refine_delay``).
 
     The model's response to the delayed surface in ``coef`` is scanned on a grid that reaches below zero
@@ -811,7 +812,7 @@ def _reference_delay(ctx: DiagContext, R: np.ndarray, surf: str, coef: str) -> t
     if rows.size < 50 or surf not in REGRESSORS:
         return None
     tau, _, se = _refine_delay(ctx, np.nan_to_num(np.asarray(R, float)), surf, rows, COEFFICIENTS.index(coef),
-                               taus=np.arange(-0.1, 0.4001, 0.005))
+                               taus=np.arange(-0.1, 0.4001, 0.005), central=central)
     if not np.isfinite(se):
         return None
     dt = float(np.median(np.diff(ctx.t))) if ctx.t.size > 1 else 0.0
@@ -826,7 +827,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
                  search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
                  alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
-                 delay_change_min_t: float = 3.0, angle_error_along: tuple = (),
+                 delay_change_min_t: float = 3.0, delay_se_central: bool = True, angle_error_along: tuple = (),
                  force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
                  scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
                  beside_residual: np.ndarray | None = None, angle_witness_exclude=(),
@@ -863,6 +864,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             below this many of its standard errors (time resolution included) is an allowance, not a change
             (``sparse.THRESHOLDS["delay_change_min_t"]``; added 2026-11-22 13:20 UTC, branch i9-delay, after the
             first freeze: the PA-28 s1 2-m/s pitot bias got a 0.010 +- 0.006 s delay beside it); 0: off.
+        delay_se_central: with ``delay_same_fit``, the reference's delay standard error by a central difference
+            about its best delay (``sparse.THRESHOLDS["delay_se_central"]``, as the flight's; ``sparse._refine_delay``).
         alpha_jackknife_s: block length, s, of the block-jackknife standard error with which a finding in alpha
             is also judged beyond the alpha scale (:func:`angle_scale_allowance` ``jackknife``, the first
             reference's slope included); 0: off (``sparse.THRESHOLDS["alpha_jackknife_s"]``).
@@ -1076,7 +1079,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 coef, term = cause.split(":", 1)
                 got = _refit_aero(ctx, R, coef, term)
             elif same_fit:
-                got = _reference_delay(ctx, R, cause.split(":", 1)[1], f["coefficient"])
+                got = _reference_delay(ctx, R, cause.split(":", 1)[1], f["coefficient"], delay_se_central)
             else:
                 try:                                   # a fit that fails on the reference compares nothing
                     got = _refit_other(ctx, ctx.Y - ctx.model_values(), f, ref, airframe)

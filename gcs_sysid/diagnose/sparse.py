@@ -1296,11 +1296,12 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
         if delays:                 # a delay shows in every coefficient of its surface: name it alone,
             f = delays[0]          # take its (model-based) effect out of all of them, search again
             surf, jf = f["cause"].split(":")[1], COEFFICIENTS.index(f["coefficient"])
+            central = bool(th.get("delay_se_central", True))
             if th.get("delay_differential", False):
-                tau, D, se, parts = _differential_delay(ctx, Rn, surf, tr, jf, reference)
+                tau, D, se, parts = _differential_delay(ctx, Rn, surf, tr, jf, reference, central=central)
                 f["evidence"]["delay_differential"] = parts
             else:
-                tau, D, se = _refine_delay(ctx, Rd, surf, tr, jf)
+                tau, D, se = _refine_delay(ctx, Rd, surf, tr, jf, central=central)
             if th.get("delay_time_resolution", False) and ctx.t.size > 1:
                 # the log's time grid: a delay is known to no better than a uniform step of one sample
                 dt = float(np.median(np.diff(ctx.t)))
@@ -1313,7 +1314,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 res = float(np.median(np.diff(ctx.t))) / np.sqrt(12.0) \
                     if th.get("delay_time_resolution", False) and ctx.t.size > 1 else 0.0
                 check = _delay_in_primary(ctx, Rn, surf, tr, jf, tau, se, reference, k_agree,
-                                          bool(th.get("delay_differential", False)), res)
+                                          bool(th.get("delay_differential", False)), res, central=central)
                 f["evidence"]["primary_coefficient"] = check
                 if not check["agrees"]:
                     # not a delay of the surface: the coefficient it controls does not see it; the lag term is
@@ -2020,7 +2021,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
 
 def _differential_delay(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarray, j: int,
                         reference: tuple[DiagContext, np.ndarray] | None,
-                        taus=np.arange(-0.1, 0.4001, 0.005)) -> tuple[float, np.ndarray, float, dict]:
+                        taus=np.arange(-0.1, 0.4001, 0.005), central: bool = True
+                        ) -> tuple[float, np.ndarray, float, dict]:
     """A delay of ``surf`` as the change of a parameter: this flight's minus the reference flight's.
 
     Each flight's delay is fitted through the model's own response to the delayed surface
@@ -2041,22 +2043,24 @@ def _differential_delay(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndar
         ctx: this flight. Rn: (T, 6) its residual (measured minus model, nuisances and earlier named
             delays removed). surf: the surface (``delta_e``). tr: training rows. j: the coefficient
             whose lag terms named the delay. reference: ``(ctx_ref, R_ref)`` or None (no difference).
+        central: :func:`_refine_delay`'s standard error by a central difference (``delay_se_central``).
 
     Returns:
         (change of the delay s, this flight's (T, 6) part of the residual at that change, its standard
         error s (both flights' linearised standard errors in quadrature), ``{"flight_s", "reference_s",
         "std_error_flight_s", "std_error_reference_s"}``).
     """
-    tau, _, se = _refine_delay(ctx, Rn, surf, tr, j, taus=taus)
+    tau, _, se = _refine_delay(ctx, Rn, surf, tr, j, taus=taus, central=central)
     tau_ref, se_ref = 0.0, 0.0
     if reference is not None:
         rctx, Rr = reference
         rows = np.nonzero(rctx.valid)[0]
         if rows.size >= 50:
-            tau_ref, _, se_ref = _refine_delay(rctx, np.nan_to_num(np.asarray(Rr, float)), surf, rows, j, taus=taus)
+            tau_ref, _, se_ref = _refine_delay(rctx, np.nan_to_num(np.asarray(Rr, float)), surf, rows, j, taus=taus,
+                                               central=central)
             se_ref = se_ref if np.isfinite(se_ref) else 0.0
     change = float(tau - tau_ref)
-    _, D, _ = _refine_delay(ctx, Rn, surf, tr, j, taus=np.array([max(change, 0.0)]))
+    _, D, _ = _refine_delay(ctx, Rn, surf, tr, j, taus=np.array([max(change, 0.0)]), central=central)
     parts = {"flight_s": float(tau), "reference_s": float(tau_ref), "std_error_flight_s": float(se),
              "std_error_reference_s": float(se_ref)}
     return change, D, float(np.hypot(se, se_ref)), parts
@@ -2069,7 +2073,7 @@ PRIMARY_COEFFICIENT = {"delta_e": "Cm", "delta_a": "Cl", "delta_r": "Cn", "delta
 
 def _delay_in_primary(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarray, j: int, tau: float, se: float,
                       reference: tuple[DiagContext, np.ndarray] | None, k: float, differential: bool,
-                      resolution_s: float = 0.0) -> dict:
+                      resolution_s: float = 0.0, central: bool = True) -> dict:
     """Does the coefficient the surface controls see the delay that coefficient ``j`` named?
 
     A servo delay moves the surface itself, so every coefficient the surface acts on follows it late by the same
@@ -2101,9 +2105,9 @@ def _delay_in_primary(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarra
     if jp == j or not bool(np.asarray(ctx.active, bool)[jp]):
         return out
     if differential:
-        tau_p, _, se_p, _ = _differential_delay(ctx, Rn, surf, tr, jp, reference)
+        tau_p, _, se_p, _ = _differential_delay(ctx, Rn, surf, tr, jp, reference, central=central)
     else:
-        tau_p, _, se_p = _refine_delay(ctx, Rn, surf, tr, jp)
+        tau_p, _, se_p = _refine_delay(ctx, Rn, surf, tr, jp, central=central)
     se_p = float(np.hypot(se_p, resolution_s))
     comb = float(np.hypot(se, se_p)) if np.isfinite(se_p) else float("inf")
     agrees = bool(abs(tau - tau_p) <= k * comb)
@@ -2115,7 +2119,7 @@ def _delay_in_primary(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarra
 
 
 def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j: int,
-                  taus=np.arange(0.0, 0.4001, 0.005)) -> tuple[float, np.ndarray, float]:
+                  taus=np.arange(0.0, 0.4001, 0.005), central: bool = True) -> tuple[float, np.ndarray, float]:
     """The delay of ``surf`` that best explains ``R`` through the model's own response.
 
     Returns:
@@ -2125,7 +2129,8 @@ def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j:
     The residual of a delay tau is ``model(X with u(t - tau)) - model(X)`` in every coefficient
     (the model's own control derivatives, not a free gain: a free gain and a lag trade off).
     Scanned on ``taus`` over the training rows, each coefficient weighted by ``1/var(R_c)``; a
-    constant per coefficient is free.
+    constant per coefficient is free. ``central``: the standard error's slope in tau by a central difference
+    about the best tau (the search's ``delay_se_central``); False clips its lower point at 0 (before 2026-11-28).
     """
     from ..aero.table import REGRESSORS
 
@@ -2148,7 +2153,7 @@ def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j:
     # the fifty-seventh session); before, the lower point was clipped at 0, which for a best tau of -h (a grid that
     # reaches below zero: a reference without a delay reads -0.005 s) put both points at about 0 and divided their
     # float noise by ~1e-16: the reference's standard error came out 0 or anything; at a best of 0 it was one-sided
-    lo = best - h if THRESHOLDS.get("delay_se_central", True) else max(best - h, 0.0)
+    lo = best - h if central else max(best - h, 0.0)
     Xp, Xm = ctx.X.copy(), ctx.X.copy()
     Xp[:, k] = np.interp(ctx.t - best - h, ctx.t, np.nan_to_num(ctx.X[:, k]))
     Xm[:, k] = np.interp(ctx.t - lo, ctx.t, np.nan_to_num(ctx.X[:, k]))

@@ -82,19 +82,19 @@ def test_a_delay_change_is_not_called_the_references_own_delay():
 
 
 @pytest.mark.parametrize("central", [True, False])
-def test_a_delay_read_below_zero_keeps_its_standard_error(monkeypatch, central):
+def test_a_delay_read_below_zero_keeps_its_standard_error(central):
     """``_refine_delay``'s standard error is that of the response's slope in tau at the best tau. A reference whose
     surface leads its log by a grid step reads -0.005 s on the differential grid; with the lower point of the slope's
     difference clipped at 0 (``delay_se_central`` False, the code before the fifty-seventh session) both points sat at
     about 0 and their float noise was divided by ~1e-16: the standard error came out 0 or anything (the JSBSim
     c172x's seed-3 reference: 0.018 s on one run, 0 on another whose states differed by 1e-6). Here the log's clock
     starts at 100 s, where a shift of 1e-16 s moves no sample: the clipped slope is all zeros and the fit has no
-    standard error (0). Central (the default): the standard error of the same flight read at +0.005 s, within 5 %."""
+    standard error (0). Central (the default): the standard error of the same flight read at +0.005 s, within 5 %.
+    The choice is the caller's (the search passes its ``delay_se_central``), not read from the module's defaults."""
     from dataclasses import replace
 
     from gcs_sysid.diagnose import sparse
 
-    monkeypatch.setitem(sparse.THRESHOLDS, "delay_se_central", central)
     af = load_airframe(AIRFRAME)
     jm = COEFFICIENTS.index("Cm")
     grid = np.arange(-0.1, 0.4001, 0.005)
@@ -104,7 +104,7 @@ def test_a_delay_read_below_zero_keeps_its_standard_error(monkeypatch, central):
         ctx = replace(ctx, t=ctx.t + 100.0)
         rows = np.nonzero(ctx.valid)[0]
         tau, _, se = sparse._refine_delay(ctx, np.nan_to_num(ctx.Y - ctx.model_values()), "delta_e", rows, jm,
-                                          taus=grid)
+                                          taus=grid, central=central)
         assert tau == pytest.approx(d, abs=0.0025)
         se_at[d] = se
     if central:
