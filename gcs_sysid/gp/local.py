@@ -104,7 +104,8 @@ class LocalStore:
     def own_rows(self, Xq: np.ndarray) -> np.ndarray | None:
         """``(Q,)`` the stored row equal bit for bit to each row of ``Xq (Q, D)``, -1 where none; None when the
         store kept no neighbours of its own rows (``own_idx``) or ``Xq`` is not of the stored rows' dtype."""
-        if self.own_idx is None or self.own_unique is None or Xq.dtype != self.X.dtype or Xq.ndim != 2 or len(Xq) == 0:
+        if self.own_idx is None or self.own_unique is None or Xq.dtype != self.X.dtype or Xq.ndim != 2 \
+                or len(Xq) == 0:
             return None
         lookup = self.__dict__.get("_row_lookup")
         if lookup is None:        # built on first use: the row's bytes -> its index (rows without ties)
