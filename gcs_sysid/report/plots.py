@@ -14,7 +14,10 @@ import math
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
+from contourpy import contour_generator
 from matplotlib.figure import Figure
+from matplotlib.patches import PathPatch
+from matplotlib.path import Path
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from ..aero.table import COEFFICIENTS, REGRESSORS, CoefficientTable
@@ -61,6 +64,28 @@ def _shade(ax, t: np.ndarray, mask: np.ndarray, label: str | None = None) -> Non
     edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(int), 0]))
     for k, (a, b) in enumerate(zip(edges[::2], edges[1::2])):
         ax.axvspan(t[a], t[b - 1], color=_HELD, alpha=0.25, lw=0, label=label if k == 0 else None)
+
+
+def _flag_marks(ax, xc: np.ndarray, yc: np.ndarray, flag: np.ndarray) -> list:
+    """Hatch ``///`` and outline (cyan) over the flagged cells of ``flag (ny, nx)`` (1.0 flagged, 0.0 not) on the
+    cell centres ``xc (nx,)``, ``yc (ny,)``: the regions matplotlib's ``contourf(levels=[0.5, 1.5])`` and
+    ``contour(levels=[0.5])`` give (contourpy's ``mpl2014`` generator with corner masking, matplotlib's defaults),
+    drawn as two patches instead of two contour sets, whose set-up cost more than their drawing. Returns the
+    artists added (to be removed before the next slice)."""
+    gen = contour_generator(x=xc, y=yc, z=flag, name="mpl2014", corner_mask=True)
+    marks = []
+    pts, codes = gen.filled(0.5, 1.5)
+    if pts:
+        marks.append(ax.add_patch(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), facecolor="none",
+                                            edgecolor="black", linewidth=0.0, hatch="///")))
+    if not flag.all():
+        pts, codes = gen.lines(0.5)
+        if pts:
+            # joins, caps and z-order as a contour set's lines (round, butt, 2): the same pixels
+            marks.append(ax.add_patch(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), fill=False,
+                                                edgecolor="#00bcd4", linewidth=1.0, joinstyle="round",
+                                                capstyle="butt", zorder=2)))
+    return marks
 
 
 def _scale(name: str) -> tuple[float, str]:
@@ -257,12 +282,8 @@ def envelope_figures(envelope: EnvelopeMap, X_train: np.ndarray, slices: list[En
             im.set_extent(extent)
             dt.set_data(px, py)
             flag = sl.flagged(c).astype(float)
-            if flag.any() and not flag.all():
-                marks.append(ax.contourf(xc, yc, flag, levels=[0.5, 1.5], colors="none", hatches=["///"]))
-                marks.append(ax.contour(xc, yc, flag, levels=[0.5], colors="#00bcd4", linewidths=1.0))
-            elif flag.all():
-                marks.append(ax.contourf(xc, yc, flag + np.linspace(0, 1e-6, flag.size).reshape(flag.shape),
-                                         levels=[0.5, 1.5], colors="none", hatches=["///"]))
+            if flag.any():
+                marks += _flag_marks(ax, xc, yc, flag)
         axes[0].set_xlim(extent[0], extent[1])   # shared by all panels
         axes[0].set_ylim(extent[2], extent[3])
         axes[0].set_xlabel(f"{sx} ({ux})", fontsize=7, labelpad=1)
