@@ -70,21 +70,23 @@ def _flag_marks(ax, xc: np.ndarray, yc: np.ndarray, flag: np.ndarray) -> list:
     """Hatch ``///`` and outline (cyan) over the flagged cells of ``flag (ny, nx)`` (1.0 flagged, 0.0 not) on the
     cell centres ``xc (nx,)``, ``yc (ny,)``: the regions matplotlib's ``contourf(levels=[0.5, 1.5])`` and
     ``contour(levels=[0.5])`` give (contourpy's ``mpl2014`` generator with corner masking, matplotlib's defaults),
-    drawn as two patches instead of two contour sets, whose set-up cost more than their drawing. Returns the
-    artists added (to be removed before the next slice)."""
+    drawn as two patches instead of two contour sets, whose set-up cost more than their drawing. The patches are
+    added as plain artists (``add_artist``: clipped to the axes, no data-limit update, which walks every Bezier
+    segment of the path; the caller sets the limits). Returns the artists added (to be removed before the next
+    slice)."""
     gen = contour_generator(x=xc, y=yc, z=flag, name="mpl2014", corner_mask=True)
     marks = []
     pts, codes = gen.filled(0.5, 1.5)
     if pts:
-        marks.append(ax.add_patch(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), facecolor="none",
-                                            edgecolor="black", linewidth=0.0, hatch="///")))
+        marks.append(ax.add_artist(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), facecolor="none",
+                                             edgecolor="black", linewidth=0.0, hatch="///")))
     if not flag.all():
         pts, codes = gen.lines(0.5)
         if pts:
             # joins, caps and z-order as a contour set's lines (round, butt, 2): the same pixels
-            marks.append(ax.add_patch(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), fill=False,
-                                                edgecolor="#00bcd4", linewidth=1.0, joinstyle="round",
-                                                capstyle="butt", zorder=2)))
+            marks.append(ax.add_artist(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), fill=False,
+                                                 edgecolor="#00bcd4", linewidth=1.0, joinstyle="round",
+                                                 capstyle="butt", zorder=2)))
     return marks
 
 
