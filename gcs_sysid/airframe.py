@@ -399,7 +399,8 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
                 f"and of opposite sign, got {math.degrees(dmin):g} and {math.degrees(dmax):g}"
             )
         lim = sd.get("limit_deg", [min(dmin, dmax) * 180 / math.pi, max(dmin, dmax) * 180 / math.pi])
-        if not (isinstance(lim, list) and len(lim) == 2 and all(isinstance(x, (int, float)) for x in lim)) or not lim[0] < 0 < lim[1]:
+        if (not (isinstance(lim, list) and len(lim) == 2 and all(isinstance(x, (int, float)) for x in lim))
+                or not lim[0] < 0 < lim[1]):
             raise InputError(f"{src}: {where} limit_deg must be [negative, positive] degrees, got {lim!r}")
         mix = sd.get("mix")
         if not isinstance(mix, Mapping) or not mix:
@@ -439,7 +440,8 @@ def airframe_from_dict(doc: Mapping[str, Any], source: str = "<airframe>") -> Ai
         if throttle is None:
             raise InputError(f"{src}: [thrust] is given but there is no [throttle] channel to drive it")
     arm = doc.get("imu_lever_arm", [0.0, 0.0, 0.0])
-    if not (isinstance(arm, list) and len(arm) == 3 and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in arm)):
+    if not (isinstance(arm, list) and len(arm) == 3
+            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in arm)):
         raise InputError(f"{src}: imu_lever_arm must be [x, y, z] in metres, got {arm!r}")
     notes = doc.get("notes", "")
     if not isinstance(notes, str):

@@ -69,7 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="coefficients the maneuver suggestions target, e.g. Cl,Cn (default: all, moment "
                         "coefficients first)")
     r.add_argument("--can-log", default=None, metavar="FILE",
-                   help="recorded CAN log (.log/.asc/.blf/.csv): DroneCAN actuator positions and airspeed (docs/live.md)")
+                   help="recorded CAN log (.log/.asc/.blf/.csv): DroneCAN actuator positions and airspeed "
+                        "(docs/live.md)")
     r.add_argument("--can-offset", type=float, default=None, metavar="S",
                    help="seconds added to the CAN log's times (default 0 with a .tlog; required with a .bin)")
     r.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
@@ -79,7 +80,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
                         "default until the twenty-fifth session; 'diagonal' is its older name) one noise variance per "
-                        "output; 'full' the learned correlation in the predictions too (docs/gp.md, 'The default noise')")
+                        "output; 'full' the learned correlation in the predictions too (docs/gp.md, "
+                        "'The default noise')")
     r.add_argument("--stated-lift-level", action="store_true",
                    help="set the aided alpha's flight mean on the airframe's stated lift line ([aero] CL0 with "
                         "CL_alpha; docs/estimation.md, 'A stated lift line sets alpha's level'; default off)")
@@ -119,7 +121,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "docs/estimation.md, 'Where the pair applies')")
     f.add_argument("--beta-profile", default="off", choices=("on", "off"),
                    help="the aided sideslip's CY_beta by the gust model's likelihood, held in the later passes (opt-in "
-                        "everywhere since the thirty-third session): 'off' the default (least squares, as the diagnosis loads its flights), "
+                        "everywhere since the thirty-third session): 'off' the default (least squares, as the "
+                        "diagnosis loads its flights), "
                         "'on' (docs/estimation.md, 'The side-force slope by the gust model's likelihood')")
     _window_args(f)
 

@@ -317,8 +317,8 @@ def variance_in_chunks(fn: Any, X: np.ndarray, chunk: int = MAP_CHUNK) -> np.nda
 
     When ``N > chunk`` each call gets ``chunk`` rows, the last one a multiple of ``chunk / 4`` (padded
     by repeating its last row, the padding's outputs dropped), so a compiled model sees at most four
-    input shapes (for a given ``N``, two), and at most one chunk's temporaries are alive at once. Rows are predicted independently, so the
-    result equals one call on all rows (to rounding; a test checks 1e-9).
+    input shapes (for a given ``N``, two), and at most one chunk's temporaries are alive at once. Rows are predicted
+    independently, so the result equals one call on all rows (to rounding; a test checks 1e-9).
 
     Args:
         fn: ``model.predict`` (or any callable accepted by :func:`model_variance`).

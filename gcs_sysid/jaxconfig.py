@@ -185,7 +185,8 @@ def _node_types(tree) -> dict | None:
 
 
 def _register_tree(tree) -> bool:
-    """Register every custom node type of ``tree`` (:func:`_register_type`); False if one cannot be (:func:`_node_types`)."""
+    """Register every custom node type of ``tree`` (:func:`_register_type`); False if one cannot be
+    (:func:`_node_types`)."""
     types = _node_types(tree)
     if types is None:
         return False
@@ -414,9 +415,10 @@ def stored_program(fn, args: tuple, static: tuple = ()):
     still traces the Python function and lowers it to StableHLO before it can look the program up: in a loaded
     profile of the replay, 4.5 of its main process's 27.6 busy seconds, 2.8 of them the GP's Adam steps (the gradient
     of the bound; ``docs/benchmarks.md``, "Twenty-seventh session, speed27"). Here the lowered program is
-    exported with :func:`jax.export.export` and serialised (``Exported.serialize``, flatbuffers) into ``<cache>/traced/`` and later processes deserialise it instead
-    of tracing (the JAX manual, "Exporting and serializing staged-out computations"). The program is the same
-    StableHLO, so XLA compiles (or loads) the same computation and the results are identical.
+    exported with :func:`jax.export.export` and serialised (``Exported.serialize``, flatbuffers) into
+    ``<cache>/traced/`` and later processes deserialise it instead of tracing (the JAX manual, "Exporting and
+    serializing staged-out computations"). The program is the same StableHLO, so XLA compiles (or loads) the same
+    computation and the results are identical.
 
     Calling the exported program still traces and lowers a wrapper of it and looks it up in the compilation cache
     (about 0.9 s for the replay's 23 stored programs; ``docs/benchmarks.md``, "Thirtieth session, speed30"). So

@@ -187,8 +187,8 @@ GP_NOISE_CORRELATION = GP_NOISE_MODES[GP_NOISE][0]
 #: loses one on 12; twenty-fifth (i8-learned): made the default under the two-seed rule (:data:`GP_NOISE`).
 GP_NOISE_POSTERIOR = GP_NOISE_MODES[GP_NOISE][1]
 
-#: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or ``"noise"``
-#: (``eval_jsbsim --gp-noise full-nstart``).
+#: With :data:`GP_NOISE_CORRELATION`, where the shared error starts (``GPConfig.noise_start``): ``"signal"`` or
+#: ``"noise"`` (``eval_jsbsim --gp-noise full-nstart``).
 GP_NOISE_START = GP_NOISE_MODES[GP_NOISE][2]
 
 

@@ -154,7 +154,8 @@ def _air_relative(states, airframe, frame, p, q, r, V, notes):
 
     need = [k for k in ("phi", "theta", "psi", "wn", "we", "wd") if k not in states.data]
     if need or len(states.t) < 3:
-        notes.append(f"gust rates ({frame}) not removed from p_hat q_hat r_hat: no {' '.join(need) or 'grid'} in the states")
+        notes.append(f"gust rates ({frame}) not removed from p_hat q_hat r_hat: no {' '.join(need) or 'grid'} "
+                     "in the states")
         return p, q, r
     d = states.data
     G = gust_rates(float(np.median(np.diff(states.t))), dcm(d["phi"], d["theta"], d["psi"]),

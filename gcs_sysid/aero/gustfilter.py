@@ -593,7 +593,8 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
         return table, None
     held = np.asarray(held, bool)
     if len(table.t) < 3 or not held.any():
-        return replace(table, notes=list(table.notes) + ["held-out air roll rate not estimated: no held-out rows"]), None
+        return replace(table, notes=list(table.notes)
+                       + ["held-out air roll rate not estimated: no held-out rows"]), None
     G = air_roll_fit(table, states, airframe, train) if fit is None else fit
     if isinstance(G, str):
         return replace(table, notes=list(table.notes) + [G.replace("gust filter", "held-out air roll rate")]), None

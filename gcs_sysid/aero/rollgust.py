@@ -129,8 +129,8 @@ def fit_roll_dynamics(dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qb
         :class:`RollDynamicsFit`; ``g`` (``p_hat_g``) is 0 with the prior variance outside the rows used.
 
     Raises:
-        ValueError: shapes that disagree (``extra`` included), ``dt`` not positive, fewer than 200 usable rows in runs of at least 50,
-            an unknown ``tau``, or a roll damping ``Cl_p`` that is not negative.
+        ValueError: shapes that disagree (``extra`` included), ``dt`` not positive, fewer than 200 usable rows in runs
+            of at least 50, an unknown ``tau``, or a roll damping ``Cl_p`` that is not negative.
     """
     from scipy.optimize import minimize
 

@@ -62,7 +62,8 @@ def standard_doc(V0: float, cfg: CampaignConfig, seed: int, throw: dict[str, flo
 def validation_doc(lim, throw: dict[str, float], name: str, duration_s: float = 90.0) -> dict:
     """Multisines on all surfaces at three airspeeds across the limits (no turbulence), in a flight of
     ``duration_s`` (>= 82 s; the campaign's flight length, so the simulation compiles once)."""
-    Vs = [lim.V_min + 0.15 * (lim.V_max - lim.V_min), 0.5 * (lim.V_min + lim.V_max), lim.V_max - 0.15 * (lim.V_max - lim.V_min)]
+    Vs = [lim.V_min + 0.15 * (lim.V_max - lim.V_min), 0.5 * (lim.V_min + lim.V_max),
+          lim.V_max - 0.15 * (lim.V_max - lim.V_min)]
     ctl = [c for c in ("delta_e", "delta_a", "delta_r") if c in throw]
     amp = {"delta_e": 3.0, "delta_a": 6.0, "delta_r": 8.0}
     doc = _base_doc(name, Vs[0], max(duration_s, 3 * 26.0 + 4.0), 777, 0.0)
@@ -119,7 +120,8 @@ def suggest(model, X: np.ndarray, Y: np.ndarray, airframe: Airframe, cfg: Campai
     from ..maneuvers import ManeuverConfig, suggest_maneuvers
 
     tab = table(X, Y, cfg.rate_hz)
-    env_cfg = EnvelopeConfig(n_grid=14, limits={"V": (lim.V_min, lim.V_max), "alpha": (math.radians(-2.0), lim.alpha_max)})
+    env_cfg = EnvelopeConfig(n_grid=14,
+                             limits={"V": (lim.V_min, lim.V_max), "alpha": (math.radians(-2.0), lim.alpha_max)})
     env = confidence_map(model, tab, tab.valid, env_cfg)
     sug = suggest_maneuvers(env, model, tab, airframe, max_suggestions=cfg.max_suggestions,
                             config=ManeuverConfig(targets=cfg.targets, max_regions=12))
@@ -171,6 +173,7 @@ def flown_check(peaks: dict[str, float], lim) -> list[str]:
         out.append(f"flew {peaks['n_min']:.2f} to {peaks['n_max']:.2f} g, outside {lim.n_min:.2f} to {lim.n_max:.2f}")
     for c, th in lim.throw.items():
         if peaks[f"defl_max_deg.{c}"] > math.degrees(th) + 0.5:
-            out.append(f"{c} reached {peaks[f'defl_max_deg.{c}']:.1f} deg (autopilot + input), throw {math.degrees(th):.1f}")
+            out.append(f"{c} reached {peaks[f'defl_max_deg.{c}']:.1f} deg (autopilot + input), "
+                       f"throw {math.degrees(th):.1f}")
     return out
 

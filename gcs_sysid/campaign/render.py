@@ -19,7 +19,8 @@ def campaign_markdown(doc: dict) -> str:
     for p in acc["per_seed"]:
         me = ", ".join(f"{c} {p['moment_errors_suggested'][c]:.1f} vs {p['moment_errors_standard'][c]:.1f}"
                        for c in MOMENT_COEFFICIENTS) if "moment_errors_suggested" in p else "-"
-        drop = (f"{p['sigma_drop_suggested']:.2e} / {p['sigma_drop_standard']:.2e}" if "sigma_drop_suggested" in p else "-")
+        drop = (f"{p['sigma_drop_suggested']:.2e} / {p['sigma_drop_standard']:.2e}" if "sigma_drop_suggested" in p
+                else "-")
         L.append(f"| {p['seed']} | {drop} | {p.get('sigma_2x', '-')} | {me} | {p.get('moments_better', '-')} | "
                  f"{p['inside_limits']} |")
     L += ["", f"All seeds: sigma 2x {acc['sigma_2x_all']}, moments lower {acc['moments_better_all']}, designed inside "
@@ -43,7 +44,8 @@ def campaign_markdown(doc: dict) -> str:
         if run["violations"]:
             L += ["Designed peaks outside the limits:", ""] + [f"- {v}" for v in run["violations"]] + [""]
         if run.get("flown_outside"):
-            L += ["Flown (simulated, autopilot included) outside the limits:", ""] + [f"- {v}" for v in run["flown_outside"]] + [""]
+            L += (["Flown (simulated, autopilot included) outside the limits:", ""]
+                  + [f"- {v}" for v in run["flown_outside"]] + [""])
     return "\n".join(L) + "\n"
 
 
@@ -61,7 +63,8 @@ def campaign_figure(doc: dict) -> bytes:
                 rows = run["arms"][arm]
                 x = [r["flight"] for r in rows]
                 axes[0, j].plot(x, [r["errors_pct"][c] for r in rows], style, ms=3, lw=1,
-                                color="C0" if arm == "suggested" else "C1", label=arm if run is doc["runs"][0] else None)
+                                color="C0" if arm == "suggested" else "C1",
+                                label=arm if run is doc["runs"][0] else None)
                 axes[1, j].plot(x, [r["sigma"].get(c, np.nan) for r in rows], style, ms=3, lw=1,
                                 color="C0" if arm == "suggested" else "C1")
         axes[0, j].set_title(c, fontsize=10)

@@ -54,7 +54,8 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
     runs = []
     for seed in config.seeds:
         rng = np.random.default_rng(seed)
-        val = fly(airframe, truth, validation_doc(lim, throw, "validation", config.flight_s), config.rate_hz, rng, noise=False)
+        val = fly(airframe, truth, validation_doc(lim, throw, "validation", config.flight_s), config.rate_hz, rng,
+                  noise=False)
         X_test, Y_test = val.X, val.Y
         f1 = fly(airframe, truth, standard_doc(V0, config, seed, throw, None, None, "standard-1")[0],
                   config.rate_hz, rng)
@@ -77,7 +78,8 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
                 "sigma": sigma_in(model1, regions), "peaks": f1.peaks}
         if target_pts is not None:
             row1["target_sigma"] = sigma_in(model1, {top.coefficients[0]: target_pts})[top.coefficients[0]]
-        say(f"seed {seed}: flight 1 (standard) errors " + " ".join(f"{c} {e:.0f}%" for c, e in row1["errors_pct"].items()))
+        say(f"seed {seed}: flight 1 (standard) errors "
+            + " ".join(f"{c} {e:.0f}%" for c, e in row1["errors_pct"].items()))
         arms: dict[str, list[dict]] = {"suggested": [row1], "standard": [row1]}
         violations: list[str] = []
         flown_bad: list[str] = []
@@ -123,7 +125,8 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
                 if target_pts is not None:
                     row["target_sigma"] = sigma_in(conditioned, {top.coefficients[0]: target_pts})[top.coefficients[0]]
                 arms[arm].append(row)
-                say(f"seed {seed}: flight {k} ({arm}) errors " + " ".join(f"{c} {e:.0f}%" for c, e in row["errors_pct"].items()))
+                say(f"seed {seed}: flight {k} ({arm}) errors "
+                    + " ".join(f"{c} {e:.0f}%" for c, e in row["errors_pct"].items()))
                 if arm == "suggested" and k < config.flights:
                     _, sug = suggest(model, X, Y, airframe, config, lim)
         budget = arms.pop("_budget", [])
@@ -131,10 +134,13 @@ def run_campaign(airframe_path: str | Path, model_path: str | Path, out_dir: str
                      "target": None if top is None else {"coefficient": top.coefficients[0], "region": top.region,
                                                          "fix": top.fix}})
     doc = {"airframe": str(airframe_path), "truth_model": str(model_path), "config": _cfg_dict(config),
-           "limits": lim.to_dict(), "identification": "true regressors + coefficient noise COEF_NOISE "
-                                                      f"{COEF_NOISE.tolist()} at {config.rate_hz:g} Hz; after each flight the GP is "
-                                                      + ("re-learned on all data" if config.refit else
-                                                         "updated incrementally (the new rows added; sigma read at the hyperparameters the flight was designed with; then hyperparameters and inducing points refreshed on the stored rows for the errors and the next design)"),
+           "limits": lim.to_dict(),
+           "identification": "true regressors + coefficient noise COEF_NOISE "
+                             f"{COEF_NOISE.tolist()} at {config.rate_hz:g} Hz; after each flight the GP is "
+                             + ("re-learned on all data" if config.refit else
+                                "updated incrementally (the new rows added; sigma read at the hyperparameters the "
+                                "flight was designed with; then hyperparameters and inducing points refreshed on the "
+                                "stored rows for the errors and the next design)"),
            "runs": runs, "acceptance": _acceptance(runs, lim)}
     if out_dir is not None:
         out = Path(out_dir)

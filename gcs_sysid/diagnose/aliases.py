@@ -167,7 +167,8 @@ def separation_advice(coef: str, named_term: str, alias_term: str, model_terms: 
                 + ("; ".join(_HOW[r] for r in only if r in _HOW) or "a longer flight with all axes excited"))
     diff = [r for r in dict.fromkeys(a + b) if (r in a) != (r in b)]
     if diff:
-        return (f"a flight where {', '.join(diff)} move independently of {', '.join(r for r in a + b if r not in diff) or 'each other'}: "
+        return (f"a flight where {', '.join(diff)} move independently of "
+                f"{', '.join(r for r in a + b if r not in diff) or 'each other'}: "
                 + "; ".join(_HOW[r] for r in diff if r in _HOW))
     same = ", ".join(dict.fromkeys(a + b)) or "the regressors"
     return (f"{named_term} and {alias_term} are functions of the same regressor(s) ({same}) that this flight "

@@ -177,8 +177,9 @@ def shift_model_alpha(model, level: float) -> ModelDict:
 
 
 #: The ``FlightStates.data`` key under which :func:`shift_alpha` records the shift it applied, rad, (T,) constant:
-#: a flight reduced again from its log (the pitot's exact re-fit, :func:`gcs_sysid.diagnose.pitot._unit_delta_rereduced`)
-#: comes back in the log's own alpha frame and must be brought into the common one before it is compared.
+#: a flight reduced again from its log (the pitot's exact re-fit,
+#: :func:`gcs_sysid.diagnose.pitot._unit_delta_rereduced`) comes back in the log's own alpha frame and must be brought
+#: into the common one before it is compared.
 SHIFT_KEY = "alpha_level_shift"
 
 

@@ -306,7 +306,8 @@ def _gyro_accel(flight, states, airframe, train, test, avg_s=1.0, opts=None):
             f_imu = f_imu - np.cross(Wd, arm) - np.cross(W, np.cross(W, arm))
         for i, ax in enumerate("xyz"):
             f = _offset(f"bias:accel_{ax}", f"a{ax}", _movavg(f_imu[:, i], n), _movavg(f_gps[:, i], n), train, test,
-                        "m/s^2", opts=opts, extra={"sensor": f"IMU specific force {ax} vs C'(dv_gps/dt - g) (1 s averages)"})
+                        "m/s^2", opts=opts,
+                        extra={"sensor": f"IMU specific force {ax} vs C'(dv_gps/dt - g) (1 s averages)"})
             if f:
                 out.append(f)
     return out
@@ -409,7 +410,8 @@ def judge(cands: list[dict], references: list[tuple[str, list[dict]]], min_score
         ev["checks"] = {k: bool(v) for k, v in checks.items()}
         c["accepted"] = bool(sensor not in seen and all(checks.values()))
         if ev["differential"]["verdict"] == "calibration" and checks["significant"] and sensor not in seen:
-            ev["calibration_note"] = (f"{c['cause']} = {c['estimate']:.3g} +- {c['std_error']:.2g} {ev.get('unit', '')}, "
+            ev["calibration_note"] = (f"{c['cause']} = {c['estimate']:.3g} +- {c['std_error']:.2g} "
+                                      f"{ev.get('unit', '')}, "
                                       "the same in the reference flight(s): a calibration note, not a cause")
             notes.append(ev["calibration_note"])
         rivals = [r for r in cands if r is not c and r["cause"].split(":")[-1] == c["cause"].split(":")[-1]]

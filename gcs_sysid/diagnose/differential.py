@@ -626,7 +626,8 @@ def _with_jackknife(beyond: dict, X: np.ndarray, r: np.ndarray, rows: np.ndarray
 
 
 def beta_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
-                         term: str, min_t: float = 3.0, min_gain_pct: float = 10.0, scale_se: bool = True) -> dict | None:
+                         term: str, min_t: float = 3.0, min_gain_pct: float = 10.0,
+                         scale_se: bool = True) -> dict | None:
     """Is a sideslip finding more than a between-flight scale of the measured sideslip?
 
     :func:`angle_scale_allowance` with ``angle="beta"`` (the sideslip's lateral coefficients CY, Cl, Cn);
@@ -943,7 +944,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
             # a sensor or pitot cause judged against the references already (compat.judge, pitot)
             if judged.get("verdict") == "changed":
                 doc["changed"].append({"cause": cause, "onset_s": f.get("onset_s"),
-                                       "reference_corrections": [c.get("estimate") for c in judged.get("references", [])]})
+                                       "reference_corrections": [c.get("estimate")
+                                                                 for c in judged.get("references", [])]})
             else:
                 doc["not_compared"].append(cause)
             keep.append(f)

@@ -364,8 +364,8 @@ def _thrust_findings(flight, airframe: Airframe, th: FaultThresholds, checked: l
             ev.update({"domain": "telemetry (throttle output against the autopilot's energy demand)",
                        "channels": [thr.channel], "onset_window_s": win, "demand": reasons, "separable": True,
                        "rivals": [], "score": None})
-            return [{"cause": "thrust_loss", "coefficient": "CX", "estimate": float(frac), "std_error": float(1.0 / rng),
-                     "onset_s": onset, "evidence": ev, "gain": {}, "kind": "fault",
+            return [{"cause": "thrust_loss", "coefficient": "CX", "estimate": float(frac),
+                     "std_error": float(1.0 / rng), "onset_s": onset, "evidence": ev, "gain": {}, "kind": "fault",
                      "summary": f"throttle channel {thr.channel} frozen at {pwm[i0]:.0f} us from {onset:.1f} s: "
                                 + reasons[0]}]
     return []

@@ -165,7 +165,8 @@ def wind_candidate(diag, states, airframe, model, window_s: float = 3.0, step_s:
     gains, score = {}, 0.0
     for k in ("V", "alpha", "beta"):
         b, a = np.sqrt(np.mean(e0[k][held] ** 2)), np.sqrt(np.mean(e1[k][held] ** 2))
-        gains[k] = {"rms_before": float(b), "rms_after": float(a), "percent": float(100 * (1 - a / b)) if b > 0 else 0.0}
+        gains[k] = {"rms_before": float(b), "rms_after": float(a),
+                    "percent": float(100 * (1 - a / b)) if b > 0 else 0.0}
         neff = effective_samples(e0[k][held].ravel()) if b > 0 else 1.0
         score += neff / 2 * np.log(b**2 / max(a**2, 1e-300)) if b > 0 else 0.0
     score -= np.log(max(held.sum() * n, 2))

@@ -176,22 +176,23 @@ COEF_WITNESS_MAX_SE_MPS: float | None = 1.0
 MIN_T_TRIANGLE_CONFIRM: float | None = 1.0
 #: The signature path (a pitot cause named on the coefficients' signature when the wind-triangle path names nothing)
 #: must agree with the wind triangle's change since the reference flight(s), by the three combined standard errors of
-#: :func:`fuse_pitot_evidence` (:func:`signature_agrees_with_triangle`; on since the forty-fifth session, by a rule written
-#: before its fresh runs: ``docs/benchmarks.md``, "Forty-fifth session, lead"). Before, only
+#: :func:`fuse_pitot_evidence` (:func:`signature_agrees_with_triangle`; on since the forty-fifth session, by a rule
+#: written before its fresh runs: ``docs/benchmarks.md``, "Forty-fifth session, lead"). Before, only
 #: the flight's own wind shift was asked of it, within 3 standard errors plus 25 %: the b737's clean s23 (seed 3)
 #: was named -1.59 +- 0.28 m/s where the triangle read +0.53 +- 0.51.
 SIGNATURE_TRIANGLE_AGREE = True
 #: The signature path's significance (:data:`MIN_T`) counts :data:`COEF_SYSTEMATIC_MPS` in quadrature with the fit's
 #: coloured standard error, as the wind-triangle path does for the same coefficient fit (on since the forty-fifth
-#: session, with :data:`SIGNATURE_TRIANGLE_AGREE`). Before, the coloured error alone: the ultrastick's clean s26 (seed 4) was named -0.26 +- 0.033 m/s
-#: (t 8; with the term 1.3).
+#: session, with :data:`SIGNATURE_TRIANGLE_AGREE`). Before, the coloured error alone: the ultrastick's clean s26
+#: (seed 4) was named -0.26 +- 0.033 m/s (t 8; with the term 1.3).
 SIGNATURE_SYSTEMATIC = True
 #: True: an accepted pitot finding takes its place among the findings by its held-out gain, like the catalogue's and
 #: the search's causes (:func:`with_pitot`; tried 2026-11-23, branch i9-heave2). False (kept): first, as
 #: :func:`gcs_sysid.diagnose.sparse.merge_findings` keeps every data-compatibility cause first. Measured with True at
 #: the new turbulence levels (rascal, t6, c172x, the heave band off and on): the pitot lost the top on 6 of the 17
-#: flights where it was named (``scale:CY`` first, 62-84 %), one of them otherwise found; with :data:`MIN_T_COEF_CONFIRM` the false
-#: pitot it guarded against is no longer accepted (``docs/benchmarks.md``, *Fifteenth session, i9-heave2*).
+#: flights where it was named (``scale:CY`` first, 62-84 %), one of them otherwise found; with
+#: :data:`MIN_T_COEF_CONFIRM` the false pitot it guarded against is no longer accepted (``docs/benchmarks.md``,
+#: *Fifteenth session, i9-heave2*).
 RANK_BY_GAIN = False
 #: The share of the wind triangle's variance (of the change since the reference flight(s)) above which
 #: :func:`pitot_resolution` names a component as what limits the flight: the autopilot wind's error (advice: a heading
@@ -588,8 +589,8 @@ def screen(fused: dict, change: dict) -> dict:
 
     It passes when the wind triangle and the closed-form coefficient fit agree and their fused change
     is at least :data:`MIN_T_SCREEN` standard errors, *or* when the wind triangle's change since the
-    reference flight(s) alone is at least :data:`MIN_T_SCREEN_TRIANGLE`: the closed-form fit misses the aided angles' response to the
-    airspeed, so on some aircraft it comes out too low to agree, and it must not keep the exact re-fit
+    reference flight(s) alone is at least :data:`MIN_T_SCREEN_TRIANGLE`: the closed-form fit misses the aided angles'
+    response to the airspeed, so on some aircraft it comes out too low to agree, and it must not keep the exact re-fit
     (which decides, with the same agreement test) from being reached.
 
     Args:
@@ -946,8 +947,8 @@ def _reference_values(references, airframe, model, cause: str) -> list[dict]:
 def with_pitot(findings: list[dict], pitot: dict, data: dict) -> list[dict]:
     """Findings with an accepted pitot cause first after the faults (with :data:`RANK_BY_GAIN`: placed by its held-out
     gain, before the first remaining non-fault finding whose gain is not larger); the aero terms of its
-    implied coefficients are its symptoms (``evidence.explains``) and leave the list. Writes ``data["pitot"]`` (the candidates and
-    their checks) and appends its calibration notes to ``data["calibration"]``.
+    implied coefficients are its symptoms (``evidence.explains``) and leave the list. Writes ``data["pitot"]`` (the
+    candidates and their checks) and appends its calibration notes to ``data["calibration"]``.
 
     Args:
         findings: the diagnosis' findings. pitot: from :func:`airspeed_cause`. data: ``Diagnosis.data``.

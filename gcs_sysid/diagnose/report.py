@@ -122,8 +122,8 @@ def _faults_section(findings: list[dict], summary: dict | None) -> str:
         return out[0] + "<p>Not looked for (no decoded flight given).</p>"
     faults = [f for f in findings if f.get("kind") == "fault"]
     if faults:
-        out.append(_table([[f["cause"], ", ".join(map(str, f["evidence"].get("channels", []))), _f(f["onset_s"], "{:.2f}"),
-                            f.get("summary", "")] for f in faults],
+        out.append(_table([[f["cause"], ", ".join(map(str, f["evidence"].get("channels", []))),
+                            _f(f["onset_s"], "{:.2f}"), f.get("summary", "")] for f in faults],
                           ["cause", "servo channel(s)", "onset (s)", "evidence"]))
     else:
         out.append("<p class='ok'>No servo output froze while the autopilot kept demanding.</p>")
@@ -229,7 +229,8 @@ def _floor_section(sparse: dict | None) -> str:
 def _search_section(search: list[dict]) -> str:
     """What the wide-library search adds to each coefficient (terms by block PRESS, gain held out)."""
     out = ["<h2>Beyond the catalogue: wide-library search (block PRESS on training rows, gain held out)</h2>"]
-    rows = [[e["coefficient"], ", ".join(f"{x['term']} = {x['estimate']:.4g} +- {x['std_error']:.2g}" for x in e["terms"])
+    rows = [[e["coefficient"], ", ".join(f"{x['term']} = {x['estimate']:.4g} +- {x['std_error']:.2g}"
+                                         for x in e["terms"])
              or "nothing", _f(e["held_out"]["percent"], "{:.0f} %"), e["n_candidates"]] for e in search]
     out.append(_table(rows, ["coefficient", "terms selected", "held-out gain", "candidates"]))
     return "\n".join(out)
@@ -290,7 +291,8 @@ def render_html(d) -> str:
     parts.append(_pitot_section(data.get("pitot"), d.findings))
     if "coefficient_diagnosis" in data:
         parts.append(f"<p class='warn'>Coefficient-level diagnosis {html.escape(data['coefficient_diagnosis'])}</p>"
-                     "<h2>diagnosis.json</h2><pre>" + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])
+                     "<h2>diagnosis.json</h2><pre>"
+                     + html.escape(json.dumps(d.to_json(), indent=1, default=str)[:20000])
                      + "</pre></body></html>")
         return "\n".join(parts)
     if data.get("differential") is not None:

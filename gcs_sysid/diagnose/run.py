@@ -87,9 +87,10 @@ AIR_ROLL_RATE = "reference:Cl"
 #: (:func:`load_measurements`, and the pitot-bias re-run of :mod:`gcs_sysid.diagnose.pitot`): False, least squares
 #: (the estimator issue 9's roster counts were measured with); True, the gust model's likelihood with the slope held
 #: (:data:`gcs_sysid.estimation.airangles.BETA_PROFILE` and ``BETA_PROFILE_HOLD``, the replay's default in the
-#: thirty-second session only, opt-in again since the thirty-third). Off here: the diagnosis compares flights through their aided sideslips, issue 9's counts
-#: with the profile are not measured, and the twenty-fifth session's run of the profile alone lost the s23's
-#: ``CY:scale`` (docs/benchmarks.md, "Twenty-fifth session, i8-beta" and "Thirty-second session, lead").
+#: thirty-second session only, opt-in again since the thirty-third). Off here: the diagnosis compares flights through
+#: their aided sideslips, issue 9's counts with the profile are not measured, and the twenty-fifth session's run of the
+#: profile alone lost the s23's ``CY:scale`` (docs/benchmarks.md, "Twenty-fifth session, i8-beta" and "Thirty-second
+#: session, lead").
 BETA_PROFILE = False
 
 
@@ -248,9 +249,9 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             default): as the diagnosis loads its reference flight, :data:`AIR_ROLL_RATE` (``"reference:Cl"``
             since the fiftieth session: Cl's air-rate target, :func:`gcs_sysid.diagnose.air_roll.air_roll_cl_table`;
             the diagnosis's reference models are fitted through here).
-        profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the thirty-second session's replay
-            estimator, ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least squares: the
-            diagnosis's reference models are fitted through here).
+        profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the thirty-second session's
+            replay estimator, ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least
+            squares: the diagnosis's reference models are fitted through here).
 
     Returns:
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
@@ -394,7 +395,8 @@ def aligned_alpha(mode: str, model, meas: Measurements, kw: dict, level_tables=(
     m1, tab, st, refs1, info = align_alpha_levels(mode, model, meas.table, meas.states, refs[:1], extra)
     refs1 = refs1 + refs[1:]
     model1 = AeroModel(m1, getattr(model, "name", "model") or "model",
-                       (getattr(model, "notes", "") or "") + f"; alpha frame moved by {info.get('level_deg', 0.0):.3g} deg "
+                       (getattr(model, "notes", "") or "")
+                       + f"; alpha frame moved by {info.get('level_deg', 0.0):.3g} deg "
                        f"({mode} level)", getattr(model, "source", "") or "")
     kw1 = dict(kw, references=refs1)
     if kw.get("search_reference") is not None and refs1:

@@ -27,7 +27,8 @@ gives, and the terms of all coefficients are ranked by it. A term is *named* whe
 at least ``min_press_drop``, the untouched-segment gain of its coefficient is at least
 ``min_gain_pct`` and its estimate is at least ``min_abs_t`` coloured standard errors from zero
 (thresholds in :data:`THRESHOLDS`, frozen on 2026-11-21 at 21:30 UTC before the final evaluation;
-set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag terms of one surface name ``delay:<surface>`` with the lag as the estimate.
+set on c172x and sgs flights of seed 1 and 11-13, pa28 never looked at). Lag terms of one surface name
+``delay:<surface>`` with the lag as the estimate.
 
 Added 2026-11-22 (issue 9): before step 2 an angle-of-attack error of the autopilot's AOA_SSA
 (``e0 + e1/V + e2 alpha/V``, from its wind estimate) is fitted on CX and CZ through the model's
@@ -218,16 +219,16 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: together (the reference's spurious ``r_hat`` column, -0.53, keeps the scale column apart from beta), and the named
 #: ``CY:beta`` read only its own column's part, about half of the change (s2 at 1.6: -0.066 of -0.10). Estimation
 #: only: it names, drops and judges nothing. A named ``scale:CY`` likewise takes the share of the monomials selected
-#: beside it in the model's side-force regressors. No threshold. Measured in ``docs/benchmarks.md``, *Twenty-third session,
-#: i9-cyscale*.
+#: beside it in the model's side-force regressors. No threshold. Measured in ``docs/benchmarks.md``, *Twenty-third
+#: session, i9-cyscale*.
 #: Added 2026-11-24 (twenty-third session, branch i9-level2): ``inadequacy_alpha_centre``, **off**: the reference's
 #: ridge inadequacy on a library in ``alpha - mean(alpha_ref)`` (:func:`_inadequacy_library`), invariant to an alpha
 #: level common to both flights (the alpha level's ``reference`` and ``pooled`` modes then agree). No new threshold.
 #: Mixed on the eternity, c172p, us25e and sgs (``docs/benchmarks.md``, *Twenty-third session, i9-level2*).
-#: Added 2026-11-24 (twenty-fourth session, branch i9-misses): ``pitch_gust_nuisance``, **off**: the estimated pitch gust
-#: rate's moment (:mod:`gcs_sysid.diagnose.gust_nuisance`; slope from the reference flight, ``"own"``: from the test
-#: flight) removed from both flights' Cm residual before the search; ``pitch_gust_highpass_s`` (0: none; 2.0 measured)
-#: the column less its centred moving mean. ka350 evaluation flights: gain 14 -> 17/20, b737 10 -> 12/12; a
+#: Added 2026-11-24 (twenty-fourth session, branch i9-misses): ``pitch_gust_nuisance``, **off**: the estimated pitch
+#: gust rate's moment (:mod:`gcs_sysid.diagnose.gust_nuisance`; slope from the reference flight, ``"own"``: from the
+#: test flight) removed from both flights' Cm residual before the search; ``pitch_gust_highpass_s`` (0: none; 2.0
+#: measured) the column less its centred moving mean. ka350 evaluation flights: gain 14 -> 17/20, b737 10 -> 12/12; a
 #: ``Cm:alpha^2`` top count lost on the us25e and the ultrastick (``docs/benchmarks.md``, *Twenty-fourth session,
 #: i9-misses*).
 #: Added 2026-11-24 (twenty-sixth session, branch i9-cma2): ``library_control_trim``, **off**: the search library's
@@ -1756,7 +1757,8 @@ def _scale_own_part(ctx: DiagContext, Xp: np.ndarray, X: np.ndarray, rows: np.nd
 
 
 def _centre_columns(A: np.ndarray, terms: list[str], named: str, rows: np.ndarray,
-                    own_parts: dict[int, np.ndarray] | None = None, fixed: dict[int, float] | None = None) -> np.ndarray:
+                    own_parts: dict[int, np.ndarray] | None = None,
+                    fixed: dict[int, float] | None = None) -> np.ndarray:
     """Columns ``[1, terms...]`` (N, 1 + K) reparameterised so that the named term's coefficient is
     :func:`_centred_weights`' ``sum_j w_j theta_j``: column j becomes ``a_j - w_j a_named`` (the same span, so the
     same fitted function; ``theta'_named = w . theta``). ``own_parts``: as :func:`_centred_weights`; ``fixed``:
@@ -1832,9 +1834,10 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         null: ``{"predict": X -> (T, 6) the unchanged model, "X": (T, 10) the measured regressors, "nuisance":
             R -> R or None}`` (``THRESHOLDS["coverage_under_null"]``): also the air angles' type-B components
             *under no change* (:func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity`, on the same
-            columns and rows) and their combination with the type-A ones, ``evidence.uncertainty.type_b_under_no_change``
-            and ``combined_under_no_change`` (what :func:`beyond_expanded_uncertainty` ``under_null`` reads); the
-            reported ``std_error`` is unchanged by it. None: not computed.
+            columns and rows) and their combination with the type-A ones,
+            ``evidence.uncertainty.type_b_under_no_change`` and ``combined_under_no_change`` (what
+            :func:`beyond_expanded_uncertainty` ``under_null`` reads); the reported ``std_error`` is unchanged by it.
+            None: not computed.
         centred_scale: with ``centred``, a ``scale:<coef>`` selected beside a named monomial of that coefficient is a
             holder too: its part in the named term's regressors (:func:`_scale_own_part`) is projected on the named
             term, so a named ``CY:beta`` reads the fitted correction's whole slope along beta, the scale's share
@@ -1937,7 +1940,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             try:
                 ref = fit_standard_errors(tref[rows], np.nan_to_num(A), Rr[rows, j] - Rr[rows, j].mean(),
                                           ["1"] + terms, block_s)
-                parts.update(reference_coloured=float(ref["coloured"][i]), reference_jackknife=float(ref["jackknife"][i]))
+                parts.update(reference_coloured=float(ref["coloured"][i]),
+                             reference_jackknife=float(ref["jackknife"][i]))
             except (ValueError, np.linalg.LinAlgError):
                 pass
     if inadequacy_jk and len(inadequacy_jk) >= 3:

@@ -52,7 +52,8 @@ def term_factors(term: str) -> tuple[int, ...]:
         if part.endswith("^2"):
             part, power = part[:-2], 2
         if part not in REGRESSORS:
-            raise InputError(f"model term '{term}': unknown variable '{part}' (expected one of {', '.join(REGRESSORS)})")
+            raise InputError(f"model term '{term}': unknown variable '{part}' "
+                             f"(expected one of {', '.join(REGRESSORS)})")
         idx += [REGRESSORS.index(part)] * power
     if len(idx) > 2:
         raise InputError(f"model term '{term}' has degree {len(idx)} (at most 2 allowed)")

@@ -40,9 +40,10 @@ The side force has the same errors in variables with another sign pattern: the a
 gust (the kinematic sideslip takes the gust the aircraft turns into with the opposite sign) and rolls and yaws with it,
 so least squares on the kinematic sideslip gives ``CY_beta`` and the rate terms the gust's share. The controls move the
 sideslip and the rates and do not see the air: the side-force model's slopes are fitted by two-stage least squares with
-the rudder, the aileron and their delays as instruments of ``beta``, ``p_hat`` and ``r_hat`` (opt-in, :data:`INSTRUMENTED_BETA`, off by default: the t6 diagnosis got worse with it on;
-Söderström and Stoica, *Instrumental variable methods for system identification*, Springer 1983; Morelli and Klein
-2016 sec. 5.4), falling back to least squares where they are weak (:data:`BETA_MIN_FIRST_STAGE_R2`).
+the rudder, the aileron and their delays as instruments of ``beta``, ``p_hat`` and ``r_hat`` (opt-in,
+:data:`INSTRUMENTED_BETA`, off by default: the t6 diagnosis got worse with it on; Söderström and Stoica, *Instrumental
+variable methods for system identification*, Springer 1983; Morelli and Klein 2016 sec. 5.4), falling back to least
+squares where they are weak (:data:`BETA_MIN_FIRST_STAGE_R2`).
 
 Two errors stay (:mod:`gcs_sysid.estimation.angleerrors`): the least-squares ``CZ_alpha`` is attenuated
 because the aircraft heaves with the gust the kinematic angle misses (``instrument_slopes``: the
@@ -85,13 +86,13 @@ MIN_VALID_S = 20.0    #: least aided flight time for the model fit, s
 MIN_RATE_HZ = 20.0    #: slowest grid (IMU) rate at which the angles are aided, Hz
 HIGHPASS_HZ = 0.3     #: the model's slopes are fitted above this frequency, Hz (at least; see HEAVE_EDGE)
 #: alpha's slopes are fitted above ``max(HIGHPASS_HZ, HEAVE_EDGE x f_heave)``, ``f_heave = qbar S CL_alpha /
-#: (2 pi m V)`` (``CL_alpha`` the wing's, :func:`lift_slope`) the heave (plunge) mode's corner, below which the aircraft rides the vertical gust and the
-#: kinematic alpha's gust error correlates with the kinematic alpha (errors in variables; ``docs/estimation.md``,
-#: "The slopes' band and the heave mode"). None (the default): the fixed :data:`HIGHPASS_HZ`. Opt-in (1.0: the
-#: corner itself): measured better on the rascal (aided alpha's error SD 0.11-0.14 -> 0.035-0.046 deg in light
-#: turbulence; issue 9's ``Cm:alpha^2`` named 0/6 -> 4/6), but on the project's sim trainer (corner 1.5 Hz) the
-#: diagnosis then names ``bias:airspeed`` before ``wind`` in tests/diagnose/test_diagnose_e2e.py: its ranking was
-#: set with the old alpha (as for :data:`INSTRUMENTED_SLOPES`).
+#: (2 pi m V)`` (``CL_alpha`` the wing's, :func:`lift_slope`) the heave (plunge) mode's corner, below which the aircraft
+#: rides the vertical gust and the kinematic alpha's gust error correlates with the kinematic alpha (errors in
+#: variables; ``docs/estimation.md``, "The slopes' band and the heave mode"). None (the default): the fixed
+#: :data:`HIGHPASS_HZ`. Opt-in (1.0: the corner itself): measured better on the rascal (aided alpha's error SD 0.11-0.14
+#: -> 0.035-0.046 deg in light turbulence; issue 9's ``Cm:alpha^2`` named 0/6 -> 4/6), but on the project's sim trainer
+#: (corner 1.5 Hz) the diagnosis then names ``bias:airspeed`` before ``wind`` in tests/diagnose/test_diagnose_e2e.py:
+#: its ranking was set with the old alpha (as for :data:`INSTRUMENTED_SLOPES`).
 HEAVE_EDGE: float | None = None
 MAX_EDGE_HZ = 2.0     #: the heave edge is capped here (the manoeuvres' band, 0.1-1.5 Hz, must stay in reach), Hz
 SIGMA_CY0 = 0.003     #: prior 1-sigma of a symmetric airframe's CY at zero sideslip (asymmetry, accel bias)
@@ -118,12 +119,12 @@ INSTRUMENTED_SLOPES = False
 #: Default of ``aided_air_angles(instrument_beta=None)``: fit the side-force model's slopes by two-stage least squares
 #: with the rudder and the aileron and their delayed copies (:data:`.angleerrors.INSTRUMENT_LAGS_S`) as instruments of
 #: the sideslip and of the rates that answer the lateral gust (:data:`BETA_ENDOGENOUS`); least squares in every pass
-#: where the instruments are weaker than :data:`BETA_MIN_FIRST_STAGE_R2` in any pass (opt-in: off by default). The aircraft weathercocks into the
-#: lateral gust the kinematic sideslip misses, so least squares flattens ``CY_beta`` and gives the yaw rate the gust's
-#: side force (MIL-F-8785C light turbulence: rascal -0.61..-0.71 against JSBSim's -1.03, ``CY_r_hat`` -1.9 against 0),
-#: and the aided sideslip inherits the fit: the GP's side-force map is then wrong at the true sideslip, where the
-#: truth's sideslip in the training regressors makes it right (``docs/estimation.md``, "Instrumented side-force
-#: slopes"; ``docs/benchmarks.md``, "Sixteenth session, i8-iv").
+#: where the instruments are weaker than :data:`BETA_MIN_FIRST_STAGE_R2` in any pass (opt-in: off by default). The
+#: aircraft weathercocks into the lateral gust the kinematic sideslip misses, so least squares flattens ``CY_beta`` and
+#: gives the yaw rate the gust's side force (MIL-F-8785C light turbulence: rascal -0.61..-0.71 against JSBSim's -1.03,
+#: ``CY_r_hat`` -1.9 against 0), and the aided sideslip inherits the fit: the GP's side-force map is then wrong at the
+#: true sideslip, where the truth's sideslip in the training regressors makes it right (``docs/estimation.md``,
+#: "Instrumented side-force slopes"; ``docs/benchmarks.md``, "Sixteenth session, i8-iv").
 INSTRUMENTED_BETA = False   # opt-in: with it on the diagnosis lost CY:scale (t6: estimators differing between flights,
 #   fixed by the shared estimator; rascal 2/6 -> 0/6 even with it: docs/benchmarks.md, i8-iv and i9-ivdiag)
 BETA_INSTRUMENTS = ("delta_r", "delta_a")   #: the controls that instrument the side-force model (with their delays)
@@ -140,10 +141,11 @@ BETA_MIN_FIRST_STAGE_R2 = 0.1
 #: (:func:`.angleerrors.first_stage_f`) against :data:`BETA_MIN_FIRST_STAGE_F` (opt-in); ``"fuller"``: Fuller's k-class
 #: (:func:`.angleerrors.iv_lstsq`, ``fuller_n``: the effective sample) on every flight, no fallback (opt-in)
 BETA_WEAK_TEST: str | None = None
-BETA_MIN_FIRST_STAGE_F = 10.0   #: Staiger and Stock's (1997) rule of thumb (Stock and Yogo 2005: critical values near 10)
+#: Staiger and Stock's (1997) rule of thumb (Stock and Yogo 2005: critical values near 10)
+BETA_MIN_FIRST_STAGE_F = 10.0
 WEAK_F_MAX_LAG_S = 2.0          #: the autocorrelation lags summed for the effective sample size, s
-#: Hold ``|CZ_alpha|`` at least at the wing's lift slope (:func:`lift_slope`, Helmbold's formula, from ``b^2 / S``) in the
-#: first pass where the fitted one is flatter (or not identified), and leave :data:`FLOOR_DROPS` out of that pass
+#: Hold ``|CZ_alpha|`` at least at the wing's lift slope (:func:`lift_slope`, Helmbold's formula, from ``b^2 / S``) in
+#: the first pass where the fitted one is flatter (or not identified), and leave :data:`FLOOR_DROPS` out of that pass
 #: (``docs/estimation.md``, "The lift-slope floor"). In MIL-F-8785C light turbulence the kinematic alpha's gust error
 #: is 1-7 deg against a 0.6-1.1 deg signal on the slow aircraft, the fitted slope a fifth of the lift slope or not
 #: identified, and the aiding fell back (sgs126 6/6 flights): with the floor every flight is aided and the aided
@@ -186,20 +188,22 @@ STATED_CL0_SIGMA = 0.02
 #: block length of the measured lift's flight-mean standard error (:func:`lift_level`: the gusts' lift is correlated), s
 LEVEL_BLOCK_S = 10.0
 #: Opt-in (default False; eighteenth session, i8-alpha): where the lift-slope floor holds, leave the curvature
-#: ``(alpha - alpha0)^2`` out of the first pass too (as :data:`FLOOR_DROPS`); the later passes fit it on the aided angle.
-#: Fitted on the kinematic angle it is that angle's gust error squared (rascal, sgs126, asw20 light: -16..+11 per rad^2
-#: against JSBSim's -0.1..0.3), and it moves the aided alpha's mean (``docs/benchmarks.md``, "Eighteenth session,
+#: ``(alpha - alpha0)^2`` out of the first pass too (as :data:`FLOOR_DROPS`); the later passes fit it on the aided
+#: angle. Fitted on the kinematic angle it is that angle's gust error squared (rascal, sgs126, asw20 light: -16..+11 per
+#: rad^2 against JSBSim's -0.1..0.3), and it moves the aided alpha's mean (``docs/benchmarks.md``, "Eighteenth session,
 #: i8-alpha").
 FLOOR_DROPS_CURVATURE = False
 #: Opt-in (default (); twenty-first session, i8-aid): the columns of the alpha model whose slopes are chosen by the
 #: *gust model's likelihood* instead of least squares (``"delta_e"``; the curvature as ``"(alpha - alpha0)^2"``), see
-#: :func:`_profile_columns`. In turbulence the kinematic alpha carries the vertical gust, the stabilising autopilot moves
-#: the elevator against the gust's pitch, and least squares gives ``CZ_delta_e`` the gust's normal force (c172p light:
-#: +0.6..+1.2 against JSBSim's -0.39; the aided alpha then carries ``-CZ_delta_e / CZ_alpha`` of the elevator).
+#: :func:`_profile_columns`. In turbulence the kinematic alpha carries the vertical gust, the stabilising autopilot
+#: moves the elevator against the gust's pitch, and least squares gives ``CZ_delta_e`` the gust's normal force (c172p
+#: light: +0.6..+1.2 against JSBSim's -0.39; the aided alpha then carries ``-CZ_delta_e / CZ_alpha`` of the elevator).
 ALPHA_PROFILE_COLUMNS: tuple[str, ...] = ()
-PROFILE_REFIT = False      #: refit the other free columns for each candidate (a profile likelihood; measured: c172p
-#: light CZ_delta_e -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
-PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
+#: refit the other free columns for each candidate (a profile likelihood; measured: c172p light CZ_delta_e
+#: -0.8..-2.0 with q_hat -10..-18, the pair slides along their collinearity); False: held at least squares
+PROFILE_REFIT = False
+#: the profiled slope is searched within +- this (per unit of its regressor) of least squares'
+PROFILE_HALF_WIDTH = 2.0
 #: Opt-in again since the thirty-third session (twenty-fifth session, i8-beta; the replay's, ``predict``'s and
 #: ``listen``'s default in the thirty-second session only): ``CY_beta`` by the gust model's likelihood, the
 #: filter-error estimate (:func:`_profile_angle_slope`): the change of variables' Jacobian ``-N log|CY_beta|`` included,
@@ -219,7 +223,8 @@ PROFILE_HALF_WIDTH = 2.0   #: the profiled slope is searched within +- this (per
 #: counts left out the bands and the correlation. With all of issue 8's counts (``benchmarks/issue8_counts.py``) the
 #: same 90-s flights give +13/-10 and +14/-6; 120-s flights of the same aircraft +12/-9 and +15/-9; and a third set
 #: fixed in advance (seeds 4-6, 90 s) **+6/-11** and **+8/-14**, net negative at both GP seeds, which the session's
-#: pre-registered rule made the end of the default. The medians at the true regressors still favour it on CY and Cn on every set.
+#: pre-registered rule made the end of the default. The medians at the true regressors still favour it on CY and Cn on
+#: every set.
 BETA_PROFILE = False
 #: On (thirty-first session, i8-truereg; it acts only with the profile, :data:`BETA_PROFILE` or ``profile_beta=True``,
 #: so the profile, when asked for, comes with its hold): the later passes keep the
@@ -748,8 +753,8 @@ def _profile_columns(dt: float, Ahm: np.ndarray, yhm: np.ndarray, A: np.ndarray,
     in variables; in closed loop the stabilising autopilot moves the elevator against the gust's pitch, so
     ``CZ_delta_e`` takes the gust's normal force). The aiding's own model says what the gust is: a first-order
     Gauss-Markov state ``g`` seen as ``z = angle_f - angle_kin = g + v`` (v white). A wrong slope ``d`` leaves
-    ``(d_true - d) x / CZ_alpha`` in ``z``, shaped like the regressor ``x`` (the elevator's steps and doublets), not like
-    the gust. So ``d`` is chosen by the concentrated likelihood of ``z`` under the gust model (maximised over the
+    ``(d_true - d) x / CZ_alpha`` in ``z``, shaped like the regressor ``x`` (the elevator's steps and doublets), not
+    like the gust. So ``d`` is chosen by the concentrated likelihood of ``z`` under the gust model (maximised over the
     correlation time and the variance ratio, :func:`_gm_search`), the other free columns refitted by least squares for
     each ``d`` (a profile likelihood): the filter-error method's parameter estimate with the gust as process noise
     (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., 2015, ch. 5; Maine and Iliff, NASA RP-1168, 1986,
@@ -915,8 +920,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     wing's lift slope, :data:`SLOPE_FLOOR`): a flatter or unidentified fitted slope is held there, the other columns
     refitted without :data:`FLOOR_DROPS`, and the identification check skipped for that pass; None: no floor;
     ``floor_held``: columns held at a stated slope where the floor holds (``{"q_hat": -CL_q}``,
-    :data:`STATED_LIFT_SLOPE`) instead of refitted or left out (its presence also marks the floor as a stated one in the note);
-    ``endog``: the other columns instrumented with the angle (beta: ``p_hat``, ``r_hat``, which answer the gust,
+    :data:`STATED_LIFT_SLOPE`) instead of refitted or left out (its presence also marks the floor as a stated one in the
+    note); ``endog``: the other columns instrumented with the angle (beta: ``p_hat``, ``r_hat``, which answer the gust,
     :data:`INSTRUMENTED_BETA`); ``min_first_stage``: the instruments' least first-stage partial R^2, below which the
     slopes fall back to ordinary least squares; ``weak_test``: ``"f"`` tests the instruments by their first-stage F
     on the effective sample size instead (:func:`.angleerrors.first_stage_f`, at least
@@ -1166,7 +1171,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         if ra > rk and (MOMENT_Z is None or not np.isfinite(se) or lam + MOMENT_Z * se < 0.5):
             mname = "Cm" if name == "alpha" else "Cl, Cn"
             fit.used = False
-            lam_note = f"; the moments follow the kinematic one: lambda = {lam:.2f} +- {se:.2f}" if np.isfinite(se) else ""
+            lam_note = (f"; the moments follow the kinematic one: lambda = {lam:.2f} +- {se:.2f}" if np.isfinite(se)
+                        else "")
             fit.reason = (f"the aided {name} fits {mname} worse than the kinematic one (residual {100 * ra:.1f} % "
                           f"vs {100 * rk:.1f} % of the variance{lam_note}): the force model is not trusted")
             return kin0, kinematic_sigma(ang, kin0, gust_sig, m, int(round(MOMENT_WINDOW_TAUS * fit.tau_s / dt))), fit
@@ -1351,7 +1357,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         why = (f"samples at {1.0 / dt:.1f} Hz: below {MIN_RATE_HZ:g} Hz the control and rate terms of CY, CZ are "
                "smeared and the force model is not trusted")
         nan = np.full(T, np.nan)
-        return AidedAngles(alpha_kin, beta_kin, nan, nan.copy(), (AxisFit("alpha", False, why), AxisFit("beta", False, why)))
+        return AidedAngles(alpha_kin, beta_kin, nan, nan.copy(),
+                           (AxisFit("alpha", False, why), AxisFit("beta", False, why)))
     with np.errstate(invalid="ignore", divide="ignore"):
         k = mass / (qbar * S)
         CY = k * f_body[:, 1]

@@ -325,7 +325,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         notes.append("rate smoother bandwidth p q r = " + ", ".join(f"{b:g}" for b in Rr.bandwidth_hz)
                      + " Hz; gyro noise = " + ", ".join(f"{s:.4f}" for s in Rr.noise_std) + " rad/s; signal "
                      "above it recovered from the residual's spectrum (Wiener) p q r: " + ", ".join(
-                         "none" if not np.isfinite(b[0]) else f"{b[0]:.1f}-{b[1]:.1f} Hz" for b in Rr.correction_band_hz))
+                         "none" if not np.isfinite(b[0]) else f"{b[0]:.1f}-{b[1]:.1f} Hz"
+                         for b in Rr.correction_band_hz))
         if cnames:
             unit = "rad/s^2 per Pa rad" if qbar_eas is not None else "rad/s^2 per rad"
             notes.append("control steps taken as known inputs (" + ", ".join(cnames) + "); step effectiveness "
@@ -482,7 +483,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                 else:
                     kn = "pitot scale kept at 1 (too few turns to separate it from the wind)"
                 notes.append(f"{kn}; mean wind N E = {wind[:, 0].mean():+.2f}, {wind[:, 1].mean():+.2f} m/s" +
-                             (f"; airspeed residuals weighted with their own RMS, {We.sigma_airspeed:.2f} m/s (turbulence)"
+                             (f"; airspeed residuals weighted with their own RMS, {We.sigma_airspeed:.2f} m/s "
+                              "(turbulence)"
                               if We.fits > 1 else ""))
                 k_pitot = We.scale
             except ValueError:

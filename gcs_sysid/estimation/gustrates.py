@@ -129,7 +129,8 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
     Raises:
         ValueError: unknown ``frame``, shapes that disagree, or ``b <= 0``.
 
-    Source: Etkin (1972) ch. 13; MIL-F-8785C sec. 3.7.2 (Dryden form, low-altitude axes); MIL-HDBK-1797 (its turbulence models).
+    Source: Etkin (1972) ch. 13; MIL-F-8785C sec. 3.7.2 (Dryden form, low-altitude axes); MIL-HDBK-1797 (its turbulence
+    models).
     """
     if frame not in FRAMES:
         raise ValueError(f"gust-rate frame must be one of {', '.join(FRAMES)}, got '{frame}'")
@@ -153,7 +154,8 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
              "(a filter-error method would estimate it from the roll moment)"]
     rates = np.zeros((T, 3))
     if frame in ("path", "path-yaw"):
-        db = np.einsum("tji,tj->ti", np.where(np.isfinite(C), C, 0.0), wdot) / Vs[:, None]   # d/dx of the gust, body axes
+        # d/dx of the gust, body axes
+        db = np.einsum("tji,tj->ti", np.where(np.isfinite(C), C, 0.0), wdot) / Vs[:, None]
         rates[:, 2] = lag_filter(dt, db[:, 1], tau_r)        # r_g = +dv_g/dx
         if frame == "path":
             rates[:, 1] = -lag_filter(dt, db[:, 2], tau_q)   # q_g = -dw_g/dx
@@ -161,7 +163,8 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
                          "(MIL-F-8785C Dryden form, Etkin's signs)")
         else:
             notes.append("q_g = 0: the pitch gust rate is not removed (its sign differs between Etkin and "
-                         "JSBSim, and the vertical gust's derivative, from alpha, is as noisy as its signal on a slow UAV)")
+                         "JSBSim, and the vertical gust's derivative, from alpha, is as noisy as its signal on a "
+                         "slow UAV)")
             notes.append("r_g = +(s/V)/(1+3b s/(pi V)) v_g in body axes (MIL-F-8785C Dryden form; Etkin's "
                          "sign, which JSBSim's shares)")
     else:

@@ -114,9 +114,9 @@ from .kalman import SteadyState, lti_response, steady_state, steady_state_smooth
 from .nodes import segments
 from .wiener import residual_wiener
 
-__all__ = ["AILERON_YAW_TIE", "BANDWIDTHS_HZ", "CONTROL_AXES", "COUPLED", "DECAYS", "SLOW_DECAYS", "HOLDS", "ZOH_EVIDENCE",
-           "RESIDUAL_FORCE_AXES", "RateEstimate", "normal_force_input", "smooth_rates", "smooth_specific_force",
-           "control_columns"]
+__all__ = ["AILERON_YAW_TIE", "BANDWIDTHS_HZ", "CONTROL_AXES", "COUPLED", "DECAYS", "SLOW_DECAYS", "HOLDS",
+           "ZOH_EVIDENCE", "RESIDUAL_FORCE_AXES", "RateEstimate", "normal_force_input", "smooth_rates",
+           "smooth_specific_force", "control_columns"]
 
 #: Candidate bandwidths (Hz) of the rate smoother; those above 0.35 x grid rate are dropped.
 BANDWIDTHS_HZ = (0.5, 1.0, 1.5, 2.5, 4.0, 6.0, 9.0, 13.0)
@@ -660,7 +660,8 @@ def _smooth_with_inputs(dt: float, Z: np.ndarray, U: np.ndarray, s: np.ndarray, 
             ee += float(e @ e)
         sel = sel_of(i, m)
         opt = opt_of(i)
-        if len(opt):   # the slow transients: taken on this axis only if the white and the coloured test both ask for them
+        # the slow transients: taken on this axis only if the white and the coloured test both ask for them
+        if len(opt):
             sel1 = np.union1d(sel, opt)
             rss = [max(ee - float(Ge[q] @ _solve(GG[np.ix_(q, q)], Ge[q])[0]), 1e-300) for q in (sel, sel1)]
             wald = _coloured_wald([(lagged(G, nd, lag), e) for G, e in inn], GG, Ge, sel, opt)

@@ -27,7 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["variance_inflation", "decorrelation_lag", "linear_residual", "ols_coloured_t", "significant_inputs", "T_KEEP", "lagged_products", "default_lag"]
+__all__ = ["variance_inflation", "decorrelation_lag", "linear_residual", "ols_coloured_t", "significant_inputs",
+           "T_KEEP", "lagged_products", "default_lag"]
 
 
 def variance_inflation(resid: np.ndarray, floor: float = 0.05, max_share: float = 0.25) -> np.ndarray:

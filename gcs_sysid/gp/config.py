@@ -91,8 +91,8 @@ class GPConfig:
             one; ``"diagonal"`` (twenty-third session, i8-noise2) only its per-output variances. The correlation
             is learned with the other hyperparameters and used by every later decision (the blocked validation's
             latent scales, the coupling test, the validated terms), so the gusts' shared error is not explained as
-            signal coupling in ``B``; it is dropped just before the posterior (:func:`gcs_sysid.gp.fit.posterior_noise`).
-            Why: with a noise correlation the
+            signal coupling in ``B``; it is dropped just before the posterior
+            (:func:`gcs_sysid.gp.fit.posterior_noise`). Why: with a noise correlation the
             posterior is a seemingly-unrelated-regressions GLS, which moves one output's mean by another's
             residual wherever their regressors or priors differ (``alpha_dot_hat`` in Cm's mean alone, each
             output's own linear terms and blocked-validation scale; Zellner 1962); sgs126 light s1: a learned CZ-Cm
@@ -293,7 +293,8 @@ class GPConfig:
         if not float(self.mean_only_ratio) > 0:
             raise InputError(f"GPConfig.mean_only_ratio must be > 0, got {self.mean_only_ratio!r}")
         if self.n_inducing_hyper is not None and int(self.n_inducing_hyper) < 1:
-            raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, got {self.n_inducing_hyper!r}")
+            raise InputError(f"GPConfig.n_inducing_hyper must be a positive integer or None, "
+                             f"got {self.n_inducing_hyper!r}")
         for name in ("n_inducing", "n_train_max", "local_neighbours", "local_batch", "batch_size", "mi_pool",
                      "latent_kernels"):
             if int(getattr(self, name)) < 1:

@@ -805,10 +805,11 @@ def posterior_noise(params: GlobalParams, cfg: GPConfig, history: FitHistory) ->
 
     ``"diagonal"`` (with ``noise_correlation``): the learned noise correlation (recorded in
     ``history.validation["noise_correlation_learned"]``, ``(P, P)`` list) is replaced by the identity, the per-output
-    variances kept. Called after the likelihood's decisions (the bound, the coupling test: the full noise covariance keeps the
-    gusts' shared error out of ``B``) and before the choices made by the posterior mean's blocked error (the
+    variances kept. Called after the likelihood's decisions (the bound, the coupling test: the full noise covariance
+    keeps the gusts' shared error out of ``B``) and before the choices made by the posterior mean's blocked error (the
     validated linear terms and mean-only inputs; the latent scales and the coupling gate in :func:`validated_global`
-    drop it themselves), so those see the posterior the model uses. Why: with a noise correlation ``Sigma_pq`` the posterior mean is a seemingly-
+    drop it themselves), so those see the posterior the model uses. Why: with a noise correlation ``Sigma_pq`` the
+    posterior mean is a seemingly-
     unrelated-regressions GLS (Zellner 1962, JASA 57, eq. 2.8): output ``q``'s residual enters output ``p``'s
     estimate. With the same regressors and priors in every output that moves nothing (Zellner's sec. 3 equivalence
     with equation-by-equation least squares); with different ones (alpha_dot_hat a mean-only input of Cm alone, each
@@ -913,7 +914,8 @@ def fit_gp(X, Y, config: GPConfig = GPConfig(), input_names=None, output_names=N
     cfg, history, t0 = config, FitHistory(), time.perf_counter()
     Y_names = None if output_names is None else list(output_names)
     if np.ndim(Y) == 2 and (Y_names is None or len(Y_names) != np.shape(Y)[1]):     # the summary's default names
-        Y_names = list(COEFFICIENTS) if np.shape(Y)[1] == len(COEFFICIENTS) else [f"y{p}" for p in range(np.shape(Y)[1])]
+        Y_names = (list(COEFFICIENTS) if np.shape(Y)[1] == len(COEFFICIENTS)
+                   else [f"y{p}" for p in range(np.shape(Y)[1])])
     X, input_names, notes = rows_without_mean_only(X, Y, cfg, input_names, Y_names)
     X, Y, more = check_training(X, Y, min_rows=3, partial=True, output_names=Y_names)
     notes += more

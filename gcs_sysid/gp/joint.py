@@ -45,7 +45,9 @@ from .model import LocalGlobalGP
 from .sparse import GlobalParams, elbo
 from .validation import _design_u, _mean_weights, _sub, block_folds
 
-__all__ = ["COUPLING_MARGIN", "COUPLING_LEVEL", "LR_LEVEL", "lr_coupling", "coupling_gain_significant", "decoupled", "decoupled_model", "couple_only", "gate_coupling", "gap_errors", "nonlinear_part", "correlation", "quadratic_features",
+__all__ = ["COUPLING_MARGIN", "COUPLING_LEVEL", "LR_LEVEL", "lr_coupling", "coupling_gain_significant", "decoupled",
+           "decoupled_model", "couple_only", "gate_coupling", "gap_errors", "nonlinear_part", "correlation",
+           "quadratic_features",
            "truth_correlation", "blocked_errors", "SelectedOutputs", "select_outputs", "forward_errors", "fit_selected"]
 
 

@@ -536,7 +536,8 @@ class LocalGlobalGP:
         P, D = self.n_outputs, self.n_inputs
         K = self.post.b.shape[0]
         mu = cho_solve((np.asarray(self.post.L), True), np.asarray(self.post.b))
-        W = np.broadcast_to(np.asarray(self.params.prior_std, float), (P, D + 1)) * mu[K - P * (D + 1):].reshape(P, D + 1)
+        W = (np.broadcast_to(np.asarray(self.params.prior_std, float), (P, D + 1))
+             * mu[K - P * (D + 1):].reshape(P, D + 1))
         sc = self.scaler
         slopes = sc.y_std[:, None] * W[:, 1:] / sc.x_std[None, :] * sc.active[None, :]
         intercept = sc.y_mean + sc.y_std * W[:, 0] - slopes @ sc.x_mean

@@ -42,10 +42,11 @@ __all__ = ["LearnOptions", "Learner", "learn_from_tlog", "iter_tlog_records", "G
 #: is None: ``"learned"`` since the twenty-sixth session (i8-live), the replay's default too
 #: (:data:`gcs_sysid.pipeline.GP_NOISE`), so ``listen`` and ``replay`` on the same flight learn the same noise model.
 #: Under the default rule for GP changes (two GP seeds against ``"independent"``, the default until then, at the same
-#: seed) on 66 tuning flights (22 aircraft x light s1-3, streamed through the learner; ``benchmarks/eval_live_jsbsim.py``):
-#: flight x count flips +34/-11 at GPConfig.seed 0 and +33/-12 at seed 1, learned output correlations above 0.5 on
-#: 24 -> 8 and 25 -> 7 flights, 5 aircraft losing a count at both seeds where ``"independent"`` merely reseeded loses
-#: one on 10 (docs/benchmarks.md, "Twenty-sixth session, i8-live"; docs/live.md, "The GP's noise").
+#: seed) on 66 tuning flights (22 aircraft x light s1-3, streamed through the learner;
+#: ``benchmarks/eval_live_jsbsim.py``): flight x count flips +34/-11 at GPConfig.seed 0 and +33/-12 at seed 1, learned
+#: output correlations above 0.5 on 24 -> 8 and 25 -> 7 flights, 5 aircraft losing a count at both seeds where
+#: ``"independent"`` merely reseeded loses one on 10 (docs/benchmarks.md, "Twenty-sixth session, i8-live"; docs/live.md,
+#: "The GP's noise").
 GP_NOISE = "learned"
 
 

@@ -129,7 +129,8 @@ def _lift0(ctx: Context) -> float:
 
 def trim_alpha(ctx: Context, V: float) -> float:
     """1-g trim alpha (rad) at airspeed V (m/s) from the identified CZ_alpha."""
-    return float(ctx.ref["alpha"] + (_lift0(ctx) / max(V, 1.0) ** 2 - _cz(ctx, ctx.ref["alpha"])) / ctx.d[("CZ", "alpha")])
+    return float(ctx.ref["alpha"]
+                 + (_lift0(ctx) / max(V, 1.0) ** 2 - _cz(ctx, ctx.ref["alpha"])) / ctx.d[("CZ", "alpha")])
 
 
 def flight_condition(ctx: Context, center: dict[str, float], axes: tuple[str, ...]) -> tuple[dict[str, Any], str]:
@@ -280,8 +281,8 @@ def design(ctx: Context, kind: str, controls: tuple[str, ...], region: FlaggedRe
         cap = min(room, rate_cap)
         if amps[c] > cap:
             which = "throw" if room <= rate_cap else "surface rate"
-            notes.append(f"{_name(c)} amplitude cut from {math.degrees(amps[c]):.1f} to {math.degrees(max(cap, 0)):.1f} "
-                         f"deg by the {which} limit")
+            notes.append(f"{_name(c)} amplitude cut from {math.degrees(amps[c]):.1f} to "
+                         f"{math.degrees(max(cap, 0)):.1f} deg by the {which} limit")
             amps[c] = cap
     u = {c: amps[c] * unit[c] for c in controls}
     resp = response(models, u, t)

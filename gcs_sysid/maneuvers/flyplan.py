@@ -77,7 +77,8 @@ def plan_document(suggestions: Sequence[Suggestion], name: str = "fly-next", alt
     if duration_s is not None and duration_s < need:
         raise InputError(f"the maneuvers need {need:g} s of flight, more than the {duration_s:g} s asked for")
     doc: dict[str, Any] = {
-        "name": name, "duration_s": float(duration_s) if duration_s is not None else need, "rate_hz": 50.0, "internal_rate_hz": 200.0,
+        "name": name, "duration_s": float(duration_s) if duration_s is not None else need, "rate_hz": 50.0,
+        "internal_rate_hz": 200.0,
         "start_time_s": start_time_s, "seed": int(seed),
         "initial": {"airspeed_mps": round(V0, 2), "altitude_m": altitude_m, "heading_deg": heading_deg},
         "home": {"lat_deg": 47.3977, "lon_deg": 8.5456, "alt_m": ground_m},

@@ -127,11 +127,13 @@ def effective_limits(airframe: Airframe, table: CoefficientTable | None = None,
         if auth[c] <= 0:
             continue
         given = (lim.throw.get(c) if lim else None)
-        throw[c] = pick(f"throw.{c}", given, lambda c=c: max(0.75 * auth[c], min(auth[c], q(c, 0.995) if len(flown.get(c, [])) else 0.0)),
+        throw[c] = pick(f"throw.{c}", given,
+                        lambda c=c: max(0.75 * auth[c], min(auth[c], q(c, 0.995) if len(flown.get(c, [])) else 0.0)),
                         "0.75 x servo travel")
         given = (lim.rate.get(c) if lim else None)
         rate[c] = pick(f"rate.{c}", given,
-                       lambda c=c: max(math.radians(60.0), q(f"rate_{c}", 0.99) if len(flown.get(f"rate_{c}", [])) else 0.0),
+                       lambda c=c: max(math.radians(60.0),
+                                       q(f"rate_{c}", 0.99) if len(flown.get(f"rate_{c}", [])) else 0.0),
                        "99 % quantile of the flown surface rate, at least 60 deg/s")
     if not V_min < V_max:
         raise InputError(f"limits contradict each other: V_min {V_min:.1f} m/s is not below V_max {V_max:.1f} m/s "

@@ -85,7 +85,8 @@ class Suggestion:
     def to_dict(self) -> dict[str, Any]:
         """JSON-able dict (waveform as lists)."""
         r = lambda x: round(float(x), 6)  # noqa: E731
-        fc = {k: ([r(x) for x in v] if isinstance(v, (list, tuple)) else r(v)) for k, v in self.flight_condition.items()}
+        fc = {k: ([r(x) for x in v] if isinstance(v, (list, tuple)) else r(v))
+              for k, v in self.flight_condition.items()}
         return {
             "rank": self.rank, "coefficients": list(self.coefficients), "kind": self.kind,
             "controls": list(self.controls), "surfaces": self.surfaces,
@@ -95,7 +96,8 @@ class Suggestion:
             "pulse_width_s": r(self.pulse_width_s), "duration_s": r(self.duration_s),
             "lead_s": r(self.lead_s), "input_s": r(self.input_s),
             "flight_condition": fc,
-            "expected_reduction": r(self.expected_reduction), "reductions": {k: r(v) for k, v in self.reductions.items()},
+            "expected_reduction": r(self.expected_reduction),
+            "reductions": {k: r(v) for k, v in self.reductions.items()},
             "priority": r(self.priority), "reason": self.reason, "region": self.region,
             "mode_hz": {k: r(v) for k, v in self.mode_hz.items()},
             "band_hz": None if self.band_hz is None else [r(x) for x in self.band_hz],

@@ -45,8 +45,9 @@ def card_fields(s) -> list[tuple[str, str]]:
     out = [("condition", cond), ("input", f"{_kind(s)} on {' + '.join(s.surfaces)}"), ("amplitude", amps),
            ("durations", f"{shape}; {s.lead_s:.0f} s trim before, {s.duration_s:.1f} s in all")]
     if ex:
-        out.append(("expected", f"p {ex['p_max_dps']:.0f} deg/s, q {ex['q_max_dps']:.0f} deg/s, r {ex['r_max_dps']:.0f} "
-                                f"deg/s; alpha {ex['alpha_min_deg']:.1f} to {ex['alpha_max_deg']:.1f} deg; bank "
+        out.append(("expected", f"p {ex['p_max_dps']:.0f} deg/s, q {ex['q_max_dps']:.0f} deg/s, "
+                                f"r {ex['r_max_dps']:.0f} deg/s; alpha {ex['alpha_min_deg']:.1f} to "
+                                f"{ex['alpha_max_deg']:.1f} deg; bank "
                                 f"{ex['bank_max_deg']:.0f} deg; load factor {ex['n_min']:.2f} to {ex['n_max']:.2f} g"))
     region = s.region.get("description") or ", ".join(s.region.get("axes", []))
     out.append(("why", f"{', '.join(s.coefficients)} poorly known at {region} "
@@ -68,7 +69,8 @@ def limit_rows(ctx: dict[str, Any]) -> list[dict[str, str]]:
     rows = [{"limit": "airspeed", "value": f"{lim['V_min_mps']:.1f}-{lim['V_max_mps']:.1f} m/s",
              "from": src.get("V_min", "?") if src.get("V_min") == src.get("V_max") else
              f"{src.get('V_min', '?')}; {src.get('V_max', '?')}"},
-            {"limit": "load factor", "value": f"{lim['n_min']:.2f} to {lim['n_max']:.2f} g", "from": src.get("n_max", "?")},
+            {"limit": "load factor", "value": f"{lim['n_min']:.2f} to {lim['n_max']:.2f} g",
+             "from": src.get("n_max", "?")},
             {"limit": "alpha_max", "value": f"{lim['alpha_max_deg']:.1f} deg", "from": src.get("alpha_max", "?")}]
     for c, v in lim.get("throw_deg", {}).items():
         rows.append({"limit": f"{c} throw / rate",
@@ -80,7 +82,8 @@ def limit_rows(ctx: dict[str, Any]) -> list[dict[str, str]]:
 
 def gate_rows(ctx: dict[str, Any]) -> list[dict[str, str]]:
     """Coefficients not ranked (quality gate), why, and what to fix first."""
-    return [{"coefficient": c, "why not ranked": v["why"], "fix first": v["fix"]} for c, v in ctx.get("gated", {}).items()]
+    return [{"coefficient": c, "why not ranked": v["why"], "fix first": v["fix"]}
+            for c, v in ctx.get("gated", {}).items()]
 
 
 def group_rows(ctx: dict[str, Any]) -> list[dict[str, str]]:
@@ -109,7 +112,8 @@ def cards_markdown(r: ReplayResult, level: int = 2) -> list[str]:
     ctx = context_of(r)
     L = []
     if not r.suggestions:
-        L += ["_No suggestion: nothing flagged, no model fitted, or every flagged coefficient failed the quality gate._", ""]
+        L += ["_No suggestion: nothing flagged, no model fitted, or every flagged coefficient failed the quality "
+              "gate._", ""]
     for s in r.suggestions:
         L += [f"{h}# Card {s.rank}: {_kind(s)} on {' + '.join(s.surfaces)} for {', '.join(s.coefficients)}", ""]
         L += [f"- **{k}**: {v}" for k, v in card_fields(s)] + [""]
@@ -133,7 +137,8 @@ def cards_markdown(r: ReplayResult, level: int = 2) -> list[str]:
 
 
 CARDS_CSS = """
-.card{border:1px solid #1d3557;border-radius:6px;padding:10px 16px;margin:10px 0;background:#fff;page-break-inside:avoid}
+.card{border:1px solid #1d3557;border-radius:6px;padding:10px 16px;margin:10px 0;background:#fff;\
+page-break-inside:avoid}
 .card h3{margin:0 0 6px;font-size:15px;color:#1d3557}.card table{margin:0}.card th{width:110px;background:#eef2f7}
 """
 

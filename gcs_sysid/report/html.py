@@ -27,7 +27,8 @@ nav a{color:#1d3557;margin-right:16px;font-size:13px;text-decoration:none}nav a:
 main{max-width:1280px;margin:0 auto;padding:8px 32px 48px}
 section{background:#fff;border:1px solid #d8dee6;border-radius:6px;padding:16px 22px;margin:18px 0}
 h2{font-size:18px;margin:0 0 12px;color:#1d3557}h3{font-size:15px;margin:18px 0 8px}
-table{border-collapse:collapse;font-size:13px;margin:6px 0 10px}th,td{border-bottom:1px solid #e3e8ee;padding:4px 10px;text-align:left;vertical-align:top}
+table{border-collapse:collapse;font-size:13px;margin:6px 0 10px}\
+th,td{border-bottom:1px solid #e3e8ee;padding:4px 10px;text-align:left;vertical-align:top}
 th{background:#eef2f7;font-weight:600}tr:hover td{background:#fafbfd}
 td.num{text-align:right;font-variant-numeric:tabular-nums}
 img{max-width:100%;height:auto;display:block;margin:8px 0}
@@ -71,7 +72,8 @@ def _numeric(v: str) -> bool:
 
 
 def _kv(pairs: list[tuple[str, str]]) -> str:
-    return "<table>" + "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in pairs) + "</table>"
+    return ("<table>" + "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in pairs)
+            + "</table>")
 
 
 def _section(anchor: str, title: str, body: str) -> str:
@@ -124,10 +126,12 @@ def _suggestions(r: ReplayResult, fig) -> str:
     if not r.suggestions:
         return '<p class="muted">No suggestions: nothing was flagged, or no model was fitted.</p>'
     reasons = "".join(f"<li><strong>#{s.rank}</strong> {html.escape(s.reason)}</li>" for s in r.suggestions)
-    return (_table(tables.suggestion_rows(r)) + "<h3>Why</h3>" + f'<ol class="reasons" style="list-style:none;padding-left:0">{reasons}</ol>'
+    return (_table(tables.suggestion_rows(r)) + "<h3>Why</h3>"
+            + f'<ol class="reasons" style="list-style:none;padding-left:0">{reasons}</ol>'
             + "<h3>Input waveforms (deviation from trim)</h3>" + _img(fig("suggestions"), "waveforms")
             + '<p class="muted">Amplitudes keep the response near-linear (target alpha, q, p, beta excursions) '
-              'and inside the limits (alpha_max, load factor, throw, surface rate); pulse widths follow the mode frequencies (doublet 2.3/w_n, 3-2-1-1 '
+              'and inside the limits (alpha_max, load factor, throw, surface rate); pulse widths follow the mode '
+              'frequencies (doublet 2.3/w_n, 3-2-1-1 '
               '1.6/w_n, Jategaonkar 2006 sec. 2.5). Expected reduction: predictive variance at the region\'s '
               'points after adding the simulated maneuver, relative to now.</p>')
 
@@ -176,7 +180,8 @@ def render_html(r: ReplayResult, path: Path, figures: dict | None = None) -> Pat
         + '<p class="muted">Measured (orange), model mean (blue) with 2-sigma band; held-out segment shaded yellow '
           '(never used for fitting).</p>',
         "errors": "<p>Error = 100 RMS(model - measured) / RMS(measured) on the held-out segment; thesis floor "
-                  f"{tables.THESIS_FLOOR_PCT['forces']} % (forces), {tables.THESIS_FLOOR_PCT['moments']} % (moments).</p>"
+                  f"{tables.THESIS_FLOOR_PCT['forces']} % (forces), "
+                  f"{tables.THESIS_FLOOR_PCT['moments']} % (moments).</p>"
                   + _table(tables.error_rows(r)),
         "model": _model(r, fig),
         "envelope": _envelope(r, fig),

@@ -124,7 +124,8 @@ def states_figure(states: FlightStates, held_out: np.ndarray) -> bytes:
               ("Body rates (deg/s)", [("p", "p"), ("q", "q"), ("r", "r")], 180 / math.pi),
               ("Airspeed (m/s)", [("V", "V true")], 1.0),
               ("Air angles (deg)", [("alpha", "alpha"), ("beta", "beta")], 180 / math.pi),
-              ("Controls (deg)", [("delta_e", "delta_e"), ("delta_a", "delta_a"), ("delta_r", "delta_r")], 180 / math.pi)]
+              ("Controls (deg)", [("delta_e", "delta_e"), ("delta_a", "delta_a"), ("delta_r", "delta_r")],
+               180 / math.pi)]
     fig = Figure(figsize=(10, 9.5))
     fig.subplots_adjust(left=0.08, right=0.93, bottom=0.055, top=0.99, hspace=0.12)
     axes = fig.subplots(len(panels), 1, sharex=True)

@@ -100,7 +100,8 @@ def error_rows(r: ReplayResult) -> list[dict[str, str]]:
             verdict = "no held-out prediction"
         else:
             verdict = "within thesis floor" if e <= floor else "above thesis floor"
-        rows.append({"coefficient": c, "held-out error (%)": fmt(e, 1), "training error (%)": fmt(m.get("error_pct_train"), 1),
+        rows.append({"coefficient": c, "held-out error (%)": fmt(e, 1),
+                     "training error (%)": fmt(m.get("error_pct_train"), 1),
                      "thesis floor (%)": fmt(floor, 1), "RMS measured": fmt(m.get("rms_measured"), 4),
                      "held-out rows": fmt(m.get("n_heldout")), "verdict": verdict})
     return rows
@@ -144,9 +145,11 @@ def suggestion_rows(r: ReplayResult) -> list[dict[str, str]]:
                      "surfaces": " + ".join({"delta_e": "elevator", "delta_a": "aileron", "delta_r": "rudder"}[c]
                                             for c in s.controls),
                      "amplitude (deg)": ", ".join(f"{math.degrees(a):.1f}" for a in s.amplitudes_rad.values()),
-                     "pulse (s)": "-" if s.kind == "multisine" else fmt(s.pulse_width_s, 2), "duration (s)": fmt(s.duration_s, 1),
+                     "pulse (s)": "-" if s.kind == "multisine" else fmt(s.pulse_width_s, 2),
+                     "duration (s)": fmt(s.duration_s, 1),
                      "V (m/s)": fmt(fc.get("V"), 1), "alpha (deg)": fmt(fc.get("alpha_deg"), 1),
-                     "peak p/q/r (deg/s)": "/".join(f"{s.expected[k]:.0f}" for k in ("p_max_dps", "q_max_dps", "r_max_dps"))
+                     "peak p/q/r (deg/s)": "/".join(f"{s.expected[k]:.0f}"
+                                                    for k in ("p_max_dps", "q_max_dps", "r_max_dps"))
                      if s.expected else "-",
                      "load factor (g)": f"{s.expected['n_min']:.2f}-{s.expected['n_max']:.2f}" if s.expected else "-",
                      "expected variance reduction": (f"{100 * s.expected_reduction:.2g} %" if s.expected_reduction < 0.1

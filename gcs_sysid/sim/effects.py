@@ -178,8 +178,8 @@ def effects_from_dict(doc: Mapping[str, Any], source: str = "<plan>") -> Effects
             or a value of the wrong type (the message names the file and key).
     """
     w = f"{source}: [effects]"
-    known = {"aero", "delay_s", "lag_s", "stuck_s", "disable_s", "disable_at", "bias", "scale", "wind_ned", "mass_delta_kg",
-             "inertia_delta", "cg_offset_m"}
+    known = {"aero", "delay_s", "lag_s", "stuck_s", "disable_s", "disable_at", "bias", "scale", "wind_ned",
+             "mass_delta_kg", "inertia_delta", "cg_offset_m"}
     for k in doc:
         if k not in known:
             raise InputError(f"{w} unknown key '{k}' (expected one of {', '.join(sorted(known))})")

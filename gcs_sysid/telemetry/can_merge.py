@@ -312,5 +312,6 @@ def merge_can_log(flight: Flight, log_path: str | Path, can_path: str | Path, of
                          "with; give --can-offset SECONDS (CAN time + offset = vehicle time)")
     else:
         clock = HostClock.fixed(0.0)
-    merged = merge_can_streams(flight, streams, clock, 0.0 if offset is None else float(offset), f"--can-log {can_path}")
+    merged = merge_can_streams(flight, streams, clock, 0.0 if offset is None else float(offset),
+                               f"--can-log {can_path}")
     return replace(merged, warnings=merged.warnings + [note]) if note else merged
