@@ -1,4 +1,5 @@
-"""Where the reconstructed air angles' error comes from, by oracle swaps (attribution only; twenty-fourth session, s23-why).
+"""Where the reconstructed air angles' error comes from, by oracle swaps (attribution only; twenty-fourth session,
+s23-why).
 
 For every flight that ``benchmarks/eval_jsbsim.py`` or the diagnosis eval left in a work directory (``*.tlog`` with its
 ``*-truth.npz``), the replay's estimator is run once with the inputs of the specific-force aiding captured
@@ -9,9 +10,9 @@ for the one fitted on JSBSim's own regressors and coefficient (the same columns,
   air (``u v w`` less the NED wind rotated into body axes, :func:`cg_angles`): the harness logs the CG's motion (GPS,
   IMU at the CG), so the two must agree; and the angles at the aerodynamic reference point (``--arp X Z``, metres
   ahead of and above the CG, :func:`point_angles`), which differ by ``omega x r / V``;
-* ``alpha``: ``main`` (the pipeline), ``CZa`` (the truth's ``CZ_alpha``), ``CZq`` (the truth's ``CZ_q_hat``), ``CZa+CZq``
-  and ``all`` (every CZ slope the truth's); ``beta``: ``main``, ``CYb`` (the truth's ``CY_beta``), ``all``, and
-  ``profile`` (nothing swapped: ``CY_beta`` of the first pass by the gust model's likelihood, the opt-in
+* ``alpha``: ``main`` (the pipeline), ``CZa`` (the truth's ``CZ_alpha``), ``CZq`` (the truth's ``CZ_q_hat``),
+  ``CZa+CZq`` and ``all`` (every CZ slope the truth's); ``beta``: ``main``, ``CYb`` (the truth's ``CY_beta``),
+  ``all``, and ``profile`` (nothing swapped: ``CY_beta`` of the first pass by the gust model's likelihood, the opt-in
   :data:`gcs_sysid.estimation.airangles.BETA_PROFILE`; twenty-fifth session, i8-beta);
 * for each: the error's mean and SD (deg) and its scale ``k``: the aided angle's variations are ``k`` times the true
   ones (:func:`error_stats`; a curvature in the angle then reads ``1 / k^2`` of the truth);
@@ -53,7 +54,8 @@ def error_stats(est: np.ndarray, true: np.ndarray, m: np.ndarray | None = None) 
         ValueError: fewer than 3 rows, or no variation in ``true``.
     """
     est, true = np.asarray(est, float), np.asarray(true, float)
-    m = np.isfinite(est) & np.isfinite(true) if m is None else np.asarray(m, bool) & np.isfinite(est) & np.isfinite(true)
+    m = (np.isfinite(est) & np.isfinite(true) if m is None
+         else np.asarray(m, bool) & np.isfinite(est) & np.isfinite(true))
     if m.sum() < 3:
         raise ValueError("error_stats: fewer than 3 rows")
     e, x = est[m] - true[m], true[m] - true[m].mean()
@@ -129,12 +131,14 @@ def shares(tlog: Path, aircraft: str, arp: tuple[float, float] | None = None,
     tr = load_truth(tlog.with_name(tlog.stem + "-truth.npz"))
     out = [f"{tlog.stem}:"]
     ac, bc = cg_angles(tr.fields)
-    line = (f"  harness: JSBSim alpha/beta - CG air angles RMS {np.degrees(np.sqrt(np.mean((ac - tr.fields['alpha'])**2))):.4f}"
+    line = (f"  harness: JSBSim alpha/beta - CG air angles RMS "
+            f"{np.degrees(np.sqrt(np.mean((ac - tr.fields['alpha'])**2))):.4f}"
             f" / {np.degrees(np.sqrt(np.mean((bc - tr.fields['beta'])**2))):.4f} deg")
     if arp is not None:
         ap, bp = point_angles(tr.fields, (arp[0], 0.0, -arp[1]))
         line += (f"; at the reference point ({arp[0]:.2f} m ahead, {arp[1]:.2f} m above) - CG: RMS "
-                 f"{np.degrees(np.sqrt(np.mean((ap - ac)**2))):.4f} / {np.degrees(np.sqrt(np.mean((bp - bc)**2))):.4f} deg")
+                 f"{np.degrees(np.sqrt(np.mean((ap - ac)**2))):.4f} / "
+                 f"{np.degrees(np.sqrt(np.mean((bp - bc)**2))):.4f} deg")
     out.append(line)
     t, dt, use = st.t, args[0], args[12]
     Xi = np.stack([np.interp(t, tr.t, x, left=np.nan, right=np.nan) for x in tr.X.T], 1)

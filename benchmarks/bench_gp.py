@@ -227,14 +227,17 @@ def main(argv=None):
     print("\nsummary")
     b = results["baseline:1000"]
     print(f"  N=1000 condition+predict 500: exact dense {b['exact_s']:.3f} s, sparse M=128 {b['sparse_s']:.3f} s, "
-          f"ratio {b['ratio_exact_over_sparse']:.1f}x; held-out error exact {b['exact_err_pct']} sparse {b['sparse_err_pct']}")
+          f"ratio {b['ratio_exact_over_sparse']:.1f}x; held-out error exact {b['exact_err_pct']} "
+          f"sparse {b['sparse_err_pct']}")
     for n in sizes:
         r = results[f"size:{n}"]
         print(f"  N={n:>6}: cold fit {r['cold_fit_s']:.1f} s, fit {r['fit_s']:.1f} s (median of {repeats}), "
-              f"predict {r['predict_s']:.2f} s, peak RSS {r['peak_rss_mib']:.0f} MiB, held-out error % {r['err_heldout_pct']}")
+              f"predict {r['predict_s']:.2f} s, peak RSS {r['peak_rss_mib']:.0f} MiB, "
+              f"held-out error % {r['err_heldout_pct']}")
     s = results["selection:3000"]
     for k, v in ((k, v) for k, v in s.items() if isinstance(v, dict)):
-        print(f"  inducing by {k:>6}: ELBO {v['elbo_median']:.1f}, mean held-out error {v['mean_err_pct_median']:.2f} %")
+        print(f"  inducing by {k:>6}: ELBO {v['elbo_median']:.1f}, "
+              f"mean held-out error {v['mean_err_pct_median']:.2f} %")
     r = results["ranking:10000"]
     print(f"  ranking {r['candidates']} maneuvers: batched {r['batched_s']:.3f} s, exact variance_after "
           f"{r['exact_per_candidate_s']:.3f} s each (~{r['exact_all_s_estimate']:.1f} s), ratio {r['ratio']:.0f}x, "

@@ -171,7 +171,8 @@ def run_envelope(n: int = 28600) -> dict:
     return {"rows_flown": int(flown.sum()), "rows_new": len(train_new), "held_out_new": len(test),
             "err_before_pct": before.round(2).tolist(), "err_streamed_pct": streamed.round(2).tolist(),
             "err_refreshed_pct": refreshed.round(2).tolist(), "err_refit_pct": full.round(2).tolist(),
-            "ratio_streamed": float(streamed.mean() / full.mean()), "ratio_refreshed": float(refreshed.mean() / full.mean()),
+            "ratio_streamed": float(streamed.mean() / full.mean()),
+            "ratio_refreshed": float(refreshed.mean() / full.mean()),
             "stream_cpu_s": stream_cpu, "stream_wall_s": stream_wall, "refresh_cpu_s": refresh_cpu,
             "refresh_wall_s": refresh_wall, "refit_cpu_s": refit_cpu, "refit_wall_s": refit_wall,
             "refresh_over_refit_cpu": refresh_cpu / refit_cpu,
@@ -197,8 +198,8 @@ def run_refresh_grid(n: int = 28600) -> dict:
     refit_cpu = time.process_time() - c0
     full = error_pct(refit.predict(X[test])[0], Yt[test])
     out = {"refit_cpu_s": refit_cpu, "err_refit_pct": full.round(2).tolist(), "variants": []}
-    variants = [None, RefreshBudget(), RefreshBudget(40, 400, 40), RefreshBudget(80, 400, 40), RefreshBudget(20, 1000, 40),
-                RefreshBudget(40, 400, 10), RefreshBudget(40, 400, 0)]
+    variants = [None, RefreshBudget(), RefreshBudget(40, 400, 40), RefreshBudget(80, 400, 40),
+                RefreshBudget(20, 1000, 40), RefreshBudget(40, 400, 10), RefreshBudget(40, 400, 0)]
     for b in variants:
         if b is not None:   # compile this budget's shapes first
             light_refresh(model, RefreshBudget(2, b.rows, min(2, b.local_steps)))
@@ -243,20 +244,24 @@ def main(argv=None):
         res = json.loads(out.stdout.strip().splitlines()[-1])
         print(f"{kind}: {json.dumps(res)}", flush=True)
         if kind == "latency":
-            print(f"  update of 50 rows at M=256: median {res['update_median_ms']:.1f} ms, p95 {res['update_p95_ms']:.1f} ms"
+            print(f"  update of 50 rows at M=256: median {res['update_median_ms']:.1f} ms, "
+                  f"p95 {res['update_p95_ms']:.1f} ms"
                   f" -> {res['per_sample_median_ms']:.3f} ms per sample (mean {res['per_sample_mean_ms']:.3f});"
                   f" predict 1000 rows after an update {res['first_predict_1000_s']:.2f} s (posterior + tree), again"
                   f" {res['next_predict_1000_s']:.2f} s; refresh {res['refresh_s']:.1f} s, light "
-                  f"{res['light_refresh_s']:.1f} s; fit on 3,000 rows {res['fit_3000_cpu_s']:.1f} CPU s ({res['gp_noise']})")
+                  f"{res['light_refresh_s']:.1f} s; fit on 3,000 rows {res['fit_3000_cpu_s']:.1f} CPU s "
+                  f"({res['gp_noise']})")
         elif kind == "envelope":
             print(f"  new region: before {res['err_before_pct']}, streamed {res['err_streamed_pct']} (mean ratio to "
-                  f"refit {res['ratio_streamed']:.2f}, CPU {res['stream_cpu_s']:.1f} s for {res['rows_new']} rows), + refresh "
+                  f"refit {res['ratio_streamed']:.2f}, CPU {res['stream_cpu_s']:.1f} s for {res['rows_new']} rows), "
+                  f"+ refresh "
                   f"{res['err_refreshed_pct']} (ratio {res['ratio_refreshed']:.2f}, CPU {res['refresh_cpu_s']:.1f} s), "
                   f"full refit {res['err_refit_pct']} (CPU {res['refit_cpu_s']:.1f} s)")
             for k in ("light", "light_reselect"):
                 print(f"  {k} refresh {res[k + '_budget']}: {res[k + '_err_pct']} (ratio to refit "
                       f"{res[k + '_ratio_to_refit']:.2f}), CPU {res[k + '_cpu_s']:.2f} s = "
-                      f"{res[k + '_cpu_over_refit']:.2f} of the refit (full refresh: {res['refresh_over_refit_cpu']:.2f})")
+                      f"{res[k + '_cpu_over_refit']:.2f} of the refit "
+                      f"(full refresh: {res['refresh_over_refit_cpu']:.2f})")
         elif kind == "refresh":
             for v in res["variants"]:
                 print(f"  refresh {v['budget']}: {v['err_pct']} (error / refit {v['err_over_refit']:.2f}), CPU "
@@ -264,7 +269,8 @@ def main(argv=None):
         else:
             for p in res["points"]:
                 print(f"  {p['rows_seen']:>7} rows: RSS {p['rss_mib']:.0f} MiB, stored {p['rows_stored']}, saved "
-                      f"{p['saved_kib']:.0f} KiB, held-out mean error {p['mean_err_pct']:.2f} %, {p['elapsed_s']:.0f} s")
+                      f"{p['saved_kib']:.0f} KiB, held-out mean error {p['mean_err_pct']:.2f} %, "
+                      f"{p['elapsed_s']:.0f} s")
 
 
 if __name__ == "__main__":

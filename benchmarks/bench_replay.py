@@ -10,8 +10,8 @@ It simulates the flight once (cached in benchmarks/out/), then alternates: a bar
 ``run_replay`` (decode, estimation, coefficients, GP fit and prediction, confidence map,
 suggestions, report), each in a fresh subprocess so that JAX compilation and imports count and the
 peak resident memory of each run can be read: the replay's own and its worker process's
-(:mod:`gcs_sysid.parallel`), and their sum sampled every 10 ms (what the replay held at once). ``--serial`` also times the
-replay without its worker. Medians and the ratio are printed.
+(:mod:`gcs_sysid.parallel`), and their sum sampled every 10 ms (what the replay held at once). ``--serial`` also
+times the replay without its worker. Medians and the ratio are printed.
 
 JAX's persistent compilation cache (:func:`gcs_sysid.jaxconfig.enable_compilation_cache`) decides
 whether a replay compiles its GP programs or loads them, so the script says which it measured: by
@@ -223,7 +223,8 @@ def main() -> None:
     # the two peaks need not coincide: their sum bounds what the replay held; the sampled total is what it held
     print(f"peak RSS               {peak_tree:7.0f} MiB main and worker together, sampled (target < 1024 MiB); "
           f"separate peaks {peak_main:.0f} + {peak_worker:.0f} MiB")
-    print(f"load average at the end {os.getloadavg()[0]:.1f} (2-core box shared with other jobs: read ratios, not seconds)")
+    print(f"load average at the end {os.getloadavg()[0]:.1f} "
+          f"(2-core box shared with other jobs: read ratios, not seconds)")
     if cold_root is not None:
         import shutil
 

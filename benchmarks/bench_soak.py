@@ -21,8 +21,9 @@ RSS is sampled every 10 s of wall time: VmRSS of this process (listener, sender,
 it runs here) plus, when the learner runs in the spare worker process (the default where there are
 two CPUs, ``docs/live.md``), that worker's VmRSS read from ``/proc/PID/status``; the criterion is on
 the sum, so moving the learner out of the listening process cannot hide its memory. ``--in-process``
-runs the learner in this process instead. The curve is printed (messages received, vehicle time covered, RSS), with the growth from the end of the
-first tenth of the run (JAX programs compiled, first GP fit, store filling) to the end and the largest
+runs the learner in this process instead. The curve is printed (messages received, vehicle time covered, RSS),
+with the growth from the end of the first tenth of the run (JAX programs compiled, first GP fit, store filling) to
+the end and the largest
 RSS after it.
 """
 

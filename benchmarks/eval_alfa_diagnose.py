@@ -68,7 +68,8 @@ def main() -> None:
                   f"gain {f['gain'].get('percent', 0):.0f} % onset {f.get('onset_s', '')}")
         for u in doc["unexplained"]:
             if u["above_threshold"]:
-                print(f"   unexplained {u['coefficient']}: rms {u['rms']:.3g}, structured {u['structured_percent']:.0f} %, "
+                print(f"   unexplained {u['coefficient']}: rms {u['rms']:.3g}, "
+                      f"structured {u['structured_percent']:.0f} %, "
                       f"worst time {u['where']['time_s']}")
         for s in doc["data"].get("notes", []):
             if "left out" in s or "not identifiable" in s:

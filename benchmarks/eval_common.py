@@ -17,7 +17,8 @@ __all__ = ["AIRCRAFT_HELP", "append_jsonl", "read_lines"]
 
 #: ``--aircraft`` help of the scripts that fly the harness's aircraft by name (``aircraft_argument``).
 AIRCRAFT_HELP = ("harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
-                 "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim model names (J3Cub, "
+                 "c684 ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim model names "
+                 "(J3Cub, "
                  "T37, "
                  "t6texan2, B747, "
                  "f16_direct, "

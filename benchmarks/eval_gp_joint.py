@@ -28,7 +28,8 @@ flight, as the replay takes them) are cut to their first ``L`` seconds (``--leng
                  removed inside the fit (before the blocked validation and the posterior), eighteenth session
     ``decnta``   the same with the stride from the training residual's decorrelation time (``hyper_stride=0``;
                  ``pipeline.DECORRELATED_GP``)
-    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``, ``decnt`` for ``jointnt``
+    ``decn``     the same for ``jointn`` (``B`` and the noise covariance diagonal); ``decnf`` for ``jointnf``,
+                 ``decnt`` for ``jointnt``
     ``indep``    six one-output GPs, ``GPConfig()`` each (each its own length-scales and noise)
     ``jointsel`` per output ``joint`` or that output's ``indep`` GP, whichever has the lower blocked
                  cross-validation error on the training rows (``gp.joint.select_outputs``, 5 time blocks,
@@ -82,20 +83,26 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.eval_common import append_jsonl  # noqa: E402
-from benchmarks.eval_gp_jsbsim import (CARRIES, MOMENTS, TRUTH_NONE, _correlations, add_flight_args, errors,  # noqa: E402
-                                       make, missing_rows)
+from benchmarks.eval_gp_jsbsim import (  # noqa: E402
+    CARRIES, MOMENTS, TRUTH_NONE, _correlations, add_flight_args, errors, make, missing_rows)
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
 from gcs_sysid.gp import GPConfig, fit_gp  # noqa: E402
 from gcs_sysid.gp.joint import SelectedOutputs, decoupled_model, forward_errors, select_outputs  # noqa: E402
 
 PATTERNS = ("none", "rates", "block")
-ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt", "dec", "decn", "decnf", "decnt", "decntc", "decnta", "indep", "jointsel", "jointself", "jointse", "jointfwd", "lmc")
+ISO_MODELS = ("joint", "joint0", "jointv", "jointvn", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf",
+              "jointnt", "dec", "decn", "decnf", "decnt", "decntc", "decnta", "indep", "jointsel", "jointself",
+              "jointse", "jointfwd", "lmc")
 HET_MODELS = ("hjoint", "hdec", "hdrop", "hindep")
 #: the comparisons ``--summarize`` counts: (model, against, pattern)
 PAIRS = (("joint", "indep", "none"), ("joint0", "indep", "none"), ("joint", "joint0", "none"),
          ("jointv", "indep", "none"), ("jointv", "joint", "none"),
-         ("jointvn", "indep", "none"), ("jointvn", "joint", "none"), ("jointself", "indep", "none"), ("jointself", "joint", "none"), ("jointse", "indep", "none"), ("jointse", "joint", "none"), ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
-         ("jointsel", "indep", "none"), ("jointsel", "joint", "none"), ("jointa", "indep", "none"), ("jointa", "joint", "none"),
+         ("jointvn", "indep", "none"), ("jointvn", "joint", "none"),
+         ("jointself", "indep", "none"), ("jointself", "joint", "none"),
+         ("jointse", "indep", "none"), ("jointse", "joint", "none"),
+         ("jointfwd", "indep", "none"), ("jointfwd", "joint", "none"),
+         ("jointsel", "indep", "none"), ("jointsel", "joint", "none"),
+         ("jointa", "indep", "none"), ("jointa", "joint", "none"),
          ("jointk", "indep", "none"), ("jointk", "joint", "none"),
          ("jointf", "indep", "none"), ("jointf", "joint", "none"),
          ("jointo", "indep", "none"), ("jointo", "joint", "none"),
@@ -296,12 +303,14 @@ def summarize(paths) -> str:
                     if s:
                         lines.append(f"| {'all' if L <= 0 else f'{L:g} s'} | {tb} | {s} |")
             if lines:
-                out += [f"\n{a} vs {b}, pattern {pattern}, {what} (better / worse by > 0.05 points / within; medians)\n",
+                out += [f"\n{a} vs {b}, pattern {pattern}, {what} "
+                        f"(better / worse by > 0.05 points / within; medians)\n",
                         "| training | turbulence | pairs |", "|---|---|---|"] + lines
     # joint vs indep per aircraft and length, forces and moments apart (where the shared kernel helps or costs)
     out += ["\njoint (and jointa) vs indep per aircraft (both turbulence levels; better / worse / within; medians)\n",
             "| model | aircraft | training | forces CX CY CZ | moments Cl Cm Cn |", "|---|---|---|---|---|"]
-    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo"):
+    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa",
+              "jointk", "jointf", "jointo"):
         for ac in sorted({r["aircraft"] for r in rows}):
             for L in lengths:
                 g = (lambda r, L=L, ac=ac: r["length"] == L and r["aircraft"] == ac)
@@ -312,8 +321,8 @@ def summarize(paths) -> str:
     # learned correlations above 0.5 where the truth's nonlinear parts have none (< 0.2)
     out.append("\nlearned |corr| > 0.5 where the truth's < 0.2 (pairs flagged / of which both carrying / pairs)\n")
     out += ["| model | training | flagged | carrying | pairs |", "|---|---|---|---|---|"]
-    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa", "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt",
-              "lmc", "hjoint"):
+    for v in ("joint", "joint0", "jointv", "jointvn", "jointself", "jointse", "jointfwd", "jointsel", "jointa",
+              "jointk", "jointf", "jointo", "jointn", "jointnf", "jointnt", "lmc", "hjoint"):
         for L in lengths:
             rs = [r for r in rows if r["variant"] == v and r["length"] == L and "flags" in r]
             if rs:

@@ -23,7 +23,8 @@ Variants (``--variants``): ``diag`` the GP with one noise variance per output (b
 ``full`` with the full 6 x 6 noise covariance in the likelihood (``GPConfig.noise_correlation``),
 ``nigp`` = ``full`` + the input-noise variance (``docs/gp.md``, "Noisy inputs"; the shipped
 default is the input noise without ``full``, for the replay's speed; with the coupling gate, on by default since
-the sixteenth session), ``nigp0`` = ``nigp`` without the coupling gate (the default before), ``global`` = ``nigp`` without the local layer, ``lsres`` = ``nigp`` fitted to the residual
+the sixteenth session), ``nigp0`` = ``nigp`` without the coupling gate (the default before), ``global`` = ``nigp``
+without the local layer, ``lsres`` = ``nigp`` fitted to the residual
 of the least-squares model (LS as the prior mean), ``indep`` six
 independent one-output GPs (same settings, each its own hyperparameters), ``lmc`` = ``nigp`` with a
 linear model of coregionalisation of two latent kernels (``GPConfig.latent_kernels = 2``: per-output
@@ -133,7 +134,8 @@ from gcs_sysid.jaxconfig import limit_blas_threads  # noqa: E402
 from gcs_sysid.gp.joint import (correlation, decoupled_model, nonlinear_part, select_outputs,  # noqa: E402
                                 truth_correlation)
 
-VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc", "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "nigpu", "ls")
+VARIANTS = ("diag", "full", "nigp", "nigp0", "nigpd", "nigpnf", "global", "lsres", "indep", "lmc", "lmc3", "nigpc",
+            "dec", "sel", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "nigpu", "ls")
 
 #: |truth correlation| below which the truth "has none" (the flags of the joint variants)
 TRUTH_NONE = 0.2
@@ -250,7 +252,8 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True, noise_start="noise")
     if variant == "nigpv":
         return replace(base, noise_correlation=True, input_noise=True, coupling_validation=True)
-    if variant == "nigpa":        # the longitudinal and lateral outputs' factors of B kept apart (GPConfig.output_groups)
+    # the longitudinal and lateral outputs' factors of B kept apart (GPConfig.output_groups)
+    if variant == "nigpa":
         return replace(base, noise_correlation=True, input_noise=True, output_groups="axes")
     if variant == "nigpk":        # one latent kernel per output group (GPConfig.output_groups="kernels")
         return replace(base, noise_correlation=True, input_noise=True, output_groups="kernels")
@@ -258,11 +261,13 @@ def _config(variant: str, base: GPConfig) -> GPConfig:
         return replace(base, noise_correlation=True, input_noise=True, output_groups="kernels-free")
     if variant == "nigpo":        # one kernel per output, loading on its axis (GPConfig.output_groups="output-kernels")
         return replace(base, noise_correlation=True, input_noise=True, output_groups="output-kernels")
-    if variant == "nigpr":        # nigp with B and the noise covariance learned again on every row (GPConfig.coupling_rows)
+    # nigp with B and the noise covariance learned again on every row (GPConfig.coupling_rows)
+    if variant == "nigpr":
         return replace(base, noise_correlation=True, input_noise=True, coupling_rows="all")
     if variant == "nigpt":        # nigp, coupling kept where the every-row bound supports it (GPConfig.coupling_test;
         return replace(base, noise_correlation=True, input_noise=True, coupling_test="lr")   # the default since s22)
-    if variant == "nigpu":        # nigp with B's couplings as learned, untested (the default until the twenty-second session)
+    # nigp with B's couplings as learned, untested (the default until the twenty-second session)
+    if variant == "nigpu":
         return replace(base, noise_correlation=True, input_noise=True, coupling_test="none")
     if variant == "nigpc":
         return replace(base, noise_correlation=True, input_noise=True, residual_correlation=True)
@@ -337,7 +342,8 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
     def indep_fit():          # six one-output GPs, shared by indep and sel
         if "indep" not in memo:
             cfg = _config("indep", base)
-            memo["indep"] = [with_offset_covariance(fit_gp(X[tr], Y[tr][:, [p]], cfg, output_names=[COEFFICIENTS[p]])[0], off)
+            memo["indep"] = [with_offset_covariance(fit_gp(X[tr], Y[tr][:, [p]], cfg,
+                                                           output_names=[COEFFICIENTS[p]])[0], off)
                              for p in range(Y.shape[1])]
         return memo["indep"]
 
@@ -381,12 +387,13 @@ def score(path: Path, variants, base: GPConfig = GPConfig(), thin: int | None = 
             else:
                 model, hist = fit_gp(X[tr], (Y - prior)[tr], _config(v, base))
                 model = with_offset_covariance(model, off)
-                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt", "nigpu"):
+                if v in ("nigp0", "nigpd", "nigpnf", "nigpv", "nigpa", "nigpk", "nigpf", "nigpo", "nigpr", "nigpt",
+                         "nigpu"):
                     extra = _correlations(model, X[tr], Xt[tr], Yt[tr])
             validation = hist.validation
             m, var = held(model.predict, include_noise=False)
             mean, sig = m + prior[h], np.sqrt(var)
-            sig_n = np.sqrt(held(model.predict)[1])                         # with the observation noise (the replay's band)
+            sig_n = np.sqrt(held(model.predict)[1])         # with the observation noise (the replay's band)
             # with the global layer's noise variance sigma_p^2 (the likelihood's) instead of the local nugget
             sig_g = np.sqrt(var + np.asarray(model.params.noise)[None, :] * model.scaler.y_std**2)
             c = model.output_correlation()
@@ -586,7 +593,8 @@ def diagnose(path: Path) -> str:
     A = np.column_stack([np.ones(len(X)), (X - X[tr].mean(0)) / np.where(sd > 0, sd, 1.0)])
     lon, lat = [1, 4, 6, 9, 10], [2, 3, 5, 7, 8]          # columns of A (1 + regressor index)
     out = []
-    for name, cols in (("all", [list(range(11))] * 6), ("sub", [[0] + (lon if p in (0, 2, 4) else lat) for p in range(6)])):
+    for name, cols in (("all", [list(range(11))] * 6),
+                       ("sub", [[0] + (lon if p in (0, 2, 4) else lat) for p in range(6)])):
         Wo = [np.linalg.lstsq(A[tr][:, c], Y[tr][:, p], rcond=None)[0] for p, c in enumerate(cols)]
         res = np.column_stack([Y[tr][:, p] - A[tr][:, c] @ w for p, (c, w) in enumerate(zip(cols, Wo))])
         Si = np.linalg.inv(np.cov(res.T))
@@ -629,21 +637,31 @@ def summarize(paths) -> str:
             return f"{np.median(vals):.0f} ({min(vals):.0f}-{max(vals):.0f})" if vals else ""
         corr = float(np.nanmedian([r["max_corr"] for r in rs]))
         name = summary_label(ac)
-        out.append(f"| {name} | {turb} | {aoa} | {v} | {len(rs)} | " + " | ".join(f"{med('err', c):.1f}" for c in COEFFICIENTS)
+        out.append(f"| {name} | {turb} | {aoa} | {v} | {len(rs)} | "
+                   + " | ".join(f"{med('err', c):.1f}" for c in COEFFICIENTS)
                    + f" | {cov('cov')} | {cov('cov_noise')} | {cov('cov_gnoise')} | {cov('cov_true')} | "
                    + f"{'' if np.isnan(corr) else f'{corr:.2f}'} |")
     # pairwise: joint (full) vs independent, GP vs least squares, per flight and coefficient
     by = {}
     for r in rows:
         by.setdefault((r["aircraft"], r["seed"], r["turbulence"], r["aoa"]), {})[r["variant"]] = r
-    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"), ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"), ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"), ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"), ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"), ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"), ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("nigpt", "nigp"), ("nigpt", "indep"), ("nigpt", "ls"), ("nigp", "nigpu"), ("nigpu", "indep"), ("lmc", "indep"), ("lmc3", "indep"), ("lmc", "nigp"),
+    for a, b in (("full", "indep"), ("nigp", "indep"), ("nigp0", "indep"), ("nigp", "nigp0"), ("nigp0", "ls"),
+                 ("nigpd", "indep"), ("nigpnf", "indep"), ("nigp", "nigpd"), ("nigpnf", "nigpd"), ("nigpnf", "nigp"),
+                 ("nigpd", "ls"), ("nigpnf", "ls"), ("dec", "nigp"), ("dec", "indep"), ("sel", "indep"),
+                 ("sel", "nigp"), ("nigpv", "nigp"), ("nigpv", "indep"), ("nigpa", "nigp"), ("nigpa", "indep"),
+                 ("nigpa", "ls"), ("nigpk", "nigp"), ("nigpk", "indep"), ("nigpk", "ls"), ("nigpf", "nigp"),
+                 ("nigpf", "indep"), ("nigpf", "ls"), ("nigpo", "nigp"), ("nigpo", "indep"), ("nigpo", "ls"),
+                 ("nigpr", "nigp"), ("nigpr", "indep"), ("nigpr", "ls"), ("nigpt", "nigp"), ("nigpt", "indep"),
+                 ("nigpt", "ls"), ("nigp", "nigpu"), ("nigpu", "indep"), ("lmc", "indep"), ("lmc3", "indep"),
+                 ("lmc", "nigp"),
                  ("lmc3", "nigp"), ("full", "ls"), ("nigp", "ls"), ("lmc", "ls"), ("lmc3", "ls"), ("full", "diag"),
                  ("nigp", "diag"), ("diag", "ls")):
         pairs = [(f[a]["err"][c], f[b]["err"][c]) for f in by.values() if a in f and b in f for c in COEFFICIENTS]
         if pairs:
             wins = sum(x < y for x, y in pairs)
             out.append(f"\n{a} better than {b}: {wins} of {len(pairs)} flight x coefficient pairs "
-                       f"(median error {np.median([x for x, _ in pairs]):.1f} vs {np.median([y for _, y in pairs]):.1f} %)")
+                       f"(median error {np.median([x for x, _ in pairs]):.1f} vs "
+                       f"{np.median([y for _, y in pairs]):.1f} %)")
     return "\n".join(out)
 
 
@@ -710,13 +728,15 @@ def main(argv=None) -> int:
                             print(f"{path.stem:26s} {r['pattern']:5s} {r['variant']:6s} err "
                                   + " ".join(f"{r['err'][c]:6.2f}" for c in COEFFICIENTS) + "  region "
                                   + " ".join(f"{r['err_region'][c]:6.2f}" for c in COEFFICIENTS) + "  gap "
-                                  + " ".join(f"{r['err_gap'][c]:6.2f}" for i, c in enumerate(COEFFICIENTS) if i in MOMENTS)
+                                  + " ".join(f"{r['err_gap'][c]:6.2f}" for i, c in enumerate(COEFFICIENTS)
+                                             if i in MOMENTS)
                                   + f"  ({r['n_missing']} of {r['n_train']} missing, {r['n_region']} held-out "
                                   f"rows in region)  {r['t_fit_s']:.1f} s", flush=True)
                             append_jsonl(a.json, [r])
                         continue
                     for r in score(path, a.variants, thin=a.thin, air_roll=a.air_roll == "on"):
-                        print(f"{path.stem:26s} {r['variant']:6s} err " + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
+                        print(f"{path.stem:26s} {r['variant']:6s} err "
+                              + " ".join(f"{r['err'][c]:6.1f}" for c in COEFFICIENTS)
                               + "  cov " + " ".join(f"{r['cov'][c]:5.1f}" for c in COEFFICIENTS)
                               + f"  corr {r['max_corr']:.2f}  {r['t_fit_s']:.1f} s", flush=True)
                         for k in ("err_true", "cov_true", "cov_true_latent", "cov_true_noise", "cov_noise"):

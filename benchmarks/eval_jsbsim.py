@@ -52,8 +52,8 @@ session's) and ``rascal`` (ArduPilot's SITL Rascal 110 without its propeller, ``
 accepted; the thirteenth session's) and ``sgs126`` (JSBSim's Schweizer SGS 1-26 glider at 3000 ft; the
 fourteenth session's) and ``asw20`` (FlightGear's ASW 20 sailplane at 3000 ft, ``asw20_glide`` also accepted; the
 fifteenth session's) and ``iar80`` (FlightGear's JSBSim IAR-80 fighter without its propeller at 10000 ft,
-``IAR80_glide`` also accepted; the sixteenth session's) and ``c684`` (FlightGear's JSBSim Caudron C.684 racer without its
-propeller at 6000 ft, ``C684_glide`` also accepted; the seventeenth session's) and ``ultrastick`` (the University of
+``IAR80_glide`` also accepted; the sixteenth session's) and ``c684`` (FlightGear's JSBSim Caudron C.684 racer without
+its propeller at 6000 ft, ``C684_glide`` also accepted; the seventeenth session's) and ``ultrastick`` (the University of
 Minnesota UAS Lab's JSBSim Ultra Stick 120 UAV without propulsion at 10000 ft, ``UltraStick120_glide`` also
 accepted; the eighteenth session's) and ``b737`` (JSBSim's stock Boeing 737, engines shut down, its own yaw damper in
 the loop, at 12000 ft; ``737`` also accepted; the nineteenth session's) and ``c172p`` (JSBSim's stock Cessna 172P,
@@ -69,9 +69,10 @@ Navion, the wheel's ``L17``, engine removed, gear up, at 10000 ft; ``Navion_glid
 session's). ``fokker50`` (JSBSim's Fokker 50 twin-turboprop airliner, engines, propwash terms and yaw damper
 removed, gear up, at 10000 ft; ``Fokker50_glide`` also accepted) is the held-out, untouched one: never in the default
 list, evaluated once after the thresholds are frozen.
-A flight already in ``--work``, flown by the same harness with the same configuration, is reused (``make_flight(reuse=True)``:
-``<stem>-flight.json`` records the configuration and the harness fingerprint); ``--fly-only`` flies
-(or finds) the flights there and stops. Results are appended as JSON lines to ``--json`` when given.
+A flight already in ``--work``, flown by the same harness with the same configuration, is reused
+(``make_flight(reuse=True)``: ``<stem>-flight.json`` records the configuration and the harness fingerprint);
+``--fly-only`` flies (or finds) the flights there and stops. Results are appended as JSON lines to ``--json`` when
+given.
 """
 
 from __future__ import annotations
@@ -138,7 +139,8 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
 
     ys2 = model.scaler.y_std ** 2
     scale = 100.0 / np.sqrt(np.mean(np.asarray(ref) ** 2, axis=0))
-    pct = lambda v: (scale * np.sqrt(np.nanmean(np.broadcast_to(v, np.shape(ref)), axis=0))).round(3).tolist()  # noqa: E731
+    pct = lambda v: (scale * np.sqrt(np.nanmean(np.broadcast_to(v, np.shape(ref)),  # noqa: E731
+                                                axis=0))).round(3).tolist()
     Xs, Xts = model.scaler.x(np.asarray(X)), model.scaler.x(np.asarray(X_true))
     if x_var is not None and model.n_mean_only:          # nothing stated for the mean-only inputs
         x_var = model.full_inputs(x_var, "x_var", np.nan)
@@ -341,7 +343,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     st.data.update(saved)
     row["meas_true_accel"] = _errs(tab_acc.Y[ok], Yt[ok])
     rms = np.sqrt(np.mean(Yt[h] ** 2, axis=0))
-    row["meas_offset"] = {c: float(100.0 * np.mean(tab.Y[h, i] - Yt[h, i]) / rms[i]) for i, c in enumerate(COEFFICIENTS)}
+    row["meas_offset"] = {c: float(100.0 * np.mean(tab.Y[h, i] - Yt[h, i]) / rms[i])
+                          for i, c in enumerate(COEFFICIENTS)}
     from gcs_sysid.estimation import estimate_states
     from gcs_sysid.telemetry import read_log
 
@@ -350,14 +353,16 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["meas_flat"] = _errs(tab_flat.Y[h], Yt[h])
     row["gp"] = _errs(res.pred_mean[h], Yt[h])
     # the coefficient's band (no white measurement noise; the truth carries none) and a measurement's band
-    row["cov_gp"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]))
+    row["cov_gp"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i])
+                                      for i in range(6)]))
     row["cov_gp_obs"] = float(np.nanmean([_coverage(res.pred_mean[h, i], res.pred_sigma_obs[h, i], Yt[h, i])
                                           for i in range(6)]))
     row["cov_gp_obs_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma_obs[h, i], Yt[h, i]) for i in range(6)]
     model = load_gp(Path(res.model_path))
     if hasattr(model, "output_correlation"):
         # the largest learned correlation between two outputs' latent parts (issue 8: none above 0.5 where the
-        # truth has none); gcs_sysid.pipeline.GP_COUPLING_TEST "lr" (the default) drops B's couplings the data do not support
+        # truth has none); gcs_sysid.pipeline.GP_COUPLING_TEST "lr" (the default) drops B's couplings the data
+        # do not support
         C = np.abs(np.asarray(model.output_correlation(), float))
         np.fill_diagonal(C, 0.0)
         row["max_corr"] = float(np.nanmax(C)) if C.size else 0.0
@@ -380,7 +385,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         Xg = np.c_[tab.X, ade]
         ok_a = ok & np.isfinite(adt)
         row["alpha_dot_hat"] = {"rms": float(np.std(adt[ok_a])),
-                                "err_pct": float(100 * np.sqrt(np.mean((ade[ok_a] - adt[ok_a]) ** 2)) / np.std(adt[ok_a])),
+                                "err_pct": float(100 * np.sqrt(np.mean((ade[ok_a] - adt[ok_a]) ** 2))
+                                                 / np.std(adt[ok_a])),
                                 "corr": float(np.corrcoef(ade[ok_a], adt[ok_a])[0, 1])}
     mt, vt = model.predict(Xt[h], include_noise=False, input_noise=False)   # exact regressors
     row["true"] = _errs(np.asarray(mt), Yt[h])
@@ -491,11 +497,11 @@ def airp_scores(res, model, airframe, h: np.ndarray, Yt: np.ndarray, g_true: np.
                 modes: tuple[str, ...]) -> dict:
     """The held-out lines with the rows' ``p_hat`` less the rolling gust estimated there
     (:func:`gcs_sysid.aero.gustfilter.heldout_air_roll`), from one replay's table and model: ``gp_airp_MODE``,
-    ``ls_airp_MODE`` (% errors per coefficient), ``cov_gp_airp_MODE`` (``_each``: per coefficient) and ``airp_MODE`` (``corr`` and ``err_pct``,
-    the RMS error of the estimated ``p_hat_g`` in % of JSBSim's ``(p - p_aero) b/(2V)``, on the held-out rows;
-    ``sd`` the estimate's SD over the true one's; ``applied`` False when the fit or its Dryden check refused). Mode
-    ``"off"`` reproduces the replay's own ``gp`` line (a check). ``gp_airp_oracle`` / ``ls_airp_oracle``: the same
-    with JSBSim's own ``p_g`` taken out of the held-out rows' ``p_hat`` (reads the truth: what a perfect gust
+    ``ls_airp_MODE`` (% errors per coefficient), ``cov_gp_airp_MODE`` (``_each``: per coefficient) and ``airp_MODE``
+    (``corr`` and ``err_pct``, the RMS error of the estimated ``p_hat_g`` in % of JSBSim's ``(p - p_aero) b/(2V)``, on
+    the held-out rows; ``sd`` the estimate's SD over the true one's; ``applied`` False when the fit or its Dryden check
+    refused). Mode ``"off"`` reproduces the replay's own ``gp`` line (a check). ``gp_airp_oracle`` / ``ls_airp_oracle``:
+    the same with JSBSim's own ``p_g`` taken out of the held-out rows' ``p_hat`` (reads the truth: what a perfect gust
     estimate would give; below it, the estimate is taking up the model's own error from the measured moment).
 
     Args:
@@ -676,13 +682,15 @@ def main(argv=None) -> int:
                     help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
     ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated", "untested"),
                     help="the replay's GP settings: 'decorrelated' sets gcs_sysid.pipeline.USE_DECORRELATED_GP "
-                         "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); 'untested' sets "
-                         "gcs_sysid.pipeline.GP_COUPLING_TEST = 'none' (B's couplings kept as learned, without the "
-                         "every-row likelihood-ratio test: the default until the twenty-second session)")
+                         "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); "
+                         "'untested' sets gcs_sysid.pipeline.GP_COUPLING_TEST = 'none' (B's couplings kept as "
+                         "learned, without the every-row likelihood-ratio test: the default until the twenty-second "
+                         "session)")
     ap.add_argument("--gp-noise", default=_pipeline.GP_NOISE, choices=tuple(_pipeline.GP_NOISE_MODES),
                     help="the replay GP's noise (gcs_sysid.pipeline.GP_NOISE_MODES; sets GP_NOISE_CORRELATION, "
                          "GP_NOISE_POSTERIOR, GP_NOISE_START): 'learned' (the default since the twenty-fifth session) "
-                         "a P x P noise covariance learned with the hyperparameters, only its diagonal in the posterior; "
+                         "a P x P noise covariance learned with the hyperparameters, only its diagonal in the "
+                         "posterior; "
                          "'independent' one variance per output (the default until the twenty-fifth session; "
                          "'diagonal' is its older name); 'full' the learned covariance in the posterior too "
                          "(eval_gp_jsbsim's nigp); 'full-nstart' full with the shared error started in the noise; "
@@ -702,7 +710,8 @@ def main(argv=None) -> int:
     ap.add_argument("--iv-beta", default=None, choices=("off", "r2", "f", "fuller"),
                     help="the side-force slopes: least squares (off), 2SLS with the first-stage R2 floor (r2: "
                          "INSTRUMENTED_BETA), or 2SLS where the effective-sample first-stage F passes (f: "
-                         "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's defaults")
+                         "BETA_WEAK_TEST='f'), or Fuller's k-class on every flight (fuller); default: the package's "
+                         "defaults")
     ap.add_argument("--beta-profile", default=None, choices=("on", "off"),
                     help="CY_beta of the replay's sideslip aiding by the gust model's likelihood, held in the later "
                          "passes (gcs_sysid.estimation.airangles.BETA_PROFILE; default: the package's, off since the "
@@ -731,9 +740,9 @@ def main(argv=None) -> int:
                          "per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero] table; gcs_sysid.estimation.airangles."
                          "STATED_LIFT_SLOPE on; default: off, the wing's floor)")
     ap.add_argument("--stated-lift-level", nargs="+", default=None, metavar="AC:CL_ALPHA:CL_Q:CL_DE:CL0[:SIGMA]",
-                    help="give the aiding a stated lift line per aircraft (slope 1/rad, per q_hat, per rad of elevator, "
-                         "CL at zero, its 1-sigma), e.g. dr1:3.57:1.05:0.16:0.252:0.01: alpha's flight mean is set "
-                         "on it (gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL on; default: off)")
+                    help="give the aiding a stated lift line per aircraft (slope 1/rad, per q_hat, per rad of "
+                         "elevator, CL at zero, its 1-sigma), e.g. dr1:3.57:1.05:0.16:0.252:0.01: alpha's flight "
+                         "mean is set on it (gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL on; default: off)")
     ap.add_argument("--gust-force-axes", default=None, choices=("yz", "xyz"),
                     help="the specific-force axes offered the turbulence state (gcs_sysid.estimation.rates."
                          "GUST_FORCE_AXES; default: the package's, y and z; xyz adds x)")
@@ -800,7 +809,8 @@ def main(argv=None) -> int:
                       f"{row['alpha_deg']:.2f}/{row['beta_deg']:.2f} (signal {row['alpha_rms_deg']:.2f}/"
                       f"{row['beta_rms_deg']:.2f}); band for a measurement {row['cov_gp_obs']:.1f}")
                 print(f"{'':32s} true  {_fmt(row['true'])}   {row['cov_true']:5.1f}  (latent alone "
-                      f"{row['cov_true_latent']:.1f}; per coefficient " + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
+                      f"{row['cov_true_latent']:.1f}; per coefficient "
+                      + " ".join(f"{c:.0f}" for c in row["cov_true_each"])
                       + ")")
                 print(f"{'':32s} tair  {_fmt(row['true_air'])}   {row['cov_true_air']:5.1f}  (at the true regressors "
                       "with the rates JSBSim's aerodynamics reads)")

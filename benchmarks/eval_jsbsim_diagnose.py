@@ -37,8 +37,8 @@ the data never tossed. A clean flight is still ``ok`` only when nothing is named
 Since the twenty-second session (decided before its freeze) an injected ``CY:scale`` is also read, in the
 with-aliases scores only, by a ``CY:beta`` finding when the flown model's side force reads beta alone
 (:func:`side_axis_variables`; nine roster aircraft, among them the eternity, t6 and b737): a factor on a side force
-of beta alone is that factor on ``CY_beta``, one hypothesis of the aircraft whatever the flight shows, scored as ``estimate / model_value - 1``
-against ``body_axis_value`` (:func:`_one_term_alias`).
+of beta alone is that factor on ``CY_beta``, one hypothesis of the aircraft whatever the flight shows, scored as
+``estimate / model_value - 1`` against ``body_axis_value`` (:func:`_one_term_alias`).
 
 Usage::
 
@@ -47,18 +47,19 @@ Usage::
     python -m benchmarks.eval_jsbsim_diagnose --aircraft fokker50 --out DIR --fly-only   # flights only
 
 ``--aircraft`` takes the harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 c684
-ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim's model names (J3Cub, T37, t6texan2, B747, f16_direct,
-F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, Eternity_glide,
+ultrastick b737 c172p eternity us25e ka350 s23 dr1 navion fokker50) or JSBSim's model names (J3Cub, T37, t6texan2, B747,
+f16_direct, F4N_fcs, Rascal110_glide, asw20_glide, IAR80_glide, C684_glide, UltraStick120_glide, 737, Eternity_glide,
 UltraStick25e_glide, KingAir350_glide, ShortS23_glide, Dr1_glide, Navion_glide, Fokker50_glide); no aircraft is
 untouched now (``j3cub``, ``c182``, ``t37``, ``t6``, ``b747``, ``f16``, ``f4n``, ``rascal``, ``sgs126``, ``asw20``,
 ``iar80``, ``c684``, ``ultrastick``, ``b737``, ``c172p``, ``eternity``, ``us25e``, ``ka350``, ``s23``, ``dr1``,
 ``navion`` and ``fokker50``, untouched until the sixth to twenty-seventh sessions' final evaluations, count as used;
-none of them is in the defaults; docs/jsbsim.md, "No untouched aircraft"). The flights of ``--out`` are reused when they were flown by the same harness (``-effects.json`` records its fingerprint) with the same
-duration, plan and draws; ``--fly-only`` flies (or finds) the reference and every case and stops,
-without fitting or diagnosing anything. ``--sensor-draw`` is ``per_aircraft`` by default since the thirty-fourth
-session (each aircraft its own sensor noise; the records before drew ``shared``), ``--turbulence-draw`` is
-``per_aircraft`` since the thirty-fifth (each aircraft its own JSBSim turbulence), and ``--plan sweep_turn`` flies
-the sweep in a steady turn (``benchmarks/jsbsim_harness/flight.py``).
+none of them is in the defaults; docs/jsbsim.md, "No untouched aircraft"). The flights of ``--out`` are reused when they
+were flown by the same harness (``-effects.json`` records its fingerprint) with the same duration, plan and draws;
+``--fly-only`` flies (or finds) the reference and every case and stops, without fitting or diagnosing anything.
+``--sensor-draw`` is ``per_aircraft`` by default since the thirty-fourth session (each aircraft its own sensor noise;
+the records before drew ``shared``), ``--turbulence-draw`` is ``per_aircraft`` since the thirty-fifth (each aircraft its
+own JSBSim turbulence), and ``--plan sweep_turn`` flies the sweep in a steady turn
+(``benchmarks/jsbsim_harness/flight.py``).
 
 Prints a table and writes one JSON line per case to ``<out>/results.jsonl``.
 """
@@ -81,7 +82,9 @@ from benchmarks.jsbsim_harness import FlightConfig  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import summary_label  # noqa: E402
 from benchmarks.jsbsim_harness.effects import EFFECTS, SIZES, Effect, case_stem, make_effect_flight  # noqa: E402
 
-__all__ = ["reference_model", "level_flights", "diagnose_case", "score_case", "side_force_scale_truth", "side_axis_variables", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter", "main"]
+__all__ = ["reference_model", "level_flights", "diagnose_case", "score_case", "side_force_scale_truth",
+           "side_axis_variables", "scoring_truth", "rescore", "summarize", "clean_scatter", "coverage_with_scatter",
+           "main"]
 
 DURATION_S = 120.0
 REF_SEED = 100
@@ -142,7 +145,8 @@ def _flight(config: FlightConfig, effects: list[Effect], out: Path, stem: str | 
 
 def _stated(files, out: Path, stem: str):
     """``files`` with the airframe the pipeline reads replaced by its copy with ``[aero]`` where
-    ``--stated-lift-slope`` or ``--stated-lift-level`` names the aircraft (:func:`benchmarks.eval_jsbsim.stated_airframe`)."""
+    ``--stated-lift-slope`` or ``--stated-lift-level`` names the aircraft
+    (:func:`benchmarks.eval_jsbsim.stated_airframe`)."""
     from dataclasses import replace
 
     from benchmarks.eval_jsbsim import STATED_AERO, STATED_LINE, stated_airframe
@@ -263,7 +267,8 @@ def diagnose_case(ac: str, seed: int, effects: list[Effect], out: Path, model_pa
         a_before = _alpha_error_deg(meas.table, files.tlog)
         model, meas, kw, info = diagnose_run.aligned_alpha(diagnose_run.ALPHA_LEVEL, model, meas, kw,
                                                            level_tables=[m.table for m in level_meas or ()])
-        _LAST_LEVEL.update(info, alpha_error_before=a_before, alpha_error_after=_alpha_error_deg(meas.table, files.tlog))
+        _LAST_LEVEL.update(info, alpha_error_before=a_before,
+                           alpha_error_after=_alpha_error_deg(meas.table, files.tlog))
     else:
         _LAST_LEVEL.update(alpha_error_before=_alpha_error_deg(meas.table, files.tlog))
     diag = diagnose(meas.table, meas.airframe, model, meas.states, output_error=False,
@@ -540,9 +545,9 @@ def clean_scatter(ac: str, out: Path, clean_seeds, ref_meas, model_path: Path, p
 
     On every clean flight the sparse search's residual (after the reference's inadequacy and the angle
     nuisance, ``keep_residual``) is fitted with the constant and the one term each effect is named by
-    (``_FORCED``; ``scale:CY`` as the search's own candidate, the model's wind-axis side force), on the training rows. Nothing was injected, so the
-    spread of these estimates over the clean flights is what a flight changes a term by when nothing
-    changed: the between-flight error the test flight's coloured standard error does not hold.
+    (``_FORCED``; ``scale:CY`` as the search's own candidate, the model's wind-axis side force), on the training rows.
+    Nothing was injected, so the spread of these estimates over the clean flights is what a flight changes a term by
+    when nothing changed: the between-flight error the test flight's coloured standard error does not hold.
 
     Returns:
         ``{cause: {"sd": float, "estimates": [...]}}`` (sample standard deviation over the clean flights;
@@ -599,13 +604,15 @@ def summarize(paths: list[str]) -> str:
         key = "clean" if not r["effects"] else " + ".join(e[0] for e in r["effects"])
         groups.setdefault((r["aircraft"], key), []).append(r)
     out = ["| aircraft | injected | cases | top | estimate within 25 % | gain >= 50 % | all three "
-           "| with aliases: top, estimate, gain, all three | 2-se coverage | what was named (estimate - model, truth) |",
+           "| with aliases: top, estimate, gain, all three | 2-se coverage "
+           "| what was named (estimate - model, truth) |",
            "|---|---|---|---|---|---|---|---|---|---|"]
     for (ac, key), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "clean", kv[0][1])):
         if key == "clean":
             ok = sum(r["score"]["ok"] for r in rs)
             named = sorted({c for r in rs for c in r["score"].get("named", [])})
-            out.append(f"| {summary_label(ac)} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | | {', '.join(named) or '-'} |")
+            out.append(f"| {summary_label(ac)} | clean | {len(rs)} | | | | no named cause {ok}/{len(rs)} | | | "
+                       f"{', '.join(named) or '-'} |")
             continue
         rows = [e for r in rs for e in r["score"].get("effects", [])]
         n = len(rows)
@@ -613,14 +620,16 @@ def summarize(paths: list[str]) -> str:
         desc = "; ".join(
             f"s{r['seed']} " + ", ".join(
                 f"{e['cause']} {e['estimate']:.3g} ({e['value']:.3g})" if e["found"] else
-                f"[{e['via_alias']} ~ {e['cause']} {_g3(e.get('estimate_alias'))}] ({e['value']:.3g})" if e.get("via_alias") else
+                f"[{e['via_alias']} ~ {e['cause']} {_g3(e.get('estimate_alias'))}] ({e['value']:.3g})"
+                if e.get("via_alias") else
                 f"[{', '.join(r['score'].get('named', [])[:2]) or 'nothing'}] ({e['value']:.3g})"
                 for e in r["score"].get("effects", []))
             for r in rs)
         out.append(f"| {summary_label(ac)} | {key} | {len(rs)} | {sum(e['top'] for e in rows)}/{n} | "
                    f"{sum(bool(e.get('est')) for e in rows)}/{n} | {sum(bool(e.get('gain')) for e in rows)}/{n} | "
                    f"{sum(bool(r['score']['ok']) for r in rs)}/{len(rs)} | "
-                   + (f"{sum(bool(e.get('top_alias')) for e in rows)}/{n}, {sum(bool(e.get('est_alias')) for e in rows)}/{n}, "
+                   + (f"{sum(bool(e.get('top_alias')) for e in rows)}/{n}, "
+                      f"{sum(bool(e.get('est_alias')) for e in rows)}/{n}, "
                       f"{sum(bool(e.get('gain_alias')) for e in rows)}/{n}, "
                       f"{sum(bool(r['score'].get('ok_alias')) for r in rs)}/{len(rs)} | "
                       if any('top_alias' in e for e in rows) else "| ")
@@ -690,9 +699,11 @@ def main(argv=None) -> int:
     p.add_argument("--scatter-json", nargs="+", metavar="JSON",
                    help="with --summary: also the 2-se coverage with these scatter-<ac>.json files")
     p.add_argument("--scatter", action="store_true",
-                   help="also fit each effect's term on the clean flights (flight-to-flight scatter, scatter-<ac>.json)")
+                   help="also fit each effect's term on the clean flights (flight-to-flight scatter, "
+                        "scatter-<ac>.json)")
     p.add_argument("--sparse-thresholds", default="{}", metavar="JSON",
-                   help="overrides of gcs_sysid.diagnose.sparse.THRESHOLDS for this run (a variant, not the frozen set)")
+                   help="overrides of gcs_sysid.diagnose.sparse.THRESHOLDS for this run (a variant, not the "
+                        "frozen set)")
     p.add_argument("--share-alpha-model", action="store_true",
                    help="aid each flight's alpha with the reference flight's CZ slopes "
                         "(gcs_sysid.diagnose.run.SHARE_ALPHA_MODEL; off by default)")
@@ -708,25 +719,25 @@ def main(argv=None) -> int:
                    help="the aiding's stated lift-slope floor per aircraft, e.g. s23:5.5:7.1 (the airframe's [aero]; "
                         "gcs_sysid.estimation.airangles.STATED_LIFT_SLOPE on; as eval_jsbsim's option; default off)")
     p.add_argument("--stated-lift-level", nargs="+", default=None, metavar="AC:CL_ALPHA:CL_Q:CL_DE:CL0[:SIGMA]",
-                   help="the aiding's stated lift line per aircraft, alpha's flight mean set on it (gcs_sysid.estimation."
-                        "airangles.STATED_LIFT_LEVEL on; as eval_jsbsim's option; default off)")
+                   help="the aiding's stated lift line per aircraft, alpha's flight mean set on it "
+                        "(gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL on; as eval_jsbsim's option; default off)")
     p.add_argument("--air-roll-rate", default=None, choices=("off", "fit", "reference", "both", "reference:Cl"),
-                   help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's fit) at "
-                        "p_hat less its own smoothed rolling gust; 'reference:Cl': the reference's Cl target only "
-                        "(gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the package's, reference:Cl)")
+                   help="the reference flight (and with 'both' the flight under test; with 'fit' only the model's "
+                        "fit) at p_hat less its own smoothed rolling gust; 'reference:Cl': the reference's Cl target "
+                        "only (gcs_sysid.diagnose.run.AIR_ROLL_RATE; default: the package's, reference:Cl)")
     p.add_argument("--wind-window", default=None, type=float, metavar="S",
                    help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
     p.add_argument("--wind-residual-scale", default=None, choices=("on", "off"),
                    help="weight the wind fit's airspeed residuals with their own RMS (gcs_sysid.estimation.estimate."
                         "WIND_RESIDUAL_SCALE; default: the package's, on since the fortieth session)")
     p.add_argument("--beta-profile", default=None, choices=("on", "off"),
-                   help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the later "
-                        "passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; default: the "
-                        "package's, off, as the replay's since the thirty-third session)")
+                   help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the "
+                        "later passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; "
+                        "default: the package's, off, as the replay's since the thirty-third session)")
     p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off", type=_number_or_off,
-                   help="the coefficients confirm a wind-triangle pitot bias only where their standard error is at most "
-                        "this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; default: the "
-                        "package's)")
+                   help="the coefficients confirm a wind-triangle pitot bias only where their standard error is "
+                        "at most this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; "
+                        "default: the package's)")
     p.add_argument("--pitot-refit-systematic", default=None, type=float, metavar="MPS",
                    help="the exact pitot re-fit's between-flight systematic error, m/s, in quadrature with its "
                         "standard error (gcs_sysid.diagnose.pitot.REFIT_SYSTEMATIC_MPS; default: the package's)")
@@ -787,8 +798,9 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         _dr.AIR_ROLL_RATE = a.air_roll_rate
     from benchmarks.eval_jsbsim import apply_aiding_options
 
-    apply_aiding_options(a)      # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile, --wind-window,
-    #                              --wind-residual-scale
+    # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile, --wind-window,
+    # --wind-residual-scale
+    apply_aiding_options(a)
     if a.beta_profile is not None:      # the diagnosis loads its flights with its own switch (load_measurements)
         from gcs_sysid.diagnose import run as _dr
 
@@ -891,12 +903,15 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
     if rows:
         n = len(rows)
         print(f"\neffect cases {len(eff)}: top {sum(r['top'] for r in rows)}/{n}, est within 25 % "
-              f"{sum(bool(r.get('est')) for r in rows)}/{n}, gain >= 50 % {sum(bool(r.get('gain')) for r in rows)}/{n}, "
+              f"{sum(bool(r.get('est')) for r in rows)}/{n}, "
+              f"gain >= 50 % {sum(bool(r.get('gain')) for r in rows)}/{n}, "
               f"all three {sum(bool(r['ok']) for r in (x['score'] for x in eff))}/{len(eff)}; with aliases: top "
-              f"{sum(bool(r.get('top_alias')) for r in rows)}/{n}, est {sum(bool(r.get('est_alias')) for r in rows)}/{n}, "
+              f"{sum(bool(r.get('top_alias')) for r in rows)}/{n}, "
+              f"est {sum(bool(r.get('est_alias')) for r in rows)}/{n}, "
               f"gain {sum(bool(r.get('gain_alias')) for r in rows)}/{n}, "
               f"all three {sum(bool(r.get('ok_alias')) for r in (x['score'] for x in eff))}/{len(eff)}; "
-              f"2-sigma coverage {sum(bool(r.get('cover')) for r in rows if r['found'])}/{sum(r['found'] for r in rows)}")
+              f"2-sigma coverage {sum(bool(r.get('cover')) for r in rows if r['found'])}/"
+              f"{sum(r['found'] for r in rows)}")
     if clean:
         print(f"clean flights: no named cause {sum(r['score']['ok'] for r in clean)}/{len(clean)}")
     if a.scatter and len(a.clean_seeds) > 1:

@@ -239,7 +239,8 @@ def summarize(paths: list[str], base: str = "independent", heldout_cl: str = "gy
             gf = np.nanmedian([r["gp"][c] for r in rs for c in FORCES])
             gm = np.nanmedian([r["gp"][c] for r in rs for c in COEFFICIENTS if c not in FORCES])
             cpu = np.median([r["cpu_learn_s"] for r in rs])
-            lines.append(f"| {n}, {s} | " + " | ".join(str(tot[i]) for i in items) + f" | {gf:.2f} / {gm:.2f} | {cpu:.1f} |")
+            lines.append(f"| {n}, {s} | " + " | ".join(str(tot[i]) for i in items)
+                         + f" | {gf:.2f} / {gm:.2f} | {cpu:.1f} |")
     lines.append("")
     lose_any: dict[str, dict[int, set]] = {}
     for n in noises:

@@ -50,7 +50,8 @@ def plausibility(result) -> list[str]:
                      f"(plausible 3.5-5.5 /rad)")
     else:
         lines.append(f"alpha spread {np.degrees(np.std(alpha)):.2f} deg: too little to fit CL_alpha")
-    lines.append(f"median CX {np.median(CX):+.3f} ({'includes thrust' if any('includes thrust' in n for n in t.notes) else 'thrust removed'})")
+    lines.append(f"median CX {np.median(CX):+.3f} "
+                 f"({'includes thrust' if any('includes thrust' in n for n in t.notes) else 'thrust removed'})")
     if result.identifiable.get("Cm", (False, ""))[0]:
         Cm = t.y("Cm")[v]
         M = np.column_stack([np.ones(v.sum()), alpha, t.x("q_hat")[v], t.x("delta_e")[v]])
@@ -80,11 +81,13 @@ def main() -> None:
         except SysidError as e:
             print(f"  error: {e}")
             continue
-        rates = {k: round(s.rate_hz, 1) for k, s in r.summaries.items() if k in ("imu", "attitude", "servo", "airspeed", "gps")}
+        rates = {k: round(s.rate_hz, 1) for k, s in r.summaries.items()
+                 if k in ("imu", "attitude", "servo", "airspeed", "gps")}
         print(f"  {time.perf_counter() - t0:.1f} s; stream rates (Hz): {rates}; valid rows {int(r.table.valid.sum())}")
         for c, (ok, why) in r.identifiable.items():
             m = r.metrics[c]
-            print(f"  {c:3s} " + (f"held-out error {m['error_pct_heldout']:6.1f} %" if ok else f"not identified: {why}"))
+            print(f"  {c:3s} "
+                  + (f"held-out error {m['error_pct_heldout']:6.1f} %" if ok else f"not identified: {why}"))
         for line in plausibility(r):
             print("  " + line)
         for n in r.notes[:6]:

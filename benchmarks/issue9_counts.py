@@ -107,7 +107,8 @@ def case_counts(r: dict) -> dict[str, bool]:
     if "error" in sc or not rows:
         return dict.fromkeys(COUNTS, False)
     e = rows[0]
-    return {"top": bool(e.get("top")), "est": bool(e.get("est")), "gain": bool(e.get("gain")), "all": bool(sc.get("ok"))}
+    return {"top": bool(e.get("top")), "est": bool(e.get("est")), "gain": bool(e.get("gain")),
+            "all": bool(sc.get("ok"))}
 
 
 def tally(recs: dict[tuple, dict]) -> dict:
@@ -184,14 +185,16 @@ def roster_table(t: dict) -> str:
             cells.append(f"{c['top']}/{c['est']}/{c['gain']}/{c['all']} of {c['n']}")
             top, ok, n = top + c["top"], ok + c["all"], n + c["n"]
         cl = t["clean"].get(a, [0, 0])
-        lines.append(f"| {aircraft_class(a)} | {a} | " + " | ".join(cells) + f" | {cl[0]}/{cl[1]} | {top}/{n} | {ok}/{n} |")
+        lines.append(f"| {aircraft_class(a)} | {a} | " + " | ".join(cells)
+                     + f" | {cl[0]}/{cl[1]} | {top}/{n} | {ok}/{n} |")
     return "\n".join(lines)
 
 
 def totals_table(t: dict) -> str:
     """The markdown totals: all effects, each effect, each class; clean flights with nothing named."""
     tot = effect_totals(t)
-    lines = ["| group | cases | top | estimate | gain | all three | clean: none named |", "|---|---|---|---|---|---|---|"]
+    lines = ["| group | cases | top | estimate | gain | all three | clean: none named |",
+             "|---|---|---|---|---|---|---|"]
     s = {k: sum(v[k] for v in tot.values()) for k in ("n",) + COUNTS}
     cn, cd = sum(v[0] for v in t["clean"].values()), sum(v[1] for v in t["clean"].values())
     lines.append(f"| all | {s['n']} | " + " | ".join(_pct(s[k], s["n"]) for k in COUNTS) + f" | {cn}/{cd} |")
@@ -199,12 +202,14 @@ def totals_table(t: dict) -> str:
         v = tot[e]
         lines.append(f"| `{e}` | {v['n']} | " + " | ".join(_pct(v[k], v["n"]) for k in COUNTS) + " | |")
     for cls in _CLASS_ORDER:
-        acs = {a for a, _ in t["cells"] if aircraft_class(a) == cls} | {a for a in t["clean"] if aircraft_class(a) == cls}
+        acs = ({a for a, _ in t["cells"] if aircraft_class(a) == cls}
+               | {a for a in t["clean"] if aircraft_class(a) == cls})
         if not acs:
             continue
         v = {k: sum(c[k] for (a, _), c in t["cells"].items() if a in acs) for k in ("n",) + COUNTS}
         cl = [sum(t["clean"].get(a, [0, 0])[i] for a in acs) for i in (0, 1)]
-        lines.append(f"| {cls} ({', '.join(sorted(acs))}) | {v['n']} | " + " | ".join(_pct(v[k], v["n"]) for k in COUNTS)
+        lines.append(f"| {cls} ({', '.join(sorted(acs))}) | {v['n']} | "
+                     + " | ".join(_pct(v[k], v["n"]) for k in COUNTS)
                      + f" | {cl[0]}/{cl[1]} |")
     if t["pairs"][1]:
         lines.append(f"\nPairs with both effects found: {t['pairs'][0]} of {t['pairs'][1]}.")
@@ -221,7 +226,8 @@ def against_table(t: dict, base: dict) -> str:
             continue
         d, band = binomial_band(a["top"], a["n"], b["top"], b["n"])
         reading = "within draw scatter" if abs(d) <= band else ("higher" if d > 0 else "lower")
-        lines.append(f"| `{e}` | {_pct(a['top'], a['n'])} | {_pct(b['top'], b['n'])} | {d:+.0f} | +-{band:.0f} | {reading} |")
+        lines.append(f"| `{e}` | {_pct(a['top'], a['n'])} | {_pct(b['top'], b['n'])} | {d:+.0f} | +-{band:.0f} | "
+                     f"{reading} |")
     return "\n".join(lines)
 
 

@@ -23,7 +23,8 @@ BANDS = ((0.0, 0.5), (0.5, 1.0), (1.0, 1.5), (1.5, 2.5), (2.5, float("inf")))
 
 
 def ratios(paths: list[str]) -> list[dict]:
-    """One row per case: ``{"effect", "aircraft", "size", "ratio", "top", "named"}`` (``ratio`` None without a floor)."""
+    """One row per case: ``{"effect", "aircraft", "size", "ratio", "top", "named"}`` (``ratio`` None without a
+    floor)."""
     cases = {}
     for p in paths:
         for line in open(p):

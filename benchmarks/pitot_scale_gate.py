@@ -1,4 +1,5 @@
-"""The pitot scale a flight's turns would give, and how sure it is (groundwork for a gated scale; no change to the estimator).
+"""The pitot scale a flight's turns would give, and how sure it is (groundwork for a gated scale; no change to the
+estimator).
 
 For each ``LOG@AIRFRAME``: the estimator's inputs (GPS velocity, attitude, pitot TAS, autopilot wind) are taken
 from :func:`gcs_sysid.estimation.estimate_states`, and the wind fit is run once more with **one** wind for the whole

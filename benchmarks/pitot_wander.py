@@ -147,7 +147,8 @@ def decompose(ac: str, d: Path) -> list[dict]:
         u = np.interp(res["t"], res["t_grid"], unt.astype(float)) > 0.999
         tri = wind_triangle(res["t_grid"], res["states"], res["valid"], meas.flight)
         rows.append({"case": lab, "triangle_mps": tri["bias_mps"], "triangle_se": tri["std_error"],
-                     "triangle_wind_correction": tri["wind_correction_mps"], "heading_span_deg": tri["heading_span_deg"],
+                     "triangle_wind_correction": tri["wind_correction_mps"],
+                     "heading_span_deg": tri["heading_span_deg"],
                      "level": float(np.mean(res["r"])), "wander": float(np.mean(w)),
                      "level_untouched": float(np.mean(res["r"][u])), "wander_untouched": float(np.mean(w[u])),
                      "n_untouched": int(u.sum()), "gm_reml": gm_fit(res), "gm_tau20": gm_fit(res, 20.0)})
@@ -203,7 +204,8 @@ def monte_carlo(n: int = 2000, sigma_w: float = SIGMA_W, tau_w: float = 20.0, se
 
     unt = ((t > 32.5) & (t < 39.5)) | ((t > 80.5) & (t < 87.5))
     lines = [f"sigma_w {sigma_w} m/s, tau {tau_w} s, {n} draws", "",
-             "| bias (m/s) | estimate | wander on untouched rows, SD | gain median | P(gain >= 50 %) | P(gain >= 10 %) |",
+             "| bias (m/s) | estimate | wander on untouched rows, SD | gain median | P(gain >= 50 %) "
+             "| P(gain >= 10 %) |",
              "|---|---|---|---|---|---|"]
     ref = flight(0.0)
     lref = ref.mean(1)

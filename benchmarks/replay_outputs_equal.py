@@ -49,7 +49,8 @@ def compare(a: Path, b: Path) -> list[str]:
     counts = {rel: _npz(a, b, rel, bad) for rel in ("model.npz", "result/result.npz") if (a / rel).exists()}
     files_a = {p.relative_to(a) for p in a.rglob("*") if p.is_file()}
     files_b = {p.relative_to(b) for p in b.rglob("*") if p.is_file()}
-    bad += [f"{f}: only in {a}" for f in sorted(files_a - files_b)] + [f"{f}: only in {b}" for f in sorted(files_b - files_a)]
+    bad += ([f"{f}: only in {a}" for f in sorted(files_a - files_b)]
+            + [f"{f}: only in {b}" for f in sorted(files_b - files_a)])
     for f in sorted(files_a & files_b):
         name = str(f)
         if name.endswith(".npz") or name == ".gcs-sysid-output":

@@ -249,7 +249,8 @@ def main(argv=None) -> int:
             counts["all"] += all(ok)
             mark = " {" + "".join(c if v else "-" for c, v in zip("TEG", ok)) + "}"
         print(line + mark + f" ({time.perf_counter() - t0:.0f} s)", flush=True)
-    print(f"single effects: top {counts['top']}/{counts['cases']}, estimate within 25 % {counts['est']}/{counts['cases']}, "
+    print(f"single effects: top {counts['top']}/{counts['cases']}, "
+          f"estimate within 25 % {counts['est']}/{counts['cases']}, "
           f"gain >= 50 % {counts['gain']}/{counts['cases']}, all three {counts['all']}/{counts['cases']}; "
           f"clean flights with nothing named "
           f"{counts['clean_ok']}/{counts['clean']}")

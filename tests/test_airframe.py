@@ -47,7 +47,8 @@ def test_elevon_mixing_round_trip():
     c = a.controls_from_pwm(pwm)
     assert np.allclose(c["delta_e"], np.radians(10)) and np.allclose(c["delta_a"], 0)
     assert np.allclose(c["delta_t"], 0.5)
-    u = {"delta_e": np.array([0.05]), "delta_a": np.array([-0.08]), "delta_r": np.array([0.0]), "delta_t": np.array([0.3])}
+    u = {"delta_e": np.array([0.05]), "delta_a": np.array([-0.08]), "delta_r": np.array([0.0]),
+         "delta_t": np.array([0.3])}
     back = a.controls_from_pwm(a.pwm_from_controls(u))
     for k in ("delta_e", "delta_a", "delta_t"):
         assert np.allclose(back[k], u[k])

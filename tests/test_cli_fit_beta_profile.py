@@ -1,5 +1,5 @@
-"""The sideslip aiding's ``CY_beta`` estimator per path: least squares everywhere by default (the gust model's likelihood
-with the slope held, ``airangles.BETA_PROFILE`` and ``BETA_PROFILE_HOLD``, was the replay's default in the
+"""The sideslip aiding's ``CY_beta`` estimator per path: least squares everywhere by default (the gust model's
+likelihood with the slope held, ``airangles.BETA_PROFILE`` and ``BETA_PROFILE_HOLD``, was the replay's default in the
 thirty-second session only); the diagnosis and ``gcs-sysid fit`` load their flights with least squares
 (``gcs_sysid.diagnose.run.BETA_PROFILE``), and ``fit --beta-profile on`` asks for the profile (docs/estimation.md, "The
 side-force slope by the gust model's likelihood")."""

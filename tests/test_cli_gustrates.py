@@ -43,8 +43,8 @@ def test_stated_lift_level_flag_switches_the_aiding(monkeypatch):
 
 
 def test_replay_air_roll_flag_sets_both_halves_of_the_pair(capsys):
-    """`--air-roll off` turns off Cl's air-rate target and its held-out rate together, `on` asks for both, no flag leaves
-    the replay's defaults (None); another value is a user error (exit 2)."""
+    """`--air-roll off` turns off Cl's air-rate target and its held-out rate together, `on` asks for both, no flag
+    leaves the replay's defaults (None); another value is a user error (exit 2)."""
     base = ["replay", "x.tlog", "--airframe", "a.toml", "--out", "o"]
     o = _replay_options(build_parser().parse_args(base + ["--air-roll", "off"]))
     assert (o.air_roll_train, o.heldout_air_roll) == (False, "off")

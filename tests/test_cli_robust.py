@@ -92,8 +92,8 @@ def test_other_commands_check_their_outputs_first(tmp_path):
     d.mkdir()
     f = tmp_path / "afile"
     f.write_text("x")
-    p, _ = cli("simulate", "--airframe", AIRFRAME, "--model", MODEL, "--maneuvers", DATA / "plans" / "sysid-trainer.toml",
-               "--out", d)
+    p, _ = cli("simulate", "--airframe", AIRFRAME, "--model", MODEL,
+               "--maneuvers", DATA / "plans" / "sysid-trainer.toml", "--out", d)
     one_line_error(p, "--out", "is a folder")
     p, _ = cli("fit", FLIGHT, "--airframe", AIRFRAME, "--out", f / "m.toml")
     one_line_error(p, "--out", "not a folder")

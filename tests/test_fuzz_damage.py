@@ -29,7 +29,8 @@ from gcs_sysid.telemetry.tlog_scan import msgid_of
 DATA = Path(__file__).resolve().parents[1] / "data"
 BASES = {
     "sim": (DATA / "flights" / "sim-trainer-sysid.tlog", 0.10, DATA / "airframes" / "sim-trainer.toml"),
-    "vtol": (DATA / "logs" / "ardupilot-quadplane-sitl-vtol.tlog", 0.25, DATA / "airframes" / "arduplane-sitl-vtol.toml"),
+    "vtol": (DATA / "logs" / "ardupilot-quadplane-sitl-vtol.tlog", 0.25,
+             DATA / "airframes" / "arduplane-sitl-vtol.toml"),
 }
 MODEL = DATA / "models" / "sim-trainer.toml"
 #: Words of the damage notes (gcs_sysid.telemetry: Flight.damage) as the report shows them.

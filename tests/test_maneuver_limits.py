@@ -47,7 +47,8 @@ def test_limits_table_parsed_and_round_trips():
     lim = af.limits
     assert lim.V_min == 12.0 and lim.V_max == 25.0 and lim.n_max == 3.0
     assert lim.alpha_max == pytest.approx(math.radians(12.0))
-    assert lim.throw["delta_r"] == pytest.approx(math.radians(20.0)) and lim.rate["delta_e"] == pytest.approx(math.radians(300))
+    assert (lim.throw["delta_r"] == pytest.approx(math.radians(20.0))
+            and lim.rate["delta_e"] == pytest.approx(math.radians(300)))
     back = airframe_from_dict(airframe_to_dict(af)).limits
     assert dataclasses.replace(back, alpha_max=lim.alpha_max) == lim and back.alpha_max == pytest.approx(lim.alpha_max)
     assert load_airframe(DATA / "airframes" / "carbon-z-t28.toml").limits.V_min == 14.0

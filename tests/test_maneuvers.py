@@ -61,7 +61,8 @@ def test_surface_per_coefficient(setup):
         assert s.t[-1] <= s.duration_s and s.flight_condition["V"] > 5
     json.dumps([s.to_dict() for s in sug], allow_nan=False)
     back = Suggestion.from_dict(json.loads(json.dumps(sug[0].to_dict())))
-    assert back.coefficients == sug[0].coefficients and np.allclose(back.u[back.control], sug[0].u[sug[0].control], atol=1e-6)
+    assert back.coefficients == sug[0].coefficients and np.allclose(back.u[back.control], sug[0].u[sug[0].control],
+                                                                    atol=1e-6)
 
 
 def test_unexplored_region_ranks_above_explored(setup):

@@ -4,8 +4,8 @@ The replay starts its worker decoding the log before it imports the estimation s
 signal and stats packages, filterpy: about 0.8 CPU s, ``docs/benchmarks.md``), so that those imports
 overlap the decoding; JAX and optax (about 0.6 CPU s) come later, while the worker smooths the specific
 force (the estimation stage's ``meanwhile``); and the main process never imports matplotlib, which only
-the worker's figures use. A module-level import of any of these in the CLI, the pipeline or the layers they load before the
-decode would put it back on the replay's critical path; these checks fail when that happens (they read
+the worker's figures use. A module-level import of any of these in the CLI, the pipeline or the layers they load before
+the decode would put it back on the replay's critical path; these checks fail when that happens (they read
 ``sys.modules`` in a fresh interpreter; nothing is timed).
 """
 

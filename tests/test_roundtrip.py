@@ -80,7 +80,8 @@ def test_replay_bands_coefficient_and_measurement(roundtrip):
     assert (white > 0).all()
     np.testing.assert_allclose(result.pred_sigma_obs[ok] ** 2 - result.pred_sigma[ok] ** 2,
                                np.broadcast_to(white, (int(ok.sum()), 6)), rtol=1e-6, atol=1e-14)
-    assert result.model_path and Path(result.model_path + ".npz").exists() and Path(result.model_path + ".json").exists()
+    assert (result.model_path and Path(result.model_path + ".npz").exists()
+            and Path(result.model_path + ".json").exists())
 
 
 def test_model_state_continues(roundtrip, tmp_path):

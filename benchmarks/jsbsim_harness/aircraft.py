@@ -182,9 +182,9 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # ends (as the c182's). Signs read from its aerodynamics: Cmde -1.12 (Mach 0) * elevator-pos
     # (positive = trailing edge down), Clda +0.181 (Mach 0) * left-aileron-pos (positive = left trailing edge
     # down, roll right), Cndr -0.0365 * rudder-pos (positive = trailing edge left, nose left);
-    # checked on the truth by tests/jsbsim/test_jsbsim_roster.py (used since the eighth session's final evaluation). Gear up (retractable; its gear-down
-    # terms, CDgear, DCYbdf, DClrDg and the |beta| term DCnbDg, vanish with it). Engines off: the
-    # "direct" thrusters give no force. 130 kt CAS at 10000 ft: the sweep's slowest level, 97.5 kt,
+    # checked on the truth by tests/jsbsim/test_jsbsim_roster.py (used since the eighth session's final evaluation).
+    # Gear up (retractable; its gear-down terms, CDgear, DCYbdf, DClrDg and the |beta| term DCnbDg, vanish with it).
+    # Engines off: the "direct" thrusters give no force. 130 kt CAS at 10000 ft: the sweep's slowest level, 97.5 kt,
     # is 1.28 times the model's power-off stall (about 76 kt EAS: 4756 lb, CL_max 1.34 at 0.26 rad
     # from its CLalpha table); the glide sinks about 12 m/s (L/D about 6), so it starts at 10000 ft
     # to end a 120-s flight well above the ground. Elevator 4.5 deg (the c172x's 3 deg gave 1.7
@@ -230,7 +230,8 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         elevator_sign=1.0, aileron_sign=-1.0, aileron_props=("fcs/left-aileron-pos-rad", None), rudder_sign=1.0,
         cmd_per_rad=(1.0 / 0.51, 1.0 / 0.2975, 1.0 / 0.43625),
         amplitude_deg=(4.0, 4.0, 3.5), pulse_s=(0.7, 0.8, 1.0), gear_up=True,
-        notes="Raytheon T-6A Texan II (JSBSim t6texan2), engine shut down, gear up, gliding; untouched by any tuning of the method"),
+        notes="Raytheon T-6A Texan II (JSBSim t6texan2), engine shut down, gear up, gliding; untouched by any tuning "
+              "of the method"),
     # b747: JSBSim's stock Boeing 747 (B747.xml, author "Unknown", 2002; an Aeromatic-style model of
     # constant derivatives and a few tables), four turbofans on "direct" thrusters (no force once
     # stopped). Chosen in the tenth session after the candidates in docs/jsbsim.md ("The b747"):
@@ -467,8 +468,8 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(1.0 / 0.43633, -1.0 / 0.43633, 1.0 / (31.0 * 0.01745)),
         amplitude_deg=(3.0, 5.0, 6.0), pulse_s=(0.5, 0.6, 0.9), gear_up=True,
         notes="ASW 20 sailplane (FlightGear's JSBSim asw20-JSBSim.xml, checked in under data/jsbsim_models/asw20) "
-              "without FlightGear's engine and ballast systems (derived model asw20_glide, XML sha256 f9ca126483a12dcc), "
-              "gear up, gliding; untouched by any tuning of the method"),
+              "without FlightGear's engine and ballast systems (derived model asw20_glide, XML sha256 "
+              "f9ca126483a12dcc), gear up, gliding; untouched by any tuning of the method"),
     # iar80: FlightGear's JSBSim IAR-80 (FGMEMBERS/IAR-80-JSB IAR80-Jsb.xml at 6d011335, Aeromatic v0.95, 2015;
     # GPL-2.0-or-later), the Romanian 1939 single-seat monoplane fighter: 6170.8 lb (4850 empty, a 459.2-lb payload
     # and 861.6 lb of fuel, all at the CG), 36-ft span, 183 ft^2 (wing loading 33.7 lb/ft^2), retractable gear. The
@@ -480,12 +481,12 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # J170 (the c172p's aerodynamics; its FCS reads fcs/*-pos-output, which nothing in JSBSim writes), the DHC-2
     # (YASim), the Skywalker X8 (no rudder) and two UAV models without a licence. A direct FCS (aerosurface_scale,
     # zero-centred, no damper): elevator, left and right aileron (the right the same sign as the left; the
-    # aerodynamics read the left alone) and rudder all +-0.35 rad x the command. Signs read from its aerodynamics: Pitch_elevator
-    # (-1 + 0.375 Mach) x elevator-pos (positive = trailing edge down), Roll_aileron +0.18 x left-aileron-pos
-    # (positive = roll right: Cl_delta_a -0.18), Yaw_rudder -0.1 x rudder-pos (positive = trailing edge left, nose
-    # left); Yaw_aileron -0.003 x left (adverse: Cn_delta_a +0.003). Gear up (Drag_gear 0.03 x gear-pos-norm).
-    # 150 kt (ic/vc-kts) at 10000 ft: 98-110 m/s TAS in the standard trial flights, alpha -2..4 deg (1st-99th
-    # percentile); the sweep flies 69-130 m/s, 1.3 x the stall at its slowest (about 45 m/s EAS: CL_max 1.3 at
+    # aerodynamics read the left alone) and rudder all +-0.35 rad x the command. Signs read from its aerodynamics:
+    # Pitch_elevator (-1 + 0.375 Mach) x elevator-pos (positive = trailing edge down), Roll_aileron +0.18 x
+    # left-aileron-pos (positive = roll right: Cl_delta_a -0.18), Yaw_rudder -0.1 x rudder-pos (positive = trailing edge
+    # left, nose left); Yaw_aileron -0.003 x left (adverse: Cn_delta_a +0.003). Gear up (Drag_gear 0.03 x
+    # gear-pos-norm). 150 kt (ic/vc-kts) at 10000 ft: 98-110 m/s TAS in the standard trial flights, alpha -2..4 deg
+    # (1st-99th percentile); the sweep flies 69-130 m/s, 1.3 x the stall at its slowest (about 45 m/s EAS: CL_max 1.3 at
     # 0.23 rad). Its CL table has a break at alpha 0 (5.5 per rad below, 4.48 above), which the sweep crosses. It
     # sinks 9.6-11 m/s (lift-to-drag about 10), so a 135-s flight from 10000 ft ends above 1500 m; MIL-F-8785C light
     # turbulence moves the air there (vertical gust 2.1-2.2 m/s standard deviation). Pulses 0.7 / 0.8 / 0.8 s: short
@@ -501,8 +502,8 @@ AIRCRAFT: dict[str, AircraftSpec] = {
         cmd_per_rad=(1.0 / 0.35, 1.0 / 0.35, 1.0 / 0.35),
         amplitude_deg=(4.0, 4.0, 4.0), pulse_s=(0.7, 0.8, 0.8), gear_up=True,
         notes="IAR-80 fighter (FlightGear's JSBSim IAR80-Jsb.xml, checked in under data/jsbsim_models/iar80) with its "
-              "engine and propeller removed (derived model IAR80_glide, XML sha256 2025fa83c41f3f74), gear up, gliding; "
-              "untouched by any tuning of the method"),
+              "engine and propeller removed (derived model IAR80_glide, XML sha256 2025fa83c41f3f74), gear up, "
+              "gliding; untouched by any tuning of the method"),
     # c684: FlightGear's JSBSim Caudron C.684 Super Rafale (FGMEMBERS/C684 C684.xml at 05ad4b2c, Guillaume Chauvat
     # 2008, version 0.4.13; GPL-2.0-or-later), a 1930s French two-seat racing and touring monoplane: 2138.5 lb as
     # loaded (640 kg empty, pilot and passenger 85 kg each on the centre line, 80 kg of fuel in each of two tanks
@@ -712,11 +713,11 @@ AIRCRAFT: dict[str, AircraftSpec] = {
     # (proverse). A stock wheel model the ninth session could not initialise (its pushback system reads FlightGear
     # properties); flown as the derived ``Dr1_glide`` (derived.py): the rotary engine and propeller, the pushback
     # force and system removed, the Cmde table reading the elevator through the identity alias. Chosen in the
-    # twenty-fifth session (docs/jsbsim.md, "The dr1"). Its FCS: elevator +-0.35 rad (20.1 deg), both ailerons +-0.30 rad (17.2 deg) with the command's
-    # sign (the aerodynamics read the left one), rudder: the command clipped at +-0.35 of its normalised range
-    # before the +-0.44-rad scale, so +-0.154 rad (8.8 deg) of travel. Signs read from its aerodynamics: CLde
-    # +0.2 and Cmde falling with elevator-pos-rad (positive = trailing edge down), Clda +0.087 per rad of
-    # left-aileron-pos-rad (positive = roll right: delta_a = -left, Cl_delta_a -0.087), Cndr -0.0502 (positive
+    # twenty-fifth session (docs/jsbsim.md, "The dr1"). Its FCS: elevator +-0.35 rad (20.1 deg), both ailerons +-0.30
+    # rad (17.2 deg) with the command's sign (the aerodynamics read the left one), rudder: the command clipped at +-0.35
+    # of its normalised range before the +-0.44-rad scale, so +-0.154 rad (8.8 deg) of travel. Signs read from its
+    # aerodynamics: CLde +0.2 and Cmde falling with elevator-pos-rad (positive = trailing edge down), Clda +0.087 per
+    # rad of left-aileron-pos-rad (positive = roll right: delta_a = -left, Cl_delta_a -0.087), Cndr -0.0502 (positive
     # rudder = nose left), Cnda +0.0552 per rad of the left aileron (Cn_delta_a -0.0552: proverse). Set from the
     # harness's truth only (alpha, beta, rates, excitation per axis, surfaces, sink), never from a method result:
     # at 80 kt the pair (Cm:alpha^2 -8 with Cn:delta_a -0.06) tucked under past the elevator's authority (alpha

@@ -48,7 +48,8 @@ def airframe_doc(spec: AircraftSpec) -> dict:
                   + f") by benchmarks/jsbsim_harness/airframes.py: "
                   f"{spec.notes}. Surfaces: full command = the end deflections; aileron = "
                   f"0.5 * (left - right) trailing edge down, as the harness defines delta_a."),
-        "inertia": {"Ixx": r(fdm["inertia/ixx-slugs_ft2"] * SLUG_FT2), "Iyy": r(fdm["inertia/iyy-slugs_ft2"] * SLUG_FT2),
+        "inertia": {"Ixx": r(fdm["inertia/ixx-slugs_ft2"] * SLUG_FT2),
+                    "Iyy": r(fdm["inertia/iyy-slugs_ft2"] * SLUG_FT2),
                     "Izz": r(fdm["inertia/izz-slugs_ft2"] * SLUG_FT2),
                     "Ixz": r(-fdm["inertia/ixz-slugs_ft2"] * SLUG_FT2)},
         "geometry": {"S": r(fdm["metrics/Sw-sqft"] * FT**2), "b": r(fdm["metrics/bw-ft"] * FT),

@@ -39,8 +39,8 @@ metrics, mass and inertia, ground reactions, propulsion and systems are the whee
   ``aerosurface_scale``, no actuator dynamics: the harness's servos are the actuators);
   ``fcs/lef-pos-rad``, ``fcs/flaperon-mix-rad`` (the stock model drives it from the ailerons, so
   its CLDflaps / CDDflaps terms made lift and drag follow the aileron) fixed at 0 (the speed
-  brake, no longer commanded by an FCS channel, stays at JSBSim's 0), because the harness's log carries no flap channel; the stock ``Landing Gear`` and
-  ``Throttle`` channels kept as they are (they drive no surface).
+  brake, no longer commanded by an FCS channel, stays at JSBSim's 0), because the harness's log carries no flap channel;
+  the stock ``Landing Gear`` and ``Throttle`` channels kept as they are (they drive no surface).
 * one identity function added to ``<aerodynamics>``: ``aero/function/elevator-pos-rad`` =
   ``fcs/elevator-pos-rad``, and the tables that looked the elevator up as an ``independentVar``
   (CDdHT, CLDh, CmDh) look it up there. The numbers are unchanged (a test checks JSBSim's
@@ -158,7 +158,8 @@ def derive_f16_direct(root: ET.Element) -> ET.Element:
     keep = {ch.get("name"): ch for ch in fc.findall("channel") if ch.get("name") in ("Landing Gear", "Throttle")}
     if set(keep) != {"Landing Gear", "Throttle"}:
         raise ValueError("f16.xml: the <flight_control> lacks its 'Landing Gear' or 'Throttle' channel")
-    new = ET.Element("flight_control", name="F-16 direct surfaces (gcs-sysid harness, benchmarks/jsbsim_harness/derived.py)")
+    new = ET.Element("flight_control",
+                     name="F-16 direct surfaces (gcs-sysid harness, benchmarks/jsbsim_harness/derived.py)")
     pitch = _el(new, "channel", name="Pitch")
     _scale(pitch, "fcs/elevator-control", "fcs/elevator-cmd-norm", 0.436, "fcs/elevator-pos-rad")
     roll = _el(new, "channel", name="Roll")
@@ -944,7 +945,8 @@ def derive_fokker50_glide(root: ET.Element) -> ET.Element:
 #: derived XML's header comment).
 DERIVED = {
     "f16_direct": ("f16", derive_f16_direct, "flight control replaced by a direct mapping of the commands to the "
-                                             "surfaces, flaps fixed at 0; aerodynamics, mass and propulsion unchanged."),
+                                             "surfaces, flaps fixed at 0; aerodynamics, mass and propulsion "
+                                             "unchanged."),
     "F4N_fcs": ("F4N", derive_f4n_fcs, "an empty <flight_control> added (the stock one is commented out), for the "
                                        "harness's injected elevator delay; everything else unchanged."),
 }
@@ -961,7 +963,8 @@ REPO_DERIVED = {
                         derive_rascal_glide, "engine and propeller removed (a glide with no propeller force); "
                                              "everything else unchanged."),
     "asw20_glide": ("data/jsbsim_models/asw20/asw20-JSBSim.xml",
-                    "FlightGear's ASW 20 (FGMEMBERS/asw20 Models/JSBSim/asw20-JSBSim.xml at 3ef71d9c, GPL-2.0-or-later), "
+                    "FlightGear's ASW 20 (FGMEMBERS/asw20 Models/JSBSim/asw20-JSBSim.xml at 3ef71d9c, "
+                    "GPL-2.0-or-later), "
                     "copied into gcs-sysid's data/jsbsim_models/asw20/",
                     derive_asw20_glide, "the GenericEngine and WaterBallast systems and the Water Dumping channel "
                                         "(FlightGear's) removed; the CmDe table reads the elevator through an alias "

@@ -65,8 +65,10 @@ def flight_envelope(truth_path: str | Path) -> dict:
 def format_envelope(name: str, e: dict) -> str:
     """One line of :func:`flight_envelope`'s result."""
     three = lambda x, fmt="{:.1f}": "/".join(fmt.format(v) for v in x)   # noqa: E731
-    return (f"{name:44s} alpha {e['alpha'][0]:5.1f}..{e['alpha'][1]:4.1f} ({e['alpha_p'][0]:.1f}..{e['alpha_p'][1]:.1f})"
-            f" beta {e['beta'][0]:5.1f}..{e['beta'][1]:4.1f} bank {e['bank_max']:3.0f} V {e['V'][0]:4.1f}-{e['V'][1]:4.1f}"
+    return (f"{name:44s} alpha {e['alpha'][0]:5.1f}..{e['alpha'][1]:4.1f} "
+            f"({e['alpha_p'][0]:.1f}..{e['alpha_p'][1]:.1f})"
+            f" beta {e['beta'][0]:5.1f}..{e['beta'][1]:4.1f} bank {e['bank_max']:3.0f} "
+            f"V {e['V'][0]:4.1f}-{e['V'][1]:4.1f}"
             f" |pqr| {three(e['rate_max'], '{:.0f}')} std pqr {three(e['rate_std'])} (held {three(e['rate_std_held'])})"
             f" std surf {three(e['surface_std'], '{:.2f}')} sink {e['sink_mps']:.2f} aborts {len(e['aborts'])}")
 

@@ -4,8 +4,8 @@ The aircraft glides (engines shut down, so that every non-gravity force is aerod
 pipeline's CX needs no thrust model) from a calibrated-airspeed initial condition, a simple
 stabilising autopilot (pitch attitude with airspeed hold, wings level, yaw damper) holds it while
 the maneuver inputs are added to the autopilot's surface commands (as ArduPlane's SYSID mode adds
-them to the controller outputs), and the sum reaches JSBSim through first-order, rate-limited servos. JSBSim's MIL-F-8785C (``Milspec``) Dryden turbulence, with its
-rotational components, and a steady wind act on it.
+them to the controller outputs), and the sum reaches JSBSim through first-order, rate-limited servos. JSBSim's
+MIL-F-8785C (``Milspec``) Dryden turbulence, with its rotational components, and a steady wind act on it.
 
 Truth (SI, body axes x fwd / y right / z down, NED) is read from JSBSim's own properties at every
 log tick: aerodynamic forces ``forces/fb{x,y,z}-aero-lbs`` and moments ``moments/{l,m,n}-aero-lbsft``

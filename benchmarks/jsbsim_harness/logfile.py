@@ -109,7 +109,8 @@ def harness_fingerprint(name: str) -> str:
 
 def _stamp(config: FlightConfig, aoa: str) -> dict:
     """What ``<stem>-flight.json`` holds, as read back from JSON (tuples as lists)."""
-    return json.loads(json.dumps({"config": asdict(config), "aoa": aoa, "harness": harness_fingerprint(config.aircraft)}))
+    return json.loads(json.dumps({"config": asdict(config), "aoa": aoa,
+                                  "harness": harness_fingerprint(config.aircraft)}))
 
 
 def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs", sensors: dict | None = None) -> int:
@@ -126,7 +127,8 @@ def write_log(rec: Recording, path: str | Path, aoa: str = "ahrs", sensors: dict
     af = load_airframe(spec.airframe_path)
     tr = rec.truth
     result = SimpleNamespace(
-        t=rec.t, rate_hz=rec.config.log_rate_hz, sensors=make_sensors(rec, aoa) if sensors is None else sensors, airframe=af,
+        t=rec.t, rate_hz=rec.config.log_rate_hz, sensors=make_sensors(rec, aoa) if sensors is None else sensors,
+        airframe=af,
         commands={k: tr[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t")},
         truth={"psi": tr["psi"]}, seed=rec.config.seed,
         demand={},   # the harness's stabiliser demand is not recorded: no NAV_CONTROLLER_OUTPUT

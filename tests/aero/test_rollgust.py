@@ -279,8 +279,8 @@ def test_held_out_rows_at_the_reconstructed_air_relative_roll_rate():
 
 
 def test_extra_design_columns_are_fitted_beside_the_gust_state():
-    """``fit_roll_dynamics(extra=)``: a column the moment does not carry (white noise) gets a slope near 0 and leaves the
-    lateral slopes and the gust as they are without it; a column of the wrong length is refused. (The twenty-fifth
+    """``fit_roll_dynamics(extra=)``: a column the moment does not carry (white noise) gets a slope near 0 and leaves
+    the lateral slopes and the gust as they are without it; a column of the wrong length is refused. (The twenty-fifth
     session's circularity check put a candidate term there, docs/diagnose.md "The air-relative roll rate".)"""
     X, Y, p, _ = _record(n=3000)
     n = len(X)

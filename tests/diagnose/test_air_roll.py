@@ -6,8 +6,8 @@ delta_a (+ k alpha beta)``, ``p_g`` MIL-F-8785C's first-order rolling gust, and 
 that flies against any moment, so ``p`` and ``delta_a`` answer a hidden ``k alpha beta`` (the s23's
 ``Cl:alpha*beta`` flights). Fitted at the gyro's ``p_hat`` the model's ``Cl_p`` and ``Cl_delta_a`` are attenuated
 and the residual reads the hidden term low (0.69-0.79 of it on seeds 1-5); fitted at the reference flight's own
-``p_hat - p_hat_g`` it reads 0.85-0.99 of it. The flight under test keeps the gyro's rate by default (``"reference"``): its own gust estimate takes
-up the hidden moment (``"both"``), which the test measures too.
+``p_hat - p_hat_g`` it reads 0.85-0.99 of it. The flight under test keeps the gyro's rate by default (``"reference"``):
+its own gust estimate takes up the hidden moment (``"both"``), which the test measures too.
 """
 
 from types import SimpleNamespace

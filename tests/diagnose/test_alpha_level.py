@@ -82,7 +82,8 @@ def test_pooling_four_flights_brings_the_level_to_their_mean_and_moves_the_model
     test = _flight(20, e_test)
     m1, tab, _, refs1, info = align_alpha_levels("pooled", model, test, None, [Reference(ref)], lv)
     a_true = test.X[:, 0] - e_test
-    # the test flight now reads the flights' mean level (to the offsets' standard errors, ~0.1 deg each; the levels differ by 1.5-3 deg)
+    # the test flight now reads the flights' mean level (to the offsets' standard errors, ~0.1 deg each; the levels
+    # differ by 1.5-3 deg)
     assert abs(np.mean(tab.X[:, 0] - a_true) - levels.mean()) < np.radians(0.4)
     assert abs(np.mean(refs1[0].table.X[:, 0] - (ref.X[:, 0] - levels[0])) - levels.mean()) < np.radians(0.4)
     assert info["level_flights"] == 4 and abs(info["frame_error_deg"] - np.degrees(levels.std(ddof=1)) / 2) < 0.2

@@ -140,8 +140,8 @@ def test_missing_reference_log_is_a_one_line_error_before_decoding(tmp_path, cap
 
     from gcs_sysid.cli import main
 
-    rc = main(["diagnose", str(ROOT / "data" / "flights" / "sim-trainer-sysid.tlog"), "--airframe", str(AIRFRAME), "--model", str(MODEL),
-               "--out", str(tmp_path / "d"), "--reference", str(tmp_path / "nope.tlog")])
+    rc = main(["diagnose", str(ROOT / "data" / "flights" / "sim-trainer-sysid.tlog"), "--airframe", str(AIRFRAME),
+               "--model", str(MODEL), "--out", str(tmp_path / "d"), "--reference", str(tmp_path / "nope.tlog")])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and "--reference" in err[0] and "nope.tlog" in err[0]
     assert not (tmp_path / "d").exists()

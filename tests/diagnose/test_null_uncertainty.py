@@ -39,7 +39,8 @@ def test_a_quadratic_model_under_an_alpha_scale_error_reads_its_own_curvature_ch
     X, rows, u, c2 = _X(), np.arange(T), 0.3, -2.0
     mean = X[:, 0].mean()
     got = angle_null_sensitivity(_predict(c2=c2), X, _cols(X), 1, 4, rows, 0, u, 0.0)
-    # about the flight mean (not exactly 0 over the rows): alpha^2 -> ((alpha - m)/(1+s) + m)^2, refitted on [1, alpha^2]
+    # about the flight mean (not exactly 0 over the rows): alpha^2 -> ((alpha - m)/(1+s) + m)^2,
+    # refitted on [1, alpha^2]
     ref = []
     for s in (u, -u):
         r = c2 * ((X[:, 0] - mean) / (1 + s) + mean) ** 2 - c2 * X[:, 0] ** 2

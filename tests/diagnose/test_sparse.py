@@ -47,7 +47,8 @@ def test_two_effects_at_once_are_both_named_and_the_shared_inadequacy_is_not(air
                   seed=5, inadequacy=_INADEQUATE)
     res = sparse_search(ctx, R, reference=ref)
     causes = {f["cause"]: f for f in res["findings"]}
-    assert set(causes) == {"Cn:delta_a", "Cl:alpha*beta"}, [(f["cause"], f["evidence"]["score"]) for f in res["findings"]]
+    assert set(causes) == {"Cn:delta_a", "Cl:alpha*beta"}, [(f["cause"], f["evidence"]["score"])
+                                                           for f in res["findings"]]
     assert causes["Cn:delta_a"]["estimate"] - causes["Cn:delta_a"]["model_value"] == pytest.approx(-0.08, rel=0.25)
     assert causes["Cl:alpha*beta"]["estimate"] - causes["Cl:alpha*beta"]["model_value"] == pytest.approx(2.0, rel=0.25)
     assert all(f["gain"]["percent"] >= 50 for f in causes.values()), [(c, f["gain"]) for c, f in causes.items()]
@@ -65,7 +66,8 @@ def test_nothing_changed_nothing_named(airframe):
 
 
 def test_merge_puts_sensor_causes_first_and_drops_unconfirmed_terms():
-    findings = [{"cause": "cg_offset", "evidence": {}}, {"cause": "bias:airspeed", "evidence": {"domain": "data compatibility"}},
+    findings = [{"cause": "cg_offset", "evidence": {}},
+                {"cause": "bias:airspeed", "evidence": {"domain": "data compatibility"}},
                 {"cause": "Cn:delta_a", "evidence": {}}]
     sparse = {"findings": [{"cause": "Cn:delta_a", "evidence": {"domain": "sparse search"}}]}
     out = merge_findings(findings, sparse)

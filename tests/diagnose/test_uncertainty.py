@@ -31,7 +31,8 @@ def test_type_a_standard_error_covers_a_slope_under_ar1_noise_where_the_white_on
     white = ours = 0
     for _ in range(reps):
         # a manoeuvre-like regressor (two slow sines, random phases) and a gust-like AR(1) residual (tau 1 s)
-        x = np.sin(2 * np.pi * 0.07 * t + rng.uniform(0, 6.3)) + 0.5 * np.sin(2 * np.pi * 0.23 * t + rng.uniform(0, 6.3))
+        x = (np.sin(2 * np.pi * 0.07 * t + rng.uniform(0, 6.3))
+             + 0.5 * np.sin(2 * np.pi * 0.23 * t + rng.uniform(0, 6.3)))
         v = _ar1(rng, n, np.exp(-dt / 1.0), 0.5)
         A = np.column_stack([np.ones(n), x])
         y = theta * x + v
@@ -80,7 +81,8 @@ def test_air_angle_type_b_propagates_scale_and_offset_through_the_fit():
 
 def test_air_data_uncertainty_reads_the_estimators_own_fits():
     class Fit:
-        used, coef, coef_sigma, bias_sigma, scale_sigma = True, np.array([0.0, -5.0]), np.array([np.nan, 0.1]), 0.002, 0.03
+        used, coef, coef_sigma, bias_sigma, scale_sigma = (True, np.array([0.0, -5.0]), np.array([np.nan, 0.1]),
+                                                            0.002, 0.03)
 
     u = air_data_uncertainty({"alpha": Fit()})
     assert abs(u["alpha"]["scale"] - np.hypot(0.02, 0.03)) < 1e-12 and u["alpha"]["offset_rad"] == 0.002

@@ -68,7 +68,8 @@ def test_events_land_on_nearest_grid_points():
 
 def test_align_flight_uses_hold_for_servo():
     fl = _flight(imu=50.0)
-    fl.streams["servo"] = Stream("servo", "SERVO_OUTPUT_RAW", np.array([0.0, 5.0]), {"pwm1": np.array([1000.0, 2000.0])})
+    fl.streams["servo"] = Stream("servo", "SERVO_OUTPUT_RAW", np.array([0.0, 5.0]),
+                                 {"pwm1": np.array([1000.0, 2000.0])})
     al = align_flight(fl, 50.0)
     v = al.values["servo"]["pwm1"]
     assert set(np.unique(v[np.isfinite(v)])) <= {1000.0, 2000.0}

@@ -104,7 +104,8 @@ def test_smooth_segments_are_not_degraded(roll):
 
 def _dense_reference(z, Wc, Ac, bw_hz):
     """Obvious slow reference: dense GLS of z on the rate columns under the nominal model's covariance,
-    then the conditional mean of the nominal states (prior as the steady-state smoother's: x_{-1} ~ N([z0, 0, 0], Pf))."""
+    then the conditional mean of the nominal states (prior as the steady-state smoother's:
+    x_{-1} ~ N([z0, 0, 0], Pf))."""
     T = len(z)
     F = np.array([[1.0, DT, 0.5 * DT * DT], [0.0, 1.0, DT], [0.0, 0.0, 1.0]])
     Q = DT * (2 * np.pi * bw_hz) ** 6 * Q_continuous_white_noise(3, DT, 1.0)

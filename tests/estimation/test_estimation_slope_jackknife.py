@@ -1,11 +1,11 @@
 """The aiding's first-pass block jackknife (``AxisFit.slope_jackknife``) states how its slopes scatter between flights.
 
-Eight synthetic flights of one aircraft (``test_estimation_airangles._record``, seeds 3-10: the kinematic sideslip misses
-a 6-s Gauss-Markov gust), once with the yaw rate answering the gust (the aircraft weathercocks into it), so that least
-squares on the kinematic angle puts a share of the gust's side force on ``r_hat`` although the side force has no
+Eight synthetic flights of one aircraft (``test_estimation_airangles._record``, seeds 3-10: the kinematic sideslip
+misses a 6-s Gauss-Markov gust), once with the yaw rate answering the gust (the aircraft weathercocks into it), so that
+least squares on the kinematic angle puts a share of the gust's side force on ``r_hat`` although the side force has no
 yaw-rate term: the spurious ``CY_r_hat`` differs from flight to flight. The jackknife of one flight must be of the size
-of that scatter (a factor of 2 either way, eight flights; on the rudder with the yaw answer it is conservative, 2.7 times
-the scatter, and that case is held to 3), and NaN for the constant. About 10 s."""
+of that scatter (a factor of 2 either way, eight flights; on the rudder with the yaw answer it is conservative, 2.7
+times the scatter, and that case is held to 3), and NaN for the constant. About 10 s."""
 
 from functools import cache
 

@@ -77,8 +77,8 @@ def test_slow_transients_left_out_change_nothing():
 
 
 def test_aileron_yaw_response_through_the_roll_axis_b747():
-    """The aileron's yaw response tied to its roll response (:data:`~gcs_sysid.estimation.rates.AILERON_YAW_TIE`, opt-in,
-    ``I_z r_dot = N + I_xz p_dot``: on the yaw axis the roll axis' fitted response to the aileron, its rate
+    """The aileron's yaw response tied to its roll response (:data:`~gcs_sysid.estimation.rates.AILERON_YAW_TIE`,
+    opt-in, ``I_z r_dot = N + I_xz p_dot``: on the yaw axis the roll axis' fitted response to the aileron, its rate
     and the aileron's step, one coefficient each, instead of the aileron's free columns there), on the same
     B747 flight: the BIC keeps the tied form, and the held-out yaw moment goes 6.57 -> 4.72 % and the whole
     flight's 8.15 -> 5.34 % (measured 2026-11-23; the free columns' numbers are the test above's). The B747

@@ -34,7 +34,8 @@ def test_band_terms_add_up_to_the_two_scored_bands(fitted, flight):
     sig_true = 100 * np.sqrt(np.mean(model.predict(Xtrue, include_noise=False, input_noise=False)[1], axis=0)) / rms
     np.testing.assert_allclose(bt["gp"]["sigma"], sig_gp, rtol=2e-3)
     np.testing.assert_allclose(bt["true"]["sigma"], sig_true, rtol=2e-3)
-    for band, terms in (("gp", ("latent", "input", "coloured")), ("true", ("latent", "offset", "scale", "map", "discrepancy"))):
+    for band, terms in (("gp", ("latent", "input", "coloured")),
+                        ("true", ("latent", "offset", "scale", "map", "discrepancy"))):
         parts = np.array([bt[band][t] for t in terms])
         assert (parts >= 0).all()
         np.testing.assert_allclose(np.sqrt(np.sum(parts**2, axis=0)), bt[band]["sigma"], rtol=2e-3)

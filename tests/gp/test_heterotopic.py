@@ -25,7 +25,8 @@ def _params(Z, lmc=False):
     if lmc:
         B2 = coregionalisation(jnp.asarray(np.array([[0.2], [-0.5], [0.6]])), jnp.array([0.05, 0.02, 0.1]))
         extra = {"lmc_lengthscale": jnp.array([[2.5, 0.6]]), "lmc_A": jnp.linalg.cholesky(B2)[None]}
-    return GlobalParams(lengthscale=jnp.array([0.8, 1.3]), A=jnp.linalg.cholesky(B), noise=jnp.array([0.01, 0.03, 0.02]),
+    return GlobalParams(lengthscale=jnp.array([0.8, 1.3]), A=jnp.linalg.cholesky(B),
+                        noise=jnp.array([0.01, 0.03, 0.02]),
                         Z=jnp.asarray(Z), prior_std=jnp.asarray(1.0), jitter=jnp.asarray(1e-10), **extra)
 
 

@@ -23,7 +23,8 @@ posterior, predict_global_chunk = jax.jit(sparse.posterior), jax.jit(sparse.pred
 def _full_noise_params(Z):
     B = coregionalisation(jnp.asarray([[0.9], [0.7], [-0.3]]), jnp.array([0.1, 0.2, 0.05]))
     R = noise_correlation_factor(jnp.asarray([[0.0, 0, 0], [1.5, 0, 0], [-0.4, 0.8, 0]]))
-    return GlobalParams(lengthscale=jnp.array([0.8, 1.3]), A=jnp.linalg.cholesky(B), noise=jnp.array([0.01, 0.03, 0.02]),
+    return GlobalParams(lengthscale=jnp.array([0.8, 1.3]), A=jnp.linalg.cholesky(B),
+                        noise=jnp.array([0.01, 0.03, 0.02]),
                         Z=jnp.asarray(Z), prior_std=jnp.asarray(1.0), jitter=jnp.asarray(1e-10), noise_chol=R)
 
 
@@ -65,7 +66,8 @@ def test_lr_coupling_keeps_only_the_coupling_every_row_supports(shared):
     rng = np.random.default_rng(3)
     X = rng.uniform(-2, 2, (25, 2))
     g0, g1 = np.sin(1.5 * X[:, 0]) * np.cos(X[:, 1]), np.tanh(2 * X[:, 1]) * np.cos(X[:, 0])
-    Y = np.column_stack([g0, g0 if shared else g1, np.cos(1.3 * X[:, 0] + X[:, 1])]) + 0.1 * rng.standard_normal((25, 3))
+    Y = (np.column_stack([g0, g0 if shared else g1, np.cos(1.3 * X[:, 0] + X[:, 1])])
+         + 0.1 * rng.standard_normal((25, 3)))
     B = coregionalisation(jnp.asarray([[0.9], [0.9], [0.0]]), jnp.array([0.19, 0.19, 1.0]))
     p = replace(_full_noise_params(X), A=jnp.linalg.cholesky(B), noise=jnp.full(3, 0.01), noise_chol=jnp.eye(3))
     st = stats_of(p, jnp.asarray(X), jnp.asarray(Y))
@@ -214,7 +216,7 @@ def test_noise_start_and_hyper_stride_are_checked():
     assert replace(CFG, coupling_rows="all").coupling_rows == "all" and CFG.coupling_rows == "subset"
     with pytest.raises(InputError, match="coupling_test"):
         replace(CFG, coupling_test="t")
-    assert replace(CFG, coupling_test="none").coupling_test == "none" and CFG.coupling_test == "lr"   # default since s22
+    assert replace(CFG, coupling_test="none").coupling_test == "none" and CFG.coupling_test == "lr"  # default since s22
 
 
 def test_coupling_off_learns_with_the_coupling_and_keeps_none():
@@ -280,7 +282,8 @@ def noisy_input_case():
     rng = np.random.default_rng(9)
     n = 500
     X_true = np.column_stack([rng.uniform(-2, 2, n), rng.uniform(-2, 2, n)])
-    f = lambda X: np.column_stack([np.tanh(1.5 * X[:, 0]) + 0.3 * X[:, 1], 0.5 * np.tanh(1.5 * X[:, 0]) - 0.2 * X[:, 1]])  # noqa: E731
+    f = lambda X: np.column_stack([np.tanh(1.5 * X[:, 0]) + 0.3 * X[:, 1],  # noqa: E731
+                                   0.5 * np.tanh(1.5 * X[:, 0]) - 0.2 * X[:, 1]])
     X_meas = X_true + np.column_stack([0.15 * rng.standard_normal(n), np.zeros(n)])
     Y = f(X_true) + 0.02 * rng.standard_normal((n, 2))
     cfg = replace(FAST, local=False)
@@ -359,5 +362,6 @@ def test_mean_gradient_equals_autodiff_of_the_global_mean(noisy_input_case):
     model, X_meas, _, _ = noisy_input_case
     Xs = model.scaler.x(X_meas[:7])
     got = mean_gradient(model.params, model.post, Xs, batch=4)            # two chunks, one padded
-    ref = jax.vmap(jax.jacfwd(lambda x: sparse.mean_global_chunk(model.params, model.post, x[None])[0]))(jnp.asarray(Xs))
+    ref = jax.vmap(jax.jacfwd(lambda x: sparse.mean_global_chunk(model.params, model.post, x[None])[0]))(
+        jnp.asarray(Xs))
     np.testing.assert_allclose(got, np.asarray(ref), rtol=1e-8, atol=1e-10)

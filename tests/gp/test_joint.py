@@ -232,8 +232,9 @@ def test_selected_outputs_correlation_is_zero_for_an_output_on_its_own_gp(gust_c
     C = SelectedOutputs(joint, (), use, np.zeros(3), np.ones(3)).output_correlation()
     np.testing.assert_allclose(C[:2, :2], joint.output_correlation()[:2, :2])
     assert np.all(C[2, :2] == 0.0) and np.all(C[:2, 2] == 0.0) and C[2, 2] == 1.0
-    np.testing.assert_allclose(SelectedOutputs(joint, (), np.ones(3, bool), np.zeros(3), np.ones(3)).output_correlation(),
-                               joint.output_correlation(), atol=1e-12)
+    np.testing.assert_allclose(
+        SelectedOutputs(joint, (), np.ones(3, bool), np.zeros(3), np.ones(3)).output_correlation(),
+        joint.output_correlation(), atol=1e-12)
 
 
 @pytest.mark.slow

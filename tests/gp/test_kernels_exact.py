@@ -20,7 +20,8 @@ exact_log_marginal, exact_predict = jax.jit(exact.exact_log_marginal), jax.jit(e
 def _params(X, Z, jitter=1e-10, prior_std=1.0):
     L = np.array([[0.9], [0.7], [-0.3]])
     B = coregionalisation(jnp.asarray(L), jnp.array([0.1, 0.2, 0.05]))
-    return GlobalParams(lengthscale=jnp.array([0.8, 1.3]), A=jnp.linalg.cholesky(B), noise=jnp.array([0.01, 0.03, 0.02]),
+    return GlobalParams(lengthscale=jnp.array([0.8, 1.3]), A=jnp.linalg.cholesky(B),
+                        noise=jnp.array([0.01, 0.03, 0.02]),
                         Z=jnp.asarray(Z), prior_std=jnp.asarray(prior_std), jitter=jnp.asarray(jitter))
 
 
@@ -78,7 +79,8 @@ def test_statistics_are_additive_so_conditioning_in_pieces_equals_all_at_once(da
     X, Y, Xq = data
     p = _params(X, X[:10], jitter=1e-8)
     whole = stats_of(p, jnp.asarray(X), jnp.asarray(Y))
-    parts = add_stats(stats_of(p, jnp.asarray(X[:11]), jnp.asarray(Y[:11])), stats_of(p, jnp.asarray(X[11:]), jnp.asarray(Y[11:])))
+    parts = add_stats(stats_of(p, jnp.asarray(X[:11]), jnp.asarray(Y[:11])),
+                      stats_of(p, jnp.asarray(X[11:]), jnp.asarray(Y[11:])))
     a = predict_global_chunk(p, posterior(p, whole), jnp.asarray(Xq))
     b = predict_global_chunk(p, posterior(p, parts), jnp.asarray(Xq))
     np.testing.assert_allclose(a[0], b[0], rtol=1e-9, atol=1e-12)

@@ -20,7 +20,8 @@ def _lmc_params(Z):
     B = [coregionalisation(jnp.asarray(L), jnp.asarray(k)) for L, k in (
         ([[0.9], [0.1], [-0.3]], [0.1, 0.02, 0.05]), ([[0.2], [0.8], [0.3]], [0.05, 0.2, 0.05]),
         ([[0.1], [0.2], [0.7]], [0.05, 0.05, 0.1]))]
-    return GlobalParams(lengthscale=jnp.array([0.4, 0.9]), A=jnp.linalg.cholesky(B[0]), noise=jnp.array([0.01, 0.03, 0.02]),
+    return GlobalParams(lengthscale=jnp.array([0.4, 0.9]), A=jnp.linalg.cholesky(B[0]),
+                        noise=jnp.array([0.01, 0.03, 0.02]),
                         Z=jnp.asarray(Z), prior_std=jnp.asarray(1.0), jitter=jnp.asarray(1e-10),
                         lmc_lengthscale=jnp.array([[2.0, 1.5], [1.0, 0.3]]),
                         lmc_A=jnp.linalg.cholesky(jnp.stack(B[1:])))

@@ -72,8 +72,8 @@ def test_variance_after_shrinks_variance_near_new_points_only(flight, fitted):
     noise = np.asarray(model.params.noise) * model.scaler.y_std**2
     np.testing.assert_array_less(np.abs(after[5:] - before[5:]), 0.05 * before[5:] + 0.01 * noise[None, :])
     # it is the variance of the model updated with any values at X_extra
-    upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(np.vstack([far, X[:5]]), include_noise=False,
-                                                                                      input_noise=False, model_error=False)[1]
+    upd = model.update(X_extra, np.zeros((len(X_extra), 6)), exchange=False).predict(
+        np.vstack([far, X[:5]]), include_noise=False, input_noise=False, model_error=False)[1]
     np.testing.assert_allclose(after, upd, rtol=1e-7)
 
 

@@ -56,7 +56,8 @@ def test_limit_blas_threads_sets_every_loaded_openblas_to_one_thread():
             "from gcs_sysid.jaxconfig import limit_blas_threads\n"
             "n = limit_blas_threads(1)\n"
             "maps = open('/proc/self/maps').read() if os.path.exists('/proc/self/maps') else ''\n"
-            "libs = {l.split()[-1] for l in maps.splitlines() if 'openblas' in os.path.basename(l.split()[-1]).lower()}\n"
+            "libs = {l.split()[-1] for l in maps.splitlines() "
+            "if 'openblas' in os.path.basename(l.split()[-1]).lower()}\n"
             "a = np.random.default_rng(0).standard_normal((50, 50))\n"
             "print(n, len(libs), float(np.abs(np.linalg.solve(a, a) - np.eye(50)).max()) < 1e-8)\n")
     n, n_libs, ok = _child(code, {}).split()

@@ -37,7 +37,8 @@ def dense_vfe_predict(params, Xs, Ys, Xq):
         return block_diag(*[(xa(X1) * S2[q]) @ xa(X2).T for q in range(len(S2))])
 
     N, P = len(Xs), B.shape[0]
-    K = np.kron(B, Q(Xs, Xs)) + lin(Xs, Xs) + np.kron(np.asarray(params.noise_cov()), np.eye(N))   # Sigma kron I (full noise)
+    # Sigma kron I (full noise)
+    K = np.kron(B, Q(Xs, Xs)) + lin(Xs, Xs) + np.kron(np.asarray(params.noise_cov()), np.eye(N))
     Kq = np.kron(B, Q(Xq, Xs)) + lin(Xq, Xs)
     mean = (Kq @ np.linalg.solve(K, Ys.T.reshape(-1))).reshape(P, -1).T
     qq = np.sum(se_kernel(Xq, Z, ls) * np.linalg.solve(Kzz, se_kernel(Z, Xq, ls)).T, 1)

@@ -12,7 +12,8 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(Path(__file__).resolve().parent))      # this directory's helpers (truth_fits, static_checks, model_checks)
+# this directory's helpers (truth_fits, static_checks, model_checks)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from benchmarks.jsbsim_harness import FlightConfig, make_flight  # noqa: E402
 

@@ -124,8 +124,10 @@ def test_summary_table_counts_each_score(tmp_path):
     hit = {"cause": "Cn:delta_a", "value": -0.06, "found": True, "top": True, "estimate": -0.058,
            "std_error": 0.002, "est": True, "gain_pct": 70.0, "gain": True, "cover": True}
     miss = {"cause": "Cn:delta_a", "value": -0.03, "found": False, "top": False}
-    recs = [{"aircraft": "c172x", "seed": 1, "effects": [["Cn:delta_a", -0.06]], "score": {"ok": True, "effects": [hit], "named": ["Cn:delta_a"]}},
-            {"aircraft": "c172x", "seed": 2, "effects": [["Cn:delta_a", -0.03]], "score": {"ok": False, "effects": [miss], "named": ["CX:alpha"]}},
+    recs = [{"aircraft": "c172x", "seed": 1, "effects": [["Cn:delta_a", -0.06]],
+             "score": {"ok": True, "effects": [hit], "named": ["Cn:delta_a"]}},
+            {"aircraft": "c172x", "seed": 2, "effects": [["Cn:delta_a", -0.03]],
+             "score": {"ok": False, "effects": [miss], "named": ["CX:alpha"]}},
             {"aircraft": "c172x", "seed": 11, "effects": [], "score": {"ok": False, "named": ["CX:alpha"]}}]
     p = tmp_path / "r.jsonl"
     p.write_text("\n".join(json.dumps(r) for r in recs) + "\n")
@@ -169,7 +171,8 @@ def test_side_force_scale_is_scored_against_the_wind_axis_factor(tmp_path):
     body = (k - 1) * -0.3 / (-0.3 - 0.05)
     assert abs(side_force_scale_truth(tmp_path / "t.npz", k) - body) < 0.01 * body
     doc = scoring_truth({"injected": [{"cause": "scale:CY", "value": k - 1, "scale": k}]}, tmp_path / "t.npz")
-    assert doc["injected"][0]["value"] == pytest.approx(0.6) and doc["injected"][0]["wind_axis_value"] == pytest.approx(0.6)
+    assert (doc["injected"][0]["value"] == pytest.approx(0.6)
+            and doc["injected"][0]["wind_axis_value"] == pytest.approx(0.6))
     assert doc["injected"][0]["body_axis_value"] == pytest.approx(body, rel=0.01)
     assert scoring_truth(doc, tmp_path / "t.npz")["injected"][0]["value"] == pytest.approx(0.6)     # idempotent
     # scored against it: 0.57 is within 25 % of 0.6; 0.43 (the body-axis single factor) is not
@@ -211,7 +214,8 @@ def test_one_term_side_force_scale_is_read_by_its_term():
     """On a model whose side force reads beta alone (eternity, t6, b737 ...), a ``CY:beta`` finding reads an
     injected ``CY:scale`` in the with-aliases scores, as the relative change of the derivative against the
     body-axis factor; the strict scores are untouched, and a side force of several terms gets no such alias."""
-    truth = {"injected": [{"cause": "scale:CY", "value": 0.6, "body_axis_value": 0.55, "side_variables": ["aero/beta-rad"]}]}
+    truth = {"injected": [{"cause": "scale:CY", "value": 0.6, "body_axis_value": 0.55,
+                           "side_variables": ["aero/beta-rad"]}]}
     f = [{"cause": "CY:beta", "estimate": -0.35, "model_value": -0.226, "std_error": 0.03, "gain": {"percent": 80}}]
     sc = score_case(f, truth)
     row = sc["effects"][0]
@@ -225,14 +229,16 @@ def test_one_term_side_force_scale_is_read_by_its_term():
     # several side-force terms, or another top finding: no alias
     many = {"injected": [dict(truth["injected"][0], side_variables=["aero/beta-rad", "fcs/rudder-pos-rad"])]}
     assert not score_case(f, many)["effects"][0]["top_alias"]
-    assert not score_case([{"cause": "Cm:delta_e", "estimate": 0.1, "gain": {"percent": 80}}] + f, truth)["effects"][0]["top_alias"]
+    assert not score_case([{"cause": "Cm:delta_e", "estimate": 0.1, "gain": {"percent": 80}}] + f,
+                          truth)["effects"][0]["top_alias"]
 
 
 def test_side_axis_variables_reads_the_flown_model():
     from benchmarks.eval_jsbsim_diagnose import side_axis_variables
 
     assert side_axis_variables("eternity") == ["aero/beta-rad"] == side_axis_variables("t6")
-    assert "fcs/rudder-pos-rad" in side_axis_variables("c172x") and "velocities/r-aero-rad_sec" in side_axis_variables("c172x")
+    assert ("fcs/rudder-pos-rad" in side_axis_variables("c172x")
+            and "velocities/r-aero-rad_sec" in side_axis_variables("c172x"))
     assert side_axis_variables("ultrastick") == ["aero/coefficient/CY"]     # summed elsewhere: not one term
     assert side_axis_variables("no-such-aircraft") == []
 

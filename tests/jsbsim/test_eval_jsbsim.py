@@ -127,9 +127,9 @@ def test_fair_least_squares_line_trains_cl_on_the_gps_air_rate_target():
 def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
     """``eval_gp_jsbsim`` (thirtieth session, i8-airfit): the cache holds the replay's air-rate pair
     (:func:`benchmarks.eval_gp_jsbsim.air_rate_arrays`) and ``score`` trains Cl on its target and asks it at the
-    held-out air rate by default. On the simulated roll axis of ``tests/aero/test_rollgust.py`` the independent GPs' Cl is closer
-    to the air-rate Cl with the pair than without (``air_roll=False``, the old tables); the other outputs' GPs see the
-    same rows and targets either way (identical errors); ``ls`` is the fair line; a cache made before the pair's
+    held-out air rate by default. On the simulated roll axis of ``tests/aero/test_rollgust.py`` the independent GPs' Cl
+    is closer to the air-rate Cl with the pair than without (``air_roll=False``, the old tables); the other outputs' GPs
+    see the same rows and targets either way (identical errors); ``ls`` is the fair line; a cache made before the pair's
     arrays is refused unless ``air_roll=False``."""
     import sys
     from pathlib import Path

@@ -1,6 +1,6 @@
 """Air angles aided by the specific force (estimation/airangles.py) on the fast JSBSim flight
-(c172x, 40 s, "calm" Milspec turbulence (the harness's light until the fifteenth session), seed 1, AOA_SSA = ArduPilot's AHRS estimate), against
-JSBSim's exact alpha and beta; the same flight with the aiding switched off is the reference.
+(c172x, 40 s, "calm" Milspec turbulence (the harness's light until the fifteenth session), seed 1, AOA_SSA = ArduPilot's
+AHRS estimate), against JSBSim's exact alpha and beta; the same flight with the aiding switched off is the reference.
 
 Thresholds FROZEN on 2026-11-21 from the first measurement (aided alpha / beta RMS error 0.116 / 0.079
 deg, kinematic 0.236 / 0.207 deg), with a margin of about a third; the final method (slopes above

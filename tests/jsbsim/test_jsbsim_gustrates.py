@@ -50,7 +50,8 @@ def test_yaw_gust_rate_moves_r_hat_towards_jsbsims_air_relative_rate(estimated):
     np.testing.assert_array_equal(yaw.X[:, 2:4], tab.X[:, 2:4])          # p_hat, q_hat: the gyro's
     r_turb = ip("r") - ip("r_aero")
     r_g = (tab.X[:, 4] - yaw.X[:, 4]) * 2 * st.data["V"] / af.b
-    # this 40 s flight: 0.56, error ratio 0.84; 90 s flights 0.63-0.84 (docs/benchmarks.md, "Fourteenth session, i8-rotgust")
+    # this 40 s flight: 0.56, error ratio 0.84; 90 s flights 0.63-0.84 (docs/benchmarks.md,
+    # "Fourteenth session, i8-rotgust")
     assert np.corrcoef(r_g[v], r_turb[v])[0, 1] > 0.45
     hat_air = ip("r_aero") * af.b / (2 * st.data["V"])
     err = lambda X: np.sqrt(np.mean((X[v, 4] - hat_air[v]) ** 2))   # noqa: E731

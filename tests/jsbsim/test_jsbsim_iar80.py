@@ -17,8 +17,8 @@ The checks here use the XML and JSBSim's own properties; none of them flies the 
 The summaries' label test moved to ``test_jsbsim_c684.py`` in the seventeenth session (the c684 is untouched).
 
 The checks it shares with the other aircraft are in ``test_jsbsim_roster.py``: names, rigid body, sign
-map, gear (its ``Drag_gear`` reads 0 once the harness has retracted it), .tlog, hidden effects, airspeed bias, the evaluation's flights in the envelope and ``--fly-only``.
-All of them but the names are slow.
+map, gear (its ``Drag_gear`` reads 0 once the harness has retracted it), .tlog, hidden effects, airspeed bias, the
+evaluation's flights in the envelope and ``--fly-only``. All of them but the names are slow.
 
 No pipeline fit, GP, diagnosis or scoring runs in these tests.
 """

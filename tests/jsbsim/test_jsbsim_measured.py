@@ -2,9 +2,9 @@
 scored against JSBSim's exact truth.
 
 Thresholds FROZEN on 2026-11-21 from the first measurement on the final harness flight (c172x,
-40 s, "calm" turbulence (the harness's light until the fifteenth session), seed 1, AOA_SSA = ArduPilot's AHRS estimate, 0.04 s servos, last 20 % a
-three-axis multisine): measured CX 1.7, CY 9.1, CZ 0.9, Cl 15.1, Cm 14.0, Cn 9.2 %; alpha 0.24 deg,
-beta 0.21 deg RMS error. The harness changed twice before that, for realism, not to pass (history
+40 s, "calm" turbulence (the harness's light until the fifteenth session), seed 1, AOA_SSA = ArduPilot's AHRS estimate,
+0.04 s servos, last 20 % a three-axis multisine): measured CX 1.7, CY 9.1, CZ 0.9, Cl 15.1, Cm 14.0, Cn 9.2 %; alpha
+0.24 deg, beta 0.21 deg RMS error. The harness changed twice before that, for realism, not to pass (history
 in docs/jsbsim.md): first schedule, ideal servos: CX 1.8, CY 5.6, CZ 0.9, Cl 20.3, Cm 19.0,
 Cn 13.7 %; final multisine, ideal servos: CX 1.7, CY 9.3, CZ 0.9, Cl 17.7, Cm 17.4, Cn 11.9 %.
 Thresholds are those values with a margin for platform

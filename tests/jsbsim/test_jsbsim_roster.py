@@ -14,15 +14,19 @@ diagnosis or scoring runs here. One 30-s flight per aircraft (light, seed 1) ser
 Used aircraft's checks are slow tests but their names' (the c182 keeps its flight checks in the
 default suite, as before the fold); the untouched fokker50's are slow too but its names', and its own
 default checks (its model, surfaces, static stability, the summaries' label) are in
-``test_jsbsim_fokker50.py`` (the navion's in ``test_jsbsim_navion.py``, the dr1's in ``test_jsbsim_dr1.py``, the s23's in ``test_jsbsim_s23.py``, the ka350's in ``test_jsbsim_ka350.py``, the us25e's in ``test_jsbsim_us25e.py``, the eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in ``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the
-sgs126's in ``test_jsbsim_sgs126.py``, the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``,
-the f16's in ``test_jsbsim_f16.py``; tuning aircraft since the eleventh to twenty-seventh sessions). Folded in the eleventh session
-from ``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's
-value); the f4n added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20
-in the fifteenth, the iar80 in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the
-b737 in the nineteenth, the c172p in the twentieth, the eternity in the twenty-first, the us25e in the
-twenty-second, the ka350 in the twenty-third, the s23 in the twenty-fourth, the dr1 in the twenty-fifth, the navion in
-the twenty-sixth, the fokker50 in the twenty-seventh.
+``test_jsbsim_fokker50.py`` (the navion's in ``test_jsbsim_navion.py``, the dr1's in ``test_jsbsim_dr1.py``, the s23's
+in ``test_jsbsim_s23.py``, the ka350's in ``test_jsbsim_ka350.py``, the us25e's in ``test_jsbsim_us25e.py``, the
+eternity's in ``test_jsbsim_eternity.py``, the c172p's in ``test_jsbsim_c172p.py``, the b737's in
+``test_jsbsim_b737.py``, the ultrastick's in ``test_jsbsim_ultrastick.py``, the c684's in ``test_jsbsim_c684.py``, the
+iar80's in ``test_jsbsim_iar80.py``, the asw20's in ``test_jsbsim_asw20.py``, the sgs126's in ``test_jsbsim_sgs126.py``,
+the rascal's in ``test_jsbsim_rascal.py``, the f4n's in ``test_jsbsim_f4n.py``, the f16's in ``test_jsbsim_f16.py``;
+tuning aircraft since the eleventh to twenty-seventh sessions). Folded in the eleventh session from
+``test_jsbsim_{c182,t37,t6,b747}.py`` (same checks, same numbers; the Ixz checks now pin each model's value); the f4n
+added in the twelfth, the rascal in the thirteenth, the sgs126 in the fourteenth, the asw20 in the fifteenth, the iar80
+in the sixteenth, the c684 in the seventeenth, the ultrastick in the eighteenth, the b737 in the nineteenth, the c172p
+in the twentieth, the eternity in the twenty-first, the us25e in the twenty-second, the ka350 in the twenty-third, the
+s23 in the twenty-fourth, the dr1 in the twenty-fifth, the navion in the twenty-sixth, the fokker50 in the
+twenty-seventh.
 """
 
 from dataclasses import dataclass
@@ -248,7 +252,8 @@ CASES = (
     # deg, sideslip 3.7, bank 12, TAS 51-92 m/s, sink 7.2-8.0 m/s, rate standard deviations at least 2.2 deg/s.
     Case("c684", "C684_glide", "c68", 2138.484, 37.8557,
          (("cm", 0, None, ("in", -0.95, -0.78)), ("cm", 1, -15.0, ("rel", 0.05)), ("cm", 2, -1.25, ("rel", 0.03)),
-          ("cm", 3, -8.0, ("rel", 0.12)), ("cl", 3, None, ("in", -0.1205, -0.114)), ("cl", 0, None, ("in", -0.07, -0.05)),
+          ("cm", 3, -8.0, ("rel", 0.12)), ("cl", 3, None, ("in", -0.1205, -0.114)),
+          ("cl", 0, None, ("in", -0.07, -0.05)),
           ("cl", 1, None, ("in", -0.46, -0.43)), ("cl", 2, 0.2, ("rel", 0.01)), ("cl", 4, 0.0, ("abs", 1e-4)),
           ("cn", 4, -0.065, ("rel", 1e-3)), ("cn", 0, 0.141, ("abs", 3e-3)), ("cn", 2, -0.12, ("rel", 0.01)),
           ("cn", 3, None, ("in", 0.001, 0.006)), ("cn", 1, 0.0, ("abs", 1e-4))),
@@ -399,8 +404,8 @@ CASES = (
     # alias and the elevator hinge moment (two <property> reads), no gear. On the 30-s calm flight
     # (derivative_slopes; inertial rates, no alpha-dot) the slopes are the DATCOM tables' at the flight's alpha
     # (-2.0 deg mean, -4.4..0.8): Cm_alpha -0.13 (the file's static slope is -0.53 per rad near alpha 0; its
-    # Cm_alphadot of about -5 goes into the short fit's Cm_alpha and Cm_q), Cm_delta_e -1.045 (CmDe -1.08); Cl_beta -0.118
-    # (Clb -0.128 at alpha 0), Cl_p -0.323, Cl_r 0.112, Cl_delta_a -0.121 (ClDs4 0.122 per rad of the left
+    # Cm_alphadot of about -5 goes into the short fit's Cm_alpha and Cm_q), Cm_delta_e -1.045 (CmDe -1.08); Cl_beta
+    # -0.118 (Clb -0.128 at alpha 0), Cl_p -0.323, Cl_r 0.112, Cl_delta_a -0.121 (ClDs4 0.122 per rad of the left
     # aileron, delta_a = -left), Cl_delta_r 0 (ClDr 0); Cn_beta 0.066 (Cnb 0.069), Cn_p -0.045, Cn_r -0.153,
     # Cn_delta_a +0.0068 (adverse: CnDa), Cn_delta_r -0.060 (CnDr -0.06). Envelope limits from the six envelope
     # flights flown in the twenty-fourth session (docs/jsbsim.md, "The s23"): alpha -6.9..3.8 deg, sideslip 7.1
@@ -516,7 +521,8 @@ def short_flight(tmp_path_factory):
 @pytest.mark.parametrize("case", _params(flight=False))
 def test_names_resolve_and_roles(case):
     """The harness name and the JSBSim model name resolve in any case, a near miss is refused; the
-    untouched aircraft alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare label."""
+    untouched aircraft alone is untouched (and held out), every other aircraft is a tuning aircraft with a bare
+    label."""
     from benchmarks.jsbsim_harness.aircraft import HELD_OUT_AIRCRAFT, TUNING_AIRCRAFT, UNTOUCHED_AIRCRAFT, summary_label
 
     assert_names_resolve(case.name, case.model, case.typo)

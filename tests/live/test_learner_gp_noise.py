@@ -78,9 +78,11 @@ def test_listen_cli_passes_gp_noise(monkeypatch, tmp_path):
     from gcs_sysid.live.cli import cmd_listen
 
     got = []
-    monkeypatch.setattr(session, "run_listen", lambda af, out, opts: got.append(opts) or {"raw_log": "r", "raw_records": 0})
+    monkeypatch.setattr(session, "run_listen",
+                        lambda af, out, opts: got.append(opts) or {"raw_log": "r", "raw_records": 0})
     base = ["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path)]
-    for extra, want in (([], None), (["--gp-noise", "learned"], "learned"), (["--gp-noise", "independent"], "independent")):
+    for extra, want in (([], None), (["--gp-noise", "learned"], "learned"),
+                        (["--gp-noise", "independent"], "independent")):
         assert cmd_listen(build_parser().parse_args(base + extra)) == 0
         assert got[-1].learn.gp_noise == want
     with pytest.raises(SystemExit):

@@ -21,9 +21,9 @@ from live_helpers import AIRFRAME, FLIGHT, free_port, player  # noqa: E402
 def test_a_signal_to_the_group_ends_with_the_model(tmp_path, sig):
     port, out = free_port(), tmp_path / "s"
     exe = Path(sys.executable).with_name("gcs-sysid")
-    lis = subprocess.Popen([str(exe), "listen", f"udpin:127.0.0.1:{port}", "--airframe", str(AIRFRAME), "--out", str(out),
-                            "--window", "4", "--step", "2", "--lag", "1", "--min-rows", "300", "--inducing", "24",
-                            "--quiet", "--no-mavsdk"], start_new_session=True, cwd=tmp_path,
+    lis = subprocess.Popen([str(exe), "listen", f"udpin:127.0.0.1:{port}", "--airframe", str(AIRFRAME),
+                            "--out", str(out), "--window", "4", "--step", "2", "--lag", "1", "--min-rows", "300",
+                            "--inducing", "24", "--quiet", "--no-mavsdk"], start_new_session=True, cwd=tmp_path,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         end = time.monotonic() + 60
