@@ -155,7 +155,8 @@ def neighbours(store: LocalStore, Xq: np.ndarray) -> tuple[np.ndarray, np.ndarra
         dist = np.asarray(dist).reshape(len(Xq), store.k)
         idx = np.asarray(idx).reshape(len(Xq), store.k)
     else:
-        idx, dist = store.own_idx[np.maximum(own, 0)], store.own_dist[np.maximum(own, 0)]
+        at = np.maximum(own, 0)                       # the misses' rows are overwritten below
+        idx, dist = store.own_idx[at], store.own_dist[at]
         if not hit.all():
             miss = ~hit
             d, i = store.tree.query(Xq[miss] * store.metric, k=store.k, workers=-1)
