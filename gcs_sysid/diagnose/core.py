@@ -230,7 +230,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
              min_rows: int = 500, unexplained_threshold_pct: float = 20.0, output_error: bool = True,
              min_gain_oe_pct: float = 45.0, project_gusts: bool = True, flight=None,
              fault_thresholds: FaultThresholds | None = None, search: bool = False,
-             references=None, search_reference=None, progress=None) -> Diagnosis:
+             references=None, search_reference=None, sparse_thresholds: dict | None = None,
+             progress=None) -> Diagnosis:
     """Hold a model against measured coefficients, name the cause(s), extend the model.
 
     Args:
@@ -272,6 +273,10 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         search_reference: ``(table, states)`` of the flight the model was fitted on, for the
             differential sparse search (None: the first of ``references`` when given, else not
             differential).
+        sparse_thresholds: overrides of :data:`gcs_sysid.diagnose.sparse.THRESHOLDS` for this call (keys of that
+            mapping): the sparse search and the differential step both read the thresholds with these on top
+            (:func:`~gcs_sysid.diagnose.sparse.sparse_search` ``thresholds``,
+            :meth:`~gcs_sysid.diagnose.differential.DifferentialOptions.from_thresholds`). None: the frozen ones.
         progress: optional callable ``progress(message)``.
 
     Returns:
@@ -423,17 +428,17 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
             search_reference = (references[0].table, references[0].states)
         from .sparse import THRESHOLDS as _SPARSE_TH
 
-        keep_rd = bool(_SPARSE_TH.get("allowance_on_search_residual", False)) \
-            or bool(_SPARSE_TH.get("angle_error_beside_named", False))
+        th = dict(_SPARSE_TH, **(sparse_thresholds or {}))
+        keep_rd = bool(th["allowance_on_search_residual"]) or bool(th["angle_error_beside_named"])
         from .uncertainty import air_data_uncertainty
 
         data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0),
-                                       keep_residual=keep_rd,
+                                       thresholds=sparse_thresholds, keep_residual=keep_rd,
                                        angle_uncertainty=air_data_uncertainty(
                                            getattr(states, "angle_fits", None),
                                            getattr(search_reference[1], "angle_fits", None)
                                            if isinstance(search_reference, tuple) else None,
-                                           pair_scale=str(_SPARSE_TH.get("coverage_scale_pair", "quadrature"))),
+                                           pair_scale=str(th["coverage_scale_pair"])),
                                        model=model0, angle_sigma=_angle_sigma(states, ctx.t))
         search_residual = data["sparse"].pop("residual", None) if data["sparse"].get("differential") else None
         data["sparse"].pop("residual", None)
@@ -466,8 +471,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["timings"]["output_error_s"] = float(time.perf_counter() - t1)
     if references:
         from .air_roll import unlike_targets
-        from .differential import differential
-        from .sparse import THRESHOLDS as _SPARSE_TH
+        from .differential import DifferentialOptions, differential
 
         # a coefficient whose target was moved on one side only witnesses no air angle's scale (air_roll.moved_targets)
         unlike = unlike_targets(table, references)
@@ -476,26 +480,8 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         t1 = time.perf_counter()
         data["differential"] = differential(diag, list(references), airframe,
                                             threshold_pct=unexplained_threshold_pct,
-                                            search_residual=search_residual if search and
-                                            _SPARSE_TH.get("allowance_on_search_residual", False) else None,
-                                            angle_scale_se=bool(_SPARSE_TH.get("angle_scale_se", False)),
-                                            alpha_scale=bool(_SPARSE_TH.get("alpha_scale_allowance", False)),
-                                            delay_same_fit=bool(_SPARSE_TH.get("delay_reference_same_fit", False)),
-                                            alpha_jackknife_s=float(_SPARSE_TH.get("alpha_jackknife_s", 0.0)),
-                                            delay_change_min_t=float(_SPARSE_TH.get("delay_change_min_t", 0.0)),
-                                            delay_se_central=bool(_SPARSE_TH.get("delay_se_central", True)),
-                                            angle_error_along=tuple(_SPARSE_TH.get("angle_error_along_term", ())),
-                                            force_moment_arm_max=float(_SPARSE_TH.get("force_moment_arm_max", 0.0)),
-                                            scale_beta_allowance=bool(_SPARSE_TH.get("scale_beta_allowance", False)),
-                                            scale_wind_axis=bool(_SPARSE_TH.get("side_force_wind_axis", False)),
-                                            angle_error_beside_named=bool(_SPARSE_TH.get("angle_error_beside_named",
-                                                                                         False)),
-                                            beside_residual=search_residual if search else None,
-                                            angle_witness_exclude=unlike,
-                                            angle_scale_type_b={"beta": float(_SPARSE_TH.get("beta_scale_type_b",
-                                                                                             0.0))},
-                                            estimate_beyond_scale=tuple(_SPARSE_TH.get("estimate_beyond_angle_scale",
-                                                                                       ()) or ()))
+                                            search_residual=search_residual, angle_witness_exclude=unlike,
+                                            options=DifferentialOptions.from_thresholds(sparse_thresholds))
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

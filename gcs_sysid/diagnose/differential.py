@@ -57,8 +57,8 @@ from .residual_gp import residual_structure
 from .terms import term_factors, term_matrix
 from .uncertainty import block_jackknife_cov
 
-__all__ = ["Reference", "differential", "offset_allowance", "beta_scale_allowance", "angle_scale_allowance",
-           "angle_error_allowance", "force_moment_allowance", "FORCE_MOMENT_ARMS",
+__all__ = ["Reference", "DifferentialOptions", "differential", "offset_allowance", "beta_scale_allowance",
+           "angle_scale_allowance", "angle_error_allowance", "force_moment_allowance", "FORCE_MOMENT_ARMS",
            "block_jackknife_se",
            "BETA_COEFFICIENTS", "ANGLE_COEFFICIENTS",
            "onset_of_change", "fit_record", "reference_logs"]
@@ -80,6 +80,111 @@ class Reference:
     flight: object = None
     label: str = "reference"
     extra: dict = field(default_factory=dict)
+
+
+#: :class:`DifferentialOptions` field -> the key of :data:`gcs_sysid.diagnose.sparse.THRESHOLDS` it is read from
+_THRESHOLD_KEYS = {
+    "allowance_on_search_residual": "allowance_on_search_residual", "angle_scale_se": "angle_scale_se",
+    "alpha_scale": "alpha_scale_allowance", "delay_same_fit": "delay_reference_same_fit",
+    "delay_change_min_t": "delay_change_min_t", "delay_se_central": "delay_se_central",
+    "alpha_jackknife_s": "alpha_jackknife_s", "angle_error_along": "angle_error_along_term",
+    "force_moment_arm_max": "force_moment_arm_max", "scale_beta_allowance": "scale_beta_allowance",
+    "scale_wind_axis": "side_force_wind_axis", "angle_error_beside_named": "angle_error_beside_named",
+    "beta_scale_type_b": "beta_scale_type_b", "estimate_beyond_scale": "estimate_beyond_angle_scale",
+}
+
+
+@dataclass(frozen=True)
+class DifferentialOptions:
+    """The switches of :func:`differential`'s between-flight allowances, one per key of the frozen thresholds
+    (:data:`gcs_sysid.diagnose.sparse.THRESHOLDS`, named in brackets), so the sparse search and the differential
+    step of one diagnosis read the same mapping (:meth:`from_thresholds`).
+
+    Attributes:
+        allowance_on_search_residual: a term the sparse search named is judged for the allowances on the search's
+            differential residual (``differential``'s ``search_residual``), not on the raw residual against the
+            model (``allowance_on_search_residual``).
+        angle_scale_se: carry the fitted angle scale's standard error into the scale allowances
+            (:func:`angle_scale_allowance`; ``angle_scale_se``).
+        alpha_scale: also judge a finding in alpha against a between-flight scale of the measured angle of attack
+            seen in the other longitudinal coefficients; the sideslip's is always judged (``alpha_scale_allowance``).
+        delay_same_fit: a delay the sparse search sized as a difference (``evidence.delay_differential``) is compared
+            with each reference by the same fit (:func:`_reference_delay`), the flight's own delay against the
+            reference's (``delay_reference_same_fit``; added 2026-11-22, branch i9-delay). Off: the reference's delay
+            by the catalogue's scan (:func:`gcs_sysid.diagnose.candidates.fit_delays`), whose grid starts at one
+            sample, so a reference without a delay reads one sample (0.02 s at 50 Hz) with a standard error of a
+            minimum on the grid's edge, and the flight's *change* was held against it.
+        delay_change_min_t: with ``delay_same_fit``, a delay whose change against the reference (its estimate) is
+            below this many of its standard errors (time resolution included) is an allowance, not a change
+            (``delay_change_min_t``; added 2026-11-22 13:20 UTC, branch i9-delay, after the first freeze: the PA-28
+            s1 2-m/s pitot bias got a 0.010 +- 0.006 s delay beside it); 0: off.
+        delay_se_central: with ``delay_same_fit``, the reference's delay standard error by a central difference about
+            its best delay, as the flight's (``delay_se_central``; ``sparse._refine_delay``).
+        alpha_jackknife_s: block length, s, of the block-jackknife standard error with which a finding in alpha is
+            also judged beyond the alpha scale (:func:`angle_scale_allowance` ``jackknife``, the first reference's
+            slope included); 0: off (``alpha_jackknife_s``).
+        angle_error_along: the air angles (``"beta"``) against whose error along a finding's own term each aero
+            finding of that angle's coefficients is also judged (:func:`angle_error_allowance`;
+            ``angle_error_along_term``; eleventh session, branch i9-b747); (): off.
+        force_moment_arm_max: a moment finding (Cl, Cm, Cn) beside named findings that change forces only is also
+            judged beyond those force changes' moment about the CG, each with a free arm of at most this many
+            reference lengths (:func:`force_moment_allowance`; ``force_moment_arm_max``; twelfth session, branch
+            i9-second); 0: off.
+        scale_beta_allowance: also judge a ``scale:<coef>`` finding of a sideslip coefficient (``scale:CY``) against a
+            between-flight scale of the measured sideslip (:func:`angle_scale_allowance` with the finding's own
+            column, :func:`_scale_column`), as a ``CY:beta`` finding is (``scale_beta_allowance``; eighteenth
+            session, branch i9-c684). A sideslip scale ``1 + s`` moves CY by ``s beta dCY/dbeta``, which on an
+            airframe whose side force is mostly its sideslip slope is ``s`` times the model's CY: the column of
+            ``scale:CY``; before, only a finding named ``CY:beta`` was judged so, and the c684's clean seed 13 named
+            ``scale:CY`` 1.146 where its sideslip read 8 % smaller against the truth than the reference's.
+        scale_wind_axis: a scale's column in the search's convention (``side_force_wind_axis``;
+            :func:`gcs_sysid.diagnose.sparse.scale_columns`).
+        angle_error_beside_named: the angle's error along a finding's term (``angle_error_along``) is fitted on the
+            other coefficients with the other named aero findings' terms there free (:func:`_named_columns`,
+            ``beside`` of :func:`angle_scale_allowance`; ``angle_error_beside_named``, nineteenth session, branch
+            i9-ultra), on ``differential``'s ``search_residual`` where given for a search finding.
+        beta_scale_type_b: the type-B standard uncertainty of the sideslip's between-flight scale (``scale_type_b``
+            of :func:`angle_scale_allowance`; ``beta_scale_type_b``); 0: none.
+        estimate_beyond_scale: causes (``"scale:CY"``) whose kept finding reports its change beyond the air angle's
+            between-flight scale, the estimate its naming was judged on (:func:`report_beyond_scale`;
+            ``estimate_beyond_angle_scale``); (): every finding keeps its selected estimate.
+    """
+
+    allowance_on_search_residual: bool
+    angle_scale_se: bool
+    alpha_scale: bool
+    delay_same_fit: bool
+    delay_change_min_t: float
+    delay_se_central: bool
+    alpha_jackknife_s: float
+    angle_error_along: tuple
+    force_moment_arm_max: float
+    scale_beta_allowance: bool
+    scale_wind_axis: bool
+    angle_error_beside_named: bool
+    beta_scale_type_b: float
+    estimate_beyond_scale: tuple
+
+    @classmethod
+    def from_thresholds(cls, overrides: dict | None = None) -> DifferentialOptions:
+        """The options read from the frozen thresholds (:data:`gcs_sysid.diagnose.sparse.THRESHOLDS`, as they are at
+        the call) with ``overrides`` (keys of that mapping) on top; the keys the differential step does not read
+        are ignored, as :func:`gcs_sysid.diagnose.sparse.sparse_search` ignores this step's.
+
+        Raises:
+            KeyError: a key this step reads is missing from the thresholds (a mapping patched by hand).
+        """
+        from .sparse import THRESHOLDS
+
+        th = dict(THRESHOLDS, **(overrides or {}))
+        kinds = {"angle_error_along": tuple, "estimate_beyond_scale": tuple, "delay_change_min_t": float,
+                 "alpha_jackknife_s": float, "force_moment_arm_max": float, "beta_scale_type_b": float}
+
+        def read(name: str, key: str):
+            kind = kinds.get(name, bool)
+            return tuple(th[key] or ()) if kind is tuple else kind(th[key])
+
+        return cls(**{name: read(name, key) for name, key in _THRESHOLD_KEYS.items()})
 
 
 def _null_value(cause: str, airframe) -> float:
@@ -534,17 +639,18 @@ def _named_columns(diag, cause: str) -> dict:
     return {c: np.column_stack(v) for c, v in cols.items()}
 
 
-def _force_changes(diag, fitted: dict, cause: str) -> dict:
+def _force_changes(diag, fitted: dict, cause: str, wind_axis: bool) -> dict:
     """Force coefficient -> (T,) change (measured minus model) of the *other* named aero findings of a force.
 
     A finding of CX, CY or CZ (an aero term or ``scale:<force>``) changes that force only, as the diagnosis
     names it: its change is the sum of its terms' estimates times their columns (``evidence.terms`` of the
     sparse search; ``scale:C`` is :func:`gcs_sysid.diagnose.sparse.scale_columns`'s column), or minus its fitted
     ``delta`` (a catalogue term). Findings of other kinds (delays, sensors, faults) move the moments through
-    their own paths and are left out. Returns {} when there is none.
+    their own paths and are left out. ``wind_axis``: the scale's column in the search's convention
+    (:attr:`DifferentialOptions.scale_wind_axis`). Returns {} when there is none.
     """
     from .context import evaluate_model
-    from .sparse import THRESHOLDS as SPARSE_TH, scale_columns
+    from .sparse import scale_columns
 
     out: dict = {}
     cols = None
@@ -561,8 +667,7 @@ def _force_changes(diag, fitted: dict, cause: str) -> dict:
             for tm in terms:
                 if tm["term"].startswith("scale:"):
                     if cols is None:
-                        cols = scale_columns(evaluate_model(diag.model, diag.X), diag.X,
-                                             wind_axis=bool(SPARSE_TH.get("side_force_wind_axis", True)))
+                        cols = scale_columns(evaluate_model(diag.model, diag.X), diag.X, wind_axis=wind_axis)
                     phi = cols[:, COEFFICIENTS.index(tm["term"].split(":", 1)[1])]
                 else:
                     try:
@@ -826,13 +931,8 @@ def _residual_of(ctx: DiagContext) -> np.ndarray:
 
 def differential(diag, references: list[Reference], airframe, *, threshold_pct: float = 20.0,
                  consistent_rel: float = 0.25, min_t: float = 3.0, min_step_chi2: float = 25.0,
-                 search_residual: np.ndarray | None = None, angle_scale_se: bool = True,
-                 alpha_scale: bool = True, delay_same_fit: bool = True, alpha_jackknife_s: float = 15.0,
-                 delay_change_min_t: float = 3.0, delay_se_central: bool = True, angle_error_along: tuple = (),
-                 force_moment_arm_max: float = 0.0, scale_beta_allowance: bool = False,
-                 scale_wind_axis: bool = True, angle_error_beside_named: bool = False,
-                 beside_residual: np.ndarray | None = None, angle_witness_exclude=(),
-                 angle_scale_type_b: dict | None = None, estimate_beyond_scale: tuple = ()) -> dict:
+                 search_residual: np.ndarray | None = None, angle_witness_exclude=(),
+                 options: DifferentialOptions | None = None) -> dict:
     """Split the findings of a diagnosis into model inadequacy and changes, against reference flight(s).
 
     Args:
@@ -845,65 +945,18 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         consistent_rel, min_t: the "same in the reference" test (see the module docstring).
         min_step_chi2: onset change-point acceptance.
         search_residual: (T, 6) the differential sparse search's residual (after the reference flight's
-            inadequacy and the angle nuisance; ``sparse.THRESHOLDS["allowance_on_search_residual"]``):
-            given, a term the search named is judged for the between-flight allowances on it, not on
-            the raw residual against the model, where the model's own inadequacy (the reference flight
-            has it too, and the search took it out) can hide a change (the JSBSim c172x ``Cm:alpha^2``).
-        angle_scale_se: carry the fitted angle scale's standard error into the scale allowances
-            (:func:`angle_scale_allowance`; ``sparse.THRESHOLDS["angle_scale_se"]``).
-        alpha_scale: also judge a finding in alpha against a between-flight scale of the measured angle of
-            attack seen in the other longitudinal coefficients (``sparse.THRESHOLDS["alpha_scale_allowance"]``;
-            the sideslip's is always judged).
-        delay_same_fit: a delay the sparse search sized as a difference (``evidence.delay_differential``) is
-            compared with each reference by the same fit (:func:`_reference_delay`): the flight's own delay
-            against the reference's (``sparse.THRESHOLDS["delay_reference_same_fit"]``; added 2026-11-22,
-            branch i9-delay). Off: the reference's delay by the catalogue's scan
-            (:func:`gcs_sysid.diagnose.candidates.fit_delays`), whose grid starts at one sample, so a
-            reference without a delay reads one sample (0.02 s at 50 Hz) with a standard error of a
-            minimum on the grid's edge, and the flight's *change* was held against it.
-        delay_change_min_t: with ``delay_same_fit``, a delay whose change against the reference (its estimate) is
-            below this many of its standard errors (time resolution included) is an allowance, not a change
-            (``sparse.THRESHOLDS["delay_change_min_t"]``; added 2026-11-22 13:20 UTC, branch i9-delay, after the
-            first freeze: the PA-28 s1 2-m/s pitot bias got a 0.010 +- 0.006 s delay beside it); 0: off.
-        delay_se_central: with ``delay_same_fit``, the reference's delay standard error by a central difference
-            about its best delay (``sparse.THRESHOLDS["delay_se_central"]``, as the flight's; ``sparse._refine_delay``).
-        alpha_jackknife_s: block length, s, of the block-jackknife standard error with which a finding in alpha
-            is also judged beyond the alpha scale (:func:`angle_scale_allowance` ``jackknife``, the first
-            reference's slope included); 0: off (``sparse.THRESHOLDS["alpha_jackknife_s"]``).
-        angle_error_along: the air angles (``"beta"``) against whose error along a finding's own term each aero
-            finding of that angle's coefficients is also judged (:func:`angle_error_allowance`;
-            ``sparse.THRESHOLDS["angle_error_along_term"]``; added in the eleventh session, branch i9-b747); ():
-            off.
-        force_moment_arm_max: a moment finding (Cl, Cm, Cn) beside named findings that change forces only is
-            also judged beyond those force changes' moment about the CG, each with a free arm of at most this
-            many reference lengths (:func:`force_moment_allowance`; ``sparse.THRESHOLDS["force_moment_arm_max"]``;
-            added in the twelfth session, branch i9-second); 0: off.
-        scale_beta_allowance: also judge a ``scale:<coef>`` finding of a sideslip coefficient (``scale:CY``) against
-            a between-flight scale of the measured sideslip (:func:`angle_scale_allowance` with the finding's own
-            column, :func:`_scale_column`), as a ``CY:beta`` finding is (``sparse.THRESHOLDS["scale_beta_allowance"]``;
-            eighteenth session, branch i9-c684). A sideslip scale ``1 + s`` moves CY by ``s beta dCY/dbeta``, which on
-            an airframe whose side force is mostly its sideslip slope is ``s`` times the model's CY: the column of
-            ``scale:CY``; before, only a finding named ``CY:beta`` was judged so, and the c684's clean seed 13 named
-            ``scale:CY`` 1.146 where its sideslip read 8 % smaller against the truth than the reference's.
-            False: off.
-        scale_wind_axis: the scale's column in the search's convention (``sparse.THRESHOLDS["side_force_wind_axis"]``).
-        angle_error_beside_named: the angle's error along a finding's term (``angle_error_along``) is fitted on the
-            other coefficients with the other named aero findings' terms there free (:func:`_named_columns`,
-            ``beside`` of :func:`angle_scale_allowance`; ``sparse.THRESHOLDS["angle_error_beside_named"]``, nineteenth
-            session, branch i9-ultra), on ``beside_residual`` where given for a search finding. False: off.
-        beside_residual: (T, 6) the search's differential residual (after the reference's inadequacy and the angle
-            nuisance; ``sparse_search(keep_residual=True)``), on which ``angle_error_beside_named`` fits a search
-            finding's angle error and judges it: on the raw residual the reference's own inadequacy (the ultrastick's
-            Cn ridge) stays in the other coefficients and the error along ``p_hat`` was not found. None: the raw one.
+            inadequacy and the angle nuisance; ``sparse_search(keep_residual=True)``). With
+            ``options.allowance_on_search_residual`` a term the search named is judged for the between-flight
+            allowances on it, not on the raw residual against the model, where the model's own inadequacy (the
+            reference flight has it too, and the search took it out) can hide a change (the JSBSim c172x
+            ``Cm:alpha^2``); with ``options.angle_error_beside_named`` a search finding's angle error is fitted and
+            judged on it: on the raw residual the reference's own inadequacy (the ultrastick's Cn ridge) stays in
+            the other coefficients and the error along ``p_hat`` was not found. None: the raw residual for both.
         angle_witness_exclude: coefficients no air angle's scale or error is fitted on (``witness_exclude`` of
             :func:`angle_scale_allowance`): those whose measured target differs in kind between this flight and the
             references (:func:`gcs_sysid.diagnose.air_roll.moved_targets`). (): none.
-        angle_scale_type_b: ``{angle: u}``, the type-B standard uncertainty of that angle's between-flight scale
-            (``scale_type_b`` of :func:`angle_scale_allowance`; ``sparse.THRESHOLDS["beta_scale_type_b"]`` for
-            ``"beta"``). None or an absent angle: 0.
-        estimate_beyond_scale: causes (``"scale:CY"``) whose kept finding reports its change beyond the air angle's
-            between-flight scale, the estimate its naming was judged on (:func:`report_beyond_scale`;
-            ``sparse.THRESHOLDS["estimate_beyond_angle_scale"]``). (): every finding keeps its selected estimate.
+        options: the allowances' switches (:class:`DifferentialOptions`); None: the frozen thresholds'
+            (:meth:`DifferentialOptions.from_thresholds`), as :func:`gcs_sysid.diagnose.core.diagnose` uses them.
 
     Returns:
         The ``differential`` document: ``references`` (label, rows, t range), ``model_inadequacy``
@@ -915,7 +968,11 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
     Raises:
         DataError: a reference with too few valid rows (from the table checks).
     """
-    type_b = {k: float(v) for k, v in (angle_scale_type_b or {}).items()}
+    opt = DifferentialOptions.from_thresholds() if options is None else options
+    type_b = {"beta": float(opt.beta_scale_type_b)}
+    # a search finding's allowances on the search's residual (allowance_on_search_residual), its angle error
+    # beside the other named findings on it too (angle_error_beside_named)
+    allowance_residual = search_residual if opt.allowance_on_search_residual else None
     refs = []
     for ref in references:
         ctx = DiagContext.build(ref.table, airframe, diag.model, ref.states, None, None)
@@ -969,8 +1026,8 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         if is_aero:                          # the between-flight allowance: an offset of the coefficient
             coef, term = cause.split(":", 1)
             R_wo = (diag.residual_after - fitted[cause].delta) if cause in fitted else diag.residual_before
-            if search_residual is not None and f.get("source") == "sparse search":
-                R_wo = np.where(valid0[:, None], search_residual, np.nan)
+            if allowance_residual is not None and f.get("source") == "sparse search":
+                R_wo = np.where(valid0[:, None], allowance_residual, np.nan)
             # a curvature that entered the search with its parent is judged with it (sparse.power_parent_blocks)
             parents = tuple(f.get("evidence", {}).get("entered_with") or ())
             allow = offset_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
@@ -983,16 +1040,16 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 continue
             f["evidence"]["offset_allowance"] = allow
             scaled = None
-            for angle in ("beta", "alpha") if alpha_scale else ("beta",):
+            for angle in ("beta", "alpha") if opt.alpha_scale else ("beta",):
                 jk = None
-                if angle == "alpha" and alpha_jackknife_s > 0:
+                if angle == "alpha" and opt.alpha_jackknife_s > 0:
                     r_ctx, r_R = (refs[0][1], refs[0][2]) if refs else (None, None)
-                    jk = {"t": diag.t, "block_s": alpha_jackknife_s,
+                    jk = {"t": diag.t, "block_s": opt.alpha_jackknife_s,
                           "reference": None if r_ctx is None else
                           (r_ctx.t, r_ctx.X, r_R[:, COEFFICIENTS.index(coef)], r_ctx.valid)}
                 scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                               coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                              scale_se=angle_scale_se, jackknife=jk, parents=parents,
+                                              scale_se=opt.angle_scale_se, jackknife=jk, parents=parents,
                                               witness_exclude=angle_witness_exclude,
                                               scale_type_b=type_b.get(angle, 0.0))
                 if scale is not None and scale["scale_only"]:
@@ -1000,19 +1057,19 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                     break
                 if scale is not None:
                     f["evidence"][f"{angle}_scale_allowance"] = scale
-            for angle in angle_error_along if scaled is None else ():
+            for angle in opt.angle_error_along if scaled is None else ():
                 # an error of the measured angle along the finding's own term (angle_error_allowance)
-                if angle_error_beside_named:
-                    R_e = np.where(valid0[:, None], beside_residual, np.nan) \
-                        if beside_residual is not None and f.get("source") == "sparse search" else R_wo
+                if opt.angle_error_beside_named:
+                    R_e = np.where(valid0[:, None], search_residual, np.nan) \
+                        if search_residual is not None and f.get("source") == "sparse search" else R_wo
                     err = angle_scale_allowance(diag.X, R_e, diag.train & valid0, diag.test & valid0, diag.model,
-                                                coef, term, angle, min_t, min_gain_pct, angle_scale_se,
+                                                coef, term, angle, min_t, min_gain_pct, opt.angle_scale_se,
                                                 along_term=True, beside=_named_columns(diag, cause),
                                                 witness_exclude=angle_witness_exclude)
                 else:
                     err = angle_error_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                                 coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                                scale_se=angle_scale_se, witness_exclude=angle_witness_exclude)
+                                                scale_se=opt.angle_scale_se, witness_exclude=angle_witness_exclude)
                 if err is not None and err["scale_only"]:
                     scaled = err
                     break
@@ -1027,9 +1084,9 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 what = "sideslip" if scaled["angle"] == "beta" else "angle of attack"
                 _note_allowance(doc, f, scaled, f"{cause}: a between-flight scale of the measured {what}, not a cause")
                 continue
-            forces = _force_changes(diag, fitted, cause) if force_moment_arm_max > 0 else {}
+            forces = _force_changes(diag, fitted, cause, opt.scale_wind_axis) if opt.force_moment_arm_max > 0 else {}
             moment = force_moment_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, coef, term,
-                                            forces, arm_max=force_moment_arm_max, min_t=min_t,
+                                            forces, arm_max=opt.force_moment_arm_max, min_t=min_t,
                                             min_gain_pct=min_gain_pct) if forces else None
             if moment is not None and moment["moment_only"]:
                 _note_allowance(doc, f, moment, f"{cause}: the moment about the CG of the named force change "
@@ -1037,18 +1094,18 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 continue
             if moment is not None:
                 f["evidence"]["force_moment_allowance"] = moment
-        if scale_beta_allowance and cause.startswith("scale:") and cause[6:] in BETA_COEFFICIENTS:
+        if opt.scale_beta_allowance and cause.startswith("scale:") and cause[6:] in BETA_COEFFICIENTS:
             # a side-force scale is judged against a between-flight scale of the measured sideslip, as CY:beta is: on
             # an airframe whose side force is mostly CY_beta beta the two are one column (the c684, eighteenth session)
             coef = cause[6:]
             R_wo = diag.residual_before
-            if search_residual is not None and f.get("source") == "sparse search":
-                R_wo = np.where(valid0[:, None], search_residual, np.nan)
-            col = _scale_column(diag.model, diag.X, coef, scale_wind_axis)
+            if allowance_residual is not None and f.get("source") == "sparse search":
+                R_wo = np.where(valid0[:, None], allowance_residual, np.nan)
+            col = _scale_column(diag.model, diag.X, coef, opt.scale_wind_axis)
             scale = angle_scale_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model, coef,
                                           cause, "beta", min_t=min_t, min_gain_pct=min_gain_pct,
-                                          scale_se=angle_scale_se, column=col, witness_exclude=angle_witness_exclude,
-                                          scale_type_b=type_b.get("beta", 0.0))
+                                          scale_se=opt.angle_scale_se, column=col,
+                                          witness_exclude=angle_witness_exclude, scale_type_b=type_b.get("beta", 0.0))
             if scale is not None and scale["scale_only"]:
                 _note_allowance(doc, f, scale, f"{cause}: a between-flight scale of the measured sideslip, not a cause")
                 continue
@@ -1064,11 +1121,11 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
         se_f = float(f["evidence"].get("std_error_decision", f["std_error"]))
         # a delay sized as a difference (sparse._differential_delay): compare the flight's own delay with each
         # reference's, both by that one fit
-        same_fit = delay_same_fit and cause.startswith("delay:") and "delay_differential" in f.get("evidence", {})
-        if same_fit and delay_change_min_t > 0 and not abs(c_f) >= delay_change_min_t * se_f:
+        same_fit = opt.delay_same_fit and cause.startswith("delay:") and "delay_differential" in f.get("evidence", {})
+        if same_fit and opt.delay_change_min_t > 0 and not abs(c_f) >= opt.delay_change_min_t * se_f:
             # the change of the delay is within its standard error (time resolution included) of none
             why = (f"{cause}: a change of {c_f:+.3f} +- {se_f:.2g} s against the reference (t {c_f / se_f:.1f} "
-                   f"< {delay_change_min_t:g}): no change beyond the fit and the log's time resolution")
+                   f"< {opt.delay_change_min_t:g}): no change beyond the fit and the log's time resolution")
             f["evidence"]["differential"] = {"verdict": "allowance", "why": why}
             doc["allowance"].append({"cause": cause, "coefficient": f["coefficient"], "estimate": f["estimate"],
                                      "gain": f.get("gain", {}), "why": why, "summary": why})
@@ -1081,7 +1138,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                 coef, term = cause.split(":", 1)
                 got = _refit_aero(ctx, R, coef, term)
             elif same_fit:
-                got = _reference_delay(ctx, R, cause.split(":", 1)[1], f["coefficient"], delay_se_central)
+                got = _reference_delay(ctx, R, cause.split(":", 1)[1], f["coefficient"], opt.delay_se_central)
             else:
                 try:                                   # a fit that fails on the reference compares nothing
                     got = _refit_other(ctx, ctx.Y - ctx.model_values(), f, ref, airframe)
@@ -1157,7 +1214,7 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                                "reference_corrections": [c.get("correction") for c in compared]})
         keep.append(f)
     for f in keep:                             # every decision is made: only what a finding reports changes
-        if f["cause"] in estimate_beyond_scale:
+        if f["cause"] in opt.estimate_beyond_scale:
             report_beyond_scale(f)
     diag.findings[:] = keep
     # structure no term explains: in the references too, or only here

@@ -9,6 +9,7 @@ asks whether the delay was already there in the reference flight. With the catal
 branch i9-delay). Synthetic flights of ``BASE``; a few seconds.
 """
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -17,7 +18,7 @@ import pytest
 from gcs_sysid.aero.table import COEFFICIENTS
 from gcs_sysid.airframe import load_airframe
 from gcs_sysid.diagnose.context import DiagContext, evaluate_model
-from gcs_sysid.diagnose.differential import Reference, _reference_delay, differential
+from gcs_sysid.diagnose.differential import DifferentialOptions, Reference, _reference_delay, differential
 from gcs_sysid.diagnose.sparse import _differential_delay
 
 from diag_flights import AIRFRAME
@@ -60,13 +61,15 @@ def test_a_delay_change_is_not_called_the_references_own_delay():
                 "std_error": float(np.hypot(se, 0.02 / np.sqrt(12.0))), "model_value": 0.0,
                 "gain": {"percent": 75.0}, "evidence": {"delay_differential": parts}}
 
+    frozen = DifferentialOptions.from_thresholds()
+    assert frozen.delay_same_fit and frozen.delay_change_min_t == 3.0
     d = _diag(ctx, finding())
-    doc = differential(d, [Reference(rtab, rst, label="ref")], af, delay_same_fit=True)
+    doc = differential(d, [Reference(rtab, rst, label="ref")], af, options=frozen)
     assert [f["cause"] for f in d.findings] == ["delay:delta_e"], doc
     assert doc["changed"][0]["cause"] == "delay:delta_e" and not doc["model_inadequacy"]
     # the catalogue's scan on the reference: one sample, "the same delay" -> model inadequacy
     d_old = _diag(ctx, finding())
-    old = differential(d_old, [Reference(rtab, rst, label="ref")], af, delay_same_fit=False)
+    old = differential(d_old, [Reference(rtab, rst, label="ref")], af, options=replace(frozen, delay_same_fit=False))
     assert d_old.findings == [] and old["model_inadequacy"][0]["cause"] == "delay:delta_e", old
     assert old["model_inadequacy"][0]["in_references"][0]["correction"] == pytest.approx(0.02, abs=0.005)
     # a "change" within its standard error of none (the PA-28 s1 pitot-bias flight's 0.010 +- 0.006 s beside
@@ -74,10 +77,10 @@ def test_a_delay_change_is_not_called_the_references_own_delay():
     small = dict(finding(), estimate=0.010, std_error=0.006,
                  evidence={"delay_differential": dict(parts, flight_s=parts["reference_s"] + 0.010)})
     d_small = _diag(ctx, small)
-    doc_small = differential(d_small, [Reference(rtab, rst, label="ref")], af, delay_same_fit=True)
+    doc_small = differential(d_small, [Reference(rtab, rst, label="ref")], af)   # options: the frozen ones
     assert d_small.findings == [] and doc_small["allowance"][0]["cause"] == "delay:delta_e", doc_small
     d_kept = _diag(ctx, dict(small, evidence={"delay_differential": small["evidence"]["delay_differential"]}))
-    differential(d_kept, [Reference(rtab, rst, label="ref")], af, delay_same_fit=True, delay_change_min_t=0.0)
+    differential(d_kept, [Reference(rtab, rst, label="ref")], af, options=replace(frozen, delay_change_min_t=0.0))
     assert [f["cause"] for f in d_kept.findings] == ["delay:delta_e"]
 
 
