@@ -2064,7 +2064,7 @@ def _differential_delay(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndar
                                                central=central)
             se_ref = se_ref if np.isfinite(se_ref) else 0.0
     change = float(tau - tau_ref)
-    _, D, _ = _refine_delay(ctx, Rn, surf, tr, j, taus=np.array([max(change, 0.0)]), central=central)
+    D = _delay_response(ctx, surf, max(change, 0.0))
     parts = {"flight_s": float(tau), "reference_s": float(tau_ref), "std_error_flight_s": float(se),
              "std_error_reference_s": float(se_ref)}
     return change, D, float(np.hypot(se, se_ref)), parts
@@ -2122,6 +2122,17 @@ def _delay_in_primary(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarra
     return out
 
 
+def _delay_response(ctx: DiagContext, surf: str, tau: float, base: np.ndarray | None = None) -> np.ndarray:
+    """(T, 6) the model's own response to a delay ``tau`` (s) of ``surf``: ``model(X with u(t - tau)) - model(X)``,
+    the surface interpolated on the log's clock (NaN read as 0). ``base``: ``ctx.model_values()`` when known."""
+    from ..aero.table import REGRESSORS
+
+    k = REGRESSORS.index(surf)
+    X = ctx.X.copy()
+    X[:, k] = np.interp(ctx.t - tau, ctx.t, np.nan_to_num(ctx.X[:, k]))
+    return np.nan_to_num(ctx.model_values(X) - (ctx.model_values() if base is None else base))
+
+
 def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j: int,
                   taus=np.arange(0.0, 0.4001, 0.005), central: bool = True) -> tuple[float, np.ndarray, float]:
     """The delay of ``surf`` that best explains ``R`` through the model's own response.
@@ -2144,9 +2155,7 @@ def _refine_delay(ctx: DiagContext, R: np.ndarray, surf: str, tr: np.ndarray, j:
     w[j] = 1.0
     best, best_s, best_D = 0.0, np.inf, np.zeros_like(R)
     for tau in taus:
-        X = ctx.X.copy()
-        X[:, k] = np.interp(ctx.t - tau, ctx.t, np.nan_to_num(ctx.X[:, k]))
-        D = np.nan_to_num(ctx.model_values(X) - base)
+        D = _delay_response(ctx, surf, tau, base)
         e = R[tr] - D[tr]
         e = e - e.mean(axis=0)
         sse = float(np.sum(w * np.sum(e**2, axis=0) * ctx.active))
