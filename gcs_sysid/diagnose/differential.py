@@ -91,6 +91,7 @@ _THRESHOLD_KEYS = {
     "force_moment_arm_max": "force_moment_arm_max", "scale_beta_allowance": "scale_beta_allowance",
     "scale_wind_axis": "side_force_wind_axis", "angle_error_beside_named": "angle_error_beside_named",
     "beta_scale_type_b": "beta_scale_type_b", "estimate_beyond_scale": "estimate_beyond_angle_scale",
+    "angle_error_parents": "angle_error_parents",
 }
 
 
@@ -148,6 +149,10 @@ class DifferentialOptions:
         estimate_beyond_scale: causes (``"scale:CY"``) whose kept finding reports its change beyond the air angle's
             between-flight scale, the estimate its naming was judged on (:func:`report_beyond_scale`;
             ``estimate_beyond_angle_scale``); (): every finding keeps its selected estimate.
+        angle_error_parents: the angle's error along a finding's term (``angle_error_along``) is judged with the
+            terms the finding entered the search with (``evidence.entered_with``: ``beta`` beside ``Cl:alpha*beta``)
+            fitted beside it, as the offset and scale allowances and the jackknife judge it (``angle_error_parents``;
+            sixtieth session). False: the term alone there (before).
     """
 
     allowance_on_search_residual: bool
@@ -164,6 +169,7 @@ class DifferentialOptions:
     angle_error_beside_named: bool
     beta_scale_type_b: float
     estimate_beyond_scale: tuple
+    angle_error_parents: bool
 
     @classmethod
     def from_thresholds(cls, overrides: dict | None = None) -> DifferentialOptions:
@@ -235,6 +241,11 @@ def _refit_other(ctx: DiagContext, R: np.ndarray, finding: dict, ref: Reference,
     return float(hit[0].estimate), float(hit[0].std_error)
 
 
+def _with_parents(parents) -> str:
+    """The words an allowance's ``why`` gives a finding judged with its parents beside it ("" without)."""
+    return f" (with {', '.join(parents)} beside it, which it entered the search with)" if parents else ""
+
+
 def _parent_columns(X: np.ndarray, parents) -> np.ndarray:
     """(T, k) the columns of the terms a finding entered the search with (``evidence.entered_with``); (T, 0) none."""
     if not parents:
@@ -290,7 +301,7 @@ def offset_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.n
     gain = 100.0 * (1.0 - a / b) if b > 0 else 0.0
     t = th / se if se > 0 else 0.0
     only = abs(t) < min_t or gain < min_gain_pct
-    with_p = f" (with {', '.join(parents)} beside it, which it entered the search with)" if parents else ""
+    with_p = _with_parents(parents)
     why = (f"with {coef}'s between-flight offset free, {coef}:{term}{with_p} is {th:+.4g} +- {se:.2g} (t {t:.1f}) "
            f"and gains {gain:.0f} % on the held-out rows beyond the offset")
     return {"offset_only": bool(only), "estimate": th, "std_error": se, "t": float(t),
@@ -488,8 +499,9 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
             t = beyond["estimate"] / se if se > 0 else 0.0
             beyond = dict(beyond, std_error=se, std_error_fit=beyond["std_error"], std_error_scale_share=share,
                           t=float(t), offset_only=bool(beyond["offset_only"] or abs(t) < min_t),
-                          why=(f"with {coef}'s between-flight offset free, {coef}:{term} is {beyond['estimate']:+.4g} "
-                               f"+- {se:.2g} (the scale's uncertainty {share:.2g} included; t {t:.1f}) and gains "
+                          why=(f"with {coef}'s between-flight offset free, {coef}:{term}{_with_parents(parents)} is "
+                               f"{beyond['estimate']:+.4g} +- {se:.2g} (the scale's uncertainty {share:.2g} included; "
+                               f"t {t:.1f}) and gains "
                                f"{beyond['gain_beyond_offset_percent']:.0f} % on the held-out rows beyond the offset"))
     if jackknife and "std_error" in beyond:
         beyond = _with_jackknife(beyond, X, R_adj[:, j], ok, term, jackknife, min_t, parents)
@@ -510,7 +522,7 @@ def angle_scale_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
 
 def angle_error_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test: np.ndarray, model, coef: str,
                           term: str, angle: str = "beta", min_t: float = 3.0, min_gain_pct: float = 10.0,
-                          scale_se: bool = True, witness_exclude=()) -> dict | None:
+                          scale_se: bool = True, witness_exclude=(), parents=()) -> dict | None:
     """Is a finding more than an error of the measured air angle that moves with the finding's own term?
 
     The scale allowance (:func:`angle_scale_allowance`) covers an angle error proportional to the angle.
@@ -531,7 +543,7 @@ def angle_error_allowance(X: np.ndarray, R: np.ndarray, train: np.ndarray, test:
     angle's group, the term is not a vocabulary monomial, or no other coefficient depends on the angle.
     """
     return angle_scale_allowance(X, R, train, test, model, coef, term, angle, min_t, min_gain_pct, scale_se,
-                                 along_term=True, witness_exclude=witness_exclude)
+                                 along_term=True, witness_exclude=witness_exclude, parents=parents)
 
 
 #: The force coefficients whose moment about the CG each moment coefficient carries when the aerodynamic force
@@ -1065,11 +1077,13 @@ def differential(diag, references: list[Reference], airframe, *, threshold_pct: 
                     err = angle_scale_allowance(diag.X, R_e, diag.train & valid0, diag.test & valid0, diag.model,
                                                 coef, term, angle, min_t, min_gain_pct, opt.angle_scale_se,
                                                 along_term=True, beside=_named_columns(diag, cause),
-                                                witness_exclude=angle_witness_exclude)
+                                                witness_exclude=angle_witness_exclude,
+                                                parents=parents if opt.angle_error_parents else ())
                 else:
                     err = angle_error_allowance(diag.X, R_wo, diag.train & valid0, diag.test & valid0, diag.model,
                                                 coef, term, angle, min_t=min_t, min_gain_pct=min_gain_pct,
-                                                scale_se=opt.angle_scale_se, witness_exclude=angle_witness_exclude)
+                                                scale_se=opt.angle_scale_se, witness_exclude=angle_witness_exclude,
+                                                parents=parents if opt.angle_error_parents else ())
                 if err is not None and err["scale_only"]:
                     scaled = err
                     break
