@@ -415,6 +415,9 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
     }
     if fault_summary is not None:
         data["faults"] = fault_summary
+    from .sparse import THRESHOLDS as _SPARSE_TH
+
+    th = dict(_SPARSE_TH, **(sparse_thresholds or {}))   # the search's and the differential step's, this call
     search_residual = None
     if search:
         from .search import search_residual as _search_wide
@@ -426,14 +429,11 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
 
         if search_reference is None and references:   # the first reference flight makes the search differential
             search_reference = (references[0].table, references[0].states)
-        from .sparse import THRESHOLDS as _SPARSE_TH
-
-        th = dict(_SPARSE_TH, **(sparse_thresholds or {}))
         keep_rd = bool(th["allowance_on_search_residual"]) or bool(th["angle_error_beside_named"])
         from .uncertainty import air_data_uncertainty
 
         data["sparse"] = sparse_search(ctx, R0, reference_context(search_reference, airframe, model0),
-                                       thresholds=sparse_thresholds, keep_residual=keep_rd,
+                                       thresholds=th, keep_residual=keep_rd,
                                        angle_uncertainty=air_data_uncertainty(
                                            getattr(states, "angle_fits", None),
                                            getattr(search_reference[1], "angle_fits", None)
@@ -481,7 +481,7 @@ def diagnose(table: CoefficientTable, airframe: Airframe, model, states=None, *,
         data["differential"] = differential(diag, list(references), airframe,
                                             threshold_pct=unexplained_threshold_pct,
                                             search_residual=search_residual, angle_witness_exclude=unlike,
-                                            options=DifferentialOptions.from_thresholds(sparse_thresholds))
+                                            options=DifferentialOptions.from_thresholds(th))
         diag.model_inadequacy = data["differential"]["model_inadequacy"]
         data["timings"]["differential_s"] = float(time.perf_counter() - t1)
     data["timings"]["diagnose_s"] = float(time.perf_counter() - t0)

@@ -45,7 +45,7 @@ unexplained change. Neither ever gets a cause name.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -183,14 +183,9 @@ class DifferentialOptions:
         from .sparse import THRESHOLDS
 
         th = dict(THRESHOLDS, **(overrides or {}))
-        kinds = {"angle_error_along": tuple, "estimate_beyond_scale": tuple, "delay_change_min_t": float,
-                 "alpha_jackknife_s": float, "force_moment_arm_max": float, "beta_scale_type_b": float}
+        kinds = {"bool": bool, "float": float, "tuple": lambda v: tuple(v or ())}   # the fields' annotations
 
-        def read(name: str, key: str):
-            kind = kinds.get(name, bool)
-            return tuple(th[key] or ()) if kind is tuple else kind(th[key])
-
-        return cls(**{name: read(name, key) for name, key in _THRESHOLD_KEYS.items()})
+        return cls(**{f.name: kinds[f.type](th[_THRESHOLD_KEYS[f.name]]) for f in fields(cls)})
 
 
 def _null_value(cause: str, airframe) -> float:
