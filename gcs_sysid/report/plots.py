@@ -66,6 +66,11 @@ def _shade(ax, t: np.ndarray, mask: np.ndarray, label: str | None = None) -> Non
         ax.axvspan(t[a], t[b - 1], color=_HELD, alpha=0.25, lw=0, label=label if k == 0 else None)
 
 
+def _one_path(pts: list, codes: list) -> Path:
+    """One matplotlib ``Path`` from contourpy's per-polygon point ``(n_i, 2)`` and code ``(n_i,)`` arrays."""
+    return Path(np.concatenate(pts), np.concatenate(codes))
+
+
 def _flag_marks(ax, xc: np.ndarray, yc: np.ndarray, flag: np.ndarray) -> list:
     """Hatch ``///`` and outline (cyan) over the flagged cells of ``flag (ny, nx)`` (1.0 flagged, 0.0 not) on the
     cell centres ``xc (nx,)``, ``yc (ny,)``: the regions matplotlib's ``contourf(levels=[0.5, 1.5])`` and
@@ -78,13 +83,13 @@ def _flag_marks(ax, xc: np.ndarray, yc: np.ndarray, flag: np.ndarray) -> list:
     marks = []
     pts, codes = gen.filled(0.5, 1.5)
     if pts:
-        marks.append(ax.add_artist(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), facecolor="none",
+        marks.append(ax.add_artist(PathPatch(_one_path(pts, codes), facecolor="none",
                                              edgecolor="black", linewidth=0.0, hatch="///")))
     if not flag.all():
         pts, codes = gen.lines(0.5)
         if pts:
             # joins, caps and z-order as a contour set's lines (round, butt, 2): the same pixels
-            marks.append(ax.add_artist(PathPatch(Path(np.concatenate(pts), np.concatenate(codes)), fill=False,
+            marks.append(ax.add_artist(PathPatch(_one_path(pts, codes), fill=False,
                                                  edgecolor="#00bcd4", linewidth=1.0, joinstyle="round",
                                                  capstyle="butt", zorder=2)))
     return marks
