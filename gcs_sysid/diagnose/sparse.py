@@ -363,7 +363,8 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "power_with_parent": ("Cm:alpha", "Cl:alpha*beta"), "delay_primary_agreement": 3.0,
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
               "hierarchy_se_degree": 3, "simpler_catalogue_powers": False,
-              "delay_se_central": True, "estimate_beyond_angle_scale": ("scale:CY",), "angle_error_parents": True}
+              "delay_se_central": True, "estimate_beyond_angle_scale": ("scale:CY",), "angle_error_parents": True,
+              "estimate_beyond_angle_error": ()}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

@@ -381,3 +381,54 @@ def test_a_side_force_scale_reports_beyond_the_sideslip_scale_by_default():
     from gcs_sysid.diagnose.sparse import THRESHOLDS
 
     assert tuple(THRESHOLDS["estimate_beyond_angle_scale"]) == ("scale:CY",)
+
+
+def _adverse_yaw_flight(seed: int, change: float, read: float):
+    """An adverse yaw ``Cn:delta_a`` = ``change`` that also drives sideslip ``-2 change delta_a`` (rad), read on a
+    sideslip that sees ``read`` of that driven part (the aided angle's low-frequency under-read): the measured
+    sideslip misses ``e delta_a``, ``e = -2 change (1 - read)``, and CY, Cl and Cn move by their model sideslip
+    derivatives times it beside the change."""
+    X, noise, train, test = _flight(seed)
+    ib, ia = REGRESSORS.index("beta"), REGRESSORS.index("delta_a")
+    X_true = X.copy()
+    X_true[:, ib] += -2.0 * change * X[:, ia]
+    X[:, ib] += -2.0 * change * read * X[:, ia]
+    Y = evaluate_model(MODEL, X_true)
+    Y[:, COEFFICIENTS.index("Cn")] += change * X[:, ia]
+    return X, Y - evaluate_model(MODEL, X) + noise, train, test
+
+
+def test_an_adverse_yaw_reports_its_change_beyond_the_sideslip_error_it_caused():
+    """``report_beyond_angle_error`` (``sparse.THRESHOLDS["estimate_beyond_angle_error"]``): an adverse yaw -0.06
+    whose sideslip the measured angle reads 0.2 of reads -0.06 + Cn_beta e (e = 0.096 rad per unit of delta_a: -0.053)
+    as selected, and -0.06 beyond the error fitted on CY (and Cl); with the sideslip read whole both read -0.06. The
+    finding then reports the change beyond the error, its standard error with the error's share in quadrature, and
+    keeps what it selected; a CY finding is not re-read."""
+    from gcs_sysid.diagnose.differential import angle_scale_allowance, offset_allowance, report_beyond_angle_error
+
+    for read, selected in ((0.2, -0.06 + MODEL["Cn"]["beta"] * 0.096), (1.0, -0.06)):
+        X, R, train, test = _adverse_yaw_flight(4, -0.06, read)
+        sel = offset_allowance(X, R, train, test, "Cn", "delta_a")
+        a = angle_scale_allowance(X, R, train, test, MODEL, "Cn", "delta_a", "beta", along_term=True)
+        assert a is not None and not a["scale_only"] and "error_along_term" in a, a
+        assert abs(sel["estimate"] - selected) < 0.002, sel
+        assert abs(a["beyond_scale"]["estimate"] + 0.06) < 0.002, a["beyond_scale"]
+        f = {"cause": "Cn:delta_a", "estimate": sel["estimate"], "std_error": 0.002, "model_value": 0.0,
+             "evidence": {"beta_error_allowance": a}}
+        assert report_beyond_angle_error(f)
+        share = a["beyond_scale"]["std_error_scale_share"]
+        assert f["estimate"] == a["beyond_scale"]["estimate"] and f["std_error"] == np.hypot(0.002, share)
+        assert f["evidence"]["estimate_as_selected"] == {"estimate": sel["estimate"], "std_error": 0.002,
+                                                         "beyond": "beta_error_allowance"}
+    plain = {"cause": "Cn:delta_a", "estimate": -0.04, "std_error": 0.002, "model_value": 0.0, "evidence": {}}
+    assert not report_beyond_angle_error(plain) and plain["estimate"] == -0.04
+
+
+def test_the_estimate_beyond_the_sideslip_error_is_read_for_the_listed_coefficients_only():
+    """``DifferentialOptions.estimate_beyond_error`` from the thresholds: the coefficients whose kept findings the
+    differential step's last loop re-reads (off by default until a rule decides)."""
+    from gcs_sysid.diagnose.differential import DifferentialOptions
+
+    assert DifferentialOptions.from_thresholds().estimate_beyond_error == ()
+    on = DifferentialOptions.from_thresholds({"estimate_beyond_angle_error": ["Cl", "Cn"]})
+    assert on.estimate_beyond_error == ("Cl", "Cn")
