@@ -1281,12 +1281,20 @@ def report_beyond_scale(f: dict) -> bool:
         est, share = b.get("estimate"), b.get("std_error_scale_share", 0.0)
         if "error_along_term" in a or est is None or not np.isfinite(est) or not np.isfinite(share):
             continue
-        mv = f.get("model_value", ev.get("model_value", 0.0))
-        ev["estimate_as_selected"] = {"estimate": f["estimate"], "std_error": f["std_error"], "beyond": key}
-        f["estimate"] = float(mv + est)
-        f["std_error"] = float(np.hypot(f["std_error"], share))
+        _report_beyond(f, est, share, key)
         return True
     return False
+
+
+def _report_beyond(f: dict, change: float, share: float, key: str) -> None:
+    """Report ``change`` beyond an allowance as a finding's change (``estimate = model_value + change``) with the
+    allowance's standard-uncertainty ``share`` added in quadrature; what the finding selected goes to
+    ``evidence.estimate_as_selected`` with ``key``, the allowance's evidence key."""
+    ev = f.setdefault("evidence", {})
+    mv = f.get("model_value", ev.get("model_value", 0.0))
+    ev["estimate_as_selected"] = {"estimate": f["estimate"], "std_error": f["std_error"], "beyond": key}
+    f["estimate"] = float(mv + change)
+    f["std_error"] = float(np.hypot(f["std_error"], share))
 
 
 def report_beyond_angle_error(f: dict) -> bool:
@@ -1320,11 +1328,7 @@ def report_beyond_angle_error(f: dict) -> bool:
     est, share = b.get("estimate"), b.get("std_error_scale_share", 0.0)
     if "error_along_term" not in a or est is None or not np.isfinite(est) or not np.isfinite(share):
         return False
-    mv = f.get("model_value", ev.get("model_value", 0.0))
-    ev["estimate_as_selected"] = {"estimate": f["estimate"], "std_error": f["std_error"],
-                                  "beyond": "beta_error_allowance"}
-    f["estimate"] = float(mv + est)
-    f["std_error"] = float(np.hypot(f["std_error"], share))
+    _report_beyond(f, est, share, "beta_error_allowance")
     return True
 
 
