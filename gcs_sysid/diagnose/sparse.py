@@ -341,6 +341,15 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: on the same flights: named causes identical in every case, estimate +5/-1, all three +5/-1, the +-2 standard error
 #: interval covering JSBSim's scale on 18 -> 22 of the 24 ``scale:CY`` findings (``docs/benchmarks.md``,
 #: *Fifty-eighth session, lead*).
+#: Added 2026-11-28 (sixty-first session), **on**: ``estimate_beyond_angle_error`` (the coefficients whose kept findings
+#: report their change beyond the sideslip's error along their own term, :func:`gcs_sysid.diagnose.differential.
+#: report_beyond_angle_error`; (): the selected estimate). Only what a kept Cl or Cn finding reports changes, never what
+#: is named: the aided sideslip under-reads slow sideslip (0.75-0.85 of JSBSim's below 0.3 Hz), so a change that moves
+#: the sideslip along its own term (an adverse yaw) reads low by the model's sideslip derivative times that error.
+#: Adopted by a rule written before its runs: the seed-3 record's flights estimate +7/-3, all three +5/-3; fresh effect
+#: seed 109 with clean seeds 110-114, both arms on the same flights: named causes identical in all 425 cases, estimate
+#: +8/-2, all three +6/-1, the +-2 standard error interval covering JSBSim's ``Cn:delta_a`` on 26 -> 42 of 48 findings
+#: (``docs/benchmarks.md``, *Sixty-first session, lead*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -364,7 +373,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
               "hierarchy_se_degree": 3, "simpler_catalogue_powers": False,
               "delay_se_central": True, "estimate_beyond_angle_scale": ("scale:CY",), "angle_error_parents": True,
-              "estimate_beyond_angle_error": ()}
+              "estimate_beyond_angle_error": ("Cl", "Cn")}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 

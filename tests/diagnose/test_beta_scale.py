@@ -426,9 +426,9 @@ def test_an_adverse_yaw_reports_its_change_beyond_the_sideslip_error_it_caused()
 
 def test_the_estimate_beyond_the_sideslip_error_is_read_for_the_listed_coefficients_only():
     """``DifferentialOptions.estimate_beyond_error`` from the thresholds: the coefficients whose kept findings the
-    differential step's last loop re-reads (off by default until a rule decides)."""
+    differential step's last loop re-reads (on for Cl and Cn since the sixty-first session; a list turns it off)."""
     from gcs_sysid.diagnose.differential import DifferentialOptions
 
-    assert DifferentialOptions.from_thresholds().estimate_beyond_error == ()
-    on = DifferentialOptions.from_thresholds({"estimate_beyond_angle_error": ["Cl", "Cn"]})
-    assert on.estimate_beyond_error == ("Cl", "Cn")
+    assert DifferentialOptions.from_thresholds().estimate_beyond_error == ("Cl", "Cn")
+    off = DifferentialOptions.from_thresholds({"estimate_beyond_angle_error": []})
+    assert off.estimate_beyond_error == ()
