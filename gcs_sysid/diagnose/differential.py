@@ -1311,8 +1311,9 @@ def report_beyond_angle_error(f: dict) -> bool:
     the c684's flights), so the model's ``Cn_beta beta`` misses ``Cn_beta e delta_a`` and the change reads low by
     it (the c684's -0.06: -0.0385 as selected, -0.0597 beyond the error; with JSBSim's sideslip in the pipeline's
     place a linear reference reads -0.0594: ``benchmarks/effect_bias_split.py``, ``docs/benchmarks.md``,
-    *Sixty-first session, lead*). A finding of ``CY`` is not re-read this way: its error is fitted on the moments,
-    which hold a moment change along the same term when there is one.
+    *Sixty-first session, lead*). Which coefficients' findings are re-read is the caller's
+    (``DifferentialOptions.estimate_beyond_error``, ``("Cl", "Cn")`` by default): not ``CY``, whose error is fitted on
+    the moments, which hold a moment change along the same term when there is one.
 
     The finding's ``estimate`` becomes ``model_value + beyond_scale.estimate`` and its ``std_error`` the selected
     combined standard uncertainty with the error's share added in quadrature (``std_error_scale_share``, JCGM

@@ -403,7 +403,7 @@ def test_an_adverse_yaw_reports_its_change_beyond_the_sideslip_error_it_caused()
     whose sideslip the measured angle reads 0.2 of reads -0.06 + Cn_beta e (e = 0.096 rad per unit of delta_a: -0.053)
     as selected, and -0.06 beyond the error fitted on CY (and Cl); with the sideslip read whole both read -0.06. The
     finding then reports the change beyond the error, its standard error with the error's share in quadrature, and
-    keeps what it selected; a CY finding is not re-read."""
+    keeps what it selected; a finding without the allowance keeps its estimate."""
     from gcs_sysid.diagnose.differential import angle_scale_allowance, offset_allowance, report_beyond_angle_error
 
     for read, selected in ((0.2, -0.06 + MODEL["Cn"]["beta"] * 0.096), (1.0, -0.06)):
