@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.jsbsim_harness.truth import load_truth
 from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS
 from gcs_sysid.diagnose.run import load_measurements
 from gcs_sysid.sim.model_file import load_model
@@ -50,14 +51,13 @@ def flight_arrays(tlog: Path, airframe: str) -> dict[str, np.ndarray]:
     Raises:
         FileNotFoundError: no ``<stem>-truth.npz`` beside the log.
     """
-    tab = load_measurements(tlog, airframe).table
     truth = tlog.with_name(tlog.stem + "-truth.npz")
     if not truth.exists():
         raise FileNotFoundError(f"{truth}: the harness truth of {tlog.name} (benchmarks/jsbsim_harness) is needed")
-    z = np.load(truth)
-    Xt = np.stack([np.interp(tab.t, z["t"], z["X"][:, j]) for j in range(len(REGRESSORS))], 1)
-    Yt = np.stack([np.interp(tab.t, z["t"], z["Y_total"][:, j]) for j in range(len(COEFFICIENTS))], 1)
-    ok = np.all(np.isfinite(tab.X), 1) & np.all(np.isfinite(tab.Y), 1)
+    tab = load_measurements(tlog, airframe).table
+    Xt, Yt = load_truth(truth).at(tab.t)      # JSBSim's aerodynamic coefficients (the total's in a glide)
+    ok = np.all(np.isfinite(tab.X), 1) & np.all(np.isfinite(tab.Y), 1) & np.all(np.isfinite(Xt), 1) \
+        & np.all(np.isfinite(Yt), 1)
     return {"X": tab.X[ok], "Y": tab.Y[ok], "Xt": Xt[ok], "Yt": Yt[ok]}
 
 

@@ -1274,27 +1274,30 @@ def report_beyond_scale(f: dict) -> bool:
     Returns:
         Whether the finding was changed.
     """
-    ev = f.setdefault("evidence", {})
-    for key in ("beta_scale_allowance", "alpha_scale_allowance"):
-        a = ev.get(key) or {}
-        b = a.get("beyond_scale") or {}
-        est, share = b.get("estimate"), b.get("std_error_scale_share", 0.0)
-        if "error_along_term" in a or est is None or not np.isfinite(est) or not np.isfinite(share):
-            continue
-        _report_beyond(f, est, share, key)
-        return True
-    return False
+    return any(_report_beyond(f, key, along_term=False) for key in ("beta_scale_allowance", "alpha_scale_allowance"))
 
 
-def _report_beyond(f: dict, change: float, share: float, key: str) -> None:
-    """Report ``change`` beyond an allowance as a finding's change (``estimate = model_value + change``) with the
-    allowance's standard-uncertainty ``share`` added in quadrature; what the finding selected goes to
-    ``evidence.estimate_as_selected`` with ``key``, the allowance's evidence key."""
+def _report_beyond(f: dict, key: str, along_term: bool) -> bool:
+    """Report the change beyond the allowance ``evidence[key]`` as the finding's change (``estimate = model_value +
+    beyond_scale.estimate``) with the allowance's standard-uncertainty share (``std_error_scale_share``) added in
+    quadrature, what the finding selected kept in ``evidence.estimate_as_selected``; only where the allowance is of
+    the kind asked (an error along the finding's term or not, ``along_term``) and its change beyond is finite.
+
+    Returns:
+        Whether the finding was changed.
+    """
     ev = f.setdefault("evidence", {})
+    a = ev.get(key) or {}
+    b = a.get("beyond_scale") or {}
+    change, share = b.get("estimate"), b.get("std_error_scale_share", 0.0)
+    if ("error_along_term" in a) != along_term or change is None or not np.isfinite(change) \
+            or not np.isfinite(share):
+        return False
     mv = f.get("model_value", ev.get("model_value", 0.0))
     ev["estimate_as_selected"] = {"estimate": f["estimate"], "std_error": f["std_error"], "beyond": key}
     f["estimate"] = float(mv + change)
     f["std_error"] = float(np.hypot(f["std_error"], share))
+    return True
 
 
 def report_beyond_angle_error(f: dict) -> bool:
@@ -1323,14 +1326,7 @@ def report_beyond_angle_error(f: dict) -> bool:
     Returns:
         Whether the finding was changed.
     """
-    ev = f.setdefault("evidence", {})
-    a = ev.get("beta_error_allowance") or {}
-    b = a.get("beyond_scale") or {}
-    est, share = b.get("estimate"), b.get("std_error_scale_share", 0.0)
-    if "error_along_term" not in a or est is None or not np.isfinite(est) or not np.isfinite(share):
-        return False
-    _report_beyond(f, est, share, "beta_error_allowance")
-    return True
+    return _report_beyond(f, "beta_error_allowance", along_term=True)
 
 
 def fit_record(log, t_from: float | None, t_to: float | None) -> dict:
