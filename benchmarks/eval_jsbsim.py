@@ -227,8 +227,9 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
             ``airangles.ALPHA_PROFILE_COLUMNS``), ``beta_profile_min_lr`` where the script has it
             (``airangles.BETA_PROFILE_MIN_LR``) and the ``on``/``off`` switches ``beta_profile``, and where the
             script has them ``kinematic_mean`` and ``floor_drops_curvature`` (``airangles.BETA_PROFILE``,
-            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``), ``wind_window`` (s: ``estimate.WIND_WINDOW_S``) and the
-            ``on``/``off`` switch ``wind_residual_scale`` (``estimate.WIND_RESIDUAL_SCALE``).
+            ``KINEMATIC_MEAN``, ``FLOOR_DROPS_CURVATURE``), ``beta_gls`` (``airangles.BETA_GLS``), ``wind_window`` (s:
+            ``estimate.WIND_WINDOW_S``) and the ``on``/``off`` switch ``wind_residual_scale``
+            (``estimate.WIND_RESIDUAL_SCALE``).
 
     Raises:
         SystemExit: a ``--stated-lift-level`` item does not parse. ValueError: a ``--stated-lift-slope`` value is
@@ -247,7 +248,7 @@ def apply_aiding_options(a: argparse.Namespace) -> None:
     if a.alpha_profile is not None:
         _aa.ALPHA_PROFILE_COLUMNS = tuple(a.alpha_profile)
     for option, flag in (("kinematic_mean", "KINEMATIC_MEAN"), ("floor_drops_curvature", "FLOOR_DROPS_CURVATURE"),
-                         ("beta_profile", "BETA_PROFILE")):
+                         ("beta_profile", "BETA_PROFILE"), ("beta_gls", "BETA_GLS")):
         if getattr(a, option, None) is not None:
             setattr(_aa, flag, getattr(a, option) == "on")
     if getattr(a, "beta_profile_min_lr", None) is not None:
@@ -720,6 +721,10 @@ def main(argv=None) -> int:
                     help="take the profiled CY_beta only where its likelihood-ratio statistic against least squares' "
                          "slope reaches LR (3.84: the chi-squared 95 %% point; gcs_sysid.estimation.airangles."
                          "BETA_PROFILE_MIN_LR; default: the package's, no test)")
+    ap.add_argument("--beta-gls", default=None, choices=("on", "off"),
+                    help="the side-force model's slopes of the sideslip aiding by generalised least squares under the "
+                         "gust model, held in the later passes (gcs_sysid.estimation.airangles.BETA_GLS; default: the "
+                         "package's)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")

@@ -734,6 +734,10 @@ def main(argv=None) -> int:
                    help="CY_beta of the sideslip aiding's first pass by the gust model's likelihood, held in the "
                         "later passes, for the flights the diagnosis loads (gcs_sysid.diagnose.run.BETA_PROFILE; "
                         "default: the package's, off, as the replay's since the thirty-third session)")
+    p.add_argument("--beta-gls", default=None, choices=("on", "off"),
+                   help="the side-force model's slopes of the sideslip aiding by generalised least squares under the "
+                        "gust model, for every flight loaded (gcs_sysid.estimation.airangles.BETA_GLS; default: the "
+                        "package's)")
     p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off", type=_number_or_off,
                    help="the coefficients confirm a wind-triangle pitot bias only where their standard error is "
                         "at most this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; "
@@ -799,7 +803,7 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
     from benchmarks.eval_jsbsim import apply_aiding_options
 
     # --beta-profile, --stated-lift-slope, --stated-lift-level, --alpha-profile, --wind-window,
-    # --wind-residual-scale
+    # --wind-residual-scale, --beta-gls
     apply_aiding_options(a)
     if a.beta_profile is not None:      # the diagnosis loads its flights with its own switch (load_measurements)
         from gcs_sysid.diagnose import run as _dr

@@ -257,6 +257,28 @@ BETA_PROFILE_EDGE_HZ = 0.1
 #: counts (+4/-5 at GP seed 0, +4/-9 at seed 1; ``docs/benchmarks.md``, "Thirty-third session, i8-counts33";
 #: ``docs/estimation.md``, "Why the s23 loses counts with it").
 BETA_PROFILE_MIN_LR: float | None = None
+#: Opt-in (sixty-second session; default False): the side-force model's slopes of the first pass by generalised least
+#: squares under the gust model (:func:`_gls_gust_fit`): every slope, ``CY_beta`` and the rate and control terms, fitted
+#: on the innovations of the Gauss-Markov gust plus white noise (a regression with ARMA(1, 1) errors, the correlation
+#: time and variance ratio by the concentrated likelihood), then held in the later passes. Least squares on the
+#: kinematic sideslip gives the rate and control columns the gust's side force wherever the aircraft or its autopilot
+#: answers the gust (JSBSim C.684, whose side force is ``-1.04 beta`` alone: ``CY_r_hat`` -1.35, ``CY_delta_r`` -0.11),
+#: and the aided sideslip then under-reads the slow sideslip those columns move with (``docs/estimation.md``, "The
+#: side-force model by generalised least squares").
+BETA_GLS = False
+#: physical signs of the side-force model's columns in :data:`BETA_GLS`'s fit: a slope of the wrong sign is held at zero
+#: and the others fitted again. A conventional fin gives ``CY_r_hat > 0`` (the yaw rate's sideslip at the fin) and a
+#: rudder deflected trailing edge left (``delta_r > 0``) a side force to the right (``CY_delta_r > 0``): least squares
+#: on the kinematic sideslip gives both the wrong sign where the aircraft or its autopilot answers the gust (JSBSim t6,
+#: iar80, f4n, c684; the 25 JSBSim aircraft's exact side force has each at zero, within 0.005, or positive)
+BETA_GLS_SIGNS: dict[str, float] = {"r_hat": 1.0, "delta_r": 1.0}
+#: the first pass's columns are high-passed here before :func:`_gls_gust_fit`, Hz (None: the full band): below it the
+#: kinematic sideslip's error is the wind estimate's drift, no first-order gust
+BETA_GLS_EDGE_HZ: float | None = 0.1
+#: the gust correlation times :func:`_gls_gust_fit` chooses from, s: :data:`TAUS_S` less 0.5 s, where the whitening
+#: is nearly a first difference and the kinematic sideslip's own share of the gust (the aircraft drifting with it)
+#: flattens ``CY_beta`` (screened on 25 JSBSim reference flights: c684, rascal, s23, sgs chose 0.5 s)
+BETA_GLS_TAUS = (1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
 #: the chi-squared 95 % point with one degree of freedom (``scipy.stats.chi2.ppf(0.95, 1)``)
 BETA_PROFILE_LR_95 = 3.841458820694124
 
@@ -717,6 +739,68 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
     return out, sig, tau, float(np.sqrt(ratio * s2)), float(np.sqrt(s2))
 
 
+def _gls_gust_fit(dt: float, A: np.ndarray, y: np.ndarray, segs: list[slice], taus: tuple[float, ...],
+                  ratios: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float]:
+    """Linear regression whose error is a first-order Gauss-Markov gust plus white noise, by maximum likelihood.
+
+    Model: ``y = A c + e``, ``e_k = g_k + v_k``, ``g_{k+1} = phi g_k + w_k`` (``phi = exp(-dt / tau)``), ``v`` white,
+    ``var(g) / var(v)`` the ratio. For each ``(tau, ratio)`` on the grid the steady-state Kalman filter of ``e`` is a
+    fixed linear filter (``x_k = (1 - K) phi x_{k-1} + K z_k``, innovation ``z_k - phi x_{k-1}``, as
+    :func:`_gm_search`); applied to ``y`` and to every column of ``A`` on each segment, it whitens the error, and least
+    squares on the filtered data is the generalised least-squares estimate (a regression with ARMA(1, 1) errors:
+    Harvey, *Forecasting, Structural Time Series Models and the Kalman Filter*, CUP 1989, sec. 3.4 and 7.2; the
+    filter-error method's output equation with the turbulence as process noise, Jategaonkar 2015 ch. 5). The grid
+    point with the largest concentrated log-likelihood is taken. A regressor that answers the gust only through the
+    aircraft's dynamics (the rates, an autopilot's rudder) depends on the gust's past innovations, not on the
+    current one, so it no longer takes the gust's side force as it does under least squares on the levels.
+
+    Args:
+        dt: grid step, s. A: (T, P) columns (NaN outside ``segs``). y: (T,) coefficient. segs: the rows to fit, as
+        contiguous slices. taus: gust correlation times, s. ratios: gust / white variance ratios.
+
+    Returns:
+        ``(c (P,), se (P,), residual (N,) of the unfiltered rows, cov (P, P), tau_s, ratio, Wa (N, P), wy (N,))``;
+        the residual is ``y - A c`` on the segments' rows, in their order; ``Wa``, ``wy`` the filtered columns and
+        coefficient at the chosen grid point (for a jackknife at that point).
+
+    Raises:
+        numpy.linalg.LinAlgError: the filtered columns are singular for every grid point (not expected: constant
+        columns are left out by the caller).
+    """
+    rows = np.concatenate([np.arange(s.start, s.stop) for s in segs])
+    best = None
+    for tau in taus:
+        phi = float(np.exp(-dt / tau))
+        for ratio in ratios:
+            q = ratio * (1.0 - phi * phi)
+            h = (1.0 - phi * phi) - q
+            Pp = 0.5 * (-h + np.sqrt(h * h + 4.0 * q))
+            S, K = Pp + 1.0, Pp / (Pp + 1.0)
+            W = []
+            for sg in segs:
+                Z = np.column_stack([A[sg], y[sg]])
+                x = lfilter([K], [1.0, -(1.0 - K) * phi], Z, axis=0)
+                e = Z.copy()
+                e[1:] -= phi * x[:-1]
+                W.append(e)
+            W = np.vstack(W)
+            c, *_ = np.linalg.lstsq(W[:, :-1], W[:, -1], rcond=None)
+            r = W[:, -1] - W[:, :-1] @ c
+            n = len(r)
+            s2 = float(r @ r) / n
+            ll = -0.5 * n * (np.log(max(s2 / S, 1e-300)) + np.log(S))
+            if best is None or ll > best[0]:
+                best = (ll, tau, ratio, c, W, s2)
+    _, tau, ratio, c, W, s2 = best
+    Wa = W[:, :-1]
+    try:
+        cov = np.linalg.inv(Wa.T @ Wa) * s2
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(Wa.T @ Wa) * s2
+    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    return c, se, y[rows] - A[rows] @ c, cov, float(tau), float(ratio), Wa, W[:, -1]
+
+
 def _floor_refit(A: np.ndarray, y: np.ndarray, a1: float, keep: list[int], held: dict[int, float] | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Least squares ``y ~ A c`` with ``c[0]`` held at ``a1``, the columns ``held`` (index -> slope) held at their
@@ -902,8 +986,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
           moments: list[np.ndarray] | None = None, instruments: np.ndarray | None = None,
           V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
           slope_floor: float | None = None, floor_held: dict[str, float] | None = None, endog: tuple[str, ...] = (),
-          min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None, profile: bool = False
-          ) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None, profile: bool = False,
+          gls: bool = False) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -927,7 +1011,10 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     on the effective sample size instead (:func:`.angleerrors.first_stage_f`, at least
     :data:`BETA_MIN_FIRST_STAGE_F`; ``min_first_stage`` 0 skips the test), None: by ``min_first_stage``; ``profile``:
     the angle's slope of the first least-squares pass by the gust model's likelihood (:func:`_profile_angle_slope`; not
-    with ``quadratic``, a floor, instruments or ``given``; :data:`BETA_PROFILE`)."""
+    with ``quadratic``, a floor, instruments or ``given``; :data:`BETA_PROFILE`); ``gls``: every slope of the first
+    pass by generalised least squares under the gust model (:func:`_gls_gust_fit`, the columns high-passed at
+    :data:`BETA_GLS_EDGE_HZ`), held in the later passes (not with ``quadratic``, a floor, instruments or ``given``;
+    :data:`BETA_GLS`)."""
     cols = [k for k, v in others.items() if np.nanstd(v[use]) > 1e-9]
     ok = use & np.isfinite(kin) & np.isfinite(coeff)
     for k in cols:
@@ -959,6 +1046,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
     nq = 2 if quadratic else 1
     fit = None
     floor_note = profile_note = ""
+    gls_held = None        # BETA_GLS: the first pass's slopes, standard errors, covariance and note
+    gls_note = ""
     held_slope = None      # BETA_PROFILE_HOLD: the first pass's profiled slope, kept in the later passes
     jk_first = None        # AxisFit.slope_jackknife: the first pass's block-jackknife standard errors
     keep: list[int] = []
@@ -1013,7 +1102,43 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                                           f"in every pass")
                     refit.first_stage_r2 = fs_r2
                     return a_ls, s_ls, refit
-        if not method.startswith(("2SLS", "given")):
+        if gls and fixed is None and not quadratic and slope_floor is None and method == "OLS":
+            if gls_held is None:
+                # the filter-error fit: all slopes on the gust model's innovations (the rates and an autopilot's
+                # controls answer the gust's past, not its innovation), then held (least squares on the aided angle
+                # would return the slopes that built it)
+                Ag = (_highpass(dt, A, segs, BETA_GLS_EDGE_HZ) if BETA_GLS_EDGE_HZ is not None
+                      else np.where(m[:, None], A - A[m].mean(axis=0), np.nan))
+                yg = (_highpass(dt, coeff[:, None], segs, BETA_GLS_EDGE_HZ)[:, 0] if BETA_GLS_EDGE_HZ is not None
+                      else np.where(m, coeff - coeff[m].mean(), np.nan))
+                P = Ag.shape[1]
+                free_g = list(range(P))
+                for _ in range(P):
+                    cg_, sg0, _, cv0, tau_g, ratio_g, Wa, wy = _gls_gust_fit(dt, Ag[:, free_g], yg, segs,
+                                                                            BETA_GLS_TAUS, RATIOS)
+                    cg, sg_, cov_g = np.zeros(P), np.full(P, np.nan), np.zeros((P, P))
+                    cg[free_g], sg_[free_g] = cg_, sg0
+                    cov_g[np.ix_(free_g, free_g)] = cv0
+                    wrong = [nq + cols.index(k) for k, sg_k in BETA_GLS_SIGNS.items()
+                             if k in cols and nq + cols.index(k) in free_g and sg_k * cg[nq + cols.index(k)] < 0]
+                    if not wrong:
+                        break
+                    free_g = [j for j in free_g if j not in wrong]
+                if sign * cg[0] > 0 and abs(cg[0]) >= MIN_T_STAT * sg_[0]:
+                    if len(free_g) == P:
+                        jk_first = _slope_jackknife(dt, len(wy),
+                                                    lambda k: np.linalg.lstsq(Wa[k], wy[k], rcond=None)[0])
+                    gls_held = (cg, sg_, cov_g, f"GLS under the gust model (tau {tau_g:g} s, ratio {ratio_g:g})"
+                                + "".join(f"; {names[j + 1]} held at 0 (wrong sign)" for j in range(P)
+                                          if j not in free_g))
+                else:
+                    # not identified on the innovations: least squares as without the option, said in the note
+                    gls, gls_note = False, (f"; GLS under the gust model not identified ({names[1]} {cg[0]:+.3g}, "
+                                            f"{abs(cg[0]) / max(sg_[0], 1e-300):.1f} standard errors): least squares")
+        if gls_held is not None:
+            cr, csr, cov_r, method = gls_held
+            res = yh[m] - Ah[m] @ cr
+        elif not method.startswith(("2SLS", "given")):
             cr, csr, res, cov_r = _lstsq(Ah[m], yh[m])
             if held_slope is not None and fit is not None:
                 # BETA_PROFILE_HOLD: the first pass's profiled slope kept (least squares on the aided angle is
@@ -1022,7 +1147,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                 cr, csr, res, cov_r = _floor_refit(Ah[m], yh[m], held_slope, list(range(1, Ah.shape[1])))
                 csr[0] = se0
                 method = "OLS with the first pass's profiled slope held"
-        if fit is None and fixed is None and held_slope is None:
+        if fit is None and fixed is None and held_slope is None and gls_held is None:
             # the first pass's coefficients as a second flight would scatter them (AxisFit.slope_jackknife): the
             # later passes fit on the aided angle, so their own standard errors cannot say it
             Am, ym = Ah[m], yh[m]
@@ -1146,6 +1271,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
         fit.slope_method = f"{fit.slope_method}; {floor_note}"
     if fit is not None and profile_note:
         fit.slope_method += profile_note
+    if fit is not None and gls_note:
+        fit.slope_method += gls_note
     gust_sig = sig          # the gust smoother's posterior 1-sigma, before the flight-common offset is added
     if fit is not None and V is not None:
         # the flight-mean vertical wind is out of reach (a constant in alpha goes into CZ0): its 1-sigma, from
@@ -1286,8 +1413,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      instrument_slopes: bool | None = None, models: dict[str, AxisFit] | None = None,
                      instrument_beta: bool | None = None, beta_band_hz: float | None = None,
                      stated_slopes: tuple[float | None, float | None] | None = None,
-                     profile_beta: bool | None = None, stated_level: dict[str, float | None] | None = None
-                     ) -> AidedAngles:
+                     profile_beta: bool | None = None, stated_level: dict[str, float | None] | None = None,
+                     gls_beta: bool | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -1341,6 +1468,9 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
             the weight ``s_w^2 / (s_w^2 + s_l^2)`` (``s_w`` the flight-mean wind's 1-sigma ``AxisFit.bias_sigma``,
             ``s_l`` the line's), ``bias_sigma`` becomes ``s_w s_l / sqrt(s_w^2 + s_l^2)`` and the move is said in
             ``AxisFit.shift_note`` (``mean_shift`` holds it, rad). None: alpha's mean is the aiding's.
+        gls_beta: the side-force model's slopes of the first pass by generalised least squares under the gust model
+            (:func:`_gls_gust_fit`), held in the later passes; only where they would be fitted by least squares (not
+            with 2SLS or a given model). None: :data:`BETA_GLS`.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -1421,7 +1551,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     be, b_sig, fb = _axis("beta", dt, beta_kin, CY, lat, u, passes, -1.0, False, not powered, mom_lat, inst_b,
                           endog=BETA_ENDOGENOUS if inst_b is not None else (), min_first_stage=min_fs_b,
                           weak_test=BETA_WEAK_TEST, band_hz=beta_band_hz,
-                          profile=BETA_PROFILE if profile_beta is None else bool(profile_beta))
+                          profile=BETA_PROFILE if profile_beta is None else bool(profile_beta),
+                          gls=BETA_GLS if gls_beta is None else bool(gls_beta))
     fb.slope_method += est_note
     share = gust_share(dt, alpha_kin, u, fb, edge)
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
