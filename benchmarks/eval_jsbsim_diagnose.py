@@ -736,8 +736,8 @@ def main(argv=None) -> int:
                         "default: the package's, off, as the replay's since the thirty-third session)")
     p.add_argument("--beta-gls", default=None, choices=("on", "off"),
                    help="the side-force model's slopes of the sideslip aiding by generalised least squares under the "
-                        "gust model, for every flight loaded (gcs_sysid.estimation.airangles.BETA_GLS; default: the "
-                        "package's)")
+                        "gust model, for every flight the diagnosis loads (gcs_sysid.diagnose.run.BETA_GLS and "
+                        "gcs_sysid.estimation.airangles.BETA_GLS; default: the package's, off)")
     p.add_argument("--pitot-witness-max-se", default=None, metavar="MPS|off", type=_number_or_off,
                    help="the coefficients confirm a wind-triangle pitot bias only where their standard error is "
                         "at most this, m/s; 'off': always (gcs_sysid.diagnose.pitot.COEF_WITNESS_MAX_SE_MPS; "
@@ -809,6 +809,10 @@ def _run(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
         from gcs_sysid.diagnose import run as _dr
 
         _dr.BETA_PROFILE = a.beta_profile == "on"
+    if a.beta_gls is not None:          # as --beta-profile: the diagnosis's own switch as well as the aiding's
+        from gcs_sysid.diagnose import run as _dr
+
+        _dr.BETA_GLS = a.beta_gls == "on"
     if a.alpha_level is not None:
         from gcs_sysid.diagnose import run as _dr
 

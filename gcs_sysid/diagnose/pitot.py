@@ -735,7 +735,7 @@ def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float, angle_fits: dict 
     from ..aero import compute_coefficients
     from ..estimation import estimate_states
     from ..telemetry.types import Stream
-    from .run import BETA_PROFILE      # the sideslip's estimator load_measurements used
+    from .run import BETA_GLS, BETA_PROFILE      # the sideslip's estimator load_measurements used
 
     if flight is None or abs(b0) < 1e-3 or not ctx.has("rho"):
         return None
@@ -754,7 +754,7 @@ def _unit_delta_rereduced(ctx: DiagContext, flight, b0: float, angle_fits: dict 
     try:
         beta_fit = (angle_fits or {}).get("beta")
         states = estimate_states(dataclasses.replace(flight, streams=streams), ctx.airframe,
-                                 turbulence_state=False, profile_beta=BETA_PROFILE,      # as load_measurements
+                                 turbulence_state=False, profile_beta=BETA_PROFILE, gls_beta=BETA_GLS,  # as loaded
                                  angle_models={"beta": beta_fit} if beta_fit is not None else None)
         table = compute_coefficients(states, ctx.airframe)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError, KeyError):

@@ -92,6 +92,11 @@ AIR_ROLL_RATE = "reference:Cl"
 #: profile alone lost the s23's ``CY:scale`` (docs/benchmarks.md, "Twenty-fifth session, i8-beta" and "Thirty-second
 #: session, lead").
 BETA_PROFILE = False
+#: The sideslip aiding's side-force slopes for every flight the diagnosis and ``fit`` load (:func:`load_measurements`,
+#: and the pitot-bias re-run of :mod:`gcs_sysid.diagnose.pitot`): True, generalised least squares under the gust model
+#: (:data:`gcs_sysid.estimation.airangles.BETA_GLS`); False, least squares (the default: the estimator issue 9's records
+#: were measured with; docs/estimation.md, "The side-force model by generalised least squares").
+BETA_GLS = False
 
 
 #: What :func:`load_measurements`' ``air_roll`` moves to the air-relative roll rate: ``"off"`` nothing, ``"p_hat"`` the
@@ -216,7 +221,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
         states = estimate_states(flight, airframe, progress=(lambda f: progress(f"estimation {f:.0%}"))
                                  if progress is not None else None, helper=helper, angle_models=angle_models,
                                  turbulence_state=False,
-                                 profile_beta=BETA_PROFILE if profile_beta is None else bool(profile_beta))
+                                 profile_beta=BETA_PROFILE if profile_beta is None else bool(profile_beta),
+                                 gls_beta=BETA_GLS)
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)

@@ -103,11 +103,11 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
 
 
 def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
-                Wd=None, offsets=None, models=None, fits=None, profile_beta=None):
+                Wd=None, offsets=None, models=None, fits=None, profile_beta=None, gls_beta=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
     records sources, sigma, notes and the flight-common offsets' 1-sigma (``offsets``, rad; and the
     gusts in the wind) and the axes' fits (``fits``); ``models``: another flight's fits to take the alpha
-    model's slopes from; ``profile_beta``: as :func:`estimate_states`; returns ``(alpha, beta)``."""
+    model's slopes from; ``profile_beta``, ``gls_beta``: as :func:`estimate_states`; returns ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
         notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
                      "control outputs)")
@@ -115,9 +115,9 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
     ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
     Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
                           airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia,
-                          models=models, profile_beta=profile_beta, stated_slopes=((getattr(airframe, "CL_alpha", None),
-                                                         getattr(airframe, "CL_q", None))
-                                                        if airangles.STATED_LIFT_SLOPE else None),
+                          models=models, profile_beta=profile_beta, gls_beta=gls_beta,
+                          stated_slopes=((getattr(airframe, "CL_alpha", None), getattr(airframe, "CL_q", None))
+                                         if airangles.STATED_LIFT_SLOPE else None),
                           stated_level=({k: getattr(airframe, k, None) for k in ("CL0", "CL_alpha", "CL_q",
                                                                                 "CL_delta_e", "CL0_sigma")}
                                         if airangles.STATED_LIFT_LEVEL and getattr(airframe, "CL0", None) is not None
@@ -159,7 +159,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     turbulence_state: bool = True,
                     gust_force_axes: tuple[int, ...] | None = None,
                     meanwhile: Callable[[], None] | None = None,
-                    profile_beta: bool | None = None) -> FlightStates:
+                    profile_beta: bool | None = None, gls_beta: bool | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -192,6 +192,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         profile_beta: the sideslip aiding's ``CY_beta`` by the gust model's likelihood (True) or by least squares
             (False); None: :data:`gcs_sysid.estimation.airangles.BETA_PROFILE` as it stands at the call (off since the
             thirty-third session; the diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_PROFILE`, off).
+        gls_beta: the side-force model's first-pass slopes by generalised least squares under the gust model (True) or
+            by least squares (False); None: :data:`gcs_sysid.estimation.airangles.BETA_GLS` as it stands at the call
+            (off; the diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_GLS`, off).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -530,7 +533,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
                                       fly, C, v_ned, sources, sigma, notes, Wd, offsets, angle_models, fits,
-                                      profile_beta)
+                                      profile_beta, gls_beta)
     else:
         if have_tas:
             V = tas

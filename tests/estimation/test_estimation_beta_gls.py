@@ -133,3 +133,31 @@ def test_gls_gust_fit_recovers_an_exogenous_slope_and_states_its_error():
     assert abs(est.mean() - 2.0) < 3 * est.std() / np.sqrt(len(est))
     # the stated standard error within a factor 1.5 of the scatter over records
     assert 1 / 1.5 < np.median(se) / est.std() < 1.5
+
+
+def test_gls_is_off_on_every_path_and_each_switch_reaches_it(monkeypatch):
+    """On the project's sample flight: neither the replay's estimator nor the diagnosis's loader runs the GLS fit by
+    default; ``estimate_states(gls_beta=True)`` and the diagnosis's own switch ``diagnose.run.BETA_GLS`` do."""
+    from pathlib import Path
+
+    from gcs_sysid.airframe import load_airframe
+    from gcs_sysid.diagnose import run as diagnose_run
+    from gcs_sysid.estimation import estimate_states
+    from gcs_sysid.telemetry import read_log
+
+    data = Path(__file__).resolve().parents[2] / "data"
+    log, airframe = data / "flights" / "sim-trainer-sysid.tlog", data / "airframes" / "sim-trainer.toml"
+    assert not airangles.BETA_GLS and not diagnose_run.BETA_GLS
+    calls = []
+    real = airangles._gls_gust_fit
+    monkeypatch.setattr(airangles, "_gls_gust_fit", lambda *a, **k: calls.append(1) or real(*a, **k))
+    flight, af = read_log(log), load_airframe(airframe)
+    assert estimate_states(flight, af).angle_fits["beta"].used and calls == []
+    diagnose_run.load_measurements(log, airframe)
+    assert calls == []
+    on = estimate_states(flight, af, gls_beta=True).angle_fits["beta"]
+    assert calls and on.slope_method.startswith("GLS under the gust model")
+    n = len(calls)
+    monkeypatch.setattr(diagnose_run, "BETA_GLS", True)
+    meas = diagnose_run.load_measurements(log, airframe)
+    assert len(calls) > n and meas.states.angle_fits["beta"].slope_method.startswith("GLS under the gust model")
