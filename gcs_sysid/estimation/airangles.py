@@ -691,6 +691,26 @@ def heave_edge_hz(slope: float, heave_gain: float, factor: float | None = None) 
     return float(min(max(HIGHPASS_HZ, f_h), max(HIGHPASS_HZ, MAX_EDGE_HZ)))
 
 
+def _gm_steady_state(dt: float, tau: float, ratio: float) -> tuple[float, float, float]:
+    """The scalar steady-state Kalman filter of ``z = g + v`` (``g`` first-order Gauss-Markov with correlation time
+    ``tau`` s, ``var(g) / var(v)`` = ``ratio``, ``var(v)`` = 1); returns ``(phi, K, S)``: the transition, the gain and
+    the innovation variance. Closed form: ``Pp^2 + Pp ((1 - phi^2) - q) - q = 0`` with ``q = ratio (1 - phi^2)``."""
+    phi = float(np.exp(-dt / tau))
+    q = ratio * (1.0 - phi * phi)
+    h = (1.0 - phi * phi) - q
+    Pp = 0.5 * (-h + np.sqrt(h * h + 4.0 * q))
+    return phi, Pp / (Pp + 1.0), Pp + 1.0
+
+
+def _gm_innovations(z: np.ndarray, phi: float, K: float) -> np.ndarray:
+    """The steady-state filter's innovations of ``z`` (N,) or of each column of ``z`` (N, P), from ``x_{-1} = 0``:
+    ``x_k = (1 - K) phi x_{k-1} + K z_k``, ``e_k = z_k - phi x_{k-1}`` (a fixed linear filter of ``z``)."""
+    x = lfilter([K], [1.0, -(1.0 - K) * phi], z, axis=0)
+    e = np.array(z, dtype=float, copy=True)
+    e[1:] -= phi * x[:-1]
+    return e
+
+
 def _gm_search(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, ...],
                ratios: tuple[float, ...]) -> tuple[float, float, float, float]:
     """The Gauss-Markov gust model's concentrated log-likelihood of ``z = g + v`` (T,), maximised over ``taus`` x
@@ -698,19 +718,11 @@ def _gm_search(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[float, .
     best = None
     n = sum(s.stop - s.start for s in segs)
     for tau in taus:
-        phi = float(np.exp(-dt / tau))
         for ratio in ratios:
-            # scalar steady state in closed form (r = 1): Pp^2 + Pp ((1 - phi^2) - q) - q = 0
-            q = ratio * (1.0 - phi * phi)
-            h = (1.0 - phi * phi) - q
-            Pp = 0.5 * (-h + np.sqrt(h * h + 4.0 * q))
-            S, K = Pp + 1.0, Pp / (Pp + 1.0)
+            phi, K, S = _gm_steady_state(dt, tau, ratio)
             ssq = 0.0
-            for sg in segs:          # x_k = (1 - K) phi x_{k-1} + K z_k from x_{-1} = 0; e_k = z_k - phi x_{k-1}
-                zs = z[sg]
-                x = lfilter([K], [1.0, -(1.0 - K) * phi], zs)
-                e = zs.copy()
-                e[1:] -= phi * x[:-1]
+            for sg in segs:
+                e = _gm_innovations(z[sg], phi, K)
                 ssq += float(np.square(e).sum()) / S     # not e @ e: a BLAS call per candidate
             ll = -0.5 * n * (np.log(max(ssq / n, 1e-300)) + np.log(S))
             if best is None or ll > best[0]:
@@ -763,32 +775,21 @@ def _gls_gust_fit(dt: float, A: np.ndarray, y: np.ndarray, segs: list[slice], ta
         the residual is ``y - A c`` on the segments' rows, in their order; ``Wa``, ``wy`` the filtered columns and
         coefficient at the chosen grid point (for a jackknife at that point).
 
-    Raises:
-        numpy.linalg.LinAlgError: the filtered columns are singular for every grid point (not expected: constant
-        columns are left out by the caller).
+    Singular filtered columns (not expected: the caller leaves constant columns out) give least squares' minimum-norm
+    solution and a pseudo-inverse covariance; nothing is raised.
     """
     rows = np.concatenate([np.arange(s.start, s.stop) for s in segs])
     best = None
     for tau in taus:
-        phi = float(np.exp(-dt / tau))
         for ratio in ratios:
-            q = ratio * (1.0 - phi * phi)
-            h = (1.0 - phi * phi) - q
-            Pp = 0.5 * (-h + np.sqrt(h * h + 4.0 * q))
-            S, K = Pp + 1.0, Pp / (Pp + 1.0)
-            W = []
-            for sg in segs:
-                Z = np.column_stack([A[sg], y[sg]])
-                x = lfilter([K], [1.0, -(1.0 - K) * phi], Z, axis=0)
-                e = Z.copy()
-                e[1:] -= phi * x[:-1]
-                W.append(e)
-            W = np.vstack(W)
+            phi, K, _ = _gm_steady_state(dt, tau, ratio)
+            W = np.vstack([_gm_innovations(np.column_stack([A[sg], y[sg]]), phi, K) for sg in segs])
             c, *_ = np.linalg.lstsq(W[:, :-1], W[:, -1], rcond=None)
             r = W[:, -1] - W[:, :-1] @ c
             n = len(r)
             s2 = float(r @ r) / n
-            ll = -0.5 * n * (np.log(max(s2 / S, 1e-300)) + np.log(S))
+            # innovations of variance sigma^2 S each: with sigma^2 profiled out the log-likelihood is -n/2 log(s2)
+            ll = -0.5 * n * np.log(max(s2, 1e-300))
             if best is None or ll > best[0]:
                 best = (ll, tau, ratio, c, W, s2)
     _, tau, ratio, c, W, s2 = best
