@@ -752,7 +752,8 @@ def _gust_smoother(dt: float, z: np.ndarray, segs: list[slice], taus: tuple[floa
 
 
 def _gls_gust_fit(dt: float, A: np.ndarray, y: np.ndarray, segs: list[slice], taus: tuple[float, ...],
-                  ratios: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float]:
+                  ratios: tuple[float, ...]
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float, np.ndarray, np.ndarray]:
     """Linear regression whose error is a first-order Gauss-Markov gust plus white noise, by maximum likelihood.
 
     Model: ``y = A c + e``, ``e_k = g_k + v_k``, ``g_{k+1} = phi g_k + w_k`` (``phi = exp(-dt / tau)``), ``v`` white,
@@ -1126,7 +1127,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                         break
                     free_g = [j for j in free_g if j not in wrong]
                 if sign * cg[0] > 0 and abs(cg[0]) >= MIN_T_STAT * sg_[0]:
-                    if len(free_g) == P:
+                    if len(free_g) == P:        # with a column held the jackknife is not stated (NaN)
                         jk_first = _slope_jackknife(dt, len(wy),
                                                     lambda k: np.linalg.lstsq(Wa[k], wy[k], rcond=None)[0])
                     gls_held = (cg, sg_, cov_g, f"GLS under the gust model (tau {tau_g:g} s, ratio {ratio_g:g})"
