@@ -2318,9 +2318,9 @@ def merge_findings(findings: list[dict], sparse: dict) -> list[dict]:
         # factors (``Cm:alpha`` for ``Cm:alpha*delta_t``) was scored on held-out data and is simpler;
         # unless simpler_catalogue_powers, not for a power of one regressor (``Cm:alpha`` for ``Cm:alpha^2``)
         coef, _, term = f["cause"].partition(":")
-        single = len(set(_factors(term) or ())) == 1
+        single = not powers and len(set(_factors(term) or ())) == 1     # asked only where powers are not simpler
         sub = next((g for g in findings if g["cause"].startswith(coef + ":")
-                    and _factors_within(g["cause"].split(":", 1)[1], term) and (powers or not single)), None)
+                    and _factors_within(g["cause"].split(":", 1)[1], term) and not single), None)
         named.append(dict(sub, source="catalogue (simpler than the search's " + f["cause"] + ")")
                      if sub is not None else dict(f, source="sparse search"))
     causes = {f["cause"] for f in keep_first + named}
