@@ -17,7 +17,7 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 SCRIPTS = ("benchmarks/eval_jsbsim_diagnose.py", "benchmarks/eval_jsbsim.py", "benchmarks/issue8_counts.py",
            "benchmarks/beta_profile_diag.py", "benchmarks/pool_eval.py", "benchmarks/scale_sideslip_truth.py",
-           "benchmarks/term_shares.py", "benchmarks/effect_bias_split.py")
+           "benchmarks/term_shares.py", "benchmarks/effect_bias_split.py", "benchmarks/sideslip_truth_screen.py")
 
 
 def unbound_globals(source: str, filename: str) -> list[str]:
