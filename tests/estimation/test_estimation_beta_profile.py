@@ -11,9 +11,9 @@ the kinematic sideslip makes ``CY_beta`` steep; the filter-error estimate does n
 import re
 
 import numpy as np
-from scipy.signal import lfilter
-
 from gcs_sysid.estimation.airangles import _axis
+
+from synthetic_sideslip import directional_record
 
 DT, T = 0.02, 4500
 CY_BETA, CY_DR = -0.55, 0.15
@@ -21,18 +21,7 @@ CY_BETA, CY_DR = -0.55, 0.15
 
 def _record(seed: int):
     """(kinematic sideslip (T,), measured CY (T,), {"delta_r": (T,)}); rad, the rudder's doublets every 10 s."""
-    rng = np.random.default_rng(seed)
-    dr = np.zeros(T)
-    for k0 in range(100, T, 500):
-        dr[k0:k0 + 50], dr[k0 + 50:k0 + 100] = 0.05, -0.05
-    phi = np.exp(-DT / 4.0)
-    g = lfilter([np.sqrt(1 - phi * phi)], [1, -phi], rng.standard_normal(T)) * np.radians(1.0)   # gust angle
-    w, zeta = 2 * np.pi * 0.2, 0.2
-    psi, rate = np.zeros(T), 0.0
-    for k in range(1, T):           # psi'' = w^2 (beta_air + N dr) - 2 zeta w psi', beta_air = -psi + g
-        rate += (w * w * (-psi[k - 1] + g[k - 1] - 0.5 * dr[k - 1]) - 2 * zeta * w * rate) * DT
-        psi[k] = psi[k - 1] + rate * DT
-    beta_kin = -psi
+    rng, beta_kin, g, _, dr = directional_record(seed, T, DT, 4.0)
     cy = CY_BETA * (beta_kin + g) + CY_DR * dr + 0.0005 * rng.standard_normal(T)
     return beta_kin, cy, {"delta_r": dr}
 
