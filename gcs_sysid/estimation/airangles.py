@@ -1116,7 +1116,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                       else np.where(m, coeff - coeff[m].mean(), np.nan))
                 P = Ag.shape[1]
                 free_g = list(range(P))
-                for _ in range(P):
+                for _attempt in range(P):          # each round holds the columns of the wrong sign at 0
                     cg_, sg0, _, cv0, tau_g, ratio_g, Wa, wy = _gls_gust_fit(dt, Ag[:, free_g], yg, segs,
                                                                             BETA_GLS_TAUS, RATIOS)
                     cg, sg_, cov_g = np.zeros(P), np.full(P, np.nan), np.zeros((P, P))
