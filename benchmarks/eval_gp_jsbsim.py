@@ -150,7 +150,7 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     from gcs_sysid.airframe import load_airframe
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.estimation import airangles
-    from gcs_sysid.pipeline import ReplayOptions, run_replay
+    from gcs_sysid.pipeline import ReplayOptions, replay_gust_rates, run_replay
 
     name = f"{aircraft}-{seed}-{turbulence}-{aoa}"
     work = cache / ("work-" + name)
@@ -164,6 +164,7 @@ def make(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, c
     Xt, Yt = truth.at(tab.t)
     t_cut = float(tab.t[held & tab.valid][0])
     ls_model, _ = run_fit(files.tlog, files.airframe, work / "fit.toml", t_to=t_cut,
+                          gust_rates=replay_gust_rates(ReplayOptions()),   # the replay's rates (eval_jsbsim's line)
                           profile_beta=airangles.BETA_PROFILE,      # the replay's sideslip estimator
                           air_roll_train=False)     # the measured Cl (the air-rate line is air_rate_arrays')
     air = air_rate_arrays(res, load_airframe(files.airframe), ls_model)

@@ -93,7 +93,7 @@ from benchmarks.jsbsim_harness import (UNTOUCHED_AIRCRAFT, FlightConfig, coeffic
                                        load_truth, make_flight)
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
-from gcs_sysid.pipeline import ReplayOptions, run_replay  # noqa: E402
+from gcs_sysid.pipeline import ReplayOptions, replay_beta_gls, replay_gust_rates, run_replay  # noqa: E402
 import gcs_sysid.pipeline as _pipeline  # noqa: E402
 
 THESIS_FORCES, THESIS_MOMENTS = 19.8, 23.8
@@ -285,9 +285,13 @@ def stated_airframe(path: Path, work: Path, stem: str) -> Path:
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None, gust_filter: bool | str | None = None,
              heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = (),
-             air_roll_train: bool | None = None, gp_seed: int = 0) -> dict:
+             air_roll_train: bool | None = None, gp_seed: int = 0, beta_gls: bool | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
-    replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``).
+    replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``; None: the
+    replay's default, :data:`gcs_sysid.pipeline.REPLAY_GUST_RATES`, given to the fit too, so that both models are
+    learned on the same rates). ``beta_gls``: ``ReplayOptions.beta_gls`` (None: the aiding's module switch,
+    ``airangles.BETA_GLS``; the fit keeps least squares' sideslip, as ``gcs-sysid fit`` does,
+    :data:`gcs_sysid.diagnose.run.BETA_GLS`).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
@@ -308,11 +312,10 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
     af_path = stated_airframe(files.airframe, work, files.tlog.stem)     # files.airframe unless --stated-lift-slope
-    res = run_replay(files.tlog, af_path, out, ReplayOptions(progress=False, gust_rates=gust_rates,
-                                                                          gust_filter=gust_filter,
-                                                                          heldout_air_roll=heldout_air_roll,
-                                                                          air_roll_train=air_roll_train,
-                                                                          gp_seed=gp_seed))
+    opts = ReplayOptions(progress=False, gust_rates=gust_rates, beta_gls=beta_gls, gust_filter=gust_filter,
+                         heldout_air_roll=heldout_air_roll, air_roll_train=air_roll_train, gp_seed=gp_seed)
+    gust_rates = replay_gust_rates(opts)      # the frame the replay used (None: the gyro's rates), for the fit too
+    res = run_replay(files.tlog, af_path, out, opts)
     t_replay = time.perf_counter() - t0 - t_fly
     tab, held = res.table, res.held_out
     Xt, Yt = truth.at(tab.t)
@@ -326,8 +329,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
-                 "gust_rates": gust_rates, "gust_filter": gust_filter, "heldout_air_roll": heldout_air_roll,
-                 "air_roll_train": air_roll_train, "gp_seed": gp_seed,
+                 "gust_rates": gust_rates, "beta_gls": replay_beta_gls(opts), "gust_filter": gust_filter,
+                 "heldout_air_roll": heldout_air_roll, "air_roll_train": air_roll_train, "gp_seed": gp_seed,
                  "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
     row["meas"] = _errs(tab.Y[h], Yt[h])
@@ -679,8 +682,9 @@ def main(argv=None) -> int:
     ap.add_argument("--airp-lines", nargs="*", default=(), choices=AIR_ROLL_MODES,
                     help="also score these heldout_air_roll modes post hoc on the same replay's model (rows "
                          "gp_airp_MODE, ls_airp_MODE, cov_gp_airp_MODE, airp_MODE; a diagnosis)")
-    ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
-                    help="p_hat q_hat r_hat relative to the air with this gust-rate frame (default: inertial)")
+    ap.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind", "inertial"),
+                    help="p_hat q_hat r_hat relative to the air with this gust-rate frame, or the gyro's ('inertial'), "
+                         "for the replay and the fit (default: the replay's, gcs_sysid.pipeline.REPLAY_GUST_RATES)")
     ap.add_argument("--gp-fit", default=None, choices=("default", "decorrelated", "untested"),
                     help="the replay's GP settings: 'decorrelated' sets gcs_sysid.pipeline.USE_DECORRELATED_GP "
                          "(hyperparameters on rows a decorrelation time apart, coupling off; docs/gp.md); "
@@ -723,8 +727,9 @@ def main(argv=None) -> int:
                          "BETA_PROFILE_MIN_LR; default: the package's, no test)")
     ap.add_argument("--beta-gls", default=None, choices=("on", "off"),
                     help="the side-force model's slopes of the sideslip aiding by generalised least squares under the "
-                         "gust model, held in the later passes (gcs_sysid.estimation.airangles.BETA_GLS; default: the "
-                         "package's)")
+                         "gust model, held in the later passes (the replay's ReplayOptions.beta_gls and "
+                         "gcs_sysid.estimation.airangles.BETA_GLS; default: the package's, off; the fit keeps least "
+                         "squares)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
@@ -804,7 +809,8 @@ def main(argv=None) -> int:
                                None if a.gust_filter is None else
                                {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter],
                                a.heldout_air_roll, tuple(a.airp_lines),
-                               None if a.air_roll_train is None else a.air_roll_train == "on", a.gp_seed)
+                               None if a.air_roll_train is None else a.air_roll_train == "on", a.gp_seed,
+                               None if a.beta_gls is None else a.beta_gls == "on")
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"

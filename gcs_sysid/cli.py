@@ -73,9 +73,14 @@ def build_parser() -> argparse.ArgumentParser:
                         "(docs/live.md)")
     r.add_argument("--can-offset", type=float, default=None, metavar="S",
                    help="seconds added to the CAN log's times (default 0 with a .tlog; required with a .bin)")
-    r.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
+    r.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind", "inertial"),
                    help="p_hat q_hat r_hat relative to the air: minus the gust rates estimated from the "
-                        "reconstructed gusts in this frame (default: the gyro's inertial rates; docs/estimation.md)")
+                        "reconstructed gusts in this frame; 'inertial' the gyro's rates (the default; "
+                        "docs/estimation.md, 'Gust rates')")
+    r.add_argument("--beta-gls", default=None, choices=("on", "off"),
+                   help="the aided sideslip's side-force model by generalised least squares under the gust model "
+                        "('on', opt-in) or least squares ('off', the default, as fit and diagnose load their flights; "
+                        "docs/estimation.md, 'The side-force model by generalised least squares')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
@@ -109,7 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--airframe", required=True)
     f.add_argument("--out", required=True, help="output model TOML file")
     f.add_argument("--gust-rates", default=None, choices=("path", "path-yaw", "mean-wind"),
-                   help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates)")
+                   help="p_hat q_hat r_hat relative to the air (as replay's --gust-rates; default: the gyro's "
+                        "rates, as diagnose reads its flights)")
     f.add_argument("--stated-lift-level", action="store_true",
                    help="alpha's flight mean on the airframe's stated lift line (as replay's --stated-lift-level)")
     f.add_argument("--air-roll", default=None, choices=("on", "off"),
@@ -170,6 +176,7 @@ def _replay_options(a: argparse.Namespace):
                          model_in=a.model_in, n_inducing=a.inducing, progress=not a.quiet, notify=_say,
                          targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")),
                          can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates,
+                         beta_gls=None if a.beta_gls is None else a.beta_gls == "on",
                          gp_noise=a.gp_noise, **_air_roll_options(getattr(a, "air_roll", None)))
 
 

@@ -15,6 +15,26 @@ def test_replay_gust_rates_reaches_the_options():
     assert a.gust_rates == "mean-wind"
 
 
+def test_replay_gust_rate_and_sideslip_flags_reach_the_stages(monkeypatch):
+    """No flag: the gyro's rates (REPLAY_GUST_RATES "inertial" -> None for the coefficients) and the aiding's module
+    default for the sideslip (airangles.BETA_GLS, off); `--gust-rates path-yaw --beta-gls on` reach the stages as
+    given, `--beta-gls off` wins over the module switch; an unknown frame in the options is an InputError."""
+    import gcs_sysid.estimation.airangles as aa
+    import gcs_sysid.pipeline as pl
+
+    base = ["replay", "x.tlog", "--airframe", "a.toml", "--out", "o"]
+    o = _replay_options(build_parser().parse_args(base))
+    assert (o.gust_rates, pl.replay_gust_rates(o), pl.replay_beta_gls(o)) == (None, None, False)
+    monkeypatch.setattr(aa, "BETA_GLS", True)
+    assert pl.replay_beta_gls(o) is True
+    o = _replay_options(build_parser().parse_args(base + ["--gust-rates", "path-yaw", "--beta-gls", "off"]))
+    assert (pl.replay_gust_rates(o), pl.replay_beta_gls(o)) == ("path-yaw", False)
+    o = _replay_options(build_parser().parse_args(base + ["--gust-rates", "inertial", "--beta-gls", "on"]))
+    assert (o.gust_rates, pl.replay_gust_rates(o), pl.replay_beta_gls(o)) == ("inertial", None, True)
+    with pytest.raises(pl.InputError, match="gust_rates: expected one of path, path-yaw, mean-wind, inertial"):
+        pl.check_replay("x.tlog", "a.toml", None, pl.ReplayOptions(gust_rates="body"))
+
+
 def test_unknown_gust_rate_frame_is_a_user_error(capsys):
     with pytest.raises(SystemExit) as e:
         main(["replay", "x.tlog", "--airframe", "a.toml", "--out", "o", "--gust-rates", "body"], handle_signals=False)
