@@ -75,3 +75,31 @@ def test_replay_air_roll_flag_sets_both_halves_of_the_pair(capsys):
     with pytest.raises(SystemExit) as e:
         main(base + ["--air-roll", "maybe"], handle_signals=False)
     assert e.value.code == 2 and "--air-roll" in capsys.readouterr().err
+
+
+def test_run_replay_hands_its_sideslip_estimator_and_rate_frame_to_the_stages(monkeypatch, tmp_path):
+    """On the project's sample flight, `run_replay` decodes the log and calls the estimation with
+    `gls_beta=replay_beta_gls(options)` and the coefficients with `gust_rates=replay_gust_rates(options)`
+    (each captured, then the run stopped): the defaults give (False, None), the options as asked."""
+    from pathlib import Path
+
+    import gcs_sysid.estimation as est
+    import gcs_sysid.pipeline as pl
+
+    data = Path(__file__).resolve().parents[1] / "data"
+    log, af = data / "flights" / "sim-trainer-sysid.tlog", data / "airframes" / "sim-trainer.toml"
+    seen = []
+    real = est.estimate_states
+
+    def states(*a, **k):
+        seen.append(k["gls_beta"])
+        return real(*a, **{**k, "gls_beta": False})      # least squares either way: the call is what is checked
+
+    monkeypatch.setattr(est, "estimate_states", states)
+    monkeypatch.setattr(pl, "compute_coefficients", lambda s, f, gust_rates: seen.append(gust_rates) or 1 / 0)
+    for opts in (pl.ReplayOptions(progress=False, write=False, parallel=False, t_to=40.0),
+                 pl.ReplayOptions(progress=False, write=False, parallel=False, t_to=40.0, beta_gls=True,
+                                  gust_rates="path-yaw")):
+        with pytest.raises(ZeroDivisionError):
+            pl.run_replay(log, af, tmp_path / "o", opts)
+    assert seen == [False, None, True, "path-yaw"]
