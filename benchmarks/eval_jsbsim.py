@@ -810,7 +810,7 @@ def main(argv=None) -> int:
                                {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter],
                                a.heldout_air_roll, tuple(a.airp_lines),
                                None if a.air_roll_train is None else a.air_roll_train == "on", a.gp_seed,
-                               None if a.beta_gls is None else a.beta_gls == "on")
+                               beta_gls=None if a.beta_gls is None else a.beta_gls == "on")
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
