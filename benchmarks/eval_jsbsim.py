@@ -285,13 +285,14 @@ def stated_airframe(path: Path, work: Path, stem: str) -> Path:
 def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: float, work: Path,
              gust_rates: str | None = None, gust_filter: bool | str | None = None,
              heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = (),
-             air_roll_train: bool | None = None, gp_seed: int = 0, beta_gls: bool | None = None) -> dict:
+             air_roll_train: bool | None = None, gp_seed: int = 0, beta_gls: bool | None = None,
+             air_yaw: bool | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``; None: the
     replay's default, :data:`gcs_sysid.pipeline.REPLAY_GUST_RATES`, given to the fit too, so that both models are
     learned on the same rates). ``beta_gls``: ``ReplayOptions.beta_gls`` (None: the aiding's module switch,
     ``airangles.BETA_GLS``; the fit keeps least squares' sideslip, as ``gcs-sysid fit`` does,
-    :data:`gcs_sysid.diagnose.run.BETA_GLS`).
+    :data:`gcs_sysid.diagnose.run.BETA_GLS`). ``air_yaw``: ``ReplayOptions.air_yaw`` (None: the default, off).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
@@ -312,8 +313,9 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     truth = load_truth(files.truth)
     out = work / f"{files.tlog.stem}-replay"
     af_path = stated_airframe(files.airframe, work, files.tlog.stem)     # files.airframe unless --stated-lift-slope
-    opts = ReplayOptions(progress=False, gust_rates=gust_rates, beta_gls=beta_gls, gust_filter=gust_filter,
-                         heldout_air_roll=heldout_air_roll, air_roll_train=air_roll_train, gp_seed=gp_seed)
+    opts = ReplayOptions(progress=False, gust_rates=gust_rates, beta_gls=beta_gls, air_yaw=air_yaw,
+                         gust_filter=gust_filter, heldout_air_roll=heldout_air_roll, air_roll_train=air_roll_train,
+                         gp_seed=gp_seed)
     gust_rates = replay_gust_rates(opts)      # the frame the replay used (None: the gyro's rates), for the fit too
     res = run_replay(files.tlog, af_path, out, opts)
     t_replay = time.perf_counter() - t0 - t_fly
@@ -329,7 +331,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ok = tab.valid & np.isfinite(Yt).all(1)
     h = held & ok
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
-                 "gust_rates": gust_rates, "beta_gls": replay_beta_gls(opts), "gust_filter": gust_filter,
+                 "gust_rates": gust_rates, "beta_gls": replay_beta_gls(opts), "air_yaw": air_yaw,
+                 "gust_filter": gust_filter,
                  "heldout_air_roll": heldout_air_roll, "air_roll_train": air_roll_train, "gp_seed": gp_seed,
                  "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
                  "n_heldout": int(h.sum()), "t_fly_s": round(t_fly, 1), "t_replay_s": round(t_replay, 1)}
@@ -730,6 +733,9 @@ def main(argv=None) -> int:
                          "gust model, held in the later passes (the replay's ReplayOptions.beta_gls and "
                          "gcs_sysid.estimation.airangles.BETA_GLS; default: the package's, off; the fit keeps least "
                          "squares)")
+    ap.add_argument("--air-yaw", default=None, choices=("on", "off"),
+                    help="Cl and Cn trained at the air-relative yaw rate (ReplayOptions.air_yaw, "
+                         "gcs_sysid.aero.airyaw; default: the replay's, off)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
@@ -810,7 +816,8 @@ def main(argv=None) -> int:
                                {"on": True, "off": False, "roll": "roll", "rollgp": "rollgp"}[a.gust_filter],
                                a.heldout_air_roll, tuple(a.airp_lines),
                                None if a.air_roll_train is None else a.air_roll_train == "on", a.gp_seed,
-                               beta_gls=None if a.beta_gls is None else a.beta_gls == "on")
+                               beta_gls=None if a.beta_gls is None else a.beta_gls == "on",
+                               air_yaw=None if a.air_yaw is None else a.air_yaw == "on")
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"

@@ -81,6 +81,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the aided sideslip's side-force model by generalised least squares under the gust model "
                         "('on', opt-in) or least squares ('off', the default, as fit and diagnose load their flights; "
                         "docs/estimation.md, 'The side-force model by generalised least squares')")
+    r.add_argument("--air-yaw", default=None, choices=("on", "off"),
+                   help="Cl and Cn learned at the air-relative yaw rate (their training targets less the yaw gust "
+                        "rate's moment, the held-out Cl and Cn asked at r_hat less the yaw gust rate; the inputs stay "
+                        "the gyro's): 'on' opt-in, 'off' the default (docs/estimation.md, 'The yaw gust rate in the "
+                        "moments' targets')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
@@ -177,6 +182,7 @@ def _replay_options(a: argparse.Namespace):
                          targets=None if a.target is None else tuple(c.strip() for c in a.target.split(",")),
                          can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates,
                          beta_gls=None if a.beta_gls is None else a.beta_gls == "on",
+                         air_yaw=None if a.air_yaw is None else a.air_yaw == "on",
                          gp_noise=a.gp_noise, **_air_roll_options(getattr(a, "air_roll", None)))
 
 

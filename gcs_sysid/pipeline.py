@@ -75,6 +75,10 @@ class ReplayOptions:
         beta_gls: the aided sideslip's side-force model by generalised least squares under the aiding's gust model
             (True) or by least squares (False; ``estimate_states(gls_beta=)``). None:
             :data:`gcs_sysid.estimation.airangles.BETA_GLS` as it stands at the call (off).
+        air_yaw: train Cl and Cn on the air-relative yaw rate (their targets ``C + C_r r_hat_g`` with the yaw gust
+            rate of the reconstructed lateral gust, :func:`gcs_sysid.aero.airyaw.air_yaw_target`; the inputs stay the
+            gyro's) and ask them at ``r_hat - r_hat_g`` on the held-out rows. None: :data:`gcs_sysid.aero.airyaw.AIR_YAW`
+            (off). Not with a ``gust_rates`` frame (that moves the shared input instead).
         alpha_dot_hat: give the GP ``alpha_dot_hat`` (``CoefficientTable.alpha_dot_hat``) as a mean-only input
             of Cm (:data:`ALPHA_DOT_GP`; ``docs/gp.md``, "Mean-only inputs"): a linear ``Cm_alpha_dot`` term,
             kept when its slope is significant with coloured residuals, negative, and lowers Cm's blocked
@@ -124,6 +128,7 @@ class ReplayOptions:
     can_offset: float | None = None
     gust_rates: str | None = None
     beta_gls: bool | None = None
+    air_yaw: bool | None = None
     alpha_dot_hat: bool = True
     gust_filter: bool | str | None = None
     heldout_air_roll: str | None = None
@@ -320,6 +325,9 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.gust_rates is not None and options.gust_rates not in (*FRAMES, INERTIAL_RATES):
         raise InputError(f"gust_rates: expected one of {', '.join((*FRAMES, INERTIAL_RATES))}, got "
                          f"{options.gust_rates!r}")
+    if options.air_yaw and replay_gust_rates(options) is not None:
+        raise InputError("air_yaw: not with a gust_rates frame (both take the yaw gust rate out of the moments: "
+                         "air_yaw through Cl's and Cn's targets, gust_rates through every output's input)")
     check_window(options.t_from, options.t_to)
     check_positive_int(options.n_inducing, "--inducing")
     if options.targets is not None:
@@ -562,6 +570,18 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             with _stage("air roll training target", timings, bar):
                 Y_fit, target_info = air_roll_target(table, states, airframe, train, fit=pair_fit)
             notes.append(target_info["note"])
+        yaw_g = None                # air_yaw: the yaw gust rate as a hat, Cl's and Cn's targets at the air's rate
+        from .aero.airyaw import AIR_YAW
+
+        if AIR_YAW if options.air_yaw is None else options.air_yaw:
+            from .aero.airyaw import air_yaw_target, yaw_gust_hat
+
+            with _stage("air yaw training target", timings, bar):
+                yaw_g, why = yaw_gust_hat(states, airframe.b)
+                if yaw_g is not None:
+                    Y_fit, yaw_info = air_yaw_target(table, Y_fit, yaw_g, train)
+                    why = yaw_info["note"]
+            notes.append(why)
         gust_fit = None
         if gust_filter:
             with _stage("gust filter", timings, bar):
@@ -685,6 +705,26 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, cols], 0.0))
+                if yaw_g is not None:   # air_yaw: Cl and Cn asked at r_hat - r_hat_g (Cl also at its air roll rate)
+                    from .aero.airyaw import AIR_YAW_OUTPUTS
+
+                    ir = REGRESSORS.index("r_hat")
+                    for name in AIR_YAW_OUTPUTS:
+                        if COEFFICIENTS.index(name) not in fit_cols:
+                            continue
+                        base = table_air if air_outputs and name in air_outputs else table
+                        Xy = base.X.copy()
+                        Xy[:, ir] -= yaw_g
+                        rows_y = held & base.valid & np.all(np.isfinite(Xy), axis=1)
+                        if not rows_y.any():
+                            continue
+                        k = fit_cols.index(COEFFICIENTS.index(name))
+                        Xq, xv = gp_inputs(replace(base, X=Xy), rows_y, use_adot)
+                        mean, var = (np.asarray(v)[:, k] for v in model.predict(Xq, x_var=xv))
+                        at = (rows_y, COEFFICIENTS.index(name))
+                        pred_mean[at] = mean
+                        pred_sigma_obs[at] = np.sqrt(var)
+                        pred_sigma[at] = np.sqrt(np.maximum(var - white[k], 0.0))
             # the measurements are drawn against the band for a measurement
             draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma_obs, held, ident)
             if stage is not None:

@@ -33,6 +33,10 @@ def test_replay_gust_rate_and_sideslip_flags_reach_the_stages(monkeypatch):
     assert (o.gust_rates, pl.replay_gust_rates(o), pl.replay_beta_gls(o)) == ("inertial", None, True)
     with pytest.raises(pl.InputError, match="gust_rates: expected one of path, path-yaw, mean-wind, inertial"):
         pl.check_replay("x.tlog", "a.toml", None, pl.ReplayOptions(gust_rates="body"))
+    o = _replay_options(build_parser().parse_args(base + ["--air-yaw", "on"]))
+    assert o.air_yaw is True and _replay_options(build_parser().parse_args(base)).air_yaw is None
+    with pytest.raises(pl.InputError, match="air_yaw: not with a gust_rates frame"):
+        pl.check_replay("x.tlog", "a.toml", None, pl.ReplayOptions(air_yaw=True, gust_rates="path-yaw"))
 
 
 def test_unknown_gust_rate_frame_is_a_user_error(capsys):

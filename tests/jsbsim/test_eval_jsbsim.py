@@ -188,7 +188,7 @@ def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
     class Stop(Exception):
         pass
 
-    def fake_evaluate(*args, beta_gls=None):
+    def fake_evaluate(*args, beta_gls=None, air_yaw=None):
         seen.append((args[-1], beta_gls))
         raise Stop               # stop before the printing, which needs a scored row
 
