@@ -291,8 +291,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``; None: the
     replay's default, :data:`gcs_sysid.pipeline.REPLAY_GUST_RATES`, given to the fit too, so that both models are
     learned on the same rates). ``beta_gls``: ``ReplayOptions.beta_gls`` (None: the aiding's module switch,
-    ``airangles.BETA_GLS``; the fit keeps least squares' sideslip, as ``gcs-sysid fit`` does,
-    :data:`gcs_sysid.diagnose.run.BETA_GLS`). ``air_yaw``: ``ReplayOptions.air_yaw`` (None: the default, off).
+    ``airangles.BETA_GLS``), given to the fit too (``run_fit(gls_beta=)``: both models on the replay's sideslip, which
+    they are scored at). ``air_yaw``: ``ReplayOptions.air_yaw`` (None: the default, off).
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
@@ -417,7 +417,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     from gcs_sysid.estimation import airangles as _aa
 
     ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
-                          gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE,
+                          gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE, gls_beta=replay_beta_gls(opts),
                           air_roll_train=False)     # the measured Cl, as issue 8's records were (not the diagnosis's)
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     from gcs_sysid.aero.gustfilter import AIR_ROLL_TRAIN, HELDOUT_AIR_ROLL
@@ -731,11 +731,14 @@ def main(argv=None) -> int:
     ap.add_argument("--beta-gls", default=None, choices=("on", "off"),
                     help="the side-force model's slopes of the sideslip aiding by generalised least squares under the "
                          "gust model, held in the later passes (the replay's ReplayOptions.beta_gls and "
-                         "gcs_sysid.estimation.airangles.BETA_GLS; default: the package's, off; the fit keeps least "
-                         "squares)")
+                         "gcs_sysid.estimation.airangles.BETA_GLS, and the least-squares line's fit; default: the "
+                         "package's, off)")
     ap.add_argument("--air-yaw", default=None, choices=("on", "off"),
                     help="Cl and Cn trained at the air-relative yaw rate (ReplayOptions.air_yaw, "
                          "gcs_sysid.aero.airyaw; default: the replay's, off)")
+    ap.add_argument("--air-yaw-outputs", nargs="+", default=None, choices=("Cl", "Cn"),
+                    help="with --air-yaw on: the outputs trained and asked at the air-relative yaw rate "
+                         "(gcs_sysid.aero.airyaw.AIR_YAW_OUTPUTS; default: the package's, Cl and Cn)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
@@ -805,6 +808,10 @@ def main(argv=None) -> int:
         import gcs_sysid.pipeline as pipeline
 
         pipeline.SIDE_FORCE_RATE_PRIOR_STD = None if a.cy_rate_prior == "off" else float(a.cy_rate_prior)
+    if a.air_yaw_outputs is not None:
+        from gcs_sysid.aero import airyaw
+
+        airyaw.AIR_YAW_OUTPUTS = tuple(a.air_yaw_outputs)
     work = Path(a.work) if a.work else Path(tempfile.mkdtemp(prefix="eval-jsbsim-"))
     rows = []
     print(f"{'flight':32s} {'':5s} " + " ".join(f"{c:>6s}" for c in COEFFICIENTS) + "   cov95  alpha/beta err deg")

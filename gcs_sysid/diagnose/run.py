@@ -163,7 +163,7 @@ def shared_angle_models(fits: dict | None) -> dict | None:
 def load_measurements(log, airframe_path, t_from: float | None = None, t_to: float | None = None,
                       progress=None, notify=None, gust_rates: str | None = None,
                       angle_models: dict | None = None, air_roll: str = "off",
-                      profile_beta: bool | None = None) -> Measurements:
+                      profile_beta: bool | None = None, gls_beta: bool | None = None) -> Measurements:
     """Decode a log and compute its coefficient table (the replay pipeline's first stages).
 
     Args:
@@ -180,6 +180,8 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
             every regressor the gyro's (:func:`~gcs_sysid.diagnose.air_roll.air_roll_cl_table`).
         profile_beta: the sideslip aiding's ``CY_beta`` estimator (``estimate_states(profile_beta=)``); None:
             :data:`BETA_PROFILE` as it stands at the call (least squares).
+        gls_beta: the side-force model's slopes by GLS under the gust model (``estimate_states(gls_beta=)``); None:
+            :data:`BETA_GLS` as it stands at the call (least squares).
 
     Raises:
         InputError, DataError: from the stages, or an airframe whose servo channels
@@ -222,7 +224,7 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
                                  if progress is not None else None, helper=helper, angle_models=angle_models,
                                  turbulence_state=False,
                                  profile_beta=BETA_PROFILE if profile_beta is None else bool(profile_beta),
-                                 gls_beta=BETA_GLS)
+                                 gls_beta=BETA_GLS if gls_beta is None else bool(gls_beta))
         tm["estimate_s"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     table = compute_coefficients(states, airframe, gust_rates=gust_rates)
@@ -238,7 +240,7 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
             progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool | None = None,
-            profile_beta: bool | None = None):
+            profile_beta: bool | None = None, gls_beta: bool | None = None):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
     Also writes ``<out>.fit.json`` with the per-coefficient statistics (and the damage found in the
@@ -258,6 +260,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
         profile_beta: the sideslip's ``CY_beta`` by the gust model's likelihood, held (the thirty-second session's
             replay estimator, ``--beta-profile on``), or by least squares (False); None: :data:`BETA_PROFILE` (least
             squares: the diagnosis's reference models are fitted through here).
+        gls_beta: the side-force model's slopes by GLS (True) or least squares (False); None: :data:`BETA_GLS`
+            (least squares, as the diagnosis loads its flights).
 
     Returns:
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
@@ -279,7 +283,7 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
-                                 air_roll=load_kind, profile_beta=profile_beta)
+                                 air_roll=load_kind, profile_beta=profile_beta, gls_beta=gls_beta)
         table, air = meas.table, None
         if air_roll_train:
             table, air = air_rate_target(meas)

@@ -128,7 +128,8 @@ def test_gls_gust_fit_recovers_an_exogenous_slope_and_states_its_error():
 
 def test_gls_is_off_on_every_path_and_each_switch_reaches_it(monkeypatch):
     """On the project's sample flight: neither the replay's estimator nor the diagnosis's loader runs the GLS fit by
-    default; ``estimate_states(gls_beta=True)`` and the diagnosis's own switch ``diagnose.run.BETA_GLS`` do."""
+    default; ``estimate_states(gls_beta=True)`` and the diagnosis's own switch ``diagnose.run.BETA_GLS`` do, and the
+    loader's ``gls_beta`` argument wins over that switch."""
     from pathlib import Path
 
     from gcs_sysid.airframe import load_airframe
@@ -152,3 +153,10 @@ def test_gls_is_off_on_every_path_and_each_switch_reaches_it(monkeypatch):
     monkeypatch.setattr(diagnose_run, "BETA_GLS", True)
     meas = diagnose_run.load_measurements(log, airframe)
     assert len(calls) > n and meas.states.angle_fits["beta"].slope_method.startswith("GLS under the gust model")
+    # the loader's own argument wins over the module switch either way (eval_jsbsim's least-squares line asks for the
+    # replay's estimator through run_fit(gls_beta=))
+    off = diagnose_run.load_measurements(log, airframe, gls_beta=False).states.angle_fits["beta"]
+    assert not off.slope_method.startswith("GLS")
+    monkeypatch.setattr(diagnose_run, "BETA_GLS", False)
+    on = diagnose_run.load_measurements(log, airframe, gls_beta=True).states.angle_fits["beta"]
+    assert on.slope_method.startswith("GLS under the gust model")
