@@ -75,9 +75,10 @@ class ReplayOptions:
         beta_gls: the aided sideslip's side-force model by generalised least squares under the aiding's gust model
             (True) or by least squares (False; ``estimate_states(gls_beta=)``). None:
             :data:`gcs_sysid.estimation.airangles.BETA_GLS` as it stands at the call (off).
-        air_yaw: train Cl and Cn on the air-relative yaw rate (their targets ``C + C_r r_hat_g`` with the yaw gust
-            rate of the reconstructed lateral gust, :func:`gcs_sysid.aero.airyaw.air_yaw_target`; the inputs stay the
-            gyro's) and ask them at ``r_hat - r_hat_g`` on the held-out rows. None: :data:`gcs_sysid.aero.airyaw.AIR_YAW`
+        air_yaw: train :data:`gcs_sysid.aero.airyaw.AIR_YAW_OUTPUTS` on the air-relative yaw rate (their targets
+            ``C + C_r r_hat_g`` with the yaw gust rate of the reconstructed lateral gust,
+            :func:`gcs_sysid.aero.airyaw.air_yaw_target`; the inputs stay the gyro's) and ask them at
+            ``r_hat - r_hat_g`` on the held-out rows. None: :data:`gcs_sysid.aero.airyaw.AIR_YAW`
             (off). Not with a ``gust_rates`` frame (that moves the shared input instead).
         alpha_dot_hat: give the GP ``alpha_dot_hat`` (``CoefficientTable.alpha_dot_hat``) as a mean-only input
             of Cm (:data:`ALPHA_DOT_GP`; ``docs/gp.md``, "Mean-only inputs"): a linear ``Cm_alpha_dot`` term,
@@ -705,7 +706,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, cols], 0.0))
-                if yaw_g is not None:   # air_yaw: Cl and Cn asked at r_hat - r_hat_g (Cl also at its air roll rate)
+                if yaw_g is not None:   # air_yaw: its outputs asked at r_hat - r_hat_g (Cl also at its air roll rate)
                     from .aero.airyaw import AIR_YAW_OUTPUTS
 
                     ir = REGRESSORS.index("r_hat")

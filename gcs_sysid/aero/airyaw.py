@@ -116,6 +116,6 @@ def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray)
         slopes[name], sds[name] = slope, float(np.std(slope * g[ok]))
         said.append(f"{name} + {name}_r r_hat_g ({name}_r {slope:+.3g} at the air-relative rate; correction SD "
                     f"{sds[name]:.2g})")
-    note = ("yaw gust rate in the training targets (Cl and Cn learned at the air-relative yaw rate, inputs at the "
-            "gyro's): " + "; ".join(said) + f"; r_hat_g SD {float(np.nanstd(g[rows])) if rows.any() else 0.0:.2g}")
+    note = (f"yaw gust rate in the training targets ({' and '.join(AIR_YAW_OUTPUTS)} learned at the air-relative yaw "
+            "rate, inputs at the gyro's): " + "; ".join(said) + f"; r_hat_g SD {float(np.nanstd(g[rows])) if rows.any() else 0.0:.2g}")
     return out, {"slopes": slopes, "rows": rows, "sd": sds, "note": note}
