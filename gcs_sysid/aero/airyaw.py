@@ -71,9 +71,10 @@ def yaw_gust_hat(states, b: float) -> tuple[np.ndarray | None, str]:
     return g, "; ".join(G.notes)
 
 
-def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray) -> tuple[np.ndarray, dict]:
-    """The training target of :data:`AIR_YAW_OUTPUTS` at the air-relative yaw rate, ``C + C_r r_hat_g`` (module
-    docstring), every other output and row as given.
+def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray,
+                   outputs: tuple[str, ...] | None = None) -> tuple[np.ndarray, dict]:
+    """The training target of ``outputs`` at the air-relative yaw rate, ``C + C_r r_hat_g`` (module docstring), every
+    other output and row as given.
 
     Args:
         table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``X`` ``(T, 10)`` with the gyro's ``r_hat``).
@@ -81,6 +82,7 @@ def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray)
             air-relative roll rate).
         r_hat_g: ``(T,)`` the yaw gust rate as a hat (:func:`yaw_gust_hat`).
         train: ``(T,)`` bool, the training rows (the only rows fitted or changed).
+        outputs: names among ``Cl``, ``Cn``; None: :data:`AIR_YAW_OUTPUTS`.
 
     Returns:
         ``(Y_new, info)``: a copy of ``Y`` with the outputs' columns changed on the fitted rows, and ``{"slopes":
@@ -90,6 +92,7 @@ def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray)
     Raises:
         ValueError: ``Y``, ``r_hat_g`` or ``train`` not of the table's length.
     """
+    outputs = AIR_YAW_OUTPUTS if outputs is None else tuple(outputs)
     T = len(table.t)
     Y, g, train = np.asarray(Y, float), np.asarray(r_hat_g, float), np.asarray(train, bool)
     if Y.shape != (T, len(COEFFICIENTS)) or g.shape != (T,) or train.shape != (T,):
@@ -100,7 +103,7 @@ def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray)
     X[:, _LAT.index("r_hat")] -= g
     rows = train & np.asarray(table.valid, bool) & np.isfinite(g) & np.all(np.isfinite(X), axis=1)
     out, slopes, sds, said = Y.copy(), {}, {}, []
-    for name in AIR_YAW_OUTPUTS:
+    for name in outputs:
         k = COEFFICIENTS.index(name)
         ok = rows & np.isfinite(Y[:, k])
         if ok.sum() < _MIN_ROWS:
@@ -116,6 +119,6 @@ def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray)
         slopes[name], sds[name] = slope, float(np.std(slope * g[ok]))
         said.append(f"{name} + {name}_r r_hat_g ({name}_r {slope:+.3g} at the air-relative rate; correction SD "
                     f"{sds[name]:.2g})")
-    note = (f"yaw gust rate in the training targets ({' and '.join(AIR_YAW_OUTPUTS)} learned at the air-relative yaw "
+    note = (f"yaw gust rate in the training targets ({' and '.join(outputs)} learned at the air-relative yaw "
             "rate, inputs at the gyro's): " + "; ".join(said) + f"; r_hat_g SD {float(np.nanstd(g[rows])) if rows.any() else 0.0:.2g}")
     return out, {"slopes": slopes, "rows": rows, "sd": sds, "note": note}

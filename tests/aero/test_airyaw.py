@@ -51,7 +51,7 @@ def _slopes(table, y, rows):
 def test_corrected_target_at_the_gyros_rate_gives_the_air_rate_slopes():
     table, g = _record()
     train = np.arange(len(g)) < 0.8 * len(g)
-    Y, info = air_yaw_target(table, table.Y, g, train)
+    Y, info = air_yaw_target(table, table.Y, g, train, outputs=("Cl", "Cn"))
     for name, (sb, sr) in (("Cn", (CN_BETA, CN_R)), ("Cl", (CL_BETA, CL_R))):
         k = COEFFICIENTS.index(name)
         raw = _slopes(table, table.Y[:, k], train)
@@ -71,7 +71,7 @@ def test_too_few_rows_leave_the_target_and_shapes_are_checked():
     table, g = _record(T=400)
     train = np.zeros(len(g), bool)
     train[:30] = True
-    Y, info = air_yaw_target(table, table.Y, g, train)
+    Y, info = air_yaw_target(table, table.Y, g, train, outputs=("Cl", "Cn"))
     assert np.array_equal(Y, table.Y) and info["slopes"] == {} and "unchanged (30 rows)" in info["note"]
     with pytest.raises(ValueError, match="air_yaw_target"):
         air_yaw_target(table, table.Y[:-1], g, train)
