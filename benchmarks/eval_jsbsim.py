@@ -734,11 +734,11 @@ def main(argv=None) -> int:
                          "gcs_sysid.estimation.airangles.BETA_GLS, and the least-squares line's fit; default: the "
                          "package's, off)")
     ap.add_argument("--air-yaw", default=None, choices=("on", "off"),
-                    help="Cl and Cn trained at the air-relative yaw rate (ReplayOptions.air_yaw, "
+                    help="AIR_YAW_OUTPUTS (Cn) trained at the air-relative yaw rate (ReplayOptions.air_yaw, "
                          "gcs_sysid.aero.airyaw; default: the replay's, off)")
     ap.add_argument("--air-yaw-outputs", nargs="+", default=None, choices=("Cl", "Cn"),
                     help="with --air-yaw on: the outputs trained and asked at the air-relative yaw rate "
-                         "(gcs_sysid.aero.airyaw.AIR_YAW_OUTPUTS; default: the package's, Cl and Cn)")
+                         "(gcs_sysid.aero.airyaw.AIR_YAW_OUTPUTS; default: the package's, Cn)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")

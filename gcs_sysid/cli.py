@@ -82,10 +82,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "('on', opt-in) or least squares ('off', the default, as fit and diagnose load their flights; "
                         "docs/estimation.md, 'The side-force model by generalised least squares')")
     r.add_argument("--air-yaw", default=None, choices=("on", "off"),
-                   help="Cl and Cn learned at the air-relative yaw rate (their training targets less the yaw gust "
-                        "rate's moment, the held-out Cl and Cn asked at r_hat less the yaw gust rate; the inputs stay "
-                        "the gyro's): 'on' opt-in, 'off' the default (docs/estimation.md, 'The yaw gust rate in the "
-                        "moments' targets')")
+                   help="Cn learned at the air-relative yaw rate (its training target less the yaw gust rate's "
+                        "moment, the held-out Cn asked at r_hat less the yaw gust rate; the inputs stay the gyro's): "
+                        "'on' opt-in, 'off' the default (docs/estimation.md, 'The yaw gust rate in the moments' "
+                        "targets')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
