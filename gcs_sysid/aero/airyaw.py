@@ -58,16 +58,14 @@ def yaw_gust_hat(states, b: float) -> tuple[np.ndarray | None, str]:
     Returns:
         ``((T,) r_hat_g, note)``; ``(None, why)`` when a field is missing or the grid is shorter than 3 samples.
     """
-    from ..estimation.ekf import dcm
-    from ..estimation.gustrates import gust_rates
+    from ..estimation.gustrates import states_gust_rates
 
-    d = states.data
-    need = [k for k in ("phi", "theta", "psi", "wn", "we", "wd", "V") if k not in d]
-    if need or len(states.t) < 3:
-        return None, f"no yaw gust rate: no {' '.join(need) or 'grid'} in the states"
-    V = np.asarray(d["V"], float)
-    G = gust_rates(float(np.median(np.diff(states.t))), dcm(d["phi"], d["theta"], d["psi"]),
-                   np.stack([d["wn"], d["we"], d["wd"]], axis=1), V, b, "path-yaw")
+    if "V" not in states.data:
+        return None, "no yaw gust rate: no V in the states"
+    V = np.asarray(states.data["V"], float)
+    G = states_gust_rates(states, V, b, "path-yaw")
+    if isinstance(G, str):
+        return None, f"no yaw gust rate: {G}"
     with np.errstate(invalid="ignore", divide="ignore"):
         g = G.rates[:, 2] * b / (2.0 * V)
     return g, "; ".join(G.notes)

@@ -149,17 +149,12 @@ def _air_relative(states, airframe, frame, p, q, r, V, notes):
     """``(p, q, r)`` for the hats: inertial (``frame`` None) or minus the estimated gust rates."""
     if frame is None:
         return p, q, r
-    from ..estimation.ekf import dcm
-    from ..estimation.gustrates import gust_rates
+    from ..estimation.gustrates import states_gust_rates
 
-    need = [k for k in ("phi", "theta", "psi", "wn", "we", "wd") if k not in states.data]
-    if need or len(states.t) < 3:
-        notes.append(f"gust rates ({frame}) not removed from p_hat q_hat r_hat: no {' '.join(need) or 'grid'} "
-                     "in the states")
+    G = states_gust_rates(states, V, airframe.b, frame)
+    if isinstance(G, str):
+        notes.append(f"gust rates ({frame}) not removed from p_hat q_hat r_hat: {G}")
         return p, q, r
-    d = states.data
-    G = gust_rates(float(np.median(np.diff(states.t))), dcm(d["phi"], d["theta"], d["psi"]),
-                   np.stack([d["wn"], d["we"], d["wd"]], axis=1), V, airframe.b, frame)
     notes.append("p_hat q_hat r_hat relative to the air: " + "; ".join(G.notes))
     return p - G.rates[:, 0], q - G.rates[:, 1], r - G.rates[:, 2]
 

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["FRAMES", "MIN_MEAN_WIND", "DRYDEN_L", "DRYDEN_RATE_FACTORS", "GustRates", "gust_rates", "lag_filter",
-           "gust_intensity", "dryden_rate_sigma"]
+           "gust_intensity", "dryden_rate_sigma", "states_gust_rates"]
 
 FRAMES = ("path", "path-yaw", "mean-wind")   #: frames of :func:`gust_rates`
 MIN_MEAN_WIND = 1.0              #: m/s; below it the mean wind has no direction and ``"mean-wind"`` takes north
@@ -180,6 +180,24 @@ def gust_rates(dt: float, C: np.ndarray, wind_ned: np.ndarray, V: np.ndarray, b:
                      "(MIL-F-8785C low-altitude axes, JSBSim's ttMilspec form)")
     rates[~good] = np.nan
     return GustRates(rates, frame, mean, tuple(notes))
+
+
+def states_gust_rates(states, V: np.ndarray, b: float, frame: str) -> GustRates | str:
+    """:func:`gust_rates` of smoothed states: their attitude ``phi theta psi`` (rad) and reconstructed wind ``wn we wd``
+    (m/s, NED) on their grid ``t`` (s), with the airspeed ``V`` ``(T,)`` m/s and the span ``b`` m.
+
+    Returns:
+        the :class:`GustRates`, or a one-line reason (``"no ... in the states"``) when a field is missing or the grid
+        has fewer than 3 samples.
+    """
+    from .ekf import dcm      # filterpy: not at import (check_replay reads FRAMES before the log is decoded)
+
+    d = states.data
+    need = [k for k in ("phi", "theta", "psi", "wn", "we", "wd") if k not in d]
+    if need or len(states.t) < 3:
+        return f"no {' '.join(need) or 'grid'} in the states"
+    return gust_rates(float(np.median(np.diff(states.t))), dcm(d["phi"], d["theta"], d["psi"]),
+                      np.stack([d["wn"], d["we"], d["wd"]], axis=1), V, b, frame)
 
 
 def _dryden_transverse_rho(x):
