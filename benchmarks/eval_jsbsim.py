@@ -401,6 +401,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["true_air"] = _errs(np.asarray(ma), Yt[h])
     row["cov_true_air"] = float(np.nanmean([_coverage(np.asarray(ma)[:, i], np.sqrt(np.asarray(va)[:, i]), Yt[h, i])
                                             for i in range(6)]))
+    row["cov_true_air_each"] = [_coverage(np.asarray(ma)[:, i], np.sqrt(np.asarray(va)[:, i]), Yt[h, i])
+                                for i in range(6)]
     row["cov_true"] = float(np.nanmean([_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i])
                                         for i in range(6)]))
     row["cov_true_each"] = [_coverage(np.asarray(mt)[:, i], np.sqrt(np.asarray(vt)[:, i]), Yt[h, i]) for i in range(6)]
@@ -411,6 +413,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row["cov_gp_each"] = [_coverage(res.pred_mean[h, i], res.pred_sigma[h, i], Yt[h, i]) for i in range(6)]
     if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
         row["band_terms"] = band_terms(model, Xg[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
+        # the band at exact conditions with the aerodynamics' rates (``tair``, ``cov_true_air``), term by term
+        row["band_terms_air"] = band_terms(model, Xg[h], Xt_air[h], None, Yt[h])["true"]
     t_cut = float(tab.t[h][0])
     # the LS line on the replay's own sideslip estimator (the two models are scored at the replay's regressors;
     # `gcs-sysid fit` alone keeps least squares' CY_beta by default, gcs_sysid.diagnose.run.BETA_PROFILE)
