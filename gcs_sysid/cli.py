@@ -86,6 +86,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "moment, the held-out Cn asked at r_hat less the yaw gust rate; the inputs stay the gyro's): "
                         "'on' opt-in, 'off' the default (docs/estimation.md, 'The yaw gust rate in the moments' "
                         "targets')")
+    r.add_argument("--rate-errors", default=None, choices=("on", "off"),
+                   help="state the gyro rates' errors as stand-ins for the air-relative rates in the model's band at "
+                        "exact conditions (predict's sigma): p_hat's scale error from the rolling gust, r_hat's "
+                        "linear error from the yaw gust rate (docs/gp.md, 'The rates' errors')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
@@ -183,6 +187,7 @@ def _replay_options(a: argparse.Namespace):
                          can_log=a.can_log, can_offset=a.can_offset, gust_rates=a.gust_rates,
                          beta_gls=None if a.beta_gls is None else a.beta_gls == "on",
                          air_yaw=None if a.air_yaw is None else a.air_yaw == "on",
+                         rate_errors=None if a.rate_errors is None else a.rate_errors == "on",
                          gp_noise=a.gp_noise, **_air_roll_options(getattr(a, "air_roll", None)))
 
 

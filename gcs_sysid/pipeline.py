@@ -80,6 +80,11 @@ class ReplayOptions:
             :func:`gcs_sysid.aero.airyaw.air_yaw_target`; the inputs stay the gyro's) and ask them at
             ``r_hat - r_hat_g`` on the held-out rows. None: :data:`gcs_sysid.aero.airyaw.AIR_YAW`
             (off). Not with a ``gust_rates`` frame (that moves the shared input instead).
+        rate_errors: state the gyro rates' errors as stand-ins for the air-relative rates in the model's band at
+            exact conditions (``gcs-sysid predict``'s sigma): ``p_hat``'s scale error from the roll fit's rolling
+            gust, ``r_hat``'s linear error from the yaw gust rate (:func:`gcs_sysid.aero.rateerrors.
+            stated_rate_errors`). The mean and the bands at the flight's own regressors are unchanged. None:
+            :data:`gcs_sysid.aero.rateerrors.RATE_ERRORS`.
         alpha_dot_hat: give the GP ``alpha_dot_hat`` (``CoefficientTable.alpha_dot_hat``) as a mean-only input
             of Cm (:data:`ALPHA_DOT_GP`; ``docs/gp.md``, "Mean-only inputs"): a linear ``Cm_alpha_dot`` term,
             kept when its slope is significant with coloured residuals, negative, and lowers Cm's blocked
@@ -130,6 +135,7 @@ class ReplayOptions:
     gust_rates: str | None = None
     beta_gls: bool | None = None
     air_yaw: bool | None = None
+    rate_errors: bool | None = None
     alpha_dot_hat: bool = True
     gust_filter: bool | str | None = None
     heldout_air_roll: str | None = None
@@ -583,6 +589,24 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     Y_fit, yaw_info = air_yaw_target(table, Y_fit, yaw_g, train)
                     why = yaw_info["note"]
             notes.append(why)
+        x_scale_var, x_map_cov = table.x_scale_var, table.x_map_cov   # the regressors' stated errors, for the model
+        from .aero.rateerrors import RATE_ERRORS
+
+        if RATE_ERRORS if options.rate_errors is None else options.rate_errors:
+            from .aero.airyaw import yaw_gust_hat
+            from .aero.rateerrors import stated_rate_errors
+
+            with _stage("rates' errors", timings, bar):
+                if gust_filter:         # the table's p_hat becomes the air-relative estimate: no gyro scale error
+                    roll = "gust filter on"
+                else:
+                    roll = pair_fit if pair_fit is not None else air_roll_fit(table, states, airframe, train)
+                if replay_gust_rates(options) is not None:     # r_hat is the air's already
+                    r_g = None
+                else:
+                    r_g = yaw_g if yaw_g is not None else yaw_gust_hat(states, airframe.b)[0]
+                x_scale_var, x_map_cov, why = stated_rate_errors(table, train, roll, r_g)
+            notes.append(why)
         gust_fit = None
         if gust_filter:
             with _stage("gust filter", timings, bar):
@@ -641,8 +665,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                         raise InputError(f"{options.model_in}: saved model has {model.n_outputs} outputs, "
                                          f"this flight identifies {len(fit_cols)}")
                     model = with_offset_covariance(model.update(X_train, Y_train), table.x_offset_cov,
-                                                   rows=len(X_train), scale_var=table.x_scale_var,
-                                                   map_cov=table.x_map_cov)
+                                                   rows=len(X_train), scale_var=x_scale_var, map_cov=x_map_cov)
                     notes.append(f"model continued from {options.model_in} (incremental update, "
                                  f"{len(X_train)} new samples)")
                 else:
@@ -674,8 +697,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     # the estimator's flight-common regressor offset (alpha: mean vertical wind / V): the
                     # band at exact conditions (gcs-sysid predict) carries it through the slope
                     # and the aided angles' common scale and linear error (docs/gp.md, "The band at exact conditions")
-                    model = with_offset_covariance(model, table.x_offset_cov, scale_var=table.x_scale_var,
-                                                   map_cov=table.x_map_cov)
+                    model = with_offset_covariance(model, table.x_offset_cov, scale_var=x_scale_var,
+                                                   map_cov=x_map_cov)
             gp_summary = model.summary()
             gp_summary["outputs"] = [COEFFICIENTS[i] for i in fit_cols]
             corr = correlation_of(gp_summary, gp_summary["outputs"])
