@@ -164,3 +164,24 @@ def test_a_lost_gp_ls_flip_where_least_squares_got_better_can_be_set_aside(tmp_p
     out = capsys.readouterr().out
     assert "rule 8(b) FAILS (seed 0 +1/-0, seed 1 +1/-1" in out             # the GP's own loss still counts
     assert "GP seed 0: 1 lost gp<ls flips set aside" in out and "sgs light s1 ahrs CY: gp 1.00 -> 1.00 %" in out
+
+
+def test_band_per_coefficient_is_information_pooled_and_split(tmp_path, capsys):
+    """The per-coefficient band at exact conditions: pooled as the mean of the flights' shares, the flights within,
+    below and above 90-98 % (bounds inclusive), a NaN left out; rows without the field give none; no count moves."""
+    a, b, c = _row("sgs", 1), _row("sgs", 2), _row("t6", 1)
+    a["cov_true_air_each"] = [100.0, 89.9, 90.0, 50.0, 98.0, float("nan")]
+    b["cov_true_air_each"] = [96.0, 92.0, 99.0, 98.1, 100.0, 95.0]
+    rows = {ic.flight_key(r): r for r in (a, b, c)}            # c: written before the field
+    cov = ic.coverage_by_coefficient(rows)
+    assert cov["CX"] == (98.0, 1, 0, 1, 2)
+    assert cov["CY"][1:] == (1, 1, 0, 2) and cov["CZ"][1:] == (1, 0, 1, 2)
+    assert cov["Cl"][0] == pytest.approx(74.05) and cov["Cl"][1:] == (0, 1, 1, 2)
+    assert cov["Cm"][1:] == (1, 0, 1, 2) and cov["Cn"] == (95.0, 1, 0, 0, 1)
+    assert ic.coverage_by_coefficient({ic.flight_key(c): c}) is None
+    assert ic.tally(rows) == ic.tally({k: {x: y for x, y in r.items() if x != "cov_true_air_each"}
+                                       for k, r in rows.items()})
+    ic.main([_write(tmp_path / "r.jsonl", [a, b, c])])
+    out = capsys.readouterr().out
+    assert "band at exact conditions per coefficient, GP seed 0 (information)" in out
+    assert "| pooled % | 98.0 | 91.0 | 94.5 | 74.0 | 99.0 | 95.0 |" in out
