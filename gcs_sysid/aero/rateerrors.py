@@ -11,14 +11,14 @@ conditions already carries for the aided air angles (``docs/gp.md``, "The band a
 
 * **Roll: a scale error of ``p_hat``.** With ``p_hat = p_hat_air + p_hat_g`` and the rolling gust uncorrelated with the
   air-relative rate, a slope fitted on the gyro's rate is the air-rate slope times the reliability ratio
-  ``var(p_hat_air) / var(p_hat) = 1 / (1 + rho)``, ``rho = var(p_hat_g) / var(p_hat_air)`` (Fuller, *Measurement
-  Error Models*, Wiley 1987, sec. 1.1: the attenuation of the least-squares slope). At exact conditions the model is
-  then off by ``dm/dp_hat rho (p_hat - mean p_hat)``: the scale term with ``scale_var[p_hat] = rho^2``. ``rho`` is
-  estimated as ``var(g) / var(p_hat)`` over the roll fit's training rows, ``g`` the filter-error method's smoothed
-  rolling gust (:func:`gcs_sysid.aero.gustfilter.fit_roll_gust`). Measured on 24 JSBSim flights of the tuning roster
-  (``docs/benchmarks.md``, "Sixty-fourth session"): the GP's ``Cl_p`` reads 0.03-0.66 of the truth's too weak
-  (median 0.23); the instruments of the roll fit do not remove it (their ``Cl_p`` is as weak: the autopilot's
-  aileron answers the gust).
+  ``var(p_hat_air) / var(p_hat) = 1 - rho``, ``rho = var(p_hat_g) / var(p_hat)`` (Fuller, *Measurement Error Models*,
+  Wiley 1987, sec. 1.1: the attenuation of the least-squares slope). At exact conditions the model is then off by
+  about ``dm/dp_hat rho (p_hat - mean p_hat)`` (first order in ``rho``: the model's own slope stands in for the true
+  one; exactly it is ``rho / (1 - rho)`` of the model's slope): the scale term with ``scale_var[p_hat] = rho^2``.
+  ``rho`` is estimated as ``var(g) / var(p_hat)`` over the roll fit's training rows, ``g`` the filter-error method's
+  smoothed rolling gust (:func:`gcs_sysid.aero.gustfilter.fit_roll_gust`). Measured on 24 JSBSim flights of the
+  tuning roster (``docs/benchmarks.md``, "Sixty-fourth session"): the GP's ``Cl_p`` reads 0.03-0.66 of the truth's
+  too weak (median 0.23); the roll fit's instrumented ``Cl_p`` is too weak as well (median 0.15).
 * **Yaw: a linear map of ``r_hat``'s error.** The yaw gust rate moves with the sideslip (a directionally stable
   aircraft turns into a lateral gust; correlation -0.23 to -0.76 on JSBSim's flights), so the gyro's ``r_hat`` carries
   an error ``r_hat_g`` that follows the regressors: ``e_r(x) = M (x - mean x)``. As for the aided angles
