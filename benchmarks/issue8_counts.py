@@ -19,6 +19,9 @@ on the held-out segment):
   cov_gp     the six-output mean coverage of the replay's band (``cov_gp``) within 90-98 %, per flight
   cov_tair   the same at exact conditions with the aero rates (``cov_true_air``), per flight
   corr       a learned output correlation above 0.5 (``max_corr``), per flight: FEWER is better
+  cov_tair_c the band at exact conditions per coefficient (``cov_true_air_each``) within 90-98 %, per flight x
+             coefficient (the sixty-fourth session; not among the default counts of the flips and the verdict,
+             :data:`DEFAULT_COUNTS`: name it with ``--counts``)
 
 Information (no count, no flip): the band at exact conditions per coefficient (``cov_true_air_each``, written
 since the sixty-fourth session): its coverage pooled over the flights (the mean of the flights' shares; every flight
@@ -93,7 +96,10 @@ COUNTS = {
     "cov_gp": ("flight", "band (cov_gp) within 90-98 %"),
     "cov_tair": ("flight", "band at exact conditions (cov_true_air) within 90-98 %"),
     "corr": ("flight", "learned output correlation above 0.5 (fewer is better)"),
+    "cov_tair_c": ("coef", "band at exact conditions per coefficient (cov_true_air_each) within 90-98 %"),
 }
+#: the counts the flips and the verdict use unless ``--counts`` names others
+DEFAULT_COUNTS = ("meas", "gp", "true_air", "gp<ls", "gp<fair", "cov_gp", "cov_tair", "corr")
 #: counts where fewer is better
 FEWER_IS_BETTER = ("corr",)
 
@@ -131,6 +137,10 @@ def item_values(row: dict) -> dict[tuple[str, str], bool | None]:
     for name, key in (("cov_gp", "cov_gp"), ("cov_tair", "cov_true_air")):
         out[(name, "")] = None if key not in row else BAND[0] <= _num(row[key]) <= BAND[1]
     out[("corr", "")] = None if "max_corr" not in row else _num(row["max_corr"]) > CORR_LIMIT
+    each = row.get("cov_true_air_each")
+    for i, c in enumerate(COEFFICIENTS):
+        out[("cov_tair_c", c)] = (None if not isinstance(each, list) or len(each) != len(COEFFICIENTS)
+                                  else BAND[0] <= _num(each[i]) <= BAND[1])
     return out
 
 
@@ -370,9 +380,10 @@ def main(argv=None) -> int:
     ap.add_argument("--against", nargs="+", default=None, metavar="JSONL[@GP_SEED]",
                     help="the base run's files: print the flips of the candidate against it per GP seed, and rule "
                          "8(b)'s verdict where two or more GP seeds are paired")
-    ap.add_argument("--counts", nargs="+", default=list(COUNTS), choices=list(COUNTS), metavar="COUNT",
-                    help="judge the flips and the verdict on these counts only (default: all of "
-                         + ", ".join(COUNTS) + ")")
+    ap.add_argument("--counts", nargs="+", default=list(DEFAULT_COUNTS), choices=list(COUNTS), metavar="COUNT",
+                    help="judge the flips and the verdict on these counts only (default: "
+                         + ", ".join(DEFAULT_COUNTS) + "; also: "
+                         + ", ".join(c for c in COUNTS if c not in DEFAULT_COUNTS) + ")")
     ap.add_argument("--ls-loss-needs-gp-worse", type=float, default=None, metavar="POINTS",
                     help="count a lost gp<ls flip only where the GP's held-out error grew by more than POINTS "
                          "percentage points; the others (least squares got better) are listed and set aside")
@@ -408,7 +419,7 @@ def main(argv=None) -> int:
     missing = sorted(set(base) ^ set(cand))
     if missing:
         print(f"GP seeds in one run only (not compared): {missing}")
-    if set(a.counts) != set(COUNTS):
+    if set(a.counts) != set(DEFAULT_COUNTS):
         print(f"flips and verdict on the counts {', '.join(a.counts)} only")
     if len(per_seed) >= 2:
         print(verdict(per_seed)[2])

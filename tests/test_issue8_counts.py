@@ -179,8 +179,15 @@ def test_band_per_coefficient_is_information_pooled_and_split(tmp_path, capsys):
     assert cov["Cl"][0] == pytest.approx(74.05) and cov["Cl"][1:] == (0, 1, 1, 2)
     assert cov["Cm"][1:] == (1, 0, 1, 2) and cov["Cn"] == (95.0, 1, 0, 0, 1)
     assert ic.coverage_by_coefficient({ic.flight_key(c): c}) is None
-    assert ic.tally(rows) == ic.tally({k: {x: y for x, y in r.items() if x != "cov_true_air_each"}
-                                       for k, r in rows.items()})
+    bare = ic.tally({k: {x: y for x, y in r.items() if x != "cov_true_air_each"} for k, r in rows.items()})
+    full = ic.tally(rows)
+    assert {ac: {n: v for n, v in t.items() if n != "cov_tair_c"} for ac, t in full.items()} == \
+        {ac: {n: v for n, v in t.items() if n != "cov_tair_c"} for ac, t in bare.items()}
+    # the per-coefficient count (opt-in for the verdict): inclusive bounds, NaN satisfies nothing, absent not scored
+    v = ic.item_values(a)
+    assert [v[("cov_tair_c", x)] for x in C] == [False, False, True, False, True, False]
+    assert full["total"]["cov_tair_c"] == [2 + 3, 12] and bare["total"]["cov_tair_c"] == [0, 0]
+    assert "cov_tair_c" not in ic.DEFAULT_COUNTS and set(ic.DEFAULT_COUNTS) < set(ic.COUNTS)
     ic.main([_write(tmp_path / "r.jsonl", [a, b, c])])
     out = capsys.readouterr().out
     assert "band at exact conditions per coefficient, GP seed 0 (information)" in out
