@@ -304,10 +304,9 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     :func:`gcs_sysid.aero.gustfilter.heldout_air_roll` scored post hoc on the same replay's model (rows
     ``gp_airp_MODE``, ``ls_airp_MODE``, ``cov_gp_airp_MODE`` and ``airp_MODE`` with the estimated gust against
     JSBSim's ``p - p_aero``; a diagnosis: the replay's table must not be gust-filtered)."""
+    from gcs_sysid.aero import rateerrors as _rateerrors
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
-
-    from gcs_sysid.aero import rateerrors as _rateerrors
 
     t0 = time.perf_counter()
     files = make_flight(FlightConfig(aircraft, duration_s=duration, turbulence=turbulence, seed=seed), work, aoa=aoa,
