@@ -89,7 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--rate-errors", default=None, choices=("on", "off"),
                    help="state the gyro rates' errors as stand-ins for the air-relative rates in the model's band at "
                         "exact conditions (predict's sigma): p_hat's scale error from the rolling gust, r_hat's "
-                        "linear error from the yaw gust rate (docs/gp.md, 'The rates' errors')")
+                        "linear error from the yaw gust rate ('on', the default) or leave the rates exact there "
+                        "('off'; docs/gp.md, 'The rates' errors')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "

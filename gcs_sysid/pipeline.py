@@ -84,7 +84,7 @@ class ReplayOptions:
             exact conditions (``gcs-sysid predict``'s sigma): ``p_hat``'s scale error from the roll fit's rolling
             gust, ``r_hat``'s linear error from the yaw gust rate (:func:`gcs_sysid.aero.rateerrors.
             stated_rate_errors`). The mean and the bands at the flight's own regressors are unchanged. None:
-            :data:`gcs_sysid.aero.rateerrors.RATE_ERRORS`.
+            :data:`gcs_sysid.aero.rateerrors.RATE_ERRORS` (on).
         alpha_dot_hat: give the GP ``alpha_dot_hat`` (``CoefficientTable.alpha_dot_hat``) as a mean-only input
             of Cm (:data:`ALPHA_DOT_GP`; ``docs/gp.md``, "Mean-only inputs"): a linear ``Cm_alpha_dot`` term,
             kept when its slope is significant with coloured residuals, negative, and lowers Cm's blocked
