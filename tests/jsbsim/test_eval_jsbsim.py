@@ -180,7 +180,7 @@ def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
 def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
     """``--gp-seed N`` is handed to :func:`eval_jsbsim.evaluate` (which passes it as ``ReplayOptions.gp_seed``);
     0 by default, as before the option existed. ``--beta-gls on|off`` arrives as ``beta_gls`` True / False (the
-    replay's ``ReplayOptions.beta_gls``), None without the flag."""
+    replay's ``ReplayOptions.beta_gls``), None without the flag; ``--rate-errors on|off`` likewise as ``rate_errors``."""
     import gcs_sysid.estimation.airangles as aa
 
     seen = []
@@ -188,14 +188,15 @@ def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
     class Stop(Exception):
         pass
 
-    def fake_evaluate(*args, beta_gls=None, air_yaw=None):
-        seen.append((args[-1], beta_gls))
+    def fake_evaluate(*args, beta_gls=None, air_yaw=None, rate_errors=None):
+        seen.append((args[-1], beta_gls) if rate_errors is None else ("rate_errors", rate_errors))
         raise Stop               # stop before the printing, which needs a scored row
 
     monkeypatch.setattr(eval_jsbsim, "evaluate", fake_evaluate)
     monkeypatch.setattr(aa, "BETA_GLS", aa.BETA_GLS)       # --beta-gls also sets the aiding's module switch
     for argv, want in (([], (0, None)), (["--gp-seed", "1"], (1, None)), (["--beta-gls", "on"], (0, True)),
-                       (["--beta-gls", "off"], (0, False))):
+                       (["--beta-gls", "off"], (0, False)), (["--rate-errors", "on"], ("rate_errors", True)),
+                       (["--rate-errors", "off"], ("rate_errors", False))):
         with pytest.raises(Stop):
             eval_jsbsim.main(["--aircraft", "sgs", "--turbulence", "light", "--work", str(tmp_path), *argv])
         assert seen[-1] == want
