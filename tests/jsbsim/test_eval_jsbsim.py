@@ -180,7 +180,8 @@ def test_eval_gp_jsbsim_scores_cl_with_the_replays_air_rate_pair(tmp_path):
 def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
     """``--gp-seed N`` is handed to :func:`eval_jsbsim.evaluate` (which passes it as ``ReplayOptions.gp_seed``);
     0 by default, as before the option existed. ``--beta-gls on|off`` arrives as ``beta_gls`` True / False (the
-    replay's ``ReplayOptions.beta_gls``), None without the flag; ``--rate-errors on|off`` likewise as ``rate_errors``."""
+    replay's ``ReplayOptions.beta_gls``), None without the flag; ``--rate-errors on|off`` likewise as
+    ``rate_errors``."""
     import gcs_sysid.estimation.airangles as aa
 
     seen = []
