@@ -598,10 +598,10 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
 
             with _stage("rates' errors", timings, bar):
                 if gust_filter:         # the table's p_hat becomes the air-relative estimate: no gyro scale error
-                    roll = "gust filter on"
+                    roll = "p_hat is the gust filter's air-relative rate"
                 else:
                     roll = pair_fit if pair_fit is not None else air_roll_fit(table, states, airframe, train)
-                if replay_gust_rates(options) is not None:     # r_hat is the air's already
+                if replay_gust_rates(options) is not None:     # r_hat is the air's already (said in the note)
                     r_g = None
                 else:
                     r_g = yaw_g if yaw_g is not None else yaw_gust_hat(states, airframe.b)[0]

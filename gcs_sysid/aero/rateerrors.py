@@ -126,9 +126,10 @@ def stated_rate_errors(table, train: np.ndarray, roll_fit=None,
         table: :class:`~gcs_sysid.aero.table.CoefficientTable`; its ``x_scale_var`` ``(10,)`` and ``x_map_cov``
             ``(10, 10, 10)`` (either None) are copied, never changed.
         train: ``(T,)`` bool, the training rows.
-        roll_fit: the air-rate pair's :class:`~gcs_sysid.aero.gustfilter.RollGustFit` (or why there is none, a str, or
-            None): ``scale_var[p_hat] = rho^2`` (:func:`roll_rate_scale`).
-        r_hat_g: ``(T,)`` the yaw gust rate as a hat, or None: ``map_cov[r_hat]`` (:func:`yaw_rate_map`).
+        roll_fit: the air-rate pair's :class:`~gcs_sysid.aero.gustfilter.RollGustFit` (or why there is none, a str
+            said in the note, or None): ``scale_var[p_hat] = rho^2`` (:func:`roll_rate_scale`).
+        r_hat_g: ``(T,)`` the yaw gust rate as a hat, or None (none known, or ``r_hat`` is the air's already):
+            ``map_cov[r_hat]`` (:func:`yaw_rate_map`).
 
     Returns:
         ``scale_var`` ``(10,)`` and ``map_cov`` ``(10, 10, 10)`` for
@@ -144,15 +145,20 @@ def stated_rate_errors(table, train: np.ndarray, roll_fit=None,
     said = []
     rho = None if roll_fit is None or isinstance(roll_fit, str) else roll_rate_scale(roll_fit, table, train)
     if rho is None:
-        said.append("p_hat: none (" + ("no roll fit" if roll_fit is None or isinstance(roll_fit, str)
-                                       else "too few rows") + ")")
+        if isinstance(roll_fit, str):       # why there is none (air_roll_fit says it in the gust filter's words)
+            why = roll_fit
+            for pre in ("gust filter not run: ", "gust filter not applied: "):
+                why = "no roll fit: " + why[len(pre):] if why.startswith(pre) else why
+        else:
+            why = "no roll fit" if roll_fit is None else "too few rows"
+        said.append(f"p_hat: none ({why})")
     else:
         sv = np.zeros(D) if sv is None else sv
         sv[_IP] = rho**2
         said.append(f"p_hat scale error {rho:.2f} (the rolling gust's share of its variance)")
     C = None if r_hat_g is None else yaw_rate_map(table, r_hat_g, train)
     if C is None:
-        said.append("r_hat: none (" + ("no yaw gust rate" if r_hat_g is None else "too few rows") + ")")
+        said.append("r_hat: none (" + ("no yaw gust rate given" if r_hat_g is None else "too few rows") + ")")
     else:
         mc = np.zeros((D, D, D)) if mc is None else mc
         mc[_IR] = C

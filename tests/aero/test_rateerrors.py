@@ -99,6 +99,7 @@ def test_stated_errors_add_to_copies_and_say_what_is_missing():
     assert np.delete(sv, IP) == pytest.approx(np.delete(sv0, IP))
     assert mc[IB, IB, IB] == 0.02 and mc[IR, IB, IB] == pytest.approx(0.01, rel=0.01)
     assert "p_hat scale error" in note and "r_hat linear error" in note
-    sv, mc, note = stated_rate_errors(_table(X), np.ones(n, bool), "gust filter not fitted", None)
+    sv, mc, note = stated_rate_errors(_table(X), np.ones(n, bool), "gust filter not run: no p on the table's grid",
+                                      None)
     assert sv is None and mc is None
-    assert "p_hat: none (no roll fit)" in note and "r_hat: none (no yaw gust rate)" in note
+    assert "p_hat: none (no roll fit: no p on the table's grid)" in note and "r_hat: none (no yaw gust rate" in note
