@@ -108,6 +108,37 @@ def _coverage(mean, sigma, ref) -> float:
     return float(100.0 * np.mean(np.abs(mean[m] - ref[m]) <= 1.96 * sigma[m])) if m.any() else float("nan")
 
 
+def _pct(ref):
+    """``var (N, 6) -> [6 floats]``: the RMS over the rows of a term's sigma, % of the truth's RMS per coefficient."""
+    scale = 100.0 / np.sqrt(np.mean(np.asarray(ref) ** 2, axis=0))
+    return lambda v: (scale * np.sqrt(np.nanmean(np.broadcast_to(v, np.shape(ref)), axis=0))).round(3).tolist()
+
+
+def exact_band_terms(model, X_true, ref) -> dict[str, list[float]]:
+    """The band at exact conditions ``X_true`` taken apart (:func:`band_terms`' ``true`` entry): ``latent``,
+    ``offset`` (``v_off``), ``scale`` (``v_scale``, inputs without a map), ``map`` (``v_map``, the stated linear errors
+    of the aided angles and, since the sixty-fourth session, the yaw rate), ``discrepancy`` (``d``) and ``sigma``
+    (their sum), % of the truth's RMS per coefficient (``X_true`` ``(N, D)`` finite, ``ref`` ``(N, 6)``)."""
+    from dataclasses import replace
+
+    from gcs_sysid.gp.discrepancy import exact_condition_variance
+
+    ys2 = model.scaler.y_std ** 2
+    pct = _pct(ref)
+    Xts = model.scaler.x(np.asarray(X_true))
+    _, lat_t = model.predict(X_true, include_noise=False, input_noise=False, model_error=False)
+    # each term alone, by the model's own formula (gcs_sysid.gp.discrepancy.exact_condition_variance)
+    Mc = model.map_cov
+    mapped = np.zeros(model.n_inputs, bool) if Mc is None else np.any(np.asarray(Mc) != 0, axis=(1, 2))
+    sv = None if model.scale_var is None else np.where(mapped, 0.0, np.asarray(model.scale_var))   # the map holds those
+    bare = replace(model, offset_cov=None, scale_var=None, map_cov=None, discrepancy=None)
+    alone = lambda **kw: exact_condition_variance(replace(bare, **kw), Xts) * ys2                 # noqa: E731
+    off, vsc, vmap = alone(offset_cov=model.offset_cov), alone(scale_var=sv), alone(map_cov=Mc)
+    d = np.zeros(model.n_outputs) if model.discrepancy is None else np.asarray(model.discrepancy)[0] * ys2
+    return {"latent": pct(lat_t), "offset": pct(off), "scale": pct(vsc), "map": pct(vmap), "discrepancy": pct(d),
+            "sigma": pct(lat_t + off + vsc + vmap + d[None, :])}
+
+
 def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]]:
     """The two scored bands taken apart: each variance term's size per coefficient (a diagnosis).
 
@@ -117,11 +148,9 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     larger of the learned and the estimator's stated variance ``x_var``), ``coloured`` (the observation noise
     less its white part, ``noise_var(white_noise=False)``), ``white`` (the white part, left out of the band)
     and ``sigma`` (the band: ``latent + input + coloured``). ``true`` (the band at exact conditions
-    ``X_true``, ``docs/gp.md``, "The band at exact conditions"): ``latent``, ``offset`` (``v_off``), ``scale``
-    (``v_scale``, angles without a map), ``map`` (``v_map``, the aided angles' common linear error),
-    ``discrepancy`` (``d``) and ``sigma`` (their sum). Each entry is the RMS over the rows of the term's
-    standard deviation, ``100 sqrt(mean(var)) / RMS(ref)``: the coefficient errors' unit (``row["gp"]``,
-    ``row["true"]``), so a band whose ``sigma`` is well above the error over-covers.
+    ``X_true``, ``docs/gp.md``, "The band at exact conditions"): :func:`exact_band_terms`. Each entry is the RMS
+    over the rows of the term's standard deviation, ``100 sqrt(mean(var)) / RMS(ref)``: the coefficient errors' unit
+    (``row["gp"]``, ``row["true"]``), so a band whose ``sigma`` is well above the error over-covers.
 
     Args:
         model: the replay's saved :class:`gcs_sysid.gp.LocalGlobalGP` (six outputs).
@@ -133,15 +162,9 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     Returns:
         ``{"gp": {term: [6 floats]}, "true": {term: [6 floats]}}``, % of the truth's RMS per coefficient.
     """
-    from dataclasses import replace
-
-    from gcs_sysid.gp.discrepancy import exact_condition_variance
-
     ys2 = model.scaler.y_std ** 2
-    scale = 100.0 / np.sqrt(np.mean(np.asarray(ref) ** 2, axis=0))
-    pct = lambda v: (scale * np.sqrt(np.nanmean(np.broadcast_to(v, np.shape(ref)),  # noqa: E731
-                                                axis=0))).round(3).tolist()
-    Xs, Xts = model.scaler.x(np.asarray(X)), model.scaler.x(np.asarray(X_true))
+    pct = _pct(ref)
+    Xs = model.scaler.x(np.asarray(X))
     if x_var is not None and model.n_mean_only:          # nothing stated for the mean-only inputs
         x_var = model.full_inputs(x_var, "x_var", np.nan)
     xv_s = None if x_var is None else np.where(model.scaler.active, np.asarray(x_var) / model.scaler.x_std ** 2, np.nan)
@@ -151,18 +174,7 @@ def band_terms(model, X, X_true, x_var, ref) -> dict[str, dict[str, list[float]]
     col = model.noise_var(white_noise=False)
     gp = {"latent": pct(lat), "input_learned": pct(learned), "input": pct(inp), "coloured": pct(col),
           "white": pct(model.noise_var() - col), "sigma": pct(lat + inp + col[None, :])}
-    _, lat_t = model.predict(X_true, include_noise=False, input_noise=False, model_error=False)
-    # each term alone, by the model's own formula (gcs_sysid.gp.discrepancy.exact_condition_variance)
-    Mc = model.map_cov
-    mapped = np.zeros(model.n_inputs, bool) if Mc is None else np.any(np.asarray(Mc) != 0, axis=(1, 2))
-    sv = None if model.scale_var is None else np.where(mapped, 0.0, np.asarray(model.scale_var))   # the map holds those
-    bare = replace(model, offset_cov=None, scale_var=None, map_cov=None, discrepancy=None)
-    alone = lambda **kw: exact_condition_variance(replace(bare, **kw), Xts) * ys2                 # noqa: E731
-    off, vsc, vmap = alone(offset_cov=model.offset_cov), alone(scale_var=sv), alone(map_cov=Mc)
-    d = np.zeros(model.n_outputs) if model.discrepancy is None else np.asarray(model.discrepancy)[0] * ys2
-    true = {"latent": pct(lat_t), "offset": pct(off), "scale": pct(vsc), "map": pct(vmap), "discrepancy": pct(d),
-            "sigma": pct(lat_t + off + vsc + vmap + d[None, :])}
-    return {"gp": gp, "true": true}
+    return {"gp": gp, "true": exact_band_terms(model, X_true, ref)}
 
 
 def true_alpha_dot(truth) -> np.ndarray:
@@ -418,7 +430,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     if model.n_outputs == 6:      # the bands' variance terms per coefficient (a diagnosis, docs/gp.md)
         row["band_terms"] = band_terms(model, Xg[h], Xt[h], None if tab.x_var is None else tab.x_var[h], Yt[h])
         # the band at exact conditions with the aerodynamics' rates (``tair``, ``cov_true_air``), term by term
-        row["band_terms_air"] = band_terms(model, Xg[h], Xt_air[h], None, Yt[h])["true"]
+        row["band_terms_air"] = exact_band_terms(model, Xt_air[h], Yt[h])
     t_cut = float(tab.t[h][0])
     # the LS line on the replay's own sideslip estimator (the two models are scored at the replay's regressors;
     # `gcs-sysid fit` alone keeps least squares' CY_beta by default, gcs_sysid.diagnose.run.BETA_PROFILE)

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["block_jackknife_cov", "block_jackknife_var", "block_jackknife_vars", "block_labels"]
+__all__ = ["block_jackknife_cov", "block_jackknife_var", "block_jackknife_vars", "block_labels",
+           "slope_second_moment"]
 
 
 def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: float = 15.0,
@@ -53,6 +54,31 @@ def block_jackknife_cov(t: np.ndarray, A: np.ndarray, r: np.ndarray, block_s: fl
     B = th.shape[0]
     d = th - th.mean(axis=0)
     return (B - 1) / B * (d.T @ d)
+
+
+def slope_second_moment(t: np.ndarray, A: np.ndarray, y: np.ndarray, block_s: float = 15.0) -> np.ndarray | None:
+    """``M M^T + Cov_jk(M)``: the second moment of the least-squares slopes ``M`` of ``y`` on the centred columns
+    ``A``, their delete-a-block jackknife covariance (:func:`block_jackknife_cov`, an intercept added) standing for
+    their sampling error (zero where the jackknife has too few blocks).
+
+    A flight-common linear error ``e(x) = M (x - mean x)`` stated with this second moment is what the band at exact
+    conditions carries for the aided air angles (:func:`gcs_sysid.estimation.airangles._map_disagreement`) and the
+    gyro's yaw rate (:func:`gcs_sysid.aero.rateerrors.yaw_rate_map`).
+
+    Args:
+        t: ``(N,)`` the rows' times, s. A: ``(N, K)`` centred regressors. y: ``(N,)`` the response (its mean is
+            taken out for the slopes; the jackknife's intercept absorbs it). block_s: block length, s.
+
+    Returns:
+        ``(K, K)``, or None when ``A`` is rank-deficient.
+    """
+    y = np.asarray(y, float)
+    M, _, rank, _ = np.linalg.lstsq(A, y - y.mean(), rcond=None)
+    if rank < A.shape[1]:
+        return None
+    cov = block_jackknife_cov(t, np.column_stack([np.ones(len(y)), A]), y, block_s)
+    jk = cov[1:, 1:] if cov is not None and np.isfinite(cov).all() else np.zeros((len(M), len(M)))
+    return np.outer(M, M) + jk
 
 
 def block_labels(t: np.ndarray, block_s: float, min_rows: int = 50) -> tuple[np.ndarray, list[int]]:

@@ -710,25 +710,27 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                 envelope = confidence_map(model, table, train, outputs=[COEFFICIENTS[i] for i in fit_cols])
             draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("predict", timings, bar):
-                rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
-                if rows.any():
-                    # the estimator's stated per-row air-angle variance: errors the residuals cannot show
-                    Xq, xv = gp_inputs(table, rows, use_adot)
-                    mean, var = model.predict(Xq, x_var=xv)
-                    pred_mean[np.ix_(rows, fit_cols)] = np.asarray(mean)
-                    pred_sigma_obs[np.ix_(rows, fit_cols)] = np.sqrt(np.asarray(var))
-                    # the coefficient's band: the same less the white measurement noise (docs/gp.md, "Two bands")
-                    pred_sigma[np.ix_(rows, fit_cols)] = np.sqrt(np.maximum(np.asarray(var) - white[None, :], 0.0))
-                rows_air = held & table_air.valid & np.all(np.isfinite(table_air.X), axis=1) if air_outputs else None
-                if air_outputs and rows_air.any():   # per output: these at the air-relative roll rate (opt-in)
-                    cols = [k for k, i in enumerate(fit_cols) if COEFFICIENTS[i] in air_outputs]
-                    Xq, xv = gp_inputs(table_air, rows_air, use_adot)
-                    mean, var = (np.asarray(v)[:, cols] for v in model.predict(Xq, x_var=xv))
-                    at = np.ix_(rows_air, [fit_cols[k] for k in cols])
+
+                def predict_rows(tab, rows, ks):
+                    """The model's mean and both bands for outputs ``ks`` (indices into ``fit_cols``) on ``tab``'s
+                    ``rows``, with the estimator's stated per-row air-angle variance (errors the residuals cannot
+                    show); the coefficient's band is the same less the white measurement noise (docs/gp.md, "Two
+                    bands")."""
+                    Xq, xv = gp_inputs(tab, rows, use_adot)
+                    mean, var = (np.asarray(v)[:, ks] for v in model.predict(Xq, x_var=xv))
+                    at = np.ix_(rows, [fit_cols[k] for k in ks])
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
-                    pred_sigma[at] = np.sqrt(np.maximum(var - white[None, cols], 0.0))
+                    pred_sigma[at] = np.sqrt(np.maximum(var - white[None, ks], 0.0))
+
+                rows = table.valid & np.all(np.isfinite(table.X), axis=1)
+                if rows.any():
+                    predict_rows(table, rows, list(range(len(fit_cols))))
+                rows_air = held & table_air.valid & np.all(np.isfinite(table_air.X), axis=1) if air_outputs else None
+                if air_outputs and rows_air.any():   # per output: these at the air-relative roll rate (opt-in)
+                    predict_rows(table_air, rows_air,
+                                 [k for k, i in enumerate(fit_cols) if COEFFICIENTS[i] in air_outputs])
                 if yaw_g is not None:   # air_yaw: its outputs asked at r_hat - r_hat_g (Cl also at its air roll rate)
                     from .aero.airyaw import AIR_YAW_OUTPUTS
 
@@ -740,15 +742,8 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                         Xy = base.X.copy()
                         Xy[:, ir] -= yaw_g
                         rows_y = held & base.valid & np.all(np.isfinite(Xy), axis=1)
-                        if not rows_y.any():
-                            continue
-                        k = fit_cols.index(COEFFICIENTS.index(name))
-                        Xq, xv = gp_inputs(replace(base, X=Xy), rows_y, use_adot)
-                        mean, var = (np.asarray(v)[:, k] for v in model.predict(Xq, x_var=xv))
-                        at = (rows_y, COEFFICIENTS.index(name))
-                        pred_mean[at] = mean
-                        pred_sigma_obs[at] = np.sqrt(var)
-                        pred_sigma[at] = np.sqrt(np.maximum(var - white[k], 0.0))
+                        if rows_y.any():
+                            predict_rows(replace(base, X=Xy), rows_y, [fit_cols.index(COEFFICIENTS.index(name))])
             # the measurements are drawn against the band for a measurement
             draw("coefficients", "coefficients_figure", table, pred_mean, pred_sigma_obs, held, ident)
             if stage is not None:

@@ -93,9 +93,10 @@ def yaw_rate_map(table, r_hat_g: np.ndarray, train: np.ndarray, block_s: float =
     Raises:
         ValueError: ``r_hat_g`` or ``train`` not ``(T,)``.
 
-    Source: the aided angles' map (:func:`gcs_sysid.estimation.airangles._map_disagreement`); Kuensch (1989).
+    Source: the aided angles' map (:func:`gcs_sysid.estimation.airangles._map_disagreement`, the same
+    :func:`gcs_sysid.jackknife.slope_second_moment`); Kuensch (1989).
     """
-    from ..jackknife import block_jackknife_cov
+    from ..jackknife import slope_second_moment
 
     T = len(table.t)
     g, train = np.asarray(r_hat_g, float), np.asarray(train, bool)
@@ -106,15 +107,12 @@ def yaw_rate_map(table, r_hat_g: np.ndarray, train: np.ndarray, block_s: float =
     if rows.sum() < _MIN_ROWS:
         return None
     keep = np.nonzero(X[rows].std(axis=0) > 1e-12)[0]
-    A = X[rows][:, keep] - X[rows][:, keep].mean(axis=0)
-    y = g[rows] - g[rows].mean()
-    M, _, rank, _ = np.linalg.lstsq(A, y, rcond=None)
-    if rank < A.shape[1]:
+    C = slope_second_moment(np.asarray(table.t, float)[rows], X[rows][:, keep] - X[rows][:, keep].mean(axis=0),
+                            g[rows], block_s)
+    if C is None:
         return None
-    cov = block_jackknife_cov(np.asarray(table.t, float)[rows], np.column_stack([np.ones(len(y)), A]), y, block_s)
-    jk = cov[1:, 1:] if cov is not None and np.isfinite(cov).all() else np.zeros((len(M), len(M)))
     out = np.zeros((len(REGRESSORS), len(REGRESSORS)))
-    out[np.ix_(keep, keep)] = np.outer(M, M) + jk
+    out[np.ix_(keep, keep)] = C
     return out
 
 

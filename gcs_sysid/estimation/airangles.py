@@ -68,7 +68,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import butter, lfilter, sosfiltfilt
 
-from ..jackknife import block_jackknife_cov, block_jackknife_vars
+from ..jackknife import block_jackknife_cov, block_jackknife_vars, slope_second_moment
 from .angleerrors import MIN_FIRST_STAGE_R2, effective_n, first_stage_f, iv_lstsq, lagged_instruments, mean_wind_sigma
 from .kalman import steady_state, steady_state_smoother
 from .nodes import segments
@@ -1379,7 +1379,7 @@ def _map_disagreement(dt: float, name: str, ang: np.ndarray, kin: np.ndarray, co
     """The aided angle's flight-common linear error along the force model's regressors (:attr:`AxisFit.map_cov`).
 
     The slopes ``M`` of (aided - kinematic) on the centred columns ``[angle, others]`` (least squares on the
-    aided rows) and their delete-a-block jackknife covariance (:func:`gcs_sysid.jackknife.block_jackknife_cov`);
+    aided rows) and their delete-a-block jackknife covariance (:func:`gcs_sysid.jackknife.slope_second_moment`);
     :func:`_scale_disagreement` is the one-column case. Conservative where the true gust correlates with a
     column (the gust is part of the true angle and the aircraft answers it with its rates): that share
     counts as possible error too.
@@ -1400,13 +1400,8 @@ def _map_disagreement(dt: float, name: str, ang: np.ndarray, kin: np.ndarray, co
     keep[0] = True
     names = tuple(n for n, k in zip((name, *cols), keep) if k)
     A = A[:, keep] - A[:, keep].mean(axis=0)
-    y = (ang - kin)[ok]
-    M, _, rank, _ = np.linalg.lstsq(A, y - y.mean(), rcond=None)
-    if rank < A.shape[1]:
-        return (), np.zeros((0, 0))
-    cov = block_jackknife_cov(np.nonzero(ok)[0] * dt, np.column_stack([np.ones(len(y)), A]), y, block_s)
-    jk = cov[1:, 1:] if cov is not None and np.isfinite(cov).all() else np.zeros((len(M), len(M)))
-    return names, np.outer(M, M) + jk
+    C = slope_second_moment(np.nonzero(ok)[0] * dt, A, (ang - kin)[ok], block_s)
+    return ((), np.zeros((0, 0))) if C is None else (names, C)
 
 
 def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: np.ndarray, qbar: np.ndarray,
