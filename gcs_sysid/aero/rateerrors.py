@@ -36,7 +36,7 @@ import numpy as np
 
 from .table import REGRESSORS
 
-__all__ = ["RATE_ERRORS", "roll_rate_scale", "yaw_rate_map", "stated_rate_errors"]
+__all__ = ["RATE_ERRORS", "roll_rate_scale", "roll_rate_variances", "yaw_rate_map", "stated_rate_errors"]
 
 #: Whether the replay states the rates' errors for the band at exact conditions (``ReplayOptions.rate_errors`` None).
 #: On since the sixty-fourth session, by a rule written before its run on fresh JSBSim flights (seeds 10-12): Cl's
@@ -65,6 +65,27 @@ def roll_rate_scale(fit, table, train: np.ndarray) -> float | None:
 
     Source: Fuller (1987) sec. 1.1 (the reliability ratio).
     """
+    v = roll_rate_variances(fit, table, train)
+    return None if v is None else v[0] / v[1]
+
+
+def roll_rate_variances(fit, table, train: np.ndarray) -> tuple[float, float] | None:
+    """The two variances :func:`roll_rate_scale` divides: ``(var(g), var(p_hat))`` over the roll fit's training rows.
+
+    Pooled over several stretches of one flight (the live learner's windows, :mod:`gcs_sysid.aero.errorpool`) the
+    ratio of the row-weighted sums is the flight's ``rho``; a mean of the stretches' ratios would let one stretch with
+    little roll excitation (a small ``var(p_hat)``) dominate.
+
+    Args:
+        fit, table, train: as :func:`roll_rate_scale`.
+
+    Returns:
+        ``(var_g, var_p)`` (``p_hat``'s units squared, ``var_p > 0``), or None with fewer than 150 rows or a constant
+        ``p_hat``.
+
+    Raises:
+        ValueError: ``train`` or the fit's arrays not ``(T,)``.
+    """
     T = len(table.t)
     g, used, train = np.asarray(fit.g, float), np.asarray(fit.used, bool), np.asarray(train, bool)
     if g.shape != (T,) or used.shape != (T,) or train.shape != (T,):
@@ -74,7 +95,7 @@ def roll_rate_scale(fit, table, train: np.ndarray) -> float | None:
     rows = used & train & np.isfinite(g) & np.isfinite(p)
     if rows.sum() < _MIN_ROWS or not np.var(p[rows]) > 0:
         return None
-    return float(np.var(g[rows]) / np.var(p[rows]))
+    return float(np.var(g[rows])), float(np.var(p[rows]))
 
 
 def yaw_rate_map(table, r_hat_g: np.ndarray, train: np.ndarray, block_s: float = 15.0) -> np.ndarray | None:
