@@ -34,6 +34,11 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "rate with the replay's roll fit (made once on the first fit's rows, with its Dryden and "
                         "instruments' checks; refused: the gyro's rate for the whole session); default off; "
                         "docs/live.md, 'The air-rate pair'")
+    p.add_argument("--rate-errors", default=None, choices=("on", "off"),
+                   help="the gyro rates' errors (the rolling gust's share of p_hat, the yaw gust rate's map of "
+                        "r_hat) in the saved model's band at exact conditions, pooled over the windows with the "
+                        "estimator's other stated regressor errors; default on, as the replay; docs/live.md, "
+                        "'The band at exact conditions'")
     p.add_argument("--silence", type=float, default=30.0, metavar="S",
                    help="report the link as silent after S seconds without a packet (default 30)")
     p.add_argument("--no-learn", action="store_true", help="only log, monitor and request rates")
@@ -62,7 +67,8 @@ def cmd_listen(a: argparse.Namespace) -> int:
             raise InputError(f"{name} {v}: must lie in 1..255")
     learn = None if a.no_learn else LearnOptions(window_s=a.window, step_s=a.step, lag_s=a.lag,
                                                  min_rows=a.min_rows, n_inducing=a.inducing,
-                                                 gp_noise=a.gp_noise, air_roll=a.air_roll == "on")
+                                                 gp_noise=a.gp_noise, air_roll=a.air_roll == "on",
+                                                 rate_errors=None if a.rate_errors is None else a.rate_errors == "on")
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
                          component=not a.no_component, system_id=a.sysid, component_id=a.compid,
                          duration_s=a.duration, silence_s=a.silence, console=not a.quiet,

@@ -94,6 +94,13 @@ class LearnOptions:
             smoothed over the window) before ``model.update``. A refused fit leaves Cl at the gyro's rate for the
             whole session (the learner's notes and ``air_roll`` status say why). The inputs stay the gyro's for
             every output; the learner asks its model nowhere at the air rate.
+        stated_errors: give the model the windows' stated regressor errors for its band at exact conditions (what
+            ``gcs-sysid predict`` states from the saved model), pooled over the windows learned
+            (:class:`gcs_sysid.aero.errorpool.WindowErrorPool`); the replay gives its model the flight's
+            (``docs/live.md``, "The band at exact conditions"). False: none (the learner before the sixty-fifth
+            session). The model's mean and its bands at the flight's own regressors do not change.
+        rate_errors: with ``stated_errors``, also the gyro rates' errors (:mod:`gcs_sysid.aero.rateerrors`; ``gcs-sysid
+            listen --rate-errors on|off``); None: :data:`gcs_sysid.aero.rateerrors.RATE_ERRORS`, as the replay.
     """
 
     window_s: float = 30.0
@@ -110,6 +117,8 @@ class LearnOptions:
     max_window_s: float | None = None
     trim_heap: bool = True
     air_roll: bool = False
+    stated_errors: bool = True
+    rate_errors: bool | None = None
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -183,6 +192,8 @@ class Learner:
             the first fit, ``"applied"`` or ``"refused"``), ``note`` (the replay's wording: what was fitted, or why
             not), and once applied ``Cl_p``, ``tau_s``, ``sigma`` (the roll fit's), ``rows_moved`` (rows learned
             with a moved Cl so far) and ``sd_first`` (the first fit's correction SD, Cl units).
+        errors: the pooled regressor errors the model carries (``LearnOptions.stated_errors``): ``state`` (``"off"``,
+            ``"pooling"``), ``windows``, ``rows`` and ``note`` (what is stated, :meth:`WindowErrorPool.statement`).
     """
 
     airframe: Airframe
@@ -203,6 +214,7 @@ class Learner:
     refreshes_deferred: int = 0
     coalesced_at: list = field(default_factory=list)
     air_roll: dict = field(default_factory=dict)
+    errors: dict = field(default_factory=dict)
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -226,6 +238,15 @@ class Learner:
         self._roll_fit = None                 # the air-rate pair's roll fit (LearnOptions.air_roll), once applied
         self._pending_roll: dict | None = None   # the pending rows' grid slices for that fit
         self.air_roll = {"state": "waiting" if self.options.air_roll else "off", "note": ""}
+        self._errors = None                   # the windows' stated regressor errors (LearnOptions.stated_errors)
+        if self.options.stated_errors:
+            from ..aero.errorpool import WindowErrorPool
+            from ..aero.rateerrors import RATE_ERRORS
+
+            rates = RATE_ERRORS if self.options.rate_errors is None else self.options.rate_errors
+            self._errors = WindowErrorPool(rate_errors=rates)
+        self.errors = {"state": "pooling" if self._errors is not None else "off", "windows": 0, "rows": 0,
+                       "note": ""}
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -261,6 +282,8 @@ class Learner:
         """Learn what is left in the window (at the end of a session): rows up to its very end."""
         if self._window:
             self.step(final=True)
+        if self._errors is not None and self.model is not None:
+            self.notes.append(f"end: {self.errors['note']}")
 
     # --- one step ----------------------------------------------------------------------------
 
@@ -349,6 +372,8 @@ class Learner:
 
         if not rows.any():
             return
+        if self._errors is not None:
+            self._errors.add(table, rows, states, self.airframe)
         X, Y, t = table.X[rows], table.Y[rows], table.t[rows]
         if self.model is not None and self._roll_fit is not None:
             Y = self._air_roll_later(table, rows, states)
@@ -380,6 +405,7 @@ class Learner:
             self.n_learned += int(ok.sum())
             self.notes.append(f"step {self.steps}: GP fitted on {int(ok.sum())} rows "
                               f"({', '.join(self.outputs)})")
+            self._state_errors()
             return
         cols = [COEFFICIENTS.index(c) for c in self.outputs]
         ok = np.any(np.isfinite(Y[:, cols]), axis=1)        # partial rows kept, as in the first fit
@@ -389,6 +415,18 @@ class Learner:
             self._since_hyper += int(ok.sum())
             if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
                 self._refresh_hyper()
+        self._state_errors()
+
+    def _state_errors(self) -> None:
+        """Give the model the pooled statement of the windows learned so far (``LearnOptions.stated_errors``): its
+        band at exact conditions only (:func:`gcs_sysid.gp.discrepancy.with_offset_covariance`, the replay's)."""
+        if self._errors is None or self.model is None:
+            return
+        from ..gp.discrepancy import with_offset_covariance
+
+        off, sv, mc, note = self._errors.statement()
+        self.model = with_offset_covariance(self.model, off, scale_var=sv, map_cov=mc)
+        self.errors = {"state": "pooling", "windows": self._errors.windows, "rows": self._errors.rows, "note": note}
 
     # --- the air-rate pair (LearnOptions.air_roll) ---------------------------------------------
 

@@ -44,6 +44,9 @@ def render_markdown(snap: dict) -> str:
                          f"{ar['state']}" + (f"; {ar['rows_moved']} rows learned with a moved Cl"
                                             if ar.get("rows_moved") is not None else "")
                          + (f" ({ar['note']})" if ar.get("note") else ""))
+        se = snap.get("stated_errors") or {}
+        if se.get("note"):
+            lines.append(f"- the model's band at exact conditions (`gcs-sysid predict`): {se['note']}")
         if snap.get("steps_coalesced") or snap.get("map_refreshes_deferred"):
             lines.append(f"- the learner fell behind: {snap.get('steps_coalesced', 0)} steps coalesced, "
                          f"{snap.get('map_refreshes_deferred', 0)} map refreshes deferred (to replay `raw.tlog` on the "

@@ -341,6 +341,7 @@ class LiveSession:
                 "map_refreshes_deferred": learner.refreshes_deferred,
                 "coalesced_at_us": list(learner.coalesced_at),
                 "air_roll": dict(getattr(learner, "air_roll", {})),
+                "stated_errors": dict(getattr(learner, "errors", {})),
                 "learner_in": "worker process" if self._remote else "this process",
             })
         return snap
