@@ -56,15 +56,18 @@ FORCES = ("CX", "CY", "CZ")
 
 
 def _pair_states(states):
-    """The part of a window's states the air-rate pair reads (:data:`gcs_sysid.aero.gustfilter.AIR_ROLL_STATE_KEYS`)."""
+    """The part of a window's states the air-rate pair and the stated errors' pool read
+    (:data:`gcs_sysid.aero.gustfilter.AIR_ROLL_STATE_KEYS`, :data:`gcs_sysid.aero.errorpool.POOL_STATE_KEYS`)."""
+    from gcs_sysid.aero.errorpool import POOL_STATE_KEYS
     from gcs_sysid.aero.gustfilter import AIR_ROLL_STATE_KEYS
     from gcs_sysid.estimation.states import FlightStates
 
     if states is None:
         return None
-    return FlightStates(states.t, states.rate_hz, {k: states.data[k] for k in AIR_ROLL_STATE_KEYS["data"]
-                                                   if k in states.data},
-                        {k: states.sigma[k] for k in AIR_ROLL_STATE_KEYS["sigma"] if k in states.sigma})
+    data = set(AIR_ROLL_STATE_KEYS["data"]) | set(POOL_STATE_KEYS["data"])
+    sigma = set(AIR_ROLL_STATE_KEYS["sigma"]) | set(POOL_STATE_KEYS["sigma"])
+    return FlightStates(states.t, states.rate_hz, {k: states.data[k] for k in sorted(data) if k in states.data},
+                        {k: states.sigma[k] for k in sorted(sigma) if k in states.sigma})
 
 
 def record_steps(tlog: Path, airframe) -> list[tuple]:
@@ -82,12 +85,14 @@ def record_steps(tlog: Path, airframe) -> list[tuple]:
     return steps
 
 
-def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = False):
+def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = False,
+          stated_errors: bool = True):
     """The learner fed ``steps`` up to vehicle time ``t_cut`` (s) and its CPU s (its ``model``, ``outputs``,
-    ``n_learned``, ``air_roll``)."""
+    ``n_learned``, ``air_roll``, ``errors``)."""
     from gcs_sysid.live.learner import Learner, LearnOptions
 
-    lr = Learner(airframe, LearnOptions(gp_noise=gp_noise, gp_seed=gp_seed, air_roll=air_roll))
+    lr = Learner(airframe, LearnOptions(gp_noise=gp_noise, gp_seed=gp_seed, air_roll=air_roll,
+                                        stated_errors=stated_errors))
     t0 = time.process_time()
     for k, (ident, table, rows, states) in enumerate(steps):
         lr.steps, lr.identifiable = k + 1, ident
@@ -96,8 +101,11 @@ def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: in
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
-             air_rolls=(False,)) -> list[dict]:
-    """One flight's rows (one per noise x GP seed x air-rate pair off/on), JSON-able.
+             air_rolls=(False,), stated=(True,)) -> list[dict]:
+    """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on), JSON-able.
+
+    ``stated``: ``LearnOptions.stated_errors`` values to run (the windows' pooled regressor errors in the model's
+    band at exact conditions, ``cov_true_air``); each row says its own in ``stated_errors``.
 
     With the pair on (``LearnOptions.air_roll``) the row also has ``gp_air_cl``: ``gp`` with Cl asked at the
     held-out rows' ``p_hat - p_hat_g`` (``heldout_air_roll`` ``"predicted:Cl"`` with the learner's own roll fit: the
@@ -135,8 +143,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     steps = record_steps(files.tlog, af)
     t_rec = time.perf_counter() - t0
     out = []
-    for noise, gs, pair in ((n, g, p) for n in noises for g in gp_seeds for p in air_rolls):
-        lr, cpu = learn(steps, af, t_cut, noise, gs, pair)
+    for noise, gs, pair, se in ((n, g, p, s) for n in noises for g in gp_seeds for p in air_rolls for s in stated):
+        lr, cpu = learn(steps, af, t_cut, noise, gs, pair, se)
         model, outputs, n_learned = lr.model, lr.outputs, lr.n_learned
         cols = [COEFFICIENTS.index(c) for c in outputs]
         mean = np.full((int(h.sum()), 6), np.nan)
@@ -158,7 +166,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                "cov_gp_each": [_coverage(mean[:, i], sig[:, i], Yt[h, i]) for i in range(6)],
                "cov_true_air_each": [_coverage(mta[:, i], sta[:, i], Yt[h, i]) for i in range(6)],
                "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:],
-               "air_roll": dict(lr.air_roll) if pair else None}
+               "air_roll": dict(lr.air_roll) if pair else None, "stated_errors": bool(se),
+               "errors_note": lr.errors.get("note", "")}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
@@ -182,7 +191,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
         row["cov_gp"] = float(np.nanmean(row["cov_gp_each"]))
         row["cov_true_air"] = float(np.nanmean(row["cov_true_air_each"]))
         out.append(row)
-        print(f"{aircraft} {turbulence} s{seed} {noise} gs{gs} pair {'on' if pair else 'off'}: gp " +
+        print(f"{aircraft} {turbulence} s{seed} {noise} gs{gs} pair {'on' if pair else 'off'} "
+              f"stated {'on' if se else 'off'}: gp " +
               " ".join(f"{c} {row['gp'][c]:.1f}" for c in COEFFICIENTS) +
               f" | cov {row['cov_gp']:.1f} / {row['cov_true_air']:.1f} corr {row['max_corr']:.2f} "
               f"cpu {cpu:.1f} s" + (f" | pair {lr.air_roll['state']}, Cl at the air rate "
@@ -191,8 +201,11 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
 
 
 def variant(row: dict) -> str:
-    """A row's learner variant: its GP noise, ``+air-roll`` with the air-rate pair on."""
-    return row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
+    """A row's learner variant: its GP noise, ``+air-roll`` with the air-rate pair on, ``-unstated`` without the
+    stated regressor errors (``LearnOptions.stated_errors`` False; rows written before the sixty-fifth session had
+    none and carry no such field)."""
+    return (row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
+            + ("-unstated" if row.get("stated_errors") is False else ""))
 
 
 def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
@@ -215,6 +228,8 @@ def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
                             for c in COEFFICIENTS),
             "cov_gp": int(90.0 <= row["cov_gp"] <= 98.0),
             "cov_true_air": int(90.0 <= row["cov_true_air"] <= 98.0),
+            "cov_true_air_c": sum(int(90.0 <= x <= 98.0) for x in row["cov_true_air_each"]
+                                  if x is not None and np.isfinite(x)),
             "no_corr": int(row["max_corr"] <= 0.5)}
 
 
@@ -241,6 +256,20 @@ def summarize(paths: list[str], base: str = "independent", heldout_cl: str = "gy
             cpu = np.median([r["cpu_learn_s"] for r in rs])
             lines.append(f"| {n}, {s} | " + " | ".join(str(tot[i]) for i in items)
                          + f" | {gf:.2f} / {gm:.2f} | {cpu:.1f} |")
+    lines += ["", "The band at exact conditions per coefficient: pooled coverage % (flights below 90 / within 90-98 / "
+              "above 98 %)", "", "| noise, GP seed | " + " | ".join(COEFFICIENTS) + " |",
+              "|---" * (len(COEFFICIENTS) + 1) + "|"]
+    for n in noises:
+        for s in gseeds:
+            rs = [by[(f, n, s)] for f in flights if (f, n, s) in by]
+            cells = []
+            for i in range(len(COEFFICIENTS)):
+                v = [(r["cov_true_air_each"][i], r["n_heldout"]) for r in rs
+                     if r["cov_true_air_each"][i] is not None and np.isfinite(r["cov_true_air_each"][i])]
+                pooled = sum(c * w for c, w in v) / max(sum(w for _, w in v), 1)
+                cells.append(f"{pooled:.1f} ({sum(c < 90 for c, _ in v)}/{sum(90 <= c <= 98 for c, _ in v)}/"
+                             f"{sum(c > 98 for c, _ in v)})")
+            lines.append(f"| {n}, {s} | " + " | ".join(cells) + " |")
     lines.append("")
     lose_any: dict[str, dict[int, set]] = {}
     for n in noises:
@@ -291,6 +320,8 @@ def main(argv=None) -> int:
     ap.add_argument("--gp-seeds", nargs="+", type=int, default=[0, 1])
     ap.add_argument("--air-roll", nargs="+", default=["off"], choices=("off", "on"),
                     help="the learner's air-rate pair (LearnOptions.air_roll) off and/or on")
+    ap.add_argument("--stated-errors", nargs="+", default=["on"], choices=("off", "on"),
+                    help="the learner's pooled regressor errors (LearnOptions.stated_errors) off and/or on")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
     ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
                     help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")
@@ -309,7 +340,7 @@ def main(argv=None) -> int:
         for turb in a.turbulence:
             for seed in a.seeds:
                 rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds,
-                                tuple(x == "on" for x in a.air_roll))
+                                tuple(x == "on" for x in a.air_roll), tuple(x == "on" for x in a.stated_errors))
                 append_jsonl(a.json, rows)
     return 0
 
