@@ -42,12 +42,6 @@ POOL_STATE_KEYS = {"data": ("p", "wn", "we", "wd", "phi", "theta", "psi", "V"), 
 
 _IP, _IR = REGRESSORS.index("p_hat"), REGRESSORS.index("r_hat")
 
-#: How the yaw rate's map is pooled: ``"mixture"`` (the row-weighted mean of every window's ``M M^T + Cov_jk(M)``, each
-#: on the window's rows) or ``"pooled"`` (one least-squares slope ``M`` on every window's handed-over rows, from the
-#: windows' summed normal equations, and its delete-a-window jackknife: the replay's form on the rows the model
-#: learned).
-YAW_MAP = "mixture"
-
 
 class WindowErrorPool:
     """Row-weighted pool of the windows' stated regressor errors (module docstring).
@@ -61,13 +55,9 @@ class WindowErrorPool:
         rows: rows added over them.
     """
 
-    def __init__(self, rate_errors: bool = True, yaw_map: str | None = None):
+    def __init__(self, rate_errors: bool = True):
         D = len(REGRESSORS)
         self.rate_errors = bool(rate_errors)
-        self.yaw_map = YAW_MAP if yaw_map is None else yaw_map
-        if self.yaw_map not in ("mixture", "pooled"):
-            raise ValueError(f"WindowErrorPool: yaw_map must be 'mixture' or 'pooled', got {self.yaw_map!r}")
-        self._normal: list[tuple[np.ndarray, np.ndarray]] = []    # "pooled": each window's [1 x]'[1 x], [1 x]' g
         self.windows = 0
         self.rows = 0
         self._off, self._n_off = np.zeros((D, D)), 0
@@ -142,47 +132,12 @@ class WindowErrorPool:
             self._var_p += n * v[1]
             self._n_roll += n
         g, why = yaw_gust_hat(states, airframe.b)
-        if g is not None and self.yaw_map == "pooled":
-            use = rows & np.asarray(table.valid, bool) & np.isfinite(g) & np.all(np.isfinite(table.X), axis=1)
-            if use.any():
-                Z = np.column_stack([np.ones(int(use.sum())), np.asarray(table.X, float)[use]])
-                self._normal.append((Z.T @ Z, Z.T @ g[use]))
-                self._n_yaw += int(use.sum())
-            return
         C = None if g is None else yaw_rate_map(table, g, ctx)
         if C is None:
             self._why_yaw = why if g is None else "too few rows"
         else:
             self._yaw += n * C
             self._n_yaw += n
-
-    def _pooled_yaw(self) -> np.ndarray | None:
-        """``M M^T + Cov_jk(M)`` of the slope of ``r_hat_g`` on the regressors over every window's handed-over rows
-        (an intercept; constant regressors left out), the jackknife deleting one window at a time (Kuensch 1989: the
-        windows' handed-over rows are disjoint contiguous blocks); None with fewer than 150 rows or 3 windows, or a
-        singular fit."""
-        from .rateerrors import _MIN_ROWS
-
-        if self._n_yaw < _MIN_ROWS or len(self._normal) < 3:
-            return None
-        G = sum(a for a, _ in self._normal)
-        h = sum(b for _, b in self._normal)
-        N = G[0, 0]
-        var = np.diag(G)[1:] / N - (G[0, 1:] / N) ** 2
-        keep = np.r_[0, 1 + np.nonzero(var > 1e-24)[0]]
-        sub = np.ix_(keep, keep)
-        try:
-            M = np.linalg.solve(G[sub], h[keep])[1:]
-            th = np.array([np.linalg.solve(G[sub] - a[sub], h[keep] - b[keep])[1:] for a, b in self._normal])
-        except np.linalg.LinAlgError:
-            return None
-        B = len(th)
-        d = th - th.mean(axis=0)
-        C = np.outer(M, M) + (B - 1) / B * (d.T @ d)
-        out = np.zeros((len(REGRESSORS), len(REGRESSORS)))
-        k = keep[1:] - 1
-        out[np.ix_(k, k)] = C
-        return out
 
     def statement(self) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None, str]:
         """The pooled statement for :func:`gcs_sysid.gp.discrepancy.with_offset_covariance`.
@@ -208,12 +163,10 @@ class WindowErrorPool:
                 said.append(f"p_hat scale error {rho:.2f} ({self._n_roll} rows)")
             else:
                 said.append(f"p_hat: none ({self._why_roll or 'no window'})")
-            C = self._pooled_yaw() if self.yaw_map == "pooled" else (self._yaw / self._n_yaw if self._n_yaw
-                                                                          else None)
-            if C is not None:
+            if self._n_yaw:
                 mc = np.zeros((D, D, D)) if mc is None else mc.copy()
-                mc[_IR] = C
+                mc[_IR] = self._yaw / self._n_yaw
                 said.append(f"r_hat linear error ({self._n_yaw} rows)")
             else:
-                said.append(f"r_hat: none ({self._why_yaw or 'no window' if not self._n_yaw else 'too few rows'})")
+                said.append(f"r_hat: none ({self._why_yaw or 'no window'})")
         return off, sv, mc, "stated regressor errors in the band at exact conditions: " + "; ".join(said)

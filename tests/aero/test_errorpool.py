@@ -91,33 +91,3 @@ def test_a_window_without_the_states_adds_no_rates_and_says_which():
     off, sv, mc, note = pool.statement()
     assert off is not None and sv is None and mc is None
     assert "p_hat: none (no wn we wd phi theta psi V in the window's states)" in note
-
-
-def test_the_pooled_yaw_map_is_the_replays_slope_on_the_rows_learned(monkeypatch):
-    """``yaw_map="pooled"``: one slope over every window's handed-over rows (the replay's ``yaw_rate_map`` form on the
-    rows the model learned), its jackknife deleting one window (disjoint 10-s blocks)."""
-    from gcs_sysid.jackknife import slope_second_moment
-
-    T, W = 500, 6
-    rng = np.random.default_rng(3)
-    Mtrue = rng.normal(size=D) * 0.1
-    tabs, gs = [], []
-    for w in range(W):
-        tab = _table(T, seed=10 + w)
-        tab.t[:] = tab.t + 10.0 * w                       # each window's rows 10 s after the last's
-        tabs.append(tab)
-        gs.append(tab.X @ Mtrue + 0.3 + 0.05 * rng.normal(size=T))
-    monkeypatch.setattr(gustfilter, "air_roll_fit", lambda *a: "gust filter not run: test")
-    it = iter(gs)
-    monkeypatch.setattr(airyaw, "yaw_gust_hat", lambda states, b: (next(it), ""))
-    pool = WindowErrorPool(rate_errors=True, yaw_map="pooled")
-    for tab in tabs:
-        pool.add(tab, np.ones(T, bool), _states(T), SimpleNamespace(b=2.0))
-    _, _, mc, note = pool.statement()
-    t = np.concatenate([tab.t for tab in tabs])
-    X = np.concatenate([tab.X for tab in tabs])
-    want = slope_second_moment(t, X - X.mean(axis=0), np.concatenate(gs), block_s=10.0)
-    assert np.allclose(mc[IR], want, rtol=1e-9, atol=1e-15)
-    assert np.count_nonzero(mc[:IR]) == 0 and f"r_hat linear error ({W * T} rows)" in note
-    with pytest.raises(ValueError, match="yaw_map"):
-        WindowErrorPool(yaw_map="mean")
