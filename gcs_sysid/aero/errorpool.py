@@ -10,7 +10,9 @@ error is then a draw from a mixture of the windows' errors, and the second momen
 components' second moments, weighted by their shares. That is what :class:`WindowErrorPool` states:
 
 * ``offset_cov``, ``scale_var`` and ``map_cov``: the row-weighted means of the windows' ``x_offset_cov``,
-  ``x_scale_var`` and ``x_map_cov`` over the windows that state each (weights: the rows each window handed to the GP);
+  ``x_scale_var`` and ``x_map_cov`` over the windows that state each (weights: the rows each window hands to the
+  learner; the few that never reach the model, a first fit's trimmed backlog or rows without an identifiable output,
+  are counted too);
 * with ``rate_errors``, ``scale_var[p_hat] = rho^2`` with ``rho`` the ratio of the row-weighted sums of ``var(g)`` and
   ``var(p_hat)`` (:func:`gcs_sysid.aero.rateerrors.roll_rate_variances`) over the windows whose roll fit was accepted,
   and ``map_cov[r_hat]`` the row-weighted mean of the windows' yaw-rate maps
