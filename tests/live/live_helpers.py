@@ -130,3 +130,19 @@ class FaultyRelay:
 
 def have(cmd: str) -> bool:
     return shutil.which(cmd) is not None or Path(sys.executable).with_name(cmd).exists()
+
+
+def listen_options(monkeypatch, tmp_path, extras: list[list[str]]) -> list:
+    """The :class:`~gcs_sysid.live.session.ListenOptions` ``gcs-sysid listen`` builds for each list of extra
+    arguments (``run_listen`` replaced: nothing listens)."""
+    import gcs_sysid.live.session as session
+    from gcs_sysid.cli import build_parser
+    from gcs_sysid.live.cli import cmd_listen
+
+    got = []
+    monkeypatch.setattr(session, "run_listen",
+                        lambda af, out, opts: got.append(opts) or {"raw_log": "r", "raw_records": 0})
+    base = ["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path)]
+    for extra in extras:
+        assert cmd_listen(build_parser().parse_args(base + extra)) == 0
+    return got

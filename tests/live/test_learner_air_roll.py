@@ -22,23 +22,17 @@ from gcs_sysid.live.learner import LearnOptions, learn_from_tlog
 from gcs_sysid.live.report import render_markdown
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from live_helpers import AIRFRAME, FLIGHT  # noqa: E402
+from live_helpers import AIRFRAME, FLIGHT, listen_options  # noqa: E402
 
 
 def test_listen_cli_passes_air_roll(monkeypatch, tmp_path):
-    import gcs_sysid.live.session as session
-    from gcs_sysid.live.cli import cmd_listen
-
-    got = []
-    monkeypatch.setattr(session, "run_listen",
-                        lambda af, out, opts: got.append(opts) or {"raw_log": "r", "raw_records": 0})
-    base = ["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path)]
-    for extra, want in (([], False), (["--air-roll", "on"], True), (["--air-roll", "off"], False)):
-        assert cmd_listen(build_parser().parse_args(base + extra)) == 0
-        assert got[-1].learn.air_roll is want
+    cases = (([], False), (["--air-roll", "on"], True), (["--air-roll", "off"], False))
+    got = listen_options(monkeypatch, tmp_path, [extra for extra, _ in cases])
+    assert [o.learn.air_roll for o in got] == [want for _, want in cases]
     assert LearnOptions().air_roll is False                        # opt-in
     with pytest.raises(SystemExit):
-        build_parser().parse_args(base + ["--air-roll", "maybe"])
+        build_parser().parse_args(["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path),
+                                   "--air-roll", "maybe"])
 
 
 def test_the_report_says_what_the_pair_did():

@@ -21,7 +21,7 @@ from gcs_sysid.live.learner import LearnOptions, iter_tlog_records, learn_from_t
 from gcs_sysid.live.report import render_markdown
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from live_helpers import AIRFRAME, FLIGHT  # noqa: E402
+from live_helpers import AIRFRAME, FLIGHT, listen_options  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -69,15 +69,10 @@ def test_the_report_says_what_the_models_band_carries():
 
 
 def test_listen_cli_passes_rate_errors(monkeypatch, tmp_path):
-    import gcs_sysid.live.session as session
-    from gcs_sysid.live.cli import cmd_listen
-
-    got = []
-    monkeypatch.setattr(session, "run_listen",
-                        lambda af, out, opts: got.append(opts) or {"raw_log": "r", "raw_records": 0})
-    base = ["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path)]
-    for extra, want in (([], None), (["--rate-errors", "on"], True), (["--rate-errors", "off"], False)):
-        assert cmd_listen(build_parser().parse_args(base + extra)) == 0
-        assert got[-1].learn.rate_errors is want and got[-1].learn.stated_errors is True
+    cases = (([], None), (["--rate-errors", "on"], True), (["--rate-errors", "off"], False))
+    got = listen_options(monkeypatch, tmp_path, [extra for extra, _ in cases])
+    assert [o.learn.rate_errors for o in got] == [want for _, want in cases]
+    assert all(o.learn.stated_errors is True for o in got)         # on by default
     with pytest.raises(SystemExit):
-        build_parser().parse_args(base + ["--rate-errors", "maybe"])
+        build_parser().parse_args(["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path),
+                                   "--rate-errors", "maybe"])
