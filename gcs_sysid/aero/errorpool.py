@@ -18,9 +18,8 @@ components' second moments, weighted by their shares. That is what :class:`Windo
   and ``map_cov[r_hat]`` the row-weighted mean of the windows' yaw-rate maps
   (:func:`~gcs_sysid.aero.rateerrors.yaw_rate_map`). Each window's roll fit and map are made on all its valid rows (the
   fit's context) up to the last row it hands over, not only those rows (10 s by default: too few for the fit's
-  checks). A ratio of pooled
-  variances, not a mean of ratios: on JSBSim's rascal one 30-s window with little roll excitation read ``rho`` 14
-  against 0.4-2.8 in the others (1.56 over the whole flight).
+  checks). A ratio of pooled variances, not a mean of ratios: on JSBSim's rascal one 30-s window with little roll
+  excitation read ``rho`` 14 against 0.4-2.8 in the others (1.56 over the whole flight).
 
 The mixture's second moment bounds the learned model's from above: the model's error is roughly the row-weighted mean
 of the windows' errors, and ``E[(sum_w a_w e_w)^2] <= sum_w a_w E[e_w^2]`` (``sum a_w = 1``; Jensen), with equality
@@ -109,7 +108,7 @@ class WindowErrorPool:
         weighted by ``rows``' count (module docstring)."""
         from .airyaw import yaw_gust_hat
         from .gustfilter import air_roll_fit
-        from .rateerrors import roll_rate_variances, yaw_rate_map
+        from .rateerrors import roll_fit_refusal, roll_rate_variances, yaw_rate_map
 
         rows = np.asarray(rows, bool)
         n = int(rows.sum())
@@ -128,7 +127,7 @@ class WindowErrorPool:
             fit = f"roll fit failed on a window ({exc})"
         v = None if isinstance(fit, str) else roll_rate_variances(fit, table, ctx)
         if v is None:
-            self._why_roll = fit if isinstance(fit, str) else "too few rows"
+            self._why_roll = roll_fit_refusal(fit) if isinstance(fit, str) else "too few rows"
         else:
             self._var_g += n * v[0]
             self._var_p += n * v[1]

@@ -36,7 +36,8 @@ import numpy as np
 
 from .table import REGRESSORS
 
-__all__ = ["RATE_ERRORS", "roll_rate_scale", "roll_rate_variances", "yaw_rate_map", "stated_rate_errors"]
+__all__ = ["RATE_ERRORS", "roll_rate_scale", "roll_rate_variances", "roll_fit_refusal", "yaw_rate_map",
+           "stated_rate_errors"]
 
 #: Whether the replay states the rates' errors for the band at exact conditions (``ReplayOptions.rate_errors`` None).
 #: On since the sixty-fourth session, by a rule written before its run on fresh JSBSim flights (seeds 10-12): Cl's
@@ -96,6 +97,14 @@ def roll_rate_variances(fit, table, train: np.ndarray) -> tuple[float, float] | 
     if rows.sum() < _MIN_ROWS or not np.var(p[rows]) > 0:
         return None
     return float(np.var(g[rows])), float(np.var(p[rows]))
+
+
+def roll_fit_refusal(why: str) -> str:
+    """Why there is no roll fit, in this module's words: :func:`gcs_sysid.aero.gustfilter.air_roll_fit`'s refusal
+    (said in the gust filter's words, ``"gust filter not run: ..."``) as ``"no roll fit: ..."``."""
+    for pre in ("gust filter not run: ", "gust filter not applied: "):
+        why = "no roll fit: " + why[len(pre):] if why.startswith(pre) else why
+    return why
 
 
 def yaw_rate_map(table, r_hat_g: np.ndarray, train: np.ndarray, block_s: float = 15.0) -> np.ndarray | None:
@@ -164,10 +173,8 @@ def stated_rate_errors(table, train: np.ndarray, roll_fit=None,
     said = []
     rho = None if roll_fit is None or isinstance(roll_fit, str) else roll_rate_scale(roll_fit, table, train)
     if rho is None:
-        if isinstance(roll_fit, str):       # why there is none (air_roll_fit says it in the gust filter's words)
-            why = roll_fit
-            for pre in ("gust filter not run: ", "gust filter not applied: "):
-                why = "no roll fit: " + why[len(pre):] if why.startswith(pre) else why
+        if isinstance(roll_fit, str):
+            why = roll_fit_refusal(roll_fit)
         else:
             why = "no roll fit" if roll_fit is None else "too few rows"
         said.append(f"p_hat: none ({why})")

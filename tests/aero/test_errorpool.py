@@ -80,6 +80,8 @@ def test_the_rolling_gusts_share_is_a_ratio_of_pooled_variances(monkeypatch):
     assert off is None and mc is None
     assert sv[IP] == pytest.approx(rho**2, rel=1e-12) and np.count_nonzero(sv) == 1
     assert f"p_hat scale error {rho:.2f} (650 rows)" in note and "r_hat: none (no yaw gust rate: test)" in note
+    pool.add(tabs[2], np.ones(T, bool), _states(T), SimpleNamespace(b=2.0))     # refused again: said as the replay says
+    assert "p_hat" in pool.statement()[3] and pool._why_roll == "no roll fit: refused here"
     assert roll_rate_scale(SimpleNamespace(g=gs[0], used=np.ones(T, bool)), tabs[0], seen[0]) == \
         pytest.approx(v[0][0] / v[0][1])
 
