@@ -22,9 +22,10 @@ asked at ``p_hat - p_hat_g``, ``heldout_air_roll`` ``"predicted:Cl"`` with the l
 question, post hoc), ``ls_air_cl`` (least squares asked there too) and ``cov_gp_air_cl`` (Cl's band there).
 
 Counts (:func:`counts`; thresholds as issue 8: held-out / true-air within 5 % forces, 10 % moments; GP better than
-LS; bands 90-98 %; a learned output correlation above 0.5) and flips of each variant (:func:`variant`: the noise,
-``+air-roll``) against ``--base`` (``independent``) at the same seed are printed by ``--summarize``
-(``--heldout-cl air``: the pair's Cl at the air-rate question).
+LS; bands 90-98 %, the band at exact conditions also per coefficient, ``cov_true_air_c``; a learned output correlation
+above 0.5) and flips of each variant (:func:`variant`: the noise, ``+air-roll``, ``-unstated``) against ``--base``
+(``independent``) at the same seed are printed by ``--summarize`` (``--heldout-cl air``: the pair's Cl at the air-rate
+question).
 
 Usage::
 
@@ -32,6 +33,8 @@ Usage::
     python benchmarks/eval_live_jsbsim.py --summarize live.jsonl
     python benchmarks/eval_live_jsbsim.py --aircraft c172x --gp-noise learned --air-roll off on --json pair.jsonl
     python benchmarks/eval_live_jsbsim.py --summarize pair.jsonl --base learned --heldout-cl gyro
+    python benchmarks/eval_live_jsbsim.py --seeds 13 14 15 --duration 120 --gp-noise learned --stated-errors off on
+    python benchmarks/eval_live_jsbsim.py --summarize stated.jsonl --base learned-unstated   # after --json stated.jsonl
 """
 
 from __future__ import annotations
