@@ -238,7 +238,7 @@ ROW_GUST_MODES = ("smoothed", "filtered", "predicted")
 def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray, qbar: np.ndarray,
                       rows: np.ndarray, Ixx: float, S: float, b: float, mode: str = "smoothed",
                       min_run: int = 10, gust_var: float | None = None,
-                      pred_var: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+                      pred_var: float | None = None, center: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """The rolling gust ``p_hat_g`` on ``rows`` (a held-out segment) from their own measured roll moment, with the
     slopes, gust process and noise of a fit made on other rows (:func:`fit_roll_dynamics`, nothing refitted).
 
@@ -268,6 +268,9 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
             (:func:`predicted_gust_variance` on the training rows; None: not given). Used in place of the fit's
             (and of ``gust_var``'s) when larger; the ``"filtered"`` one follows as ``(1 - K)^2 P + K^2 R`` (the fit's
             gain ``K``; Gelb 1974, sec. 7.2).
+        center: take each run's mean step-moment residual out before filtering: the run's level goes to an intercept,
+            not to the zero-mean gust (rows estimated at another level than the fit's, e.g. a later live window;
+            :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_ROWS_CENTER`). The run's mean of the gust itself is given up.
 
     Returns:
         ``(g, g_var)``, each ``(T,)``: ``p_hat_g`` and its variance on the usable runs of ``rows``; 0 and the fit's
@@ -301,6 +304,8 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
         Pf = (1 - ss.K) ** 2 * Pp + ss.K**2 * G.R
     for s0, s1 in _segments(use, min_run):
         zz = z[s0:s1]
+        if center:
+            zz = zz - np.mean(zz[np.isfinite(zz)])
         if mode == "smoothed":
             s[s0:s1], var[s0:s1] = _smooth(zz, a, ss, 1.0), ss.Ps
         else:

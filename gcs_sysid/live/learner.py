@@ -91,9 +91,9 @@ class LearnOptions:
             on the rows of the GP's first fit, their Cl moved to the air-relative roll rate
             (:func:`~gcs_sysid.aero.gustfilter.air_roll_target`), and every later window's new rows' Cl moved with
             that fit's fixed parameters (:func:`~gcs_sysid.aero.gustfilter.air_roll_target_on_rows`, the gust
-            smoothed over the window) before ``model.update``. A refused fit leaves Cl at the gyro's rate for the
-            whole session (the learner's notes and ``air_roll`` status say why). The inputs stay the gyro's for
-            every output; the learner asks its model nowhere at the air rate.
+            smoothed over the window on its residual less the window's mean) before ``model.update``. A refused fit
+            leaves Cl at the gyro's rate for the whole session (the learner's notes and ``air_roll`` status say why).
+            The inputs stay the gyro's for every output; the learner asks its model nowhere at the air rate.
         stated_errors: give the model the windows' stated regressor errors for its band at exact conditions (what
             ``gcs-sysid predict`` states from the saved model), pooled over the windows learned
             (:class:`gcs_sysid.aero.errorpool.WindowErrorPool`); the replay gives its model the flight's

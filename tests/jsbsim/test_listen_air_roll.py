@@ -6,7 +6,8 @@ Threshold FROZEN on 2026-11-25 from the measurement on the c172x, 90 s, light tu
 ``LearnOptions(n_inducing=24)``, the default 30 s windows every 10 s): the learned model's Cl over the rows it learned,
 asked at JSBSim's own regressors with the air-relative rates (the c172x's aerodynamics reads ``p-aero``), against
 JSBSim's Cl, % of its RMS: 27.96 % without the pair, 10.38 % with it (:data:`GAIN_MEASURED`). The test asks for half
-that gain.
+that gain. On 2026-11-28 (sixty-sixth session, the later windows' gust centred): 28.06 % and 11.70 %; the threshold
+is kept.
 The calm-air side (the fit refused, the model unchanged) is ``tests/live/test_learner_air_roll.py``.
 """
 
@@ -56,7 +57,10 @@ def gust_flight(tmp_path_factory):
 @pytest.mark.slow
 def test_the_rows_target_of_a_fixed_fit_is_the_fits_own_on_its_rows(gust_flight):
     """The shared function the learner's later steps use (the gust smoothed with a fit's fixed parameters) gives,
-    on the fit's own rows, the target the fit itself gives (:func:`air_roll_target`): one filter, not a copy."""
+    on the fit's own rows, the target the fit itself gives (:func:`air_roll_target`): one filter, not a copy. With
+    the run's mean residual taken out (``AIR_ROLL_ROWS_CENTER``, the default since the sixty-sixth session) it differs
+    from it by that mean's smoothed moment only: here 2 % of Cl's SD (a filter-error fit's residual is not zero-mean
+    on its own rows)."""
     af = load_airframe(gust_flight.airframe)
     states = estimate_states(read_log(gust_flight.tlog), af)
     tab = compute_coefficients(states, af)
@@ -64,9 +68,13 @@ def test_the_rows_target_of_a_fixed_fit_is_the_fits_own_on_its_rows(gust_flight)
     G = air_roll_fit(tab, states, af, train)
     assert not isinstance(G, str), G
     Y1, i1 = air_roll_target(tab, states, af, train, fit=G)
-    Y2, i2 = air_roll_target_on_rows(G, tab, states, af, G.used, context=G.used)
+    Y2, i2 = air_roll_target_on_rows(G, tab, states, af, G.used, context=G.used, center=False)
     assert i2["rows"].sum() == i1["rows"].sum() > 1000
     assert np.allclose(Y2[G.used, CL], Y1[G.used, CL], rtol=0, atol=1e-9 * np.std(Y1[G.used, CL]))
+    Yc, ic = air_roll_target_on_rows(G, tab, states, af, G.used, context=G.used)
+    assert ic["rows"].sum() == i1["rows"].sum()
+    d = Yc[G.used, CL] - Y1[G.used, CL]
+    assert 0 < np.sqrt(np.mean(d**2)) < 0.05 * np.std(Y1[G.used, CL])
     assert np.array_equal(np.delete(Y2, CL, 1), np.delete(tab.Y, CL, 1), equal_nan=True)
     assert air_roll_target_on_rows("gust filter not applied: x", tab, states, af, train)[1]["note"] == \
         "Cl's air-rate training target not applied: x"
