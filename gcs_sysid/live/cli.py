@@ -29,10 +29,11 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "correlation with the hyperparameters and keeps only its diagonal in the predictions; "
                         "'independent' one variance per output (the default until the twenty-sixth session); "
                         "docs/live.md, 'The GP's noise'")
-    p.add_argument("--air-roll", default="off", choices=("on", "off"),
+    p.add_argument("--air-roll", default="on", choices=("on", "off"),
                    help="the air-rate pair in the learner: 'on' moves Cl's training target to the air-relative roll "
                         "rate with the replay's roll fit (made once on the first fit's rows, with its Dryden and "
-                        "instruments' checks; refused: the gyro's rate for the whole session); default off; "
+                        "instruments' checks; refused: the gyro's rate for the whole session); default on (since the "
+                        "sixty-sixth session; 'off': Cl learned at the gyro's rate); "
                         "docs/live.md, 'The air-rate pair'")
     p.add_argument("--rate-errors", default=None, choices=("on", "off"),
                    help="the gyro rates' errors (the rolling gust's share of p_hat, the yaw gust rate's map of "

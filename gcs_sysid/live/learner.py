@@ -85,8 +85,8 @@ class LearnOptions:
             heap's free pages back to the system (:func:`gcs_sysid.live.heap.release_free_heap`), so
             the resident size follows what is held, not the high-water mark of the longest window or
             refresh so far, and one stage's freed temporaries do not stack under the next one's.
-        air_roll: the air-rate pair's training half (``gcs-sysid listen --air-roll on``; off by default,
-            ``docs/live.md``, "The air-rate pair"): the replay's roll fit with its two checks
+        air_roll: the air-rate pair's training half (``gcs-sysid listen --air-roll on|off``; on by default since the
+            sixty-sixth session, ``docs/live.md``, "The air-rate pair"): the replay's roll fit with its two checks
             (:func:`gcs_sysid.aero.gustfilter.air_roll_fit`: the Dryden check and the instruments' check) made once
             on the rows of the GP's first fit, their Cl moved to the air-relative roll rate
             (:func:`~gcs_sysid.aero.gustfilter.air_roll_target`), and every later window's new rows' Cl moved with
@@ -116,7 +116,7 @@ class LearnOptions:
     hyper_every: int = 15000
     max_window_s: float | None = None
     trim_heap: bool = True
-    air_roll: bool = False
+    air_roll: bool = True
     stated_errors: bool = True
     rate_errors: bool | None = None
 

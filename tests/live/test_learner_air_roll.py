@@ -1,4 +1,5 @@
-"""`listen --air-roll on` (the air-rate pair in the live learner; thirty-first session, live-pair31) in calm air.
+"""`listen --air-roll on` (the air-rate pair in the live learner; thirty-first session, live-pair31; the default since the
+sixty-sixth session) in calm air.
 
 The project's sample flight (``data/flights/sim-trainer-sysid.tlog``: the simulation's turbulence moves the air, not
 the roll moment, so there is no rolling gust to find) is fed through the learner with the pair on and off. The
@@ -26,10 +27,10 @@ from live_helpers import AIRFRAME, FLIGHT, listen_options  # noqa: E402
 
 
 def test_listen_cli_passes_air_roll(monkeypatch, tmp_path):
-    cases = (([], False), (["--air-roll", "on"], True), (["--air-roll", "off"], False))
+    cases = (([], True), (["--air-roll", "on"], True), (["--air-roll", "off"], False))
     got = listen_options(monkeypatch, tmp_path, [extra for extra, _ in cases])
     assert [o.learn.air_roll for o in got] == [want for _, want in cases]
-    assert LearnOptions().air_roll is False                        # opt-in
+    assert LearnOptions().air_roll is True                         # the default since the sixty-sixth session
     with pytest.raises(SystemExit):
         build_parser().parse_args(["listen", "udpin:0.0.0.0:14550", "--airframe", "a.toml", "--out", str(tmp_path),
                                    "--air-roll", "maybe"])
@@ -47,7 +48,7 @@ def test_the_report_says_what_the_pair_did():
 def test_in_calm_air_the_pair_is_refused_and_the_model_is_the_one_without_it():
     af = load_airframe(AIRFRAME)
     opts = dict(n_inducing=24)
-    off = learn_from_tlog(FLIGHT, af, LearnOptions(**opts))
+    off = learn_from_tlog(FLIGHT, af, LearnOptions(air_roll=False, **opts))
     on = learn_from_tlog(FLIGHT, af, LearnOptions(air_roll=True, **opts))
     assert off.air_roll["state"] == "off" and on.air_roll["state"] == "refused", on.air_roll
     note = on.air_roll["note"]
