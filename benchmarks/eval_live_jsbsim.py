@@ -16,8 +16,9 @@ For each JSBSim flight (``benchmarks.jsbsim_harness``, as ``eval_jsbsim.py``; fl
    (the largest learned output correlation, ``model.output_correlation()``) and ``ls`` (``run_fit`` on the
    training window, once per flight).
 
-``--air-roll off on`` also runs each noise x GP seed with the learner's air-rate pair (``LearnOptions.air_roll``;
-thirty-first session, live-pair31): such rows add the learner's ``air_roll`` status, ``gp_air_cl`` (the held-out Cl
+``--air-roll off on`` runs each noise x GP seed without and with the learner's air-rate pair (``LearnOptions.air_roll``;
+thirty-first session, live-pair31; the learner's default and this script's since the sixty-sixth session): rows with
+the pair add the learner's ``air_roll`` status, ``gp_air_cl`` (the held-out Cl
 asked at ``p_hat - p_hat_g``, ``heldout_air_roll`` ``"predicted:Cl"`` with the learner's own roll fit: the replay's
 question, post hoc), ``ls_air_cl`` (least squares asked there too) and ``cov_gp_air_cl`` (Cl's band there).
 
@@ -79,7 +80,7 @@ def record_steps(tlog: Path, airframe) -> list[tuple]:
     from gcs_sysid.live.learner import Learner, LearnOptions, iter_tlog_records
 
     steps: list[tuple] = []
-    rec = Learner(airframe, LearnOptions())
+    rec = Learner(airframe, LearnOptions(air_roll=False))   # records what each step hands over; learns nothing
     rec._learn = lambda table, rows, states=None: steps.append((dict(rec.identifiable), table, rows.copy(),
                                                                 _pair_states(states)))   # no GP here
     for stamp, packet in iter_tlog_records(tlog):
@@ -88,7 +89,7 @@ def record_steps(tlog: Path, airframe) -> list[tuple]:
     return steps
 
 
-def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = False,
+def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = True,
           stated_errors: bool = True):
     """The learner fed ``steps`` up to vehicle time ``t_cut`` (s) and its CPU s (its ``model``, ``outputs``,
     ``n_learned``, ``air_roll``, ``errors``)."""
@@ -104,7 +105,7 @@ def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: in
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
-             air_rolls=(False,), stated=(True,)) -> list[dict]:
+             air_rolls=(True,), stated=(True,)) -> list[dict]:
     """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on), JSON-able.
 
     ``stated``: ``LearnOptions.stated_errors`` values to run (the windows' pooled regressor errors in the model's
@@ -321,8 +322,9 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=90.0)
     ap.add_argument("--gp-noise", nargs="+", default=["independent", "learned"])
     ap.add_argument("--gp-seeds", nargs="+", type=int, default=[0, 1])
-    ap.add_argument("--air-roll", nargs="+", default=["off"], choices=("off", "on"),
-                    help="the learner's air-rate pair (LearnOptions.air_roll) off and/or on")
+    ap.add_argument("--air-roll", nargs="+", default=["on"], choices=("off", "on"),
+                    help="the learner's air-rate pair (LearnOptions.air_roll, on by default since the sixty-sixth "
+                         "session) off and/or on")
     ap.add_argument("--stated-errors", nargs="+", default=["on"], choices=("off", "on"),
                     help="the learner's pooled regressor errors (LearnOptions.stated_errors) off and/or on")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
