@@ -14,7 +14,9 @@ For each JSBSim flight (``benchmarks.jsbsim_harness``, as ``eval_jsbsim.py``; fl
    truth's RMS), ``true_air`` (at the true regressors with the rates JSBSim's aerodynamics reads), ``cov_gp``
    (the coefficient's band at the estimated regressors, without the white noise), ``cov_true_air``, ``max_corr``
    (the largest learned output correlation, ``model.output_correlation()``) and ``ls`` (``run_fit`` on the
-   training window, once per flight).
+   training window, once per flight); ``gp_win`` (sixty-sixth session) asks the model at the held-out rows as the
+   learner's own windows estimated them (:func:`held_rows_of_windows`; ``n_heldout_win`` rows): each window is
+   estimated on its own, so ``gp`` at the whole-flight table's regressors mixes the two estimators' levels.
 
 ``--air-roll off on`` runs each noise x GP seed without and with the learner's air-rate pair (``LearnOptions.air_roll``;
 thirty-first session, live-pair31; the learner's default and this script's since the sixty-sixth session): rows with
@@ -54,7 +56,7 @@ from benchmarks.eval_common import append_jsonl  # noqa: E402
 from benchmarks.eval_jsbsim import _coverage, _errs, aero_reads_air_rates  # noqa: E402
 from benchmarks.jsbsim_harness import UNTOUCHED_AIRCRAFT, FlightConfig, load_truth, make_flight  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
-from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
+from gcs_sysid.aero.table import COEFFICIENTS, REGRESSORS  # noqa: E402
 
 FORCES = ("CX", "CY", "CZ")
 
@@ -87,6 +89,23 @@ def record_steps(tlog: Path, airframe) -> list[tuple]:
         rec.feed(stamp, packet)
     rec.finish()
     return steps
+
+
+def held_rows_of_windows(steps: list[tuple], t_cut: float) -> tuple[np.ndarray, np.ndarray]:
+    """The held-out rows (vehicle time at or after ``t_cut``, s) as the live learner's windows estimated them: each
+    step's new valid rows with finite regressors, ``(X (N, 10), t (N,))`` in time order (each row is new in one step).
+    The model asked there is asked at its own estimator's regressors, as a live session would ask it of the rows it
+    has not learned yet; the whole-flight table's ``gp`` asks it at the replay's."""
+    Xs, ts = [], []
+    for _, table, rows, _ in steps:
+        sel = rows & np.asarray(table.valid, bool) & (table.t >= t_cut) & np.all(np.isfinite(table.X), axis=1)
+        Xs.append(table.X[sel])
+        ts.append(table.t[sel])
+    if not Xs:
+        return np.zeros((0, len(REGRESSORS))), np.zeros(0)
+    X, t = np.concatenate(Xs), np.concatenate(ts)
+    order = np.argsort(t, kind="stable")
+    return X[order], t[order]
 
 
 def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = True,
@@ -146,6 +165,10 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     t0 = time.perf_counter()
     steps = record_steps(files.tlog, af)
     t_rec = time.perf_counter() - t0
+    Xw, tw = held_rows_of_windows(steps, t_cut)
+    Ytw = truth.at(tw)[1]
+    okw = np.isfinite(Ytw).all(1)
+    Xw, Ytw = Xw[okw], Ytw[okw]
     out = []
     for noise, gs, pair, se in ((n, g, p, s) for n in noises for g in gp_seeds for p in air_rolls for s in stated):
         lr, cpu = learn(steps, af, t_cut, noise, gs, pair, se)
@@ -158,6 +181,9 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
         white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
         mean[:, cols] = np.asarray(m)
         sig[:, cols] = np.sqrt(np.maximum(np.asarray(v) - white[None, :], 0.0))
+        mean_w = np.full(Ytw.shape, np.nan)
+        if len(Xw):
+            mean_w[:, cols] = np.asarray(model.predict(Xw)[0])
         ma, va = model.predict(Xt_air[h], include_noise=False, input_noise=False)
         mta[:, cols], sta[:, cols] = np.asarray(ma), np.sqrt(np.asarray(va))
         C = np.abs(np.asarray(model.output_correlation(), float))
@@ -167,6 +193,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                "n_heldout": int(h.sum()), "t_record_s": round(t_rec, 1),
                "cpu_learn_s": round(cpu, 2), "noise_correlation": bool(model.config.noise_correlation),
                "gp": _errs(mean, Yt[h]), "true_air": _errs(mta, Yt[h]), "ls": ls,
+               "gp_win": _errs(mean_w, Ytw) if len(Xw) else None, "n_heldout_win": int(len(Xw)),
                "cov_gp_each": [_coverage(mean[:, i], sig[:, i], Yt[h, i]) for i in range(6)],
                "cov_true_air_each": [_coverage(mta[:, i], sta[:, i], Yt[h, i]) for i in range(6)],
                "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:],
