@@ -304,8 +304,8 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
         Pf = (1 - ss.K) ** 2 * Pp + ss.K**2 * G.R
     for s0, s1 in _segments(use, min_run):
         zz = z[s0:s1]
-        if center:
-            zz = zz - np.mean(zz[np.isfinite(zz)])
+        if center:                  # the run's rows are finite (use)
+            zz = zz - zz.mean()
         if mode == "smoothed":
             s[s0:s1], var[s0:s1] = _smooth(zz, a, ss, 1.0), ss.Ps
         else:
