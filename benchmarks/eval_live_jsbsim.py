@@ -38,6 +38,8 @@ Usage::
     python benchmarks/eval_live_jsbsim.py --summarize pair.jsonl --base learned --heldout-cl gyro
     python benchmarks/eval_live_jsbsim.py --seeds 13 14 15 --duration 120 --gp-noise learned --stated-errors off on
     python benchmarks/eval_live_jsbsim.py --summarize stated.jsonl --base learned-unstated   # after --json stated.jsonl
+    python benchmarks/eval_live_jsbsim.py --seeds 22 --duration 120 --gp-noise learned --lift-line off on --json l.jsonl
+    python benchmarks/eval_live_jsbsim.py --summarize l.jsonl --base learned+air-roll --heldout-cl gyro
 """
 
 from __future__ import annotations
@@ -76,18 +78,22 @@ def _pair_states(states):
                         {k: states.sigma[k] for k in sorted(sigma) if k in states.sigma})
 
 
-def record_steps(tlog: Path, airframe) -> list[tuple]:
+def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None) -> list[tuple]:
     """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states)`` of every GP step
-    (``states``: the part the air-rate pair reads)."""
+    (``states``: the part the air-rate pair reads). ``lift_line``: the learner's carried lift line
+    (``LearnOptions.lift_line``: it changes the windows' estimates, so it is recorded here, not in :func:`learn`);
+    ``status``: a dict updated with the recorder's ``lift_line`` status at the end."""
     from gcs_sysid.live.learner import Learner, LearnOptions, iter_tlog_records
 
     steps: list[tuple] = []
-    rec = Learner(airframe, LearnOptions(air_roll=False))   # records what each step hands over; learns nothing
+    rec = Learner(airframe, LearnOptions(air_roll=False, lift_line=lift_line))   # records each step; learns nothing
     rec._learn = lambda table, rows, states=None: steps.append((dict(rec.identifiable), table, rows.copy(),
                                                                 _pair_states(states)))   # no GP here
     for stamp, packet in iter_tlog_records(tlog):
         rec.feed(stamp, packet)
     rec.finish()
+    if status is not None:
+        status.update(rec.lift_line)
     return steps
 
 
@@ -123,9 +129,28 @@ def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: in
     return lr, time.process_time() - t0
 
 
+def window_levels(steps: list[tuple], truth) -> list[float]:
+    """Each step's mean alpha error against JSBSim's over the rows it hands over, deg (NaN-free steps only): the
+    window's alpha level (the carried lift line's question)."""
+    out = []
+    for _, table, rows, _ in steps:
+        sel = rows & np.asarray(table.valid, bool) & np.isfinite(table.X[:, 0])
+        if sel.any():
+            e = table.X[sel, 0] - truth.at(table.t[sel])[0][:, 0]
+            if np.isfinite(e).any():
+                out.append(float(np.degrees(np.nanmean(e))))
+    return out
+
+
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
-             air_rolls=(True,), stated=(True,)) -> list[dict]:
-    """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on), JSON-able.
+             air_rolls=(True,), stated=(True,), lift_lines=(False,)) -> list[dict]:
+    """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on x lift line off/on),
+    JSON-able.
+
+    ``lift_lines``: ``LearnOptions.lift_line`` values (the windows' lift line carried across them; each value records
+    its own steps, :func:`record_steps`); each row says its own in ``lift_line`` with the learner's status in
+    ``lift_line_status`` and its windows' alpha levels against the truth in ``alpha_levels_deg``
+    (:func:`window_levels`).
 
     ``stated``: ``LearnOptions.stated_errors`` values to run (the windows' pooled regressor errors in the model's
     band at exact conditions, ``cov_true_air``); each row says its own in ``stated_errors``.
@@ -162,9 +187,22 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                           profile_beta=airangles.BETA_PROFILE,      # the learner's sideslip estimator
                           air_roll_train=False)     # the measured Cl (not the diagnosis's reference target)
     ls = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
+    out = []
+    for ll in lift_lines:
+        out += _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut,
+                               Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll)
+    return out
+
+
+def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut, Xt_air, h,
+                    ls_model, ls, noises, gp_seeds, air_rolls, stated, ll) -> list[dict]:
+    """:func:`evaluate`'s rows of one ``lift_line`` value ``ll``."""
+    Yt = truth.at(tab.t)[1]
     t0 = time.perf_counter()
-    steps = record_steps(files.tlog, af)
+    status: dict = {}
+    steps = record_steps(files.tlog, af, lift_line=ll, status=status)
     t_rec = time.perf_counter() - t0
+    levels = window_levels(steps, truth)
     Xw, tw = held_rows_of_windows(steps, t_cut)
     Ytw = truth.at(tw)[1]
     okw = np.isfinite(Ytw).all(1)
@@ -198,7 +236,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
                "cov_true_air_each": [_coverage(mta[:, i], sta[:, i], Yt[h, i]) for i in range(6)],
                "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:],
                "air_roll": dict(lr.air_roll) if pair else None, "stated_errors": bool(se),
-               "errors_note": lr.errors.get("note", "")}
+               "errors_note": lr.errors.get("note", ""), "lift_line": bool(ll),
+               "lift_line_status": status, "alpha_levels_deg": [round(x, 3) for x in levels]}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
@@ -223,7 +262,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
         row["cov_true_air"] = float(np.nanmean(row["cov_true_air_each"]))
         out.append(row)
         print(f"{aircraft} {turbulence} s{seed} {noise} gs{gs} pair {'on' if pair else 'off'} "
-              f"stated {'on' if se else 'off'}: gp " +
+              f"stated {'on' if se else 'off'} line {'on' if ll else 'off'}: gp " +
               " ".join(f"{c} {row['gp'][c]:.1f}" for c in COEFFICIENTS) +
               f" | cov {row['cov_gp']:.1f} / {row['cov_true_air']:.1f} corr {row['max_corr']:.2f} "
               f"cpu {cpu:.1f} s" + (f" | pair {lr.air_roll['state']}, Cl at the air rate "
@@ -234,9 +273,10 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
 def variant(row: dict) -> str:
     """A row's learner variant: its GP noise, ``+air-roll`` with the air-rate pair on, ``-unstated`` without the
     stated regressor errors (``LearnOptions.stated_errors`` False; rows written before the sixty-fifth session had
-    none and carry no such field)."""
+    none and carry no such field), ``+lift-line`` with the windows' lift line carried (``LearnOptions.lift_line``)."""
     return (row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
-            + ("-unstated" if row.get("stated_errors") is False else ""))
+            + ("-unstated" if row.get("stated_errors") is False else "")
+            + ("+lift-line" if row.get("lift_line") else ""))
 
 
 def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
@@ -354,6 +394,8 @@ def main(argv=None) -> int:
                          "session) off and/or on")
     ap.add_argument("--stated-errors", nargs="+", default=["on"], choices=("off", "on"),
                     help="the learner's pooled regressor errors (LearnOptions.stated_errors) off and/or on")
+    ap.add_argument("--lift-line", nargs="+", default=["off"], choices=("off", "on"),
+                    help="the learner's lift line carried across its windows (LearnOptions.lift_line) off and/or on")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
     ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
                     help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")
@@ -372,7 +414,8 @@ def main(argv=None) -> int:
         for turb in a.turbulence:
             for seed in a.seeds:
                 rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds,
-                                tuple(x == "on" for x in a.air_roll), tuple(x == "on" for x in a.stated_errors))
+                                tuple(x == "on" for x in a.air_roll), tuple(x == "on" for x in a.stated_errors),
+                                tuple(x == "on" for x in a.lift_line))
                 append_jsonl(a.json, rows)
     return 0
 

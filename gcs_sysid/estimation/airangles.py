@@ -322,6 +322,8 @@ class AxisFit:
         bias_sigma: 1-sigma of the angle's flight-common offset, rad (alpha: the flight-mean vertical
             wind over the airspeed, :func:`gcs_sysid.estimation.angleerrors.mean_wind_sigma`; NaN for beta,
             whose mean the wind fit and the CY0 prior set). Included in the per-sample sigma.
+        wind_sigma: alpha moved onto a stated lift line (``mean_shift``): the flight-mean wind's 1-sigma before the
+            move (``bias_sigma`` then holds the combined one), rad; NaN where no line moved the angle.
         map_columns: regressors of the force model the aided angle is built from: the angle itself, then
             the others (alpha: ``alpha q_hat delta_e``; beta: ``beta p_hat r_hat delta_a delta_r``), those that
             vary; empty where not aided.
@@ -367,6 +369,7 @@ class AxisFit:
     slope_method: str = "OLS"
     first_stage_r2: float = float("nan")
     bias_sigma: float = float("nan")
+    wind_sigma: float = float("nan")
     scale_sigma: float = float("nan")
     map_columns: tuple[str, ...] = ()
     map_cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
@@ -1594,6 +1597,7 @@ def _level_onto_line(dt: float, a: np.ndarray, a_sig: np.ndarray, fa: AxisFit, C
     a = np.where(u, a + shift, a)
     a_sig = np.sqrt(np.maximum(a_sig**2 - old**2, 0.0) + post**2)
     fa.mean_shift = float(shift)
+    fa.wind_sigma = float(s_w)
     fa.bias_sigma = float(post)
     fa.shift_note = (f"alpha mean moved by {np.degrees(shift):+.2f} deg onto the stated lift line (CL0 "
                      f"{g('CL0', 0.0):+.3f} +- {s_l0:.3f}: line's level {np.degrees(d):+.2f} +- {np.degrees(s_l):.2f} "

@@ -103,11 +103,12 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
 
 
 def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
-                Wd=None, offsets=None, models=None, fits=None, profile_beta=None, gls_beta=None):
+                Wd=None, offsets=None, models=None, fits=None, profile_beta=None, gls_beta=None, lift_line=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
     records sources, sigma, notes and the flight-common offsets' 1-sigma (``offsets``, rad; and the
     gusts in the wind) and the axes' fits (``fits``); ``models``: another flight's fits to take the alpha
-    model's slopes from; ``profile_beta``, ``gls_beta``: as :func:`estimate_states`; returns ``(alpha, beta)``."""
+    model's slopes from; ``profile_beta``, ``gls_beta``, ``lift_line``: as :func:`estimate_states`; returns
+    ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
         notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
                      "control outputs)")
@@ -118,8 +119,9 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
                           models=models, profile_beta=profile_beta, gls_beta=gls_beta,
                           stated_slopes=((getattr(airframe, "CL_alpha", None), getattr(airframe, "CL_q", None))
                                          if airangles.STATED_LIFT_SLOPE else None),
-                          stated_level=({k: getattr(airframe, k, None) for k in ("CL0", "CL_alpha", "CL_q",
-                                                                                "CL_delta_e", "CL0_sigma")}
+                          stated_level=(dict(lift_line) if lift_line is not None else
+                                        {k: getattr(airframe, k, None) for k in ("CL0", "CL_alpha", "CL_q",
+                                                                                 "CL_delta_e", "CL0_sigma")}
                                         if airangles.STATED_LIFT_LEVEL and getattr(airframe, "CL0", None) is not None
                                         else None))
     notes.extend(describe(Ai))
@@ -159,7 +161,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     turbulence_state: bool = True,
                     gust_force_axes: tuple[int, ...] | None = None,
                     meanwhile: Callable[[], None] | None = None,
-                    profile_beta: bool | None = None, gls_beta: bool | None = None) -> FlightStates:
+                    profile_beta: bool | None = None, gls_beta: bool | None = None,
+                    lift_line: dict[str, float] | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -195,6 +198,11 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         gls_beta: the side-force model's first-pass slopes by generalised least squares under the gust model (True) or
             by least squares (False); None: :data:`gcs_sysid.estimation.airangles.BETA_GLS` as it stands at the call
             (off; the diagnosis and ``fit`` pass :data:`gcs_sysid.diagnose.run.BETA_GLS`, off).
+        lift_line: a lift line to set the aided alpha's level on, ``{"CL0", "CL_alpha", "CL_q", "CL_delta_e",
+            "CL0_sigma"}`` (:func:`gcs_sysid.estimation.airangles.aided_air_angles`, ``stated_level``; the live
+            learner's line carried across its windows, :class:`gcs_sysid.aero.liftline.LiftLinePool`). It takes the
+            place of the airframe's stated line (:data:`~gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL`). None:
+            the airframe's where that opt-in is on, else none.
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -533,7 +541,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
                                       fly, C, v_ned, sources, sigma, notes, Wd, offsets, angle_models, fits,
-                                      profile_beta, gls_beta)
+                                      profile_beta, gls_beta, lift_line)
     else:
         if have_tas:
             V = tas

@@ -101,6 +101,11 @@ class LearnOptions:
             session). The model's mean and its bands at the flight's own regressors do not change.
         rate_errors: with ``stated_errors``, also the gyro rates' errors (:mod:`gcs_sysid.aero.rateerrors`; ``gcs-sysid
             listen --rate-errors on|off``); None: :data:`gcs_sysid.aero.rateerrors.RATE_ERRORS`, as the replay.
+        lift_line: carry a lift line across the windows (``gcs-sysid listen --lift-line on|off``; opt-in): every
+            window's rows, at the window's own alpha level, join a pool (:class:`gcs_sysid.aero.liftline.LiftLinePool`:
+            slopes within windows, the level from all of them), and the next window's aided alpha is set on the
+            pool's line (:func:`gcs_sysid.estimation.estimate_states`, ``lift_line``) instead of on its own 30 s of
+            mean vertical wind (``docs/live.md``, "The lift line carried across windows").
     """
 
     window_s: float = 30.0
@@ -119,6 +124,7 @@ class LearnOptions:
     air_roll: bool = True
     stated_errors: bool = True
     rate_errors: bool | None = None
+    lift_line: bool = False
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -194,6 +200,9 @@ class Learner:
             with a moved Cl so far) and ``sd_first`` (the first fit's correction SD, Cl units).
         errors: the pooled regressor errors the model carries (``LearnOptions.stated_errors``): ``state`` (``"off"``,
             ``"pooling"``), ``windows``, ``rows`` and ``note`` (what is stated, :meth:`WindowErrorPool.statement`).
+        lift_line: the carried lift line's status (``LearnOptions.lift_line``): ``state`` (``"off"``, ``"pooling"``
+            before the pool states a line, ``"carried"``), ``windows`` (pooled), ``handed`` (windows estimated on a
+            line) and ``note`` (:meth:`~gcs_sysid.aero.liftline.LiftLinePool.note`).
     """
 
     airframe: Airframe
@@ -215,6 +224,7 @@ class Learner:
     coalesced_at: list = field(default_factory=list)
     air_roll: dict = field(default_factory=dict)
     errors: dict = field(default_factory=dict)
+    lift_line: dict = field(default_factory=dict)
 
     def __post_init__(self):
         from ..jaxconfig import enable_compilation_cache, enable_x64, limit_blas_threads
@@ -247,6 +257,13 @@ class Learner:
             self._errors = WindowErrorPool(rate_errors=rates)
         self.errors = {"state": "pooling" if self._errors is not None else "off", "windows": 0, "rows": 0,
                        "note": ""}
+        self._line = None                     # the lift line carried across windows (LearnOptions.lift_line)
+        if self.options.lift_line:
+            from ..aero.liftline import LiftLinePool
+
+            self._line = LiftLinePool(self.options.window_s)
+        self.lift_line = {"state": "pooling" if self._line is not None else "off", "windows": 0, "handed": 0,
+                          "note": ""}
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -303,7 +320,8 @@ class Learner:
                 raise SysidError("no usable messages in the window")
             if self.can_source is not None:
                 flight = self._merge_can(flight, data)
-            states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz)
+            line = self._line.line() if self._line is not None else None
+            states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz, lift_line=line)
             self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
         except SysidError as exc:
@@ -324,6 +342,8 @@ class Learner:
         if start is not None:
             rows &= table.t > start
         self._t_done = max(end, start) if start is not None else end
+        if self._line is not None:
+            self._pool_line(table, rows, states, line)
         self._learn(table, rows, states)
         t2 = time.perf_counter()
         if self.model is not None and (final or self._refresh_due or self.steps % self.options.refresh_every == 0):
@@ -339,6 +359,14 @@ class Learner:
             release_free_heap()
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": t3 - t2,
                         "trim": time.perf_counter() - t3}
+
+    def _pool_line(self, table: CoefficientTable, rows: np.ndarray, states, line: dict | None) -> None:
+        """The window's rows into the lift-line pool (at its own level) and the status updated; ``line``: the line
+        this window was estimated on (None: its own level)."""
+        self._line.add(table, rows, states, self.airframe)
+        handed = self.lift_line["handed"] + (line is not None)
+        self.lift_line = {"state": "carried" if self._line.line() is not None else "pooling",
+                          "windows": self._line.windows, "handed": handed, "note": self._line.note()}
 
     def _merge_can(self, flight, data: bytes):
         """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
