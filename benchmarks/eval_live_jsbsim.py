@@ -64,18 +64,20 @@ FORCES = ("CX", "CY", "CZ")
 
 
 def _pair_states(states):
-    """The part of a window's states the air-rate pair and the stated errors' pool read
-    (:data:`gcs_sysid.aero.gustfilter.AIR_ROLL_STATE_KEYS`, :data:`gcs_sysid.aero.errorpool.POOL_STATE_KEYS`)."""
+    """The part of a window's states the air-rate pair, the stated errors' pool and the lift line's pool read
+    (:data:`gcs_sysid.aero.gustfilter.AIR_ROLL_STATE_KEYS`, :data:`gcs_sysid.aero.errorpool.POOL_STATE_KEYS`;
+    ``ax`` and alpha's aiding fit, :class:`gcs_sysid.aero.liftline.LiftLinePool`)."""
     from gcs_sysid.aero.errorpool import POOL_STATE_KEYS
     from gcs_sysid.aero.gustfilter import AIR_ROLL_STATE_KEYS
     from gcs_sysid.estimation.states import FlightStates
 
     if states is None:
         return None
-    data = set(AIR_ROLL_STATE_KEYS["data"]) | set(POOL_STATE_KEYS["data"])
+    data = set(AIR_ROLL_STATE_KEYS["data"]) | set(POOL_STATE_KEYS["data"]) | {"ax"}
     sigma = set(AIR_ROLL_STATE_KEYS["sigma"]) | set(POOL_STATE_KEYS["sigma"])
     return FlightStates(states.t, states.rate_hz, {k: states.data[k] for k in sorted(data) if k in states.data},
-                        {k: states.sigma[k] for k in sorted(sigma) if k in states.sigma})
+                        {k: states.sigma[k] for k in sorted(sigma) if k in states.sigma},
+                        angle_fits={k: v for k, v in states.angle_fits.items() if k == "alpha"})
 
 
 def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None) -> list[tuple]:
@@ -115,17 +117,22 @@ def held_rows_of_windows(steps: list[tuple], t_cut: float) -> tuple[np.ndarray, 
 
 
 def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = True,
-          stated_errors: bool = True):
+          stated_errors: bool = True, lift_line: bool = False):
     """The learner fed ``steps`` up to vehicle time ``t_cut`` (s) and its CPU s (its ``model``, ``outputs``,
-    ``n_learned``, ``air_roll``, ``errors``)."""
+    ``n_learned``, ``air_roll``, ``errors``, ``lift_line``). With ``lift_line`` (steps recorded with it,
+    :func:`record_steps`) the session's end is played too: its rows moved onto the windows' line and learned again
+    (:meth:`Learner.relevel`, what the final step of a session does)."""
     from gcs_sysid.live.learner import Learner, LearnOptions
 
     lr = Learner(airframe, LearnOptions(gp_noise=gp_noise, gp_seed=gp_seed, air_roll=air_roll,
-                                        stated_errors=stated_errors))
+                                        stated_errors=stated_errors, lift_line=lift_line))
     t0 = time.process_time()
     for k, (ident, table, rows, states) in enumerate(steps):
         lr.steps, lr.identifiable = k + 1, ident
+        lr._window_in(table, rows & (table.t < t_cut), states)
         lr._learn(table, rows & (table.t < t_cut), states)
+    if lift_line:
+        lr.relevel()
     return lr, time.process_time() - t0
 
 
@@ -209,7 +216,7 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
     Xw, Ytw = Xw[okw], Ytw[okw]
     out = []
     for noise, gs, pair, se in ((n, g, p, s) for n in noises for g in gp_seeds for p in air_rolls for s in stated):
-        lr, cpu = learn(steps, af, t_cut, noise, gs, pair, se)
+        lr, cpu = learn(steps, af, t_cut, noise, gs, pair, se, ll)
         model, outputs, n_learned = lr.model, lr.outputs, lr.n_learned
         cols = [COEFFICIENTS.index(c) for c in outputs]
         mean = np.full((int(h.sum()), 6), np.nan)
@@ -237,7 +244,8 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
                "max_corr": float(np.nanmax(C)) if C.size else 0.0, "notes": list(model.notes)[-3:],
                "air_roll": dict(lr.air_roll) if pair else None, "stated_errors": bool(se),
                "errors_note": lr.errors.get("note", ""), "lift_line": bool(ll),
-               "lift_line_status": status, "alpha_levels_deg": [round(x, 3) for x in levels]}
+               "lift_line_status": {**status, **{k: v for k, v in lr.lift_line.items() if k != "note"}},
+               "alpha_levels_deg": [round(x, 3) for x in levels]}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc

@@ -75,8 +75,10 @@ class LiftLinePool:
         self.windows = 0
         self.rows = 0
         self.span_s = 0.0
+        self.handed = 0          # windows added that a carried line had moved
+        self._means: dict = {}   # key -> (rows, mean of LINE_COLUMNS at the own level, mean CL, the line's move)
 
-    def add(self, table, rows: np.ndarray, states, airframe) -> int:
+    def add(self, table, rows: np.ndarray, states, airframe, key=None) -> int:
         """Add one window's rows at the window's own alpha level.
 
         Args:
@@ -86,6 +88,8 @@ class LiftLinePool:
                 the specific force along body x, m/s^2; ``qbar``, Pa; ``angle_fits["alpha"]`` the aiding's fit:
                 ``mean_shift`` is undone where a line moved alpha, ``wind_sigma`` or ``bias_sigma`` is ``s_k``).
             airframe: mass (kg) and S (m^2).
+            key: a name for the window's rows (hashable; None: the count of windows added before): its means are
+                kept for :meth:`move` (the window's rows moved onto a later line).
 
         Returns:
             the number of rows added (0: none finite).
@@ -108,6 +112,8 @@ class LiftLinePool:
         if n < 2:
             return 0
         z, y = Z[m], CL[m]
+        self._means[self.windows if key is None else key] = (n, z.mean(axis=0), float(y.mean()), shift)
+        self.handed += int(moved)
         zc, yc = z - z.mean(axis=0), y - y.mean()
         self._Sz += z.sum(axis=0)
         self._Sy += float(y.sum())
@@ -149,6 +155,22 @@ class LiftLinePool:
         s_line = theta[0] * np.sqrt(self._Ss2 / self._Ns2 / K)
         return {"CL0": float(CL0), "CL_alpha": float(theta[0]), "CL_q": float(max(theta[1], 0.0)),
                 "CL_delta_e": float(theta[2]), "CL0_sigma": float(s_line)}
+
+    def move(self, key, line: dict[str, float]) -> float:
+        """The move of window ``key``'s rows (as learned: their own level plus the carried line's move then) onto
+        ``line``'s level, rad: ``d - shift``, ``d`` the window's own level's offset from the line
+        (``mean((CL - CL0 - CL_q q_hat - CL_delta_e delta_e) / CL_alpha - alpha)`` over its rows, from the means kept;
+        :func:`gcs_sysid.estimation.airangles.lift_level` with the full weight), ``shift`` the carried line's move.
+        0 for a window without rows in the pool.
+
+        Args:
+            key: as given to :meth:`add`. line: a :meth:`line`.
+        """
+        if key not in self._means:
+            return 0.0
+        _, zm, ym, shift = self._means[key]
+        d = (ym - line["CL0"] - line["CL_q"] * zm[1] - line["CL_delta_e"] * zm[2]) / line["CL_alpha"] - zm[0]
+        return float(d - shift)
 
     def note(self) -> str:
         """One line: the line stated now, or why none."""

@@ -264,6 +264,8 @@ class Learner:
             self._line = LiftLinePool(self.options.window_s)
         self.lift_line = {"state": "pooling" if self._line is not None else "off", "windows": 0, "handed": 0,
                           "note": ""}
+        self._win = np.zeros(0, int)          # the window (learning call) each kept row came from
+        self._win_key = 0
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -342,9 +344,10 @@ class Learner:
         if start is not None:
             rows &= table.t > start
         self._t_done = max(end, start) if start is not None else end
-        if self._line is not None:
-            self._pool_line(table, rows, states, line)
+        self._window_in(table, rows, states)
         self._learn(table, rows, states)
+        if final and self._line is not None:
+            self.relevel()
         t2 = time.perf_counter()
         if self.model is not None and (final or self._refresh_due or self.steps % self.options.refresh_every == 0):
             if not final and self.behind is not None and self._replayed is None and self.behind():
@@ -360,13 +363,80 @@ class Learner:
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": t3 - t2,
                         "trim": time.perf_counter() - t3}
 
-    def _pool_line(self, table: CoefficientTable, rows: np.ndarray, states, line: dict | None) -> None:
-        """The window's rows into the lift-line pool (at its own level) and the status updated; ``line``: the line
-        this window was estimated on (None: its own level)."""
-        self._line.add(table, rows, states, self.airframe)
-        handed = self.lift_line["handed"] + (line is not None)
-        self.lift_line = {"state": "carried" if self._line.line() is not None else "pooling",
-                          "windows": self._line.windows, "handed": handed, "note": self._line.note()}
+    def _window_in(self, table: CoefficientTable, rows: np.ndarray, states) -> None:
+        """A window's rows are about to be learned (``rows`` (T,) bool): a new key for the rows kept, and with
+        ``LearnOptions.lift_line`` the rows into the lift-line pool (at the window's own level, under that key).
+        The step runs it before :meth:`_learn`; so does a caller feeding :meth:`_learn` recorded windows."""
+        if not rows.any():
+            return
+        self._win_key += 1
+        if self._line is None:
+            return
+        self._line.add(table, rows, states, self.airframe, key=self._win_key)
+        self.lift_line = {**self.lift_line, "state": "carried" if self._line.line() is not None else "pooling",
+                          "windows": self._line.windows, "handed": self._line.handed, "note": self._line.note()}
+        self.lift_line = {**self.lift_line, "state": "carried" if self._line.line() is not None else "pooling",
+                          "windows": self._line.windows, "handed": self._line.handed, "note": self._line.note()}
+
+    def relevel(self) -> None:
+        """Move every kept row's alpha onto the lift line of all windows so far and learn the GP again on them
+        (``LearnOptions.lift_line``; run by the final step, before its refresh; ``docs/live.md``, "The lift line
+        carried across windows").
+
+        Each window's rows were learned at the level of the line carried when it was estimated; the line of all
+        windows is the best level the session has, and rows at one level are what a GP learns a slope from (the
+        windows' levels differ by degrees; :mod:`gcs_sysid.aero.liftline`). The rows kept (:attr:`X`, at most
+        ``max_rows``, thinned evenly beyond) are moved by their window's :meth:`LiftLinePool.move` and learned
+        again as the session learned them: the first fit on the first ``min_rows`` rows (the same outputs and
+        ``GPConfig``), then ``model.update`` window by window with the light hyperparameter refreshes; targets as
+        learned (the air-rate pair's Cl included). The model's band at exact conditions then states alpha's offset
+        as the line's level's 1-sigma (``CL0_sigma / CL_alpha``) in place of the windows' own. Nothing happens
+        without a model or a line; :attr:`lift_line` says what was done (``state`` ``"relevelled"``, ``moved_rms``
+        rad, ``rows``).
+        """
+        from ..gp import fit_gp
+
+        line = self._line.line() if self._line is not None else None
+        if self.model is None or line is None or not len(self.t):
+            if self._line is not None:
+                self.lift_line = {**self.lift_line, "note": self._line.note() + "; rows not relevelled"}
+            return
+        moves = np.array([self._line.move(int(k), line) for k in self._win])
+        self.X[:, REGRESSORS.index("alpha")] += moves
+        cols = [COEFFICIENTS.index(c) for c in self.outputs]
+        model, pending, n, self._since_hyper = None, [], 0, 0
+        for k in dict.fromkeys(self._win.tolist()):      # the windows in the order learned
+            sel = self._win == k
+            X, Y = self.X[sel], self.Y[sel][:, cols]
+            ok = np.any(np.isfinite(Y), axis=1)
+            X, Y = X[ok], Y[ok]
+            if model is None:
+                pending.append((X, Y))
+                if sum(len(x) for x, _ in pending) < self.options.min_rows:
+                    continue
+                X, Y = np.concatenate([x for x, _ in pending]), np.concatenate([y for _, y in pending])
+                model, _ = fit_gp(X, Y, learner_gp_config(self.options))
+            elif len(X):
+                model = model.update(X, Y)
+                self._since_hyper += len(X)
+            n += len(X)
+            self.model = model
+            if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
+                self._refresh_hyper()
+                model = self.model
+        if model is None:                                  # fewer kept rows than min_rows: one fit on them all
+            X, Y = np.concatenate([x for x, _ in pending]), np.concatenate([y for _, y in pending])
+            model, _ = fit_gp(X, Y, learner_gp_config(self.options))
+            n = len(X)
+        self.model, self.n_learned = model, n
+        s_a = line["CL0_sigma"] / line["CL_alpha"]
+        self._state_errors(alpha_sigma=s_a)
+        rms = float(np.sqrt(np.mean(moves**2)))
+        self.lift_line = {**self.lift_line, "state": "relevelled", "moved_rms": rms, "rows": int(n),
+                          "note": (f"{self._line.note()}; the {n} rows kept moved onto it (RMS move "
+                                   f"{np.degrees(rms):.2f} deg) and learned again; alpha's stated offset "
+                                   f"{np.degrees(s_a):.2f} deg")}
+        self.notes.append(f"step {self.steps}: {self.lift_line['note']}")
 
     def _merge_can(self, flight, data: bytes):
         """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
@@ -445,14 +515,21 @@ class Learner:
                 self._refresh_hyper()
         self._state_errors()
 
-    def _state_errors(self) -> None:
+    def _state_errors(self, alpha_sigma: float | None = None) -> None:
         """Give the model the pooled statement of the windows learned so far (``LearnOptions.stated_errors``): its
-        band at exact conditions only (:func:`gcs_sysid.gp.discrepancy.with_offset_covariance`, the replay's)."""
+        band at exact conditions only (:func:`gcs_sysid.gp.discrepancy.with_offset_covariance`, the replay's).
+        ``alpha_sigma`` (rad): alpha's offset stated as this 1-sigma, uncorrelated with the others' (the rows at
+        one lift line's level, :meth:`relevel`), in place of the windows' pooled one."""
         if self._errors is None or self.model is None:
             return
         from ..gp.discrepancy import with_offset_covariance
 
         off, sv, mc, note = self._errors.statement()
+        if alpha_sigma is not None and off is not None:
+            off = off.copy()
+            off[0, :] = off[:, 0] = 0.0
+            off[0, 0] = alpha_sigma**2
+            note += f"; alpha offset restated {alpha_sigma:.4f} rad (the rows at the lift line's level)"
         self.model = with_offset_covariance(self.model, off, scale_var=sv, map_cov=mc)
         self.errors = {"state": "pooling", "windows": self._errors.windows, "rows": self._errors.rows, "note": note}
 
@@ -572,8 +649,9 @@ class Learner:
         self.X = np.concatenate([self.X, X])
         self.Y = np.concatenate([self.Y, Y])
         self.t = np.concatenate([self.t, t])
+        self._win = np.concatenate([self._win, np.full(len(t), self._win_key, int)])
         if len(self.t) > self.options.max_rows:   # thin evenly: the flown envelope stays covered
-            self.X, self.Y, self.t = self.X[::2], self.Y[::2], self.t[::2]
+            self.X, self.Y, self.t, self._win = self.X[::2], self.Y[::2], self.t[::2], self._win[::2]
 
     def table(self) -> CoefficientTable:
         """The learned rows kept, as a :class:`CoefficientTable` (all rows valid)."""
