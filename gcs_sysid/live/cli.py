@@ -35,6 +35,11 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "instruments' checks; refused: the gyro's rate for the whole session); default on (since the "
                         "sixty-sixth session; 'off': Cl learned at the gyro's rate); "
                         "docs/live.md, 'The air-rate pair'")
+    p.add_argument("--lift-line", default="off", choices=("on", "off"),
+                   help="carry a lift line across the learner's windows: each window's alpha level is set on the line "
+                        "of the windows so far instead of its own 30 s of mean vertical wind, and at the end every "
+                        "row is moved onto the line of all windows and learned again; default off; docs/live.md, "
+                        "'The lift line carried across windows'")
     p.add_argument("--rate-errors", default=None, choices=("on", "off"),
                    help="the gyro rates' errors (the rolling gust's share of p_hat, the yaw gust rate's map of "
                         "r_hat) in the saved model's band at exact conditions, pooled over the windows with the "
@@ -69,6 +74,7 @@ def cmd_listen(a: argparse.Namespace) -> int:
     learn = None if a.no_learn else LearnOptions(window_s=a.window, step_s=a.step, lag_s=a.lag,
                                                  min_rows=a.min_rows, n_inducing=a.inducing,
                                                  gp_noise=a.gp_noise, air_roll=a.air_roll == "on",
+                                                 lift_line=a.lift_line == "on",
                                                  rate_errors=None if a.rate_errors is None else a.rate_errors == "on")
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
                          component=not a.no_component, system_id=a.sysid, component_id=a.compid,

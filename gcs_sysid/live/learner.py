@@ -392,7 +392,7 @@ class Learner:
         learned (the air-rate pair's Cl included). The model's band at exact conditions then states alpha's offset
         as the line's level's 1-sigma (``CL0_sigma / CL_alpha``) in place of the windows' own. Nothing happens
         without a model or a line; :attr:`lift_line` says what was done (``state`` ``"relevelled"``, ``moved_rms``
-        rad, ``rows``).
+        and ``level_sigma`` rad, ``rows``).
         """
         from ..gp import fit_gp
 
@@ -433,6 +433,7 @@ class Learner:
         self._state_errors(alpha_sigma=s_a)
         rms = float(np.sqrt(np.mean(moves**2)))
         self.lift_line = {**self.lift_line, "state": "relevelled", "moved_rms": rms, "rows": int(n),
+                          "level_sigma": float(s_a),
                           "note": (f"{self._line.note()}; the {n} rows kept moved onto it (RMS move "
                                    f"{np.degrees(rms):.2f} deg) and learned again; alpha's stated offset "
                                    f"{np.degrees(s_a):.2f} deg")}

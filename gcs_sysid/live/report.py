@@ -44,6 +44,10 @@ def render_markdown(snap: dict) -> str:
                          f"{ar['state']}" + (f"; {ar['rows_moved']} rows learned with a moved Cl"
                                             if ar.get("rows_moved") is not None else "")
                          + (f" ({ar['note']})" if ar.get("note") else ""))
+        ll = snap.get("lift_line") or {}
+        if ll.get("state", "off") != "off":
+            lines.append(f"- the lift line carried across windows (`--lift-line on`): {ll['state']}"
+                         + (f" ({ll['note']})" if ll.get("note") else ""))
         se = snap.get("stated_errors") or {}
         if se.get("note"):
             lines.append(f"- the model's band at exact conditions (`gcs-sysid predict`): {se['note']}")

@@ -342,6 +342,7 @@ class LiveSession:
                 "coalesced_at_us": list(learner.coalesced_at),
                 "air_roll": dict(getattr(learner, "air_roll", {})),
                 "stated_errors": dict(getattr(learner, "errors", {})),
+                "lift_line": dict(getattr(learner, "lift_line", {})),
                 "learner_in": "worker process" if self._remote else "this process",
             })
         return snap
