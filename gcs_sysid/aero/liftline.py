@@ -41,7 +41,7 @@ import numpy as np
 
 from .table import REGRESSORS
 
-__all__ = ["LiftLinePool", "LINE_COLUMNS", "MIN_LINE_S"]
+__all__ = ["LiftLinePool", "LINE_COLUMNS", "MIN_LINE_S", "MAX_LEVEL_SIGMA"]
 
 #: the line's regressors after the intercept (names of :data:`gcs_sysid.aero.table.REGRESSORS`)
 LINE_COLUMNS = ("alpha", "q_hat", "delta_e")
@@ -49,6 +49,15 @@ LINE_COLUMNS = ("alpha", "q_hat", "delta_e")
 MIN_LINE_S = 5.0
 #: a column whose within-window SD is below this (its units: rad or -) is left out of the slopes (held at 0)
 MIN_COLUMN_SD = 1e-4
+#: the largest 1-sigma of the line's level (``CL0_sigma / CL_alpha``, rad) at which the line is carried (:meth:`
+#: LiftLinePool.carried`). Rows at one level are what a GP learns alpha's slopes from, but that level carries the
+#: flight's mean vertical wind, which nothing in the log observes; where it is large (slow aircraft in turbulence) a
+#: model learned on one biased level trusts it, while rows whose levels wander lean on the other regressors. Set at
+#: 1 deg on the tuning flights of the sixty-seventh session (JSBSim, 25 aircraft, seed 19, 120 s, light): every
+#: flight whose line stated 0.15-0.70 deg learned CZ better at JSBSim's regressors with its rows on the line
+#: (12 of 12), those at 1.16-3.64 deg as often worse as better and up to three times worse (rascal, eternity, us25e;
+#: ``docs/benchmarks.md``, "Sixty-seventh session").
+MAX_LEVEL_SIGMA = float(np.radians(1.0))
 
 
 class LiftLinePool:
@@ -156,7 +165,13 @@ class LiftLinePool:
         return {"CL0": float(CL0), "CL_alpha": float(theta[0]), "CL_q": float(max(theta[1], 0.0)),
                 "CL_delta_e": float(theta[2]), "CL0_sigma": float(s_line)}
 
-    def move(self, key, line: dict[str, float]) -> float:
+    def carried(self) -> dict[str, float] | None:
+        """:meth:`line` where its level's 1-sigma ``CL0_sigma / CL_alpha`` is at most :data:`MAX_LEVEL_SIGMA`, else
+        None (the windows keep their own levels)."""
+        ln = self.line()
+        return ln if ln is not None and ln["CL0_sigma"] / ln["CL_alpha"] <= MAX_LEVEL_SIGMA else None
+
+    def move(self, key, line: dict[str, float] | None) -> float:
         """The move of window ``key``'s rows (as learned: their own level plus the carried line's move then) onto
         ``line``'s level, rad: ``d - shift``, ``d`` the window's own level's offset from the line
         (``mean((CL - CL0 - CL_q q_hat - CL_delta_e delta_e) / CL_alpha - alpha)`` over its rows, from the means kept;
@@ -164,11 +179,13 @@ class LiftLinePool:
         0 for a window without rows in the pool.
 
         Args:
-            key: as given to :meth:`add`. line: a :meth:`line`.
+            key: as given to :meth:`add`. line: a :meth:`line`; None: back to the window's own level (``-shift``).
         """
         if key not in self._means:
             return 0.0
         _, zm, ym, shift = self._means[key]
+        if line is None:
+            return -float(shift)
         d = (ym - line["CL0"] - line["CL_q"] * zm[1] - line["CL_delta_e"] * zm[2]) / line["CL_alpha"] - zm[0]
         return float(d - shift)
 

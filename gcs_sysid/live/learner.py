@@ -322,7 +322,7 @@ class Learner:
                 raise SysidError("no usable messages in the window")
             if self.can_source is not None:
                 flight = self._merge_can(flight, data)
-            line = self._line.line() if self._line is not None else None
+            line = self._line.carried() if self._line is not None else None
             states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz, lift_line=line)
             self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
@@ -390,19 +390,50 @@ class Learner:
         again as the session learned them: the first fit on the first ``min_rows`` rows (the same outputs and
         ``GPConfig``), then ``model.update`` window by window with the light hyperparameter refreshes; targets as
         learned (the air-rate pair's Cl included). The model's band at exact conditions then states alpha's offset
-        as the line's level's 1-sigma (``CL0_sigma / CL_alpha``) in place of the windows' own. Nothing happens
-        without a model or a line; :attr:`lift_line` says what was done (``state`` ``"relevelled"``, ``moved_rms``
-        and ``level_sigma`` rad, ``rows``).
+        as the line's level's 1-sigma (``CL0_sigma / CL_alpha``) in place of the windows' own. Where that 1-sigma
+        exceeds :data:`gcs_sysid.aero.liftline.MAX_LEVEL_SIGMA` (1 deg) the rows go back to their own windows'
+        levels instead (learned again only if a carried line had moved some) and the windows' own statement stays.
+        Nothing happens without a model or a line; :attr:`lift_line` says what was done (``state`` ``"relevelled"``
+        or ``"own levels"``, ``moved_rms`` and ``level_sigma`` rad, ``rows``).
         """
-        from ..gp import fit_gp
+        from ..aero.liftline import MAX_LEVEL_SIGMA
 
         line = self._line.line() if self._line is not None else None
         if self.model is None or line is None or not len(self.t):
             if self._line is not None:
                 self.lift_line = {**self.lift_line, "note": self._line.note() + "; rows not relevelled"}
             return
-        moves = np.array([self._line.move(int(k), line) for k in self._win])
+        s_a = line["CL0_sigma"] / line["CL_alpha"]
+        onto = line if s_a <= MAX_LEVEL_SIGMA else None
+        moves = np.array([self._line.move(int(k), onto) for k in self._win])
+        rms = float(np.sqrt(np.mean(moves**2)))
+        base = {**self.lift_line, "moved_rms": rms, "level_sigma": float(s_a), "rows": 0}
+        if onto is None:
+            self.lift_line = {**base, "state": "own levels",
+                              "note": (f"{self._line.note()}; its level's 1-sigma {np.degrees(s_a):.2f} deg is above "
+                                       f"{np.degrees(MAX_LEVEL_SIGMA):g} deg: the rows keep their own windows' "
+                                       "levels" + (f" (moved back by {np.degrees(rms):.2f} deg RMS and learned again)"
+                                                   if rms > 0 else ""))}
+            self.notes.append(f"step {self.steps}: {self.lift_line['note']}")
+            if rms == 0:
+                return
         self.X[:, REGRESSORS.index("alpha")] += moves
+        n = self._learn_again()
+        self.lift_line["rows"] = n
+        if onto is None:
+            self._state_errors()
+            return
+        self._state_errors(alpha_sigma=s_a)
+        self.lift_line = {**base, "state": "relevelled", "rows": n,
+                          "note": (f"{self._line.note()}; the {n} rows kept moved onto it (RMS move "
+                                   f"{np.degrees(rms):.2f} deg) and learned again; alpha's stated offset "
+                                   f"{np.degrees(s_a):.2f} deg")}
+        self.notes.append(f"step {self.steps}: {self.lift_line['note']}")
+
+    def _learn_again(self) -> int:
+        """The GP learned again on the kept rows as the session learned them (:meth:`relevel`); returns the rows."""
+        from ..gp import fit_gp
+
         cols = [COEFFICIENTS.index(c) for c in self.outputs]
         model, pending, n, self._since_hyper = None, [], 0, 0
         for k in dict.fromkeys(self._win.tolist()):      # the windows in the order learned
@@ -429,15 +460,7 @@ class Learner:
             model, _ = fit_gp(X, Y, learner_gp_config(self.options))
             n = len(X)
         self.model, self.n_learned = model, n
-        s_a = line["CL0_sigma"] / line["CL_alpha"]
-        self._state_errors(alpha_sigma=s_a)
-        rms = float(np.sqrt(np.mean(moves**2)))
-        self.lift_line = {**self.lift_line, "state": "relevelled", "moved_rms": rms, "rows": int(n),
-                          "level_sigma": float(s_a),
-                          "note": (f"{self._line.note()}; the {n} rows kept moved onto it (RMS move "
-                                   f"{np.degrees(rms):.2f} deg) and learned again; alpha's stated offset "
-                                   f"{np.degrees(s_a):.2f} deg")}
-        self.notes.append(f"step {self.steps}: {self.lift_line['note']}")
+        return int(n)
 
     def _merge_can(self, flight, data: bytes):
         """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
