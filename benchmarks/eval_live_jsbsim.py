@@ -24,6 +24,11 @@ the pair add the learner's ``air_roll`` status, ``gp_air_cl`` (the held-out Cl
 asked at ``p_hat - p_hat_g``, ``heldout_air_roll`` ``"predicted:Cl"`` with the learner's own roll fit: the replay's
 question, post hoc), ``ls_air_cl`` (least squares asked there too) and ``cov_gp_air_cl`` (Cl's band there).
 
+``--lift-line off on`` (sixty-seventh session) records the windows twice, without and with the lift line carried
+across them (``LearnOptions.lift_line``: it changes the windows' estimates), and the learner with it plays the session's
+end (:meth:`Learner.relevel`); rows add ``lift_line``, ``lift_line_status`` and ``alpha_levels_deg`` (each window's
+mean alpha error against JSBSim's, :func:`window_levels`).
+
 Counts (:func:`counts`; thresholds as issue 8: held-out / true-air within 5 % forces, 10 % moments; GP better than
 LS; bands 90-98 %, the band at exact conditions also per coefficient, ``cov_true_air_c``; a learned output correlation
 above 0.5) and flips of each variant (:func:`variant`: the noise, ``+air-roll``, ``-unstated``) against ``--base``

@@ -101,11 +101,15 @@ class LearnOptions:
             session). The model's mean and its bands at the flight's own regressors do not change.
         rate_errors: with ``stated_errors``, also the gyro rates' errors (:mod:`gcs_sysid.aero.rateerrors`; ``gcs-sysid
             listen --rate-errors on|off``); None: :data:`gcs_sysid.aero.rateerrors.RATE_ERRORS`, as the replay.
-        lift_line: carry a lift line across the windows (``gcs-sysid listen --lift-line on|off``; opt-in): every
-            window's rows, at the window's own alpha level, join a pool (:class:`gcs_sysid.aero.liftline.LiftLinePool`:
-            slopes within windows, the level from all of them), and the next window's aided alpha is set on the
-            pool's line (:func:`gcs_sysid.estimation.estimate_states`, ``lift_line``) instead of on its own 30 s of
-            mean vertical wind (``docs/live.md``, "The lift line carried across windows").
+        lift_line: carry a lift line across the windows (``gcs-sysid listen --lift-line on|off``; opt-in: the rule
+            written for it held for CZ and failed for Cm on fresh flights, ``docs/benchmarks.md``, "Sixty-seventh
+            session"): every window's rows, at the window's own alpha level, join a pool
+            (:class:`gcs_sysid.aero.liftline.LiftLinePool`: slopes within windows, the level from all of them); the
+            next window's aided alpha is set on the pool's line (:func:`gcs_sysid.estimation.estimate_states`,
+            ``lift_line``) instead of on its own 30 s of mean vertical wind, and at the session's end every kept row
+            is moved onto the line of all windows and learned again (:meth:`Learner.relevel`); both only where the
+            line's level is known to :data:`gcs_sysid.aero.liftline.MAX_LEVEL_SIGMA` (``docs/live.md``, "The lift
+            line carried across windows").
     """
 
     window_s: float = 30.0
@@ -201,8 +205,10 @@ class Learner:
         errors: the pooled regressor errors the model carries (``LearnOptions.stated_errors``): ``state`` (``"off"``,
             ``"pooling"``), ``windows``, ``rows`` and ``note`` (what is stated, :meth:`WindowErrorPool.statement`).
         lift_line: the carried lift line's status (``LearnOptions.lift_line``): ``state`` (``"off"``, ``"pooling"``
-            before the pool states a line, ``"carried"``), ``windows`` (pooled), ``handed`` (windows estimated on a
-            line) and ``note`` (:meth:`~gcs_sysid.aero.liftline.LiftLinePool.note`).
+            before the pool states a line, ``"carried"``, and at the end ``"relevelled"`` or ``"own levels"``,
+            :meth:`relevel`), ``windows`` (pooled), ``handed`` (windows a carried line moved), ``note``
+            (:meth:`~gcs_sysid.aero.liftline.LiftLinePool.note` and what the end did) and after the end
+            ``moved_rms``, ``level_sigma`` (rad) and ``rows``.
     """
 
     airframe: Airframe
@@ -300,7 +306,9 @@ class Learner:
     def finish(self) -> None:
         """Learn what is left in the window (at the end of a session): rows up to its very end."""
         if self._window:
-            self.step(final=True)
+            self.step(final=True)       # with LearnOptions.lift_line it relevels before its refresh
+        elif self._line is not None:
+            self.relevel()
         if self._errors is not None and self.model is not None:
             self.notes.append(f"end: {self.errors['note']}")
 
