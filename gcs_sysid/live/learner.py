@@ -14,7 +14,10 @@ The same stages as the replay (:mod:`gcs_sysid.pipeline`), run causally on a lag
    ``LearnOptions.air_roll`` Cl's target is first moved to the air-relative roll rate (the air-rate pair's
    roll fit made once on the first fit's rows, its fixed parameters on every later window; ``docs/live.md``,
    "The air-rate pair");
-4. every ``refresh_every`` steps the confidence map and the maneuver suggestions are refreshed.
+4. every ``refresh_every`` steps the confidence map and the maneuver suggestions are refreshed;
+5. with ``LearnOptions.lift_line`` (opt-in) each window's alpha level is set on the lift line of the windows so far,
+   and the final step moves every kept row onto the line of all windows and learns the GP again on them
+   (:meth:`Learner.relevel`; ``docs/live.md``, "The lift line carried across windows").
 
 The schedule is driven by the records' stamps, never by the processing's wall clock, so feeding the
 records of a session's ``raw.tlog`` again (:func:`learn_from_tlog`) gives the same windows, the same
