@@ -85,15 +85,18 @@ def _pair_states(states):
                         angle_fits={k: v for k, v in states.angle_fits.items() if k == "alpha"})
 
 
-def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None) -> list[tuple]:
+def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None,
+                 alpha_profile: tuple[str, ...] | None = None) -> list[tuple]:
     """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states)`` of every GP step
     (``states``: the part the air-rate pair reads). ``lift_line``: the learner's carried lift line
     (``LearnOptions.lift_line``: it changes the windows' estimates, so it is recorded here, not in :func:`learn`);
-    ``status``: a dict updated with the recorder's ``lift_line`` status at the end."""
+    ``status``: a dict updated with the recorder's ``lift_line`` status at the end; ``alpha_profile``:
+    ``LearnOptions.alpha_profile`` (the windows' estimates too)."""
     from gcs_sysid.live.learner import Learner, LearnOptions, iter_tlog_records
 
     steps: list[tuple] = []
-    rec = Learner(airframe, LearnOptions(air_roll=False, lift_line=lift_line))   # records each step; learns nothing
+    rec = Learner(airframe, LearnOptions(air_roll=False, lift_line=lift_line,   # records each step; learns nothing
+                                         alpha_profile=alpha_profile))
     rec._learn = lambda table, rows, states=None: steps.append((dict(rec.identifiable), table, rows.copy(),
                                                                 _pair_states(states)))   # no GP here
     for stamp, packet in iter_tlog_records(tlog):
@@ -155,14 +158,16 @@ def window_levels(steps: list[tuple], truth) -> list[float]:
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
-             air_rolls=(True,), stated=(True,), lift_lines=(False,)) -> list[dict]:
+             air_rolls=(True,), stated=(True,), lift_lines=(False,), alpha_profile: bool = False) -> list[dict]:
     """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on x lift line off/on),
     JSON-able.
 
     ``lift_lines``: ``LearnOptions.lift_line`` values (the windows' lift line carried across them; each value records
     its own steps, :func:`record_steps`); each row says its own in ``lift_line`` with the learner's status in
     ``lift_line_status`` and its windows' alpha levels against the truth in ``alpha_levels_deg``
-    (:func:`window_levels`).
+    (:func:`window_levels`). ``alpha_profile``: the learner's windows with ``LearnOptions.alpha_profile =
+    ("delta_e",)`` (the whole-flight estimate and the LS reference keep least squares); rows say it in
+    ``alpha_profile``.
 
     ``stated``: ``LearnOptions.stated_errors`` values to run (the windows' pooled regressor errors in the model's
     band at exact conditions, ``cov_true_air``); each row says its own in ``stated_errors``.
@@ -202,17 +207,18 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     out = []
     for ll in lift_lines:
         out += _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut,
-                               Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll)
+                               Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile)
     return out
 
 
 def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut, Xt_air, h,
-                    ls_model, ls, noises, gp_seeds, air_rolls, stated, ll) -> list[dict]:
+                    ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile=False) -> list[dict]:
     """:func:`evaluate`'s rows of one ``lift_line`` value ``ll``."""
     Yt = truth.at(tab.t)[1]
     t0 = time.perf_counter()
     status: dict = {}
-    steps = record_steps(files.tlog, af, lift_line=ll, status=status)
+    steps = record_steps(files.tlog, af, lift_line=ll, status=status,
+                         alpha_profile=("delta_e",) if alpha_profile else None)
     t_rec = time.perf_counter() - t0
     levels = window_levels(steps, truth)
     Xw, tw = held_rows_of_windows(steps, t_cut)
@@ -250,7 +256,7 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
                "air_roll": dict(lr.air_roll) if pair else None, "stated_errors": bool(se),
                "errors_note": lr.errors.get("note", ""), "lift_line": bool(ll),
                "lift_line_status": {**status, **{k: v for k, v in lr.lift_line.items() if k != "note"}},
-               "alpha_levels_deg": [round(x, 3) for x in levels]}
+               "alpha_levels_deg": [round(x, 3) for x in levels], "alpha_profile": bool(alpha_profile)}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
@@ -289,7 +295,7 @@ def variant(row: dict) -> str:
     none and carry no such field), ``+lift-line`` with the windows' lift line carried (``LearnOptions.lift_line``)."""
     return (row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
             + ("-unstated" if row.get("stated_errors") is False else "")
-            + ("+lift-line" if row.get("lift_line") else ""))
+            + ("+lift-line" if row.get("lift_line") else "") + ("+alpha-profile" if row.get("alpha_profile") else ""))
 
 
 def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
@@ -409,6 +415,9 @@ def main(argv=None) -> int:
                     help="the learner's pooled regressor errors (LearnOptions.stated_errors) off and/or on")
     ap.add_argument("--lift-line", nargs="+", default=["off"], choices=("off", "on"),
                     help="the learner's lift line carried across its windows (LearnOptions.lift_line) off and/or on")
+    ap.add_argument("--alpha-profile", default="off", choices=("off", "on"),
+                    help="the learner's windows with the elevator's slope by the gust likelihood (LearnOptions."
+                         "alpha_profile)")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
     ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
                     help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")
@@ -428,7 +437,7 @@ def main(argv=None) -> int:
             for seed in a.seeds:
                 rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds,
                                 tuple(x == "on" for x in a.air_roll), tuple(x == "on" for x in a.stated_errors),
-                                tuple(x == "on" for x in a.lift_line))
+                                tuple(x == "on" for x in a.lift_line), a.alpha_profile == "on")
                 append_jsonl(a.json, rows)
     return 0
 

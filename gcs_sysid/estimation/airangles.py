@@ -993,7 +993,7 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
           V: np.ndarray | None = None, given: AxisFit | None = None, band_hz: float | None = None,
           slope_floor: float | None = None, floor_held: dict[str, float] | None = None, endog: tuple[str, ...] = (),
           min_first_stage: float = MIN_FIRST_STAGE_R2, weak_test: str | None = None, profile: bool = False,
-          gls: bool = False) -> tuple[np.ndarray, np.ndarray, AxisFit]:
+          gls: bool = False, profile_columns: tuple[str, ...] | None = None) -> tuple[np.ndarray, np.ndarray, AxisFit]:
     """Aid one angle; ``coeff`` is the measured CZ (alpha) or CY (beta), ``sign`` the expected sign
     of its slope (both negative), ``quadratic`` adds ``(angle - mean)^2`` to the model (CZ: lift
     curvature; measured on the SGS 2-33, where a linear CZ(alpha) leaves 0.3 deg of alpha error);
@@ -1199,7 +1199,8 @@ def _axis(name: str, dt: float, kin: np.ndarray, coeff: np.ndarray, others: dict
                 if BETA_PROFILE_HOLD:
                     held_slope = float(cr[0])
                     profile_note += ", held in the later passes"
-        prof = ([names.index(k) - 1 for k in ALPHA_PROFILE_COLUMNS if k in names[2:]]
+        cols_p = ALPHA_PROFILE_COLUMNS if profile_columns is None else profile_columns
+        prof = ([names.index(k) - 1 for k in cols_p if k in names[2:]]
                 if name == "alpha" and fixed is None and not method.startswith("2SLS") else [])
         if prof:
             # the columns least squares cannot separate from the gust get the slope under which the force-derived
@@ -1415,7 +1416,7 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
                      instrument_beta: bool | None = None, beta_band_hz: float | None = None,
                      stated_slopes: tuple[float | None, float | None] | None = None,
                      profile_beta: bool | None = None, stated_level: dict[str, float | None] | None = None,
-                     gls_beta: bool | None = None) -> AidedAngles:
+                     gls_beta: bool | None = None, alpha_profile: tuple[str, ...] | None = None) -> AidedAngles:
     """Fuse the kinematic air angles with the specific force (gust as a Gauss-Markov state).
 
     Args:
@@ -1472,6 +1473,8 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
         gls_beta: the side-force model's slopes of the first pass by generalised least squares under the gust model
             (:func:`_gls_gust_fit`), held in the later passes; only where they would be fitted by least squares (not
             with 2SLS or a given model). None: :data:`BETA_GLS`.
+        alpha_profile: the alpha model's columns whose slopes are chosen by the gust model's likelihood (e.g.
+            ``("delta_e",)``; :func:`_profile_columns`); None: :data:`ALPHA_PROFILE_COLUMNS` as it stands at the call.
 
     Returns:
         :class:`AidedAngles` (alpha's sigma includes ``AxisFit.bias_sigma``, the flight-mean vertical wind's
@@ -1559,7 +1562,7 @@ def aided_air_angles(dt: float, alpha_kin: np.ndarray, beta_kin: np.ndarray, V: 
     held = SLOPE_FLOOR and np.isfinite(floor) and share >= FLOOR_MIN_GUST_SHARE
     a, a_sig, fa = _axis("alpha", dt, alpha_kin, CZ, lon, u, passes, -1.0, True, False, mom_lon, inst, V,
                          (models or {}).get("alpha"), band_hz=edge, slope_floor=floor if held else None,
-                         floor_held=floor_held)
+                         floor_held=floor_held, profile_columns=alpha_profile)
     if stated_level is not None and fa.used and stated_level.get("CL0") is not None:
         a, a_sig = _level_onto_line(dt, a, a_sig, fa, k * f_body[:, 0], CZ, q_hat, de, u, stated_level)
     if "first pass with CZ_alpha held at" in fa.slope_method:

@@ -103,12 +103,13 @@ def _vane_angles(flight: Flight, airframe: Airframe, al):
 
 
 def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C, v_ned, sources, sigma, notes,
-                Wd=None, offsets=None, models=None, fits=None, profile_beta=None, gls_beta=None, lift_line=None):
+                Wd=None, offsets=None, models=None, fits=None, profile_beta=None, gls_beta=None, lift_line=None,
+                alpha_profile=None):
     """The kinematic alpha, beta aided by the specific force (:mod:`.airangles`) where the log allows;
     records sources, sigma, notes and the flight-common offsets' 1-sigma (``offsets``, rad; and the
     gusts in the wind) and the axes' fits (``fits``); ``models``: another flight's fits to take the alpha
-    model's slopes from; ``profile_beta``, ``gls_beta``, ``lift_line``: as :func:`estimate_states`; returns
-    ``(alpha, beta)``."""
+    model's slopes from; ``profile_beta``, ``gls_beta``, ``lift_line``, ``alpha_profile``: as :func:`estimate_states`;
+    returns ``(alpha, beta)``."""
     if f_cg is None or W is None or fly is None or not all(k in data for k in ("delta_e", "delta_a", "delta_r")):
         notes.append("alpha, beta: kinematic only (specific-force aiding needs accelerometers, gyro, pitot and "
                      "control outputs)")
@@ -116,7 +117,7 @@ def _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe, fly, C,
     ctrl = {k: data[k] for k in ("delta_e", "delta_a", "delta_r", "delta_t") if k in data}
     Ai = aided_air_angles(dt, alpha, beta, V, 0.5 * rho * V**2, f_cg - abias, W, ctrl, airframe.mass, airframe.S,
                           airframe.b, airframe.c, fly & np.isfinite(V), rate_dot=Wd, inertia=airframe.inertia,
-                          models=models, profile_beta=profile_beta, gls_beta=gls_beta,
+                          models=models, profile_beta=profile_beta, gls_beta=gls_beta, alpha_profile=alpha_profile,
                           stated_slopes=((getattr(airframe, "CL_alpha", None), getattr(airframe, "CL_q", None))
                                          if airangles.STATED_LIFT_SLOPE else None),
                           stated_level=(dict(lift_line) if lift_line is not None else
@@ -162,7 +163,8 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
                     gust_force_axes: tuple[int, ...] | None = None,
                     meanwhile: Callable[[], None] | None = None,
                     profile_beta: bool | None = None, gls_beta: bool | None = None,
-                    lift_line: dict[str, float] | None = None) -> FlightStates:
+                    lift_line: dict[str, float] | None = None,
+                    alpha_profile: tuple[str, ...] | None = None) -> FlightStates:
     """Smooth the states of a flight on a uniform grid.
 
     Args:
@@ -203,6 +205,9 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
             learner's line carried across its windows, :class:`gcs_sysid.aero.liftline.LiftLinePool`). It takes the
             place of the airframe's stated line (:data:`~gcs_sysid.estimation.airangles.STATED_LIFT_LEVEL`). None:
             the airframe's where that opt-in is on, else none.
+        alpha_profile: the alpha aiding's columns whose slopes are chosen by the gust model's likelihood
+            (``("delta_e",)``: the elevator's, which least squares loads with the gust's normal force in closed loop);
+            None: :data:`gcs_sysid.estimation.airangles.ALPHA_PROFILE_COLUMNS` as it stands at the call (``()``).
 
     Returns:
         :class:`FlightStates`; keys that could not be estimated are absent from
@@ -541,7 +546,7 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
         elif aid_air_angles:
             alpha, beta = _aid_angles(dt, alpha, beta, V, rho, f_cg, abias, W, data, airframe,
                                       fly, C, v_ned, sources, sigma, notes, Wd, offsets, angle_models, fits,
-                                      profile_beta, gls_beta, lift_line)
+                                      profile_beta, gls_beta, lift_line, alpha_profile)
     else:
         if have_tas:
             V = tas

@@ -40,6 +40,11 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "of the windows so far instead of its own 30 s of mean vertical wind, and at the end every "
                         "row is moved onto the line of all windows and learned again; default off; docs/live.md, "
                         "'The lift line carried across windows'")
+    p.add_argument("--alpha-profile", default="off", choices=("on", "off"),
+                   help="the windows' alpha aiding takes the elevator's slope by the gust model's likelihood instead "
+                        "of least squares (in closed loop least squares loads it with the gust's normal force, and "
+                        "the model reads Cm_delta_e short); default off; docs/live.md, 'The lift line carried across "
+                        "windows'")
     p.add_argument("--rate-errors", default=None, choices=("on", "off"),
                    help="the gyro rates' errors (the rolling gust's share of p_hat, the yaw gust rate's map of "
                         "r_hat) in the saved model's band at exact conditions, pooled over the windows with the "
@@ -75,6 +80,7 @@ def cmd_listen(a: argparse.Namespace) -> int:
                                                  min_rows=a.min_rows, n_inducing=a.inducing,
                                                  gp_noise=a.gp_noise, air_roll=a.air_roll == "on",
                                                  lift_line=a.lift_line == "on",
+                                                 alpha_profile=("delta_e",) if a.alpha_profile == "on" else None,
                                                  rate_errors=None if a.rate_errors is None else a.rate_errors == "on")
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,
                          component=not a.no_component, system_id=a.sysid, component_id=a.compid,

@@ -113,6 +113,12 @@ class LearnOptions:
             is moved onto the line of all windows and learned again (:meth:`Learner.relevel`); both only where the
             line's level is known to :data:`gcs_sysid.aero.liftline.MAX_LEVEL_SIGMA` (``docs/live.md``, "The lift
             line carried across windows").
+        alpha_profile: the windows' alpha aiding's columns whose slopes are chosen by the gust model's likelihood
+            (``("delta_e",)``, ``gcs-sysid listen --alpha-profile on``: the elevator's slope, which least squares loads
+            with the gust's normal force in closed loop, so that the aided alpha carries a share of the elevator and
+            the model reads ``Cm_delta_e - k Cm_alpha``; :func:`gcs_sysid.estimation.estimate_states`,
+            ``alpha_profile``); None: :data:`gcs_sysid.estimation.airangles.ALPHA_PROFILE_COLUMNS` (``()``, least
+            squares), as the replay and the diagnosis.
     """
 
     window_s: float = 30.0
@@ -132,6 +138,7 @@ class LearnOptions:
     stated_errors: bool = True
     rate_errors: bool | None = None
     lift_line: bool = False
+    alpha_profile: tuple[str, ...] | None = None
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -334,7 +341,8 @@ class Learner:
             if self.can_source is not None:
                 flight = self._merge_can(flight, data)
             line = self._line.carried() if self._line is not None else None
-            states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz, lift_line=line)
+            states = estimate_states(flight, self.airframe, rate_hz=self.options.rate_hz, lift_line=line,
+                                     alpha_profile=self.options.alpha_profile)
             self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
         except SysidError as exc:

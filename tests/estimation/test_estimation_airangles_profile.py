@@ -60,3 +60,17 @@ def test_elevator_slope_by_the_gust_likelihood_removes_the_elevator_loading(monk
     assert abs(fa_ml.coef[j] - CZ_DE) < 0.5 * abs(fa_ls.coef[j] - CZ_DE)
     assert abs(_loading(ml.alpha, alpha_true, d_e)) < 0.5 * abs(_loading(ls.alpha, alpha_true, d_e))
     assert "gust model's likelihood" in fa_ml.slope_method and not np.isfinite(fa_ml.coef_sigma[j])
+
+
+def test_the_call_argument_is_the_module_option_for_one_call(monkeypatch):
+    """``aided_air_angles(alpha_profile=)`` (what the live learner's ``LearnOptions.alpha_profile`` hands down through
+    ``estimate_states``) gives the module option's result for that call only, either way round."""
+    args, _, _ = _closed_loop(5)
+    monkeypatch.setattr(airangles, "ALPHA_PROFILE_COLUMNS", ("delta_e",))
+    glob = aided_air_angles(*args)
+    monkeypatch.setattr(airangles, "ALPHA_PROFILE_COLUMNS", ())
+    call = aided_air_angles(*args, alpha_profile=("delta_e",))
+    plain = aided_air_angles(*args)
+    assert np.array_equal(call.alpha, glob.alpha) and not np.array_equal(call.alpha, plain.alpha)
+    monkeypatch.setattr(airangles, "ALPHA_PROFILE_COLUMNS", ("delta_e",))
+    assert np.array_equal(aided_air_angles(*args, alpha_profile=()).alpha, plain.alpha)
