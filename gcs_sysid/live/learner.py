@@ -424,7 +424,8 @@ class Learner:
             return
         s_a = line["CL0_sigma"] / line["CL_alpha"]
         onto = line if s_a <= MAX_LEVEL_SIGMA else None
-        moves = np.array([self._line.move(int(k), onto) for k in self._win])
+        keys, inv = np.unique(self._win, return_inverse=True)
+        moves = np.array([self._line.move(int(k), onto) for k in keys])[inv]      # one move per window
         rms = float(np.sqrt(np.mean(moves**2)))
         base = {**self.lift_line, "moved_rms": rms, "level_sigma": float(s_a), "rows": 0}
         if onto is None:
@@ -451,35 +452,41 @@ class Learner:
 
     def _learn_again(self) -> int:
         """The GP learned again on the kept rows as the session learned them (:meth:`relevel`); returns the rows."""
-        from ..gp import fit_gp
-
         cols = [COEFFICIENTS.index(c) for c in self.outputs]
-        model, pending, n, self._since_hyper = None, [], 0, 0
+        self.model, pending, self.n_learned, self._since_hyper = None, [], 0, 0
         for k in dict.fromkeys(self._win.tolist()):      # the windows in the order learned
             sel = self._win == k
             X, Y = self.X[sel], self.Y[sel][:, cols]
+            if self.model is not None:
+                self._update_gp(X, Y)
+                continue
             ok = np.any(np.isfinite(Y), axis=1)
-            X, Y = X[ok], Y[ok]
-            if model is None:
-                pending.append((X, Y))
-                if sum(len(x) for x, _ in pending) < self.options.min_rows:
-                    continue
-                X, Y = np.concatenate([x for x, _ in pending]), np.concatenate([y for _, y in pending])
-                model, _ = fit_gp(X, Y, learner_gp_config(self.options))
-            elif len(X):
-                model = model.update(X, Y)
-                self._since_hyper += len(X)
-            n += len(X)
-            self.model = model
-            if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
-                self._refresh_hyper()
-                model = self.model
-        if model is None:                                  # fewer kept rows than min_rows: one fit on them all
-            X, Y = np.concatenate([x for x, _ in pending]), np.concatenate([y for _, y in pending])
-            model, _ = fit_gp(X, Y, learner_gp_config(self.options))
-            n = len(X)
-        self.model, self.n_learned = model, n
-        return int(n)
+            pending.append((X[ok], Y[ok]))
+            if sum(len(x) for x, _ in pending) >= self.options.min_rows:
+                self._first_fit_again(pending)
+        if self.model is None:                             # fewer kept rows than min_rows: one fit on them all
+            self._first_fit_again(pending)
+        return int(self.n_learned)
+
+    def _first_fit_again(self, pending: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        """:meth:`_learn_again`'s first fit on the rows held (the session's outputs and ``GPConfig``)."""
+        from ..gp import fit_gp
+
+        X, Y = np.concatenate([x for x, _ in pending]), np.concatenate([y for _, y in pending])
+        self.model, _ = fit_gp(X, Y, learner_gp_config(self.options))
+        self.n_learned = len(X)
+
+    def _update_gp(self, X: np.ndarray, Y: np.ndarray) -> None:
+        """``model.update`` with the rows ``X`` (N, 10), ``Y`` (N, P: the model's outputs) that carry an output
+        (partial rows kept, as in the first fit), and the light hyperparameter refresh when it is due."""
+        ok = np.any(np.isfinite(Y), axis=1)
+        if not ok.any():
+            return
+        self.model = self.model.update(X[ok], Y[ok])
+        self.n_learned += int(ok.sum())
+        self._since_hyper += int(ok.sum())
+        if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
+            self._refresh_hyper()
 
     def _merge_can(self, flight, data: bytes):
         """The window's flight with the CAN streams stamped up to its last record merged (or as it was)."""
@@ -548,14 +555,7 @@ class Learner:
                               f"({', '.join(self.outputs)})")
             self._state_errors()
             return
-        cols = [COEFFICIENTS.index(c) for c in self.outputs]
-        ok = np.any(np.isfinite(Y[:, cols]), axis=1)        # partial rows kept, as in the first fit
-        if ok.any():
-            self.model = self.model.update(X[ok], Y[ok][:, cols])
-            self.n_learned += int(ok.sum())
-            self._since_hyper += int(ok.sum())
-            if self.options.hyper_every and self._since_hyper >= self.options.hyper_every:
-                self._refresh_hyper()
+        self._update_gp(X, Y[:, [COEFFICIENTS.index(c) for c in self.outputs]])
         self._state_errors()
 
     def _state_errors(self, alpha_sigma: float | None = None) -> None:
