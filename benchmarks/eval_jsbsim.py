@@ -298,14 +298,16 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
              gust_rates: str | None = None, gust_filter: bool | str | None = None,
              heldout_air_roll: str | None = None, airp_lines: tuple[str, ...] = (),
              air_roll_train: bool | None = None, gp_seed: int = 0, beta_gls: bool | None = None,
-             air_yaw: bool | None = None, rate_errors: bool | None = None) -> dict:
+             air_yaw: bool | None = None, rate_errors: bool | None = None, air_pitch: bool | None = None) -> dict:
     """One flight scored (see the module docstring); returns a JSON-able dict. ``gust_rates``: the
     replay's and the fit's ``p_hat q_hat r_hat`` relative to the air (``ReplayOptions.gust_rates``; None: the
     replay's default, :data:`gcs_sysid.pipeline.REPLAY_GUST_RATES`, given to the fit too, so that both models are
     learned on the same rates). ``beta_gls``: ``ReplayOptions.beta_gls`` (None: the aiding's module switch,
     ``airangles.BETA_GLS``), given to the fit too (``run_fit(gls_beta=)``: both models on the replay's sideslip, which
     they are scored at). ``air_yaw``: ``ReplayOptions.air_yaw`` (None: the default, off). ``rate_errors``:
-    ``ReplayOptions.rate_errors`` (None: the default; the band at exact conditions only).
+    ``ReplayOptions.rate_errors`` (None: the default; the band at exact conditions only). ``air_pitch``:
+    ``ReplayOptions.air_pitch`` (None: the default, :data:`gcs_sysid.aero.airpitch.AIR_PITCH`); the least-squares line
+    (``run_fit``) is fitted at the gyro's ``q_hat`` either way and scored at the replay's held-out regressors.
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
@@ -317,6 +319,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ``gp_airp_MODE``, ``ls_airp_MODE``, ``cov_gp_airp_MODE`` and ``airp_MODE`` with the estimated gust against
     JSBSim's ``p - p_aero``; a diagnosis: the replay's table must not be gust-filtered)."""
     from gcs_sysid.aero import rateerrors as _rateerrors
+    from gcs_sysid.aero import airpitch as _airpitch
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -328,7 +331,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     out = work / f"{files.tlog.stem}-replay"
     af_path = stated_airframe(files.airframe, work, files.tlog.stem)     # files.airframe unless --stated-lift-slope
     opts = ReplayOptions(progress=False, gust_rates=gust_rates, beta_gls=beta_gls, air_yaw=air_yaw,
-                         rate_errors=rate_errors,
+                         rate_errors=rate_errors, air_pitch=air_pitch,
                          gust_filter=gust_filter, heldout_air_roll=heldout_air_roll, air_roll_train=air_roll_train,
                          gp_seed=gp_seed)
     gust_rates = replay_gust_rates(opts)      # the frame the replay used (None: the gyro's rates), for the fit too
@@ -348,6 +351,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
                  "gust_rates": gust_rates, "beta_gls": replay_beta_gls(opts), "air_yaw": air_yaw,
                  "rate_errors": _rateerrors.RATE_ERRORS if rate_errors is None else rate_errors,
+                 "air_pitch": _airpitch.AIR_PITCH if air_pitch is None else air_pitch,
+                 "air_pitch_note": next((n for n in res.table.notes if "pitch gust" in n), None),
                  "gust_filter": gust_filter,
                  "heldout_air_roll": heldout_air_roll, "air_roll_train": air_roll_train, "gp_seed": gp_seed,
                  "cy_rate_prior": _pipeline.SIDE_FORCE_RATE_PRIOR_STD,
@@ -762,6 +767,9 @@ def main(argv=None) -> int:
     ap.add_argument("--rate-errors", default=None, choices=("on", "off"),
                     help="the gyro rates' errors in the band at exact conditions (ReplayOptions.rate_errors, "
                          "gcs_sysid.aero.rateerrors; default: the replay's)")
+    ap.add_argument("--air-pitch", default=None, choices=("on", "off"),
+                    help="q_hat at the air-relative estimate, less the pitch gust rate with its fitted share "
+                         "(ReplayOptions.air_pitch, gcs_sysid.aero.airpitch; default: the replay's, off)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")
@@ -848,7 +856,8 @@ def main(argv=None) -> int:
                                None if a.air_roll_train is None else a.air_roll_train == "on", a.gp_seed,
                                beta_gls=None if a.beta_gls is None else a.beta_gls == "on",
                                air_yaw=None if a.air_yaw is None else a.air_yaw == "on",
-                               rate_errors=None if a.rate_errors is None else a.rate_errors == "on")
+                               rate_errors=None if a.rate_errors is None else a.rate_errors == "on",
+                               air_pitch=None if a.air_pitch is None else a.air_pitch == "on")
                 row["gp_fit"] = a.gp_fit
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"

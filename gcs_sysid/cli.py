@@ -86,6 +86,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "moment, the held-out Cn asked at r_hat less the yaw gust rate; the inputs stay the gyro's): "
                         "'on' opt-in, 'off' the default (docs/estimation.md, 'The yaw gust rate in the moments' "
                         "targets')")
+    r.add_argument("--air-pitch", default=None, choices=("on", "off"),
+                   help="q_hat at the air-relative estimate, the gyro's less the pitch gust rate from the "
+                        "reconstructed wind with its share in Cm fitted on the training rows (free sign; applied only "
+                        "when the fit shows it), for every output and row: 'on' opt-in, 'off' the default "
+                        "(docs/estimation.md, 'The air-relative pitch rate')")
     r.add_argument("--rate-errors", default=None, choices=("on", "off"),
                    help="state the gyro rates' errors as stand-ins for the air-relative rates in the model's band at "
                         "exact conditions (predict's sigma): p_hat's scale error from the rolling gust, r_hat's "
@@ -189,6 +194,7 @@ def _replay_options(a: argparse.Namespace):
                          beta_gls=None if a.beta_gls is None else a.beta_gls == "on",
                          air_yaw=None if a.air_yaw is None else a.air_yaw == "on",
                          rate_errors=None if a.rate_errors is None else a.rate_errors == "on",
+                         air_pitch=None if a.air_pitch is None else a.air_pitch == "on",
                          gp_noise=a.gp_noise, **_air_roll_options(getattr(a, "air_roll", None)))
 
 

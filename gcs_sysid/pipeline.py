@@ -114,6 +114,10 @@ class ReplayOptions:
             (Cl asked at ``p_hat - p_hat_g`` on the held-out rows); with ``"off"`` the held-out Cl is the model's at
             ``p_g = 0``. Not with ``gust_filter`` (that moves every output's ``p_hat`` instead). None:
             :data:`gcs_sysid.aero.gustfilter.AIR_ROLL_TRAIN` (on), off when ``gust_filter`` is on.
+        air_pitch: move every row's ``q_hat`` to the air-relative estimate ``q_hat - kappa g`` (``g`` the pitch gust
+            rate from the reconstructed wind, ``kappa`` its share in Cm fitted on the training rows with a free sign,
+            applied only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`), for every output, training and
+            held-out rows alike. None: :data:`gcs_sysid.aero.airpitch.AIR_PITCH` (off).
         gp_seed: ``GPConfig.seed`` of the GP fit (the hyperparameters' row subset, the inducing points; as the live
             learner's ``LearnOptions.gp_seed``). 0: ``GPConfig``'s own default. Issue 8's counts are judged at two
             seeds (the project's rule 8(b); ``benchmarks/eval_jsbsim.py --gp-seed``).
@@ -142,6 +146,7 @@ class ReplayOptions:
     air_roll_train: bool | None = None
     gp_noise: str | None = None
     gp_seed: int = 0
+    air_pitch: bool | None = None
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
@@ -554,6 +559,17 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
+        from .aero.airpitch import AIR_PITCH
+
+        if AIR_PITCH if options.air_pitch is None else options.air_pitch:
+            from .aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
+
+            with _stage("air pitch rate", timings, bar):
+                g_pitch, why = pitch_gust_hat(states, airframe.c, airframe.b)
+                if g_pitch is None:
+                    notes.append(why)
+                else:
+                    table = air_pitch_table(table, g_pitch, air_pitch_fit(table, g_pitch, train))  # its note
         from .aero.gustfilter import (AIR_ROLL_TRAIN, GUST_FILTER, HELDOUT_AIR_ROLL, air_roll_fit, air_roll_target,
                                       filter_gust_table, heldout_air_roll)
 

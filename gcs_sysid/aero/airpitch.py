@@ -1,0 +1,163 @@
+"""The air-relative pitch rate: the table's ``q_hat`` less the pitch gust rate the flight's own data support.
+
+The aerodynamics reads the body's pitch rate relative to the air, ``q - q_g`` (Etkin, *Dynamics of Atmospheric
+Flight*, Wiley 1972, ch. 13, gust gradients: ``q_g = -dw_g/dx``); the gyro measures ``q``. A coefficient learned at the
+gyro's ``q_hat`` carries the pitching gust moment ``-Cm_q q_hat_g`` as noise in its input: the fitted ``Cm_q`` is too
+weak (errors in variables; Fuller, *Measurement Error Models*, Wiley 1987, sec. 1.1) and ``Cm_alpha``, which moves with
+``q`` in a pitch manoeuvre, takes up the difference. Measured on 25 JSBSim flights of the tuning set (least squares of
+Cm on the ten regressors over the replay's training rows; ``docs/benchmarks.md``, "Sixty-eighth session"): with JSBSim's
+exact ``q_aero`` in place of the gyro's rate the navion's ``Cm_alpha`` reads -0.57 (its XML), with the gyro's -0.73;
+the s23's 0.00 against -0.47.
+
+The pitch gust rate is estimated from the reconstructed wind (:func:`gcs_sysid.estimation.gustrates.gust_rates`,
+frame ``"path"``: MIL-F-8785C's Dryden lag over ``4b/(pi V)`` of the vertical gust's derivative along the path, Etkin's
+sign) as a hat, ``g = q_g c / (2V)``. Its sign relative to the aerodynamics is the flight's to say, not this module's:
+JSBSim's turbulence (``FGWinds::Turbulence``, ``ttMilspec`` eq. 34, ``xi_q`` stepped with ``+d xi_w/dt / V``) has the
+opposite of Etkin's, and its aerodynamics reads ``q - xi_q``. So the share is fitted: least squares of Cm on
+``[1, x, g]`` (``x`` the regressors that vary over the training rows) gives ``Cm_q`` and ``c_g``, and with
+``Cm = Cm_q (q_hat - kappa g) + ...``,
+
+    kappa = -c_g / Cm_q,        q_hat_air = q_hat - kappa g        (every row, the held-out ones too)
+
+(an estimate of the air-relative rate from the data the flight holds: ``g`` and the gyro; the least-squares ``kappa``
+is the gust estimate's regression share, below 1 where ``g`` is noisy). It is applied only when the fit shows it:
+``|t(c_g)| >=`` :data:`MIN_T`, a damping ``Cm_q < 0`` and ``|kappa| <=`` :data:`MAX_KAPPA`; otherwise the table is
+returned as it is and the note says why. Every output then sees the air-relative ``q_hat`` (CZ's ``CZ_q`` reads the
+same rate), the GP learns on it and is asked at it on the held-out rows; ``gcs-sysid predict`` at exact conditions asks
+at the air's own rate, as JSBSim's truth and a user's simulator define it.
+
+In a filter-error method (Jategaonkar, *Flight Vehicle System Identification*, 2nd ed., AIAA 2015, ch. 5 and 7) the
+pitching gust is process noise of the pitch equation; here its estimate from the air data is used offline, as
+:mod:`gcs_sysid.aero.airyaw` does for the yawing gust.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .table import COEFFICIENTS, REGRESSORS
+
+__all__ = ["AIR_PITCH", "MIN_T", "MAX_KAPPA", "pitch_gust_hat", "air_pitch_fit", "air_pitch_table"]
+
+#: Whether the replay moves ``q_hat`` to the air-relative rate (``ReplayOptions.air_pitch`` None). Opt-in until a rule
+#: written before its run on fresh flights says otherwise (``docs/benchmarks.md``, "Sixty-eighth session").
+AIR_PITCH = False
+#: The smallest ``|t|`` of the gust column's coefficient in the Cm fit that applies the share (frozen before the
+#: sixty-eighth session's rule: on the tuning flights the shares that did not help had ``|t|`` 1-8)
+MIN_T = 10.0
+#: The largest ``|kappa|``: more than the gust estimate's own size would be a fit of something else
+MAX_KAPPA = 1.5
+_MIN_ROWS = 200
+_IQ = REGRESSORS.index("q_hat")
+
+
+def pitch_gust_hat(states, c: float, b: float) -> tuple[np.ndarray | None, str]:
+    """The pitch gust rate as a hat, ``g = q_g c / (2 V)``, from the states' reconstructed wind.
+
+    ``q_g`` is :func:`gcs_sysid.estimation.gustrates.gust_rates`' frame ``"path"`` (body axes, Etkin's sign, the
+    MIL-F-8785C Dryden lag over ``4 b / (pi V)``).
+
+    Args:
+        states: smoothed states with ``phi theta psi`` (rad), ``wn we wd`` (m/s, NED) and ``V`` (m/s) on a uniform
+            grid ``t`` (s).
+        c: mean aerodynamic chord, m.
+        b: wing span, m.
+
+    Returns:
+        ``((T,) g, note)``; ``(None, why)`` when a field is missing or the grid is shorter than 3 samples.
+    """
+    from ..estimation.gustrates import states_gust_rates
+
+    if "V" not in states.data:
+        return None, "no pitch gust rate: no V in the states"
+    V = np.asarray(states.data["V"], float)
+    G = states_gust_rates(states, V, b, "path")
+    if isinstance(G, str):
+        return None, f"no pitch gust rate: {G}"
+    with np.errstate(invalid="ignore", divide="ignore"):
+        g = G.rates[:, 1] * c / (2.0 * V)
+    return g, "pitch gust rate from the reconstructed wind (MIL-F-8785C Dryden form along the path, Etkin's sign)"
+
+
+def air_pitch_fit(table, g: np.ndarray, train: np.ndarray) -> dict:
+    """The gust column's share in Cm, fitted on the training rows (module docstring).
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` (``X`` ``(T, 10)`` with the gyro's ``q_hat``,
+            ``Y`` ``(T, 6)``).
+        g: ``(T,)`` the pitch gust rate as a hat (:func:`pitch_gust_hat`), NaN where unknown.
+        train: ``(T,)`` bool, the training rows (the only rows fitted).
+
+    Returns:
+        ``{"applied": bool, "kappa", "t", "c_g", "Cm_q", "rows", "note"}``: ``applied`` when the three conditions
+        hold; ``kappa`` and the rest NaN where no fit was made (fewer than 200 usable rows, or a singular fit).
+
+    Raises:
+        ValueError: ``g`` or ``train`` not of the table's length.
+    """
+    T = len(table.t)
+    g, train = np.asarray(g, float), np.asarray(train, bool)
+    if g.shape != (T,) or train.shape != (T,):
+        raise ValueError(f"air_pitch_fit: expected g and train of shape ({T},), got {g.shape} and {train.shape}")
+    X = np.asarray(table.X, float)
+    y = np.asarray(table.Y, float)[:, COEFFICIENTS.index("Cm")]
+    rows = train & np.asarray(table.valid, bool) & np.isfinite(g) & np.isfinite(y) & np.isfinite(X).all(1)
+    nan = {"applied": False, "kappa": float("nan"), "t": float("nan"), "c_g": float("nan"), "Cm_q": float("nan"),
+           "rows": int(rows.sum())}
+    if rows.sum() < _MIN_ROWS:
+        return nan | {"note": f"q_hat is the gyro's: {int(rows.sum())} rows for the pitch gust fit (at least "
+                              f"{_MIN_ROWS})"}
+    Xr = X[rows]
+    varying = [j for j in range(X.shape[1]) if np.std(Xr[:, j]) > 1e-9 * max(1.0, abs(np.mean(Xr[:, j])))]
+    if _IQ not in varying:
+        return nan | {"note": "q_hat is the gyro's: q_hat does not vary over the training rows"}
+    A = np.column_stack([np.ones(len(Xr)), Xr[:, varying], g[rows]])
+    coef, _, rank, _ = np.linalg.lstsq(A, y[rows], rcond=None)
+    if rank < A.shape[1]:
+        return nan | {"note": "q_hat is the gyro's: the pitch gust fit is singular"}
+    resid = y[rows] - A @ coef
+    s2 = float(resid @ resid) / max(len(resid) - A.shape[1], 1)
+    R = np.linalg.qr(A, mode="r")                        # (A^T A)^-1 = R^-1 R^-T: solve, do not invert
+    Rinv_last = np.linalg.solve(R, np.eye(A.shape[1])[:, -1])
+    se = float(np.sqrt(s2 * (Rinv_last @ Rinv_last)))
+    c_g, Cm_q = float(coef[-1]), float(coef[1 + varying.index(_IQ)])
+    t = c_g / se if se > 0 else float("inf")
+    kappa = -c_g / Cm_q if Cm_q != 0 else float("nan")
+    why = []
+    if not abs(t) >= MIN_T:
+        why.append(f"|t| {abs(t):.1f} < {MIN_T:g}")
+    if not Cm_q < 0:
+        why.append(f"Cm_q {Cm_q:+.3g} not a damping")
+    if not abs(kappa) <= MAX_KAPPA:
+        why.append(f"|kappa| {abs(kappa):.2f} > {MAX_KAPPA:g}")
+    applied = not why
+    head = (f"pitch gust share in Cm: kappa {kappa:+.2f} (t {t:+.1f}, Cm_q {Cm_q:+.3g}, {int(rows.sum())} training "
+            f"rows; {'Etkin' if kappa > 0 else 'JSBSim ttMilspec'}'s sign)")
+    note = (f"q_hat is the air-relative estimate q_hat - kappa g: {head}" if applied
+            else f"q_hat is the gyro's: {head} not applied ({'; '.join(why)})")
+    return {"applied": applied, "kappa": kappa, "t": t, "c_g": c_g, "Cm_q": Cm_q, "rows": int(rows.sum()),
+            "note": note}
+
+
+def air_pitch_table(table, g: np.ndarray, fit: dict):
+    """The table with ``q_hat`` at the air-relative estimate ``q_hat - kappa g`` on every row where ``g`` is known,
+    when ``fit["applied"]``; the table as given otherwise. The fit's note is added to the table's notes either way.
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable`.
+        g: ``(T,)`` the pitch gust rate as a hat (:func:`pitch_gust_hat`).
+        fit: :func:`air_pitch_fit`'s result on this table and ``g``.
+
+    Returns:
+        a new :class:`~gcs_sysid.aero.table.CoefficientTable` (the input is not changed).
+    """
+    notes = list(table.notes) + [fit["note"]]
+    if not fit["applied"]:
+        return replace(table, notes=notes)
+    X = np.array(table.X, float, copy=True)
+    g = np.asarray(g, float)
+    ok = np.isfinite(g)
+    X[ok, _IQ] = X[ok, _IQ] - fit["kappa"] * g[ok]
+    return replace(table, X=X, notes=notes)
