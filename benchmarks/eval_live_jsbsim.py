@@ -86,17 +86,19 @@ def _pair_states(states):
 
 
 def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None,
-                 alpha_profile: tuple[str, ...] | None = None) -> list[tuple]:
+                 alpha_profile: tuple[str, ...] | None = None, air_pitch: bool = False,
+                 pitch_status: dict | None = None) -> list[tuple]:
     """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states)`` of every GP step
     (``states``: the part the air-rate pair reads). ``lift_line``: the learner's carried lift line
     (``LearnOptions.lift_line``: it changes the windows' estimates, so it is recorded here, not in :func:`learn`);
     ``status``: a dict updated with the recorder's ``lift_line`` status at the end; ``alpha_profile``:
-    ``LearnOptions.alpha_profile`` (the windows' estimates too)."""
+    ``LearnOptions.alpha_profile`` (the windows' estimates too); ``air_pitch``: ``LearnOptions.air_pitch`` (the windows'
+    ``q_hat``), with the recorder's ``air_pitch`` status put into ``pitch_status``."""
     from gcs_sysid.live.learner import Learner, LearnOptions, iter_tlog_records
 
     steps: list[tuple] = []
     rec = Learner(airframe, LearnOptions(air_roll=False, lift_line=lift_line,   # records each step; learns nothing
-                                         alpha_profile=alpha_profile))
+                                         alpha_profile=alpha_profile, air_pitch=air_pitch))
     rec._learn = lambda table, rows, states=None: steps.append((dict(rec.identifiable), table, rows.copy(),
                                                                 _pair_states(states)))   # no GP here
     for stamp, packet in iter_tlog_records(tlog):
@@ -104,6 +106,8 @@ def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | N
     rec.finish()
     if status is not None:
         status.update(rec.lift_line)
+    if pitch_status is not None:
+        pitch_status.update(rec.air_pitch)
     return steps
 
 
@@ -158,7 +162,8 @@ def window_levels(steps: list[tuple], truth) -> list[float]:
 
 
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
-             air_rolls=(True,), stated=(True,), lift_lines=(False,), alpha_profile: bool = False) -> list[dict]:
+             air_rolls=(True,), stated=(True,), lift_lines=(False,), alpha_profile: bool = False,
+             air_pitch: bool = False) -> list[dict]:
     """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on x lift line off/on),
     JSON-able.
 
@@ -167,7 +172,11 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     ``lift_line_status`` and its windows' alpha levels against the truth in ``alpha_levels_deg``
     (:func:`window_levels`). ``alpha_profile``: the learner's windows with ``LearnOptions.alpha_profile =
     ("delta_e",)`` (the whole-flight estimate and the LS reference keep least squares); rows say it in
-    ``alpha_profile``.
+    ``alpha_profile``. ``air_pitch``: the learner's windows with ``LearnOptions.air_pitch`` (each window's ``q_hat`` at
+    the air-relative estimate where its own fit shows the pitch gust's share) and the whole-flight table's too (the
+    replay's ``air_pitch`` on its training rows: the held-out question ``gp`` asks at the same kind of ``q_hat``; the
+    least-squares line stays at the gyro's); rows say it in ``air_pitch`` with the recorder's status in
+    ``air_pitch_status``.
 
     ``stated``: ``LearnOptions.stated_errors`` values to run (the windows' pooled regressor errors in the model's
     band at exact conditions, ``cov_true_air``); each row says its own in ``stated_errors``.
@@ -193,6 +202,12 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     tab = compute_coefficients(states_all, af)
     held = held_out_mask(tab.t, tab.valid, 0.2)
     t_cut = float(tab.t[held][0])
+    if air_pitch:                 # the whole-flight table as the replay's --air-pitch makes it
+        from gcs_sysid.aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
+
+        g = pitch_gust_hat(states_all, af.c, af.b)[0]
+        if g is not None:
+            tab = air_pitch_table(tab, g, air_pitch_fit(tab, g, tab.valid & ~held))
     Xt, Yt = truth.at(tab.t)
     Xt_air = Xt.copy()
     cst = truth.meta["constants"]
@@ -207,18 +222,22 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     out = []
     for ll in lift_lines:
         out += _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut,
-                               Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile)
+                               Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile,
+                               air_pitch)
     return out
 
 
 def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut, Xt_air, h,
-                    ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile=False) -> list[dict]:
+                    ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile=False,
+                    air_pitch=False) -> list[dict]:
     """:func:`evaluate`'s rows of one ``lift_line`` value ``ll``."""
     Yt = truth.at(tab.t)[1]
     t0 = time.perf_counter()
     status: dict = {}
+    pitch_status: dict = {}
     steps = record_steps(files.tlog, af, lift_line=ll, status=status,
-                         alpha_profile=("delta_e",) if alpha_profile else None)
+                         alpha_profile=("delta_e",) if alpha_profile else None, air_pitch=air_pitch,
+                         pitch_status=pitch_status)
     t_rec = time.perf_counter() - t0
     levels = window_levels(steps, truth)
     Xw, tw = held_rows_of_windows(steps, t_cut)
@@ -256,7 +275,8 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
                "air_roll": dict(lr.air_roll) if pair else None, "stated_errors": bool(se),
                "errors_note": lr.errors.get("note", ""), "lift_line": bool(ll),
                "lift_line_status": {**status, **{k: v for k, v in lr.lift_line.items() if k != "note"}},
-               "alpha_levels_deg": [round(x, 3) for x in levels], "alpha_profile": bool(alpha_profile)}
+               "alpha_levels_deg": [round(x, 3) for x in levels], "alpha_profile": bool(alpha_profile),
+               "air_pitch": bool(air_pitch), "air_pitch_status": {k: v for k, v in pitch_status.items() if k != "note"}}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
@@ -292,10 +312,12 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
 def variant(row: dict) -> str:
     """A row's learner variant: its GP noise, ``+air-roll`` with the air-rate pair on, ``-unstated`` without the
     stated regressor errors (``LearnOptions.stated_errors`` False; rows written before the sixty-fifth session had
-    none and carry no such field), ``+lift-line`` with the windows' lift line carried (``LearnOptions.lift_line``)."""
+    none and carry no such field), ``+lift-line`` with the windows' lift line carried (``LearnOptions.lift_line``),
+    ``+alpha-profile`` with ``LearnOptions.alpha_profile``, ``+air-pitch`` with ``LearnOptions.air_pitch``."""
     return (row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
             + ("-unstated" if row.get("stated_errors") is False else "")
-            + ("+lift-line" if row.get("lift_line") else "") + ("+alpha-profile" if row.get("alpha_profile") else ""))
+            + ("+lift-line" if row.get("lift_line") else "") + ("+alpha-profile" if row.get("alpha_profile") else "")
+            + ("+air-pitch" if row.get("air_pitch") else ""))
 
 
 def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
@@ -418,6 +440,9 @@ def main(argv=None) -> int:
     ap.add_argument("--alpha-profile", default="off", choices=("off", "on"),
                     help="the learner's windows with the elevator's slope by the gust likelihood (LearnOptions."
                          "alpha_profile)")
+    ap.add_argument("--air-pitch", default="off", choices=("off", "on"),
+                    help="the learner's windows (and the whole-flight table) with q_hat at the air-relative estimate "
+                         "(LearnOptions.air_pitch)")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
     ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
                     help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")
@@ -437,7 +462,8 @@ def main(argv=None) -> int:
             for seed in a.seeds:
                 rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds,
                                 tuple(x == "on" for x in a.air_roll), tuple(x == "on" for x in a.stated_errors),
-                                tuple(x == "on" for x in a.lift_line), a.alpha_profile == "on")
+                                tuple(x == "on" for x in a.lift_line), a.alpha_profile == "on",
+                                air_pitch=a.air_pitch == "on")
                 append_jsonl(a.json, rows)
     return 0
 

@@ -340,6 +340,9 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.air_yaw and replay_gust_rates(options) is not None:
         raise InputError("air_yaw: not with a gust_rates frame (both take the yaw gust rate out of the moments: "
                          "air_yaw through Cl's and Cn's targets, gust_rates through every output's input)")
+    if options.air_pitch and replay_gust_rates(options) in ("path", "mean-wind"):
+        raise InputError(f"air_pitch: not with the gust_rates frame {replay_gust_rates(options)!r} (both take the "
+                         "pitch gust rate out of q_hat; 'path-yaw' leaves q_hat the gyro's)")
     check_window(options.t_from, options.t_to)
     check_positive_int(options.n_inducing, "--inducing")
     if options.targets is not None:
@@ -561,7 +564,9 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         train = table.valid & ~held
         from .aero.airpitch import AIR_PITCH
 
-        if AIR_PITCH if options.air_pitch is None else options.air_pitch:
+        # the default gives way to a gust_rates frame that already takes the pitch gust rate out of q_hat
+        if (AIR_PITCH and replay_gust_rates(options) not in ("path", "mean-wind")) if options.air_pitch is None \
+                else options.air_pitch:
             from .aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
 
             with _stage("air pitch rate", timings, bar):

@@ -37,6 +37,10 @@ def test_replay_gust_rate_and_sideslip_flags_reach_the_stages(monkeypatch):
     assert o.air_yaw is True and _replay_options(build_parser().parse_args(base)).air_yaw is None
     with pytest.raises(pl.InputError, match="air_yaw: not with a gust_rates frame"):
         pl.check_replay("x.tlog", "a.toml", None, pl.ReplayOptions(air_yaw=True, gust_rates="path-yaw"))
+    o = _replay_options(build_parser().parse_args(base + ["--air-pitch", "on"]))
+    assert o.air_pitch is True and _replay_options(build_parser().parse_args(base)).air_pitch is None
+    with pytest.raises(pl.InputError, match="air_pitch: not with the gust_rates frame 'path'"):
+        pl.check_replay("x.tlog", "a.toml", None, pl.ReplayOptions(air_pitch=True, gust_rates="path"))
 
 
 def test_unknown_gust_rate_frame_is_a_user_error(capsys):

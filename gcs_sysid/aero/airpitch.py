@@ -4,10 +4,10 @@ The aerodynamics reads the body's pitch rate relative to the air, ``q - q_g`` (E
 Flight*, Wiley 1972, ch. 13, gust gradients: ``q_g = -dw_g/dx``); the gyro measures ``q``. A coefficient learned at the
 gyro's ``q_hat`` carries the pitching gust moment ``-Cm_q q_hat_g`` as noise in its input: the fitted ``Cm_q`` is too
 weak (errors in variables; Fuller, *Measurement Error Models*, Wiley 1987, sec. 1.1) and ``Cm_alpha``, which moves with
-``q`` in a pitch manoeuvre, takes up the difference. Measured on 25 JSBSim flights of the tuning set (least squares of
-Cm on the ten regressors over the replay's training rows; ``docs/benchmarks.md``, "Sixty-eighth session"): with JSBSim's
-exact ``q_aero`` in place of the gyro's rate the navion's ``Cm_alpha`` reads -0.57 (its XML), with the gyro's -0.73;
-the s23's 0.00 against -0.47.
+``q`` in a pitch manoeuvre, takes up the difference. Measured on JSBSim flights (least squares of Cm on ``[1, alpha,
+q_hat, delta_e]`` over the replay's training rows, each regressor swapped for JSBSim's in turn; ``docs/benchmarks.md``,
+"Sixty-eighth session"): on the navion and the s23 only ``q_hat`` moves them; with JSBSim's ``q_aero`` the navion's ``Cm_alpha`` reads
+-0.57, as least squares of JSBSim's own Cm does, with the gyro's -0.73; the s23's 0.00 against -0.47.
 
 The pitch gust rate is estimated from the reconstructed wind (:func:`gcs_sysid.estimation.gustrates.gust_rates`,
 frame ``"path"``: MIL-F-8785C's Dryden lag over ``4b/(pi V)`` of the vertical gust's derivative along the path, Etkin's

@@ -40,6 +40,10 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "of the windows so far instead of its own 30 s of mean vertical wind, and at the end every "
                         "row is moved onto the line of all windows and learned again; default off; docs/live.md, "
                         "'The lift line carried across windows'")
+    p.add_argument("--air-pitch", default="off", choices=("on", "off"),
+                   help="each window's q_hat at the air-relative estimate, the gyro's less the pitch gust rate from "
+                        "the reconstructed wind times its share in Cm fitted on the window (free sign; applied only "
+                        "when the fit shows it); default off; docs/estimation.md, 'The air-relative pitch rate'")
     p.add_argument("--alpha-profile", default="off", choices=("on", "off"),
                    help="the windows' alpha aiding takes the elevator's slope by the gust model's likelihood instead "
                         "of least squares (in closed loop least squares loads it with the gust's normal force, and "
@@ -79,7 +83,7 @@ def cmd_listen(a: argparse.Namespace) -> int:
     learn = None if a.no_learn else LearnOptions(window_s=a.window, step_s=a.step, lag_s=a.lag,
                                                  min_rows=a.min_rows, n_inducing=a.inducing,
                                                  gp_noise=a.gp_noise, air_roll=a.air_roll == "on",
-                                                 lift_line=a.lift_line == "on",
+                                                 lift_line=a.lift_line == "on", air_pitch=a.air_pitch == "on",
                                                  alpha_profile=("delta_e",) if a.alpha_profile == "on" else None,
                                                  rate_errors=None if a.rate_errors is None else a.rate_errors == "on")
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,

@@ -119,6 +119,10 @@ class LearnOptions:
             the model reads ``Cm_delta_e - k Cm_alpha``; :func:`gcs_sysid.estimation.estimate_states`,
             ``alpha_profile``); None: :data:`gcs_sysid.estimation.airangles.ALPHA_PROFILE_COLUMNS` (``()``, least
             squares), as the replay and the diagnosis.
+        air_pitch: each window's ``q_hat`` moved to the air-relative estimate, the gyro's less the pitch gust rate
+            from the window's reconstructed wind times its share in Cm fitted on the window's rows (free sign, applied
+            only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``;
+            opt-in, as the replay's ``--air-pitch``).
     """
 
     window_s: float = 30.0
@@ -139,6 +143,7 @@ class LearnOptions:
     rate_errors: bool | None = None
     lift_line: bool = False
     alpha_profile: tuple[str, ...] | None = None
+    air_pitch: bool = False
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
@@ -280,6 +285,8 @@ class Learner:
             self._line = LiftLinePool(self.options.window_s)
         self.lift_line = {"state": "pooling" if self._line is not None else "off", "windows": 0, "handed": 0,
                           "note": ""}
+        self.air_pitch = {"state": "waiting" if self.options.air_pitch else "off", "windows": 0, "applied": 0,
+                          "note": ""}
         self._win = np.zeros(0, int)          # the window (learning call) each kept row came from
         self._win_key = 0
 
@@ -345,6 +352,8 @@ class Learner:
                                      alpha_profile=self.options.alpha_profile)
             self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
+            if self.options.air_pitch:
+                table = self._air_pitch(table, states)
         except SysidError as exc:
             self.notes.append(f"step {self.steps}: window skipped ({exc})")
             return
@@ -381,6 +390,23 @@ class Learner:
             release_free_heap()
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": t3 - t2,
                         "trim": time.perf_counter() - t3}
+
+    def _air_pitch(self, table: CoefficientTable, states) -> CoefficientTable:
+        """The window's table with ``q_hat`` at the air-relative estimate where the window's own fit shows the pitch
+        gust's share (``LearnOptions.air_pitch``; :func:`gcs_sysid.aero.airpitch.air_pitch_fit` on the window's valid
+        rows); :attr:`air_pitch` counts the windows and says the last fit, the notes each change of state."""
+        from ..aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
+
+        g, why = pitch_gust_hat(states, self.airframe.c, self.airframe.b)
+        fit = air_pitch_fit(table, g, np.asarray(table.valid, bool)) if g is not None else None
+        state = "no gust rate" if fit is None else "applied" if fit["applied"] else "gyro's rate"
+        note = why if fit is None else fit["note"]
+        if state != self.air_pitch["state"]:
+            self.notes.append(f"step {self.steps}: {note}")
+        self.air_pitch = {"state": state, "windows": self.air_pitch["windows"] + 1,
+                          "applied": self.air_pitch["applied"] + int(state == "applied"),
+                          "kappa": None if fit is None else fit["kappa"], "note": note}
+        return table if fit is None else air_pitch_table(table, g, fit)
 
     def _window_in(self, table: CoefficientTable, rows: np.ndarray, states) -> None:
         """A window's rows are about to be learned (``rows`` (T,) bool): a new key for the rows kept, and with

@@ -85,7 +85,8 @@ def _status(learner) -> dict:
             "suggestions": [SuggestionText(str(s.reason)) for s in learner.suggestions[:5]],
             "has_model": model is not None, "rows_stored": len(rows) if rows is not None else 0,
             "air_roll": dict(learner.air_roll), "errors": dict(learner.errors),
-            "lift_line": dict(learner.lift_line), "pid": os.getpid(), "rss_mib": _rss_mib()}
+            "lift_line": dict(learner.lift_line), "air_pitch": dict(learner.air_pitch), "pid": os.getpid(),
+            "rss_mib": _rss_mib()}
 
 
 class _Held:
@@ -240,6 +241,7 @@ class RemoteLearner:
         self.air_roll: dict = {}
         self.errors: dict = {}
         self.lift_line: dict = {}
+        self.air_pitch: dict = {}
         self._confidence: dict = {}
         self._extra_notes: list[str] = []
         self.queued = 0
@@ -275,7 +277,7 @@ class RemoteLearner:
     def _update(self, st: dict) -> None:
         for k in ("steps", "n_learned", "outputs", "timings", "control_sources", "coalesced", "refreshes_deferred",
                   "coalesced_at", "identifiable", "suggestions", "has_model", "rows_stored", "rss_mib", "air_roll",
-                  "errors", "lift_line"):
+                  "errors", "lift_line", "air_pitch"):
             setattr(self, k, st[k])
         self.notes = st["notes"] + self._extra_notes
         self._confidence = st["confidence"]

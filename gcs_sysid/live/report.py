@@ -48,6 +48,10 @@ def render_markdown(snap: dict) -> str:
         if ll.get("state", "off") != "off":
             lines.append(f"- the lift line carried across windows (`--lift-line on`): {ll['state']}"
                          + (f" ({ll['note']})" if ll.get("note") else ""))
+        ap = snap.get("air_pitch") or {}
+        if ap.get("state", "off") != "off":
+            lines.append(f"- the air-relative pitch rate (`--air-pitch on`): {ap.get('applied', 0)} of "
+                         f"{ap.get('windows', 0)} windows moved" + (f" ({ap['note']})" if ap.get("note") else ""))
         se = snap.get("stated_errors") or {}
         if se.get("note"):
             lines.append(f"- the model's band at exact conditions (`gcs-sysid predict`): {se['note']}")

@@ -343,6 +343,7 @@ class LiveSession:
                 "air_roll": dict(getattr(learner, "air_roll", {})),
                 "stated_errors": dict(getattr(learner, "errors", {})),
                 "lift_line": dict(getattr(learner, "lift_line", {})),
+                "air_pitch": dict(getattr(learner, "air_pitch", {})),
                 "learner_in": "worker process" if self._remote else "this process",
             })
         return snap

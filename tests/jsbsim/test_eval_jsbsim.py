@@ -189,15 +189,17 @@ def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
     class Stop(Exception):
         pass
 
-    def fake_evaluate(*args, beta_gls=None, air_yaw=None, rate_errors=None):
-        seen.append((args[-1], beta_gls) if rate_errors is None else ("rate_errors", rate_errors))
+    def fake_evaluate(*args, beta_gls=None, air_yaw=None, rate_errors=None, air_pitch=None):
+        seen.append(("air_pitch", air_pitch) if air_pitch is not None else
+                    (args[-1], beta_gls) if rate_errors is None else ("rate_errors", rate_errors))
         raise Stop               # stop before the printing, which needs a scored row
 
     monkeypatch.setattr(eval_jsbsim, "evaluate", fake_evaluate)
     monkeypatch.setattr(aa, "BETA_GLS", aa.BETA_GLS)       # --beta-gls also sets the aiding's module switch
     for argv, want in (([], (0, None)), (["--gp-seed", "1"], (1, None)), (["--beta-gls", "on"], (0, True)),
                        (["--beta-gls", "off"], (0, False)), (["--rate-errors", "on"], ("rate_errors", True)),
-                       (["--rate-errors", "off"], ("rate_errors", False))):
+                       (["--rate-errors", "off"], ("rate_errors", False)),
+                       (["--air-pitch", "on"], ("air_pitch", True)), (["--air-pitch", "off"], ("air_pitch", False))):
         with pytest.raises(Stop):
             eval_jsbsim.main(["--aircraft", "sgs", "--turbulence", "light", "--work", str(tmp_path), *argv])
         assert seen[-1] == want
