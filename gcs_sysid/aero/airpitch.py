@@ -68,16 +68,11 @@ def pitch_gust_hat(states, c: float, b: float) -> tuple[np.ndarray | None, str]:
     Returns:
         ``((T,) g, note)``; ``(None, why)`` when a field is missing or the grid is shorter than 3 samples.
     """
-    from ..estimation.gustrates import states_gust_rates
+    from ..estimation.gustrates import states_gust_hat
 
-    if "V" not in states.data:
-        return None, "no pitch gust rate: no V in the states"
-    V = np.asarray(states.data["V"], float)
-    G = states_gust_rates(states, V, b, "path")
-    if isinstance(G, str):
-        return None, f"no pitch gust rate: {G}"
-    with np.errstate(invalid="ignore", divide="ignore"):
-        g = G.rates[:, 1] * c / (2.0 * V)
+    g, why = states_gust_hat(states, b, "path", "q", c)
+    if g is None:
+        return None, why.replace("no gust rate", "no pitch gust rate")
     return g, "pitch gust rate from the reconstructed wind (MIL-F-8785C Dryden form along the path, Etkin's sign)"
 
 

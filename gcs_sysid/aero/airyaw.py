@@ -58,17 +58,10 @@ def yaw_gust_hat(states, b: float) -> tuple[np.ndarray | None, str]:
     Returns:
         ``((T,) r_hat_g, note)``; ``(None, why)`` when a field is missing or the grid is shorter than 3 samples.
     """
-    from ..estimation.gustrates import states_gust_rates
+    from ..estimation.gustrates import states_gust_hat
 
-    if "V" not in states.data:
-        return None, "no yaw gust rate: no V in the states"
-    V = np.asarray(states.data["V"], float)
-    G = states_gust_rates(states, V, b, "path-yaw")
-    if isinstance(G, str):
-        return None, f"no yaw gust rate: {G}"
-    with np.errstate(invalid="ignore", divide="ignore"):
-        g = G.rates[:, 2] * b / (2.0 * V)
-    return g, "; ".join(G.notes)
+    g, why = states_gust_hat(states, b, "path-yaw", "r", b)
+    return g, why if g is not None else why.replace("no gust rate", "no yaw gust rate")
 
 
 def air_yaw_target(table, Y: np.ndarray, r_hat_g: np.ndarray, train: np.ndarray,

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["FRAMES", "MIN_MEAN_WIND", "DRYDEN_L", "DRYDEN_RATE_FACTORS", "GustRates", "gust_rates", "lag_filter",
-           "gust_intensity", "dryden_rate_sigma", "states_gust_rates"]
+           "gust_intensity", "dryden_rate_sigma", "states_gust_rates", "states_gust_hat"]
 
 FRAMES = ("path", "path-yaw", "mean-wind")   #: frames of :func:`gust_rates`
 MIN_MEAN_WIND = 1.0              #: m/s; below it the mean wind has no direction and ``"mean-wind"`` takes north
@@ -198,6 +198,32 @@ def states_gust_rates(states, V: np.ndarray, b: float, frame: str) -> GustRates 
         return f"no {' '.join(need) or 'grid'} in the states"
     return gust_rates(float(np.median(np.diff(states.t))), dcm(d["phi"], d["theta"], d["psi"]),
                       np.stack([d["wn"], d["we"], d["wd"]], axis=1), V, b, frame)
+
+
+def states_gust_hat(states, b: float, frame: str, axis: str, length: float) -> tuple[np.ndarray | None, str]:
+    """One gust rate of :func:`states_gust_rates` as a hat, ``rate * length / (2 V)`` with the states' airspeed ``V``.
+
+    Args:
+        states: smoothed states with ``phi theta psi`` (rad), ``wn we wd`` (m/s, NED) and ``V`` (m/s) on a uniform
+            grid ``t`` (s).
+        b: wing span, m (the Dryden lags).
+        frame: one of :data:`FRAMES`.
+        axis: ``"p"``, ``"q"`` or ``"r"``.
+        length: the hat's reference length, m (``b`` for ``p`` and ``r``, the chord ``c`` for ``q``).
+
+    Returns:
+        ``((T,) hat, the rates' notes joined)``; ``(None, why)`` when a field is missing or the grid is shorter than 3
+        samples.
+    """
+    if "V" not in states.data:
+        return None, "no gust rate: no V in the states"
+    V = np.asarray(states.data["V"], float)
+    G = states_gust_rates(states, V, b, frame)
+    if isinstance(G, str):
+        return None, f"no gust rate: {G}"
+    with np.errstate(invalid="ignore", divide="ignore"):
+        hat = G.rates[:, "pqr".index(axis)] * length / (2.0 * V)
+    return hat, "; ".join(G.notes)
 
 
 def _dryden_transverse_rho(x):
