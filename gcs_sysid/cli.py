@@ -89,8 +89,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--air-pitch", default=None, choices=("on", "off"),
                    help="q_hat at the air-relative estimate, the gyro's less the pitch gust rate from the "
                         "reconstructed wind with its share in Cm fitted on the training rows (free sign; applied only "
-                        "when the fit shows it), for every output and row: 'on' opt-in, 'off' the default "
-                        "(docs/estimation.md, 'The air-relative pitch rate')")
+                        "when the fit shows it), for every output and row: 'on' the default (off with --gust-rates "
+                        "path or mean-wind), 'off' the gyro's q_hat (docs/estimation.md, 'The air-relative pitch "
+                        "rate')")
     r.add_argument("--rate-errors", default=None, choices=("on", "off"),
                    help="state the gyro rates' errors as stand-ins for the air-relative rates in the model's band at "
                         "exact conditions (predict's sigma): p_hat's scale error from the rolling gust, r_hat's "

@@ -117,7 +117,8 @@ class ReplayOptions:
         air_pitch: move every row's ``q_hat`` to the air-relative estimate ``q_hat - kappa g`` (``g`` the pitch gust
             rate from the reconstructed wind, ``kappa`` its share in Cm fitted on the training rows with a free sign,
             applied only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`), for every output, training and
-            held-out rows alike. None: :data:`gcs_sysid.aero.airpitch.AIR_PITCH` (off).
+            held-out rows alike. None: :data:`gcs_sysid.aero.airpitch.AIR_PITCH` (on), off with a ``gust_rates`` frame
+            that already moves ``q_hat`` (``"path"``, ``"mean-wind"``).
         gp_seed: ``GPConfig.seed`` of the GP fit (the hyperparameters' row subset, the inducing points; as the live
             learner's ``LearnOptions.gp_seed``). 0: ``GPConfig``'s own default. Issue 8's counts are judged at two
             seeds (the project's rule 8(b); ``benchmarks/eval_jsbsim.py --gp-seed``).

@@ -67,7 +67,7 @@ def test_the_share_is_fitted_with_its_sign_and_the_moved_table_reads_the_air_rat
     others = [j for j in range(len(REGRESSORS)) if j != IQ]
     assert np.array_equal(moved.X[:, others], table.X[:, others]) and np.array_equal(moved.Y, table.Y)
     assert table.notes == ["as computed"] and "air-relative estimate" in moved.notes[-1]
-    assert ("Etkin" if sign > 0 else "JSBSim") in moved.notes[-1]
+    assert ("opposite" in moved.notes[-1]) == (sign < 0) and "Etkin's" in moved.notes[-1]
 
 
 def test_no_gust_moment_leaves_the_gyros_rate():
