@@ -121,8 +121,10 @@ class LearnOptions:
             squares), as the replay and the diagnosis.
         air_pitch: each window's ``q_hat`` moved to the air-relative estimate, the gyro's less the pitch gust rate
             from the window's reconstructed wind times its share in Cm fitted on the window's rows (free sign, applied
-            only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``;
-            opt-in, as the replay's ``--air-pitch``).
+            only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``).
+            Opt-in: the rule written for it held for Cm on fresh flights (at JSBSim's regressors 42.5 -> 36.0 %
+            median, better on 40 of 50) and failed on the learned output correlations (``docs/benchmarks.md``,
+            "Sixty-eighth session"); the replay's ``air_pitch`` is on.
     """
 
     window_s: float = 30.0
