@@ -6,8 +6,9 @@ gyro's ``q_hat`` carries the pitching gust moment ``-Cm_q q_hat_g`` as noise in 
 weak (errors in variables; Fuller, *Measurement Error Models*, Wiley 1987, sec. 1.1) and ``Cm_alpha``, which moves with
 ``q`` in a pitch manoeuvre, takes up the difference. Measured on JSBSim flights (least squares of Cm on ``[1, alpha,
 q_hat, delta_e]`` over the replay's training rows, each regressor swapped for JSBSim's in turn; ``docs/benchmarks.md``,
-"Sixty-eighth session"): on the navion and the s23 only ``q_hat`` moves them; with JSBSim's ``q_aero`` the navion's ``Cm_alpha`` reads
--0.57, as least squares of JSBSim's own Cm does, with the gyro's -0.73; the s23's 0.00 against -0.47.
+"Sixty-eighth session"): on the navion and the s23 only ``q_hat`` moves them; with JSBSim's ``q_aero`` the navion's
+``Cm_alpha`` reads -0.57, as least squares of JSBSim's own Cm does, with the gyro's -0.73; the s23's 0.00 against
+-0.47.
 
 The pitch gust rate is estimated from the reconstructed wind (:func:`gcs_sysid.estimation.gustrates.gust_rates`,
 frame ``"path"``: MIL-F-8785C's Dryden lag over ``4b/(pi V)`` of the vertical gust's derivative along the path, Etkin's
