@@ -215,6 +215,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
         if aero_reads_air_rates(aircraft)[ax]:
             Xt_air[:, 2 + j] = np.interp(tab.t, truth.t, truth.fields[f"{ax}_aero"]) * cst[ref] / (2 * Xt[:, 9])
     h = held & tab.valid & np.isfinite(Yt).all(1) & np.all(np.isfinite(tab.X), axis=1)
+    truth_corr = truth_residual_correlation(Xt_air, Yt, tab.valid & ~held)
     ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-livefit.toml", t_to=t_cut,
                           profile_beta=airangles.BETA_PROFILE,      # the learner's sideslip estimator
                           air_roll_train=False)     # the measured Cl (not the diagnosis's reference target)
@@ -223,13 +224,13 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     for ll in lift_lines:
         out += _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut,
                                Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile,
-                               air_pitch)
+                               air_pitch, truth_corr)
     return out
 
 
 def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut, Xt_air, h,
                     ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile=False,
-                    air_pitch=False) -> list[dict]:
+                    air_pitch=False, truth_corr=None) -> list[dict]:
     """:func:`evaluate`'s rows of one ``lift_line`` value ``ll``."""
     Yt = truth.at(tab.t)[1]
     t0 = time.perf_counter()
@@ -276,7 +277,10 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
                "errors_note": lr.errors.get("note", ""), "lift_line": bool(ll),
                "lift_line_status": {**status, **{k: v for k, v in lr.lift_line.items() if k != "note"}},
                "alpha_levels_deg": [round(x, 3) for x in levels], "alpha_profile": bool(alpha_profile),
-               "air_pitch": bool(air_pitch), "air_pitch_status": {k: v for k, v in pitch_status.items() if k != "note"}}
+               "air_pitch": bool(air_pitch), "air_pitch_status": {k: v for k, v in pitch_status.items() if k != "note"},
+               "corr_pairs": {f"{a}-{b}": round(float(C[i, j]), 3) for i, a in enumerate(outputs)
+                              for j, b in enumerate(outputs) if i < j},
+               "truth_resid_corr": truth_corr}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
             if lr._roll_fit is not None and "Cl" in outputs:   # Cl asked at the held-out air rate, post hoc
@@ -307,6 +311,19 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
               f"cpu {cpu:.1f} s" + (f" | pair {lr.air_roll['state']}, Cl at the air rate "
                                      f"{row['gp_air_cl']['Cl']:.1f}" if pair else ""), flush=True)
     return out
+
+
+def truth_residual_correlation(Xt_air: np.ndarray, Yt: np.ndarray, rows: np.ndarray) -> dict[str, float]:
+    """The correlations between JSBSim's coefficients' residuals after least squares on the ten exact regressors (with
+    the rates its aerodynamics reads) over ``rows``, per output pair ``"A-B"`` (|r|, the learned correlations' pairs):
+    the coupling the truth itself has beyond a linear model of the regressors (issue 8: "no learned output correlation
+    above 0.5 where the truth has none"). ``Xt_air`` ``(T, 10)``, ``Yt`` ``(T, 6)``, ``rows`` ``(T,)`` bool."""
+    ok = rows & np.isfinite(Xt_air).all(1) & np.isfinite(Yt).all(1)
+    A = np.column_stack([np.ones(int(ok.sum())), Xt_air[ok]])
+    R = Yt[ok] - A @ np.linalg.lstsq(A, Yt[ok], rcond=None)[0]
+    C = np.abs(np.corrcoef(R.T))
+    return {f"{a}-{b}": round(float(C[i, j]), 3) for i, a in enumerate(COEFFICIENTS) for j, b in enumerate(COEFFICIENTS)
+            if i < j}
 
 
 def variant(row: dict) -> str:
