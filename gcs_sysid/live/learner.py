@@ -123,8 +123,9 @@ class LearnOptions:
             from the window's reconstructed wind times its share in Cm fitted on the window's rows (free sign, applied
             only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``).
             Opt-in: the rule written for it held for Cm on fresh flights (at JSBSim's regressors 42.5 -> 36.0 %
-            median, better on 40 of 50) and failed on the learned output correlations (``docs/benchmarks.md``,
-            "Sixty-eighth session"); the replay's ``air_pitch`` is on.
+            median, better on 40 of 50) and failed on the learned output correlations, a second rule on fresh flights
+            failed on the count within the lines at exact conditions (``docs/benchmarks.md``, "Sixty-eighth
+            session"); the replay's ``air_pitch`` is on.
     """
 
     window_s: float = 30.0
