@@ -1,5 +1,7 @@
 """Pieces the benchmark scripts share word for word: the ``--aircraft`` help of the harness's names and the
-``--json`` records (one JSON line per result, appended; read back, plain or gzip-compressed, by :func:`read_lines`).
+``--json`` records (one JSON line per result, appended; read back, plain or gzip-compressed, by :func:`read_lines`);
+the rows' output-pair correlations (:func:`pair_correlations`) and the truth's own coupling beyond a linear model
+(:func:`truth_residual_correlation`, sixty-eighth session).
 
 Moved here from ``eval_jsbsim.py``, ``eval_gp_jsbsim.py``, ``eval_gp_joint.py``, ``eval_live_jsbsim.py``,
 ``eval_accel_sigma.py``, ``alpha_stages.py``, ``rate_floor.py`` and ``beta_band.py`` (twenty-eighth session, a
@@ -13,7 +15,9 @@ import json
 from collections.abc import Iterable
 from pathlib import Path
 
-__all__ = ["AIRCRAFT_HELP", "append_jsonl", "read_lines"]
+import numpy as np
+
+__all__ = ["AIRCRAFT_HELP", "append_jsonl", "read_lines", "truth_residual_correlation", "pair_correlations"]
 
 #: ``--aircraft`` help of the scripts that fly the harness's aircraft by name (``aircraft_argument``).
 AIRCRAFT_HELP = ("harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
@@ -65,3 +69,24 @@ def read_lines(path: str | Path) -> list[str]:
         with gzip.open(p, "rt", encoding="utf-8") as f:
             return f.read().splitlines()
     return p.read_text(encoding="utf-8").splitlines()
+
+
+def truth_residual_correlation(Xt_air: np.ndarray, Yt: np.ndarray, rows: np.ndarray) -> dict[str, float]:
+    """The correlations between JSBSim's coefficients' residuals after least squares on the ten exact regressors (with
+    the rates its aerodynamics reads) over ``rows``, per output pair ``"A-B"`` (|r|, the learned correlations' pairs):
+    the coupling the truth itself has beyond a linear model of the regressors (issue 8: "no learned output correlation
+    above 0.5 where the truth has none"). ``Xt_air`` ``(T, 10)``, ``Yt`` ``(T, 6)``, ``rows`` ``(T,)`` bool."""
+    ok = rows & np.isfinite(Xt_air).all(1) & np.isfinite(Yt).all(1)
+    A = np.column_stack([np.ones(int(ok.sum())), Xt_air[ok]])
+    R = Yt[ok] - A @ np.linalg.lstsq(A, Yt[ok], rcond=None)[0]
+    from gcs_sysid.aero.table import COEFFICIENTS
+
+    return pair_correlations(np.corrcoef(R.T), COEFFICIENTS)
+
+
+def pair_correlations(C, names) -> dict[str, float]:
+    """``{"A-B": |C[i, j]|}`` over the pairs ``i < j`` of ``names`` (rounded to 3 digits): a correlation matrix
+    ``(P, P)`` as the eval rows keep it (the learned output correlations, ``corr_pairs``; the truth's residual ones,
+    ``truth_resid_corr``)."""
+    C = np.abs(np.asarray(C, float))
+    return {f"{a}-{b}": round(float(C[i, j]), 3) for i, a in enumerate(names) for j, b in enumerate(names) if i < j}

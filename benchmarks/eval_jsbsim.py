@@ -88,7 +88,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.eval_common import AIRCRAFT_HELP, append_jsonl  # noqa: E402
+from benchmarks.eval_common import (AIRCRAFT_HELP, append_jsonl, pair_correlations,  # noqa: E402
+                                    truth_residual_correlation)
 from benchmarks.jsbsim_harness import (UNTOUCHED_AIRCRAFT, FlightConfig, coefficient_errors,  # noqa: E402
                                        load_truth, make_flight)
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
@@ -394,6 +395,9 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
         C = np.abs(np.asarray(model.output_correlation(), float))
         np.fill_diagonal(C, 0.0)
         row["max_corr"] = float(np.nanmax(C)) if C.size else 0.0
+        # the pairs, and the truth's own coupling beyond a linear model (issue 8's "where the truth has none")
+        row["corr_pairs"] = pair_correlations(C, model.output_names)
+        row["truth_resid_corr"] = truth_residual_correlation(Xt_air, Yt, res.train & ok)
         row["gp_coupling_test"] = _pipeline.GP_COUPLING_TEST
         row["gp_noise_correlation"] = _pipeline.GP_NOISE_CORRELATION
         row["gp_noise_posterior"] = _pipeline.GP_NOISE_POSTERIOR

@@ -59,7 +59,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.eval_common import append_jsonl  # noqa: E402
+from benchmarks.eval_common import append_jsonl, pair_correlations, truth_residual_correlation  # noqa: E402
 from benchmarks.eval_jsbsim import _coverage, _errs, aero_reads_air_rates  # noqa: E402
 from benchmarks.jsbsim_harness import UNTOUCHED_AIRCRAFT, FlightConfig, load_truth, make_flight  # noqa: E402
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument  # noqa: E402
@@ -278,8 +278,7 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
                "lift_line_status": {**status, **{k: v for k, v in lr.lift_line.items() if k != "note"}},
                "alpha_levels_deg": [round(x, 3) for x in levels], "alpha_profile": bool(alpha_profile),
                "air_pitch": bool(air_pitch), "air_pitch_status": {k: v for k, v in pitch_status.items() if k != "note"},
-               "corr_pairs": {f"{a}-{b}": round(float(C[i, j]), 3) for i, a in enumerate(outputs)
-                              for j, b in enumerate(outputs) if i < j},
+               "corr_pairs": pair_correlations(C, outputs),
                "truth_resid_corr": truth_corr}
         if pair:
             row["gp_air_cl"], row["ls_air_cl"] = dict(row["gp"]), dict(ls)
@@ -311,19 +310,6 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
               f"cpu {cpu:.1f} s" + (f" | pair {lr.air_roll['state']}, Cl at the air rate "
                                      f"{row['gp_air_cl']['Cl']:.1f}" if pair else ""), flush=True)
     return out
-
-
-def truth_residual_correlation(Xt_air: np.ndarray, Yt: np.ndarray, rows: np.ndarray) -> dict[str, float]:
-    """The correlations between JSBSim's coefficients' residuals after least squares on the ten exact regressors (with
-    the rates its aerodynamics reads) over ``rows``, per output pair ``"A-B"`` (|r|, the learned correlations' pairs):
-    the coupling the truth itself has beyond a linear model of the regressors (issue 8: "no learned output correlation
-    above 0.5 where the truth has none"). ``Xt_air`` ``(T, 10)``, ``Yt`` ``(T, 6)``, ``rows`` ``(T,)`` bool."""
-    ok = rows & np.isfinite(Xt_air).all(1) & np.isfinite(Yt).all(1)
-    A = np.column_stack([np.ones(int(ok.sum())), Xt_air[ok]])
-    R = Yt[ok] - A @ np.linalg.lstsq(A, Yt[ok], rcond=None)[0]
-    C = np.abs(np.corrcoef(R.T))
-    return {f"{a}-{b}": round(float(C[i, j]), 3) for i, a in enumerate(COEFFICIENTS) for j, b in enumerate(COEFFICIENTS)
-            if i < j}
 
 
 def variant(row: dict) -> str:

@@ -1,10 +1,11 @@
-"""`benchmarks/eval_live_jsbsim.truth_residual_correlation`: the truth's own coupling between two coefficients beyond a
-linear model of the regressors (issue 8's "where the truth has none"): a shared nonlinear term reads near 1, independent
-residuals near 0, and a shared linear term (which the regressors explain) does not count."""
+"""`benchmarks/eval_common.truth_residual_correlation` (the eval rows' `truth_resid_corr`): the truth's own coupling
+between two coefficients beyond a linear model of the regressors (issue 8's "where the truth has none"): a shared
+nonlinear term reads near 1, independent residuals near 0, and a shared linear term (which the regressors explain) does
+not count."""
 
 import numpy as np
 
-from benchmarks.eval_live_jsbsim import truth_residual_correlation
+from benchmarks.eval_common import truth_residual_correlation
 
 
 def test_shared_nonlinear_residual_reads_as_a_coupling_and_linear_terms_do_not():
