@@ -94,7 +94,8 @@ from benchmarks.jsbsim_harness import (UNTOUCHED_AIRCRAFT, FlightConfig, coeffic
                                        load_truth, make_flight)
 from benchmarks.jsbsim_harness.aircraft import aircraft_argument, summary_label  # noqa: E402
 from gcs_sysid.aero.table import COEFFICIENTS  # noqa: E402
-from gcs_sysid.pipeline import ReplayOptions, replay_beta_gls, replay_gust_rates, run_replay  # noqa: E402
+from gcs_sysid.pipeline import (ReplayOptions, replay_air_pitch, replay_beta_gls, replay_gust_rates,  # noqa: E402
+                               run_replay)
 import gcs_sysid.pipeline as _pipeline  # noqa: E402
 
 THESIS_FORCES, THESIS_MOMENTS = 19.8, 23.8
@@ -320,7 +321,6 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     ``gp_airp_MODE``, ``ls_airp_MODE``, ``cov_gp_airp_MODE`` and ``airp_MODE`` with the estimated gust against
     JSBSim's ``p - p_aero``; a diagnosis: the replay's table must not be gust-filtered)."""
     from gcs_sysid.aero import rateerrors as _rateerrors
-    from gcs_sysid.aero import airpitch as _airpitch
     from gcs_sysid.diagnose import run_fit
     from gcs_sysid.gp import load_gp
 
@@ -352,7 +352,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     row: dict = {"aircraft": aircraft, "seed": seed, "turbulence": turbulence, "aoa": aoa, "duration_s": duration,
                  "gust_rates": gust_rates, "beta_gls": replay_beta_gls(opts), "air_yaw": air_yaw,
                  "rate_errors": _rateerrors.RATE_ERRORS if rate_errors is None else rate_errors,
-                 "air_pitch": _airpitch.AIR_PITCH if air_pitch is None else air_pitch,
+                 "air_pitch": replay_air_pitch(opts),
                  "air_pitch_note": next((n for n in res.table.notes if "pitch gust" in n), None),
                  "gust_filter": gust_filter,
                  "heldout_air_roll": heldout_air_roll, "air_roll_train": air_roll_train, "gp_seed": gp_seed,
@@ -773,7 +773,7 @@ def main(argv=None) -> int:
                          "gcs_sysid.aero.rateerrors; default: the replay's)")
     ap.add_argument("--air-pitch", default=None, choices=("on", "off"),
                     help="q_hat at the air-relative estimate, less the pitch gust rate with its fitted share "
-                         "(ReplayOptions.air_pitch, gcs_sysid.aero.airpitch; default: the replay's, off)")
+                         "(ReplayOptions.air_pitch, gcs_sysid.aero.airpitch; default: the replay's, on)")
     ap.add_argument("--fly-only", action="store_true", help="only fly (or find) the flights in --work; no scoring")
     ap.add_argument("--wind-window", default=None, type=float, metavar="S",
                     help="the wind fit's window length, s (default: the package's estimate.WIND_WINDOW_S)")

@@ -203,11 +203,9 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     held = held_out_mask(tab.t, tab.valid, 0.2)
     t_cut = float(tab.t[held][0])
     if air_pitch:                 # the whole-flight table as the replay's --air-pitch makes it
-        from gcs_sysid.aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
+        from gcs_sysid.aero.airpitch import apply_air_pitch
 
-        g = pitch_gust_hat(states_all, af.c, af.b)[0]
-        if g is not None:
-            tab = air_pitch_table(tab, g, air_pitch_fit(tab, g, tab.valid & ~held))
+        tab = apply_air_pitch(tab, states_all, af, tab.valid & ~held)[0]
     Xt, Yt = truth.at(tab.t)
     Xt_air = Xt.copy()
     cst = truth.meta["constants"]

@@ -313,6 +313,20 @@ def replay_beta_gls(options: ReplayOptions) -> bool:
     return bool(airangles.BETA_GLS if options.beta_gls is None else options.beta_gls)
 
 
+#: the gust-rate frames whose hats already take the pitch gust rate out of ``q_hat`` (:func:`replay_air_pitch`)
+_PITCH_FRAMES = ("path", "mean-wind")
+
+
+def replay_air_pitch(options: ReplayOptions) -> bool:
+    """Whether the replay moves ``q_hat`` to the air-relative estimate: ``options.air_pitch``, or when it is None
+    :data:`gcs_sysid.aero.airpitch.AIR_PITCH` unless the gust-rate frame already moves ``q_hat``."""
+    from .aero.airpitch import AIR_PITCH
+
+    if options.air_pitch is not None:
+        return bool(options.air_pitch)
+    return AIR_PITCH and replay_gust_rates(options) not in _PITCH_FRAMES
+
+
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
                  options: ReplayOptions = ReplayOptions()):
     """Check every input and option of a replay before any work; returns the loaded airframe.
@@ -341,7 +355,7 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.air_yaw and replay_gust_rates(options) is not None:
         raise InputError("air_yaw: not with a gust_rates frame (both take the yaw gust rate out of the moments: "
                          "air_yaw through Cl's and Cn's targets, gust_rates through every output's input)")
-    if options.air_pitch and replay_gust_rates(options) in ("path", "mean-wind"):
+    if options.air_pitch and replay_gust_rates(options) in _PITCH_FRAMES:
         raise InputError(f"air_pitch: not with the gust_rates frame {replay_gust_rates(options)!r} (both take the "
                          "pitch gust rate out of q_hat; 'path-yaw' leaves q_hat the gyro's)")
     check_window(options.t_from, options.t_to)
@@ -563,19 +577,13 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
         ident = identifiability(states, table)
         held = held_out_mask(table.t, table.valid, options.holdout)
         train = table.valid & ~held
-        from .aero.airpitch import AIR_PITCH
-
-        # the default gives way to a gust_rates frame that already takes the pitch gust rate out of q_hat
-        if (AIR_PITCH and replay_gust_rates(options) not in ("path", "mean-wind")) if options.air_pitch is None \
-                else options.air_pitch:
-            from .aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
+        if replay_air_pitch(options):
+            from .aero.airpitch import apply_air_pitch
 
             with _stage("air pitch rate", timings, bar):
-                g_pitch, why = pitch_gust_hat(states, airframe.c, airframe.b)
-                if g_pitch is None:
+                table, fit, why = apply_air_pitch(table, states, airframe, train)
+                if fit is None:                  # else the note is the table's
                     notes.append(why)
-                else:
-                    table = air_pitch_table(table, g_pitch, air_pitch_fit(table, g_pitch, train))  # its note
         from .aero.gustfilter import (AIR_ROLL_TRAIN, GUST_FILTER, HELDOUT_AIR_ROLL, air_roll_fit, air_roll_target,
                                       filter_gust_table, heldout_air_roll)
 

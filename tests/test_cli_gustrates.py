@@ -41,6 +41,11 @@ def test_replay_gust_rate_and_sideslip_flags_reach_the_stages(monkeypatch):
     assert o.air_pitch is True and _replay_options(build_parser().parse_args(base)).air_pitch is None
     with pytest.raises(pl.InputError, match="air_pitch: not with the gust_rates frame 'path'"):
         pl.check_replay("x.tlog", "a.toml", None, pl.ReplayOptions(air_pitch=True, gust_rates="path"))
+    # the default (on) gives way to a frame that already moves q_hat; an explicit choice stands
+    assert pl.replay_air_pitch(pl.ReplayOptions()) is True
+    assert pl.replay_air_pitch(pl.ReplayOptions(gust_rates="mean-wind")) is False
+    assert pl.replay_air_pitch(pl.ReplayOptions(gust_rates="path-yaw")) is True
+    assert pl.replay_air_pitch(pl.ReplayOptions(air_pitch=False)) is False
 
 
 def test_unknown_gust_rate_frame_is_a_user_error(capsys):

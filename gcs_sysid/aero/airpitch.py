@@ -40,7 +40,7 @@ import numpy as np
 
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["AIR_PITCH", "MIN_T", "MAX_KAPPA", "pitch_gust_hat", "air_pitch_fit", "air_pitch_table"]
+__all__ = ["AIR_PITCH", "MIN_T", "MAX_KAPPA", "pitch_gust_hat", "air_pitch_fit", "air_pitch_table", "apply_air_pitch"]
 
 #: Whether the replay moves ``q_hat`` to the air-relative rate (``ReplayOptions.air_pitch`` None). On since the
 #: sixty-eighth session: its rule, written before the run, held on fresh JSBSim flights (seeds 16-18, 25 aircraft, GP
@@ -160,3 +160,24 @@ def air_pitch_table(table, g: np.ndarray, fit: dict):
     ok = np.isfinite(g)
     X[ok, _IQ] = X[ok, _IQ] - fit["kappa"] * g[ok]
     return replace(table, X=X, notes=notes)
+
+
+def apply_air_pitch(table, states, airframe, rows: np.ndarray):
+    """The three steps in one: :func:`pitch_gust_hat` of ``states``, :func:`air_pitch_fit` on ``rows`` and
+    :func:`air_pitch_table` (what the replay's stage, the live learner's windows and the evaluations do).
+
+    Args:
+        table: :class:`~gcs_sysid.aero.table.CoefficientTable` on the states' grid.
+        states: the smoothed states the table was computed from.
+        airframe: :class:`~gcs_sysid.airframe.Airframe` (its chord ``c`` and span ``b``, m).
+        rows: ``(T,)`` bool, the rows the share is fitted on.
+
+    Returns:
+        ``(table, fit, note)``: the table with ``q_hat`` moved where the fit shows it (its note added), the fit's
+        dict and its note; ``(table as given, None, why)`` where the states give no pitch gust rate.
+    """
+    g, why = pitch_gust_hat(states, airframe.c, airframe.b)
+    if g is None:
+        return table, None, why
+    fit = air_pitch_fit(table, g, rows)
+    return air_pitch_table(table, g, fit), fit, fit["note"]

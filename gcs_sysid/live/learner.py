@@ -398,18 +398,16 @@ class Learner:
         """The window's table with ``q_hat`` at the air-relative estimate where the window's own fit shows the pitch
         gust's share (``LearnOptions.air_pitch``; :func:`gcs_sysid.aero.airpitch.air_pitch_fit` on the window's valid
         rows); :attr:`air_pitch` counts the windows and says the last fit, the notes each change of state."""
-        from ..aero.airpitch import air_pitch_fit, air_pitch_table, pitch_gust_hat
+        from ..aero.airpitch import apply_air_pitch
 
-        g, why = pitch_gust_hat(states, self.airframe.c, self.airframe.b)
-        fit = air_pitch_fit(table, g, np.asarray(table.valid, bool)) if g is not None else None
+        table, fit, note = apply_air_pitch(table, states, self.airframe, np.asarray(table.valid, bool))
         state = "no gust rate" if fit is None else "applied" if fit["applied"] else "gyro's rate"
-        note = why if fit is None else fit["note"]
         if state != self.air_pitch["state"]:
             self.notes.append(f"step {self.steps}: {note}")
         self.air_pitch = {"state": state, "windows": self.air_pitch["windows"] + 1,
                           "applied": self.air_pitch["applied"] + int(state == "applied"),
                           "kappa": None if fit is None else fit["kappa"], "note": note}
-        return table if fit is None else air_pitch_table(table, g, fit)
+        return table
 
     def _window_in(self, table: CoefficientTable, rows: np.ndarray, states) -> None:
         """A window's rows are about to be learned (``rows`` (T,) bool): a new key for the rows kept, and with
