@@ -40,7 +40,8 @@ import numpy as np
 
 from .table import COEFFICIENTS, REGRESSORS
 
-__all__ = ["AIR_PITCH", "MIN_T", "MAX_KAPPA", "pitch_gust_hat", "air_pitch_fit", "air_pitch_table", "apply_air_pitch"]
+__all__ = ["AIR_PITCH", "MIN_T", "MAX_KAPPA", "pitch_gust_hat", "air_pitch_fit", "air_pitch_table", "apply_air_pitch",
+           "AirPitchPool"]
 
 #: Whether the replay moves ``q_hat`` to the air-relative rate (``ReplayOptions.air_pitch`` None). On since the
 #: sixty-eighth session: its rule, written before the run, held on fresh JSBSim flights (seeds 16-18, 25 aircraft, GP
@@ -117,10 +118,17 @@ def air_pitch_fit(table, g: np.ndarray, train: np.ndarray) -> dict:
         return nan | {"note": "q_hat is the gyro's: the pitch gust fit is singular"}
     resid = y[rows] - A @ coef
     s2 = float(resid @ resid) / max(len(resid) - A.shape[1], 1)
-    R = np.linalg.qr(A, mode="r")                        # (A^T A)^-1 = R^-1 R^-T: solve, do not invert
-    Rinv_last = np.linalg.solve(R, np.eye(A.shape[1])[:, -1])
-    se = float(np.sqrt(s2 * (Rinv_last @ Rinv_last)))
-    c_g, Cm_q = float(coef[-1]), float(coef[1 + varying.index(_IQ)])
+    # (A^T A)^-1 = R^-1 R^-T with R upper triangular: its last diagonal element is 1 / R_nn^2 (the last row of R^-1
+    # is e_n / R_nn; until 2026-11-29 this read the last column's norm, the element of (R R^T)^-1, which is never
+    # smaller: |t| was understated)
+    R = np.linalg.qr(A, mode="r")
+    se = float(np.sqrt(s2) / abs(R[-1, -1])) if R[-1, -1] != 0 else float("inf")
+    return _judged(float(coef[-1]), float(coef[1 + varying.index(_IQ)]), se, int(rows.sum()))
+
+
+def _judged(c_g: float, Cm_q: float, se: float, n_rows: int, where: str = "") -> dict:
+    """:func:`air_pitch_fit`'s result from the gust column's coefficient ``c_g``, ``Cm_q`` and ``c_g``'s standard
+    error ``se`` over ``n_rows`` training rows: the three conditions of the module docstring and the note."""
     t = c_g / se if se > 0 else float("inf")
     kappa = -c_g / Cm_q if Cm_q != 0 else float("nan")
     why = []
@@ -132,12 +140,103 @@ def air_pitch_fit(table, g: np.ndarray, train: np.ndarray) -> dict:
         why.append(f"|kappa| {abs(kappa):.2f} > {MAX_KAPPA:g}")
     applied = not why
     sign = "Etkin's sign" if kappa > 0 else "the sign opposite to Etkin's, JSBSim ttMilspec's"
-    head = (f"pitch gust share in Cm: kappa {kappa:+.2f} (t {t:+.1f}, Cm_q {Cm_q:+.3g}, {int(rows.sum())} training "
-            f"rows; {sign})")
+    head = (f"pitch gust share in Cm: kappa {kappa:+.2f} (t {t:+.1f}, Cm_q {Cm_q:+.3g}, {n_rows} training "
+            f"rows{where}; {sign})")
     note = (f"q_hat is the air-relative estimate q_hat - kappa g: {head}" if applied
             else f"q_hat is the gyro's: {head} not applied ({'; '.join(why)})")
-    return {"applied": applied, "kappa": kappa, "t": t, "c_g": c_g, "Cm_q": Cm_q, "rows": int(rows.sum()),
-            "note": note}
+    return {"applied": applied, "kappa": kappa, "t": t, "c_g": c_g, "Cm_q": Cm_q, "rows": n_rows, "note": note}
+
+
+class AirPitchPool:
+    """The pitch gust share fitted over a live session's windows together: one ``kappa`` for every window.
+
+    :func:`air_pitch_fit` on a 30-s window reads ``|t|`` 3-30 on JSBSim's flights, so a window-by-window fit moves
+    some windows' ``q_hat`` and leaves others at the gyro's, and the learned model mixes the two rates (the sixty-eighth
+    session's live runs: 5 of 10 windows moved on many flights). Here each window adds the normal equations of its
+    new rows (each row once) to a pool and the share is judged on the pool: the same regression as
+    :func:`air_pitch_fit`, ``Cm`` on the ten regressors and ``g``, with an intercept of its own per window (each
+    window's columns centred on the window's means: its own alpha level and trim), so the pooled fit equals the
+    whole-flight fit with per-window levels, and ``t`` grows with the rows pooled. The conditions of the module
+    docstring (``MIN_T``, ``Cm_q < 0``, ``MAX_KAPPA``) apply to the pooled fit.
+
+    Source: pooled least squares with group intercepts (the within estimator; Greene, *Econometric Analysis*, 7th ed.,
+    Pearson 2012, sec. 11.4), by accumulated normal equations (Golub and Van Loan 2013, sec. 5.3).
+    """
+
+    _MIN_WINDOW_ROWS = 20
+
+    def __init__(self) -> None:
+        k = len(REGRESSORS) + 1
+        self._S = np.zeros((k, k))           # centred cross-products of [X, g]
+        self._sy = np.zeros(k)               # centred [X, g]^T Cm
+        self._syy = 0.0
+        self.rows = 0
+        self.windows = 0
+
+    def add(self, table, g: np.ndarray, rows: np.ndarray) -> int:
+        """Pool one window's rows.
+
+        Args:
+            table: the window's :class:`~gcs_sysid.aero.table.CoefficientTable` (gyro ``q_hat``).
+            g: ``(T,)`` its pitch gust rate as a hat (:func:`pitch_gust_hat`), NaN where unknown.
+            rows: ``(T,)`` bool, the window's new rows (each row of the session pooled once).
+
+        Returns:
+            the rows added (0 where fewer than 20 are usable: a window's own level needs rows to be read).
+
+        Raises:
+            ValueError: ``g`` or ``rows`` not of the table's length.
+        """
+        T = len(table.t)
+        g, rows = np.asarray(g, float), np.asarray(rows, bool)
+        if g.shape != (T,) or rows.shape != (T,):
+            raise ValueError(f"AirPitchPool.add: expected g and rows of shape ({T},), got {g.shape} and {rows.shape}")
+        X = np.asarray(table.X, float)
+        y = np.asarray(table.Y, float)[:, COEFFICIENTS.index("Cm")]
+        ok = rows & np.asarray(table.valid, bool) & np.isfinite(g) & np.isfinite(y) & np.isfinite(X).all(1)
+        n = int(ok.sum())
+        if n < self._MIN_WINDOW_ROWS:
+            return 0
+        A = np.column_stack([X[ok], g[ok]])
+        A = A - A.mean(0)
+        yc = y[ok] - y[ok].mean()
+        self._S += A.T @ A
+        self._sy += A.T @ yc
+        self._syy += float(yc @ yc)
+        self.rows += n
+        self.windows += 1
+        return n
+
+    def fit(self) -> dict:
+        """The pooled share: :func:`air_pitch_fit`'s dict (``applied``, ``kappa``, ``t``, ``c_g``, ``Cm_q``, ``rows``,
+        ``note``) plus ``windows``; NaN values and ``applied`` False below 200 pooled rows or for a singular fit."""
+        k = self._S.shape[0]
+        nan = {"applied": False, "kappa": float("nan"), "t": float("nan"), "c_g": float("nan"), "Cm_q": float("nan"),
+               "rows": self.rows, "windows": self.windows}
+        if self.rows < _MIN_ROWS:
+            return nan | {"note": f"q_hat is the gyro's: {self.rows} rows pooled for the pitch gust fit (at least "
+                                  f"{_MIN_ROWS})"}
+        d = np.diag(self._S)
+        keep = [j for j in range(k) if d[j] > 1e-18 * self.rows]     # columns that vary within some window
+        if _IQ not in keep or (k - 1) not in keep:
+            return nan | {"note": "q_hat is the gyro's: q_hat or the pitch gust rate does not vary over the pooled "
+                                  "rows"}
+        S = self._S[np.ix_(keep, keep)]
+        sc = 1.0 / np.sqrt(np.diag(S))                                 # equilibrated: columns of unit norm
+        Ss = S * sc[:, None] * sc[None, :]
+        try:
+            L = np.linalg.cholesky(Ss)
+        except np.linalg.LinAlgError:
+            return nan | {"note": "q_hat is the gyro's: the pooled pitch gust fit is singular"}
+        if np.min(np.diag(L)) ** 2 < 1e-12:
+            return nan | {"note": "q_hat is the gyro's: the pooled pitch gust fit is singular"}
+        b = np.linalg.solve(L.T, np.linalg.solve(L, self._sy[keep] * sc)) * sc
+        dof = self.rows - len(keep) - self.windows                     # a level per window
+        s2 = max(self._syy - float(b @ self._sy[keep]), 0.0) / max(dof, 1)
+        e = np.linalg.solve(L, np.eye(len(keep))[:, -1])               # (S^-1)_gg = |L^-1 e_g|^2 sc_g^2
+        se = float(np.sqrt(s2 * float(e @ e))) * sc[-1]
+        out = _judged(float(b[-1]), float(b[keep.index(_IQ)]), se, self.rows, f" in {self.windows} windows pooled")
+        return out | {"windows": self.windows}
 
 
 def air_pitch_table(table, g: np.ndarray, fit: dict):
@@ -162,7 +261,7 @@ def air_pitch_table(table, g: np.ndarray, fit: dict):
     return replace(table, X=X, notes=notes)
 
 
-def apply_air_pitch(table, states, airframe, rows: np.ndarray):
+def apply_air_pitch(table, states, airframe, rows: np.ndarray, pool: AirPitchPool | None = None):
     """The three steps in one: :func:`pitch_gust_hat` of ``states``, :func:`air_pitch_fit` on ``rows`` and
     :func:`air_pitch_table` (what the replay's stage, the live learner's windows and the evaluations do).
 
@@ -170,7 +269,10 @@ def apply_air_pitch(table, states, airframe, rows: np.ndarray):
         table: :class:`~gcs_sysid.aero.table.CoefficientTable` on the states' grid.
         states: the smoothed states the table was computed from.
         airframe: :class:`~gcs_sysid.airframe.Airframe` (its chord ``c`` and span ``b``, m).
-        rows: ``(T,)`` bool, the rows the share is fitted on.
+        rows: ``(T,)`` bool, the rows the share is fitted on; with ``pool``, the rows added to it (a live window's
+            new rows).
+        pool: the live session's :class:`AirPitchPool`: ``rows`` are added and the pooled share moves every row of
+            the table; None: the table's own fit on ``rows``.
 
     Returns:
         ``(table, fit, note)``: the table with ``q_hat`` moved where the fit shows it (its note added), the fit's
@@ -179,5 +281,9 @@ def apply_air_pitch(table, states, airframe, rows: np.ndarray):
     g, why = pitch_gust_hat(states, airframe.c, airframe.b)
     if g is None:
         return table, None, why
-    fit = air_pitch_fit(table, g, rows)
+    if pool is None:
+        fit = air_pitch_fit(table, g, rows)
+    else:
+        pool.add(table, g, rows)
+        fit = pool.fit()
     return air_pitch_table(table, g, fit), fit, fit["note"]

@@ -120,12 +120,14 @@ class LearnOptions:
             ``alpha_profile``); None: :data:`gcs_sysid.estimation.airangles.ALPHA_PROFILE_COLUMNS` (``()``, least
             squares), as the replay and the diagnosis.
         air_pitch: each window's ``q_hat`` moved to the air-relative estimate, the gyro's less the pitch gust rate
-            from the window's reconstructed wind times its share in Cm fitted on the window's rows (free sign, applied
-            only when the fit shows it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``).
-            Opt-in: the rule written for it held for Cm on fresh flights (at JSBSim's regressors 42.5 -> 36.0 %
-            median, better on 40 of 50) and failed on the learned output correlations, a second rule on fresh flights
-            failed on the count within the lines at exact conditions (``docs/benchmarks.md``, "Sixty-eighth
-            session"); the replay's ``air_pitch`` is on.
+            from the window's reconstructed wind times its share in Cm (free sign, applied only when the fit shows
+            it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``), the share fitted on every
+            window's new rows so far together, each window with its own level
+            (:class:`~gcs_sysid.aero.airpitch.AirPitchPool`, since the sixty-ninth session: a fit per window moved
+            some windows and left others at the gyro's rate). Opt-in: with a fit per window the rule written for it
+            held for Cm on fresh flights (at JSBSim's regressors 42.5 -> 36.0 % median, better on 40 of 50) and failed
+            on the learned output correlations, a second rule failed on the count within the lines at exact
+            conditions (``docs/benchmarks.md``, "Sixty-eighth session"); the replay's ``air_pitch`` is on.
     """
 
     window_s: float = 30.0
@@ -222,6 +224,10 @@ class Learner:
             with a moved Cl so far) and ``sd_first`` (the first fit's correction SD, Cl units).
         errors: the pooled regressor errors the model carries (``LearnOptions.stated_errors``): ``state`` (``"off"``,
             ``"pooling"``), ``windows``, ``rows`` and ``note`` (what is stated, :meth:`WindowErrorPool.statement`).
+        air_pitch: the air-relative pitch rate's status (``LearnOptions.air_pitch``): ``state`` (``"off"``,
+            ``"waiting"`` before the first window, ``"applied"``, ``"gyro's rate"`` while the pooled fit does not show
+            the share, ``"no gust rate"``), ``windows`` seen, ``applied`` (windows moved), the pooled ``kappa`` and
+            ``t``, ``rows_pooled`` and the fit's ``note``.
         lift_line: the carried lift line's status (``LearnOptions.lift_line``): ``state`` (``"off"``, ``"pooling"``
             before the pool states a line, ``"carried"``, and at the end ``"relevelled"`` or ``"own levels"``,
             :meth:`relevel`), ``windows`` (pooled), ``handed`` (windows a carried line moved), ``note``
@@ -288,6 +294,11 @@ class Learner:
             self._line = LiftLinePool(self.options.window_s)
         self.lift_line = {"state": "pooling" if self._line is not None else "off", "windows": 0, "handed": 0,
                           "note": ""}
+        self._pitch_pool = None               # the pitch gust share pooled over windows (LearnOptions.air_pitch)
+        if self.options.air_pitch:
+            from ..aero.airpitch import AirPitchPool
+
+            self._pitch_pool = AirPitchPool()
         self.air_pitch = {"state": "waiting" if self.options.air_pitch else "off", "windows": 0, "applied": 0,
                           "note": ""}
         self._win = np.zeros(0, int)          # the window (learning call) each kept row came from
@@ -355,14 +366,11 @@ class Learner:
                                      alpha_profile=self.options.alpha_profile)
             self.control_sources = {k: v for k, v in states.sources.items() if k.startswith("delta_")}
             table = compute_coefficients(states, self.airframe)
-            if self.options.air_pitch:
-                table = self._air_pitch(table, states)
         except SysidError as exc:
             self.notes.append(f"step {self.steps}: window skipped ({exc})")
             return
-        t1 = time.perf_counter()
-        self.identifiable = identifiability(states, table)
         if not len(table.t):
+            self.identifiable = identifiability(states, table)
             return
         end = table.t[-1] if final else table.t[-1] - self.options.lag_s
         start = self._t_done
@@ -375,6 +383,10 @@ class Learner:
         if start is not None:
             rows &= table.t > start
         self._t_done = max(end, start) if start is not None else end
+        if self._pitch_pool is not None:      # the new rows into the pool; the pooled share moves the window's q_hat
+            table = self._air_pitch(table, states, rows)
+        t1 = time.perf_counter()
+        self.identifiable = identifiability(states, table)
         self._window_in(table, rows, states)
         self._learn(table, rows, states)
         if final and self._line is not None:
@@ -394,19 +406,21 @@ class Learner:
         self.timings = {"decode+estimate": t1 - t0, "learn": t2 - t1, "refresh": t3 - t2,
                         "trim": time.perf_counter() - t3}
 
-    def _air_pitch(self, table: CoefficientTable, states) -> CoefficientTable:
-        """The window's table with ``q_hat`` at the air-relative estimate where the window's own fit shows the pitch
-        gust's share (``LearnOptions.air_pitch``; :func:`gcs_sysid.aero.airpitch.air_pitch_fit` on the window's valid
-        rows); :attr:`air_pitch` counts the windows and says the last fit, the notes each change of state."""
+    def _air_pitch(self, table: CoefficientTable, states, rows: np.ndarray) -> CoefficientTable:
+        """The window's table with ``q_hat`` at the air-relative estimate where the session's pooled fit shows the
+        pitch gust's share (``LearnOptions.air_pitch``; the window's new ``rows`` (T,) bool added to the
+        :class:`gcs_sysid.aero.airpitch.AirPitchPool` first); :attr:`air_pitch` counts the windows and says the
+        pooled fit, the notes each change of state."""
         from ..aero.airpitch import apply_air_pitch
 
-        table, fit, note = apply_air_pitch(table, states, self.airframe, np.asarray(table.valid, bool))
+        table, fit, note = apply_air_pitch(table, states, self.airframe, rows, pool=self._pitch_pool)
         state = "no gust rate" if fit is None else "applied" if fit["applied"] else "gyro's rate"
         if state != self.air_pitch["state"]:
             self.notes.append(f"step {self.steps}: {note}")
         self.air_pitch = {"state": state, "windows": self.air_pitch["windows"] + 1,
                           "applied": self.air_pitch["applied"] + int(state == "applied"),
-                          "kappa": None if fit is None else fit["kappa"], "note": note}
+                          "kappa": None if fit is None else fit["kappa"], "t": None if fit is None else fit["t"],
+                          "rows_pooled": self._pitch_pool.rows, "note": note}
         return table
 
     def _window_in(self, table: CoefficientTable, rows: np.ndarray, states) -> None:

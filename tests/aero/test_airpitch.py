@@ -87,3 +87,49 @@ def test_too_few_rows_and_bad_shapes():
     assert not fit["applied"] and np.isnan(fit["kappa"]) and "100 rows" in fit["note"]
     with pytest.raises(ValueError, match="air_pitch_fit"):
         air_pitch_fit(table, g[:-1], train)
+
+
+def test_the_pool_is_the_fit_with_a_level_per_window():
+    from dataclasses import replace
+
+    from gcs_sysid.aero.airpitch import AirPitchPool
+
+    table, g, _ = _record(-1.0)
+    T = len(g)
+    one = np.zeros(T, bool)
+    one[:1500] = True
+    pool = AirPitchPool()
+    assert pool.add(table, g, one) == 1500
+    a, b = pool.fit(), air_pitch_fit(table, g, one)
+    for k in ("kappa", "t", "c_g", "Cm_q"):             # one window pooled: the window's own fit, to rounding
+        assert a[k] == pytest.approx(b[k], rel=1e-6), k
+    assert a["applied"] == b["applied"] and a["windows"] == 1 and "1 windows pooled" in a["note"]
+    # t is the gust coefficient's t statistic: c_g / sqrt(s^2 [(A^T A)^-1]_gg), A = [1, varying regressors, g]
+    X = table.X[one]
+    A = np.column_stack([np.ones(1500), X[:, np.std(X, 0) > 0], g[one]])
+    coef = np.linalg.lstsq(A, table.Y[one, ICM], rcond=None)[0]
+    r = table.Y[one, ICM] - A @ coef
+    se = np.sqrt(r @ r / (1500 - A.shape[1]) * np.linalg.inv(A.T @ A)[-1, -1])
+    assert b["t"] == pytest.approx(coef[-1] / se, rel=1e-6)
+    # four 30-s windows, each with its own Cm level (a window's trim and alpha level): the pool reads the share the
+    # whole record has; one fit over the four with a single level takes the jumps as noise
+    Y = table.Y.copy()
+    wins = [np.arange(T) // 1500 == k for k in range(4)]
+    for k, w in enumerate(wins):
+        Y[w, ICM] += 0.01 * (-1) ** k
+    jumpy = replace(table, Y=Y)
+    pool = AirPitchPool()
+    for w in wins:
+        pool.add(jumpy, g, w)
+    p, whole = pool.fit(), air_pitch_fit(table, g, np.ones(T, bool))
+    assert p["applied"] and p["windows"] == 4 and p["rows"] == T
+    assert p["kappa"] == pytest.approx(whole["kappa"], abs=0.02) and abs(p["t"]) > abs(a["t"])
+    single = air_pitch_fit(jumpy, g, np.ones(T, bool))
+    assert abs(single["t"]) < 0.5 * abs(p["t"])
+    # a window too short for its own level adds nothing; wrong shapes are refused
+    short = np.zeros(T, bool)
+    short[:10] = True
+    assert pool.add(table, g, short) == 0 and pool.rows == T
+    with pytest.raises(ValueError, match="AirPitchPool.add"):
+        pool.add(table, g[:-1], short)
+    assert not AirPitchPool().fit()["applied"] and "0 rows pooled" in AirPitchPool().fit()["note"]
