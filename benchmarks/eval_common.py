@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["AIRCRAFT_HELP", "append_jsonl", "read_lines", "truth_residual_correlation", "pair_correlations"]
+__all__ = ["AIRCRAFT_HELP", "append_jsonl", "read_lines", "truth_residual_correlation", "pair_correlations",
+           "false_couplings", "LEARNED_CORR_LIMIT", "TRUTH_NONE_LIMIT"]
 
 #: ``--aircraft`` help of the scripts that fly the harness's aircraft by name (``aircraft_argument``).
 AIRCRAFT_HELP = ("harness names (c172x sgs pa28 j3cub c182 t37 t6 b747 f16 f4n rascal sgs126 asw20 iar80 "
@@ -90,3 +91,39 @@ def pair_correlations(C, names) -> dict[str, float]:
     ``truth_resid_corr``)."""
     C = np.abs(np.asarray(C, float))
     return {f"{a}-{b}": round(float(C[i, j]), 3) for i, a in enumerate(names) for j, b in enumerate(names) if i < j}
+
+
+#: issue 8's line: a learned output correlation above this (|r|) is a coupling
+LEARNED_CORR_LIMIT = 0.5
+#: the truth "has none" for a pair whose residual correlation (:func:`truth_residual_correlation`) is below this;
+#: chosen before any count used it (the sixty-eighth session's rule 68c, ``docs/benchmarks.md``): well below the
+#: learned line, so that a pair counts only where the truth is clearly uncoupled
+TRUTH_NONE_LIMIT = 0.3
+
+
+def false_couplings(corr_pairs: dict | None, truth_resid_corr: dict | None) -> list[str] | None:
+    """The output pairs a model couples where the truth does not: issue 8's "no learned output correlation above 0.5
+    where the truth has none", read pair by pair.
+
+    Args:
+        corr_pairs: ``{"A-B": |r|}``, the model's learned output correlations (an eval row's ``corr_pairs``).
+        truth_resid_corr: ``{"A-B": |r|}``, JSBSim's residual correlations on the same flight's training rows (an
+            eval row's ``truth_resid_corr``, :func:`truth_residual_correlation`).
+
+    Returns:
+        the pairs with a learned ``|r| > LEARNED_CORR_LIMIT`` and a truth ``|r| < TRUTH_NONE_LIMIT``, sorted; a pair
+        the truth's dict lacks (or holds as NaN) is not counted. None when either dict is missing (a row written
+        before the fields existed).
+    """
+    if not isinstance(corr_pairs, dict) or not isinstance(truth_resid_corr, dict):
+        return None
+    out = []
+    for pair, r in corr_pairs.items():
+        t = truth_resid_corr.get(pair)
+        try:
+            r, t = float(r), float(t)
+        except (TypeError, ValueError):
+            continue
+        if r > LEARNED_CORR_LIMIT and t < TRUTH_NONE_LIMIT:       # NaN compares False: not counted
+            out.append(pair)
+    return sorted(out)

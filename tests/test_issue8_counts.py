@@ -10,10 +10,15 @@ C = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 
 
 def _row(ac="sgs", seed=1, gp_seed=0, meas=(1, 1, 1, 1, 1, 1), gp=(1, 1, 1, 1, 1, 1), tair=(1, 1, 1, 1, 1, 1),
-         ls=(2, 2, 2, 2, 2, 2), fair=None, cov_gp=95.0, cov_tair=95.0, corr=0.1):
+         ls=(2, 2, 2, 2, 2, 2), fair=None, cov_gp=95.0, cov_tair=95.0, corr=0.1, truth_corr=0.1):
+    # the learned correlation sits on the CZ-Cm pair; JSBSim's residual one on that pair is truth_corr (None: a row
+    # written before the pair fields)
     r = {"aircraft": ac, "turbulence": "light", "seed": seed, "aoa": "ahrs", "gp_seed": gp_seed,
          "meas": dict(zip(C, meas)), "gp": dict(zip(C, gp)), "true_air": dict(zip(C, tair)),
          "ls": dict(zip(C, ls)), "cov_gp": cov_gp, "cov_true_air": cov_tair, "max_corr": corr}
+    if truth_corr is not None:
+        r["corr_pairs"] = {"CX-CY": 0.05, "CZ-Cm": corr}
+        r["truth_resid_corr"] = {"CX-CY": 0.02, "CZ-Cm": truth_corr}
     if fair is not None:
         r["ls_airtrain"] = dict(zip(C, fair))
     return r
@@ -40,8 +45,24 @@ def test_gp_against_both_least_squares_lines_and_the_flight_counts():
     assert v[("gp<fair", "Cl")] is True and ("gp<fair", "CY") not in v      # Cl only: the others are ls's
     assert v[("cov_gp", "")] is True and v[("cov_tair", "")] is False
     assert v[("corr", "")] is True
+    assert v[("corr_false", "")] is True              # the truth's CZ-Cm residuals are uncorrelated (0.1)
     w = ic.item_values(_row())                        # no ls_airtrain: the fair line is not scored at all
     assert w[("gp<fair", "Cl")] is None
+
+
+def test_a_learned_coupling_the_truth_has_is_not_false():
+    # issue 8's line as written: "no learned output correlation above 0.5 where the truth has none"
+    v = ic.item_values(_row(corr=0.9, truth_corr=0.86))       # JSBSim's own CZ-Cm coupling (fokker50 s2: 0.86)
+    assert v[("corr", "")] is True and v[("corr_false", "")] is False
+    v = ic.item_values(_row(corr=0.9, truth_corr=0.3))        # 0.3 is not "none": strict below
+    assert v[("corr_false", "")] is False
+    v = ic.item_values(_row(corr=0.5, truth_corr=0.0))        # 0.5 is not "above"
+    assert v[("corr_false", "")] is False
+    v = ic.item_values(_row(corr=0.9, truth_corr=None))       # a row written before the pair fields: not scored
+    assert v[("corr", "")] is True and v[("corr_false", "")] is None
+    r = _row(corr=0.9, truth_corr=float("nan"))               # a truth the flight could not compute: not counted
+    assert ic.item_values(r)[("corr_false", "")] is False
+    assert "corr_false" in ic.DEFAULT_COUNTS and "corr" not in ic.DEFAULT_COUNTS
 
 
 def test_counts_per_aircraft_and_total():
@@ -60,18 +81,18 @@ def test_flips_and_rule_8b_at_two_gp_seeds(tmp_path, capsys):
     LS = (9, 2, 2, 2, 2, 2)        # sgs's CX: GP < LS either way
     for gs in (0, 1):
         base += [_row("sgs", 1, gs, gp=(6, 1, 1, 1, 1, 1), ls=LS), _row("t6", 1, gs), _row("s23", 1, gs, corr=0.8)]
-    # seed 0: sgs wins CX held out, s23's correlation drops (a win), t6 loses its band -> +2/-1
+    # seed 0: sgs wins CX held out, s23's correlation drops (a win in corr and corr_false), t6 loses its band -> +3/-1
     cand += [_row("sgs", 1, 0, ls=LS), _row("t6", 1, 0, cov_gp=99.0), _row("s23", 1, 0, corr=0.2)]
     # seed 1: sgs wins CX, t6 loses CY true-air and Cl's GP < LS, s23 unchanged -> +1/-2
     cand += [_row("sgs", 1, 1, ls=LS), _row("t6", 1, 1, tair=(1, 7, 1, 1, 1, 1), gp=(1, 1, 1, 3, 1, 1)),
              _row("s23", 1, 1, corr=0.8)]
     ch0, un0 = ic.flips({ic.flight_key(r): r for r in base[:3]}, {ic.flight_key(r): r for r in cand[:3]})
     assert un0 == [] and sorted((c["aircraft"], c["count"], c["win"]) for c in ch0) == [
-        ("s23", "corr", True), ("sgs", "gp", True), ("t6", "cov_gp", False)]
+        ("s23", "corr", True), ("s23", "corr_false", True), ("sgs", "gp", True), ("t6", "cov_gp", False)]
     holds, both, text = ic.verdict({0: ch0, 1: ic.flips({ic.flight_key(r): r for r in base[3:]},
                                                         {ic.flight_key(r): r for r in cand[3:]})[0]})
     assert not holds and both == ["t6"]
-    assert "seed 0 +2/-1" in text and "seed 1 +1/-2" in text
+    assert "seed 0 +3/-1" in text and "seed 1 +1/-2" in text      # verdict() judges every flip it is given
     # the same through the command line: the rows' own gp_seed pairs the files
     b = _write(tmp_path / "b.jsonl", base)
     c = _write(tmp_path / "c.jsonl", cand)
