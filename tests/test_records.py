@@ -41,3 +41,7 @@ def test_issue8_totals_match_the_readme(seed):
     stated = {k: (int(a), int(b)) for k, a, b in re.findall(r"([\w<]+) (\d+)/(\d+)", line)}
     assert set(stated) == {"meas", "gp", "true_air", "gp<ls", "gp<fair"}
     assert {k: tuple(total[k]) for k in stated} == stated
+    # the correlation line as written needs both pair fields on every line (since the sixty-ninth session)
+    assert all("corr_pairs" in r and "truth_resid_corr" in r for r in runs[seed].values())
+    stated_false = re.search(r"corr_false \(.*?\) (\d+)/75 and (\d+)/75", README.replace("\n  ", " "))
+    assert tuple(total["corr_false"]) == (int(stated_false.group(1 + seed)), 75)
