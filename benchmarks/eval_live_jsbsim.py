@@ -87,7 +87,7 @@ def _pair_states(states):
 
 
 def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None,
-                 alpha_profile: tuple[str, ...] | None = None, air_pitch: bool = False,
+                 alpha_profile: tuple[str, ...] | None = None, air_pitch: bool = True,
                  pitch_status: dict | None = None) -> list[tuple]:
     """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states)`` of every GP step
     (``states``: the part the air-rate pair reads). ``lift_line``: the learner's carried lift line
@@ -164,7 +164,7 @@ def window_levels(steps: list[tuple], truth) -> list[float]:
 
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
              air_rolls=(True,), stated=(True,), lift_lines=(False,), alpha_profile: bool = False,
-             air_pitch: bool = False) -> list[dict]:
+             air_pitch: bool = True) -> list[dict]:
     """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on x lift line off/on),
     JSON-able.
 
@@ -174,7 +174,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     (:func:`window_levels`). ``alpha_profile``: the learner's windows with ``LearnOptions.alpha_profile =
     ("delta_e",)`` (the whole-flight estimate and the LS reference keep least squares); rows say it in
     ``alpha_profile``. ``air_pitch``: the learner's windows with ``LearnOptions.air_pitch`` (each window's ``q_hat`` at
-    the air-relative estimate where its own fit shows the pitch gust's share) and the whole-flight table's too (the
+    the air-relative estimate where the windows' pooled fit shows the pitch gust's share; the learner's default since
+    the sixty-ninth session) and the whole-flight table's too (the
     replay's ``air_pitch`` on its training rows: the held-out question ``gp`` asks at the same kind of ``q_hat``; the
     least-squares line stays at the gyro's); rows say it in ``air_pitch`` with the recorder's status in
     ``air_pitch_status``.
@@ -229,7 +230,7 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
 
 def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut, Xt_air, h,
                     ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile=False,
-                    air_pitch=False, truth_corr=None) -> list[dict]:
+                    air_pitch=True, truth_corr=None) -> list[dict]:
     """:func:`evaluate`'s rows of one ``lift_line`` value ``ll``."""
     Yt = truth.at(tab.t)[1]
     t0 = time.perf_counter()
@@ -450,9 +451,9 @@ def main(argv=None) -> int:
     ap.add_argument("--alpha-profile", default="off", choices=("off", "on"),
                     help="the learner's windows with the elevator's slope by the gust likelihood (LearnOptions."
                          "alpha_profile)")
-    ap.add_argument("--air-pitch", default="off", choices=("off", "on"),
+    ap.add_argument("--air-pitch", default="on", choices=("off", "on"),
                     help="the learner's windows (and the whole-flight table) with q_hat at the air-relative estimate "
-                         "(LearnOptions.air_pitch)")
+                         "(LearnOptions.air_pitch; default on, as the learner's since the sixty-ninth session)")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
     ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
                     help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")

@@ -116,3 +116,24 @@ def test_run_replay_hands_its_sideslip_estimator_and_rate_frame_to_the_stages(mo
         with pytest.raises(ZeroDivisionError):
             pl.run_replay(log, af, tmp_path / "o", opts)
     assert seen == [False, None, True, "path-yaw"]
+
+
+@pytest.mark.parametrize("flag, expected", [([], True), (["--air-pitch", "off"], False), (["--air-pitch", "on"], True)])
+def test_listen_air_pitch_is_on_by_default(monkeypatch, flag, expected):
+    """`listen`'s windows learn at the air-relative q_hat unless told otherwise (sixty-ninth session, rule 69), as
+    `LearnOptions`' own default."""
+    import gcs_sysid.live.session as session
+    from gcs_sysid.live.cli import cmd_listen
+    from gcs_sysid.live.learner import LearnOptions
+
+    seen = {}
+
+    def fake_run_listen(airframe, out, opts):
+        seen["learn"] = opts.learn
+        return {"raw_log": "raw.tlog", "raw_records": 0}
+
+    monkeypatch.setattr(session, "run_listen", fake_run_listen)
+    a = build_parser().parse_args(["listen", "udpin:127.0.0.1:14550", "--airframe", "a.toml", "--out", "o"] + flag)
+    assert cmd_listen(a) == 0
+    assert seen["learn"].air_pitch is expected
+    assert LearnOptions().air_pitch is True

@@ -40,10 +40,12 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "of the windows so far instead of its own 30 s of mean vertical wind, and at the end every "
                         "row is moved onto the line of all windows and learned again; default off; docs/live.md, "
                         "'The lift line carried across windows'")
-    p.add_argument("--air-pitch", default="off", choices=("on", "off"),
+    p.add_argument("--air-pitch", default="on", choices=("on", "off"),
                    help="each window's q_hat at the air-relative estimate, the gyro's less the pitch gust rate from "
-                        "the reconstructed wind times its share in Cm fitted on the window (free sign; applied only "
-                        "when the fit shows it); default off; docs/estimation.md, 'The air-relative pitch rate'")
+                        "the reconstructed wind times its share in Cm fitted on the session's windows together (free "
+                        "sign; applied only when the pooled fit shows it); default on (since the sixty-ninth "
+                        "session; 'off': the gyro's q_hat); docs/live.md, 'The air-relative pitch rate in the "
+                        "windows'")
     p.add_argument("--alpha-profile", default="off", choices=("on", "off"),
                    help="the windows' alpha aiding takes the elevator's slope by the gust model's likelihood instead "
                         "of least squares (in closed loop least squares loads it with the gust's normal force, and "

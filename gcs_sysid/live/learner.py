@@ -124,10 +124,12 @@ class LearnOptions:
             it; :mod:`gcs_sysid.aero.airpitch`, ``gcs-sysid listen --air-pitch on|off``), the share fitted on every
             window's new rows so far together, each window with its own level
             (:class:`~gcs_sysid.aero.airpitch.AirPitchPool`, since the sixty-ninth session: a fit per window moved
-            some windows and left others at the gyro's rate). Opt-in: with a fit per window the rule written for it
-            held for Cm on fresh flights (at JSBSim's regressors 42.5 -> 36.0 % median, better on 40 of 50) and failed
-            on the learned output correlations, a second rule failed on the count within the lines at exact
-            conditions (``docs/benchmarks.md``, "Sixty-eighth session"); the replay's ``air_pitch`` is on.
+            some windows and left others at the gyro's rate). On by default since the sixty-ninth session: the rule
+            written before its run held on fresh JSBSim flights (seeds 30-31, 25 aircraft, GP seeds 0 and 1: 445 of
+            500 windows moved; at JSBSim's regressors Cm 45.7 -> 37.5 % median, better on 36 of 50 flights and worse
+            on 11; held-out flight x coefficients within the lines +8/-0 and +6/-0 at the two GP seeds;
+            ``docs/benchmarks.md``, "Sixty-ninth session"); with a fit per window two rules had failed (sixty-eighth
+            session). ``False``: the gyro's ``q_hat``, as before.
     """
 
     window_s: float = 30.0
@@ -148,7 +150,7 @@ class LearnOptions:
     rate_errors: bool | None = None
     lift_line: bool = False
     alpha_profile: tuple[str, ...] | None = None
-    air_pitch: bool = False
+    air_pitch: bool = True
 
     def __post_init__(self):
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):

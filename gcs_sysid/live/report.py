@@ -50,7 +50,7 @@ def render_markdown(snap: dict) -> str:
                          + (f" ({ll['note']})" if ll.get("note") else ""))
         ap = snap.get("air_pitch") or {}
         if ap.get("state", "off") != "off":
-            lines.append(f"- the air-relative pitch rate (`--air-pitch on`): {ap.get('applied', 0)} of "
+            lines.append(f"- the air-relative pitch rate (`--air-pitch`, on by default): {ap.get('applied', 0)} of "
                          f"{ap.get('windows', 0)} windows moved" + (f" ({ap['note']})" if ap.get("note") else ""))
         se = snap.get("stated_errors") or {}
         if se.get("note"):
