@@ -309,7 +309,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     they are scored at). ``air_yaw``: ``ReplayOptions.air_yaw`` (None: the default, off). ``rate_errors``:
     ``ReplayOptions.rate_errors`` (None: the default; the band at exact conditions only). ``air_pitch``:
     ``ReplayOptions.air_pitch`` (None: the default, :data:`gcs_sysid.aero.airpitch.AIR_PITCH`); the least-squares line
-    (``run_fit``) is fitted at the gyro's ``q_hat`` either way and scored at the replay's held-out regressors.
+    (``run_fit(air_pitch=)``) is fitted at the same kind of ``q_hat`` as the replay's (since the sixty-ninth session;
+    before, at the gyro's either way) and scored at the replay's held-out regressors; rows say it in ``ls_air_pitch``.
     ``true`` scores the model at the true regressors with the inertial rates (as the truth file
     keeps them), ``true_air`` with the rates the aircraft's JSBSim aerodynamics reads (air-relative
     ``p_aero q_aero r_aero`` on the axes where its XML reads ``p-aero`` etc., :func:`aero_reads_air_rates`;
@@ -447,8 +448,10 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
 
     ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE, gls_beta=replay_beta_gls(opts),
-                          air_roll_train=False)     # the measured Cl, as issue 8's records were (not the diagnosis's)
+                          air_roll_train=False,     # the measured Cl, as issue 8's records were (not the diagnosis's)
+                          air_pitch=replay_air_pitch(opts))   # the replay's kind of q_hat: the same data as the GP
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
+    row["ls_air_pitch"] = replay_air_pitch(opts)
     from gcs_sysid.aero.gustfilter import AIR_ROLL_TRAIN, HELDOUT_AIR_ROLL
 
     if (AIR_ROLL_TRAIN and not gust_filter) if air_roll_train is None else air_roll_train:

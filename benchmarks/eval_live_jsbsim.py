@@ -177,8 +177,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     the air-relative estimate where the windows' pooled fit shows the pitch gust's share; the learner's default since
     the sixty-ninth session) and the whole-flight table's too (the
     replay's ``air_pitch`` on its training rows: the held-out question ``gp`` asks at the same kind of ``q_hat``; the
-    least-squares line stays at the gyro's); rows say it in ``air_pitch`` with the recorder's status in
-    ``air_pitch_status``.
+    least-squares line is fitted at that kind too since the sixty-ninth session, ``run_fit(air_pitch=)``, at the
+    gyro's before); rows say it in ``air_pitch`` with the recorder's status in ``air_pitch_status``.
 
     ``stated``: ``LearnOptions.stated_errors`` values to run (the windows' pooled regressor errors in the model's
     band at exact conditions, ``cov_true_air``); each row says its own in ``stated_errors``.
@@ -218,7 +218,8 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     truth_corr = truth_residual_correlation(Xt_air, Yt, tab.valid & ~held)
     ls_model, _ = run_fit(files.tlog, files.airframe, work / f"{files.tlog.stem}-livefit.toml", t_to=t_cut,
                           profile_beta=airangles.BETA_PROFILE,      # the learner's sideslip estimator
-                          air_roll_train=False)     # the measured Cl (not the diagnosis's reference target)
+                          air_roll_train=False,     # the measured Cl (not the diagnosis's reference target)
+                          air_pitch=air_pitch)      # the whole-flight table's kind of q_hat (sixty-ninth session)
     ls = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
     out = []
     for ll in lift_lines:

@@ -141,6 +141,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "'on', or 'off' (the measured Cl at the gyro's rate); not given: as diagnose reads its "
                         "reference flight (Cl's air-rate target, docs/diagnose.md, 'The air-relative roll rate'; "
                         "docs/estimation.md, 'Where the pair applies')")
+    f.add_argument("--air-pitch", default="off", choices=("on", "off"),
+                   help="q_hat at the air-relative estimate, the gyro's less the pitch gust rate from the "
+                        "reconstructed wind times its share in Cm fitted on the window (as replay's default; applied "
+                        "only where the fit shows it, with a note in the model's header and <out>.fit.json): 'on', "
+                        "or 'off' (the default: the gyro's q_hat, as diagnose reads its flights); "
+                        "docs/estimation.md, 'The air-relative pitch rate'")
     f.add_argument("--beta-profile", default="off", choices=("on", "off"),
                    help="the aided sideslip's CY_beta by the gust model's likelihood, held in the later passes (opt-in "
                         "everywhere since the thirty-third session): 'off' the default (least squares, as the "
@@ -284,6 +290,11 @@ def _check_fit(a: argparse.Namespace) -> None:
     from .outdir import check_out_file
 
     _check_window(a)
+    if getattr(a, "air_pitch", "off") == "on" and a.gust_rates in ("path", "mean-wind"):
+        from .errors import InputError
+
+        raise InputError(f"--air-pitch on: not with --gust-rates {a.gust_rates} (its q_hat is relative to the air "
+                         "already)")
     load_airframe(a.airframe)
     out = Path(a.out)
     check_out_file(out, "--out")
@@ -295,7 +306,8 @@ def _cmd_fit(a: argparse.Namespace) -> int:
 
     _stated_lift_level(a)
     run_fit(a.log, a.airframe, a.out, t_from=a.t_from, t_to=a.t_to, notify=_say, gust_rates=a.gust_rates,
-            air_roll_train=None if a.air_roll is None else a.air_roll == "on", profile_beta=a.beta_profile == "on")
+            air_roll_train=None if a.air_roll is None else a.air_roll == "on", profile_beta=a.beta_profile == "on",
+            air_pitch=a.air_pitch == "on")
     print(f"wrote {a.out}")
     return 0
 

@@ -240,7 +240,7 @@ def load_measurements(log, airframe_path, t_from: float | None = None, t_to: flo
 
 def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: float | None = None,
             progress=None, notify=None, gust_rates: str | None = None, air_roll_train: bool | None = None,
-            profile_beta: bool | None = None, gls_beta: bool | None = None):
+            profile_beta: bool | None = None, gls_beta: bool | None = None, air_pitch: bool = False):
     """``gcs-sysid fit``: stepwise equation-error model from a log, written as a model file.
 
     Also writes ``<out>.fit.json`` with the per-coefficient statistics (and the damage found in the
@@ -262,13 +262,19 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             squares: the diagnosis's reference models are fitted through here).
         gls_beta: the side-force model's slopes by GLS (True) or least squares (False); None: :data:`BETA_GLS`
             (least squares, as the diagnosis loads its flights).
+        air_pitch: ``q_hat`` at the air-relative estimate where the window's own fit shows the pitch gust's share
+            (``--air-pitch on``; :func:`gcs_sysid.aero.airpitch.apply_air_pitch` on every valid row of the window,
+            as the replay's default does on its training rows), so the model's ``q_hat`` terms read the air's rate;
+            the note goes into the model's header and ``<out>.fit.json``'s ``air_pitch``. False (the default): the
+            gyro's ``q_hat``, as the diagnosis reads its flights.
 
     Returns:
         (model, report) as :func:`gcs_sysid.diagnose.fit.fit_model`.
 
     Raises:
         InputError: ``air_roll_train`` True with :data:`AIR_ROLL_RATE` moving the fit's ``p_hat`` regressor already
-            (the gust would be taken out twice); from the stages.
+            (the gust would be taken out twice); ``air_pitch`` with a ``gust_rates`` frame that moves ``q_hat``
+            already (``"path"``, ``"mean-wind"``); from the stages.
     """
     from ..sim.model_file import save_model
     from .fit import fit_model
@@ -280,6 +286,9 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     # explicit on/off: the replay's pair or the measured Cl (a p_hat mode still moves the regressor); None: the
     # diagnosis's own mode, as load_measurements loads its reference flight (air_roll_kind)
     load_kind = "off" if air_roll_train is not None and kind == "Cl" else kind
+    if air_pitch and gust_rates in ("path", "mean-wind"):
+        raise InputError(f"fit --air-pitch on: not with --gust-rates {gust_rates} (its q_hat is relative to the air "
+                         "already)")
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
@@ -293,11 +302,22 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
                    "Cl_p": float(info["Cl_p"]) if info["applied"] else None,
                    "note": f"{info['note']} (the diagnosis's air roll rate {AIR_ROLL_RATE!r}; --air-roll off: "
                            "the measured Cl)"}
+        pitch = None
+        if air_pitch:
+            from ..aero.airpitch import apply_air_pitch
+
+            table, fit, note = apply_air_pitch(table, meas.states, meas.airframe, np.asarray(table.valid, bool))
+            pitch = {"applied": bool(fit is not None and fit["applied"]),
+                     "kappa": None if fit is None else float(fit["kappa"]),
+                     "t": None if fit is None else float(fit["t"]), "note": note}
         model, report = fit_model(table, name=Path(out_path).stem)
         if air is not None:
             report.notes.append(air["note"])
+        if pitch is not None:
+            report.notes.append(pitch["note"])
         model = type(model)(model.terms, model.name, f"fitted from {Path(str(log)).name} by gcs-sysid fit", "")
-        header = report.header() + ("" if air is None else "\n" + air["note"])
+        header = report.header() + ("" if air is None else "\n" + air["note"]) + \
+            ("" if pitch is None else "\n" + pitch["note"])
         save_model(model, stage.path(out), header=header)
         doc = report.to_json()
         if isinstance(doc, dict):                 # which flight: diagnose finds it again (differential diagnosis)
@@ -306,6 +326,8 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             doc["reference_flights"] = [fit_record(log, t_from, t_to)]
             off = {"target": "gyro", "applied": False, "Cl_p": None, "note": "off (--air-roll off)"}
             doc["air_roll"] = off if air is None else {k: air[k] for k in ("target", "applied", "Cl_p", "note")}
+            doc["air_pitch"] = pitch if pitch is not None else {"applied": False, "kappa": None, "t": None,
+                                                                 "note": "off (--air-pitch off)"}
         if meas.flight.damage and isinstance(doc, dict):
             doc["log_damage"] = list(meas.flight.damage)
         stage.path(out.with_suffix(".fit.json")).write_text(json.dumps(doc, indent=1, default=float))
