@@ -96,15 +96,8 @@ def air_pitch_fit(table, g: np.ndarray, train: np.ndarray) -> dict:
     Raises:
         ValueError: ``g`` or ``train`` not of the table's length.
     """
-    T = len(table.t)
-    g, train = np.asarray(g, float), np.asarray(train, bool)
-    if g.shape != (T,) or train.shape != (T,):
-        raise ValueError(f"air_pitch_fit: expected g and train of shape ({T},), got {g.shape} and {train.shape}")
-    X = np.asarray(table.X, float)
-    y = np.asarray(table.Y, float)[:, COEFFICIENTS.index("Cm")]
-    rows = train & np.asarray(table.valid, bool) & np.isfinite(g) & np.isfinite(y) & np.isfinite(X).all(1)
-    nan = {"applied": False, "kappa": float("nan"), "t": float("nan"), "c_g": float("nan"), "Cm_q": float("nan"),
-           "rows": int(rows.sum())}
+    X, y, g, rows = _usable(table, g, train, "air_pitch_fit", "train")
+    nan = _no_fit(int(rows.sum()))
     if rows.sum() < _MIN_ROWS:
         return nan | {"note": f"q_hat is the gyro's: {int(rows.sum())} rows for the pitch gust fit (at least "
                               f"{_MIN_ROWS})"}
@@ -124,6 +117,25 @@ def air_pitch_fit(table, g: np.ndarray, train: np.ndarray) -> dict:
     R = np.linalg.qr(A, mode="r")
     se = float(np.sqrt(s2) / abs(R[-1, -1])) if R[-1, -1] != 0 else float("inf")
     return _judged(float(coef[-1]), float(coef[1 + varying.index(_IQ)]), se, int(rows.sum()))
+
+
+def _usable(table, g, rows, who: str, name: str):
+    """``(X (T, 10), Cm (T,), g (T,), usable (T,) bool)``: the table's regressors and Cm, ``g`` as floats, and the
+    given ``rows`` that are valid with ``g``, Cm and every regressor finite. Raises ValueError (naming ``who`` and
+    ``name``) where ``g`` or ``rows`` is not of the table's length."""
+    T = len(table.t)
+    g, rows = np.asarray(g, float), np.asarray(rows, bool)
+    if g.shape != (T,) or rows.shape != (T,):
+        raise ValueError(f"{who}: expected g and {name} of shape ({T},), got {g.shape} and {rows.shape}")
+    X = np.asarray(table.X, float)
+    y = np.asarray(table.Y, float)[:, COEFFICIENTS.index("Cm")]
+    return X, y, g, rows & np.asarray(table.valid, bool) & np.isfinite(g) & np.isfinite(y) & np.isfinite(X).all(1)
+
+
+def _no_fit(n_rows: int) -> dict:
+    """The result's fields where no fit was made (the note is the caller's)."""
+    return {"applied": False, "kappa": float("nan"), "t": float("nan"), "c_g": float("nan"), "Cm_q": float("nan"),
+            "rows": n_rows}
 
 
 def _judged(c_g: float, Cm_q: float, se: float, n_rows: int, where: str = "") -> dict:
@@ -187,13 +199,7 @@ class AirPitchPool:
         Raises:
             ValueError: ``g`` or ``rows`` not of the table's length.
         """
-        T = len(table.t)
-        g, rows = np.asarray(g, float), np.asarray(rows, bool)
-        if g.shape != (T,) or rows.shape != (T,):
-            raise ValueError(f"AirPitchPool.add: expected g and rows of shape ({T},), got {g.shape} and {rows.shape}")
-        X = np.asarray(table.X, float)
-        y = np.asarray(table.Y, float)[:, COEFFICIENTS.index("Cm")]
-        ok = rows & np.asarray(table.valid, bool) & np.isfinite(g) & np.isfinite(y) & np.isfinite(X).all(1)
+        X, y, g, ok = _usable(table, g, rows, "AirPitchPool.add", "rows")
         n = int(ok.sum())
         if n < self._MIN_WINDOW_ROWS:
             return 0
@@ -211,8 +217,7 @@ class AirPitchPool:
         """The pooled share: :func:`air_pitch_fit`'s dict (``applied``, ``kappa``, ``t``, ``c_g``, ``Cm_q``, ``rows``,
         ``note``) plus ``windows``; NaN values and ``applied`` False below 200 pooled rows or for a singular fit."""
         k = self._S.shape[0]
-        nan = {"applied": False, "kappa": float("nan"), "t": float("nan"), "c_g": float("nan"), "Cm_q": float("nan"),
-               "rows": self.rows, "windows": self.windows}
+        nan = _no_fit(self.rows) | {"windows": self.windows}
         if self.rows < _MIN_ROWS:
             return nan | {"note": f"q_hat is the gyro's: {self.rows} rows pooled for the pitch gust fit (at least "
                                   f"{_MIN_ROWS})"}
