@@ -223,9 +223,10 @@ class AirPitchPool:
                                   f"{_MIN_ROWS})"}
         d = np.diag(self._S)
         keep = [j for j in range(k) if d[j] > 1e-18 * self.rows]     # columns that vary within some window
-        if _IQ not in keep or (k - 1) not in keep:
-            return nan | {"note": "q_hat is the gyro's: q_hat or the pitch gust rate does not vary over the pooled "
-                                  "rows"}
+        flat = [name for j, name in ((_IQ, "q_hat"), (k - 1, "the pitch gust rate")) if j not in keep]
+        if flat:
+            return nan | {"note": f"q_hat is the gyro's: {' and '.join(flat)} does not vary over the "
+                                  f"{self.rows} pooled rows"}
         S = self._S[np.ix_(keep, keep)]
         sc = 1.0 / np.sqrt(np.diag(S))                                 # equilibrated: columns of unit norm
         Ss = S * sc[:, None] * sc[None, :]

@@ -133,3 +133,13 @@ def test_the_pool_is_the_fit_with_a_level_per_window():
     with pytest.raises(ValueError, match="AirPitchPool.add"):
         pool.add(table, g[:-1], short)
     assert not AirPitchPool().fit()["applied"] and "0 rows pooled" in AirPitchPool().fit()["note"]
+
+
+def test_the_pool_says_which_column_does_not_vary():
+    from gcs_sysid.aero.airpitch import AirPitchPool
+
+    table, g, _ = _record(1.0, T=1000)
+    pool = AirPitchPool()
+    pool.add(table, np.zeros(len(g)), np.ones(len(g), bool))     # a window whose wind carries no gust
+    fit = pool.fit()
+    assert not fit["applied"] and "the pitch gust rate does not vary over the 1000 pooled rows" in fit["note"]
