@@ -43,8 +43,9 @@ not correlated). The bounds are inclusive (``<= 3``, ``90 <= cov <= 98``); ``gp 
 strict.
 
 A flip is one flight x coefficient (or flight) whose count changes between the base (``--against``) and the
-candidate (the positional files): a win where it becomes satisfied (for ``corr`` and ``corr_false``: where a flight's correlation
-drops to 0.5 or below), a loss the other way. Runs are paired by flight (aircraft, turbulence, seed, AOA_SSA) and
+candidate (the positional files): a win where it becomes satisfied (for ``corr``: where a flight's correlation
+drops to 0.5 or below; for ``corr_false``: where no pair above 0.5 is left that the truth does not couple), a loss the
+other way. Runs are paired by flight (aircraft, turbulence, seed, AOA_SSA) and
 by GP seed: the rows' ``gp_seed`` field (``eval_jsbsim.py --gp-seed``, written since the thirty-third session; 0
 when absent), or ``FILE@N`` to state it for every row of a file written before that. With pairs at two or more GP
 seeds the rule 8(b) verdict is printed: it holds when at every seed the wins are at least twice the losses and
