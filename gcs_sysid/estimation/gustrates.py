@@ -95,14 +95,21 @@ def lag_filter(dt: float, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
     *Digital Control of Dynamic Systems*, 3rd ed., sec. 4.3).
     """
     x = np.asarray(x, float)
-    a = np.exp(-dt / np.broadcast_to(np.asarray(tau, float), x.shape))
-    y = np.empty_like(x)
-    prev = next((v for v in x if np.isfinite(v)), 0.0)
-    for k in range(len(x)):
-        xk = x[k] if np.isfinite(x[k]) else prev
-        prev = a[k] * prev + (1.0 - a[k]) * xk if k else xk
+    a = np.exp(-dt / np.broadcast_to(np.asarray(tau, float), x.shape)).tolist()
+    fin = np.isfinite(x)
+    xs = np.where(fin, x, np.nan).tolist()           # Python floats: the recursion runs about 5x faster than on
+    prev = float(x[np.argmax(fin)]) if fin.any() else 0.0     # numpy scalars, with the same IEEE arithmetic
+    y = [0.0] * len(xs)
+    for k, xk in enumerate(xs):
+        if xk != xk:                                  # not finite: the output holds
+            xk = prev
+        if k:
+            ak = a[k]
+            prev = ak * prev + (1.0 - ak) * xk
+        else:
+            prev = xk
         y[k] = prev
-    return y
+    return np.array(y, float)
 
 
 def _ddt(dt: float, x: np.ndarray) -> np.ndarray:
