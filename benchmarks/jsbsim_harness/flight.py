@@ -11,8 +11,8 @@ Truth (SI, body axes x fwd / y right / z down, NED) is read from JSBSim's own pr
 log tick: aerodynamic forces ``forces/fb{x,y,z}-aero-lbs`` and moments ``moments/{l,m,n}-aero-lbsft``
 (JSBSim transfers the moments from its aerodynamic reference point to the CG, ``FGAerodynamics``;
 checked against ``J w_dot + w x J w``: 1e-11 on the minisgs, 0.2 % with the rounded airframe file in
-``tests/jsbsim``), ``aero/alpha-rad``,
-``aero/beta-rad``, ``velocities/vt-fps``, ``aero/qbar-psf``, the inertial body rates
+``tests/jsbsim``), ``aero/alpha-rad``, ``aero/alphadot-rad_sec`` (what the XMLs' ``Cm_alphadot`` terms read: it
+carries the gust's vertical acceleration), ``aero/beta-rad``, ``velocities/vt-fps``, ``aero/qbar-psf``, the inertial body rates
 ``velocities/{p,q,r}i-rad_sec`` and their derivatives, and ``atmosphere/total-wind-*-fps``
 (steady wind plus turbulence, the velocity of the air over the ground).
 
@@ -401,6 +401,7 @@ _PROPS = {
     "u": ("velocities/u-fps", FT), "v": ("velocities/v-fps", FT), "w": ("velocities/w-fps", FT),
     "vn": ("velocities/v-north-fps", FT), "ve": ("velocities/v-east-fps", FT), "vd": ("velocities/v-down-fps", FT),
     "V": ("velocities/vt-fps", FT), "alpha": ("aero/alpha-rad", 1.0), "beta": ("aero/beta-rad", 1.0),
+    "alpha_dot": ("aero/alphadot-rad_sec", 1.0),    # what the XMLs' Cm_alphadot / CL_alphadot terms read
     "qbar": ("aero/qbar-psf", LBF / FT**2), "rho": ("atmosphere/rho-slugs_ft3", SLUG / FT**3),
     "press_abs": ("atmosphere/P-psf", LBF / FT**2), "temperature": ("atmosphere/T-R", 5.0 / 9.0),
     "wn": ("atmosphere/total-wind-north-fps", FT), "we": ("atmosphere/total-wind-east-fps", FT),

@@ -47,3 +47,20 @@ def test_alpha_rate_against_jsbsim(fast_flight):
     diff = np.gradient(st.data["alpha"], st.t)
     print(f"d(alpha)/dt: RMS error {100 * rms(diff[m] - ref[m]) / rms(ref[m]):.1f} %")
     assert rms(diff[m] - ref[m]) > 2.0 * rms(est[m] - ref[m])
+
+
+def test_the_truths_alpha_dot_is_jsbsims_and_the_rebuild_matches_it(fast_flight):
+    """Since the sixty-ninth session the truth keeps JSBSim's own ``aero/alphadot-rad_sec`` (what the XMLs'
+    ``Cm_alphadot`` terms read); ``eval_jsbsim.true_alpha_dot``, which issue 8's scores at exact conditions use, rebuilds
+    it from the ground velocity's derivative. Measured on the navion and b737 light s1 flights: correlation 0.998 and
+    0.999, RMS difference 6.5 and 4.4 % of the signal; on the fast flight 0.999 and 4.7 %. Asked here: above 0.99 and
+    below 15 % (thresholds set from those measurements)."""
+    from benchmarks.eval_jsbsim import true_alpha_dot
+
+    truth = load_truth(fast_flight.truth)
+    assert "alpha_dot" in truth.fields
+    own, rebuilt = truth.fields["alpha_dot"], true_alpha_dot(truth)
+    ok = np.isfinite(own) & np.isfinite(rebuilt)
+    assert ok.mean() > 0.99 and np.std(own[ok]) > 0
+    assert np.corrcoef(own[ok], rebuilt[ok])[0, 1] > 0.99
+    assert np.sqrt(np.mean((own[ok] - rebuilt[ok]) ** 2)) < 0.15 * np.std(own[ok])
