@@ -446,12 +446,12 @@ def evaluate(aircraft: str, seed: int, turbulence: str, aoa: str, duration: floa
     # `gcs-sysid fit` alone keeps least squares' CY_beta by default, gcs_sysid.diagnose.run.BETA_PROFILE)
     from gcs_sysid.estimation import airangles as _aa
 
+    row["ls_air_pitch"] = replay_air_pitch(opts)     # the replay's kind of q_hat: the same data as the GP
     ls_model, _ = run_fit(files.tlog, af_path, work / f"{files.tlog.stem}-fit.toml", t_to=t_cut,
                           gust_rates=gust_rates, profile_beta=_aa.BETA_PROFILE, gls_beta=replay_beta_gls(opts),
                           air_roll_train=False,     # the measured Cl, as issue 8's records were (not the diagnosis's)
-                          air_pitch=replay_air_pitch(opts))   # the replay's kind of q_hat: the same data as the GP
+                          air_pitch=row["ls_air_pitch"])
     row["ls"] = _errs(ls_model.evaluate(tab.X[h]), Yt[h])
-    row["ls_air_pitch"] = replay_air_pitch(opts)
     from gcs_sysid.aero.gustfilter import AIR_ROLL_TRAIN, HELDOUT_AIR_ROLL
 
     if (AIR_ROLL_TRAIN and not gust_filter) if air_roll_train is None else air_roll_train:

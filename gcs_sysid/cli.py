@@ -290,11 +290,9 @@ def _check_fit(a: argparse.Namespace) -> None:
     from .outdir import check_out_file
 
     _check_window(a)
-    if getattr(a, "air_pitch", "off") == "on" and a.gust_rates in ("path", "mean-wind"):
-        from .errors import InputError
+    from .diagnose.run import check_fit_air_pitch
 
-        raise InputError(f"--air-pitch on: not with --gust-rates {a.gust_rates} (its q_hat is relative to the air "
-                         "already)")
+    check_fit_air_pitch(a.air_pitch == "on", a.gust_rates)
     load_airframe(a.airframe)
     out = Path(a.out)
     check_out_file(out, "--out")

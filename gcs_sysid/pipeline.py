@@ -313,18 +313,15 @@ def replay_beta_gls(options: ReplayOptions) -> bool:
     return bool(airangles.BETA_GLS if options.beta_gls is None else options.beta_gls)
 
 
-#: the gust-rate frames whose hats already take the pitch gust rate out of ``q_hat`` (:func:`replay_air_pitch`)
-_PITCH_FRAMES = ("path", "mean-wind")
-
-
 def replay_air_pitch(options: ReplayOptions) -> bool:
     """Whether the replay moves ``q_hat`` to the air-relative estimate: ``options.air_pitch``, or when it is None
     :data:`gcs_sysid.aero.airpitch.AIR_PITCH` unless the gust-rate frame already moves ``q_hat``."""
     from .aero.airpitch import AIR_PITCH
+    from .estimation.gustrates import PITCH_FRAMES
 
     if options.air_pitch is not None:
         return bool(options.air_pitch)
-    return AIR_PITCH and replay_gust_rates(options) not in _PITCH_FRAMES
+    return AIR_PITCH and replay_gust_rates(options) not in PITCH_FRAMES
 
 
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
@@ -347,7 +344,7 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
                          "rows: gust_filter through every output's p_hat, air_roll_train through Cl's target)")
     if options.gp_noise is not None:
         gp_noise_fields(options.gp_noise)
-    from .estimation.gustrates import FRAMES
+    from .estimation.gustrates import FRAMES, PITCH_FRAMES
 
     if options.gust_rates is not None and options.gust_rates not in (*FRAMES, INERTIAL_RATES):
         raise InputError(f"gust_rates: expected one of {', '.join((*FRAMES, INERTIAL_RATES))}, got "
@@ -355,7 +352,7 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
     if options.air_yaw and replay_gust_rates(options) is not None:
         raise InputError("air_yaw: not with a gust_rates frame (both take the yaw gust rate out of the moments: "
                          "air_yaw through Cl's and Cn's targets, gust_rates through every output's input)")
-    if options.air_pitch and replay_gust_rates(options) in _PITCH_FRAMES:
+    if options.air_pitch and replay_gust_rates(options) in PITCH_FRAMES:
         raise InputError(f"air_pitch: not with the gust_rates frame {replay_gust_rates(options)!r} (both take the "
                          "pitch gust rate out of q_hat; 'path-yaw' leaves q_hat the gyro's)")
     check_window(options.t_from, options.t_to)

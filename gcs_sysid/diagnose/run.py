@@ -18,7 +18,7 @@ DIAGNOSE_OUTPUTS = ("diagnosis.json", "model_extended.toml", "report.html")
 #: Logs at least this large (a 10-minute 50 Hz flight is ~7 MB) are decoded with the spare worker process.
 SPLIT_MIN_BYTES = 4 << 20
 
-__all__ = ["Measurements", "load_measurements", "run_fit", "air_rate_target", "run_diagnose"]
+__all__ = ["Measurements", "load_measurements", "run_fit", "air_rate_target", "check_fit_air_pitch", "run_diagnose"]
 
 
 @dataclass
@@ -286,9 +286,7 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
     # explicit on/off: the replay's pair or the measured Cl (a p_hat mode still moves the regressor); None: the
     # diagnosis's own mode, as load_measurements loads its reference flight (air_roll_kind)
     load_kind = "off" if air_roll_train is not None and kind == "Cl" else kind
-    if air_pitch and gust_rates in ("path", "mean-wind"):
-        raise InputError(f"fit --air-pitch on: not with --gust-rates {gust_rates} (its q_hat is relative to the air "
-                         "already)")
+    check_fit_air_pitch(air_pitch, gust_rates)
     out = Path(out_path)
     with StagedFiles(out, out.with_suffix(".fit.json"), option="--out") as stage:
         meas = load_measurements(log, airframe_path, t_from, t_to, progress, notify, gust_rates=gust_rates,
@@ -332,6 +330,21 @@ def run_fit(log, airframe_path, out_path, t_from: float | None = None, t_to: flo
             doc["log_damage"] = list(meas.flight.damage)
         stage.path(out.with_suffix(".fit.json")).write_text(json.dumps(doc, indent=1, default=float))
     return model, report
+
+
+def check_fit_air_pitch(air_pitch: bool, gust_rates: str | None) -> None:
+    """``gcs-sysid fit --air-pitch on`` refused with a ``--gust-rates`` frame whose ``q_hat`` is relative to the air
+    already (:data:`gcs_sysid.estimation.gustrates.PITCH_FRAMES`); run by :func:`run_fit` and by the CLI before any
+    work.
+
+    Raises:
+        InputError: ``air_pitch`` with such a frame.
+    """
+    from ..estimation.gustrates import PITCH_FRAMES
+
+    if air_pitch and gust_rates in PITCH_FRAMES:
+        raise InputError(f"--air-pitch on: not with --gust-rates {gust_rates} (its q_hat is relative to the air "
+                         "already)")
 
 
 def air_rate_target(meas: Measurements):

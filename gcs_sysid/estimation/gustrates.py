@@ -50,9 +50,12 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["FRAMES", "MIN_MEAN_WIND", "DRYDEN_L", "DRYDEN_RATE_FACTORS", "GustRates", "gust_rates", "lag_filter",
-           "gust_intensity", "dryden_rate_sigma", "states_gust_rates", "states_gust_hat"]
+           "gust_intensity", "dryden_rate_sigma", "states_gust_rates", "states_gust_hat", "PITCH_FRAMES"]
 
 FRAMES = ("path", "path-yaw", "mean-wind")   #: frames of :func:`gust_rates`
+#: the frames whose rates include the pitch gust rate ``q_g`` (``"path-yaw"`` sets it to 0): a ``q_hat`` relative to
+#: the air made with one of them must not be moved again by :mod:`gcs_sysid.aero.airpitch`
+PITCH_FRAMES = ("path", "mean-wind")
 MIN_MEAN_WIND = 1.0              #: m/s; below it the mean wind has no direction and ``"mean-wind"`` takes north
 #: m; the Dryden scale length of MIL-F-8785C's medium/high-altitude model (1750 ft above 2000 ft, sec. 3.7.2; the
 #: transverse spectrum ``sigma^2 L/pi (1 + 3 L^2 W^2)/(1 + L^2 W^2)^2``), the one JSBSim's ``ttMilspec`` flies there
