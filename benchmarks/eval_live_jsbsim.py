@@ -89,8 +89,10 @@ def _pair_states(states):
 def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | None = None,
                  alpha_profile: tuple[str, ...] | None = None, air_pitch: bool = True,
                  pitch_status: dict | None = None) -> list[tuple]:
-    """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states)`` of every GP step
-    (``states``: the part the air-rate pair reads). ``lift_line``: the learner's carried lift line
+    """Stream ``tlog`` through a live :class:`Learner`; the ``(identifiable, table, rows, states, pitch)`` of every GP
+    step (``states``: the part the air-rate pair reads; ``pitch``: the window's pitch gust rate ``g`` (T,) as a hat
+    and the share its ``q_hat`` was moved with, and the pooled fit after it, for :meth:`Learner.pitch_relearn`; None
+    with ``air_pitch`` off). ``lift_line``: the learner's carried lift line
     (``LearnOptions.lift_line``: it changes the windows' estimates, so it is recorded here, not in :func:`learn`);
     ``status``: a dict updated with the recorder's ``lift_line`` status at the end; ``alpha_profile``:
     ``LearnOptions.alpha_profile`` (the windows' estimates too); ``air_pitch``: ``LearnOptions.air_pitch`` (the windows'
@@ -101,7 +103,7 @@ def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | N
     rec = Learner(airframe, LearnOptions(air_roll=False, lift_line=lift_line,   # records each step; learns nothing
                                          alpha_profile=alpha_profile, air_pitch=air_pitch))
     rec._learn = lambda table, rows, states=None: steps.append((dict(rec.identifiable), table, rows.copy(),
-                                                                _pair_states(states)))   # no GP here
+                                                                _pair_states(states), _pitch_of(rec)))   # no GP here
     for stamp, packet in iter_tlog_records(tlog):
         rec.feed(stamp, packet)
     rec.finish()
@@ -112,13 +114,23 @@ def record_steps(tlog: Path, airframe, lift_line: bool = False, status: dict | N
     return steps
 
 
+def _pitch_of(rec) -> dict | None:
+    """The recorder's current window's pitch gust rate, the share applied to it and the pooled fit after it."""
+    if rec._pitch_pool is None or rec._pitch_window is None:
+        return None
+    g, kappa = rec._pitch_window
+    fit = rec._pitch_pool.fit()
+    return {"g": g, "kappa": kappa,
+            "fit": {"applied": bool(fit["applied"]), "kappa": float(fit["kappa"]), "windows": int(fit["windows"])}}
+
+
 def held_rows_of_windows(steps: list[tuple], t_cut: float) -> tuple[np.ndarray, np.ndarray]:
     """The held-out rows (vehicle time at or after ``t_cut``, s) as the live learner's windows estimated them: each
     step's new valid rows with finite regressors, ``(X (N, 10), t (N,))`` in time order (each row is new in one step).
     The model asked there is asked at its own estimator's regressors, as a live session would ask it of the rows it
     has not learned yet; the whole-flight table's ``gp`` asks it at the replay's."""
     Xs, ts = [], []
-    for _, table, rows, _ in steps:
+    for _, table, rows, _, _ in steps:
         sel = rows & np.asarray(table.valid, bool) & (table.t >= t_cut) & np.all(np.isfinite(table.X), axis=1)
         Xs.append(table.X[sel])
         ts.append(table.t[sel])
@@ -130,20 +142,32 @@ def held_rows_of_windows(steps: list[tuple], t_cut: float) -> tuple[np.ndarray, 
 
 
 def learn(steps: list[tuple], airframe, t_cut: float, gp_noise: str, gp_seed: int, air_roll: bool = True,
-          stated_errors: bool = True, lift_line: bool = False):
+          stated_errors: bool = True, lift_line: bool = False, pitch_relearn: bool = False):
     """The learner fed ``steps`` up to vehicle time ``t_cut`` (s) and its CPU s (its ``model``, ``outputs``,
-    ``n_learned``, ``air_roll``, ``errors``, ``lift_line``). With ``lift_line`` (steps recorded with it,
-    :func:`record_steps`) the session's end is played too: its rows moved onto the windows' line and learned again
-    (:meth:`Learner.relevel`, what the final step of a session does)."""
+    ``n_learned``, ``air_roll``, ``errors``, ``lift_line``, ``air_pitch``). With ``lift_line`` (steps recorded with
+    it, :func:`record_steps`) the session's end is played too: its rows moved onto the windows' line and learned
+    again (:meth:`Learner.relevel`, what the final step of a session does). With ``pitch_relearn`` (steps recorded
+    with ``air_pitch``) the end first moves the rows to the pooled pitch gust share as it stood after the last
+    window with training rows and learns again (:meth:`Learner.pitch_relearn`)."""
     from gcs_sysid.live.learner import Learner, LearnOptions
 
     lr = Learner(airframe, LearnOptions(gp_noise=gp_noise, gp_seed=gp_seed, air_roll=air_roll,
-                                        stated_errors=stated_errors, lift_line=lift_line))
+                                        stated_errors=stated_errors, lift_line=lift_line,
+                                        air_pitch_relearn=pitch_relearn))
     t0 = time.process_time()
-    for k, (ident, table, rows, states) in enumerate(steps):
+    last_fit = None
+    for k, (ident, table, rows, states, pitch) in enumerate(steps):
         lr.steps, lr.identifiable = k + 1, ident
-        lr._window_in(table, rows & (table.t < t_cut), states)
-        lr._learn(table, rows & (table.t < t_cut), states)
+        train = rows & (table.t < t_cut)
+        lr._pitch_window = None if pitch is None or pitch["g"] is None else (pitch["g"], pitch["kappa"])
+        if pitch is not None and train.any():
+            last_fit = pitch["fit"]
+        lr._window_in(table, train, states)
+        lr._learn(table, train, states)
+    if pitch_relearn:
+        if last_fit is None:
+            raise SystemExit("--pitch-relearn on needs steps recorded with --air-pitch on")
+        lr.pitch_relearn(last_fit)
     if lift_line:
         lr.relevel()
     return lr, time.process_time() - t0
@@ -153,7 +177,7 @@ def window_levels(steps: list[tuple], truth) -> list[float]:
     """Each step's mean alpha error against JSBSim's over the rows it hands over, deg (NaN-free steps only): the
     window's alpha level (the carried lift line's question)."""
     out = []
-    for _, table, rows, _ in steps:
+    for _, table, rows, _, _ in steps:
         sel = rows & np.asarray(table.valid, bool) & np.isfinite(table.X[:, 0])
         if sel.any():
             e = table.X[sel, 0] - truth.at(table.t[sel])[0][:, 0]
@@ -164,7 +188,7 @@ def window_levels(steps: list[tuple], truth) -> list[float]:
 
 def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: Path, noises, gp_seeds,
              air_rolls=(True,), stated=(True,), lift_lines=(False,), alpha_profile: bool = False,
-             air_pitch: bool = True) -> list[dict]:
+             air_pitch: bool = True, pitch_relearns=(False,)) -> list[dict]:
     """One flight's rows (one per noise x GP seed x air-rate pair off/on x stated errors off/on x lift line off/on),
     JSON-able.
 
@@ -225,13 +249,13 @@ def evaluate(aircraft: str, seed: int, turbulence: str, duration: float, work: P
     for ll in lift_lines:
         out += _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut,
                                Xt_air, h, ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile,
-                               air_pitch, truth_corr)
+                               air_pitch, truth_corr, pitch_relearns)
     return out
 
 
 def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, states_all, tab, held, t_cut, Xt_air, h,
                     ls_model, ls, noises, gp_seeds, air_rolls, stated, ll, alpha_profile=False,
-                    air_pitch=True, truth_corr=None) -> list[dict]:
+                    air_pitch=True, truth_corr=None, pitch_relearns=(False,)) -> list[dict]:
     """:func:`evaluate`'s rows of one ``lift_line`` value ``ll``."""
     Yt = truth.at(tab.t)[1]
     t0 = time.perf_counter()
@@ -247,8 +271,9 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
     okw = np.isfinite(Ytw).all(1)
     Xw, Ytw = Xw[okw], Ytw[okw]
     out = []
-    for noise, gs, pair, se in ((n, g, p, s) for n in noises for g in gp_seeds for p in air_rolls for s in stated):
-        lr, cpu = learn(steps, af, t_cut, noise, gs, pair, se, ll)
+    for noise, gs, pair, se, pr in ((n, g, p, s, r) for n in noises for g in gp_seeds for p in air_rolls
+                                    for s in stated for r in pitch_relearns):
+        lr, cpu = learn(steps, af, t_cut, noise, gs, pair, se, ll, pr)
         model, outputs, n_learned = lr.model, lr.outputs, lr.n_learned
         cols = [COEFFICIENTS.index(c) for c in outputs]
         mean = np.full((int(h.sum()), 6), np.nan)
@@ -279,6 +304,7 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
                "lift_line_status": {**status, **{k: v for k, v in lr.lift_line.items() if k != "note"}},
                "alpha_levels_deg": [round(x, 3) for x in levels], "alpha_profile": bool(alpha_profile),
                "air_pitch": bool(air_pitch), "air_pitch_status": {k: v for k, v in pitch_status.items() if k != "note"},
+               "pitch_relearn": bool(pr), "pitch_relearn_info": lr.air_pitch.get("relearn"),
                "corr_pairs": pair_correlations(C, outputs),
                "truth_resid_corr": truth_corr}
         if pair:
@@ -305,7 +331,7 @@ def _evaluate_steps(aircraft, seed, turbulence, duration, files, truth, af, stat
         row["cov_true_air"] = float(np.nanmean(row["cov_true_air_each"]))
         out.append(row)
         print(f"{aircraft} {turbulence} s{seed} {noise} gs{gs} pair {'on' if pair else 'off'} "
-              f"stated {'on' if se else 'off'} line {'on' if ll else 'off'}: gp " +
+              f"stated {'on' if se else 'off'} line {'on' if ll else 'off'} relearn {'on' if pr else 'off'}: gp " +
               " ".join(f"{c} {row['gp'][c]:.1f}" for c in COEFFICIENTS) +
               f" | cov {row['cov_gp']:.1f} / {row['cov_true_air']:.1f} corr {row['max_corr']:.2f} "
               f"cpu {cpu:.1f} s" + (f" | pair {lr.air_roll['state']}, Cl at the air rate "
@@ -321,7 +347,7 @@ def variant(row: dict) -> str:
     return (row["gp_noise"] + ("+air-roll" if row.get("air_roll") else "")
             + ("-unstated" if row.get("stated_errors") is False else "")
             + ("+lift-line" if row.get("lift_line") else "") + ("+alpha-profile" if row.get("alpha_profile") else "")
-            + ("+air-pitch" if row.get("air_pitch") else ""))
+            + ("+air-pitch" if row.get("air_pitch") else "") + ("+pitch-relearn" if row.get("pitch_relearn") else ""))
 
 
 def counts(row: dict, heldout_cl: str = "gyro") -> dict[str, int]:
@@ -455,6 +481,9 @@ def main(argv=None) -> int:
     ap.add_argument("--air-pitch", default="on", choices=("off", "on"),
                     help="the learner's windows (and the whole-flight table) with q_hat at the air-relative estimate "
                          "(LearnOptions.air_pitch; default on, as the learner's since the sixty-ninth session)")
+    ap.add_argument("--pitch-relearn", nargs="+", default=["off"], choices=("off", "on"),
+                    help="the learner's end with the rows moved to the final pooled pitch gust share and learned again "
+                         "(LearnOptions.air_pitch_relearn) off and/or on, on the same recording")
     ap.add_argument("--base", default="independent", help="--summarize: the variant flips are counted against")
     ap.add_argument("--heldout-cl", default="gyro", choices=("gyro", "air"),
                     help="--summarize: the pair's held-out Cl at the gyro's rate or at the reconstructed air rate")
@@ -475,7 +504,8 @@ def main(argv=None) -> int:
                 rows = evaluate(ac, seed, turb, a.duration, work, a.gp_noise, a.gp_seeds,
                                 tuple(x == "on" for x in a.air_roll), tuple(x == "on" for x in a.stated_errors),
                                 tuple(x == "on" for x in a.lift_line), a.alpha_profile == "on",
-                                air_pitch=a.air_pitch == "on")
+                                air_pitch=a.air_pitch == "on",
+                                pitch_relearns=tuple(x == "on" for x in a.pitch_relearn))
                 append_jsonl(a.json, rows)
     return 0
 

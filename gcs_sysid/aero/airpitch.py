@@ -267,7 +267,8 @@ def air_pitch_table(table, g: np.ndarray, fit: dict):
     return replace(table, X=X, notes=notes)
 
 
-def apply_air_pitch(table, states, airframe, rows: np.ndarray, pool: AirPitchPool | None = None):
+def apply_air_pitch(table, states, airframe, rows: np.ndarray, pool: AirPitchPool | None = None,
+                    g: np.ndarray | None = None):
     """The three steps in one: :func:`pitch_gust_hat` of ``states``, :func:`air_pitch_fit` on ``rows`` and
     :func:`air_pitch_table` (what the replay's stage, the live learner's windows and the evaluations do).
 
@@ -279,12 +280,16 @@ def apply_air_pitch(table, states, airframe, rows: np.ndarray, pool: AirPitchPoo
             new rows).
         pool: the live session's :class:`AirPitchPool`: ``rows`` are added and the pooled share moves every row of
             the table; None: the table's own fit on ``rows``.
+        g: ``(T,)`` the pitch gust rate as a hat when the caller has it already (:func:`pitch_gust_hat` of
+            ``states``); None: computed here.
 
     Returns:
         ``(table, fit, note)``: the table with ``q_hat`` moved where the fit shows it (its note added), the fit's
         dict and its note; ``(table as given, None, why)`` where the states give no pitch gust rate.
     """
-    g, why = pitch_gust_hat(states, airframe.c, airframe.b)
+    why = ""
+    if g is None:
+        g, why = pitch_gust_hat(states, airframe.c, airframe.b)
     if g is None:
         return table, None, why
     if pool is None:

@@ -46,6 +46,10 @@ def add_listen_parser(sub) -> argparse.ArgumentParser:
                         "sign; applied only when the pooled fit shows it); default on (since the sixty-ninth "
                         "session; 'off': the gyro's q_hat); docs/live.md, 'The air-relative pitch rate in the "
                         "windows'")
+    p.add_argument("--air-pitch-relearn", default="off", choices=("on", "off"),
+                   help="with --air-pitch on: at the session's end move every learned row's q_hat to the share of "
+                        "all windows (each window was learned at the share of its time) and learn the GP again; "
+                        "default off; docs/live.md, 'The air-relative pitch rate in the windows'")
     p.add_argument("--alpha-profile", default="off", choices=("on", "off"),
                    help="the windows' alpha aiding takes the elevator's slope by the gust model's likelihood instead "
                         "of least squares (in closed loop least squares loads it with the gust's normal force, and "
@@ -86,6 +90,7 @@ def cmd_listen(a: argparse.Namespace) -> int:
                                                  min_rows=a.min_rows, n_inducing=a.inducing,
                                                  gp_noise=a.gp_noise, air_roll=a.air_roll == "on",
                                                  lift_line=a.lift_line == "on", air_pitch=a.air_pitch == "on",
+                                                 air_pitch_relearn=a.air_pitch_relearn == "on",
                                                  alpha_profile=("delta_e",) if a.alpha_profile == "on" else None,
                                                  rate_errors=None if a.rate_errors is None else a.rate_errors == "on")
     opts = ListenOptions(connection=a.connection, baud=a.baud, learn=learn, request=not a.no_request,

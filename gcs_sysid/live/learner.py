@@ -130,6 +130,12 @@ class LearnOptions:
             on 11; held-out flight x coefficients within the lines +8/-0 and +6/-0 at the two GP seeds;
             ``docs/benchmarks.md``, "Sixty-ninth session"); with a fit per window two rules had failed (sixty-eighth
             session). ``False``: the gyro's ``q_hat``, as before.
+        air_pitch_relearn: with ``air_pitch``, at the session's end every kept row's ``q_hat`` is moved to the final
+            pooled share's (the gyro's less ``kappa g`` with the share of all windows; the gyro's where that fit
+            does not pass the gates) and the GP is learned again on the kept rows as the session learned them
+            (:meth:`Learner.pitch_relearn`; ``gcs-sysid listen --air-pitch-relearn on|off``): each window was
+            learned at the share of its time, which settles over the windows and starts at the gyro's rate on
+            slow aircraft. Opt-in (``docs/live.md``, "The air-relative pitch rate in the windows").
     """
 
     window_s: float = 30.0
@@ -151,8 +157,11 @@ class LearnOptions:
     lift_line: bool = False
     alpha_profile: tuple[str, ...] | None = None
     air_pitch: bool = True
+    air_pitch_relearn: bool = False
 
     def __post_init__(self):
+        if self.air_pitch_relearn and not self.air_pitch:
+            raise InputError("--air-pitch-relearn on needs --air-pitch on (it moves the rows to the pooled share)")
         if not (self.step_s > 0 and self.window_s > self.step_s and self.lag_s >= 0):
             raise InputError(f"--window {self.window_s} s must be longer than --step {self.step_s} s > 0, "
                              f"and --lag {self.lag_s} s >= 0")
@@ -229,7 +238,8 @@ class Learner:
         air_pitch: the air-relative pitch rate's status (``LearnOptions.air_pitch``): ``state`` (``"off"``,
             ``"waiting"`` before the first window, ``"applied"``, ``"gyro's rate"`` while the pooled fit does not show
             the share, ``"no gust rate"``), ``windows`` seen, ``applied`` (windows moved), the pooled ``kappa`` and
-            ``t``, ``rows_pooled`` and the fit's ``note``.
+            ``t``, ``rows_pooled`` and the fit's ``note``; after :meth:`pitch_relearn` also ``relearn`` (``kappa``
+            the rows were moved to, ``rows_moved``, ``moved_rms`` in ``q_hat`` units, ``rows`` learned again).
         lift_line: the carried lift line's status (``LearnOptions.lift_line``): ``state`` (``"off"``, ``"pooling"``
             before the pool states a line, ``"carried"``, and at the end ``"relevelled"`` or ``"own levels"``,
             :meth:`relevel`), ``windows`` (pooled), ``handed`` (windows a carried line moved), ``note``
@@ -305,6 +315,9 @@ class Learner:
                           "note": ""}
         self._win = np.zeros(0, int)          # the window (learning call) each kept row came from
         self._win_key = 0
+        self._pitch_g = np.zeros(0)           # each kept row's pitch gust rate as a hat (0 where unknown) ...
+        self._pitch_k = np.zeros(0)           # ... and the share its q_hat was moved with (0: the gyro's rate)
+        self._pitch_window: tuple | None = None   # the current window's (g (T,), share applied)
 
     # --- feeding -----------------------------------------------------------------------------
 
@@ -340,8 +353,11 @@ class Learner:
         """Learn what is left in the window (at the end of a session): rows up to its very end."""
         if self._window:
             self.step(final=True)       # with LearnOptions.lift_line it relevels before its refresh
-        elif self._line is not None:
-            self.relevel()
+        else:
+            if self.options.air_pitch_relearn:
+                self.pitch_relearn()
+            if self._line is not None:
+                self.relevel()
         if self._errors is not None and self.model is not None:
             self.notes.append(f"end: {self.errors['note']}")
 
@@ -391,6 +407,8 @@ class Learner:
         self.identifiable = identifiability(states, table)
         self._window_in(table, rows, states)
         self._learn(table, rows, states)
+        if final and self.options.air_pitch_relearn:
+            self.pitch_relearn()
         if final and self._line is not None:
             self.relevel()
         t2 = time.perf_counter()
@@ -413,10 +431,17 @@ class Learner:
         pitch gust's share (``LearnOptions.air_pitch``; the window's new ``rows`` (T,) bool added to the
         :class:`gcs_sysid.aero.airpitch.AirPitchPool` first); :attr:`air_pitch` counts the windows and says the
         pooled fit, the notes each change of state."""
-        from ..aero.airpitch import apply_air_pitch
+        from ..aero.airpitch import apply_air_pitch, pitch_gust_hat
 
-        table, fit, note = apply_air_pitch(table, states, self.airframe, rows, pool=self._pitch_pool)
-        state = "no gust rate" if fit is None else "applied" if fit["applied"] else "gyro's rate"
+        g, why = pitch_gust_hat(states, self.airframe.c, self.airframe.b)
+        if g is None:
+            table, fit, note = table, None, why
+        else:
+            table, fit, note = apply_air_pitch(table, states, self.airframe, rows, pool=self._pitch_pool, g=g)
+        applied = fit is not None and fit["applied"]
+        self._pitch_window = (None if g is None else np.where(np.isfinite(g), g, 0.0),
+                              float(fit["kappa"]) if applied else 0.0)
+        state = "no gust rate" if fit is None else "applied" if applied else "gyro's rate"
         if state != self.air_pitch["state"]:
             self.notes.append(f"step {self.steps}: {note}")
         self.air_pitch = {"state": state, "windows": self.air_pitch["windows"] + 1,
@@ -493,6 +518,43 @@ class Learner:
                                    f"{np.degrees(s_a):.2f} deg")}
         self.notes.append(f"step {self.steps}: {self.lift_line['note']}")
 
+    def pitch_relearn(self, fit: dict | None = None) -> int:
+        """Move every kept row's ``q_hat`` to the session's final pitch gust share and learn the GP again on them
+        (``LearnOptions.air_pitch_relearn``; run by the final step, before :meth:`relevel`).
+
+        Each window was learned at the share pooled up to it (:class:`gcs_sysid.aero.airpitch.AirPitchPool`), which
+        settles over the windows and, on slow aircraft, starts at the gyro's rate until the pool passes its gates.
+        The share of all windows is the best the session has: each kept row's ``q_hat`` becomes the gyro's less
+        ``kappa g`` with that share (the gyro's where the final fit does not pass the gates), so every row is at one
+        kind of rate, and the GP is learned again as the session learned it (:meth:`_learn_again`).
+
+        Args:
+            fit: the pooled fit to move to (:meth:`AirPitchPool.fit`'s dict: ``applied``, ``kappa``); None: the
+                session's pool now.
+
+        Returns:
+            the rows learned again (0 when nothing moved, without a model, or with ``LearnOptions.air_pitch`` off).
+        """
+        if self._pitch_pool is None or self.model is None or not len(self.t):
+            return 0
+        fit = self._pitch_pool.fit() if fit is None else fit
+        kappa = float(fit["kappa"]) if fit.get("applied") else 0.0
+        d = (self._pitch_k - kappa) * self._pitch_g       # q_hat_gyro - kappa g  less  q_hat_gyro - k g
+        moved = int(np.count_nonzero(d))
+        info = {"kappa": kappa, "rows_moved": moved, "moved_rms": float(np.sqrt(np.mean(d**2))), "rows": 0}
+        if moved:
+            self.X[:, REGRESSORS.index("q_hat")] += d
+            self._pitch_k[:] = kappa
+            info["rows"] = self._learn_again()
+            self._state_errors()
+        what = (f"the share of all {fit.get('windows', self._pitch_pool.windows)} windows, kappa {kappa:.3f}" if kappa
+                else "the gyro's rate (the pooled fit of all windows does not show the share)")
+        info["note"] = (f"end: {moved} of {len(self.t)} kept rows' q_hat moved to {what} (RMS move "
+                        f"{info['moved_rms']:.2e})" + (" and learned again" if moved else ""))
+        self.air_pitch = {**self.air_pitch, "relearn": info}
+        self.notes.append(f"step {self.steps}: {info['note']}")
+        return info["rows"]
+
     def _learn_again(self) -> int:
         """The GP learned again on the kept rows as the session learned them (:meth:`relevel`); returns the rows."""
         cols = [COEFFICIENTS.index(c) for c in self.outputs]
@@ -568,7 +630,8 @@ class Learner:
         X, Y, t = table.X[rows], table.Y[rows], table.t[rows]
         if self.model is not None and self._roll_fit is not None:
             Y = self._air_roll_later(table, rows, states)
-        self._keep(X, Y, t)
+        g, k = self._pitch_window if self._pitch_window is not None else (None, 0.0)
+        self._keep(X, Y, t, np.zeros(len(t)) if g is None or len(g) != len(rows) else g[rows], k)
         if self.model is None:
             self._pending.append((X, Y))
             if self.options.air_roll:
@@ -731,13 +794,19 @@ class Learner:
         if self.options.trim_heap:   # its ~35-40 MiB of temporaries, before the map reuses the heap
             release_free_heap()
 
-    def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray) -> None:
+    def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray, g: np.ndarray | None = None,
+              kappa: float = 0.0) -> None:
+        """Keep learned rows: ``X`` (N, 10), ``Y`` (N, 6), ``t`` (N,) s, their pitch gust rate ``g`` (N,) as a hat
+        (None: zeros) and the share ``kappa`` their ``q_hat`` was moved with (for :meth:`pitch_relearn`)."""
         self.X = np.concatenate([self.X, X])
         self.Y = np.concatenate([self.Y, Y])
         self.t = np.concatenate([self.t, t])
         self._win = np.concatenate([self._win, np.full(len(t), self._win_key, int)])
+        self._pitch_g = np.concatenate([self._pitch_g, np.zeros(len(t)) if g is None else np.asarray(g, float)])
+        self._pitch_k = np.concatenate([self._pitch_k, np.full(len(t), float(kappa))])
         if len(self.t) > self.options.max_rows:   # thin evenly: the flown envelope stays covered
             self.X, self.Y, self.t, self._win = self.X[::2], self.Y[::2], self.t[::2], self._win[::2]
+            self._pitch_g, self._pitch_k = self._pitch_g[::2], self._pitch_k[::2]
 
     def table(self) -> CoefficientTable:
         """The learned rows kept, as a :class:`CoefficientTable` (all rows valid)."""
