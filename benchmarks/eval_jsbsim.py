@@ -709,6 +709,9 @@ def main(argv=None) -> int:
                     help="the held-out rows' p_hat less the rolling gust estimated there from their own measured roll "
                          "moment with the training rows' roll fit (ReplayOptions.heldout_air_roll, "
                          "gcs_sysid.aero.gustfilter.heldout_air_roll; default: the replay's, HELDOUT_AIR_ROLL)")
+    ap.add_argument("--heldout-gust-var", default=None, choices=("fit", "moment", "rts", "nis", "innov"),
+                    help="the variance under which the held-out rows' air roll rate states its error (the held-out "
+                         "band of Cl; gcs_sysid.aero.gustfilter.HELDOUT_GUST_VAR; default: the package's)")
     ap.add_argument("--air-roll-train", default=None, choices=("on", "off"),
                     help="train the GP's Cl on the measured Cl less the roll fit's rolling-gust moment, Cl at the "
                          "air-relative roll rate (ReplayOptions.air_roll_train, gcs_sysid.aero.gustfilter."
@@ -846,6 +849,10 @@ def main(argv=None) -> int:
         import gcs_sysid.pipeline as pipeline
 
         pipeline.SIDE_FORCE_RATE_PRIOR_STD = None if a.cy_rate_prior == "off" else float(a.cy_rate_prior)
+    from gcs_sysid.aero import gustfilter as _gustfilter
+
+    if a.heldout_gust_var is not None:
+        _gustfilter.HELDOUT_GUST_VAR = a.heldout_gust_var
     if a.air_yaw_outputs is not None:
         from gcs_sysid.aero import airyaw
 
@@ -866,6 +873,7 @@ def main(argv=None) -> int:
                                rate_errors=None if a.rate_errors is None else a.rate_errors == "on",
                                air_pitch=None if a.air_pitch is None else a.air_pitch == "on")
                 row["gp_fit"] = a.gp_fit
+                row["heldout_gust_var"] = _gustfilter.HELDOUT_GUST_VAR
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

@@ -10,7 +10,7 @@ C = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 
 
 def _row(ac="sgs", seed=1, gp_seed=0, meas=(1, 1, 1, 1, 1, 1), gp=(1, 1, 1, 1, 1, 1), tair=(1, 1, 1, 1, 1, 1),
-         ls=(2, 2, 2, 2, 2, 2), fair=None, cov_gp=95.0, cov_tair=95.0, corr=0.1, truth_corr=0.1):
+         ls=(2, 2, 2, 2, 2, 2), fair=None, cov_gp=95.0, cov_tair=95.0, corr=0.1, truth_corr=0.1, cov_each=None):
     # the learned correlation sits on the CZ-Cm pair; JSBSim's residual one on that pair is truth_corr (None: a row
     # written before the pair fields)
     r = {"aircraft": ac, "turbulence": "light", "seed": seed, "aoa": "ahrs", "gp_seed": gp_seed,
@@ -21,6 +21,8 @@ def _row(ac="sgs", seed=1, gp_seed=0, meas=(1, 1, 1, 1, 1, 1), gp=(1, 1, 1, 1, 1
         r["truth_resid_corr"] = {"CX-CY": 0.02, "CZ-Cm": truth_corr}
     if fair is not None:
         r["ls_airtrain"] = dict(zip(C, fair))
+    if cov_each is not None:                  # the held-out band per coefficient (None: a row written without it)
+        r["cov_gp_each"] = list(cov_each)
     return r
 
 
@@ -80,26 +82,30 @@ def test_flips_and_rule_8b_at_two_gp_seeds(tmp_path, capsys):
     base, cand = [], []
     LS = (9, 2, 2, 2, 2, 2)        # sgs's CX: GP < LS either way
     for gs in (0, 1):
-        base += [_row("sgs", 1, gs, gp=(6, 1, 1, 1, 1, 1), ls=LS), _row("t6", 1, gs), _row("s23", 1, gs, corr=0.8)]
-    # seed 0: sgs wins CX held out, s23's correlation drops (a win in corr and corr_false), t6 loses its band -> +3/-1
-    cand += [_row("sgs", 1, 0, ls=LS), _row("t6", 1, 0, cov_gp=99.0), _row("s23", 1, 0, corr=0.2)]
+        base += [_row("sgs", 1, gs, gp=(6, 1, 1, 1, 1, 1), ls=LS), _row("t6", 1, gs, cov_each=(95,) * 6),
+                 _row("s23", 1, gs, corr=0.8)]
+    # seed 0: sgs wins CX held out, s23's correlation drops (a win in corr and corr_false), t6 loses its six-output
+    # band and Cl's (cov_gp, cov_gp_c) -> +3/-2
+    cand += [_row("sgs", 1, 0, ls=LS), _row("t6", 1, 0, cov_gp=99.0, cov_each=(95, 95, 95, 85, 95, 95)),
+             _row("s23", 1, 0, corr=0.2)]
     # seed 1: sgs wins CX, t6 loses CY true-air and Cl's GP < LS, s23 unchanged -> +1/-2
     cand += [_row("sgs", 1, 1, ls=LS), _row("t6", 1, 1, tair=(1, 7, 1, 1, 1, 1), gp=(1, 1, 1, 3, 1, 1)),
              _row("s23", 1, 1, corr=0.8)]
     ch0, un0 = ic.flips({ic.flight_key(r): r for r in base[:3]}, {ic.flight_key(r): r for r in cand[:3]})
     assert un0 == [] and sorted((c["aircraft"], c["count"], c["win"]) for c in ch0) == [
-        ("s23", "corr", True), ("s23", "corr_false", True), ("sgs", "gp", True), ("t6", "cov_gp", False)]
+        ("s23", "corr", True), ("s23", "corr_false", True), ("sgs", "gp", True), ("t6", "cov_gp", False),
+        ("t6", "cov_gp_c", False)]
     holds, both, text = ic.verdict({0: ch0, 1: ic.flips({ic.flight_key(r): r for r in base[3:]},
                                                         {ic.flight_key(r): r for r in cand[3:]})[0]})
     assert not holds and both == ["t6"]
-    assert "seed 0 +3/-1" in text and "seed 1 +1/-2" in text      # verdict() judges every flip it is given
+    assert "seed 0 +3/-2" in text and "seed 1 +1/-2" in text      # verdict() judges every flip it is given
     # the same through the command line: the rows' own gp_seed pairs the files
     b = _write(tmp_path / "b.jsonl", base)
     c = _write(tmp_path / "c.jsonl", cand)
     assert ic.main([c, "--against", b]) == 0
     out = capsys.readouterr().out
     assert "rule 8(b) FAILS" in out and "aircraft losing a count at every seed: t6" in out
-    assert "lost: t6 light s1 ahrs cov_gp" in out
+    assert "lost: t6 light s1 ahrs cov_gp_c" in out      # the per-coefficient band, a default count
 
 
 def test_rule_8b_needs_a_win_and_twice_the_losses():
@@ -219,3 +225,19 @@ def test_band_per_coefficient_is_information_pooled_and_split(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "band at exact conditions per coefficient, GP seed 0 (information)" in out
     assert "| pooled % | 98.0 | 91.0 | 94.5 | 74.0 | 99.0 | 95.0 |" in out
+
+
+def test_the_held_out_band_per_coefficient_decides_in_the_six_output_means_place(tmp_path, capsys):
+    """Since the seventieth session ``cov_gp_c`` (the held-out band per flight x coefficient) is a default count and
+    ``cov_gp`` (its six-output mean) is tabled only: a mean inside 90-98 % can hide Cl far below it."""
+    hidden = _row("sgs", 1, cov_gp=95.0, cov_each=(99.5, 96.0, 99.8, 80.0, 97.0, 99.0))   # mean 95.2 %
+    v = ic.item_values(hidden)
+    assert v[("cov_gp", "")] is True
+    assert [v[("cov_gp_c", c)] for c in C] == [False, True, False, False, True, False]
+    assert all(ic.item_values(_row())[("cov_gp_c", c)] is None for c in C)      # written without the field
+    edge = ic.item_values(_row(cov_each=(90.0, 98.0, 89.99, 98.01, float("nan"), 95.0)))
+    assert [edge[("cov_gp_c", c)] for c in C] == [True, True, False, False, False, True]
+    assert "cov_gp_c" in ic.DEFAULT_COUNTS and "cov_gp" not in ic.DEFAULT_COUNTS
+    ic.main([_write(tmp_path / "r.jsonl", [hidden])])
+    out = capsys.readouterr().out
+    assert "held-out band per coefficient, GP seed 0 (information)" in out and "| pooled % | 99.5 |" in out
