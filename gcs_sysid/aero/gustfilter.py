@@ -108,7 +108,14 @@ HELDOUT_AIR_ROLL = "predicted:Cl"
 #: which the one-step prediction carries (thirty-second session, i8-clband, docs/benchmarks.md). ``"innov"`` on 75
 #: light flights at GP seeds 0 and 1: Cl's band median 88.1 -> 92.1 and 88.7 -> 92.3 % (flights within 90-98 %
 #: 27 -> 45, 23 -> 44), nothing else moved; the issue's coverage count (the six outputs' mean band) 69 -> 67 and
-#: 70 -> 69 with no win, so rule 8(b) is not met and ``"fit"`` is kept.
+#: 70 -> 69 with no win, so rule 8(b) is not met and ``"fit"`` is kept. Judged again in the seventieth session with
+#: issue 8's held-out band counted per flight x coefficient (``issue8_counts.py``'s ``cov_gp_c``), on fresh flights
+#: (seeds 19-21, the 25 aircraft, GP seeds 0 and 1; a rule written before the run): ``"innov"`` moves only Cl's band
+#: (median 88.5 -> 92.8 and 89.2 -> 92.9 %, in 90-98 % on 29 -> 55 and 30 -> 52 of 75 flights; every mean and every
+#: other band identical), rule 8(b) holds (+26/-0, +23/-1), but the rule's guard on the six-output mean failed at GP
+#: seed 1 (70 -> 66 of 75 flights, against a limit of 3: the mean crosses 98 % where CX, CZ and Cn already sit near
+#: 100 %, Cl itself inside 90-98 % on each of those flights), so ``"fit"`` is kept (``docs/benchmarks.md``,
+#: "Seventieth session").
 HELDOUT_GUST_VAR = "fit"
 #: Every value ``heldout_air_roll`` takes (:func:`air_roll_mode`): ``"off"``; a gust mode of
 #: :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` (every output asked at the air rate, the twenty-fourth session's);
