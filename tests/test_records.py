@@ -45,3 +45,7 @@ def test_issue8_totals_match_the_readme(seed):
     assert all("corr_pairs" in r and "truth_resid_corr" in r for r in runs[seed].values())
     stated_false = re.search(r"corr_false \(.*?\) (\d+)/75 and (\d+)/75", README.replace("\n  ", " "))
     assert tuple(total["corr_false"]) == (int(stated_false.group(1 + seed)), 75)
+    # the held-out band per coefficient (a default count since the seventieth session) from the lines' cov_gp_each
+    assert all(len(r["cov_gp_each"]) == 6 for r in runs[seed].values())
+    stated_c = re.search(r"cov_gp_c \(.*?\) (\d+)/450 and (\d+)/450", README.replace("\n  ", " "))
+    assert tuple(total["cov_gp_c"]) == (int(stated_c.group(1 + seed)), 450)
