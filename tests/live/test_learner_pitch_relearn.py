@@ -91,3 +91,23 @@ def test_the_option_needs_the_air_pitch():
     with pytest.raises(InputError, match="--air-pitch-relearn on needs --air-pitch on"):
         LearnOptions(air_pitch=False, air_pitch_relearn=True)
     assert LearnOptions().air_pitch_relearn is False
+
+
+@pytest.mark.parametrize("flags, expected", [([], False), (["--air-pitch-relearn", "on"], True)])
+def test_listen_passes_the_option_and_refuses_it_without_the_air_pitch(monkeypatch, tmp_path, capsys, flags, expected):
+    import gcs_sysid.live.session as session
+    from gcs_sysid.cli import main
+
+    seen = {}
+
+    def fake_run_listen(airframe, out, opts):
+        seen["learn"] = opts.learn
+        return {"raw_log": "raw.tlog", "raw_records": 0}
+
+    monkeypatch.setattr(session, "run_listen", fake_run_listen)
+    base = ["listen", "udpin:127.0.0.1:14550", "--airframe", str(ROOT / "data" / "airframes" / "sim-trainer.toml"),
+            "--out", str(tmp_path / "o")]
+    assert main(base + flags, handle_signals=False) == 0 and seen["learn"].air_pitch_relearn is expected
+    seen.clear()
+    assert main(base + ["--air-pitch", "off", "--air-pitch-relearn", "on"], handle_signals=False) == 2
+    assert "--air-pitch-relearn on needs --air-pitch on" in capsys.readouterr().err and not seen
