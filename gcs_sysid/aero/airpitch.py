@@ -287,11 +287,10 @@ def apply_air_pitch(table, states, airframe, rows: np.ndarray, pool: AirPitchPoo
         ``(table, fit, note)``: the table with ``q_hat`` moved where the fit shows it (its note added), the fit's
         dict and its note; ``(table as given, None, why)`` where the states give no pitch gust rate.
     """
-    why = ""
     if g is None:
         g, why = pitch_gust_hat(states, airframe.c, airframe.b)
-    if g is None:
-        return table, None, why
+        if g is None:
+            return table, None, why
     if pool is None:
         fit = air_pitch_fit(table, g, rows)
     else:

@@ -315,8 +315,10 @@ class Learner:
                           "note": ""}
         self._win = np.zeros(0, int)          # the window (learning call) each kept row came from
         self._win_key = 0
-        self._pitch_g = np.zeros(0)           # each kept row's pitch gust rate as a hat (0 where unknown) ...
-        self._pitch_k = np.zeros(0)           # ... and the share its q_hat was moved with (0: the gyro's rate)
+        # with LearnOptions.air_pitch_relearn: each kept row's pitch gust rate as a hat (0 where unknown) and the
+        # share its q_hat was moved with (0: the gyro's rate)
+        self._pitch_g = np.zeros(0)
+        self._pitch_k = np.zeros(0)
         self._pitch_window: tuple | None = None   # the current window's (g (T,), share applied)
 
     # --- feeding -----------------------------------------------------------------------------
@@ -533,9 +535,10 @@ class Learner:
                 session's pool now.
 
         Returns:
-            the rows learned again (0 when nothing moved, without a model, or with ``LearnOptions.air_pitch`` off).
+            the rows learned again (0 when nothing moved, without a model, or with ``LearnOptions.air_pitch`` or
+            ``air_pitch_relearn`` off: the rows' gust rates are kept only with the latter).
         """
-        if self._pitch_pool is None or self.model is None or not len(self.t):
+        if not self.options.air_pitch_relearn or self._pitch_pool is None or self.model is None or not len(self.t):
             return 0
         fit = self._pitch_pool.fit() if fit is None else fit
         kappa = float(fit["kappa"]) if fit.get("applied") else 0.0
@@ -631,7 +634,7 @@ class Learner:
         if self.model is not None and self._roll_fit is not None:
             Y = self._air_roll_later(table, rows, states)
         g, k = self._pitch_window if self._pitch_window is not None else (None, 0.0)
-        self._keep(X, Y, t, np.zeros(len(t)) if g is None or len(g) != len(rows) else g[rows], k)
+        self._keep(X, Y, t, None if g is None or len(g) != len(rows) else g[rows], k)
         if self.model is None:
             self._pending.append((X, Y))
             if self.options.air_roll:
@@ -796,17 +799,21 @@ class Learner:
 
     def _keep(self, X: np.ndarray, Y: np.ndarray, t: np.ndarray, g: np.ndarray | None = None,
               kappa: float = 0.0) -> None:
-        """Keep learned rows: ``X`` (N, 10), ``Y`` (N, 6), ``t`` (N,) s, their pitch gust rate ``g`` (N,) as a hat
-        (None: zeros) and the share ``kappa`` their ``q_hat`` was moved with (for :meth:`pitch_relearn`)."""
+        """Keep learned rows: ``X`` (N, 10), ``Y`` (N, 6), ``t`` (N,) s; with ``LearnOptions.air_pitch_relearn``
+        also their pitch gust rate ``g`` (N,) as a hat (None: zeros) and the share ``kappa`` their ``q_hat`` was
+        moved with (for :meth:`pitch_relearn`)."""
         self.X = np.concatenate([self.X, X])
         self.Y = np.concatenate([self.Y, Y])
         self.t = np.concatenate([self.t, t])
         self._win = np.concatenate([self._win, np.full(len(t), self._win_key, int)])
-        self._pitch_g = np.concatenate([self._pitch_g, np.zeros(len(t)) if g is None else np.asarray(g, float)])
-        self._pitch_k = np.concatenate([self._pitch_k, np.full(len(t), float(kappa))])
+        relearn = self.options.air_pitch_relearn
+        if relearn:
+            self._pitch_g = np.concatenate([self._pitch_g, np.zeros(len(t)) if g is None else np.asarray(g, float)])
+            self._pitch_k = np.concatenate([self._pitch_k, np.full(len(t), float(kappa))])
         if len(self.t) > self.options.max_rows:   # thin evenly: the flown envelope stays covered
             self.X, self.Y, self.t, self._win = self.X[::2], self.Y[::2], self.t[::2], self._win[::2]
-            self._pitch_g, self._pitch_k = self._pitch_g[::2], self._pitch_k[::2]
+            if relearn:
+                self._pitch_g, self._pitch_k = self._pitch_g[::2], self._pitch_k[::2]
 
     def table(self) -> CoefficientTable:
         """The learned rows kept, as a :class:`CoefficientTable` (all rows valid)."""
