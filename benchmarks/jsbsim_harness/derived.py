@@ -1073,6 +1073,29 @@ def derived_sha(name: str) -> str:
     return hashlib.sha256(derived_xml(name)).hexdigest()[:16]
 
 
+def _move_into_place(src: Path, dest: Path, want: bytes, old: Path) -> None:
+    """Rename the folder ``src`` to ``dest`` (an existing ``dest`` moved to ``old`` first and removed after). Where a
+    concurrent writer (another test worker on a fresh installation) put its own copy at ``dest`` between the check and
+    the rename, the rename fails; that is success if ``dest`` now holds ``want`` as its model XML.
+
+    Raises:
+        OSError: the rename failed and ``dest`` does not hold ``want``.
+    """
+    moved = False
+    try:
+        if dest.exists():
+            dest.rename(old)
+            moved = True
+        src.rename(dest)
+    except OSError:
+        xml = dest / f"{dest.name}.xml"
+        if not (xml.is_file() and xml.read_bytes() == want):
+            raise
+    finally:
+        if moved:
+            shutil.rmtree(old, ignore_errors=True)
+
+
 def install_derived_models(aircraft_dir: Path | None = None) -> list[Path]:
     """Write every model of :data:`DERIVED` into the wheel's ``aircraft/`` folder (or ``aircraft_dir``)
     where it is missing or differs; returns the folders written.
@@ -1080,7 +1103,8 @@ def install_derived_models(aircraft_dir: Path | None = None) -> list[Path]:
     Each is the stock folder copied (its ``Systems/`` included) with the XML replaced by
     :func:`derived_xml` as ``<name>/<name>.xml`` (a :data:`REPO_DERIVED` model: a folder with that
     XML alone); written in a temporary folder beside it and renamed into place, so that a concurrent
-    reader sees the old folder or the new one.
+    reader sees the old folder or the new one, and a concurrent writer that got there first leaves its copy
+    (:func:`_move_into_place`).
 
     A folder that cannot be written (a read-only installation) gives a ``UserWarning`` naming it;
     flying that model then fails in JSBSim's loader.
@@ -1101,14 +1125,10 @@ def install_derived_models(aircraft_dir: Path | None = None) -> list[Path]:
             else:
                 (tmp / name).mkdir()
             (tmp / name / f"{name}.xml").write_bytes(want)
-            old = None
-            if dest.exists():
-                old = base / f".{name}-old-{os.getpid()}"
-                dest.rename(old)
-            (tmp / name).rename(dest)
-            shutil.rmtree(tmp, ignore_errors=True)
-            if old is not None:
-                shutil.rmtree(old, ignore_errors=True)
+            try:
+                _move_into_place(tmp / name, dest, want, base / f".{name}-old-{os.getpid()}")
+            finally:
+                shutil.rmtree(tmp, ignore_errors=True)
             written.append(dest)
         except OSError as e:
             warnings.warn(f"could not write the derived JSBSim model '{name}' into {base}: {e}; "
