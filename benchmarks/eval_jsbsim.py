@@ -712,6 +712,9 @@ def main(argv=None) -> int:
     ap.add_argument("--heldout-gust-var", default=None, choices=("fit", "moment", "rts", "nis", "innov"),
                     help="the variance under which the held-out rows' air roll rate states its error (the held-out "
                          "band of Cl; gcs_sysid.aero.gustfilter.HELDOUT_GUST_VAR; default: the package's)")
+    ap.add_argument("--coefficient-band", default=None, choices=_pipeline.COEFFICIENT_BANDS,
+                    help="the coefficient's band at the flight's own regressors (gcs_sysid.pipeline.COEFFICIENT_BAND; "
+                         "'stated': gcs_sysid.gp.coefband; default: the package's)")
     ap.add_argument("--air-roll-train", default=None, choices=("on", "off"),
                     help="train the GP's Cl on the measured Cl less the roll fit's rolling-gust moment, Cl at the "
                          "air-relative roll rate (ReplayOptions.air_roll_train, gcs_sysid.aero.gustfilter."
@@ -853,6 +856,8 @@ def main(argv=None) -> int:
 
     if a.heldout_gust_var is not None:
         _gustfilter.HELDOUT_GUST_VAR = a.heldout_gust_var
+    if a.coefficient_band is not None:
+        _pipeline.COEFFICIENT_BAND = a.coefficient_band
     if a.air_yaw_outputs is not None:
         from gcs_sysid.aero import airyaw
 
@@ -874,6 +879,7 @@ def main(argv=None) -> int:
                                air_pitch=None if a.air_pitch is None else a.air_pitch == "on")
                 row["gp_fit"] = a.gp_fit
                 row["heldout_gust_var"] = _gustfilter.HELDOUT_GUST_VAR
+                row["coefficient_band"] = _pipeline.COEFFICIENT_BAND
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

@@ -122,6 +122,12 @@ class ReplayOptions:
         gp_seed: ``GPConfig.seed`` of the GP fit (the hyperparameters' row subset, the inducing points; as the live
             learner's ``LearnOptions.gp_seed``). 0: ``GPConfig``'s own default. Issue 8's counts are judged at two
             seeds (the project's rule 8(b); ``benchmarks/eval_jsbsim.py --gp-seed``).
+        coefficient_band: the coefficient's band at the flight's own regressors (``<C>_sigma``, ``pred_sigma``):
+            ``"white"`` the measurement's band less its white part (``docs/gp.md``, "Two bands"); ``"stated"`` for
+            the outputs of :data:`STATED_BAND_SIGN`, the blocked cross-validation's residual variance plus or minus
+            the measured coefficient's error variance that the estimator states
+            (:mod:`gcs_sysid.gp.coefband`), the white band elsewhere and where nothing is stated. None:
+            :data:`COEFFICIENT_BAND`. The means and the measurement's band do not change.
     """
 
     rate_hz: float = 50.0
@@ -148,6 +154,26 @@ class ReplayOptions:
     gp_noise: str | None = None
     gp_seed: int = 0
     air_pitch: bool | None = None
+    coefficient_band: str | None = None
+
+
+#: ``ReplayOptions.coefficient_band`` values (``docs/gp.md``, "The coefficient's band from the stated measurement
+#: error").
+COEFFICIENT_BANDS = ("white", "stated")
+
+#: The replay's coefficient band when ``ReplayOptions.coefficient_band`` is None (``eval_jsbsim --coefficient-band``
+#: sets it): ``"white"``, the measurement's band less its white part (the eleventh session's).
+COEFFICIENT_BAND = "white"
+
+#: With ``coefficient_band="stated"``, the sign of the measured error's variance per output
+#: (:func:`gcs_sysid.gp.coefband.stated_band_variance`): ``+1`` where the measured coefficient aids an air angle
+#: (CZ alpha, CY beta: :data:`gcs_sysid.aero.coefficients.STATED_INPUT_NOISE`), so the model follows its error;
+#: ``-1`` where the model averages it out. Cl and CX keep the white band: Cl's held-out rows are asked at the
+#: held-out air roll rate, whose stated variance sets that band; CX's measured error holds the thrust model's, which
+#: the estimator does not state and the model partly follows through ``delta_t`` and ``V`` (with ``-1``, CX's band
+#: covered 45-60 % on several of issue 8's used flights, seeds 19-21: ``docs/benchmarks.md``, "Seventy-first
+#: session").
+STATED_BAND_SIGN = {"CY": 1.0, "CZ": 1.0, "Cm": -1.0, "Cn": -1.0}
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
@@ -324,6 +350,19 @@ def replay_air_pitch(options: ReplayOptions) -> bool:
     return AIR_PITCH and replay_gust_rates(options) not in PITCH_FRAMES
 
 
+def replay_coefficient_band(options: ReplayOptions) -> str:
+    """The replay's coefficient band (a name of :data:`COEFFICIENT_BANDS`): ``options.coefficient_band``, or
+    :data:`COEFFICIENT_BAND` as it stands now when that is None.
+
+    Raises:
+        InputError: the name is not one of :data:`COEFFICIENT_BANDS`.
+    """
+    name = COEFFICIENT_BAND if options.coefficient_band is None else options.coefficient_band
+    if name not in COEFFICIENT_BANDS:
+        raise InputError(f"coefficient band {name!r}: expected one of {', '.join(COEFFICIENT_BANDS)}")
+    return name
+
+
 def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path | None,
                  options: ReplayOptions = ReplayOptions()):
     """Check every input and option of a replay before any work; returns the loaded airframe.
@@ -364,6 +403,7 @@ def check_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path
                              f"among {', '.join(COEFFICIENTS)}")
     if options.model_in:
         check_model_state(options.model_in)
+    replay_coefficient_band(options)
     check_log(log)
     if options.can_log is not None:
         from .telemetry.can_merge import check_can_log
@@ -738,6 +778,14 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
             draw("envelope", "envelope_figures", envelope, table.X[train])
             with _stage("predict", timings, bar):
                 white = model.noise_var(white_noise=True) - model.noise_var(white_noise=False)
+                band_sign = band_y_var = None
+                if replay_coefficient_band(options) == "stated" and model.discrepancy is not None:
+                    from .aero.coefficients import stated_output_variance
+
+                    band_y_var = stated_output_variance(states, airframe)
+                    band_sign = np.array([STATED_BAND_SIGN.get(COEFFICIENTS[i], 0.0) for i in fit_cols])
+                    if band_y_var is None:
+                        notes.append("coefficient band: the estimator states no measurement error; the white band")
 
                 def predict_rows(tab, rows, ks):
                     """The model's mean and both bands for outputs ``ks`` (indices into ``fit_cols``) on ``tab``'s
@@ -750,6 +798,11 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, ks], 0.0))
+                    if band_sign is not None and band_y_var is not None:   # opt-in: the stated band (gp.coefband)
+                        from .gp.coefband import stated_band_variance
+
+                        vs = stated_band_variance(model, Xq, band_y_var[rows][:, fit_cols], band_sign)[:, ks]
+                        pred_sigma[at] = np.where(np.isfinite(vs), np.sqrt(vs), pred_sigma[at])
 
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)
                 if rows.any():

@@ -33,8 +33,7 @@ from ..estimation.states import FlightStates
 from .table import REGRESSORS, CoefficientTable
 
 __all__ = ["compute_coefficients", "aero_moments", "stated_input_variance", "stated_scale_variance",
-           "stated_map_covariance", "QBAR_MIN",
-           "STATED_INPUT_NOISE"]
+           "stated_map_covariance", "stated_output_variance", "QBAR_MIN", "STATED_INPUT_NOISE"]
 
 QBAR_MIN = 5.0  #: Pa; rows with a smaller dynamic pressure are not valid (coefficients blow up)
 #: Regressors whose per-row error variance the estimator states for the GP's band (``CoefficientTable.x_var``):
@@ -123,6 +122,42 @@ def stated_map_covariance(states: FlightStates) -> np.ndarray | None:
         idx = [REGRESSORS.index(c) for c in cols]
         out[REGRESSORS.index(k)][np.ix_(idx, idx)] = C
     return out if np.any(out) else None
+
+
+def stated_output_variance(states: FlightStates, airframe: Airframe) -> np.ndarray | None:
+    """Per-row variance of the measured coefficients' errors that the estimator's smoothers state.
+
+    The forces from the smoothed specific force's 1-sigma (``states.sigma["ax" | "ay" | "az"]``, m/s^2):
+    ``(m sigma_a / (qbar S))^2``; the moments from the angular accelerations' (``"p_dot" | "q_dot" | "r_dot"``,
+    rad/s^2) through the moment equations (:func:`aero_moments`, the rates' own errors left out):
+    ``Cl: (Ixx^2 s_p^2 + Ixz^2 s_r^2) / (qbar S b)^2``, ``Cm: Iyy^2 s_q^2 / (qbar S c)^2``,
+    ``Cn: (Izz^2 s_r^2 + Ixz^2 s_p^2) / (qbar S b)^2``. The thrust model's error (CX) is not stated.
+
+    Args:
+        states: smoothed states with ``sigma`` and ``qbar`` (Pa).
+        airframe: mass (kg), inertia (kg m^2), S (m^2), b and c (m).
+
+    Returns:
+        ``(T, 6)`` in the coefficients' units squared (columns :data:`~gcs_sysid.aero.table.COEFFICIENTS`;
+        NaN where a sigma is not stated or ``qbar <= 0``), or None when no sigma of these is stated.
+    """
+    sig = getattr(states, "sigma", None) or {}
+    keys = ("ax", "ay", "az", "p_dot", "q_dot", "r_dot")
+    if "qbar" not in states.data or not any(k in sig for k in keys):
+        return None
+    T = len(states)
+    s2 = {k: np.asarray(sig[k], float) ** 2 if k in sig else np.full(T, np.nan) for k in keys}
+    qbar = np.asarray(states.data["qbar"], float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        qS2 = np.where(qbar > 0, (qbar * airframe.S) ** 2, np.nan)
+        m2 = airframe.mass**2
+        Ixx2, Iyy2, Izz2, Ixz2 = airframe.Ixx**2, airframe.Iyy**2, airframe.Izz**2, airframe.Ixz**2
+        cross = lambda k: 0.0 if Ixz2 == 0 else Ixz2 * s2[k]  # noqa: E731 (no NaN from an unstated cross term)
+        out = np.stack([m2 * s2["ax"] / qS2, m2 * s2["ay"] / qS2, m2 * s2["az"] / qS2,
+                        (Ixx2 * s2["p_dot"] + cross("r_dot")) / (qS2 * airframe.b**2),
+                        Iyy2 * s2["q_dot"] / (qS2 * airframe.c**2),
+                        (Izz2 * s2["r_dot"] + cross("p_dot")) / (qS2 * airframe.b**2)], axis=1)
+    return out
 
 
 def aero_moments(airframe: Airframe, p, q, r, p_dot, q_dot, r_dot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,0 +1,103 @@
+"""The coefficient's band at a flight's own regressors from the out-of-sample residual and the stated measurement error.
+
+The replay states two bands at a flight's estimated regressors (``docs/gp.md``, "Two bands"): one for a new
+*measurement* and one for the *coefficient itself* (what a simulator needs, and what JSBSim's truth is). Write the
+model's error against the true coefficient as the sum of its residual against the measurement and the measurement's
+own error:
+
+    T = m(x) - C = (m(x) - Y) + (Y - C) = R + E,      var T = var R + var E + 2 cov(R, E)
+
+``var R`` is what the blocked cross-validation measures on time blocks the fit did not see: ``cv_p``, the mean
+squared error of each held-back block (:mod:`gcs_sysid.gp.discrepancy`, there split into ``d_p + w_p``). ``var E``
+is the measured coefficient's error, which the estimator states row by row from its smoothers (the specific force's
+and the angular accelerations' 1-sigma through the force and moment equations,
+:func:`gcs_sysid.aero.coefficients.stated_output_variance`). The covariance depends on whether the model can follow
+the measurement's error:
+
+- **an output that aids an air angle** (CZ aids alpha, CY aids beta: the specific-force aiding of
+  :mod:`gcs_sysid.estimation.airangles`): the angle takes up the measured coefficient's error, the model at the
+  estimated angle gives the measurement back with its error, and ``R`` does not contain ``E`` (``cov(R, E) ~ 0``):
+  ``var T = cv + var E``;
+- **any other output**: the regressors do not carry the measurement's error, the model averages it out, ``R``
+  contains ``-E`` (``cov(R, E) ~ -var E``): ``var T = cv - var E``.
+
+So the band is ``max(cv_p + s_p var E_p(x), latent_p(x) + input_p(x))`` with ``s_p = +1`` or ``-1`` per output,
+floored at what the model's own posterior says (the latent variance and NIGP's learned input noise through the
+slope, McHutchon and Rasmussen 2011, eq. 4) so that a row far from the data keeps its width. The variance
+decomposition is the errors-in-variables one (Fuller, *Measurement Error Models*, Wiley 1987, sec. 1.1: the
+observed response is the true one plus its error, and what a regression on an error-free regressor averages out);
+the out-of-sample residual variance is cross-validation's (Rasmussen and Williams 2006, sec. 5.3).
+
+Measured on issue 8's JSBSim flights (``docs/benchmarks.md``, "Seventy-first session"): on the held-out segment
+CZ's error is ``sqrt(R^2 + E^2)`` (1.12 and 0.72 against 1.29 % of the truth's RMS, medians), Cn's
+``sqrt(R^2 - E^2)`` (13.5 and 8.7 against 11.4 %), and the stated ``E`` of the forces is 0.8-1.0 of the true one.
+The replay applies it to CY, CZ, Cm and Cn (:data:`gcs_sysid.pipeline.STATED_BAND_SIGN`). Cl is left out (its
+held-out rows are asked at the held-out air roll rate, :mod:`gcs_sysid.aero.gustfilter`, whose own stated variance
+sets its band; the training rows' cross-validation does not measure that query), and so is CX (its measured error
+holds the thrust model's, which is not stated, and the model follows part of it through ``delta_t`` and ``V``).
+
+References:
+    C. E. Rasmussen and C. K. I. Williams (2006), *Gaussian Processes for Machine Learning*, MIT Press, sec. 5.3.
+    A. McHutchon and C. E. Rasmussen (2011), "Gaussian process training with input noise", NIPS 24.
+    W. A. Fuller (1987), *Measurement Error Models*, Wiley, sec. 1.1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["cv_variance", "stated_band_variance"]
+
+
+def cv_variance(model) -> np.ndarray | None:
+    """``(P,)`` the blocked cross-validation's mean squared error per output in the outputs' units squared
+    (``d_p + w_p`` of the model's discrepancy, :mod:`gcs_sysid.gp.discrepancy`), or None when the model has none
+    (the validation did not run)."""
+    if model.discrepancy is None:
+        return None
+    D = np.asarray(model.discrepancy, float)
+    return (D[0] + D[1]) * np.asarray(model.scaler.y_std, float) ** 2
+
+
+def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.ndarray:
+    """The coefficient's band variance at a flight's own regressors (module docstring).
+
+    Args:
+        model: a :class:`gcs_sysid.gp.LocalGlobalGP` with ``P`` outputs and a discrepancy (blocked validation).
+        X: ``(N, D)`` the model's inputs at the rows (data units; NaN rows give NaN).
+        y_var: ``(N, P)`` the stated variance of the measured outputs' errors (outputs' units squared; NaN where
+            none is stated: NaN out).
+        sign: ``(P,)`` ``+1`` (the output aids a regressor: ``cv + var E``), ``-1`` (``cv - var E``) or ``0`` (not
+            stated: NaN out).
+
+    Returns:
+        ``(N, P)`` variance in the outputs' units squared, NaN where the row, its ``y_var`` or the output's sign
+        gives none (the caller keeps its other band there).
+
+    Raises:
+        InputError: the model has no discrepancy, or ``y_var`` / ``sign`` do not match ``X`` and the outputs.
+    """
+    cv = cv_variance(model)
+    if cv is None:
+        raise InputError("stated coefficient band: the model has no blocked cross-validation (discrepancy)")
+    X = np.asarray(X, float)
+    y_var = np.asarray(y_var, float)
+    s = np.asarray(sign, float)
+    P = model.n_outputs
+    if y_var.shape != (len(X), P) or s.shape != (P,):
+        raise InputError(f"stated coefficient band: y_var must be ({len(X)}, {P}) and sign ({P},), "
+                         f"got {y_var.shape} and {s.shape}")
+    out = np.full((len(X), P), np.nan)
+    if not len(X) or not np.any(s != 0):
+        return out
+    _, lat = model.predict(X, include_noise=False, input_noise=False, model_error=False)
+    ok = np.all(np.isfinite(X), axis=1)
+    learned = np.zeros((len(X), P))
+    if model.input_var is not None and ok.any():
+        learned[ok] = model.input_variance_s(model.scaler.x(X[ok])) * np.asarray(model.scaler.y_std, float) ** 2
+    floor = np.asarray(lat, float) + learned
+    with np.errstate(invalid="ignore"):
+        v = np.maximum(cv[None, :] + s[None, :] * y_var, floor)
+    return np.where((s != 0)[None, :] & np.isfinite(y_var) & ok[:, None], v, np.nan)
