@@ -97,6 +97,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "exact conditions (predict's sigma): p_hat's scale error from the rolling gust, r_hat's "
                         "linear error from the yaw gust rate ('on', the default) or leave the rates exact there "
                         "('off'; docs/gp.md, 'The rates' errors')")
+    r.add_argument("--coefficient-band", default=None, choices=("white", "stated"),
+                   help="the coefficient's band at the flight's own regressors (coefficients.csv's <C>_sigma): "
+                        "'white' (the default) the measurement's band less its white part; 'stated' for CY, CZ, Cm "
+                        "and Cn the blocked validation's residual variance plus (CY, CZ: they aid an air angle) or "
+                        "minus (Cm, Cn) the measured coefficient's error variance the estimator states (docs/gp.md, "
+                        "'The coefficient's band from the stated measurement error')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
@@ -202,6 +208,7 @@ def _replay_options(a: argparse.Namespace):
                          air_yaw=None if a.air_yaw is None else a.air_yaw == "on",
                          rate_errors=None if a.rate_errors is None else a.rate_errors == "on",
                          air_pitch=None if a.air_pitch is None else a.air_pitch == "on",
+                         coefficient_band=a.coefficient_band,
                          gp_noise=a.gp_noise, **_air_roll_options(getattr(a, "air_roll", None)))
 
 
