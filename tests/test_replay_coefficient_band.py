@@ -51,9 +51,9 @@ def test_stated_output_variance_by_hand():
 
 
 def test_stated_band_moves_only_its_outputs_bands(tmp_path):
-    """On a part of the sample flight: CY, CZ, Cm, Cn take the stated band (recomputed here from the saved model and
-    the states), CX and Cl keep the white one (the measurement's band less the white share), which the stated band
-    also falls back to where nothing is stated."""
+    """On a part of the sample flight: the outputs of STATED_BAND_SIGN take the stated band (recomputed here from the
+    saved model and the states), Cl keeps the white one (the measurement's band less the white share), which the stated
+    band also falls back to where nothing is stated."""
     opts = dict(progress=False, parallel=False, t_from=60.0, t_to=150.0)
     stated = run_replay(LOG, AIRFRAME, tmp_path / "stated", ReplayOptions(coefficient_band="stated", **opts))
     model = load_gp(Path(stated.model_path))
@@ -64,7 +64,7 @@ def test_stated_band_moves_only_its_outputs_bands(tmp_path):
     if model.n_mean_only:
         a = stated.table.alpha_dot_hat[rows]
         X = np.c_[X, np.where(np.isfinite(a), a, 0.0)]
-    sign = np.array([STATED_BAND_SIGN.get(c, 0.0) for c in COEFFICIENTS])
+    sign = np.array([STATED_BAND_SIGN.get(c, np.nan) for c in COEFFICIENTS])
     v = stated_band_variance(model, X, stated_output_variance(stated.states, load_airframe(AIRFRAME))[rows], sign)
     expect = np.where(np.isfinite(v), np.sqrt(v), white[rows])
     np.testing.assert_allclose(stated.pred_sigma[rows], expect, rtol=1e-9, atol=1e-15)

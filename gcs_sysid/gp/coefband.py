@@ -69,12 +69,12 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.nd
         X: ``(N, D)`` the model's inputs at the rows (data units; NaN rows give NaN).
         y_var: ``(N, P)`` the stated variance of the measured outputs' errors (outputs' units squared; NaN where
             none is stated: NaN out).
-        sign: ``(P,)`` ``+1`` (the output aids a regressor: ``cv + var E``), ``-1`` (``cv - var E``) or ``0`` (not
-            stated: NaN out).
+        sign: ``(P,)`` ``+1`` (the regressors carry the output's measured error: ``cv + var E``), ``-1`` (the model
+            averages it out: ``cv - var E``), ``0`` (``cv`` alone: ``y_var`` not read) or NaN (not applied: NaN out).
 
     Returns:
-        ``(N, P)`` variance in the outputs' units squared, NaN where the row, its ``y_var`` or the output's sign
-        gives none (the caller keeps its other band there).
+        ``(N, P)`` variance in the outputs' units squared, NaN where the row, its ``y_var`` (sign +-1) or the
+        output's sign gives none (the caller keeps its other band there).
 
     Raises:
         InputError: the model has no discrepancy, or ``y_var`` / ``sign`` do not match ``X`` and the outputs.
@@ -90,7 +90,8 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.nd
         raise InputError(f"stated coefficient band: y_var must be ({len(X)}, {P}) and sign ({P},), "
                          f"got {y_var.shape} and {s.shape}")
     out = np.full((len(X), P), np.nan)
-    if not len(X) or not np.any(s != 0):
+    applied = np.isfinite(s)
+    if not len(X) or not applied.any():
         return out
     _, lat = model.predict(X, include_noise=False, input_noise=False, model_error=False)
     ok = np.all(np.isfinite(X), axis=1)
@@ -98,6 +99,7 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.nd
     if model.input_var is not None and ok.any():
         learned[ok] = model.input_variance_s(model.scaler.x(X[ok])) * np.asarray(model.scaler.y_std, float) ** 2
     floor = np.asarray(lat, float) + learned
+    stated = np.where((s == 0)[None, :], 0.0, y_var)          # cv alone needs no stated error
     with np.errstate(invalid="ignore"):
-        v = np.maximum(cv[None, :] + s[None, :] * y_var, floor)
-    return np.where((s != 0)[None, :] & np.isfinite(y_var) & ok[:, None], v, np.nan)
+        v = np.maximum(cv[None, :] + np.where(applied, s, 0.0)[None, :] * stated, floor)
+    return np.where(applied[None, :] & np.isfinite(stated) & ok[:, None], v, np.nan)

@@ -55,7 +55,7 @@ def _ratio(model, X, C, y_var, sign, p):
 def test_each_regime_covers_the_truth_and_the_other_sign_does_not(aided_flight):
     model, X, C, y_var = aided_flight
     assert cv_variance(model) is not None
-    right = np.zeros(6)
+    right = np.full(6, np.nan)
     right[AIDED], right[PLAIN] = 1.0, -1.0
     r_aided, cov_aided = _ratio(model, X, C, y_var, right, AIDED)
     r_plain, cov_plain = _ratio(model, X, C, y_var, right, PLAIN)
@@ -70,18 +70,19 @@ def test_each_regime_covers_the_truth_and_the_other_sign_does_not(aided_flight):
 
 def test_band_floor_unstated_rows_and_errors(aided_flight):
     model, X, C, y_var = aided_flight
-    sign = np.array([0.0, 1.0, 0.0, 0.0, -1.0, 0.0])
+    sign = np.array([np.nan, 1.0, 0.0, np.nan, -1.0, np.nan])
     yv = y_var[400:450].copy()
     yv[:5, AIDED] = np.nan                                             # nothing stated on these rows
     yv[:, PLAIN] = 1e6                                                 # more than the residual: the floor
     v = stated_band_variance(model, X[400:450], yv, sign)
-    assert np.isnan(v[:, [0, 2, 3, 5]]).all()                          # sign 0: the caller keeps its band
+    assert np.isnan(v[:, [0, 3, 5]]).all()                             # no sign: the caller keeps its band
     assert np.isnan(v[:5, AIDED]).all() and np.isfinite(v[5:, AIDED]).all()
     _, lat = model.predict(X[400:450], include_noise=False, input_noise=False, model_error=False)
     learned = model.input_variance_s(model.scaler.x(X[400:450])) * model.scaler.y_std**2
     np.testing.assert_allclose(v[:, PLAIN], (lat + learned)[:, PLAIN], rtol=1e-12)
     cv = cv_variance(model)
     np.testing.assert_allclose(v[5:, AIDED], np.maximum(cv[AIDED] + yv[5:, AIDED], (lat + learned)[5:, AIDED]))
+    np.testing.assert_allclose(v[:, 2], np.maximum(cv[2], (lat + learned)[:, 2]))   # sign 0: cv alone, y_var unread
     with pytest.raises(InputError, match="y_var must be"):
         stated_band_variance(model, X[400:450], yv[:, :5], sign)
     from dataclasses import replace
