@@ -23,18 +23,22 @@ the measurement's error:
 
 So the band is ``max(cv_p + s_p var E_p(x), latent_p(x) + input_p(x))`` with ``s_p = +1`` or ``-1`` per output,
 floored at what the model's own posterior says (the latent variance and NIGP's learned input noise through the
-slope, McHutchon and Rasmussen 2011, eq. 4) so that a row far from the data keeps its width. The variance
-decomposition is the errors-in-variables one (Fuller, *Measurement Error Models*, Wiley 1987, sec. 1.1: the
-observed response is the true one plus its error, and what a regression on an error-free regressor averages out);
-the out-of-sample residual variance is cross-validation's (Rasmussen and Williams 2006, sec. 5.3).
+slope, McHutchon and Rasmussen 2011, eq. 4) so that a row far from the data keeps its width. ``s_p = 0`` takes the
+out-of-sample residual alone: the averaged regime without its correction, the conservative choice where the stated
+``E`` is short or incomplete. The variance decomposition is the errors-in-variables one (Fuller, *Measurement Error
+Models*, Wiley 1987, sec. 1.1: the observed response is the true one plus its error, and what a regression on an
+error-free regressor averages out); the out-of-sample residual variance is cross-validation's (Rasmussen and Williams
+2006, sec. 5.3).
 
 Measured on issue 8's JSBSim flights (``docs/benchmarks.md``, "Seventy-first session"): on the held-out segment
-CZ's error is ``sqrt(R^2 + E^2)`` (1.12 and 0.72 against 1.29 % of the truth's RMS, medians), Cn's
-``sqrt(R^2 - E^2)`` (13.5 and 8.7 against 11.4 %), and the stated ``E`` of the forces is 0.8-1.0 of the true one.
-The replay applies it to CY, CZ, Cm and Cn (:data:`gcs_sysid.pipeline.STATED_BAND_SIGN`). Cl is left out (its
-held-out rows are asked at the held-out air roll rate, :mod:`gcs_sysid.aero.gustfilter`, whose own stated variance
-sets its band; the training rows' cross-validation does not measure that query), and so is CX (its measured error
-holds the thrust model's, which is not stated, and the model follows part of it through ``delta_t`` and ``V``).
+CZ's error is ``sqrt(R^2 + E^2)`` (1.12 and 0.72 against 1.29 % of the truth's RMS, medians), Cn's close to
+``sqrt(R^2 - E^2)`` (13.5 and 8.7 against 11.4 %), and the stated ``E`` of the forces is 0.8-1.0 of the true one, of
+the moments 0.5-0.7 (the rate smoother's prior part). The replay's signs (:data:`gcs_sysid.pipeline.STATED_BAND_SIGN`)
+were chosen on those flights: ``+1`` for CY, CZ and Cm (Cm's error there was the residual plus about a third of its
+measured error, which the short stated error through ``+1`` matches), ``0`` for CX and Cn (``-1`` with the short or
+incomplete stated error put too many flights below 90 %). Cl is left out: its held-out rows are asked at the held-out
+air roll rate (:mod:`gcs_sysid.aero.gustfilter`), whose own stated variance sets its band, and the training rows'
+cross-validation does not measure that query.
 
 References:
     C. E. Rasmussen and C. K. I. Williams (2006), *Gaussian Processes for Machine Learning*, MIT Press, sec. 5.3.
