@@ -31,8 +31,8 @@ error-free regressor averages out); the out-of-sample residual variance is cross
 2006, sec. 5.3).
 
 Measured on issue 8's JSBSim flights (``docs/benchmarks.md``, "Seventy-first session"): on the held-out segment
-CZ's error is ``sqrt(R^2 + E^2)`` (1.12 and 0.72 against 1.29 % of the truth's RMS, medians), Cn's close to
-``sqrt(R^2 - E^2)`` (13.5 and 8.7 against 11.4 %), and the stated ``E`` of the forces is 0.8-1.0 of the true one, of
+CZ's error is ``sqrt(R^2 + E^2)`` (1.41 and 0.73 against 1.56 % of the truth's RMS, medians of 75 flights), Cn's close
+to ``sqrt(R^2 - E^2)`` (13.7 and 8.3 against 11.6 %), and the stated ``E`` of the forces is 0.8-1.0 of the true one, of
 the moments 0.5-0.7 (the rate smoother's prior part). The replay's signs (:data:`gcs_sysid.pipeline.STATED_BAND_SIGN`)
 were chosen on those flights: ``+1`` for CY, CZ and Cm (Cm's error there was the residual plus about a third of its
 measured error, which the short stated error through ``+1`` matches), ``0`` for CX and Cn (``-1`` with the short or
