@@ -34,11 +34,11 @@ Measured on issue 8's JSBSim flights (``docs/benchmarks.md``, "Seventy-first ses
 CZ's error is ``sqrt(R^2 + E^2)`` (1.41 and 0.73 against 1.56 % of the truth's RMS, medians of 75 flights), Cn's close
 to ``sqrt(R^2 - E^2)`` (13.7 and 8.3 against 11.6 %), and the stated ``E`` of the forces is 0.8-1.0 of the true one, of
 the moments 0.5-0.7 (the rate smoother's prior part). The replay's signs (:data:`gcs_sysid.pipeline.STATED_BAND_SIGN`)
-were chosen on those flights: ``+1`` for CY, CZ and Cm (Cm's error there was the residual plus about a third of its
-measured error, which the short stated error through ``+1`` matches), ``0`` for CX and Cn (``-1`` with the short or
-incomplete stated error put too many flights below 90 %). Cl is left out: its held-out rows are asked at the held-out
-air roll rate (:mod:`gcs_sysid.aero.gustfilter`), whose own stated variance sets its band, and the training rows'
-cross-validation does not measure that query.
+were chosen on those flights: ``+1`` for CZ and Cm (Cm's error there was the residual plus about a third of its
+measured error, which the short stated error through ``+1`` matches), ``0`` for Cn (``-1`` with the short stated
+error put too many flights below 90 %); CX, CY and Cl keep the white band (CY's and CX's tie it; Cl's held-out rows
+are asked at the held-out air roll rate, :mod:`gcs_sysid.aero.gustfilter`, whose own stated variance sets its band,
+and the training rows' cross-validation does not measure that query).
 
 References:
     C. E. Rasmussen and C. K. I. Williams (2006), *Gaussian Processes for Machine Learning*, MIT Press, sec. 5.3.
