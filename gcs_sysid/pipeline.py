@@ -796,15 +796,21 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     show); the coefficient's band is the same less the white measurement noise (docs/gp.md, "Two
                     bands")."""
                     Xq, xv = gp_inputs(tab, rows, use_adot)
-                    mean, var = (np.asarray(v)[:, ks] for v in model.predict(Xq, x_var=xv))
+                    if band_sign is None:
+                        mean, var = (np.asarray(v)[:, ks] for v in model.predict(Xq, x_var=xv))
+                    else:                            # one pass: predict's mean and variance and two of its terms
+                        mean, var, lat, learned = model.predict_parts(Xq, x_var=xv)
                     at = np.ix_(rows, [fit_cols[k] for k in ks])
+                    if band_sign is not None:        # the stated band (gp.coefband)
+                        from .gp.coefband import stated_band_variance
+
+                        vs = stated_band_variance(model, Xq, band_y_var[rows][:, fit_cols], band_sign,
+                                                  parts=(lat, learned))[:, ks]
+                        mean, var = mean[:, ks], var[:, ks]
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, ks], 0.0))
-                    if band_sign is not None:        # opt-in: the stated band (gp.coefband)
-                        from .gp.coefband import stated_band_variance
-
-                        vs = stated_band_variance(model, Xq, band_y_var[rows][:, fit_cols], band_sign)[:, ks]
+                    if band_sign is not None:
                         pred_sigma[at] = np.where(np.isfinite(vs), np.sqrt(vs), pred_sigma[at])
 
                 rows = table.valid & np.all(np.isfinite(table.X), axis=1)

@@ -65,7 +65,7 @@ def cv_variance(model) -> np.ndarray | None:
     return (D[0] + D[1]) * np.asarray(model.scaler.y_std, float) ** 2
 
 
-def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.ndarray:
+def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign, parts=None) -> np.ndarray:
     """The coefficient's band variance at a flight's own regressors (module docstring).
 
     Args:
@@ -75,6 +75,8 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.nd
             none is stated: NaN out).
         sign: ``(P,)`` ``+1`` (the regressors carry the output's measured error: ``cv + var E``), ``-1`` (the model
             averages it out: ``cv - var E``), ``0`` (``cv`` alone: ``y_var`` not read) or NaN (not applied: NaN out).
+        parts: ``(latent, learned_input)``, each ``(N, P)``, from :meth:`gcs_sysid.gp.LocalGlobalGP.predict_parts` at
+            ``X`` when the caller has them (the replay's one pass), or None (computed here).
 
     Returns:
         ``(N, P)`` variance in the outputs' units squared, NaN where the row, its ``y_var`` (sign +-1) or the
@@ -97,12 +99,9 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign) -> np.nd
     applied = np.isfinite(s)
     if not len(X) or not applied.any():
         return out
-    _, lat = model.predict(X, include_noise=False, input_noise=False, model_error=False)
+    lat, learned = model.predict_parts(X)[2:] if parts is None else parts
     ok = np.all(np.isfinite(X), axis=1)
-    learned = np.zeros((len(X), P))
-    if model.input_var is not None and ok.any():
-        learned[ok] = model.input_variance_s(model.scaler.x(X[ok])) * np.asarray(model.scaler.y_std, float) ** 2
-    floor = np.asarray(lat, float) + learned
+    floor = np.asarray(lat, float) + np.asarray(learned, float)
     stated = np.where((s == 0)[None, :], 0.0, y_var)          # cv alone needs no stated error
     with np.errstate(invalid="ignore"):
         v = np.maximum(cv[None, :] + np.where(applied, s, 0.0)[None, :] * stated, floor)

@@ -240,6 +240,55 @@ class LocalGlobalGP:
             var = var + self.input_variance_s(Xs, xv_s)
         return self._finish(ok, mean, var)
 
+    def predict_parts(self, X, x_var=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`predict` at a flight's own regressors (``predict(X, x_var=x_var)``: noise and input noise on) and two
+        of its terms, from one pass over the layers and one gradient.
+
+        Args:
+            X: ``(N, D)`` regressors in data units (rows with NaN give NaN outputs).
+            x_var: as :meth:`predict`'s.
+
+        Returns:
+            ``(mean, var, latent, learned_input)``, each ``(N, P)`` in the outputs' units (squared for the
+            variances): ``mean`` and ``var`` equal to :meth:`predict`'s to the last bit; ``latent`` the latent variance
+            (``predict(X, include_noise=False, input_noise=False, model_error=False)``); ``learned_input`` NIGP's
+            learned input noise through the slope alone (McHutchon and Rasmussen 2011, eq. 4; zeros when none was
+            learned), without the stated ``x_var``. :func:`gcs_sysid.gp.coefband.stated_band_variance` reads the last
+            two.
+
+        Raises:
+            InputError: as :meth:`predict`.
+        """
+        from .inputnoise import mean_gradient, slope_variance
+
+        enable_x64()
+        Xs, ok = self._standardise_query(X)
+        xv_s = None
+        if x_var is not None:
+            xv = np.asarray(x_var, float)
+            if self.n_mean_only and xv.ndim == 2 and xv.shape[1] == self.n_inputs - self.n_mean_only:
+                xv = self.full_inputs(xv, "x_var", np.nan)
+            if xv.shape != (len(ok), self.n_inputs):
+                raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
+            xv_s = np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
+        mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
+        if self.local_params is not None and self.store is not None:
+            ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
+            mean, var = mean + ml, var + vl
+        lat = var
+        var = var + self._noise_s()[None, :]
+        learned = np.zeros(np.shape(lat))
+        if (self.input_var is not None or xv_s is not None) and len(Xs):
+            grad = mean_gradient(self.params, self.post, Xs, self.config.batch_size)
+            lv = np.zeros(self.n_inputs) if self.input_var is None else np.asarray(self.input_var, float)
+            learned = slope_variance(grad, lv)
+            used = learned if xv_s is None else np.einsum("npd,nd->np", grad**2, np.fmax(lv[None, :], xv_s))
+            var = var + used
+        mean_o, var_o = self._finish(ok, mean, var)
+        _, lat_o = self._finish(ok, mean, lat)
+        _, learned_o = self._finish(ok, mean, learned)
+        return mean_o, var_o, lat_o, learned_o
+
     def _noise_s(self) -> np.ndarray:
         """``(P,)`` observation-noise variance (standardised): the larger of the global likelihood's and the
         local nugget. The local nugget, learned from nearest-neighbour differences of 50 Hz rows that share a

@@ -89,3 +89,24 @@ def test_band_floor_unstated_rows_and_errors(aided_flight):
 
     with pytest.raises(InputError, match="no blocked cross-validation"):
         stated_band_variance(replace(model, discrepancy=None), X[400:450], yv, sign)
+
+
+def test_predict_parts_is_predict_and_its_terms(fitted, flight):
+    """The replay's one pass: ``predict``'s mean and variance to the last bit, the latent variance and the learned
+    input term as their own calls give them (NaN rows NaN; the stated ``x_var`` only in ``var``)."""
+    model, _ = fitted
+    X = flight[0][400:].copy()
+    X[3] = np.nan
+    xv = np.full(X.shape, np.nan)
+    xv[:, 0] = 4.0 * np.asarray(model.input_var)[0] * model.scaler.x_std[0] ** 2
+    mean, var, lat, learned = model.predict_parts(X, x_var=xv)
+    m0, v0 = model.predict(X, x_var=xv)
+    np.testing.assert_array_equal(mean, m0)
+    np.testing.assert_array_equal(var, v0)
+    np.testing.assert_allclose(lat, model.predict(X, include_noise=False, input_noise=False, model_error=False)[1],
+                               rtol=1e-12)
+    ok = np.isfinite(X).all(1)
+    expect = model.input_variance_s(model.scaler.x(X[ok])) * model.scaler.y_std**2
+    np.testing.assert_allclose(learned[ok], expect, rtol=1e-9, atol=1e-18)
+    assert np.isnan(learned[3]).all() and np.isnan(var[3]).all()
+    assert (var[ok] > lat[ok] + learned[ok]).all()                   # noise and the stated term on top
