@@ -162,8 +162,10 @@ class ReplayOptions:
 COEFFICIENT_BANDS = ("white", "stated")
 
 #: The replay's coefficient band when ``ReplayOptions.coefficient_band`` is None (``eval_jsbsim --coefficient-band``
-#: sets it): ``"white"``, the measurement's band less its white part (the eleventh session's).
-COEFFICIENT_BAND = "white"
+#: sets it): ``"stated"`` since the seventy-first session (rule 74, fresh seeds 40-42, with Cl's ``"innov"`` band:
+#: ``docs/benchmarks.md``, "Seventy-first session"); before, ``"white"``, the measurement's band less its white part
+#: (the eleventh session's), which CX, CY and Cl keep.
+COEFFICIENT_BAND = "stated"
 
 #: With ``coefficient_band="stated"``, the sign of the measured error's variance per output
 #: (:func:`gcs_sysid.gp.coefband.stated_band_variance`; an output not named keeps the white band): ``+1`` where the

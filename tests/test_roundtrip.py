@@ -69,7 +69,9 @@ def test_report_files_written(roundtrip):
 
 def test_replay_bands_coefficient_and_measurement(roundtrip):
     """``pred_sigma`` (the coefficient) is ``pred_sigma_obs`` (a new measurement) less the model's white
-    measurement noise, row by row (docs/gp.md, "Two bands")."""
+    measurement noise, row by row (docs/gp.md, "Two bands"), on the outputs that keep that band (the stated band of
+    the others: tests/test_replay_coefficient_band.py)."""
+    from gcs_sysid import pipeline
     from gcs_sysid.gp import load_gp
 
     _, result, _ = roundtrip
@@ -78,8 +80,11 @@ def test_replay_bands_coefficient_and_measurement(roundtrip):
     assert ok.sum() > 500
     white = model.noise_var() - model.noise_var(white_noise=False)
     assert (white > 0).all()
-    np.testing.assert_allclose(result.pred_sigma_obs[ok] ** 2 - result.pred_sigma[ok] ** 2,
-                               np.broadcast_to(white, (int(ok.sum()), 6)), rtol=1e-6, atol=1e-14)
+    keep = [k for k, c in enumerate(pipeline.COEFFICIENTS)
+            if pipeline.COEFFICIENT_BAND == "white" or c not in pipeline.STATED_BAND_SIGN]
+    assert keep
+    np.testing.assert_allclose(result.pred_sigma_obs[ok][:, keep] ** 2 - result.pred_sigma[ok][:, keep] ** 2,
+                               np.broadcast_to(white[keep], (int(ok.sum()), len(keep))), rtol=1e-6, atol=1e-14)
     assert (result.model_path and Path(result.model_path + ".npz").exists()
             and Path(result.model_path + ".json").exists())
 
