@@ -99,10 +99,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "('off'; docs/gp.md, 'The rates' errors')")
     r.add_argument("--coefficient-band", default=None, choices=("white", "stated"),
                    help="the coefficient's band at the flight's own regressors (coefficients.csv's <C>_sigma): "
-                        "'white' (the default) the measurement's band less its white part; 'stated' for CZ, Cm and "
-                        "Cn the blocked validation's residual variance, for CZ and Cm plus the measured coefficient's "
-                        "error variance the estimator states (CX, CY, Cl: white; docs/gp.md, 'The coefficient's band "
-                        "from the stated measurement error')")
+                        "'stated' (the default) for CZ, Cm and Cn the blocked validation's residual variance, for CZ "
+                        "and Cm plus the measured coefficient's error variance the estimator states (CX, CY, Cl: "
+                        "white); 'white' the measurement's band less its white part for all six (docs/gp.md, 'The "
+                        "coefficient's band from the stated measurement error')")
     r.add_argument("--gp-noise", default=None, choices=("learned", "independent", "diagonal", "full", "full-nstart"),
                    help="the GP's output noise: 'learned' (the default) learns the outputs' noise correlation with "
                         "the hyperparameters and keeps only its diagonal in the predictions; 'independent' (the "
