@@ -796,7 +796,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     """The model's mean and both bands for outputs ``ks`` (indices into ``fit_cols``) on ``tab``'s
                     ``rows``, with the estimator's stated per-row air-angle variance (errors the residuals cannot
                     show); the coefficient's band is the same less the white measurement noise (docs/gp.md, "Two
-                    bands")."""
+                    bands"), or for the outputs of STATED_BAND_SIGN the stated band (gp.coefband)."""
                     Xq, xv = gp_inputs(tab, rows, use_adot)
                     if band_sign is None:
                         mean, var = (np.asarray(v)[:, ks] for v in model.predict(Xq, x_var=xv))
