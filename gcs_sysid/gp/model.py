@@ -215,14 +215,7 @@ class LocalGlobalGP:
         """
         enable_x64()
         Xs, ok = self._standardise_query(X)
-        xv_s = None
-        if x_var is not None and input_noise:
-            xv = np.asarray(x_var, float)
-            if self.n_mean_only and xv.ndim == 2 and xv.shape[1] == self.n_inputs - self.n_mean_only:
-                xv = self.full_inputs(xv, "x_var", np.nan)      # none stated for the mean-only inputs
-            if xv.shape != (len(ok), self.n_inputs):
-                raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
-            xv_s = np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
+        xv_s = self._x_var_s(x_var, ok) if input_noise else None
         mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         noise = self._noise_s()
         if self.local_params is not None and self.store is not None:
@@ -263,14 +256,7 @@ class LocalGlobalGP:
 
         enable_x64()
         Xs, ok = self._standardise_query(X)
-        xv_s = None
-        if x_var is not None:
-            xv = np.asarray(x_var, float)
-            if self.n_mean_only and xv.ndim == 2 and xv.shape[1] == self.n_inputs - self.n_mean_only:
-                xv = self.full_inputs(xv, "x_var", np.nan)
-            if xv.shape != (len(ok), self.n_inputs):
-                raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
-            xv_s = np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
+        xv_s = self._x_var_s(x_var, ok)
         mean, var = global_predict(self.params, self.post, Xs, self.config.batch_size, self.var_scale)
         if self.local_params is not None and self.store is not None:
             ml, vl = local_predict(self.local_params, self.store, Xs, self.config.batch_size)
@@ -280,14 +266,37 @@ class LocalGlobalGP:
         learned = np.zeros(np.shape(lat))
         if (self.input_var is not None or xv_s is not None) and len(Xs):
             grad = mean_gradient(self.params, self.post, Xs, self.config.batch_size)
-            lv = np.zeros(self.n_inputs) if self.input_var is None else np.asarray(self.input_var, float)
-            learned = slope_variance(grad, lv)
-            used = learned if xv_s is None else np.einsum("npd,nd->np", grad**2, np.fmax(lv[None, :], xv_s))
-            var = var + used
+            learned = slope_variance(grad, self._learned_input_var())
+            var = var + (learned if xv_s is None else self._stated_slope_variance(grad, xv_s))
         mean_o, var_o = self._finish(ok, mean, var)
         _, lat_o = self._finish(ok, mean, lat)
         _, learned_o = self._finish(ok, mean, learned)
         return mean_o, var_o, lat_o, learned_o
+
+    def _x_var_s(self, x_var, ok) -> np.ndarray | None:
+        """The stated per-row input variances of :meth:`predict` (``x_var``, data units, ``(N, D)`` or without the
+        mean-only inputs) standardised for the rows ``ok``; None when none is given.
+
+        Raises:
+            InputError: ``x_var`` is not ``X``'s shape.
+        """
+        if x_var is None:
+            return None
+        xv = np.asarray(x_var, float)
+        if self.n_mean_only and xv.ndim == 2 and xv.shape[1] == self.n_inputs - self.n_mean_only:
+            xv = self.full_inputs(xv, "x_var", np.nan)      # none stated for the mean-only inputs
+        if xv.shape != (len(ok), self.n_inputs):
+            raise InputError(f"x_var: expected shape ({len(ok)}, {self.n_inputs}) like X, got {xv.shape}")
+        return np.where(self.scaler.active, xv[ok] / self.scaler.x_std**2, np.nan)
+
+    def _learned_input_var(self) -> np.ndarray:
+        """``(D,)`` NIGP's learned input variances (standardised), zeros when none was learned."""
+        return np.zeros(self.n_inputs) if self.input_var is None else np.asarray(self.input_var, float)
+
+    def _stated_slope_variance(self, grad: np.ndarray, x_var_s: np.ndarray) -> np.ndarray:
+        """``(N, P)`` the slope term with, per row and input, the larger of the learned and the stated variance
+        (``x_var_s`` standardised; NaN: the learned one). McHutchon and Rasmussen (2011), eq. 4."""
+        return np.einsum("npd,nd->np", grad**2, np.fmax(self._learned_input_var()[None, :], np.asarray(x_var_s, float)))
 
     def _noise_s(self) -> np.ndarray:
         """``(P,)`` observation-noise variance (standardised): the larger of the global likelihood's and the
@@ -329,11 +338,9 @@ class LocalGlobalGP:
         if self.input_var is None and x_var_s is None:
             return np.zeros((len(Xs), self.n_outputs))
         grad = mean_gradient(self.params, self.post, Xs, self.config.batch_size)
-        learned = np.zeros(self.n_inputs) if self.input_var is None else np.asarray(self.input_var, float)
         if x_var_s is None:
-            return slope_variance(grad, learned)
-        per_row = np.fmax(learned[None, :], np.asarray(x_var_s, float))     # NaN (not stated): the learned one
-        return np.einsum("npd,nd->np", grad**2, per_row)
+            return slope_variance(grad, self._learned_input_var())
+        return self._stated_slope_variance(grad, x_var_s)      # NaN (not stated): the learned one
 
     def predict_global(self, X, include_noise: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance ``(N, P)`` of the global layer alone (linear mean + sparse ICM GP)."""
