@@ -689,6 +689,23 @@ def summarize(paths: list[str]) -> str:
     return "\n".join(out)
 
 
+def _band_output(pipeline, spec: str) -> None:
+    """Set one output's stated-band regime from ``C=SPEC`` (``--band-output``); SystemExit on a bad spec."""
+    name, _, how = spec.partition("=")
+    if name not in COEFFICIENTS or how not in ("+1", "1", "0", "-1", "d", "white"):
+        raise SystemExit(f"--band-output {spec!r}: expected C=SPEC with C one of {', '.join(COEFFICIENTS)} and SPEC "
+                         "+1, 0, -1, d or white")
+    signs = dict(pipeline.STATED_BAND_SIGN)
+    less = [c for c in pipeline.STATED_BAND_LESS_WHITE if c != name]
+    signs.pop(name, None)
+    if how != "white":
+        signs[name] = 0.0 if how == "d" else float(how)
+        if how == "d":
+            less.append(name)
+    pipeline.STATED_BAND_SIGN = signs
+    pipeline.STATED_BAND_LESS_WHITE = tuple(less)
+
+
 def main(argv=None) -> int:
     from gcs_sysid.aero.gustfilter import AIR_ROLL_MODES
 
@@ -715,6 +732,10 @@ def main(argv=None) -> int:
     ap.add_argument("--coefficient-band", default=None, choices=_pipeline.COEFFICIENT_BANDS,
                     help="the coefficient's band at the flight's own regressors (gcs_sysid.pipeline.COEFFICIENT_BAND; "
                          "'stated': gcs_sysid.gp.coefband; default: the package's)")
+    ap.add_argument("--band-output", action="append", default=[], metavar="C=SPEC",
+                    help="with the stated band, one output's regime (edits gcs_sysid.pipeline.STATED_BAND_SIGN and "
+                         "STATED_BAND_LESS_WHITE for this run): SPEC +1, 0 or -1 (the sign of the stated error), d "
+                         "(the discrepancy: the residual less its white nugget) or white (the white band); repeatable")
     ap.add_argument("--air-roll-train", default=None, choices=("on", "off"),
                     help="train the GP's Cl on the measured Cl less the roll fit's rolling-gust moment, Cl at the "
                          "air-relative roll rate (ReplayOptions.air_roll_train, gcs_sysid.aero.gustfilter."
@@ -858,6 +879,8 @@ def main(argv=None) -> int:
         _gustfilter.HELDOUT_GUST_VAR = a.heldout_gust_var
     if a.coefficient_band is not None:
         _pipeline.COEFFICIENT_BAND = a.coefficient_band
+    for spec in a.band_output:
+        _band_output(_pipeline, spec)
     if a.air_yaw_outputs is not None:
         from gcs_sysid.aero import airyaw
 
@@ -880,6 +903,8 @@ def main(argv=None) -> int:
                 row["gp_fit"] = a.gp_fit
                 row["heldout_gust_var"] = _gustfilter.HELDOUT_GUST_VAR
                 row["coefficient_band"] = _pipeline.COEFFICIENT_BAND
+                row["band_outputs"] = {c: ("d" if c in _pipeline.STATED_BAND_LESS_WHITE else v)
+                                       for c, v in _pipeline.STATED_BAND_SIGN.items()}
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

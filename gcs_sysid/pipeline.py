@@ -178,6 +178,12 @@ COEFFICIENT_BAND = "stated"
 #: band (``docs/benchmarks.md``, "Seventy-first session": rules 72 and 73, and the signs chosen on their flights).
 STATED_BAND_SIGN = {"CZ": 1.0, "Cm": 1.0, "Cn": 0.0}
 
+#: With ``coefficient_band="stated"``, the outputs of :data:`STATED_BAND_SIGN` whose blocked-validation residual is
+#: taken less its white nugget (the model discrepancy ``d_p``; ``less_white`` of
+#: :func:`gcs_sysid.gp.coefband.stated_band_variance`): the model averages a white measurement error out. Empty: none
+#: (an option judged on issue 8's flights, ``docs/benchmarks.md``, "Seventy-second session").
+STATED_BAND_LESS_WHITE: tuple[str, ...] = ()
+
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
 #: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md). Never CZ's mean: from the force
@@ -787,6 +793,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
 
                     band_y_var = stated_output_variance(states, airframe)
                     band_sign = np.array([STATED_BAND_SIGN.get(COEFFICIENTS[i], np.nan) for i in fit_cols])
+                    band_less_white = np.array([COEFFICIENTS[i] in STATED_BAND_LESS_WHITE for i in fit_cols])
                     if band_y_var is None:          # the outputs that need it keep the white band
                         band_y_var = np.full(table.Y.shape, np.nan)
                         notes.append("coefficient band: the estimator states no measurement error; "
@@ -807,7 +814,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                         from .gp.coefband import stated_band_variance
 
                         vs = stated_band_variance(model, Xq, band_y_var[rows][:, fit_cols], band_sign,
-                                                  parts=(lat, learned))[:, ks]
+                                                  parts=(lat, learned), less_white=band_less_white)[:, ks]
                         mean, var = mean[:, ks], var[:, ks]
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)

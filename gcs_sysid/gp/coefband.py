@@ -25,7 +25,12 @@ So the band is ``max(cv_p + s_p var E_p(x), latent_p(x) + input_p(x))`` with ``s
 floored at what the model's own posterior says (the latent variance and NIGP's learned input noise through the
 slope, McHutchon and Rasmussen 2011, eq. 4) so that a row far from the data keeps its width. ``s_p = 0`` takes the
 out-of-sample residual alone: the averaged regime without its correction, the conservative choice where the stated
-``E`` is short or incomplete. The variance decomposition is the errors-in-variables one (Fuller, *Measurement Error
+``E`` is short or incomplete. ``less_white`` takes the averaged regime's correction from the residuals instead of the
+stated error: ``cv_p`` less the white nugget ``w_p`` (the lag-1 semivariogram of the training residuals), which is the
+model discrepancy ``d_p = max(0, cv_p - w_p)`` of :mod:`gcs_sysid.gp.discrepancy`. A white measurement error shows in
+full in ``w_p`` and the model averages it out; what persists in time (a model error, a gust the regressors miss)
+stays. It leaves the coloured part of the measured error in the band (conservative where that part is averaged out
+too) and needs nothing stated. The variance decomposition is the errors-in-variables one (Fuller, *Measurement Error
 Models*, Wiley 1987, sec. 1.1: the observed response is the true one plus its error, and what a regression on an
 error-free regressor averages out); the out-of-sample residual variance is cross-validation's (Rasmussen and Williams
 2006, sec. 5.3).
@@ -65,7 +70,7 @@ def cv_variance(model) -> np.ndarray | None:
     return (D[0] + D[1]) * np.asarray(model.scaler.y_std, float) ** 2
 
 
-def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign, parts=None) -> np.ndarray:
+def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign, parts=None, less_white=None) -> np.ndarray:
     """The coefficient's band variance at a flight's own regressors (module docstring).
 
     Args:
@@ -77,13 +82,16 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign, parts=No
             averages it out: ``cv - var E``), ``0`` (``cv`` alone: ``y_var`` not read) or NaN (not applied: NaN out).
         parts: ``(latent, learned_input)``, each ``(N, P)``, from :meth:`gcs_sysid.gp.LocalGlobalGP.predict_parts` at
             ``X`` when the caller has them (the replay's one pass), or None (computed here).
+        less_white: ``(P,)`` bool, or None (all False): True takes the discrepancy ``d_p = max(0, cv_p - w_p)`` in
+            place of ``cv_p`` (the white nugget out; module docstring), with that output's ``sign``.
 
     Returns:
         ``(N, P)`` variance in the outputs' units squared, NaN where the row, its ``y_var`` (sign +-1) or the
         output's sign gives none (the caller keeps its other band there).
 
     Raises:
-        InputError: the model has no discrepancy, or ``y_var`` / ``sign`` do not match ``X`` and the outputs.
+        InputError: the model has no discrepancy, or ``y_var`` / ``sign`` / ``less_white`` do not match ``X`` and
+            the outputs.
     """
     cv = cv_variance(model)
     if cv is None:
@@ -92,9 +100,12 @@ def stated_band_variance(model, X: np.ndarray, y_var: np.ndarray, sign, parts=No
     y_var = np.asarray(y_var, float)
     s = np.asarray(sign, float)
     P = model.n_outputs
-    if y_var.shape != (len(X), P) or s.shape != (P,):
-        raise InputError(f"stated coefficient band: y_var must be ({len(X)}, {P}) and sign ({P},), "
-                         f"got {y_var.shape} and {s.shape}")
+    lw = np.zeros(P, bool) if less_white is None else np.asarray(less_white, bool)
+    if y_var.shape != (len(X), P) or s.shape != (P,) or lw.shape != (P,):
+        raise InputError(f"stated coefficient band: y_var must be ({len(X)}, {P}), sign and less_white ({P},), "
+                         f"got {y_var.shape}, {s.shape} and {lw.shape}")
+    d = np.asarray(model.discrepancy, float)[0] * np.asarray(model.scaler.y_std, float) ** 2
+    cv = np.where(lw, d, cv)                                   # d_p = max(0, cv_p - w_p)
     out = np.full((len(X), P), np.nan)
     applied = np.isfinite(s)
     if not len(X) or not applied.any():
