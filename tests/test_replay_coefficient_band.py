@@ -15,7 +15,7 @@ from gcs_sysid.errors import InputError
 from gcs_sysid.estimation.states import FlightStates
 from gcs_sysid.gp import load_gp
 from gcs_sysid.gp.coefband import stated_band_variance
-from gcs_sysid.pipeline import STATED_BAND_SIGN, ReplayOptions, check_replay, run_replay
+from gcs_sysid.pipeline import STATED_BAND_LESS_WHITE, STATED_BAND_SIGN, ReplayOptions, check_replay, run_replay
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 LOG, AIRFRAME = DATA / "flights" / "sim-trainer-sysid.tlog", DATA / "airframes" / "sim-trainer.toml"
@@ -65,7 +65,9 @@ def test_stated_band_moves_only_its_outputs_bands(tmp_path):
         a = stated.table.alpha_dot_hat[rows]
         X = np.c_[X, np.where(np.isfinite(a), a, 0.0)]
     sign = np.array([STATED_BAND_SIGN.get(c, np.nan) for c in COEFFICIENTS])
-    v = stated_band_variance(model, X, stated_output_variance(stated.states, load_airframe(AIRFRAME))[rows], sign)
+    less_white = np.array([c in STATED_BAND_LESS_WHITE for c in COEFFICIENTS])
+    v = stated_band_variance(model, X, stated_output_variance(stated.states, load_airframe(AIRFRAME))[rows], sign,
+                             less_white=less_white)
     expect = np.where(np.isfinite(v), np.sqrt(v), white[rows])
     np.testing.assert_allclose(stated.pred_sigma[rows], expect, rtol=1e-9, atol=1e-15)
     for k, c in enumerate(COEFFICIENTS):          # the stated band differs from the white one where it applies

@@ -44,9 +44,9 @@ def aided_flight():
     return model, X_est, C, y_var
 
 
-def _ratio(model, X, C, y_var, sign, p):
+def _ratio(model, X, C, y_var, sign, p, less_white=None):
     """RMS band / RMS error of output ``p`` on the held-out rows, and the truth's coverage (%)."""
-    v = stated_band_variance(model, X[400:], y_var[400:], sign)[:, p]
+    v = stated_band_variance(model, X[400:], y_var[400:], sign, less_white=less_white)[:, p]
     m = model.predict(X[400:])[0][:, p]
     err = m - C[400:, p]
     return float(np.sqrt(np.mean(v)) / np.sqrt(np.mean(err**2))), float(100 * np.mean(np.abs(err) <= 1.96 * np.sqrt(v)))
@@ -66,6 +66,34 @@ def test_each_regime_covers_the_truth_and_the_other_sign_does_not(aided_flight):
     wrong = -right
     assert _ratio(model, X, C, y_var, wrong, AIDED)[0] < 0.5            # the model gives the error back
     assert _ratio(model, X, C, y_var, wrong, PLAIN)[0] > 2.0 * r_plain  # the model averaged it out
+
+
+def test_discrepancy_band_takes_the_white_nugget_out(aided_flight):
+    """``less_white``: the residual less its white nugget (the model discrepancy ``d``). Cm's white measurement error
+    shows in the nugget and the model averages it out, so ``d`` matches ``cv - var E`` with nothing stated and is far
+    narrower than the residual alone; CY's coloured, aided error is not in the nugget's reach and ``d`` is far too
+    narrow there (the regime is the caller's choice per output, as the sign is)."""
+    model, X, C, y_var = aided_flight
+    unstated = np.full_like(y_var, np.nan)                            # sign 0 reads no stated error
+    sign = np.full(6, np.nan)
+    sign[AIDED] = sign[PLAIN] = 0.0
+    lw = np.zeros(6, bool)
+    lw[AIDED] = lw[PLAIN] = True
+    r_d, cov_d = _ratio(model, X, C, unstated, sign, PLAIN, lw)
+    r_cv, _ = _ratio(model, X, C, unstated, sign, PLAIN)
+    r_stated, _ = _ratio(model, X, C, y_var, np.where(lw, -1.0, np.nan), PLAIN)
+    assert 0.7 <= r_d <= 2.0 and cov_d >= 85.0, (r_d, cov_d)           # as cv - var E (the test above)
+    assert abs(r_d / r_stated - 1.0) < 0.1, (r_d, r_stated)            # the nugget finds the white error's variance
+    assert r_d < 0.6 * r_cv, (r_d, r_cv)                               # the white part is out
+    assert _ratio(model, X, C, unstated, sign, AIDED, lw)[0] < 0.5      # the aided output's error is not white
+    v = stated_band_variance(model, X[400:450], unstated[400:450], sign, less_white=lw)
+    _, lat = model.predict(X[400:450], include_noise=False, input_noise=False, model_error=False)
+    learned = model.input_variance_s(model.scaler.x(X[400:450])) * model.scaler.y_std**2
+    d = np.asarray(model.discrepancy)[0] * model.scaler.y_std**2
+    np.testing.assert_allclose(v[:, PLAIN], np.maximum(d[PLAIN], (lat + learned)[:, PLAIN]), rtol=1e-12)
+    assert d[PLAIN] < cv_variance(model)[PLAIN]
+    with pytest.raises(InputError, match="less_white"):
+        stated_band_variance(model, X[400:450], unstated[400:450], sign, less_white=lw[:5])
 
 
 def test_band_floor_unstated_rows_and_errors(aided_flight):
