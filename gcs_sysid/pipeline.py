@@ -180,8 +180,9 @@ STATED_BAND_SIGN = {"CZ": 1.0, "Cm": 1.0, "Cn": 0.0}
 
 #: With ``coefficient_band="stated"``, the outputs of :data:`STATED_BAND_SIGN` whose blocked-validation residual is
 #: taken less its white nugget (the model discrepancy ``d_p``; ``less_white`` of
-#: :func:`gcs_sysid.gp.coefband.stated_band_variance`): the model averages a white measurement error out. Empty: none
-#: (an option judged on issue 8's flights, ``docs/benchmarks.md``, "Seventy-second session").
+#: :func:`gcs_sysid.gp.coefband.stated_band_variance`): the model averages a white measurement error out. Empty: none.
+#: CX with it (sign 0) gained 8 of 75 flights in 90-98 % on fresh seeds 43-45 at both GP seeds but failed rule 8(b)
+#: there (+15/-7, +18/-10: rule 75, ``docs/benchmarks.md``, "Seventy-second session"), so it stays opt-in.
 STATED_BAND_LESS_WHITE: tuple[str, ...] = ()
 
 
