@@ -203,3 +203,21 @@ def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
         with pytest.raises(Stop):
             eval_jsbsim.main(["--aircraft", "sgs", "--turbulence", "light", "--work", str(tmp_path), *argv])
         assert seen[-1] == want
+
+
+def test_band_output_sets_one_outputs_stated_band_regime(monkeypatch):
+    """``--band-output C=SPEC`` edits the pipeline's ``STATED_BAND_SIGN`` / ``STATED_BAND_LESS_WHITE`` for one output
+    (rule 75's arms: ``CX=white`` against ``CX=d``) and refuses an unknown output or regime."""
+    import gcs_sysid.pipeline as pipeline
+
+    monkeypatch.setattr(pipeline, "STATED_BAND_SIGN", {"CZ": 1.0, "Cm": 1.0, "Cn": 0.0})
+    monkeypatch.setattr(pipeline, "STATED_BAND_LESS_WHITE", ())
+    eval_jsbsim._band_output(pipeline, "CX=d")
+    assert pipeline.STATED_BAND_SIGN["CX"] == 0.0 and pipeline.STATED_BAND_LESS_WHITE == ("CX",)
+    eval_jsbsim._band_output(pipeline, "CX=white")
+    assert "CX" not in pipeline.STATED_BAND_SIGN and pipeline.STATED_BAND_LESS_WHITE == ()
+    eval_jsbsim._band_output(pipeline, "Cn=-1")
+    assert pipeline.STATED_BAND_SIGN == {"CZ": 1.0, "Cm": 1.0, "Cn": -1.0}
+    for bad in ("CQ=d", "CX=2", "CX"):
+        with pytest.raises(SystemExit, match="--band-output"):
+            eval_jsbsim._band_output(pipeline, bad)
