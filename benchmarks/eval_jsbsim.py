@@ -692,18 +692,22 @@ def summarize(paths: list[str]) -> str:
 def _band_output(pipeline, spec: str) -> None:
     """Set one output's stated-band regime from ``C=SPEC`` (``--band-output``); SystemExit on a bad spec."""
     name, _, how = spec.partition("=")
-    if name not in COEFFICIENTS or how not in ("+1", "1", "0", "-1", "d", "white"):
+    if name not in COEFFICIENTS or how not in ("+1", "1", "0", "-1", "d", "white", "white-learned"):
         raise SystemExit(f"--band-output {spec!r}: expected C=SPEC with C one of {', '.join(COEFFICIENTS)} and SPEC "
-                         "+1, 0, -1, d or white")
+                         "+1, 0, -1, d, white or white-learned")
     signs = dict(pipeline.STATED_BAND_SIGN)
     less = [c for c in pipeline.STATED_BAND_LESS_WHITE if c != name]
+    learned = [c for c in pipeline.WHITE_BAND_NO_STATED_INPUT if c != name]
     signs.pop(name, None)
-    if how != "white":
+    if how == "white-learned":
+        learned.append(name)
+    elif how != "white":
         signs[name] = 0.0 if how == "d" else float(how)
         if how == "d":
             less.append(name)
     pipeline.STATED_BAND_SIGN = signs
     pipeline.STATED_BAND_LESS_WHITE = tuple(less)
+    pipeline.WHITE_BAND_NO_STATED_INPUT = tuple(learned)
 
 
 def main(argv=None) -> int:
@@ -735,7 +739,8 @@ def main(argv=None) -> int:
     ap.add_argument("--band-output", action="append", default=[], metavar="C=SPEC",
                     help="with the stated band, one output's regime (edits gcs_sysid.pipeline.STATED_BAND_SIGN and "
                          "STATED_BAND_LESS_WHITE for this run): SPEC +1, 0 or -1 (the sign of the stated error), d "
-                         "(the discrepancy: the residual less its white nugget) or white (the white band); repeatable")
+                         "(the discrepancy: the residual less its white nugget), white (the white band) or "
+                         "white-learned (the white band without the stated regressor variances); repeatable")
     ap.add_argument("--air-roll-train", default=None, choices=("on", "off"),
                     help="train the GP's Cl on the measured Cl less the roll fit's rolling-gust moment, Cl at the "
                          "air-relative roll rate (ReplayOptions.air_roll_train, gcs_sysid.aero.gustfilter."
@@ -905,6 +910,7 @@ def main(argv=None) -> int:
                 row["coefficient_band"] = _pipeline.COEFFICIENT_BAND
                 row["band_outputs"] = {c: ("d" if c in _pipeline.STATED_BAND_LESS_WHITE else v)
                                        for c, v in _pipeline.STATED_BAND_SIGN.items()}
+                row["band_outputs"].update({c: "white-learned" for c in _pipeline.WHITE_BAND_NO_STATED_INPUT})
                 rows.append(row)
                 name = f"{ac} {turb} s{seed} {a.aoa}"
                 print(f"{name:32s} meas  {_fmt(row['meas'])}")

@@ -185,6 +185,14 @@ STATED_BAND_SIGN = {"CZ": 1.0, "Cm": 1.0, "Cn": 0.0}
 #: there (+15/-7, +18/-10: rule 75, ``docs/benchmarks.md``, "Seventy-second session"), so it stays opt-in.
 STATED_BAND_LESS_WHITE: tuple[str, ...] = ()
 
+#: The outputs whose white coefficient band (``coefficient_band="white"``, or an output outside
+#: :data:`STATED_BAND_SIGN`) leaves out the estimator's stated regressor variances (``CoefficientTable.x_var``) and
+#: keeps NIGP's learned input noise: for an output that does not aid an air angle, the residual the likelihood's noise
+#: is learned from already holds what the angles' errors do to it (``T = R + E``, the angle's error in both), so the
+#: stated term through the slope counts it twice (``docs/gp.md``, "The coefficient's band from the stated measurement
+#: error"). Empty: none (an option judged on issue 8's flights, ``docs/benchmarks.md``, "Seventy-second session").
+WHITE_BAND_NO_STATED_INPUT: tuple[str, ...] = ()
+
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
 #: session's trial as an 11th input of every output made CZ worse, docs/benchmarks.md). Never CZ's mean: from the force
@@ -800,13 +808,17 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                         notes.append("coefficient band: the estimator states no measurement error; "
                                      + ", ".join(c for c, v in STATED_BAND_SIGN.items() if v) + " keep the white band")
 
+                no_stated = np.array([COEFFICIENTS[i] in WHITE_BAND_NO_STATED_INPUT for i in fit_cols])
+                noise_all = model.noise_var(white_noise=True)
+
                 def predict_rows(tab, rows, ks):
                     """The model's mean and both bands for outputs ``ks`` (indices into ``fit_cols``) on ``tab``'s
                     ``rows``, with the estimator's stated per-row air-angle variance (errors the residuals cannot
                     show); the coefficient's band is the same less the white measurement noise (docs/gp.md, "Two
                     bands"), or for the outputs of STATED_BAND_SIGN the stated band (gp.coefband)."""
                     Xq, xv = gp_inputs(tab, rows, use_adot)
-                    if band_sign is None:
+                    parts = band_sign is not None or no_stated[ks].any()
+                    if not parts:
                         mean, var = (np.asarray(v)[:, ks] for v in model.predict(Xq, x_var=xv))
                     else:                            # one pass: predict's mean and variance and two of its terms
                         mean, var, lat, learned = model.predict_parts(Xq, x_var=xv)
@@ -816,10 +828,15 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
 
                         vs = stated_band_variance(model, Xq, band_y_var[rows][:, fit_cols], band_sign,
                                                   parts=(lat, learned), less_white=band_less_white)[:, ks]
+                    if parts:
                         mean, var = mean[:, ks], var[:, ks]
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, ks], 0.0))
+                    if no_stated[ks].any():          # the white band with the learned input noise alone
+                        v0 = (np.asarray(lat) + np.asarray(learned))[:, ks] + noise_all[None, ks]
+                        pred_sigma[at] = np.where(no_stated[ks][None, :],
+                                                  np.sqrt(np.maximum(v0 - white[None, ks], 0.0)), pred_sigma[at])
                     if band_sign is not None:
                         pred_sigma[at] = np.where(np.isfinite(vs), np.sqrt(vs), pred_sigma[at])
 

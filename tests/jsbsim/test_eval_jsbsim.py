@@ -206,13 +206,18 @@ def test_gp_seed_option_reaches_the_replay(monkeypatch, tmp_path):
 
 
 def test_band_output_sets_one_outputs_stated_band_regime(monkeypatch):
-    """``--band-output C=SPEC`` edits the pipeline's ``STATED_BAND_SIGN`` / ``STATED_BAND_LESS_WHITE`` for one output
-    (rule 75's arms: ``CX=white`` against ``CX=d``) and refuses an unknown output or regime."""
+    """``--band-output C=SPEC`` edits the pipeline's ``STATED_BAND_SIGN`` / ``STATED_BAND_LESS_WHITE`` /
+    ``WHITE_BAND_NO_STATED_INPUT`` for one output (rule 75's arms: ``CX=white`` against ``CX=d``; rule 76's against
+    ``CX=white-learned``) and refuses an unknown output or regime."""
     import gcs_sysid.pipeline as pipeline
 
     monkeypatch.setattr(pipeline, "STATED_BAND_SIGN", {"CZ": 1.0, "Cm": 1.0, "Cn": 0.0})
     monkeypatch.setattr(pipeline, "STATED_BAND_LESS_WHITE", ())
+    monkeypatch.setattr(pipeline, "WHITE_BAND_NO_STATED_INPUT", ())
+    eval_jsbsim._band_output(pipeline, "CX=white-learned")
+    assert "CX" not in pipeline.STATED_BAND_SIGN and pipeline.WHITE_BAND_NO_STATED_INPUT == ("CX",)
     eval_jsbsim._band_output(pipeline, "CX=d")
+    assert pipeline.WHITE_BAND_NO_STATED_INPUT == ()
     assert pipeline.STATED_BAND_SIGN["CX"] == 0.0 and pipeline.STATED_BAND_LESS_WHITE == ("CX",)
     eval_jsbsim._band_output(pipeline, "CX=white")
     assert "CX" not in pipeline.STATED_BAND_SIGN and pipeline.STATED_BAND_LESS_WHITE == ()
