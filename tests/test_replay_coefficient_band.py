@@ -1,4 +1,4 @@
-"""`replay --coefficient-band stated`: the coefficient's band of CY, CZ, Cm and Cn from the blocked validation's
+"""`replay --coefficient-band stated`: the coefficient's band of CZ, Cm and Cn from the blocked validation's
 residual and the estimator's stated measurement error (gcs_sysid.gp.coefband); the means, the measurement's band
 and the other outputs' bands do not move."""
 
@@ -50,15 +50,21 @@ def test_stated_output_variance_by_hand():
     assert np.isfinite(part[[0, 1, 3], 2]).all() and np.isnan(np.delete(part, 2, axis=1)).all()
 
 
-def test_stated_band_moves_only_its_outputs_bands(tmp_path):
+def test_stated_band_moves_only_its_outputs_bands(tmp_path, monkeypatch):
     """On a part of the sample flight: the outputs of STATED_BAND_SIGN take the stated band (recomputed here from the
-    saved model and the states), Cl keeps the white one (the measurement's band less the white share), which the stated
-    band also falls back to where nothing is stated."""
+    saved model and the states); CX, named in WHITE_BAND_NO_STATED_INPUT for this run, the white band with NIGP's
+    learned input noise alone (latent + learned input term + noise, less the white share); CY and Cl keep the white
+    one (the measurement's band less the white share), which the stated band also falls back to where nothing is
+    stated."""
+    from gcs_sysid import pipeline
+
+    monkeypatch.setattr(pipeline, "WHITE_BAND_NO_STATED_INPUT", ("CX",))
     opts = dict(progress=False, parallel=False, t_from=60.0, t_to=150.0)
     stated = run_replay(LOG, AIRFRAME, tmp_path / "stated", ReplayOptions(coefficient_band="stated", **opts))
     model = load_gp(Path(stated.model_path))
     assert model.n_outputs == 6
-    white = np.sqrt(np.maximum(stated.pred_sigma_obs**2 - (model.noise_var() - model.noise_var(False))[None], 0.0))
+    w = model.noise_var() - model.noise_var(False)
+    white = np.sqrt(np.maximum(stated.pred_sigma_obs**2 - w[None], 0.0))
     rows = stated.table.valid & np.all(np.isfinite(stated.table.X), axis=1)
     X = stated.table.X[rows]
     if model.n_mean_only:
@@ -68,8 +74,12 @@ def test_stated_band_moves_only_its_outputs_bands(tmp_path):
     less_white = np.array([c in STATED_BAND_LESS_WHITE for c in COEFFICIENTS])
     v = stated_band_variance(model, X, stated_output_variance(stated.states, load_airframe(AIRFRAME))[rows], sign,
                              less_white=less_white)
-    expect = np.where(np.isfinite(v), np.sqrt(v), white[rows])
+    _, _, lat, learned = model.predict_parts(X)
+    learned_band = np.sqrt(np.maximum(lat + learned + model.noise_var()[None] - w[None], 0.0))
+    no_stated = np.array([c == "CX" for c in COEFFICIENTS])
+    expect = np.where(np.isfinite(v), np.sqrt(v), np.where(no_stated[None], learned_band, white[rows]))
     np.testing.assert_allclose(stated.pred_sigma[rows], expect, rtol=1e-9, atol=1e-15)
     for k, c in enumerate(COEFFICIENTS):          # the stated band differs from the white one where it applies
         moved = np.mean(np.abs(stated.pred_sigma[rows, k] - white[rows, k]) > 1e-6 * np.abs(white[rows, k]))
-        assert (moved > 0.5) == (c in STATED_BAND_SIGN), (c, moved)
+        assert (moved > 0.5) == (c in STATED_BAND_SIGN or c == "CX"), (c, moved)
+    assert (stated.pred_sigma[rows, 0] <= white[rows, 0] * (1 + 1e-9)).all()   # a term left out, never added

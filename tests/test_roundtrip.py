@@ -70,7 +70,7 @@ def test_report_files_written(roundtrip):
 def test_replay_bands_coefficient_and_measurement(roundtrip):
     """``pred_sigma`` (the coefficient) is ``pred_sigma_obs`` (a new measurement) less the model's white
     measurement noise, row by row (docs/gp.md, "Two bands"), on the outputs that keep that band (the stated band of
-    the others: tests/test_replay_coefficient_band.py)."""
+    the others, and the white band without the stated regressor variances: tests/test_replay_coefficient_band.py)."""
     from gcs_sysid import pipeline
     from gcs_sysid.gp import load_gp
 
@@ -80,8 +80,8 @@ def test_replay_bands_coefficient_and_measurement(roundtrip):
     assert ok.sum() > 500
     white = model.noise_var() - model.noise_var(white_noise=False)
     assert (white > 0).all()
-    keep = [k for k, c in enumerate(pipeline.COEFFICIENTS)
-            if pipeline.COEFFICIENT_BAND == "white" or c not in pipeline.STATED_BAND_SIGN]
+    keep = [k for k, c in enumerate(pipeline.COEFFICIENTS) if c not in pipeline.WHITE_BAND_NO_STATED_INPUT
+            and (pipeline.COEFFICIENT_BAND == "white" or c not in pipeline.STATED_BAND_SIGN)]
     assert keep
     np.testing.assert_allclose(result.pred_sigma_obs[ok][:, keep] ** 2 - result.pred_sigma[ok][:, keep] ** 2,
                                np.broadcast_to(white[keep], (int(ok.sum()), len(keep))), rtol=1e-6, atol=1e-14)
