@@ -190,8 +190,11 @@ STATED_BAND_LESS_WHITE: tuple[str, ...] = ()
 #: keeps NIGP's learned input noise: for an output that does not aid an air angle, the residual the likelihood's noise
 #: is learned from already holds what the angles' errors do to it (``T = R + E``, the angle's error in both), so the
 #: stated term through the slope counts it twice (``docs/gp.md``, "The coefficient's band from the stated measurement
-#: error"). Empty: none (an option judged on issue 8's flights, ``docs/benchmarks.md``, "Seventy-second session").
-WHITE_BAND_NO_STATED_INPUT: tuple[str, ...] = ()
+#: error"). ``("CX",)`` since the seventy-second session (rule 76, written before its run on fresh seeds 46-48: CX in
+#: 90-98 % on 35 -> 39 and 35 -> 40 of 75 flights at GP seeds 0 and 1, flips +5/-1 and +6/-1, the means identical;
+#: ``docs/benchmarks.md``, "Seventy-second session"). CY and CZ aid an air angle and keep the stated term (without it
+#: their bands collapse); Cl's stated term is its held-out air roll rate's; Cm and Cn take the stated band.
+WHITE_BAND_NO_STATED_INPUT: tuple[str, ...] = ("CX",)
 
 
 #: The GP settings that make ``alpha_dot_hat`` a mean-only input of Cm (not CZ, not a kernel input; the seventh
