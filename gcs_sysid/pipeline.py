@@ -126,8 +126,9 @@ class ReplayOptions:
             ``"white"`` the measurement's band less its white part (``docs/gp.md``, "Two bands"); ``"stated"`` for
             the outputs of :data:`STATED_BAND_SIGN`, the blocked cross-validation's residual variance plus or minus
             the measured coefficient's error variance that the estimator states
-            (:mod:`gcs_sysid.gp.coefband`), the white band elsewhere and where nothing is stated. None:
-            :data:`COEFFICIENT_BAND`. The means and the measurement's band do not change.
+            (:mod:`gcs_sysid.gp.coefband`), the white band elsewhere and where nothing is stated. Either way the
+            outputs of :data:`WHITE_BAND_NO_STATED_INPUT` (CX) take the white band without the estimator's stated
+            regressor variances. None: :data:`COEFFICIENT_BAND`. The means and the measurement's band do not change.
     """
 
     rate_hz: float = 50.0

@@ -32,7 +32,9 @@ class ReplayResult:
         pred_mean: (T, 6) model mean on every row; NaN where invalid.
         pred_sigma: (T, 6) 1-sigma of the coefficient itself at the row's estimated regressors: latent variance,
             the regressors' errors through the slope and the coloured part of the observation noise, without
-            the white measurement noise (``docs/gp.md``, "Two bands"); with ``ReplayOptions.coefficient_band``
+            the white measurement noise (``docs/gp.md``, "Two bands"; the outputs of
+            ``pipeline.WHITE_BAND_NO_STATED_INPUT`` with the learned input noise alone); with
+            ``ReplayOptions.coefficient_band``
             ``"stated"`` the outputs of ``pipeline.STATED_BAND_SIGN`` instead from the blocked validation's residual
             and the estimator's stated measurement error (:mod:`gcs_sysid.gp.coefband`); NaN where invalid.
         pred_sigma_obs: (T, 6) 1-sigma of a new measurement of it (the white band's ``pred_sigma`` plus the white
