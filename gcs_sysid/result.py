@@ -34,9 +34,9 @@ class ReplayResult:
             the regressors' errors through the slope and the coloured part of the observation noise, without
             the white measurement noise (``docs/gp.md``, "Two bands"; the outputs of
             ``pipeline.WHITE_BAND_NO_STATED_INPUT`` with the learned input noise alone); with
-            ``ReplayOptions.coefficient_band``
-            ``"stated"`` the outputs of ``pipeline.STATED_BAND_SIGN`` instead from the blocked validation's residual
-            and the estimator's stated measurement error (:mod:`gcs_sysid.gp.coefband`); NaN where invalid.
+            ``ReplayOptions.coefficient_band`` ``"stated"`` the outputs of ``pipeline.STATED_BAND_SIGN`` instead from
+            the blocked validation's residual and the estimator's stated measurement error
+            (:mod:`gcs_sysid.gp.coefband`); NaN where invalid.
         pred_sigma_obs: (T, 6) 1-sigma of a new measurement of it (the white band's ``pred_sigma`` plus the white
             measurement noise); NaN where invalid or not known (a result saved before the eleventh session: there
             ``pred_sigma`` held this band, and :func:`gcs_sysid.report.load_result` moves it here).
