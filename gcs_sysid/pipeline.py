@@ -813,7 +813,7 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                                      + ", ".join(c for c, v in STATED_BAND_SIGN.items() if v) + " keep the white band")
 
                 no_stated = np.array([COEFFICIENTS[i] in WHITE_BAND_NO_STATED_INPUT for i in fit_cols])
-                noise_all = model.noise_var(white_noise=True)
+                noise_coef = model.noise_var(white_noise=False)     # the noise less its white part
 
                 def predict_rows(tab, rows, ks):
                     """The model's mean and both bands for outputs ``ks`` (indices into ``fit_cols``) on ``tab``'s
@@ -821,26 +821,21 @@ def run_replay(log: str | Path, airframe_path: str | Path, out_dir: str | Path,
                     show); the coefficient's band is the same less the white measurement noise (docs/gp.md, "Two
                     bands"), or for the outputs of STATED_BAND_SIGN the stated band (gp.coefband)."""
                     Xq, xv = gp_inputs(tab, rows, use_adot)
-                    parts = band_sign is not None or no_stated[ks].any()
-                    if not parts:
-                        mean, var = (np.asarray(v)[:, ks] for v in model.predict(Xq, x_var=xv))
-                    else:                            # one pass: predict's mean and variance and two of its terms
-                        mean, var, lat, learned = model.predict_parts(Xq, x_var=xv)
+                    # one pass: predict's mean and variance (to the last bit) and two of its terms
+                    mean, var, lat, learned = model.predict_parts(Xq, x_var=xv)
                     at = np.ix_(rows, [fit_cols[k] for k in ks])
                     if band_sign is not None:        # the stated band (gp.coefband)
                         from .gp.coefband import stated_band_variance
 
                         vs = stated_band_variance(model, Xq, band_y_var[rows][:, fit_cols], band_sign,
                                                   parts=(lat, learned), less_white=band_less_white)[:, ks]
-                    if parts:
-                        mean, var = mean[:, ks], var[:, ks]
+                    mean, var = mean[:, ks], var[:, ks]
                     pred_mean[at] = mean
                     pred_sigma_obs[at] = np.sqrt(var)
                     pred_sigma[at] = np.sqrt(np.maximum(var - white[None, ks], 0.0))
                     if no_stated[ks].any():          # the white band with the learned input noise alone
-                        v0 = (np.asarray(lat) + np.asarray(learned))[:, ks] + noise_all[None, ks]
-                        pred_sigma[at] = np.where(no_stated[ks][None, :],
-                                                  np.sqrt(np.maximum(v0 - white[None, ks], 0.0)), pred_sigma[at])
+                        v0 = (lat + learned)[:, ks] + noise_coef[None, ks]
+                        pred_sigma[at] = np.where(no_stated[ks][None, :], np.sqrt(v0), pred_sigma[at])
                     if band_sign is not None:
                         pred_sigma[at] = np.where(np.isfinite(vs), np.sqrt(vs), pred_sigma[at])
 
