@@ -733,6 +733,10 @@ def main(argv=None) -> int:
     ap.add_argument("--heldout-gust-var", default=None, choices=("fit", "moment", "rts", "nis", "innov"),
                     help="the variance under which the held-out rows' air roll rate states its error (the held-out "
                          "band of Cl; gcs_sysid.aero.gustfilter.HELDOUT_GUST_VAR; default: the package's)")
+    ap.add_argument("--heldout-gust-cutoff", default=None, choices=("on", "off"),
+                    help="the held-out air roll rate's stated error also carries the rolling gust's moment the rate "
+                         "smoother cut off the measured Cl (gcs_sysid.aero.gustfilter.HELDOUT_GUST_CUTOFF, "
+                         "gcs_sysid.aero.rollgust.gust_cutoff_variance; default: the package's)")
     ap.add_argument("--coefficient-band", default=None, choices=_pipeline.COEFFICIENT_BANDS,
                     help="the coefficient's band at the flight's own regressors (gcs_sysid.pipeline.COEFFICIENT_BAND; "
                          "'stated': gcs_sysid.gp.coefband; default: the package's)")
@@ -882,6 +886,8 @@ def main(argv=None) -> int:
 
     if a.heldout_gust_var is not None:
         _gustfilter.HELDOUT_GUST_VAR = a.heldout_gust_var
+    if a.heldout_gust_cutoff is not None:
+        _gustfilter.HELDOUT_GUST_CUTOFF = a.heldout_gust_cutoff == "on"
     if a.coefficient_band is not None:
         _pipeline.COEFFICIENT_BAND = a.coefficient_band
     for spec in a.band_output:
@@ -907,6 +913,7 @@ def main(argv=None) -> int:
                                air_pitch=None if a.air_pitch is None else a.air_pitch == "on")
                 row["gp_fit"] = a.gp_fit
                 row["heldout_gust_var"] = _gustfilter.HELDOUT_GUST_VAR
+                row["heldout_gust_cutoff"] = _gustfilter.HELDOUT_GUST_CUTOFF
                 row["coefficient_band"] = _pipeline.COEFFICIENT_BAND
                 row["band_outputs"] = {c: ("d" if c in _pipeline.STATED_BAND_LESS_WHITE else v)
                                        for c, v in _pipeline.STATED_BAND_SIGN.items()}

@@ -119,6 +119,13 @@ HELDOUT_AIR_ROLL = "predicted:Cl"
 #: and Cn (:data:`gcs_sysid.pipeline.COEFFICIENT_BAND`), which no longer over-covers, as one candidate judged on fresh
 #: flights by a rule written before its run (rule 74, seeds 40-42; ``docs/benchmarks.md``, "Seventy-first session").
 HELDOUT_GUST_VAR = "innov"
+#: Whether the held-out air roll rate's stated variance (:func:`heldout_gust_pred_var`) also carries the part of the
+#: rolling gust's moment that the rate smoother cut off the measured Cl (:func:`gcs_sysid.aero.rollgust.
+#: gust_cutoff_variance`, at the roll axis' bandwidth, :attr:`gcs_sysid.estimation.states.FlightStates.
+#: rate_bandwidth_hz`). The stated ``R`` of the measured moment is the smoother's white-snap prior there, 0.1-0.6 of
+#: the true ``p_dot`` error's variance on JSBSim's light flights; Cl's held-out band was short on 22-26 of 75 flights
+#: (seventy-third session, docs/benchmarks.md). Opt-in until judged on fresh flights by a rule written before its run.
+HELDOUT_GUST_CUTOFF = False
 #: Every value ``heldout_air_roll`` takes (:func:`air_roll_mode`): ``"off"``; a gust mode of
 #: :data:`gcs_sysid.aero.rollgust.ROW_GUST_MODES` (every output asked at the air rate, the twenty-fourth session's);
 #: or that mode with ``":Cl"`` (per output: only Cl asked at the air rate, CX..CZ, Cm and Cn at the gyro's
@@ -630,21 +637,41 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
     note = (f"held-out rows' p_hat relative to the air" + ("" if outputs is None else f" (for {', '.join(outputs)})")
             + f": the rolling gust ({mode}, SD {np.std(g[held]):.4f}) of the roll fit on the training rows taken out ("
             + G.notes[0] + ")")
+    cv, bw = _gust_cutoff(G, states, dt) if HELDOUT_GUST_VAR not in ("fit", "moment") else (0.0, float("nan"))
+    if cv > 0:
+        note += (f"; its stated error carries the gust's moment above the rate smoother's roll bandwidth ({bw:g} Hz), "
+                 f"which the measured Cl never held: SD {np.sqrt(cv):.2g} (Cl)")
     return replace(table, X=X, x_var=xv, notes=list(table.notes) + [note]), {"mode": mode, "outputs": outputs, "g": g,
                                                                              "g_var": g_var, "fit": G}
 
 
-def heldout_gust_pred_var(fit, table, states, airframe, dt: float, how: str | None = None) -> float | None:
+def _gust_cutoff(fit, states, dt: float, cutoff: bool | None = None) -> tuple[float, float]:
+    """``(variance Cl^2, roll bandwidth Hz)`` of :func:`gcs_sysid.aero.rollgust.gust_cutoff_variance` where ``cutoff``
+    (None: :data:`HELDOUT_GUST_CUTOFF`) is on and the states carry the rate smoother's bandwidth; ``(0, nan)``
+    otherwise."""
+    from .rollgust import gust_cutoff_variance
+
+    bw = getattr(states, "rate_bandwidth_hz", None)
+    if not (HELDOUT_GUST_CUTOFF if cutoff is None else cutoff) or bw is None or not np.isfinite(bw[0]):
+        return 0.0, float("nan")
+    return gust_cutoff_variance(fit, dt, float(bw[0])), float(bw[0])
+
+
+def heldout_gust_pred_var(fit, table, states, airframe, dt: float, how: str | None = None,
+                          cutoff: bool | None = None) -> float | None:
     """The held-out prediction's error variance of ``p_hat_g`` (dimensionless) that :data:`HELDOUT_GUST_VAR`
     (``how``; None: it) measures on the fit's own rows, or None where it states none (``"fit"``, ``"moment"``).
 
     ``"rts"``, ``"nis"`` and ``"innov"``: :func:`gcs_sysid.aero.rollgust.predicted_gust_variance` by that method on
-    ``fit.used`` (the training rows the roll fit read; the log's own moment only, no truth).
+    ``fit.used`` (the training rows the roll fit read; the log's own moment only, no truth). With ``cutoff`` (None:
+    :data:`HELDOUT_GUST_CUTOFF`) and the states' roll-axis bandwidth known, plus the gust's moment the rate smoother
+    cut off the measured Cl (:func:`gcs_sysid.aero.rollgust.gust_cutoff_variance`); without a bandwidth, nothing.
 
     Args:
         fit: the air-rate pair's roll fit (:func:`air_roll_fit`). table: the coefficient table it was made on
-            (``X`` ``(T, 10)``, ``Y`` ``(T, 6)``, ``qbar`` ``(T,)`` Pa). states: ``data["p"]`` ``(T,)`` rad/s.
-            airframe: ``Ixx`` kg m^2, ``S`` m^2, ``b`` m. dt: grid interval, s.
+            (``X`` ``(T, 10)``, ``Y`` ``(T, 6)``, ``qbar`` ``(T,)`` Pa). states: ``data["p"]`` ``(T,)`` rad/s and
+            ``rate_bandwidth_hz`` ``(3,)`` Hz (or None). airframe: ``Ixx`` kg m^2, ``S`` m^2, ``b`` m. dt: grid
+            interval, s.
 
     Raises:
         ValueError: an unknown ``how``.
@@ -656,8 +683,9 @@ def heldout_gust_pred_var(fit, table, states, airframe, dt: float, how: str | No
         return None
     if how not in PRED_VAR_METHODS:
         raise ValueError(f"heldout_gust_pred_var: one of ('fit', 'moment') + {PRED_VAR_METHODS} expected, got {how!r}")
+    cv = _gust_cutoff(fit, states, dt, cutoff)[0]
     return predicted_gust_variance(fit, dt, table.X, table.Y, states.data["p"], table.qbar, np.asarray(fit.used, bool),
-                                   airframe.Ixx, airframe.S, airframe.b, method=how)
+                                   airframe.Ixx, airframe.S, airframe.b, method=how, cutoff_var=cv)
 
 
 def gust_moment_variance(fit: RollGustFit) -> float:

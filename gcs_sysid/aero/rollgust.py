@@ -56,7 +56,8 @@ from .gustfilter import LAT_TERMS, RollGustFit, _gains, _innovations, _segments,
 from .table import COEFFICIENTS, REGRESSORS
 
 __all__ = ["ROLL_TAU", "ROW_GUST_MODES", "RollDynamicsFit", "dryden_roll_tau", "causal_roll_moment",
-           "fit_roll_dynamics", "roll_gust_on_rows", "PRED_VAR_METHODS", "predicted_gust_variance"]
+           "fit_roll_dynamics", "roll_gust_on_rows", "PRED_VAR_METHODS", "predicted_gust_variance",
+           "gust_cutoff_variance"]
 
 _IP = LAT_TERMS.index("p_hat") + 1       # the roll-rate column in the design (intercept at 0)
 _MIN_ROWS, _MIN_RUN = 200, 50
@@ -317,6 +318,59 @@ def roll_gust_on_rows(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarra
     return -s / cl_p, var / cl_p**2
 
 
+def _step_slopes(G: RollDynamicsFit, dt: float, who: str) -> np.ndarray:
+    """``(7,)`` the step slopes the fit's filter used: ``theta`` times the step's damping factor
+    ``(e^{L_p dt} - 1)/(L_p dt)``. Raises ValueError (the message starts with ``who``) without a finite ``L_p``."""
+    if not np.isfinite(G.L_p):
+        raise ValueError(f"{who}: the fit has no roll damping L_p")
+    x = G.L_p * dt
+    return np.asarray(G.theta, float) * (np.expm1(x) / x if x != 0 else 1.0)
+
+
+def gust_cutoff_variance(G: RollDynamicsFit, dt: float, bandwidth_hz: float) -> float:
+    """The part of the rolling gust's moment that the rate smoother cuts off the measured Cl, as a variance (Cl units).
+
+    The measured Cl takes ``Ixx p_dot`` from the rate smoother (:mod:`gcs_sysid.estimation.rates`), which follows
+    the roll acceleration only up to its bandwidth; above it the gust's moment is missing from the measurement and no
+    statistic of the gyro shows it (:mod:`gcs_sysid.estimation.smootherror`: the smoother's stated error takes its
+    white-snap prior there; on JSBSim's light flights the stated ``p_dot`` error variance is 0.1-0.6 of the true one,
+    docs/benchmarks.md, "Seventy-third session"). The fit's own gust model says what is there: the step moment's
+    gust term ``s`` (Cl units) is first-order Gauss-Markov, ``sigma_s = sigma |Cl_p,step|``, ``a = exp(-dt/tau)``,
+    and the roll rate answers it through the roll mode, ``(j w - L_p) p = s / k`` (``k = Ixx/(qbar S b)``). The
+    smoothed acceleration then misses ``k (D - j w) p`` of the moment, so in Cl units
+
+        var = mean over w in (0, pi) of  |D(w) - j w/dt|^2 / (w^2/dt^2 + L_p^2) * S_s(w),
+        S_s(w) = sigma_s^2 (1 - a^2) / (1 - 2 a cos w + a^2)           (the sampled first-order process)
+
+    with ``|D - j w/dt|^2`` :func:`gcs_sysid.estimation.smootherror.cutoff_gain` at the roll axis' bandwidth. The
+    Wiener correction of the smoother's residual (which recovers some signal just above the bandwidth) is left out,
+    so the figure leans high; the gust's sigma from the likelihood (about half JSBSim's, module docstring) leans low.
+
+    Args:
+        G: the roll fit (with a finite ``L_p``). dt: grid interval, s. bandwidth_hz: the rate smoother's roll-axis
+            bandwidth, Hz (:attr:`gcs_sysid.estimation.states.FlightStates.rate_bandwidth_hz`).
+
+    Returns:
+        the variance, Cl^2 (0 for a fit without a gust).
+
+    Raises:
+        ValueError: a fit without a finite ``L_p``, or ``dt``/``bandwidth_hz`` not positive.
+
+    Source: Bendat and Piersol, *Random Data*, 4th ed., 2010, sec. 6.1 (the linear estimate's error spectrum);
+    MIL-F-8785C sec. 3.7.2 (the rolling gust as a first-order process); Stevens, Lewis and Johnson (2016), eq. 1.7-18.
+    """
+    from ..estimation.smootherror import N_FREQ, cutoff_gain
+
+    cl_p = float(_step_slopes(G, dt, "gust_cutoff_variance")[_IP])
+    var_s = float(G.sigma * cl_p) ** 2
+    if not (np.isfinite(var_s) and var_s > 0):
+        return 0.0
+    w = np.pi * (np.arange(N_FREQ) + 0.5) / N_FREQ
+    a = float(np.exp(-dt / G.tau))
+    S = var_s * (1 - a * a) / (1 - 2 * a * np.cos(w) + a * a)
+    return float(np.mean(cutoff_gain(dt, bandwidth_hz, w) / ((w / dt) ** 2 + G.L_p**2) * S))
+
+
 def _step_residual(G: RollDynamicsFit, dt: float, X, Y, p, qbar, Ixx: float, S: float, b: float, who: str):
     """The step moment's residual on the fit's step slopes and the fit's steady-state filter: ``(z, cl_p, a, ss)``,
     ``z`` ``(T,)`` (NaN where the step moment is not defined), ``cl_p`` the step's ``Cl_p``, ``a = exp(-dt/tau)``,
@@ -331,10 +385,7 @@ def _step_residual(G: RollDynamicsFit, dt: float, X, Y, p, qbar, Ixx: float, S: 
             np.shape(v) != (T,) for v in (p, qbar)):
         raise ValueError(f"{who}: X (T, {len(REGRESSORS)}), Y (T, {len(COEFFICIENTS)}), p, qbar (T,) expected, got "
                          f"{X.shape}, {Y.shape}, {[np.shape(v) for v in (p, qbar)]}")
-    if not np.isfinite(G.L_p):
-        raise ValueError(f"{who}: the fit has no roll damping L_p")
-    x = G.L_p * dt
-    th = np.asarray(G.theta, float) * (np.expm1(x) / x if x != 0 else 1.0)   # the step slopes the filter used
+    th = _step_slopes(G, dt, who)
     cl_p = float(th[_IP])
     cols = [REGRESSORS.index(k) for k in LAT_TERMS]
     A = np.c_[np.ones(T), X[:, cols]]
@@ -351,7 +402,7 @@ PRED_VAR_METHODS = ("rts", "nis", "innov")
 
 def predicted_gust_variance(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.ndarray, p: np.ndarray,
                             qbar: np.ndarray, rows: np.ndarray, Ixx: float, S: float, b: float, method: str = "rts",
-                            min_run: int = 10) -> float:
+                            min_run: int = 10, cutoff_var: float = 0.0) -> float:
     """The one-step-ahead estimate's error variance of ``p_hat_g`` (dimensionless), measured on rows where the
     gust's moment is known to the fit (its training rows), not stated by the fit's likelihood: what
     :func:`roll_gust_on_rows` ``"predicted"`` should state on a held-out segment (its ``pred_var``). Nothing but
@@ -383,25 +434,31 @@ def predicted_gust_variance(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.
     2.0-6.0 times ``R`` and slow, and the GP's held-out Cl error against the truth is close to ``mean(nu^2)`` plus
     it, which only ``"innov"`` reads (with ``R``, still short of it).
 
-    Each is floored at the fit's own ``P`` (the variance :func:`roll_gust_on_rows` states without it).
+    Each is floored at the fit's own ``P`` (the variance :func:`roll_gust_on_rows` states without it). ``cutoff_var``
+    (Cl units, e.g. :func:`gust_cutoff_variance`) is added to any of them: the gust's moment the measured Cl never
+    held, which the prediction, made from measured moments, misses against the true moment whatever the method.
 
     Args:
         G: the fit (:class:`RollDynamicsFit`, with ``L_p``). dt: grid interval, s.
         X: ``(T, 10)`` regressors (gyro hats). Y: ``(T, 6)`` measured coefficients. p: ``(T,)`` the smoothed roll
             rate, rad/s. qbar: ``(T,)`` Pa. rows: ``(T,)`` bool, where to measure (the fit's rows, ``G.used``).
         Ixx, S, b: kg m^2, m^2, m. method: one of :data:`PRED_VAR_METHODS`. min_run: shortest run of usable rows.
+        cutoff_var: Cl^2, added before the division by ``Cl_p,step^2`` (0: none).
 
     Returns:
         the variance of ``p_hat_g``'s one-step prediction error (dimensionless); the fit's ``P / Cl_p,step^2``
-        when no run is usable.
+        when no run is usable (with ``cutoff_var`` added in both cases).
 
     Raises:
-        ValueError: an unknown ``method``, shapes that disagree, or a fit without a finite ``L_p``.
+        ValueError: an unknown ``method``, ``cutoff_var`` negative or not finite, shapes that disagree, or a fit
+            without a finite ``L_p``.
     """
     from scipy.signal import lfilter
 
     if method not in PRED_VAR_METHODS:
         raise ValueError(f"predicted_gust_variance: method must be one of {PRED_VAR_METHODS}, got {method!r}")
+    if not (np.isfinite(cutoff_var) and cutoff_var >= 0):
+        raise ValueError(f"predicted_gust_variance: cutoff_var must be finite and >= 0, got {cutoff_var}")
     z, cl_p, a, ss = _step_residual(G, dt, X, Y, p, qbar, Ixx, S, b, "predicted_gust_variance")
     if np.shape(rows) != z.shape:
         raise ValueError(f"predicted_gust_variance: rows must be {z.shape}, got {np.shape(rows)}")
@@ -413,6 +470,6 @@ def predicted_gust_variance(G: RollDynamicsFit, dt: float, X: np.ndarray, Y: np.
         d = xp - _smooth(zz, a, ss, 1.0) if method == "rts" else zz - xp
         sq, n = sq + float(d @ d), n + len(d)
     if n == 0:
-        return float(ss.P / cl_p**2)
+        return float((ss.P + cutoff_var) / cl_p**2)
     P = sq / n + {"rts": ss.Ps, "nis": -G.R, "innov": G.R}[method]
-    return float(max(P, ss.P) / cl_p**2)
+    return float((max(P, ss.P) + cutoff_var) / cl_p**2)

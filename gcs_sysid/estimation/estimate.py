@@ -624,4 +624,5 @@ def estimate_states(flight: Flight, airframe: Airframe, rate_hz: float = 50.0,
     for c in ("Cl", "Cm", "Cn"):
         ident[c] = ident["moment_coefficients"]
     prog(1.0)
-    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident, offsets, fits)
+    return FlightStates(t, rate, data, sigma, valid, sources, missing, notes, ident, offsets, fits,
+                        rate_bandwidth_hz=None if gyro is None else np.asarray(Rr.bandwidth_hz, float))

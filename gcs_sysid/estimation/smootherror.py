@@ -19,7 +19,9 @@ docs/benchmarks.md "Thirteenth session, i8-sigma") the prior is 0.15-2.6x the tr
 power or less: no gyro-based statistic reads it.
 
 :func:`accel_error_split` returns both parts for a smoother (bandwidth, gyro noise), so a caller can tell
-the stated error the residuals can show from the part they cannot.
+the stated error the residuals can show from the part they cannot. :func:`cutoff_gain` is the distortion's
+weight ``|D - j 2 pi f|^2`` alone, for a caller with a better prior than white snap for some part of the signal
+(the rolling gust's roll acceleration, :func:`gcs_sysid.aero.rollgust.gust_cutoff_variance`).
 
 References:
     J. S. Bendat and A. G. Piersol, *Random Data*, 4th ed., Wiley 2010, sec. 6.1 (the Wiener filter
@@ -32,7 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["N_FREQ", "model_response", "accel_error_split"]
+__all__ = ["N_FREQ", "model_response", "accel_error_split", "cutoff_gain"]
 
 #: Frequencies of the midpoint rule over (0, pi) rad/sample (the parts sum to ``Ps[1, 1]`` within 1e-5).
 N_FREQ = 4096
@@ -94,3 +96,35 @@ def accel_error_split(dt: float, bandwidth_hz: float, noise_std: float) -> tuple
     noise = s2 * float(np.mean(np.abs(model_response(F, Q, H, omega)) ** 2))
     return noise, max(total - noise, 0.0)
 
+
+
+def cutoff_gain(dt: float, bandwidth_hz: float, omega: np.ndarray) -> np.ndarray:
+    """``|D(omega) - j omega/dt|^2``: the squared error the rate smoother makes of a rate's derivative, per unit of the
+    rate's spectrum (the distortion's weight in the module docstring's split).
+
+    A rate component with spectral density ``S(omega)`` (rad/s)^2 per unit of normalised frequency gives the smoothed
+    angular acceleration an error of variance ``mean over (0, pi) of cutoff_gain * S`` (rad/s^2)^2 (the noise-driven
+    part not included): about ``omega^2/dt^2 S`` above the smoother's bandwidth, where it follows nothing, and near 0
+    below it.
+
+    Args:
+        dt: grid step, s.
+        bandwidth_hz: the smoother's bandwidth on the axis (``RateEstimate.bandwidth_hz``), Hz.
+        omega: (K,) normalised angular frequencies, rad/sample, in (0, pi].
+
+    Returns:
+        (K,) the gain, 1/s^2.
+
+    Raises:
+        ValueError: ``dt`` or ``bandwidth_hz`` not positive and finite.
+
+    Source: Bendat and Piersol (2010), sec. 6.1 (the error of a linear estimate at each frequency).
+    """
+    from .rates import _nominal_model
+
+    for name, v in (("dt", dt), ("bandwidth_hz", bandwidth_hz)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be positive and finite, got {v}")
+    F, Q, H = _nominal_model(dt, bandwidth_hz)
+    omega = np.asarray(omega, float)
+    return np.abs(model_response(F, Q, H, omega) - 1j * omega / dt) ** 2

@@ -51,6 +51,10 @@ class FlightStates:
         angle_fits: ``"alpha"`` / ``"beta"`` -> the :class:`gcs_sysid.estimation.airangles.AxisFit` of the
             specific-force aiding (its force model and gust parameters); empty when the angles were not aided.
             Another flight of the same aircraft can be aided with them (``estimate_states(angle_models=...)``).
+        rate_bandwidth_hz: ``(3,)`` the rate smoother's bandwidth on p, q, r, Hz (maximum likelihood;
+            :attr:`gcs_sysid.estimation.rates.RateEstimate.bandwidth_hz`): what a later stage needs to say which part of
+            an angular acceleration the smoother cut off (:mod:`gcs_sysid.estimation.smootherror`). None where the
+            rates were not smoothed (no gyro) or the states were read back from a result file.
     """
 
     t: np.ndarray
@@ -64,6 +68,7 @@ class FlightStates:
     identifiability: dict[str, tuple[bool, str]] = field(default_factory=dict)
     offsets: dict[str, float] = field(default_factory=dict)
     angle_fits: dict = field(default_factory=dict)
+    rate_bandwidth_hz: np.ndarray | None = None
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self.data[key]

@@ -506,3 +506,41 @@ def test_rows_at_another_level_do_not_hand_it_to_the_gust():
     assert err[True, False][0] > 0.3 and err[True, True][0] < 0.1, err
     assert err[True, True][1] < 0.7 * err[True, False][1], err
     assert err[False, True][1] < 1.2 * err[False, False][1], err
+
+
+@pytest.mark.parametrize("bw", [1.5, 4.0])
+def test_gust_cutoff_variance_is_the_gust_moment_the_rate_smoother_misses(bw):
+    """A gust-only roll axis integrated finely and sampled on the grid; the rate smoother (noise-free gyro, so only its
+    distortion is left) gives ``p_dot``: the measured Cl misses the gust's moment above the bandwidth by the variance
+    :func:`gust_cutoff_variance` states from the gust model alone (no record read)."""
+    from gcs_sysid.estimation.kalman import steady_state, steady_state_smoother
+    from gcs_sysid.estimation.rates import _nominal_model
+
+    rng = np.random.default_rng(11)
+    n, h, k = 20000, B / (2 * V), QBAR * S * B / IXX
+    tau = rg.dryden_roll_tau(B, V)
+    m, d = n * SUB, DT / SUB
+    a = np.exp(-d / tau)
+    pg = lfilter([np.sqrt(1 - a * a) * SIG_PG], [1, -a], rng.normal(size=m))
+    p = np.zeros(m)
+    for i in range(m - 1):
+        p[i + 1] = p[i] + d * k * CLP * h * (p[i] - pg[i])
+    j = np.arange(0, m, SUB)
+    true_cl = CLP * h * (p[j] - pg[j])                    # the aerodynamic moment at each grid instant
+    F, Q, H = _nominal_model(DT, bw)
+    xs, _ = steady_state_smoother(F, steady_state(F, Q, H, np.eye(1)), H, p[j][:, None], np.zeros(3))
+    err = (IXX * xs[:, 1] / (QBAR * S * B) - true_cl)[500:-500]
+    L_p = k * CLP * h
+    x = L_p * DT
+    theta = np.zeros(7)
+    theta[rg._IP] = CLP / (np.expm1(x) / x)               # the fit's slope whose step slope is CLP
+    G = rg.RollDynamicsFit(g=np.zeros(n), g_var=np.zeros(n), used=np.ones(n, bool), theta=theta, theta0=theta,
+                           Cl_p=CLP, tau=tau, sigma=SIG_PG * h, R=0.0, nll=0.0, nll_white=0.0, nfev=0, converged=True,
+                           notes=(), L_p=L_p)
+    stated = rg.gust_cutoff_variance(G, DT, bw)
+    assert np.var(err) == pytest.approx(stated, rel=0.15)
+    # most of the gust moment's variance above the bandwidth, little of it below
+    assert stated < 0.5 * np.var(CLP * h * pg[j])
+    assert rg.gust_cutoff_variance(G, DT, 2 * bw) < stated
+    with pytest.raises(ValueError, match="bandwidth_hz"):
+        rg.gust_cutoff_variance(G, DT, 0.0)
