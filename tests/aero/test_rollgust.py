@@ -544,3 +544,35 @@ def test_gust_cutoff_variance_is_the_gust_moment_the_rate_smoother_misses(bw):
     assert rg.gust_cutoff_variance(G, DT, 2 * bw) < stated
     with pytest.raises(ValueError, match="bandwidth_hz"):
         rg.gust_cutoff_variance(G, DT, 0.0)
+
+
+def test_heldout_air_roll_adds_the_cut_off_gust_moment_where_the_bandwidth_is_known(monkeypatch):
+    """With ``HELDOUT_GUST_CUTOFF`` on, the held-out air roll rate's stated variance is the ``"innov"`` one plus
+    :func:`gust_cutoff_variance` at the states' roll bandwidth over ``Cl_p,step^2`` and the note gives its size; the
+    estimate itself does not move; states without a bandwidth (read back from a result file) add nothing."""
+    from types import SimpleNamespace
+
+    from gcs_sysid.aero import gustfilter as gf
+
+    X, Y, p, g = _record(seed=1)
+    rng = np.random.default_rng(7)
+    held, st, tab = _roll_case(X, Y, p, g, rng)
+    st.sigma = {"p_dot": np.full(len(X), 0.01), "r_dot": np.full(len(X), 0.01)}
+    air = SimpleNamespace(Ixx=IXX, Izz=2 * IXX, Ixz=0.0, S=S, b=B)
+    monkeypatch.setattr(gf, "HELDOUT_GUST_VAR", "innov")
+    out = {}
+    for cut, bw in ((False, np.array([2.5, 1.5, 2.5])), (True, np.array([2.5, 1.5, 2.5])), (True, None)):
+        monkeypatch.setattr(gf, "HELDOUT_GUST_CUTOFF", cut)
+        st.rate_bandwidth_hz = bw
+        out[cut, bw is None] = gf.heldout_air_roll(tab, st, air, ~held, held, mode="predicted:Cl")
+    base, cut, nobw = out[False, False], out[True, False], out[True, True]
+    F = base[1]["fit"]
+    x = F.L_p * DT
+    cl_p = F.theta[rg._IP] * np.expm1(x) / x
+    added = rg.gust_cutoff_variance(F, DT, 2.5) / cl_p**2
+    h = held & (base[1]["g_var"] < F.sigma**2)
+    assert added > 0 and h.sum() > 900
+    np.testing.assert_allclose(cut[1]["g_var"][h], base[1]["g_var"][h] + added, rtol=1e-9)
+    assert np.array_equal(cut[0].X, base[0].X)
+    assert np.array_equal(nobw[1]["g_var"], base[1]["g_var"])
+    assert "cut" not in base[0].notes[-1] and "roll bandwidth (2.5 Hz)" in cut[0].notes[-1]
