@@ -350,6 +350,14 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: seed 109 with clean seeds 110-114, both arms on the same flights: named causes identical in all 425 cases, estimate
 #: +8/-2, all three +6/-1, the +-2 standard error interval covering JSBSim's ``Cn:delta_a`` on 26 -> 42 of 48 findings
 #: (``docs/benchmarks.md``, *Sixty-first session, lead*).
+#: Added 2026-11-29 (seventy-third session), a bug fix, **on** (0.1; 0.0 restores the difference at ``+- u``):
+#: ``type_b_scale_step``, the angle of attack's scale component of a named change's *reported* type B taken to first
+#: order (:func:`gcs_sysid.diagnose.uncertainty.angle_sensitivity` ``scale_step``, as ``coverage_scale_step`` does
+#: under no change; 0.1 is where ``1 / (1 + s)`` is linear within 1 %). The stated alpha scale uncertainty reaches
+#: 0.5-3.4 (``AxisFit.scale_sigma``, the gust's share of the aided angle), and at ``+- u`` a term in a power of alpha
+#: came out without bound: 13 of the two records' ``Cm:alpha^2`` findings reported standard errors of 57-552921 on
+#: estimates of -2.6 to -41. What is named reads ``std_error_decision`` and the alpha components under no change,
+#: neither of which this touches (``docs/benchmarks.md``, *Seventy-third session*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -373,7 +381,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
               "hierarchy_se_degree": 3, "simpler_catalogue_powers": False,
               "delay_se_central": True, "estimate_beyond_angle_scale": ("scale:CY",), "angle_error_parents": True,
-              "estimate_beyond_angle_error": ("Cl", "Cn")}
+              "estimate_beyond_angle_error": ("Cl", "Cn"), "type_b_scale_step": 0.1}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -1365,7 +1373,8 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 _with_uncertainty(f, ctx, Xlib, knots, at_naming[f["cause"]], tr, ref_after, M0, model0,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
-                                  null=null, trim=trim)
+                                  null=null, trim=trim,
+                                  type_b_scale_step=float(th.get("type_b_scale_step", 0.0) or 0.0))
     if th.get("errors_in_variables", False) and angle_sigma:
         Xlib = Xc if th.get("angle_nuisance", True) else ctx.X
         for f in named:
@@ -1391,7 +1400,7 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                                   bool(th.get("side_force_wind_axis", False)), angle_uncertainty,
                                   float(th.get("alpha_jackknife_s", 15.0)) or 15.0, [b - base for b in base_jk],
                                   centred=True, null=null, centred_scale=bool(th.get("centred_scale", False)),
-                                  trim=trim)
+                                  trim=trim, type_b_scale_step=float(th.get("type_b_scale_step", 0.0) or 0.0))
     result["findings"] = named
     return result
 
@@ -1806,7 +1815,7 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
                       M0: np.ndarray, model0, wind_axis: bool, angle_u: dict | None, block_s: float,
                       inadequacy_jk: list[np.ndarray] | None = None, centred: bool = False,
                       null: dict | None = None, centred_scale: bool = False,
-                      trim: dict[str, float] | None = None) -> None:
+                      trim: dict[str, float] | None = None, type_b_scale_step: float = 0.0) -> None:
     """Replace a named term's ``std_error`` by its combined standard uncertainty (in place).
 
     The components (:mod:`gcs_sysid.diagnose.uncertainty`; GUM, JCGM 100:2008, eq. 10): this flight's fit,
@@ -1855,6 +1864,10 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
             fit takes the flight's weight for it.
         trim: the library's surface trims (:func:`control_trim`, ``THRESHOLDS["library_control_trim"]``): the
             monomials' surface factors are rebuilt about them, as the search selected them; None: as measured.
+        type_b_scale_step: the angle of attack's scale component of the reported type B taken to first order at
+            this relative step (``THRESHOLDS["type_b_scale_step"]``, :func:`gcs_sysid.diagnose.uncertainty.
+            angle_sensitivity` ``scale_step``); 0: at ``+- u``. The sideslip's stays at ``+- u``: the naming test
+            under no change reads it (``combined_under_no_change_alpha``), and its rule is frozen.
     """
     from .uncertainty import angle_sensitivity, combine, fit_standard_errors, type_a
 
@@ -1964,7 +1977,8 @@ def _with_uncertainty(f: dict, ctx: DiagContext, X: np.ndarray, knots, r: np.nda
         if not (u.get("scale", 0) > 0 or u.get("offset_rad", 0) > 0):
             continue
         sens = angle_sensitivity(columns, X, rr, tr, i, REGRESSORS.index(angle), float(u.get("scale", 0.0)),
-                                 float(u.get("offset_rad", 0.0)))
+                                 float(u.get("offset_rad", 0.0)),
+                                 scale_step=float(type_b_scale_step) if angle == "alpha" else 0.0)
         typeb.update({f"{angle}_scale": sens["scale"], f"{angle}_offset": sens["offset"]})
     typeb_null = {}
     if null is not None:

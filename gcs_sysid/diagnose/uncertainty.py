@@ -277,7 +277,8 @@ def elevator_loading(fit) -> float | None:
 
 
 def angle_sensitivity(columns: Callable[[np.ndarray], np.ndarray], X: np.ndarray, r: np.ndarray,
-                      rows: np.ndarray, index: int, k_angle: int, scale: float, offset: float) -> dict:
+                      rows: np.ndarray, index: int, k_angle: int, scale: float, offset: float,
+                      scale_step: float = 0.0) -> dict:
     """Standard uncertainty of one fitted coefficient from an air angle's scale and offset (type B).
 
     Args:
@@ -286,9 +287,18 @@ def angle_sensitivity(columns: Callable[[np.ndarray], np.ndarray], X: np.ndarray
         index: column of the coefficient in ``columns``' output. k_angle: column of the angle in ``X``.
         scale: standard uncertainty of the angle's relative scale (about its mean over ``rows``).
         offset: standard uncertainty of its offset, rad.
+        scale_step: the largest relative step of the scale's central difference; with ``scale > scale_step > 0``
+            the difference is taken at ``+- scale_step`` and multiplied by ``scale / scale_step``: the first-order
+            sensitivity coefficient times the standard uncertainty (GUM, JCGM 100:2008, eq. 10), as
+            :func:`gcs_sysid.diagnose.null_uncertainty.angle_null_sensitivity` does under no change. At ``+- scale``
+            with a stated scale uncertainty near 1 the minus branch shrinks the angle's excursions to nearly nothing
+            and a term in a power of the angle comes out without bound (JSBSim c172x seed 3, ``Cm:alpha^2`` -8:
+            alpha's stated scale uncertainty 0.98, the reported standard error 3138 on an estimate of -1.9). 0: the
+            step is ``scale`` (as before).
 
     Returns:
-        ``{"scale": u, "offset": u}``: ``|theta(+u) - theta(-u)| / 2`` for each (0 when its input is 0).
+        ``{"scale": u, "offset": u}``: ``|theta(+h) - theta(-h)| / 2 * u / h`` for each, ``h = u`` but for the scale
+        above ``scale_step`` (0 when its input is 0).
     """
     mean = float(np.nanmean(X[rows, k_angle]))
     out = {}
@@ -296,16 +306,17 @@ def angle_sensitivity(columns: Callable[[np.ndarray], np.ndarray], X: np.ndarray
         if not u > 0:
             out[what] = 0.0
             continue
+        h = float(scale_step) if what == "scale" and 0.0 < scale_step < u else float(u)
         th = []
         for sgn in (1.0, -1.0):
             Xp = X.copy()
             if what == "scale":
-                Xp[:, k_angle] = mean + (1.0 + sgn * u) * (X[:, k_angle] - mean)
+                Xp[:, k_angle] = mean + (1.0 + sgn * h) * (X[:, k_angle] - mean)
             else:
-                Xp[:, k_angle] = X[:, k_angle] + sgn * u
+                Xp[:, k_angle] = X[:, k_angle] + sgn * h
             A = np.nan_to_num(np.asarray(columns(Xp), float)[rows])
             th.append(np.linalg.lstsq(A, r[rows], rcond=None)[0][index])
-        out[what] = float(abs(th[0] - th[1]) / 2.0)
+        out[what] = float(abs(th[0] - th[1]) / 2.0 * (u / h))
     return out
 
 
