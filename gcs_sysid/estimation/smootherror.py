@@ -97,7 +97,6 @@ def accel_error_split(dt: float, bandwidth_hz: float, noise_std: float) -> tuple
     return noise, max(total - noise, 0.0)
 
 
-
 def cutoff_gain(dt: float, bandwidth_hz: float, omega: np.ndarray) -> np.ndarray:
     """``|D(omega) - j omega/dt|^2``: the squared error the rate smoother makes of a rate's derivative, per unit of the
     rate's spectrum (the distortion's weight in the module docstring's split).

@@ -10,6 +10,7 @@ standard error ignores the colour of the residual.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.signal import lfilter
 
 from gcs_sysid.diagnose.regression import ols
@@ -77,6 +78,29 @@ def test_air_angle_type_b_propagates_scale_and_offset_through_the_fit():
     assert abs(u["scale"] - 0.05 * 2.0) < 0.01 and u["offset"] < 1e-9      # a linear term: u_s theta; no offset effect
     assert angle_sensitivity(beta_only, X, r, rows, 1, 0, 0.05, 0.01) == {"scale": 0.0, "offset": 0.0}
     assert abs(combine({"a": 3.0, "b": 4.0, "c": float("nan"), "d": None}) - 5.0) < 1e-12
+
+
+def test_scale_type_b_of_a_power_term_is_first_order_at_a_small_step():
+    """A term in alpha^2 (the change -8 read on an alpha with a stated scale uncertainty of 0.98): at +- u the minus
+    branch shrinks alpha's excursions to 2 % and the coefficient comes out 2500 times its size; at a 0.1 step times
+    u / step it is the first-order sensitivity, 2 |theta| u (theta scales as (1 + s)^-2); below the step nothing
+    changes."""
+    rng = np.random.default_rng(2)
+    n = 4000
+    X = np.zeros((n, 10))
+    X[:, 0] = 0.05 + 0.04 * rng.standard_normal(n)
+    r = -8.0 * X[:, 0] ** 2
+    rows = np.arange(n)
+
+    def quad(Xp):
+        return np.column_stack([np.ones(len(Xp)), Xp[:, 0], Xp[:, 0] ** 2])
+
+    at_u = angle_sensitivity(quad, X, r, rows, 2, 0, scale=0.98, offset=0.0)["scale"]
+    first = angle_sensitivity(quad, X, r, rows, 2, 0, scale=0.98, offset=0.0, scale_step=0.1)["scale"]
+    assert at_u > 1000 * 8.0
+    assert first == pytest.approx(2 * 8.0 * 0.98, rel=0.03)
+    small = angle_sensitivity(quad, X, r, rows, 2, 0, scale=0.05, offset=0.01)
+    assert angle_sensitivity(quad, X, r, rows, 2, 0, scale=0.05, offset=0.01, scale_step=0.1) == small
 
 
 def test_air_data_uncertainty_reads_the_estimators_own_fits():
