@@ -575,4 +575,4 @@ def test_heldout_air_roll_adds_the_cut_off_gust_moment_where_the_bandwidth_is_kn
     np.testing.assert_allclose(cut[1]["g_var"][h], base[1]["g_var"][h] + added, rtol=1e-9)
     assert np.array_equal(cut[0].X, base[0].X)
     assert np.array_equal(nobw[1]["g_var"], base[1]["g_var"])
-    assert "cut" not in base[0].notes[-1] and "roll bandwidth (2.5 Hz)" in cut[0].notes[-1]
+    assert "roll bandwidth" not in base[0].notes[-1] and "roll bandwidth (2.5 Hz)" in cut[0].notes[-1]
