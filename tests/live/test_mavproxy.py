@@ -83,11 +83,14 @@ def test_listen_behind_mavproxy_router_with_the_module_loaded(tmp_path):
     # some at its master socket); the router delivers all of it, unchanged, to the listener ...
     routed = [p for p in read_records(tmp_path / "mav.tlog") if p in recorded]
     assert len(routed) > 0.3 * sent
-    assert [p for p in read_records(tmp_path / "listen" / "raw.tlog") if p in recorded] == routed
+    # (MAVProxy's log may lose its last few writes when it is stopped: once 6 of 3633 packets that the listener and
+    # the module both received; so the listener's record starts with MAVProxy's and may hold a few more at its end)
+    got = [p for p in read_records(tmp_path / "listen" / "raw.tlog") if p in recorded]
+    assert got[:len(routed)] == routed and len(got) - len(routed) <= max(50, 0.02 * len(routed))
     # ... and hands the module every packet from the moment the vehicle is detected (the first
     # records, before its first HEARTBEAT, are not given to modules)
     in_module = [p for p in read_records(module_out / "raw.tlog") if p in recorded]
-    assert len(in_module) >= len(routed) - 20 and in_module == routed[len(routed) - len(in_module):]
+    assert len(in_module) >= len(got) - 20 and in_module == got[len(got) - len(in_module):]
     # both components speak back to the vehicle side: the module's directly, the listener's through the router
     far_end = _sources(far)
     for comp in (191, 192):
