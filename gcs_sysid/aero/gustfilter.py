@@ -626,10 +626,12 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
     if isinstance(G, str):
         return replace(table, notes=list(table.notes) + [G.replace("gust filter", "held-out air roll rate")]), None
     dt = float(np.median(np.diff(table.t)))
+    # the cut-off gust moment enters only a variance measured on the training rows (not "fit", "moment")
+    cv, bw = _gust_cutoff(G, states, dt) if HELDOUT_GUST_VAR not in ("fit", "moment") else (0.0, float("nan"))
     g, g_var = roll_gust_on_rows(G, dt, table.X, table.Y, states.data["p"], table.qbar, held & table.valid,
                                  airframe.Ixx, airframe.S, airframe.b, mode=mode,
                                  gust_var=gust_moment_variance(G) if HELDOUT_GUST_VAR == "moment" else None,
-                                 pred_var=heldout_gust_pred_var(G, table, states, airframe, dt))
+                                 pred_var=heldout_gust_pred_var(G, table, states, airframe, dt, cutoff_var=cv))
     g, g_var = np.where(held, g, 0.0), np.where(held, g_var, 0.0)
     j = REGRESSORS.index("p_hat")
     X = table.X.copy()
@@ -639,7 +641,6 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
     note = (f"held-out rows' p_hat relative to the air" + ("" if outputs is None else f" (for {', '.join(outputs)})")
             + f": the rolling gust ({mode}, SD {np.std(g[held]):.4f}) of the roll fit on the training rows taken out ("
             + G.notes[0] + ")")
-    cv, bw = _gust_cutoff(G, states, dt) if HELDOUT_GUST_VAR not in ("fit", "moment") else (0.0, float("nan"))
     if cv > 0:
         note += (f"; its stated error carries the gust's moment above the rate smoother's roll bandwidth ({bw:g} Hz), "
                  f"which the measured Cl never held: SD {np.sqrt(cv):.2g} (Cl)")
@@ -647,27 +648,27 @@ def heldout_air_roll(table, states, airframe, train: np.ndarray, held: np.ndarra
                                                                              "g_var": g_var, "fit": G}
 
 
-def _gust_cutoff(fit, states, dt: float, cutoff: bool | None = None) -> tuple[float, float]:
-    """``(variance Cl^2, roll bandwidth Hz)`` of :func:`gcs_sysid.aero.rollgust.gust_cutoff_variance` where ``cutoff``
-    (None: :data:`HELDOUT_GUST_CUTOFF`) is on and the states carry the rate smoother's bandwidth; ``(0, nan)``
-    otherwise."""
+def _gust_cutoff(fit, states, dt: float) -> tuple[float, float]:
+    """``(variance Cl^2, roll bandwidth Hz)`` of :func:`gcs_sysid.aero.rollgust.gust_cutoff_variance` where
+    :data:`HELDOUT_GUST_CUTOFF` is on and the states carry the rate smoother's bandwidth; ``(0, nan)`` otherwise."""
     from .rollgust import gust_cutoff_variance
 
     bw = getattr(states, "rate_bandwidth_hz", None)
-    if not (HELDOUT_GUST_CUTOFF if cutoff is None else cutoff) or bw is None or not np.isfinite(bw[0]):
+    if not HELDOUT_GUST_CUTOFF or bw is None or not np.isfinite(bw[0]):
         return 0.0, float("nan")
     return gust_cutoff_variance(fit, dt, float(bw[0])), float(bw[0])
 
 
 def heldout_gust_pred_var(fit, table, states, airframe, dt: float, how: str | None = None,
-                          cutoff: bool | None = None) -> float | None:
+                          cutoff_var: float | None = None) -> float | None:
     """The held-out prediction's error variance of ``p_hat_g`` (dimensionless) that :data:`HELDOUT_GUST_VAR`
     (``how``; None: it) measures on the fit's own rows, or None where it states none (``"fit"``, ``"moment"``).
 
     ``"rts"``, ``"nis"`` and ``"innov"``: :func:`gcs_sysid.aero.rollgust.predicted_gust_variance` by that method on
-    ``fit.used`` (the training rows the roll fit read; the log's own moment only, no truth). With ``cutoff`` (None:
-    :data:`HELDOUT_GUST_CUTOFF`) and the states' roll-axis bandwidth known, plus the gust's moment the rate smoother
-    cut off the measured Cl (:func:`gcs_sysid.aero.rollgust.gust_cutoff_variance`); without a bandwidth, nothing.
+    ``fit.used`` (the training rows the roll fit read; the log's own moment only, no truth), plus ``cutoff_var`` (Cl^2,
+    the gust's moment the rate smoother cut off the measured Cl; None: :func:`gcs_sysid.aero.rollgust.
+    gust_cutoff_variance` where :data:`HELDOUT_GUST_CUTOFF` is on and the states' roll-axis bandwidth is known, else
+    nothing).
 
     Args:
         fit: the air-rate pair's roll fit (:func:`air_roll_fit`). table: the coefficient table it was made on
@@ -685,7 +686,7 @@ def heldout_gust_pred_var(fit, table, states, airframe, dt: float, how: str | No
         return None
     if how not in PRED_VAR_METHODS:
         raise ValueError(f"heldout_gust_pred_var: one of ('fit', 'moment') + {PRED_VAR_METHODS} expected, got {how!r}")
-    cv = _gust_cutoff(fit, states, dt, cutoff)[0]
+    cv = _gust_cutoff(fit, states, dt)[0] if cutoff_var is None else float(cutoff_var)
     return predicted_gust_variance(fit, dt, table.X, table.Y, states.data["p"], table.qbar, np.asarray(fit.used, bool),
                                    airframe.Ixx, airframe.S, airframe.b, method=how, cutoff_var=cv)
 
