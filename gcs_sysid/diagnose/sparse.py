@@ -358,6 +358,13 @@ __all__ = ["THRESHOLDS", "stlsq", "select_terms", "sparse_search", "merge_findin
 #: came out without bound: 13 of the two records' ``Cm:alpha^2`` findings reported standard errors of 57-552921 on
 #: estimates of -2.6 to -41. What is named reads ``std_error_decision`` and the alpha components under no change,
 #: neither of which this touches (``docs/benchmarks.md``, *Seventy-third session*).
+#: Added 2026-11-29 (seventy-fourth session): ``delay_lead_max_t`` (a factor ``k``; 0 off; read with
+#: ``delay_differential``): a ``delay:<surface>`` whose flight's own delay (:func:`_differential_delay`'s ``flight_s``)
+#: lies more than ``k`` of its standard errors below zero is a lead, not a servo delay (:func:`_delay_lead`), and goes to
+#: ``not_named`` with the reading, as a delay the controlled coefficient does not see. Found on the JSBSim Eternity's
+#: clean flight s118 (``delay:delta_a`` -0.035 +- 0.010 s; its own aileron delay -0.045 +- 0.007 s). No tuned
+#: threshold: 3 is the project's ``delay_change_min_t``. Judged by rule 79 (``docs/benchmarks.md``, *Seventy-fourth
+#: session*).
 NAMING_COVERAGE_FACTOR = 2.0
 THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.05, "max_terms": 4,
               "min_step_gain": 0.03, "rounds": 2, "inadequacy": "ridge", "min_abs_t": 5.0,
@@ -381,7 +388,7 @@ THRESHOLDS = {"min_press_drop": 0.4, "min_gain_pct": 25.0, "stlsq_threshold": 0.
               "coverage_beta_along": "columns", "beta_scale_type_b": 0.04, "hierarchy_se": 2.0,
               "hierarchy_se_degree": 3, "simpler_catalogue_powers": False,
               "delay_se_central": True, "estimate_beyond_angle_scale": ("scale:CY",), "angle_error_parents": True,
-              "estimate_beyond_angle_error": ("Cl", "Cn"), "type_b_scale_step": 0.1}
+              "estimate_beyond_angle_error": ("Cl", "Cn"), "type_b_scale_step": 0.1, "delay_lead_max_t": 0.0}
 
 _LAGS_S = tuple(np.round(np.arange(0.02, 0.301, 0.02), 3))
 
@@ -1328,24 +1335,31 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 se = float(np.hypot(se, dt / np.sqrt(12.0)))
             f["estimate"], f["std_error"] = tau, se
             f["evidence"]["refined_on"] = "model response to the delayed surface, all coefficients"
+            res = float(np.median(np.diff(ctx.t))) / np.sqrt(12.0) \
+                if th.get("delay_time_resolution", False) and ctx.t.size > 1 else 0.0
+            why = None
+            if th.get("delay_differential", False):
+                lead = _delay_lead(f["evidence"]["delay_differential"], surf, res,
+                                   float(th.get("delay_lead_max_t", 0.0) or 0.0))
+                f["evidence"]["lead"] = lead
+                why = lead["why"]
             k_agree = float(th.get("delay_primary_agreement", 0.0) or 0.0)
-            if k_agree > 0:
-                res = float(np.median(np.diff(ctx.t))) / np.sqrt(12.0) \
-                    if th.get("delay_time_resolution", False) and ctx.t.size > 1 else 0.0
+            if why is None and k_agree > 0:
                 check = _delay_in_primary(ctx, Rn, surf, tr, jf, tau, se, reference, k_agree,
                                           bool(th.get("delay_differential", False)), res, central=central)
                 f["evidence"]["primary_coefficient"] = check
-                if not check["agrees"]:
-                    # not a delay of the surface: the coefficient it controls does not see it; the lag term is
-                    # left in the residual (not named) and the other coefficients' first terms are named as usual
-                    result.setdefault("not_named", []).append(
-                        {"cause": f["cause"], "coefficient": f["coefficient"], "beyond": False,
-                         "change": float(tau), "why": check["why"]})
-                    new = [g for g in new if g is not f]
-                    for g in new:
-                        at_naming[g["cause"]] = Rd[:, COEFFICIENTS.index(g["coefficient"])].copy()
-                    named += [g for g in new if not g["cause"].startswith("delay:")]
-                    break
+                why = check["why"] if not check["agrees"] else None
+            if why is not None:
+                # not a delay of the surface (a lead, or one the coefficient it controls does not see): the lag
+                # term is left in the residual (not named) and the other coefficients' first terms are named as usual
+                result.setdefault("not_named", []).append(
+                    {"cause": f["cause"], "coefficient": f["coefficient"], "beyond": False,
+                     "change": float(tau), "why": why})
+                new = [g for g in new if g is not f]
+                for g in new:
+                    at_naming[g["cause"]] = Rd[:, COEFFICIENTS.index(g["coefficient"])].copy()
+                named += [g for g in new if not g["cause"].startswith("delay:")]
+                break
             Rd, Rn = Rd - D, Rn - D
             named.append(f)
             continue
@@ -2097,6 +2111,32 @@ def _differential_delay(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndar
 #: The coefficient each surface is the control of (its control power: Cm_delta_e, Cl_delta_a, Cn_delta_r; thrust
 #: along x), where a delay of the surface must show (:func:`_delay_in_primary`).
 PRIMARY_COEFFICIENT = {"delta_e": "Cm", "delta_a": "Cl", "delta_r": "Cn", "delta_t": "CX"}
+
+
+def _delay_lead(parts: dict, surf: str, resolution_s: float, k: float) -> dict:
+    """Is the flight's own delay of ``surf`` a lead (the surface's response ahead of its logged command)?
+
+    A servo moves after it is commanded, so its delay is never negative; both flights are logged alike, so a lead the
+    flight reads beyond its reference is no servo delay either (a closed loop reads as one: the autopilot's surface
+    answering the disturbance the aircraft already feels). The flight's delay :func:`_differential_delay` fitted on its
+    own residual (``parts["flight_s"]``) is a lead when it lies more than ``k`` of its standard errors (the fit's and
+    the log's time resolution, in quadrature) below zero. The JSBSim Eternity's clean flight s118: ``delay:delta_a``
+    -0.035 +- 0.010 s named as a change, the flight's own aileron delay -0.045 +- 0.007 s (``docs/benchmarks.md``,
+    "Seventy-fourth session").
+
+    Args:
+        parts: :func:`_differential_delay`'s parts (``flight_s``, ``std_error_flight_s``, s). surf: the surface.
+        resolution_s: the log's time resolution, s (0: none). k: the factor (0: the check is off).
+
+    Returns:
+        ``{"flight_s", "std_error_s", "lead", "why"}``: ``why`` None unless a lead (always None with ``k`` 0).
+    """
+    fs = float(parts.get("flight_s", np.nan))
+    se = float(np.hypot(float(parts.get("std_error_flight_s", np.nan)), resolution_s))
+    lead = bool(k > 0 and np.isfinite(fs) and np.isfinite(se) and fs < -k * se)
+    why = (f"{surf} leads its logged command by {-fs:.3f} +- {se:.3f} s on this flight ({-fs / se:.1f} standard "
+           "errors): a servo moves after its command, so a lead is no delay of the surface") if lead else None
+    return {"flight_s": fs, "std_error_s": se, "lead": lead, "why": why}
 
 
 def _delay_in_primary(ctx: DiagContext, Rn: np.ndarray, surf: str, tr: np.ndarray, j: int, tau: float, se: float,

@@ -5,6 +5,10 @@ all the one it controls (the rudder's Cn). On the project's synthetic flights a 
 response to a 0.1-s late rudder, Cn and Cl untouched) is refused with the reason; the same delay in every coefficient
 is named. The JSBSim Eternity's clean flight s15 named ``delay:delta_a`` 0.110 +- 0.006 s
 on CY while Cl read 0.000 +- 0.006 s (docs/benchmarks.md, "Thirty-eighth session").
+
+Nor is a lead (``delay_lead_max_t``): a response ahead of its logged command reads as a negative delay of the flight
+itself, which no servo has (the JSBSim Eternity's clean flight s118, ``delay:delta_a`` -0.035 s as a change, the
+flight's own -0.045 +- 0.007 s; docs/benchmarks.md, "Seventy-fourth session").
 """
 
 import numpy as np
@@ -59,3 +63,39 @@ def test_a_delay_in_every_coefficient_is_named(airframe):
     assert f["estimate"] == pytest.approx(0.1, abs=0.015)
     check = f["evidence"]["primary_coefficient"]
     assert check["agrees"] and check["primary"] == "Cn"
+
+
+def _leading(airframe, seed, lead_s):
+    """A synthetic flight whose every coefficient answers the rudder ``lead_s`` early (the response ahead of the
+    logged command)."""
+    table, states = measured(BASE, seed=seed, hidden=None, duration=90.0)
+    c0 = DiagContext.build(table, airframe, BASE, states)
+    X = c0.X.copy()
+    X[:, K_R] = np.interp(c0.t + lead_s, c0.t, np.nan_to_num(c0.X[:, K_R]))
+    table.Y[:] += np.nan_to_num(c0.model_values(X) - c0.model_values())
+    ctx = DiagContext.build(table, airframe, BASE, states)
+    return ctx, ctx.Y - ctx.model_values()
+
+
+def test_a_surface_that_leads_its_command_is_not_a_delay(airframe):
+    # a servo moves after its command: a response 0.08 s ahead of the log reads as a negative delay, named with the
+    # check off and refused with the reading when it is on (delay_lead_max_t; the JSBSim Eternity's clean s118)
+    ref = _flight(airframe, 4)
+    ctx, R = _leading(airframe, 5, 0.08)
+    off = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_lead_max_t=0.0))
+    f = next(f for f in off["findings"] if f["cause"] == "delay:delta_r")
+    assert f["evidence"]["delay_differential"]["flight_s"] == pytest.approx(-0.08, abs=0.015)
+    assert f["evidence"]["lead"]["lead"] is False and f["evidence"]["lead"]["why"] is None
+    on = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_lead_max_t=3.0))
+    assert not any(g["cause"].startswith("delay:") for g in on["findings"])
+    refused = [n for n in on["not_named"] if n["cause"] == "delay:delta_r"]
+    assert refused and "delta_r leads its logged command by 0.0" in refused[0]["why"]
+
+
+def test_a_lag_is_named_with_the_lead_check_on(airframe):
+    ref = _flight(airframe, 4)
+    ctx, R = _flight(airframe, 5, columns=slice(None))
+    res = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_lead_max_t=3.0))
+    f = next(f for f in res["findings"] if f["cause"] == "delay:delta_r")
+    assert f["estimate"] == pytest.approx(0.1, abs=0.015)
+    assert f["evidence"]["lead"]["lead"] is False and f["evidence"]["lead"]["flight_s"] > 0
