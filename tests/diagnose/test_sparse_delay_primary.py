@@ -86,7 +86,8 @@ def test_a_surface_that_leads_its_command_is_not_a_delay(airframe):
     f = next(f for f in off["findings"] if f["cause"] == "delay:delta_r")
     assert f["evidence"]["delay_differential"]["flight_s"] == pytest.approx(-0.08, abs=0.015)
     assert f["evidence"]["lead"]["lead"] is False and f["evidence"]["lead"]["why"] is None
-    on = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_lead_max_t=3.0))
+    on = sparse_search(ctx, R, reference=ref)
+    assert THRESHOLDS["delay_lead_max_t"] == 3.0
     assert not any(g["cause"].startswith("delay:") for g in on["findings"])
     refused = [n for n in on["not_named"] if n["cause"] == "delay:delta_r"]
     assert refused and "delta_r leads its logged command by 0.0" in refused[0]["why"]
@@ -95,7 +96,7 @@ def test_a_surface_that_leads_its_command_is_not_a_delay(airframe):
 def test_a_lag_is_named_with_the_lead_check_on(airframe):
     ref = _flight(airframe, 4)
     ctx, R = _flight(airframe, 5, columns=slice(None))
-    res = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_lead_max_t=3.0))
+    res = sparse_search(ctx, R, reference=ref)
     f = next(f for f in res["findings"] if f["cause"] == "delay:delta_r")
     assert f["estimate"] == pytest.approx(0.1, abs=0.015)
     assert f["evidence"]["lead"]["lead"] is False and f["evidence"]["lead"]["flight_s"] > 0
