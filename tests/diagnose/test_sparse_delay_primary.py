@@ -43,16 +43,24 @@ def _flight(airframe, seed, columns=None):
     return ctx, ctx.Y - ctx.model_values()
 
 
+def _refused(ctx, R, ref, check: str) -> tuple[dict, str]:
+    """The search with the check ``check`` off (its result) and at the default 3.0 (the refusal's reason), asserting
+    that the default names no delay and lists ``delay:delta_r`` under ``not_named``."""
+    off = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, **{check: 0.0}))
+    on = sparse_search(ctx, R, reference=ref)
+    assert THRESHOLDS[check] == 3.0
+    assert not any(f["cause"].startswith("delay:") for f in on["findings"])
+    refused = [n for n in on["not_named"] if n["cause"] == "delay:delta_r"]
+    assert refused
+    return off, refused[0]["why"]
+
+
 def test_a_lag_in_a_weaker_coefficient_alone_is_not_a_delay(airframe):
     ref = _flight(airframe, 4)
     ctx, R = _flight(airframe, 5, columns=[1])                                    # CY alone
-    off = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_primary_agreement=0.0))
+    off, why = _refused(ctx, R, ref, "delay_primary_agreement")
     assert [f["cause"] for f in off["findings"]] == ["delay:delta_r"]           # the check off: named on CY
-    on = sparse_search(ctx, R, reference=ref)
-    assert THRESHOLDS["delay_primary_agreement"] == 3.0
-    assert not any(f["cause"].startswith("delay:") for f in on["findings"])
-    refused = [n for n in on["not_named"] if n["cause"] == "delay:delta_r"]
-    assert refused and "Cn (the coefficient delta_r controls)" in refused[0]["why"]
+    assert "Cn (the coefficient delta_r controls)" in why
 
 
 def test_a_delay_in_every_coefficient_is_named(airframe):
@@ -63,6 +71,8 @@ def test_a_delay_in_every_coefficient_is_named(airframe):
     assert f["estimate"] == pytest.approx(0.1, abs=0.015)
     check = f["evidence"]["primary_coefficient"]
     assert check["agrees"] and check["primary"] == "Cn"
+    lead = f["evidence"]["lead"]                                                 # its own delay: a lag, not a lead
+    assert lead["lead"] is False and lead["flight_s"] > 0
 
 
 def _leading(airframe, seed, lead_s):
@@ -82,21 +92,8 @@ def test_a_surface_that_leads_its_command_is_not_a_delay(airframe):
     # check off and refused with the reading when it is on (delay_lead_max_t; the JSBSim Eternity's clean s118)
     ref = _flight(airframe, 4)
     ctx, R = _leading(airframe, 5, 0.08)
-    off = sparse_search(ctx, R, reference=ref, thresholds=dict(THRESHOLDS, delay_lead_max_t=0.0))
+    off, why = _refused(ctx, R, ref, "delay_lead_max_t")
     f = next(f for f in off["findings"] if f["cause"] == "delay:delta_r")
     assert f["evidence"]["delay_differential"]["flight_s"] == pytest.approx(-0.08, abs=0.015)
     assert f["evidence"]["lead"]["lead"] is False and f["evidence"]["lead"]["why"] is None
-    on = sparse_search(ctx, R, reference=ref)
-    assert THRESHOLDS["delay_lead_max_t"] == 3.0
-    assert not any(g["cause"].startswith("delay:") for g in on["findings"])
-    refused = [n for n in on["not_named"] if n["cause"] == "delay:delta_r"]
-    assert refused and "delta_r leads its logged command by 0.0" in refused[0]["why"]
-
-
-def test_a_lag_is_named_with_the_lead_check_on(airframe):
-    ref = _flight(airframe, 4)
-    ctx, R = _flight(airframe, 5, columns=slice(None))
-    res = sparse_search(ctx, R, reference=ref)
-    f = next(f for f in res["findings"] if f["cause"] == "delay:delta_r")
-    assert f["estimate"] == pytest.approx(0.1, abs=0.015)
-    assert f["evidence"]["lead"]["lead"] is False and f["evidence"]["lead"]["flight_s"] > 0
+    assert "delta_r leads its logged command by 0.0" in why
