@@ -30,13 +30,14 @@ def airframe():
     return load_airframe(AIRFRAME)
 
 
-def _flight(airframe, seed, columns=None):
-    """A synthetic flight; with ``columns``, those coefficients get the model's response to the rudder 0.1 s late."""
+def _flight(airframe, seed, columns=None, lag_s=0.1):
+    """A synthetic flight; with ``columns``, those coefficients get the model's response to the rudder ``lag_s`` late
+    (negative: early, the response ahead of the logged command)."""
     table, states = measured(BASE, seed=seed, hidden=None, duration=90.0)
     if columns is not None:
         c0 = DiagContext.build(table, airframe, BASE, states)
         X = c0.X.copy()
-        X[:, K_R] = np.interp(c0.t - 0.1, c0.t, np.nan_to_num(c0.X[:, K_R]))
+        X[:, K_R] = np.interp(c0.t - lag_s, c0.t, np.nan_to_num(c0.X[:, K_R]))
         D = np.nan_to_num(c0.model_values(X) - c0.model_values())
         table.Y[:, columns] += D[:, columns]
     ctx = DiagContext.build(table, airframe, BASE, states)
@@ -75,23 +76,11 @@ def test_a_delay_in_every_coefficient_is_named(airframe):
     assert lead["lead"] is False and lead["flight_s"] > 0
 
 
-def _leading(airframe, seed, lead_s):
-    """A synthetic flight whose every coefficient answers the rudder ``lead_s`` early (the response ahead of the
-    logged command)."""
-    table, states = measured(BASE, seed=seed, hidden=None, duration=90.0)
-    c0 = DiagContext.build(table, airframe, BASE, states)
-    X = c0.X.copy()
-    X[:, K_R] = np.interp(c0.t + lead_s, c0.t, np.nan_to_num(c0.X[:, K_R]))
-    table.Y[:] += np.nan_to_num(c0.model_values(X) - c0.model_values())
-    ctx = DiagContext.build(table, airframe, BASE, states)
-    return ctx, ctx.Y - ctx.model_values()
-
-
 def test_a_surface_that_leads_its_command_is_not_a_delay(airframe):
     # a servo moves after its command: a response 0.08 s ahead of the log reads as a negative delay, named with the
     # check off and refused with the reading when it is on (delay_lead_max_t; the JSBSim Eternity's clean s118)
     ref = _flight(airframe, 4)
-    ctx, R = _leading(airframe, 5, 0.08)
+    ctx, R = _flight(airframe, 5, columns=slice(None), lag_s=-0.08)
     off, why = _refused(ctx, R, ref, "delay_lead_max_t")
     f = next(f for f in off["findings"] if f["cause"] == "delay:delta_r")
     assert f["evidence"]["delay_differential"]["flight_s"] == pytest.approx(-0.08, abs=0.015)
