@@ -1330,17 +1330,16 @@ def sparse_search(ctx: DiagContext, R: np.ndarray, reference: tuple[DiagContext,
                 f["evidence"]["delay_differential"] = parts
             else:
                 tau, D, se = _refine_delay(ctx, Rd, surf, tr, jf, central=central)
-            if th.get("delay_time_resolution", False) and ctx.t.size > 1:
-                # the log's time grid: a delay is known to no better than a uniform step of one sample
-                dt = float(np.median(np.diff(ctx.t)))
-                f["evidence"]["std_error_parts"] = {"fit": se, "time_resolution": dt / np.sqrt(12.0)}
-                se = float(np.hypot(se, dt / np.sqrt(12.0)))
+            timed = bool(th.get("delay_time_resolution", False)) and ctx.t.size > 1
+            # the log's time grid: a delay is known to no better than a uniform step of one sample
+            res = float(np.median(np.diff(ctx.t))) / np.sqrt(12.0) if timed else 0.0
+            if timed:
+                f["evidence"]["std_error_parts"] = {"fit": se, "time_resolution": res}
+                se = float(np.hypot(se, res))
             f["estimate"], f["std_error"] = tau, se
             f["evidence"]["refined_on"] = "model response to the delayed surface, all coefficients"
-            res = float(np.median(np.diff(ctx.t))) / np.sqrt(12.0) \
-                if th.get("delay_time_resolution", False) and ctx.t.size > 1 else 0.0
             why = None
-            if th.get("delay_differential", False):
+            if "delay_differential" in f["evidence"]:
                 lead = _delay_lead(f["evidence"]["delay_differential"], surf, res,
                                    float(th.get("delay_lead_max_t", 0.0) or 0.0))
                 f["evidence"]["lead"] = lead
