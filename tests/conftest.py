@@ -8,6 +8,11 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+# With a CUDA build of jaxlib each JAX process takes 75 % of the GPU's memory at its first call, so of several test
+# processes on one GPU (the xdist workers, the CLI subprocesses) all but the first fail; allocate on demand instead
+# (JAX's documentation, "GPU memory allocation"). The CPU build ignores it. docs/gp.md, "On a GPU".
+os.environ.setdefault("XLA_PYTHON_CLIENT_PREALLOCATE", "false")
+
 # Compiled JAX programs go to a cache private to this test session (inherited by the xdist
 # workers and the CLI subprocesses), so the suite neither reads nor fills the user's cache. The
 # process that made the folder removes it at exit (the workers and subprocesses have ended by then);
